@@ -1,0 +1,50 @@
+#pragma once
+// The estimator as every caller uses it (daemon, simulator, offline tools): SI drive samples in,
+// SI and pu estimates out. Holds the conditioner (frames, pu, input extensions) and RpemEstimator.
+
+#include <cstdint>
+
+#include "rpem/core/conditioner.hpp"
+#include "rpem/core/drive_sample.hpp"
+#include "rpem/core/estimator.hpp"
+#include "rpem/core/settings.hpp"
+
+namespace rpem::core {
+
+struct Estimate {
+  std::int64_t t_ns = 0;
+  double psi_m_Wb = 0.0;
+  double r_s_Ohm = 0.0;
+  Vec2 epsilon_A = Vec2::Zero();  ///< prediction error i − î, rotor frame
+  Vec2 i_hat_A = Vec2::Zero();    ///< predicted current, rotor frame
+  Vec2 i_meas_A = Vec2::Zero();   ///< measured current, rotor frame (after input corrections)
+  double speed_pu = 0.0;
+  EstimatorOutput detail;         ///< per-unit detail: θ̂, Ψᵀ, L, code, flags
+};
+
+class DriveEstimator {
+ public:
+  DriveEstimator(const MachineSi& machine, const EstimatorSettings& settings) noexcept;
+
+  /// One sample. Real-time safe.
+  [[nodiscard]] Estimate step(const DriveSample& sample) noexcept;
+
+  void reset() noexcept;
+  void resynchronize() noexcept;
+  void set_frozen(bool frozen) noexcept { core_.set_frozen(frozen); }
+  void set_estimates(double psi_m_Wb, double r_s_Ohm) noexcept;
+  /// Reloads gains, limits and model extensions, keeping θ̂, Hessians and predictor state.
+  void reconfigure(const MachineSi& machine, const EstimatorSettings& settings) noexcept;
+
+  [[nodiscard]] const PerUnitBase& base() const noexcept { return base_; }
+  [[nodiscard]] const RpemEstimator& core() const noexcept { return core_; }
+  [[nodiscard]] double psi_m_Wb() const noexcept;
+  [[nodiscard]] double r_s_Ohm() const noexcept;
+
+ private:
+  PerUnitBase base_;
+  SampleConditioner conditioner_;
+  RpemEstimator core_;
+};
+
+}  // namespace rpem::core

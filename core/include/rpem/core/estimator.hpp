@@ -1,0 +1,121 @@
+#pragma once
+// The Ψᵀ-based recursive prediction error estimator of ψm and r_s, per-unit, rotor frame.
+//
+//   θ̂[k] = [ θ̂[k−1] + L[k]·ε[k] ]_{D_M}                        (eq_RPEM_intro)
+//   ε[k] = i[k] − î[k, θ̂[k−1]]                                  (open-loop prediction error)
+//
+// One call of step() is one sample: predict (predictor.hpp), form Ψᵀ (dynamic or steady state),
+// compute L (gain.hpp), schedule it (eq:GainSchedule), update and project (eq:paramsubset).
+// step() is real-time safe: noexcept, no allocation, no locks, no system calls.
+
+#include <array>
+#include <cstdint>
+
+#include "rpem/core/gain.hpp"
+#include "rpem/core/machine.hpp"
+#include "rpem/core/predictor.hpp"
+#include "rpem/core/scheduler.hpp"
+#include "rpem/core/types.hpp"
+
+namespace rpem::core {
+
+enum class GradientForm : std::uint8_t { kSteadyState = 0, kDynamic = 1 };
+
+struct EstimatorConfig {
+  MachinePu model;              ///< nominal model; x_d, x_q are used as they are
+  double omega_n_rad_s = 0.0;   ///< ω_n, the electrical base speed
+  Algorithm algorithm = Algorithm::kSga;
+  Discretization discretization = Discretization::kTrapezoidal;
+  GradientForm gradient_psi_m = GradientForm::kSteadyState;
+  GradientForm gradient_r_s = GradientForm::kSteadyState;
+  std::array<GainSequences, 3> gains{};  ///< indexed by Algorithm
+  GainFloors floors;
+  SchedulerConfig scheduler;
+  ParameterBounds bounds;
+  Vec2 initial_theta_pu = Vec2::Zero();
+  Vec2 initial_sga_hessian_pu = Vec2::Zero();  ///< r[0] per parameter
+  Mat2 initial_gna_hessian_pu = Mat2::Zero();  ///< R[0]
+  double nominal_sample_period_s = 125e-6;     ///< the period the γ_0 refer to; γ scales with dt
+  double max_sample_interval_s = 1e-3;         ///< a longer interval resynchronises the predictor
+  double max_predicted_current_pu = 20.0;      ///< |î| beyond this counts as divergence
+  bool adapt_psi_m = true;
+  bool adapt_r_s = true;
+};
+
+/// One conditioned sample (see conditioner.hpp): the interval since the previous sample and the
+/// current measured at its end.
+struct EstimatorSample {
+  PredictorInterval interval;
+  Vec2 i_meas_pu = Vec2::Zero();
+  bool resync = false;  ///< first sample, or samples were lost before this one
+};
+
+/// Stable result codes; they are published in diagnostics (numbers never change).
+enum class StepCode : std::uint8_t {
+  kAdapted = 0,             ///< prediction, gradient and update done (the update may be scheduled out)
+  kSynchronized = 1,        ///< predictor (re)initialised from this measurement; no update
+  kRejectedNonFinite = 2,   ///< NaN or Inf in the sample; ignored, predictor will resynchronise
+  kPredictorDiverged = 3,   ///< |î| exceeded its bound; predictor resynchronised
+};
+
+namespace step_flag {
+inline constexpr std::uint16_t kGainFloored = 1U << 0;     ///< gain_flag::kFloored
+inline constexpr std::uint16_t kPseudoInverse = 1U << 1;   ///< gain_flag::kPseudoInverse
+inline constexpr std::uint16_t kProjectedPsiM = 1U << 2;   ///< ψ̂m clamped to D_M
+inline constexpr std::uint16_t kProjectedRs = 1U << 3;     ///< r̂s clamped to D_M
+inline constexpr std::uint16_t kFrozen = 1U << 4;          ///< adaptation frozen by command
+inline constexpr std::uint16_t kPsiMActive = 1U << 5;      ///< ψ̂m adapted in this sample
+inline constexpr std::uint16_t kRsActive = 1U << 6;        ///< r̂s adapted in this sample
+}  // namespace step_flag
+
+struct EstimatorState {
+  Vec2 theta_pu = Vec2::Zero();  ///< θ̂ = [ψ̂m, r̂s]
+  PredictorState predictor;
+  Vec2 sga_hessian_pu = Vec2::Zero();
+  Mat2 gna_hessian_pu = Mat2::Zero();
+  bool synchronized = false;
+  bool frozen = false;
+};
+
+struct EstimatorOutput {
+  Vec2 theta_pu = Vec2::Zero();
+  Vec2 epsilon_pu = Vec2::Zero();
+  Vec2 i_hat_pu = Vec2::Zero();
+  Mat2 gradient = Mat2::Zero();  ///< Ψᵀ used for the gain
+  Mat2 gain = Mat2::Zero();      ///< L after scheduling
+  StepCode code = StepCode::kSynchronized;
+  std::uint16_t flags = 0;
+};
+
+class RpemEstimator {
+ public:
+  explicit RpemEstimator(const EstimatorConfig& config) noexcept;
+
+  /// One sample. Real-time safe.
+  EstimatorOutput step(const EstimatorSample& sample) noexcept;
+
+  /// θ̂ and the Hessians back to their initial values; the predictor resynchronises. Real-time safe.
+  void reset() noexcept;
+  /// The next sample re-initialises the predictor from the measurement. Real-time safe.
+  void resynchronize() noexcept { state_.synchronized = false; }
+  /// Seeds θ̂ (projected onto D_M), e.g. from persisted estimates. Real-time safe.
+  void set_theta(const Vec2& theta_pu) noexcept;
+  /// Freezes or releases adaptation; prediction continues. Real-time safe.
+  void set_frozen(bool frozen) noexcept { state_.frozen = frozen; }
+  /// Replaces gains, floors, scheduler, bounds and algorithm while keeping θ̂, Hessians and the
+  /// predictor (SIGHUP reload). Not real-time: call between steps from the owning thread.
+  void reconfigure(const EstimatorConfig& config) noexcept;
+
+  [[nodiscard]] const EstimatorConfig& config() const noexcept { return config_; }
+  [[nodiscard]] const EstimatorState& state() const noexcept { return state_; }
+
+ private:
+  void synchronize(const EstimatorSample& sample) noexcept;
+  [[nodiscard]] MachinePu model_with_estimates() const noexcept;
+  [[nodiscard]] Mat2 select_gradient(double n_pu) const noexcept;
+
+  EstimatorConfig config_;
+  EstimatorState state_;
+};
+
+}  // namespace rpem::core

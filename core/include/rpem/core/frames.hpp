@@ -1,0 +1,44 @@
+#pragma once
+// Reference-frame transforms, amplitude-invariant. The estimator's inputs pass through these
+// functions and nowhere else (SampleConditioner); the simulator and tools reuse them.
+//
+//   Clarke:  x_α = (2/3)(x_a − x_b/2 − x_c/2),  x_β = (x_b − x_c)/√3
+//   Park:    x^r = T_ss^r(ϑ)·x^s = [cos ϑ  sin ϑ; −sin ϑ  cos ϑ]·x^s   (Eq_FullOrderModel)
+
+#include <cmath>
+
+#include "rpem/core/types.hpp"
+
+namespace rpem::core {
+
+/// cos and sin of the electrical angle, computed once and shared by a forward and an inverse Park.
+struct Rotation {
+  double cos = 1.0;
+  double sin = 0.0;
+  [[nodiscard]] static Rotation of(double theta_rad) noexcept { return {std::cos(theta_rad), std::sin(theta_rad)}; }
+};
+
+[[nodiscard]] inline Vec2 clarke(const Vec3& abc) noexcept {
+  return {(2.0 / 3.0) * (abc[0] - 0.5 * abc[1] - 0.5 * abc[2]), (abc[1] - abc[2]) / kSqrt3};
+}
+
+[[nodiscard]] inline Vec3 inverse_clarke(const Vec2& ab) noexcept {
+  return {ab[0], -0.5 * ab[0] + 0.5 * kSqrt3 * ab[1], -0.5 * ab[0] - 0.5 * kSqrt3 * ab[1]};
+}
+
+/// Stator (αβ) → rotor (dq) frame.
+[[nodiscard]] inline Vec2 park(const Vec2& ab, const Rotation& r) noexcept {
+  return {r.cos * ab[0] + r.sin * ab[1], -r.sin * ab[0] + r.cos * ab[1]};
+}
+
+/// Rotor (dq) → stator (αβ) frame.
+[[nodiscard]] inline Vec2 inverse_park(const Vec2& dq, const Rotation& r) noexcept {
+  return {r.cos * dq[0] - r.sin * dq[1], r.sin * dq[0] + r.cos * dq[1]};
+}
+
+/// Wraps an angle to (−π, π].
+[[nodiscard]] inline double wrap_angle(double theta_rad) noexcept {
+  return std::remainder(theta_rad, 2.0 * kPi);
+}
+
+}  // namespace rpem::core

@@ -1,0 +1,57 @@
+#pragma once
+// Speed-dependent gain scheduling (eq:GainSchedule) and projection onto D_M (eq:paramsubset).
+
+#include <cmath>
+#include <cstdint>
+
+#include "rpem/core/types.hpp"
+
+namespace rpem::core {
+
+/// eq:GainSchedule limits, |n_lim,1| ≥ |n_lim,2|.
+struct SchedulerConfig {
+  double psi_m_min_speed_pu = 0.0;  ///< n_lim,1: ψ̂m adapts only where |n| > n_lim,1
+  double r_s_max_speed_pu = 0.0;    ///< n_lim,2: r̂s adapts only where |n| < n_lim,2
+};
+
+/// Which parameters may adapt in this sample.
+struct Schedule {
+  bool psi_m = false;
+  bool r_s = false;
+};
+
+/// eq:GainSchedule. The speed is the mean over the prediction interval.
+[[nodiscard]] inline Schedule schedule(const SchedulerConfig& c, double n_pu) noexcept {
+  const double speed = std::abs(n_pu);
+  return {speed > c.psi_m_min_speed_pu, speed < c.r_s_max_speed_pu};
+}
+
+/// Zeroes the gain rows of parameters that may not adapt.
+inline void apply_schedule(const Schedule& s, Mat2& gain) noexcept {
+  if (!s.psi_m) gain.row(kPsiM).setZero();
+  if (!s.r_s) gain.row(kRs).setZero();
+}
+
+/// D_M of eq:paramsubset.
+struct ParameterBounds {
+  Vec2 min_pu = Vec2::Zero();
+  Vec2 max_pu = Vec2::Zero();
+};
+
+/// Projection onto the box D_M (the Euclidean projection of a box is the clamp). Returns a bit per
+/// parameter that was clamped (bit kPsiM, bit kRs).
+[[nodiscard]] inline std::uint8_t project(const ParameterBounds& b, Vec2& theta) noexcept {
+  std::uint8_t clamped = 0;
+  for (int j = 0; j < 2; ++j) {
+    if (theta[j] < b.min_pu[j]) {
+      theta[j] = b.min_pu[j];
+      clamped |= static_cast<std::uint8_t>(1U << j);
+    } else if (theta[j] > b.max_pu[j]) {
+      theta[j] = b.max_pu[j];
+      clamped |= static_cast<std::uint8_t>(1U << j);
+    }
+  }
+  return clamped;
+}
+
+}  // namespace rpem::core

@@ -1,0 +1,33 @@
+#pragma once
+// Fixed-size linear-algebra types used throughout the estimator core. Nothing here allocates.
+
+#include <Eigen/Core>
+
+namespace rpem::core {
+
+inline constexpr double kPi = 3.14159265358979323846;
+inline constexpr double kSqrt3 = 1.7320508075688772;
+
+using Vec2 = Eigen::Matrix<double, 2, 1>;
+using Vec3 = Eigen::Matrix<double, 3, 1>;
+using Mat2 = Eigen::Matrix<double, 2, 2>;
+
+/// Index of each identified parameter in the parameter vector θ̂ = [ψ̂m, r̂s]ᵀ (eq:ParamVectorModified).
+enum class Param : int { kPsiM = 0, kRs = 1 };
+inline constexpr int kPsiM = static_cast<int>(Param::kPsiM);
+inline constexpr int kRs = static_cast<int>(Param::kRs);
+
+/// Determinant of a 2×2 matrix.
+[[nodiscard]] inline double det2(const Mat2& m) noexcept { return m(0, 0) * m(1, 1) - m(0, 1) * m(1, 0); }
+
+/// Adjugate of a 2×2 matrix: adj(M) = det(M)·M⁻¹.
+[[nodiscard]] inline Mat2 adjugate2(const Mat2& m) noexcept {
+  Mat2 a;
+  a << m(1, 1), -m(0, 1), -m(1, 0), m(0, 0);
+  return a;
+}
+
+/// Closed-form inverse of a 2×2 matrix (the caller guarantees det ≠ 0).
+[[nodiscard]] inline Mat2 inverse2(const Mat2& m) noexcept { return adjugate2(m) / det2(m); }
+
+}  // namespace rpem::core

@@ -1,0 +1,47 @@
+#include "rpem/core/drive_estimator.hpp"
+
+namespace rpem::core {
+
+DriveEstimator::DriveEstimator(const MachineSi& machine, const EstimatorSettings& settings) noexcept
+    : base_(PerUnitBase::from_rated(machine.rated)),
+      conditioner_(base_, settings.corrections),
+      core_(make_estimator_config(base_, machine, settings)) {}
+
+Estimate DriveEstimator::step(const DriveSample& sample) noexcept {
+  const EstimatorSample conditioned = conditioner_.condition(sample);
+  Estimate e;
+  e.t_ns = sample.t_ns;
+  e.detail = core_.step(conditioned);
+  e.psi_m_Wb = base_.flux_Wb_of(e.detail.theta_pu[kPsiM]);
+  e.r_s_Ohm = base_.resistance_Ohm_of(e.detail.theta_pu[kRs]);
+  e.epsilon_A = e.detail.epsilon_pu * base_.current_A;
+  e.i_hat_A = e.detail.i_hat_pu * base_.current_A;
+  e.i_meas_A = conditioned.i_meas_pu * base_.current_A;
+  e.speed_pu = conditioned.interval.n_end_pu;
+  return e;
+}
+
+void DriveEstimator::reset() noexcept {
+  conditioner_.reset();
+  core_.reset();
+}
+
+void DriveEstimator::resynchronize() noexcept {
+  conditioner_.reset();
+  core_.resynchronize();
+}
+
+void DriveEstimator::set_estimates(double psi_m_Wb, double r_s_Ohm) noexcept {
+  core_.set_theta({base_.flux_pu(psi_m_Wb), base_.resistance_pu(r_s_Ohm)});
+}
+
+void DriveEstimator::reconfigure(const MachineSi& machine, const EstimatorSettings& settings) noexcept {
+  base_ = PerUnitBase::from_rated(machine.rated);
+  conditioner_.set_corrections(settings.corrections);
+  core_.reconfigure(make_estimator_config(base_, machine, settings));
+}
+
+double DriveEstimator::psi_m_Wb() const noexcept { return base_.flux_Wb_of(core_.state().theta_pu[kPsiM]); }
+double DriveEstimator::r_s_Ohm() const noexcept { return base_.resistance_Ohm_of(core_.state().theta_pu[kRs]); }
+
+}  // namespace rpem::core

@@ -1,0 +1,148 @@
+#include "rpem/core/estimator.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace rpem::core {
+namespace {
+
+bool finite(const EstimatorSample& s) noexcept {
+  const auto& iv = s.interval;
+  return std::isfinite(iv.dt_s) && std::isfinite(iv.n_start_pu) && std::isfinite(iv.n_end_pu) &&
+         iv.u_start_pu.allFinite() && iv.u_end_pu.allFinite() && s.i_meas_pu.allFinite();
+}
+
+/// γ_0 are per nominal sample; a longer or shorter interval scales them so that the adaptation time
+/// constant T_0 = T_samp/γ_0 stays fixed in seconds. Capped at 1 (a filter gain above 1 is unstable).
+Vec2 scaled(const Vec2& gamma, double factor) noexcept { return (gamma * factor).cwiseMin(1.0); }
+
+/// The GNA matrix Hessian has one forgetting factor: that of the parameter being estimated
+/// (tab_psimgains gives one per estimation case); outside both regions the slower one.
+double gna_hessian_sequence(const Schedule& active, const Vec2& gamma_r) noexcept {
+  if (active.psi_m && !active.r_s) return gamma_r[kPsiM];
+  if (active.r_s && !active.psi_m) return gamma_r[kRs];
+  return gamma_r.minCoeff();
+}
+
+}  // namespace
+
+RpemEstimator::RpemEstimator(const EstimatorConfig& config) noexcept : config_(config) { reset(); }
+
+void RpemEstimator::reset() noexcept {
+  state_.theta_pu = config_.initial_theta_pu;
+  (void)project(config_.bounds, state_.theta_pu);
+  state_.sga_hessian_pu = config_.initial_sga_hessian_pu;
+  state_.gna_hessian_pu = config_.initial_gna_hessian_pu;
+  state_.predictor = PredictorState{};
+  state_.synchronized = false;
+}
+
+void RpemEstimator::set_theta(const Vec2& theta_pu) noexcept {
+  state_.theta_pu = theta_pu;
+  (void)project(config_.bounds, state_.theta_pu);
+  state_.synchronized = false;
+}
+
+void RpemEstimator::reconfigure(const EstimatorConfig& config) noexcept {
+  config_ = config;
+  (void)project(config_.bounds, state_.theta_pu);
+}
+
+MachinePu RpemEstimator::model_with_estimates() const noexcept {
+  MachinePu m = config_.model;
+  m.psi_m_pu = state_.theta_pu[kPsiM];
+  m.r_s_pu = state_.theta_pu[kRs];
+  return m;
+}
+
+void RpemEstimator::synchronize(const EstimatorSample& sample) noexcept {
+  state_.predictor.i_hat_pu = sample.i_meas_pu;
+  // Start the dynamic gradients at their equilibrium so they need no settling time.
+  state_.predictor.gradient =
+      steady_state_gradients(model_with_estimates(), sample.interval.n_end_pu, sample.i_meas_pu);
+  state_.synchronized = true;
+}
+
+Mat2 RpemEstimator::select_gradient(double n_pu) const noexcept {
+  const Mat2 steady = steady_state_gradients(model_with_estimates(), n_pu, state_.predictor.i_hat_pu);
+  Mat2 g = state_.predictor.gradient;
+  if (config_.gradient_psi_m == GradientForm::kSteadyState) g.col(kPsiM) = steady.col(kPsiM);
+  if (config_.gradient_r_s == GradientForm::kSteadyState) g.col(kRs) = steady.col(kRs);
+  return g;
+}
+
+EstimatorOutput RpemEstimator::step(const EstimatorSample& sample) noexcept {
+  EstimatorOutput out;
+  out.theta_pu = state_.theta_pu;
+  out.flags = state_.frozen ? step_flag::kFrozen : 0;
+
+  if (!finite(sample)) {
+    state_.synchronized = false;
+    out.code = StepCode::kRejectedNonFinite;
+    return out;
+  }
+  const auto& iv = sample.interval;
+  if (sample.resync || !state_.synchronized || !(iv.dt_s > 0.0) || iv.dt_s > config_.max_sample_interval_s) {
+    synchronize(sample);
+    out.i_hat_pu = state_.predictor.i_hat_pu;
+    out.code = StepCode::kSynchronized;
+    return out;
+  }
+
+  const MachinePu model = model_with_estimates();
+  predict(model, config_.omega_n_rad_s, config_.discretization, iv, state_.predictor);
+  const Vec2& i_hat = state_.predictor.i_hat_pu;
+  if (!i_hat.allFinite() || i_hat.lpNorm<Eigen::Infinity>() > config_.max_predicted_current_pu ||
+      !state_.predictor.gradient.allFinite()) {
+    synchronize(sample);
+    out.i_hat_pu = state_.predictor.i_hat_pu;
+    out.code = StepCode::kPredictorDiverged;
+    return out;
+  }
+
+  out.i_hat_pu = i_hat;
+  out.epsilon_pu = sample.i_meas_pu - i_hat;
+  out.gradient = select_gradient(iv.n_end_pu);
+
+  const double factor = iv.dt_s / config_.nominal_sample_period_s;
+  const GainSequences& seq = config_.gains[static_cast<std::size_t>(config_.algorithm)];
+  const Vec2 gamma_r = scaled(seq.hessian, factor);
+  const Vec2 gamma_l = scaled(seq.gain, factor);
+
+  // eq:GainSchedule decides which parameters may move in this sample.
+  Schedule active = schedule(config_.scheduler, iv.n_end_pu);
+  active.psi_m = active.psi_m && config_.adapt_psi_m && !state_.frozen;
+  active.r_s = active.r_s && config_.adapt_r_s && !state_.frozen;
+
+  GainOutput gain;
+  switch (config_.algorithm) {
+    case Algorithm::kSga:
+      gain = sga_gain(out.gradient, gamma_r, gamma_l, config_.floors, state_.sga_hessian_pu);
+      break;
+    case Algorithm::kGna:
+      gain = gna_gain(out.gradient, gna_hessian_sequence(active, gamma_r), gamma_l, config_.floors,
+                      state_.gna_hessian_pu);
+      break;
+    case Algorithm::kPhyInt:
+      gain = phyint_gain(model, iv.n_end_pu, i_hat, gamma_l, config_.floors);
+      break;
+  }
+  if (gain.flags & gain_flag::kFloored) out.flags |= step_flag::kGainFloored;
+  if (gain.flags & gain_flag::kPseudoInverse) out.flags |= step_flag::kPseudoInverse;
+
+  apply_schedule(active, gain.gain);
+  if (active.psi_m) out.flags |= step_flag::kPsiMActive;
+  if (active.r_s) out.flags |= step_flag::kRsActive;
+
+  state_.theta_pu += gain.gain * out.epsilon_pu;
+  const std::uint8_t clamped = project(config_.bounds, state_.theta_pu);
+  if (clamped & (1U << kPsiM)) out.flags |= step_flag::kProjectedPsiM;
+  if (clamped & (1U << kRs)) out.flags |= step_flag::kProjectedRs;
+
+  out.gain = gain.gain;
+  out.theta_pu = state_.theta_pu;
+  out.code = StepCode::kAdapted;
+  return out;
+}
+
+}  // namespace rpem::core

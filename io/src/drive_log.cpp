@@ -1,0 +1,204 @@
+#include "rpem/io/drive_log.hpp"
+
+#include <charconv>
+#include <cmath>
+#include <filesystem>
+
+#include "rpem/core/frames.hpp"
+#include "rpem/io/number_format.hpp"
+
+namespace rpem::io {
+namespace {
+
+void split(const std::string& line, std::vector<std::string>& cells) {
+  cells.clear();
+  std::size_t start = 0;
+  while (true) {
+    const std::size_t comma = line.find(',', start);
+    std::string cell = line.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
+    const auto first = cell.find_first_not_of(" \t\r");
+    const auto last = cell.find_last_not_of(" \t\r");
+    cells.push_back(first == std::string::npos ? std::string() : cell.substr(first, last - first + 1));
+    if (comma == std::string::npos) break;
+    start = comma + 1;
+  }
+}
+
+}  // namespace
+
+DriveLogReader::DriveLogReader(const std::string& path) : path_(path), in_(path, std::ios::binary) {
+  if (!in_) throw DriveLogError(path, 0, 0, "", "cannot open file");
+  std::error_code ec;
+  bytes_total_ = std::filesystem::file_size(path, ec);
+  std::string header_line;
+  if (!std::getline(in_, header_line)) throw DriveLogError(path, 1, 0, "", "empty file: expected a header row");
+  line_ = 1;
+  bytes_read_ = header_line.size() + 1;
+  split(header_line, header_);
+  auto find = [&](const char* name) {
+    Column c;
+    for (std::size_t k = 0; k < header_.size(); ++k) {
+      if (header_[k] == name) {
+        if (c.present()) fail(name, "column appears twice in the header");
+        c.index = static_cast<int>(k);
+      }
+    }
+    return c;
+  };
+  t_ = find("t");
+  theta_ = find("theta_el");
+  omega_ = find("omega_el");
+  udc_ = find("u_dc");
+  ua_ = find("u_a"), ub_ = find("u_b"), uc_ = find("u_c");
+  ud_ = find("u_d"), uq_ = find("u_q");
+  ia_ = find("i_a"), ib_ = find("i_b"), ic_ = find("i_c");
+  id_ = find("i_d"), iq_ = find("i_q");
+  tw_ = find("T_winding"), tm_ = find("T_magnet"), tq_ = find("torque_cmd");
+
+  for (auto [col, name] : {std::pair{t_, "t"}, {theta_, "theta_el"}, {omega_, "omega_el"}, {udc_, "u_dc"}}) {
+    if (!col.present()) fail(name, "required column is missing from the header");
+  }
+  auto group = [&](std::initializer_list<std::pair<Column, const char*>> cols, const char* what) {
+    int present = 0;
+    for (const auto& [c, n] : cols) present += c.present() ? 1 : 0;
+    if (present != 0 && present != static_cast<int>(cols.size())) {
+      for (const auto& [c, n] : cols) {
+        if (!c.present()) fail(n, std::string("incomplete ") + what + " column group");
+      }
+    }
+    return present != 0;
+  };
+  layout_.voltage_abc = group({{ua_, "u_a"}, {ub_, "u_b"}, {uc_, "u_c"}}, "phase-voltage");
+  layout_.voltage_dq = group({{ud_, "u_d"}, {uq_, "u_q"}}, "rotor-frame voltage");
+  layout_.current_abc = group({{ia_, "i_a"}, {ib_, "i_b"}, {ic_, "i_c"}}, "phase-current");
+  layout_.current_dq = group({{id_, "i_d"}, {iq_, "i_q"}}, "rotor-frame current");
+  if (!layout_.voltage_abc && !layout_.voltage_dq) fail("u_a,u_b,u_c|u_d,u_q", "no voltage-command columns");
+  if (!layout_.current_abc && !layout_.current_dq) fail("i_a,i_b,i_c|i_d,i_q", "no current columns");
+  layout_.t_winding = tw_.present();
+  layout_.t_magnet = tm_.present();
+  layout_.torque_cmd = tq_.present();
+}
+
+void DriveLogReader::fail(const std::string& column, const std::string& reason) const {
+  throw DriveLogError(path_, line_, 0, "column " + column, reason);
+}
+
+double DriveLogReader::cell(const Column& c, const char* name) const {
+  if (static_cast<std::size_t>(c.index) >= cells_.size()) fail(name, "row has too few cells");
+  const std::string& s = cells_[static_cast<std::size_t>(c.index)];
+  if (s.empty()) fail(name, "empty cell");
+  double v = 0.0;
+  const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
+  if (ec != std::errc() || end != s.data() + s.size()) fail(name, "'" + s + "' is not a number");
+  if (std::isnan(v)) fail(name, "NaN");
+  if (!std::isfinite(v)) fail(name, "'" + s + "' is not finite");
+  return v;
+}
+
+bool DriveLogReader::next(DriveLogRow& row) {
+  std::string text;
+  while (std::getline(in_, text)) {
+    ++line_;
+    bytes_read_ += text.size() + 1;
+    if (text.find_first_not_of(" \t\r") == std::string::npos) continue;  // blank line
+    split(text, cells_);
+    if (cells_.size() != header_.size()) {
+      fail("*", "row has " + std::to_string(cells_.size()) + " cells, header has " + std::to_string(header_.size()));
+    }
+    core::DriveSample& s = row.sample;
+    const double t_s = cell(t_, "t");
+    if (previous_t_s_ && !(t_s > *previous_t_s_)) fail("t", "time does not increase");
+    previous_t_s_ = t_s;
+    s.t_ns = std::llround(t_s * 1e9);
+    s.theta_el_rad = cell(theta_, "theta_el");
+    s.omega_el_rad_s = cell(omega_, "omega_el");
+    s.u_dc_V = cell(udc_, "u_dc");
+    s.gap_before = false;
+    if (layout_.voltage_abc) {
+      s.voltage_frame = core::Frame::kAbc;
+      s.u_V = {cell(ua_, "u_a"), cell(ub_, "u_b"), cell(uc_, "u_c")};
+      if (layout_.voltage_dq) (void)cell(ud_, "u_d"), (void)cell(uq_, "u_q");  // validate all present cells
+    } else {
+      s.voltage_frame = core::Frame::kDq;
+      s.u_V = {cell(ud_, "u_d"), cell(uq_, "u_q"), 0.0};
+    }
+    if (layout_.current_abc) {
+      s.current_frame = core::Frame::kAbc;
+      s.i_A = {cell(ia_, "i_a"), cell(ib_, "i_b"), cell(ic_, "i_c")};
+      if (layout_.current_dq) (void)cell(id_, "i_d"), (void)cell(iq_, "i_q");
+    } else {
+      s.current_frame = core::Frame::kDq;
+      s.i_A = {cell(id_, "i_d"), cell(iq_, "i_q"), 0.0};
+    }
+    row.t_winding_C = layout_.t_winding ? std::optional(cell(tw_, "T_winding")) : std::nullopt;
+    row.t_magnet_C = layout_.t_magnet ? std::optional(cell(tm_, "T_magnet")) : std::nullopt;
+    row.torque_cmd_Nm = layout_.torque_cmd ? std::optional(cell(tq_, "torque_cmd")) : std::nullopt;
+    return true;
+  }
+  return false;
+}
+
+std::vector<DriveLogRow> read_drive_log(const std::string& path) {
+  DriveLogReader reader(path);
+  std::vector<DriveLogRow> rows;
+  DriveLogRow row;
+  while (reader.next(row)) rows.push_back(row);
+  return rows;
+}
+
+DriveLogWriter::DriveLogWriter(const std::string& path, const DriveLogLayout& layout)
+    : out_(path, std::ios::binary | std::ios::trunc), layout_(layout) {
+  if (!out_) throw DriveLogError(path, 0, 0, "", "cannot create file");
+  std::string h = "t,theta_el,omega_el,u_dc";
+  if (layout_.voltage_abc) h += ",u_a,u_b,u_c";
+  if (layout_.voltage_dq) h += ",u_d,u_q";
+  if (layout_.current_abc) h += ",i_a,i_b,i_c";
+  if (layout_.current_dq) h += ",i_d,i_q";
+  if (layout_.t_winding) h += ",T_winding";
+  if (layout_.t_magnet) h += ",T_magnet";
+  if (layout_.torque_cmd) h += ",torque_cmd";
+  out_ << h << '\n';
+}
+
+void DriveLogWriter::write(const DriveLogRow& row) {
+  const core::DriveSample& s = row.sample;
+  const core::Rotation rot = core::Rotation::of(s.theta_el_rad);
+  auto to_abc = [&](core::Frame f, const core::Vec3& v) -> core::Vec3 {
+    if (f == core::Frame::kAbc) return v;
+    const core::Vec2 ab = f == core::Frame::kAlphaBeta ? core::Vec2(v.head<2>()) : core::inverse_park(v.head<2>(), rot);
+    return core::inverse_clarke(ab);
+  };
+  auto to_dq = [&](core::Frame f, const core::Vec3& v) -> core::Vec2 {
+    if (f == core::Frame::kDq) return v.head<2>();
+    const core::Vec2 ab = f == core::Frame::kAbc ? core::clarke(v) : core::Vec2(v.head<2>());
+    return core::park(ab, rot);
+  };
+  line_.clear();
+  append_number(line_, 1e-9 * static_cast<double>(s.t_ns));
+  for (double v : {s.theta_el_rad, s.omega_el_rad_s, s.u_dc_V}) append_number(line_ += ',', v);
+  if (layout_.voltage_abc) {
+    const core::Vec3 u = to_abc(s.voltage_frame, s.u_V);
+    for (int k = 0; k < 3; ++k) append_number(line_ += ',', u[k]);
+  }
+  if (layout_.voltage_dq) {
+    const core::Vec2 u = to_dq(s.voltage_frame, s.u_V);
+    for (int k = 0; k < 2; ++k) append_number(line_ += ',', u[k]);
+  }
+  if (layout_.current_abc) {
+    const core::Vec3 i = to_abc(s.current_frame, s.i_A);
+    for (int k = 0; k < 3; ++k) append_number(line_ += ',', i[k]);
+  }
+  if (layout_.current_dq) {
+    const core::Vec2 i = to_dq(s.current_frame, s.i_A);
+    for (int k = 0; k < 2; ++k) append_number(line_ += ',', i[k]);
+  }
+  if (layout_.t_winding) append_number(line_ += ',', row.t_winding_C.value_or(std::nan("")));
+  if (layout_.t_magnet) append_number(line_ += ',', row.t_magnet_C.value_or(std::nan("")));
+  if (layout_.torque_cmd) append_number(line_ += ',', row.torque_cmd_Nm.value_or(std::nan("")));
+  line_ += '\n';
+  out_ << line_;
+}
+
+void DriveLogWriter::flush() { out_.flush(); }
+
+}  // namespace rpem::io

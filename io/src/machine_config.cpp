@@ -1,0 +1,198 @@
+#include "rpem/io/machine_config.hpp"
+
+#include <limits>
+#include <tuple>
+#include <stdexcept>
+
+namespace rpem::io {
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+core::MachineSi parse_machine(YamlMap m) {
+  core::MachineSi out;
+  YamlMap rated = m.map("rated");
+  out.rated.voltage_ll_rms_V = rated.number("voltage_ll_rms_V", 1.0, 1e5);
+  out.rated.current_rms_A = rated.number("current_rms_A", 1e-3, 1e5);
+  out.rated.speed_rpm = rated.number("speed_rpm", 1.0, 1e6);
+  out.rated.pole_pairs = static_cast<int>(rated.integer("pole_pairs", 1, 100));
+  (void)rated.number_or("power_W", 0.0, 0.0, 1e9);    // informational
+  (void)rated.number_or("torque_Nm", 0.0, 0.0, 1e7);  // informational
+  rated.finish();
+  out.r_s_Ohm = m.number("r_s_Ohm", 1e-6, 1e4);
+  out.l_d_H = m.number("l_d_H", 1e-8, 100.0);
+  out.l_q_H = m.number("l_q_H", 1e-8, 100.0);
+  out.psi_m_Wb = m.number("psi_m_Wb", 1e-6, 100.0);
+  m.finish();
+  return out;
+}
+
+core::GainSequences parse_sequences(YamlMap g, bool with_hessian) {
+  core::GainSequences s;
+  const char* names[2] = {"psi_m", "r_s"};
+  for (int j = 0; j < 2; ++j) {
+    YamlMap p = g.map(names[j]);
+    s.hessian[j] = with_hessian ? p.number("hessian", 0.0, 1.0) : 0.0;
+    s.gain[j] = p.number("gain", 0.0, 1.0);
+    p.finish();
+  }
+  g.finish();
+  return s;
+}
+
+core::GradientForm parse_form(YamlMap& m, const char* key) {
+  return m.choice_or(key, "steady_state", {"steady_state", "dynamic"}) == "dynamic" ? core::GradientForm::kDynamic
+                                                                                    : core::GradientForm::kSteadyState;
+}
+
+core::EstimatorSettings parse_estimator(YamlMap e, const core::MachineSi& machine) {
+  core::EstimatorSettings s;
+  s.algorithm = parse_algorithm(e.choice_or("algorithm", "sga", {"sga", "gna", "phyint"}));
+  s.discretization = e.choice_or("discretization", "trapezoidal", {"trapezoidal", "explicit_euler"}) == "explicit_euler"
+                         ? core::Discretization::kExplicitEuler
+                         : core::Discretization::kTrapezoidal;
+  if (auto g = e.optional_map("gradient")) {
+    s.gradient_psi_m = parse_form(*g, "psi_m");
+    s.gradient_r_s = parse_form(*g, "r_s");
+    g->finish();
+  }
+  s.nominal_sample_period_s = e.number_or("sample_period_s", 125e-6, 1e-6, 1.0);
+  s.max_sample_interval_s = e.number_or("max_sample_interval_s", 8.0 * s.nominal_sample_period_s,
+                                        s.nominal_sample_period_s, 10.0);
+  if (auto a = e.optional_map("adapt")) {
+    s.adapt_psi_m = a->boolean_or("psi_m", true);
+    s.adapt_r_s = a->boolean_or("r_s", true);
+    a->finish();
+  }
+
+  YamlMap bounds = e.map("bounds");
+  std::tie(s.psi_m_min_Wb, s.psi_m_max_Wb) = bounds.interval("psi_m_Wb", 1e-6, 100.0);
+  std::tie(s.r_s_min_Ohm, s.r_s_max_Ohm) = bounds.interval("r_s_Ohm", 1e-6, 1e4);
+  bounds.finish();
+
+  s.initial_psi_m_Wb = machine.psi_m_Wb;
+  s.initial_r_s_Ohm = machine.r_s_Ohm;
+  if (auto init = e.optional_map("initial")) {
+    s.initial_psi_m_Wb = init->number_or("psi_m_Wb", machine.psi_m_Wb, s.psi_m_min_Wb, s.psi_m_max_Wb);
+    s.initial_r_s_Ohm = init->number_or("r_s_Ohm", machine.r_s_Ohm, s.r_s_min_Ohm, s.r_s_max_Ohm);
+    init->finish();
+  }
+
+  YamlMap sched = e.map("scheduler");
+  s.psi_m_min_speed_rpm = sched.number("psi_m_min_speed_rpm", 0.0, 1e6);
+  s.r_s_max_speed_rpm = sched.number("r_s_max_speed_rpm", 0.0, 1e6);
+  if (s.r_s_max_speed_rpm > s.psi_m_min_speed_rpm) {
+    sched.fail("r_s_max_speed_rpm", "must not exceed psi_m_min_speed_rpm (|n_lim,1| >= |n_lim,2|, eq:GainSchedule)");
+  }
+  sched.finish();
+
+  YamlMap gains = e.map("gains");
+  s.gains[static_cast<int>(core::Algorithm::kSga)] = parse_sequences(gains.map("sga"), true);
+  s.gains[static_cast<int>(core::Algorithm::kGna)] = parse_sequences(gains.map("gna"), true);
+  s.gains[static_cast<int>(core::Algorithm::kPhyInt)] = parse_sequences(gains.map("phyint"), false);
+  gains.finish();
+
+  YamlMap hess = e.map("initial_hessian");
+  const auto r0 = hess.numbers("sga_pu", 2, 0.0, 1e6);
+  s.initial_sga_hessian_pu = {r0[0], r0[1]};
+  const auto big_r0 = hess.numbers("gna_pu", 3, -1e6, 1e6);  // [R11, R12, R22]
+  s.initial_gna_hessian_pu << big_r0[0], big_r0[1], big_r0[1], big_r0[2];
+  if (big_r0[0] < 0.0 || big_r0[2] < 0.0 || big_r0[0] * big_r0[2] < big_r0[1] * big_r0[1]) {
+    hess.fail("gna_pu", "R[0] = [[R11, R12], [R12, R22]] must be positive semi-definite");
+  }
+  hess.finish();
+
+  YamlMap floors = e.map("floors");
+  s.floors.sga_hessian_min_pu = floors.number("sga_hessian_min_pu", 0.0, kInf);
+  s.floors.gna_determinant_min_pu = floors.number("gna_determinant_min_pu", 0.0, kInf);
+  s.floors.gna_eigenvalue_min_pu = floors.number("gna_eigenvalue_min_pu", 0.0, kInf);
+  s.floors.phyint_denominator_min_pu = floors.number("phyint_denominator_min_pu", 0.0, kInf);
+  floors.finish();
+  e.finish();
+  return s;
+}
+
+core::InputCorrections parse_extensions(YamlMap x) {
+  core::InputCorrections c;
+  if (auto d = x.optional_map("deadtime")) {
+    c.deadtime_t_dead_s = d->number_or("t_dead_s", 0.0, 0.0, 1e-3);
+    c.switching_frequency_Hz = d->number_or("switching_frequency_Hz", 0.0, 0.0, 1e6);
+    c.deadtime_v_err_V = d->number_or("v_err_V", 0.0, -1e4, 1e4);
+    c.deadtime_current_band_A = d->number_or("current_band_A", 0.0, 0.0, 1e4);
+    if (c.deadtime_t_dead_s > 0.0 && c.switching_frequency_Hz <= 0.0) {
+      d->fail("switching_frequency_Hz", "t_dead_s needs the switching frequency");
+    }
+    d->finish();
+  }
+  if (auto t = x.optional_map("theta_offset")) {
+    c.theta_offset_rad = t->number("offset_rad", -3.2, 3.2);
+    t->finish();
+  }
+  for (const char* kind : {"current_offset", "current_gain"}) {
+    if (!x.has(kind)) {
+      (void)x.optional_map(kind);
+      continue;
+    }
+    for (YamlMap& p : x.maps(kind)) {
+      const std::string phase = p.choice("phase", {"a", "b", "c"});
+      const int k = phase[0] - 'a';
+      if (std::string(kind) == "current_offset") {
+        c.current_offset_A[k] = p.number("offset_A", -1e4, 1e4);
+      } else {
+        c.current_gain_error[k] = p.number("gain_error", -0.5, 0.5);
+      }
+      p.finish();
+    }
+  }
+  if (auto d = x.optional_map("delay")) {
+    c.delay_s = d->number("delay_s", 0.0, 1e-2);
+    d->finish();
+  }
+  x.finish();
+  return c;
+}
+
+}  // namespace
+
+const char* to_string(core::Algorithm a) noexcept {
+  switch (a) {
+    case core::Algorithm::kSga:
+      return "sga";
+    case core::Algorithm::kGna:
+      return "gna";
+    case core::Algorithm::kPhyInt:
+      return "phyint";
+  }
+  return "?";
+}
+
+core::Algorithm parse_algorithm(const std::string& name) {
+  if (name == "sga") return core::Algorithm::kSga;
+  if (name == "gna") return core::Algorithm::kGna;
+  if (name == "phyint") return core::Algorithm::kPhyInt;
+  throw std::invalid_argument("unknown algorithm '" + name + "' (expected sga, gna or phyint)");
+}
+
+MachineConfig parse_machine_config(YamlMap& root) {
+  MachineConfig c;
+  c.machine = parse_machine(root.map("machine"));
+  c.estimator = parse_estimator(root.map("estimator"), c.machine);
+  if (auto x = root.optional_map("model_extensions")) c.estimator.corrections = parse_extensions(*x);
+  return c;
+}
+
+MachineConfig load_machine_config(const std::string& path) {
+  YamlMap root = YamlMap::load_file(path);
+  MachineConfig c = parse_machine_config(root);
+  root.finish();
+  return c;
+}
+
+MachineConfig builtin_paper_config() {
+  YamlMap root = YamlMap::load_string(builtin_paper_config_text(), "<built-in paper-ipmsm.yaml>");
+  MachineConfig c = parse_machine_config(root);
+  root.finish();
+  return c;
+}
+
+}  // namespace rpem::io

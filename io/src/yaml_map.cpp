@@ -1,0 +1,204 @@
+#include "rpem/io/yaml_map.hpp"
+
+#include <charconv>
+#include <cmath>
+#include <sstream>
+
+namespace rpem::io {
+namespace {
+
+std::string describe_range(double lo, double hi) {
+  std::ostringstream s;
+  s << "[" << lo << ", " << hi << "]";
+  return s.str();
+}
+
+}  // namespace
+
+YamlMap YamlMap::load_file(const std::string& path) {
+  YAML::Node root;
+  try {
+    root = YAML::LoadFile(path);
+  } catch (const YAML::BadFile&) {
+    throw ConfigError(path, 0, 0, "", "cannot open file");
+  } catch (const YAML::ParserException& e) {
+    throw ConfigError(path, static_cast<std::size_t>(e.mark.line + 1), static_cast<std::size_t>(e.mark.column + 1),
+                      "", "YAML syntax: " + e.msg);
+  }
+  if (!root.IsMap()) throw ConfigError(path, 1, 1, "", "the document must be a mapping");
+  return YamlMap(root, path, "");
+}
+
+YamlMap YamlMap::load_string(const std::string& text, const std::string& name) {
+  YAML::Node root;
+  try {
+    root = YAML::Load(text);
+  } catch (const YAML::ParserException& e) {
+    throw ConfigError(name, static_cast<std::size_t>(e.mark.line + 1), static_cast<std::size_t>(e.mark.column + 1),
+                      "", "YAML syntax: " + e.msg);
+  }
+  if (!root.IsMap()) throw ConfigError(name, 1, 1, "", "the document must be a mapping");
+  return YamlMap(root, name, "");
+}
+
+YamlMap::YamlMap(YAML::Node node, std::string file, std::string path)
+    : node_(std::move(node)), file_(std::move(file)), path_(std::move(path)) {}
+
+std::string YamlMap::field(const std::string& key) const { return path_.empty() ? key : path_ + "." + key; }
+
+void YamlMap::fail_at(const YAML::Node& node, const std::string& key, const std::string& reason) const {
+  const YAML::Mark mark = node.Mark();
+  const bool valid = mark.line >= 0;
+  throw ConfigError(file_, valid ? static_cast<std::size_t>(mark.line + 1) : 0,
+                    valid ? static_cast<std::size_t>(mark.column + 1) : 0, field(key), reason);
+}
+
+void YamlMap::fail(const std::string& key, const std::string& reason) const {
+  if (!key.empty() && node_[key]) fail_at(node_[key], key, reason);
+  fail_at(node_, key, reason);
+}
+
+bool YamlMap::has(const std::string& key) const { return static_cast<bool>(node_[key]); }
+
+YAML::Node YamlMap::get(const std::string& key) {
+  used_.insert(key);
+  const YAML::Node n = node_[key];
+  if (!n) fail_at(node_, key, "required key is missing");
+  return n;
+}
+
+double YamlMap::as_number(const YAML::Node& n, const std::string& key, double lo, double hi) const {
+  if (!n.IsScalar()) fail_at(n, key, "expected a number");
+  const std::string& s = n.Scalar();
+  double v = 0.0;
+  const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
+  if (ec != std::errc() || end != s.data() + s.size()) fail_at(n, key, "'" + s + "' is not a number");
+  if (!std::isfinite(v)) fail_at(n, key, "'" + s + "' is not finite");
+  if (v < lo || v > hi) fail_at(n, key, s + " is outside " + describe_range(lo, hi));
+  return v;
+}
+
+double YamlMap::number(const std::string& key, double lo, double hi) { return as_number(get(key), key, lo, hi); }
+
+double YamlMap::number_or(const std::string& key, double fallback, double lo, double hi) {
+  if (!has(key)) {
+    used_.insert(key);
+    return fallback;
+  }
+  return number(key, lo, hi);
+}
+
+long YamlMap::integer(const std::string& key, long lo, long hi) {
+  const YAML::Node n = get(key);
+  if (!n.IsScalar()) fail_at(n, key, "expected an integer");
+  const std::string& s = n.Scalar();
+  long v = 0;
+  const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
+  if (ec != std::errc() || end != s.data() + s.size()) fail_at(n, key, "'" + s + "' is not an integer");
+  if (v < lo || v > hi) fail_at(n, key, s + " is outside " + describe_range(static_cast<double>(lo), static_cast<double>(hi)));
+  return v;
+}
+
+long YamlMap::integer_or(const std::string& key, long fallback, long lo, long hi) {
+  if (!has(key)) {
+    used_.insert(key);
+    return fallback;
+  }
+  return integer(key, lo, hi);
+}
+
+bool YamlMap::boolean_or(const std::string& key, bool fallback) {
+  if (!has(key)) {
+    used_.insert(key);
+    return fallback;
+  }
+  const YAML::Node n = get(key);
+  if (n.IsScalar()) {
+    const std::string& s = n.Scalar();
+    if (s == "true") return true;
+    if (s == "false") return false;
+  }
+  fail_at(n, key, "expected true or false");
+}
+
+std::string YamlMap::text(const std::string& key) {
+  const YAML::Node n = get(key);
+  if (!n.IsScalar()) fail_at(n, key, "expected a string");
+  return n.Scalar();
+}
+
+std::string YamlMap::text_or(const std::string& key, const std::string& fallback) {
+  if (!has(key)) {
+    used_.insert(key);
+    return fallback;
+  }
+  return text(key);
+}
+
+std::string YamlMap::choice(const std::string& key, std::initializer_list<const char*> choices) {
+  const std::string v = text(key);
+  std::string list;
+  for (const char* c : choices) {
+    if (v == c) return v;
+    list += list.empty() ? c : std::string(", ") + c;
+  }
+  fail_at(node_[key], key, "'" + v + "' is not one of: " + list);
+}
+
+std::string YamlMap::choice_or(const std::string& key, const std::string& fallback,
+                               std::initializer_list<const char*> choices) {
+  if (!has(key)) {
+    used_.insert(key);
+    return fallback;
+  }
+  return choice(key, choices);
+}
+
+std::vector<double> YamlMap::numbers(const std::string& key, std::size_t n, double lo, double hi) {
+  const YAML::Node seq = get(key);
+  if (!seq.IsSequence() || seq.size() == 0) fail_at(seq, key, "expected a list of numbers");
+  if (n > 0 && seq.size() != n) fail_at(seq, key, "expected " + std::to_string(n) + " numbers, got " + std::to_string(seq.size()));
+  std::vector<double> out;
+  for (std::size_t i = 0; i < seq.size(); ++i) out.push_back(as_number(seq[i], key + "[" + std::to_string(i) + "]", lo, hi));
+  return out;
+}
+
+std::pair<double, double> YamlMap::interval(const std::string& key, double lo, double hi) {
+  const std::vector<double> v = numbers(key, 2, lo, hi);
+  if (!(v[0] < v[1])) fail_at(node_[key], key, "expected [min, max] with min < max");
+  return {v[0], v[1]};
+}
+
+YamlMap YamlMap::map(const std::string& key) {
+  const YAML::Node n = get(key);
+  if (!n.IsMap()) fail_at(n, key, "expected a mapping");
+  return YamlMap(n, file_, field(key));
+}
+
+std::optional<YamlMap> YamlMap::optional_map(const std::string& key) {
+  if (!has(key)) {
+    used_.insert(key);
+    return std::nullopt;
+  }
+  return map(key);
+}
+
+std::vector<YamlMap> YamlMap::maps(const std::string& key) {
+  const YAML::Node seq = get(key);
+  if (!seq.IsSequence()) fail_at(seq, key, "expected a list");
+  std::vector<YamlMap> out;
+  for (std::size_t i = 0; i < seq.size(); ++i) {
+    if (!seq[i].IsMap()) fail_at(seq[i], key + "[" + std::to_string(i) + "]", "expected a mapping");
+    out.emplace_back(seq[i], file_, field(key) + "[" + std::to_string(i) + "]");
+  }
+  return out;
+}
+
+void YamlMap::finish() const {
+  for (auto it = node_.begin(); it != node_.end(); ++it) {
+    const std::string key = it->first.as<std::string>();
+    if (used_.count(key) == 0) fail_at(it->first, key, "unknown key");
+  }
+}
+
+}  // namespace rpem::io

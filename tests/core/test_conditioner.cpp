@@ -1,0 +1,128 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "rpem/core/conditioner.hpp"
+#include "rpem/core/drive_estimator.hpp"
+#include "support/model_data.hpp"
+#include "support/paper_machine.hpp"
+
+namespace rpem::core {
+namespace {
+
+DriveSample sample(std::int64_t t_ns, double theta, const Vec3& u_abc, const Vec3& i_abc) {
+  DriveSample s;
+  s.t_ns = t_ns;
+  s.theta_el_rad = theta;
+  s.omega_el_rad_s = 31.4;
+  s.u_dc_V = 220.0;
+  s.u_V = u_abc;
+  s.i_A = i_abc;
+  return s;
+}
+
+TEST(Conditioner, HeldStatorCommandEntersAtBothEndsOfTheInterval) {
+  const PerUnitBase b = test::paper_base();
+  SampleConditioner c(b, {});
+  const Vec3 u0(100.0, -30.0, -70.0), u1(10.0, 20.0, -30.0), i(1.0, 2.0, -3.0);
+  const EstimatorSample first = c.condition(sample(0, 0.3, u0, i));
+  EXPECT_TRUE(first.resync);
+  const EstimatorSample second = c.condition(sample(125'000, 0.35, u1, i));
+  EXPECT_FALSE(second.resync);
+  EXPECT_DOUBLE_EQ(second.interval.dt_s, 125e-6);
+  const Vec2 u0_ab = clarke(u0) / b.voltage_V;
+  EXPECT_LT((second.interval.u_start_pu - park(u0_ab, Rotation::of(0.3))).norm(), 1e-15);
+  EXPECT_LT((second.interval.u_end_pu - park(u0_ab, Rotation::of(0.35))).norm(), 1e-15);
+  EXPECT_LT((second.i_meas_pu - park(clarke(i), Rotation::of(0.35)) / b.current_A).norm(), 1e-15);
+  EXPECT_NEAR(second.interval.n_end_pu, 31.4 / b.omega_el_rad_s, 1e-15);
+}
+
+TEST(Conditioner, RotorFrameCommandIsHeldInTheStatorFrame) {
+  const PerUnitBase b = test::paper_base();
+  SampleConditioner c(b, {});
+  DriveSample s0 = sample(0, 1.0, Vec3(50.0, 20.0, 0.0), Vec3(1.0, 0.5, 0.0));
+  s0.voltage_frame = Frame::kDq;
+  s0.current_frame = Frame::kDq;
+  (void)c.condition(s0);
+  DriveSample s1 = s0;
+  s1.t_ns = 100'000;
+  s1.theta_el_rad = 1.2;
+  const EstimatorSample out = c.condition(s1);
+  EXPECT_LT((out.interval.u_start_pu - Vec2(50.0, 20.0) / b.voltage_V).norm(), 1e-15);
+  const Vec2 held = inverse_park(Vec2(50.0, 20.0), Rotation::of(1.0));
+  EXPECT_LT((out.interval.u_end_pu - park(held, Rotation::of(1.2)) / b.voltage_V).norm(), 1e-15);
+  EXPECT_LT((out.i_meas_pu - Vec2(1.0, 0.5) / b.current_A).norm(), 1e-15);
+}
+
+TEST(Conditioner, GapAndNonFiniteInputRestartTheChain) {
+  SampleConditioner c(test::paper_base(), {});
+  (void)c.condition(sample(0, 0.0, Vec3::Zero(), Vec3::Zero()));
+  DriveSample gap = sample(125'000, 0.0, Vec3::Zero(), Vec3::Zero());
+  gap.gap_before = true;
+  EXPECT_TRUE(c.condition(gap).resync);
+  DriveSample bad = sample(250'000, std::nan(""), Vec3::Zero(), Vec3::Zero());
+  EXPECT_FALSE(c.condition(bad).i_meas_pu.allFinite());
+  EXPECT_TRUE(c.condition(sample(375'000, 0.0, Vec3::Zero(), Vec3::Zero())).resync);
+}
+
+TEST(Conditioner, DeadTimeVoltageErrorOpposesEachPhaseCurrent) {
+  // Textbook: each leg loses v_err = t_dead·f_sw·u_dc in the direction of its current.
+  const PerUnitBase b = test::paper_base();
+  InputCorrections corr;
+  corr.deadtime_t_dead_s = 2e-6;
+  corr.switching_frequency_Hz = 4000.0;
+  SampleConditioner c(b, corr);
+  const Vec3 i(2.0, -0.5, -1.5), u(0.0, 0.0, 0.0);
+  (void)c.condition(sample(0, 0.0, u, i));
+  const EstimatorSample out = c.condition(sample(125'000, 0.0, u, i));
+  const double v_err = 2e-6 * 4000.0 * 220.0;  // 1.76 V
+  const Vec2 expected = clarke(Vec3(-v_err, v_err, v_err)) / b.voltage_V;
+  EXPECT_LT((out.interval.u_start_pu - expected).norm(), 1e-15);
+}
+
+TEST(Conditioner, AngleOffsetAndCurrentSensorCorrections) {
+  const PerUnitBase b = test::paper_base();
+  InputCorrections corr;
+  corr.theta_offset_rad = 0.05;
+  corr.current_offset_A = Vec3(0.1, 0.0, 0.0);
+  corr.current_gain_error = Vec3(0.0, 0.02, 0.0);
+  SampleConditioner c(b, corr);
+  const Vec3 i_true(1.0, -0.4, -0.6);
+  const Vec3 i_meas(1.0 + 0.1, -0.4 * 1.02, -0.6);
+  const EstimatorSample out = c.condition(sample(0, 0.7, Vec3::Zero(), i_meas));
+  EXPECT_LT((out.i_meas_pu - park(clarke(i_true), Rotation::of(0.75)) / b.current_A).norm(), 1e-15);
+}
+
+TEST(Conditioner, DelayBlendsThePreviousCommandIntoTheInterval) {
+  const PerUnitBase b = test::paper_base();
+  InputCorrections corr;
+  corr.delay_s = 25e-6;
+  SampleConditioner c(b, corr);
+  const Vec3 ua(10.0, -5.0, -5.0), ub(-20.0, 10.0, 10.0);
+  (void)c.condition(sample(0, 0.0, ua, Vec3::Zero()));
+  (void)c.condition(sample(125'000, 0.0, ub, Vec3::Zero()));
+  const EstimatorSample out = c.condition(sample(250'000, 0.0, ua, Vec3::Zero()));
+  const Vec2 expected = (0.8 * clarke(ub) + 0.2 * clarke(ua)) / b.voltage_V;
+  EXPECT_LT((out.interval.u_start_pu - expected).norm(), 1e-15);
+}
+
+TEST(DriveEstimator, SiPhaseSamplesConvergeLikeThePerUnitPath) {
+  const PerUnitBase base = test::paper_base();
+  test::ModelDataGenerator gen;
+  gen.plant = test::paper_machine_pu();
+  gen.plant.psi_m_pu *= 0.92;
+  gen.omega_n_rad_s = base.omega_el_rad_s;
+  gen.n_pu = -0.4;
+  gen.i_ref_pu = mtpa_reference(gen.plant, 0.2);
+  DriveEstimator est(test::paper_machine_si(), test::paper_settings());
+  std::int64_t t_ns = 0;
+  Estimate e;
+  for (int k = 0; k < 48000; ++k) e = est.step(gen.next_si(base, t_ns));
+  EXPECT_EQ(e.detail.code, StepCode::kAdapted);
+  EXPECT_NEAR(e.psi_m_Wb / (0.92 * 1.14), 1.0, 1e-3);
+  EXPECT_NEAR(e.r_s_Ohm, 2.25, 1e-12);
+  EXPECT_LT(e.epsilon_A.norm(), 1e-3);
+}
+
+}  // namespace
+}  // namespace rpem::core

@@ -1,0 +1,49 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "rpem/core/frames.hpp"
+#include "support/seed.hpp"
+
+namespace rpem::core {
+namespace {
+
+TEST(Frames, ClarkeIsAmplitudeInvariant) {
+  // GIVEN a balanced set of amplitude 2 at angle φ THEN the αβ vector has length 2 and angle φ.
+  const double phi = 0.7;
+  const Vec3 abc(2.0 * std::cos(phi), 2.0 * std::cos(phi - 2.0 * kPi / 3.0), 2.0 * std::cos(phi + 2.0 * kPi / 3.0));
+  const Vec2 ab = clarke(abc);
+  EXPECT_NEAR(ab[0], 2.0 * std::cos(phi), 1e-14);
+  EXPECT_NEAR(ab[1], 2.0 * std::sin(phi), 1e-14);
+}
+
+TEST(Frames, ParkAlignsTheRotatingVector) {
+  const double theta = 1.1;
+  const Vec2 ab(std::cos(theta), std::sin(theta));
+  const Vec2 dq = park(ab, Rotation::of(theta));
+  EXPECT_NEAR(dq[0], 1.0, 1e-15);
+  EXPECT_NEAR(dq[1], 0.0, 1e-15);
+}
+
+TEST(Frames, RoundTripsOnRandomInputs) {
+  std::mt19937_64 rng(test::test_seed(11));
+  std::uniform_real_distribution<double> u(-10.0, 10.0);
+  for (int k = 0; k < 1000; ++k) {
+    const Vec2 ab(u(rng), u(rng));
+    const Rotation r = Rotation::of(u(rng));
+    EXPECT_LT((inverse_park(park(ab, r), r) - ab).norm(), 1e-12);
+    EXPECT_LT((clarke(inverse_clarke(ab)) - ab).norm(), 1e-12);
+    // A zero-sequence component never reaches αβ.
+    const Vec3 abc = inverse_clarke(ab) + Vec3::Constant(u(rng));
+    EXPECT_LT((clarke(abc) - ab).norm(), 1e-12);
+  }
+}
+
+TEST(Frames, WrapAngle) {
+  EXPECT_NEAR(wrap_angle(3.0 * kPi + 0.1), -kPi + 0.1, 1e-12);
+  EXPECT_NEAR(wrap_angle(-0.25), -0.25, 1e-15);
+}
+
+}  // namespace
+}  // namespace rpem::core
