@@ -1,0 +1,34 @@
+#include "rpem/io/estimate_log.hpp"
+
+#include "rpem/io/errors.hpp"
+#include "rpem/io/number_format.hpp"
+
+namespace rpem::io {
+
+EstimateLogWriter::EstimateLogWriter(const std::string& path) : out_(path, std::ios::binary | std::ios::trunc) {
+  if (!out_) throw InputError(path, 0, 0, "", "cannot create file");
+  out_ << "t,psi_m,r_s,psi_m_pu,r_s_pu,eps_d,eps_q,i_hat_d,i_hat_q,i_d,i_q,n_pu,"
+          "psi_m_active,r_s_active,code,flags,sga_r_psi_m,sga_r_r_s,gna_det_R\n";
+}
+
+void EstimateLogWriter::write(const core::Estimate& e, const core::DriveEstimator& estimator) {
+  const auto& d = e.detail;
+  const auto& st = estimator.core().state();
+  line_.clear();
+  append_number(line_, 1e-9 * static_cast<double>(e.t_ns));
+  for (double v : {e.psi_m_Wb, e.r_s_Ohm, d.theta_pu[core::kPsiM], d.theta_pu[core::kRs], e.epsilon_A[0],
+                   e.epsilon_A[1], e.i_hat_A[0], e.i_hat_A[1], e.i_meas_A[0], e.i_meas_A[1], e.speed_pu}) {
+    append_number(line_ += ',', v);
+  }
+  line_ += (d.flags & core::step_flag::kPsiMActive) ? ",1" : ",0";
+  line_ += (d.flags & core::step_flag::kRsActive) ? ",1" : ",0";
+  line_ += ',' + std::to_string(static_cast<int>(d.code));
+  line_ += ',' + std::to_string(d.flags);
+  for (double v : {st.sga_hessian_pu[0], st.sga_hessian_pu[1], core::det2(st.gna_hessian_pu)}) {
+    append_number(line_ += ',', v);
+  }
+  line_ += '\n';
+  out_ << line_;
+}
+
+}  // namespace rpem::io

@@ -1,0 +1,132 @@
+// The configuration loader: the paper file loads to tab_machineData / tab_psimgains; unknown keys,
+// wrong types and out-of-range values are rejected with file:line.
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <regex>
+#include <sstream>
+
+#include "rpem/io/machine_config.hpp"
+#include "support/temp_file.hpp"
+
+namespace rpem::io {
+namespace {
+
+std::string paper_text() {
+  std::ifstream in(test::source_dir() + "/config/paper-ipmsm.yaml");
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+/// Replaces the first match of `pattern` in the paper config and returns the loader's message.
+std::string error_after_edit(const std::string& pattern, const std::string& replacement) {
+  const std::string text = std::regex_replace(paper_text(), std::regex(pattern), replacement,
+                                              std::regex_constants::format_first_only);
+  EXPECT_NE(text, paper_text()) << "pattern did not match: " << pattern;
+  test::TempFile f("cfg.yaml", text);
+  try {
+    (void)load_machine_config(f.path());
+  } catch (const ConfigError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(MachineConfig, PaperFileMatchesThePaperTables) {
+  const MachineConfig c = load_machine_config(test::source_dir() + "/config/paper-ipmsm.yaml");
+  EXPECT_EQ(c.machine.rated.pole_pairs, 3);
+  EXPECT_DOUBLE_EQ(c.machine.rated.voltage_ll_rms_V, 400.0);
+  EXPECT_DOUBLE_EQ(c.machine.rated.current_rms_A, 4.93);
+  EXPECT_DOUBLE_EQ(c.machine.r_s_Ohm, 2.25);
+  EXPECT_DOUBLE_EQ(c.machine.psi_m_Wb, 1.14);
+  EXPECT_DOUBLE_EQ(c.machine.l_d_H, 0.0953);
+  EXPECT_DOUBLE_EQ(c.machine.l_q_H, 0.206);
+  const auto& e = c.estimator;
+  EXPECT_EQ(e.algorithm, core::Algorithm::kSga);
+  EXPECT_DOUBLE_EQ(e.psi_m_min_speed_rpm, 100.0);
+  EXPECT_DOUBLE_EQ(e.r_s_max_speed_rpm, 10.0);
+  const auto& sga = e.gains[0];
+  const auto& gna = e.gains[1];
+  const auto& phy = e.gains[2];
+  EXPECT_DOUBLE_EQ(sga.hessian[0], 6.25e-4);
+  EXPECT_DOUBLE_EQ(sga.gain[0], 3.25e-4);
+  EXPECT_DOUBLE_EQ(sga.hessian[1], 6.25e-4);
+  EXPECT_DOUBLE_EQ(sga.gain[1], 6.25e-5);
+  EXPECT_DOUBLE_EQ(gna.hessian[0], 6.25e-4);
+  EXPECT_DOUBLE_EQ(gna.gain[0], 3.25e-4);
+  EXPECT_DOUBLE_EQ(gna.hessian[1], 6.25e-5);
+  EXPECT_DOUBLE_EQ(gna.gain[1], 7.5e-6);
+  EXPECT_DOUBLE_EQ(phy.gain[0], 3.25e-4);
+  EXPECT_DOUBLE_EQ(phy.gain[1], 6.25e-5);
+  EXPECT_DOUBLE_EQ(e.nominal_sample_period_s, 125e-6);
+  EXPECT_EQ(e.corrections.theta_offset_rad, 0.0);
+}
+
+TEST(MachineConfig, BuiltInConfigIsThePaperFile) {
+  EXPECT_EQ(builtin_paper_config_text(), paper_text());
+  const MachineConfig c = builtin_paper_config();
+  EXPECT_DOUBLE_EQ(c.machine.psi_m_Wb, 1.14);
+}
+
+struct BadEdit {
+  const char* name;
+  const char* pattern;
+  const char* replacement;
+  const char* expected;
+};
+
+class MalformedConfig : public ::testing::TestWithParam<BadEdit> {};
+
+TEST_P(MalformedConfig, IsRejectedWithFileLineAndField) {
+  const std::string msg = error_after_edit(GetParam().pattern, GetParam().replacement);
+  EXPECT_NE(msg.find(GetParam().expected), std::string::npos) << "message: " << msg;
+  EXPECT_NE(msg.find("cfg.yaml:"), std::string::npos) << "message: " << msg;
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Cases, MalformedConfig,
+    ::testing::Values(
+        BadEdit{"unknown_top", "\nmachine:", "\nmachnie_typo: 1\nmachine:", ":3:1: machnie_typo: unknown key"},
+        BadEdit{"unknown_nested", "r_s_Ohm: 2.25", "r_s_Ohm: 2.25\n  r_s_ohm: 2.25", "machine.r_s_ohm: unknown key"},
+        BadEdit{"out_of_range_gain", "gain: 3.25e-4", "gain: 3.25", "estimator.gains.sga.psi_m.gain: 3.25 is outside [0, 1]"},
+        BadEdit{"negative_resistance", "r_s_Ohm: 2.25", "r_s_Ohm: -2.25", "machine.r_s_Ohm: -2.25 is outside"},
+        BadEdit{"not_a_number", "l_d_H: 0.0953", "l_d_H: small", "machine.l_d_H: 'small' is not a number"},
+        BadEdit{"bad_choice", "algorithm: sga", "algorithm: kalman", "estimator.algorithm: 'kalman' is not one of: sga, gna, phyint"},
+        BadEdit{"missing", "    pole_pairs: 3 .*\n", "", "machine.rated.pole_pairs: required key is missing"},
+        BadEdit{"fractional_pole_pairs", "pole_pairs: 3", "pole_pairs: 3.5", "'3.5' is not an integer"},
+        BadEdit{"reversed_bounds", "psi_m_Wb: \\[0.57, 1.71\\]", "psi_m_Wb: [1.71, 0.57]", "min < max"},
+        BadEdit{"initial_outside_bounds", "initial: \\{psi_m_Wb: 1.14", "initial: {psi_m_Wb: 2.0", "estimator.initial.psi_m_Wb: 2.0 is outside [0.57, 1.71]"},
+        BadEdit{"scheduler_order", "r_s_max_speed_rpm: 10 ", "r_s_max_speed_rpm: 200 ", "must not exceed psi_m_min_speed_rpm"},
+        BadEdit{"indefinite_hessian", "gna_pu: \\[1.0, 0.0, 1.0\\]", "gna_pu: [1.0, 2.0, 1.0]", "positive semi-definite"},
+        BadEdit{"wrong_length", "sga_pu: \\[1.0, 1.0\\]", "sga_pu: [1.0]", "expected 2 numbers, got 1"},
+        BadEdit{"bool", "psi_m: true", "psi_m: yes please", "expected true or false"},
+        BadEdit{"syntax", "machine:", "machine: [", "YAML syntax"},
+        BadEdit{"ext_unknown", "\nestimator:", "\nmodel_extensions:\n  deadtime: {t_dead_s: 1.0e-6, switching_frequency_Hz: 4000, colour: red}\nestimator:",
+                "model_extensions.deadtime.colour: unknown key"}),
+    [](const auto& p) { return std::string(p.param.name); });
+
+TEST(MachineConfig, ModelExtensionsAreRead) {
+  const std::string text = paper_text() +
+                           "model_extensions:\n"
+                           "  deadtime: {t_dead_s: 2.0e-6, switching_frequency_Hz: 4000}\n"
+                           "  theta_offset: {offset_rad: 0.05}\n"
+                           "  current_offset: [{phase: b, offset_A: 0.1}]\n"
+                           "  current_gain: [{phase: c, gain_error: -0.02}]\n"
+                           "  delay: {delay_s: 1.0e-5}\n";
+  test::TempFile f("ext.yaml", text);
+  const MachineConfig c = load_machine_config(f.path());
+  EXPECT_DOUBLE_EQ(c.estimator.corrections.deadtime_t_dead_s, 2e-6);
+  EXPECT_DOUBLE_EQ(c.estimator.corrections.switching_frequency_Hz, 4000.0);
+  EXPECT_DOUBLE_EQ(c.estimator.corrections.theta_offset_rad, 0.05);
+  EXPECT_DOUBLE_EQ(c.estimator.corrections.current_offset_A[1], 0.1);
+  EXPECT_DOUBLE_EQ(c.estimator.corrections.current_gain_error[2], -0.02);
+  EXPECT_DOUBLE_EQ(c.estimator.corrections.delay_s, 1e-5);
+}
+
+TEST(MachineConfig, MissingFileIsAConfigError) {
+  EXPECT_THROW((void)load_machine_config("/nonexistent/x.yaml"), ConfigError);
+}
+
+}  // namespace
+}  // namespace rpem::io

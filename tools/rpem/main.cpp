@@ -1,0 +1,41 @@
+// rpem — the offline tool of rpem-drive. `rpem --help` lists the subcommands.
+
+#include <cstdio>
+#include <exception>
+#include <vector>
+
+#include "commands.hpp"
+#include "rpem/io/errors.hpp"
+
+int main(int argc, char** argv) {
+  using namespace rpem::tools;
+  CLI::App app{"rpem: offline tools of rpem-drive (online identification of PMSM psi_m and R_s)"};
+  app.require_subcommand(1);
+  std::vector<Runner> runners;
+  runners.push_back(add_estimate_command(app));
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int code = app.exit(e);
+    return code == 0 ? kExitOk : kExitUsage;
+  }
+  try {
+    for (const Runner& run : runners) {
+      const int code = run();
+      if (code >= 0) return code;
+    }
+  } catch (const rpem::io::ConfigError& e) {
+    std::fprintf(stderr, "rpem: configuration error: %s\n", e.what());
+    return kExitConfig;
+  } catch (const rpem::io::DriveLogError& e) {
+    std::fprintf(stderr, "rpem: drive-log error: %s\n", e.what());
+    return kExitDataError;
+  } catch (const rpem::io::InputError& e) {
+    std::fprintf(stderr, "rpem: %s\n", e.what());
+    return kExitIoError;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "rpem: error: %s\n", e.what());
+    return 1;
+  }
+  return kExitUsage;
+}
