@@ -3,6 +3,7 @@ function(rpem_target_defaults target)
   target_compile_options(${target} PRIVATE
     -Wall -Wextra -Wpedantic -Wshadow -Wconversion -Wno-sign-conversion
     -Wnon-virtual-dtor -Wold-style-cast -Wcast-align -Wunused -Woverloaded-virtual
+    -Wno-restrict  # GCC 12 at -O3 reports false positives inside std::string (GCC bug 105329)
     -Wdouble-promotion -Wformat=2 -Wimplicit-fallthrough)
   if(RPEM_WERROR)
     target_compile_options(${target} PRIVATE -Werror)

@@ -16,5 +16,6 @@ inline constexpr int kExitConfig = 78;     ///< EX_CONFIG: bad configuration
 using Runner = std::function<int()>;
 
 Runner add_estimate_command(CLI::App& app);
+Runner add_sim_command(CLI::App& app);
 
 }  // namespace rpem::tools

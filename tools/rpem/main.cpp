@@ -13,6 +13,7 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   std::vector<Runner> runners;
   runners.push_back(add_estimate_command(app));
+  runners.push_back(add_sim_command(app));
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

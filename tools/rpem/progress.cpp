@@ -24,7 +24,7 @@ void Progress::update(std::uint64_t done, std::uint64_t total) {
     return;
   }
   const int decile = static_cast<int>(fraction * 10.0);
-  if (decile > last_decile_ && decile < 10) {
+  if (decile > last_decile_ && decile > 0 && decile < 10) {
     last_decile_ = decile;
     std::fprintf(stderr, "%s: %d %%\n", label_.c_str(), decile * 10);
   }

@@ -36,9 +36,23 @@ struct Rotation {
   return {r.cos * dq[0] - r.sin * dq[1], r.sin * dq[0] + r.cos * dq[1]};
 }
 
-/// Wraps an angle to (−π, π].
+/// Wraps an angle to [−π, π] (arithmetic only: no libm call on the real-time path).
 [[nodiscard]] inline double wrap_angle(double theta_rad) noexcept {
-  return std::remainder(theta_rad, 2.0 * kPi);
+  constexpr double kInvTwoPi = 1.0 / (2.0 * kPi);
+  const double turns = theta_rad * kInvTwoPi;
+  const auto nearest = static_cast<double>(static_cast<long long>(turns + (turns >= 0.0 ? 0.5 : -0.5)));
+  return theta_rad - 2.0 * kPi * nearest;
+}
+
+/// cos and sin of a small angle x (|x| ≤ 0.1) by Taylor series; error below 1e-12 there.
+[[nodiscard]] inline Rotation small_rotation(double x) noexcept {
+  const double x2 = x * x;
+  return {1.0 - x2 * (0.5 - x2 * (1.0 / 24.0 - x2 / 720.0)), x * (1.0 - x2 * (1.0 / 6.0 - x2 / 120.0))};
+}
+
+/// The rotation by the sum of the two angles.
+[[nodiscard]] inline Rotation compose(const Rotation& a, const Rotation& b) noexcept {
+  return {a.cos * b.cos - a.sin * b.sin, a.sin * b.cos + a.cos * b.sin};
 }
 
 }  // namespace rpem::core

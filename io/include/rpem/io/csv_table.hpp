@@ -1,0 +1,33 @@
+#pragma once
+// A small numeric CSV table (data files such as flux maps and bench profiles): a header row and
+// numeric cells. Every problem throws InputError with file, line and column.
+
+#include <string>
+#include <vector>
+
+#include "rpem/io/errors.hpp"
+
+namespace rpem::io {
+
+class CsvTable {
+ public:
+  /// Reads `path`. Non-numeric cells are errors unless their column is listed in `text_columns`
+  /// (those read as NaN). "nan" cells are accepted only when `allow_nan` is true.
+  static CsvTable read(const std::string& path, bool allow_nan = false,
+                       const std::vector<std::string>& text_columns = {});
+
+  [[nodiscard]] bool has(const std::string& name) const;
+  /// The column's values; throws InputError naming the file if it is missing.
+  [[nodiscard]] const std::vector<double>& column(const std::string& name) const;
+  [[nodiscard]] std::size_t rows() const noexcept { return rows_; }
+  [[nodiscard]] const std::vector<std::string>& header() const noexcept { return header_; }
+  [[nodiscard]] const std::string& path() const noexcept { return path_; }
+
+ private:
+  std::string path_;
+  std::vector<std::string> header_;
+  std::vector<std::vector<double>> columns_;
+  std::size_t rows_ = 0;
+};
+
+}  // namespace rpem::io

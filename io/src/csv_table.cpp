@@ -1,0 +1,78 @@
+#include "rpem/io/csv_table.hpp"
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <fstream>
+
+namespace rpem::io {
+namespace {
+
+std::vector<std::string> split(const std::string& line) {
+  std::vector<std::string> cells;
+  std::size_t start = 0;
+  while (true) {
+    const std::size_t comma = line.find(',', start);
+    std::string cell = line.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
+    const auto first = cell.find_first_not_of(" \t\r\"");
+    const auto last = cell.find_last_not_of(" \t\r\"");
+    cells.push_back(first == std::string::npos ? std::string() : cell.substr(first, last - first + 1));
+    if (comma == std::string::npos) break;
+    start = comma + 1;
+  }
+  return cells;
+}
+
+}  // namespace
+
+CsvTable CsvTable::read(const std::string& path, bool allow_nan, const std::vector<std::string>& text_columns) {
+  std::ifstream in(path);
+  if (!in) throw InputError(path, 0, 0, "", "cannot open file");
+  CsvTable t;
+  t.path_ = path;
+  std::string line;
+  if (!std::getline(in, line)) throw InputError(path, 1, 0, "", "empty file: expected a header row");
+  t.header_ = split(line);
+  t.columns_.resize(t.header_.size());
+  std::vector<bool> is_text(t.header_.size(), false);
+  for (std::size_t c = 0; c < t.header_.size(); ++c) {
+    is_text[c] = std::find(text_columns.begin(), text_columns.end(), t.header_[c]) != text_columns.end();
+  }
+  std::size_t line_no = 1;
+  while (std::getline(in, line)) {
+    ++line_no;
+    if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
+    const auto cells = split(line);
+    if (cells.size() != t.header_.size()) {
+      throw InputError(path, line_no, 0, "", "row has " + std::to_string(cells.size()) + " cells, header has " +
+                                                 std::to_string(t.header_.size()));
+    }
+    for (std::size_t c = 0; c < cells.size(); ++c) {
+      double v = std::nan("");
+      if (!is_text[c]) {
+        const std::string& s = cells[c];
+        const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
+        if (s.empty() || ec != std::errc() || end != s.data() + s.size()) {
+          throw InputError(path, line_no, c + 1, "column " + t.header_[c], "'" + s + "' is not a number");
+        }
+        if (std::isnan(v) && !allow_nan) throw InputError(path, line_no, c + 1, "column " + t.header_[c], "NaN");
+        if (std::isinf(v)) throw InputError(path, line_no, c + 1, "column " + t.header_[c], "not finite");
+      }
+      t.columns_[c].push_back(v);
+    }
+    ++t.rows_;
+  }
+  return t;
+}
+
+bool CsvTable::has(const std::string& name) const {
+  return std::find(header_.begin(), header_.end(), name) != header_.end();
+}
+
+const std::vector<double>& CsvTable::column(const std::string& name) const {
+  const auto it = std::find(header_.begin(), header_.end(), name);
+  if (it == header_.end()) throw InputError(path_, 1, 0, "column " + name, "required column is missing");
+  return columns_[static_cast<std::size_t>(it - header_.begin())];
+}
+
+}  // namespace rpem::io

@@ -1,0 +1,86 @@
+#pragma once
+// The simulated drive: plant + inverter + FOC + sensors, stepped one control period at a time. It
+// produces exactly what a drive logs (docs/drive-log.md: commands, not actual voltages) and, beside
+// it, the truth. One simulator serves `rpem sim`, `rpem reproduce`, rpemd's built-in source, the tests
+// and the benchmarks.
+//
+// Period k (t_k = k·T): sample the sensors; emit row k with the command that acts over [t_k, t_k+1]
+// (computed in period k − 1); run the FOC on the samples (its command acts in period k + 1);
+// integrate the plant over [t_k, t_k+1] with the inverter's mean voltage per plant step.
+
+#include <cstdint>
+#include <memory>
+
+#include "rpem/io/drive_log.hpp"
+#include "rpem/sim/foc.hpp"
+#include "rpem/sim/inverter.hpp"
+#include "rpem/sim/plant.hpp"
+#include "rpem/sim/scenario.hpp"
+#include "rpem/sim/sensors.hpp"
+
+namespace rpem::sim {
+
+/// The true state at a sample instant (the truth CSV).
+struct TruthRow {
+  std::int64_t t_ns = 0;
+  PlantParameters parameters;
+  double l_d_H = 0.0, l_q_H = 0.0;  ///< apparent inductances at the operating point
+  double t_winding_C = 0.0, t_magnet_C = 0.0;
+  double omega_el_rad_s = 0.0;
+  double theta_el_rad = 0.0;
+  double torque_Nm = 0.0;
+  core::Vec2 i_dq_A = core::Vec2::Zero();
+};
+
+class DriveSimulator {
+ public:
+  explicit DriveSimulator(Scenario scenario);
+
+  /// Advances one control period. Returns false once the scenario's duration is reached.
+  bool next(io::DriveLogRow& row, TruthRow& truth) noexcept;
+
+  /// The drive-log layout this scenario writes.
+  [[nodiscard]] io::DriveLogLayout layout() const noexcept;
+  [[nodiscard]] const Scenario& scenario() const noexcept { return scenario_; }
+  [[nodiscard]] const PmsmPlant& plant() const noexcept { return plant_; }
+  [[nodiscard]] std::int64_t period_ns() const noexcept { return period_ns_; }
+  [[nodiscard]] std::int64_t samples_total() const noexcept { return samples_total_; }
+
+ private:
+  [[nodiscard]] PlantParameters parameters_at(double t_s) noexcept;
+  /// Samples the sensors at t_k and runs the controller.
+  void sample_and_control(double t_s) noexcept;
+  /// Integrates the plant over [t_k, t_k+1].
+  void integrate(std::int64_t k) noexcept;
+  void fill_row(std::int64_t t_ns, io::DriveLogRow& row) const noexcept;
+  void fill_truth(std::int64_t t_ns, TruthRow& truth) const noexcept;
+
+  Scenario scenario_;
+  PmsmPlant plant_;
+  Inverter inverter_;
+  FocController foc_;
+  Sensors sensors_;
+  std::int64_t period_ns_;
+  std::int64_t samples_total_;
+  std::int64_t k_ = 0;             ///< index of the next logged sample
+  std::int64_t warmup_periods_ = 0;
+  int substeps_ = 1;
+
+  PlantParameters parameters_;
+  double torque_signal_Nm_ = 0.0;
+  double u_dc_V_ = 0.0;
+  core::Vec2 command_now_V_ = core::Vec2::Zero();   ///< acts over the current period
+  core::Vec2 command_next_V_ = core::Vec2::Zero();  ///< computed this period, acts in the next
+  Duties duties_now_, duties_next_, duties_before_;
+  double u_dc_meas_V_ = 0.0;
+  double torque_cmd_Nm_ = 0.0;
+  double t_winding_C_ = 0.0;
+  double t_magnet_C_ = 0.0;
+
+  // samples taken at the start of the current period
+  core::Vec3 i_meas_A_ = core::Vec3::Zero();
+  double theta_meas_rad_ = 0.0;
+  double omega_meas_rad_s_ = 0.0;
+};
+
+}  // namespace rpem::sim

@@ -1,0 +1,162 @@
+#include "rpem/sim/drive_simulator.hpp"
+
+#include <cmath>
+
+#include "rpem/core/machine.hpp"
+
+namespace rpem::sim {
+namespace {
+
+Magnetics make_magnetics(const Scenario& s) {
+  if (s.flux_map_file.empty()) return Magnetics();
+  return Magnetics(std::make_shared<const FluxMap>(FluxMap::load_csv(s.flux_map_file)));
+}
+
+double rpm_to_el_rad_s(double rpm, int pole_pairs) { return rpm * 2.0 * core::kPi / 60.0 * pole_pairs; }
+
+}  // namespace
+
+DriveSimulator::DriveSimulator(Scenario scenario)
+    : scenario_(std::move(scenario)),
+      plant_(scenario_.machine.machine.rated.pole_pairs, make_magnetics(scenario_), scenario_.mechanics),
+      inverter_(scenario_.inverter),
+      foc_(scenario_.control, scenario_.machine.machine),
+      sensors_(scenario_.sensors, scenario_.machine.machine.rated.pole_pairs, scenario_.sample_period_s,
+               scenario_.seed),
+      period_ns_(std::llround(scenario_.sample_period_s * 1e9)),
+      samples_total_(std::llround(scenario_.duration_s / scenario_.sample_period_s)),
+      warmup_periods_(std::llround(scenario_.warmup_s / scenario_.sample_period_s)),
+      substeps_(static_cast<int>(std::lround(scenario_.sample_period_s / scenario_.plant_step_s))) {
+  // Start at the operating point of t = 0 (then settle over the warm-up).
+  const int p = scenario_.machine.machine.rated.pole_pairs;
+  parameters_ = parameters_at(-scenario_.warmup_s);
+  const double omega = rpm_to_el_rad_s(scenario_.signal(Quantity::kSpeed).initial(), p);
+  const core::PerUnitBase base = core::PerUnitBase::from_rated(scenario_.machine.machine.rated);
+  const core::MachinePu nominal = core::to_pu(base, scenario_.machine.machine);
+  const double torque0 = scenario_.control.speed_control ? 0.0 : scenario_.signal(Quantity::kTorque).initial();
+  const core::Vec2 i0 = core::mtpa_reference(nominal, base.torque_pu(torque0)) * base.current_A;
+  plant_.reset(i0, 0.0, omega, parameters_);
+  const core::Vec2 u0 = core::steady_state_voltage(nominal, base.speed_pu(omega), i0 / base.current_A) * base.voltage_V;
+  command_now_V_ = command_next_V_ = core::inverse_park(u0, core::Rotation::of(0.0));
+  u_dc_meas_V_ = u_dc_V_;
+  duties_now_ = duties_next_ = duties_before_ = modulate(command_now_V_, u_dc_V_, scenario_.inverter.third_harmonic_injection);
+  for (std::int64_t k = -warmup_periods_; k < 0; ++k) {
+    sample_and_control(static_cast<double>(k) * scenario_.sample_period_s);
+    integrate(k);
+  }
+}
+
+PlantParameters DriveSimulator::parameters_at(double t_s) noexcept {
+  Scenario& s = scenario_;
+  const double tw = s.signal(Quantity::kTWinding).at(t_s);
+  const double tm = s.signal(Quantity::kTMagnet).at(t_s);
+  PlantParameters p;
+  p.r_s_Ohm = s.signal(Quantity::kRs).at(t_s) * (1.0 + s.thermal.r_s_coeff_per_K * (tw - s.thermal.reference_C));
+  p.psi_m_Wb = s.signal(Quantity::kPsiM).at(t_s) * (1.0 + s.thermal.psi_m_coeff_per_K * (tm - s.thermal.reference_C));
+  p.l_d_H = s.signal(Quantity::kLd).at(t_s);
+  p.l_q_H = s.signal(Quantity::kLq).at(t_s);
+  p.r_fe_Ohm = s.r_fe_Ohm;
+  torque_signal_Nm_ = s.signal(Quantity::kTorque).at(t_s);
+  u_dc_V_ = s.signal(Quantity::kUdc).at(t_s);
+  t_winding_C_ = tw;
+  t_magnet_C_ = tm;
+  return p;
+}
+
+void DriveSimulator::sample_and_control(double t_s) noexcept {
+  const int p = scenario_.machine.machine.rated.pole_pairs;
+  parameters_ = parameters_at(t_s);
+  const double speed_el = rpm_to_el_rad_s(scenario_.signal(Quantity::kSpeed).at(t_s), p);
+  plant_.set_speed(speed_el);
+  plant_.begin_period(parameters_, scenario_.plant_step_s, scenario_.mechanics.dynamometer ? 0.0 : torque_signal_Nm_);
+
+  i_meas_A_ = sensors_.currents(plant_.phase_currents());
+  theta_meas_rad_ = sensors_.angle(plant_.state().theta_el_rad);
+  omega_meas_rad_s_ = sensors_.speed();
+  u_dc_meas_V_ = sensors_.dc_link(u_dc_V_);
+
+  // The command computed last period acts now; compute the next one.
+  command_now_V_ = command_next_V_;
+  duties_before_ = duties_now_;
+  duties_now_ = duties_next_;
+  FocInput in;
+  in.i_abc_A = i_meas_A_;
+  in.theta_el_rad = theta_meas_rad_;
+  in.omega_el_rad_s = omega_meas_rad_s_;
+  in.u_dc_V = u_dc_meas_V_;
+  in.torque_ref_Nm = scenario_.control.speed_control ? 0.0 : torque_signal_Nm_;
+  in.speed_ref_el_rad_s = speed_el;
+  const FocOutput out = foc_.step(in);
+  torque_cmd_Nm_ = out.torque_ref_Nm;
+  command_next_V_ = out.u_ab_V;
+  duties_next_ = modulate(out.u_ab_V, u_dc_meas_V_, scenario_.inverter.third_harmonic_injection);
+}
+
+void DriveSimulator::integrate(std::int64_t k) noexcept {
+  // The carrier valley is at even k (rising half), the peak at odd k.
+  const bool rising = (k % 2) == 0;
+  const double h = scenario_.plant_step_s;
+  for (int s = 0; s < substeps_; ++s) {
+    const double tau = s * h;
+    const Duties& d = tau < scenario_.inverter_delay_s ? duties_before_ : duties_now_;
+    plant_.step(inverter_.mean_voltage(rising, tau, h, d, plant_.phase_currents(), u_dc_V_));
+  }
+}
+
+void DriveSimulator::fill_row(std::int64_t t_ns, io::DriveLogRow& row) const noexcept {
+  core::DriveSample& s = row.sample;
+  s.t_ns = t_ns;
+  s.theta_el_rad = theta_meas_rad_;
+  s.omega_el_rad_s = omega_meas_rad_s_;
+  s.u_dc_V = u_dc_meas_V_;
+  s.voltage_frame = core::Frame::kAbc;
+  s.u_V = core::inverse_clarke(command_now_V_);
+  s.current_frame = core::Frame::kAbc;
+  s.i_A = i_meas_A_;
+  s.gap_before = false;
+  row.t_winding_C = scenario_.log.temperatures ? std::optional(t_winding_C_) : std::nullopt;
+  row.t_magnet_C = scenario_.log.temperatures ? std::optional(t_magnet_C_) : std::nullopt;
+  row.torque_cmd_Nm = scenario_.log.torque_cmd ? std::optional(torque_cmd_Nm_) : std::nullopt;
+}
+
+void DriveSimulator::fill_truth(std::int64_t t_ns, TruthRow& truth) const noexcept {
+  const PlantState& st = plant_.state();
+  truth.t_ns = t_ns;
+  truth.parameters = parameters_;
+  truth.omega_el_rad_s = st.omega_el_rad_s;
+  truth.theta_el_rad = core::wrap_angle(st.theta_el_rad);
+  truth.torque_Nm = st.torque_Nm;
+  truth.i_dq_A = st.i_A;
+  truth.t_winding_C = t_winding_C_;
+  truth.t_magnet_C = t_magnet_C_;
+  if (const FluxMap* map = plant_.magnetics().map()) {
+    const core::Mat2 j = map->jacobian(st.i_A);  // differential inductances at the operating point
+    truth.l_d_H = j(0, 0);
+    truth.l_q_H = j(1, 1);
+  } else {
+    truth.l_d_H = parameters_.l_d_H;
+    truth.l_q_H = parameters_.l_q_H;
+  }
+}
+
+bool DriveSimulator::next(io::DriveLogRow& row, TruthRow& truth) noexcept {
+  if (k_ >= samples_total_) return false;
+  const double t_s = static_cast<double>(k_) * scenario_.sample_period_s;
+  const std::int64_t t_ns = k_ * period_ns_;
+  sample_and_control(t_s);
+  fill_row(t_ns, row);
+  fill_truth(t_ns, truth);
+  integrate(k_);
+  ++k_;
+  return true;
+}
+
+io::DriveLogLayout DriveSimulator::layout() const noexcept {
+  io::DriveLogLayout l;
+  l.voltage_dq = l.current_dq = scenario_.log.dq_columns;
+  l.t_winding = l.t_magnet = scenario_.log.temperatures;
+  l.torque_cmd = scenario_.log.torque_cmd;
+  return l;
+}
+
+}  // namespace rpem::sim

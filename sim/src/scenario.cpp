@@ -1,0 +1,198 @@
+#include "rpem/sim/scenario.hpp"
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <optional>
+#include <sstream>
+
+namespace rpem::sim {
+namespace {
+
+namespace fs = std::filesystem;
+constexpr double kHuge = 1e12;
+
+std::string resolve(const std::string& base_dir, const std::string& path) {
+  if (path.empty() || fs::path(path).is_absolute() || base_dir.empty()) return path;
+  return (fs::path(base_dir) / path).lexically_normal().string();
+}
+
+void parse_inverter(io::YamlMap m, Scenario& s) {
+  s.inverter.model = m.choice_or("model", "switching", {"switching", "averaged"}) == "averaged" ? InverterModel::kAveraged
+                                                                                               : InverterModel::kSwitching;
+  s.inverter.switching_frequency_Hz = m.number_or("switching_frequency_Hz", 4000.0, 100.0, 1e6);
+  s.inverter.dead_time_s = m.number_or("dead_time_s", 0.0, 0.0, 1e-4);
+  s.inverter.v_igbt_V = m.number_or("v_igbt_V", 0.0, 0.0, 100.0);
+  s.inverter.v_diode_V = m.number_or("v_diode_V", 0.0, 0.0, 100.0);
+  s.inverter.third_harmonic_injection = m.boolean_or("third_harmonic", true);
+  s.inverter_delay_s = m.number_or("delay_s", 0.0, 0.0, 1e-3);
+  m.finish();
+}
+
+void parse_plant(io::YamlMap m, Scenario& s, const std::string& base_dir) {
+  const bool averaged = s.inverter.model == InverterModel::kAveraged;
+  s.plant_step_s = m.number_or("step_s", averaged ? s.sample_period_s : 1e-6, 1e-8, s.sample_period_s);
+  s.flux_map_file = resolve(base_dir, m.text_or("flux_map", ""));
+  s.r_fe_Ohm = m.number_or("r_fe_Ohm", 0.0, 0.0, 1e9);
+  if (auto mech = m.optional_map("mechanics")) {
+    s.mechanics.dynamometer = mech->choice_or("mode", "dynamometer", {"dynamometer", "inertia"}) == "dynamometer";
+    s.mechanics.inertia_kgm2 = mech->number_or("inertia_kgm2", 0.01, 1e-7, 1e4);
+    s.mechanics.friction_Nms = mech->number_or("friction_Nms", 0.0, 0.0, 1e4);
+    mech->finish();
+  }
+  m.finish();
+}
+
+void parse_control(io::YamlMap m, Scenario& s) {
+  s.control.speed_control = m.choice_or("mode", "torque", {"torque", "speed"}) == "speed";
+  s.control.current_bandwidth_Hz = m.number_or("current_bandwidth_Hz", 400.0, 1.0, 1e4);
+  s.control.speed_bandwidth_Hz = m.number_or("speed_bandwidth_Hz", 5.0, 0.01, 1e3);
+  s.control.max_current_A = m.number_or("max_current_A", 0.0, 0.0, 1e5);
+  s.control.voltage_margin = m.number_or("voltage_margin", 0.95, 0.5, 1.0);
+  s.control.field_weakening = m.boolean_or("field_weakening", true);
+  m.finish();
+}
+
+core::Vec3 vec3(io::YamlMap& m, const std::string& key, double lo, double hi) {
+  if (!m.has(key)) {
+    (void)m.text_or(key, "");
+    return core::Vec3::Zero();
+  }
+  const auto v = m.numbers(key, 3, lo, hi);
+  return {v[0], v[1], v[2]};
+}
+
+void parse_sensors(io::YamlMap m, Scenario& s) {
+  auto& c = s.sensors;
+  c.current_noise_A = m.number_or("current_noise_A", 0.0, 0.0, 1e3);
+  c.current_lsb_A = m.number_or("current_lsb_A", 0.0, 0.0, 1e3);
+  c.current_offset_A = vec3(m, "current_offset_A", -1e3, 1e3);
+  c.current_gain_error = vec3(m, "current_gain_error", -0.5, 0.5);
+  c.encoder_counts = m.number_or("encoder_counts", 0.0, 0.0, 1e9);
+  c.theta_offset_rad = m.number_or("theta_offset_rad", 0.0, -3.2, 3.2);
+  c.speed_window = static_cast<int>(m.integer_or("speed_window", 8, 1, 10000));
+  c.u_dc_noise_V = m.number_or("u_dc_noise_V", 0.0, 0.0, 1e3);
+  c.u_dc_lsb_V = m.number_or("u_dc_lsb_V", 0.0, 0.0, 1e3);
+  m.finish();
+}
+
+Quantity parse_quantity(io::YamlMap& m, const std::string& key) {
+  const std::string name = m.choice(key, {"psi_m_Wb", "r_s_Ohm", "l_d_H", "l_q_H", "speed_rpm", "torque_Nm", "u_dc_V",
+                                          "t_winding_C", "t_magnet_C"});
+  for (std::size_t q = 0; q < kQuantityNames.size(); ++q) {
+    if (name == kQuantityNames[q]) return static_cast<Quantity>(q);
+  }
+  m.fail(key, "unknown quantity");
+}
+
+void parse_events(std::vector<io::YamlMap> events, Scenario& s) {
+  std::array<double, static_cast<int>(Quantity::kCount)> last_t;
+  last_t.fill(-kHuge);
+  for (io::YamlMap& e : events) {
+    SignalEvent ev;
+    ev.t_s = e.number("t_s", -kHuge, kHuge);
+    const Quantity q = parse_quantity(e, "quantity");
+    const std::string kind = e.choice("kind", {"step", "ramp", "thermal"});
+    ev.kind = kind == "step" ? EventKind::kStep : (kind == "ramp" ? EventKind::kRamp : EventKind::kThermal);
+    const bool has_value = e.has("value"), has_scale = e.has("scale");
+    if (has_value == has_scale) e.fail("value", "give exactly one of value and scale");
+    ev.target = has_value ? e.number("value", -kHuge, kHuge) : e.number("scale", -1e3, 1e3) * s.signal(q).initial();
+    if (ev.kind == EventKind::kRamp) ev.duration_s = e.number("duration_s", 0.0, kHuge);
+    if (ev.kind == EventKind::kThermal) ev.duration_s = e.number("tau_s", 1e-6, kHuge);
+    e.finish();
+    auto& last = last_t[static_cast<std::size_t>(q)];
+    if (ev.t_s < last) e.fail("t_s", "events of one quantity must be in time order");
+    last = ev.t_s;
+    s.signal(q).add(ev);
+  }
+}
+
+void set_initial_signals(Scenario& s, std::optional<io::YamlMap> init) {
+  const core::MachineSi& m = s.machine.machine;
+  auto value = [&](const char* key, double fallback, double lo, double hi) {
+    return init ? init->number_or(key, fallback, lo, hi) : fallback;
+  };
+  s.signal(Quantity::kPsiM) = Signal(value("psi_m_Wb", m.psi_m_Wb, 1e-6, 100.0));
+  s.signal(Quantity::kRs) = Signal(value("r_s_Ohm", m.r_s_Ohm, 1e-6, 1e4));
+  s.signal(Quantity::kLd) = Signal(value("l_d_H", m.l_d_H, 1e-8, 100.0));
+  s.signal(Quantity::kLq) = Signal(value("l_q_H", m.l_q_H, 1e-8, 100.0));
+  s.signal(Quantity::kSpeed) = Signal(value("speed_rpm", 0.0, -1e6, 1e6));
+  s.signal(Quantity::kTorque) = Signal(value("torque_Nm", 0.0, -1e6, 1e6));
+  s.signal(Quantity::kUdc) = Signal(value("u_dc_V", 220.0, 1.0, 1e5));
+  s.signal(Quantity::kTWinding) = Signal(value("t_winding_C", s.thermal.reference_C, -273.0, 1000.0));
+  s.signal(Quantity::kTMagnet) = Signal(value("t_magnet_C", s.thermal.reference_C, -273.0, 1000.0));
+  if (init) init->finish();
+}
+
+}  // namespace
+
+Scenario paper_scenario() {
+  Scenario s;
+  s.name = "paper";
+  s.source = "<built-in>";
+  s.machine = io::builtin_paper_config();
+  set_initial_signals(s, std::nullopt);
+  return s;
+}
+
+Scenario parse_scenario(const std::string& text, const std::string& name, const std::string& base_dir) {
+  io::YamlMap root = io::YamlMap::load_string(text, name);
+  Scenario s;
+  s.source = name;
+  s.name = root.text_or("name", fs::path(name).stem().string());
+  const std::string machine = root.text_or("machine", "builtin:paper-ipmsm");
+  if (machine == "builtin:paper-ipmsm") {
+    s.machine = io::builtin_paper_config();
+  } else {
+    s.machine = io::load_machine_config(resolve(base_dir, machine));
+  }
+  s.duration_s = root.number("duration_s", 1e-3, 1e7);
+  s.warmup_s = root.number_or("warmup_s", 0.2, 0.0, 1e4);
+  s.sample_period_s = root.number_or("sample_period_s", 125e-6, 1e-6, 1.0);
+  s.seed = static_cast<std::uint64_t>(root.integer_or("seed", 1, 0, 1L << 62));
+  if (auto m = root.optional_map("inverter")) parse_inverter(*m, s);
+  s.plant_step_s = s.inverter.model == InverterModel::kAveraged ? s.sample_period_s : 1e-6;
+  if (auto m = root.optional_map("plant")) parse_plant(*m, s, base_dir);
+  const double steps = s.sample_period_s / s.plant_step_s;
+  if (std::abs(steps - std::round(steps)) > 1e-6) root.fail("plant", "step_s must divide sample_period_s");
+  if (std::abs(s.sample_period_s * s.inverter.switching_frequency_Hz - 0.5) > 1e-9) {
+    root.fail("sample_period_s", "must be half the switching period (PWM double update)");
+  }
+  if (auto m = root.optional_map("control")) parse_control(*m, s);
+  s.control.period_s = s.sample_period_s;
+  s.control.inertia_kgm2 = s.mechanics.inertia_kgm2;
+  if (s.control.speed_control && s.mechanics.dynamometer) {
+    root.fail("control", "speed control needs plant.mechanics.mode: inertia (a dynamometer imposes the speed)");
+  }
+  if (auto m = root.optional_map("sensors")) parse_sensors(*m, s);
+  if (auto m = root.optional_map("thermal")) {
+    s.thermal.reference_C = m->number_or("reference_C", 20.0, -273.0, 1000.0);
+    s.thermal.r_s_coeff_per_K = m->number_or("r_s_coeff_per_K", 0.00393, -1.0, 1.0);
+    s.thermal.psi_m_coeff_per_K = m->number_or("psi_m_coeff_per_K", -0.0012, -1.0, 1.0);
+    m->finish();
+  }
+  set_initial_signals(s, root.optional_map("initial"));
+  if (root.has("events")) {
+    parse_events(root.maps("events"), s);
+  } else {
+    (void)root.optional_map("events");
+  }
+  if (auto m = root.optional_map("log")) {
+    s.log.dq_columns = m->boolean_or("dq_columns", false);
+    s.log.temperatures = m->boolean_or("temperatures", false);
+    s.log.torque_cmd = m->boolean_or("torque_cmd", false);
+    m->finish();
+  }
+  root.finish();
+  return s;
+}
+
+Scenario load_scenario(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw io::ConfigError(path, 0, 0, "", "cannot open file");
+  std::stringstream text;
+  text << in.rdbuf();
+  return parse_scenario(text.str(), path, fs::path(path).parent_path().string());
+}
+
+}  // namespace rpem::sim

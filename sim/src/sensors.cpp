@@ -1,0 +1,55 @@
+#include "rpem/sim/sensors.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "rpem/core/frames.hpp"
+
+namespace rpem::sim {
+
+Sensors::Sensors(const SensorConfig& config, int pole_pairs, double period_s, std::uint64_t seed)
+    : config_(config),
+      pole_pairs_(pole_pairs),
+      period_s_(period_s),
+      rng_(seed),
+      angle_history_mech_(static_cast<std::size_t>(std::max(2, config.speed_window + 1)), 0.0) {}
+
+double Sensors::quantize(double x, double lsb) noexcept { return lsb > 0.0 ? lsb * std::round(x / lsb) : x; }
+
+core::Vec3 Sensors::currents(const core::Vec3& i_abc_A) noexcept {
+  core::Vec3 out;
+  for (int x = 0; x < 3; ++x) {
+    double v = i_abc_A[x] * (1.0 + config_.current_gain_error[x]) + config_.current_offset_A[x];
+    if (config_.current_noise_A > 0.0) v += config_.current_noise_A * normal_(rng_);
+    out[x] = quantize(v, config_.current_lsb_A);
+  }
+  return out;
+}
+
+double Sensors::angle(double theta_el_true_rad) noexcept {
+  double mech = theta_el_true_rad / pole_pairs_;
+  if (config_.encoder_counts > 0.0) {
+    const double count = 2.0 * core::kPi / config_.encoder_counts;
+    mech = count * std::floor(mech / count);
+  }
+  head_ = (head_ + 1) % angle_history_mech_.size();
+  angle_history_mech_[head_] = mech;
+  count_ = std::min(count_ + 1, angle_history_mech_.size());
+  return core::wrap_angle(mech * pole_pairs_ - config_.theta_offset_rad);
+}
+
+double Sensors::speed() const noexcept {
+  if (count_ < 2) return 0.0;
+  const std::size_t span = count_ - 1;
+  const std::size_t n = angle_history_mech_.size();
+  const double oldest = angle_history_mech_[(head_ + n - span) % n];
+  return pole_pairs_ * (angle_history_mech_[head_] - oldest) / (static_cast<double>(span) * period_s_);
+}
+
+double Sensors::dc_link(double u_dc_V) noexcept {
+  double v = u_dc_V;
+  if (config_.u_dc_noise_V > 0.0) v += config_.u_dc_noise_V * normal_(rng_);
+  return quantize(v, config_.u_dc_lsb_V);
+}
+
+}  // namespace rpem::sim
