@@ -36,6 +36,8 @@ DriveSimulator::DriveSimulator(Scenario scenario)
   const double torque0 = scenario_.control.speed_control ? 0.0 : scenario_.signal(Quantity::kTorque).initial();
   const core::Vec2 i0 = core::mtpa_reference(nominal, base.torque_pu(torque0)) * base.current_A;
   plant_.reset(i0, 0.0, omega, parameters_);
+  // Prime the encoder history as if the machine had been turning at this speed.
+  for (int j = scenario_.sensors.speed_window; j > 0; --j) (void)sensors_.angle(-j * omega * scenario_.sample_period_s);
   const core::Vec2 u0 = core::steady_state_voltage(nominal, base.speed_pu(omega), i0 / base.current_A) * base.voltage_V;
   command_now_V_ = command_next_V_ = core::inverse_park(u0, core::Rotation::of(0.0));
   u_dc_meas_V_ = u_dc_V_;

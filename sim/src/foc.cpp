@@ -20,7 +20,28 @@ void FocController::reset() noexcept {
   mtpa_i_A_.setZero();
   integral_V_.setZero();
   speed_integral_Nm_ = 0.0;
-  i_d_fw_A_ = 0.0;
+}
+
+core::Vec2 FocController::field_weaken(core::Vec2 i_ref, double torque_Nm, double omega,
+                                       double u_limit) const noexcept {
+  // Voltage ellipse of the nominal model (R neglected; the margin covers it):
+  //   (ω·L_q·i_q)² + (ω·(L_d·i_d + ψ_m))² ≤ u_limit²
+  const double l_d = nominal_.l_d_H, l_q = nominal_.l_q_H, psi = nominal_.psi_m_Wb;
+  const double flux_limit2 = omega == 0.0 ? 1e30 : (u_limit / omega) * (u_limit / omega);
+  const double psi_q = l_q * i_ref[1];
+  const double psi_d_max = std::sqrt(std::max(0.0, flux_limit2 - psi_q * psi_q));
+  const double i_d_fw = (psi_d_max - psi) / l_d;
+  if (i_d_fw < i_ref[0]) {
+    // Weaken the field and re-solve i_q for the torque at the new i_d (the reluctance torque grows).
+    i_ref[0] = std::max(i_d_fw, -i_max_A_);
+    i_ref[1] = torque_Nm / (1.5 * nominal_.rated.pole_pairs * (psi + (l_d - l_q) * i_ref[0]));
+  }
+  // Current limit first, then whatever q current the voltage still allows at that i_d.
+  double iq_max = std::sqrt(std::max(0.0, i_max_A_ * i_max_A_ - i_ref[0] * i_ref[0]));
+  const double psi_d = l_d * i_ref[0] + psi;
+  iq_max = std::min(iq_max, std::sqrt(std::max(0.0, flux_limit2 - psi_d * psi_d)) / l_q);
+  i_ref[1] = std::clamp(i_ref[1], -iq_max, iq_max);
+  return i_ref;
 }
 
 FocOutput FocController::step(const FocInput& in) noexcept {
@@ -49,10 +70,8 @@ FocOutput FocController::step(const FocInput& in) noexcept {
     mtpa_i_A_ = core::mtpa_reference(nominal_pu_, base_.torque_pu(torque_ref)) * base_.current_A;
   }
   core::Vec2 i_ref = mtpa_i_A_;
-  if (config_.field_weakening) i_ref[0] = std::min(i_ref[0], i_d_fw_A_);
-  i_ref[0] = std::max(i_ref[0], -i_max_A_);
-  const double iq_max = std::sqrt(std::max(0.0, i_max_A_ * i_max_A_ - i_ref[0] * i_ref[0]));
-  i_ref[1] = std::clamp(i_ref[1], -iq_max, iq_max);
+  const double u_max = in.u_dc_V / core::kSqrt3;
+  if (config_.field_weakening) i_ref = field_weaken(i_ref, torque_ref, omega, config_.voltage_margin * u_max);
   out.i_ref_A = i_ref;
 
   // dq current PI with decoupling.
@@ -62,24 +81,18 @@ FocOutput FocController::step(const FocInput& in) noexcept {
   const core::Vec2 kp(wc * nominal_.l_d_H, wc * nominal_.l_q_H);
   const double ki = wc * nominal_.r_s_Ohm;
   const core::Vec2 error = i_ref - i_dq;
-  const core::Vec2 feedforward(-omega * nominal_.l_q_H * i_dq[1],
-                               omega * (nominal_.l_d_H * i_dq[0] + nominal_.psi_m_Wb));
+  // Decoupling from the references: no extra feedback path through the measured currents.
+  const core::Vec2 feedforward(-omega * nominal_.l_q_H * i_ref[1],
+                               omega * (nominal_.l_d_H * i_ref[0] + nominal_.psi_m_Wb));
   const core::Vec2 candidate_integral = integral_V_ + ki * t * error;
   core::Vec2 u_dq = kp.cwiseProduct(error) + candidate_integral + feedforward;
 
-  const double u_max = in.u_dc_V / core::kSqrt3;
   const double magnitude = u_dq.norm();
   if (magnitude > u_max) {
     u_dq *= u_max / magnitude;  // keep the direction; hold the integrators (anti-windup)
     out.voltage_limited = true;
   } else {
     integral_V_ = candidate_integral;
-  }
-  if (config_.field_weakening) {
-    // |u| ≈ ω·L_d·|Δi_d| sensitivity: an integrator with ~100 rad/s of loop bandwidth at rated speed.
-    const double k_fw = 100.0 / (base_.omega_el_rad_s * nominal_.l_d_H);
-    i_d_fw_A_ += k_fw * (config_.voltage_margin * u_max - magnitude) * t;
-    i_d_fw_A_ = std::clamp(i_d_fw_A_, -i_max_A_, 0.0);
   }
 
   // The command acts during the next period: rotate at the mid-point of that interval.

@@ -1,6 +1,6 @@
 #pragma once
 // Field-oriented control at the PWM double-update rate (Section II, fig_FOCblockdiagram):
-// speed PI → torque reference → MTPA (eq_refcurrents) with voltage-feedback field weakening →
+// speed PI → torque reference → MTPA (eq_refcurrents) → field weakening on the voltage ellipse →
 // dq current PI with decoupling → inverse Park at the angle of the middle of the interval in which
 // the command will act (ϑ + 1.5·ω·T: one period of computation delay plus half a period of PWM).
 // The controller uses the nominal machine model, not the plant's true parameters.
@@ -16,7 +16,7 @@ struct FocConfig {
   double current_bandwidth_Hz = 400.0;
   double speed_bandwidth_Hz = 5.0;
   double max_current_A = 0.0;     ///< |i| limit; 0: √2 × rated rms current
-  double voltage_margin = 0.95;   ///< field weakening holds |u| at this fraction of u_dc/√3
+  double voltage_margin = 0.95;   ///< field weakening keeps the steady-state |u| below this × u_dc/√3
   bool field_weakening = true;
   bool speed_control = false;     ///< false: torque mode (the scenario commands torque)
   double inertia_kgm2 = 0.01;     ///< for tuning the speed loop
@@ -45,6 +45,10 @@ class FocController {
   void reset() noexcept;
 
  private:
+  /// Field weakening on the nominal model's voltage ellipse, then the current limit.
+  [[nodiscard]] core::Vec2 field_weaken(core::Vec2 i_ref, double torque_Nm, double omega,
+                                        double u_limit) const noexcept;
+
   FocConfig config_;
   core::MachineSi nominal_;
   core::PerUnitBase base_;
@@ -52,7 +56,6 @@ class FocController {
   double i_max_A_;
   core::Vec2 integral_V_ = core::Vec2::Zero();
   double speed_integral_Nm_ = 0.0;
-  double i_d_fw_A_ = 0.0;
   double mtpa_torque_Nm_ = 0.0;                   ///< torque of the cached MTPA references
   core::Vec2 mtpa_i_A_ = core::Vec2::Zero();
 };
