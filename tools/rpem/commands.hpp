@@ -17,5 +17,7 @@ using Runner = std::function<int()>;
 
 Runner add_estimate_command(CLI::App& app);
 Runner add_sim_command(CLI::App& app);
+Runner add_reproduce_command(CLI::App& app);
+Runner add_figures_command(CLI::App& app);
 
 }  // namespace rpem::tools

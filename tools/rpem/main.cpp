@@ -14,6 +14,8 @@ int main(int argc, char** argv) {
   std::vector<Runner> runners;
   runners.push_back(add_estimate_command(app));
   runners.push_back(add_sim_command(app));
+  runners.push_back(add_reproduce_command(app));
+  runners.push_back(add_figures_command(app));
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
