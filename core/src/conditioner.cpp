@@ -18,11 +18,23 @@ bool finite(const DriveSample& s) noexcept {
 
 }  // namespace
 
+SampleConditioner::SampleConditioner(const PerUnitBase& base, const InputCorrections& corrections) noexcept
+    : base_(base),
+      inv_current_A_(1.0 / base.current_A),
+      inv_voltage_V_(1.0 / base.voltage_V),
+      inv_omega_rad_s_(1.0 / base.omega_el_rad_s) {
+  set_corrections(corrections);
+}
+
+void SampleConditioner::set_corrections(const InputCorrections& c) noexcept {
+  corrections_ = c;
+  inv_current_gain_ = (Vec3::Ones() + c.current_gain_error).cwiseInverse();
+}
+
 Vec2 SampleConditioner::current_dq_A(const DriveSample& s, const Rotation& rot) const noexcept {
   switch (s.current_frame) {
     case Frame::kAbc: {
-      const Vec3 corrected =
-          (s.i_A - corrections_.current_offset_A).cwiseQuotient(Vec3::Ones() + corrections_.current_gain_error);
+      const Vec3 corrected = (s.i_A - corrections_.current_offset_A).cwiseProduct(inv_current_gain_);
       return park(clarke(corrected), rot);
     }
     case Frame::kAlphaBeta:
@@ -65,8 +77,8 @@ EstimatorSample SampleConditioner::condition(const DriveSample& s) noexcept {
 
   const Rotation rot = Rotation::of(s.theta_el_rad + corrections_.theta_offset_rad);
   const Vec2 i_dq_A = current_dq_A(s, rot);
-  const double n_pu = base_.speed_pu(s.omega_el_rad_s);
-  out.i_meas_pu = i_dq_A / base_.current_A;
+  const double n_pu = s.omega_el_rad_s * inv_omega_rad_s_;  // base_.speed_pu(), without the division
+  out.i_meas_pu = i_dq_A * inv_current_A_;
 
   // The command issued now, as the machine will see it (dead-time from the current at issue time).
   const Vec2 u_applied_ab_V =
@@ -79,7 +91,7 @@ EstimatorSample SampleConditioner::condition(const DriveSample& s) noexcept {
     iv.n_end_pu = n_pu;
     // Delay extension: the first `delay` of the interval still sees the command before.
     const double w = iv.dt_s > 0.0 ? std::clamp(corrections_.delay_s / iv.dt_s, 0.0, 1.0) : 0.0;
-    const Vec2 u_held_ab_pu = ((1.0 - w) * previous_u_ab_V_ + w * older_u_ab_V_) / base_.voltage_V;
+    const Vec2 u_held_ab_pu = ((1.0 - w) * previous_u_ab_V_ + w * older_u_ab_V_) * inv_voltage_V_;
     iv.u_start_pu = park(u_held_ab_pu, previous_rotation_);
     iv.u_end_pu = park(u_held_ab_pu, rot);
   } else {

@@ -26,7 +26,12 @@ double gna_hessian_sequence(const Schedule& active, const Vec2& gamma_r) noexcep
 
 }  // namespace
 
-RpemEstimator::RpemEstimator(const EstimatorConfig& config) noexcept : config_(config) { reset(); }
+RpemEstimator::RpemEstimator(const EstimatorConfig& config) noexcept
+    : config_(config),
+      coefficients_(PredictorCoefficients::of(config.model, config.omega_n_rad_s)),
+      inverse_nominal_period_(1.0 / config.nominal_sample_period_s) {
+  reset();
+}
 
 void RpemEstimator::reset() noexcept {
   state_.theta_pu = config_.initial_theta_pu;
@@ -45,6 +50,8 @@ void RpemEstimator::set_theta(const Vec2& theta_pu) noexcept {
 
 void RpemEstimator::reconfigure(const EstimatorConfig& config) noexcept {
   config_ = config;
+  coefficients_ = PredictorCoefficients::of(config.model, config.omega_n_rad_s);
+  inverse_nominal_period_ = 1.0 / config.nominal_sample_period_s;
   (void)project(config_.bounds, state_.theta_pu);
 }
 
@@ -90,7 +97,7 @@ EstimatorOutput RpemEstimator::step(const EstimatorSample& sample) noexcept {
   }
 
   const MachinePu model = model_with_estimates();
-  predict(model, config_.omega_n_rad_s, config_.discretization, iv, state_.predictor);
+  predict(model, coefficients_, config_.discretization, iv, state_.predictor);
   const Vec2& i_hat = state_.predictor.i_hat_pu;
   if (!i_hat.allFinite() || i_hat.lpNorm<Eigen::Infinity>() > config_.max_predicted_current_pu ||
       !state_.predictor.gradient.allFinite()) {
@@ -104,7 +111,7 @@ EstimatorOutput RpemEstimator::step(const EstimatorSample& sample) noexcept {
   out.epsilon_pu = sample.i_meas_pu - i_hat;
   out.gradient = select_gradient(iv.n_end_pu);
 
-  const double factor = iv.dt_s / config_.nominal_sample_period_s;
+  const double factor = iv.dt_s * inverse_nominal_period_;
   const GainSequences& seq = config_.gains[static_cast<std::size_t>(config_.algorithm)];
   const Vec2 gamma_r = scaled(seq.hessian, factor);
   const Vec2 gamma_l = scaled(seq.gain, factor);

@@ -3,7 +3,7 @@
 namespace rpem::core {
 namespace {
 
-/// The model's coefficients for one call: ω_n/x_d and ω_n/x_q, computed once (two divisions).
+/// The model's coefficients for one call.
 struct Coefficients {
   double wd;  ///< ω_n/x_d
   double wq;  ///< ω_n/x_q
@@ -27,9 +27,9 @@ struct Coefficients {
 
 }  // namespace
 
-void predict(const MachinePu& model, double omega_n, Discretization method, const PredictorInterval& iv,
-             PredictorState& s) noexcept {
-  const Coefficients c{omega_n / model.x_d_pu, omega_n / model.x_q_pu, model};
+void predict(const MachinePu& model, const PredictorCoefficients& pc, Discretization method,
+             const PredictorInterval& iv, PredictorState& s) noexcept {
+  const Coefficients c{pc.wd, pc.wq, model};
   const double h = iv.dt_s;
   const Mat2 a_start = c.system(iv.n_start_pu);
   const Vec2 i_prev = s.i_hat_pu;

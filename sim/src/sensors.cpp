@@ -11,16 +11,20 @@ Sensors::Sensors(const SensorConfig& config, int pole_pairs, double period_s, st
     : config_(config),
       pole_pairs_(pole_pairs),
       period_s_(period_s),
-      rng_(seed),
+      normal_(seed),
       angle_history_mech_(static_cast<std::size_t>(std::max(2, config.speed_window + 1)), 0.0) {}
 
-double Sensors::quantize(double x, double lsb) noexcept { return lsb > 0.0 ? lsb * std::round(x / lsb) : x; }
+double Sensors::quantize(double x, double lsb) noexcept {
+  if (lsb <= 0.0) return x;
+  const double steps = x / lsb;  // round half away from zero without a libm call
+  return lsb * static_cast<double>(static_cast<long long>(steps + (steps >= 0.0 ? 0.5 : -0.5)));
+}
 
 core::Vec3 Sensors::currents(const core::Vec3& i_abc_A) noexcept {
   core::Vec3 out;
   for (int x = 0; x < 3; ++x) {
     double v = i_abc_A[x] * (1.0 + config_.current_gain_error[x]) + config_.current_offset_A[x];
-    if (config_.current_noise_A > 0.0) v += config_.current_noise_A * normal_(rng_);
+    if (config_.current_noise_A > 0.0) v += config_.current_noise_A * normal_();
     out[x] = quantize(v, config_.current_lsb_A);
   }
   return out;
@@ -30,7 +34,9 @@ double Sensors::angle(double theta_el_true_rad) noexcept {
   double mech = theta_el_true_rad / pole_pairs_;
   if (config_.encoder_counts > 0.0) {
     const double count = 2.0 * core::kPi / config_.encoder_counts;
-    mech = count * std::floor(mech / count);
+    const double counts = mech / count;
+    const auto truncated = static_cast<double>(static_cast<long long>(counts));
+    mech = count * (truncated > counts ? truncated - 1.0 : truncated);  // floor, without a libm call
   }
   head_ = (head_ + 1) % angle_history_mech_.size();
   angle_history_mech_[head_] = mech;
@@ -48,7 +54,7 @@ double Sensors::speed() const noexcept {
 
 double Sensors::dc_link(double u_dc_V) noexcept {
   double v = u_dc_V;
-  if (config_.u_dc_noise_V > 0.0) v += config_.u_dc_noise_V * normal_(rng_);
+  if (config_.u_dc_noise_V > 0.0) v += config_.u_dc_noise_V * normal_();
   return quantize(v, config_.u_dc_lsb_V);
 }
 

@@ -99,7 +99,7 @@ INSTANTIATE_TEST_SUITE_P(
         BadEdit{"initial_outside_bounds", "initial: \\{psi_m_Wb: 1.14", "initial: {psi_m_Wb: 2.0", "estimator.initial.psi_m_Wb: 2.0 is outside [0.57, 1.71]"},
         BadEdit{"scheduler_order", "r_s_max_speed_rpm: 10 ", "r_s_max_speed_rpm: 200 ", "must not exceed psi_m_min_speed_rpm"},
         BadEdit{"indefinite_hessian", "gna_pu: \\[1.0, 0.0, 1.0\\]", "gna_pu: [1.0, 2.0, 1.0]", "positive semi-definite"},
-        BadEdit{"wrong_length", "sga_pu: \\[1.0, 1.0\\]", "sga_pu: [1.0]", "expected 2 numbers, got 1"},
+        BadEdit{"wrong_length", "sga_pu: \\[100.0, 100.0\\]", "sga_pu: [1.0]", "expected 2 numbers, got 1"},
         BadEdit{"bool", "psi_m: true", "psi_m: yes please", "expected true or false"},
         BadEdit{"syntax", "machine:", "machine: [", "YAML syntax"},
         BadEdit{"ext_unknown", "\nestimator:", "\nmodel_extensions:\n  deadtime: {t_dead_s: 1.0e-6, switching_frequency_Hz: 4000, colour: red}\nestimator:",

@@ -29,8 +29,7 @@ struct InputCorrections {
 
 class SampleConditioner {
  public:
-  SampleConditioner(const PerUnitBase& base, const InputCorrections& corrections) noexcept
-      : base_(base), corrections_(corrections) {}
+  SampleConditioner(const PerUnitBase& base, const InputCorrections& corrections) noexcept;
 
   /// Converts one sample. A non-finite input yields a non-finite sample (rejected by the estimator)
   /// and restarts the interval chain. Real-time safe.
@@ -39,7 +38,7 @@ class SampleConditioner {
   /// Forgets the previous sample: the next one starts a new interval chain (resynchronises).
   void reset() noexcept { has_previous_ = false; }
 
-  void set_corrections(const InputCorrections& c) noexcept { corrections_ = c; }
+  void set_corrections(const InputCorrections& c) noexcept;
   [[nodiscard]] const InputCorrections& corrections() const noexcept { return corrections_; }
   [[nodiscard]] const PerUnitBase& base() const noexcept { return base_; }
 
@@ -53,6 +52,9 @@ class SampleConditioner {
 
   PerUnitBase base_;
   InputCorrections corrections_;
+  // Reciprocals, so the per-sample path multiplies instead of dividing.
+  double inv_current_A_ = 0.0, inv_voltage_V_ = 0.0, inv_omega_rad_s_ = 0.0;
+  Vec3 inv_current_gain_ = Vec3::Ones();  ///< 1/(1 + gain error) per phase
   bool has_previous_ = false;
   std::int64_t previous_t_ns_ = 0;
   Rotation previous_rotation_;

@@ -116,6 +116,8 @@ class RpemEstimator {
 
   EstimatorConfig config_;
   EstimatorState state_;
+  PredictorCoefficients coefficients_;   ///< from config_.model; refreshed by reconfigure()
+  double inverse_nominal_period_ = 0.0;  ///< 1/T_samp
 };
 
 }  // namespace rpem::core

@@ -39,10 +39,26 @@ struct PredictorState {
   Mat2 gradient = Mat2::Zero();
 };
 
+/// ω_n/x_d and ω_n/x_q: they change only with the model inductances, so callers that step often
+/// compute them once.
+struct PredictorCoefficients {
+  double wd = 0.0;  ///< ω_n/x_d [1/s]
+  double wq = 0.0;  ///< ω_n/x_q [1/s]
+  [[nodiscard]] static PredictorCoefficients of(const MachinePu& m, double omega_n_rad_s) noexcept {
+    return {omega_n_rad_s / m.x_d_pu, omega_n_rad_s / m.x_q_pu};
+  }
+};
+
 /// Advances the predictor and its dynamic gradients by one interval. `model` carries the current
-/// estimates ψ̂m, r̂s and the model inductances x_d, x_q.
-void predict(const MachinePu& model, double omega_n_rad_s, Discretization method, const PredictorInterval& interval,
-             PredictorState& state) noexcept;
+/// estimates ψ̂m, r̂s and the model inductances x_d, x_q; `c` must be PredictorCoefficients::of(model).
+void predict(const MachinePu& model, const PredictorCoefficients& c, Discretization method,
+             const PredictorInterval& interval, PredictorState& state) noexcept;
+
+/// The same, computing the coefficients on the way.
+inline void predict(const MachinePu& model, double omega_n_rad_s, Discretization method,
+                    const PredictorInterval& interval, PredictorState& state) noexcept {
+  predict(model, PredictorCoefficients::of(model, omega_n_rad_s), method, interval, state);
+}
 
 /// One-step transition matrix of the discrete predictor at constant speed (for stability analysis).
 [[nodiscard]] Mat2 transition_matrix(const MachinePu& model, double omega_n_rad_s, Discretization method, double dt_s,

@@ -4,10 +4,10 @@
 // DC-link voltage (noise, quantisation). The sensor errors are the effects rpem diagnose must find.
 
 #include <cstdint>
-#include <random>
 #include <vector>
 
 #include "rpem/core/types.hpp"
+#include "rpem/sim/gaussian.hpp"
 
 namespace rpem::sim {
 
@@ -40,8 +40,7 @@ class Sensors {
   SensorConfig config_;
   int pole_pairs_;
   double period_s_;
-  std::mt19937_64 rng_;
-  std::normal_distribution<double> normal_{0.0, 1.0};
+  GaussianNoise normal_;
   std::vector<double> angle_history_mech_;  ///< unwrapped measured mechanical angles, ring buffer
   std::size_t head_ = 0;
   std::size_t count_ = 0;

@@ -1,0 +1,50 @@
+#!/usr/bin/env python3
+"""Formats Google Benchmark JSON files as Markdown tables (median and max of the repetitions)."""
+import json
+import sys
+
+ALGORITHMS = {"0": "SGA", "1": "GNA", "2": "PhyInt"}
+
+
+def label(name):
+    parts = dict(p.split(":") for p in name.split("/")[1:] if ":" in p)
+    if name.startswith("BM_EstimatorStep"):
+        grad = "dynamic" if parts.get("dynamic_gradient") == "1" else "steady-state"
+        return f"estimator step, {ALGORITHMS[parts['algorithm']]}, {grad} gradients"
+    if name.startswith("BM_SimulateOneSecond"):
+        fidelity = "averaged" if parts.get("averaged") == "1" else "switching (1 µs plant)"
+        est = "with estimator" if parts.get("estimator") == "1" else "without estimator"
+        return f"simulator, {fidelity}, {est}"
+    return name
+
+
+def main(paths):
+    context = None
+    rows = {}
+    for path in paths:
+        with open(path) as f:
+            data = json.load(f)
+        context = data["context"]
+        for b in data["benchmarks"]:
+            if b.get("run_type") != "aggregate":
+                continue
+            base = b["run_name"]
+            agg = b["aggregate_name"]
+            rows.setdefault(base, {})[agg] = b
+    print(f"Run: {context['date']}, {context['num_cpus']} CPUs at {context['mhz_per_cpu']} MHz, "
+          f"rpem built Release (-O3)\n")
+    print("| benchmark | median | max | unit / counter |")
+    print("|---|---|---|---|")
+    for base, aggs in rows.items():
+        med = aggs.get("median")
+        mx = aggs.get("max")
+        if "x_real_time" in med:
+            print(f"| {label(base)} | {med['x_real_time']:.0f}× real time | "
+                  f"{aggs['min']['x_real_time'] if 'min' in aggs else med['x_real_time']:.0f}× (slowest) | wall {med['real_time']:.1f} ms per simulated s |")
+        else:
+            worst = mx["real_time"] if mx else float("nan")
+            print(f"| {label(base)} | {med['real_time']:.1f} ns | {worst:.1f} ns | ns per step (max of {med['repetitions']} repetition means) |")
+
+
+if __name__ == "__main__":
+    main(sys.argv[1:])
