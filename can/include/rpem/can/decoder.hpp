@@ -1,0 +1,76 @@
+#pragma once
+// Telemetry frames → drive samples (the receiver's side; used by rpemd and `rpem record`). Pure: no
+// I/O, no allocation, no exceptions. Every frame or sample that cannot be trusted is dropped and
+// counted by kind; the next sample that passes carries gap_before so the estimator resynchronises.
+
+#include <cstdint>
+#include <span>
+
+#include "rpem/can/frame.hpp"
+#include "rpem/core/drive_sample.hpp"
+
+namespace rpem::can {
+
+/// Counters by kind of bad input (published in diagnostics; numbers only ever grow).
+struct DecoderCounters {
+  std::uint64_t frames = 0;           ///< frames offered to the decoder
+  std::uint64_t samples = 0;          ///< samples delivered
+  std::uint64_t unknown_id = 0;       ///< not a telemetry ID
+  std::uint64_t wrong_dlc = 0;        ///< wrong length or FD/classic type for the ID, or bad n_samples
+  std::uint64_t bad_version = 0;      ///< protocol version other than 1
+  std::uint64_t crc_error = 0;        ///< E2E CRC mismatch
+  std::uint64_t frames_lost = 0;      ///< alive-counter jumps: frames (FD) or samples (classic) missing
+  std::uint64_t duplicated = 0;       ///< same counter as the previous frame
+  std::uint64_t reordered = 0;        ///< counter behind the previous one
+  std::uint64_t stale = 0;            ///< drive time not after the last delivered sample
+  std::uint64_t out_of_range = 0;     ///< a saturated value
+  std::uint64_t invalid_value = 0;    ///< a "no valid value" code, or an invalid angle
+  std::uint64_t incomplete = 0;       ///< classic: a sample missing some of its five frames
+  std::uint64_t gaps = 0;             ///< samples delivered with gap_before
+};
+
+class TelemetryDecoder {
+ public:
+  /// Decodes one frame into up to three samples (SI, phase frames). Returns how many.
+  [[nodiscard]] std::size_t decode(const CanFrame& frame, std::span<core::DriveSample> out) noexcept;
+
+  /// Forgets the stream state (counters are kept): the next frame starts a new stream with a gap.
+  void resynchronize() noexcept;
+
+  [[nodiscard]] const DecoderCounters& counters() const noexcept { return counters_; }
+
+ private:
+  enum class Sequence { kNext, kFirst, kLost, kDuplicate, kReordered };
+  [[nodiscard]] Sequence check_sequence(std::uint8_t counter, bool& has_last, std::uint8_t& last) noexcept;
+  [[nodiscard]] std::size_t decode_fd(const CanFrame& f, std::span<core::DriveSample> out) noexcept;
+  [[nodiscard]] std::size_t decode_classic(const CanFrame& f, std::span<core::DriveSample> out) noexcept;
+  [[nodiscard]] std::int64_t unwrap_us(std::uint32_t t_us, int bits) noexcept;
+  /// Accepts a sample at time t: rejects it as stale, else marks a pending gap. True if accepted.
+  [[nodiscard]] bool accept(core::DriveSample& s) noexcept;
+
+  DecoderCounters counters_;
+  bool gap_pending_ = true;
+  bool has_last_fd_counter_ = false;
+  std::uint8_t last_fd_counter_ = 0;
+  bool has_last_classic_counter_ = false;
+  std::uint8_t last_classic_counter_ = 0;
+  bool has_time_ = false;
+  std::int64_t last_time_us_ = 0;   ///< unwrapped drive time of the last delivered sample
+  bool has_epoch_ = false;
+  std::int64_t epoch_us_ = 0;       ///< unwrapping state
+  std::uint32_t last_raw_us_ = 0;
+
+  // Classic assembly of one sample from five frames.
+  std::uint8_t classic_counter_ = 0;
+  std::uint8_t classic_mask_ = 0;
+  bool classic_bad_ = false;
+  std::array<std::int16_t, 3> classic_i_{};
+  std::array<std::int16_t, 3> classic_u_{};
+  std::uint16_t classic_theta_ = 0;
+  std::int16_t classic_omega_ = 0;
+  std::uint16_t classic_udc_ = 0;
+  std::uint32_t classic_t_ = 0;
+  std::uint8_t classic_status_ = 0;
+};
+
+}  // namespace rpem::can

@@ -1,0 +1,85 @@
+#pragma once
+// SocketCAN transport: a raw CAN socket with CAN FD enabled, kernel ID and error filters, kernel
+// receive timestamps, the kernel's dropped-frame counter (SO_RXQ_OVFL), error frames decoded into
+// counters, non-blocking reads with poll(2), and automatic reopening when the interface goes down and
+// up (or disappears and returns). Not real-time code: it runs on the receive thread.
+
+#include <cstdint>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "rpem/can/frame.hpp"
+
+namespace rpem::can {
+
+struct ReceivedFrame {
+  CanFrame frame;
+  std::int64_t kernel_rx_ns = 0;  ///< kernel receive timestamp (CLOCK_REALTIME), 0 if unavailable
+};
+
+struct ChannelCounters {
+  std::uint64_t rx_frames = 0;
+  std::uint64_t tx_frames = 0;
+  std::uint64_t tx_dropped = 0;        ///< send queue full or interface down
+  std::uint64_t kernel_drops = 0;      ///< SO_RXQ_OVFL: frames the kernel dropped for this socket
+  std::uint64_t reopens = 0;           ///< successful reopen after a failure
+  std::uint64_t open_failures = 0;
+  std::uint64_t error_frames = 0;
+  std::uint64_t bus_off = 0;
+  std::uint64_t error_passive = 0;     ///< controller reported rx or tx error-passive
+  std::uint64_t error_warning = 0;
+  std::uint64_t controller_overflow = 0;
+  std::uint64_t protocol_violations = 0;
+  std::uint64_t restarted = 0;         ///< controller restarted after bus-off
+  std::uint64_t no_ack = 0;
+};
+
+class SocketCanChannel {
+ public:
+  struct Options {
+    std::string interface;
+    bool fd = true;                      ///< enable CAN FD frames
+    std::vector<std::uint32_t> ids;      ///< kernel filter: accept these IDs only (empty: all)
+    bool receive_errors = true;          ///< subscribe to error frames
+    int receive_buffer_bytes = 1 << 20;  ///< SO_RCVBUFFORCE, falling back to SO_RCVBUF
+    int reopen_interval_ms = 100;
+  };
+
+  explicit SocketCanChannel(Options options);
+  ~SocketCanChannel();
+  SocketCanChannel(const SocketCanChannel&) = delete;
+  SocketCanChannel& operator=(const SocketCanChannel&) = delete;
+
+  /// Waits up to timeout_ms for frames and reads what is available (up to out.size()). Error frames
+  /// are counted and also returned (frame.error). Returns 0 on timeout or while the interface is down
+  /// (reopening in the background of these calls).
+  [[nodiscard]] std::size_t receive(std::span<ReceivedFrame> out, int timeout_ms);
+
+  /// Sends one frame; waits up to timeout_ms for room in the queue. False if dropped.
+  bool send(const CanFrame& frame, int timeout_ms = 10);
+
+  [[nodiscard]] bool is_open() const noexcept { return fd_ >= 0; }
+  [[nodiscard]] const ChannelCounters& counters() const noexcept { return counters_; }
+  [[nodiscard]] const std::string& last_error() const noexcept { return last_error_; }
+  /// The socket, for callers that multiplex; −1 while closed.
+  [[nodiscard]] int native_handle() const noexcept { return fd_; }
+
+ private:
+  bool open();
+  void close_socket(const std::string& why);
+  void count_error_frame(const CanFrame& f);
+
+  Options options_;
+  int fd_ = -1;
+  bool was_open_ = false;
+  std::int64_t next_open_attempt_ns_ = 0;
+  std::uint32_t last_overflow_ = 0;
+  ChannelCounters counters_;
+  std::string last_error_;
+};
+
+/// Throws std::runtime_error with the reason if the interface cannot be opened now (start-up check).
+void require_interface(const std::string& interface);
+
+}  // namespace rpem::can
