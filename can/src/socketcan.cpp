@@ -50,7 +50,9 @@ bool SocketCanChannel::open() {
   }
   const int on = 1;
   if (options_.fd) (void)setsockopt(fd, SOL_CAN_RAW, CAN_RAW_FD_FRAMES, &on, sizeof on);
-  if (!options_.ids.empty()) {
+  if (!options_.receive) {
+    (void)setsockopt(fd, SOL_CAN_RAW, CAN_RAW_FILTER, nullptr, 0);
+  } else if (!options_.ids.empty()) {
     std::vector<can_filter> filters;
     for (std::uint32_t id : options_.ids) filters.push_back({id, CAN_SFF_MASK | CAN_EFF_FLAG | CAN_RTR_FLAG});
     (void)setsockopt(fd, SOL_CAN_RAW, CAN_RAW_FILTER, filters.data(),

@@ -19,5 +19,7 @@ Runner add_estimate_command(CLI::App& app);
 Runner add_sim_command(CLI::App& app);
 Runner add_reproduce_command(CLI::App& app);
 Runner add_figures_command(CLI::App& app);
+Runner add_replay_command(CLI::App& app);
+Runner add_record_command(CLI::App& app);
 
 }  // namespace rpem::tools

@@ -7,7 +7,9 @@
 #include <optional>
 #include <string>
 
+#include "can_stream.hpp"
 #include "commands.hpp"
+#include "rpem/can/protocol.hpp"
 #include "progress.hpp"
 #include "rpem/core/drive_estimator.hpp"
 #include "rpem/io/estimate_log.hpp"
@@ -22,11 +24,19 @@ struct SimOptions {
   std::string out;
   std::string truth;
   std::string estimate;
+  StreamOptions stream;
 };
 
 int run_sim(const SimOptions& o) {
   sim::DriveSimulator simulator(sim::load_scenario(o.scenario));
-  io::DriveLogWriter log(o.out, simulator.layout());
+  std::optional<io::DriveLogWriter> log;
+  if (!o.out.empty()) log.emplace(o.out, simulator.layout());
+  std::optional<TelemetryStreamer> streamer;
+  if (!o.stream.interface.empty() || !o.stream.candump_out.empty()) streamer.emplace(o.stream);
+  if (!log && !streamer) {
+    std::fprintf(stderr, "rpem sim: give --out LOG.csv, --can IFACE or --candump FILE\n");
+    return kExitUsage;
+  }
   std::optional<sim::TruthLogWriter> truth;
   if (!o.truth.empty()) truth.emplace(o.truth);
   std::optional<io::EstimateLogWriter> est_log;
@@ -36,21 +46,25 @@ int run_sim(const SimOptions& o) {
     const auto& cfg = simulator.scenario().machine;
     estimator = std::make_unique<core::DriveEstimator>(cfg.machine, cfg.estimator);
   }
+  if (streamer && o.stream.rate > 0) std::fprintf(stderr, "rpem sim: streaming '%s' on %s at %.3g× real time\n", simulator.scenario().name.c_str(), o.stream.interface.empty() ? o.stream.candump_out.c_str() : o.stream.interface.c_str(), o.stream.rate);
   Progress progress("rpem sim");
   io::DriveLogRow row;
   sim::TruthRow truth_row;
   std::uint64_t n = 0;
   const auto total = static_cast<std::uint64_t>(simulator.samples_total());
   while (simulator.next(row, truth_row)) {
-    log.write(row);
+    if (log) log->write(row);
+    if (streamer) streamer->send(row.sample, can::protocol::status::kPwmEnabled | can::protocol::status::kSimulated);
     if (truth) truth->write(truth_row);
     if (estimator) est_log->write(estimator->step(row.sample), *estimator);
     if ((++n & 0x3FF) == 0) progress.update(n, total);
   }
-  char summary[160];
-  std::snprintf(summary, sizeof summary, "%llu samples of '%s' written to %s", static_cast<unsigned long long>(n),
-                simulator.scenario().name.c_str(), o.out.c_str());
+  if (streamer) streamer->finish();
+  std::string summary = std::to_string(n) + " samples of '" + simulator.scenario().name + "'";
+  if (log) summary += " written to " + o.out;
+  if (streamer) summary += ", streamed as " + std::to_string(streamer->frames_sent()) + " frames";
   progress.finish(summary);
+  if (streamer && !streamer->lateness_summary().empty()) std::fprintf(stderr, "rpem sim: %s\n", streamer->lateness_summary().c_str());
   return kExitOk;
 }
 
@@ -60,9 +74,11 @@ Runner add_sim_command(CLI::App& app) {
   auto opts = std::make_shared<SimOptions>();
   CLI::App* cmd = app.add_subcommand("sim", "Simulate the drive of a scenario and write its drive log");
   cmd->add_option("--scenario", opts->scenario, "scenario YAML (docs/scenarios.md)")->required()->check(CLI::ExistingFile);
-  cmd->add_option("--out", opts->out, "drive-log CSV to write")->required();
+  cmd->add_option("--out", opts->out, "drive-log CSV to write");
   cmd->add_option("--truth", opts->truth, "also write the true parameters and state (CSV)");
   cmd->add_option("--estimate", opts->estimate, "also run the estimator in the loop and write its CSV");
+  cmd->add_option("--can", opts->stream.interface, "stream the drive's telemetry on this SocketCAN interface, in real time");
+  add_stream_options(cmd, opts->stream);
   return [cmd, opts]() { return cmd->parsed() ? run_sim(*opts) : -1; };
 }
 

@@ -40,6 +40,7 @@ class SocketCanChannel {
   struct Options {
     std::string interface;
     bool fd = true;                      ///< enable CAN FD frames
+    bool receive = true;                 ///< false: a send-only socket (empty kernel filter)
     std::vector<std::uint32_t> ids;      ///< kernel filter: accept these IDs only (empty: all)
     bool receive_errors = true;          ///< subscribe to error frames
     int receive_buffer_bytes = 1 << 20;  ///< SO_RCVBUFFORCE, falling back to SO_RCVBUF

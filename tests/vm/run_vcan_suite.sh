@@ -1,0 +1,41 @@
+#!/usr/bin/env bash
+# ctest entry of the `vcan` label: runs tests/vm/vcan_suite.sh natively where the host kernel has vcan,
+# otherwise inside the PREEMPT_RT VM (tests/vm/vm_rig.sh), then checks its outputs on the host:
+# recorded = sent within the resolution, the candump capture decodes with the DBC, canplayer's replay
+# and the classic mapping round-trip too.
+#   run_vcan_suite.sh BUILD_DIR
+set -euo pipefail
+build=$(cd "$1" && pwd)
+here=$(cd "$(dirname "$0")" && pwd)
+repo=$(cd "$here/../.." && pwd)
+out=$(mktemp -d)
+trap 'rm -rf "$out"' EXIT
+cp "$repo/scenarios/can-stream.yaml" "$out/"
+
+host_has_vcan() {
+  [[ $(id -u) -eq 0 ]] && ip link add dev rpemprobe0 type vcan 2>/dev/null && ip link del rpemprobe0
+}
+
+if host_has_vcan && ip link show vcan0 >/dev/null 2>&1; then
+  echo "run_vcan_suite: native vcan0"
+  (cd "$out" && PATH="$build/tools:$build/tests/can:$PATH" sh "$here/vcan_suite.sh" "$out")
+else
+  echo "run_vcan_suite: no vcan on this host; running in the PREEMPT_RT VM"
+  "$here/vm_rig.sh" run --timeout 900 --share "$out" \
+    --file "$build/tools/rpem" --file "$build/tests/can/test_socketcan" \
+    --file "$here/vcan_suite.sh" --file "$repo/scenarios/can-stream.yaml" \
+    -- 'sh /work/vcan_suite.sh /host'
+fi
+
+echo "run_vcan_suite: checking the outputs on the host"
+python3 "$repo/tests/can/compare_logs.py" "$out/sent.csv" "$out/recorded.csv" --fd-udc
+python3 "$repo/tests/can/dbc_decode.py" "$repo/can/rpem_telemetry.dbc" "$out/capture.log" "$out/sent.csv"
+python3 "$repo/tests/can/compare_logs.py" "$out/sent.csv" "$out/replayed.csv" --fd-udc
+python3 "$repo/tests/can/compare_logs.py" "$out/classic_sent.csv" "$out/classic_recorded.csv"
+for f in record.txt record2.txt record3.txt; do
+  if ! grep -q "gaps 1, lost 0, duplicated 0, reordered 0, crc 0" "$out/$f"; then
+    echo "run_vcan_suite: $f reports losses:"; cat "$out/$f"; exit 1
+  fi
+  grep -q "kernel drops 0," "$out/$f" || { echo "run_vcan_suite: kernel drops in $f"; cat "$out/$f"; exit 1; }
+done
+echo "run_vcan_suite: passed"

@@ -1,0 +1,42 @@
+#!/bin/sh
+# The vcan suite, run where vcan0 exists (inside the VM, or natively). Writes its results into $1.
+#   1. SocketCAN unit tests on vcan0 (test_socketcan)
+#   2. sim → vcan0 → record: the simulated drive streamed in real time and recorded back
+#   3. the same traffic captured with candump -L (checked against the DBC on the host)
+#   4. canplayer replays that capture into rpem record
+#   5. classic-CAN mapping through vcan0
+out=${1:-/host}
+fail=0
+step() { echo "vcan_suite: $*"; }
+
+step "SocketCAN tests"
+test_socketcan --gtest_color=no || fail=1
+
+step "sim -> vcan0 -> record (CAN FD), captured by candump"
+candump -L vcan0,100:7FF > "$out/capture.log" &
+dump=$!
+rpem record --can vcan0 --out "$out/recorded.csv" --idle-timeout 1.5 > "$out/record.txt" 2>&1 &
+rec=$!
+sleep 0.5
+rpem sim --scenario can-stream.yaml --can vcan0 --out "$out/sent.csv" 2> "$out/sim.txt" || fail=1
+wait $rec || fail=1
+kill $dump; wait $dump 2>/dev/null
+cat "$out/record.txt"
+
+step "canplayer -> record"
+rpem record --can vcan0 --out "$out/replayed.csv" --idle-timeout 1.5 > "$out/record2.txt" 2>&1 &
+rec=$!
+sleep 0.5
+canplayer -I "$out/capture.log" vcan0=vcan0 || fail=1
+wait $rec || fail=1
+cat "$out/record2.txt"
+
+step "replay -> record (classic CAN)"
+rpem record --can vcan0 --out "$out/classic_recorded.csv" --idle-timeout 1.5 > "$out/record3.txt" 2>&1 &
+rec=$!
+sleep 0.5
+head -n 2001 "$out/sent.csv" > "$out/classic_sent.csv"
+rpem replay "$out/classic_sent.csv" --can vcan0 --classic --rate 4 || fail=1
+wait $rec || fail=1
+cat "$out/record3.txt"
+exit $fail
