@@ -29,11 +29,16 @@ void add_stream_options(CLI::App* cmd, StreamOptions& o) {
   cmd->add_option("--samples-per-frame", o.samples_per_frame, "samples per CAN FD frame")->check(CLI::Range(1, 3));
   cmd->add_flag("--wall-timestamps", o.wall_timestamps, "stamp samples with their scheduled wall-clock time (latency tests)");
   cmd->add_option("--candump", o.candump_out, "also write the frames as a candump -L log");
+  cmd->add_option("--drop-probability", o.drop_probability, "test aid: drop this fraction of losses at random")
+      ->check(CLI::Range(0.0, 1.0));
+  cmd->add_option("--drop-burst", o.drop_burst, "test aid: frames lost per loss event")->check(CLI::Range(1, 1000));
+  cmd->add_option("--drop-seed", o.drop_seed, "test aid: seed of the loss pattern");
 }
 
 TelemetryStreamer::TelemetryStreamer(const StreamOptions& options)
     : options_(options),
-      encoder_(options.classic ? can::BusMode::kClassic : can::BusMode::kFd, options.samples_per_frame) {
+      encoder_(options.classic ? can::BusMode::kClassic : can::BusMode::kFd, options.samples_per_frame),
+      rng_state_(options.drop_seed * 0x9E3779B97F4A7C15ULL + 1) {
   if (!options_.interface.empty()) {
     can::require_interface(options_.interface);
     can::SocketCanChannel::Options o;
@@ -56,6 +61,19 @@ const can::ChannelCounters* TelemetryStreamer::channel_counters() const {
 }
 
 void TelemetryStreamer::emit(const can::CanFrame& f) {
+  if (options_.drop_probability > 0.0) {
+    // xorshift64*: a loss starts with the given probability per frame and lasts drop_burst frames.
+    rng_state_ ^= rng_state_ >> 12;
+    rng_state_ ^= rng_state_ << 25;
+    rng_state_ ^= rng_state_ >> 27;
+    const double u = static_cast<double>((rng_state_ * 0x2545F4914F6CDD1DULL) >> 11) * 0x1.0p-53;
+    if (burst_left_ == 0 && u < options_.drop_probability / options_.drop_burst) burst_left_ = options_.drop_burst;
+    if (burst_left_ > 0) {
+      --burst_left_;
+      ++dropped_;
+      return;
+    }
+  }
   ++frames_;
   if (channel_) (void)channel_->send(f, 50);
   if (candump_.is_open()) {

@@ -21,6 +21,9 @@ struct StreamOptions {
   bool classic = false;        ///< classic CAN mapping (five frames per sample)
   int samples_per_frame = 3;   ///< CAN FD
   bool wall_timestamps = false;  ///< stamp samples with their scheduled CLOCK_REALTIME time (latency tests)
+  double drop_probability = 0.0;  ///< test aid: drop frames at random with this probability…
+  int drop_burst = 1;             ///< …each loss taking this many consecutive frames
+  std::uint64_t drop_seed = 1;
 };
 
 /// The options shared by every streaming subcommand (--rate, --classic, --samples-per-frame, …).
@@ -37,6 +40,7 @@ class TelemetryStreamer {
   void finish();
 
   [[nodiscard]] std::uint64_t frames_sent() const noexcept { return frames_; }
+  [[nodiscard]] std::uint64_t frames_dropped() const noexcept { return dropped_; }
   /// How far behind schedule the frames left (percentiles), for latency measurements.
   [[nodiscard]] std::string lateness_summary() const;
   [[nodiscard]] const can::ChannelCounters* channel_counters() const;
@@ -54,6 +58,9 @@ class TelemetryStreamer {
   std::int64_t start_real_ns_ = 0;
   std::int64_t last_real_ns_ = 0;
   std::uint64_t frames_ = 0;
+  std::uint64_t dropped_ = 0;
+  int burst_left_ = 0;
+  std::uint64_t rng_state_;
   std::vector<double> lateness_us_;
 };
 

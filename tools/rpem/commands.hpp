@@ -21,5 +21,7 @@ Runner add_reproduce_command(CLI::App& app);
 Runner add_figures_command(CLI::App& app);
 Runner add_replay_command(CLI::App& app);
 Runner add_record_command(CLI::App& app);
+Runner add_listen_command(CLI::App& app);
+Runner add_command_command(CLI::App& app);
 
 }  // namespace rpem::tools

@@ -18,6 +18,8 @@ int main(int argc, char** argv) {
   runners.push_back(add_figures_command(app));
   runners.push_back(add_replay_command(app));
   runners.push_back(add_record_command(app));
+  runners.push_back(add_listen_command(app));
+  runners.push_back(add_command_command(app));
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

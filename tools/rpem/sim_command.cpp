@@ -62,7 +62,10 @@ int run_sim(const SimOptions& o) {
   if (streamer) streamer->finish();
   std::string summary = std::to_string(n) + " samples of '" + simulator.scenario().name + "'";
   if (log) summary += " written to " + o.out;
-  if (streamer) summary += ", streamed as " + std::to_string(streamer->frames_sent()) + " frames";
+  if (streamer) {
+    summary += ", streamed as " + std::to_string(streamer->frames_sent()) + " frames";
+    if (streamer->frames_dropped() > 0) summary += " (" + std::to_string(streamer->frames_dropped()) + " dropped on purpose)";
+  }
   progress.finish(summary);
   if (streamer && !streamer->lateness_summary().empty()) std::fprintf(stderr, "rpem sim: %s\n", streamer->lateness_summary().c_str());
   return kExitOk;

@@ -1,0 +1,73 @@
+#pragma once
+// rpemd's configuration (docs/rpemd.md, examples in config/): an optional `daemon` section beside the
+// machine configuration sections (`machine`, `estimator`, `model_extensions`) — so a machine file such
+// as `rpem diagnose`'s extended.yaml is also a complete rpemd configuration — or
+// `daemon.machine_config` pointing at one. Strict: unknown keys and out-of-range values are errors
+// (ConfigError; rpemd exits 78).
+
+#include <cstdint>
+#include <string>
+
+#include "rpem/daemon/realtime.hpp"
+#include "rpem/io/machine_config.hpp"
+
+namespace rpem::daemon {
+
+enum class SourceType { kSim, kCan };
+enum class RealtimeMode { kRequired, kPreferred, kOff };
+
+struct TemperatureModel {
+  double reference_C = 20.0;
+  double r_s_ref_Ohm = 0.0;    ///< r_s at reference_C (default: the machine's offline r_s)
+  double psi_m_ref_Wb = 0.0;   ///< ψm at reference_C (default: the machine's offline ψm)
+  double r_s_coeff_per_K = 0.00393;
+  double psi_m_coeff_per_K = -0.0012;
+};
+
+struct ValidityConfig {
+  double r_s_after_s = 2.0;          ///< r_s valid after this much standstill adaptation (then held)
+  double psi_m_after_s = 1.0;        ///< ψm valid after this much adaptation, while above the speed limit
+  double convergence_window_s = 2.0;
+  double convergence_band = 0.002;   ///< relative spread over the window
+};
+
+struct DaemonConfig {
+  std::string source_file;  ///< where it was loaded from ("<built-in>")
+  io::MachineConfig machine;
+
+  SourceType source = SourceType::kSim;
+  std::string can_interface = "can0";
+  std::string sim_scenario = "builtin:rpemd-demo";
+  bool sim_loop = true;
+
+  double loop_period_s = 125e-6;
+  RealtimeMode realtime = RealtimeMode::kPreferred;
+  bool lock_memory = true;
+  ThreadPolicy loop_thread{true, 80, -1};
+  ThreadPolicy receive_thread{true, 70, -1};
+  ThreadPolicy publish_thread{false, 0, -1};
+  double stale_timeout_s = 0.1;
+
+  std::string lcm_url;  ///< empty: LCM's default (udpm://239.255.76.67:7667?ttl=0)
+  std::string channel_prefix;
+  double estimate_rate_Hz = 10.0;
+  double measurement_rate_Hz = 100.0;
+  double diagnostics_rate_Hz = 1.0;
+  bool commands_enabled = false;
+
+  TemperatureModel temperature;
+  ValidityConfig validity;
+
+  std::string state_file;  ///< empty: $STATE_DIRECTORY/estimates.json, else $XDG_STATE_HOME or ~/.local/state/rpemd/
+  double state_write_interval_s = 5.0;
+  double state_max_age_s = 3600.0;
+  double status_interval_s = 1.0;  ///< a status line on stdout; 0: none
+};
+
+[[nodiscard]] DaemonConfig load_daemon_config(const std::string& path);
+[[nodiscard]] DaemonConfig builtin_daemon_config();
+/// The state file path after defaults.
+[[nodiscard]] std::string resolve_state_file(const DaemonConfig& c);
+[[nodiscard]] const std::string& builtin_demo_scenario_text();
+
+}  // namespace rpem::daemon

@@ -1,0 +1,23 @@
+#pragma once
+// Real-time set-up of a thread (call from the thread itself, at start-up): scheduling policy and
+// priority, CPU affinity, a prefaulted stack; and mlockall for the process. Each returns an empty
+// string on success or the reason it failed (the caller decides whether that is fatal).
+
+#include <string>
+
+namespace rpem::daemon {
+
+struct ThreadPolicy {
+  bool fifo = false;  ///< SCHED_FIFO, else SCHED_OTHER
+  int priority = 0;   ///< 1–99 for SCHED_FIFO
+  int cpu = -1;       ///< pin to this CPU; −1: no pinning
+};
+
+[[nodiscard]] std::string apply_thread_policy(const ThreadPolicy& policy);
+[[nodiscard]] std::string lock_memory();
+/// Touches `bytes` of stack so later use does not page-fault.
+void prefault_stack(std::size_t bytes);
+/// Names the calling thread (top, ps -L).
+void name_thread(const char* name);
+
+}  // namespace rpem::daemon

@@ -1,0 +1,34 @@
+#pragma once
+// Persistence of the last converged estimates (docs/rpemd.md): JSON, written atomically — a temporary
+// file in the same directory, fsync, rename, fsync of the directory — so a crash leaves the old or the
+// new file, never a torn one. Not real-time: the publisher thread writes, start-up reads.
+
+#include <cstdint>
+#include <optional>
+#include <string>
+
+namespace rpem::daemon {
+
+struct PersistedEstimates {
+  std::optional<double> psi_m_Wb;  ///< present if ψm had converged
+  std::optional<double> r_s_Ohm;   ///< present if r_s had converged
+  std::int64_t written_unix_s = 0;
+};
+
+/// Writes atomically; returns an empty string or the reason it failed.
+[[nodiscard]] std::string write_state_file(const std::string& path, const PersistedEstimates& e);
+
+enum class StateFileStatus : std::int8_t { kNone = 0, kLoaded = 1, kTooOld = 2, kImplausible = 3, kCorrupt = 4 };
+
+struct LoadedState {
+  StateFileStatus status = StateFileStatus::kNone;
+  PersistedEstimates estimates;
+  std::string message;  ///< for the log
+};
+
+/// Reads and checks a state file: age against max_age_s (and not in the future), values against the
+/// bounds of D_M. A missing file is kNone; anything unreadable is kCorrupt (reported, not fatal).
+[[nodiscard]] LoadedState load_state_file(const std::string& path, double max_age_s, double psi_min_Wb,
+                                          double psi_max_Wb, double rs_min_Ohm, double rs_max_Ohm);
+
+}  // namespace rpem::daemon

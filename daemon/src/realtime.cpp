@@ -1,0 +1,45 @@
+#include "rpem/daemon/realtime.hpp"
+
+#include <pthread.h>
+#include <sched.h>
+#include <sys/mman.h>
+
+#include <cerrno>
+#include <cstring>
+
+namespace rpem::daemon {
+
+std::string apply_thread_policy(const ThreadPolicy& p) {
+  std::string problems;
+  if (p.cpu >= 0) {
+    cpu_set_t set;
+    CPU_ZERO(&set);
+    CPU_SET(p.cpu, &set);
+    if (const int rc = pthread_setaffinity_np(pthread_self(), sizeof set, &set); rc != 0) {
+      problems += std::string("cpu ") + std::to_string(p.cpu) + ": " + std::strerror(rc) + "; ";
+    }
+  }
+  sched_param param{};
+  param.sched_priority = p.fifo ? p.priority : 0;
+  if (const int rc = pthread_setschedparam(pthread_self(), p.fifo ? SCHED_FIFO : SCHED_OTHER, &param); rc != 0) {
+    problems += std::string("SCHED_FIFO ") + std::to_string(p.priority) + ": " + std::strerror(rc) +
+                (rc == EPERM ? " (needs LimitRTPRIO or CAP_SYS_NICE)" : "") + "; ";
+  }
+  return problems;
+}
+
+std::string lock_memory() {
+  if (mlockall(MCL_CURRENT | MCL_FUTURE) != 0) {
+    return std::string("mlockall: ") + std::strerror(errno) + (errno == ENOMEM || errno == EPERM ? " (needs LimitMEMLOCK)" : "");
+  }
+  return "";
+}
+
+void prefault_stack(std::size_t bytes) {
+  volatile unsigned char* block = static_cast<volatile unsigned char*>(__builtin_alloca(bytes));
+  for (std::size_t k = 0; k < bytes; k += 4096) block[k] = 0;
+}
+
+void name_thread(const char* name) { pthread_setname_np(pthread_self(), name); }
+
+}  // namespace rpem::daemon
