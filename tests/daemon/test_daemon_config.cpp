@@ -1,0 +1,69 @@
+#include <gtest/gtest.h>
+
+#include <filesystem>
+
+#include "rpem/daemon/daemon_config.hpp"
+#include "support/temp_file.hpp"
+
+namespace rpem::daemon {
+namespace {
+
+TEST(DaemonConfig, BuiltInDefaultIsTheSimulatedPaperMachine) {
+  const DaemonConfig c = builtin_daemon_config();
+  EXPECT_EQ(c.source, SourceType::kSim);
+  EXPECT_EQ(c.sim_scenario, "builtin:rpemd-demo");
+  EXPECT_DOUBLE_EQ(c.machine.machine.psi_m_Wb, 1.14);
+  EXPECT_DOUBLE_EQ(c.loop_period_s, 125e-6);
+  EXPECT_FALSE(c.commands_enabled);
+  EXPECT_DOUBLE_EQ(c.temperature.r_s_ref_Ohm, 2.25);
+}
+
+TEST(DaemonConfig, ShippedExamplesLoad) {
+  for (const char* f : {"/config/rpemd-sim.yaml", "/config/rpemd-can.yaml", "/config/paper-ipmsm.yaml"}) {
+    SCOPED_TRACE(f);
+    const DaemonConfig c = load_daemon_config(test::source_dir() + f);
+    EXPECT_GT(c.loop_period_s, 0.0);
+  }
+  const DaemonConfig can = load_daemon_config(test::source_dir() + "/config/rpemd-can.yaml");
+  EXPECT_EQ(can.source, SourceType::kCan);
+  EXPECT_EQ(can.can_interface, "can0");
+}
+
+TEST(DaemonConfig, AMachineFileAloneIsAConfiguration) {
+  // rpem diagnose's extended.yaml is a machine file: rpemd must take it as it is.
+  const DaemonConfig c = load_daemon_config(test::source_dir() + "/config/paper-ipmsm.yaml");
+  EXPECT_EQ(c.source, SourceType::kSim);
+  EXPECT_DOUBLE_EQ(c.machine.machine.l_q_H, 0.206);
+}
+
+struct Bad {
+  const char* name;
+  const char* text;
+  const char* expected;
+};
+class BadDaemonConfig : public ::testing::TestWithParam<Bad> {};
+
+TEST_P(BadDaemonConfig, IsRejectedWithFileLineAndField) {
+  test::TempFile f("rpemd.yaml", std::string(GetParam().text));
+  try {
+    (void)load_daemon_config(f.path());
+    FAIL() << "accepted";
+  } catch (const io::ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find(GetParam().expected), std::string::npos) << e.what();
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Cases, BadDaemonConfig,
+    ::testing::Values(
+        Bad{"unknown", "daemon: {sauce: {type: can}}\n", ":1:10: daemon.sauce: unknown key"},
+        Bad{"source_type", "daemon:\n  source: {type: serial}\n", "daemon.source.type: 'serial' is not one of: sim, can"},
+        Bad{"priority", "daemon:\n  loop: {thread: {policy: fifo, priority: 120}}\n", "daemon.loop.thread.priority: 120 is outside [1, 99]"},
+        Bad{"period", "daemon:\n  loop: {period_s: 5}\n", "daemon.loop.period_s: 5 is outside"},
+        Bad{"both_machines", "daemon: {machine_config: a.yaml}\nmachine: {}\n", "give the machine inline or daemon.machine_config"},
+        Bad{"iface", "daemon:\n  source: {type: can, can: {interface: ''}}\n", "not an interface name"},
+        Bad{"coefficient_sign", "daemon:\n  temperature: {psi_m_coeff_per_K: 0.001}\n", "psi_m_coeff_per_K: 0.001 is outside"}),
+    [](const auto& p) { return std::string(p.param.name); });
+
+}  // namespace
+}  // namespace rpem::daemon

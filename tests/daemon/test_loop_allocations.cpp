@@ -1,0 +1,77 @@
+// The loop's period work allocates nothing: 20 s of samples at 8 kHz, every kind of command, stale
+// periods and all report kinds, counted by replacing the global allocation functions.
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <cstdlib>
+#include <new>
+
+#include "rpem/daemon/estimator_loop.hpp"
+#include "support/model_data.hpp"
+#include "support/paper_machine.hpp"
+
+namespace {
+std::atomic<long> g_allocations{0};
+}  // namespace
+
+#pragma GCC diagnostic ignored "-Wmismatched-new-delete"
+void* operator new(std::size_t n) {
+  g_allocations.fetch_add(1, std::memory_order_relaxed);
+  if (void* p = std::malloc(n == 0 ? 1 : n)) return p;
+  throw std::bad_alloc();
+}
+void* operator new[](std::size_t n) { return operator new(n); }
+void operator delete(void* p) noexcept { std::free(p); }
+void operator delete[](void* p) noexcept { std::free(p); }
+void operator delete(void* p, std::size_t) noexcept { std::free(p); }
+void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
+
+namespace rpem::daemon {
+namespace {
+
+TEST(LoopAllocations, NoneInTheLoopsPeriodWork) {
+  DaemonConfig config = builtin_daemon_config();
+  SpscQueue<core::DriveSample> input(4096);
+  SpscQueue<Command> commands(16);
+  SpscQueue<Report> output(1 << 16);
+  EstimatorLoop loop(config, input, commands, output);
+  test::ModelDataGenerator gen;
+  gen.plant = test::paper_machine_pu();
+  gen.omega_n_rad_s = test::paper_base().omega_el_rad_s;
+  gen.n_pu = 0.4;
+  gen.i_ref_pu = core::mtpa_reference(gen.plant, 0.4);
+  std::vector<core::DriveSample> samples;
+  std::int64_t t_ns = 0;
+  const core::PerUnitBase base = test::paper_base();
+  for (int k = 0; k < 160'000; ++k) samples.push_back(gen.next_si(base, t_ns));
+  std::vector<Command> cmds(5);
+  cmds[0].kind = Command::Kind::kFreeze;
+  cmds[1].kind = Command::Kind::kUnfreeze;
+  cmds[2].kind = Command::Kind::kSetValues;
+  cmds[2].psi_m_Wb = 1.1;
+  cmds[2].r_s_Ohm = 2.3;
+  cmds[3].kind = Command::Kind::kReconfigure;
+  cmds[3].machine = config.machine.machine;
+  cmds[3].settings = config.machine.estimator;
+  cmds[4].kind = Command::Kind::kReset;
+
+  const long before = g_allocations.load();
+  std::int64_t now = 1'000'000'000;
+  std::size_t next = 0;
+  Report drain;
+  for (int period = 0; period < 20'000; ++period) {
+    if (period % 4000 == 100) (void)commands.push(cmds[static_cast<std::size_t>(period / 4000)]);
+    const bool stall = period >= 9000 && period < 9500;  // a stale half-second
+    for (int s = 0; s < 8 && !stall && next < samples.size(); ++s) (void)input.push(samples[next++]);
+    now += 1'000'000;
+    loop.process(now);
+    if (period % 1000 == 0) {
+      while (output.pop(drain)) {
+      }
+    }
+  }
+  EXPECT_EQ(g_allocations.load() - before, 0);
+}
+
+}  // namespace
+}  // namespace rpem::daemon
