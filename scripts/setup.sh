@@ -17,7 +17,7 @@ packages=(
   # CAN tooling and the PREEMPT_RT VM test rig (qemu, busybox initramfs)
   can-utils iproute2 qemu-system-x86 busybox-static cpio kmod xz-utils zstd
   # systemd-analyze for unit verification; dpkg-deb for the .deb package
-  systemd dpkg-dev fakeroot
+  systemd dpkg-dev fakeroot debootstrap
 )
 
 missing=()

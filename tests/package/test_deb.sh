@@ -1,0 +1,66 @@
+#!/usr/bin/env bash
+# The .deb on a clean Debian 12: debootstrap (minbase, cached as a tarball) → fresh root → apt install the
+# package (dependencies from Debian) → the unit verifies and scores ≤ 2.5 → rpemd runs from the
+# installed configuration as an unprivileged user (the way the service runs it) and estimates.
+#   test_deb.sh BUILD_DIR
+set -euo pipefail
+build=$(cd "$1" && pwd)
+cache=${RPEM_DEBOOTSTRAP_CACHE:-$build/debootstrap-cache}
+mkdir -p "$cache"
+base=$cache/bookworm-minbase.tar
+if [[ ! -f $base ]]; then
+  echo "test_deb: debootstrap bookworm (once, cached in $base)"
+  tmp=$(mktemp -d)
+  debootstrap --variant=minbase bookworm "$tmp" http://deb.debian.org/debian >"$cache/debootstrap.log" 2>&1
+  tar -C "$tmp" -cf "$base" .
+  rm -rf "$tmp"
+fi
+
+(cd "$build" && cpack -G DEB >/dev/null)
+deb=$(ls -t "$build"/rpem-drive_*_amd64.deb | head -n1)
+root=$(mktemp -d)
+cleanup() {
+  for m in dev/pts dev proc sys; do umount "$root/$m" 2>/dev/null || true; done
+  rm -rf "$root"
+}
+trap cleanup EXIT
+tar -C "$root" -xf "$base"
+cp /etc/resolv.conf "$root/etc/resolv.conf"
+mount -t proc proc "$root/proc"
+mount -t sysfs sys "$root/sys"
+mount --bind /dev "$root/dev"
+mount --bind /dev/pts "$root/dev/pts"
+cp "$deb" "$root/tmp/"
+in_root() { chroot "$root" /usr/bin/env -i PATH=/usr/sbin:/usr/bin:/sbin:/bin HOME=/root "$@"; }
+
+echo "test_deb: installing $(basename "$deb") into a clean Debian 12"
+in_root apt-get update -q >/dev/null
+DEBIAN_FRONTEND=noninteractive in_root apt-get install -y -q --no-install-recommends "/tmp/$(basename "$deb")" >"$root/tmp/apt.log" 2>&1 ||
+  { cat "$root/tmp/apt.log"; exit 1; }
+in_root dpkg -s rpem-drive | grep -q "Status: install ok installed"
+[[ -L $root/etc/systemd/system/multi-user.target.wants/rpemd.service ]] || { echo "test_deb: rpemd.service not enabled"; exit 1; }
+
+echo "test_deb: checking the installed unit"
+in_root systemd-analyze verify /usr/lib/systemd/system/rpemd.service
+score=$(in_root systemd-analyze security --offline=yes /usr/lib/systemd/system/rpemd.service 2>&1 | awk '/Overall exposure level/{print $(NF-2)}')
+echo "test_deb: exposure $score"
+awk -v s="$score" 'BEGIN { exit !(s <= 2.5) }' || { echo "test_deb: exposure $score > 2.5"; exit 1; }
+
+echo "test_deb: running the installed rpemd with the installed configuration, as an unprivileged user with"
+echo "          the unit's LimitRTPRIO=90 and LimitMEMLOCK=infinity (so SCHED_FIFO and mlockall need no root)"
+in_root /usr/sbin/rpemd --config /etc/rpemd/rpemd.yaml --check-config
+in_root mkdir -p /var/lib/rpemd && in_root chown nobody:nogroup /var/lib/rpemd
+set +e
+in_root prlimit --rtprio=90 --memlock=unlimited setpriv --reuid=nobody --regid=nogroup --clear-groups \
+  /usr/bin/env STATE_DIRECTORY=/var/lib/rpemd \
+  timeout -s TERM 25 /usr/sbin/rpemd --config /etc/rpemd/rpemd.yaml >"$root/tmp/rpemd.out" 2>&1
+rc=$?
+set -e
+cat "$root/tmp/rpemd.out"
+[[ $rc -eq 124 || $rc -eq 0 ]] || { echo "test_deb: rpemd exited with $rc"; exit 1; }
+grep -q "rpemd running" "$root/tmp/rpemd.out" || { echo "test_deb: no estimates"; exit 1; }
+if grep -q "warning" "$root/tmp/rpemd.out"; then echo "test_deb: real-time set-up incomplete under the unit's limits"; exit 1; fi
+grep -q "rpemd: stopped" "$root/tmp/rpemd.out" || { echo "test_deb: no clean stop on SIGTERM"; exit 1; }
+[[ -f $root/var/lib/rpemd/estimates.json ]] || { echo "test_deb: no state file written at shutdown"; exit 1; }
+in_root /usr/bin/rpem --help >/dev/null
+echo "test_deb: passed"
