@@ -96,6 +96,8 @@ EstimatorSample SampleConditioner::condition(const DriveSample& s) noexcept {
     iv.u_end_pu = park(u_held_ab_pu, rot);
   } else {
     out.resync = true;
+    // The gap's length (0 for the first sample) lets the estimator keep ε across a short one.
+    out.interval.dt_s = has_previous_ ? 1e-9 * static_cast<double>(s.t_ns - previous_t_ns_) : 0.0;
     out.interval.n_start_pu = n_pu;
     out.interval.n_end_pu = n_pu;
   }

@@ -40,12 +40,14 @@ void RpemEstimator::reset() noexcept {
   state_.gna_hessian_pu = config_.initial_gna_hessian_pu;
   state_.predictor = PredictorState{};
   state_.synchronized = false;
+  state_.epsilon_valid = false;
 }
 
 void RpemEstimator::set_theta(const Vec2& theta_pu) noexcept {
   state_.theta_pu = theta_pu;
   (void)project(config_.bounds, state_.theta_pu);
   state_.synchronized = false;
+  state_.epsilon_valid = false;
 }
 
 void RpemEstimator::reconfigure(const EstimatorConfig& config) noexcept {
@@ -63,10 +65,17 @@ MachinePu RpemEstimator::model_with_estimates() const noexcept {
 }
 
 void RpemEstimator::synchronize(const EstimatorSample& sample) noexcept {
-  state_.predictor.i_hat_pu = sample.i_meas_pu;
-  // Start the dynamic gradients at their equilibrium so they need no settling time.
-  state_.predictor.gradient =
-      steady_state_gradients(model_with_estimates(), sample.interval.n_end_pu, sample.i_meas_pu);
+  const double gap = sample.interval.dt_s;
+  const bool carry = state_.synchronized && state_.epsilon_valid && gap > 0.0 && gap <= config_.max_gap_carry_s;
+  if (carry) {
+    state_.predictor.i_hat_pu = sample.i_meas_pu - state_.last_epsilon_pu;  // gradients carry on too
+  } else {
+    state_.predictor.i_hat_pu = sample.i_meas_pu;
+    // Start the dynamic gradients at their equilibrium so they need no settling time.
+    state_.predictor.gradient =
+        steady_state_gradients(model_with_estimates(), sample.interval.n_end_pu, sample.i_meas_pu);
+    state_.epsilon_valid = false;
+  }
   state_.synchronized = true;
 }
 
@@ -85,6 +94,7 @@ EstimatorOutput RpemEstimator::step(const EstimatorSample& sample) noexcept {
 
   if (!finite(sample)) {
     state_.synchronized = false;
+    state_.epsilon_valid = false;
     out.code = StepCode::kRejectedNonFinite;
     return out;
   }
@@ -101,6 +111,7 @@ EstimatorOutput RpemEstimator::step(const EstimatorSample& sample) noexcept {
   const Vec2& i_hat = state_.predictor.i_hat_pu;
   if (!i_hat.allFinite() || i_hat.lpNorm<Eigen::Infinity>() > config_.max_predicted_current_pu ||
       !state_.predictor.gradient.allFinite()) {
+    state_.epsilon_valid = false;
     synchronize(sample);
     out.i_hat_pu = state_.predictor.i_hat_pu;
     out.code = StepCode::kPredictorDiverged;
@@ -109,6 +120,8 @@ EstimatorOutput RpemEstimator::step(const EstimatorSample& sample) noexcept {
 
   out.i_hat_pu = i_hat;
   out.epsilon_pu = sample.i_meas_pu - i_hat;
+  state_.last_epsilon_pu = out.epsilon_pu;
+  state_.epsilon_valid = true;
   out.gradient = select_gradient(iv.n_end_pu);
 
   const double factor = iv.dt_s * inverse_nominal_period_;

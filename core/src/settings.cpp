@@ -27,6 +27,7 @@ EstimatorConfig make_estimator_config(const PerUnitBase& base, const MachineSi& 
   c.initial_gna_hessian_pu = s.initial_gna_hessian_pu;
   c.nominal_sample_period_s = s.nominal_sample_period_s;
   c.max_sample_interval_s = s.max_sample_interval_s;
+  c.max_gap_carry_s = s.max_gap_carry_s;
   c.adapt_psi_m = s.adapt_psi_m;
   c.adapt_r_s = s.adapt_r_s;
   return c;

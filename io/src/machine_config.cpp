@@ -59,6 +59,7 @@ core::EstimatorSettings parse_estimator(YamlMap e, const core::MachineSi& machin
   s.nominal_sample_period_s = e.number_or("sample_period_s", 125e-6, 1e-6, 1.0);
   s.max_sample_interval_s = e.number_or("max_sample_interval_s", 8.0 * s.nominal_sample_period_s,
                                         s.nominal_sample_period_s, 10.0);
+  s.max_gap_carry_s = e.number_or("max_gap_carry_s", 20e-3, 0.0, 1.0);
   if (auto a = e.optional_map("adapt")) {
     s.adapt_psi_m = a->boolean_or("psi_m", true);
     s.adapt_r_s = a->boolean_or("r_s", true);

@@ -37,6 +37,7 @@ struct EstimatorConfig {
   Mat2 initial_gna_hessian_pu = Mat2::Zero();  ///< R[0]
   double nominal_sample_period_s = 125e-6;     ///< the period the γ_0 refer to; γ scales with dt
   double max_sample_interval_s = 1e-3;         ///< a longer interval resynchronises the predictor
+  double max_gap_carry_s = 20e-3;              ///< across a shorter gap the prediction error is kept
   double max_predicted_current_pu = 20.0;      ///< |î| beyond this counts as divergence
   bool adapt_psi_m = true;
   bool adapt_r_s = true;
@@ -45,7 +46,7 @@ struct EstimatorConfig {
 /// One conditioned sample (see conditioner.hpp): the interval since the previous sample and the
 /// current measured at its end.
 struct EstimatorSample {
-  PredictorInterval interval;
+  PredictorInterval interval;  ///< with resync: dt_s is the gap since the last sample (0: none known)
   Vec2 i_meas_pu = Vec2::Zero();
   bool resync = false;  ///< first sample, or samples were lost before this one
 };
@@ -75,6 +76,8 @@ struct EstimatorState {
   Mat2 gna_hessian_pu = Mat2::Zero();
   bool synchronized = false;
   bool frozen = false;
+  Vec2 last_epsilon_pu = Vec2::Zero();  ///< ε of the last adapted sample
+  bool epsilon_valid = false;
 };
 
 struct EstimatorOutput {
@@ -110,6 +113,8 @@ class RpemEstimator {
   [[nodiscard]] const EstimatorState& state() const noexcept { return state_; }
 
  private:
+  /// Re-anchors the predictor on the measurement. Across a short gap in a running stream it keeps the
+  /// last prediction error (î = i − ε), which the open-loop predictor needs a time constant to rebuild.
   void synchronize(const EstimatorSample& sample) noexcept;
   [[nodiscard]] MachinePu model_with_estimates() const noexcept;
   [[nodiscard]] Mat2 select_gradient(double n_pu) const noexcept;

@@ -37,6 +37,7 @@ struct EstimatorSettings {
   Mat2 initial_gna_hessian_pu = Mat2::Zero();
   double nominal_sample_period_s = 125e-6;
   double max_sample_interval_s = 1e-3;
+  double max_gap_carry_s = 20e-3;
   bool adapt_psi_m = true;
   bool adapt_r_s = true;
   InputCorrections corrections;
