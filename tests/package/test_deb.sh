@@ -16,7 +16,8 @@ if [[ ! -f $base ]]; then
   rm -rf "$tmp"
 fi
 
-(cd "$build" && cpack -G DEB >/dev/null)
+# Packed under the strictest umask on purpose: the package's modes must not depend on the builder's.
+(umask 077 && cd "$build" && cpack -G DEB >/dev/null)
 deb=$(ls -t "$build"/rpem-drive_*_amd64.deb | head -n1)
 root=$(mktemp -d)
 cleanup() {
@@ -25,6 +26,7 @@ cleanup() {
 }
 trap cleanup EXIT
 tar -C "$root" -xf "$base"
+chmod 0755 "$root"  # mktemp's 0700 (kept by tar for ".") would shut the unprivileged run out of /
 cp /etc/resolv.conf "$root/etc/resolv.conf"
 mount -t proc proc "$root/proc"
 mount -t sysfs sys "$root/sys"

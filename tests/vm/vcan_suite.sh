@@ -13,7 +13,9 @@ step "SocketCAN tests"
 test_socketcan --gtest_color=no || fail=1
 
 step "sim -> vcan0 -> record (CAN FD), captured by candump"
-candump -L vcan0,100:7FF > "$out/capture.log" &
+# A large socket buffer (-r, as rpem record uses): under emulation candump is scheduled late and would
+# otherwise lose frames to its default-sized receive queue.
+candump -r 8388608 -L vcan0,100:7FF > "$out/capture.log" &
 dump=$!
 rpem record --can vcan0 --out "$out/recorded.csv" --idle-timeout 1.5 > "$out/record.txt" 2>&1 &
 rec=$!
