@@ -42,6 +42,7 @@ void parse_daemon(io::YamlMap d, DaemonConfig& c, const std::string& base_dir) {
     const std::string rt = l->choice_or("realtime", "preferred", {"required", "preferred", "off"});
     c.realtime = rt == "required" ? RealtimeMode::kRequired : rt == "off" ? RealtimeMode::kOff : RealtimeMode::kPreferred;
     c.lock_memory = l->boolean_or("lock_memory", true);
+    c.cpu_dma_latency_us = static_cast<int>(l->integer_or("cpu_dma_latency_us", 0, -1, 100000));
     if (auto t = l->optional_map("thread")) c.loop_thread = parse_thread(*t, c.loop_thread);
     l->finish();
   }

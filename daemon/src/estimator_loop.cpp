@@ -129,6 +129,7 @@ void EstimatorLoop::report_estimate(std::int64_t) noexcept {
   EstimateReport r;
   r.utime_us = clock_ns(CLOCK_REALTIME) / 1000;
   r.sample_time_us = last_sample_.t_ns / 1000;
+  r.newest_rx_ns = last_sample_.rx_ns;
   r.samples = samples_;
   r.psi_m_Wb = estimator_.psi_m_Wb();
   r.r_s_Ohm = estimator_.r_s_Ohm();
@@ -264,7 +265,9 @@ void EstimatorLoop::run(std::atomic<bool>& stop) {
     while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr) == EINTR) {
     }
     const std::int64_t woke = clock_ns(CLOCK_MONOTONIC);
-    latency_.add(1e-3 * static_cast<double>(woke - next));
+    const double late_us = 1e-3 * static_cast<double>(woke - next);
+    latency_.add(late_us);
+    run_latency_.add(late_us);
     process(woke);
     ++periods_;
     const std::int64_t done = clock_ns(CLOCK_MONOTONIC);

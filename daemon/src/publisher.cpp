@@ -74,7 +74,12 @@ void Publisher::publish_estimate(const EstimateReport& r) {
   m.frozen = r.frozen;
   m.state = static_cast<std::int8_t>(r.state);
   m.algorithm = io::to_string(r.algorithm);
-  publish_raw(channel("RPEM_ESTIMATE"), m.encode(buffer_.data(), 0, static_cast<int>(buffer_.size())));
+  if (publish_raw(channel("RPEM_ESTIMATE"), m.encode(buffer_.data(), 0, static_cast<int>(buffer_.size()))) &&
+      r.newest_rx_ns > 0) {
+    const double us = 1e-3 * static_cast<double>(unix_us() * 1000 - r.newest_rx_ns);
+    rx_to_publish_.add(us);
+    rx_to_publish_run_.add(us);
+  }
 }
 
 void Publisher::publish_measurement(const MeasurementReport& r) {
@@ -108,6 +113,10 @@ void Publisher::publish_diagnostics(const LoopStatsReport& r) {
   m.loop_work_max_us = r.work_max_us;
   m.overruns = r.overruns;
   m.loop_periods = r.periods;
+  m.rx_to_publish_p50_us = rx_to_publish_.percentile(0.5);
+  m.rx_to_publish_p99_us = rx_to_publish_.percentile(0.99);
+  m.rx_to_publish_max_us = rx_to_publish_.max();
+  rx_to_publish_.reset();
   m.samples = r.samples;
   m.resyncs = r.resyncs;
   m.rejected_non_finite = r.rejected_non_finite;

@@ -2,7 +2,11 @@
 
 #include <pthread.h>
 #include <sched.h>
+#include <fcntl.h>
 #include <sys/mman.h>
+#include <unistd.h>
+
+#include <cstdint>
 
 #include <cerrno>
 #include <cstring>
@@ -33,6 +37,21 @@ std::string lock_memory() {
     return std::string("mlockall: ") + std::strerror(errno) + (errno == ENOMEM || errno == EPERM ? " (needs LimitMEMLOCK)" : "");
   }
   return "";
+}
+
+int request_cpu_dma_latency(int us, std::string& problem) {
+  const int fd = ::open("/dev/cpu_dma_latency", O_WRONLY | O_CLOEXEC);
+  if (fd < 0) {
+    problem = std::string("/dev/cpu_dma_latency: ") + std::strerror(errno);
+    return -1;
+  }
+  const std::int32_t value = us;
+  if (::write(fd, &value, sizeof value) != static_cast<ssize_t>(sizeof value)) {
+    problem = std::string("/dev/cpu_dma_latency: ") + std::strerror(errno);
+    ::close(fd);
+    return -1;
+  }
+  return fd;
 }
 
 void prefault_stack(std::size_t bytes) {

@@ -8,6 +8,7 @@
 // SIGINT: stop; SIGHUP: reload gains and limits) and systemd notification and watchdog.
 
 #include <signal.h>
+#include <unistd.h>
 #include <systemd/sd-daemon.h>
 
 #include <CLI/CLI.hpp>
@@ -44,11 +45,13 @@ const char* realtime_name(RealtimeMode m) {
 
 int main(int argc, char** argv) {
   CLI::App app{"rpemd: online identification of PMSM magnet flux linkage and stator resistance (docs/rpemd.md)"};
-  std::string config_path, can_override;
+  std::string config_path, can_override, histogram_path;
   bool check_only = false;
   app.add_option("--config", config_path, "configuration YAML (default: built-in, simulated drive)");
   app.add_option("--can", can_override, "use this CAN interface as the source (overrides the configuration)");
   app.add_flag("--check-config", check_only, "validate the configuration and exit");
+  app.add_option("--latency-histogram", histogram_path,
+                 "at exit, write the loop's wake-up latency histogram (µs, count; as cyclictest -h) to this file");
   CLI11_PARSE(app, argc, argv);
 
   DaemonConfig config;
@@ -82,6 +85,13 @@ int main(int argc, char** argv) {
       }
       std::fprintf(stderr, "rpemd: warning: %s; continuing without locked memory\n", problem.c_str());
     }
+  }
+
+  int qos_fd = -1;  // held open while rpemd runs
+  if (config.cpu_dma_latency_us >= 0 && config.realtime != RealtimeMode::kOff) {
+    std::string problem;
+    qos_fd = request_cpu_dma_latency(config.cpu_dma_latency_us, problem);
+    if (qos_fd < 0) std::fprintf(stderr, "rpemd: note: %s; deep CPU idle states may add wake-up latency\n", problem.c_str());
   }
 
   SpscQueue<rpem::core::DriveSample> samples(8192);
@@ -178,6 +188,28 @@ int main(int argc, char** argv) {
   loop_thread.join();
   stop_publisher = true;
   publisher_thread.join();
+  const LatencyHistogram& wake = loop.run_latency();
+  std::fprintf(stderr,
+               "rpemd: loop wake-up latency over the run [us]: p50 %.0f, p99 %.0f, p99.9 %.0f, max %.1f; "
+               "%lld overruns in %lld periods\n",
+               wake.percentile(0.5), wake.percentile(0.99), wake.percentile(0.999), wake.max(),
+               static_cast<long long>(loop.overruns()), static_cast<long long>(loop.periods()));
+  if (!histogram_path.empty()) {
+    if (FILE* f = std::fopen(histogram_path.c_str(), "w")) {
+      for (int us = 0; us < LatencyHistogram::kBins; ++us) {
+        if (wake.bin(us) > 0) std::fprintf(f, "%06d %lld\n", us, static_cast<long long>(wake.bin(us)));
+      }
+      std::fprintf(f, "# Histogram Overflows: %lld\n# Max Latencies: %.0f\n",
+                   static_cast<long long>(wake.bin(LatencyHistogram::kBins)), wake.max());
+      std::fclose(f);
+    }
+  }
+  if (publisher.rx_to_publish().count() > 0) {
+    const LatencyHistogram& rx = publisher.rx_to_publish();
+    std::fprintf(stderr, "rpemd: CAN receive -> LCM publish [us]: p50 %.0f, p99 %.0f, max %.1f (%lld estimates)\n",
+                 rx.percentile(0.5), rx.percentile(0.99), rx.max(), static_cast<long long>(rx.count()));
+  }
+  if (qos_fd >= 0) ::close(qos_fd);
   std::fprintf(stderr, "rpemd: stopped\n");
   return exit_code;
 }

@@ -67,7 +67,10 @@ class CanSource final : public SampleSource {
       }
       for (std::size_t f = 0; f < n; ++f) {
         const std::size_t got = decoder.decode(frames[f].frame, samples);
-        for (std::size_t k = 0; k < got; ++k) push(out_, samples[k], stats_);
+        for (std::size_t k = 0; k < got; ++k) {
+          samples[k].rx_ns = frames[f].kernel_rx_ns;
+          push(out_, samples[k], stats_);
+        }
       }
       publish(decoder.counters(), channel.counters());
     }

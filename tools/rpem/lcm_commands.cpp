@@ -54,12 +54,13 @@ struct Listener {
   void on_diagnostics(const lcm::ReceiveBuffer*, const std::string&, const rpem::diagnostics_t* m) {
     ++diagnostics;
     if (!print_diagnostics) return;
-    std::printf("diag %lld: state %d samples %lld resyncs %lld overruns %lld latency p99 %.1f us max %.1f us | can frames %lld "
+    std::printf("diag %lld: state %d samples %lld resyncs %lld overruns %lld latency p99 %.1f us max %.1f us | rx->publish p99 %.0f us | can frames %lld "
                 "lost %lld crc %lld dlc %lld unknown %lld gaps %lld kernel drops %lld reopens %lld | queue drops in %lld "
                 "out %lld | publish failures %lld | commands %lld malformed %lld rejected %lld last %lld:%d | state file %d\n",
                 static_cast<long long>(m->utime), static_cast<int>(m->state), static_cast<long long>(m->samples),
                 static_cast<long long>(m->resyncs),
                 static_cast<long long>(m->overruns), m->wakeup_latency_p99_us, m->wakeup_latency_max_us,
+                m->rx_to_publish_p99_us,
                 static_cast<long long>(m->can_frames), static_cast<long long>(m->can_frames_lost),
                 static_cast<long long>(m->can_crc_error), static_cast<long long>(m->can_wrong_dlc),
                 static_cast<long long>(m->can_unknown_id), static_cast<long long>(m->can_gaps),

@@ -22,6 +22,7 @@ struct DriveSample {
   Frame current_frame = Frame::kAbc;
   Vec3 i_A = Vec3::Zero();  ///< measured current in current_frame
   bool gap_before = false;  ///< samples were lost immediately before this one
+  std::int64_t rx_ns = 0;   ///< when the transport received it (CLOCK_REALTIME, kernel stamp); 0: unknown
 };
 
 }  // namespace rpem::core

@@ -43,6 +43,7 @@ struct DaemonConfig {
   double loop_period_s = 125e-6;
   RealtimeMode realtime = RealtimeMode::kPreferred;
   bool lock_memory = true;
+  int cpu_dma_latency_us = 0;  ///< PM QoS request while running; −1: none
   ThreadPolicy loop_thread{true, 80, -1};
   ThreadPolicy receive_thread{true, 70, -1};
   ThreadPolicy publish_thread{false, 0, -1};

@@ -33,6 +33,10 @@ class EstimatorLoop {
   /// Problems met while applying the real-time policy (empty when all was granted).
   [[nodiscard]] const std::string& setup_problems() const noexcept { return setup_problems_; }
   [[nodiscard]] bool started() const noexcept { return started_.load(std::memory_order_acquire); }
+  /// Whole-run wake-up latency and overruns (read after the loop has stopped).
+  [[nodiscard]] const LatencyHistogram& run_latency() const noexcept { return run_latency_; }
+  [[nodiscard]] std::int64_t overruns() const noexcept { return overruns_; }
+  [[nodiscard]] std::int64_t periods() const noexcept { return periods_; }
 
   /// One period's work without the sleep, for tests: commands, samples, reports. `now_ns` is the
   /// monotonic time of the period. Real-time safe.
@@ -59,7 +63,8 @@ class EstimatorLoop {
   std::int64_t period_ns_;
   std::int64_t estimate_interval_ns_, measurement_interval_ns_, stats_interval_ns_;
   std::int64_t next_estimate_ns_ = 0, next_measurement_ns_ = 0, next_stats_ns_ = 0;
-  LatencyHistogram latency_;
+  LatencyHistogram latency_;      ///< this reporting interval
+  LatencyHistogram run_latency_;  ///< the whole run
   double work_max_us_ = 0.0;
   std::int64_t overruns_ = 0, periods_ = 0;
 

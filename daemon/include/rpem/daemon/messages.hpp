@@ -40,6 +40,7 @@ struct Command {
 struct EstimateReport {
   std::int64_t utime_us = 0;
   std::int64_t sample_time_us = 0;
+  std::int64_t newest_rx_ns = 0;  ///< kernel receive time of the newest sample (CAN), 0 otherwise
   std::int64_t samples = 0;
   double psi_m_Wb = 0.0, r_s_Ohm = 0.0, psi_m_pu = 0.0, r_s_pu = 0.0;
   double t_magnet_C = 0.0, t_winding_C = 0.0, speed_pu = 0.0;

@@ -10,6 +10,7 @@
 #include <string>
 
 #include "rpem/daemon/daemon_config.hpp"
+#include "rpem/daemon/latency_histogram.hpp"
 #include "rpem/daemon/messages.hpp"
 #include "rpem/daemon/sources.hpp"
 #include "rpem/daemon/spsc_queue.hpp"
@@ -38,6 +39,8 @@ class Publisher {
   void run(std::atomic<bool>& stop);
 
   [[nodiscard]] PublisherCounters& counters() noexcept { return counters_; }
+  /// CAN receive → LCM publish over the whole run (read after the thread has stopped).
+  [[nodiscard]] const LatencyHistogram& rx_to_publish() const noexcept { return rx_to_publish_run_; }
   [[nodiscard]] std::string channel(const char* name) const { return config_.channel_prefix + name; }
 
  private:
@@ -61,6 +64,8 @@ class Publisher {
   std::vector<std::uint8_t> buffer_;
   std::string state_path_;
 
+  LatencyHistogram rx_to_publish_;      ///< since the last diagnostics message
+  LatencyHistogram rx_to_publish_run_;  ///< the whole run
   EstimateReport last_estimate_;
   bool have_estimate_ = false;
   std::int64_t last_seq_accepted_ = 0;

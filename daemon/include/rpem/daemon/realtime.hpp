@@ -15,6 +15,10 @@ struct ThreadPolicy {
 
 [[nodiscard]] std::string apply_thread_policy(const ThreadPolicy& policy);
 [[nodiscard]] std::string lock_memory();
+/// Holds the CPU's wake-up latency at most `us` (PM QoS via /dev/cpu_dma_latency, as cyclictest does),
+/// keeping deep idle states away for as long as the returned descriptor stays open. Returns the
+/// descriptor, or −1 with the reason in `problem`.
+[[nodiscard]] int request_cpu_dma_latency(int us, std::string& problem);
 /// Touches `bytes` of stack so later use does not page-fault.
 void prefault_stack(std::size_t bytes);
 /// Names the calling thread (top, ps -L).

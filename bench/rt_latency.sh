@@ -1,0 +1,121 @@
+#!/usr/bin/env bash
+# rpemd's estimator loop against cyclictest at the same period, priority and CPU on the same machine.
+# The two alternate in slices (ROUNDS × SLICE seconds each), so the shared machine's noise falls on
+# both alike; their histograms are summed. Prints p50/p99/max, the ratios, rpemd's overruns against the
+# periods in which cyclictest itself woke more than a period late, and rpemd's CPU use per thread.
+#   rt_latency.sh BUILD_DIR [SECONDS] [host|vm|both]      (SECONDS per program, default 60)
+# host: sim source, 125 µs, SCHED_FIFO 80 on CPU 1 (other threads on CPU 0).
+# vm:   CAN source in the PREEMPT_RT VM (emulated: 1 ms), `rpem sim --can` streaming; also CAN receive →
+#       LCM publish latency.
+set -euo pipefail
+build=$(cd "$1" && pwd)
+seconds=${2:-60}
+where=${3:-both}
+repo=$(cd "$(dirname "$0")/.." && pwd)
+out=$(mktemp -d)
+trap 'rm -rf "$out"' EXIT
+rounds=6
+slice=$((seconds / rounds))
+
+report() {  # label, period µs, cyclictest histograms…, --, rpemd histograms…
+  python3 - "$@" <<'PY'
+import sys
+label, period = sys.argv[1], int(sys.argv[2])
+args = sys.argv[3:]
+split = args.index("--")
+def load(files):
+    counts, overflow, mx = {}, 0, 0
+    for f in files:
+        for line in open(f):
+            if line.startswith("# Histogram Overflows"):
+                overflow += sum(int(x) for x in line.split(":")[1].split())
+            elif line.startswith("# Max Latencies"):
+                mx = max([mx] + [int(float(x)) for x in line.split(":")[1].split()])
+            elif not line.startswith("#") and line.strip():
+                us, n = line.split()[:2]
+                counts[int(us)] = counts.get(int(us), 0) + int(n)
+    total = sum(counts.values()) + overflow
+    def pct(q):
+        seen = 0
+        for us in sorted(counts):
+            seen += counts[us]
+            if seen >= q * total:
+                return us
+        return mx
+    late = sum(n for us, n in counts.items() if us >= period) + overflow
+    return pct(0.5), pct(0.99), max([mx] + list(counts)), total, late
+c = load(args[:split])
+r = load(args[split + 1:])
+print(f"{label}: cyclictest  p50 {c[0]} µs, p99 {c[1]} µs, max {c[2]} µs; {c[4]} of {c[3]} wake-ups a period or more late")
+print(f"{label}: rpemd loop  p50 {r[0]} µs, p99 {r[1]} µs, max {r[2]} µs; {r[4]} of {r[3]} wake-ups a period or more late")
+print(f"{label}: ratio rpemd/cyclictest  p50 {r[0] / max(1, c[0]):.2f}, p99 {r[1] / max(1, c[1]):.2f}")
+PY
+}
+
+host() {
+  cat >"$out/rpemd-host.yaml" <<YAML
+daemon:
+  loop: {period_s: 125.0e-6, realtime: required, thread: {policy: fifo, priority: 80, cpu: 1}}
+  receive_thread: {policy: fifo, priority: 70, cpu: 0}
+  publish_thread: {policy: other, cpu: 0}
+  state: {file: $out/state.json}
+  status_interval_s: 0
+YAML
+  echo "== host: $rounds × ${slice} s each of cyclictest -m -p 80 -i 125 -a 1 and rpemd (loop 125 µs, FIFO 80, CPU 1, sim source)"
+  local cyc=() rpm=()
+  for r in $(seq 1 $rounds); do
+    cyclictest -m -q -p 80 -i 125 -a 1 -t 1 -D "$slice" -h 20000 --histfile="$out/c$r.hist" >/dev/null
+    cyc+=("$out/c$r.hist")
+    "$build/daemon/rpemd" --config "$out/rpemd-host.yaml" --latency-histogram "$out/r$r.hist" 2>"$out/r$r.txt" &
+    local pid=$!
+    sleep "$slice"
+    if [[ $r -eq 1 ]]; then
+      for t in /proc/$pid/task/*; do
+        echo "$(cat "$t/comm") $(awk '{print $14 + $15}' "$t/stat")"
+      done | awk -v s="$slice" '{printf "  cpu %-14s %5.1f %% of a core\n", $1, $2 / s}'
+    fi
+    kill -TERM $pid
+    wait $pid || true
+    rpm+=("$out/r$r.hist")
+  done
+  grep -h "overruns" "$out"/r*.txt | awk '{o += $(NF-4); p += $(NF-1)} END {printf "host: rpemd overruns %d in %d periods\n", o, p}'
+  report host 125 "${cyc[@]}" -- "${rpm[@]}"
+}
+
+vm() {
+  cat >"$out/stream.yaml" <<YAML
+name: latency-stream
+machine: builtin:paper-ipmsm
+duration_s: $((seconds * 2 / 5 + 4))
+inverter: {model: averaged}
+sensors: {current_noise_A: 0.02, current_lsb_A: 0.01, encoder_counts: 16384}
+initial: {speed_rpm: 300, torque_Nm: 13.04, u_dc_V: 220}
+YAML
+  cat >"$out/rpemd-vm.yaml" <<YAML
+daemon:
+  source: {type: can, can: {interface: vcan0}}
+  loop: {period_s: 1.0e-3, realtime: required, thread: {policy: fifo, priority: 80, cpu: 1}}
+  receive_thread: {policy: fifo, priority: 70, cpu: 0}
+  state: {file: /tmp/state.json}
+  status_interval_s: 0
+YAML
+  echo "== PREEMPT_RT VM (emulated): cyclictest -p 80 -i 1000 -a 1 (${seconds} s), then rpemd (CAN, loop 1 ms) with the drive streaming"
+  "$repo/tests/vm/vm_rig.sh" run --timeout $((seconds * 6 + 300)) --share "$out" --file "$build/daemon/rpemd" \
+    --file "$build/tools/rpem" --file "$out/stream.yaml" --file "$out/rpemd-vm.yaml" -- "
+      cyclictest -m -q -p 80 -i 1000 -a 1 -t 1 -D $seconds -h 20000 --histfile=/host/cvm.hist > /dev/null
+      rpemd --config rpemd-vm.yaml --latency-histogram /host/rvm.hist 2> /host/rpemd-vm.txt &
+      pid=\$!
+      sleep 1
+      rpem sim --scenario stream.yaml --can vcan0 --rate 0.4 2> /dev/null
+      for t in /proc/\$pid/task/*; do echo \"\$(cat \$t/comm) \$(awk '{print \$14 + \$15}' \$t/stat)\"; done > /host/cpu-vm.txt
+      kill -TERM \$pid; wait \$pid" >/dev/null 2>&1 || true
+  grep -E "overruns|publish" "$out/rpemd-vm.txt" | sed 's/^/vm: /'
+  awk -v s="$((seconds + 1))" '{printf "  cpu %-14s %5.1f %% of an emulated core\n", $1, $2 / s}' "$out/cpu-vm.txt"
+  report vm 1000 "$out/cvm.hist" -- "$out/rvm.hist"
+}
+
+date -u
+lscpu | grep -E "^Model name|^CPU\(s\)" | sed 's/  */ /g'
+uname -r
+if [[ $where == host || $where == both ]]; then host; fi
+if [[ $where == vm || $where == both ]]; then vm; fi
