@@ -18,34 +18,43 @@ bool finite(const DriveSample& s) noexcept {
 
 }  // namespace
 
-SampleConditioner::SampleConditioner(const PerUnitBase& base, const InputCorrections& corrections) noexcept
-    : base_(base),
-      inv_current_A_(1.0 / base.current_A),
-      inv_voltage_V_(1.0 / base.voltage_V),
-      inv_omega_rad_s_(1.0 / base.omega_el_rad_s) {
-  set_corrections(corrections);
+SampleConditioner::SampleConditioner(const PerUnitBase& base, const MachinePu& machine,
+                                     const ModelExtensions& extensions) noexcept {
+  reconfigure(base, machine, extensions);
 }
 
-void SampleConditioner::set_corrections(const InputCorrections& c) noexcept {
-  corrections_ = c;
-  inv_current_gain_ = (Vec3::Ones() + c.current_gain_error).cwiseInverse();
+void SampleConditioner::reconfigure(const PerUnitBase& base, const MachinePu& machine,
+                                    const ModelExtensions& x) noexcept {
+  base_ = base;
+  machine_ = machine;
+  inv_current_A_ = 1.0 / base.current_A;
+  inv_voltage_V_ = 1.0 / base.voltage_V;
+  inv_omega_rad_s_ = 1.0 / base.omega_el_rad_s;
+  extensions_ = x;
+  inv_current_gain_ = (Vec3::Ones() + x.current_gain_error).cwiseInverse();
+  inv_r_fe_pu_ = x.iron_loss_r_fe_Ohm > 0.0 ? base_.impedance_Ohm / x.iron_loss_r_fe_Ohm : 0.0;
+  offset_rotation_ = Rotation::of(x.theta_offset_rad);
 }
 
-Vec2 SampleConditioner::current_dq_A(const DriveSample& s, const Rotation& rot) const noexcept {
+Vec2 SampleConditioner::current_alphabeta_A(const DriveSample& s, const Rotation& logged) const noexcept {
+  const bool phase_corrections = !extensions_.current_offset_A.isZero() || !extensions_.current_gain_error.isZero();
+  Vec2 i_ab;
   switch (s.current_frame) {
-    case Frame::kAbc: {
-      const Vec3 corrected = (s.i_A - corrections_.current_offset_A).cwiseProduct(inv_current_gain_);
-      return park(clarke(corrected), rot);
-    }
+    case Frame::kAbc:
+      return clarke((s.i_A - extensions_.current_offset_A).cwiseProduct(inv_current_gain_));
     case Frame::kAlphaBeta:
-      return park(s.i_A.head<2>(), rot);
+      i_ab = s.i_A.head<2>();
+      break;
     case Frame::kDq:
+      i_ab = inverse_park(s.i_A.head<2>(), logged);
       break;
   }
-  return s.i_A.head<2>();
+  // A drive that logs αβ or dq made them from its phase measurements; the corrections act there.
+  if (phase_corrections) i_ab = clarke((inverse_clarke(i_ab) - extensions_.current_offset_A).cwiseProduct(inv_current_gain_));
+  return i_ab;
 }
 
-Vec2 SampleConditioner::command_alphabeta_V(const DriveSample& s, const Rotation& rot) noexcept {
+Vec2 SampleConditioner::command_alphabeta_V(const DriveSample& s, const Rotation& logged) noexcept {
   switch (s.voltage_frame) {
     case Frame::kAbc:
       return clarke(s.u_V);
@@ -54,17 +63,61 @@ Vec2 SampleConditioner::command_alphabeta_V(const DriveSample& s, const Rotation
     case Frame::kDq:
       break;
   }
-  return inverse_park(s.u_V.head<2>(), rot);
+  return inverse_park(s.u_V.head<2>(), logged);
+}
+
+double SampleConditioner::deadtime_voltage_V(double u_dc_V) const noexcept {
+  return extensions_.deadtime_v_err_V + extensions_.deadtime_t_dead_s * extensions_.switching_frequency_Hz * u_dc_V;
 }
 
 Vec2 SampleConditioner::deadtime_error_alphabeta_V(const Vec2& i_ab_A, double u_dc_V) const noexcept {
-  const InputCorrections& c = corrections_;
-  const double v_err = c.deadtime_v_err_V + c.deadtime_t_dead_s * c.switching_frequency_Hz * u_dc_V;
+  const double v_err = deadtime_voltage_V(u_dc_V);
   if (v_err == 0.0) return Vec2::Zero();
   const Vec3 i_abc = inverse_clarke(i_ab_A);
   Vec3 leg_error;
-  for (int x = 0; x < 3; ++x) leg_error[x] = -v_err * soft_sign(i_abc[x], c.deadtime_current_band_A);
+  for (int x = 0; x < 3; ++x) leg_error[x] = -v_err * soft_sign(i_abc[x], extensions_.deadtime_current_band_A);
   return clarke(leg_error);  // the zero sequence does not reach the machine
+}
+
+SampleConditioner::Measured SampleConditioner::measure(const DriveSample& s) const noexcept {
+  Measured m;
+  m.logged = Rotation::of(s.theta_el_rad);
+  m.rot = extensions_.theta_offset_rad == 0.0 ? m.logged : compose(m.logged, offset_rotation_);
+  m.i_ab_A = current_alphabeta_A(s, m.logged);
+  m.i_dq_pu = park(m.i_ab_A, m.rot) * inv_current_A_;
+  m.n_pu = s.omega_el_rad_s * inv_omega_rad_s_;  // base_.speed_pu(), without the division
+  m.x_d_pu = machine_.x_d_pu;
+  m.x_q_pu = machine_.x_q_pu;
+  if (extensions_.saturation()) {
+    m.x_d_pu *= extensions_.inductance_d.factor(m.i_dq_pu[0] * base_.current_A);
+    m.x_q_pu *= extensions_.inductance_q.factor(m.i_dq_pu[1] * base_.current_A);
+  }
+  m.i_fe_dq_pu.setZero();
+  if (inv_r_fe_pu_ > 0.0) {
+    // Iron loss: the induced voltage n·J·ψ drives i_fe = n·J·ψ/r_fe beside the magnetising current.
+    const Vec2 psi(m.x_d_pu * m.i_dq_pu[0] + machine_.psi_m_pu, m.x_q_pu * m.i_dq_pu[1]);
+    m.i_fe_dq_pu = (m.n_pu * inv_r_fe_pu_) * Vec2(-psi[1], psi[0]);
+    m.i_dq_pu -= m.i_fe_dq_pu;
+  }
+  return m;
+}
+
+SteadyStateInputs SampleConditioner::steady_state(const DriveSample& s) const noexcept {
+  SteadyStateInputs out;
+  const Measured m = measure(s);
+  Vec2 u_dq_V = park(command_alphabeta_V(s, m.logged), m.rot);
+  const double v_err = deadtime_voltage_V(s.u_dc_V);
+  const double i_norm = m.i_ab_A.norm();
+  if (v_err != 0.0 && i_norm > 0.0) {
+    // The six-step leg error's fundamental, opposite to the current: amplitude (4/π)·v_err.
+    u_dq_V -= (4.0 / kPi) * v_err * park(m.i_ab_A, m.rot) / i_norm;
+  }
+  out.u_pu = u_dq_V * inv_voltage_V_ - machine_.r_s_pu * m.i_fe_dq_pu;
+  out.i_pu = m.i_dq_pu;
+  out.n_pu = m.n_pu;
+  out.x_d_pu = m.x_d_pu;
+  out.x_q_pu = m.x_q_pu;
+  return out;
 }
 
 EstimatorSample SampleConditioner::condition(const DriveSample& s) noexcept {
@@ -75,37 +128,40 @@ EstimatorSample SampleConditioner::condition(const DriveSample& s) noexcept {
     return out;
   }
 
-  const Rotation rot = Rotation::of(s.theta_el_rad + corrections_.theta_offset_rad);
-  const Vec2 i_dq_A = current_dq_A(s, rot);
-  const double n_pu = s.omega_el_rad_s * inv_omega_rad_s_;  // base_.speed_pu(), without the division
-  out.i_meas_pu = i_dq_A * inv_current_A_;
+  const Measured m = measure(s);
+  out.i_meas_pu = m.i_dq_pu;
+  if (extensions_.saturation()) {
+    out.x_d_pu = m.x_d_pu;
+    out.x_q_pu = m.x_q_pu;
+  }
 
-  // The command issued now, as the machine will see it (dead-time from the current at issue time).
-  const Vec2 u_applied_ab_V =
-      command_alphabeta_V(s, rot) + deadtime_error_alphabeta_V(inverse_park(i_dq_A, rot), s.u_dc_V);
+  // The command issued now, as the machine will see it (dead-time from the current at issue time;
+  // the resistive drop of the iron-loss current, which the magnetising-current model does not carry).
+  Vec2 u_applied_ab_V = command_alphabeta_V(s, m.logged) + deadtime_error_alphabeta_V(m.i_ab_A, s.u_dc_V);
+  if (inv_r_fe_pu_ > 0.0) u_applied_ab_V -= inverse_park(m.i_fe_dq_pu, m.rot) * (machine_.r_s_pu * base_.voltage_V);
 
   if (has_previous_ && !s.gap_before) {
     auto& iv = out.interval;
     iv.dt_s = 1e-9 * static_cast<double>(s.t_ns - previous_t_ns_);
     iv.n_start_pu = previous_n_pu_;
-    iv.n_end_pu = n_pu;
+    iv.n_end_pu = m.n_pu;
     // Delay extension: the first `delay` of the interval still sees the command before.
-    const double w = iv.dt_s > 0.0 ? std::clamp(corrections_.delay_s / iv.dt_s, 0.0, 1.0) : 0.0;
+    const double w = iv.dt_s > 0.0 ? std::clamp(extensions_.delay_s / iv.dt_s, 0.0, 1.0) : 0.0;
     const Vec2 u_held_ab_pu = ((1.0 - w) * previous_u_ab_V_ + w * older_u_ab_V_) * inv_voltage_V_;
     iv.u_start_pu = park(u_held_ab_pu, previous_rotation_);
-    iv.u_end_pu = park(u_held_ab_pu, rot);
+    iv.u_end_pu = park(u_held_ab_pu, m.rot);
   } else {
     out.resync = true;
     // The gap's length (0 for the first sample) lets the estimator keep ε across a short one.
     out.interval.dt_s = has_previous_ ? 1e-9 * static_cast<double>(s.t_ns - previous_t_ns_) : 0.0;
-    out.interval.n_start_pu = n_pu;
-    out.interval.n_end_pu = n_pu;
+    out.interval.n_start_pu = m.n_pu;
+    out.interval.n_end_pu = m.n_pu;
   }
 
   older_u_ab_V_ = has_previous_ ? previous_u_ab_V_ : u_applied_ab_V;
   previous_u_ab_V_ = u_applied_ab_V;
-  previous_rotation_ = rot;
-  previous_n_pu_ = n_pu;
+  previous_rotation_ = m.rot;
+  previous_n_pu_ = m.n_pu;
   previous_t_ns_ = s.t_ns;
   has_previous_ = true;
   return out;

@@ -4,7 +4,7 @@ namespace rpem::core {
 
 DriveEstimator::DriveEstimator(const MachineSi& machine, const EstimatorSettings& settings) noexcept
     : base_(PerUnitBase::from_rated(machine.rated)),
-      conditioner_(base_, settings.corrections),
+      conditioner_(base_, to_pu(base_, machine), settings.extensions),
       core_(make_estimator_config(base_, machine, settings)) {}
 
 Estimate DriveEstimator::step(const DriveSample& sample) noexcept {
@@ -37,7 +37,7 @@ void DriveEstimator::set_estimates(double psi_m_Wb, double r_s_Ohm) noexcept {
 
 void DriveEstimator::reconfigure(const MachineSi& machine, const EstimatorSettings& settings) noexcept {
   base_ = PerUnitBase::from_rated(machine.rated);
-  conditioner_.set_corrections(settings.corrections);
+  conditioner_.reconfigure(base_, to_pu(base_, machine), settings.extensions);
   core_.reconfigure(make_estimator_config(base_, machine, settings));
 }
 

@@ -57,14 +57,18 @@ void RpemEstimator::reconfigure(const EstimatorConfig& config) noexcept {
   (void)project(config_.bounds, state_.theta_pu);
 }
 
-MachinePu RpemEstimator::model_with_estimates() const noexcept {
+MachinePu RpemEstimator::model_for(const EstimatorSample& sample) const noexcept {
   MachinePu m = config_.model;
   m.psi_m_pu = state_.theta_pu[kPsiM];
   m.r_s_pu = state_.theta_pu[kRs];
+  if (sample.x_d_pu > 0.0 && sample.x_q_pu > 0.0) {
+    m.x_d_pu = sample.x_d_pu;
+    m.x_q_pu = sample.x_q_pu;
+  }
   return m;
 }
 
-void RpemEstimator::synchronize(const EstimatorSample& sample) noexcept {
+void RpemEstimator::synchronize(const EstimatorSample& sample, const MachinePu& model) noexcept {
   const double gap = sample.interval.dt_s;
   const bool carry = state_.synchronized && state_.epsilon_valid && gap > 0.0 && gap <= config_.max_gap_carry_s;
   if (carry) {
@@ -72,15 +76,14 @@ void RpemEstimator::synchronize(const EstimatorSample& sample) noexcept {
   } else {
     state_.predictor.i_hat_pu = sample.i_meas_pu;
     // Start the dynamic gradients at their equilibrium so they need no settling time.
-    state_.predictor.gradient =
-        steady_state_gradients(model_with_estimates(), sample.interval.n_end_pu, sample.i_meas_pu);
+    state_.predictor.gradient = steady_state_gradients(model, sample.interval.n_end_pu, sample.i_meas_pu);
     state_.epsilon_valid = false;
   }
   state_.synchronized = true;
 }
 
-Mat2 RpemEstimator::select_gradient(double n_pu) const noexcept {
-  const Mat2 steady = steady_state_gradients(model_with_estimates(), n_pu, state_.predictor.i_hat_pu);
+Mat2 RpemEstimator::select_gradient(const MachinePu& model, double n_pu) const noexcept {
+  const Mat2 steady = steady_state_gradients(model, n_pu, state_.predictor.i_hat_pu);
   Mat2 g = state_.predictor.gradient;
   if (config_.gradient_psi_m == GradientForm::kSteadyState) g.col(kPsiM) = steady.col(kPsiM);
   if (config_.gradient_r_s == GradientForm::kSteadyState) g.col(kRs) = steady.col(kRs);
@@ -99,20 +102,23 @@ EstimatorOutput RpemEstimator::step(const EstimatorSample& sample) noexcept {
     return out;
   }
   const auto& iv = sample.interval;
+  const MachinePu model = model_for(sample);
   if (sample.resync || !state_.synchronized || !(iv.dt_s > 0.0) || iv.dt_s > config_.max_sample_interval_s) {
-    synchronize(sample);
+    synchronize(sample, model);
     out.i_hat_pu = state_.predictor.i_hat_pu;
     out.code = StepCode::kSynchronized;
     return out;
   }
 
-  const MachinePu model = model_with_estimates();
-  predict(model, coefficients_, config_.discretization, iv, state_.predictor);
+  // Saturation extensions give each sample its own inductances (two divisions); else the cached ones.
+  const PredictorCoefficients coefficients =
+      sample.x_d_pu > 0.0 ? PredictorCoefficients::of(model, config_.omega_n_rad_s) : coefficients_;
+  predict(model, coefficients, config_.discretization, iv, state_.predictor);
   const Vec2& i_hat = state_.predictor.i_hat_pu;
   if (!i_hat.allFinite() || i_hat.lpNorm<Eigen::Infinity>() > config_.max_predicted_current_pu ||
       !state_.predictor.gradient.allFinite()) {
     state_.epsilon_valid = false;
-    synchronize(sample);
+    synchronize(sample, model);
     out.i_hat_pu = state_.predictor.i_hat_pu;
     out.code = StepCode::kPredictorDiverged;
     return out;
@@ -122,7 +128,7 @@ EstimatorOutput RpemEstimator::step(const EstimatorSample& sample) noexcept {
   out.epsilon_pu = sample.i_meas_pu - i_hat;
   state_.last_epsilon_pu = out.epsilon_pu;
   state_.epsilon_valid = true;
-  out.gradient = select_gradient(iv.n_end_pu);
+  out.gradient = select_gradient(model, iv.n_end_pu);
 
   const double factor = iv.dt_s * inverse_nominal_period_;
   const GainSequences& seq = config_.gains[static_cast<std::size_t>(config_.algorithm)];

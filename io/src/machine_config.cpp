@@ -113,8 +113,27 @@ core::EstimatorSettings parse_estimator(YamlMap e, const core::MachineSi& machin
   return s;
 }
 
-core::InputCorrections parse_extensions(YamlMap x) {
-  core::InputCorrections c;
+core::InductanceCurve parse_inductance_curve(YamlMap m) {
+  core::InductanceCurve c;
+  c.level = m.number_or("level", 1.0, 0.05, 20.0);
+  c.curvature_per_A2 = m.number_or("curvature_per_A2", 0.0, -1e3, 1e3);
+  m.finish();
+  return c;
+}
+
+ParameterDrift parse_drift(YamlMap m, const char* ref_key, double ref_min, double ref_max) {
+  ParameterDrift d;
+  if (m.has("coeff_per_K")) d.coeff_per_K = m.number("coeff_per_K", -0.1, 0.1);
+  d.reference_C = m.number_or("reference_C", 20.0, -273.0, 500.0);
+  if (m.has(ref_key)) d.value_ref = m.number(ref_key, ref_min, ref_max);
+  if (m.has("rel_change")) d.rel_change = m.number("rel_change", -0.9, 10.0);
+  if (!d.coeff_per_K && !d.rel_change) m.fail("coeff_per_K", "a drift needs coeff_per_K or rel_change");
+  m.finish();
+  return d;
+}
+
+void parse_extensions(YamlMap x, MachineConfig& config) {
+  core::ModelExtensions& c = config.estimator.extensions;
   if (auto d = x.optional_map("deadtime")) {
     c.deadtime_t_dead_s = d->number_or("t_dead_s", 0.0, 0.0, 1e-3);
     c.switching_frequency_Hz = d->number_or("switching_frequency_Hz", 0.0, 0.0, 1e6);
@@ -130,10 +149,7 @@ core::InputCorrections parse_extensions(YamlMap x) {
     t->finish();
   }
   for (const char* kind : {"current_offset", "current_gain"}) {
-    if (!x.has(kind)) {
-      (void)x.optional_map(kind);
-      continue;
-    }
+    if (!x.has(kind)) continue;
     for (YamlMap& p : x.maps(kind)) {
       const std::string phase = p.choice("phase", {"a", "b", "c"});
       const int k = phase[0] - 'a';
@@ -149,8 +165,15 @@ core::InputCorrections parse_extensions(YamlMap x) {
     c.delay_s = d->number("delay_s", 0.0, 1e-2);
     d->finish();
   }
+  if (auto l = x.optional_map("ld_saturation")) c.inductance_d = parse_inductance_curve(*l);
+  if (auto l = x.optional_map("lq_saturation")) c.inductance_q = parse_inductance_curve(*l);
+  if (auto f = x.optional_map("iron_loss")) {
+    c.iron_loss_r_fe_Ohm = f->number("r_fe_Ohm", 1e-3, 1e9);
+    f->finish();
+  }
+  if (auto r = x.optional_map("rs_drift")) config.rs_drift = parse_drift(*r, "r_s_ref_Ohm", 1e-6, 1e4);
+  if (auto p = x.optional_map("psim_drift")) config.psim_drift = parse_drift(*p, "psi_m_ref_Wb", 1e-6, 100.0);
   x.finish();
-  return c;
 }
 
 }  // namespace
@@ -178,7 +201,7 @@ MachineConfig parse_machine_config(YamlMap& root) {
   MachineConfig c;
   c.machine = parse_machine(root.map("machine"));
   c.estimator = parse_estimator(root.map("estimator"), c.machine);
-  if (auto x = root.optional_map("model_extensions")) c.estimator.corrections = parse_extensions(*x);
+  if (auto x = root.optional_map("model_extensions")) parse_extensions(*x, c);
   return c;
 }
 

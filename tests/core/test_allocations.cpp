@@ -50,9 +50,16 @@ TEST_P(Allocations, NoneAcrossOneHundredThousandSteps) {
   EstimatorSettings settings = test::paper_settings(GetParam().algorithm);
   settings.gradient_psi_m = settings.gradient_r_s = GetParam().form;
   settings.discretization = GetParam().discretization;
-  settings.corrections.deadtime_t_dead_s = 1e-6;  // exercise the input extensions too
-  settings.corrections.switching_frequency_Hz = 4000.0;
-  settings.corrections.delay_s = 10e-6;
+  // Every model extension on, so their per-sample paths are counted too.
+  ModelExtensions& x = settings.extensions;
+  x.deadtime_t_dead_s = 1e-6;
+  x.switching_frequency_Hz = 4000.0;
+  x.delay_s = 10e-6;
+  x.theta_offset_rad = 0.02;
+  x.current_offset_A = Vec3(0.05, 0.0, -0.02);
+  x.current_gain_error = Vec3(0.01, 0.0, 0.0);
+  x.inductance_q = {1.1, -0.002};
+  x.iron_loss_r_fe_Ohm = 3000.0;
   DriveEstimator est(test::paper_machine_si(), settings);
   test::ModelDataGenerator gen;
   gen.plant = test::paper_machine_pu();

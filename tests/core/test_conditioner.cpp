@@ -23,7 +23,7 @@ DriveSample sample(std::int64_t t_ns, double theta, const Vec3& u_abc, const Vec
 
 TEST(Conditioner, HeldStatorCommandEntersAtBothEndsOfTheInterval) {
   const PerUnitBase b = test::paper_base();
-  SampleConditioner c(b, {});
+  SampleConditioner c(b, test::paper_machine_pu(), {});
   const Vec3 u0(100.0, -30.0, -70.0), u1(10.0, 20.0, -30.0), i(1.0, 2.0, -3.0);
   const EstimatorSample first = c.condition(sample(0, 0.3, u0, i));
   EXPECT_TRUE(first.resync);
@@ -39,7 +39,7 @@ TEST(Conditioner, HeldStatorCommandEntersAtBothEndsOfTheInterval) {
 
 TEST(Conditioner, RotorFrameCommandIsHeldInTheStatorFrame) {
   const PerUnitBase b = test::paper_base();
-  SampleConditioner c(b, {});
+  SampleConditioner c(b, test::paper_machine_pu(), {});
   DriveSample s0 = sample(0, 1.0, Vec3(50.0, 20.0, 0.0), Vec3(1.0, 0.5, 0.0));
   s0.voltage_frame = Frame::kDq;
   s0.current_frame = Frame::kDq;
@@ -55,7 +55,7 @@ TEST(Conditioner, RotorFrameCommandIsHeldInTheStatorFrame) {
 }
 
 TEST(Conditioner, GapAndNonFiniteInputRestartTheChain) {
-  SampleConditioner c(test::paper_base(), {});
+  SampleConditioner c(test::paper_base(), test::paper_machine_pu(), {});
   (void)c.condition(sample(0, 0.0, Vec3::Zero(), Vec3::Zero()));
   DriveSample gap = sample(125'000, 0.0, Vec3::Zero(), Vec3::Zero());
   gap.gap_before = true;
@@ -68,10 +68,10 @@ TEST(Conditioner, GapAndNonFiniteInputRestartTheChain) {
 TEST(Conditioner, DeadTimeVoltageErrorOpposesEachPhaseCurrent) {
   // Textbook: each leg loses v_err = t_dead·f_sw·u_dc in the direction of its current.
   const PerUnitBase b = test::paper_base();
-  InputCorrections corr;
+  ModelExtensions corr;
   corr.deadtime_t_dead_s = 2e-6;
   corr.switching_frequency_Hz = 4000.0;
-  SampleConditioner c(b, corr);
+  SampleConditioner c(b, test::paper_machine_pu(), corr);
   const Vec3 i(2.0, -0.5, -1.5), u(0.0, 0.0, 0.0);
   (void)c.condition(sample(0, 0.0, u, i));
   const EstimatorSample out = c.condition(sample(125'000, 0.0, u, i));
@@ -82,11 +82,11 @@ TEST(Conditioner, DeadTimeVoltageErrorOpposesEachPhaseCurrent) {
 
 TEST(Conditioner, AngleOffsetAndCurrentSensorCorrections) {
   const PerUnitBase b = test::paper_base();
-  InputCorrections corr;
+  ModelExtensions corr;
   corr.theta_offset_rad = 0.05;
   corr.current_offset_A = Vec3(0.1, 0.0, 0.0);
   corr.current_gain_error = Vec3(0.0, 0.02, 0.0);
-  SampleConditioner c(b, corr);
+  SampleConditioner c(b, test::paper_machine_pu(), corr);
   const Vec3 i_true(1.0, -0.4, -0.6);
   const Vec3 i_meas(1.0 + 0.1, -0.4 * 1.02, -0.6);
   const EstimatorSample out = c.condition(sample(0, 0.7, Vec3::Zero(), i_meas));
@@ -95,15 +95,90 @@ TEST(Conditioner, AngleOffsetAndCurrentSensorCorrections) {
 
 TEST(Conditioner, DelayBlendsThePreviousCommandIntoTheInterval) {
   const PerUnitBase b = test::paper_base();
-  InputCorrections corr;
+  ModelExtensions corr;
   corr.delay_s = 25e-6;
-  SampleConditioner c(b, corr);
+  SampleConditioner c(b, test::paper_machine_pu(), corr);
   const Vec3 ua(10.0, -5.0, -5.0), ub(-20.0, 10.0, 10.0);
   (void)c.condition(sample(0, 0.0, ua, Vec3::Zero()));
   (void)c.condition(sample(125'000, 0.0, ub, Vec3::Zero()));
   const EstimatorSample out = c.condition(sample(250'000, 0.0, ua, Vec3::Zero()));
   const Vec2 expected = (0.8 * clarke(ub) + 0.2 * clarke(ua)) / b.voltage_V;
   EXPECT_LT((out.interval.u_start_pu - expected).norm(), 1e-15);
+}
+
+TEST(Conditioner, RotorFrameLogsTakeTheAngleOffsetAndPhaseCorrectionsToo) {
+  // A dq log was made with the logged angle: back to the stator frame with it, forward with the true one.
+  const PerUnitBase b = test::paper_base();
+  ModelExtensions corr;
+  corr.theta_offset_rad = -0.04;
+  corr.current_offset_A = Vec3(0.0, 0.2, 0.0);
+  SampleConditioner c(b, test::paper_machine_pu(), corr);
+  const Rotation logged = Rotation::of(0.9), truth = Rotation::of(0.86);
+  const Vec3 i_true(1.5, -0.2, -1.3);
+  const Vec2 i_dq_logged = park(clarke(i_true + corr.current_offset_A), logged);
+  DriveSample s = sample(0, 0.9, Vec3(30.0, 40.0, 0.0), Vec3(i_dq_logged[0], i_dq_logged[1], 0.0));
+  s.voltage_frame = s.current_frame = Frame::kDq;
+  const EstimatorSample out = c.condition(s);
+  EXPECT_LT((out.i_meas_pu - park(clarke(i_true), truth) / b.current_A).norm(), 1e-14);
+  const SteadyStateInputs ss = c.steady_state(s);
+  EXPECT_LT((ss.u_pu - park(inverse_park(Vec2(30.0, 40.0), logged), truth) / b.voltage_V).norm(), 1e-14);
+}
+
+TEST(Conditioner, SaturationCurvesGiveEachSampleItsInductances) {
+  // L(i) = L_nom·(level + curvature·i²) per axis, at the measured axis current.
+  const PerUnitBase b = test::paper_base();
+  const MachinePu m = test::paper_machine_pu();
+  ModelExtensions corr;
+  corr.inductance_d = {1.05, 0.0};
+  corr.inductance_q = {1.2, -0.004};
+  SampleConditioner c(b, m, corr);
+  const Vec2 i_dq_A(-2.0, 5.0);
+  const Vec3 i_abc = inverse_clarke(inverse_park(i_dq_A, Rotation::of(0.3)));
+  const EstimatorSample out = c.condition(sample(0, 0.3, Vec3::Zero(), i_abc));
+  EXPECT_NEAR(out.x_d_pu, m.x_d_pu * 1.05, 1e-14);
+  EXPECT_NEAR(out.x_q_pu, m.x_q_pu * (1.2 - 0.004 * 25.0), 1e-13);
+  SampleConditioner nominal(b, m, {});
+  EXPECT_EQ(nominal.condition(sample(0, 0.3, Vec3::Zero(), i_abc)).x_q_pu, 0.0);  // 0: the configured model
+}
+
+TEST(Conditioner, IronLossCurrentIsRemovedAndItsResistiveDropToo) {
+  // i_s = i_m + n·J·ψ(i_m)/r_fe; the model sees i_m and u − r_s·i_fe (docs/model-extensions.md).
+  const PerUnitBase b = test::paper_base();
+  const MachinePu m = test::paper_machine_pu();
+  ModelExtensions corr;
+  corr.iron_loss_r_fe_Ohm = 2000.0;
+  SampleConditioner c(b, m, corr);
+  const double n = 31.4 / b.omega_el_rad_s, r_fe = 2000.0 / b.impedance_Ohm;
+  const Vec2 i_pu(-0.2, 0.5);
+  const Vec2 psi(m.x_d_pu * i_pu[0] + m.psi_m_pu, m.x_q_pu * i_pu[1]);
+  const Vec2 i_fe = n / r_fe * Vec2(-psi[1], psi[0]);
+  DriveSample s = sample(0, 0.0, Vec3(100.0, 50.0, 0.0), Vec3(i_pu[0] * b.current_A, i_pu[1] * b.current_A, 0.0));
+  s.voltage_frame = s.current_frame = Frame::kDq;
+  const SteadyStateInputs ss = c.steady_state(s);
+  EXPECT_LT((ss.i_pu - (i_pu - i_fe)).norm(), 1e-14);
+  EXPECT_LT((ss.u_pu - (Vec2(100.0, 50.0) / b.voltage_V - m.r_s_pu * i_fe)).norm(), 1e-14);
+}
+
+TEST(Conditioner, SteadyStateDeadTimeIsTheRevolutionAverageOfTheLegErrors) {
+  // Independent computation: average the six-step leg errors of balanced currents over one electrical
+  // revolution in the rotor frame; its mean is the fundamental −(4/π)·v_err·i/|i|.
+  const PerUnitBase b = test::paper_base();
+  ModelExtensions corr;
+  corr.deadtime_v_err_V = 3.0;
+  SampleConditioner c(b, test::paper_machine_pu(), corr);
+  const Vec2 i_dq(-1.0, 4.0);
+  Vec2 mean = Vec2::Zero();
+  constexpr int kSteps = 36000;
+  for (int k = 0; k < kSteps; ++k) {
+    const Rotation r = Rotation::of(2.0 * kPi * (k + 0.5) / kSteps);
+    const Vec3 i_abc = inverse_clarke(inverse_park(i_dq, r));
+    Vec3 leg;
+    for (int x = 0; x < 3; ++x) leg[x] = i_abc[x] > 0.0 ? -3.0 : 3.0;
+    mean += park(clarke(leg), r) / kSteps;
+  }
+  DriveSample s = sample(0, 1.1, Vec3::Zero(), Vec3(i_dq[0], i_dq[1], 0.0));
+  s.voltage_frame = s.current_frame = Frame::kDq;
+  EXPECT_LT((c.steady_state(s).u_pu * b.voltage_V - mean).norm(), 2e-3);  // quadrature error of the average
 }
 
 TEST(DriveEstimator, SiPhaseSamplesConvergeLikeThePerUnitPath) {

@@ -60,7 +60,7 @@ TEST(MachineConfig, PaperFileMatchesThePaperTables) {
   EXPECT_DOUBLE_EQ(phy.gain[0], 3.25e-4);
   EXPECT_DOUBLE_EQ(phy.gain[1], 6.25e-5);
   EXPECT_DOUBLE_EQ(e.nominal_sample_period_s, 125e-6);
-  EXPECT_EQ(e.corrections.theta_offset_rad, 0.0);
+  EXPECT_EQ(e.extensions.theta_offset_rad, 0.0);
 }
 
 TEST(MachineConfig, BuiltInConfigIsThePaperFile) {
@@ -103,7 +103,11 @@ INSTANTIATE_TEST_SUITE_P(
         BadEdit{"bool", "psi_m: true", "psi_m: yes please", "expected true or false"},
         BadEdit{"syntax", "machine:", "machine: [", "YAML syntax"},
         BadEdit{"ext_unknown", "\nestimator:", "\nmodel_extensions:\n  deadtime: {t_dead_s: 1.0e-6, switching_frequency_Hz: 4000, colour: red}\nestimator:",
-                "model_extensions.deadtime.colour: unknown key"}),
+                "model_extensions.deadtime.colour: unknown key"},
+        BadEdit{"drift_without_law", "\nestimator:", "\nmodel_extensions:\n  rs_drift: {reference_C: 20}\nestimator:",
+                "a drift needs coeff_per_K or rel_change"},
+        BadEdit{"negative_r_fe", "\nestimator:", "\nmodel_extensions:\n  iron_loss: {r_fe_Ohm: -5}\nestimator:",
+                "iron_loss.r_fe_Ohm"}),
     [](const auto& p) { return std::string(p.param.name); });
 
 TEST(MachineConfig, ModelExtensionsAreRead) {
@@ -113,15 +117,27 @@ TEST(MachineConfig, ModelExtensionsAreRead) {
                            "  theta_offset: {offset_rad: 0.05}\n"
                            "  current_offset: [{phase: b, offset_A: 0.1}]\n"
                            "  current_gain: [{phase: c, gain_error: -0.02}]\n"
-                           "  delay: {delay_s: 1.0e-5}\n";
+                           "  delay: {delay_s: 1.0e-5}\n"
+                           "  lq_saturation: {level: 1.2, curvature_per_A2: -0.001}\n"
+                           "  iron_loss: {r_fe_Ohm: 2500}\n"
+                           "  rs_drift: {coeff_per_K: 0.0039, reference_C: 25}\n"
+                           "  psim_drift: {rel_change: -0.05}\n";
   test::TempFile f("ext.yaml", text);
   const MachineConfig c = load_machine_config(f.path());
-  EXPECT_DOUBLE_EQ(c.estimator.corrections.deadtime_t_dead_s, 2e-6);
-  EXPECT_DOUBLE_EQ(c.estimator.corrections.switching_frequency_Hz, 4000.0);
-  EXPECT_DOUBLE_EQ(c.estimator.corrections.theta_offset_rad, 0.05);
-  EXPECT_DOUBLE_EQ(c.estimator.corrections.current_offset_A[1], 0.1);
-  EXPECT_DOUBLE_EQ(c.estimator.corrections.current_gain_error[2], -0.02);
-  EXPECT_DOUBLE_EQ(c.estimator.corrections.delay_s, 1e-5);
+  EXPECT_DOUBLE_EQ(c.estimator.extensions.deadtime_t_dead_s, 2e-6);
+  EXPECT_DOUBLE_EQ(c.estimator.extensions.switching_frequency_Hz, 4000.0);
+  EXPECT_DOUBLE_EQ(c.estimator.extensions.theta_offset_rad, 0.05);
+  EXPECT_DOUBLE_EQ(c.estimator.extensions.current_offset_A[1], 0.1);
+  EXPECT_DOUBLE_EQ(c.estimator.extensions.current_gain_error[2], -0.02);
+  EXPECT_DOUBLE_EQ(c.estimator.extensions.delay_s, 1e-5);
+  EXPECT_DOUBLE_EQ(c.estimator.extensions.inductance_q.level, 1.2);
+  EXPECT_DOUBLE_EQ(c.estimator.extensions.inductance_q.curvature_per_A2, -0.001);
+  EXPECT_TRUE(c.estimator.extensions.inductance_d.nominal());
+  EXPECT_DOUBLE_EQ(c.estimator.extensions.iron_loss_r_fe_Ohm, 2500.0);
+  EXPECT_DOUBLE_EQ(c.rs_drift.coeff_per_K.value(), 0.0039);
+  EXPECT_DOUBLE_EQ(c.rs_drift.reference_C, 25.0);
+  EXPECT_FALSE(c.psim_drift.coeff_per_K.has_value());
+  EXPECT_DOUBLE_EQ(c.psim_drift.rel_change.value(), -0.05);
 }
 
 TEST(MachineConfig, MissingFileIsAConfigError) {

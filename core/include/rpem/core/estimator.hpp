@@ -49,6 +49,9 @@ struct EstimatorSample {
   PredictorInterval interval;  ///< with resync: dt_s is the gap since the last sample (0: none known)
   Vec2 i_meas_pu = Vec2::Zero();
   bool resync = false;  ///< first sample, or samples were lost before this one
+  /// Model inductances at this sample's current (the saturation extensions); 0: the configured ones.
+  double x_d_pu = 0.0;
+  double x_q_pu = 0.0;
 };
 
 /// Stable result codes; they are published in diagnostics (numbers never change).
@@ -115,9 +118,10 @@ class RpemEstimator {
  private:
   /// Re-anchors the predictor on the measurement. Across a short gap in a running stream it keeps the
   /// last prediction error (î = i − ε), which the open-loop predictor needs a time constant to rebuild.
-  void synchronize(const EstimatorSample& sample) noexcept;
-  [[nodiscard]] MachinePu model_with_estimates() const noexcept;
-  [[nodiscard]] Mat2 select_gradient(double n_pu) const noexcept;
+  void synchronize(const EstimatorSample& sample, const MachinePu& model) noexcept;
+  /// The configured model with the current estimates and the sample's inductances, if it has any.
+  [[nodiscard]] MachinePu model_for(const EstimatorSample& sample) const noexcept;
+  [[nodiscard]] Mat2 select_gradient(const MachinePu& model, double n_pu) const noexcept;
 
   EstimatorConfig config_;
   EstimatorState state_;

@@ -40,7 +40,7 @@ struct EstimatorSettings {
   double max_gap_carry_s = 20e-3;
   bool adapt_psi_m = true;
   bool adapt_r_s = true;
-  InputCorrections corrections;
+  ModelExtensions extensions;  ///< model_extensions (docs/model-extensions.md)
 };
 
 [[nodiscard]] MachinePu to_pu(const PerUnitBase& base, const MachineSi& m) noexcept;

@@ -2,6 +2,7 @@
 // Loads the machine + estimator configuration (schema: docs/configuration.md; example:
 // config/paper-ipmsm.yaml). Unknown keys and out-of-range values are rejected with file:line.
 
+#include <optional>
 #include <string>
 
 #include "rpem/core/settings.hpp"
@@ -9,9 +10,22 @@
 
 namespace rpem::io {
 
+/// A parameter's thermal drift (model_extensions.rs_drift / psim_drift, found by `rpem diagnose`):
+///   value(T) = value_ref·(1 + coeff_per_K·(T − reference_C))
+/// or, where the log had no temperatures, its relative change over the log (informational). The
+/// estimator tracks ψm and R_s itself; a coefficient calibrates rpemd's temperature derivation.
+struct ParameterDrift {
+  std::optional<double> coeff_per_K;
+  double reference_C = 20.0;
+  std::optional<double> value_ref;   ///< r_s_ref_Ohm or psi_m_ref_Wb (default: the machine's)
+  std::optional<double> rel_change;  ///< change over the diagnosed log, relative to nominal
+};
+
 struct MachineConfig {
   core::MachineSi machine;
   core::EstimatorSettings estimator;
+  ParameterDrift rs_drift;
+  ParameterDrift psim_drift;
 };
 
 /// Reads the `machine`, `estimator` and optional `model_extensions` sections of `root`
