@@ -120,6 +120,36 @@ SteadyStateInputs SampleConditioner::steady_state(const DriveSample& s) const no
   return out;
 }
 
+Vec2 SampleConditioner::logged_current_dq_A(const DriveSample& s) const noexcept {
+  switch (s.current_frame) {
+    case Frame::kAbc:
+      return park(clarke(s.i_A), Rotation::of(s.theta_el_rad));
+    case Frame::kAlphaBeta:
+      return park(s.i_A.head<2>(), Rotation::of(s.theta_el_rad));
+    case Frame::kDq:
+      break;
+  }
+  return s.i_A.head<2>();
+}
+
+Vec2 SampleConditioner::observed_current_dq_A(const DriveSample& s, const Vec2& i_model_pu) const noexcept {
+  const Rotation logged = Rotation::of(s.theta_el_rad);
+  const Rotation rot = extensions_.theta_offset_rad == 0.0 ? logged : compose(logged, offset_rotation_);
+  Vec2 i_pu = i_model_pu;
+  if (inv_r_fe_pu_ > 0.0) {
+    const double x_d = machine_.x_d_pu * extensions_.inductance_d.factor(i_pu[0] * base_.current_A);
+    const double x_q = machine_.x_q_pu * extensions_.inductance_q.factor(i_pu[1] * base_.current_A);
+    const Vec2 psi(x_d * i_pu[0] + machine_.psi_m_pu, x_q * i_pu[1]);
+    i_pu += (s.omega_el_rad_s * inv_omega_rad_s_ * inv_r_fe_pu_) * Vec2(-psi[1], psi[0]);
+  }
+  Vec2 i_ab_A = inverse_park(i_pu * base_.current_A, rot);
+  if (!extensions_.current_offset_A.isZero() || !extensions_.current_gain_error.isZero()) {
+    const Vec3 i_abc = inverse_clarke(i_ab_A);
+    i_ab_A = clarke(i_abc.cwiseProduct(Vec3::Ones() + extensions_.current_gain_error) + extensions_.current_offset_A);
+  }
+  return park(i_ab_A, logged);
+}
+
 EstimatorSample SampleConditioner::condition(const DriveSample& s) noexcept {
   EstimatorSample out;
   if (!finite(s)) {

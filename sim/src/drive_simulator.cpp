@@ -41,7 +41,8 @@ DriveSimulator::DriveSimulator(Scenario scenario)
   const core::Vec2 u0 = core::steady_state_voltage(nominal, base.speed_pu(omega), i0 / base.current_A) * base.voltage_V;
   command_now_V_ = command_next_V_ = core::inverse_park(u0, core::Rotation::of(0.0));
   u_dc_meas_V_ = u_dc_V_;
-  duties_now_ = duties_next_ = duties_before_ = modulate(command_now_V_, u_dc_V_, scenario_.inverter.third_harmonic_injection);
+  duties_now_ = duties_next_ = modulate(command_now_V_, u_dc_V_, scenario_.inverter.third_harmonic_injection);
+  u_dc_modulated_V_ = u_dc_V_;
   for (std::int64_t k = -warmup_periods_; k < 0; ++k) {
     sample_and_control(static_cast<double>(k) * scenario_.sample_period_s);
     integrate(k);
@@ -77,10 +78,17 @@ void DriveSimulator::sample_and_control(double t_s) noexcept {
   omega_meas_rad_s_ = sensors_.speed();
   u_dc_meas_V_ = sensors_.dc_link(u_dc_V_);
 
-  // The command computed last period acts now; compute the next one.
+  // The command computed last period acts now; compute the next one. With an inverter delay δ < T the
+  // command acts δ late: over this period the previous command holds for δ and this one for T − δ, in
+  // volt-seconds (1 − δ/T)·u_k + (δ/T)·u_{k−1} — a transport delay under zero-order hold.
+  const core::Vec2 command_before_V = command_now_V_;
   command_now_V_ = command_next_V_;
-  duties_before_ = duties_now_;
   duties_now_ = duties_next_;
+  if (scenario_.inverter_delay_s > 0.0) {
+    const double w = std::min(scenario_.inverter_delay_s / scenario_.sample_period_s, 1.0);
+    duties_now_ = modulate((1.0 - w) * command_now_V_ + w * command_before_V, u_dc_modulated_V_,
+                           scenario_.inverter.third_harmonic_injection);
+  }
   FocInput in;
   in.i_abc_A = i_meas_A_;
   in.theta_el_rad = theta_meas_rad_;
@@ -92,6 +100,7 @@ void DriveSimulator::sample_and_control(double t_s) noexcept {
   torque_cmd_Nm_ = out.torque_ref_Nm;
   command_next_V_ = out.u_ab_V;
   duties_next_ = modulate(out.u_ab_V, u_dc_meas_V_, scenario_.inverter.third_harmonic_injection);
+  u_dc_modulated_V_ = u_dc_meas_V_;
 }
 
 void DriveSimulator::integrate(std::int64_t k) noexcept {
@@ -100,8 +109,7 @@ void DriveSimulator::integrate(std::int64_t k) noexcept {
   const double h = scenario_.plant_step_s;
   for (int s = 0; s < substeps_; ++s) {
     const double tau = s * h;
-    const Duties& d = tau < scenario_.inverter_delay_s ? duties_before_ : duties_now_;
-    plant_.step(inverter_.mean_voltage(rising, tau, h, d, plant_.phase_currents(), u_dc_V_));
+    plant_.step(inverter_.mean_voltage(rising, tau, h, duties_now_, plant_.phase_currents(), u_dc_V_));
   }
 }
 

@@ -26,6 +26,7 @@ void parse_inverter(io::YamlMap m, Scenario& s) {
   s.inverter.v_diode_V = m.number_or("v_diode_V", 0.0, 0.0, 100.0);
   s.inverter.third_harmonic_injection = m.boolean_or("third_harmonic", true);
   s.inverter_delay_s = m.number_or("delay_s", 0.0, 0.0, 1e-3);
+  if (s.inverter_delay_s >= s.sample_period_s) m.fail("delay_s", "must be below the sample period");
   m.finish();
 }
 

@@ -181,6 +181,31 @@ TEST(Conditioner, SteadyStateDeadTimeIsTheRevolutionAverageOfTheLegErrors) {
   EXPECT_LT((c.steady_state(s).u_pu * b.voltage_V - mean).norm(), 2e-3);  // quadrature error of the average
 }
 
+TEST(Conditioner, ObservationModelInvertsTheCorrections) {
+  // observed(corrected(measurement)) = measurement in the log's frame, for the sensor and angle effects
+  // exactly, and for iron loss to first order in i_fe (ψ is evaluated at the other current).
+  const PerUnitBase b = test::paper_base();
+  ModelExtensions x;
+  x.theta_offset_rad = 0.07;
+  x.current_offset_A = Vec3(0.1, -0.05, 0.0);
+  x.current_gain_error = Vec3(0.0, 0.03, -0.01);
+  SampleConditioner c(b, test::paper_machine_pu(), x);
+  const Vec3 i_true(2.0, -0.7, -1.3);  // a three-wire machine: no zero sequence
+  const DriveSample s = sample(0, 2.1, Vec3::Zero(),
+                               i_true.cwiseProduct(Vec3::Ones() + x.current_gain_error) + x.current_offset_A);
+  const EstimatorSample out = c.condition(s);
+  EXPECT_LT((c.observed_current_dq_A(s, out.i_meas_pu) - c.logged_current_dq_A(s)).norm(), 1e-13);
+  EXPECT_LT((c.logged_current_dq_A(s) - park(clarke(s.i_A), Rotation::of(2.1))).norm(), 1e-15);
+  x.iron_loss_r_fe_Ohm = 3000.0;
+  SampleConditioner with_fe(b, test::paper_machine_pu(), x);
+  const EstimatorSample fe = with_fe.condition(s);
+  const double i_fe_A = (c.logged_current_dq_A(s) - with_fe.observed_current_dq_A(s, out.i_meas_pu)).norm();
+  EXPECT_GT(i_fe_A, 1e-3);  // the model current differs by the iron-loss current …
+  // … and the round trip errs by i_fe·(the change of ψ it causes)/r_fe ≈ i_fe·|n|·x_q/r_fe.
+  const double relative = (31.4 / b.omega_el_rad_s) * test::paper_machine_pu().x_q_pu / (3000.0 / b.impedance_Ohm);
+  EXPECT_LT((with_fe.observed_current_dq_A(s, fe.i_meas_pu) - c.logged_current_dq_A(s)).norm(), 2.0 * relative * i_fe_A);
+}
+
 TEST(DriveEstimator, SiPhaseSamplesConvergeLikeThePerUnitPath) {
   const PerUnitBase base = test::paper_base();
   test::ModelDataGenerator gen;

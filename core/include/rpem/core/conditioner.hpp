@@ -68,6 +68,14 @@ class SampleConditioner {
   /// samples. Real-time safe.
   [[nodiscard]] SteadyStateInputs steady_state(const DriveSample& s) const noexcept;
 
+  /// The logged current as dq at the logged angle, uncorrected [A]: what the log itself says.
+  [[nodiscard]] Vec2 logged_current_dq_A(const DriveSample& s) const noexcept;
+  /// What the log would show for a model current (magnetising, rotor frame, pu): the extensions'
+  /// observation model — iron-loss current added, per-phase gain and offset applied — as dq at the
+  /// logged angle [A]. The inverse of the corrections condition() applies; `rpem diagnose` compares
+  /// models in this measured space.
+  [[nodiscard]] Vec2 observed_current_dq_A(const DriveSample& s, const Vec2& i_model_pu) const noexcept;
+
   /// Forgets the previous sample: the next one starts a new interval chain (resynchronises).
   void reset() noexcept { has_previous_ = false; }
 

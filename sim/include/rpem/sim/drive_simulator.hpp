@@ -71,7 +71,8 @@ class DriveSimulator {
   double u_dc_V_ = 0.0;
   core::Vec2 command_now_V_ = core::Vec2::Zero();   ///< acts over the current period
   core::Vec2 command_next_V_ = core::Vec2::Zero();  ///< computed this period, acts in the next
-  Duties duties_now_, duties_next_, duties_before_;
+  Duties duties_now_, duties_next_;
+  double u_dc_modulated_V_ = 0.0;  ///< the measured DC link duties_next_ was modulated for
   double u_dc_meas_V_ = 0.0;
   double torque_cmd_Nm_ = 0.0;
   double t_winding_C_ = 0.0;

@@ -53,7 +53,7 @@ struct Scenario {
   double sample_period_s = 125e-6;    ///< control and logging period (PWM double update)
   std::uint64_t seed = 1;
   InverterConfig inverter;
-  double inverter_delay_s = 0.0;      ///< extra delay before a new duty takes effect (hidden effect)
+  double inverter_delay_s = 0.0;      ///< the command acts this much late, < one period (hidden effect)
   double plant_step_s = 1e-6;
   std::string flux_map_file;          ///< empty: constant inductances
   MechanicsConfig mechanics;

@@ -1,0 +1,45 @@
+#pragma once
+// Drive logs with a known effect hidden in them, for testing and demonstrating `rpem diagnose`: a
+// test-bench profile on the paper's machine that gives every effect a chance to show (standstill at
+// several currents of both signs, low and high speed in both directions, torque steps), simulated with
+// the switching-level inverter and realistic sensors, with one or more catalogue effects put into the
+// simulated hardware — or the measured Beckhoff flux maps as the plant's magnetics (saturation on a real
+// machine's curves; config/beckhoff-am8141.yaml is its data-sheet model).
+
+#include <cstdint>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "rpem/io/drive_log.hpp"
+#include "rpem/sim/scenario.hpp"
+
+namespace rpem::analysis {
+
+/// One hidden effect with its true value, in the catalogue's terms (effects.hpp).
+struct HiddenEffect {
+  std::string name;   ///< catalogue name, or "none"
+  double value = 0.0; ///< t_dead_s, offset_rad, offset_A, gain_error, ΔT [K], delay_s, r_fe_Ohm
+  int phase = -1;     ///< for current_offset and current_gain
+  bool temperatures_logged = false;  ///< rs_drift, psim_drift: T columns in the log
+};
+
+/// The profile on the paper's machine (u_dc 565 V, 4 kHz, 8 kHz logging, dynamometer).
+[[nodiscard]] sim::Scenario diagnose_profile(double duration_s, std::uint64_t seed);
+
+/// The Beckhoff AM8141 at its data sheet, with the measured flux map (`flux_map_csv`) as magnetics.
+[[nodiscard]] sim::Scenario flux_map_profile(const std::string& machine_yaml, const std::string& flux_map_csv,
+                                             double duration_s, std::uint64_t seed);
+
+/// Puts the effect into the scenario's hardware or machine.
+void hide(sim::Scenario& s, const HiddenEffect& e);
+
+/// Draws one effect of the catalogue with a realistic magnitude (docs/diagnose.md, "Hidden-effect
+/// tests"): dead time 0.5–3 µs, θ offset 1–6°, sensor offset 0.5–3 % of rated current, gain error
+/// 1–4 %, R_s drift of 20–60 K, ψm drift of 20–60 K, delay 15–60 µs, iron loss r_fe 20–60 pu.
+[[nodiscard]] HiddenEffect draw_effect(std::mt19937_64& rng, const sim::Scenario& s, const std::string& name);
+
+/// Simulates a scenario into drive-log rows (what `rpem sim` would write).
+[[nodiscard]] std::vector<io::DriveLogRow> simulate(const sim::Scenario& s, io::DriveLogLayout* layout = nullptr);
+
+}  // namespace rpem::analysis

@@ -1,0 +1,60 @@
+#pragma once
+// A drive log held in memory for `rpem diagnose`, with what the diagnosis needs to know about it: which
+// model replays it (transient or steady state), which samples take part, and how they split into
+// training and held-out blocks.
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "rpem/core/settings.hpp"
+#include "rpem/io/drive_log.hpp"
+
+namespace rpem::analysis {
+
+/// Transient logs (sampled at the control rate) replay the open-loop discrete predictor; logs whose
+/// samples lie far apart against the electrical time constants replay the steady-state model.
+enum class ModelMode { kTransient, kSteadyState };
+
+[[nodiscard]] const char* to_string(ModelMode m) noexcept;
+
+struct LogData {
+  std::string path;
+  std::vector<io::DriveLogRow> rows;
+  io::DriveLogLayout layout;
+  ModelMode mode = ModelMode::kTransient;
+  double t_start_s = 0.0, t_end_s = 0.0;
+  double median_dt_s = 0.0;
+  double max_current_A = 0.0;   ///< largest measured current amplitude
+  double max_speed_rad_s = 0.0; ///< largest |ω_el|
+  double mean_u_dc_V = 0.0;
+  /// Transient logs: the electrical speed as the centred difference of the logged angle over
+  /// ±speed_half_window samples — no lag, unlike a drive's causal speed signal. The replay uses it;
+  /// the estimator runs see the logged speed, as the drive gave it.
+  std::vector<double> replay_speed_rad_s;
+  /// Samples that take part (steady state leaves out idle and transitional rows).
+  std::vector<bool> used;
+  std::size_t excluded_idle = 0, excluded_transitional = 0;
+  /// Block index of each sample; even blocks train, odd blocks are held out.
+  std::vector<int> block;
+  int blocks = 0;
+
+  [[nodiscard]] bool training(std::size_t k) const noexcept { return used[k] && block[k] % 2 == 0; }
+  [[nodiscard]] bool heldout(std::size_t k) const noexcept { return used[k] && block[k] % 2 == 1; }
+};
+
+struct LogOptions {
+  std::optional<ModelMode> mode;  ///< empty: decided from the sample interval
+  int blocks = 40;                ///< training and held-out blocks, alternating, equal in time
+  int speed_half_window = 4;      ///< transient logs: replay speed from the angle over ±this many samples
+};
+
+/// Loads and characterises a log (throws io::DriveLogError on bad input).
+[[nodiscard]] LogData load_log(const std::string& path, const core::MachineSi& machine, const LogOptions& options);
+
+/// The same from rows already in memory (tests, the simulator).
+[[nodiscard]] LogData prepare_log(std::vector<io::DriveLogRow> rows, const io::DriveLogLayout& layout,
+                                  const core::MachineSi& machine, const LogOptions& options,
+                                  const std::string& path = "<memory>");
+
+}  // namespace rpem::analysis

@@ -1,0 +1,68 @@
+#pragma once
+// Forward selection of effects (docs/diagnose.md, "How an effect is accepted"). Each round screens
+// every remaining candidate, fits the most promising jointly with the effects already found, and
+// accepts the one that lowers the held-out residual most — only if the held-out gain is both large
+// (≥ min_gain_pct of RMS) and consistent across the held-out blocks: a one-sided Wilcoxon signed-rank
+// test on the per-block log ratios ln(SSR before/SSR after) (blocks the effect cannot touch have a
+// ratio of 0 and drop out) must give p ≤ max_p. So noise, which a training fit always "explains" a
+// little, is not named as an effect. Two candidates that explain the same residual equally well and
+// in the same way are reported as not identifiable instead of one of them being guessed.
+
+#include <string>
+#include <vector>
+
+#include "rpem/analysis/diagnose/effect_fit.hpp"
+
+namespace rpem::analysis {
+
+struct SelectionOptions {
+  double min_gain_pct = 2.0;   ///< held-out RMS gain an effect must bring
+  double max_p = 0.01;         ///< signed-rank p over the held-out blocks
+  int max_effects = 4;
+  int shortlist = 4;           ///< candidates fitted in full per round
+  /// Ambiguity: a rival that passes the same acceptance tests, that the held-out blocks do not prefer
+  /// the winner to (signed-rank p above this) …
+  double ambiguity_p = 0.05;
+  /// … and whose change to the model's currents correlates at least this well with the winner's.
+  double ambiguity_correlation = 0.9;
+  int threads = 2;
+};
+
+/// One candidate's result in one round (the report's audit trail).
+struct CandidateScore {
+  Effect effect;
+  double screen_ssr = 0.0;        ///< predicted training gain [A²]
+  bool fitted = false;
+  double gain_pct = 0.0;          ///< held-out RMS gain over the round's starting model
+  double p_value = 1.0;           ///< signed-rank test of the held-out block improvements
+  std::vector<double> parameters;
+  std::vector<double> block_log_ratio;  ///< ln(SSR before / SSR after) per held-out block
+};
+
+struct FoundEffect {
+  Effect effect;
+  double heldout_rms_before_A = 0.0;  ///< the model before this effect was added
+  double heldout_rms_after_A = 0.0;   ///< … and after (both with all effects found before it)
+  double gain_pct = 0.0;
+  double p_value = 1.0;
+};
+
+struct Selection {
+  EffectSet model;                     ///< the found effects, fitted jointly
+  std::vector<FoundEffect> found;
+  std::vector<Unidentifiable> not_identifiable;
+  std::vector<std::vector<CandidateScore>> rounds;
+  double nominal_heldout_rms_A = 0.0;
+  double extended_heldout_rms_A = 0.0;
+};
+
+[[nodiscard]] Selection select_effects(const EffectFitter& fitter, const SelectionOptions& options);
+
+/// Held-out RMS of block scores [A].
+[[nodiscard]] double rms(const BlockScores& b);
+/// Per-block log ratios ln(SSR before/SSR after).
+[[nodiscard]] std::vector<double> block_log_ratios(const BlockScores& before, const BlockScores& after);
+/// One-sided Wilcoxon signed-rank p-value that the values lie above zero (zeros dropped; exact).
+[[nodiscard]] double signed_rank_p(const std::vector<double>& values);
+
+}  // namespace rpem::analysis

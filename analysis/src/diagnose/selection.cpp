@@ -1,0 +1,172 @@
+#include "rpem/analysis/diagnose/selection.hpp"
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <cstdio>
+#include <functional>
+#include <thread>
+
+namespace rpem::analysis {
+namespace {
+
+/// Runs body(i) for i in [0, n) on `threads` threads.
+void parallel_for(std::size_t n, int threads, const std::function<void(std::size_t)>& body) {
+  std::atomic<std::size_t> next{0};
+  auto worker = [&] {
+    for (std::size_t i = next++; i < n; i = next++) body(i);
+  };
+  std::vector<std::thread> pool;
+  for (int t = 1; t < std::min<int>(threads, static_cast<int>(n)); ++t) pool.emplace_back(worker);
+  worker();
+  for (auto& t : pool) t.join();
+}
+
+double gain_pct(const BlockScores& before, const BlockScores& after) {
+  return 100.0 * (1.0 - std::sqrt(after.total() / std::max(before.total(), 1e-300)));
+}
+
+/// What data would tell two effects apart (the report's advice).
+std::string separating_data(const std::string& a, const std::string& b) {
+  auto is = [&](const char* x, const char* y) { return (a == x && b == y) || (a == y && b == x); };
+  if (is("rs_drift", "deadtime")) return "standstill at two or more current levels (the resistive drop grows with |i|, the dead-time error does not)";
+  if (is("theta_offset", "delay")) return "operation at two or more speeds (a delay turns the voltage by ω·delay, an encoder offset by a fixed angle)";
+  if (is("psim_drift", "ld_saturation")) return "operation at two or more d-axis currents";
+  if (is("iron_loss", "psim_drift") || is("iron_loss", "theta_offset")) return "the same torque at two or more speeds";
+  if (is("rs_drift", "iron_loss")) return "standstill with current (no iron loss there)";
+  return "operating points where the two act differently (other speeds, currents or current signs)";
+}
+
+/// How alike two model changes are over the held-out samples.
+double change_correlation(const EffectFitter& f, const EffectSet& base, const EffectSet& a, const EffectSet& b) {
+  ReplayOutput r0, ra, rb;
+  const ModelReplay& replay = f.replay();
+  replay.run(base.model(f.context()), r0);
+  replay.run(a.model(f.context()), ra);
+  replay.run(b.model(f.context()), rb);
+  double ab = 0.0, aa = 0.0, bb = 0.0;
+  const LogData& log = replay.log();
+  for (std::size_t k = 0; k < log.rows.size(); ++k) {
+    if (!log.heldout(k) || !r0.valid[k] || !ra.valid[k] || !rb.valid[k]) continue;
+    const core::Vec2 da = ra.model_A[k] - r0.model_A[k], db = rb.model_A[k] - r0.model_A[k];
+    ab += da.dot(db);
+    aa += da.squaredNorm();
+    bb += db.squaredNorm();
+  }
+  return aa > 0.0 && bb > 0.0 ? ab / std::sqrt(aa * bb) : 0.0;
+}
+
+}  // namespace
+
+double rms(const BlockScores& b) { return b.samples ? std::sqrt(b.total() / static_cast<double>(b.samples)) : 0.0; }
+
+std::vector<double> block_log_ratios(const BlockScores& before, const BlockScores& after) {
+  std::vector<double> r;
+  for (std::size_t b = 0; b < std::min(before.ssr.size(), after.ssr.size()); ++b) {
+    r.push_back(std::log(std::max(before.ssr[b], 1e-300) / std::max(after.ssr[b], 1e-300)));
+  }
+  return r;
+}
+
+double signed_rank_p(const std::vector<double>& values) {
+  // Blocks the effect leaves unchanged (|ln ratio| below round-off) carry no evidence either way.
+  std::vector<double> d;
+  for (double v : values) {
+    if (std::abs(v) > 1e-9) d.push_back(v);
+  }
+  const std::size_t n = d.size();
+  if (n == 0) return 1.0;
+  std::vector<std::size_t> order(n);
+  for (std::size_t i = 0; i < n; ++i) order[i] = i;
+  std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return std::abs(d[a]) < std::abs(d[b]); });
+  std::size_t w_plus = 0;  // sum of the ranks (1 … n) of the positive values
+  for (std::size_t r = 0; r < n; ++r) {
+    if (d[order[r]] > 0.0) w_plus += r + 1;
+  }
+  // Exact null distribution: the number of subsets of {1 … n} with each rank sum.
+  const std::size_t max_sum = n * (n + 1) / 2;
+  std::vector<double> ways(max_sum + 1, 0.0);
+  ways[0] = 1.0;
+  for (std::size_t r = 1; r <= n; ++r) {
+    for (std::size_t w = max_sum; w >= r; --w) ways[w] += ways[w - r];
+  }
+  double tail = 0.0;
+  for (std::size_t w = w_plus; w <= max_sum; ++w) tail += ways[w];
+  return tail / std::pow(2.0, static_cast<double>(n));
+}
+
+Selection select_effects(const EffectFitter& fitter, const SelectionOptions& options) {
+  Selection sel;
+  const EffectContext& context = fitter.context();
+  BlockScores current = fitter.heldout(sel.model);
+  sel.nominal_heldout_rms_A = rms(current);
+  std::vector<Effect> excluded;
+
+  while (static_cast<int>(sel.found.size()) < options.max_effects) {
+    std::vector<CandidateScore> round;
+    for (const Effect& e : candidates(context)) {
+      if (sel.model.contains(e) || std::find(excluded.begin(), excluded.end(), e) != excluded.end()) continue;
+      CandidateScore candidate;
+      candidate.effect = e;
+      round.push_back(candidate);
+    }
+    if (round.empty()) break;
+    parallel_for(round.size(), options.threads,
+                 [&](std::size_t i) { round[i].screen_ssr = fitter.screen(sel.model, round[i].effect); });
+    std::sort(round.begin(), round.end(), [](const auto& a, const auto& b) { return a.screen_ssr > b.screen_ssr; });
+
+    const std::size_t shortlisted = std::min<std::size_t>(round.size(), static_cast<std::size_t>(options.shortlist));
+    std::vector<EffectSet> fitted(shortlisted);
+    std::vector<BlockScores> scores(shortlisted);
+    parallel_for(shortlisted, options.threads, [&](std::size_t i) {
+      fitted[i] = fitter.fit(sel.model.with(round[i].effect, context));
+      scores[i] = fitter.heldout(fitted[i]);
+    });
+    std::size_t best = 0;
+    for (std::size_t i = 0; i < shortlisted; ++i) {
+      round[i].fitted = true;
+      round[i].gain_pct = gain_pct(current, scores[i]);
+      round[i].block_log_ratio = block_log_ratios(current, scores[i]);
+      round[i].p_value = signed_rank_p(round[i].block_log_ratio);
+      round[i].parameters = fitted[i].parameters.back();
+      if (scores[i].total() < scores[best].total()) best = i;
+    }
+    const CandidateScore winner = round[best];
+    sel.rounds.push_back(round);
+    if (winner.gain_pct < options.min_gain_pct || winner.p_value > options.max_p) break;
+
+    // A rival that passes too, that the held-out blocks do not tell from the winner, and that changes
+    // the model in the same way, makes the winner a guess.
+    bool ambiguous = false;
+    for (std::size_t i = 0; i < shortlisted && !ambiguous; ++i) {
+      const CandidateScore& rival = round[i];
+      if (i == best || rival.effect.name() == winner.effect.name()) continue;
+      if (rival.gain_pct < options.min_gain_pct || rival.p_value > options.max_p) continue;
+      const double p_preferred = signed_rank_p(block_log_ratios(scores[i], scores[best]));
+      if (p_preferred <= options.ambiguity_p) continue;
+      const double corr = change_correlation(fitter, sel.model, fitted[best], fitted[i]);
+      if (std::abs(corr) < options.ambiguity_correlation) continue;
+      char reason[640];
+      std::snprintf(reason, sizeof reason,
+                    "both change the model's currents the same way in this log (correlation %.3f) and lower the "
+                    "held-out residual alike (%.1f %% and %.1f %%; the held-out blocks prefer neither, p = %.2f); a "
+                    "log with %s would separate them",
+                    corr, winner.gain_pct, rival.gain_pct, p_preferred,
+                    separating_data(winner.effect.name(), rival.effect.name()).c_str());
+      sel.not_identifiable.push_back({{winner.effect.label(), rival.effect.label()}, reason});
+      excluded.push_back(winner.effect);
+      excluded.push_back(rival.effect);
+      ambiguous = true;
+    }
+    if (ambiguous) continue;
+
+    sel.found.push_back({winner.effect, rms(current), rms(scores[best]), winner.gain_pct, winner.p_value});
+    sel.model = fitted[best];
+    current = scores[best];
+  }
+  sel.extended_heldout_rms_A = rms(current);
+  for (const Unidentifiable& u : unobservable(context)) sel.not_identifiable.push_back(u);
+  return sel;
+}
+
+}  // namespace rpem::analysis
