@@ -55,7 +55,7 @@ DriveLogReader::DriveLogReader(const std::string& path) : path_(path), in_(path,
   id_ = find("i_d"), iq_ = find("i_q");
   tw_ = find("T_winding"), tm_ = find("T_magnet"), tq_ = find("torque_cmd");
 
-  for (auto [col, name] : {std::pair{t_, "t"}, {theta_, "theta_el"}, {omega_, "omega_el"}, {udc_, "u_dc"}}) {
+  for (auto [col, name] : {std::pair{t_, "t"}, {omega_, "omega_el"}}) {
     if (!col.present()) fail(name, "required column is missing from the header");
   }
   auto group = [&](std::initializer_list<std::pair<Column, const char*>> cols, const char* what) {
@@ -74,6 +74,16 @@ DriveLogReader::DriveLogReader(const std::string& path) : path_(path), in_(path,
   layout_.current_dq = group({{id_, "i_d"}, {iq_, "i_q"}}, "rotor-frame current");
   if (!layout_.voltage_abc && !layout_.voltage_dq) fail("u_a,u_b,u_c|u_d,u_q", "no voltage-command columns");
   if (!layout_.current_abc && !layout_.current_dq) fail("i_a,i_b,i_c|i_d,i_q", "no current columns");
+  // A log entirely in the rotor frame needs no angle, and may not know its DC link (docs/drive-log.md).
+  const bool rotor_frame_only = !layout_.voltage_abc && !layout_.current_abc;
+  for (auto [col, name] : {std::pair{theta_, "theta_el"}, {udc_, "u_dc"}}) {
+    if (!col.present() && !rotor_frame_only) {
+      fail(name, "required column is missing from the header (optional only when voltage and current are both "
+                 "given as u_d,u_q and i_d,i_q only)");
+    }
+  }
+  layout_.angle = theta_.present();
+  layout_.u_dc = udc_.present();
   layout_.t_winding = tw_.present();
   layout_.t_magnet = tm_.present();
   layout_.torque_cmd = tq_.present();
@@ -110,9 +120,9 @@ bool DriveLogReader::next(DriveLogRow& row) {
     if (previous_t_s_ && !(t_s > *previous_t_s_)) fail("t", "time does not increase");
     previous_t_s_ = t_s;
     s.t_ns = std::llround(t_s * 1e9);
-    s.theta_el_rad = cell(theta_, "theta_el");
+    s.theta_el_rad = theta_.present() ? cell(theta_, "theta_el") : 0.0;
     s.omega_el_rad_s = cell(omega_, "omega_el");
-    s.u_dc_V = cell(udc_, "u_dc");
+    s.u_dc_V = udc_.present() ? cell(udc_, "u_dc") : 0.0;
     s.gap_before = false;
     if (layout_.voltage_abc) {
       s.voltage_frame = core::Frame::kAbc;

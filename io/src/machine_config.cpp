@@ -1,8 +1,11 @@
 #include "rpem/io/machine_config.hpp"
 
 #include <limits>
-#include <tuple>
+#include <sstream>
 #include <stdexcept>
+#include <tuple>
+
+#include "rpem/io/number_format.hpp"
 
 namespace rpem::io {
 namespace {
@@ -177,6 +180,96 @@ void parse_extensions(YamlMap x, MachineConfig& config) {
 }
 
 }  // namespace
+
+namespace {
+
+/// "{key: value, …}" from the pairs whose value is present.
+class FlowMap {
+ public:
+  FlowMap& add(const char* key, double v) {
+    text_ += (text_.empty() ? "" : ", ") + std::string(key) + ": ";
+    append_number(text_, v);
+    return *this;
+  }
+  FlowMap& add(const char* key, const std::string& v) {
+    text_ += (text_.empty() ? "" : ", ") + std::string(key) + ": " + v;
+    return *this;
+  }
+  [[nodiscard]] std::string str() const { return "{" + text_ + "}"; }
+
+ private:
+  std::string text_;
+};
+
+void drift_entry(std::ostringstream& out, const char* key, const ParameterDrift& d, const char* ref_key) {
+  if (!d.coeff_per_K && !d.rel_change) return;
+  FlowMap m;
+  if (d.coeff_per_K) m.add("coeff_per_K", *d.coeff_per_K).add("reference_C", d.reference_C);
+  if (d.value_ref) m.add(ref_key, *d.value_ref);
+  if (d.rel_change) m.add("rel_change", *d.rel_change);
+  out << "  " << key << ": " << m.str() << "\n";
+}
+
+void curve_entry(std::ostringstream& out, const char* key, const core::InductanceCurve& c) {
+  if (c.nominal()) return;
+  out << "  " << key << ": " << FlowMap().add("level", c.level).add("curvature_per_A2", c.curvature_per_A2).str() << "\n";
+}
+
+}  // namespace
+
+void check_log_supports(const MachineConfig& c, const std::string& config_name, bool log_has_u_dc,
+                        const std::string& log_path) {
+  if (c.estimator.extensions.deadtime_t_dead_s > 0.0 && !log_has_u_dc) {
+    throw ConfigError(config_name, 0, 0, "model_extensions.deadtime.t_dead_s",
+                      "a dead time in seconds needs the DC-link voltage, and " + log_path +
+                          " has no u_dc column (give the error as v_err_V instead)");
+  }
+}
+
+std::string model_extensions_yaml(const MachineConfig& c) {
+  const core::ModelExtensions& x = c.estimator.extensions;
+  std::ostringstream out;
+  if (x.deadtime_v_err_V != 0.0 || x.deadtime_t_dead_s != 0.0) {
+    FlowMap m;
+    if (x.deadtime_t_dead_s != 0.0) m.add("t_dead_s", x.deadtime_t_dead_s);
+    if (x.switching_frequency_Hz != 0.0) m.add("switching_frequency_Hz", x.switching_frequency_Hz);
+    if (x.deadtime_v_err_V != 0.0) m.add("v_err_V", x.deadtime_v_err_V);
+    if (x.deadtime_current_band_A != 0.0) m.add("current_band_A", x.deadtime_current_band_A);
+    out << "  deadtime: " << m.str() << "\n";
+  }
+  if (x.theta_offset_rad != 0.0) out << "  theta_offset: " << FlowMap().add("offset_rad", x.theta_offset_rad).str() << "\n";
+  const char* const phases[3] = {"a", "b", "c"};
+  for (const auto& [key, values, field] : {std::tuple{"current_offset", x.current_offset_A, "offset_A"},
+                                           std::tuple{"current_gain", x.current_gain_error, "gain_error"}}) {
+    std::string items;
+    for (int k = 0; k < 3; ++k) {
+      if (values[k] == 0.0) continue;
+      items += (items.empty() ? "" : ", ") + FlowMap().add("phase", std::string(phases[k])).add(field, values[k]).str();
+    }
+    if (!items.empty()) out << "  " << key << ": [" << items << "]\n";
+  }
+  if (x.delay_s != 0.0) out << "  delay: " << FlowMap().add("delay_s", x.delay_s).str() << "\n";
+  curve_entry(out, "ld_saturation", x.inductance_d);
+  curve_entry(out, "lq_saturation", x.inductance_q);
+  if (x.iron_loss_r_fe_Ohm > 0.0) out << "  iron_loss: " << FlowMap().add("r_fe_Ohm", x.iron_loss_r_fe_Ohm).str() << "\n";
+  drift_entry(out, "rs_drift", c.rs_drift, "r_s_ref_Ohm");
+  drift_entry(out, "psim_drift", c.psim_drift, "psi_m_ref_Wb");
+  const std::string body = out.str();
+  return body.empty() ? "" : "model_extensions:\n" + body;
+}
+
+std::string replace_model_extensions(const std::string& yaml_text, const std::string& section) {
+  std::istringstream in(yaml_text);
+  std::string line, out;
+  bool inside = false;
+  while (std::getline(in, line)) {
+    const bool top_level = !line.empty() && line[0] != ' ' && line[0] != '\t' && line[0] != '#';
+    if (top_level) inside = line.rfind("model_extensions:", 0) == 0;
+    if (!inside) out += line + "\n";
+  }
+  while (out.size() >= 2 && out[out.size() - 1] == '\n' && out[out.size() - 2] == '\n') out.pop_back();
+  return section.empty() ? out : out + "\n" + section;
+}
 
 const char* to_string(core::Algorithm a) noexcept {
   switch (a) {

@@ -54,6 +54,18 @@ TEST(DriveLog, ReadsDqOnlyLog) {
   EXPECT_DOUBLE_EQ(row.sample.u_V[1], 80.0);
 }
 
+TEST(DriveLog, RotorFrameOnlyLogMayOmitAngleAndDcLink) {
+  test::TempFile f("log.csv", "t,omega_el,u_d,u_q,i_d,i_q,T_magnet\n0,2300,-125,37,-194,66,52\n2.5,2300,-126,35,-195,66,53\n");
+  DriveLogReader r(f.path());
+  EXPECT_FALSE(r.layout().angle);
+  EXPECT_FALSE(r.layout().u_dc);
+  DriveLogRow row;
+  ASSERT_TRUE(r.next(row));
+  EXPECT_EQ(row.sample.theta_el_rad, 0.0);
+  EXPECT_EQ(row.sample.u_dc_V, 0.0);
+  EXPECT_EQ(row.t_magnet_C, 52.0);
+}
+
 struct BadCase {
   const char* name;
   std::string content;
@@ -74,6 +86,9 @@ INSTANTIATE_TEST_SUITE_P(
         BadCase{"empty", "", ":1: empty file"},
         BadCase{"missing_time", "theta_el,omega_el,u_dc,u_a,u_b,u_c,i_a,i_b,i_c\n", ":1: column t: required column"},
         BadCase{"no_current", "t,theta_el,omega_el,u_dc,u_a,u_b,u_c\n", "no current columns"},
+        BadCase{"no_angle_with_phases", "t,omega_el,u_dc,u_a,u_b,u_c,i_a,i_b,i_c\n",
+                ":1: column theta_el: required column is missing from the header (optional only when"},
+        BadCase{"no_dc_link_with_phases", "t,theta_el,omega_el,u_d,u_q,i_a,i_b,i_c\n", ":1: column u_dc: required"},
         BadCase{"incomplete_abc", "t,theta_el,omega_el,u_dc,u_a,u_b,i_a,i_b,i_c\n", "column u_c: incomplete"},
         BadCase{"duplicate", "t,t,theta_el,omega_el,u_dc,u_a,u_b,u_c,i_a,i_b,i_c\n", "column t: column appears twice"},
         BadCase{"non_numeric", kHeader + "0,0,0,220,1,2,3,abc,0,0\n", ":2: column i_a: 'abc' is not a number"},

@@ -140,6 +140,41 @@ TEST(MachineConfig, ModelExtensionsAreRead) {
   EXPECT_DOUBLE_EQ(c.psim_drift.rel_change.value(), -0.05);
 }
 
+TEST(MachineConfig, ExtensionsWrittenAsYamlReadBackToTheSameValues) {
+  // What rpem diagnose writes into extended.yaml must load to exactly what it found.
+  MachineConfig c = load_machine_config(test::TempFile("p.yaml", paper_text()).path());
+  core::ModelExtensions& x = c.estimator.extensions;
+  x.deadtime_v_err_V = 2.0647012345678;
+  x.theta_offset_rad = -0.0497918;
+  x.current_offset_A = core::Vec3(0.0, -0.0449122, 0.013);
+  x.current_gain_error = core::Vec3(0.02, 0.0, 0.0);
+  x.delay_s = 2.4e-5;
+  x.inductance_q = {1.2223, -0.000453337};
+  x.iron_loss_r_fe_Ohm = 1261.24;
+  c.rs_drift.coeff_per_K = 0.00391698;
+  c.rs_drift.reference_C = 25.0;
+  c.psim_drift.rel_change = -0.067;
+  const std::string text = replace_model_extensions(paper_text() + "model_extensions:\n  delay: {delay_s: 7.77e-7}\n",
+                                                    model_extensions_yaml(c));
+  EXPECT_EQ(text.find("7.77e-7"), std::string::npos);  // the old section is gone
+  const MachineConfig back = load_machine_config(test::TempFile("x.yaml", text).path());
+  const core::ModelExtensions& y = back.estimator.extensions;
+  EXPECT_EQ(y.deadtime_v_err_V, x.deadtime_v_err_V);
+  EXPECT_EQ(y.theta_offset_rad, x.theta_offset_rad);
+  EXPECT_EQ(y.current_offset_A, x.current_offset_A);
+  EXPECT_EQ(y.current_gain_error, x.current_gain_error);
+  EXPECT_EQ(y.delay_s, x.delay_s);
+  EXPECT_EQ(y.inductance_q.level, x.inductance_q.level);
+  EXPECT_EQ(y.inductance_q.curvature_per_A2, x.inductance_q.curvature_per_A2);
+  EXPECT_TRUE(y.inductance_d.nominal());
+  EXPECT_EQ(y.iron_loss_r_fe_Ohm, x.iron_loss_r_fe_Ohm);
+  EXPECT_EQ(back.rs_drift.coeff_per_K, c.rs_drift.coeff_per_K);
+  EXPECT_EQ(back.rs_drift.reference_C, 25.0);
+  EXPECT_EQ(back.psim_drift.rel_change, c.psim_drift.rel_change);
+  EXPECT_EQ(back.machine.r_s_Ohm, c.machine.r_s_Ohm);  // the rest of the file is kept
+  EXPECT_EQ(replace_model_extensions(paper_text(), ""), paper_text());
+}
+
 TEST(MachineConfig, MissingFileIsAConfigError) {
   EXPECT_THROW((void)load_machine_config("/nonexistent/x.yaml"), ConfigError);
 }

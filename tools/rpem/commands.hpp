@@ -23,5 +23,6 @@ Runner add_replay_command(CLI::App& app);
 Runner add_record_command(CLI::App& app);
 Runner add_listen_command(CLI::App& app);
 Runner add_command_command(CLI::App& app);
+Runner add_diagnose_command(CLI::App& app);
 
 }  // namespace rpem::tools

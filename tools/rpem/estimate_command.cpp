@@ -28,6 +28,7 @@ int run_estimate(const EstimateOptions& o) {
   if (!o.algorithm.empty()) cfg.estimator.algorithm = io::parse_algorithm(o.algorithm);
 
   io::DriveLogReader reader(o.log);
+  io::check_log_supports(cfg, o.config.empty() ? "builtin:paper-ipmsm" : o.config, reader.layout().u_dc, o.log);
   io::EstimateLogWriter writer(o.out);
   core::DriveEstimator estimator(cfg.machine, cfg.estimator);
   Progress progress("rpem estimate");

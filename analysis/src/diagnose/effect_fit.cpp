@@ -39,6 +39,7 @@ class ReplayCost {
 
 ExtendedModel EffectSet::model(const EffectContext& c) const {
   ExtendedModel m;
+  m.extensions = c.base_extensions;
   for (std::size_t j = 0; j < effects.size(); ++j) apply(effects[j], parameters[j].data(), c, m);
   return m;
 }
@@ -61,7 +62,7 @@ double BlockScores::total() const {
 EffectFitter::EffectFitter(const ModelReplay& replay, const EffectContext& context)
     : replay_(replay), context_(context) {
   ReplayOutput nominal;
-  replay_.run(ExtendedModel{}, nominal);
+  replay_.run(EffectSet{}.model(context_), nominal);
   const LogData& log = replay_.log();
   for (std::size_t k = 0; k < log.rows.size(); ++k) {
     if (log.training(k) && nominal.valid[k]) training_.push_back(k);

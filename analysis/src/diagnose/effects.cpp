@@ -4,7 +4,6 @@
 #include <cmath>
 #include <limits>
 
-#include "rpem/io/number_format.hpp"
 
 namespace rpem::analysis {
 namespace {
@@ -32,17 +31,13 @@ DriftLaw::Basis drift_basis(bool has_temperature) {
   return has_temperature ? DriftLaw::Basis::kTemperature : DriftLaw::Basis::kTime;
 }
 
-/// Against temperature the nominal value holds at the reference temperature (one parameter, the
-/// coefficient); against time the log may start off nominal (offset and change over the log).
+/// value = nominal·(1 + offset + slope·x): the configuration's value need not hold at the reference
+/// temperature (or at the log's start); the offset says how far it is off there.
 DriftLaw drift(const double* p, DriftLaw::Basis basis) {
   DriftLaw d;
   d.basis = basis;
-  if (basis == DriftLaw::Basis::kTemperature) {
-    d.slope = kDriftPerKelvinScale * p[0];
-  } else {
-    d.offset = kDriftOffsetScale * p[0];
-    d.slope = kDriftPerLogScale * p[1];
-  }
+  d.offset = kDriftOffsetScale * p[0];
+  d.slope = (basis == DriftLaw::Basis::kTemperature ? kDriftPerKelvinScale : kDriftPerLogScale) * p[1];
   return d;
 }
 
@@ -53,22 +48,31 @@ core::InductanceCurve curve(const double* p, double max_axis_current_A) {
   return k;
 }
 
-std::string number(double v) {
-  std::string s;
-  io::append_number(s, v);
-  return s;
-}
-
 std::vector<NamedValue> describe_drift(const double* p, bool has_temperature, double nominal, const char* ref_name,
                                        const EffectContext& c) {
   const DriftLaw d = drift(p, drift_basis(has_temperature));
   if (has_temperature) {
-    return {{"coeff_per_K", d.slope, ""}, {"reference_C", c.reference_C, ""}, {ref_name, nominal, ""}};
+    // Relative to the value at the reference temperature, as the configuration records a drift.
+    return {{"coeff_per_K", d.slope / (1.0 + d.offset), ""}, {"reference_C", c.reference_C, ""},
+            {ref_name, nominal * (1.0 + d.offset), ""}};
   }
   return {{"rel_change", d.slope, ""}, {"rel_offset", d.offset, ""}, {"over_s", c.t_span_s, ""}};
 }
 
 }  // namespace
+
+double drift_factor(const DriftLaw& d, double tau, const std::optional<double>& temperature_C,
+                    double reference_C) noexcept {
+  switch (d.basis) {
+    case DriftLaw::Basis::kNone:
+      return 1.0;
+    case DriftLaw::Basis::kTime:
+      return 1.0 + d.offset + d.slope * tau;
+    case DriftLaw::Basis::kTemperature:
+      return 1.0 + d.offset + d.slope * (temperature_C.value_or(reference_C) - reference_C);
+  }
+  return 1.0;
+}
 
 std::string Effect::name() const {
   switch (kind) {
@@ -88,11 +92,13 @@ std::string Effect::name() const {
 
 std::string Effect::label() const { return phase >= 0 ? name() + "(" + kPhase[phase] + ")" : name(); }
 
-EffectContext EffectContext::of(const LogData& log, const core::MachineSi& machine, double reference_C,
+EffectContext EffectContext::of(const LogData& log, const core::MachineSi& machine,
+                                const core::ModelExtensions& base_extensions, double reference_C,
                                 double switching_frequency_Hz) {
   EffectContext c;
   c.mode = log.mode;
   c.machine = machine;
+  c.base_extensions = base_extensions;
   const core::PerUnitBase base = core::PerUnitBase::from_rated(machine.rated);
   c.base_current_A = base.current_A;
   const core::SampleConditioner raw(base, core::to_pu(base, machine), {});
@@ -138,15 +144,14 @@ std::vector<Unidentifiable> unobservable(const EffectContext& c) {
            "from theta_offset"}};
 }
 
-int parameter_count(const Effect& e, const EffectContext& c) noexcept {
+int parameter_count(const Effect& e, const EffectContext& /*c*/) noexcept {
   switch (e.kind) {
     case EffectKind::kLdSaturation:
     case EffectKind::kLqSaturation:
       return 2;
     case EffectKind::kRsDrift:
-      return c.t_winding ? 1 : 2;
     case EffectKind::kPsimDrift:
-      return c.t_magnet ? 1 : 2;
+      return 2;
     default:
       return 1;
   }
@@ -251,23 +256,6 @@ std::vector<NamedValue> describe(const Effect& e, const double* p, const EffectC
       return {{"r_fe_Ohm", x.iron_loss_r_fe_Ohm, ""}};
   }
   return {};
-}
-
-YamlEntry yaml_entry(const Effect& e, const double* p, const EffectContext& c) {
-  std::string v = "{";
-  bool first = true;
-  for (const NamedValue& n : describe(e, p, c)) {
-    // Descriptive extras stay out of the configuration (the schema rejects unknown keys).
-    static const std::vector<std::string> kConfigKeys = {
-        "v_err_V", "level", "curvature_per_A2", "offset_rad", "phase", "offset_A", "gain_error", "coeff_per_K",
-        "reference_C", "r_s_ref_Ohm", "psi_m_ref_Wb", "rel_change", "delay_s", "r_fe_Ohm"};
-    if (std::find(kConfigKeys.begin(), kConfigKeys.end(), n.name) == kConfigKeys.end()) continue;
-    v += (first ? "" : ", ") + n.name + ": " + (n.text.empty() ? number(n.value) : n.text);
-    first = false;
-  }
-  v += "}";
-  const bool per_phase = e.kind == EffectKind::kCurrentOffset || e.kind == EffectKind::kCurrentGain;
-  return {e.name(), v, per_phase};
 }
 
 }  // namespace rpem::analysis

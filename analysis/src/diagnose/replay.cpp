@@ -11,18 +11,6 @@ namespace {
 /// A gap longer than this many median intervals restarts the predictor from the measurement.
 constexpr double kMaxIntervals = 8.0;
 
-double drift_factor(const DriftLaw& d, double tau, const std::optional<double>& temperature_C, double reference_C) {
-  switch (d.basis) {
-    case DriftLaw::Basis::kNone:
-      return 1.0;
-    case DriftLaw::Basis::kTime:
-      return 1.0 + d.offset + d.slope * tau;
-    case DriftLaw::Basis::kTemperature:
-      return 1.0 + d.offset + d.slope * (temperature_C.value_or(reference_C) - reference_C);
-  }
-  return 1.0;
-}
-
 }  // namespace
 
 ModelReplay::ModelReplay(const LogData& log, const core::MachineSi& machine, double reference_C)
@@ -34,8 +22,7 @@ ModelReplay::ModelReplay(const LogData& log, const core::MachineSi& machine, dou
 
 void ModelReplay::drifted(const ExtendedModel& model, std::size_t k, core::MachinePu& m) const noexcept {
   const io::DriveLogRow& row = log_.rows[k];
-  const double tau = (1e-9 * static_cast<double>(row.sample.t_ns) - log_.t_start_s) /
-                     std::max(log_.t_end_s - log_.t_start_s, 1e-12);
+  const double tau = log_.time_fraction(k);
   m.r_s_pu = nominal_.r_s_pu * drift_factor(model.r_s, tau, row.t_winding_C, reference_C_);
   m.psi_m_pu = nominal_.psi_m_pu * drift_factor(model.psi_m, tau, row.t_magnet_C, reference_C_);
 }

@@ -2,7 +2,8 @@
 // The drive-log CSV: the project's measured-data format (docs/drive-log.md).
 // One header row; SI units; required columns t, theta_el, omega_el, u_dc, a voltage command
 // (u_a,u_b,u_c and/or u_d,u_q) and a measured current (i_a,i_b,i_c and/or i_d,i_q); optional
-// T_winding, T_magnet [°C], torque_cmd [Nm]. Extra columns are ignored.
+// T_winding, T_magnet [°C], torque_cmd [Nm]. Extra columns are ignored. A log whose voltage and current
+// are both in the rotor frame only may omit theta_el and u_dc.
 
 #include <cstdint>
 #include <fstream>
@@ -24,6 +25,8 @@ struct DriveLogRow {
 
 /// Which column groups a log holds (the reader prefers abc where both are present).
 struct DriveLogLayout {
+  bool angle = true;  ///< theta_el present (a rotor-frame-only log may omit it: 0 is used)
+  bool u_dc = true;   ///< u_dc present (a rotor-frame-only log may omit it: 0, i.e. unknown)
   bool voltage_abc = true;
   bool voltage_dq = false;
   bool current_abc = true;

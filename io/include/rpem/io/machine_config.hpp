@@ -6,6 +6,7 @@
 #include <string>
 
 #include "rpem/core/settings.hpp"
+#include "rpem/io/drive_log.hpp"
 #include "rpem/io/yaml_map.hpp"
 
 namespace rpem::io {
@@ -38,6 +39,18 @@ struct MachineConfig {
 /// The built-in configuration: config/paper-ipmsm.yaml compiled into the binary.
 [[nodiscard]] const std::string& builtin_paper_config_text();
 [[nodiscard]] MachineConfig builtin_paper_config();
+
+/// Throws ConfigError when the configuration needs a column the log lacks (a dead time in seconds scales
+/// with u_dc).
+void check_log_supports(const MachineConfig& c, const std::string& config_name, bool log_has_u_dc,
+                        const std::string& log_path);
+
+/// The `model_extensions` section for a configuration's extensions and drifts (flow-style YAML that
+/// parse_machine_config() reads back to the same values); empty when the model is nominal.
+[[nodiscard]] std::string model_extensions_yaml(const MachineConfig& c);
+
+/// `yaml_text` with its top-level `model_extensions` section (if any) replaced by `section`.
+[[nodiscard]] std::string replace_model_extensions(const std::string& yaml_text, const std::string& section);
 
 [[nodiscard]] const char* to_string(core::Algorithm a) noexcept;
 [[nodiscard]] core::Algorithm parse_algorithm(const std::string& name);  ///< throws std::invalid_argument

@@ -3,6 +3,7 @@
 // named SI parameters (docs/model-extensions.md). For the fit, each effect's parameters are scaled so
 // that 0 is the nominal model and 1 a typical magnitude; describe() gives them back in SI.
 
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -43,6 +44,10 @@ struct DriftLaw {
   double slope = 0.0;
 };
 
+/// The drift's factor at time fraction `tau` (0 … 1 through the log) or temperature `temperature_C`.
+[[nodiscard]] double drift_factor(const DriftLaw& d, double tau, const std::optional<double>& temperature_C,
+                                  double reference_C) noexcept;
+
 /// The model diagnose replays: the nominal machine with model extensions and drifts.
 struct ExtendedModel {
   core::ModelExtensions extensions;
@@ -53,6 +58,7 @@ struct ExtendedModel {
 struct EffectContext {
   ModelMode mode = ModelMode::kTransient;
   core::MachineSi machine;
+  core::ModelExtensions base_extensions;  ///< the input configuration's own: part of the nominal model
   double base_current_A = 0.0;       ///< I_b
   double max_i_d_A = 0.0, max_i_q_A = 0.0;  ///< largest |i_d|, |i_q| logged
   double max_speed_rad_s = 0.0;
@@ -63,7 +69,8 @@ struct EffectContext {
   double mean_u_dc_V = 0.0;
   double switching_frequency_Hz = 0.0;  ///< 0: unknown (t_dead_s is then not reported)
 
-  [[nodiscard]] static EffectContext of(const LogData& log, const core::MachineSi& machine, double reference_C,
+  [[nodiscard]] static EffectContext of(const LogData& log, const core::MachineSi& machine,
+                                        const core::ModelExtensions& base_extensions, double reference_C,
                                         double switching_frequency_Hz);
 };
 
@@ -91,14 +98,5 @@ struct NamedValue {
   std::string text;
 };
 [[nodiscard]] std::vector<NamedValue> describe(const Effect& e, const double* p, const EffectContext& c);
-
-/// The effect's model_extensions entry for extended.yaml: `key: value`, or one item of the list under
-/// `key` for the per-phase sensor effects (flow-style YAML).
-struct YamlEntry {
-  std::string key;
-  std::string value;
-  bool list_item = false;
-};
-[[nodiscard]] YamlEntry yaml_entry(const Effect& e, const double* p, const EffectContext& c);
 
 }  // namespace rpem::analysis

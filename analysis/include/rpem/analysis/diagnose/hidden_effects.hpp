@@ -1,10 +1,8 @@
 #pragma once
 // Drive logs with a known effect hidden in them, for testing and demonstrating `rpem diagnose`: a
-// test-bench profile on the paper's machine that gives every effect a chance to show (standstill at
-// several currents of both signs, low and high speed in both directions, torque steps), simulated with
-// the switching-level inverter and realistic sensors, with one or more catalogue effects put into the
-// simulated hardware — or the measured Beckhoff flux maps as the plant's magnetics (saturation on a real
-// machine's curves; config/beckhoff-am8141.yaml is its data-sheet model).
+// scenario (scenarios/diagnose-bench.yaml: a test-bench profile that gives every effect a chance to show;
+// scenarios/diagnose-beckhoff.yaml: a motor on its measured flux map) with catalogue effects put into
+// the simulated hardware.
 
 #include <cstdint>
 #include <random>
@@ -23,13 +21,6 @@ struct HiddenEffect {
   int phase = -1;     ///< for current_offset and current_gain
   bool temperatures_logged = false;  ///< rs_drift, psim_drift: T columns in the log
 };
-
-/// The profile on the paper's machine (u_dc 565 V, 4 kHz, 8 kHz logging, dynamometer).
-[[nodiscard]] sim::Scenario diagnose_profile(double duration_s, std::uint64_t seed);
-
-/// The Beckhoff AM8141 at its data sheet, with the measured flux map (`flux_map_csv`) as magnetics.
-[[nodiscard]] sim::Scenario flux_map_profile(const std::string& machine_yaml, const std::string& flux_map_csv,
-                                             double duration_s, std::uint64_t seed);
 
 /// Puts the effect into the scenario's hardware or machine.
 void hide(sim::Scenario& s, const HiddenEffect& e);

@@ -3,6 +3,7 @@
 // model replays it (transient or steady state), which samples take part, and how they split into
 // training and held-out blocks.
 
+#include <algorithm>
 #include <optional>
 #include <string>
 #include <vector>
@@ -39,6 +40,10 @@ struct LogData {
   std::vector<int> block;
   int blocks = 0;
 
+  /// Where sample k lies in the log's time span, 0 … 1.
+  [[nodiscard]] double time_fraction(std::size_t k) const noexcept {
+    return (1e-9 * static_cast<double>(rows[k].sample.t_ns) - t_start_s) / std::max(t_end_s - t_start_s, 1e-12);
+  }
   [[nodiscard]] bool training(std::size_t k) const noexcept { return used[k] && block[k] % 2 == 0; }
   [[nodiscard]] bool heldout(std::size_t k) const noexcept { return used[k] && block[k] % 2 == 1; }
 };

@@ -1,0 +1,196 @@
+// report.md and report.html: a person's view of the diagnosis (docs/diagnose.md, "Reading the report").
+#include <cstdio>
+#include <fstream>
+#include <stdexcept>
+
+#include "rpem/analysis/diagnose/diagnose_output.hpp"
+#include "rpem/analysis/report_document.hpp"
+
+namespace rpem::analysis {
+namespace {
+
+/// v with `significant` significant digits.
+std::string num(double v, int significant = 4) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.*g", significant, v);
+  return buf;
+}
+
+/// v with `decimals` decimals.
+std::string fixed(double v, int decimals) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.*f", decimals, v);
+  return buf;
+}
+
+std::string pct(double v) { return fixed(v, 1) + " %"; }
+
+std::string optional_pct(const std::optional<double>& v) { return v ? pct(*v) : "—"; }
+
+std::string parameters_text(const std::vector<NamedValue>& values) {
+  std::string s;
+  for (const NamedValue& v : values) {
+    s += (s.empty() ? "" : ", ") + v.name + " = " + (v.text.empty() ? num(v.value) : v.text);
+  }
+  return s;
+}
+
+void summary(ReportDocument& doc, const Diagnosis& d, const std::string& config_path) {
+  const Selection& s = d.selection;
+  const LogData& log = *d.log;
+  std::string text = "The nominal model (`" + config_path + "`) replayed on the inputs of `" + log.path + "` (" +
+                     std::to_string(log.rows.size()) + " samples over " + num(log.t_end_s - log.t_start_s, 3) +
+                     " s, " + (log.mode == ModelMode::kTransient ? "transient: the open-loop discrete predictor"
+                                                                 : "steady state: the closed-form steady-state model") +
+                     ") predicts the currents with a held-out residual of **" + num(s.nominal_heldout_rms_A) + " A RMS**. ";
+  if (s.found.empty()) {
+    text += "No effect of the catalogue lowers it significantly: the diagnosis is **none**.";
+  } else {
+    text += "Found: ";
+    for (std::size_t j = 0; j < s.found.size(); ++j) {
+      text += (j ? "; " : "") + std::string("**") + s.found[j].effect.label() + "** (" +
+              parameters_text(found_parameters(d, j)) + ")";
+    }
+    text += ". The extended model lowers the held-out residual to **" + num(s.extended_heldout_rms_A) + " A** (" +
+            pct(100.0 * (1.0 - s.extended_heldout_rms_A / std::max(s.nominal_heldout_rms_A, 1e-300))) + " less).";
+  }
+  doc.paragraph(text);
+  if (!s.not_identifiable.empty()) {
+    std::vector<std::string> items;
+    for (const Unidentifiable& u : s.not_identifiable) {
+      std::string names;
+      for (const std::string& e : u.effects) names += (names.empty() ? "" : " / ") + ("`" + e + "`");
+      items.push_back(names + ": " + u.reason);
+    }
+    doc.paragraph("Not identifiable from this log:");
+    doc.bullets(items);
+  }
+}
+
+void effects_table(ReportDocument& doc, const Diagnosis& d) {
+  if (d.selection.found.empty()) return;
+  doc.heading(1, "Effects found");
+  std::vector<std::vector<std::string>> rows;
+  for (std::size_t j = 0; j < d.selection.found.size(); ++j) {
+    const FoundEffect& f = d.selection.found[j];
+    rows.push_back({f.effect.label(), parameters_text(found_parameters(d, j)), num(f.heldout_rms_before_A),
+                    num(f.heldout_rms_after_A), pct(f.gain_pct), num(f.p_value, 2)});
+  }
+  doc.table({"effect", "parameters (SI; final joint fit)", "held-out RMS before [A]", "after [A]", "gain", "p"}, rows);
+  doc.paragraph("Before and after are the held-out residual RMS of the model without and with the effect, each with the "
+                "effects found before it. The configuration with these effects is `extended.yaml`; `rpem estimate "
+                "--config extended.yaml` and rpemd use it as it is.");
+}
+
+void residuals(ReportDocument& doc, const Diagnosis& d, const std::vector<std::string>& figures) {
+  const ResidualStatistics& st = d.statistics;
+  auto has = [&](const char* f) { return std::find(figures.begin(), figures.end(), f) != figures.end(); };
+  doc.heading(1, "What the nominal model gets wrong");
+  doc.paragraph("Residual RMS over all used samples: " + num(st.rms_A.before) + " A nominal, " + num(st.rms_A.after) +
+                " A extended; at standstill " + num(st.standstill_rms_A.before) + " → " + num(st.standstill_rms_A.after) +
+                " A, in motion " + num(st.motion_rms_A.before) + " → " + num(st.motion_rms_A.after) + " A.");
+  doc.figure("residual_time.png", "Operating profile, residual RMS of the nominal (red) and extended (green) model, and "
+                                  "the nominal model's mean residual, against time.");
+  doc.figure("residual_map.png", "Residual RMS over the speed × i_q plane: where the nominal model errs, and what is left.");
+  std::vector<std::vector<std::string>> rows;
+  for (const RegionStatistics& r : st.regions) {
+    rows.push_back({r.speed, r.load, std::to_string(r.samples), num(r.rms_A.before), num(r.rms_A.after),
+                    num(r.mean_d_A.before), num(r.mean_q_A.before), num(r.mean_d_A.after), num(r.mean_q_A.after)});
+  }
+  doc.table({"speed", "load", "samples", "RMS nominal [A]", "RMS extended [A]", "mean ε_d nominal", "mean ε_q nominal",
+             "mean ε_d extended", "mean ε_q extended"},
+            rows);
+  if (has("harmonics.png")) {
+    doc.figure("harmonics.png", "Residual amplitude at harmonics of the electrical angle, in the dq frame: a current "
+                                "sensor offset shows at the 1st, a gain error at the 2nd, dead time at the 6th.");
+    std::vector<std::vector<std::string>> h;
+    for (const HarmonicContent& c : st.harmonics) {
+      h.push_back({std::to_string(c.order), num(c.amplitude_A.before), num(c.amplitude_A.after)});
+    }
+    doc.table({"harmonic", "nominal [A]", "extended [A]"}, h);
+  }
+  if (has("phase_sign.png")) {
+    doc.figure("phase_sign.png", "Mean residual of each phase while its current is positive and negative: dead time pulls "
+                                 "the logged current below the model's in the current's direction.");
+  }
+  if (has("residual_temperature.png")) {
+    doc.figure("residual_temperature.png", "The residual against the logged temperature: a thermal drift shows as a trend.");
+  }
+  std::vector<std::vector<std::string>> c;
+  for (const RegressorCorrelation& r : st.correlations) {
+    c.push_back({r.regressor, fixed(r.d.before, 3), fixed(r.q.before, 3), fixed(r.d.after, 3), fixed(r.q.after, 3)});
+  }
+  doc.paragraph("Correlation of the residual with candidate regressors:");
+  doc.table({"regressor", "ε_d nominal", "ε_q nominal", "ε_d extended", "ε_q extended"}, c);
+  doc.figure("overlay.png", d.log->mode == ModelMode::kTransient
+                                ? "The logged current against both models in the 0.1 s where the nominal model errs most."
+                                : "The logged current against both models, row by row.");
+}
+
+void estimator(ReportDocument& doc, const Diagnosis& d) {
+  const EstimatorComparison& c = d.estimates;
+  if (c.nominal.empty()) return;
+  doc.heading(1, "The estimator with the extended model");
+  doc.paragraph(c.method == "rpem"
+                    ? "The RPEM estimator (as `rpem estimate` and rpemd run it) over this log with the input configuration "
+                      "and with `extended.yaml`. Values: mean over the last quarter of the log; errors: RMS against the "
+                      "truth over the second half, where a truth was given."
+                    : "A steady-state log cannot drive the recursive estimator (its samples lie seconds apart). Instead, "
+                      "each row's steady-state equations give the ψm and R_s the data implies — R_s = (u_d + ω·L_q·i_q)/i_d, "
+                      "ψm = (u_q − R_s·i_q)/ω − L_d·i_d, with the extended model's corrections — set against what the "
+                      "nominal model assumes (constant values) and what the extended model assumes (its drifts). Values: "
+                      "mean over the last quarter; errors: RMS against the implied values over the second half.");
+  doc.figure("estimates.png", c.method == "rpem" ? "ψm and R_s estimated with the nominal (red) and the extended (green) model."
+                                                : "ψm and R_s as the nominal (red) and the extended (green) model assume them, "
+                                                  "and as the data implies them (black).");
+  doc.table({"model", "ψm [Wb]", "R_s [Ω]", "ψm error", "R_s error"},
+            {{"nominal", num(c.nominal_summary.psi_m_Wb), num(c.nominal_summary.r_s_Ohm),
+              optional_pct(c.nominal_summary.psi_m_error_pct), optional_pct(c.nominal_summary.r_s_error_pct)},
+             {"extended", num(c.extended_summary.psi_m_Wb), num(c.extended_summary.r_s_Ohm),
+              optional_pct(c.extended_summary.psi_m_error_pct), optional_pct(c.extended_summary.r_s_error_pct)}});
+}
+
+void selection(ReportDocument& doc, const Diagnosis& d) {
+  doc.heading(1, "How the effects were selected");
+  doc.paragraph("The log is cut into " + std::to_string(d.log->blocks) +
+                " blocks of equal duration; even blocks train, odd blocks are held out. Each round ranks every remaining "
+                "candidate by the training gain its first Gauss–Newton step predicts, fits the best " +
+                std::to_string(d.options.selection.shortlist) +
+                " jointly with the effects already found (Ceres), and accepts the one that lowers the held-out residual "
+                "most — if it lowers its RMS by at least " + num(d.options.selection.min_gain_pct, 3) +
+                " % and the held-out blocks agree (one-sided Wilcoxon signed-rank test on the per-block log ratios, p ≤ " +
+                num(d.options.selection.max_p, 3) + ").");
+  for (std::size_t r = 0; r < d.selection.rounds.size(); ++r) {
+    std::vector<std::vector<std::string>> rows;
+    for (const CandidateScore& c : d.selection.rounds[r]) {
+      if (!c.fitted) continue;
+      rows.push_back({c.effect.label(), num(c.screen_ssr), pct(c.gain_pct), num(c.p_value, 2)});
+    }
+    doc.paragraph("Round " + std::to_string(r + 1) + ":");
+    doc.table({"candidate", "screened training gain [A²]", "held-out gain", "p"}, rows);
+  }
+  const LogData& log = *d.log;
+  if (log.excluded_idle + log.excluded_transitional > 0) {
+    doc.paragraph("Left out of the steady-state analysis: " + std::to_string(log.excluded_idle) + " idle rows and " +
+                  std::to_string(log.excluded_transitional) + " rows in transition between operating points.");
+  }
+  doc.paragraph("Diagnosis time: " + fixed(d.elapsed_s, 2) + " s.");
+}
+
+}  // namespace
+
+void write_diagnose_report(const std::string& dir, const Diagnosis& d, const std::string& config_path) {
+  const std::vector<std::string> figures = write_diagnose_figures(dir, d);
+  ReportDocument doc("Diagnosis of " + d.log->path);
+  summary(doc, d, config_path);
+  effects_table(doc, d);
+  residuals(doc, d, figures);
+  estimator(doc, d);
+  selection(doc, d);
+  for (const auto& [name, text] : {std::pair{"/report.md", doc.markdown()}, std::pair{"/report.html", doc.html()}}) {
+    std::ofstream f(dir + name);
+    if (!f || !(f << text)) throw std::runtime_error("cannot write " + dir + name);
+  }
+}
+
+}  // namespace rpem::analysis

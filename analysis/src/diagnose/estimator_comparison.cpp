@@ -1,0 +1,117 @@
+#include "rpem/analysis/diagnose/estimator_comparison.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "rpem/core/drive_estimator.hpp"
+#include "rpem/io/csv_table.hpp"
+
+namespace rpem::analysis {
+namespace {
+
+/// Points kept per track.
+constexpr std::size_t kTrackPoints = 2000;
+
+/// Linear interpolation of a track's column at t (clamped at the ends).
+double interpolate(const std::vector<double>& t, const std::vector<double>& v, double at) {
+  if (t.empty()) return 0.0;
+  const auto it = std::lower_bound(t.begin(), t.end(), at);
+  if (it == t.begin()) return v.front();
+  if (it == t.end()) return v.back();
+  const std::size_t j = static_cast<std::size_t>(it - t.begin());
+  const double w = (at - t[j - 1]) / std::max(t[j] - t[j - 1], 1e-300);
+  return v[j - 1] + w * (v[j] - v[j - 1]);
+}
+
+EstimateSummary summarise(const ParameterTrack& track, const ParameterTrack& truth) {
+  EstimateSummary s;
+  if (track.empty()) return s;
+  const double t0 = track.t_s.front(), t1 = track.t_s.back();
+  double psi = 0.0, r = 0.0, n = 0.0, e_psi = 0.0, e_r = 0.0, m = 0.0;
+  for (std::size_t k = 0; k < track.t_s.size(); ++k) {
+    const double t = track.t_s[k];
+    if (t >= t0 + 0.75 * (t1 - t0)) {
+      psi += track.psi_m_Wb[k];
+      r += track.r_s_Ohm[k];
+      n += 1.0;
+    }
+    if (!truth.empty() && t >= t0 + 0.5 * (t1 - t0)) {
+      e_psi += std::pow(track.psi_m_Wb[k] / interpolate(truth.t_s, truth.psi_m_Wb, t) - 1.0, 2);
+      e_r += std::pow(track.r_s_Ohm[k] / interpolate(truth.t_s, truth.r_s_Ohm, t) - 1.0, 2);
+      m += 1.0;
+    }
+  }
+  s.psi_m_Wb = n > 0 ? psi / n : track.psi_m_Wb.back();
+  s.r_s_Ohm = n > 0 ? r / n : track.r_s_Ohm.back();
+  if (m > 0) {
+    s.psi_m_error_pct = 100.0 * std::sqrt(e_psi / m);
+    s.r_s_error_pct = 100.0 * std::sqrt(e_r / m);
+  }
+  return s;
+}
+
+ParameterTrack run_rpem(const LogData& log, const io::MachineConfig& config) {
+  core::DriveEstimator estimator(config.machine, config.estimator);
+  ParameterTrack track;
+  const std::size_t every = std::max<std::size_t>(1, log.rows.size() / kTrackPoints);
+  for (std::size_t k = 0; k < log.rows.size(); ++k) {
+    const core::Estimate e = estimator.step(log.rows[k].sample);
+    if (k % every == 0) track.add(1e-9 * static_cast<double>(e.t_ns), e.psi_m_Wb, e.r_s_Ohm);
+  }
+  return track;
+}
+
+/// Per used steady-state row: what the data implies (→ implied) and what each model assumes.
+void steady_state_tracks(const LogData& log, const io::MachineConfig& nominal, const ExtendedModel& model,
+                         double reference_C, EstimatorComparison& c) {
+  const core::MachineSi& machine = nominal.machine;
+  const core::PerUnitBase base = core::PerUnitBase::from_rated(machine.rated);
+  const core::MachinePu pu = core::to_pu(base, machine);
+  const core::SampleConditioner conditioner(base, pu, model.extensions);
+  for (std::size_t k = 0; k < log.rows.size(); ++k) {
+    if (!log.used[k]) continue;
+    const io::DriveLogRow& row = log.rows[k];
+    const core::SteadyStateInputs in = conditioner.steady_state(row.sample);
+    if (std::abs(in.n_pu) < 1e-3 || std::abs(in.i_pu[0]) < 1e-6) continue;
+    const double tau = log.time_fraction(k);
+    const double r_factor = drift_factor(model.r_s, tau, row.t_winding_C, reference_C);
+    const double psi_factor = drift_factor(model.psi_m, tau, row.t_magnet_C, reference_C);
+    const double r_implied = (in.u_pu[0] + in.n_pu * in.x_q_pu * in.i_pu[1]) / in.i_pu[0];
+    const double psi_implied = (in.u_pu[1] - pu.r_s_pu * r_factor * in.i_pu[1]) / in.n_pu - in.x_d_pu * in.i_pu[0];
+    const double t = 1e-9 * static_cast<double>(row.sample.t_ns);
+    c.truth.add(t, base.flux_Wb_of(psi_implied), base.resistance_Ohm_of(r_implied));
+    c.nominal.add(t, machine.psi_m_Wb, machine.r_s_Ohm);
+    c.extended.add(t, machine.psi_m_Wb * psi_factor, machine.r_s_Ohm * r_factor);
+  }
+}
+
+}  // namespace
+
+ParameterTrack load_truth(const std::string& path) {
+  const io::CsvTable table = io::CsvTable::read(path);
+  ParameterTrack t;
+  t.t_s = table.column("t");
+  t.psi_m_Wb = table.column("psi_m");
+  t.r_s_Ohm = table.column("r_s");
+  return t;
+}
+
+EstimatorComparison compare_estimates(const LogData& log, const io::MachineConfig& nominal,
+                                      const io::MachineConfig& extended_config, const ExtendedModel& extended,
+                                      const EffectContext& context, const ParameterTrack& truth) {
+  EstimatorComparison c;
+  c.truth = truth;
+  if (log.mode == ModelMode::kTransient) {
+    c.method = "rpem";
+    c.nominal = run_rpem(log, nominal);
+    c.extended = run_rpem(log, extended_config);
+  } else {
+    c.method = "steady_state";
+    steady_state_tracks(log, nominal, extended, context.reference_C, c);
+  }
+  c.nominal_summary = summarise(c.nominal, c.truth);
+  c.extended_summary = summarise(c.extended, c.truth);
+  return c;
+}
+
+}  // namespace rpem::analysis

@@ -1,0 +1,48 @@
+#!/usr/bin/env python3
+"""Converts the Paderborn "Electric Motor Temperature" bench data (../shared/data/paderborn-motor-temperature/,
+W. Kirchgässner, O. Wallscheid, J. Böcker, LEA Paderborn University, CC BY-SA 4.0) into a rotor-frame drive
+log (docs/drive-log.md) for `rpem diagnose`. The source files are read, never changed.
+
+  paderborn_to_drive_log.py SOURCE.csv OUT.csv --pole-pairs P [--sample-period-s 2.5]
+
+The data set does not publish the pole-pair number; its dq equations fix only p·L and p·ψm, so the
+electrical speed needs an assumed p (docs/diagnose.md states the one used). Rows are 2 Hz samples, every
+5th kept in profile_A_every5th.csv: one row per 2.5 s. Columns written: t, omega_el (from motor_speed
+[rpm]), u_d, u_q, i_d, i_q, T_winding (stator_winding), T_magnet (pm); theta_el and u_dc are not in the
+data (a rotor-frame-only log may omit them)."""
+import argparse
+import csv
+import math
+import sys
+
+
+def main() -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("source")
+    ap.add_argument("out")
+    ap.add_argument("--pole-pairs", type=int, required=True, help="assumed pole-pair number")
+    ap.add_argument("--sample-period-s", type=float, default=2.5, help="time between rows (default 2.5)")
+    a = ap.parse_args()
+    need = ["u_d", "u_q", "i_d", "i_q", "motor_speed", "stator_winding", "pm"]
+    with open(a.source, newline="") as src, open(a.out, "w", newline="") as dst:
+        rows = csv.DictReader(src)
+        missing = [c for c in need if c not in (rows.fieldnames or [])]
+        if missing:
+            print(f"{a.source}:1: missing columns {', '.join(missing)}", file=sys.stderr)
+            return 65
+        out = csv.writer(dst)
+        out.writerow(["t", "omega_el", "u_d", "u_q", "i_d", "i_q", "T_winding", "T_magnet"])
+        for k, r in enumerate(rows):
+            try:
+                v = {c: float(r[c]) for c in need}
+            except ValueError as e:
+                print(f"{a.source}:{k + 2}: {e}", file=sys.stderr)
+                return 65
+            omega = v["motor_speed"] * 2.0 * math.pi / 60.0 * a.pole_pairs
+            out.writerow([repr(k * a.sample_period_s), repr(omega), repr(v["u_d"]), repr(v["u_q"]), repr(v["i_d"]),
+                          repr(v["i_q"]), repr(v["stator_winding"]), repr(v["pm"])])
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

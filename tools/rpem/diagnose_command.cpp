@@ -1,0 +1,118 @@
+// rpem diagnose --log LOG.csv --config MACHINE.yaml --out DIR [--truth TRUTH.csv] …
+// Shows what the nominal model gets wrong on measured data, names the cause from the catalogue of
+// effects, extends the model and measures the gain (docs/diagnose.md). Writes DIR/report.html,
+// DIR/report.md, the figures, DIR/diagnosis.json and DIR/extended.yaml.
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include "commands.hpp"
+#include "rpem/analysis/diagnose/diagnose_output.hpp"
+#include "rpem/io/errors.hpp"
+
+namespace rpem::tools {
+namespace {
+
+struct DiagnoseCliOptions {
+  std::string log, config, out, truth, model = "auto";
+  double reference_C = 20.0;
+  double switching_frequency_Hz = 0.0;
+  analysis::SelectionOptions selection;
+  int blocks = 40;
+};
+
+std::string read_text(const std::string& path) {
+  std::ifstream f(path);
+  if (!f) throw io::ConfigError(path, 0, 0, "", "cannot open file");
+  std::ostringstream s;
+  s << f.rdbuf();
+  return s.str();
+}
+
+int run_diagnose(const DiagnoseCliOptions& o) {
+  const std::string config_text = o.config.empty() ? io::builtin_paper_config_text() : read_text(o.config);
+  const io::MachineConfig config = o.config.empty() ? io::builtin_paper_config() : io::load_machine_config(o.config);
+  const std::string config_name = o.config.empty() ? "builtin:paper-ipmsm" : o.config;
+
+  analysis::LogOptions log_options;
+  log_options.blocks = o.blocks;
+  if (o.model != "auto") {
+    log_options.mode = o.model == "transient" ? analysis::ModelMode::kTransient : analysis::ModelMode::kSteadyState;
+  }
+  std::fprintf(stderr, "rpem diagnose: reading %s\n", o.log.c_str());
+  analysis::LogData log = analysis::load_log(o.log, config.machine, log_options);
+  io::check_log_supports(config, config_name, log.layout.u_dc, o.log);
+  const analysis::ParameterTrack truth = o.truth.empty() ? analysis::ParameterTrack{} : analysis::load_truth(o.truth);
+
+  analysis::DiagnoseOptions options;
+  options.reference_C = o.reference_C;
+  options.switching_frequency_Hz = o.switching_frequency_Hz;
+  options.selection = o.selection;
+  std::fprintf(stderr, "rpem diagnose: %zu samples, %s model; fitting the catalogue's effects\n", log.rows.size(),
+               analysis::to_string(log.mode));
+  const analysis::Diagnosis d = analysis::diagnose(std::move(log), config, options, truth);
+
+  std::error_code ec;
+  std::filesystem::create_directories(o.out, ec);
+  if (ec) throw io::InputError(o.out, 0, 0, "", "cannot create directory: " + ec.message());
+  analysis::write_diagnosis_json(o.out + "/diagnosis.json", d, config_name);
+  analysis::write_extended_yaml(o.out + "/extended.yaml", d, config_text);
+  analysis::write_diagnose_report(o.out, d, config_name);
+
+  const analysis::Selection& s = d.selection;
+  std::printf("nominal model: held-out residual %.4g A RMS\n", s.nominal_heldout_rms_A);
+  if (s.found.empty()) std::printf("effects: none\n");
+  for (std::size_t j = 0; j < s.found.size(); ++j) {
+    std::printf("effect %s:", s.found[j].effect.label().c_str());
+    for (const analysis::NamedValue& v : analysis::found_parameters(d, j)) {
+      if (v.text.empty()) {
+        std::printf(" %s=%.6g", v.name.c_str(), v.value);
+      } else {
+        std::printf(" %s=%s", v.name.c_str(), v.text.c_str());
+      }
+    }
+    std::printf(" (held-out gain %.1f %%)\n", s.found[j].gain_pct);
+  }
+  for (const analysis::Unidentifiable& u : s.not_identifiable) {
+    std::string names;
+    for (const std::string& e : u.effects) names += (names.empty() ? "" : " / ") + e;
+    std::printf("not identifiable: %s\n", names.c_str());
+  }
+  std::printf("extended model: held-out residual %.4g A RMS\n", s.extended_heldout_rms_A);
+  std::printf("wrote %s/report.html, report.md, diagnosis.json, extended.yaml (%.2f s)\n", o.out.c_str(), d.elapsed_s);
+  return kExitOk;
+}
+
+}  // namespace
+
+Runner add_diagnose_command(CLI::App& app) {
+  auto o = std::make_shared<DiagnoseCliOptions>();
+  CLI::App* cmd = app.add_subcommand(
+      "diagnose", "Show what the model gets wrong on measured data, name the cause, extend the model, measure the gain");
+  cmd->add_option("--log", o->log, "drive-log CSV (docs/drive-log.md)")->required()->check(CLI::ExistingFile);
+  cmd->add_option("--config", o->config, "machine configuration YAML, the nominal model (default: built-in paper-ipmsm)")
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--out", o->out, "directory for report.html, report.md, figures, diagnosis.json, extended.yaml")
+      ->required();
+  cmd->add_option("--truth", o->truth, "true parameters (t, psi_m, r_s) to judge the estimates against, e.g. rpem sim --truth")
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--model", o->model, "replay model: auto (from the sample interval), transient, steady_state")
+      ->check(CLI::IsMember({"auto", "transient", "steady_state"}));
+  cmd->add_option("--reference-temperature-C", o->reference_C,
+                  "temperature at which the configuration's r_s and psi_m hold (for drifts against temperature)");
+  cmd->add_option("--switching-frequency-Hz", o->switching_frequency_Hz,
+                  "PWM frequency, to report dead time in seconds (default: model_extensions.deadtime's)")
+      ->check(CLI::PositiveNumber);
+  cmd->add_option("--min-gain-pct", o->selection.min_gain_pct, "held-out RMS gain an effect must bring [%] (default 2)")
+      ->check(CLI::Range(0.0, 100.0));
+  cmd->add_option("--max-p", o->selection.max_p, "largest signed-rank p over the held-out blocks (default 0.01)")
+      ->check(CLI::Range(0.0, 1.0));
+  cmd->add_option("--blocks", o->blocks, "training + held-out blocks (default 40)")->check(CLI::Range(4, 1000));
+  cmd->add_option("--threads", o->selection.threads, "fitting threads (default 2)")->check(CLI::Range(1, 64));
+  return [cmd, o]() { return cmd->parsed() ? run_diagnose(*o) : -1; };
+}
+
+}  // namespace rpem::tools
