@@ -15,6 +15,8 @@ def label(name):
         fidelity = "averaged" if parts.get("averaged") == "1" else "switching (1 µs plant)"
         est = "with estimator" if parts.get("estimator") == "1" else "without estimator"
         return f"simulator, {fidelity}, {est}"
+    if name.startswith("BM_DiagnoseTwentySecondLog"):
+        return "rpem diagnose, 20 s log at 8 kHz (read, diagnose, write report)"
     return name
 
 
@@ -43,7 +45,9 @@ def main(paths):
                   f"{aggs['min']['x_real_time'] if 'min' in aggs else med['x_real_time']:.0f}× (slowest) | wall {med['real_time']:.1f} ms per simulated s |")
         else:
             worst = mx["real_time"] if mx else float("nan")
-            print(f"| {label(base)} | {med['real_time']:.1f} ns | {worst:.1f} ns | ns per step (max of {med['repetitions']} repetition means) |")
+            unit = med.get("time_unit", "ns")
+            what = "per step" if unit == "ns" else "per run"
+            print(f"| {label(base)} | {med['real_time']:.2f} {unit} | {worst:.2f} {unit} | {unit} {what} (max of {med['repetitions']} repetition means) |")
 
 
 if __name__ == "__main__":

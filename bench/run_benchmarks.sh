@@ -1,16 +1,19 @@
 #!/usr/bin/env bash
 # Builds the benchmarks (Release) and runs them; prints the results as Markdown with the machine they
-# ran on, for docs/benchmarks.md. Usage: bench/run_benchmarks.sh [estimator|simulator|all]
+# ran on, for docs/benchmarks.md. Usage: bench/run_benchmarks.sh [estimator|simulator|diagnose|all]
 set -euo pipefail
 cd "$(dirname "$0")/.."
 what=${1:-all}
 cmake -S . -B build/bench -G Ninja -DCMAKE_BUILD_TYPE=Release -DRPEM_BUILD_TESTS=OFF >/dev/null
-cmake --build build/bench --target bench_estimator bench_simulator >/dev/null
+cmake --build build/bench --target bench_estimator bench_simulator bench_diagnose >/dev/null
 out=$(mktemp -d)
 if [[ $what == all || $what == estimator ]]; then
   build/bench/bench/bench_estimator --benchmark_min_time=0.5 --benchmark_format=json >"$out/estimator.json"
 fi
 if [[ $what == all || $what == simulator ]]; then
   build/bench/bench/bench_simulator --benchmark_format=json >"$out/simulator.json"
+fi
+if [[ $what == all || $what == diagnose ]]; then
+  build/bench/bench/bench_diagnose --benchmark_format=json >"$out/diagnose.json"
 fi
 python3 bench/format_benchmarks.py "$out"/*.json

@@ -19,6 +19,16 @@ std::string escape_html(const std::string& s) {
   return out;
 }
 
+/// A table cell for Markdown: its pipes escaped.
+std::string markdown_cell(const std::string& s) {
+  std::string out;
+  for (char c : s) {
+    if (c == '|') out += '\\';
+    out += c;
+  }
+  return out;
+}
+
 /// Markdown's inline `code` and **bold** as HTML (the only inline markup the reports use).
 std::string inline_html(const std::string& text) {
   const std::string s = escape_html(text);
@@ -73,7 +83,7 @@ std::string ReportDocument::markdown() const {
       case Kind::kTable:
         for (std::size_t r = 0; r < b.rows.size(); ++r) {
           md << '|';
-          for (const std::string& cell : b.rows[r]) md << ' ' << cell << " |";
+          for (const std::string& cell : b.rows[r]) md << ' ' << markdown_cell(cell) << " |";
           md << '\n';
           if (r == 0) {
             md << '|';

@@ -86,6 +86,34 @@ void parse_daemon(io::YamlMap d, DaemonConfig& c, const std::string& base_dir) {
   d.finish();
 }
 
+/// The temperature model's defaults from the drifts a diagnosis found (docs/model-extensions.md); the
+/// daemon section's own `temperature` keys, parsed afterwards, override them.
+void temperature_from_drifts(const std::string& name, DaemonConfig& c) {
+  const io::ParameterDrift &r = c.machine.rs_drift, &p = c.machine.psim_drift;
+  if (r.coeff_per_K && p.coeff_per_K && r.reference_C != p.reference_C) {
+    throw io::ConfigError(name, 0, 0, "model_extensions.psim_drift.reference_C",
+                          "rpemd's temperature model needs rs_drift and psim_drift at one reference temperature");
+  }
+  if (r.coeff_per_K) {
+    if (*r.coeff_per_K <= 0.0) {
+      throw io::ConfigError(name, 0, 0, "model_extensions.rs_drift.coeff_per_K",
+                            "a winding temperature needs a resistance that rises with it (coefficient > 0)");
+    }
+    c.temperature.reference_C = r.reference_C;
+    c.temperature.r_s_coeff_per_K = *r.coeff_per_K;
+    if (r.value_ref) c.temperature.r_s_ref_Ohm = *r.value_ref;
+  }
+  if (p.coeff_per_K) {
+    if (*p.coeff_per_K >= 0.0) {
+      throw io::ConfigError(name, 0, 0, "model_extensions.psim_drift.coeff_per_K",
+                            "a magnet temperature needs a flux linkage that falls with it (coefficient < 0)");
+    }
+    c.temperature.reference_C = p.reference_C;
+    c.temperature.psi_m_coeff_per_K = *p.coeff_per_K;
+    if (p.value_ref) c.temperature.psi_m_ref_Wb = *p.value_ref;
+  }
+}
+
 void fill_defaults(DaemonConfig& c) {
   if (c.temperature.r_s_ref_Ohm <= 0.0) c.temperature.r_s_ref_Ohm = c.machine.machine.r_s_Ohm;
   if (c.temperature.psi_m_ref_Wb <= 0.0) c.temperature.psi_m_ref_Wb = c.machine.machine.psi_m_Wb;
@@ -107,6 +135,7 @@ DaemonConfig parse(io::YamlMap& root, const std::string& name, const std::string
   } else {
     c.machine = io::builtin_paper_config();
   }
+  temperature_from_drifts(name, c);
   if (d) parse_daemon(*d, c, base_dir);
   root.finish();
   fill_defaults(c);

@@ -36,6 +36,27 @@ TEST(DaemonConfig, AMachineFileAloneIsAConfiguration) {
   EXPECT_DOUBLE_EQ(c.machine.machine.l_q_H, 0.206);
 }
 
+TEST(DaemonConfig, DriftsFoundByDiagnoseCalibrateTheTemperatureModel) {
+  // extended.yaml with drifts against temperature: rpemd derives temperatures with them, unless its own
+  // daemon.temperature section says otherwise.
+  const std::string machine = test::read_file(test::source_dir() + "/config/paper-ipmsm.yaml") +
+                              "model_extensions:\n"
+                              "  rs_drift: {coeff_per_K: 0.0041, reference_C: 25, r_s_ref_Ohm: 2.3}\n"
+                              "  psim_drift: {coeff_per_K: -0.00105, reference_C: 25}\n";
+  test::TempFile f("ext.yaml", machine);
+  const DaemonConfig c = load_daemon_config(f.path());
+  EXPECT_DOUBLE_EQ(c.temperature.reference_C, 25.0);
+  EXPECT_DOUBLE_EQ(c.temperature.r_s_coeff_per_K, 0.0041);
+  EXPECT_DOUBLE_EQ(c.temperature.r_s_ref_Ohm, 2.3);
+  EXPECT_DOUBLE_EQ(c.temperature.psi_m_coeff_per_K, -0.00105);
+  EXPECT_DOUBLE_EQ(c.temperature.psi_m_ref_Wb, 1.14);  // not found: the machine's
+  test::TempFile g("own.yaml", machine + "daemon:\n  temperature: {r_s_coeff_per_K: 0.00393}\n");
+  EXPECT_DOUBLE_EQ(load_daemon_config(g.path()).temperature.r_s_coeff_per_K, 0.00393);
+  test::TempFile h("bad.yaml", test::read_file(test::source_dir() + "/config/paper-ipmsm.yaml") +
+                                   "model_extensions:\n  psim_drift: {coeff_per_K: 0.001}\n");
+  EXPECT_THROW((void)load_daemon_config(h.path()), io::ConfigError);
+}
+
 struct Bad {
   const char* name;
   const char* text;

@@ -5,6 +5,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <optional>
 #include <string>
 
@@ -31,6 +32,12 @@ class TempFile {
  private:
   std::filesystem::path path_;
 };
+
+/// A whole file as text (empty if it cannot be read).
+inline std::string read_file(const std::string& path) {
+  std::ifstream f(path);
+  return std::string(std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>());
+}
 
 /// The repository root (set by CTest; falls back to the source tree layout).
 inline std::string source_dir() {

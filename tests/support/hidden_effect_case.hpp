@@ -1,0 +1,176 @@
+#pragma once
+// One hidden-effect case of `rpem diagnose` (docs/diagnose.md, "Hidden-effect tests"): a scenario with
+// effects put into the simulated hardware, simulated at switching level with noise, diagnosed, and
+// judged — the right names, each parameter within 15 % of the truth; null cases must find nothing.
+// With the measured Beckhoff flux maps as the plant's magnetics the truth is the map itself.
+
+#include <cmath>
+#include <cstdio>
+#include <ostream>
+#include <random>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "rpem/analysis/diagnose/diagnose_output.hpp"
+#include "rpem/analysis/diagnose/hidden_effects.hpp"
+#include "rpem/sim/flux_map.hpp"
+#include "support/temp_file.hpp"
+
+namespace rpem::test {
+
+inline constexpr double kParameterTolerance = 0.15;
+
+struct HiddenCase {
+  std::string profile = "bench";           ///< "bench", "beckhoff400" or "beckhoff800"
+  std::vector<std::string> effects;        ///< catalogue names; empty: a null case
+  std::uint64_t seed = 1;
+};
+
+/// GoogleTest's name for a case in test listings.
+inline void PrintTo(const HiddenCase& c, std::ostream* os) {
+  *os << c.profile << " seed " << c.seed << " hidden:";
+  for (const auto& e : c.effects) *os << ' ' << e;
+  if (c.effects.empty()) *os << " none";
+}
+
+struct CaseOutcome {
+  bool correct = false;
+  bool null_case = false;
+  bool false_positive = false;  ///< a null case that named an effect
+  std::string detail;           ///< what was hidden, what was found, and why it is judged so
+};
+
+inline double parameter(const std::vector<analysis::NamedValue>& values, const std::string& name, std::string* text = nullptr) {
+  for (const auto& v : values) {
+    if (v.name == name) {
+      if (text) *text = v.text;
+      return v.value;
+    }
+  }
+  return std::nan("");
+}
+
+inline bool within(double got, double truth, double tolerance = kParameterTolerance) {
+  return std::isfinite(got) && std::abs(got / truth - 1.0) <= tolerance;
+}
+
+/// Judges one found effect against one hidden effect; appends the reason to `why`.
+inline bool matches(const analysis::HiddenEffect& h, const std::vector<analysis::NamedValue>& p, std::string& why) {
+  constexpr double kCopper = 0.00393, kMagnet = -0.0012;  // the simulator's thermal coefficients
+  double got = std::nan(""), truth = std::nan("");
+  std::string phase;
+  if (h.name == "deadtime") got = parameter(p, "t_dead_s"), truth = h.value;
+  if (h.name == "theta_offset") got = parameter(p, "offset_rad"), truth = h.value;
+  if (h.name == "current_offset") got = parameter(p, "offset_A"), truth = h.value, parameter(p, "phase", &phase);
+  if (h.name == "current_gain") got = parameter(p, "gain_error"), truth = h.value, parameter(p, "phase", &phase);
+  if (h.name == "rs_drift" || h.name == "psim_drift") {
+    const double coeff = h.name == "rs_drift" ? kCopper : kMagnet;
+    got = h.temperatures_logged ? parameter(p, "coeff_per_K") : parameter(p, "rel_change");
+    truth = h.temperatures_logged ? coeff : coeff * h.value;
+  }
+  if (h.name == "delay") got = parameter(p, "delay_s"), truth = h.value;
+  if (h.name == "iron_loss") got = parameter(p, "r_fe_Ohm"), truth = h.value;
+  char buf[160];
+  std::snprintf(buf, sizeof buf, " %s: %.5g vs true %.5g (%+.1f %%)", h.name.c_str(), got, truth, 100.0 * (got / truth - 1.0));
+  why += buf;
+  if (h.phase >= 0 && phase != std::string(1, static_cast<char>('a' + h.phase))) {
+    why += " [wrong phase " + phase + "]";
+    return false;
+  }
+  return within(got, truth);
+}
+
+/// The Beckhoff map's own features, which a diagnosis against the data sheet should name.
+inline bool explained_by_map(const std::string& name, const std::vector<analysis::NamedValue>& p, const sim::FluxMap& map,
+                             std::string& why) {
+  char buf[200];
+  if (name == "lq_saturation" || name == "ld_saturation") {
+    const bool q = name == "lq_saturation";
+    const double i = parameter(p, "i_max_A");
+    const core::Vec2 at = q ? core::Vec2(0.0, i) : core::Vec2(-i, 0.0);
+    const double truth = q ? map.flux(at)[1] / i : (map.magnet_flux_Wb() - map.flux(at)[0]) / i;
+    const double got = parameter(p, "l_at_max_current_H");
+    std::snprintf(buf, sizeof buf, " %s: L(%.2f A) %.4g H vs the map's %.4g H (%+.1f %%)", name.c_str(), i, got, truth,
+                  100.0 * (got / truth - 1.0));
+    why += buf;
+    return within(got, truth);
+  }
+  if (name == "theta_offset") {  // the map's magnet axis is off the d axis by atan(ψ_q(0,0)/ψ_d(0,0))
+    const core::Vec2 psi0 = map.flux(core::Vec2::Zero());
+    const double truth = std::atan2(psi0[1], psi0[0]), got = parameter(p, "offset_rad");
+    std::snprintf(buf, sizeof buf, " theta_offset: %.4g rad vs the map's magnet axis %.4g rad", got, truth);
+    why += buf;
+    return within(got, truth);
+  }
+  if (name == "psim_drift") {  // the map's cross-saturation lowers ψ_d under load by up to 1 %
+    const double a = std::abs(parameter(p, "rel_offset")), b = std::abs(parameter(p, "rel_change"));
+    std::snprintf(buf, sizeof buf, " psim_drift: offset %.3g, change %.3g (the map's cross-saturation: ≤ 0.01)", a, b);
+    why += buf;
+    return a <= 0.01 && b <= 0.01;
+  }
+  why += " " + name + ": not a feature of the map";
+  return false;
+}
+
+inline CaseOutcome run_hidden_case(const HiddenCase& c) {
+  const std::string src = source_dir();
+  const bool beckhoff = c.profile != "bench";
+  sim::Scenario s = sim::load_scenario(src + (beckhoff ? "/scenarios/diagnose-beckhoff.yaml" : "/scenarios/diagnose-bench.yaml"));
+  if (c.profile == "beckhoff800") {
+    s.flux_map_file = src + "/../shared/data/flux-maps/beckhoff_AM8141_measured_800rpm.csv";
+  }
+  s.seed = c.seed;
+  std::mt19937_64 rng(c.seed);
+  std::vector<analysis::HiddenEffect> hidden;
+  for (const std::string& name : c.effects) {
+    hidden.push_back(analysis::draw_effect(rng, s, name));
+    analysis::hide(s, hidden.back());
+  }
+  io::DriveLogLayout layout;
+  std::vector<io::DriveLogRow> rows = analysis::simulate(s, &layout);
+  analysis::LogData log = analysis::prepare_log(std::move(rows), layout, s.machine.machine, {});
+  analysis::DiagnoseOptions options;
+  options.switching_frequency_Hz = s.inverter.switching_frequency_Hz;
+  const analysis::Diagnosis d = analysis::diagnose(std::move(log), s.machine, options);
+
+  CaseOutcome out;
+  out.null_case = hidden.empty() && !beckhoff;
+  std::string found_names;
+  for (const auto& f : d.selection.found) found_names += " " + f.effect.label();
+  out.detail = c.profile + " seed " + std::to_string(c.seed) + ", hidden:";
+  for (const auto& h : hidden) out.detail += " " + h.name;
+  out.detail += hidden.empty() ? " none" : "";
+  out.detail += "; found:" + (found_names.empty() ? std::string(" none") : found_names) + ";";
+
+  if (beckhoff) {
+    const sim::FluxMap map = sim::FluxMap::load_csv(s.flux_map_file);
+    bool saturation = false, all_explained = true;
+    for (std::size_t j = 0; j < d.selection.found.size(); ++j) {
+      const std::string name = d.selection.found[j].effect.name();
+      const bool ok = explained_by_map(name, analysis::found_parameters(d, j), map, out.detail);
+      saturation = saturation || (name == "lq_saturation" && ok);
+      all_explained = all_explained && ok;
+    }
+    out.correct = saturation && all_explained;
+    return out;
+  }
+  std::multiset<std::string> expected, found;
+  for (const auto& h : hidden) expected.insert(h.name);
+  for (const auto& f : d.selection.found) found.insert(f.effect.name());
+  out.false_positive = out.null_case && !found.empty();
+  if (expected != found) {
+    out.detail += " [wrong names]";
+    return out;
+  }
+  bool all = true;
+  for (const auto& h : hidden) {
+    for (std::size_t j = 0; j < d.selection.found.size(); ++j) {
+      if (d.selection.found[j].effect.name() == h.name) all = matches(h, analysis::found_parameters(d, j), out.detail) && all;
+    }
+  }
+  out.correct = all;
+  return out;
+}
+
+}  // namespace rpem::test

@@ -1,0 +1,160 @@
+// `rpem diagnose` as a user runs it (docs/diagnose.md): simulate a drive with a hidden dead time, diagnose
+// the log, and carry extended.yaml into `rpem estimate` and rpemd; bad input gets a clear error and the
+// documented exit code; and the worked example on the Paderborn bench data keeps its result.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "support/process.hpp"
+#include "support/temp_file.hpp"
+
+namespace rpem {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string rpem_tool() { return test::binary_dir() + "/tools/rpem"; }
+
+std::string read(const std::string& path) {
+  std::ifstream f(path);
+  std::stringstream s;
+  s << f.rdbuf();
+  return s.str();
+}
+
+/// A fresh directory for one test's files (each test removes it when it passes).
+std::string out_dir(const std::string& name) {
+  const fs::path dir = fs::temp_directory_path() / ("rpem_cli_diagnose_" + name);
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir.string();
+}
+
+/// The last r_s of an estimate CSV.
+double last_r_s(const std::string& path) {
+  std::ifstream in(path);
+  std::string line, last;
+  while (std::getline(in, line)) last = line;
+  std::stringstream s(last);
+  double t = 0, psi = 0, r = 0;
+  char comma = 0;
+  s >> t >> comma >> psi >> comma >> r;
+  return r;
+}
+
+TEST(CliDiagnose, FindsAHiddenDeadTimeAndTheExtendedModelCarriesIntoTheTools) {
+  const std::string dir = out_dir("deadtime");
+  std::string scenario = read(test::source_dir() + "/scenarios/diagnose-bench.yaml");
+  const std::string anchor = "inverter: {model: switching";
+  ASSERT_NE(scenario.find(anchor), std::string::npos);
+  scenario.replace(scenario.find(anchor), anchor.size(), "inverter: {dead_time_s: 1.5e-6, model: switching");
+  std::ofstream(dir + "/scenario.yaml") << scenario;
+  const std::string log = dir + "/log.csv", truth = dir + "/truth.csv", out = dir + "/diagnosis";
+  auto r = test::run_command(rpem_tool() + " sim --scenario " + dir + "/scenario.yaml --out " + log + " --truth " + truth);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+
+  r = test::run_command(rpem_tool() + " diagnose --log " + log + " --out " + out + " --truth " + truth +
+                        " --switching-frequency-Hz 4000");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("effect deadtime:"), std::string::npos) << r.output;
+  for (const char* f : {"report.html", "report.md", "diagnosis.json", "extended.yaml", "residual_time.png",
+                        "residual_map.png", "overlay.png", "harmonics.png", "phase_sign.png", "estimates.png"}) {
+    EXPECT_GT(fs::file_size(out + "/" + f), 1000U) << f;
+  }
+  const nlohmann::json d = nlohmann::json::parse(read(out + "/diagnosis.json"));
+  ASSERT_EQ(d["effects"].size(), 1U) << d.dump(2);
+  EXPECT_EQ(d["effects"][0]["name"], "deadtime");
+  EXPECT_NEAR(d["effects"][0]["params"]["t_dead_s"].get<double>() / 1.5e-6, 1.0, 0.15);
+  EXPECT_LT(d["effects"][0]["heldout_rms_after"].get<double>(), 0.1 * d["effects"][0]["heldout_rms_before"].get<double>());
+  EXPECT_TRUE(d["not_identifiable"].empty());
+  // With the truth given, the report judges the estimator: dead time looks like resistance at standstill.
+  EXPECT_GT(d["nominal"]["estimates"]["r_s_error_pct"].get<double>(), 10.0);
+  EXPECT_LT(d["extended"]["estimates"]["r_s_error_pct"].get<double>(), 1.0);
+
+  // extended.yaml is a configuration `rpem estimate` and rpemd take as it is.
+  r = test::run_command(rpem_tool() + " estimate --log " + log + " --config " + out + "/extended.yaml --out " + dir +
+                        "/est_ext.csv --every 100");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  r = test::run_command(rpem_tool() + " estimate --log " + log + " --config " + test::source_dir() +
+                        "/config/paper-ipmsm.yaml --out " + dir + "/est_nom.csv --every 100");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NEAR(last_r_s(dir + "/est_ext.csv") / 2.25, 1.0, 0.01);
+  EXPECT_GT(last_r_s(dir + "/est_nom.csv") / 2.25, 1.10);
+  if (fs::exists(test::binary_dir() + "/daemon/rpemd")) {
+    r = test::run_command(test::binary_dir() + "/daemon/rpemd --config " + out + "/extended.yaml --check-config");
+    EXPECT_EQ(r.exit_code, 0) << r.output;
+  }
+  fs::remove_all(dir);
+}
+
+TEST(CliDiagnose, BadInputGetsAClearErrorAndItsExitCode) {
+  const std::string dir = out_dir("bad");
+  std::ofstream(dir + "/bad.csv") << "t,theta_el,omega_el,u_dc,u_a,u_b,u_c,i_a,i_b,i_c\n0,0,0,220,1,2,3,0,0,0\n0.1,0,0,x,1,2,3,0,0,0\n";
+  auto r = test::run_command(rpem_tool() + " diagnose --log " + dir + "/bad.csv --out " + dir + "/o");
+  EXPECT_EQ(r.exit_code, 65) << r.output;
+  EXPECT_NE(r.output.find("bad.csv:3: column u_dc: 'x' is not a number"), std::string::npos) << r.output;
+
+  std::ofstream(dir + "/cfg.yaml") << read(test::source_dir() + "/config/paper-ipmsm.yaml") << "colour: blue\n";
+  std::ofstream(dir + "/short.csv") << "t,omega_el,u_d,u_q,i_d,i_q\n0,100,1,2,3,4\n";
+  r = test::run_command(rpem_tool() + " diagnose --log " + dir + "/short.csv --config " + dir + "/cfg.yaml --out " + dir + "/o");
+  EXPECT_EQ(r.exit_code, 78) << r.output;
+  EXPECT_NE(r.output.find("colour: unknown key"), std::string::npos) << r.output;
+
+  r = test::run_command(rpem_tool() + " diagnose --log " + dir + "/short.csv --out " + dir + "/o");
+  EXPECT_EQ(r.exit_code, 65) << r.output;
+  EXPECT_NE(r.output.find("short.csv"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("at least 80 rows"), std::string::npos) << r.output;
+
+  // A dead time in seconds needs u_dc, which a rotor-frame-only log may lack: refused, naming both files.
+  std::ofstream(dir + "/dt.yaml") << read(test::source_dir() + "/config/paper-ipmsm.yaml")
+                                  << "model_extensions:\n  deadtime: {t_dead_s: 1.0e-6, switching_frequency_Hz: 4000}\n";
+  std::ofstream log(dir + "/dq.csv");
+  log << "t,omega_el,u_d,u_q,i_d,i_q\n";
+  for (int k = 0; k < 100; ++k) log << k * 2.5 << ",100,10,120,-1,3\n";
+  log.close();
+  r = test::run_command(rpem_tool() + " diagnose --log " + dir + "/dq.csv --config " + dir + "/dt.yaml --out " + dir + "/o");
+  EXPECT_EQ(r.exit_code, 78) << r.output;
+  EXPECT_NE(r.output.find("dq.csv has no u_dc column"), std::string::npos) << r.output;
+
+  r = test::run_command(rpem_tool() + " diagnose --log " + dir + "/dq.csv");
+  EXPECT_EQ(r.exit_code, 64) << r.output;
+  fs::remove_all(dir);
+}
+
+TEST(CliDiagnose, PaderbornWorkedExampleKeepsItsResult) {
+  // docs/diagnose.md, "Worked example": the bench profile against the commissioned constant-parameter
+  // model. Two-sided bounds, so an unexplained change either way is noticed.
+  const std::string source = test::source_dir() + "/../shared/data/paderborn-motor-temperature/profile_A_every5th.csv";
+  ASSERT_TRUE(fs::exists(source)) << source << " (the shared data beside the repository)";
+  const std::string dir = out_dir("paderborn");
+  auto r = test::run_command("python3 " + test::source_dir() + "/scripts/paderborn_to_drive_log.py " + source + " " + dir +
+                             "/profile.csv --pole-pairs 4");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  r = test::run_command(rpem_tool() + " diagnose --log " + dir + "/profile.csv --config " + test::source_dir() +
+                        "/config/paderborn-pmsm.yaml --out " + dir + "/diagnosis");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const nlohmann::json d = nlohmann::json::parse(read(dir + "/diagnosis/diagnosis.json"));
+  EXPECT_EQ(d["log"]["model"], "steady_state");
+  EXPECT_EQ(d["log"]["excluded_idle"], 2);
+  const double nominal = d["nominal"]["heldout_rms"], extended = d["extended"]["heldout_rms"];
+  EXPECT_GT(nominal, 7.5);
+  EXPECT_LT(nominal, 9.5);
+  ASSERT_EQ(d["effects"].size(), 1U) << d["effects"].dump(2);
+  const auto& e = d["effects"][0];
+  EXPECT_EQ(e["name"], "psim_drift");
+  const double coeff = e["params"]["coeff_per_K"];  // NdFeB: about −0.1 %/K
+  EXPECT_LT(coeff, -0.0009);
+  EXPECT_GT(coeff, -0.0012);
+  EXPECT_GT(e["gain_pct"].get<double>(), 80.0);
+  EXPECT_LT(extended, 1.5);
+  EXPECT_GT(extended, 0.5);
+  EXPECT_LT(d["extended"]["estimates"]["psi_m_error_pct"].get<double>(), 0.5);
+  EXPECT_GT(d["nominal"]["estimates"]["psi_m_error_pct"].get<double>(), 3.0);
+  fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace rpem
