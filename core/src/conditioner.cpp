@@ -34,14 +34,18 @@ void SampleConditioner::reconfigure(const PerUnitBase& base, const MachinePu& ma
   inv_current_gain_ = (Vec3::Ones() + x.current_gain_error).cwiseInverse();
   inv_r_fe_pu_ = x.iron_loss_r_fe_Ohm > 0.0 ? base_.impedance_Ohm / x.iron_loss_r_fe_Ohm : 0.0;
   offset_rotation_ = Rotation::of(x.theta_offset_rad);
+  angle_offset_ = x.theta_offset_rad != 0.0;
+  phase_corrections_ = !x.current_offset_A.isZero(0.0) || !x.current_gain_error.isZero(0.0);
+  saturation_ = x.saturation();
+  deadtime_ = x.deadtime_v_err_V != 0.0 || x.deadtime_t_dead_s != 0.0;
 }
 
 Vec2 SampleConditioner::current_alphabeta_A(const DriveSample& s, const Rotation& logged) const noexcept {
-  const bool phase_corrections = !extensions_.current_offset_A.isZero() || !extensions_.current_gain_error.isZero();
   Vec2 i_ab;
   switch (s.current_frame) {
     case Frame::kAbc:
-      return clarke((s.i_A - extensions_.current_offset_A).cwiseProduct(inv_current_gain_));
+      return phase_corrections_ ? clarke((s.i_A - extensions_.current_offset_A).cwiseProduct(inv_current_gain_))
+                                : clarke(s.i_A);
     case Frame::kAlphaBeta:
       i_ab = s.i_A.head<2>();
       break;
@@ -50,7 +54,7 @@ Vec2 SampleConditioner::current_alphabeta_A(const DriveSample& s, const Rotation
       break;
   }
   // A drive that logs αβ or dq made them from its phase measurements; the corrections act there.
-  if (phase_corrections) i_ab = clarke((inverse_clarke(i_ab) - extensions_.current_offset_A).cwiseProduct(inv_current_gain_));
+  if (phase_corrections_) i_ab = clarke((inverse_clarke(i_ab) - extensions_.current_offset_A).cwiseProduct(inv_current_gain_));
   return i_ab;
 }
 
@@ -71,6 +75,7 @@ double SampleConditioner::deadtime_voltage_V(double u_dc_V) const noexcept {
 }
 
 Vec2 SampleConditioner::deadtime_error_alphabeta_V(const Vec2& i_ab_A, double u_dc_V) const noexcept {
+  if (!deadtime_) return Vec2::Zero();
   const double v_err = deadtime_voltage_V(u_dc_V);
   if (v_err == 0.0) return Vec2::Zero();
   const Vec3 i_abc = inverse_clarke(i_ab_A);
@@ -82,13 +87,13 @@ Vec2 SampleConditioner::deadtime_error_alphabeta_V(const Vec2& i_ab_A, double u_
 SampleConditioner::Measured SampleConditioner::measure(const DriveSample& s) const noexcept {
   Measured m;
   m.logged = Rotation::of(s.theta_el_rad);
-  m.rot = extensions_.theta_offset_rad == 0.0 ? m.logged : compose(m.logged, offset_rotation_);
+  m.rot = angle_offset_ ? compose(m.logged, offset_rotation_) : m.logged;
   m.i_ab_A = current_alphabeta_A(s, m.logged);
   m.i_dq_pu = park(m.i_ab_A, m.rot) * inv_current_A_;
   m.n_pu = s.omega_el_rad_s * inv_omega_rad_s_;  // base_.speed_pu(), without the division
   m.x_d_pu = machine_.x_d_pu;
   m.x_q_pu = machine_.x_q_pu;
-  if (extensions_.saturation()) {
+  if (saturation_) {
     m.x_d_pu *= extensions_.inductance_d.factor(m.i_dq_pu[0] * base_.current_A);
     m.x_q_pu *= extensions_.inductance_q.factor(m.i_dq_pu[1] * base_.current_A);
   }
@@ -134,7 +139,7 @@ Vec2 SampleConditioner::logged_current_dq_A(const DriveSample& s) const noexcept
 
 Vec2 SampleConditioner::observed_current_dq_A(const DriveSample& s, const Vec2& i_model_pu) const noexcept {
   const Rotation logged = Rotation::of(s.theta_el_rad);
-  const Rotation rot = extensions_.theta_offset_rad == 0.0 ? logged : compose(logged, offset_rotation_);
+  const Rotation rot = angle_offset_ ? compose(logged, offset_rotation_) : logged;
   Vec2 i_pu = i_model_pu;
   if (inv_r_fe_pu_ > 0.0) {
     const double x_d = machine_.x_d_pu * extensions_.inductance_d.factor(i_pu[0] * base_.current_A);
@@ -143,7 +148,7 @@ Vec2 SampleConditioner::observed_current_dq_A(const DriveSample& s, const Vec2& 
     i_pu += (s.omega_el_rad_s * inv_omega_rad_s_ * inv_r_fe_pu_) * Vec2(-psi[1], psi[0]);
   }
   Vec2 i_ab_A = inverse_park(i_pu * base_.current_A, rot);
-  if (!extensions_.current_offset_A.isZero() || !extensions_.current_gain_error.isZero()) {
+  if (phase_corrections_) {
     const Vec3 i_abc = inverse_clarke(i_ab_A);
     i_ab_A = clarke(i_abc.cwiseProduct(Vec3::Ones() + extensions_.current_gain_error) + extensions_.current_offset_A);
   }
@@ -160,7 +165,7 @@ EstimatorSample SampleConditioner::condition(const DriveSample& s) noexcept {
 
   const Measured m = measure(s);
   out.i_meas_pu = m.i_dq_pu;
-  if (extensions_.saturation()) {
+  if (saturation_) {
     out.x_d_pu = m.x_d_pu;
     out.x_q_pu = m.x_q_pu;
   }

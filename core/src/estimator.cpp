@@ -113,7 +113,10 @@ EstimatorOutput RpemEstimator::step(const EstimatorSample& sample) noexcept {
   // Saturation extensions give each sample its own inductances (two divisions); else the cached ones.
   const PredictorCoefficients coefficients =
       sample.x_d_pu > 0.0 ? PredictorCoefficients::of(model, config_.omega_n_rad_s) : coefficients_;
-  predict(model, coefficients, config_.discretization, iv, state_.predictor);
+  // With steady-state forms for both parameters the dynamic gradients would be computed for nothing.
+  const bool dynamic = config_.gradient_psi_m == GradientForm::kDynamic || config_.gradient_r_s == GradientForm::kDynamic;
+  predict(model, coefficients, config_.discretization, iv, state_.predictor,
+          dynamic ? Gradients::kAdvance : Gradients::kSkip);
   const Vec2& i_hat = state_.predictor.i_hat_pu;
   if (!i_hat.allFinite() || i_hat.lpNorm<Eigen::Infinity>() > config_.max_predicted_current_pu ||
       !state_.predictor.gradient.allFinite()) {

@@ -28,7 +28,7 @@ struct Coefficients {
 }  // namespace
 
 void predict(const MachinePu& model, const PredictorCoefficients& pc, Discretization method,
-             const PredictorInterval& iv, PredictorState& s) noexcept {
+             const PredictorInterval& iv, PredictorState& s, Gradients gradients) noexcept {
   const Coefficients c{pc.wd, pc.wq, model};
   const double h = iv.dt_s;
   const Mat2 a_start = c.system(iv.n_start_pu);
@@ -36,6 +36,7 @@ void predict(const MachinePu& model, const PredictorCoefficients& pc, Discretiza
 
   if (method == Discretization::kExplicitEuler) {
     s.i_hat_pu = i_prev + h * (a_start * i_prev + c.current_forcing(iv.n_start_pu, iv.u_start_pu));
+    if (gradients == Gradients::kSkip) return;
     s.gradient.col(kPsiM) += h * (a_start * s.gradient.col(kPsiM) + c.psi_forcing(iv.n_start_pu));
     s.gradient.col(kRs) += h * (a_start * s.gradient.col(kRs) + c.rs_forcing(i_prev));
     return;
@@ -48,6 +49,7 @@ void predict(const MachinePu& model, const PredictorCoefficients& pc, Discretiza
   s.i_hat_pu = m_inv * (n_start * i_prev + 0.5 * h *
                                                (c.current_forcing(iv.n_start_pu, iv.u_start_pu) +
                                                 c.current_forcing(iv.n_end_pu, iv.u_end_pu)));
+  if (gradients == Gradients::kSkip) return;
   s.gradient.col(kPsiM) =
       m_inv * (n_start * s.gradient.col(kPsiM) + 0.5 * h * (c.psi_forcing(iv.n_start_pu) + c.psi_forcing(iv.n_end_pu)));
   s.gradient.col(kRs) =

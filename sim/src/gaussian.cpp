@@ -23,10 +23,9 @@ struct Tables {
   }
 };
 
-const Tables& tables() {
-  static const Tables t;
-  return t;
-}
+// Built once at start-up, so the per-sample path reads it without a guard.
+const Tables kTables;
+const Tables& tables() { return kTables; }
 
 std::uint64_t rotl(std::uint64_t x, int k) noexcept { return (x << k) | (x >> (64 - k)); }
 

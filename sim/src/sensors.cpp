@@ -12,11 +12,19 @@ Sensors::Sensors(const SensorConfig& config, int pole_pairs, double period_s, st
       pole_pairs_(pole_pairs),
       period_s_(period_s),
       normal_(seed),
-      angle_history_mech_(static_cast<std::size_t>(std::max(2, config.speed_window + 1)), 0.0) {}
+      angle_history_mech_(static_cast<std::size_t>(std::max(2, config.speed_window + 1)), 0.0) {
+  inv_current_lsb_ = config.current_lsb_A > 0.0 ? 1.0 / config.current_lsb_A : 0.0;
+  inv_u_dc_lsb_ = config.u_dc_lsb_V > 0.0 ? 1.0 / config.u_dc_lsb_V : 0.0;
+  inv_pole_pairs_ = 1.0 / pole_pairs;
+  if (config.encoder_counts > 0.0) {
+    encoder_step_rad_ = 2.0 * core::kPi / config.encoder_counts;
+    inv_encoder_step_ = config.encoder_counts / (2.0 * core::kPi);
+  }
+}
 
-double Sensors::quantize(double x, double lsb) noexcept {
+double Sensors::quantize(double x, double lsb, double inv_lsb) noexcept {
   if (lsb <= 0.0) return x;
-  const double steps = x / lsb;  // round half away from zero without a libm call
+  const double steps = x * inv_lsb;  // round half away from zero without a libm call
   return lsb * static_cast<double>(static_cast<long long>(steps + (steps >= 0.0 ? 0.5 : -0.5)));
 }
 
@@ -25,18 +33,17 @@ core::Vec3 Sensors::currents(const core::Vec3& i_abc_A) noexcept {
   for (int x = 0; x < 3; ++x) {
     double v = i_abc_A[x] * (1.0 + config_.current_gain_error[x]) + config_.current_offset_A[x];
     if (config_.current_noise_A > 0.0) v += config_.current_noise_A * normal_();
-    out[x] = quantize(v, config_.current_lsb_A);
+    out[x] = quantize(v, config_.current_lsb_A, inv_current_lsb_);
   }
   return out;
 }
 
 double Sensors::angle(double theta_el_true_rad) noexcept {
-  double mech = theta_el_true_rad / pole_pairs_;
+  double mech = theta_el_true_rad * inv_pole_pairs_;
   if (config_.encoder_counts > 0.0) {
-    const double count = 2.0 * core::kPi / config_.encoder_counts;
-    const double counts = mech / count;
+    const double counts = mech * inv_encoder_step_;
     const auto truncated = static_cast<double>(static_cast<long long>(counts));
-    mech = count * (truncated > counts ? truncated - 1.0 : truncated);  // floor, without a libm call
+    mech = encoder_step_rad_ * (truncated > counts ? truncated - 1.0 : truncated);  // floor, without a libm call
   }
   head_ = (head_ + 1) % angle_history_mech_.size();
   angle_history_mech_[head_] = mech;
@@ -55,7 +62,7 @@ double Sensors::speed() const noexcept {
 double Sensors::dc_link(double u_dc_V) noexcept {
   double v = u_dc_V;
   if (config_.u_dc_noise_V > 0.0) v += config_.u_dc_noise_V * normal_();
-  return quantize(v, config_.u_dc_lsb_V);
+  return quantize(v, config_.u_dc_lsb_V, inv_u_dc_lsb_);
 }
 
 }  // namespace rpem::sim

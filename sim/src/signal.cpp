@@ -21,12 +21,21 @@ double Signal::segment_value(double t) const noexcept {
   return e.target;
 }
 
-double Signal::at(double t) noexcept {
+double Signal::advance(double t) noexcept {
   while (active_ + 1 < static_cast<int>(events_.size()) && events_[static_cast<std::size_t>(active_ + 1)].t_s <= t) {
     start_value_ = segment_value(events_[static_cast<std::size_t>(active_ + 1)].t_s);
     ++active_;
   }
-  return segment_value(t);
+  const double v = segment_value(t);
+  if (active_ + 1 == static_cast<int>(events_.size())) {
+    // The last event: a step is final at once, a ramp at its end; a thermal approach never quite is.
+    const SignalEvent* e = active_ >= 0 ? &events_[static_cast<std::size_t>(active_)] : nullptr;
+    if (!e || e->kind == EventKind::kStep || (e->kind == EventKind::kRamp && t >= e->t_s + e->duration_s)) {
+      settled_ = true;
+      value_ = v;
+    }
+  }
+  return v;
 }
 
 }  // namespace rpem::sim

@@ -130,7 +130,7 @@ TEST(PhyInt, PsiGainIsMinusGammaXd) {
 }
 
 TEST(PhyInt, RsUpdateRecoversGammaTimesTheResistanceError) {
-  // ε from eq_epsilon_steadystate (δψ = 0) with î = i: L·ε = γ·δr̂s (the 1/m weight, erratum E4).
+  // ε from eq_epsilon_steadystate (δψ = 0) with î = i: L·ε = γ·δr̂s (the 1/m weight, erratum E3).
   const MachinePu m = test::paper_machine_pu();
   const double drs = 0.0035, gamma = 6.25e-5;
   GainFloors f;

@@ -66,7 +66,7 @@ void ModelReplay::run_transient(const ExtendedModel& model, ReplayOutput& out) c
       m.x_q_pu = e.x_q_pu;
       coefficients = core::PredictorCoefficients::of(m, base_.omega_el_rad_s);
     }
-    core::predict(m, coefficients, core::Discretization::kTrapezoidal, iv, state);
+    core::predict(m, coefficients, core::Discretization::kTrapezoidal, iv, state, core::Gradients::kSkip);
     if (!log_.used[k]) continue;
     out.model_A[k] = conditioner.observed_current_dq_A(s, state.i_hat_pu);
     out.residual_A[k] = conditioner.logged_current_dq_A(s) - out.model_A[k];

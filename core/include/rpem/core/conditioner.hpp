@@ -109,6 +109,8 @@ class SampleConditioner {
   double inv_r_fe_pu_ = 0.0;                 ///< 1/r_fe in pu; 0 without iron loss
   Vec3 inv_current_gain_ = Vec3::Ones();     ///< 1/(1 + gain error) per phase
   Rotation offset_rotation_;                 ///< by theta_offset_rad
+  // Which extensions are active, decided when configured (the per-sample path tests one flag each).
+  bool angle_offset_ = false, phase_corrections_ = false, saturation_ = false, deadtime_ = false;
   bool has_previous_ = false;
   std::int64_t previous_t_ns_ = 0;
   Rotation previous_rotation_;

@@ -55,7 +55,7 @@ struct GainOutput {
 ///   L_2j = γ_r·D / (m·den_j) over the m ∈ {1, 2} components with |den_j| ≥ floor, where
 ///   den_d = −r̂s·î_d − n·x̂_q·î_q,  den_q = −r̂s·î_q + n·x̂_d·î_d,  D = r̂s² + n²·x̂_d·x̂_q.
 /// The 1/m weight makes L·ε = γ·δr̂s in steady state; the printed form (m = 1) gives 2γ·δr̂s when
-/// both components are used (erratum E4, docs/derivations.md).
+/// both components are used (erratum E3, docs/derivations.md).
 [[nodiscard]] GainOutput phyint_gain(const MachinePu& model, double n_pu, const Vec2& i_hat_pu,
                                      const Vec2& gamma_gain, const GainFloors& floors) noexcept;
 

@@ -49,10 +49,14 @@ struct PredictorCoefficients {
   }
 };
 
+/// Whether predict() also advances the dynamic gradients (unneeded when only steady-state forms are
+/// used, or only the current is wanted).
+enum class Gradients : std::uint8_t { kAdvance = 0, kSkip = 1 };
+
 /// Advances the predictor and its dynamic gradients by one interval. `model` carries the current
 /// estimates ψ̂m, r̂s and the model inductances x_d, x_q; `c` must be PredictorCoefficients::of(model).
 void predict(const MachinePu& model, const PredictorCoefficients& c, Discretization method,
-             const PredictorInterval& interval, PredictorState& state) noexcept;
+             const PredictorInterval& interval, PredictorState& state, Gradients gradients = Gradients::kAdvance) noexcept;
 
 /// The same, computing the coefficients on the way.
 inline void predict(const MachinePu& model, double omega_n_rad_s, Discretization method,

@@ -35,11 +35,15 @@ class Sensors {
   [[nodiscard]] double dc_link(double u_dc_V) noexcept;
 
  private:
-  [[nodiscard]] static double quantize(double x, double lsb) noexcept;
+  /// Rounds to a multiple of lsb (inv_lsb = 1/lsb; lsb 0: unchanged).
+  [[nodiscard]] static double quantize(double x, double lsb, double inv_lsb) noexcept;
 
   SensorConfig config_;
   int pole_pairs_;
   double period_s_;
+  // Reciprocals, so the per-period path multiplies instead of dividing.
+  double inv_current_lsb_ = 0.0, inv_u_dc_lsb_ = 0.0, inv_pole_pairs_ = 1.0;
+  double encoder_step_rad_ = 0.0, inv_encoder_step_ = 0.0;  ///< mechanical angle per count
   GaussianNoise normal_;
   std::vector<double> angle_history_mech_;  ///< unwrapped measured mechanical angles, ring buffer
   std::size_t head_ = 0;
