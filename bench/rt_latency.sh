@@ -99,10 +99,18 @@ daemon:
   state: {file: /tmp/state.json}
   status_interval_s: 0
 YAML
-  echo "== PREEMPT_RT VM (emulated): cyclictest -p 80 -i 1000 -a 1 (${seconds} s), then rpemd (CAN, loop 1 ms) with the drive streaming"
-  "$repo/tests/vm/vm_rig.sh" run --timeout $((seconds * 6 + 300)) --share "$out" --file "$build/daemon/rpemd" \
+  echo "== PREEMPT_RT VM (emulated): ${seconds} s each, with the drive streaming into vcan0 both times (same load):"
+  echo "   cyclictest -p 80 -i 1000 -a 1 beside rpem record (the receiving load), then rpemd (CAN source, loop 1 ms)"
+  "$repo/tests/vm/vm_rig.sh" run --timeout $((seconds * 8 + 300)) --share "$out" --file "$build/daemon/rpemd" \
     --file "$build/tools/rpem" --file "$out/stream.yaml" --file "$out/rpemd-vm.yaml" -- "
+      rpem record --can vcan0 --out /tmp/recorded.csv --idle-timeout 3 > /dev/null 2>&1 &
+      rec=\$!
+      sleep 1
+      rpem sim --scenario stream.yaml --can vcan0 --rate 0.4 > /dev/null 2>&1 &
+      sim=\$!
+      sleep 1
       cyclictest -m -q -p 80 -i 1000 -a 1 -t 1 -D $seconds -h 20000 --histfile=/host/cvm.hist > /dev/null
+      kill \$sim; wait \$rec
       rpemd --config rpemd-vm.yaml --latency-histogram /host/rvm.hist 2> /host/rpemd-vm.txt &
       pid=\$!
       sleep 1

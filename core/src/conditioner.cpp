@@ -40,22 +40,15 @@ void SampleConditioner::reconfigure(const PerUnitBase& base, const MachinePu& ma
   deadtime_ = x.deadtime_v_err_V != 0.0 || x.deadtime_t_dead_s != 0.0;
 }
 
+Vec3 SampleConditioner::corrected_phases_A(const Vec3& measured_A) const noexcept {
+  return (measured_A - extensions_.current_offset_A).cwiseProduct(inv_current_gain_);
+}
+
 Vec2 SampleConditioner::current_alphabeta_A(const DriveSample& s, const Rotation& logged) const noexcept {
-  Vec2 i_ab;
-  switch (s.current_frame) {
-    case Frame::kAbc:
-      return phase_corrections_ ? clarke((s.i_A - extensions_.current_offset_A).cwiseProduct(inv_current_gain_))
-                                : clarke(s.i_A);
-    case Frame::kAlphaBeta:
-      i_ab = s.i_A.head<2>();
-      break;
-    case Frame::kDq:
-      i_ab = inverse_park(s.i_A.head<2>(), logged);
-      break;
-  }
+  if (s.current_frame == Frame::kAbc) return clarke(phase_corrections_ ? corrected_phases_A(s.i_A) : Vec3(s.i_A));
+  const Vec2 i_ab = s.current_frame == Frame::kAlphaBeta ? Vec2(s.i_A.head<2>()) : inverse_park(s.i_A.head<2>(), logged);
   // A drive that logs αβ or dq made them from its phase measurements; the corrections act there.
-  if (phase_corrections_) i_ab = clarke((inverse_clarke(i_ab) - extensions_.current_offset_A).cwiseProduct(inv_current_gain_));
-  return i_ab;
+  return phase_corrections_ ? clarke(corrected_phases_A(inverse_clarke(i_ab))) : i_ab;
 }
 
 Vec2 SampleConditioner::command_alphabeta_V(const DriveSample& s, const Rotation& logged) noexcept {
@@ -84,9 +77,20 @@ Vec2 SampleConditioner::deadtime_error_alphabeta_V(const Vec2& i_ab_A, double u_
   return clarke(leg_error);  // the zero sequence does not reach the machine
 }
 
-SampleConditioner::Measured SampleConditioner::measure(const DriveSample& s) const noexcept {
+Rotation SampleConditioner::logged_rotation(const DriveSample& s) noexcept {
+  constexpr unsigned kExactRotationEvery = 32;  // composition round-off stays below 1e-13
+  constexpr double kLargestIncrement = 0.1;     // small_rotation() is exact to 1e-12 up to here
+  if (has_previous_ && !s.gap_before && ++rotations_since_exact_ < kExactRotationEvery) {
+    const double step = wrap_angle(s.theta_el_rad - previous_logged_theta_rad_);
+    if (step <= kLargestIncrement && step >= -kLargestIncrement) return compose(previous_logged_, small_rotation(step));
+  }
+  rotations_since_exact_ = 0;
+  return Rotation::of(s.theta_el_rad);
+}
+
+SampleConditioner::Measured SampleConditioner::measure(const DriveSample& s, const Rotation& logged) const noexcept {
   Measured m;
-  m.logged = Rotation::of(s.theta_el_rad);
+  m.logged = logged;
   m.rot = angle_offset_ ? compose(m.logged, offset_rotation_) : m.logged;
   m.i_ab_A = current_alphabeta_A(s, m.logged);
   m.i_dq_pu = park(m.i_ab_A, m.rot) * inv_current_A_;
@@ -109,7 +113,7 @@ SampleConditioner::Measured SampleConditioner::measure(const DriveSample& s) con
 
 SteadyStateInputs SampleConditioner::steady_state(const DriveSample& s) const noexcept {
   SteadyStateInputs out;
-  const Measured m = measure(s);
+  const Measured m = measure(s, Rotation::of(s.theta_el_rad));
   Vec2 u_dq_V = park(command_alphabeta_V(s, m.logged), m.rot);
   const double v_err = deadtime_voltage_V(s.u_dc_V);
   const double i_norm = m.i_ab_A.norm();
@@ -163,7 +167,7 @@ EstimatorSample SampleConditioner::condition(const DriveSample& s) noexcept {
     return out;
   }
 
-  const Measured m = measure(s);
+  const Measured m = measure(s, logged_rotation(s));
   out.i_meas_pu = m.i_dq_pu;
   if (saturation_) {
     out.x_d_pu = m.x_d_pu;
@@ -181,8 +185,11 @@ EstimatorSample SampleConditioner::condition(const DriveSample& s) noexcept {
     iv.n_start_pu = previous_n_pu_;
     iv.n_end_pu = m.n_pu;
     // Delay extension: the first `delay` of the interval still sees the command before.
-    const double w = iv.dt_s > 0.0 ? std::clamp(extensions_.delay_s / iv.dt_s, 0.0, 1.0) : 0.0;
-    const Vec2 u_held_ab_pu = ((1.0 - w) * previous_u_ab_V_ + w * older_u_ab_V_) * inv_voltage_V_;
+    Vec2 u_held_ab_pu = previous_u_ab_V_ * inv_voltage_V_;
+    if (extensions_.delay_s > 0.0 && iv.dt_s > 0.0) {
+      const double w = std::clamp(extensions_.delay_s / iv.dt_s, 0.0, 1.0);
+      u_held_ab_pu = ((1.0 - w) * previous_u_ab_V_ + w * older_u_ab_V_) * inv_voltage_V_;
+    }
     iv.u_start_pu = park(u_held_ab_pu, previous_rotation_);
     iv.u_end_pu = park(u_held_ab_pu, m.rot);
   } else {
@@ -195,6 +202,8 @@ EstimatorSample SampleConditioner::condition(const DriveSample& s) noexcept {
 
   older_u_ab_V_ = has_previous_ ? previous_u_ab_V_ : u_applied_ab_V;
   previous_u_ab_V_ = u_applied_ab_V;
+  previous_logged_ = m.logged;
+  previous_logged_theta_rad_ = s.theta_el_rad;
   previous_rotation_ = m.rot;
   previous_n_pu_ = m.n_pu;
   previous_t_ns_ = s.t_ns;

@@ -45,5 +45,14 @@ TEST(Frames, WrapAngle) {
   EXPECT_NEAR(wrap_angle(-0.25), -0.25, 1e-15);
 }
 
+TEST(Frames, SmallRotationMatchesSinCosToRoundOff) {
+  // The Taylor series' first omitted terms bound the error: x^10/10! and x^9/9! < 3e-15 for |x| <= 0.1.
+  for (double x = -0.1; x <= 0.1; x += 0.001) {
+    const Rotation r = small_rotation(x);
+    EXPECT_NEAR(r.cos, std::cos(x), 3e-15) << x;
+    EXPECT_NEAR(r.sin, std::sin(x), 3e-15) << x;
+  }
+}
+
 }  // namespace
 }  // namespace rpem::core
