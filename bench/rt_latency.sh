@@ -61,11 +61,21 @@ daemon:
   state: {file: $out/state.json}
   status_interval_s: 0
 YAML
-  echo "== host: $rounds × ${slice} s each of cyclictest -m -p 80 -i 125 -a 1 and rpemd (loop 125 µs, FIFO 80, CPU 1, sim source)"
-  local cyc=() rpm=()
+  # The same daemon kept entirely on CPU 0: the load rpemd's own other threads put beside its loop.
+  sed -e 's/cpu: 1}/cpu: 0}/' "$out/rpemd-host.yaml" >"$out/rpemd-cpu0.yaml"
+  echo "== host: $rounds × ${slice} s each of cyclictest -m -p 80 -i 125 -a 1 (alone; and beside an rpemd kept on CPU 0)"
+  echo "   and of rpemd (loop 125 µs, FIFO 80, CPU 1, sim source; its other threads on CPU 0)"
+  local cyc=() cycl=() rpm=()
   for r in $(seq 1 $rounds); do
     cyclictest -m -q -p 80 -i 125 -a 1 -t 1 -D "$slice" -h 20000 --histfile="$out/c$r.hist" >/dev/null
     cyc+=("$out/c$r.hist")
+    "$build/daemon/rpemd" --config "$out/rpemd-cpu0.yaml" 2>/dev/null >/dev/null &
+    local load=$!
+    sleep 1
+    cyclictest -m -q -p 80 -i 125 -a 1 -t 1 -D "$slice" -h 20000 --histfile="$out/l$r.hist" >/dev/null
+    kill -TERM $load
+    wait $load || true
+    cycl+=("$out/l$r.hist")
     "$build/daemon/rpemd" --config "$out/rpemd-host.yaml" --latency-histogram "$out/r$r.hist" 2>"$out/r$r.txt" &
     local pid=$!
     sleep "$slice"
@@ -80,6 +90,7 @@ YAML
   done
   grep -h "overruns" "$out"/r*.txt | awk '{o += $(NF-4); p += $(NF-1)} END {printf "host: rpemd overruns %d in %d periods\n", o, p}'
   report host 125 "${cyc[@]}" -- "${rpm[@]}"
+  report "host, cyclictest beside rpemd on CPU 0" 125 "${cycl[@]}" -- "${rpm[@]}"
 }
 
 vm() {
