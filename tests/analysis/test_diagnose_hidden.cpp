@@ -40,5 +40,26 @@ INSTANTIATE_TEST_SUITE_P(
                       test::HiddenCase{"beckhoff400", {}, 114}, test::HiddenCase{"beckhoff800", {}, 115}),
     name_of);
 
+TEST(HiddenEffect, WhatTheDataCannotSeparateIsReportedNotGuessed) {
+  // Standstill at one current: a dead time and a current-sensor offset on the phase that carries the
+  // largest current change the model identically. Neither may be named — nor anything else for the
+  // same residual — and the pair must be reported as not identifiable.
+  sim::Scenario s = sim::load_scenario(test::source_dir() + "/scenarios/diagnose-bench.yaml");
+  s.duration_s = 5.0;
+  s.signal(sim::Quantity::kSpeed) = sim::Signal(0.0);
+  s.signal(sim::Quantity::kTorque) = sim::Signal(13.0);
+  analysis::hide(s, {"deadtime", 1.5e-6});
+  io::DriveLogLayout layout;
+  analysis::LogData log = analysis::prepare_log(analysis::simulate(s, &layout), layout, s.machine.machine, {});
+  const analysis::Diagnosis d = analysis::diagnose(std::move(log), s.machine, {});
+  EXPECT_TRUE(d.selection.found.empty());
+  ASSERT_FALSE(d.selection.not_identifiable.empty());
+  const auto& group = d.selection.not_identifiable.front().effects;
+  EXPECT_NE(std::find(group.begin(), group.end(), "deadtime"), group.end());
+  EXPECT_GE(group.size(), 2U);
+  EXPECT_NE(d.selection.not_identifiable.front().reason.find("would separate them"), std::string::npos);
+  EXPECT_NEAR(d.selection.extended_heldout_rms_A, d.selection.nominal_heldout_rms_A, 1e-12);  // no model named
+}
+
 }  // namespace
 }  // namespace rpem

@@ -159,7 +159,9 @@ void selection(ReportDocument& doc, const Diagnosis& d) {
                 " jointly with the effects already found (Ceres), and accepts the one that lowers the held-out residual "
                 "most — if it lowers its RMS by at least " + num(d.options.selection.min_gain_pct, 3) +
                 " % and the held-out blocks agree (one-sided Wilcoxon signed-rank test on the per-block log ratios, p ≤ " +
-                num(d.options.selection.max_p, 3) + ").");
+                num(d.options.selection.max_p, 3) +
+                "). Candidates the held-out blocks cannot tell from the winner, and that change the model alike, make "
+                "it a guess: the group is reported as not identifiable and nobody is named for that residual.");
   for (std::size_t r = 0; r < d.selection.rounds.size(); ++r) {
     std::vector<std::vector<std::string>> rows;
     for (const CandidateScore& c : d.selection.rounds[r]) {

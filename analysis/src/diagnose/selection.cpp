@@ -34,6 +34,9 @@ std::string separating_data(const std::string& a, const std::string& b) {
   if (is("psim_drift", "ld_saturation")) return "operation at two or more d-axis currents";
   if (is("iron_loss", "psim_drift") || is("iron_loss", "theta_offset")) return "the same torque at two or more speeds";
   if (is("rs_drift", "iron_loss")) return "standstill with current (no iron loss there)";
+  if (is("deadtime", "current_offset")) {
+    return "current of both signs in that phase, or motion (an offset then shows at the fundamental, dead time at the 6th)";
+  }
   return "operating points where the two act differently (other speeds, currents or current signs)";
 }
 
@@ -100,9 +103,9 @@ Selection select_effects(const EffectFitter& fitter, const SelectionOptions& opt
   const EffectContext& context = fitter.context();
   BlockScores current = fitter.heldout(sel.model);
   sel.nominal_heldout_rms_A = rms(current);
-  std::vector<Effect> excluded;
+  std::vector<Effect> excluded, stand_ins;
 
-  while (static_cast<int>(sel.found.size()) < options.max_effects) {
+  while (static_cast<int>(sel.found.size() + stand_ins.size()) < options.max_effects) {
     std::vector<CandidateScore> round;
     for (const Effect& e : candidates(context)) {
       if (sel.model.contains(e) || std::find(excluded.begin(), excluded.end(), e) != excluded.end()) continue;
@@ -135,10 +138,11 @@ Selection select_effects(const EffectFitter& fitter, const SelectionOptions& opt
     sel.rounds.push_back(round);
     if (winner.gain_pct < options.min_gain_pct || winner.p_value > options.max_p) break;
 
-    // A rival that passes too, that the held-out blocks do not tell from the winner, and that changes
-    // the model in the same way, makes the winner a guess.
-    bool ambiguous = false;
-    for (std::size_t i = 0; i < shortlisted && !ambiguous; ++i) {
+    // Rivals that pass too, that the held-out blocks do not tell from the winner, and that change the
+    // model in the same way, make the winner a guess: the group is reported, nobody is named.
+    std::vector<std::string> group = {winner.effect.label()};
+    std::string reason;
+    for (std::size_t i = 0; i < shortlisted; ++i) {
       const CandidateScore& rival = round[i];
       if (i == best || rival.effect.name() == winner.effect.name()) continue;
       if (rival.gain_pct < options.min_gain_pct || rival.p_value > options.max_p) continue;
@@ -146,23 +150,41 @@ Selection select_effects(const EffectFitter& fitter, const SelectionOptions& opt
       if (p_preferred <= options.ambiguity_p) continue;
       const double corr = change_correlation(fitter, sel.model, fitted[best], fitted[i]);
       if (std::abs(corr) < options.ambiguity_correlation) continue;
-      char reason[640];
-      std::snprintf(reason, sizeof reason,
-                    "both change the model's currents the same way in this log (correlation %.3f) and lower the "
-                    "held-out residual alike (%.1f %% and %.1f %%; the held-out blocks prefer neither, p = %.2f); a "
+      char text[640];
+      std::snprintf(text, sizeof text,
+                    "%s%s and %s change the model's currents the same way in this log (correlation %.3f) and lower "
+                    "the held-out residual alike (%.1f %% and %.1f %%; the held-out blocks prefer neither, p = %.2f); a "
                     "log with %s would separate them",
-                    corr, winner.gain_pct, rival.gain_pct, p_preferred,
+                    reason.empty() ? "" : "; ", winner.effect.label().c_str(), rival.effect.label().c_str(), corr,
+                    winner.gain_pct, rival.gain_pct, p_preferred,
                     separating_data(winner.effect.name(), rival.effect.name()).c_str());
-      sel.not_identifiable.push_back({{winner.effect.label(), rival.effect.label()}, reason});
-      excluded.push_back(winner.effect);
+      reason += text;
+      group.push_back(rival.effect.label());
       excluded.push_back(rival.effect);
-      ambiguous = true;
     }
-    if (ambiguous) continue;
+    if (group.size() > 1) {
+      // The winner stays in the model as an unnamed stand-in, so that no later candidate is named for the
+      // residual the group explains; it is taken out again at the end.
+      sel.not_identifiable.push_back({group, reason});
+      stand_ins.push_back(winner.effect);
+      sel.model = fitted[best];
+      current = scores[best];
+      continue;
+    }
 
     sel.found.push_back({winner.effect, rms(current), rms(scores[best]), winner.gain_pct, winner.p_value});
     sel.model = fitted[best];
     current = scores[best];
+  }
+  if (!stand_ins.empty()) {
+    EffectSet named;
+    for (std::size_t j = 0; j < sel.model.effects.size(); ++j) {
+      if (std::find(stand_ins.begin(), stand_ins.end(), sel.model.effects[j]) != stand_ins.end()) continue;
+      named.effects.push_back(sel.model.effects[j]);
+      named.parameters.push_back(sel.model.parameters[j]);
+    }
+    sel.model = named;
+    current = fitter.heldout(sel.model);
   }
   sel.extended_heldout_rms_A = rms(current);
   for (const Unidentifiable& u : unobservable(context)) sel.not_identifiable.push_back(u);

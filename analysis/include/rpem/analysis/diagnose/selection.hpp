@@ -5,8 +5,10 @@
 // (≥ min_gain_pct of RMS) and consistent across the held-out blocks: a one-sided Wilcoxon signed-rank
 // test on the per-block log ratios ln(SSR before/SSR after) (blocks the effect cannot touch have a
 // ratio of 0 and drop out) must give p ≤ max_p. So noise, which a training fit always "explains" a
-// little, is not named as an effect. Two candidates that explain the same residual equally well and
-// in the same way are reported as not identifiable instead of one of them being guessed.
+// little, is not named as an effect. Candidates that explain the same residual equally well and in the
+// same way are reported together as not identifiable instead of one of them being guessed; the best of
+// them stays in the model, unnamed, for the rest of the selection, so that no later candidate is named
+// for that residual either, and is taken out of the final model.
 
 #include <string>
 #include <vector>
@@ -42,13 +44,13 @@ struct CandidateScore {
 struct FoundEffect {
   Effect effect;
   double heldout_rms_before_A = 0.0;  ///< the model before this effect was added
-  double heldout_rms_after_A = 0.0;   ///< … and after (both with all effects found before it)
+  double heldout_rms_after_A = 0.0;   ///< … and after (both with the effects found or stood in before it)
   double gain_pct = 0.0;
   double p_value = 1.0;
 };
 
 struct Selection {
-  EffectSet model;                     ///< the found effects, fitted jointly
+  EffectSet model;                     ///< the found (named) effects, fitted jointly
   std::vector<FoundEffect> found;
   std::vector<Unidentifiable> not_identifiable;
   std::vector<std::vector<CandidateScore>> rounds;
