@@ -13,9 +13,11 @@ step "SocketCAN tests"
 test_socketcan --gtest_color=no || fail=1
 
 step "sim -> vcan0 -> record (CAN FD), captured by candump"
-# A large socket buffer (-r, as rpem record uses): under emulation candump is scheduled late and would
-# otherwise lose frames to its default-sized receive queue.
-candump -r 8388608 -L vcan0,100:7FF > "$out/capture.log" &
+# Under emulation candump is scheduled late: it gets a large socket buffer (-r, as rpem record has; the
+# limit raised first) and writes its capture to RAM — each line to the 9p-shared host directory would be
+# slow enough to overflow any buffer — and the capture is copied out afterwards.
+echo 16777216 > /proc/sys/net/core/rmem_max 2>/dev/null
+candump -r 8388608 -L vcan0,100:7FF > /tmp/capture.log &
 dump=$!
 rpem record --can vcan0 --out "$out/recorded.csv" --idle-timeout 1.5 > "$out/record.txt" 2>&1 &
 rec=$!
@@ -23,13 +25,14 @@ sleep 0.5
 rpem sim --scenario can-stream.yaml --can vcan0 --out "$out/sent.csv" 2> "$out/sim.txt" || fail=1
 wait $rec || fail=1
 kill $dump; wait $dump 2>/dev/null
+cp /tmp/capture.log "$out/capture.log"
 cat "$out/record.txt"
 
 step "canplayer -> record"
 rpem record --can vcan0 --out "$out/replayed.csv" --idle-timeout 1.5 > "$out/record2.txt" 2>&1 &
 rec=$!
 sleep 0.5
-canplayer -I "$out/capture.log" vcan0=vcan0 || fail=1
+canplayer -I /tmp/capture.log vcan0=vcan0 || fail=1
 wait $rec || fail=1
 cat "$out/record2.txt"
 
