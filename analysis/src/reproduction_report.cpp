@@ -132,8 +132,10 @@ std::vector<std::string> plot_reproduction(const std::string& dir, const std::ve
         for (std::size_t a = 0; a < 3; ++a) block.columns[2 + a].push_back(r.runs[a].trajectory[k].estimate * scale);
       }
       fig.add_data(std::move(block));
-      fig.add_line("set title " + gp_quote(c->figure + ": " + c->description + " (n = " + fmt(c->n_pu, 3) + ", τ = " +
-                                           fmt(c->tau_pu) + " pu)") + " noenhanced font ',9'");
+      // Two lines (figure, then conditions) so neighbouring panels' titles do not run into each other.
+      fig.add_line("set title " + gp_quote(c->figure) + ".\"\\n\"." +
+                   gp_quote(c->description + " (n = " + fmt(c->n_pu, 3) + ", τ = " + fmt(c->tau_pu) + " pu)") +
+                   " noenhanced font ',9'");
       fig.add_line(std::string("set ylabel ") + (psi ? "'ψ_m [pu]'" : "'r_s [pu]'"));
       fig.add_line("plot $" + c->id + " u 1:2 w l lw 2 dt 2 lc 'black' t 'true', '' u 1:3 w l lw 1.5 lc rgb '#1f77b4' t 'SGA', "
                    "'' u 1:4 w l lw 1.5 lc rgb '#d62728' t 'GNA', '' u 1:5 w l lw 1.5 lc rgb '#2ca02c' t 'PhyInt'");

@@ -86,20 +86,33 @@ TEST_F(Reproduction, MatchesTheGoldenResultsWithinTwoSidedBounds) {
   }
 }
 
-TEST_F(Reproduction, SgaMatchesTabComparisonWithinAFactorOfTwo) {
-  // tab_comparison, SGA column: ψm ~2 s (no load), ~1.5 s (0.4 load); R_s 8 s (standstill), 6 s (0.005 pu).
-  for (auto [id, paper_s] : {std::pair{"VI_psim_a", 2.0}, {"VI_psim_b", 1.5}, {"VI_rs_a", 8.0}, {"VI_rs_b", 6.0}}) {
-    const auto& t = run(id, core::Algorithm::kSga).metrics.convergence_time_s;
-    ASSERT_TRUE(t) << id;
-    EXPECT_GE(*t, paper_s / 2.0) << id;
-    EXPECT_LE(*t, paper_s * 2.0) << id;
+TEST_F(Reproduction, MatchesTabComparisonWithinAFactorOfTwo) {
+  // tab_comparison: ψm ~2 s / ~0.5 s (no load), ~1.5 s / ~1.5 s (0.4 load); R_s 8 s / 8 s (standstill),
+  // 6 s / 4 s (0.005 pu) for SGA / GNA.
+  struct Row {
+    const char* id;
+    double sga_s, gna_s;
+  };
+  for (const Row r : {Row{"VI_psim_a", 2.0, 0.5}, Row{"VI_psim_b", 1.5, 1.5}, Row{"VI_rs_a", 8.0, 8.0},
+                      Row{"VI_rs_b", 6.0, 4.0}}) {
+    for (auto [algorithm, paper_s] : {std::pair{core::Algorithm::kSga, r.sga_s}, {core::Algorithm::kGna, r.gna_s}}) {
+      SCOPED_TRACE(std::string(r.id) + "/" + io::to_string(algorithm));
+      const auto& t = run(r.id, algorithm).metrics.convergence_time_s;
+      ASSERT_TRUE(t);
+      EXPECT_GE(*t, paper_s / 2.0);
+      EXPECT_LE(*t, paper_s * 2.0);
+    }
   }
-  // GNA's ψm column too (~0.5 s and ~1.5 s); its R_s column is the documented exception.
-  for (auto [id, paper_s] : {std::pair{"VI_psim_a", 0.5}, {"VI_psim_b", 1.5}}) {
+}
+
+TEST_F(Reproduction, TabulatedGnaGainsCannotGiveTabComparisonsRsTimes) {
+  // docs/reproduction.md: with tab_psimgains' GNA column (γ_0,rk = 6.25e-5, γ_0,Lk = 7.5e-6) the Newton
+  // step's rate is at most γ_0,Lk / (1 − (1 − γ_0,rk)^k) per sample whatever R[0]; from 8 % into ±1 %
+  // that takes at least 13.9 s, against tab_comparison's 8 s and 4 s.
+  for (const char* id : {"VI_rs_a_gna_tabulated", "VI_rs_b_gna_tabulated"}) {
     const auto& t = run(id, core::Algorithm::kGna).metrics.convergence_time_s;
     ASSERT_TRUE(t) << id;
-    EXPECT_GE(*t, paper_s / 2.0) << id;
-    EXPECT_LE(*t, paper_s * 2.0) << id;
+    EXPECT_GE(*t, 13.9) << id;
   }
 }
 
