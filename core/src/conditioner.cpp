@@ -77,17 +77,6 @@ Vec2 SampleConditioner::deadtime_error_alphabeta_V(const Vec2& i_ab_A, double u_
   return clarke(leg_error);  // the zero sequence does not reach the machine
 }
 
-Rotation SampleConditioner::logged_rotation(const DriveSample& s) noexcept {
-  constexpr unsigned kExactRotationEvery = 32;  // composition round-off stays below 1e-13
-  constexpr double kLargestIncrement = 0.1;     // small_rotation() is exact to 1e-12 up to here
-  if (has_previous_ && !s.gap_before && ++rotations_since_exact_ < kExactRotationEvery) {
-    const double step = wrap_angle(s.theta_el_rad - previous_logged_theta_rad_);
-    if (step <= kLargestIncrement && step >= -kLargestIncrement) return compose(previous_logged_, small_rotation(step));
-  }
-  rotations_since_exact_ = 0;
-  return Rotation::of(s.theta_el_rad);
-}
-
 SampleConditioner::Measured SampleConditioner::measure(const DriveSample& s, const Rotation& logged) const noexcept {
   Measured m;
   m.logged = logged;
@@ -167,7 +156,8 @@ EstimatorSample SampleConditioner::condition(const DriveSample& s) noexcept {
     return out;
   }
 
-  const Measured m = measure(s, logged_rotation(s));
+  if (!has_previous_ || s.gap_before) logged_rotation_.reset();  // no increment across a gap
+  const Measured m = measure(s, logged_rotation_.at(s.theta_el_rad));
   out.i_meas_pu = m.i_dq_pu;
   if (saturation_) {
     out.x_d_pu = m.x_d_pu;
@@ -202,8 +192,6 @@ EstimatorSample SampleConditioner::condition(const DriveSample& s) noexcept {
 
   older_u_ab_V_ = has_previous_ ? previous_u_ab_V_ : u_applied_ab_V;
   previous_u_ab_V_ = u_applied_ab_V;
-  previous_logged_ = m.logged;
-  previous_logged_theta_rad_ = s.theta_el_rad;
   previous_rotation_ = m.rot;
   previous_n_pu_ = m.n_pu;
   previous_t_ns_ = s.t_ns;

@@ -20,6 +20,7 @@ void FocController::reset() noexcept {
   mtpa_i_A_.setZero();
   integral_V_.setZero();
   speed_integral_Nm_ = 0.0;
+  rotation_.reset();
 }
 
 core::Vec2 FocController::field_weaken(core::Vec2 i_ref, double torque_Nm, double omega,
@@ -29,6 +30,9 @@ core::Vec2 FocController::field_weaken(core::Vec2 i_ref, double torque_Nm, doubl
   const double l_d = nominal_.l_d_H, l_q = nominal_.l_q_H, psi = nominal_.psi_m_Wb;
   const double flux_limit2 = omega == 0.0 ? 1e30 : (u_limit / omega) * (u_limit / omega);
   const double psi_q = l_q * i_ref[1];
+  const double psi_d0 = l_d * i_ref[0] + psi;
+  // Inside both the voltage ellipse and the current circle nothing below changes i_ref: skip the roots.
+  if (psi_d0 * psi_d0 + psi_q * psi_q <= flux_limit2 && i_ref.squaredNorm() <= i_max_A_ * i_max_A_) return i_ref;
   const double psi_d_max = std::sqrt(std::max(0.0, flux_limit2 - psi_q * psi_q));
   const double i_d_fw = (psi_d_max - psi) / l_d;
   if (i_d_fw < i_ref[0]) {
@@ -70,12 +74,12 @@ FocOutput FocController::step(const FocInput& in) noexcept {
     mtpa_i_A_ = core::mtpa_reference(nominal_pu_, base_.torque_pu(torque_ref)) * base_.current_A;
   }
   core::Vec2 i_ref = mtpa_i_A_;
-  const double u_max = in.u_dc_V / core::kSqrt3;
+  const double u_max = in.u_dc_V * core::kInvSqrt3;
   if (config_.field_weakening) i_ref = field_weaken(i_ref, torque_ref, omega, config_.voltage_margin * u_max);
   out.i_ref_A = i_ref;
 
   // dq current PI with decoupling.
-  const core::Rotation rot = core::Rotation::of(in.theta_el_rad);
+  const core::Rotation rot = rotation_.at(in.theta_el_rad);
   const core::Vec2 i_dq = core::park(core::clarke(in.i_abc_A), rot);
   const double wc = 2.0 * core::kPi * config_.current_bandwidth_Hz;
   const core::Vec2 kp(wc * nominal_.l_d_H, wc * nominal_.l_q_H);
@@ -87,9 +91,9 @@ FocOutput FocController::step(const FocInput& in) noexcept {
   const core::Vec2 candidate_integral = integral_V_ + ki * t * error;
   core::Vec2 u_dq = kp.cwiseProduct(error) + candidate_integral + feedforward;
 
-  const double magnitude = u_dq.norm();
-  if (magnitude > u_max) {
-    u_dq *= u_max / magnitude;  // keep the direction; hold the integrators (anti-windup)
+  const double magnitude2 = u_dq.squaredNorm();
+  if (magnitude2 > u_max * u_max) {
+    u_dq *= u_max / std::sqrt(magnitude2);  // keep the direction; hold the integrators (anti-windup)
     out.voltage_limited = true;
   } else {
     integral_V_ = candidate_integral;

@@ -12,9 +12,9 @@ Duties modulate(const core::Vec2& u_ab_V, double u_dc_V, bool third_harmonic) no
   double u_zero = 0.0;
   const double amplitude2 = u_ab_V.squaredNorm();
   if (third_harmonic && amplitude2 > 0.0) {
-    // −(U/6)·cos 3φ with cos φ = u_a/U:  −(1/6)·(4·u_a³/U² − 3·u_a)
+    // −(U/6)·cos 3φ with cos φ = u_a/U:  −(1/6)·(4·u_a³/U² − 3·u_a) = u_a·(1/2 − (2/3)·u_a²/U²)
     const double ua = u_abc[0];
-    u_zero = -(4.0 * ua * ua * ua / amplitude2 - 3.0 * ua) / 6.0;
+    u_zero = ua * (0.5 - (2.0 / 3.0) * ua * ua / amplitude2);
   }
   Duties out;
   const double inv_u_dc = 1.0 / u_dc_V;

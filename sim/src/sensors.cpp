@@ -45,7 +45,7 @@ double Sensors::angle(double theta_el_true_rad) noexcept {
     const auto truncated = static_cast<double>(static_cast<long long>(counts));
     mech = encoder_step_rad_ * (truncated > counts ? truncated - 1.0 : truncated);  // floor, without a libm call
   }
-  head_ = (head_ + 1) % angle_history_mech_.size();
+  if (++head_ == angle_history_mech_.size()) head_ = 0;
   angle_history_mech_[head_] = mech;
   count_ = std::min(count_ + 1, angle_history_mech_.size());
   return core::wrap_angle(mech * pole_pairs_ - config_.theta_offset_rad);
@@ -55,7 +55,8 @@ double Sensors::speed() const noexcept {
   if (count_ < 2) return 0.0;
   const std::size_t span = count_ - 1;
   const std::size_t n = angle_history_mech_.size();
-  const double oldest = angle_history_mech_[(head_ + n - span) % n];
+  const std::size_t oldest_index = head_ >= span ? head_ - span : head_ + n - span;
+  const double oldest = angle_history_mech_[oldest_index];
   return pole_pairs_ * (angle_history_mech_[head_] - oldest) / (static_cast<double>(span) * period_s_);
 }
 

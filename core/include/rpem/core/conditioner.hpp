@@ -96,9 +96,6 @@ class SampleConditioner {
     double x_d_pu, x_q_pu;  ///< inductances at the measured current (the nominal ones without curves)
   };
   [[nodiscard]] Measured measure(const DriveSample& s, const Rotation& logged) const noexcept;
-  /// The rotation at the sample's logged angle: between consecutive samples by a Taylor-series
-  /// increment from the previous one (no libm call), exactly every kExactRotationEvery samples.
-  [[nodiscard]] Rotation logged_rotation(const DriveSample& s) noexcept;
   /// The true phase currents from measured ones: (measured − offset)/(1 + gain error).
   [[nodiscard]] Vec3 corrected_phases_A(const Vec3& measured_A) const noexcept;
   [[nodiscard]] Vec2 current_alphabeta_A(const DriveSample& s, const Rotation& logged) const noexcept;
@@ -121,9 +118,7 @@ class SampleConditioner {
   Rotation previous_rotation_;
   double previous_n_pu_ = 0.0;
   Vec2 previous_u_ab_V_ = Vec2::Zero();  ///< applied voltage of the previous command (after corrections)
-  Rotation previous_logged_;             ///< at the previous sample's logged angle
-  double previous_logged_theta_rad_ = 0.0;
-  unsigned rotations_since_exact_ = 0;
+  RotationTracker logged_rotation_;      ///< at the logged angle, incremental between consecutive samples
   Vec2 older_u_ab_V_ = Vec2::Zero();     ///< the command before that (for the delay extension)
 };
 

@@ -28,8 +28,11 @@ struct Schedule {
 
 /// Zeroes the gain rows of parameters that may not adapt.
 inline void apply_schedule(const Schedule& s, Mat2& gain) noexcept {
-  if (!s.psi_m) gain.row(kPsiM).setZero();
-  if (!s.r_s) gain.row(kRs).setZero();
+  // A row mask applied column by column: Mat2 is column-major, and zeroing a row element-wise made the
+  // next whole-column loads wait on two scalar stores (store-forwarding stalls on the per-sample path).
+  const Vec2 mask(s.psi_m ? 1.0 : 0.0, s.r_s ? 1.0 : 0.0);
+  gain.col(0) = gain.col(0).cwiseProduct(mask);
+  gain.col(1) = gain.col(1).cwiseProduct(mask);
 }
 
 /// D_M of eq:paramsubset.

@@ -7,6 +7,7 @@ namespace rpem::core {
 
 inline constexpr double kPi = 3.14159265358979323846;
 inline constexpr double kSqrt3 = 1.7320508075688772;
+inline constexpr double kInvSqrt3 = 1.0 / kSqrt3;  ///< per-sample code multiplies (a division costs ~4× more)
 
 using Vec2 = Eigen::Matrix<double, 2, 1>;
 using Vec3 = Eigen::Matrix<double, 3, 1>;

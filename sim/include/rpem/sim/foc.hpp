@@ -5,6 +5,7 @@
 // the command will act (ϑ + 1.5·ω·T: one period of computation delay plus half a period of PWM).
 // The controller uses the nominal machine model, not the plant's true parameters.
 
+#include "rpem/core/frames.hpp"
 #include "rpem/core/per_unit.hpp"
 #include "rpem/core/settings.hpp"
 #include "rpem/core/types.hpp"
@@ -58,6 +59,7 @@ class FocController {
   double speed_integral_Nm_ = 0.0;
   double mtpa_torque_Nm_ = 0.0;                   ///< torque of the cached MTPA references
   core::Vec2 mtpa_i_A_ = core::Vec2::Zero();
+  core::RotationTracker rotation_;                ///< at the measured angle
 };
 
 }  // namespace rpem::sim
