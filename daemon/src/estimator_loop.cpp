@@ -30,6 +30,7 @@ EstimatorLoop::EstimatorLoop(const DaemonConfig& config, SpscQueue<core::DriveSa
       output_(output),
       estimator_(config.machine.machine, config.machine.estimator),
       period_ns_(static_cast<std::int64_t>(config.loop_period_s * 1e9)),
+      wake_ahead_ns_(static_cast<std::int64_t>(config.loop_wake_ahead_s * 1e9)),
       estimate_interval_ns_(interval_ns(config.estimate_rate_Hz)),
       measurement_interval_ns_(interval_ns(config.measurement_rate_Hz)),
       stats_interval_ns_(interval_ns(config.diagnostics_rate_Hz)) {
@@ -261,10 +262,15 @@ void EstimatorLoop::run(std::atomic<bool>& stop) {
   started_.store(true, std::memory_order_release);
   while (!stop.load(std::memory_order_relaxed)) {
     next += period_ns_;
-    timespec ts{static_cast<time_t>(next / 1'000'000'000), static_cast<long>(next % 1'000'000'000)};
+    const std::int64_t wake = next - wake_ahead_ns_;
+    timespec ts{static_cast<time_t>(wake / 1'000'000'000), static_cast<long>(wake % 1'000'000'000)};
     while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr) == EINTR) {
     }
-    const std::int64_t woke = clock_ns(CLOCK_MONOTONIC);
+    std::int64_t woke = clock_ns(CLOCK_MONOTONIC);
+    while (woke < next) {  // timer anticipation (loop.wake_ahead_s): spin to the deadline
+      spin_pause();
+      woke = clock_ns(CLOCK_MONOTONIC);
+    }
     const double late_us = 1e-3 * static_cast<double>(woke - next);
     latency_.add(late_us);
     run_latency_.add(late_us);

@@ -41,6 +41,9 @@ struct DaemonConfig {
   bool sim_loop = true;
 
   double loop_period_s = 125e-6;
+  /// Timer anticipation: sleep until this long before each deadline, then spin to it, so the loop
+  /// starts on time despite the platform's wake-up latency (costs wake_ahead/period of the core). 0: off.
+  double loop_wake_ahead_s = 0.0;
   RealtimeMode realtime = RealtimeMode::kPreferred;
   bool lock_memory = true;
   int cpu_dma_latency_us = 0;  ///< PM QoS request while running; −1: none

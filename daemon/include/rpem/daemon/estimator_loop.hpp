@@ -61,6 +61,7 @@ class EstimatorLoop {
 
   // Timing
   std::int64_t period_ns_;
+  std::int64_t wake_ahead_ns_;
   std::int64_t estimate_interval_ns_, measurement_interval_ns_, stats_interval_ns_;
   std::int64_t next_estimate_ns_ = 0, next_measurement_ns_ = 0, next_stats_ns_ = 0;
   LatencyHistogram latency_;      ///< this reporting interval

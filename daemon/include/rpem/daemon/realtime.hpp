@@ -23,5 +23,13 @@ struct ThreadPolicy {
 void prefault_stack(std::size_t bytes);
 /// Names the calling thread (top, ps -L).
 void name_thread(const char* name);
+/// One iteration's hint to the CPU inside a busy-wait (x86 PAUSE, ARM YIELD): no system call.
+inline void spin_pause() noexcept {
+#if defined(__x86_64__) || defined(__i386__)
+  __builtin_ia32_pause();
+#elif defined(__aarch64__) || defined(__arm__)
+  asm volatile("yield");
+#endif
+}
 
 }  // namespace rpem::daemon
