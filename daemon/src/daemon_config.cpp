@@ -39,7 +39,11 @@ void parse_daemon(io::YamlMap d, DaemonConfig& c, const std::string& base_dir) {
   }
   if (auto l = d.optional_map("loop")) {
     c.loop_period_s = l->number_or("period_s", c.loop_period_s, 10e-6, 0.1);
-    c.loop_wake_ahead_s = l->number_or("wake_ahead_s", c.loop_wake_ahead_s, 0.0, 0.5 * c.loop_period_s);
+    if (l->has("wake_ahead_s") && l->text_or("wake_ahead_s", "") == "auto") {
+      c.loop_wake_ahead_auto = true;
+    } else {
+      c.loop_wake_ahead_s = l->number_or("wake_ahead_s", c.loop_wake_ahead_s, 0.0, 0.5 * c.loop_period_s);
+    }
     const std::string rt = l->choice_or("realtime", "preferred", {"required", "preferred", "off"});
     c.realtime = rt == "required" ? RealtimeMode::kRequired : rt == "off" ? RealtimeMode::kOff : RealtimeMode::kPreferred;
     c.lock_memory = l->boolean_or("lock_memory", true);

@@ -31,6 +31,10 @@ EstimatorLoop::EstimatorLoop(const DaemonConfig& config, SpscQueue<core::DriveSa
       estimator_(config.machine.machine, config.machine.estimator),
       period_ns_(static_cast<std::int64_t>(config.loop_period_s * 1e9)),
       wake_ahead_ns_(static_cast<std::int64_t>(config.loop_wake_ahead_s * 1e9)),
+      wake_ahead_calibration_periods_(config.loop_wake_ahead_auto
+                                          ? std::max<std::int64_t>(1, std::llround(1.0 / config.loop_period_s))
+                                          : 0),
+      wake_ahead_published_ns_(config.loop_wake_ahead_auto ? -1 : wake_ahead_ns_),
       estimate_interval_ns_(interval_ns(config.estimate_rate_Hz)),
       measurement_interval_ns_(interval_ns(config.measurement_rate_Hz)),
       stats_interval_ns_(interval_ns(config.diagnostics_rate_Hz)) {
@@ -282,6 +286,12 @@ void EstimatorLoop::run(std::atomic<bool>& stop) {
       // The next deadline has passed: count it and restart the schedule from now.
       ++overruns_;
       next = done - done % period_ns_;
+    }
+    if (periods_ == wake_ahead_calibration_periods_) {
+      // `wake_ahead_s: auto`: anticipate by the median wake-up latency of the first second (a one-off
+      // scan of the histogram's bins, a few µs).
+      wake_ahead_ns_ = std::min<std::int64_t>(period_ns_ / 2, std::llround(1e3 * run_latency_.percentile(0.5)));
+      wake_ahead_published_ns_.store(wake_ahead_ns_, std::memory_order_release);
     }
     heartbeat_.fetch_add(1, std::memory_order_release);
   }

@@ -133,11 +133,17 @@ int main(int argc, char** argv) {
   }
   source->start(stop_acquisition);
 
+  char wake_ahead[32];
+  if (config.loop_wake_ahead_auto) {
+    std::snprintf(wake_ahead, sizeof wake_ahead, "auto");
+  } else {
+    std::snprintf(wake_ahead, sizeof wake_ahead, "%.0f µs", config.loop_wake_ahead_s * 1e6);
+  }
   std::fprintf(stderr,
-               "rpemd: source %s '%s', loop %.0f µs (realtime %s), machine %s, algorithm %s, LCM %s, channels %sRPEM_*, "
-               "commands %s, state file %s\n",
+               "rpemd: source %s '%s', loop %.0f µs (realtime %s, wake-ahead %s), machine %s, algorithm %s, LCM %s, "
+               "channels %sRPEM_*, commands %s, state file %s\n",
                config.source == SourceType::kCan ? "can" : "sim", source->name().c_str(), config.loop_period_s * 1e6,
-               realtime_name(config.realtime), config.source_file.c_str(), rpem::io::to_string(est.algorithm),
+               realtime_name(config.realtime), wake_ahead, config.source_file.c_str(), rpem::io::to_string(est.algorithm),
                config.lcm_url.empty() ? "default" : config.lcm_url.c_str(), config.channel_prefix.c_str(),
                config.commands_enabled ? "enabled" : "disabled", state_path.c_str());
   sd_notifyf(0, "READY=1\nSTATUS=estimating from %s", source->name().c_str());
@@ -148,7 +154,13 @@ int main(int argc, char** argv) {
   const auto wait = std::chrono::microseconds(watchdog ? watchdog_usec / 2 : 1'000'000);
   std::uint64_t last_beat = loop.heartbeat();
   int exit_code = 0;
+  bool wake_ahead_reported = !config.loop_wake_ahead_auto;
   while (true) {
+    if (!wake_ahead_reported && loop.wake_ahead_ns() >= 0) {
+      std::fprintf(stderr, "rpemd: timer anticipation calibrated: the loop wakes %.0f µs ahead of each deadline\n",
+                   1e-3 * static_cast<double>(loop.wake_ahead_ns()));
+      wake_ahead_reported = true;
+    }
     timespec timeout{static_cast<time_t>(wait.count() / 1'000'000), static_cast<long>(wait.count() % 1'000'000) * 1000};
     const int sig = sigtimedwait(&signals, nullptr, &timeout);
     if (sig == SIGTERM || sig == SIGINT) {

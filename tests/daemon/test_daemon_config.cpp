@@ -29,6 +29,17 @@ TEST(DaemonConfig, ShippedExamplesLoad) {
   EXPECT_EQ(can.can_interface, "can0");
 }
 
+TEST(DaemonConfig, WakeAheadIsOffANumberOrAuto) {
+  EXPECT_DOUBLE_EQ(builtin_daemon_config().loop_wake_ahead_s, 0.0);
+  EXPECT_FALSE(builtin_daemon_config().loop_wake_ahead_auto);
+  const test::TempFile number("wake_number.yaml", "daemon:\n  loop: {period_s: 125.0e-6, wake_ahead_s: 40.0e-6}\n");
+  const DaemonConfig n = load_daemon_config(number.path());
+  EXPECT_DOUBLE_EQ(n.loop_wake_ahead_s, 40e-6);
+  EXPECT_FALSE(n.loop_wake_ahead_auto);
+  const test::TempFile automatic("wake_auto.yaml", "daemon:\n  loop: {wake_ahead_s: auto}\n");
+  EXPECT_TRUE(load_daemon_config(automatic.path()).loop_wake_ahead_auto);
+}
+
 TEST(DaemonConfig, AMachineFileAloneIsAConfiguration) {
   // rpem diagnose's extended.yaml is a machine file: rpemd must take it as it is.
   const DaemonConfig c = load_daemon_config(test::source_dir() + "/config/paper-ipmsm.yaml");

@@ -44,6 +44,9 @@ struct DaemonConfig {
   /// Timer anticipation: sleep until this long before each deadline, then spin to it, so the loop
   /// starts on time despite the platform's wake-up latency (costs wake_ahead/period of the core). 0: off.
   double loop_wake_ahead_s = 0.0;
+  /// `wake_ahead_s: auto`: the loop runs its first second plainly, then anticipates by the median
+  /// wake-up latency it measured (at most half a period).
+  bool loop_wake_ahead_auto = false;
   RealtimeMode realtime = RealtimeMode::kPreferred;
   bool lock_memory = true;
   int cpu_dma_latency_us = 0;  ///< PM QoS request while running; −1: none

@@ -37,6 +37,8 @@ class EstimatorLoop {
   [[nodiscard]] const LatencyHistogram& run_latency() const noexcept { return run_latency_; }
   [[nodiscard]] std::int64_t overruns() const noexcept { return overruns_; }
   [[nodiscard]] std::int64_t periods() const noexcept { return periods_; }
+  /// The timer anticipation in use [ns]; with `wake_ahead_s: auto`, −1 until calibrated.
+  [[nodiscard]] std::int64_t wake_ahead_ns() const noexcept { return wake_ahead_published_ns_.load(std::memory_order_acquire); }
 
   /// One period's work without the sleep, for tests: commands, samples, reports. `now_ns` is the
   /// monotonic time of the period. Real-time safe.
@@ -62,6 +64,8 @@ class EstimatorLoop {
   // Timing
   std::int64_t period_ns_;
   std::int64_t wake_ahead_ns_;
+  std::int64_t wake_ahead_calibration_periods_;  ///< > 0: `auto`, calibrate after this many periods
+  std::atomic<std::int64_t> wake_ahead_published_ns_;
   std::int64_t estimate_interval_ns_, measurement_interval_ns_, stats_interval_ns_;
   std::int64_t next_estimate_ns_ = 0, next_measurement_ns_ = 0, next_stats_ns_ = 0;
   LatencyHistogram latency_;      ///< this reporting interval
