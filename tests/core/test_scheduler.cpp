@@ -1,5 +1,8 @@
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <limits>
+
 #include "rpem/core/scheduler.hpp"
 
 namespace rpem::core {
@@ -44,6 +47,19 @@ TEST(Projection, ClampsToTheBoxAndReportsWhich) {
   Vec2 both(9.0, -1.0);
   EXPECT_EQ(project(b, both), (1U << kPsiM) | (1U << kRs));
   EXPECT_EQ(both, Vec2(1.5, 0.02));
+}
+
+TEST(Scheduler, ARowThatMayNotAdaptIsZeroEvenIfItsGainIsNotFinite) {
+  Mat2 gain;
+  gain << std::nan(""), 2.0, 3.0, std::numeric_limits<double>::infinity();
+  Schedule s;
+  s.psi_m = false;
+  s.r_s = true;
+  apply_schedule(s, gain);
+  EXPECT_EQ(gain(kPsiM, 0), 0.0);
+  EXPECT_EQ(gain(kPsiM, 1), 0.0);
+  EXPECT_EQ(gain(kRs, 0), 3.0);
+  EXPECT_TRUE(std::isinf(gain(kRs, 1)));
 }
 
 }  // namespace

@@ -30,9 +30,10 @@ struct Schedule {
 inline void apply_schedule(const Schedule& s, Mat2& gain) noexcept {
   // A row mask applied column by column: Mat2 is column-major, and zeroing a row element-wise made the
   // next whole-column loads wait on two scalar stores (store-forwarding stalls on the per-sample path).
-  const Vec2 mask(s.psi_m ? 1.0 : 0.0, s.r_s ? 1.0 : 0.0);
-  gain.col(0) = gain.col(0).cwiseProduct(mask);
-  gain.col(1) = gain.col(1).cwiseProduct(mask);
+  // A select, not a product: a row that may not adapt is zero even where its gain is not finite.
+  const Eigen::Array<bool, 2, 1> keep(s.psi_m, s.r_s);
+  gain.col(0) = keep.select(gain.col(0).array(), 0.0).matrix();
+  gain.col(1) = keep.select(gain.col(1).array(), 0.0).matrix();
 }
 
 /// D_M of eq:paramsubset.
