@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Converts the Paderborn "Electric Motor Temperature" bench data (../shared/data/paderborn-motor-temperature/,
+"""Converts the Paderborn "Electric Motor Temperature" bench data (data/paderborn-motor-temperature/,
 W. Kirchgässner, O. Wallscheid, J. Böcker, LEA Paderborn University, CC BY-SA 4.0) into a rotor-frame drive
 log (docs/drive-log.md) for `rpem diagnose`. The source files are read, never changed.
 

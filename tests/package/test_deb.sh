@@ -72,4 +72,18 @@ fi
 grep -q "rpemd: stopped" "$root/tmp/rpemd.out" || { echo "test_deb: no clean stop on SIGTERM"; exit 1; }
 [[ -f $root/var/lib/rpemd/estimates.json ]] || { echo "test_deb: no state file written at shutdown"; exit 1; }
 in_root /usr/bin/rpem --help >/dev/null
+
+echo "test_deb: the copyright file and the data the shipped scenarios use"
+copyright=$root/usr/share/doc/rpem-drive/copyright
+[[ -f $copyright ]] || { echo "test_deb: no /usr/share/doc/rpem-drive/copyright"; exit 1; }
+grep -q '^Format: https://www.debian.org/doc/packaging-manuals/copyright-format/1.0/' "$copyright" ||
+  { echo "test_deb: copyright is not in Debian's machine-readable format"; exit 1; }
+for set in "$(dirname "$0")"/../../data/*/; do
+  name=$(basename "$set")
+  grep -q "^Files: data/$name/\*" "$copyright" || { echo "test_deb: copyright does not name data set $name"; exit 1; }
+  (cd "$root/usr/share/rpem-drive/data/$name" && sha256sum --check --strict --quiet SHA256SUMS) ||
+    { echo "test_deb: installed data set $name missing or changed"; exit 1; }
+done
+in_root /usr/bin/rpem sim --scenario /usr/share/rpem-drive/scenarios/diagnose-beckhoff.yaml --out /tmp/beckhoff.csv >/dev/null 2>&1 ||
+  { echo "test_deb: the installed diagnose-beckhoff scenario does not run (its flux map or machine not found?)"; exit 1; }
 echo "test_deb: passed"

@@ -1,4 +1,4 @@
-// Flux maps: the measured Beckhoff AM8141 maps (../shared/data/flux-maps/, UltraZohm, Apache-2.0) load,
+// Flux maps: the measured Beckhoff AM8141 maps (data/beckhoff-am8141-flux-maps/, UltraZohm, Apache-2.0) load,
 // interpolate exactly at grid points, have consistent Jacobians, invert, and show the saturation the
 // data README describes (inductances 15–20 % above the data sheet, falling with current).
 #include <gtest/gtest.h>
@@ -7,13 +7,14 @@
 
 #include "rpem/io/csv_table.hpp"
 #include "rpem/sim/magnetics.hpp"
+#include "support/data_file.hpp"
 #include "support/temp_file.hpp"
 
 namespace rpem::sim {
 namespace {
 
 std::string beckhoff(int rpm) {
-  return test::source_dir() + "/../shared/data/flux-maps/beckhoff_AM8141_measured_" + std::to_string(rpm) + "rpm.csv";
+  return test::data_file("beckhoff-am8141-flux-maps/beckhoff_AM8141_measured_" + std::to_string(rpm) + "rpm.csv");
 }
 
 TEST(FluxMap, ReproducesEveryMeasuredPoint) {

@@ -15,6 +15,7 @@
 #include "rpem/analysis/diagnose/diagnose_output.hpp"
 #include "rpem/analysis/diagnose/hidden_effects.hpp"
 #include "rpem/sim/flux_map.hpp"
+#include "support/data_file.hpp"
 #include "support/temp_file.hpp"
 
 namespace rpem::test {
@@ -118,7 +119,7 @@ inline CaseOutcome run_hidden_case(const HiddenCase& c) {
   const bool beckhoff = c.profile != "bench";
   sim::Scenario s = sim::load_scenario(src + (beckhoff ? "/scenarios/diagnose-beckhoff.yaml" : "/scenarios/diagnose-bench.yaml"));
   if (c.profile == "beckhoff800") {
-    s.flux_map_file = src + "/../shared/data/flux-maps/beckhoff_AM8141_measured_800rpm.csv";
+    s.flux_map_file = data_file("beckhoff-am8141-flux-maps/beckhoff_AM8141_measured_800rpm.csv");
   }
   s.seed = c.seed;
   std::mt19937_64 rng(c.seed);

@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "support/process.hpp"
+#include "support/data_file.hpp"
 #include "support/temp_file.hpp"
 
 namespace rpem {
@@ -127,8 +128,7 @@ TEST(CliDiagnose, BadInputGetsAClearErrorAndItsExitCode) {
 TEST(CliDiagnose, PaderbornWorkedExampleKeepsItsResult) {
   // docs/diagnose.md, "Worked example": the bench profile against the commissioned constant-parameter
   // model. Two-sided bounds, so an unexplained change either way is noticed.
-  const std::string source = test::source_dir() + "/../shared/data/paderborn-motor-temperature/profile_A_every5th.csv";
-  ASSERT_TRUE(fs::exists(source)) << source << " (the shared data beside the repository)";
+  const std::string source = test::data_file("paderborn-motor-temperature/profile_A_every5th.csv");
   const std::string dir = out_dir("paderborn");
   auto r = test::run_command("python3 " + test::source_dir() + "/scripts/paderborn_to_drive_log.py " + source + " " + dir +
                              "/profile.csv --pole-pairs 4");

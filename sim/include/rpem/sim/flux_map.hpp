@@ -1,6 +1,6 @@
 #pragma once
 // Measured flux-linkage maps ψ_d(i_d, i_q), ψ_q(i_d, i_q) on a rectilinear grid (e.g. the Beckhoff
-// AM8141 maps of ../shared/data/flux-maps/, UltraZohm project, Apache-2.0), bilinear between grid
+// AM8141 maps of data/beckhoff-am8141-flux-maps/, UltraZohm project, Apache-2.0), bilinear between grid
 // points and linear beyond the grid edges.
 
 #include <string>
