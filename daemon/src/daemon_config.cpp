@@ -67,11 +67,12 @@ void parse_daemon(io::YamlMap d, DaemonConfig& c, const std::string& base_dir) {
     cmd->finish();
   }
   if (auto t = d.optional_map("temperature")) {
-    c.temperature.reference_C = t->number_or("reference_C", c.temperature.reference_C, -273.0, 500.0);
-    c.temperature.r_s_ref_Ohm = t->number_or("r_s_ref_Ohm", c.temperature.r_s_ref_Ohm, 1e-6, 1e4);
-    c.temperature.psi_m_ref_Wb = t->number_or("psi_m_ref_Wb", c.temperature.psi_m_ref_Wb, 1e-6, 100.0);
-    c.temperature.r_s_coeff_per_K = t->number_or("r_s_coeff_per_K", c.temperature.r_s_coeff_per_K, 1e-5, 0.1);
-    c.temperature.psi_m_coeff_per_K = t->number_or("psi_m_coeff_per_K", c.temperature.psi_m_coeff_per_K, -0.1, -1e-6);
+    core::ThermalModel& m = c.temperature;
+    m.r_s.reference_C = m.psi_m.reference_C = t->number_or("reference_C", m.r_s.reference_C, -273.0, 500.0);
+    m.r_s.value_ref = t->number_or("r_s_ref_Ohm", m.r_s.value_ref, 1e-6, 1e4);
+    m.psi_m.value_ref = t->number_or("psi_m_ref_Wb", m.psi_m.value_ref, 1e-6, 100.0);
+    m.r_s.coeff_per_K = t->number_or("r_s_coeff_per_K", m.r_s.coeff_per_K, 1e-5, 0.1);
+    m.psi_m.coeff_per_K = t->number_or("psi_m_coeff_per_K", m.psi_m.coeff_per_K, -0.1, -1e-6);
     t->finish();
   }
   if (auto v = d.optional_map("validity")) {
@@ -95,33 +96,25 @@ void parse_daemon(io::YamlMap d, DaemonConfig& c, const std::string& base_dir) {
 /// daemon section's own `temperature` keys, parsed afterwards, override them.
 void temperature_from_drifts(const std::string& name, DaemonConfig& c) {
   const io::ParameterDrift &r = c.machine.rs_drift, &p = c.machine.psim_drift;
-  if (r.coeff_per_K && p.coeff_per_K && r.reference_C != p.reference_C) {
-    throw io::ConfigError(name, 0, 0, "model_extensions.psim_drift.reference_C",
-                          "rpemd's temperature model needs rs_drift and psim_drift at one reference temperature");
-  }
-  if (r.coeff_per_K) {
-    if (*r.coeff_per_K <= 0.0) {
+  if (r.law) {
+    if (r.law->coeff_per_K <= 0.0) {
       throw io::ConfigError(name, 0, 0, "model_extensions.rs_drift.coeff_per_K",
                             "a winding temperature needs a resistance that rises with it (coefficient > 0)");
     }
-    c.temperature.reference_C = r.reference_C;
-    c.temperature.r_s_coeff_per_K = *r.coeff_per_K;
-    if (r.value_ref) c.temperature.r_s_ref_Ohm = *r.value_ref;
+    c.temperature.r_s = *r.law;
   }
-  if (p.coeff_per_K) {
-    if (*p.coeff_per_K >= 0.0) {
+  if (p.law) {
+    if (p.law->coeff_per_K >= 0.0) {
       throw io::ConfigError(name, 0, 0, "model_extensions.psim_drift.coeff_per_K",
                             "a magnet temperature needs a flux linkage that falls with it (coefficient < 0)");
     }
-    c.temperature.reference_C = p.reference_C;
-    c.temperature.psi_m_coeff_per_K = *p.coeff_per_K;
-    if (p.value_ref) c.temperature.psi_m_ref_Wb = *p.value_ref;
+    c.temperature.psi_m = *p.law;
   }
 }
 
 void fill_defaults(DaemonConfig& c) {
-  if (c.temperature.r_s_ref_Ohm <= 0.0) c.temperature.r_s_ref_Ohm = c.machine.machine.r_s_Ohm;
-  if (c.temperature.psi_m_ref_Wb <= 0.0) c.temperature.psi_m_ref_Wb = c.machine.machine.psi_m_Wb;
+  if (c.temperature.r_s.value_ref <= 0.0) c.temperature.r_s.value_ref = c.machine.machine.r_s_Ohm;
+  if (c.temperature.psi_m.value_ref <= 0.0) c.temperature.psi_m.value_ref = c.machine.machine.psi_m_Wb;
 }
 
 DaemonConfig parse(io::YamlMap& root, const std::string& name, const std::string& base_dir) {

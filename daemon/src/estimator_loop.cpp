@@ -141,8 +141,8 @@ void EstimatorLoop::report_estimate(std::int64_t) noexcept {
   r.psi_m_pu = estimator_.core().state().theta_pu[core::kPsiM];
   r.r_s_pu = estimator_.core().state().theta_pu[core::kRs];
   const TemperatureModel& t = config_.temperature;
-  r.t_winding_C = t.reference_C + (r.r_s_Ohm / t.r_s_ref_Ohm - 1.0) / t.r_s_coeff_per_K;
-  r.t_magnet_C = t.reference_C + (r.psi_m_Wb / t.psi_m_ref_Wb - 1.0) / t.psi_m_coeff_per_K;
+  r.t_winding_C = t.r_s.temperature_C(r.r_s_Ohm);
+  r.t_magnet_C = t.psi_m.temperature_C(r.psi_m_Wb);
   r.speed_pu = last_.speed_pu;
   r.psi_m_adapting = last_.detail.flags & core::step_flag::kPsiMActive;
   r.r_s_adapting = last_.detail.flags & core::step_flag::kRsActive;

@@ -126,11 +126,19 @@ core::InductanceCurve parse_inductance_curve(YamlMap m) {
 
 ParameterDrift parse_drift(YamlMap m, const char* ref_key, double ref_min, double ref_max) {
   ParameterDrift d;
-  if (m.has("coeff_per_K")) d.coeff_per_K = m.number("coeff_per_K", -0.1, 0.1);
-  d.reference_C = m.number_or("reference_C", 20.0, -273.0, 500.0);
-  if (m.has(ref_key)) d.value_ref = m.number(ref_key, ref_min, ref_max);
+  if (!m.has("coeff_per_K") && !m.has("rel_change")) m.fail("coeff_per_K", "a drift needs coeff_per_K or rel_change");
+  if (m.has("coeff_per_K")) {
+    core::DriftLaw law;
+    law.coeff_per_K = m.number("coeff_per_K", -0.1, 0.1);
+    law.reference_C = m.number_or("reference_C", 20.0, -273.0, 500.0);
+    law.value_ref = m.number_or(ref_key, 0.0, ref_min, ref_max);
+    d.law = law;
+  } else {
+    for (const char* key : {"reference_C", ref_key}) {
+      if (m.has(key)) m.fail(key, "belongs to a drift against temperature (coeff_per_K)");
+    }
+  }
   if (m.has("rel_change")) d.rel_change = m.number("rel_change", -0.9, 10.0);
-  if (!d.coeff_per_K && !d.rel_change) m.fail("coeff_per_K", "a drift needs coeff_per_K or rel_change");
   m.finish();
   return d;
 }
@@ -202,10 +210,12 @@ class FlowMap {
 };
 
 void drift_entry(std::ostringstream& out, const char* key, const ParameterDrift& d, const char* ref_key) {
-  if (!d.coeff_per_K && !d.rel_change) return;
+  if (!d.law && !d.rel_change) return;
   FlowMap m;
-  if (d.coeff_per_K) m.add("coeff_per_K", *d.coeff_per_K).add("reference_C", d.reference_C);
-  if (d.value_ref) m.add(ref_key, *d.value_ref);
+  if (d.law) {
+    m.add("coeff_per_K", d.law->coeff_per_K).add("reference_C", d.law->reference_C);
+    if (d.law->value_ref > 0.0) m.add(ref_key, d.law->value_ref);
+  }
   if (d.rel_change) m.add("rel_change", *d.rel_change);
   out << "  " << key << ": " << m.str() << "\n";
 }

@@ -54,8 +54,8 @@ PlantParameters DriveSimulator::parameters_at(double t_s) noexcept {
   const double tw = s.signal(Quantity::kTWinding).at(t_s);
   const double tm = s.signal(Quantity::kTMagnet).at(t_s);
   PlantParameters p;
-  p.r_s_Ohm = s.signal(Quantity::kRs).at(t_s) * (1.0 + s.thermal.r_s_coeff_per_K * (tw - s.thermal.reference_C));
-  p.psi_m_Wb = s.signal(Quantity::kPsiM).at(t_s) * (1.0 + s.thermal.psi_m_coeff_per_K * (tm - s.thermal.reference_C));
+  p.r_s_Ohm = s.signal(Quantity::kRs).at(t_s) * s.thermal.r_s.factor(tw);
+  p.psi_m_Wb = s.signal(Quantity::kPsiM).at(t_s) * s.thermal.psi_m.factor(tm);
   p.l_d_H = s.signal(Quantity::kLd).at(t_s);
   p.l_q_H = s.signal(Quantity::kLq).at(t_s);
   p.r_fe_Ohm = s.r_fe_Ohm;

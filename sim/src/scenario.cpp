@@ -120,8 +120,8 @@ void set_initial_signals(Scenario& s, std::optional<io::YamlMap> init) {
   s.signal(Quantity::kSpeed) = Signal(value("speed_rpm", 0.0, -1e6, 1e6));
   s.signal(Quantity::kTorque) = Signal(value("torque_Nm", 0.0, -1e6, 1e6));
   s.signal(Quantity::kUdc) = Signal(value("u_dc_V", 220.0, 1.0, 1e5));
-  s.signal(Quantity::kTWinding) = Signal(value("t_winding_C", s.thermal.reference_C, -273.0, 1000.0));
-  s.signal(Quantity::kTMagnet) = Signal(value("t_magnet_C", s.thermal.reference_C, -273.0, 1000.0));
+  s.signal(Quantity::kTWinding) = Signal(value("t_winding_C", s.thermal.r_s.reference_C, -273.0, 1000.0));
+  s.signal(Quantity::kTMagnet) = Signal(value("t_magnet_C", s.thermal.psi_m.reference_C, -273.0, 1000.0));
   if (init) init->finish();
 }
 
@@ -167,9 +167,10 @@ Scenario parse_scenario(const std::string& text, const std::string& name, const 
   }
   if (auto m = root.optional_map("sensors")) parse_sensors(*m, s);
   if (auto m = root.optional_map("thermal")) {
-    s.thermal.reference_C = m->number_or("reference_C", 20.0, -273.0, 1000.0);
-    s.thermal.r_s_coeff_per_K = m->number_or("r_s_coeff_per_K", 0.00393, -1.0, 1.0);
-    s.thermal.psi_m_coeff_per_K = m->number_or("psi_m_coeff_per_K", -0.0012, -1.0, 1.0);
+    core::ThermalModel& t = s.thermal;
+    t.r_s.reference_C = t.psi_m.reference_C = m->number_or("reference_C", t.r_s.reference_C, -273.0, 1000.0);
+    t.r_s.coeff_per_K = m->number_or("r_s_coeff_per_K", t.r_s.coeff_per_K, -1.0, 1.0);
+    t.psi_m.coeff_per_K = m->number_or("psi_m_coeff_per_K", t.psi_m.coeff_per_K, -1.0, 1.0);
     m->finish();
   }
   set_initial_signals(s, root.optional_map("initial"));

@@ -15,7 +15,7 @@ TEST(DaemonConfig, BuiltInDefaultIsTheSimulatedPaperMachine) {
   EXPECT_DOUBLE_EQ(c.machine.machine.psi_m_Wb, 1.14);
   EXPECT_DOUBLE_EQ(c.loop_period_s, 125e-6);
   EXPECT_FALSE(c.commands_enabled);
-  EXPECT_DOUBLE_EQ(c.temperature.r_s_ref_Ohm, 2.25);
+  EXPECT_DOUBLE_EQ(c.temperature.r_s.value_ref, 2.25);
 }
 
 TEST(DaemonConfig, ShippedExamplesLoad) {
@@ -56,13 +56,14 @@ TEST(DaemonConfig, DriftsFoundByDiagnoseCalibrateTheTemperatureModel) {
                               "  psim_drift: {coeff_per_K: -0.00105, reference_C: 25}\n";
   test::TempFile f("ext.yaml", machine);
   const DaemonConfig c = load_daemon_config(f.path());
-  EXPECT_DOUBLE_EQ(c.temperature.reference_C, 25.0);
-  EXPECT_DOUBLE_EQ(c.temperature.r_s_coeff_per_K, 0.0041);
-  EXPECT_DOUBLE_EQ(c.temperature.r_s_ref_Ohm, 2.3);
-  EXPECT_DOUBLE_EQ(c.temperature.psi_m_coeff_per_K, -0.00105);
-  EXPECT_DOUBLE_EQ(c.temperature.psi_m_ref_Wb, 1.14);  // not found: the machine's
+  EXPECT_DOUBLE_EQ(c.temperature.r_s.reference_C, 25.0);
+  EXPECT_DOUBLE_EQ(c.temperature.r_s.coeff_per_K, 0.0041);
+  EXPECT_DOUBLE_EQ(c.temperature.r_s.value_ref, 2.3);
+  EXPECT_DOUBLE_EQ(c.temperature.psi_m.reference_C, 25.0);
+  EXPECT_DOUBLE_EQ(c.temperature.psi_m.coeff_per_K, -0.00105);
+  EXPECT_DOUBLE_EQ(c.temperature.psi_m.value_ref, 1.14);  // not found: the machine's
   test::TempFile g("own.yaml", machine + "daemon:\n  temperature: {r_s_coeff_per_K: 0.00393}\n");
-  EXPECT_DOUBLE_EQ(load_daemon_config(g.path()).temperature.r_s_coeff_per_K, 0.00393);
+  EXPECT_DOUBLE_EQ(load_daemon_config(g.path()).temperature.r_s.coeff_per_K, 0.00393);
   test::TempFile h("bad.yaml", test::read_file(test::source_dir() + "/config/paper-ipmsm.yaml") +
                                    "model_extensions:\n  psim_drift: {coeff_per_K: 0.001}\n");
   EXPECT_THROW((void)load_daemon_config(h.path()), io::ConfigError);

@@ -134,9 +134,11 @@ TEST(MachineConfig, ModelExtensionsAreRead) {
   EXPECT_DOUBLE_EQ(c.estimator.extensions.inductance_q.curvature_per_A2, -0.001);
   EXPECT_TRUE(c.estimator.extensions.inductance_d.nominal());
   EXPECT_DOUBLE_EQ(c.estimator.extensions.iron_loss_r_fe_Ohm, 2500.0);
-  EXPECT_DOUBLE_EQ(c.rs_drift.coeff_per_K.value(), 0.0039);
-  EXPECT_DOUBLE_EQ(c.rs_drift.reference_C, 25.0);
-  EXPECT_FALSE(c.psim_drift.coeff_per_K.has_value());
+  ASSERT_TRUE(c.rs_drift.law.has_value());
+  EXPECT_DOUBLE_EQ(c.rs_drift.law->coeff_per_K, 0.0039);
+  EXPECT_DOUBLE_EQ(c.rs_drift.law->reference_C, 25.0);
+  EXPECT_DOUBLE_EQ(c.rs_drift.law->value_ref, 0.0);  // not given: the machine's
+  EXPECT_FALSE(c.psim_drift.law.has_value());
   EXPECT_DOUBLE_EQ(c.psim_drift.rel_change.value(), -0.05);
 }
 
@@ -151,8 +153,7 @@ TEST(MachineConfig, ExtensionsWrittenAsYamlReadBackToTheSameValues) {
   x.delay_s = 2.4e-5;
   x.inductance_q = {1.2223, -0.000453337};
   x.iron_loss_r_fe_Ohm = 1261.24;
-  c.rs_drift.coeff_per_K = 0.00391698;
-  c.rs_drift.reference_C = 25.0;
+  c.rs_drift.law = core::DriftLaw{0.00391698, 25.0, 2.31};
   c.psim_drift.rel_change = -0.067;
   const std::string text = replace_model_extensions(paper_text() + "model_extensions:\n  delay: {delay_s: 7.77e-7}\n",
                                                     model_extensions_yaml(c));
@@ -168,8 +169,10 @@ TEST(MachineConfig, ExtensionsWrittenAsYamlReadBackToTheSameValues) {
   EXPECT_EQ(y.inductance_q.curvature_per_A2, x.inductance_q.curvature_per_A2);
   EXPECT_TRUE(y.inductance_d.nominal());
   EXPECT_EQ(y.iron_loss_r_fe_Ohm, x.iron_loss_r_fe_Ohm);
-  EXPECT_EQ(back.rs_drift.coeff_per_K, c.rs_drift.coeff_per_K);
-  EXPECT_EQ(back.rs_drift.reference_C, 25.0);
+  ASSERT_TRUE(back.rs_drift.law.has_value());
+  EXPECT_EQ(back.rs_drift.law->coeff_per_K, c.rs_drift.law->coeff_per_K);
+  EXPECT_EQ(back.rs_drift.law->reference_C, 25.0);
+  EXPECT_EQ(back.rs_drift.law->value_ref, 2.31);
   EXPECT_EQ(back.psim_drift.rel_change, c.psim_drift.rel_change);
   EXPECT_EQ(back.machine.r_s_Ohm, c.machine.r_s_Ohm);  // the rest of the file is kept
   EXPECT_EQ(replace_model_extensions(paper_text(), ""), paper_text());

@@ -13,7 +13,7 @@
 #include <vector>
 
 #include "rpem/analysis/diagnose/diagnose_output.hpp"
-#include "rpem/analysis/diagnose/hidden_effects.hpp"
+#include "support/hidden_effects.hpp"
 #include "rpem/sim/flux_map.hpp"
 #include "support/data_file.hpp"
 #include "support/temp_file.hpp"
@@ -57,8 +57,8 @@ inline bool within(double got, double truth, double tolerance = kParameterTolera
 }
 
 /// Judges one found effect against one hidden effect; appends the reason to `why`.
-inline bool matches(const analysis::HiddenEffect& h, const std::vector<analysis::NamedValue>& p, std::string& why) {
-  constexpr double kCopper = 0.00393, kMagnet = -0.0012;  // the simulator's thermal coefficients
+inline bool matches(const HiddenEffect& h, const std::vector<analysis::NamedValue>& p, const core::ThermalModel& thermal,
+                    std::string& why) {
   double got = std::nan(""), truth = std::nan("");
   std::string phase;
   if (h.name == "deadtime") got = parameter(p, "t_dead_s"), truth = h.value;
@@ -66,7 +66,7 @@ inline bool matches(const analysis::HiddenEffect& h, const std::vector<analysis:
   if (h.name == "current_offset") got = parameter(p, "offset_A"), truth = h.value, parameter(p, "phase", &phase);
   if (h.name == "current_gain") got = parameter(p, "gain_error"), truth = h.value, parameter(p, "phase", &phase);
   if (h.name == "rs_drift" || h.name == "psim_drift") {
-    const double coeff = h.name == "rs_drift" ? kCopper : kMagnet;
+    const double coeff = h.name == "rs_drift" ? thermal.r_s.coeff_per_K : thermal.psi_m.coeff_per_K;
     got = h.temperatures_logged ? parameter(p, "coeff_per_K") : parameter(p, "rel_change");
     truth = h.temperatures_logged ? coeff : coeff * h.value;
   }
@@ -123,13 +123,13 @@ inline CaseOutcome run_hidden_case(const HiddenCase& c) {
   }
   s.seed = c.seed;
   std::mt19937_64 rng(c.seed);
-  std::vector<analysis::HiddenEffect> hidden;
+  std::vector<HiddenEffect> hidden;
   for (const std::string& name : c.effects) {
-    hidden.push_back(analysis::draw_effect(rng, s, name));
-    analysis::hide(s, hidden.back());
+    hidden.push_back(draw_effect(rng, s, name));
+    hide(s, hidden.back());
   }
   io::DriveLogLayout layout;
-  std::vector<io::DriveLogRow> rows = analysis::simulate(s, &layout);
+  std::vector<io::DriveLogRow> rows = simulate(s, &layout);
   analysis::LogData log = analysis::prepare_log(std::move(rows), layout, s.machine.machine, {});
   analysis::DiagnoseOptions options;
   options.switching_frequency_Hz = s.inverter.switching_frequency_Hz;
@@ -167,7 +167,7 @@ inline CaseOutcome run_hidden_case(const HiddenCase& c) {
   bool all = true;
   for (const auto& h : hidden) {
     for (std::size_t j = 0; j < d.selection.found.size(); ++j) {
-      if (d.selection.found[j].effect.name() == h.name) all = matches(h, analysis::found_parameters(d, j), out.detail) && all;
+      if (d.selection.found[j].effect.name() == h.name) all = matches(h, analysis::found_parameters(d, j), s.thermal, out.detail) && all;
     }
   }
   out.correct = all;

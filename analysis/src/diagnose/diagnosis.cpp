@@ -18,8 +18,7 @@ double value_of(const std::vector<NamedValue>& values, const char* name) {
 io::ParameterDrift recorded_drift(const std::vector<NamedValue>& values, bool temperature) {
   io::ParameterDrift d;
   if (temperature) {
-    d.coeff_per_K = value_of(values, "coeff_per_K");
-    d.reference_C = value_of(values, "reference_C");
+    d.law = core::DriftLaw{value_of(values, "coeff_per_K"), value_of(values, "reference_C")};
   } else {
     d.rel_change = value_of(values, "rel_change");
   }

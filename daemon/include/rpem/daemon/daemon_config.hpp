@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <string>
 
+#include "rpem/core/thermal.hpp"
 #include "rpem/daemon/realtime.hpp"
 #include "rpem/io/machine_config.hpp"
 
@@ -16,13 +17,9 @@ namespace rpem::daemon {
 enum class SourceType { kSim, kCan };
 enum class RealtimeMode { kRequired, kPreferred, kOff };
 
-struct TemperatureModel {
-  double reference_C = 20.0;
-  double r_s_ref_Ohm = 0.0;    ///< r_s at reference_C (default: the machine's offline r_s)
-  double psi_m_ref_Wb = 0.0;   ///< ψm at reference_C (default: the machine's offline ψm)
-  double r_s_coeff_per_K = 0.00393;
-  double psi_m_coeff_per_K = -0.0012;
-};
+/// Winding and magnet temperatures from r̂s and ψ̂m: the inverse of the drift laws (core/thermal.hpp);
+/// value_ref defaults to the machine's offline r_s and ψm.
+using TemperatureModel = core::ThermalModel;
 
 struct ValidityConfig {
   double r_s_after_s = 2.0;          ///< r_s valid after this much standstill adaptation (then held)

@@ -6,19 +6,18 @@
 #include <string>
 
 #include "rpem/core/settings.hpp"
+#include "rpem/core/thermal.hpp"
 #include "rpem/io/drive_log.hpp"
 #include "rpem/io/yaml_map.hpp"
 
 namespace rpem::io {
 
-/// A parameter's thermal drift (model_extensions.rs_drift / psim_drift, found by `rpem diagnose`):
-///   value(T) = value_ref·(1 + coeff_per_K·(T − reference_C))
-/// or, where the log had no temperatures, its relative change over the log (informational). The
-/// estimator tracks ψm and R_s itself; a coefficient calibrates rpemd's temperature derivation.
+/// A parameter's drift (model_extensions.rs_drift / psim_drift, found by `rpem diagnose`): against
+/// temperature, the law of core/thermal.hpp (coeff_per_K, reference_C, r_s_ref_Ohm / psi_m_ref_Wb;
+/// value_ref 0: the machine's), which `rpem diagnose` replays and which calibrates rpemd's temperature
+/// derivation; or, where the log had no temperatures, its relative change over that log (informational).
 struct ParameterDrift {
-  std::optional<double> coeff_per_K;
-  double reference_C = 20.0;
-  std::optional<double> value_ref;   ///< r_s_ref_Ohm or psi_m_ref_Wb (default: the machine's)
+  std::optional<core::DriftLaw> law;
   std::optional<double> rel_change;  ///< change over the diagnosed log, relative to nominal
 };
 

@@ -31,12 +31,6 @@ enum class Quantity : int {
 inline constexpr std::array<const char*, static_cast<int>(Quantity::kCount)> kQuantityNames = {
     "psi_m_Wb", "r_s_Ohm", "l_d_H", "l_q_H", "speed_rpm", "torque_Nm", "u_dc_V", "t_winding_C", "t_magnet_C"};
 
-/// Temperature coupling: r_s = r_s(ref)·(1 + α_Cu·(T_w − T_ref)), ψ_m = ψ_m(ref)·(1 + α_PM·(T_m − T_ref)).
-struct ThermalCoupling {
-  double reference_C = 20.0;
-  double r_s_coeff_per_K = 0.00393;
-  double psi_m_coeff_per_K = -0.0012;
-};
 
 struct LogOptions {
   bool dq_columns = false;
@@ -59,7 +53,9 @@ struct Scenario {
   MechanicsConfig mechanics;
   FocConfig control;
   SensorConfig sensors;
-  ThermalCoupling thermal;
+  /// Temperature coupling (core/thermal.hpp): r_s and ψm signals are the values at the laws' reference
+  /// temperature; the laws' value_ref is unused.
+  core::ThermalModel thermal;
   double r_fe_Ohm = 0.0;              ///< iron-loss resistance; 0: none (hidden effect)
   std::array<Signal, static_cast<int>(Quantity::kCount)> signals;
   LogOptions log;

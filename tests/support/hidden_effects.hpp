@@ -1,6 +1,6 @@
 #pragma once
-// Drive logs with a known effect hidden in them, for testing and demonstrating `rpem diagnose`: a
-// scenario (scenarios/diagnose-bench.yaml: a test-bench profile that gives every effect a chance to show;
+// Drive logs with a known effect hidden in them, for the tests and the benchmark of `rpem diagnose` (the
+// rpem::test_support library; not part of the product): a scenario (scenarios/diagnose-bench.yaml: a test-bench profile that gives every effect a chance to show;
 // scenarios/diagnose-beckhoff.yaml: a motor on its measured flux map) with catalogue effects put into
 // the simulated hardware.
 
@@ -12,7 +12,7 @@
 #include "rpem/io/drive_log.hpp"
 #include "rpem/sim/scenario.hpp"
 
-namespace rpem::analysis {
+namespace rpem::test {
 
 /// One hidden effect with its true value, in the catalogue's terms (effects.hpp).
 struct HiddenEffect {
@@ -33,4 +33,4 @@ void hide(sim::Scenario& s, const HiddenEffect& e);
 /// Simulates a scenario into drive-log rows (what `rpem sim` would write).
 [[nodiscard]] std::vector<io::DriveLogRow> simulate(const sim::Scenario& s, io::DriveLogLayout* layout = nullptr);
 
-}  // namespace rpem::analysis
+}  // namespace rpem::test

@@ -1,11 +1,11 @@
-#include "rpem/analysis/diagnose/hidden_effects.hpp"
+#include "support/hidden_effects.hpp"
 
 #include <cmath>
 #include <stdexcept>
 
 #include "rpem/sim/drive_simulator.hpp"
 
-namespace rpem::analysis {
+namespace rpem::test {
 namespace {
 
 constexpr double kDeg = 3.14159265358979323846 / 180.0;
@@ -27,10 +27,10 @@ void hide(sim::Scenario& s, const HiddenEffect& e) {
   } else if (e.name == "current_gain") {
     s.sensors.current_gain_error[e.phase] = e.value;
   } else if (e.name == "rs_drift") {
-    s.signal(sim::Quantity::kTWinding).add({0.0, sim::EventKind::kRamp, s.thermal.reference_C + e.value, t_end});
+    s.signal(sim::Quantity::kTWinding).add({0.0, sim::EventKind::kRamp, s.thermal.r_s.reference_C + e.value, t_end});
     s.log.temperatures = e.temperatures_logged;
   } else if (e.name == "psim_drift") {
-    s.signal(sim::Quantity::kTMagnet).add({0.0, sim::EventKind::kRamp, s.thermal.reference_C + e.value, t_end});
+    s.signal(sim::Quantity::kTMagnet).add({0.0, sim::EventKind::kRamp, s.thermal.psi_m.reference_C + e.value, t_end});
     s.log.temperatures = e.temperatures_logged;
   } else if (e.name == "delay") {
     s.inverter_delay_s = e.value;
@@ -79,4 +79,4 @@ std::vector<io::DriveLogRow> simulate(const sim::Scenario& s, io::DriveLogLayout
   return rows;
 }
 
-}  // namespace rpem::analysis
+}  // namespace rpem::test
