@@ -18,6 +18,14 @@ bool finite(const DriveSample& s) noexcept {
 
 }  // namespace
 
+double FluxHarmonic::amplitude_Wb() const noexcept {
+  // ψ_h = A·cos x + B·sin x with A = [d_cos, q_cos], B = [d_sin, q_sin]:
+  // |ψ_h|² = (|A|² + |B|²)/2 + ((|A|² − |B|²)/2)·cos 2x + (A·B)·sin 2x, whose largest value is below.
+  const double aa = d_cos_Wb * d_cos_Wb + q_cos_Wb * q_cos_Wb, bb = d_sin_Wb * d_sin_Wb + q_sin_Wb * q_sin_Wb;
+  const double ab = d_cos_Wb * d_sin_Wb + q_cos_Wb * q_sin_Wb;
+  return std::sqrt(0.5 * (aa + bb) + std::hypot(0.5 * (aa - bb), ab));
+}
+
 SampleConditioner::SampleConditioner(const PerUnitBase& base, const MachinePu& machine,
                                      const ModelExtensions& extensions) noexcept {
   reconfigure(base, machine, extensions);
@@ -38,6 +46,53 @@ void SampleConditioner::reconfigure(const PerUnitBase& base, const MachinePu& ma
   phase_corrections_ = !x.current_offset_A.isZero(0.0) || !x.current_gain_error.isZero(0.0);
   saturation_ = x.saturation();
   deadtime_ = x.deadtime_v_err_V != 0.0 || x.deadtime_t_dead_s != 0.0;
+  harmonics_ = x.harmonics();
+  for (std::size_t j = 0; j < harmonics_pu_.size(); ++j) {
+    const FluxHarmonic& h = x.flux_harmonics[j];
+    harmonics_pu_[j] = {base.flux_pu(h.d_cos_Wb), base.flux_pu(h.d_sin_Wb), base.flux_pu(h.q_cos_Wb), base.flux_pu(h.q_sin_Wb)};
+  }
+  cross_ = x.cross_coupling_H_per_A != 0.0;
+  half_cross_pu_ = 0.5 * x.cross_coupling_H_per_A * base.current_A * base.current_A / base.flux_Wb;
+  cross_x_q_pu_per_A_ = x.cross_coupling_H_per_A / base.inductance_H;
+  delay_ = x.delay_s > 0.0;
+}
+
+Vec2 SampleConditioner::inductances_pu(const Vec2& i_dq_pu) const noexcept {
+  Vec2 x(machine_.x_d_pu, machine_.x_q_pu);
+  if (saturation_) {
+    const Vec2 i_A = i_dq_pu * base_.current_A;
+    x[0] *= extensions_.inductance_d.factor(i_A[0]);
+    x[1] = x[1] * extensions_.inductance_q.factor(i_A[1]) + cross_x_q_pu_per_A_ * i_A[0];
+  }
+  return x;
+}
+
+Vec2 SampleConditioner::extra_emf_pu(const Rotation& rot, double n_pu, const Vec2& i_dq_pu, bool harmonics) const noexcept {
+  Vec2 e = Vec2::Zero();
+  if (!harmonics_ && !cross_) return e;
+  if (harmonics && harmonics_) {
+    for (std::size_t j = 0; j < harmonics_pu_.size(); ++j) {
+      const FluxHarmonic& h = harmonics_pu_[j];
+      if (h.nominal()) continue;
+      const double order = kFluxHarmonicOrders[j];
+      const Rotation z = multiple(rot, kFluxHarmonicOrders[j]);
+      const double psi_d = h.d_cos_Wb * z.cos + h.d_sin_Wb * z.sin, psi_q = h.q_cos_Wb * z.cos + h.q_sin_Wb * z.sin;
+      const double dpsi_d = order * (h.d_sin_Wb * z.cos - h.d_cos_Wb * z.sin);
+      const double dpsi_q = order * (h.q_sin_Wb * z.cos - h.q_cos_Wb * z.sin);
+      e += Vec2(dpsi_d - psi_q, dpsi_q + psi_d);  // ∂ψ_h/∂ϑ + J·ψ_h
+    }
+  }
+  if (cross_) e[1] += half_cross_pu_ * i_dq_pu[1] * i_dq_pu[1];  // J·[(c/2)·i_q², 0]
+  return n_pu * e;
+}
+
+Vec2 SampleConditioner::delayed_command_alphabeta_V(double dt_s) const noexcept {
+  // The command that acts over this interval was issued delay = (m + f)·dt before it: for the first
+  // f of the interval the older one of the two issued around that instant still holds (zero-order hold).
+  const double periods = std::clamp(extensions_.delay_s / dt_s, 0.0, kMaxDelayPeriods + 0.999999);
+  const int m = static_cast<int>(periods);
+  const double f = periods - m;
+  return (1.0 - f) * commands_[static_cast<std::size_t>(m)] + f * commands_[static_cast<std::size_t>(m) + 1];
 }
 
 Vec3 SampleConditioner::corrected_phases_A(const Vec3& measured_A) const noexcept {
@@ -84,12 +139,9 @@ SampleConditioner::Measured SampleConditioner::measure(const DriveSample& s, con
   m.i_ab_A = current_alphabeta_A(s, m.logged);
   m.i_dq_pu = park(m.i_ab_A, m.rot) * inv_current_A_;
   m.n_pu = s.omega_el_rad_s * inv_omega_rad_s_;  // base_.speed_pu(), without the division
-  m.x_d_pu = machine_.x_d_pu;
-  m.x_q_pu = machine_.x_q_pu;
-  if (saturation_) {
-    m.x_d_pu *= extensions_.inductance_d.factor(m.i_dq_pu[0] * base_.current_A);
-    m.x_q_pu *= extensions_.inductance_q.factor(m.i_dq_pu[1] * base_.current_A);
-  }
+  const Vec2 x = inductances_pu(m.i_dq_pu);
+  m.x_d_pu = x[0];
+  m.x_q_pu = x[1];
   m.i_fe_dq_pu.setZero();
   if (inv_r_fe_pu_ > 0.0) {
     // Iron loss: the induced voltage n·J·ψ drives i_fe = n·J·ψ/r_fe beside the magnetising current.
@@ -110,7 +162,8 @@ SteadyStateInputs SampleConditioner::steady_state(const DriveSample& s) const no
     // The six-step leg error's fundamental, opposite to the current: amplitude (4/π)·v_err.
     u_dq_V -= (4.0 / kPi) * v_err * park(m.i_ab_A, m.rot) / i_norm;
   }
-  out.u_pu = u_dq_V * inv_voltage_V_ - machine_.r_s_pu * m.i_fe_dq_pu;
+  // Flux harmonics average out over the revolution a steady-state row stands for; cross-saturation stays.
+  out.u_pu = u_dq_V * inv_voltage_V_ - machine_.r_s_pu * m.i_fe_dq_pu - extra_emf_pu(m.rot, m.n_pu, m.i_dq_pu, false);
   out.i_pu = m.i_dq_pu;
   out.n_pu = m.n_pu;
   out.x_d_pu = m.x_d_pu;
@@ -135,9 +188,8 @@ Vec2 SampleConditioner::observed_current_dq_A(const DriveSample& s, const Vec2& 
   const Rotation rot = angle_offset_ ? compose(logged, offset_rotation_) : logged;
   Vec2 i_pu = i_model_pu;
   if (inv_r_fe_pu_ > 0.0) {
-    const double x_d = machine_.x_d_pu * extensions_.inductance_d.factor(i_pu[0] * base_.current_A);
-    const double x_q = machine_.x_q_pu * extensions_.inductance_q.factor(i_pu[1] * base_.current_A);
-    const Vec2 psi(x_d * i_pu[0] + machine_.psi_m_pu, x_q * i_pu[1]);
+    const Vec2 x = inductances_pu(i_pu);
+    const Vec2 psi(x[0] * i_pu[0] + machine_.psi_m_pu, x[1] * i_pu[1]);
     i_pu += (s.omega_el_rad_s * inv_omega_rad_s_ * inv_r_fe_pu_) * Vec2(-psi[1], psi[0]);
   }
   Vec2 i_ab_A = inverse_park(i_pu * base_.current_A, rot);
@@ -164,24 +216,24 @@ EstimatorSample SampleConditioner::condition(const DriveSample& s) noexcept {
     out.x_q_pu = m.x_q_pu;
   }
 
-  // The command issued now, as the machine will see it (dead-time from the current at issue time;
-  // the resistive drop of the iron-loss current, which the magnetising-current model does not carry).
-  Vec2 u_applied_ab_V = command_alphabeta_V(s, m.logged) + deadtime_error_alphabeta_V(m.i_ab_A, s.u_dc_V);
-  if (inv_r_fe_pu_ > 0.0) u_applied_ab_V -= inverse_park(m.i_fe_dq_pu, m.rot) * (machine_.r_s_pu * base_.voltage_V);
+  // The corrections the machine's voltage takes over the coming interval, from the current now: the
+  // dead-time error, and the resistive drop of the iron-loss current (which the magnetising-current
+  // model does not carry).
+  const Vec2 command_ab_V = command_alphabeta_V(s, m.logged);
+  Vec2 correction_ab_V = deadtime_error_alphabeta_V(m.i_ab_A, s.u_dc_V);
+  if (inv_r_fe_pu_ > 0.0) correction_ab_V -= inverse_park(m.i_fe_dq_pu, m.rot) * (machine_.r_s_pu * base_.voltage_V);
+  const Vec2 emf_pu = extra_emf_pu(m.rot, m.n_pu, m.i_dq_pu, true);
 
-  if (has_previous_ && !s.gap_before) {
+  const bool chained = has_previous_ && !s.gap_before;
+  if (chained) {
     auto& iv = out.interval;
     iv.dt_s = 1e-9 * static_cast<double>(s.t_ns - previous_t_ns_);
     iv.n_start_pu = previous_n_pu_;
     iv.n_end_pu = m.n_pu;
-    // Delay extension: the first `delay` of the interval still sees the command before.
-    Vec2 u_held_ab_pu = previous_u_ab_V_ * inv_voltage_V_;
-    if (extensions_.delay_s > 0.0 && iv.dt_s > 0.0) {
-      const double w = std::clamp(extensions_.delay_s / iv.dt_s, 0.0, 1.0);
-      u_held_ab_pu = ((1.0 - w) * previous_u_ab_V_ + w * older_u_ab_V_) * inv_voltage_V_;
-    }
-    iv.u_start_pu = park(u_held_ab_pu, previous_rotation_);
-    iv.u_end_pu = park(u_held_ab_pu, m.rot);
+    const Vec2 command = delay_ && iv.dt_s > 0.0 ? delayed_command_alphabeta_V(iv.dt_s) : commands_[0];
+    const Vec2 u_held_ab_pu = (command + previous_correction_ab_V_) * inv_voltage_V_;
+    iv.u_start_pu = park(u_held_ab_pu, previous_rotation_) - previous_emf_pu_;
+    iv.u_end_pu = park(u_held_ab_pu, m.rot) - emf_pu;
   } else {
     out.resync = true;
     // The gap's length (0 for the first sample) lets the estimator keep ε across a short one.
@@ -190,8 +242,16 @@ EstimatorSample SampleConditioner::condition(const DriveSample& s) noexcept {
     out.interval.n_end_pu = m.n_pu;
   }
 
-  older_u_ab_V_ = has_previous_ ? previous_u_ab_V_ : u_applied_ab_V;
-  previous_u_ab_V_ = u_applied_ab_V;
+  if (!delay_) {
+    commands_[0] = command_ab_V;
+  } else if (chained) {
+    for (std::size_t j = commands_.size() - 1; j > 0; --j) commands_[j] = commands_[j - 1];
+    commands_[0] = command_ab_V;
+  } else {
+    commands_.fill(command_ab_V);  // what came before the chain is unknown: the first command stands in
+  }
+  previous_correction_ab_V_ = correction_ab_V;
+  previous_emf_pu_ = emf_pu;
   previous_rotation_ = m.rot;
   previous_n_pu_ = m.n_pu;
   previous_t_ns_ = s.t_ns;

@@ -1,5 +1,6 @@
 #include "rpem/io/machine_config.hpp"
 
+#include <array>
 #include <limits>
 #include <sstream>
 #include <stdexcept>
@@ -116,6 +117,14 @@ core::EstimatorSettings parse_estimator(YamlMap e, const core::MachineSi& machin
   return s;
 }
 
+/// model_extensions' key of flux harmonic j: flux_harmonic_6, flux_harmonic_12.
+std::string harmonic_key(std::size_t j) { return "flux_harmonic_" + std::to_string(core::kFluxHarmonicOrders[j]); }
+
+/// A flux harmonic's keys and fields.
+std::array<std::pair<const char*, double*>, 4> harmonic_fields(core::FluxHarmonic& f) {
+  return {{{"d_cos_Wb", &f.d_cos_Wb}, {"d_sin_Wb", &f.d_sin_Wb}, {"q_cos_Wb", &f.q_cos_Wb}, {"q_sin_Wb", &f.q_sin_Wb}}};
+}
+
 core::InductanceCurve parse_inductance_curve(YamlMap m) {
   core::InductanceCurve c;
   c.level = m.number_or("level", 1.0, 0.05, 20.0);
@@ -173,8 +182,24 @@ void parse_extensions(YamlMap x, MachineConfig& config) {
     }
   }
   if (auto d = x.optional_map("delay")) {
+    const double period_s = config.estimator.nominal_sample_period_s;
     c.delay_s = d->number("delay_s", 0.0, 1e-2);
+    if (c.delay_s >= (core::kMaxDelayPeriods + 1) * period_s) {
+      d->fail("delay_s", "must be below " + std::to_string(core::kMaxDelayPeriods + 1) +
+                             " sample periods (estimator.sample_period_s)");
+    }
     d->finish();
+  }
+  if (auto k = x.optional_map("cross_saturation")) {
+    c.cross_coupling_H_per_A = k->number("coupling_H_per_A", -10.0, 10.0);
+    k->finish();
+  }
+  for (std::size_t j = 0; j < core::kFluxHarmonicOrders.size(); ++j) {
+    if (auto h = x.optional_map(harmonic_key(j))) {
+      core::FluxHarmonic& f = c.flux_harmonics[j];
+      for (auto [key, value] : harmonic_fields(f)) *value = h->number_or(key, 0.0, -100.0, 100.0);
+      h->finish();
+    }
   }
   if (auto l = x.optional_map("ld_saturation")) c.inductance_d = parse_inductance_curve(*l);
   if (auto l = x.optional_map("lq_saturation")) c.inductance_q = parse_inductance_curve(*l);
@@ -262,6 +287,18 @@ std::string model_extensions_yaml(const MachineConfig& c) {
   curve_entry(out, "ld_saturation", x.inductance_d);
   curve_entry(out, "lq_saturation", x.inductance_q);
   if (x.iron_loss_r_fe_Ohm > 0.0) out << "  iron_loss: " << FlowMap().add("r_fe_Ohm", x.iron_loss_r_fe_Ohm).str() << "\n";
+  if (x.cross_coupling_H_per_A != 0.0) {
+    out << "  cross_saturation: " << FlowMap().add("coupling_H_per_A", x.cross_coupling_H_per_A).str() << "\n";
+  }
+  for (std::size_t j = 0; j < core::kFluxHarmonicOrders.size(); ++j) {
+    core::FluxHarmonic h = x.flux_harmonics[j];
+    if (h.nominal()) continue;
+    FlowMap m;
+    for (auto [key, value] : harmonic_fields(h)) {
+      if (*value != 0.0) m.add(key, *value);
+    }
+    out << "  " << harmonic_key(j) << ": " << m.str() << "\n";
+  }
   drift_entry(out, "rs_drift", c.rs_drift, "r_s_ref_Ohm");
   drift_entry(out, "psim_drift", c.psim_drift, "psi_m_ref_Wb");
   const std::string body = out.str();

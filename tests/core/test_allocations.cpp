@@ -54,12 +54,15 @@ TEST_P(Allocations, NoneAcrossOneHundredThousandSteps) {
   ModelExtensions& x = settings.extensions;
   x.deadtime_t_dead_s = 1e-6;
   x.switching_frequency_Hz = 4000.0;
-  x.delay_s = 10e-6;
+  x.delay_s = 2.4 * 125e-6;  // whole and fractional periods: the command history
   x.theta_offset_rad = 0.02;
   x.current_offset_A = Vec3(0.05, 0.0, -0.02);
   x.current_gain_error = Vec3(0.01, 0.0, 0.0);
   x.inductance_q = {1.1, -0.002};
   x.iron_loss_r_fe_Ohm = 3000.0;
+  x.cross_coupling_H_per_A = -1e-3;
+  x.flux_harmonics[0] = {0.01, 0.0, 0.0, 0.01};
+  x.flux_harmonics[1] = {0.0, 0.004, -0.002, 0.0};
   DriveEstimator est(test::paper_machine_si(), settings);
   test::ModelDataGenerator gen;
   gen.plant = test::paper_machine_pu();

@@ -106,6 +106,10 @@ INSTANTIATE_TEST_SUITE_P(
                 "model_extensions.deadtime.colour: unknown key"},
         BadEdit{"drift_without_law", "\nestimator:", "\nmodel_extensions:\n  rs_drift: {reference_C: 20}\nestimator:",
                 "a drift needs coeff_per_K or rel_change"},
+        BadEdit{"delay_beyond_the_history", "\nestimator:", "\nmodel_extensions:\n  delay: {delay_s: 5.0e-4}\nestimator:",
+                "model_extensions.delay.delay_s: must be below 4 sample periods"},
+        BadEdit{"harmonic_unknown_key", "\nestimator:", "\nmodel_extensions:\n  flux_harmonic_6: {d_Wb: 0.01}\nestimator:",
+                "model_extensions.flux_harmonic_6.d_Wb: unknown key"},
         BadEdit{"negative_r_fe", "\nestimator:", "\nmodel_extensions:\n  iron_loss: {r_fe_Ohm: -5}\nestimator:",
                 "iron_loss.r_fe_Ohm"}),
     [](const auto& p) { return std::string(p.param.name); });
@@ -121,7 +125,10 @@ TEST(MachineConfig, ModelExtensionsAreRead) {
                            "  lq_saturation: {level: 1.2, curvature_per_A2: -0.001}\n"
                            "  iron_loss: {r_fe_Ohm: 2500}\n"
                            "  rs_drift: {coeff_per_K: 0.0039, reference_C: 25}\n"
-                           "  psim_drift: {rel_change: -0.05}\n";
+                           "  psim_drift: {rel_change: -0.05}\n"
+                           "  cross_saturation: {coupling_H_per_A: -0.002}\n"
+                           "  flux_harmonic_6: {d_cos_Wb: 0.01, q_sin_Wb: -0.02}\n"
+                           "  flux_harmonic_12: {q_cos_Wb: 0.003}\n";
   test::TempFile f("ext.yaml", text);
   const MachineConfig c = load_machine_config(f.path());
   EXPECT_DOUBLE_EQ(c.estimator.extensions.deadtime_t_dead_s, 2e-6);
@@ -140,6 +147,11 @@ TEST(MachineConfig, ModelExtensionsAreRead) {
   EXPECT_DOUBLE_EQ(c.rs_drift.law->value_ref, 0.0);  // not given: the machine's
   EXPECT_FALSE(c.psim_drift.law.has_value());
   EXPECT_DOUBLE_EQ(c.psim_drift.rel_change.value(), -0.05);
+  EXPECT_DOUBLE_EQ(c.estimator.extensions.cross_coupling_H_per_A, -0.002);
+  EXPECT_DOUBLE_EQ(c.estimator.extensions.flux_harmonics[0].d_cos_Wb, 0.01);
+  EXPECT_DOUBLE_EQ(c.estimator.extensions.flux_harmonics[0].q_sin_Wb, -0.02);
+  EXPECT_DOUBLE_EQ(c.estimator.extensions.flux_harmonics[0].d_sin_Wb, 0.0);
+  EXPECT_DOUBLE_EQ(c.estimator.extensions.flux_harmonics[1].q_cos_Wb, 0.003);
 }
 
 TEST(MachineConfig, ExtensionsWrittenAsYamlReadBackToTheSameValues) {
@@ -150,9 +162,11 @@ TEST(MachineConfig, ExtensionsWrittenAsYamlReadBackToTheSameValues) {
   x.theta_offset_rad = -0.0497918;
   x.current_offset_A = core::Vec3(0.0, -0.0449122, 0.013);
   x.current_gain_error = core::Vec3(0.02, 0.0, 0.0);
-  x.delay_s = 2.4e-5;
+  x.delay_s = 2.3 * 125e-6;  // whole periods and a fraction
   x.inductance_q = {1.2223, -0.000453337};
   x.iron_loss_r_fe_Ohm = 1261.24;
+  x.cross_coupling_H_per_A = -0.00123456789;
+  x.flux_harmonics[1] = {0.0031, -0.0007, 0.0, 0.0125};
   c.rs_drift.law = core::DriftLaw{0.00391698, 25.0, 2.31};
   c.psim_drift.rel_change = -0.067;
   const std::string text = replace_model_extensions(paper_text() + "model_extensions:\n  delay: {delay_s: 7.77e-7}\n",
@@ -169,6 +183,12 @@ TEST(MachineConfig, ExtensionsWrittenAsYamlReadBackToTheSameValues) {
   EXPECT_EQ(y.inductance_q.curvature_per_A2, x.inductance_q.curvature_per_A2);
   EXPECT_TRUE(y.inductance_d.nominal());
   EXPECT_EQ(y.iron_loss_r_fe_Ohm, x.iron_loss_r_fe_Ohm);
+  EXPECT_EQ(y.cross_coupling_H_per_A, x.cross_coupling_H_per_A);
+  EXPECT_TRUE(y.flux_harmonics[0].nominal());
+  EXPECT_EQ(y.flux_harmonics[1].d_cos_Wb, 0.0031);
+  EXPECT_EQ(y.flux_harmonics[1].d_sin_Wb, -0.0007);
+  EXPECT_EQ(y.flux_harmonics[1].q_cos_Wb, 0.0);
+  EXPECT_EQ(y.flux_harmonics[1].q_sin_Wb, 0.0125);
   ASSERT_TRUE(back.rs_drift.law.has_value());
   EXPECT_EQ(back.rs_drift.law->coeff_per_K, c.rs_drift.law->coeff_per_K);
   EXPECT_EQ(back.rs_drift.law->reference_C, 25.0);

@@ -8,6 +8,8 @@
 // ϑ = ϑ_logged + offset. For the interval [t_{k−1}, t_k] the command u^s_{k−1} (stator frame, held)
 // enters the trapezoidal predictor at both ends: u_start = T(ϑ_{k−1})·u^s_{k−1}, u_end = T(ϑ_k)·u^s_{k−1}.
 
+#include <array>
+
 #include "rpem/core/drive_sample.hpp"
 #include "rpem/core/estimator.hpp"
 #include "rpem/core/frames.hpp"
@@ -25,6 +27,25 @@ struct InductanceCurve {
   [[nodiscard]] double factor(double i_A) const noexcept { return level + curvature_per_A2 * i_A * i_A; }
 };
 
+/// A harmonic of the rotor-frame flux linkage (flux_harmonic_6, flux_harmonic_12): the magnet's flux
+/// distribution and slotting add to ψ_dq = [L_d·i_d + ψm, L_q·i_q]
+///   ψ_h(ϑ) = [d_cos·cos hϑ + d_sin·sin hϑ,  q_cos·cos hϑ + q_sin·sin hϑ]   [Wb]
+/// of order h = 6k (the 5th and 7th, 11th and 13th of the phase back-EMF). It induces, at speed ω,
+///   e_h = ω·(∂ψ_h/∂ϑ + J·ψ_h),  J = [0 −1; 1 0]                   (docs/model-extensions.md)
+/// which the conditioner takes from the applied voltage.
+struct FluxHarmonic {
+  double d_cos_Wb = 0.0, d_sin_Wb = 0.0, q_cos_Wb = 0.0, q_sin_Wb = 0.0;
+  [[nodiscard]] bool nominal() const noexcept { return d_cos_Wb == 0.0 && d_sin_Wb == 0.0 && q_cos_Wb == 0.0 && q_sin_Wb == 0.0; }
+  /// The largest |ψ_h| over a revolution [Wb].
+  [[nodiscard]] double amplitude_Wb() const noexcept;
+};
+
+/// The orders of ModelExtensions::flux_harmonics.
+inline constexpr std::array<int, 2> kFluxHarmonicOrders{6, 12};
+
+/// Delays up to this many sample periods (whole and fractional) are modelled.
+inline constexpr int kMaxDelayPeriods = 3;
+
 /// Model extensions (all defaults: the nominal model). Input side: what the sensors and the inverter do
 /// to the logged quantities; machine side: what the constant-parameter model leaves out.
 struct ModelExtensions {
@@ -35,12 +56,27 @@ struct ModelExtensions {
   double deadtime_t_dead_s = 0.0;            ///< dead time; adds t_dead·f_sw·u_dc to the voltage error
   double switching_frequency_Hz = 0.0;       ///< f_sw for the dead-time term
   double deadtime_current_band_A = 0.0;      ///< sign(i) is linear within ±band (0: hard sign)
-  double delay_s = 0.0;                      ///< extra delay of the applied voltage, 0 ≤ delay < T_samp
+  /// Extra delay of the applied voltage, 0 ≤ delay < (kMaxDelayPeriods + 1)·T_samp: whole control periods
+  /// (a drive's computation delay) and fractions of one.
+  double delay_s = 0.0;
   InductanceCurve inductance_d;              ///< ld_saturation
   InductanceCurve inductance_q;              ///< lq_saturation
+  /// cross_saturation: the reciprocal coupling c of the co-energy term (c/2)·i_d·i_q², so that
+  ///   ψ_d = L_d·i_d + ψm + (c/2)·i_q²,   ψ_q = (L_q + c·i_d)·i_q      [c in H/A = Wb/A²]
+  /// (L_q against i_d, and the d-axis flux against the load); quasi-static (docs/model-extensions.md).
+  double cross_coupling_H_per_A = 0.0;
   double iron_loss_r_fe_Ohm = 0.0;           ///< resistance parallel to the induced voltage; 0: none
+  std::array<FluxHarmonic, kFluxHarmonicOrders.size()> flux_harmonics{};  ///< orders kFluxHarmonicOrders
 
-  [[nodiscard]] bool saturation() const noexcept { return !inductance_d.nominal() || !inductance_q.nominal(); }
+  [[nodiscard]] bool saturation() const noexcept {
+    return !inductance_d.nominal() || !inductance_q.nominal() || cross_coupling_H_per_A != 0.0;
+  }
+  [[nodiscard]] bool harmonics() const noexcept {
+    for (const FluxHarmonic& h : flux_harmonics) {
+      if (!h.nominal()) return true;
+    }
+    return false;
+  }
 };
 
 /// One sample's inputs for the steady-state model (dq logs sampled far apart in time): the command
@@ -102,6 +138,15 @@ class SampleConditioner {
   [[nodiscard]] static Vec2 command_alphabeta_V(const DriveSample& s, const Rotation& logged) noexcept;
   [[nodiscard]] double deadtime_voltage_V(double u_dc_V) const noexcept;
   [[nodiscard]] Vec2 deadtime_error_alphabeta_V(const Vec2& i_ab_A, double u_dc_V) const noexcept;
+  /// The voltage the flux harmonics and the cross-saturation's d-axis flux induce at this sample, rotor
+  /// frame [pu]: n·(∂ψ_h/∂ϑ + J·ψ_h) + n·J·[(c/2)·i_q², 0].
+  /// (`harmonics` false: without the flux harmonics, for the steady state.)
+  [[nodiscard]] Vec2 extra_emf_pu(const Rotation& rot, double n_pu, const Vec2& i_dq_pu, bool harmonics) const noexcept;
+  /// x_d, x_q at a rotor-frame current [pu]: the saturation curves and the cross-coupling's L_q(i_d).
+  [[nodiscard]] Vec2 inductances_pu(const Vec2& i_dq_pu) const noexcept;
+  /// The command the machine sees over the interval ending now, stator frame [V]: the command issued
+  /// `delay` earlier, blended between the two issued around that instant.
+  [[nodiscard]] Vec2 delayed_command_alphabeta_V(double dt_s) const noexcept;
 
   PerUnitBase base_;
   MachinePu machine_;
@@ -111,15 +156,21 @@ class SampleConditioner {
   double inv_r_fe_pu_ = 0.0;                 ///< 1/r_fe in pu; 0 without iron loss
   Vec3 inv_current_gain_ = Vec3::Ones();     ///< 1/(1 + gain error) per phase
   Rotation offset_rotation_;                 ///< by theta_offset_rad
+  std::array<FluxHarmonic, kFluxHarmonicOrders.size()> harmonics_pu_{};  ///< flux harmonics in pu
+  double half_cross_pu_ = 0.0;               ///< c/2 in pu (ψ_b/I_b²)
+  double cross_x_q_pu_per_A_ = 0.0;          ///< c/L_b: x_q's change per ampere of i_d [pu/A]
   // Which extensions are active, decided when configured (the per-sample path tests one flag each).
   bool angle_offset_ = false, phase_corrections_ = false, saturation_ = false, deadtime_ = false;
+  bool harmonics_ = false, cross_ = false, delay_ = false;
   bool has_previous_ = false;
   std::int64_t previous_t_ns_ = 0;
   Rotation previous_rotation_;
   double previous_n_pu_ = 0.0;
-  Vec2 previous_u_ab_V_ = Vec2::Zero();  ///< applied voltage of the previous command (after corrections)
+  Vec2 previous_correction_ab_V_ = Vec2::Zero();  ///< inverter and iron-loss corrections at the previous sample
+  Vec2 previous_emf_pu_ = Vec2::Zero();           ///< extra_emf_pu() at the previous sample
   RotationTracker logged_rotation_;      ///< at the logged angle, incremental between consecutive samples
-  Vec2 older_u_ab_V_ = Vec2::Zero();     ///< the command before that (for the delay extension)
+  /// The last commands issued, stator frame [V], newest first (commands_[0] is the previous sample's).
+  std::array<Vec2, kMaxDelayPeriods + 2> commands_{};
 };
 
 }  // namespace rpem::core

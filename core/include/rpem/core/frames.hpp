@@ -58,6 +58,16 @@ struct Rotation {
   return {a.cos * b.cos - a.sin * b.sin, a.sin * b.cos + a.cos * b.sin};
 }
 
+/// The rotation by n times the angle (n ≥ 0): cos nϑ and sin nϑ by repeated squaring, no libm call.
+[[nodiscard]] inline Rotation multiple(const Rotation& r, int n) noexcept {
+  Rotation result, square = r;
+  for (; n > 0; n >>= 1) {
+    if (n & 1) result = compose(result, square);
+    square = compose(square, square);
+  }
+  return result;
+}
+
 /// cos and sin of an angle that moves little between calls (a logged or measured rotor angle, sample by
 /// sample): the previous rotation composed with the increment's small_rotation(), with an exact libm
 /// evaluation every kExactEvery calls, after reset() and for increments beyond 0.1 rad. Composition
