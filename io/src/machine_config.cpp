@@ -305,6 +305,39 @@ std::string model_extensions_yaml(const MachineConfig& c) {
   return body.empty() ? "" : "model_extensions:\n" + body;
 }
 
+std::string replace_machine_values(const std::string& yaml_text, const std::vector<std::pair<std::string, double>>& values,
+                                   const std::string& comment) {
+  std::istringstream in(yaml_text);
+  std::string line, out;
+  bool inside = false;
+  std::vector<bool> done(values.size(), false);
+  while (std::getline(in, line)) {
+    const bool top_level = !line.empty() && line[0] != ' ' && line[0] != '\t' && line[0] != '#';
+    if (top_level) inside = line.rfind("machine:", 0) == 0;
+    const std::size_t indent = line.find_first_not_of(' ');
+    if (inside && indent != std::string::npos && indent > 0) {
+      for (std::size_t j = 0; j < values.size(); ++j) {
+        const std::string key = values[j].first + ":";
+        if (line.compare(indent, key.size(), key) != 0) continue;
+        // A direct child: the first indented level of the section.
+        std::string old = line.substr(indent + key.size());
+        old = old.substr(0, old.find('#'));
+        old.erase(0, old.find_first_not_of(' '));
+        old.erase(old.find_last_not_of(' ') + 1);
+        line = line.substr(0, indent) + key + " ";
+        append_number(line, values[j].second);
+        line += "  # " + comment + " (was " + old + ")";
+        done[j] = true;
+      }
+    }
+    out += line + "\n";
+  }
+  for (std::size_t j = 0; j < values.size(); ++j) {
+    if (!done[j]) throw ConfigError("<configuration text>", 0, 0, "machine." + values[j].first, "not found to replace");
+  }
+  return out;
+}
+
 std::string replace_model_extensions(const std::string& yaml_text, const std::string& section) {
   std::istringstream in(yaml_text);
   std::string line, out;

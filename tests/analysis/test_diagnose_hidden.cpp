@@ -58,7 +58,7 @@ TEST(HiddenEffect, WhatTheDataCannotSeparateIsReportedNotGuessed) {
   EXPECT_NE(std::find(group.begin(), group.end(), "deadtime"), group.end());
   EXPECT_GE(group.size(), 2U);
   EXPECT_NE(d.selection.not_identifiable.front().reason.find("would separate them"), std::string::npos);
-  EXPECT_NEAR(d.selection.extended_heldout_rms_A, d.selection.nominal_heldout_rms_A, 1e-12);  // no model named
+  EXPECT_NEAR(d.selection.extended_heldout_rms_A, d.selection.start_heldout_rms_A, 1e-12);  // no model named
 }
 
 }  // namespace

@@ -5,6 +5,7 @@
 
 #include "rpem/analysis/diagnose/effect_fit.hpp"
 #include "rpem/analysis/diagnose/selection.hpp"
+#include "rpem/analysis/diagnose/verdict.hpp"
 #include "support/model_data.hpp"
 #include "support/paper_machine.hpp"
 
@@ -53,31 +54,68 @@ double rms_residual(const ReplayOutput& r) {
 TEST(Replay, DataFromTheModelItselfLeavesNoResidual) {
   // The replay is the estimator's predictor; where the ramp-free log's centred speed equals the logged
   // one, only round-off remains. (The generator steps the speed at 1 s; the centred difference there
-  // straddles the step for ±4 samples, which is where the bound comes from.)
+  // straddles the step for ±4 samples, which is where the bound comes from. Every block restarts the
+  // prediction from the measurement.)
   const LogData log = model_log(1.0);
   EXPECT_EQ(log.mode, ModelMode::kTransient);
-  const ModelReplay replay(log, test::paper_machine_si(), 20.0);
+  const ModelReplay replay(log, test::paper_machine_si().rated);
   ReplayOutput r;
-  replay.run(ExtendedModel{}, r);
+  replay.run(ExtendedModel{test::paper_machine_si(), {}, {}, {}, 0.0, 0.0}, r);
   EXPECT_LT(rms_residual(r), 2e-3);
   double late = 0.0;  // 1.75 s (≈ 20 time constants) after the speed step: round-off only
   for (std::size_t k = 22000; k < r.valid.size(); ++k) late = std::max(late, r.residual_A[k].norm());
   EXPECT_LT(late, 1e-9);
 }
 
-TEST(EffectFit, RecoversAKnownFluxErrorExactly) {
-  // The machine's ψm is 5 % below the configuration's: a psim_drift with offset −0.05 and no change.
+TEST(EffectFit, TheCalibrationRecoversAKnownFluxErrorExactly) {
+  // The machine's ψm is 5 % below the configuration's: the calibrated baseline finds it (scaled: −5 %).
   // (At constant speed: the generator's instantaneous speed step would disturb the centred speed.)
   const LogData log = model_log(0.95, false);
-  const ModelReplay replay(log, test::paper_machine_si(), 20.0);
-  const EffectContext context = EffectContext::of(log, test::paper_machine_si(), {}, 20.0, 0.0);
+  const ModelReplay replay(log, test::paper_machine_si().rated);
+  const ExtendedModel base = make_base_model(test::paper_machine_si(), {}, std::nullopt, std::nullopt, log);
+  const EffectContext context = EffectContext::of(log, test::paper_machine_si(), base, 20.0, 0.0);
   const EffectFitter fitter(replay, context);
-  const EffectSet fitted = fitter.fit(EffectSet{}.with({EffectKind::kPsimDrift}, context));
-  const ExtendedModel m = fitted.model(context);
-  EXPECT_EQ(m.psi_m.basis, DriftLaw::Basis::kTime);
-  EXPECT_NEAR(m.psi_m.offset, -0.05, 1e-6);
-  EXPECT_NEAR(m.psi_m.slope, 0.0, 1e-6);
+  EffectSet start;
+  start.calibrated = {true, true, false, false};
+  const EffectSet fitted = fitter.fit(start);
+  EXPECT_NEAR(fitted.model(context).machine.psi_m_Wb / test::paper_machine_si().psi_m_Wb, 0.95, 1e-7);
+  EXPECT_NEAR(fitted.model(context).machine.r_s_Ohm / test::paper_machine_si().r_s_Ohm, 1.0, 1e-5);
   EXPECT_LT(fitter.training_ssr(fitted), 1e-6 * fitter.training_ssr(EffectSet{}));
+  // A drift against time adds nothing once the constant is calibrated.
+  const EffectSet with_drift = fitter.fit(fitted.with(effect("psim_drift"), context));
+  EXPECT_NEAR(with_drift.model(context).psi_m_trend, 0.0, 1e-6);
+}
+
+TEST(EffectFit, ExcitationDecidesWhichConstantsAreIdentifiable) {
+  // R_s shows where the resistive drop is a large part of the voltage: at standstill under current. A log
+  // at one speed of 0.4 pu does not pin it within 1 % (its voltage is mostly EMF); with standstill first
+  // it does. ψm, the EMF itself, is pinned either way.
+  auto intervals = [](bool standstill) {
+    const LogData log = model_log(1.0, standstill);
+    const ModelReplay replay(log, test::paper_machine_si().rated);
+    const ExtendedModel base = make_base_model(test::paper_machine_si(), {}, std::nullopt, std::nullopt, log);
+    const EffectContext context = EffectContext::of(log, test::paper_machine_si(), base, 20.0, 0.0);
+    return EffectFitter(replay, context).intervals(EffectSet{}, 0.02);
+  };
+  const CalibrationIntervals moving = intervals(false), both = intervals(true);
+  EXPECT_LT(moving.excitation_half_width[0], 0.01);
+  EXPECT_GT(moving.excitation_half_width[1], 0.01);
+  EXPECT_LT(both.excitation_half_width[0], 0.01);
+  EXPECT_LT(both.excitation_half_width[1], 0.01);
+}
+
+TEST(Catalogue, EveryRowIsComplete) {
+  for (const EffectRow& r : catalogue()) {
+    EXPECT_FALSE(r.name.empty());
+    EXPECT_TRUE(r.apply && r.describe) << r.name;
+    EXPECT_FALSE(r.shows_as.empty()) << r.name;
+    EXPECT_FALSE(r.enters.empty()) << r.name;
+    EXPECT_TRUE(r.steady_state || !r.not_in_steady_state.empty()) << r.name;
+    for (const auto& s : r.starts) EXPECT_EQ(static_cast<int>(s.size()), r.parameters) << r.name;
+    for (const Confusion& c : r.confusions) EXPECT_NO_THROW((void)effect_row(c.other)) << r.name << " → " << c.other;
+  }
+  EXPECT_THROW((void)effect("cogging"), std::invalid_argument);
+  for (const char* name : {"flux_harmonic_6", "flux_harmonic_12", "cross_saturation", "delay"}) EXPECT_NO_THROW((void)effect(name));
 }
 
 TEST(LogData, SteadyStateLeavesOutIdleAndTransitionalRowsAndBlocksAlternate) {

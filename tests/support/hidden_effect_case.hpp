@@ -104,6 +104,14 @@ inline bool explained_by_map(const std::string& name, const std::vector<analysis
     why += buf;
     return within(got, truth);
   }
+  if (name == "cross_saturation") {  // the map's d-axis flux at the largest q current against its magnet flux
+    const double i = parameter(p, "max_i_q_A");
+    const double truth = map.flux(core::Vec2(0.0, i))[0] / map.flux(core::Vec2::Zero())[0] - 1.0;
+    const double got = parameter(p, "psi_d_rel_change_at_max_i_q");
+    std::snprintf(buf, sizeof buf, " cross_saturation: ψ_d %+.3g %% at %.2f A vs the map's %+.3g %%", 100.0 * got, i, 100.0 * truth);
+    why += buf;
+    return std::abs(got - truth) <= std::max(kParameterTolerance * std::abs(truth), 0.003);
+  }
   if (name == "psim_drift") {  // the map's cross-saturation lowers ψ_d under load by up to 1 %
     const double a = std::abs(parameter(p, "rel_offset")), b = std::abs(parameter(p, "rel_change"));
     std::snprintf(buf, sizeof buf, " psim_drift: offset %.3g, change %.3g (the map's cross-saturation: ≤ 0.01)", a, b);
@@ -145,8 +153,16 @@ inline CaseOutcome run_hidden_case(const HiddenCase& c) {
   out.detail += "; found:" + (found_names.empty() ? std::string(" none") : found_names) + ";";
 
   if (beckhoff) {
+    // The map's L_q, 15-20 % above the data sheet's, must be found: as lq_saturation, or as the calibrated
+    // L_q (within 15 % of the map's apparent inductance at half the largest q current).
     const sim::FluxMap map = sim::FluxMap::load_csv(s.flux_map_file);
-    bool saturation = false, all_explained = true;
+    const double i_half = 0.5 * d.context.max_i_q_A;
+    const double l_map = map.flux(core::Vec2(0.0, i_half))[1] / i_half, l_cal = d.calibration.value[3];
+    bool saturation = d.calibration.identifiable[3] && within(l_cal, l_map), all_explained = true;
+    char buf[160];
+    std::snprintf(buf, sizeof buf, " calibrated L_q %.4g H vs the map's %.4g H at %.2f A (%+.1f %%);", l_cal, l_map, i_half,
+                  100.0 * (l_cal / l_map - 1.0));
+    out.detail += buf;
     for (std::size_t j = 0; j < d.selection.found.size(); ++j) {
       const std::string name = d.selection.found[j].effect.name();
       const bool ok = explained_by_map(name, analysis::found_parameters(d, j), map, out.detail);

@@ -71,8 +71,22 @@ TEST(CliDiagnose, FindsAHiddenDeadTimeAndTheExtendedModelCarriesIntoTheTools) {
   EXPECT_NEAR(d["effects"][0]["params"]["t_dead_s"].get<double>() / 1.5e-6, 1.0, 0.15);
   EXPECT_LT(d["effects"][0]["heldout_rms_after"].get<double>(), 0.1 * d["effects"][0]["heldout_rms_before"].get<double>());
   EXPECT_TRUE(d["not_identifiable"].empty());
+  EXPECT_TRUE(d["effects"][0]["kept"].get<bool>());
+  // The documented keys: the baseline as configured, the calibrated constants (here the configuration's
+  // own, within their intervals), the noise floor and the verdict.
+  EXPECT_GT(d["baseline"]["heldout_rms"].get<double>(), 0.5);
+  for (const char* key : {"psi_m_Wb", "r_s_Ohm"}) {
+    const auto ci = d["calibration"][std::string(key) + "_ci95"];
+    ASSERT_TRUE(ci.is_array()) << key;
+    EXPECT_LE(ci[0].get<double>(), d["calibration"]["configured"][key].get<double>() * 1.005) << key;
+    EXPECT_GE(ci[1].get<double>(), d["calibration"]["configured"][key].get<double>() * 0.995) << key;
+  }
+  EXPECT_TRUE(d["calibration"]["findings"].empty()) << d["calibration"].dump(2);
+  EXPECT_NEAR(d["noise_floor_A"].get<double>(), 0.023, 0.003);  // σ = 0.02 A per phase: √(4/3)·σ in dq
+  EXPECT_EQ(d["verdict"], "explained");
+  EXPECT_LT(d["ratio"].get<double>(), 1.5);
   // With the truth given, the report judges the estimator: dead time looks like resistance at standstill.
-  EXPECT_GT(d["nominal"]["estimates"]["r_s_error_pct"].get<double>(), 10.0);
+  EXPECT_GT(d["baseline"]["estimates"]["r_s_error_pct"].get<double>(), 10.0);
   EXPECT_LT(d["extended"]["estimates"]["r_s_error_pct"].get<double>(), 1.0);
 
   // extended.yaml is a configuration `rpem estimate` and rpemd take as it is.
@@ -139,20 +153,29 @@ TEST(CliDiagnose, PaderbornWorkedExampleKeepsItsResult) {
   const nlohmann::json d = nlohmann::json::parse(read(dir + "/diagnosis/diagnosis.json"));
   EXPECT_EQ(d["log"]["model"], "steady_state");
   EXPECT_EQ(d["log"]["excluded_idle"], 2);
-  const double nominal = d["nominal"]["heldout_rms"], extended = d["extended"]["heldout_rms"];
-  EXPECT_GT(nominal, 7.5);
-  EXPECT_LT(nominal, 9.5);
+  const double baseline = d["baseline"]["heldout_rms"], extended = d["extended"]["heldout_rms"];
+  EXPECT_GT(baseline, 7.5);
+  EXPECT_LT(baseline, 9.5);
   ASSERT_EQ(d["effects"].size(), 1U) << d["effects"].dump(2);
   const auto& e = d["effects"][0];
   EXPECT_EQ(e["name"], "psim_drift");
   const double coeff = e["params"]["coeff_per_K"];  // NdFeB: about −0.1 %/K
   EXPECT_LT(coeff, -0.0009);
   EXPECT_GT(coeff, -0.0012);
-  EXPECT_GT(e["gain_pct"].get<double>(), 80.0);
+  EXPECT_EQ(e["params"]["material"], "NdFeB");
+  EXPECT_GT(e["gain_pct"].get<double>(), 60.0);  // against the calibrated baseline
   EXPECT_LT(extended, 1.5);
   EXPECT_GT(extended, 0.5);
+  // R_s against the winding temperature would be 2.5 times copper's coefficient: reported, not named.
+  ASSERT_EQ(d["implausible"].size(), 1U) << d["implausible"].dump(2);
+  EXPECT_EQ(d["implausible"][0]["effect"], "rs_drift");
+  EXPECT_GT(d["implausible"][0]["params"]["coeff_per_K"].get<double>(), 2.0 * 0.00393);
+  // What is left is far above the floor: said so, with where it lives.
+  EXPECT_EQ(d["verdict"], "unexplained");
+  EXPECT_GT(d["ratio"].get<double>(), 1.5);
+  EXPECT_FALSE(d["findings"].empty());
   EXPECT_LT(d["extended"]["estimates"]["psi_m_error_pct"].get<double>(), 0.5);
-  EXPECT_GT(d["nominal"]["estimates"]["psi_m_error_pct"].get<double>(), 3.0);
+  EXPECT_GT(d["baseline"]["estimates"]["psi_m_error_pct"].get<double>(), 3.0);
   fs::remove_all(dir);
 }
 

@@ -63,7 +63,13 @@ int run_diagnose(const DiagnoseCliOptions& o) {
   analysis::write_diagnose_report(o.out, d, config_name);
 
   const analysis::Selection& s = d.selection;
-  std::printf("nominal model: held-out residual %.4g A RMS\n", s.nominal_heldout_rms_A);
+  std::printf("baseline (the configuration as it is): held-out residual %.4g A RMS\n", d.baseline_heldout_rms_A);
+  std::printf("calibrated baseline: held-out residual %.4g A RMS", d.calibration.heldout_rms_A);
+  for (std::size_t i = 0; i < analysis::kCalibrated.size(); ++i) {
+    if (d.calibration.identifiable[i]) std::printf(" %s=%.6g", analysis::kCalibrated[i], d.calibration.value[i]);
+  }
+  std::printf("\n");
+  for (const std::string& f : analysis::calibration_findings(d)) std::printf("calibration: %s\n", f.c_str());
   if (s.found.empty()) std::printf("effects: none\n");
   for (std::size_t j = 0; j < s.found.size(); ++j) {
     std::printf("effect %s:", s.found[j].effect.label().c_str());
@@ -74,7 +80,11 @@ int run_diagnose(const DiagnoseCliOptions& o) {
         std::printf(" %s=%s", v.name.c_str(), v.text.c_str());
       }
     }
-    std::printf(" (held-out gain %.1f %%)\n", s.found[j].gain_pct);
+    const analysis::EstimatorCheck* c = analysis::estimator_check(d, j);
+    std::printf(" (held-out gain %.1f %%%s)\n", s.found[j].gain_pct, c && !c->kept ? "; not in extended.yaml: the estimator predicts worse with it" : "");
+  }
+  for (const analysis::ImplausibleEffect& i : s.implausible) {
+    std::printf("implausible, not named: %s: %s\n", i.effect.label().c_str(), i.why.reason.c_str());
   }
   for (const analysis::Unidentifiable& u : s.not_identifiable) {
     std::string names;
@@ -82,6 +92,9 @@ int run_diagnose(const DiagnoseCliOptions& o) {
     std::printf("not identifiable: %s\n", names.c_str());
   }
   std::printf("extended model: held-out residual %.4g A RMS\n", s.extended_heldout_rms_A);
+  std::printf("verdict: %s (%.3g times the noise floor of %.3g A)\n", d.verdict.explained ? "explained" : "unexplained",
+              d.verdict.ratio, d.verdict.noise_floor_A);
+  for (const std::string& f : d.verdict.findings) std::printf("  %s\n", f.c_str());
   std::printf("wrote %s/report.html, report.md, diagnosis.json, extended.yaml (%.2f s)\n", o.out.c_str(), d.elapsed_s);
   return kExitOk;
 }
@@ -93,7 +106,9 @@ Runner add_diagnose_command(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand(
       "diagnose", "Show what the model gets wrong on measured data, name the cause, extend the model, measure the gain");
   cmd->add_option("--log", o->log, "drive-log CSV (docs/drive-log.md)")->required()->check(CLI::ExistingFile);
-  cmd->add_option("--config", o->config, "machine configuration YAML, the nominal model (default: built-in paper-ipmsm)")
+  cmd->add_option("--config", o->config,
+                  "machine configuration YAML, the baseline: its whole model, extensions and drift laws (default: built-in "
+                  "paper-ipmsm); an extended.yaml of another recording is one")
       ->check(CLI::ExistingFile);
   cmd->add_option("--out", o->out, "directory for report.html, report.md, figures, diagnosis.json, extended.yaml")
       ->required();
@@ -102,7 +117,7 @@ Runner add_diagnose_command(CLI::App& app) {
   cmd->add_option("--model", o->model, "replay model: auto (from the sample interval), transient, steady_state")
       ->check(CLI::IsMember({"auto", "transient", "steady_state"}));
   cmd->add_option("--reference-temperature-C", o->reference_C,
-                  "temperature at which the configuration's r_s and psi_m hold (for drifts against temperature)");
+                  "temperature to which found drift laws are referred (default 20)");
   cmd->add_option("--switching-frequency-Hz", o->switching_frequency_Hz,
                   "PWM frequency, to report dead time in seconds (default: model_extensions.deadtime's)")
       ->check(CLI::PositiveNumber);

@@ -1,9 +1,10 @@
 // The figures of a diagnosis (docs/diagnose.md, "Reading the report"): residual against time with the
 // operating profile, residual maps over the speed–current plane, harmonic content, the dead-time
 // signature or the residual against temperature, measured against modelled currents, and the estimates
-// with the nominal and the extended model. Before (nominal) and after (extended) side by side throughout.
+// with the configuration and the extended model. Before (the configuration) and after (extended) side by side throughout.
 #include <algorithm>
 #include <cmath>
+#include <array>
 #include <limits>
 
 #include "rpem/analysis/diagnose/diagnose_output.hpp"
@@ -22,16 +23,24 @@ struct SampleView {
 
 /// Per-sample operating point of the log, SI.
 std::vector<SampleView> operating_points(const Diagnosis& d) {
-  const core::PerUnitBase base = core::PerUnitBase::from_rated(d.context.machine.rated);
-  const core::SampleConditioner raw(base, core::to_pu(base, d.context.machine), {});
   std::vector<SampleView> v;
   v.reserve(d.log->rows.size());
-  for (const io::DriveLogRow& row : d.log->rows) {
-    const core::Vec2 i = raw.logged_current_dq_A(row.sample);
-    v.push_back({1e-9 * static_cast<double>(row.sample.t_ns),
-                 row.sample.omega_el_rad_s * 60.0 / (2.0 * core::kPi * d.context.machine.rated.pole_pairs), i[0], i[1]});
+  for (std::size_t k = 0; k < d.log->rows.size(); ++k) {
+    const core::DriveSample& s = d.log->rows[k].sample;
+    const core::Vec2& i = d.log->logged_i_dq_A[k];
+    v.push_back({1e-9 * static_cast<double>(s.t_ns), s.omega_el_rad_s * 60.0 / (2.0 * core::kPi * d.context.machine.rated.pole_pairs),
+                 i[0], i[1]});
   }
   return v;
+}
+
+/// The temperature column a figure draws against (the winding's if logged), and whether it varies.
+const TemperatureColumn& drawn_temperature(const Diagnosis& d) {
+  return d.context.t_winding.logged ? d.context.t_winding : d.context.t_magnet;
+}
+bool temperature_varies(const Diagnosis& d) {
+  const TemperatureColumn& c = drawn_temperature(d);
+  return c.logged && c.span_K >= 1.0;
 }
 
 /// Time-binned profile and residual statistics (every sample for short logs).
@@ -48,11 +57,11 @@ DataBlock time_bins(const Diagnosis& d, const std::vector<SampleView>& ops) {
       all += 1;
       const auto& row = d.log->rows[k];
       temp += row.t_winding_C.value_or(row.t_magnet_C.value_or(kNaN));
-      if (!d.nominal_replay.valid[k] || !d.extended_replay.valid[k]) continue;
-      sb += d.nominal_replay.residual_A[k].squaredNorm();
+      if (!d.baseline_replay.valid[k] || !d.extended_replay.valid[k]) continue;
+      sb += d.baseline_replay.residual_A[k].squaredNorm();
       sa += d.extended_replay.residual_A[k].squaredNorm();
-      md += d.nominal_replay.residual_A[k][0];
-      mq += d.nominal_replay.residual_A[k][1];
+      md += d.baseline_replay.residual_A[k][0];
+      mq += d.baseline_replay.residual_A[k][1];
       cnt += 1;
     }
     const double values[8] = {t / all, sp / all, iq / all, cnt ? std::sqrt(sb / cnt) : kNaN, cnt ? std::sqrt(sa / cnt) : kNaN,
@@ -63,7 +72,7 @@ DataBlock time_bins(const Diagnosis& d, const std::vector<SampleView>& ops) {
 }
 
 std::string residual_time(const std::string& dir, const Diagnosis& d, const std::vector<SampleView>& ops) {
-  const bool temps = d.log->layout.t_winding || d.log->layout.t_magnet;
+  const bool temps = temperature_varies(d);
   GnuplotFigure fig(dir + "/residual_time.png", 1400, 1000);
   fig.add_data(time_bins(d, ops));
   fig.add_line("set multiplot layout 3,1 title 'What the model gets wrong, against time' noenhanced");
@@ -74,8 +83,8 @@ std::string residual_time(const std::string& dir, const Diagnosis& d, const std:
                (temps ? ", '' u 1:8 axes x1y2 w l lw 2 t 'T'" : ""));
   fig.add_line("unset y2tics; unset y2label; set ytics mirror");
   fig.add_line("set title 'residual RMS (logged − model)'; set ylabel '|ε| [A]'; set logscale y");
-  fig.add_line("plot $time u 1:4 w l lw 2 lc rgb '#d62728' t 'nominal model', '' u 1:5 w l lw 2 lc rgb '#2ca02c' t 'extended model'");
-  fig.add_line("unset logscale y; set title 'mean residual of the nominal model'; set ylabel 'ε [A]'");
+  fig.add_line("plot $time u 1:4 w l lw 2 lc rgb '#d62728' t 'configuration', '' u 1:5 w l lw 2 lc rgb '#2ca02c' t 'extended model'");
+  fig.add_line("unset logscale y; set title 'mean residual of the configuration'; set ylabel 'ε [A]'");
   fig.add_line("plot $time u 1:6 w l lw 2 t 'ε_d', '' u 1:7 w l lw 2 t 'ε_q'");
   fig.add_line("unset multiplot");
   fig.render();
@@ -86,7 +95,7 @@ std::string residual_map(const std::string& dir, const Diagnosis& d, const std::
   constexpr int kX = 40, kY = 30;
   double s_lo = 1e300, s_hi = -1e300, q_lo = 1e300, q_hi = -1e300;
   for (std::size_t k = 0; k < ops.size(); ++k) {
-    if (!d.nominal_replay.valid[k]) continue;
+    if (!d.baseline_replay.valid[k]) continue;
     s_lo = std::min(s_lo, ops[k].speed_rpm);
     s_hi = std::max(s_hi, ops[k].speed_rpm);
     q_lo = std::min(q_lo, ops[k].i_q_A);
@@ -96,11 +105,11 @@ std::string residual_map(const std::string& dir, const Diagnosis& d, const std::
   if (q_hi <= q_lo) q_hi = q_lo + 1.0;
   std::vector<double> sb(kX * kY, 0.0), sa(kX * kY, 0.0), cnt(kX * kY, 0.0);
   for (std::size_t k = 0; k < ops.size(); ++k) {
-    if (!d.nominal_replay.valid[k] || !d.extended_replay.valid[k]) continue;
+    if (!d.baseline_replay.valid[k] || !d.extended_replay.valid[k]) continue;
     const int x = std::min(kX - 1, static_cast<int>((ops[k].speed_rpm - s_lo) / (s_hi - s_lo) * kX));
     const int y = std::min(kY - 1, static_cast<int>((ops[k].i_q_A - q_lo) / (q_hi - q_lo) * kY));
     const int c = y * kX + x;
-    sb[c] += d.nominal_replay.residual_A[k].squaredNorm();
+    sb[c] += d.baseline_replay.residual_A[k].squaredNorm();
     sa[c] += d.extended_replay.residual_A[k].squaredNorm();
     cnt[c] += 1;
   }
@@ -129,7 +138,7 @@ std::string residual_map(const std::string& dir, const Diagnosis& d, const std::
   fig.add_line("set palette defined (0 '#313695', 1 '#74add1', 2 '#ffffbf', 3 '#f46d43', 4 '#a50026')");
   fig.add_line("set view map; set datafile missing NaN");
   if (hi > lo) fig.add_line("set cbrange [" + std::to_string(lo) + ":" + std::to_string(hi) + "]");
-  fig.add_line("set title 'nominal model'; plot $map u 1:2:3 w points pt 5 ps 2.2 lc palette notitle");
+  fig.add_line("set title 'configuration'; plot $map u 1:2:3 w points pt 5 ps 2.2 lc palette notitle");
   fig.add_line("set title 'extended model'; plot $map u 1:2:4 w points pt 5 ps 2.2 lc palette notitle");
   fig.add_line("unset multiplot");
   fig.render();
@@ -148,7 +157,7 @@ std::string harmonics(const std::string& dir, const Diagnosis& d) {
   fig.add_line("set title 'Residual content at harmonics of the electrical angle (samples in motion)' noenhanced");
   fig.add_line("set xlabel 'harmonic order (dq frame; 0 = mean)'; set ylabel 'amplitude [A]'; set logscale y; set grid");
   fig.add_line("set style fill solid 0.8; set boxwidth 0.35; set xtics 1");
-  fig.add_line("plot $h u ($1-0.18):2 w boxes lc rgb '#d62728' t 'nominal model', '' u ($1+0.18):3 w boxes lc rgb '#2ca02c' t 'extended model'");
+  fig.add_line("plot $h u ($1-0.18):2 w boxes lc rgb '#d62728' t 'configuration', '' u ($1+0.18):3 w boxes lc rgb '#2ca02c' t 'extended model'");
   fig.render();
   return "harmonics.png";
 }
@@ -168,44 +177,64 @@ std::string phase_sign(const std::string& dir, const Diagnosis& d) {
   fig.add_line("set title 'Mean phase residual by the sign of the phase current (dead time pulls it against the current)' noenhanced");
   fig.add_line("set ylabel 'mean residual [A]'; set xtics (\"a\" 0, \"b\" 1, \"c\" 2); set grid; set xrange [-0.6:2.6]");
   fig.add_line("set style fill solid 0.8; set boxwidth 0.18");
-  fig.add_line("plot $p u ($1-0.3):2 w boxes lc rgb '#d62728' t 'nominal, i > 0', '' u ($1-0.1):3 w boxes lc rgb '#ff9896' t 'nominal, i < 0', "
+  fig.add_line("plot $p u ($1-0.3):2 w boxes lc rgb '#d62728' t 'configuration, i > 0', '' u ($1-0.1):3 w boxes lc rgb '#ff9896' t 'configuration, i < 0', "
                "'' u ($1+0.1):4 w boxes lc rgb '#2ca02c' t 'extended, i > 0', '' u ($1+0.3):5 w boxes lc rgb '#98df8a' t 'extended, i < 0'");
   fig.render();
   return "phase_sign.png";
 }
 
 std::string residual_vs_temperature(const std::string& dir, const Diagnosis& d) {
-  DataBlock b{"t", std::vector<std::vector<double>>(5)};  // T, eps_d before, eps_q before, eps_d after, eps_q after
-  const bool winding = d.log->layout.t_winding;
-  for (std::size_t k = 0; k < d.log->rows.size(); ++k) {
-    if (!d.nominal_replay.valid[k] || !d.extended_replay.valid[k]) continue;
+  // Binned over the temperature's range: the mean residual per bin, so a trend shows however long the log.
+  constexpr int kBins = 60;
+  const bool winding = d.context.t_winding.logged;
+  double lo = 1e300, hi = -1e300;
+  auto temperature = [&](std::size_t k) {
     const auto& row = d.log->rows[k];
-    b.columns[0].push_back(winding ? row.t_winding_C.value_or(kNaN) : row.t_magnet_C.value_or(kNaN));
-    b.columns[1].push_back(d.nominal_replay.residual_A[k][0]);
-    b.columns[2].push_back(d.nominal_replay.residual_A[k][1]);
-    b.columns[3].push_back(d.extended_replay.residual_A[k][0]);
-    b.columns[4].push_back(d.extended_replay.residual_A[k][1]);
+    return winding ? row.t_winding_C.value_or(kNaN) : row.t_magnet_C.value_or(kNaN);
+  };
+  for (std::size_t k = 0; k < d.log->rows.size(); ++k) {
+    if (!d.baseline_replay.valid[k] || !std::isfinite(temperature(k))) continue;
+    lo = std::min(lo, temperature(k));
+    hi = std::max(hi, temperature(k));
+  }
+  std::vector<std::array<double, 5>> sums(kBins, std::array<double, 5>{});
+  for (std::size_t k = 0; k < d.log->rows.size(); ++k) {
+    if (!d.baseline_replay.valid[k] || !d.extended_replay.valid[k] || !std::isfinite(temperature(k))) continue;
+    const int b = std::min(kBins - 1, static_cast<int>((temperature(k) - lo) / std::max(hi - lo, 1e-9) * kBins));
+    auto& s = sums[static_cast<std::size_t>(b)];
+    s[0] += 1.0;
+    s[1] += d.baseline_replay.residual_A[k][0];
+    s[2] += d.baseline_replay.residual_A[k][1];
+    s[3] += d.extended_replay.residual_A[k][0];
+    s[4] += d.extended_replay.residual_A[k][1];
+  }
+  DataBlock b{"t", std::vector<std::vector<double>>(5)};  // T, eps_d before, eps_q before, eps_d after, eps_q after
+  for (int i = 0; i < kBins; ++i) {
+    const auto& s = sums[static_cast<std::size_t>(i)];
+    if (s[0] == 0.0) continue;
+    b.columns[0].push_back(lo + (i + 0.5) * (hi - lo) / kBins);
+    for (int c = 1; c < 5; ++c) b.columns[static_cast<std::size_t>(c)].push_back(s[static_cast<std::size_t>(c)] / s[0]);
   }
   GnuplotFigure fig(dir + "/residual_temperature.png", 1000, 550);
   fig.add_data(std::move(b));
-  fig.add_line(std::string("set title 'Residual against the ") + (winding ? "winding" : "magnet") + " temperature' noenhanced");
-  fig.add_line(std::string("set xlabel '") + (winding ? "T_winding" : "T_magnet") + " [°C]'; set ylabel 'ε [A]'; set grid; set key outside right");
-  fig.add_line("plot $t u 1:2 w p pt 7 ps 0.4 lc rgb '#d62728' t 'ε_d nominal', '' u 1:3 w p pt 7 ps 0.4 lc rgb '#ff7f0e' t 'ε_q nominal', "
-               "'' u 1:4 w p pt 7 ps 0.4 lc rgb '#2ca02c' t 'ε_d extended', '' u 1:5 w p pt 7 ps 0.4 lc rgb '#17becf' t 'ε_q extended'");
+  fig.add_line(std::string("set title 'Mean residual against the ") + (winding ? "winding" : "magnet") + " temperature' noenhanced");
+  fig.add_line(std::string("set xlabel '") + (winding ? "T_winding" : "T_magnet") + " [°C]'; set ylabel 'mean ε [A]'; set grid; set key outside right");
+  fig.add_line("plot $t u 1:2 w lp pt 7 ps 0.6 lc rgb '#d62728' t 'ε_d configuration', '' u 1:3 w lp pt 7 ps 0.6 lc rgb '#ff7f0e' t 'ε_q configuration', "
+               "'' u 1:4 w lp pt 7 ps 0.6 lc rgb '#2ca02c' t 'ε_d extended', '' u 1:5 w lp pt 7 ps 0.6 lc rgb '#17becf' t 'ε_q extended'");
   fig.render();
   return "residual_temperature.png";
 }
 
 std::string overlay(const std::string& dir, const Diagnosis& d, const std::vector<SampleView>& ops) {
-  // Transient logs: the 0.1 s window where the nominal model errs most; steady state: the whole log.
+  // Transient logs: the 0.1 s window where the configuration errs most; steady state: the whole log.
   const std::size_t n = d.log->rows.size();
   std::size_t first = 0, last = n;
   if (d.log->mode == ModelMode::kTransient) {
     const std::size_t window = std::max<std::size_t>(2, static_cast<std::size_t>(0.1 / std::max(d.log->median_dt_s, 1e-9)));
     double best = -1.0, sum = 0.0;
     for (std::size_t k = 0; k < n; ++k) {
-      sum += d.nominal_replay.valid[k] ? d.nominal_replay.residual_A[k].squaredNorm() : 0.0;
-      if (k >= window) sum -= d.nominal_replay.valid[k - window] ? d.nominal_replay.residual_A[k - window].squaredNorm() : 0.0;
+      sum += d.baseline_replay.valid[k] ? d.baseline_replay.residual_A[k].squaredNorm() : 0.0;
+      if (k >= window) sum -= d.baseline_replay.valid[k - window] ? d.baseline_replay.residual_A[k - window].squaredNorm() : 0.0;
       if (k + 1 >= window && sum > best) {
         best = sum;
         first = k + 1 - window;
@@ -215,20 +244,20 @@ std::string overlay(const std::string& dir, const Diagnosis& d, const std::vecto
   }
   DataBlock b{"o", std::vector<std::vector<double>>(7)};
   for (std::size_t k = first; k < last; ++k) {
-    if (!d.nominal_replay.valid[k] || !d.extended_replay.valid[k]) continue;
-    const double v[7] = {ops[k].t_s, ops[k].i_d_A, ops[k].i_q_A, d.nominal_replay.model_A[k][0], d.nominal_replay.model_A[k][1],
+    if (!d.baseline_replay.valid[k] || !d.extended_replay.valid[k]) continue;
+    const double v[7] = {ops[k].t_s, ops[k].i_d_A, ops[k].i_q_A, d.baseline_replay.model_A[k][0], d.baseline_replay.model_A[k][1],
                          d.extended_replay.model_A[k][0], d.extended_replay.model_A[k][1]};
     for (int c = 0; c < 7; ++c) b.columns[static_cast<std::size_t>(c)].push_back(v[c]);
   }
   const std::string style = d.log->mode == ModelMode::kTransient ? "w l lw 2" : "w p pt 7 ps 0.5";
   GnuplotFigure fig(dir + "/overlay.png", 1400, 800);
   fig.add_data(std::move(b));
-  fig.add_line("set multiplot layout 2,1 title 'Logged current against the nominal and the extended model' noenhanced");
+  fig.add_line("set multiplot layout 2,1 title 'Logged current against the configuration and the extended model' noenhanced");
   fig.add_line("set grid; set xlabel 't [s]'; set key outside right");
   fig.add_line("set title 'd axis'; set ylabel 'i_d [A]'; plot $o u 1:2 " + style + " lc rgb 'black' t 'logged', '' u 1:4 " + style +
-               " lc rgb '#d62728' t 'nominal', '' u 1:6 " + style + " lc rgb '#2ca02c' t 'extended'");
+               " lc rgb '#d62728' t 'configuration', '' u 1:6 " + style + " lc rgb '#2ca02c' t 'extended'");
   fig.add_line("set title 'q axis'; set ylabel 'i_q [A]'; plot $o u 1:3 " + style + " lc rgb 'black' t 'logged', '' u 1:5 " + style +
-               " lc rgb '#d62728' t 'nominal', '' u 1:7 " + style + " lc rgb '#2ca02c' t 'extended'");
+               " lc rgb '#d62728' t 'configuration', '' u 1:7 " + style + " lc rgb '#2ca02c' t 'extended'");
   fig.add_line("unset multiplot");
   fig.render();
   return "overlay.png";
@@ -253,14 +282,14 @@ std::string estimates(const std::string& dir, const Diagnosis& d) {
            (rpem ? " w l lw 2 dt 2 lc rgb 'black' t 'truth'" : " w p pt 7 ps 0.4 lc rgb 'black' t 'implied by the data'");
   };
   fig.add_line(std::string("set multiplot layout 2,1 title '") +
-               (rpem ? "RPEM estimates with the nominal and the extended model"
+               (rpem ? "RPEM estimates with the configuration and the extended model"
                      : "ψm and R_s as each model assumes them, and as each steady-state row implies them") +
                "' noenhanced");
   fig.add_line("set grid; set xlabel 't [s]'; set key outside right");
   fig.add_line("set title 'magnet flux linkage'; set ylabel 'ψm [Wb]'; plot $nom u 1:2 " + style +
-               " lc rgb '#d62728' t 'nominal', $ext u 1:2 " + style + " lc rgb '#2ca02c' t 'extended'" + with_truth(2));
+               " lc rgb '#d62728' t 'configuration', $ext u 1:2 " + style + " lc rgb '#2ca02c' t 'extended'" + with_truth(2));
   fig.add_line("set title 'stator resistance'; set ylabel 'R_s [Ω]'; plot $nom u 1:3 " + style +
-               " lc rgb '#d62728' t 'nominal', $ext u 1:3 " + style + " lc rgb '#2ca02c' t 'extended'" + with_truth(3));
+               " lc rgb '#d62728' t 'configuration', $ext u 1:3 " + style + " lc rgb '#2ca02c' t 'extended'" + with_truth(3));
   fig.add_line("unset multiplot");
   fig.render();
   return "estimates.png";
@@ -273,7 +302,7 @@ std::vector<std::string> write_diagnose_figures(const std::string& dir, const Di
   std::vector<std::string> out = {residual_time(dir, d, ops), residual_map(dir, d, ops), overlay(dir, d, ops)};
   if (!d.statistics.harmonics.empty()) out.push_back(harmonics(dir, d));
   if (!d.statistics.phase_signs.empty()) out.push_back(phase_sign(dir, d));
-  if (d.log->layout.t_winding || d.log->layout.t_magnet) out.push_back(residual_vs_temperature(dir, d));
+  if (temperature_varies(d)) out.push_back(residual_vs_temperature(dir, d));  // a constant axis shows nothing
   if (!d.estimates.nominal.empty()) out.push_back(estimates(dir, d));
   return out;
 }

@@ -1,4 +1,6 @@
 // diagnosis.json and extended.yaml (schema: docs/diagnose.md).
+#include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <stdexcept>
@@ -8,18 +10,53 @@
 namespace rpem::analysis {
 namespace {
 
+/// The calibrated constants' names in a person's words.
+constexpr std::array<const char*, kCalibrated.size()> kCalibratedText{"ψm", "R_s", "L_d", "L_q"};
+
 nlohmann::json params_json(const std::vector<NamedValue>& values) {
   nlohmann::json p = nlohmann::json::object();
   for (const NamedValue& v : values) p[v.name] = v.text.empty() ? nlohmann::json(v.value) : nlohmann::json(v.text);
   return p;
 }
 
+nlohmann::json optional_json(const std::optional<double>& v) { return v ? nlohmann::json(*v) : nlohmann::json(nullptr); }
+
+nlohmann::json finite_json(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); }
+
 nlohmann::json summary_json(const EstimateSummary& s) {
+  return {{"psi_m_Wb", s.psi_m_Wb},
+          {"r_s_Ohm", s.r_s_Ohm},
+          {"psi_m_error_pct", optional_json(s.psi_m_error_pct)},
+          {"r_s_error_pct", optional_json(s.r_s_error_pct)}};
+}
+
+nlohmann::json drift_json(const io::ParameterDrift& d) {
+  if (d.law) return {{"coeff_per_K", d.law->coeff_per_K}, {"reference_C", d.law->reference_C}, {"value_ref", d.law->value_ref}};
+  if (d.rel_change) return {{"rel_change", *d.rel_change}};
+  return nullptr;
+}
+
+nlohmann::json calibration_json(const Diagnosis& d) {
+  const Calibration& c = d.calibration;
   nlohmann::json j;
-  j["psi_m_Wb"] = s.psi_m_Wb;
-  j["r_s_Ohm"] = s.r_s_Ohm;
-  j["psi_m_error_pct"] = s.psi_m_error_pct ? nlohmann::json(*s.psi_m_error_pct) : nlohmann::json(nullptr);
-  j["r_s_error_pct"] = s.r_s_error_pct ? nlohmann::json(*s.r_s_error_pct) : nlohmann::json(nullptr);
+  nlohmann::json configured = nlohmann::json::object(), identifiable = nlohmann::json::array();
+  for (std::size_t i = 0; i < kCalibrated.size(); ++i) {
+    const std::string key = kCalibrated[i];
+    j[key] = c.value[i];
+    const double hw = c.intervals.half_width[i] * c.value[i];
+    j[key + "_ci95"] = c.identifiable[i] && std::isfinite(hw) ? nlohmann::json({c.value[i] - hw, c.value[i] + hw}) : nlohmann::json(nullptr);
+    j[key + "_excitation_ci95_rel"] = finite_json(c.intervals.excitation_half_width[i]);
+    configured[key] = c.configured[i];
+    if (c.identifiable[i]) identifiable.push_back(key);
+  }
+  j["identifiable"] = identifiable;
+  j["configured"] = configured;
+  j["at_mean_temperature_C"] = {{"psi_m_Wb", d.context.t_magnet.logged ? nlohmann::json(d.context.t_magnet.mean_C) : nlohmann::json(nullptr)},
+                                {"r_s_Ohm", d.context.t_winding.logged ? nlohmann::json(d.context.t_winding.mean_C) : nlohmann::json(nullptr)}};
+  j["heldout_rms"] = c.heldout_rms_A;
+  j["rpem"] = {{"psi_m_Wb", d.estimates.nominal_summary.psi_m_Wb}, {"r_s_Ohm", d.estimates.nominal_summary.r_s_Ohm},
+               {"method", d.estimates.method}};
+  j["findings"] = calibration_findings(d);
   return j;
 }
 
@@ -28,10 +65,38 @@ void write_text(const std::string& path, const std::string& text) {
   if (!f || !(f << text)) throw std::runtime_error("cannot write " + path);
 }
 
+std::string pct(double v) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%.1f", 100.0 * std::abs(v));
+  return b;
+}
+
 }  // namespace
 
 std::vector<NamedValue> found_parameters(const Diagnosis& d, std::size_t j) {
-  return describe(d.selection.model.effects[j], d.selection.model.parameters[j].data(), d.context);
+  const Effect& e = d.selection.model.effects[j];
+  return e.row->describe(e, d.extended_model, d.context);
+}
+
+const EstimatorCheck* estimator_check(const Diagnosis& d, std::size_t j) {
+  const Effect& e = d.selection.found[j].effect;
+  for (const EstimatorCheck& c : d.estimator_checks) {
+    if (c.effect == e) return &c;
+  }
+  return nullptr;
+}
+
+std::vector<std::string> calibration_findings(const Diagnosis& d) {
+  std::vector<std::string> out;
+  const Calibration& c = d.calibration;
+  for (std::size_t i = 0; i < kCalibrated.size(); ++i) {
+    if (!c.identifiable[i]) continue;
+    const double rel = c.configured[i] / c.value[i] - 1.0;  // the configuration against the calibrated value
+    const double hw = std::isfinite(c.intervals.half_width[i]) ? c.intervals.half_width[i] : 0.0;
+    if (std::abs(c.value[i] / c.configured[i] - 1.0) <= std::max(hw, 0.005)) continue;  // within its interval (or 0.5 %)
+    out.push_back(std::string("the configuration's ") + kCalibratedText[i] + " is " + pct(rel) + " % " + (rel > 0.0 ? "high" : "low"));
+  }
+  return out;
 }
 
 void write_diagnosis_json(const std::string& path, const Diagnosis& d, const std::string& config_path) {
@@ -47,23 +112,42 @@ void write_diagnosis_json(const std::string& path, const Diagnosis& d, const std
                 {"excluded_idle", log.excluded_idle},
                 {"excluded_transitional", log.excluded_transitional},
                 {"duration_s", log.t_end_s - log.t_start_s},
-                {"median_sample_interval_s", log.median_dt_s}};
+                {"median_sample_interval_s", log.median_dt_s},
+                {"t_winding_span_K", d.context.t_winding.logged ? nlohmann::json(d.context.t_winding.span_K) : nlohmann::json(nullptr)},
+                {"t_magnet_span_K", d.context.t_magnet.logged ? nlohmann::json(d.context.t_magnet.span_K) : nlohmann::json(nullptr)}};
   out["machine_config"] = config_path;
+  out["verdict"] = d.verdict.explained ? "explained" : "unexplained";
+  out["noise_floor_A"] = d.verdict.noise_floor_A;
+  out["ratio"] = finite_json(d.verdict.ratio);
+  out["findings"] = d.verdict.findings;
+
+  out["baseline"] = {{"heldout_rms", d.baseline_heldout_rms_A},
+                     {"rms", d.statistics.rms_A.before},
+                     {"model_extensions", io::model_extensions_yaml(d.config)},
+                     {"rs_drift", drift_json(d.config.rs_drift)},
+                     {"psim_drift", drift_json(d.config.psim_drift)},
+                     {"drift_laws_replayed", {{"rs_drift", d.context.base.r_s_law.has_value()}, {"psim_drift", d.context.base.psi_m_law.has_value()}}},
+                     {"estimates", summary_json(d.estimates.nominal_summary)}};
+  out["calibration"] = calibration_json(d);
 
   out["effects"] = nlohmann::json::array();
   for (std::size_t j = 0; j < s.found.size(); ++j) {
     const FoundEffect& f = s.found[j];
-    out["effects"].push_back({{"name", f.effect.name()},
-                              {"params", params_json(found_parameters(d, j))},
-                              {"heldout_rms_before", f.heldout_rms_before_A},
-                              {"heldout_rms_after", f.heldout_rms_after_A},
-                              {"gain_pct", f.gain_pct},
-                              {"p_value", f.p_value}});
+    nlohmann::json e = {{"name", f.effect.name()},
+                        {"label", f.effect.label()},
+                        {"params", params_json(found_parameters(d, j))},
+                        {"heldout_rms_before", f.heldout_rms_before_A},
+                        {"heldout_rms_after", f.heldout_rms_after_A},
+                        {"gain_pct", f.gain_pct},
+                        {"p_value", f.p_value}};
+    if (const EstimatorCheck* c = estimator_check(d, j)) {
+      e["kept"] = c->kept;
+      e["estimator"] = c->applicable ? nlohmann::json({{"heldout_eps_rms_with", c->with_A}, {"heldout_eps_rms_without", c->without_A}})
+                                     : nlohmann::json(nullptr);
+    }
+    out["effects"].push_back(e);
   }
-  const double gain = s.nominal_heldout_rms_A > 0.0 ? 100.0 * (1.0 - s.extended_heldout_rms_A / s.nominal_heldout_rms_A) : 0.0;
-  out["nominal"] = {{"heldout_rms", s.nominal_heldout_rms_A},
-                    {"rms", d.statistics.rms_A.before},
-                    {"estimates", summary_json(d.estimates.nominal_summary)}};
+  const double gain = s.start_heldout_rms_A > 0.0 ? 100.0 * (1.0 - s.extended_heldout_rms_A / s.start_heldout_rms_A) : 0.0;
   out["extended"] = {{"heldout_rms", s.extended_heldout_rms_A},
                      {"rms", d.statistics.rms_A.after},
                      {"gain_pct", gain},
@@ -71,6 +155,14 @@ void write_diagnosis_json(const std::string& path, const Diagnosis& d, const std
   out["estimates_method"] = d.estimates.method;
   out["not_identifiable"] = nlohmann::json::array();
   for (const Unidentifiable& u : s.not_identifiable) out["not_identifiable"].push_back({{"effects", u.effects}, {"reason", u.reason}});
+  out["implausible"] = nlohmann::json::array();
+  for (const ImplausibleEffect& i : s.implausible) {
+    out["implausible"].push_back({{"effect", i.effect.label()},
+                                  {"params", params_json(i.parameters)},
+                                  {"gain_pct", i.gain_pct},
+                                  {"reason", i.why.reason},
+                                  {"more_likely", i.why.more_likely}});
+  }
 
   out["selection"] = nlohmann::json::array();
   for (const auto& round : s.rounds) {
@@ -90,16 +182,28 @@ void write_diagnosis_json(const std::string& path, const Diagnosis& d, const std
                     {"max_p", d.options.selection.max_p},
                     {"reference_C", d.context.reference_C},
                     {"switching_frequency_Hz", d.context.switching_frequency_Hz},
-                    {"blocks", log.blocks}};
+                    {"blocks", log.blocks},
+                    {"explained_ratio", kExplainedRatio},
+                    {"identifiable_half_width", kIdentifiableHalfWidth},
+                    {"min_drift_span_K", kMinDriftSpan_K}};
   out["elapsed_s"] = d.elapsed_s;
   write_text(path, out.dump(2) + "\n");
 }
 
 void write_extended_yaml(const std::string& path, const Diagnosis& d, const std::string& config_text) {
-  std::string header = "# Written by rpem diagnose: " + d.log->path + " diagnosed with this configuration; the\n"
-                       "# model_extensions section holds the effects found (docs/diagnose.md, docs/model-extensions.md).\n";
-  if (d.selection.found.empty()) header += "# No effect was found: the model is the input's.\n";
-  write_text(path, header + io::replace_model_extensions(config_text, io::model_extensions_yaml(d.extended_config)));
+  std::string header = "# Written by rpem diagnose: " + d.log->path + " diagnosed with this configuration as the baseline;\n"
+                       "# the machine's calibrated constants and the model_extensions section hold what it found\n"
+                       "# (docs/diagnose.md, docs/model-extensions.md).\n";
+  bool kept = false;
+  for (const EstimatorCheck& c : d.estimator_checks) kept = kept || c.kept;
+  if (!kept) header += "# No effect was added: the model_extensions are the input's.\n";
+  std::vector<std::pair<std::string, double>> constants;
+  for (std::size_t i = 0; i < kCalibrated.size(); ++i) {
+    const double v = d.extended_config.machine.*kCalibratedFields[i];
+    if (d.calibration.identifiable[i] && v != d.config.machine.*kCalibratedFields[i]) constants.emplace_back(kCalibrated[i], v);
+  }
+  const std::string text = constants.empty() ? config_text : io::replace_machine_values(config_text, constants, "calibrated by rpem diagnose");
+  write_text(path, header + io::replace_model_extensions(text, io::model_extensions_yaml(d.extended_config)));
 }
 
 }  // namespace rpem::analysis

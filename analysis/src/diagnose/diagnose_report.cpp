@@ -1,4 +1,7 @@
 // report.md and report.html: a person's view of the diagnosis (docs/diagnose.md, "Reading the report").
+#include <algorithm>
+#include <array>
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <stdexcept>
@@ -35,26 +38,45 @@ std::string parameters_text(const std::vector<NamedValue>& values) {
   return s;
 }
 
+constexpr std::array<const char*, kCalibrated.size()> kCalibratedText{"ψm [Wb]", "R_s [Ω]", "L_d [H]", "L_q [H]"};
+
 void summary(ReportDocument& doc, const Diagnosis& d, const std::string& config_path) {
   const Selection& s = d.selection;
   const LogData& log = *d.log;
-  std::string text = "The nominal model (`" + config_path + "`) replayed on the inputs of `" + log.path + "` (" +
-                     std::to_string(log.rows.size()) + " samples over " + num(log.t_end_s - log.t_start_s, 3) +
-                     " s, " + (log.mode == ModelMode::kTransient ? "transient: the open-loop discrete predictor"
-                                                                 : "steady state: the closed-form steady-state model") +
-                     ") predicts the currents with a held-out residual of **" + num(s.nominal_heldout_rms_A) + " A RMS**. ";
+  std::string text = "**Verdict: " + std::string(d.verdict.explained ? "explained" : "unexplained") + "** — the final held-out "
+                     "residual is " + num(s.extended_heldout_rms_A) + " A RMS, " + num(d.verdict.ratio, 3) +
+                     " times the noise floor of " + num(d.verdict.noise_floor_A, 3) + " A estimated from the data (explained "
+                     "up to " + num(kExplainedRatio, 2) + " times).";
+  doc.paragraph(text);
+  text = "The configuration (`" + config_path + "`, its whole model: model extensions and drift laws) replayed on the inputs of `" +
+         log.path + "` (" + std::to_string(log.rows.size()) + " samples over " + num(log.t_end_s - log.t_start_s, 3) + " s, " +
+         (log.mode == ModelMode::kTransient ? "transient: the open-loop discrete predictor"
+                                            : "steady state: the closed-form steady-state model") +
+         ") predicts the currents with a held-out residual of **" + num(d.baseline_heldout_rms_A) + " A RMS**; with the "
+         "machine's constants calibrated on the log, **" + num(d.calibration.heldout_rms_A) + " A**. ";
+  const std::vector<std::string> findings = calibration_findings(d);
+  for (std::size_t i = 0; i < findings.size(); ++i) text += (i ? "; " : "Calibration: ") + findings[i] + (i + 1 == findings.size() ? ". " : "");
   if (s.found.empty()) {
-    text += "No effect of the catalogue lowers it significantly: the diagnosis is **none**.";
+    text += "No effect of the catalogue lowers the calibrated baseline's residual significantly.";
   } else {
     text += "Found: ";
     for (std::size_t j = 0; j < s.found.size(); ++j) {
-      text += (j ? "; " : "") + std::string("**") + s.found[j].effect.label() + "** (" +
-              parameters_text(found_parameters(d, j)) + ")";
+      text += (j ? "; " : "") + std::string("**") + s.found[j].effect.label() + "** (" + parameters_text(found_parameters(d, j)) + ")";
     }
     text += ". The extended model lowers the held-out residual to **" + num(s.extended_heldout_rms_A) + " A** (" +
-            pct(100.0 * (1.0 - s.extended_heldout_rms_A / std::max(s.nominal_heldout_rms_A, 1e-300))) + " less).";
+            pct(100.0 * (1.0 - s.extended_heldout_rms_A / std::max(s.start_heldout_rms_A, 1e-300))) +
+            " below the calibrated baseline).";
   }
   doc.paragraph(text);
+  if (!s.implausible.empty()) {
+    std::vector<std::string> items;
+    for (const ImplausibleEffect& i : s.implausible) {
+      items.push_back("`" + i.effect.label() + "` (" + parameters_text(i.parameters) + ", held-out gain " + pct(i.gain_pct) +
+                      ") is not named: " + i.why.reason + ". More likely: " + i.why.more_likely + ".");
+    }
+    doc.paragraph("Physically implausible, not named:");
+    doc.bullets(items);
+  }
   if (!s.not_identifiable.empty()) {
     std::vector<std::string> items;
     for (const Unidentifiable& u : s.not_identifiable) {
@@ -67,38 +89,89 @@ void summary(ReportDocument& doc, const Diagnosis& d, const std::string& config_
   }
 }
 
+void calibration(ReportDocument& doc, const Diagnosis& d) {
+  const Calibration& c = d.calibration;
+  doc.heading(1, "The calibrated baseline");
+  doc.paragraph("Before any effect, the machine's constants that this log identifies are fitted on the training blocks, "
+                "jointly with every effect found later; a constant is identifiable when the log's excitation and noise "
+                "floor alone pin it within ±" + num(100.0 * kIdentifiableHalfWidth, 2) + " % (95 %). Intervals: cluster-"
+                "robust over the training blocks, at the final model. The RPEM estimator's own estimates with the "
+                "configuration (mean over the last quarter of the log) are the cross-check.");
+  std::vector<std::vector<std::string>> rows;
+  for (std::size_t i = 0; i < kCalibrated.size(); ++i) {
+    const double hw = c.intervals.half_width[i] * c.value[i];
+    std::string rpem = "—";
+    if (i == 0 && d.estimates.method == "rpem") rpem = num(d.estimates.nominal_summary.psi_m_Wb);
+    if (i == 1 && d.estimates.method == "rpem") rpem = num(d.estimates.nominal_summary.r_s_Ohm);
+    rows.push_back({kCalibratedText[i], num(c.configured[i]), c.identifiable[i] ? num(c.value[i]) : "not identifiable",
+                    c.identifiable[i] && std::isfinite(hw) ? "[" + num(c.value[i] - hw) + ", " + num(c.value[i] + hw) + "]" : "—",
+                    c.identifiable[i] ? pct(100.0 * (c.configured[i] / c.value[i] - 1.0)) : "—", rpem});
+  }
+  doc.table({"constant", "configured", "calibrated", "95 % interval", "configuration off by", "RPEM estimate"}, rows);
+  std::string temps;
+  if (d.context.t_magnet.logged) temps += " ψm at the log's mean magnet temperature, " + num(d.context.t_magnet.mean_C, 3) + " °C.";
+  if (d.context.t_winding.logged) temps += " R_s at the mean winding temperature, " + num(d.context.t_winding.mean_C, 3) + " °C.";
+  if (!temps.empty()) doc.paragraph("Under a drift law the constants are the law's values at the log's mean temperature:" + temps);
+}
+
 void effects_table(ReportDocument& doc, const Diagnosis& d) {
   if (d.selection.found.empty()) return;
   doc.heading(1, "Effects found");
   std::vector<std::vector<std::string>> rows;
   for (std::size_t j = 0; j < d.selection.found.size(); ++j) {
     const FoundEffect& f = d.selection.found[j];
+    const EstimatorCheck* c = estimator_check(d, j);
+    std::string kept = "yes";
+    if (c && c->applicable) {
+      kept = std::string(c->kept ? "yes" : "no") + ": the estimator's held-out ε is " + num(c->with_A) + " A with it, " +
+             num(c->without_A) + " A without";
+    } else if (c) {
+      kept = "yes (a steady-state log: no recursive estimator to check)";
+    }
     rows.push_back({f.effect.label(), parameters_text(found_parameters(d, j)), num(f.heldout_rms_before_A),
-                    num(f.heldout_rms_after_A), pct(f.gain_pct), num(f.p_value, 2)});
+                    num(f.heldout_rms_after_A), pct(f.gain_pct), num(f.p_value, 2), kept});
   }
-  doc.table({"effect", "parameters (SI; final joint fit)", "held-out RMS before [A]", "after [A]", "gain", "p"}, rows);
+  doc.table({"effect", "parameters (SI; final joint fit)", "held-out RMS before [A]", "after [A]", "gain", "p", "in extended.yaml"},
+            rows);
   doc.paragraph("Before and after are the held-out residual RMS of the model without and with the effect, each with the "
-                "effects found before it. The configuration with these effects is `extended.yaml`; `rpem estimate "
-                "--config extended.yaml` and rpemd use it as it is.");
+                "effects found before it. An effect goes into `extended.yaml` only if the RPEM estimator with it (and the "
+                "effects kept before it) predicts the held-out blocks at least as well as without it; `rpem estimate "
+                "--config extended.yaml` and rpemd use that file as it is, and `rpem diagnose --config extended.yaml` "
+                "replays it as the baseline of the next recording.");
+}
+
+void verdict_section(ReportDocument& doc, const Diagnosis& d, const std::vector<std::string>& figures) {
+  doc.heading(1, d.verdict.explained ? "What is left: noise" : "What is left: unexplained");
+  if (d.verdict.explained) {
+    doc.paragraph("The final model's held-out residual is within " + num(kExplainedRatio, 2) + " times the noise floor: what "
+                  "is left is the sensors' noise.");
+    return;
+  }
+  doc.paragraph("The final model's held-out residual stays " + num(d.verdict.ratio, 3) + " times above the noise floor. "
+                "Where it lives, and what would explain it:");
+  doc.bullets(d.verdict.findings);
+  auto has = [&](const char* f) { return std::find(figures.begin(), figures.end(), f) != figures.end(); };
+  if (has("residual_map.png")) doc.paragraph("The operating-point map (`residual_map.png`) and the content against the electrical "
+                                             "angle (`harmonics.png`) below show it in full.");
 }
 
 void residuals(ReportDocument& doc, const Diagnosis& d, const std::vector<std::string>& figures) {
   const ResidualStatistics& st = d.statistics;
   auto has = [&](const char* f) { return std::find(figures.begin(), figures.end(), f) != figures.end(); };
-  doc.heading(1, "What the nominal model gets wrong");
-  doc.paragraph("Residual RMS over all used samples: " + num(st.rms_A.before) + " A nominal, " + num(st.rms_A.after) +
+  doc.heading(1, "What the configuration gets wrong");
+  doc.paragraph("Residual RMS over all used samples: " + num(st.rms_A.before) + " A with the configuration, " + num(st.rms_A.after) +
                 " A extended; at standstill " + num(st.standstill_rms_A.before) + " → " + num(st.standstill_rms_A.after) +
                 " A, in motion " + num(st.motion_rms_A.before) + " → " + num(st.motion_rms_A.after) + " A.");
-  doc.figure("residual_time.png", "Operating profile, residual RMS of the nominal (red) and extended (green) model, and "
-                                  "the nominal model's mean residual, against time.");
-  doc.figure("residual_map.png", "Residual RMS over the speed × i_q plane: where the nominal model errs, and what is left.");
+  doc.figure("residual_time.png", "Operating profile, residual RMS of the configuration (red) and the extended model "
+                                  "(green), and the configuration's mean residual, against time.");
+  doc.figure("residual_map.png", "Residual RMS over the speed × i_q plane: where the configuration errs, and what is left.");
   std::vector<std::vector<std::string>> rows;
   for (const RegionStatistics& r : st.regions) {
     rows.push_back({r.speed, r.load, std::to_string(r.samples), num(r.rms_A.before), num(r.rms_A.after),
                     num(r.mean_d_A.before), num(r.mean_q_A.before), num(r.mean_d_A.after), num(r.mean_q_A.after)});
   }
-  doc.table({"speed", "load", "samples", "RMS nominal [A]", "RMS extended [A]", "mean ε_d nominal", "mean ε_q nominal",
-             "mean ε_d extended", "mean ε_q extended"},
+  doc.table({"speed", "load", "samples", "RMS configuration [A]", "RMS extended [A]", "mean ε_d configuration",
+             "mean ε_q configuration", "mean ε_d extended", "mean ε_q extended"},
             rows);
   if (has("harmonics.png")) {
     doc.figure("harmonics.png", "Residual amplitude at harmonics of the electrical angle, in the dq frame: a current "
@@ -107,7 +180,7 @@ void residuals(ReportDocument& doc, const Diagnosis& d, const std::vector<std::s
     for (const HarmonicContent& c : st.harmonics) {
       h.push_back({std::to_string(c.order), num(c.amplitude_A.before), num(c.amplitude_A.after)});
     }
-    doc.table({"harmonic", "nominal [A]", "extended [A]"}, h);
+    doc.table({"harmonic", "configuration [A]", "extended [A]"}, h);
   }
   if (has("phase_sign.png")) {
     doc.figure("phase_sign.png", "Mean residual of each phase while its current is positive and negative: dead time pulls "
@@ -121,9 +194,9 @@ void residuals(ReportDocument& doc, const Diagnosis& d, const std::vector<std::s
     c.push_back({r.regressor, fixed(r.d.before, 3), fixed(r.q.before, 3), fixed(r.d.after, 3), fixed(r.q.after, 3)});
   }
   doc.paragraph("Correlation of the residual with candidate regressors:");
-  doc.table({"regressor", "ε_d nominal", "ε_q nominal", "ε_d extended", "ε_q extended"}, c);
+  doc.table({"regressor", "ε_d configuration", "ε_q configuration", "ε_d extended", "ε_q extended"}, c);
   doc.figure("overlay.png", d.log->mode == ModelMode::kTransient
-                                ? "The logged current against both models in the 0.1 s where the nominal model errs most."
+                                ? "The logged current against both models in the 0.1 s where the configuration errs most."
                                 : "The logged current against both models, row by row.");
 }
 
@@ -138,13 +211,13 @@ void estimator(ReportDocument& doc, const Diagnosis& d) {
                     : "A steady-state log cannot drive the recursive estimator (its samples lie seconds apart). Instead, "
                       "each row's steady-state equations give the ψm and R_s the data implies — R_s = (u_d + ω·L_q·i_q)/i_d, "
                       "ψm = (u_q − R_s·i_q)/ω − L_d·i_d, with the extended model's corrections — set against what the "
-                      "nominal model assumes (constant values) and what the extended model assumes (its drifts). Values: "
+                      "configuration assumes and what the extended model assumes (its drifts). Values: "
                       "mean over the last quarter; errors: RMS against the implied values over the second half.");
-  doc.figure("estimates.png", c.method == "rpem" ? "ψm and R_s estimated with the nominal (red) and the extended (green) model."
-                                                : "ψm and R_s as the nominal (red) and the extended (green) model assume them, "
+  doc.figure("estimates.png", c.method == "rpem" ? "ψm and R_s estimated with the configuration (red) and the extended model (green)."
+                                                : "ψm and R_s as the configuration (red) and the extended model (green) assume them, "
                                                   "and as the data implies them (black).");
   doc.table({"model", "ψm [Wb]", "R_s [Ω]", "ψm error", "R_s error"},
-            {{"nominal", num(c.nominal_summary.psi_m_Wb), num(c.nominal_summary.r_s_Ohm),
+            {{"configuration", num(c.nominal_summary.psi_m_Wb), num(c.nominal_summary.r_s_Ohm),
               optional_pct(c.nominal_summary.psi_m_error_pct), optional_pct(c.nominal_summary.r_s_error_pct)},
              {"extended", num(c.extended_summary.psi_m_Wb), num(c.extended_summary.r_s_Ohm),
               optional_pct(c.extended_summary.psi_m_error_pct), optional_pct(c.extended_summary.r_s_error_pct)}});
@@ -185,7 +258,9 @@ void write_diagnose_report(const std::string& dir, const Diagnosis& d, const std
   const std::vector<std::string> figures = write_diagnose_figures(dir, d);
   ReportDocument doc("Diagnosis of " + d.log->path);
   summary(doc, d, config_path);
+  calibration(doc, d);
   effects_table(doc, d);
+  verdict_section(doc, d, figures);
   residuals(doc, d, figures);
   estimator(doc, d);
   selection(doc, d);

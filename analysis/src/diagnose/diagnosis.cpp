@@ -7,60 +7,172 @@
 namespace rpem::analysis {
 namespace {
 
-double value_of(const std::vector<NamedValue>& values, const char* name) {
-  for (const NamedValue& v : values) {
-    if (v.name == name) return v.value;
-  }
-  return 0.0;
+/// How a drift of the model is recorded in a configuration: a law against temperature (referred to
+/// `reference_C`, value_ref the model's constant), a change over the log, or the input's own entry.
+io::ParameterDrift recorded_drift(const io::ParameterDrift& input, const std::optional<core::DriftLaw>& law, double trend,
+                                  double value, double reference_C) {
+  if (law) return {recorded_law(*law, value, reference_C), std::nullopt};
+  if (trend != 0.0) return {std::nullopt, trend / (1.0 - 0.5 * trend)};
+  return input;
 }
 
-/// A found drift as the configuration records it.
-io::ParameterDrift recorded_drift(const std::vector<NamedValue>& values, bool temperature) {
-  io::ParameterDrift d;
-  if (temperature) {
-    d.law = core::DriftLaw{value_of(values, "coeff_per_K"), value_of(values, "reference_C")};
-  } else {
-    d.rel_change = value_of(values, "rel_change");
+/// The effects of `set` that `keep` admits, at their jointly fitted values, with the calibrated constants.
+EffectSet subset(const EffectSet& set, const std::vector<bool>& keep) {
+  EffectSet s = set;
+  s.effects.clear();
+  s.parameters.clear();
+  for (std::size_t j = 0; j < set.effects.size(); ++j) {
+    if (!keep[j]) continue;
+    s.effects.push_back(set.effects[j]);
+    s.parameters.push_back(set.parameters[j]);
   }
-  return d;
+  return s;
+}
+
+/// Greedy, in the order found: an effect stays in extended.yaml only if the RPEM estimator with it (and
+/// the effects kept before it) predicts the held-out blocks at least as well as without it.
+std::vector<EstimatorCheck> check_estimator(const Diagnosis& d, std::vector<bool>& keep) {
+  constexpr double kTolerance = 1e-3;  // "at least as well": within rounding of the RMS
+  std::vector<EstimatorCheck> checks;
+  const EffectSet& model = d.selection.model;
+  keep.assign(model.effects.size(), true);
+  if (d.log->mode != ModelMode::kTransient) {
+    for (const Effect& e : model.effects) checks.push_back({e, false, 0.0, 0.0, true});
+    return checks;
+  }
+  std::vector<bool> trial(model.effects.size(), false);
+  auto rms_with = [&](const std::vector<bool>& k) {
+    const ExtendedModel m = subset(model, k).model(d.context);
+    return estimator_heldout_rms_A(*d.log, config_of(d.config, m, d.calibration.identifiable, d.context.reference_C));
+  };
+  double current = rms_with(trial);
+  for (std::size_t j = 0; j < model.effects.size(); ++j) {
+    trial[j] = true;
+    const double with = rms_with(trial);
+    EstimatorCheck c{model.effects[j], true, with, current, with <= current * (1.0 + kTolerance)};
+    if (c.kept) {
+      current = with;
+    } else {
+      trial[j] = false;
+    }
+    keep[j] = c.kept;
+    checks.push_back(c);
+  }
+  return checks;
+}
+
+/// Whether the fitted constant i is identified: its cluster-robust interval narrow, away from the bound.
+bool identified(const EffectSet& set, const CalibrationIntervals& ci, std::size_t i) {
+  return ci.half_width[i] <= kIdentifiedHalfWidth && std::abs(set.calibration[i]) < 0.99 * kCalibrationBound;
+}
+
+/// Constants the excitation pins down but that the uncalibrated effects had pushed away at the start get
+/// another chance with the effects found: freed, the final model refitted, and kept where they are now
+/// identified and the held-out residual is no worse.
+void readmit_constants(const EffectFitter& fitter, double floor, const CalibrationIntervals& excitation, Diagnosis& d) {
+  EffectSet trial = d.selection.model;
+  std::vector<std::size_t> readmitted;
+  for (std::size_t i = 0; i < kCalibrated.size(); ++i) {
+    if (trial.calibrated[i] || excitation.excitation_half_width[i] > kIdentifiableHalfWidth) continue;
+    trial.calibrated[i] = true;
+    readmitted.push_back(i);
+  }
+  if (readmitted.empty()) return;
+  trial = fitter.fit(trial);
+  const CalibrationIntervals ci = fitter.intervals(trial, floor);
+  bool all = true;
+  for (std::size_t i : readmitted) {
+    if (identified(trial, ci, i)) continue;
+    trial.calibrated[i] = false;
+    trial.calibration[i] = 0.0;
+    all = false;
+  }
+  if (!all) trial = fitter.fit(trial);
+  const double heldout = rms(fitter.heldout(trial));
+  if (heldout > d.selection.extended_heldout_rms_A) return;
+  for (std::size_t i : readmitted) d.calibration.identifiable[i] = trial.calibrated[i];
+  d.selection.model = trial;
+  d.selection.extended_heldout_rms_A = heldout;
 }
 
 }  // namespace
 
-Diagnosis diagnose(LogData log, const io::MachineConfig& config, const DiagnoseOptions& options,
-                   const ParameterTrack& truth) {
-  const auto start = std::chrono::steady_clock::now();
+io::MachineConfig config_of(const io::MachineConfig& input, const ExtendedModel& model,
+                            const std::array<bool, kCalibrated.size()>& constants, double reference_C) {
+  io::MachineConfig c = input;
+  c.estimator.extensions = model.extensions;
+  for (std::size_t i = 0; i < kCalibrated.size(); ++i) {
+    if (constants[i]) c.machine.*kCalibratedFields[i] = model.machine.*kCalibratedFields[i];
+  }
+  c.rs_drift = recorded_drift(input.rs_drift, model.r_s_law, model.r_s_trend, model.machine.r_s_Ohm, reference_C);
+  c.psim_drift = recorded_drift(input.psim_drift, model.psi_m_law, model.psi_m_trend, model.machine.psi_m_Wb, reference_C);
+  // Under a law the machine's constant is its value at the law's reference temperature.
+  if (model.r_s_law && constants[1]) c.machine.r_s_Ohm = c.rs_drift.law->value_ref;
+  if (model.psi_m_law && constants[0]) c.machine.psi_m_Wb = c.psim_drift.law->value_ref;
+  return c;
+}
+
+Diagnosis diagnose(LogData log, const io::MachineConfig& config, const DiagnoseOptions& options, const ParameterTrack& truth) {
+  const auto start_time = std::chrono::steady_clock::now();
   Diagnosis d;
   d.options = options;
   d.log = std::make_unique<LogData>(std::move(log));
   d.config = config;
   const double f_sw = options.switching_frequency_Hz > 0.0 ? options.switching_frequency_Hz
                                                           : config.estimator.extensions.switching_frequency_Hz;
-  d.context = EffectContext::of(*d.log, config.machine, config.estimator.extensions, options.reference_C, f_sw);
+  const ExtendedModel base = make_base_model(config.machine, config.estimator.extensions, config.rs_drift.law,
+                                             config.psim_drift.law, *d.log);
+  d.context = EffectContext::of(*d.log, config.machine, base, options.reference_C, f_sw);
 
-  const ModelReplay replay(*d.log, config.machine, options.reference_C);
+  const ModelReplay replay(*d.log, config.machine.rated);
   const EffectFitter fitter(replay, d.context);
-  d.selection = select_effects(fitter, options.selection);
 
-  d.extended_model = d.selection.model.model(d.context);
-  d.extended_config = config;
-  d.extended_config.estimator.extensions = d.extended_model.extensions;
-  for (std::size_t j = 0; j < d.selection.model.effects.size(); ++j) {
-    const Effect& e = d.selection.model.effects[j];
-    if (e.kind != EffectKind::kRsDrift && e.kind != EffectKind::kPsimDrift) continue;
-    const auto values = describe(e, d.selection.model.parameters[j].data(), d.context);
-    if (e.kind == EffectKind::kRsDrift) {
-      d.extended_config.rs_drift = recorded_drift(values, d.context.t_winding);
-    } else {
-      d.extended_config.psim_drift = recorded_drift(values, d.context.t_magnet);
-    }
+  // The configuration as it is, and the noise floor of its residual (the same for every model).
+  replay.run(base, d.baseline_replay);
+  d.baseline_heldout_rms_A = rms(fitter.heldout(EffectSet{}));
+  const double floor = noise_floor_A(*d.log, d.baseline_replay);
+
+  // The calibrated baseline: the constants the log's excitation pins down, fitted on the training blocks.
+  EffectSet start;
+  const CalibrationIntervals excitation = fitter.intervals(start, floor);
+  for (std::size_t i = 0; i < kCalibrated.size(); ++i) {
+    start.calibrated[i] = excitation.excitation_half_width[i] <= kIdentifiableHalfWidth;
+    d.calibration.identifiable[i] = start.calibrated[i];
+    d.calibration.configured[i] = base.machine.*kCalibratedFields[i];
   }
+  if (start.free_calibration() > 0) start = fitter.fit(start);
+  // A constant the excitation would pin down but whose fit the model's own errors move far (its
+  // cluster-robust interval wide, or at the ±50 % bound) is not identified: it stays configured.
+  if (start.free_calibration() > 0) {
+    const CalibrationIntervals fitted = fitter.intervals(start, floor);
+    bool dropped = false;
+    for (std::size_t i = 0; i < kCalibrated.size(); ++i) {
+      if (!start.calibrated[i] || identified(start, fitted, i)) continue;
+      start.calibrated[i] = d.calibration.identifiable[i] = false;
+      start.calibration[i] = 0.0;
+      dropped = true;
+    }
+    if (dropped && start.free_calibration() > 0) start = fitter.fit(start);
+  }
+  d.calibration.heldout_rms_A = rms(fitter.heldout(start));
 
-  replay.run(EffectSet{}.model(d.context), d.nominal_replay);
+  d.selection = select_effects(fitter, options.selection, start);
+  readmit_constants(fitter, floor, excitation, d);
+  d.calibration.intervals = fitter.intervals(d.selection.model, floor);
+  d.extended_model = d.selection.model.model(d.context);
+  for (std::size_t i = 0; i < kCalibrated.size(); ++i) d.calibration.value[i] = d.extended_model.machine.*kCalibratedFields[i];
+
+  std::vector<bool> keep;
+  d.estimator_checks = check_estimator(d, keep);
+  d.extended_config = config_of(config, subset(d.selection.model, keep).model(d.context), d.calibration.identifiable,
+                                options.reference_C);
+
   replay.run(d.extended_model, d.extended_replay);
-  d.statistics = residual_statistics(*d.log, d.context, d.nominal_replay, d.extended_replay);
+  d.statistics = residual_statistics(*d.log, d.context, d.baseline_replay, d.extended_replay);
+  d.verdict = verdict(d.selection.extended_heldout_rms_A, floor, d.statistics);
   d.estimates = compare_estimates(*d.log, config, d.extended_config, d.extended_model, d.context, truth);
-  d.elapsed_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  d.elapsed_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_time).count();
+
   return d;
 }
 

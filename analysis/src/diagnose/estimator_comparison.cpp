@@ -62,30 +62,40 @@ ParameterTrack run_rpem(const LogData& log, const io::MachineConfig& config) {
 }
 
 /// Per used steady-state row: what the data implies (→ implied) and what each model assumes.
-void steady_state_tracks(const LogData& log, const io::MachineConfig& nominal, const ExtendedModel& model,
-                         double reference_C, EstimatorComparison& c) {
-  const core::MachineSi& machine = nominal.machine;
+void steady_state_tracks(const LogData& log, const EffectContext& context, const ExtendedModel& model, EstimatorComparison& c) {
+  const core::MachineSi& machine = context.base.machine;
   const core::PerUnitBase base = core::PerUnitBase::from_rated(machine.rated);
-  const core::MachinePu pu = core::to_pu(base, machine);
+  const core::MachinePu pu = core::to_pu(base, model.machine);
   const core::SampleConditioner conditioner(base, pu, model.extensions);
   for (std::size_t k = 0; k < log.rows.size(); ++k) {
     if (!log.used[k]) continue;
     const io::DriveLogRow& row = log.rows[k];
     const core::SteadyStateInputs in = conditioner.steady_state(row.sample);
     if (std::abs(in.n_pu) < 1e-3 || std::abs(in.i_pu[0]) < 1e-6) continue;
-    const double tau = log.time_fraction(k);
-    const double r_factor = drift_factor(model.r_s, tau, row.t_winding_C, reference_C);
-    const double psi_factor = drift_factor(model.psi_m, tau, row.t_magnet_C, reference_C);
+    const double r_model = r_s_at(model, log, k), psi_model = psi_m_at(model, log, k);
     const double r_implied = (in.u_pu[0] + in.n_pu * in.x_q_pu * in.i_pu[1]) / in.i_pu[0];
-    const double psi_implied = (in.u_pu[1] - pu.r_s_pu * r_factor * in.i_pu[1]) / in.n_pu - in.x_d_pu * in.i_pu[0];
+    const double psi_implied = (in.u_pu[1] - base.resistance_pu(r_model) * in.i_pu[1]) / in.n_pu - in.x_d_pu * in.i_pu[0];
     const double t = 1e-9 * static_cast<double>(row.sample.t_ns);
     c.truth.add(t, base.flux_Wb_of(psi_implied), base.resistance_Ohm_of(r_implied));
-    c.nominal.add(t, machine.psi_m_Wb, machine.r_s_Ohm);
-    c.extended.add(t, machine.psi_m_Wb * psi_factor, machine.r_s_Ohm * r_factor);
+    c.nominal.add(t, psi_m_at(context.base, log, k), r_s_at(context.base, log, k));
+    c.extended.add(t, psi_model, r_model);
   }
 }
 
 }  // namespace
+
+double estimator_heldout_rms_A(const LogData& log, const io::MachineConfig& config) {
+  core::DriveEstimator estimator(config.machine, config.estimator);
+  double sum = 0.0;
+  std::size_t n = 0;
+  for (std::size_t k = 0; k < log.rows.size(); ++k) {
+    const core::Estimate e = estimator.step(log.rows[k].sample);
+    if (!log.heldout(k) || e.detail.code != core::StepCode::kAdapted) continue;
+    sum += e.epsilon_A.squaredNorm();
+    ++n;
+  }
+  return n ? std::sqrt(sum / static_cast<double>(n)) : 0.0;
+}
 
 ParameterTrack load_truth(const std::string& path) {
   const io::CsvTable table = io::CsvTable::read(path);
@@ -107,7 +117,7 @@ EstimatorComparison compare_estimates(const LogData& log, const io::MachineConfi
     c.extended = run_rpem(log, extended_config);
   } else {
     c.method = "steady_state";
-    steady_state_tracks(log, nominal, extended, context.reference_C, c);
+    steady_state_tracks(log, context, extended, c);
   }
   c.nominal_summary = summarise(c.nominal, c.truth);
   c.extended_summary = summarise(c.extended, c.truth);

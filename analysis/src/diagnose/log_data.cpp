@@ -50,10 +50,12 @@ LogData prepare_log(std::vector<io::DriveLogRow> rows, const io::DriveLogLayout&
   const core::PerUnitBase base = core::PerUnitBase::from_rated(machine.rated);
   const core::SampleConditioner raw(base, core::to_pu(base, machine), {});
   std::vector<double> current(n), speed(n);
+  d.logged_i_dq_A.resize(n);
   double u_dc_sum = 0.0;
   for (std::size_t k = 0; k < n; ++k) {
     const core::DriveSample& s = d.rows[k].sample;
-    current[k] = raw.logged_current_dq_A(s).norm();
+    d.logged_i_dq_A[k] = raw.logged_current_dq_A(s);
+    current[k] = d.logged_i_dq_A[k].norm();
     speed[k] = s.omega_el_rad_s;
     d.max_current_A = std::max(d.max_current_A, current[k]);
     d.max_speed_rad_s = std::max(d.max_speed_rad_s, std::abs(speed[k]));
@@ -65,7 +67,8 @@ LogData prepare_log(std::vector<io::DriveLogRow> rows, const io::DriveLogLayout&
   d.mode = options.mode.value_or(d.median_dt_s >= kSteadyStateTimeConstants * time_constant_s ? ModelMode::kSteadyState
                                                                                                : ModelMode::kTransient);
 
-  d.replay_speed_rad_s = speed;
+  d.replay_samples.resize(n);
+  for (std::size_t k = 0; k < n; ++k) d.replay_samples[k] = d.rows[k].sample;
   if (d.mode == ModelMode::kTransient && options.speed_half_window > 0) {
     const std::size_t w = static_cast<std::size_t>(options.speed_half_window);
     for (std::size_t k = w; k + w < n; ++k) {
@@ -74,7 +77,7 @@ LogData prepare_log(std::vector<io::DriveLogRow> rows, const io::DriveLogLayout&
       // Only across a gap-free stretch; else the logged speed stays.
       bool gap = false;
       for (std::size_t j = k - w + 1; j <= k + w && !gap; ++j) gap = d.rows[j].sample.gap_before;
-      if (!gap && dt > 0.0) d.replay_speed_rad_s[k] = core::wrap_angle(b.theta_el_rad - a.theta_el_rad) / dt;
+      if (!gap && dt > 0.0) d.replay_samples[k].omega_el_rad_s = core::wrap_angle(b.theta_el_rad - a.theta_el_rad) / dt;
     }
   }
 

@@ -5,7 +5,9 @@
 #include <cmath>
 #include <cstdio>
 #include <functional>
+#include <numeric>
 #include <thread>
+#include <tuple>
 
 namespace rpem::analysis {
 namespace {
@@ -26,27 +28,13 @@ double gain_pct(const BlockScores& before, const BlockScores& after) {
   return 100.0 * (1.0 - std::sqrt(after.total() / std::max(before.total(), 1e-300)));
 }
 
-/// What data would tell two effects apart (the report's advice).
-std::string separating_data(const std::string& a, const std::string& b) {
-  auto is = [&](const char* x, const char* y) { return (a == x && b == y) || (a == y && b == x); };
-  if (is("rs_drift", "deadtime")) return "standstill at two or more current levels (the resistive drop grows with |i|, the dead-time error does not)";
-  if (is("theta_offset", "delay")) return "operation at two or more speeds (a delay turns the voltage by ω·delay, an encoder offset by a fixed angle)";
-  if (is("psim_drift", "ld_saturation")) return "operation at two or more d-axis currents";
-  if (is("iron_loss", "psim_drift") || is("iron_loss", "theta_offset")) return "the same torque at two or more speeds";
-  if (is("rs_drift", "iron_loss")) return "standstill with current (no iron loss there)";
-  if (is("deadtime", "current_offset")) {
-    return "current of both signs in that phase, or motion (an offset then shows at the fundamental, dead time at the 6th)";
-  }
-  return "operating points where the two act differently (other speeds, currents or current signs)";
-}
-
 /// How alike two model changes are over the held-out samples.
 double change_correlation(const EffectFitter& f, const EffectSet& base, const EffectSet& a, const EffectSet& b) {
   ReplayOutput r0, ra, rb;
   const ModelReplay& replay = f.replay();
-  replay.run(base.model(f.context()), r0);
-  replay.run(a.model(f.context()), ra);
-  replay.run(b.model(f.context()), rb);
+  replay.run(base.model(f.context()), r0, Blocks::kHeldout);
+  replay.run(a.model(f.context()), ra, Blocks::kHeldout);
+  replay.run(b.model(f.context()), rb, Blocks::kHeldout);
   double ab = 0.0, aa = 0.0, bb = 0.0;
   const LogData& log = replay.log();
   for (std::size_t k = 0; k < log.rows.size(); ++k) {
@@ -98,11 +86,12 @@ double signed_rank_p(const std::vector<double>& values) {
   return tail / std::pow(2.0, static_cast<double>(n));
 }
 
-Selection select_effects(const EffectFitter& fitter, const SelectionOptions& options) {
+Selection select_effects(const EffectFitter& fitter, const SelectionOptions& options, const EffectSet& start) {
   Selection sel;
+  sel.model = start;
   const EffectContext& context = fitter.context();
   BlockScores current = fitter.heldout(sel.model);
-  sel.nominal_heldout_rms_A = rms(current);
+  sel.start_heldout_rms_A = rms(current);
   std::vector<Effect> excluded, stand_ins;
 
   while (static_cast<int>(sel.found.size() + stand_ins.size()) < options.max_effects) {
@@ -114,38 +103,91 @@ Selection select_effects(const EffectFitter& fitter, const SelectionOptions& opt
       round.push_back(candidate);
     }
     if (round.empty()) break;
-    parallel_for(round.size(), options.threads,
-                 [&](std::size_t i) { round[i].screen_ssr = fitter.screen(sel.model, round[i].effect); });
-    std::sort(round.begin(), round.end(), [](const auto& a, const auto& b) { return a.screen_ssr > b.screen_ssr; });
+    const ScreenBasis basis = fitter.screen_basis(sel.model);
+    std::vector<std::vector<double>> starts(round.size());
+    parallel_for(round.size(), options.threads, [&](std::size_t i) {
+      std::tie(starts[i], round[i].screen_ssr) = fitter.best_start(basis, sel.model, round[i].effect);
+    });
+    std::vector<std::size_t> order(round.size());
+    for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+    std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return round[a].screen_ssr > round[b].screen_ssr; });
+    {
+      std::vector<CandidateScore> sorted;
+      std::vector<std::vector<double>> sorted_starts;
+      for (std::size_t i : order) {
+        sorted.push_back(round[i]);
+        sorted_starts.push_back(starts[i]);
+      }
+      round = std::move(sorted);
+      starts = std::move(sorted_starts);
+    }
 
-    const std::size_t shortlisted = std::min<std::size_t>(round.size(), static_cast<std::size_t>(options.shortlist));
+    // The shortlist: the best few, without those the screening credits with less than a small share of
+    // the best (they cannot win unless the screening's first step misleads by that much).
+    std::size_t shortlisted = std::min<std::size_t>(round.size(), static_cast<std::size_t>(options.shortlist));
+    while (shortlisted > 2 && round[shortlisted - 1].screen_ssr < options.shortlist_share * round.front().screen_ssr) --shortlisted;
     std::vector<EffectSet> fitted(shortlisted);
     std::vector<BlockScores> scores(shortlisted);
-    parallel_for(shortlisted, options.threads, [&](std::size_t i) {
-      fitted[i] = fitter.fit(sel.model.with(round[i].effect, context));
+    std::vector<double> reduction(shortlisted, 0.0);
+    const double ssr_now = std::inner_product(basis.r0.begin(), basis.r0.end(), basis.r0.begin(), 0.0);
+    auto fit = [&](std::size_t i) {
+      double ssr = 0.0;
+      fitted[i] = fitter.fit(sel.model.with(round[i].effect, context, starts[i]), &ssr);
+      reduction[i] = ssr_now - ssr;
       scores[i] = fitter.heldout(fitted[i]);
-    });
-    std::size_t best = 0;
-    for (std::size_t i = 0; i < shortlisted; ++i) {
       round[i].fitted = true;
+    };
+    // The leaders first; a later one only if its screening could rival what the leaders' fits achieved.
+    const std::size_t leaders = std::min<std::size_t>(shortlisted, static_cast<std::size_t>(std::max(options.threads, 1)));
+    parallel_for(leaders, options.threads, fit);
+    const double achieved = *std::max_element(reduction.begin(), reduction.begin() + static_cast<std::ptrdiff_t>(leaders));
+    std::vector<std::size_t> rivals;
+    for (std::size_t i = leaders; i < shortlisted; ++i) {
+      if (round[i].screen_ssr >= options.rival_share * achieved) rivals.push_back(i);
+    }
+    parallel_for(rivals.size(), options.threads, [&](std::size_t j) { fit(rivals[j]); });
+    std::vector<std::size_t> ranked;
+    for (std::size_t i = 0; i < shortlisted; ++i) {
+      if (!round[i].fitted) continue;
       round[i].gain_pct = gain_pct(current, scores[i]);
       round[i].block_log_ratio = block_log_ratios(current, scores[i]);
       round[i].p_value = signed_rank_p(round[i].block_log_ratio);
       round[i].parameters = fitted[i].parameters.back();
-      if (scores[i].total() < scores[best].total()) best = i;
+      ranked.push_back(i);
+    }
+    std::sort(ranked.begin(), ranked.end(), [&](std::size_t a, std::size_t b) { return scores[a].total() < scores[b].total(); });
+    sel.rounds.push_back(round);
+    // The best plausible candidate; implausible ones that would have passed are reported and set aside.
+    std::size_t best = shortlisted;
+    bool set_aside = false;
+    for (std::size_t i : ranked) {
+      const CandidateScore& c = round[i];
+      if (c.gain_pct < options.min_gain_pct || c.p_value > options.max_p) break;
+      const ExtendedModel m = fitted[i].model(context);
+      const std::optional<Implausibility> why = c.effect.row->judge ? c.effect.row->judge(c.effect, m, context) : std::nullopt;
+      if (!why) {
+        best = i;
+        break;
+      }
+      sel.implausible.push_back({c.effect, c.effect.row->describe(c.effect, m, context), c.gain_pct, *why});
+      excluded.push_back(c.effect);
+      set_aside = true;
+    }
+    if (best == shortlisted) {
+      if (set_aside) continue;  // only implausible ones passed: the next round looks again without them
+      break;
     }
     const CandidateScore winner = round[best];
-    sel.rounds.push_back(round);
-    if (winner.gain_pct < options.min_gain_pct || winner.p_value > options.max_p) break;
 
     // Rivals that pass too, that the held-out blocks do not tell from the winner, and that change the
     // model in the same way, make the winner a guess: the group is reported, nobody is named.
     std::vector<std::string> group = {winner.effect.label()};
     std::string reason;
-    for (std::size_t i = 0; i < shortlisted; ++i) {
+    for (std::size_t i : ranked) {
       const CandidateScore& rival = round[i];
       if (i == best || rival.effect.name() == winner.effect.name()) continue;
       if (rival.gain_pct < options.min_gain_pct || rival.p_value > options.max_p) continue;
+      if (std::find(excluded.begin(), excluded.end(), rival.effect) != excluded.end()) continue;
       const double p_preferred = signed_rank_p(block_log_ratios(scores[i], scores[best]));
       if (p_preferred <= options.ambiguity_p) continue;
       const double corr = change_correlation(fitter, sel.model, fitted[best], fitted[i]);
@@ -156,8 +198,7 @@ Selection select_effects(const EffectFitter& fitter, const SelectionOptions& opt
                     "the held-out residual alike (%.1f %% and %.1f %%; the held-out blocks prefer neither, p = %.2f); a "
                     "log with %s would separate them",
                     reason.empty() ? "" : "; ", winner.effect.label().c_str(), rival.effect.label().c_str(), corr,
-                    winner.gain_pct, rival.gain_pct, p_preferred,
-                    separating_data(winner.effect.name(), rival.effect.name()).c_str());
+                    winner.gain_pct, rival.gain_pct, p_preferred, separating_data(winner.effect, rival.effect).c_str());
       reason += text;
       group.push_back(rival.effect.label());
       excluded.push_back(rival.effect);
@@ -177,13 +218,9 @@ Selection select_effects(const EffectFitter& fitter, const SelectionOptions& opt
     current = scores[best];
   }
   if (!stand_ins.empty()) {
-    EffectSet named;
-    for (std::size_t j = 0; j < sel.model.effects.size(); ++j) {
-      if (std::find(stand_ins.begin(), stand_ins.end(), sel.model.effects[j]) != stand_ins.end()) continue;
-      named.effects.push_back(sel.model.effects[j]);
-      named.parameters.push_back(sel.model.parameters[j]);
-    }
-    sel.model = named;
+    EffectSet named = sel.model;
+    for (const Effect& e : stand_ins) named = named.without(e);
+    sel.model = named.effects.empty() ? start : fitter.fit(named);
     current = fitter.heldout(sel.model);
   }
   sel.extended_heldout_rms_A = rms(current);

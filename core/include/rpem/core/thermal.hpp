@@ -39,7 +39,10 @@ struct DriftLaw {
   }
 };
 
-/// A material's range of temperature coefficients [1/K].
+/// The temperature the materials' coefficients below refer to (α relative to the value there).
+inline constexpr double kMaterialReference_C = 20.0;
+
+/// A material's range of temperature coefficients [1/K], relative to the value at kMaterialReference_C.
 struct MaterialCoefficient {
   std::string_view material;
   double typical_per_K;

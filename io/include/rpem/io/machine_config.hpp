@@ -4,6 +4,8 @@
 
 #include <optional>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "rpem/core/settings.hpp"
 #include "rpem/core/thermal.hpp"
@@ -47,6 +49,13 @@ void check_log_supports(const MachineConfig& c, const std::string& config_name, 
 /// The `model_extensions` section for a configuration's extensions and drifts (flow-style YAML that
 /// parse_machine_config() reads back to the same values); empty when the model is nominal.
 [[nodiscard]] std::string model_extensions_yaml(const MachineConfig& c);
+
+/// `yaml_text` with values of the top-level `machine` section's own keys replaced (each pair: key, value),
+/// each followed by `comment` and the value it replaced; the rest of the text is kept as it is. Throws
+/// ConfigError if a key is not there.
+[[nodiscard]] std::string replace_machine_values(const std::string& yaml_text,
+                                                 const std::vector<std::pair<std::string, double>>& values,
+                                                 const std::string& comment);
 
 /// `yaml_text` with its top-level `model_extensions` section (if any) replaced by `section`.
 [[nodiscard]] std::string replace_model_extensions(const std::string& yaml_text, const std::string& section);

@@ -20,7 +20,14 @@ void write_extended_yaml(const std::string& path, const Diagnosis& d, const std:
 
 void write_diagnose_report(const std::string& dir, const Diagnosis& d, const std::string& config_path);
 
-/// The found effect j's parameters in SI (describe() of the final joint fit).
+/// The found effect j's parameters in SI (its row's describe() of the final joint fit).
 [[nodiscard]] std::vector<NamedValue> found_parameters(const Diagnosis& d, std::size_t j);
+
+/// What the calibration says about the configuration, one sentence per identifiable constant whose
+/// configured value lies outside the calibrated 95 % interval (e.g. "the configuration's ψm is 5.1 % high").
+[[nodiscard]] std::vector<std::string> calibration_findings(const Diagnosis& d);
+
+/// The estimator check of the found effect j (nullptr if none).
+[[nodiscard]] const EstimatorCheck* estimator_check(const Diagnosis& d, std::size_t j);
 
 }  // namespace rpem::analysis

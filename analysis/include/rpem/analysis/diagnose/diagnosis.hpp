@@ -1,8 +1,10 @@
 #pragma once
-// `rpem diagnose` as a library call (docs/diagnose.md): replay the nominal model on a log's inputs,
-// find which catalogue effects explain what it gets wrong, extend the model with them, measure the
-// gain on held-out data and on the estimator, and keep everything the report needs.
+// `rpem diagnose` as a library call (docs/diagnose.md): replay the configuration's whole model (the
+// baseline) on a log's inputs, calibrate the machine's constants the log identifies, find which
+// catalogue effects explain what the calibrated baseline still gets wrong, extend the model with them,
+// measure the gain on held-out data and on the estimator, and judge what is left against the noise floor.
 
+#include <array>
 #include <memory>
 #include <string>
 
@@ -11,32 +13,67 @@
 #include "rpem/analysis/diagnose/log_data.hpp"
 #include "rpem/analysis/diagnose/residual_statistics.hpp"
 #include "rpem/analysis/diagnose/selection.hpp"
+#include "rpem/analysis/diagnose/verdict.hpp"
 #include "rpem/io/machine_config.hpp"
 
 namespace rpem::analysis {
 
 struct DiagnoseOptions {
-  double reference_C = 20.0;            ///< temperature at which the configuration's r_s and ψm hold
+  double reference_C = 20.0;            ///< temperature to which found drift laws are referred
   double switching_frequency_Hz = 0.0;  ///< for t_dead_s (0: the configuration's, else unknown)
   SelectionOptions selection;
+};
+
+/// A calibrated constant is identifiable when the log's excitation alone (its noise floor and the
+/// replay's sensitivity to the constant) pins it within this relative 95 % half-width …
+inline constexpr double kIdentifiableHalfWidth = 0.01;
+/// … and its fit to the calibrated baseline is pinned within this one by the cluster-robust interval
+/// (which the model's own errors widen), away from the ±50 % bound.
+inline constexpr double kIdentifiedHalfWidth = 0.1;
+
+/// The calibrated baseline (docs/diagnose.md, "The calibrated baseline"), kCalibrated order.
+struct Calibration {
+  std::array<double, kCalibrated.size()> configured{};  ///< the configuration's (ψm, R_s at the log's mean temperature under a drift law)
+  std::array<double, kCalibrated.size()> value{};       ///< calibrated (configured where not identifiable)
+  std::array<bool, kCalibrated.size()> identifiable{};
+  CalibrationIntervals intervals;  ///< at the final model
+  double heldout_rms_A = 0.0;      ///< the calibrated baseline's held-out residual
+};
+
+/// Whether a found effect helps the estimator (docs/diagnose.md, "An extension must help the estimator").
+struct EstimatorCheck {
+  Effect effect;
+  bool applicable = false;    ///< a recursive-estimator check exists (transient logs)
+  double with_A = 0.0;        ///< held-out RMS of ε with the effects kept so far and this one
+  double without_A = 0.0;     ///< … with the effects kept so far
+  bool kept = true;
 };
 
 struct Diagnosis {
   DiagnoseOptions options;
   std::unique_ptr<LogData> log;         ///< owned: the replays refer to it
   io::MachineConfig config;             ///< as given
-  io::MachineConfig extended_config;    ///< with the found effects (extended.yaml)
+  io::MachineConfig extended_config;    ///< calibrated constants and the kept effects (extended.yaml)
   EffectContext context;
+  double baseline_heldout_rms_A = 0.0;  ///< the configuration's whole model, as it is
+  Calibration calibration;
   Selection selection;
-  ExtendedModel extended_model;
-  ReplayOutput nominal_replay, extended_replay;
-  ResidualStatistics statistics;
-  EstimatorComparison estimates;
+  std::vector<EstimatorCheck> estimator_checks;  ///< one per found effect, in the order found
+  ExtendedModel extended_model;         ///< the calibrated baseline with every found effect
+  ReplayOutput baseline_replay, extended_replay;
+  ResidualStatistics statistics;        ///< before: the baseline; after: the extended model
+  Verdict verdict;
+  EstimatorComparison estimates;        ///< nominal: the configuration; extended: extended_config
   double elapsed_s = 0.0;
 };
 
 /// `truth` may be empty (unknown).
 [[nodiscard]] Diagnosis diagnose(LogData log, const io::MachineConfig& config, const DiagnoseOptions& options,
                                  const ParameterTrack& truth = {});
+
+/// The configuration a model stands for: `input` with the model's identifiable constants, extensions and
+/// drift laws (referred to `reference_C`).
+[[nodiscard]] io::MachineConfig config_of(const io::MachineConfig& input, const ExtendedModel& model,
+                                          const std::array<bool, kCalibrated.size()>& constants, double reference_C);
 
 }  // namespace rpem::analysis

@@ -1,9 +1,12 @@
 #pragma once
-// Fitting effects to a log: the parameters of a set of effects minimise the training blocks' squared
-// residuals of the replay (nonlinear least squares, Ceres, forward differences through the whole
-// replay); the held-out blocks judge the result. Screening ranks candidates cheaply by the first
-// Gauss–Newton step: the reduction r₀ᵀJ(JᵀJ)⁻¹Jᵀr₀ of the training sum of squares it predicts.
+// Fitting effects to a log: the baseline's calibrated constants and the parameters of a set of effects
+// minimise the training blocks' squared residuals of the replay (nonlinear least squares, Ceres, forward
+// differences through the replay of the training blocks); the held-out blocks judge the result.
+// Screening ranks candidates cheaply by the first Gauss–Newton step: the reduction r₀ᵀJ(JᵀJ)⁻¹Jᵀr₀ of
+// the training sum of squares it predicts, with the calibrated constants' columns in J, so that what
+// the calibration already explains is not credited to a candidate.
 
+#include <array>
 #include <vector>
 
 #include "rpem/analysis/diagnose/effects.hpp"
@@ -11,14 +14,19 @@
 
 namespace rpem::analysis {
 
-/// A set of effects with their scaled parameters.
+/// The baseline's calibrated constants and a set of effects with their scaled parameters.
 struct EffectSet {
+  std::array<double, kCalibrated.size()> calibration{};  ///< relative changes, scaled (1 = 1 %)
+  std::array<bool, kCalibrated.size()> calibrated{};     ///< which the fits may move (identifiable)
   std::vector<Effect> effects;
   std::vector<std::vector<double>> parameters;
 
   [[nodiscard]] ExtendedModel model(const EffectContext& c) const;
-  [[nodiscard]] EffectSet with(const Effect& e, const EffectContext& c) const;  ///< plus `e` at its nominal (zero) parameters
+  /// Plus `e` at `start` (its zero parameters if empty).
+  [[nodiscard]] EffectSet with(const Effect& e, const EffectContext& c, const std::vector<double>& start = {}) const;
+  [[nodiscard]] EffectSet without(const Effect& e) const;
   [[nodiscard]] bool contains(const Effect& e) const;
+  [[nodiscard]] int free_calibration() const;
 };
 
 struct BlockScores {
@@ -27,20 +35,44 @@ struct BlockScores {
   [[nodiscard]] double total() const;
 };
 
+/// The calibrated constants' 95 % intervals (docs/diagnose.md, "The calibrated baseline").
+struct CalibrationIntervals {
+  /// Cluster-robust over the training blocks (sandwich (JᵀJ)⁻¹·(Σ_b J_bᵀr_b r_bᵀJ_b)·(JᵀJ)⁻¹), relative.
+  std::array<double, kCalibrated.size()> half_width{};
+  /// What the log's excitation alone allows (σ²·(JᵀJ)⁻¹ with σ the noise floor), relative.
+  std::array<double, kCalibrated.size()> excitation_half_width{};
+};
+
+/// What the screening of one round shares: the starting residuals and the calibration's columns.
+struct ScreenBasis {
+  std::vector<double> r0;
+  std::vector<std::vector<double>> columns;  ///< Jacobian columns of the free calibrated constants
+  double explained = 0.0;                    ///< what those columns alone would remove [A²]
+};
+
 class EffectFitter {
  public:
   EffectFitter(const ModelReplay& replay, const EffectContext& context);
 
-  /// Fits every parameter of `start` jointly from its values; returns the fitted set.
-  [[nodiscard]] EffectSet fit(const EffectSet& start) const;
+  /// Fits every free parameter of `start` jointly from its values; returns the fitted set (and, if
+  /// asked, its training sum of squares).
+  [[nodiscard]] EffectSet fit(const EffectSet& start, double* training_ssr = nullptr) const;
 
-  /// Training sum of squares `base` would lose, to first order, by adding `candidate`.
-  [[nodiscard]] double screen(const EffectSet& base, const Effect& candidate) const;
+  [[nodiscard]] ScreenBasis screen_basis(const EffectSet& base) const;
+  /// Training sum of squares `base` would lose, to first order, by adding `candidate` at `start`.
+  [[nodiscard]] double screen(const ScreenBasis& basis, const EffectSet& base, const Effect& candidate,
+                              const std::vector<double>& start) const;
+  /// The candidate's best start (of its row's starts) and what the screening credits it with.
+  [[nodiscard]] std::pair<std::vector<double>, double> best_start(const ScreenBasis& basis, const EffectSet& base,
+                                                                  const Effect& candidate) const;
 
   /// Training sum of squares [A²].
   [[nodiscard]] double training_ssr(const EffectSet& set) const;
   /// Sums of squares per held-out block.
   [[nodiscard]] BlockScores heldout(const EffectSet& set) const;
+
+  /// The calibrated constants' intervals for a fitted set; `noise_floor_A` scales the excitation's.
+  [[nodiscard]] CalibrationIntervals intervals(const EffectSet& set, double noise_floor_A) const;
 
   [[nodiscard]] const ModelReplay& replay() const noexcept { return replay_; }
   [[nodiscard]] const EffectContext& context() const noexcept { return context_; }
@@ -49,9 +81,12 @@ class EffectFitter {
   void training_residuals(const EffectSet& set, std::vector<double>& out) const;
 
  private:
+  /// Forward-difference Jacobian column of the training residuals for a change h of one parameter.
+  [[nodiscard]] std::vector<double> column(const EffectSet& moved, const std::vector<double>& r0, double h) const;
+
   const ModelReplay& replay_;
   EffectContext context_;
-  std::vector<std::size_t> training_;  ///< samples with a prediction in training blocks (nominal replay)
+  std::vector<std::size_t> training_;  ///< samples with a prediction in training blocks (baseline replay)
 };
 
 }  // namespace rpem::analysis

@@ -1,80 +1,146 @@
 #pragma once
-// The catalogue of effects `rpem diagnose` can name (docs/diagnose.md). Each is a model extension with
-// named SI parameters (docs/model-extensions.md). For the fit, each effect's parameters are scaled so
-// that 0 is the nominal model and 1 a typical magnitude; describe() gives them back in SI.
+// The catalogue of effects `rpem diagnose` can name (docs/diagnose.md, "The catalogue"), as a table: one
+// row per effect — its name, its scaled parameters with their bounds, the logs that can show it, how it
+// enters the model (apply), what it reports in SI (describe), what it cannot be told apart from and which
+// data would separate them, and when a fitted value is physically implausible. Adding an effect is adding
+// a row to analysis/src/diagnose/catalogue.cpp; nothing else in the diagnosis switches over effects.
+//
+// For the fit each effect's parameters are scaled so that 0 is the model without it (the baseline's
+// value) and 1 a typical magnitude. Every effect adds to the model it is applied to, so effects found in
+// a log add to those the configuration already has.
 
+#include <array>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <utility>
 #include <vector>
 
 #include "rpem/analysis/diagnose/log_data.hpp"
 #include "rpem/core/conditioner.hpp"
 #include "rpem/core/settings.hpp"
+#include "rpem/core/thermal.hpp"
 
 namespace rpem::analysis {
 
-enum class EffectKind : int {
-  kDeadtime = 0,   ///< inverter voltage error −sign(i)·v_err per leg
-  kLdSaturation,   ///< L_d(i_d) = L_d,nom·(level + curvature·i_d²)
-  kLqSaturation,   ///< L_q(i_q)
-  kThetaOffset,    ///< encoder misalignment
-  kCurrentOffset,  ///< per-phase current sensor offset
-  kCurrentGain,    ///< per-phase current sensor gain error
-  kRsDrift,        ///< R_s against winding temperature or time
-  kPsimDrift,      ///< ψm against magnet temperature or time
-  kDelay,          ///< the command acts late
-  kIronLoss,       ///< resistance parallel to the induced voltage
-};
-
-struct Effect {
-  EffectKind kind = EffectKind::kDeadtime;
-  int phase = -1;  ///< 0, 1, 2 (a, b, c) for the per-phase sensor effects
-  [[nodiscard]] std::string name() const;   ///< catalogue name, e.g. "current_offset"
-  [[nodiscard]] std::string label() const;  ///< with the phase, e.g. "current_offset(b)"
-  bool operator==(const Effect&) const = default;
-};
-
-/// A parameter's drift: value = nominal·(1 + offset + slope·x), x the time through the log (0 … 1) or
-/// the temperature above the reference [K].
-struct DriftLaw {
-  enum class Basis { kNone, kTime, kTemperature };
-  Basis basis = Basis::kNone;
-  double offset = 0.0;
-  double slope = 0.0;
-};
-
-/// The drift's factor at time fraction `tau` (0 … 1 through the log) or temperature `temperature_C`.
-[[nodiscard]] double drift_factor(const DriftLaw& d, double tau, const std::optional<double>& temperature_C,
-                                  double reference_C) noexcept;
-
-/// The model diagnose replays: the nominal machine with model extensions and drifts.
+/// The model diagnose replays: the machine's constants, its model extensions, and how R_s and ψm move
+/// through the log — against the logged temperatures (laws whose value at their reference temperature
+/// is the machine's constant; value_ref is not used) or, without temperatures, a relative trend over the
+/// log centred on its middle.
 struct ExtendedModel {
+  core::MachineSi machine;
   core::ModelExtensions extensions;
-  DriftLaw r_s, psi_m;
+  std::optional<core::DriftLaw> r_s_law, psi_m_law;
+  double r_s_trend = 0.0, psi_m_trend = 0.0;
+};
+
+/// A temperature column of the log.
+struct TemperatureColumn {
+  bool logged = false;
+  double mean_C = 0.0;
+  double span_K = 0.0;  ///< between its 5th and 95th percentile
 };
 
 /// Facts of the log and the machine that the parametrisations and descriptions need.
 struct EffectContext {
   ModelMode mode = ModelMode::kTransient;
-  core::MachineSi machine;
-  core::ModelExtensions base_extensions;  ///< the input configuration's own: part of the nominal model
-  double base_current_A = 0.0;       ///< I_b
+  core::MachineSi machine;  ///< as configured
+  ExtendedModel base;       ///< the configuration's whole model (extensions and drift laws), the baseline
+  double base_current_A = 0.0;              ///< I_b
   double max_i_d_A = 0.0, max_i_q_A = 0.0;  ///< largest |i_d|, |i_q| logged
   double max_speed_rad_s = 0.0;
   double t_start_s = 0.0, t_span_s = 0.0;
-  bool t_winding = false, t_magnet = false;  ///< temperature columns present
-  double reference_C = 20.0;         ///< temperature at which the nominal r_s and ψm hold
-  double sample_period_s = 0.0;      ///< median sample interval
+  TemperatureColumn t_winding, t_magnet;
+  double reference_C = 20.0;          ///< temperature at which reported drift laws are referred
+  double sample_period_s = 0.0;       ///< median sample interval
   double mean_u_dc_V = 0.0;
   double switching_frequency_Hz = 0.0;  ///< 0: unknown (t_dead_s is then not reported)
 
-  [[nodiscard]] static EffectContext of(const LogData& log, const core::MachineSi& machine,
-                                        const core::ModelExtensions& base_extensions, double reference_C,
-                                        double switching_frequency_Hz);
+  /// `base`: the configuration's model as it replays on this log (make_base_model).
+  [[nodiscard]] static EffectContext of(const LogData& log, const core::MachineSi& machine, const ExtendedModel& base,
+                                        double reference_C, double switching_frequency_Hz);
 };
 
-/// Every candidate this log could show (one per phase for the per-phase sensor effects).
+/// The configuration's whole model for a log (docs/diagnose.md, item "The configuration is the baseline"):
+/// its model extensions and its drift laws, which act against the log's temperature columns (referred to
+/// the column's mean temperature, where the fit is best conditioned); a law whose column the log lacks
+/// cannot act and leaves the constant.
+[[nodiscard]] ExtendedModel make_base_model(const core::MachineSi& machine, const core::ModelExtensions& extensions,
+                                            const std::optional<core::DriftLaw>& r_s_law,
+                                            const std::optional<core::DriftLaw>& psi_m_law, const LogData& log);
+
+/// The temperature columns of a log.
+[[nodiscard]] TemperatureColumn winding_column(const LogData& log);
+[[nodiscard]] TemperatureColumn magnet_column(const LogData& log);
+
+/// A drift coefficient against a temperature column is a candidate only when the column spans at least
+/// this much (docs/diagnose.md, "Drift laws"): copper's 0.39 %/K moves R_s by 3.9 % over it, NdFeB's
+/// −0.1 %/K ψm by 1 %, both well above what the held-out test resolves.
+inline constexpr double kMinDriftSpan_K = 10.0;
+
+/// One named SI parameter of a found effect (`text` for non-numeric ones such as the phase).
+struct NamedValue {
+  std::string name;
+  double value = 0.0;
+  std::string text;
+};
+
+/// Another effect this one can be mistaken for, and the data that would separate them.
+struct Confusion {
+  std::string_view other;
+  std::string_view separating_data;
+};
+
+/// Why a fitted effect is not physical, and what the residual it explains more likely is.
+struct Implausibility {
+  std::string reason;
+  std::string more_likely;
+};
+
+struct Effect;
+
+/// One row of the catalogue.
+struct EffectRow {
+  std::string_view name;
+  int parameters = 1;            ///< scaled parameters
+  bool per_phase = false;        ///< a candidate once per phase
+  bool steady_state = true;      ///< a steady-state log can show it
+  std::string_view not_in_steady_state;  ///< why it cannot (diagnosis.json not_identifiable)
+  std::string_view shows_as;     ///< the residual's signature (report, docs)
+  std::string_view enters;       ///< how it enters the model (docs)
+  std::vector<Confusion> confusions;
+  /// Starting points (scaled) for effects whose residual is not convex in their parameters; the
+  /// screening tries each and the fit starts from the best. Empty: zero.
+  std::vector<std::vector<double>> starts;
+  /// Whether this log can show it at all (beyond its kind); nullptr: always.
+  bool (*applies)(const EffectContext&) = nullptr;
+  /// Bounds of scaled parameter i; nullptr: unbounded.
+  std::pair<double, double> (*bounds)(const EffectContext&, int i) = nullptr;
+  /// Adds the effect with scaled parameters p to the model.
+  void (*apply)(const Effect&, const double* p, const EffectContext&, ExtendedModel&) = nullptr;
+  /// Its SI parameters as they stand in a model (the configuration's part included).
+  std::vector<NamedValue> (*describe)(const Effect&, const ExtendedModel&, const EffectContext&) = nullptr;
+  /// Set when the fitted model is physically implausible; nullptr: always plausible.
+  std::optional<Implausibility> (*judge)(const Effect&, const ExtendedModel&, const EffectContext&) = nullptr;
+};
+
+/// The catalogue, in the order candidates are listed.
+[[nodiscard]] const std::vector<EffectRow>& catalogue();
+/// The row of an effect by name (throws std::invalid_argument naming the catalogue for an unknown one).
+[[nodiscard]] const EffectRow& effect_row(std::string_view name);
+
+struct Effect {
+  const EffectRow* row = nullptr;
+  int phase = -1;  ///< 0, 1, 2 (a, b, c) for the per-phase effects
+  [[nodiscard]] std::string name() const { return std::string(row->name); }
+  [[nodiscard]] std::string label() const;  ///< with the phase, e.g. "current_offset(b)"
+  bool operator==(const Effect&) const = default;
+};
+
+/// The effect by name (and phase).
+[[nodiscard]] Effect effect(std::string_view name, int phase = -1);
+
+/// Every candidate this log could show.
 [[nodiscard]] std::vector<Effect> candidates(const EffectContext& c);
 
 /// Effects this kind of log cannot show at all, with the reason (diagnosis.json "not_identifiable").
@@ -84,19 +150,29 @@ struct Unidentifiable {
 };
 [[nodiscard]] std::vector<Unidentifiable> unobservable(const EffectContext& c);
 
-[[nodiscard]] int parameter_count(const Effect& e, const EffectContext& c) noexcept;
-/// Bounds of the scaled parameter i (±large where the physics sets none).
+/// What data would tell two effects apart (the catalogue's confusions; a general answer otherwise).
+[[nodiscard]] std::string separating_data(const Effect& a, const Effect& b);
+
+/// Bounds of the scaled parameter i (±∞ where the physics sets none).
 [[nodiscard]] std::pair<double, double> parameter_bounds(const Effect& e, const EffectContext& c, int i);
 
-/// Adds the effect with scaled parameters p to the model.
-void apply(const Effect& e, const double* p, const EffectContext& c, ExtendedModel& model);
+/// The machine's constants that the baseline calibrates (docs/diagnose.md, "The calibrated baseline"):
+/// ψm, R_s, L_d, L_q, each as a relative change, scaled so that 1 is 1 %.
+inline constexpr std::array<const char*, 4> kCalibrated{"psi_m_Wb", "r_s_Ohm", "l_d_H", "l_q_H"};
+inline constexpr double kCalibrationScale = 0.01;
+/// A calibrated constant stays within ±50 % of the configuration's.
+inline constexpr double kCalibrationBound = 50.0;
 
-/// One named SI parameter of a found effect (`text` for non-numeric ones such as the phase).
-struct NamedValue {
-  std::string name;
-  double value = 0.0;
-  std::string text;
-};
-[[nodiscard]] std::vector<NamedValue> describe(const Effect& e, const double* p, const EffectContext& c);
+/// The machine's fields in kCalibrated order.
+inline constexpr std::array<double core::MachineSi::*, 4> kCalibratedFields{
+    &core::MachineSi::psi_m_Wb, &core::MachineSi::r_s_Ohm, &core::MachineSi::l_d_H, &core::MachineSi::l_q_H};
+
+/// R_s and ψm of a model at sample k of the log [Ω, Wb].
+[[nodiscard]] double r_s_at(const ExtendedModel& m, const LogData& log, std::size_t k) noexcept;
+[[nodiscard]] double psi_m_at(const ExtendedModel& m, const LogData& log, std::size_t k) noexcept;
+
+/// A drift law of a model as the configuration records it: referred to `reference_C`, value_ref the
+/// model's constant.
+[[nodiscard]] core::DriftLaw recorded_law(const core::DriftLaw& law, double value_at_law_reference, double reference_C);
 
 }  // namespace rpem::analysis

@@ -49,10 +49,15 @@ struct EstimatorComparison {
 };
 
 /// `extended` is the model with the found effects (drifts apply to the steady-state method only:
-/// the recursive estimator tracks ψm and R_s itself).
+/// the recursive estimator tracks ψm and R_s itself); the steady-state method's "nominal" is the
+/// context's baseline.
 [[nodiscard]] EstimatorComparison compare_estimates(const LogData& log, const io::MachineConfig& nominal,
                                                     const io::MachineConfig& extended_config,
                                                     const ExtendedModel& extended, const EffectContext& context,
                                                     const ParameterTrack& truth);
+
+/// RMS of the RPEM estimator's prediction error ε over the held-out blocks when it runs over the whole
+/// log with `config` (docs/diagnose.md, "An extension must help the estimator") [A].
+[[nodiscard]] double estimator_heldout_rms_A(const LogData& log, const io::MachineConfig& config);
 
 }  // namespace rpem::analysis

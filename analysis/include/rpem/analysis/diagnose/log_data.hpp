@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "rpem/core/settings.hpp"
+#include "rpem/core/types.hpp"
 #include "rpem/io/drive_log.hpp"
 
 namespace rpem::analysis {
@@ -29,10 +30,12 @@ struct LogData {
   double max_current_A = 0.0;   ///< largest measured current amplitude
   double max_speed_rad_s = 0.0; ///< largest |ω_el|
   double mean_u_dc_V = 0.0;
-  /// Transient logs: the electrical speed as the centred difference of the logged angle over
-  /// ±speed_half_window samples — no lag, unlike a drive's causal speed signal. The replay uses it;
-  /// the estimator runs see the logged speed, as the drive gave it.
-  std::vector<double> replay_speed_rad_s;
+  /// The samples the replay runs on: as logged, but (transient logs) with the electrical speed as the
+  /// centred difference of the logged angle over ±speed_half_window samples — no lag, unlike a drive's
+  /// causal speed signal. The estimator runs see the logged speed, as the drive gave it.
+  std::vector<core::DriveSample> replay_samples;
+  /// The logged current as dq at the logged angle [A]: what every model is compared with.
+  std::vector<core::Vec2> logged_i_dq_A;
   /// Samples that take part (steady state leaves out idle and transitional rows).
   std::vector<bool> used;
   std::size_t excluded_idle = 0, excluded_transitional = 0;
@@ -46,6 +49,8 @@ struct LogData {
   }
   [[nodiscard]] bool training(std::size_t k) const noexcept { return used[k] && block[k] % 2 == 0; }
   [[nodiscard]] bool heldout(std::size_t k) const noexcept { return used[k] && block[k] % 2 == 1; }
+  /// Whether sample k opens its block.
+  [[nodiscard]] bool block_start(std::size_t k) const noexcept { return k == 0 || block[k] != block[k - 1]; }
 };
 
 struct LogOptions {

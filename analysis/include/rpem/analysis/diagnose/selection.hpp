@@ -1,7 +1,9 @@
 #pragma once
-// Forward selection of effects (docs/diagnose.md, "How an effect is accepted"). Each round screens
-// every remaining candidate, fits the most promising jointly with the effects already found, and
-// accepts the one that lowers the held-out residual most — only if the held-out gain is both large
+// Forward selection of effects (docs/diagnose.md, "How an effect is accepted"), starting from the
+// calibrated baseline. Each round screens every remaining candidate, fits the most promising jointly
+// with the effects already found and the calibrated constants, and accepts the one that lowers the
+// held-out residual most — if it is physically plausible (a drift law's coefficient in a material's
+// range; an implausible one is reported, never named, and the next candidate takes its place) and only if the held-out gain is both large
 // (≥ min_gain_pct of RMS) and consistent across the held-out blocks: a one-sided Wilcoxon signed-rank
 // test on the per-block log ratios ln(SSR before/SSR after) (blocks the effect cannot touch have a
 // ratio of 0 and drop out) must give p ≤ max_p. So noise, which a training fit always "explains" a
@@ -21,7 +23,11 @@ struct SelectionOptions {
   double min_gain_pct = 2.0;   ///< held-out RMS gain an effect must bring
   double max_p = 0.01;         ///< signed-rank p over the held-out blocks
   int max_effects = 4;
-  int shortlist = 4;           ///< candidates fitted in full per round
+  int shortlist = 4;           ///< candidates fitted in full per round (at most) …
+  double shortlist_share = 0.05;  ///< … of those screened at this share of the best or more (at least 2);
+  /// after the first `threads` fits, a shortlisted candidate is fitted only if its screening credits it
+  /// with this share of the training gain the best of them achieved (it could not rival it otherwise).
+  double rival_share = 0.25;
   /// Ambiguity: a rival that passes the same acceptance tests, that the held-out blocks do not prefer
   /// the winner to (signed-rank p above this) …
   double ambiguity_p = 0.05;
@@ -49,16 +55,26 @@ struct FoundEffect {
   double p_value = 1.0;
 };
 
+/// A candidate that would have been accepted but whose fitted value is not physical.
+struct ImplausibleEffect {
+  Effect effect;
+  std::vector<NamedValue> parameters;
+  double gain_pct = 0.0;
+  Implausibility why;
+};
+
 struct Selection {
-  EffectSet model;                     ///< the found (named) effects, fitted jointly
+  EffectSet model;                     ///< the calibrated constants and the found (named) effects, fitted jointly
   std::vector<FoundEffect> found;
   std::vector<Unidentifiable> not_identifiable;
+  std::vector<ImplausibleEffect> implausible;
   std::vector<std::vector<CandidateScore>> rounds;
-  double nominal_heldout_rms_A = 0.0;
+  double start_heldout_rms_A = 0.0;     ///< the model selection started from (the calibrated baseline)
   double extended_heldout_rms_A = 0.0;
 };
 
-[[nodiscard]] Selection select_effects(const EffectFitter& fitter, const SelectionOptions& options);
+/// `start`: the calibrated baseline (its calibrated constants stay free in every fit).
+[[nodiscard]] Selection select_effects(const EffectFitter& fitter, const SelectionOptions& options, const EffectSet& start);
 
 /// Held-out RMS of block scores [A].
 [[nodiscard]] double rms(const BlockScores& b);

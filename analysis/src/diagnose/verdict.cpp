@@ -1,0 +1,110 @@
+#include "rpem/analysis/diagnose/verdict.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+
+namespace rpem::analysis {
+namespace {
+
+/// The median of χ²₁: a squared standard normal lies below it half the time.
+constexpr double kMedianChiSquare1 = 0.454936;
+/// Var(r_{k+1} − 2·r_k + r_{k−1}) / Var(r) for white r.
+constexpr double kSecondDifferenceGain = 6.0;
+
+double median(std::vector<double> v) {
+  if (v.empty()) return 0.0;
+  const auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
+  std::nth_element(v.begin(), mid, v.end());
+  return *mid;
+}
+
+std::string num(double v) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%.3g", v);
+  return b;
+}
+
+/// What a residual at harmonic h of the electrical angle (dq frame) is most often.
+std::string harmonic_meaning(int h) {
+  if (h == 0) return "an error that depends on the operating point (saturation of another shape, cross-saturation, a "
+                     "resistance or flux error varying with the load)";
+  if (h == 1) return "a current-sensor offset or an unbalanced winding";
+  if (h == 2) return "a current-sensor gain error or an unbalanced impedance";
+  if (h % 6 == 0) return "rotor-frame flux harmonics of another form, or an inverter voltage error of another shape than "
+                         "the catalogue's dead time";
+  return "an angle-periodic error outside the catalogue (encoder eccentricity, slotting)";
+}
+
+/// What a residual correlated with a regressor most likely is.
+std::string regressor_meaning(const std::string& r) {
+  if (r.rfind("T_", 0) == 0) return "a temperature dependence the catalogue's drift laws do not carry";
+  if (r.rfind("time", 0) == 0) return "a drift over the log (heating without logged temperatures)";
+  if (r.find("speed") != std::string::npos) return "a speed-dependent error (angle, delay, iron loss, the EMF's shape)";
+  return "a current-dependent error (resistance, the inverter's voltage error, saturation)";
+}
+
+}  // namespace
+
+double noise_floor_A(const LogData& log, const ReplayOutput& replay) {
+  std::vector<double> d2, q2;
+  const std::size_t n = log.rows.size();
+  for (std::size_t k = 1; k + 1 < n; ++k) {
+    if (!replay.valid[k - 1] || !replay.valid[k] || !replay.valid[k + 1]) continue;
+    if (log.block[k - 1] != log.block[k + 1] || log.rows[k].sample.gap_before || log.rows[k + 1].sample.gap_before) continue;
+    const core::Vec2 e = replay.residual_A[k + 1] - 2.0 * replay.residual_A[k] + replay.residual_A[k - 1];
+    d2.push_back(e[0] * e[0]);
+    q2.push_back(e[1] * e[1]);
+  }
+  if (d2.size() < 10) return 0.0;
+  const double scale = 1.0 / (kSecondDifferenceGain * kMedianChiSquare1);
+  return std::sqrt(scale * (median(std::move(d2)) + median(std::move(q2))));
+}
+
+Verdict verdict(double final_heldout_rms_A, double floor_A, const ResidualStatistics& st) {
+  Verdict v;
+  v.noise_floor_A = floor_A;
+  v.ratio = floor_A > 0.0 ? final_heldout_rms_A / floor_A : std::numeric_limits<double>::infinity();
+  v.explained = v.ratio <= kExplainedRatio;
+  if (v.explained) return v;
+
+  // Where it lives: standstill against motion, and the region that carries the most.
+  v.findings.push_back("at standstill " + num(st.standstill_rms_A.after) + " A RMS, in motion " + num(st.motion_rms_A.after) +
+                       " A RMS (noise floor " + num(floor_A) + " A)");
+  const RegionStatistics* worst = nullptr;
+  for (const RegionStatistics& r : st.regions) {
+    if (!worst || r.rms_A.after > worst->rms_A.after) worst = &r;
+  }
+  if (worst) {
+    v.findings.push_back("largest in the region " + worst->speed + ", " + worst->load + ": " + num(worst->rms_A.after) +
+                         " A RMS, mean ε_d " + num(worst->mean_d_A.after) + " A, ε_q " + num(worst->mean_q_A.after) + " A");
+  }
+  // Against the electrical angle: the strongest harmonic, if it stands out.
+  const HarmonicContent* strongest = nullptr;
+  for (const HarmonicContent& h : st.harmonics) {
+    if (!strongest || h.amplitude_A.after > strongest->amplitude_A.after) strongest = &h;
+  }
+  if (strongest && strongest->amplitude_A.after > floor_A) {
+    v.findings.push_back("against the electrical angle the residual is strongest at harmonic " + std::to_string(strongest->order) +
+                         " (" + num(strongest->amplitude_A.after) + " A): most often " + harmonic_meaning(strongest->order));
+  }
+  // With what it moves.
+  const RegressorCorrelation* best = nullptr;
+  double best_r = 0.0;
+  for (const RegressorCorrelation& c : st.correlations) {
+    const double r = std::max(std::abs(c.d.after), std::abs(c.q.after));
+    if (r > best_r) {
+      best_r = r;
+      best = &c;
+    }
+  }
+  if (best && best_r >= 0.3) {
+    v.findings.push_back("it correlates with " + best->regressor + " (" + num(best_r) + "): " + regressor_meaning(best->regressor));
+  }
+  v.findings.push_back("a log with more operating points — standstill at several currents of both signs, several speeds at "
+                       "several loads, temperatures that span tens of kelvin — would tell more effects apart");
+  return v;
+}
+
+}  // namespace rpem::analysis
