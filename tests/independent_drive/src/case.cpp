@@ -257,8 +257,8 @@ void draw_effect_parameters(Case& c) {
 
   if (e.deadtime.on) e.deadtime.t_dead_s = t_dead;
   if (e.delay.on) {
-    e.delay.delay_s = (whole + frac) * t_c;
-    e.delay.periods = kAuto;
+    e.delay.periods = whole + frac;
+    e.delay.delay_s = e.delay.periods * t_c;
   }
   if (e.theta_offset.on) e.theta_offset.offset_rad = theta;
   if (e.current_offset.on) e.current_offset = {true, off_phase, offset};

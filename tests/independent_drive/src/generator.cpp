@@ -179,15 +179,23 @@ Result generate(const Case& input) {
       const Vec2 i_dq = park(clarke(i_meas), theta_meas);
       averager->add_sample(t, {i_dq.x, i_dq.y, cmd.u_dq_V.x, cmd.u_dq_V.y, omega_meas, u_dc_meas, t_w, t_m});
     }
-    PlantRow row{t, wrap_2pi(x.theta_rad), op.omega_el_rad_s, now.i_A, {}, op.psi_m_Wb, op.r_s_Ohm,
-                 plant.torque_Nm(x, now, op, p), c.thermal.winding.at(t), c.thermal.magnet.at(t)};
+    PlantRow row;
+    row.t_s = t;
+    row.theta_el_rad = wrap_2pi(x.theta_rad);
+    row.omega_el_rad_s = op.omega_el_rad_s;
+    row.i_A = now.i_A;
+    row.psi_m_Wb = op.psi_m_Wb;
+    row.r_s_Ohm = op.r_s_Ohm;
+    row.torque_Nm = plant.torque_Nm(x, now, op, p);
+    row.T_winding_C = c.thermal.winding.at(t);
+    row.T_magnet_C = c.thermal.magnet.at(t);
     delay.push(cmd.duty);
 
     // The plant over [t, t + T_c): the delayed issues, each held, in RK4 sub-steps.
     const double f = delay.fraction();
     struct Segment { double t0, t1; const std::array<double, 3>* duty; };
     Segment segments[2] = {{t, t + f * t_c, &delay.first()}, {t + f * t_c, t + t_c, &delay.second()}};
-    Vec2 u_integral;
+    Vec2 u_integral, u_integral_ab;
     for (const Segment& s : segments) {
       const double length = s.t1 - s.t0;
       if (!(length > 0.0)) continue;
@@ -197,13 +205,16 @@ Result generate(const Case& input) {
       now = plant.evaluate(x, legs, drivers(s.t0));
       for (int j = 0; j < steps; ++j) {
         const double t0 = s.t0 + j * h;
+        const double theta_before = x.theta_rad;
         const PlantEval next = rk4_step(plant, x, now, t0, h, legs, drivers);
         u_integral = u_integral + (0.5 * h) * (now.u_V + next.u_V);
+        u_integral_ab = u_integral_ab + (0.5 * h) * (inverse_park(now.u_V, theta_before) + inverse_park(next.u_V, x.theta_rad));
         if (plant_average) averager->add_segment(t0, outputs(now, t0), t0 + h, outputs(next, t0 + h));
         now = next;
       }
     }
     row.u_applied_V = (1.0 / t_c) * u_integral;
+    row.u_applied_ab_V = (1.0 / t_c) * u_integral_ab;
     if (c.keep_plant_rows) r.plant.push_back(row);
   }
 
