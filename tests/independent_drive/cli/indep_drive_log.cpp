@@ -115,7 +115,10 @@ int main(int argc, char** argv) {
     c.keep_plant_rows = !plant_out.empty();
     if (!profile.empty()) c.profile.points = indep::read_profile_csv(profile).points();
     for (const std::string& s : sets) apply_set(c, s);
-    if (draw_effects) indep::draw_effect_parameters(c);
+    if (draw_effects) {
+      indep::draw_effect_parameters(c);
+      for (const std::string& s : sets) apply_set(c, s);  // what the user set explicitly wins over the draw
+    }
   } catch (const std::invalid_argument& e) {
     std::cerr << "indep_drive_log: " << e.what() << "\n";
     return kExitUsage;
@@ -130,8 +133,10 @@ int main(int argc, char** argv) {
     if (!out.empty()) indep::write_file(out, averaged ? indep::averaged_csv(r.averaged) : indep::log_csv(r.log));
     if (!truth_path.empty()) indep::write_file(truth_path, indep::truth_json(r.truth));
     if (!plant_out.empty()) indep::write_file(plant_out, indep::plant_csv(r.plant));
+    std::string hidden;
+    for (const std::string& name : indep::enabled_effects(c.effects)) hidden += (hidden.empty() ? "" : ",") + name;
     std::fprintf(stderr, "indep_drive_log: %.1f s at %.0f Hz generated in %.2f s (effects: %s)\n", c.duration_s,
-                 c.control.rate_Hz, seconds, effects.c_str());
+                 c.control.rate_Hz, seconds, hidden.empty() ? "none" : hidden.c_str());
   } catch (const std::invalid_argument& e) {
     std::cerr << "indep_drive_log: " << e.what() << "\n";
     return kExitUsage;
