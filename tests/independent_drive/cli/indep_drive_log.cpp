@@ -119,14 +119,6 @@ int main(int argc, char** argv) {
       indep::draw_effect_parameters(c);
       for (const std::string& s : sets) apply_set(c, s);  // what the user set explicitly wins over the draw
     }
-  } catch (const std::invalid_argument& e) {
-    std::cerr << "indep_drive_log: " << e.what() << "\n";
-    return kExitUsage;
-  } catch (const std::runtime_error& e) {
-    std::cerr << "indep_drive_log: " << e.what() << "\n";
-    return kExitData;
-  }
-  try {
     const auto start = std::chrono::steady_clock::now();
     const indep::Result r = indep::generate(c);
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
