@@ -20,8 +20,8 @@ const std::vector<EffectEntry>& effect_catalogue() {
       {"deadtime", [](Effects& e) -> bool& { return e.deadtime.on; }, "smooth dead-time and device voltage per leg"},
       {"delay", [](Effects& e) -> bool& { return e.delay.on; }, "command applied late, whole and fractional periods"},
       {"theta_offset", [](Effects& e) -> bool& { return e.theta_offset.on; }, "encoder zero off the d axis"},
-      {"current_offset", [](Effects& e) -> bool& { return e.current_offset.on; }, "one phase's current sensor offset"},
-      {"current_gain", [](Effects& e) -> bool& { return e.current_gain.on; }, "one phase's current sensor gain"},
+      {"current_offset", [](Effects& e) -> bool& { return e.current_offset.on; }, "current sensor offsets per phase"},
+      {"current_gain", [](Effects& e) -> bool& { return e.current_gain.on; }, "current sensor gains per phase"},
       {"ld_saturation", [](Effects& e) -> bool& { return e.saturation.ld; }, "L_d against i_d (measured map)"},
       {"lq_saturation", [](Effects& e) -> bool& { return e.saturation.lq; }, "L_q against i_q (measured map)"},
       {"cross_saturation", [](Effects& e) -> bool& { return e.saturation.cross; }, "psi_d against i_q, L_q against i_d (map)"},
@@ -99,10 +99,8 @@ Case resolve_defaults(Case c) {
   fill(e.delay.delay_s, t_c);
   e.delay.periods = e.delay.delay_s / t_c;
   require(e.delay.delay_s >= 0.0 && e.delay.periods < DelayLine::kMaxPeriods, "delay: delay_s must be in [0, 4 control periods)");
-  fill(e.current_offset.value, 0.015 * i_peak);
-  require(e.current_offset.phase >= 0 && e.current_offset.phase <= 2 && e.current_gain.phase >= 0 && e.current_gain.phase <= 2,
-          "current_offset/current_gain: phase must be 0, 1 or 2");
-  require(e.current_gain.value > 0.0, "current_gain.gain must be > 0");
+  for (double& v : e.current_offset.value) fill(v, 0.015 * i_peak);
+  for (double g : e.current_gain.value) require(g > 0.0, "current_gain: every phase's gain must be > 0");
   if (e.saturation.map_path.empty()) e.saturation.map_path = INDEP_DRIVE_DEFAULT_MAP;
   fill(e.saturation.full_scale_current_A, i_peak);
   require(e.saturation.full_scale_current_A > 0.0 && e.saturation.depth >= 0.0, "saturation: full_scale_current_A > 0, depth >= 0");
@@ -161,10 +159,12 @@ const std::vector<Entry>& table() {
       {"delay.periods", "1", [](Case& c, double v) { c.effects.delay.periods = v; }},
       {"theta_offset.offset_rad", "rad", [](Case& c, double v) { c.effects.theta_offset.offset_rad = v; }},
       {"theta_offset.offset_deg", "deg", [](Case& c, double v) { c.effects.theta_offset.offset_rad = v * kPi / 180.0; }},
-      {"current_offset.phase", "0-2", [](Case& c, double v) { c.effects.current_offset.phase = as_int(v, 0, 2); }},
-      {"current_offset.offset_A", "A", [](Case& c, double v) { c.effects.current_offset.value = v; }},
-      {"current_gain.phase", "0-2", [](Case& c, double v) { c.effects.current_gain.phase = as_int(v, 0, 2); }},
-      {"current_gain.gain", "1", [](Case& c, double v) { c.effects.current_gain.value = v; }},
+      {"current_offset.a_A", "A", [](Case& c, double v) { c.effects.current_offset.value[0] = v; }},
+      {"current_offset.b_A", "A", [](Case& c, double v) { c.effects.current_offset.value[1] = v; }},
+      {"current_offset.c_A", "A", [](Case& c, double v) { c.effects.current_offset.value[2] = v; }},
+      {"current_gain.a", "1", [](Case& c, double v) { c.effects.current_gain.value[0] = v; }},
+      {"current_gain.b", "1", [](Case& c, double v) { c.effects.current_gain.value[1] = v; }},
+      {"current_gain.c", "1", [](Case& c, double v) { c.effects.current_gain.value[2] = v; }},
       {"saturation.full_scale_current_A", "A", [](Case& c, double v) { c.effects.saturation.full_scale_current_A = v; }},
       {"saturation.depth", "1", [](Case& c, double v) { c.effects.saturation.depth = v; }},
       {"saturation.degree", "3-7", [](Case& c, double v) { c.effects.saturation.degree = as_int(v, 3, 7); }},
@@ -261,8 +261,14 @@ void draw_effect_parameters(Case& c) {
     e.delay.delay_s = e.delay.periods * t_c;
   }
   if (e.theta_offset.on) e.theta_offset.offset_rad = theta;
-  if (e.current_offset.on) e.current_offset = {true, off_phase, offset};
-  if (e.current_gain.on) e.current_gain = {true, gain_phase, gain};
+  if (e.current_offset.on) {
+    e.current_offset.value = {0.0, 0.0, 0.0};
+    e.current_offset.value[static_cast<std::size_t>(off_phase)] = offset;
+  }
+  if (e.current_gain.on) {
+    e.current_gain.value = {1.0, 1.0, 1.0};
+    e.current_gain.value[static_cast<std::size_t>(gain_phase)] = gain;
+  }
   if (e.saturation.any()) {
     e.saturation.depth = depth;
     e.saturation.full_scale_current_A = full_scale;

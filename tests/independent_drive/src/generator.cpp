@@ -60,8 +60,8 @@ HarmonicFlux harmonics_of(const Effects& e) {
 
 SensorErrors sensor_errors_of(const Effects& e) {
   SensorErrors s;
-  if (e.current_gain.on) s.gain[static_cast<std::size_t>(e.current_gain.phase)] = e.current_gain.value;
-  if (e.current_offset.on) s.offset_A[static_cast<std::size_t>(e.current_offset.phase)] = e.current_offset.value;
+  if (e.current_gain.on) s.gain = e.current_gain.value;
+  if (e.current_offset.on) s.offset_A = e.current_offset.value;
   if (e.theta_offset.on) s.logged_minus_true_rad = -e.theta_offset.offset_rad;
   return s;
 }

@@ -52,16 +52,34 @@ EffectTruth theta_offset(const Case& c) {
           {}};
 }
 
+/// Per-phase keys `<prefix>_a<unit>`…, `phase` naming the phases that differ from `neutral`, and the first
+/// of them under `key` (with `gain_error` for gains) so a single-phase error reads as one number.
+EffectTruth phase_errors(const char* name, const char* form, const PhaseErrorParams& p, double neutral, const char* prefix,
+                         const char* unit, const char* key) {
+  EffectTruth t{name, form, {}, {}};
+  std::string phases;
+  for (std::size_t k = 0; k < 3; ++k) {
+    const std::string phase = phase_name(static_cast<int>(k));
+    t.values.emplace_back(std::string(prefix) + "_" + phase + unit, p.value[k]);
+    if (p.value[k] == neutral) continue;
+    if (phases.empty()) {
+      t.values.emplace_back(key, p.value[k]);
+      if (neutral == 1.0) t.values.emplace_back("gain_error", p.value[k] - 1.0);
+    }
+    phases += (phases.empty() ? "" : ",") + phase;
+  }
+  t.labels.emplace_back("phase", phases);
+  return t;
+}
+
 EffectTruth current_offset(const Case& c) {
-  const PhaseErrorParams& p = c.effects.current_offset;
-  return {"current_offset", "i_measured = i_true + offset_A on one phase, before noise and quantisation",
-          {{"offset_A", p.value}}, {{"phase", phase_name(p.phase)}}};
+  return phase_errors("current_offset", "i_measured = i_true + offset per phase, before noise and quantisation",
+                      c.effects.current_offset, 0.0, "offset", "_A", "offset_A");
 }
 
 EffectTruth current_gain(const Case& c) {
-  const PhaseErrorParams& p = c.effects.current_gain;
-  return {"current_gain", "i_measured = gain * i_true on one phase, before noise and quantisation",
-          {{"gain", p.value}, {"gain_error", p.value - 1.0}}, {{"phase", phase_name(p.phase)}}};
+  return phase_errors("current_gain", "i_measured = gain * i_true per phase, before noise and quantisation",
+                      c.effects.current_gain, 1.0, "gain", "", "gain");
 }
 
 /// The saturation effects, each evaluated with its own terms only, at the log's largest currents.

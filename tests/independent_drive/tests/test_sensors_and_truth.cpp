@@ -17,8 +17,8 @@ TEST(IndepSensors, LoggedCurrentsAndAngleCarryTheHiddenErrorsWithinOneQuantisati
   c.sensors.adc_bits = 12;
   c.sensors.encoder_counts_per_rev = 4096;
   enable_effects(c.effects, "current_offset,current_gain,theta_offset");
-  c.effects.current_offset = {true, 2, 0.12};
-  c.effects.current_gain = {true, 0, 0.96};
+  c.effects.current_offset.value = {0.0, 0.0, 0.12};
+  c.effects.current_gain.value = {0.96, 1.0, 1.0};
   c.effects.theta_offset.offset_rad = 0.07;
   testing::hold(c, 250.0, 18.0);
   const Result r = generate(c);
@@ -34,7 +34,10 @@ TEST(IndepSensors, LoggedCurrentsAndAngleCarryTheHiddenErrorsWithinOneQuantisati
   }
   EXPECT_EQ(r.truth.effect("theta_offset")->value("offset_rad"), 0.07);
   EXPECT_EQ(r.truth.effect("current_offset")->labels.at(0).second, "c");
+  EXPECT_EQ(r.truth.effect("current_offset")->value("offset_A"), 0.12);
+  EXPECT_EQ(r.truth.effect("current_offset")->value("offset_a_A"), 0.0);
   EXPECT_EQ(r.truth.effect("current_gain")->value("gain_error"), 0.96 - 1.0);
+  EXPECT_EQ(r.truth.effect("current_gain")->labels.at(0).second, "a");
 }
 
 TEST(IndepDraw, TrueMachineStaysWithinItsSpansAndIsIndependentOfTheEffects) {

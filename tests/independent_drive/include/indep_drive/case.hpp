@@ -1,6 +1,7 @@
 #pragma once
 // A case: everything the generator needs, in SI (README "API"). Fields set to kAuto take the default
 // derived from the machine that README "Defaults" gives; resolve_defaults() fills them in.
+#include <array>
 #include <cstdint>
 #include <limits>
 #include <optional>
@@ -40,10 +41,10 @@ struct ThetaOffsetParams {
   bool on = false;
   double offset_rad = 0.05235987755982988;  // 3°, θ_true = θ_logged + offset_rad
 };
+/// A current sensor error per phase (a, b, c).
 struct PhaseErrorParams {
   bool on = false;
-  int phase = 0;  // 0 = a, 1 = b, 2 = c
-  double value = 0.0;
+  std::array<double, 3> value{};
 };
 struct SaturationParams {
   bool ld = false, lq = false, cross = false;
@@ -71,8 +72,8 @@ struct Effects {
   DeadTimeParams deadtime;
   DelayParams delay;
   ThetaOffsetParams theta_offset;
-  PhaseErrorParams current_offset{false, 0, kAuto};  // value: offset_A, 0.015·√2·I_n
-  PhaseErrorParams current_gain{false, 1, 1.03};     // value: measured/true
+  PhaseErrorParams current_offset{false, {kAuto, 0.0, 0.0}};  // offset_A per phase; a: 0.015·√2·I_n
+  PhaseErrorParams current_gain{false, {1.0, 1.03, 1.0}};     // measured/true per phase
   SaturationParams saturation;                        // ld_saturation, lq_saturation, cross_saturation
   HarmonicParams flux_harmonic_6{false, {6, 0.02, 0.4, 0.012, -0.9}};
   HarmonicParams flux_harmonic_12{false, {12, 0.006, 1.1, 0.004, 0.2}};
