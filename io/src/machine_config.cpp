@@ -129,6 +129,7 @@ core::InductanceCurve parse_inductance_curve(YamlMap m) {
   core::InductanceCurve c;
   c.level = m.number_or("level", 1.0, 0.05, 20.0);
   c.curvature_per_A2 = m.number_or("curvature_per_A2", 0.0, -1e3, 1e3);
+  c.slope_per_A = m.number_or("slope_per_A", 0.0, -1e3, 1e3);
   m.finish();
   return c;
 }
@@ -247,7 +248,10 @@ void drift_entry(std::ostringstream& out, const char* key, const ParameterDrift&
 
 void curve_entry(std::ostringstream& out, const char* key, const core::InductanceCurve& c) {
   if (c.nominal()) return;
-  out << "  " << key << ": " << FlowMap().add("level", c.level).add("curvature_per_A2", c.curvature_per_A2).str() << "\n";
+  FlowMap m;
+  m.add("level", c.level).add("curvature_per_A2", c.curvature_per_A2);
+  if (c.slope_per_A != 0.0) m.add("slope_per_A", c.slope_per_A);
+  out << "  " << key << ": " << m.str() << "\n";
 }
 
 }  // namespace

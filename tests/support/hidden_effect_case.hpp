@@ -88,9 +88,9 @@ inline bool explained_by_map(const std::string& name, const std::vector<analysis
   char buf[200];
   if (name == "lq_saturation" || name == "ld_saturation") {
     const bool q = name == "lq_saturation";
-    const double i = parameter(p, "i_max_A");
-    const core::Vec2 at = q ? core::Vec2(0.0, i) : core::Vec2(-i, 0.0);
-    const double truth = q ? map.flux(at)[1] / i : (map.magnet_flux_Wb() - map.flux(at)[0]) / i;
+    const double i = parameter(p, "i_max_A");  // signed for the d axis
+    const core::Vec2 at = q ? core::Vec2(0.0, i) : core::Vec2(i, 0.0);
+    const double truth = q ? map.flux(at)[1] / i : (map.flux(at)[0] - map.magnet_flux_Wb()) / i;
     const double got = parameter(p, "l_at_max_current_H");
     std::snprintf(buf, sizeof buf, " %s: L(%.2f A) %.4g H vs the map's %.4g H (%+.1f %%)", name.c_str(), i, got, truth,
                   100.0 * (got / truth - 1.0));

@@ -77,29 +77,34 @@ template <bool kD>
 EffectRow saturation() {
   EffectRow r;
   r.name = kD ? "ld_saturation" : "lq_saturation";
+  r.parameters = kD ? 2 : 1;  // the d axis also has the magnet's asymmetry (a slope in i_d)
   r.shows_as = kD ? "errors growing with |i_d|; transients" : "errors growing with |i_q|; transients";
-  r.enters = "L(i) = L·(level + curvature·i²) of that axis' current, at the measured current each sample (the calibrated "
-             "L is the level)";
+  r.enters = kD ? "L_d(i_d) = L_d·(level + slope·i_d + curvature·i_d²) at the measured current each sample (the calibrated "
+                  "L_d is the level)"
+                : "L_q(i_q) = L_q·(level + curvature·i_q²) at the measured current each sample (the calibrated L_q is the level)";
   if (kD) {
-    r.confusions = {{"psim_drift", "operation at two or more d-axis currents"}};
+    r.confusions = {{"psim_drift", "operation at two or more d-axis currents"},
+                    {"cross_saturation", "the same d-axis current at two or more q-axis currents"}};
   } else {
     r.confusions = {{"cross_saturation", "the same q-axis current at two or more d-axis currents"}};
   }
   r.bounds = [](const EffectContext&, int) { return range(-0.9 / kRelativeScale, 10.0 / kRelativeScale); };
   r.apply = [](const Effect&, const double* p, const EffectContext& c, ExtendedModel& m) {
-    const double i_max = kD ? c.max_i_d_A : c.max_i_q_A;
-    (kD ? m.extensions.inductance_d : m.extensions.inductance_q).curvature_per_A2 +=
-        kRelativeScale * p[0] / std::max(i_max * i_max, 1e-12);
+    const double i_max = std::max(kD ? c.max_i_d_A : c.max_i_q_A, 1e-6);
+    core::InductanceCurve& k = kD ? m.extensions.inductance_d : m.extensions.inductance_q;
+    k.curvature_per_A2 += kRelativeScale * p[0] / (i_max * i_max);
+    if (kD) k.slope_per_A += kRelativeScale * p[1] / i_max;
   };
   r.describe = [](const Effect&, const ExtendedModel& m, const EffectContext& c) {
     const core::InductanceCurve& k = kD ? m.extensions.inductance_d : m.extensions.inductance_q;
-    const double i_max = kD ? c.max_i_d_A : c.max_i_q_A;
+    const double i_max = kD ? c.extreme_i_d_A : c.max_i_q_A;  // where the log's current went furthest
     const double l = kD ? m.machine.l_d_H : m.machine.l_q_H;
-    return std::vector<NamedValue>{{"level", k.level, ""},
-                                   {"curvature_per_A2", k.curvature_per_A2, ""},
-                                   {"i_max_A", i_max, ""},
-                                   {"l_at_max_current_H", l * k.factor(i_max), ""},
-                                   {"l_rel_at_max_current", k.factor(i_max) / k.factor(0.0), ""}};
+    std::vector<NamedValue> out = {{"level", k.level, ""}, {"curvature_per_A2", k.curvature_per_A2, ""}};
+    if (kD) out.push_back({"slope_per_A", k.slope_per_A, ""});
+    out.push_back({"i_max_A", i_max, ""});
+    out.push_back({"l_at_max_current_H", l * k.factor(i_max), ""});
+    out.push_back({"l_rel_at_max_current", k.factor(i_max) / k.factor(0.0), ""});
+    return out;
   };
   return r;
 }
@@ -250,19 +255,31 @@ EffectRow drift() {
     if (material) out.push_back({"material", 0.0, std::string(material->material)});
     return out;
   };
-  r.judge = [](const Effect&, const ExtendedModel& m, const EffectContext&) -> std::optional<Implausibility> {
+  r.judge = [](const Effect&, const ExtendedModel& m, const EffectContext&,
+                const std::vector<double>& half_width) -> std::optional<Implausibility> {
     const std::optional<core::DriftLaw>& law = kWinding ? m.r_s_law : m.psi_m_law;
     if (!law) return std::nullopt;  // against time: no temperature to judge it by
     const double alpha = material_alpha(*law, kWinding ? m.machine.r_s_Ohm : m.machine.psi_m_Wb);
+    // The coefficient's own 95 % interval, referred like the coefficient: implausible only if it misses
+    // every material's range.
+    const double delta = half_width.empty() || law->coeff_per_K == 0.0
+                             ? 0.0
+                             : std::abs(half_width[0] * kPerKelvinScale * alpha / law->coeff_per_K);
+    const auto overlaps = [&](const auto& materials) {
+      for (const core::MaterialCoefficient& mat : materials) {
+        if (alpha + delta >= mat.min_per_K && alpha - delta <= mat.max_per_K) return true;
+      }
+      return false;
+    };
     if (kWinding) {
-      if (core::material_of(core::kWindingMaterials, alpha)) return std::nullopt;
+      if (overlaps(core::kWindingMaterials)) return std::nullopt;
       return Implausibility{"R_s would change by " + pct(alpha) + " %/K against T_winding (" +
                                 materials_text(core::kWindingMaterials) + " at 20 °C)",
                             "a temperature-dependent error that is not resistance — an inverter voltage error (dead time, "
                             "device drops) or an inductance that changes with the operating point the temperature follows; "
                             "standstill at two or more currents per temperature would separate them"};
     }
-    if (core::material_of(core::kMagnetMaterials, alpha)) return std::nullopt;
+    if (overlaps(core::kMagnetMaterials)) return std::nullopt;
     return Implausibility{"ψm would change by " + pct(alpha) + " %/K against T_magnet (" +
                               materials_text(core::kMagnetMaterials) + " at 20 °C)",
                           "a flux error that follows the load the temperature follows — cross-saturation or an inductance "
@@ -354,12 +371,18 @@ EffectRow flux_harmonic() {
   };
   r.describe = [](const Effect&, const ExtendedModel& m, const EffectContext&) {
     const core::FluxHarmonic& h = m.extensions.flux_harmonics[kJ];
+    const double psi = m.machine.psi_m_Wb;
+    // Each axis as ψm·A·cos(hϑ + φ): A = |(cos, sin)|/ψm, φ = atan2(−sin, cos).
     return std::vector<NamedValue>{{"d_cos_Wb", h.d_cos_Wb, ""},
                                    {"d_sin_Wb", h.d_sin_Wb, ""},
                                    {"q_cos_Wb", h.q_cos_Wb, ""},
                                    {"q_sin_Wb", h.q_sin_Wb, ""},
+                                   {"d_amplitude_rel", std::hypot(h.d_cos_Wb, h.d_sin_Wb) / psi, ""},
+                                   {"d_phase_rad", std::atan2(-h.d_sin_Wb, h.d_cos_Wb), ""},
+                                   {"q_amplitude_rel", std::hypot(h.q_cos_Wb, h.q_sin_Wb) / psi, ""},
+                                   {"q_phase_rad", std::atan2(-h.q_sin_Wb, h.q_cos_Wb), ""},
                                    {"amplitude_Wb", h.amplitude_Wb(), ""},
-                                   {"amplitude_rel", h.amplitude_Wb() / m.machine.psi_m_Wb, ""}};
+                                   {"amplitude_rel", h.amplitude_Wb() / psi, ""}};
   };
   return r;
 }

@@ -156,7 +156,7 @@ Diagnosis diagnose(LogData log, const io::MachineConfig& config, const DiagnoseO
   }
   d.calibration.heldout_rms_A = rms(fitter.heldout(start));
 
-  d.selection = select_effects(fitter, options.selection, start);
+  d.selection = select_effects(fitter, options.selection, start, floor);
   readmit_constants(fitter, floor, excitation, d);
   d.calibration.intervals = fitter.intervals(d.selection.model, floor);
   d.extended_model = d.selection.model.model(d.context);

@@ -384,6 +384,14 @@ CalibrationIntervals EffectFitter::intervals(const EffectSet& set, double noise_
     out.half_width[i] = excited ? kZ * kCalibrationScale * std::sqrt(std::max(robust(k, k), 0.0)) / factor : kInf;
     out.excitation_half_width[i] = excited ? kZ * kCalibrationScale * std::sqrt(sigma2 * h_inv(k, k)) / factor : kInf;
   }
+  auto k = static_cast<Eigen::Index>(kCalibrated.size());
+  for (const auto& p : set.parameters) {
+    std::vector<double> hw;
+    for (std::size_t i = 0; i < p.size(); ++i, ++k) {
+      hw.push_back(unexcited[k] < 0.5 ? kZ * std::sqrt(std::max(robust(k, k), 0.0)) : kInf);
+    }
+    out.effect_half_width.push_back(hw);
+  }
   return out;
 }
 

@@ -77,6 +77,7 @@ EffectContext EffectContext::of(const LogData& log, const core::MachineSi& machi
   c.base_current_A = pu.current_A;
   for (std::size_t k = 0; k < log.rows.size(); ++k) {
     if (!log.used[k]) continue;
+    if (std::abs(log.logged_i_dq_A[k][0]) > c.max_i_d_A) c.extreme_i_d_A = log.logged_i_dq_A[k][0];
     c.max_i_d_A = std::max(c.max_i_d_A, std::abs(log.logged_i_dq_A[k][0]));
     c.max_i_q_A = std::max(c.max_i_q_A, std::abs(log.logged_i_dq_A[k][1]));
   }

@@ -86,7 +86,8 @@ double signed_rank_p(const std::vector<double>& values) {
   return tail / std::pow(2.0, static_cast<double>(n));
 }
 
-Selection select_effects(const EffectFitter& fitter, const SelectionOptions& options, const EffectSet& start) {
+Selection select_effects(const EffectFitter& fitter, const SelectionOptions& options, const EffectSet& start,
+                         double noise_floor_A) {
   Selection sel;
   sel.model = start;
   const EffectContext& context = fitter.context();
@@ -160,11 +161,25 @@ Selection select_effects(const EffectFitter& fitter, const SelectionOptions& opt
     // The best plausible candidate; implausible ones that would have passed are reported and set aside.
     std::size_t best = shortlisted;
     bool set_aside = false;
+    // Accepted only if large, consistent, and standing out of the noise: the model change it brings (the
+    // held-out RMS² it removes) must be at least min_change_of_floor of the noise floor.
+    const double before = rms(current);
+    const double min_change2 = std::pow(options.min_change_of_floor * noise_floor_A, 2);
+    auto passes = [&](std::size_t i) {
+      const CandidateScore& c = round[i];
+      const double after = rms(scores[i]);
+      return c.gain_pct >= options.min_gain_pct && c.p_value <= options.max_p && before * before - after * after >= min_change2;
+    };
     for (std::size_t i : ranked) {
       const CandidateScore& c = round[i];
-      if (c.gain_pct < options.min_gain_pct || c.p_value > options.max_p) break;
+      if (!passes(i)) break;
       const ExtendedModel m = fitted[i].model(context);
-      const std::optional<Implausibility> why = c.effect.row->judge ? c.effect.row->judge(c.effect, m, context) : std::nullopt;
+      std::optional<Implausibility> why;
+      if (c.effect.row->judge && c.effect.row->judge(c.effect, m, context, {})) {
+        // Judged again within the fitted parameter's own uncertainty.
+        const CalibrationIntervals ci = fitter.intervals(fitted[i], noise_floor_A);
+        why = c.effect.row->judge(c.effect, m, context, ci.effect_half_width.back());
+      }
       if (!why) {
         best = i;
         break;
@@ -186,7 +201,7 @@ Selection select_effects(const EffectFitter& fitter, const SelectionOptions& opt
     for (std::size_t i : ranked) {
       const CandidateScore& rival = round[i];
       if (i == best || rival.effect.name() == winner.effect.name()) continue;
-      if (rival.gain_pct < options.min_gain_pct || rival.p_value > options.max_p) continue;
+      if (!passes(i)) continue;
       if (std::find(excluded.begin(), excluded.end(), rival.effect) != excluded.end()) continue;
       const double p_preferred = signed_rank_p(block_log_ratios(scores[i], scores[best]));
       if (p_preferred <= options.ambiguity_p) continue;

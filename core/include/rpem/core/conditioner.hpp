@@ -18,13 +18,16 @@
 namespace rpem::core {
 
 /// An axis inductance as a function of that axis' current (ld_saturation, lq_saturation):
-///   L(i) = L_nom·(level + curvature·i²)
-/// level 1 and curvature 0 is the nominal constant inductance.
+///   L(i) = L_nom·(level + slope·i + curvature·i²)
+/// level 1, slope and curvature 0 is the nominal constant inductance. The slope is the d axis' asymmetry:
+/// the magnet biases the d path, so field-weakening current (i_d < 0) de-saturates it and magnetising
+/// current saturates it; the q axis is symmetric (slope 0).
 struct InductanceCurve {
   double level = 1.0;
   double curvature_per_A2 = 0.0;
-  [[nodiscard]] bool nominal() const noexcept { return level == 1.0 && curvature_per_A2 == 0.0; }
-  [[nodiscard]] double factor(double i_A) const noexcept { return level + curvature_per_A2 * i_A * i_A; }
+  double slope_per_A = 0.0;
+  [[nodiscard]] bool nominal() const noexcept { return level == 1.0 && curvature_per_A2 == 0.0 && slope_per_A == 0.0; }
+  [[nodiscard]] double factor(double i_A) const noexcept { return level + (slope_per_A + curvature_per_A2 * i_A) * i_A; }
 };
 
 /// A harmonic of the rotor-frame flux linkage (flux_harmonic_6, flux_harmonic_12): the magnet's flux

@@ -41,6 +41,8 @@ struct CalibrationIntervals {
   std::array<double, kCalibrated.size()> half_width{};
   /// What the log's excitation alone allows (σ²·(JᵀJ)⁻¹ with σ the noise floor), relative.
   std::array<double, kCalibrated.size()> excitation_half_width{};
+  /// The effects' scaled parameters, cluster-robust (same order as the set's).
+  std::vector<std::vector<double>> effect_half_width;
 };
 
 /// What the screening of one round shares: the starting residuals and the calibration's columns.

@@ -48,6 +48,7 @@ struct EffectContext {
   ExtendedModel base;       ///< the configuration's whole model (extensions and drift laws), the baseline
   double base_current_A = 0.0;              ///< I_b
   double max_i_d_A = 0.0, max_i_q_A = 0.0;  ///< largest |i_d|, |i_q| logged
+  double extreme_i_d_A = 0.0;               ///< the logged i_d of largest magnitude, signed
   double max_speed_rad_s = 0.0;
   double t_start_s = 0.0, t_span_s = 0.0;
   TemperatureColumn t_winding, t_magnet;
@@ -120,8 +121,10 @@ struct EffectRow {
   void (*apply)(const Effect&, const double* p, const EffectContext&, ExtendedModel&) = nullptr;
   /// Its SI parameters as they stand in a model (the configuration's part included).
   std::vector<NamedValue> (*describe)(const Effect&, const ExtendedModel&, const EffectContext&) = nullptr;
-  /// Set when the fitted model is physically implausible; nullptr: always plausible.
-  std::optional<Implausibility> (*judge)(const Effect&, const ExtendedModel&, const EffectContext&) = nullptr;
+  /// Set when the fitted model is physically implausible beyond its parameters' 95 % half-widths
+  /// (scaled; empty: exact); nullptr: always plausible.
+  std::optional<Implausibility> (*judge)(const Effect&, const ExtendedModel&, const EffectContext&,
+                                         const std::vector<double>& half_width) = nullptr;
 };
 
 /// The catalogue, in the order candidates are listed.

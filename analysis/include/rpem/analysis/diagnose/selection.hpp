@@ -22,6 +22,9 @@ namespace rpem::analysis {
 struct SelectionOptions {
   double min_gain_pct = 2.0;   ///< held-out RMS gain an effect must bring
   double max_p = 0.01;         ///< signed-rank p over the held-out blocks
+  /// The held-out RMS² an effect removes must be at least (this × the noise floor)²: a model change below
+  /// half the sensors' noise is not worth naming, however consistent.
+  double min_change_of_floor = 0.5;
   int max_effects = 4;
   int shortlist = 4;           ///< candidates fitted in full per round (at most) …
   double shortlist_share = 0.05;  ///< … of those screened at this share of the best or more (at least 2);
@@ -73,8 +76,10 @@ struct Selection {
   double extended_heldout_rms_A = 0.0;
 };
 
-/// `start`: the calibrated baseline (its calibrated constants stay free in every fit).
-[[nodiscard]] Selection select_effects(const EffectFitter& fitter, const SelectionOptions& options, const EffectSet& start);
+/// `start`: the calibrated baseline (its calibrated constants stay free in every fit); `noise_floor_A`:
+/// the log's (verdict.hpp).
+[[nodiscard]] Selection select_effects(const EffectFitter& fitter, const SelectionOptions& options, const EffectSet& start,
+                                       double noise_floor_A);
 
 /// Held-out RMS of block scores [A].
 [[nodiscard]] double rms(const BlockScores& b);
