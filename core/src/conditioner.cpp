@@ -51,9 +51,11 @@ void SampleConditioner::reconfigure(const PerUnitBase& base, const MachinePu& ma
     const FluxHarmonic& h = x.flux_harmonics[j];
     harmonics_pu_[j] = {base.flux_pu(h.d_cos_Wb), base.flux_pu(h.d_sin_Wb), base.flux_pu(h.q_cos_Wb), base.flux_pu(h.q_sin_Wb)};
   }
-  cross_ = x.cross_coupling_H_per_A != 0.0;
+  cross_ = x.cross_coupling_H_per_A != 0.0 || x.cross_coupling_H_per_A2 != 0.0;
   half_cross_pu_ = 0.5 * x.cross_coupling_H_per_A * base.current_A * base.current_A / base.flux_Wb;
+  cross2_pu_ = x.cross_coupling_H_per_A2 * base.current_A * base.current_A * base.current_A / base.flux_Wb;
   cross_x_q_pu_per_A_ = x.cross_coupling_H_per_A / base.inductance_H;
+  cross_x_q_pu_per_A2_ = x.cross_coupling_H_per_A2 / base.inductance_H;
   delay_ = x.delay_s > 0.0;
 }
 
@@ -62,7 +64,7 @@ Vec2 SampleConditioner::inductances_pu(const Vec2& i_dq_pu) const noexcept {
   if (saturation_) {
     const Vec2 i_A = i_dq_pu * base_.current_A;
     x[0] *= extensions_.inductance_d.factor(i_A[0]);
-    x[1] = x[1] * extensions_.inductance_q.factor(i_A[1]) + cross_x_q_pu_per_A_ * i_A[0];
+    x[1] = x[1] * extensions_.inductance_q.factor(i_A[1]) + (cross_x_q_pu_per_A_ + cross_x_q_pu_per_A2_ * i_A[0]) * i_A[0];
   }
   return x;
 }
@@ -82,7 +84,7 @@ Vec2 SampleConditioner::extra_emf_pu(const Rotation& rot, double n_pu, const Vec
       e += Vec2(dpsi_d - psi_q, dpsi_q + psi_d);  // ∂ψ_h/∂ϑ + J·ψ_h
     }
   }
-  if (cross_) e[1] += half_cross_pu_ * i_dq_pu[1] * i_dq_pu[1];  // J·[(c/2)·i_q², 0]
+  if (cross_) e[1] += (half_cross_pu_ + cross2_pu_ * i_dq_pu[0]) * i_dq_pu[1] * i_dq_pu[1];  // J·[Δψ_d, 0]
   return n_pu * e;
 }
 

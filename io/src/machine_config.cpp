@@ -192,7 +192,8 @@ void parse_extensions(YamlMap x, MachineConfig& config) {
     d->finish();
   }
   if (auto k = x.optional_map("cross_saturation")) {
-    c.cross_coupling_H_per_A = k->number("coupling_H_per_A", -10.0, 10.0);
+    c.cross_coupling_H_per_A = k->number_or("coupling_H_per_A", 0.0, -10.0, 10.0);
+    c.cross_coupling_H_per_A2 = k->number_or("coupling_H_per_A2", 0.0, -10.0, 10.0);
     k->finish();
   }
   for (std::size_t j = 0; j < core::kFluxHarmonicOrders.size(); ++j) {
@@ -291,8 +292,11 @@ std::string model_extensions_yaml(const MachineConfig& c) {
   curve_entry(out, "ld_saturation", x.inductance_d);
   curve_entry(out, "lq_saturation", x.inductance_q);
   if (x.iron_loss_r_fe_Ohm > 0.0) out << "  iron_loss: " << FlowMap().add("r_fe_Ohm", x.iron_loss_r_fe_Ohm).str() << "\n";
-  if (x.cross_coupling_H_per_A != 0.0) {
-    out << "  cross_saturation: " << FlowMap().add("coupling_H_per_A", x.cross_coupling_H_per_A).str() << "\n";
+  if (x.cross_coupling_H_per_A != 0.0 || x.cross_coupling_H_per_A2 != 0.0) {
+    FlowMap m;
+    if (x.cross_coupling_H_per_A != 0.0) m.add("coupling_H_per_A", x.cross_coupling_H_per_A);
+    if (x.cross_coupling_H_per_A2 != 0.0) m.add("coupling_H_per_A2", x.cross_coupling_H_per_A2);
+    out << "  cross_saturation: " << m.str() << "\n";
   }
   for (std::size_t j = 0; j < core::kFluxHarmonicOrders.size(); ++j) {
     core::FluxHarmonic h = x.flux_harmonics[j];

@@ -17,5 +17,17 @@ TEST(IndependentData, OneCasePerKind) {
   }
 }
 
+TEST(IndependentData, ACommandDelayOfWholePeriodsIsToldFromAnAngleOffset) {
+  // The most common drive delay, two whole control periods, together with a 3° encoder offset: at one
+  // speed they would both turn the voltage; the profile's speeds tell them apart (issue 10 item 3).
+  for (double periods : {1.0, 2.0, 2.5}) {
+    test::IndependentCase c{{"delay", "theta_offset"}, 31, test::kIndependentDuration_s,
+                            {{"delay.periods", periods}, {"theta_offset.offset_rad", 0.05236}}};
+    const test::IndependentOutcome out = test::run_independent_case(c);
+    std::printf("%s %s\n", out.correct ? "right" : "WRONG", out.detail.c_str());
+    EXPECT_TRUE(out.correct) << out.detail;
+  }
+}
+
 }  // namespace
 }  // namespace rpem

@@ -3,6 +3,8 @@
 // parameter error exactly, and the log's preparation (mode, exclusions, blocks).
 #include <gtest/gtest.h>
 
+#include <random>
+
 #include "rpem/analysis/diagnose/effect_fit.hpp"
 #include "rpem/analysis/diagnose/selection.hpp"
 #include "rpem/analysis/diagnose/verdict.hpp"
@@ -102,6 +104,48 @@ TEST(EffectFit, ExcitationDecidesWhichConstantsAreIdentifiable) {
   EXPECT_GT(moving.excitation_half_width[1], 0.01);
   EXPECT_LT(both.excitation_half_width[0], 0.01);
   EXPECT_LT(both.excitation_half_width[1], 0.01);
+}
+
+TEST(NoiseFloor, SecondDifferencesRecoverTheWhiteNoiseUnderASmoothError) {
+  // A residual of white noise (σ = 0.02 A per axis: floor √2·σ) plus a model error that is smooth at the
+  // sampling rate (a 270 Hz ripple of 0.1 A at 8 kHz, a slow drift, a step): the floor is the noise's.
+  LogData log;
+  constexpr std::size_t n = 40000;
+  log.rows.resize(n);
+  log.block.assign(n, 0);
+  for (std::size_t k = 0; k < n; ++k) log.block[k] = static_cast<int>(k / 1000);
+  ReplayOutput r;
+  r.valid.assign(n, true);
+  r.residual_A.resize(n);
+  std::mt19937_64 rng(11);
+  std::normal_distribution<double> noise(0.0, 0.02);
+  for (std::size_t k = 0; k < n; ++k) {
+    const double t = static_cast<double>(k) * 125e-6;
+    const double smooth = 0.1 * std::sin(2.0 * core::kPi * 270.0 * t) + 0.5 * t + (k > 20000 ? 0.3 : 0.0);
+    r.residual_A[k] = core::Vec2(smooth + noise(rng), -smooth + noise(rng));
+  }
+  EXPECT_NEAR(noise_floor_A(log, r), std::sqrt(2.0) * 0.02, 0.03 * std::sqrt(2.0) * 0.02);
+}
+
+TEST(Verdict, ExplainedUpToTheBoundAndOtherwiseWhereTheResidualLives) {
+  ResidualStatistics st;
+  st.standstill_rms_A = {1.0, 0.05};
+  st.motion_rms_A = {1.0, 0.2};
+  st.regions = {{"n ≥ 0.5 pu", "i_q > 0", 1000, {1.0, 0.3}, {0.0, 0.1}, {0.0, -0.2}}};
+  st.harmonics = {{0, {0.1, 0.01}}, {6, {0.5, 0.15}}, {12, {0.1, 0.02}}};
+  st.correlations = {{"|speed| [pu]", {0.1, 0.6}, {0.1, 0.2}}};
+  const Verdict explained = verdict(0.029, 0.02, st);
+  EXPECT_TRUE(explained.explained);  // 1.45 ≤ 1.5
+  EXPECT_TRUE(explained.findings.empty());
+  const Verdict v = verdict(0.2, 0.02, st);
+  EXPECT_FALSE(v.explained);
+  EXPECT_DOUBLE_EQ(v.ratio, 10.0);
+  std::string all;
+  for (const std::string& f : v.findings) all += f + "\n";
+  EXPECT_NE(all.find("harmonic 6"), std::string::npos) << all;
+  EXPECT_NE(all.find("flux harmonics"), std::string::npos) << all;
+  EXPECT_NE(all.find("|speed|"), std::string::npos) << all;
+  EXPECT_NE(all.find("n ≥ 0.5 pu"), std::string::npos) << all;
 }
 
 TEST(Catalogue, EveryRowIsComplete) {

@@ -89,6 +89,21 @@ TEST(FluxHarmonic, AverageOutOfTheSteadyState) {
   EXPECT_EQ((with.steady_state(s).u_pu - without.steady_state(s).u_pu).norm(), 0.0);
 }
 
+TEST(CrossSaturation, TheSecondTermAddsCTwoIdToBothHalves) {
+  // ψ_d += c₂·i_d·i_q², ψ_q += c₂·i_d²·i_q: x_q moves by c₂·i_d², the q voltage by ω·c₂·i_d·i_q².
+  const PerUnitBase b = test::paper_base();
+  const MachinePu m = test::paper_machine_pu();
+  const double c2 = 3e-4;  // H/A²
+  ModelExtensions x;
+  x.cross_coupling_H_per_A2 = c2;
+  const Vec2 i_A(-4.0, 6.0);
+  SampleConditioner cond(b, m, x);
+  const EstimatorSample out = cond.condition(dq_sample(0, 0.3, Vec2(40.0, 180.0), i_A));
+  EXPECT_NEAR(out.x_q_pu * b.inductance_H, m.x_q_pu * b.inductance_H + c2 * i_A[0] * i_A[0], 1e-15);
+  const Vec2 change = end_voltage_change_pu(x, 0.3, 0.32, i_A);
+  EXPECT_NEAR(change[1] * b.voltage_V, -kOmega * c2 * i_A[0] * i_A[1] * i_A[1], 1e-12);
+}
+
 TEST(CrossSaturation, LqFollowsIdAndTheDAxisFluxFollowsTheLoad) {
   // ψ_d = L_d·i_d + ψm + (c/2)·i_q², ψ_q = (L_q + c·i_d)·i_q: the apparent x_q moves by c·i_d, and the
   // extra d-axis flux induces ω·(c/2)·i_q² on the q axis (J·[Δψ_d, 0]).

@@ -167,6 +167,7 @@ TEST(MachineConfig, ExtensionsWrittenAsYamlReadBackToTheSameValues) {
   x.inductance_d = {1.0, 0.0, -0.0123};
   x.iron_loss_r_fe_Ohm = 1261.24;
   x.cross_coupling_H_per_A = -0.00123456789;
+  x.cross_coupling_H_per_A2 = 2.5e-5;
   x.flux_harmonics[1] = {0.0031, -0.0007, 0.0, 0.0125};
   c.rs_drift.law = core::DriftLaw{0.00391698, 25.0, 2.31};
   c.psim_drift.rel_change = -0.067;
@@ -185,6 +186,7 @@ TEST(MachineConfig, ExtensionsWrittenAsYamlReadBackToTheSameValues) {
   EXPECT_EQ(y.inductance_d.slope_per_A, -0.0123);
   EXPECT_EQ(y.iron_loss_r_fe_Ohm, x.iron_loss_r_fe_Ohm);
   EXPECT_EQ(y.cross_coupling_H_per_A, x.cross_coupling_H_per_A);
+  EXPECT_EQ(y.cross_coupling_H_per_A2, x.cross_coupling_H_per_A2);
   EXPECT_TRUE(y.flux_harmonics[0].nominal());
   EXPECT_EQ(y.flux_harmonics[1].d_cos_Wb, 0.0031);
   EXPECT_EQ(y.flux_harmonics[1].d_sin_Wb, -0.0007);

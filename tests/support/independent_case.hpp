@@ -7,6 +7,7 @@
 // 5 % of the true machine's.
 
 #include <cmath>
+#include <cstdlib>
 #include <cstdio>
 #include <set>
 #include <string>
@@ -25,6 +26,8 @@ struct IndependentCase {
   std::vector<std::string> effects;  ///< the independent generator's names; empty: a null case
   std::uint64_t seed = 1;
   double duration_s = 8.0;
+  /// Effect parameters set instead of drawn (the generator's keys, e.g. {"delay.periods", 2}).
+  std::vector<std::pair<std::string, double>> set;
 };
 
 struct IndependentOutcome {
@@ -122,8 +125,9 @@ inline std::vector<Comparison> compare(const std::string& name, const std::vecto
     c.push_back({got, true_l, true_l});
   } else if (name == "cross_saturation") {
     // The d-axis flux's change under load, relative to ψm, at the generator's point.
-    const double at = t.value("at_i_q_A");
-    const double got = 0.5 * value(p, "coupling_H_per_A") * at * at / truth.true_machine.psi_m_Wb;
+    const double at_d = t.value("at_i_d_A"), at_q = t.value("at_i_q_A");
+    const double got = (0.5 * value(p, "coupling_H_per_A") + value(p, "coupling_H_per_A2") * at_d) * at_q * at_q /
+                       truth.true_machine.psi_m_Wb;
     c.push_back({got, t.value("psi_d_change_rel"), std::abs(t.value("psi_d_change_rel"))});
   } else if (name == "flux_harmonic_6" || name == "flux_harmonic_12") {
     // Each axis' amplitude, relative to the larger of the two.
@@ -152,14 +156,17 @@ inline constexpr double kIndependentDuration_s = 8.0;
 /// The profile's largest torque, in the generator's torque unit (the rated current's torque; its default
 /// stops at 0.8 of it): a commissioning record uses the drive's torque range.
 inline constexpr double kIndependentTorque_pu = 1.0;
+/// The profile's largest speed, of the rated speed (the generator's default 0.5): speed-dependent effects
+/// (iron loss, delay, angle, harmonics) show more at higher speed.
+inline constexpr double kIndependentSpeed_pu = 0.8;
 
-/// The test's commissioning profile: the generator's built-in one (speeds to half the rated speed, torques
+/// The test's commissioning profile: the generator's built-in one (speeds to kIndependentSpeed_pu, torques
 /// to kIndependentTorque_pu of the rated current's) with d-axis current injected as a commissioning record
 /// does — +0.3 of the rated peak current at standstill under load (4-8 % of the log), −0.5 of it from 60 %
 /// of the log on (field weakening through the reversal and the last torque steps) — so that the d axis is
 /// excited beyond its MTPA current.
 inline std::vector<indep::ProfilePoint> independent_profile(const indep::MachineConfig& m, double duration_s) {
-  const indep::OperatingProfile base = indep::default_profile(m, duration_s, 0.5, kIndependentTorque_pu);
+  const indep::OperatingProfile base = indep::default_profile(m, duration_s, kIndependentSpeed_pu, kIndependentTorque_pu);
   const double i_peak = m.rated_peak_current_A();
   const std::vector<std::pair<double, double>> steps = {  // (time fraction, injection from then on [A])
       {0.04, 0.3 * i_peak}, {0.08, 0.0}, {0.60, -0.5 * i_peak}};
@@ -230,6 +237,7 @@ inline IndependentOutcome run_independent_case(const IndependentCase& ic) {
   for (const std::string& e : ic.effects) names += (names.empty() ? "" : ",") + e;
   indep::enable_effects(c.effects, names.empty() ? "none" : names);
   indep::draw_effect_parameters(c);
+  for (const auto& [key, value] : ic.set) indep::set_parameter(c, key, value);
   const indep::Result r = indep::generate(c);
 
   io::DriveLogLayout layout;
@@ -239,6 +247,9 @@ inline IndependentOutcome run_independent_case(const IndependentCase& ic) {
   analysis::DiagnoseOptions options;
   options.switching_frequency_Hz = r.truth.switching_frequency_Hz;
   const analysis::Diagnosis d = analysis::diagnose(std::move(log), config, options);
+  if (const char* dir = std::getenv("RPEM_INDEPENDENT_JSON_DIR")) {  // to look into a case: its diagnosis.json
+    analysis::write_diagnosis_json(std::string(dir) + "/seed" + std::to_string(ic.seed) + ".json", d, config_path);
+  }
 
   IndependentOutcome out;
   out.null_case = ic.effects.empty();

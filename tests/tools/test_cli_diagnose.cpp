@@ -179,5 +179,48 @@ TEST(CliDiagnose, PaderbornWorkedExampleKeepsItsResult) {
   fs::remove_all(dir);
 }
 
+TEST(CliDiagnose, AModelExtendedOnOneRecordingIsTheBaselineOfTheNext) {
+  // docs/diagnose.md, "The configuration is the baseline": Paderborn profile A cut at the load change; the
+  // heat-up extends the commissioned model (its magnet drift), and the cool-down is judged with the plain
+  // configuration and with the heat-up's extended.yaml as it is. The drift law carries: the extended
+  // baseline predicts the recording it never saw far better, and is reported as such.
+  const std::string source = test::data_file("paderborn-motor-temperature/profile_A_every5th.csv");
+  const std::string dir = out_dir("carry");
+  auto r = test::run_command("python3 " + test::source_dir() + "/scripts/paderborn_to_drive_log.py " + source + " " + dir +
+                             "/profile.csv --pole-pairs 4");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  std::ifstream in(dir + "/profile.csv");
+  std::ofstream heat(dir + "/heatup.csv"), cool(dir + "/cooldown.csv");
+  std::string line;
+  for (int k = 0; std::getline(in, line); ++k) {
+    if (k <= 1760) heat << line << "\n";
+    if (k == 0 || k > 1760) cool << line << "\n";
+  }
+  heat.close();
+  cool.close();
+  const std::string config = test::source_dir() + "/config/paderborn-pmsm.yaml";
+  r = test::run_command(rpem_tool() + " diagnose --log " + dir + "/heatup.csv --config " + config + " --out " + dir + "/heatup");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const nlohmann::json a = nlohmann::json::parse(read(dir + "/heatup/diagnosis.json"));
+  ASSERT_FALSE(a["effects"].empty()) << a.dump(2);
+  EXPECT_EQ(a["effects"][0]["name"], "psim_drift");
+  EXPECT_NE(read(dir + "/heatup/extended.yaml").find("psim_drift"), std::string::npos);
+  r = test::run_command(rpem_tool() + " diagnose --log " + dir + "/cooldown.csv --config " + config + " --out " + dir + "/plain");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  r = test::run_command(rpem_tool() + " diagnose --log " + dir + "/cooldown.csv --config " + dir + "/heatup/extended.yaml --out " +
+                        dir + "/carried");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const nlohmann::json plain = nlohmann::json::parse(read(dir + "/plain/diagnosis.json"));
+  const nlohmann::json carried = nlohmann::json::parse(read(dir + "/carried/diagnosis.json"));
+  EXPECT_TRUE(carried["baseline"]["drift_laws_replayed"]["psim_drift"].get<bool>());
+  EXPECT_FALSE(plain["baseline"]["drift_laws_replayed"]["psim_drift"].get<bool>());
+  const double p = plain["baseline"]["heldout_rms"], c = carried["baseline"]["heldout_rms"];
+  std::printf("cool-down baseline held-out residual: plain %.3f A, heat-up's extended.yaml %.3f A\n", p, c);
+  EXPECT_LT(c, 0.5 * p);
+  // The found effects add to the configuration's: the carried drift stays in the cool-down's extended.yaml.
+  EXPECT_NE(read(dir + "/carried/extended.yaml").find("psim_drift"), std::string::npos);
+  fs::remove_all(dir);
+}
+
 }  // namespace
 }  // namespace rpem

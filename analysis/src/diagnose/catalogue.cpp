@@ -73,6 +73,17 @@ EffectRow deadtime() {
 
 // --- saturation --------------------------------------------------------------------------------------
 
+/// The largest |L(i)/L(0) − 1| of a curve for currents in [lo, hi].
+double largest_change(const core::InductanceCurve& k, double lo, double hi) {
+  double largest = 0.0;
+  constexpr int kPoints = 41;
+  for (int j = 0; j < kPoints; ++j) {
+    const double i = lo + (hi - lo) * j / (kPoints - 1);
+    largest = std::max(largest, std::abs(k.factor(i) / k.factor(0.0) - 1.0));
+  }
+  return largest;
+}
+
 template <bool kD>
 EffectRow saturation() {
   EffectRow r;
@@ -95,6 +106,11 @@ EffectRow saturation() {
     k.curvature_per_A2 += kRelativeScale * p[0] / (i_max * i_max);
     if (kD) k.slope_per_A += kRelativeScale * p[1] / i_max;
   };
+  r.negligible = [](const Effect&, const ExtendedModel& m, const EffectContext& c) {
+    const core::InductanceCurve& k = kD ? m.extensions.inductance_d : m.extensions.inductance_q;
+    return (kD ? largest_change(k, c.min_i_d_A, c.max_signed_i_d_A) : largest_change(k, -c.max_i_q_A, c.max_i_q_A)) <
+           kNegligibleInductanceChange;
+  };
   r.describe = [](const Effect&, const ExtendedModel& m, const EffectContext& c) {
     const core::InductanceCurve& k = kD ? m.extensions.inductance_d : m.extensions.inductance_q;
     const double i_max = kD ? c.extreme_i_d_A : c.max_i_q_A;  // where the log's current went furthest
@@ -112,22 +128,40 @@ EffectRow saturation() {
 EffectRow cross_saturation() {
   EffectRow r;
   r.name = "cross_saturation";
+  r.parameters = 2;
   r.shows_as = "the d-axis flux falling with the load, L_q changing with i_d: q-axis errors growing with i_q², d-axis ones "
                "with i_d·i_q";
-  r.enters = "ψ_d = L_d·i_d + ψm + (c/2)·i_q², ψ_q = (L_q + c·i_d)·i_q (one reciprocal coupling c)";
+  r.enters = "ψ_d = L_d·i_d + ψm + (c/2 + c₂·i_d)·i_q², ψ_q = (L_q + c·i_d + c₂·i_d²)·i_q (the two lowest-order reciprocal "
+             "co-energy terms even in i_q)";
   r.confusions = {{"lq_saturation", "the same q-axis current at two or more d-axis currents"},
+                  {"ld_saturation", "the same d-axis current at two or more q-axis currents"},
                   {"psim_drift", "a load change at constant temperature"}};
   r.apply = [](const Effect&, const double* p, const EffectContext& c, ExtendedModel& m) {
-    const double i_q = std::max(c.max_i_q_A, 0.05 * c.base_current_A);
-    m.extensions.cross_coupling_H_per_A += 2.0 * kCrossScale * c.machine.psi_m_Wb / (i_q * i_q) * p[0];
+    const double i_q = std::max(c.max_i_q_A, 0.05 * c.base_current_A), i_d = std::max(c.max_i_d_A, 0.05 * c.base_current_A);
+    const double psi = kCrossScale * c.machine.psi_m_Wb;  // the d-axis flux change a scaled 1 makes at the extremes
+    m.extensions.cross_coupling_H_per_A += 2.0 * psi / (i_q * i_q) * p[0];
+    m.extensions.cross_coupling_H_per_A2 += psi / (i_q * i_q * i_d) * p[1];
+  };
+  r.negligible = [](const Effect&, const ExtendedModel& m, const EffectContext& c) {
+    // L_q's change over the logged d currents, and the d-axis flux's under load (as a share of L_d·I).
+    const double k = m.extensions.cross_coupling_H_per_A, k2 = m.extensions.cross_coupling_H_per_A2;
+    double largest = 0.0;
+    for (double i_d : {c.min_i_d_A, c.max_signed_i_d_A}) {
+      largest = std::max(largest, std::abs((k + k2 * i_d) * i_d) / m.machine.l_q_H);
+      largest = std::max(largest, std::abs((0.5 * k + k2 * i_d) * c.max_i_q_A) / m.machine.l_d_H);
+    }
+    return largest < kNegligibleInductanceChange;
   };
   r.describe = [](const Effect&, const ExtendedModel& m, const EffectContext& c) {
-    const double k = m.extensions.cross_coupling_H_per_A;
+    const double k = m.extensions.cross_coupling_H_per_A, k2 = m.extensions.cross_coupling_H_per_A2;
+    const double i_d = c.extreme_i_d_A, i_q = c.max_i_q_A, psi = m.machine.psi_m_Wb;
     return std::vector<NamedValue>{{"coupling_H_per_A", k, ""},
-                                   {"psi_d_rel_change_at_max_i_q", 0.5 * k * c.max_i_q_A * c.max_i_q_A / m.machine.psi_m_Wb, ""},
-                                   {"l_q_rel_change_at_max_negative_i_d", -k * c.max_i_d_A / m.machine.l_q_H, ""},
-                                   {"max_i_q_A", c.max_i_q_A, ""},
-                                   {"max_i_d_A", c.max_i_d_A, ""}};
+                                   {"coupling_H_per_A2", k2, ""},
+                                   {"psi_d_rel_change_at_max_i_q", 0.5 * k * i_q * i_q / psi, ""},
+                                   {"psi_d_rel_change_at_extremes", (0.5 * k + k2 * i_d) * i_q * i_q / psi, ""},
+                                   {"l_q_rel_change_at_extreme_i_d", (k + k2 * i_d) * i_d / m.machine.l_q_H, ""},
+                                   {"max_i_q_A", i_q, ""},
+                                   {"extreme_i_d_A", i_d, ""}};
   };
   return r;
 }

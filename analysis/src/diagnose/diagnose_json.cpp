@@ -113,6 +113,8 @@ void write_diagnosis_json(const std::string& path, const Diagnosis& d, const std
                 {"excluded_transitional", log.excluded_transitional},
                 {"duration_s", log.t_end_s - log.t_start_s},
                 {"median_sample_interval_s", log.median_dt_s},
+                {"i_d_range_A", {d.context.min_i_d_A, d.context.max_signed_i_d_A}},
+                {"max_i_q_A", d.context.max_i_q_A},
                 {"t_winding_span_K", d.context.t_winding.logged ? nlohmann::json(d.context.t_winding.span_K) : nlohmann::json(nullptr)},
                 {"t_magnet_span_K", d.context.t_magnet.logged ? nlohmann::json(d.context.t_magnet.span_K) : nlohmann::json(nullptr)}};
   out["machine_config"] = config_path;
@@ -155,13 +157,15 @@ void write_diagnosis_json(const std::string& path, const Diagnosis& d, const std
   out["estimates_method"] = d.estimates.method;
   out["not_identifiable"] = nlohmann::json::array();
   for (const Unidentifiable& u : s.not_identifiable) out["not_identifiable"].push_back({{"effects", u.effects}, {"reason", u.reason}});
-  out["implausible"] = nlohmann::json::array();
-  for (const ImplausibleEffect& i : s.implausible) {
-    out["implausible"].push_back({{"effect", i.effect.label()},
-                                  {"params", params_json(i.parameters)},
-                                  {"gain_pct", i.gain_pct},
-                                  {"reason", i.why.reason},
-                                  {"more_likely", i.why.more_likely}});
+  for (const auto& [key, list] : {std::pair{"implausible", &s.implausible}, std::pair{"negligible", &s.negligible}}) {
+    out[key] = nlohmann::json::array();
+    for (const ImplausibleEffect& i : *list) {
+      out[key].push_back({{"effect", i.effect.label()},
+                          {"params", params_json(i.parameters)},
+                          {"gain_pct", i.gain_pct},
+                          {"reason", i.why.reason},
+                          {"more_likely", i.why.more_likely}});
+    }
   }
 
   out["selection"] = nlohmann::json::array();

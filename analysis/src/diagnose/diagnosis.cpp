@@ -95,6 +95,30 @@ void readmit_constants(const EffectFitter& fitter, double floor, const Calibrati
   d.selection.extended_heldout_rms_A = heldout;
 }
 
+/// An effect that the readmitted constants leave physically negligible was standing in for them: it is
+/// taken out of the named effects and the model refitted.
+void prune_negligible(const EffectFitter& fitter, Diagnosis& d) {
+  Selection& s = d.selection;
+  const ExtendedModel m = s.model.model(d.context);
+  EffectSet kept = s.model;
+  std::vector<FoundEffect> found;
+  for (const FoundEffect& f : s.found) {
+    const EffectRow& row = *f.effect.row;
+    if (row.negligible && row.negligible(f.effect, m, d.context)) {
+      kept = kept.without(f.effect);
+      s.negligible.push_back({f.effect, row.describe(f.effect, m, d.context), f.gain_pct,
+                              {"negligible once the calibrated constants were refitted with the effects found",
+                               "part of the calibrated constants it stood in for"}});
+      continue;
+    }
+    found.push_back(f);
+  }
+  if (found.size() == s.found.size()) return;
+  s.found = found;
+  s.model = fitter.fit(kept);
+  s.extended_heldout_rms_A = rms(fitter.heldout(s.model));
+}
+
 }  // namespace
 
 io::MachineConfig config_of(const io::MachineConfig& input, const ExtendedModel& model,
@@ -158,6 +182,7 @@ Diagnosis diagnose(LogData log, const io::MachineConfig& config, const DiagnoseO
 
   d.selection = select_effects(fitter, options.selection, start, floor);
   readmit_constants(fitter, floor, excitation, d);
+  prune_negligible(fitter, d);
   d.calibration.intervals = fitter.intervals(d.selection.model, floor);
   d.extended_model = d.selection.model.model(d.context);
   for (std::size_t i = 0; i < kCalibrated.size(); ++i) d.calibration.value[i] = d.extended_model.machine.*kCalibratedFields[i];

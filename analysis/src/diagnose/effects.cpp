@@ -81,6 +81,15 @@ EffectContext EffectContext::of(const LogData& log, const core::MachineSi& machi
     c.max_i_d_A = std::max(c.max_i_d_A, std::abs(log.logged_i_dq_A[k][0]));
     c.max_i_q_A = std::max(c.max_i_q_A, std::abs(log.logged_i_dq_A[k][1]));
   }
+  std::vector<double> i_d;
+  for (std::size_t k = 0; k < log.rows.size(); ++k) {
+    if (log.used[k]) i_d.push_back(log.logged_i_dq_A[k][0]);
+  }
+  if (!i_d.empty()) {
+    std::sort(i_d.begin(), i_d.end());
+    c.min_i_d_A = i_d[i_d.size() / 100];
+    c.max_signed_i_d_A = i_d[i_d.size() - 1 - i_d.size() / 100];
+  }
   c.max_speed_rad_s = log.max_speed_rad_s;
   c.t_start_s = log.t_start_s;
   c.t_span_s = std::max(log.t_end_s - log.t_start_s, 1e-9);

@@ -162,17 +162,18 @@ Selection select_effects(const EffectFitter& fitter, const SelectionOptions& opt
     std::size_t best = shortlisted;
     bool set_aside = false;
     // Accepted only if large, consistent, and standing out of the noise: the model change it brings (the
-    // held-out RMS² it removes) must be at least min_change_of_floor of the noise floor.
+    // held-out RMS² it removes) must be at least (min_change_of_floor × the noise floor)².
     const double before = rms(current);
     const double min_change2 = std::pow(options.min_change_of_floor * noise_floor_A, 2);
     auto passes = [&](std::size_t i) {
       const CandidateScore& c = round[i];
       const double after = rms(scores[i]);
-      return c.gain_pct >= options.min_gain_pct && c.p_value <= options.max_p && before * before - after * after >= min_change2;
+      if (c.gain_pct < options.min_gain_pct || c.p_value > options.max_p || before * before - after * after < min_change2) return false;
+      return !(c.effect.row->negligible && c.effect.row->negligible(c.effect, fitted[i].model(context), context));
     };
     for (std::size_t i : ranked) {
       const CandidateScore& c = round[i];
-      if (!passes(i)) break;
+      if (!passes(i)) continue;  // the best that passes: each is tested on its own
       const ExtendedModel m = fitted[i].model(context);
       std::optional<Implausibility> why;
       if (c.effect.row->judge && c.effect.row->judge(c.effect, m, context, {})) {

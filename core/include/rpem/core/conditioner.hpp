@@ -64,15 +64,18 @@ struct ModelExtensions {
   double delay_s = 0.0;
   InductanceCurve inductance_d;              ///< ld_saturation
   InductanceCurve inductance_q;              ///< lq_saturation
-  /// cross_saturation: the reciprocal coupling c of the co-energy term (c/2)·i_d·i_q², so that
-  ///   ψ_d = L_d·i_d + ψm + (c/2)·i_q²,   ψ_q = (L_q + c·i_d)·i_q      [c in H/A = Wb/A²]
+  /// cross_saturation: the two lowest-order reciprocal co-energy terms even in i_q, (c/2)·i_d·i_q² and
+  /// (c₂/2)·i_d²·i_q², so that
+  ///   ψ_d = L_d·i_d + ψm + (c/2 + c₂·i_d)·i_q²,   ψ_q = (L_q + c·i_d + c₂·i_d²)·i_q
   /// (L_q against i_d, and the d-axis flux against the load); quasi-static (docs/model-extensions.md).
-  double cross_coupling_H_per_A = 0.0;
+  double cross_coupling_H_per_A = 0.0;    ///< c [H/A = Wb/A²]
+  double cross_coupling_H_per_A2 = 0.0;   ///< c₂ [H/A² = Wb/A³]
   double iron_loss_r_fe_Ohm = 0.0;           ///< resistance parallel to the induced voltage; 0: none
   std::array<FluxHarmonic, kFluxHarmonicOrders.size()> flux_harmonics{};  ///< orders kFluxHarmonicOrders
 
   [[nodiscard]] bool saturation() const noexcept {
-    return !inductance_d.nominal() || !inductance_q.nominal() || cross_coupling_H_per_A != 0.0;
+    return !inductance_d.nominal() || !inductance_q.nominal() || cross_coupling_H_per_A != 0.0 ||
+           cross_coupling_H_per_A2 != 0.0;
   }
   [[nodiscard]] bool harmonics() const noexcept {
     for (const FluxHarmonic& h : flux_harmonics) {
@@ -142,7 +145,7 @@ class SampleConditioner {
   [[nodiscard]] double deadtime_voltage_V(double u_dc_V) const noexcept;
   [[nodiscard]] Vec2 deadtime_error_alphabeta_V(const Vec2& i_ab_A, double u_dc_V) const noexcept;
   /// The voltage the flux harmonics and the cross-saturation's d-axis flux induce at this sample, rotor
-  /// frame [pu]: n·(∂ψ_h/∂ϑ + J·ψ_h) + n·J·[(c/2)·i_q², 0].
+  /// frame [pu]: n·(∂ψ_h/∂ϑ + J·ψ_h) + n·J·[(c/2 + c₂·i_d)·i_q², 0].
   /// (`harmonics` false: without the flux harmonics, for the steady state.)
   [[nodiscard]] Vec2 extra_emf_pu(const Rotation& rot, double n_pu, const Vec2& i_dq_pu, bool harmonics) const noexcept;
   /// x_d, x_q at a rotor-frame current [pu]: the saturation curves and the cross-coupling's L_q(i_d).
@@ -161,7 +164,9 @@ class SampleConditioner {
   Rotation offset_rotation_;                 ///< by theta_offset_rad
   std::array<FluxHarmonic, kFluxHarmonicOrders.size()> harmonics_pu_{};  ///< flux harmonics in pu
   double half_cross_pu_ = 0.0;               ///< c/2 in pu (ψ_b/I_b²)
+  double cross2_pu_ = 0.0;                   ///< c₂ in pu (ψ_b/I_b³)
   double cross_x_q_pu_per_A_ = 0.0;          ///< c/L_b: x_q's change per ampere of i_d [pu/A]
+  double cross_x_q_pu_per_A2_ = 0.0;         ///< c₂/L_b [pu/A²]
   // Which extensions are active, decided when configured (the per-sample path tests one flag each).
   bool angle_offset_ = false, phase_corrections_ = false, saturation_ = false, deadtime_ = false;
   bool harmonics_ = false, cross_ = false, delay_ = false;

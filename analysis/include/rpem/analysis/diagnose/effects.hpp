@@ -49,6 +49,7 @@ struct EffectContext {
   double base_current_A = 0.0;              ///< I_b
   double max_i_d_A = 0.0, max_i_q_A = 0.0;  ///< largest |i_d|, |i_q| logged
   double extreme_i_d_A = 0.0;               ///< the logged i_d of largest magnitude, signed
+  double min_i_d_A = 0.0, max_signed_i_d_A = 0.0;  ///< the logged i_d's range (1st to 99th percentile)
   double max_speed_rad_s = 0.0;
   double t_start_s = 0.0, t_span_s = 0.0;
   TemperatureColumn t_winding, t_magnet;
@@ -78,6 +79,10 @@ struct EffectContext {
 /// this much (docs/diagnose.md, "Drift laws"): copper's 0.39 %/K moves R_s by 3.9 % over it, NdFeB's
 /// −0.1 %/K ψm by 1 %, both well above what the held-out test resolves.
 inline constexpr double kMinDriftSpan_K = 10.0;
+
+/// A saturation that changes an inductance by less than this over the logged currents is negligible: within
+/// the tolerance of any data sheet and of no consequence to the estimator.
+inline constexpr double kNegligibleInductanceChange = 0.01;
 
 /// One named SI parameter of a found effect (`text` for non-numeric ones such as the phase).
 struct NamedValue {
@@ -121,6 +126,10 @@ struct EffectRow {
   void (*apply)(const Effect&, const double* p, const EffectContext&, ExtendedModel&) = nullptr;
   /// Its SI parameters as they stand in a model (the configuration's part included).
   std::vector<NamedValue> (*describe)(const Effect&, const ExtendedModel&, const EffectContext&) = nullptr;
+  /// Whether the fitted effect is too small to matter physically (an inductance that moves by less than
+  /// kNegligibleInductanceChange over the logged currents); nullptr: never. Such an effect is not named,
+  /// however much residual it takes: it stands in for some other error of the model.
+  bool (*negligible)(const Effect&, const ExtendedModel&, const EffectContext&) = nullptr;
   /// Set when the fitted model is physically implausible beyond its parameters' 95 % half-widths
   /// (scaled; empty: exact); nullptr: always plausible.
   std::optional<Implausibility> (*judge)(const Effect&, const ExtendedModel&, const EffectContext&,

@@ -23,8 +23,8 @@ struct SelectionOptions {
   double min_gain_pct = 2.0;   ///< held-out RMS gain an effect must bring
   double max_p = 0.01;         ///< signed-rank p over the held-out blocks
   /// The held-out RMS² an effect removes must be at least (this × the noise floor)²: a model change below
-  /// half the sensors' noise is not worth naming, however consistent.
-  double min_change_of_floor = 0.5;
+  /// 0.4 of the sensors' noise (RMS) is not worth naming, however consistent.
+  double min_change_of_floor = 0.4;
   int max_effects = 4;
   int shortlist = 4;           ///< candidates fitted in full per round (at most) …
   double shortlist_share = 0.05;  ///< … of those screened at this share of the best or more (at least 2);
@@ -71,6 +71,8 @@ struct Selection {
   std::vector<FoundEffect> found;
   std::vector<Unidentifiable> not_identifiable;
   std::vector<ImplausibleEffect> implausible;
+  /// Found, then negligible once the calibrated constants were refitted with the effects (diagnosis.cpp).
+  std::vector<ImplausibleEffect> negligible;
   std::vector<std::vector<CandidateScore>> rounds;
   double start_heldout_rms_A = 0.0;     ///< the model selection started from (the calibrated baseline)
   double extended_heldout_rms_A = 0.0;
