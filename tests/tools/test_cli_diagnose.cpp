@@ -156,7 +156,13 @@ TEST(CliDiagnose, PaderbornWorkedExampleKeepsItsResult) {
   const double baseline = d["baseline"]["heldout_rms"], extended = d["extended"]["heldout_rms"];
   EXPECT_GT(baseline, 7.5);
   EXPECT_LT(baseline, 9.5);
-  ASSERT_EQ(d["effects"].size(), 1U) << d["effects"].dump(2);
+  // The magnet's drift is the finding; at this one speed a second, small operating-point error may pass
+  // the held-out test too (docs/diagnose.md: a θ offset of −0.2°, 8 % of what is left), never a large one.
+  ASSERT_GE(d["effects"].size(), 1U) << d["effects"].dump(2);
+  ASSERT_LE(d["effects"].size(), 2U) << d["effects"].dump(2);
+  if (d["effects"].size() == 2U) {
+    EXPECT_LT(d["effects"][1]["gain_pct"].get<double>(), 15.0) << d["effects"].dump(2);
+  }
   const auto& e = d["effects"][0];
   EXPECT_EQ(e["name"], "psim_drift");
   const double coeff = e["params"]["coeff_per_K"];  // NdFeB: about −0.1 %/K
@@ -165,6 +171,7 @@ TEST(CliDiagnose, PaderbornWorkedExampleKeepsItsResult) {
   EXPECT_EQ(e["params"]["material"], "NdFeB");
   EXPECT_GT(e["gain_pct"].get<double>(), 60.0);  // against the calibrated baseline
   EXPECT_LT(extended, 1.5);
+  EXPECT_EQ(d["calibration"]["identifiable"][0], "psi_m_Wb");
   EXPECT_GT(extended, 0.5);
   // R_s against the winding temperature would be 2.5 times copper's coefficient: reported, not named.
   ASSERT_EQ(d["implausible"].size(), 1U) << d["implausible"].dump(2);

@@ -247,6 +247,7 @@ template <bool kWinding>
 EffectRow drift() {
   EffectRow r;
   r.name = kWinding ? "rs_drift" : "psim_drift";
+  r.frees_constant = kWinding ? 1 : 0;  // kCalibrated: r_s_Ohm, psi_m_Wb
   r.shows_as = kWinding ? "a trend with the winding temperature (or time), growing with |i|"
                         : "a trend with the magnet temperature (or time), growing with speed";
   r.enters = kWinding ? "R_s(T) = R_s,ref·(1 + coeff·(T − reference)) against T_winding (without temperatures: a change over "
@@ -294,14 +295,16 @@ EffectRow drift() {
     const std::optional<core::DriftLaw>& law = kWinding ? m.r_s_law : m.psi_m_law;
     if (!law) return std::nullopt;  // against time: no temperature to judge it by
     const double alpha = material_alpha(*law, kWinding ? m.machine.r_s_Ohm : m.machine.psi_m_Wb);
-    // The coefficient's own 95 % interval, referred like the coefficient: implausible only if it misses
-    // every material's range.
+    // The coefficient's own 95 % interval, referred like the coefficient: implausible if it misses every
+    // material's range — the interval counted at most half the range's magnitude, so that a coefficient the
+    // log cannot pin down (its interval as wide as a material's whole coefficient) is never named.
     const double delta = half_width.empty() || law->coeff_per_K == 0.0
                              ? 0.0
                              : std::abs(half_width[0] * kPerKelvinScale * alpha / law->coeff_per_K);
     const auto overlaps = [&](const auto& materials) {
       for (const core::MaterialCoefficient& mat : materials) {
-        if (alpha + delta >= mat.min_per_K && alpha - delta <= mat.max_per_K) return true;
+        const double d = std::min(delta, 0.5 * std::max(std::abs(mat.min_per_K), std::abs(mat.max_per_K)));
+        if (alpha + d >= mat.min_per_K && alpha - d <= mat.max_per_K) return true;
       }
       return false;
     };
@@ -366,6 +369,10 @@ EffectRow iron_loss() {
   r.name = "iron_loss";
   r.shows_as = "errors growing with speed, none at standstill";
   r.enters = "a resistance parallel to the induced voltage: i_s = i_m + n·J·ψ(i_m)/r_fe";
+  // Its signature is the growth with speed: at one speed it is one more operating-point-dependent current
+  // error, like a resistance or flux error at that speed.
+  r.confusions = {{"psim_drift", "the same torque at two or more speeds"}, {"rs_drift", "the same current at two or more speeds"}};
+  r.applies = [](const EffectContext& c) { return c.speed_spread_rel >= kMinSpeedSpread; };
   r.bounds = [](const EffectContext& c, int) { return range(-base_conductance(c) / iron_loss_conductance_scale(c), kInf); };
   r.apply = [](const Effect&, const double* p, const EffectContext& c, ExtendedModel& m) {
     const double g = base_conductance(c) + iron_loss_conductance_scale(c) * p[0];

@@ -183,6 +183,8 @@ Diagnosis diagnose(LogData log, const io::MachineConfig& config, const DiagnoseO
   d.selection = select_effects(fitter, options.selection, start, floor);
   readmit_constants(fitter, floor, excitation, d);
   prune_negligible(fitter, d);
+  // A drift law found brings the constant it is referred to (EffectRow::frees_constant).
+  for (std::size_t i = 0; i < kCalibrated.size(); ++i) d.calibration.identifiable[i] = d.selection.model.calibrated[i];
   d.calibration.intervals = fitter.intervals(d.selection.model, floor);
   d.extended_model = d.selection.model.model(d.context);
   for (std::size_t i = 0; i < kCalibrated.size(); ++i) d.calibration.value[i] = d.extended_model.machine.*kCalibratedFields[i];

@@ -131,6 +131,7 @@ ExtendedModel EffectSet::model(const EffectContext& c) const {
 
 EffectSet EffectSet::with(const Effect& e, const EffectContext&, const std::vector<double>& start) const {
   EffectSet s = *this;
+  if (e.row->frees_constant >= 0) s.calibrated[static_cast<std::size_t>(e.row->frees_constant)] = true;
   s.effects.push_back(e);
   s.parameters.push_back(start.empty() ? std::vector<double>(static_cast<std::size_t>(e.row->parameters), 0.0) : start);
   return s;
@@ -228,6 +229,13 @@ double EffectFitter::screen(const ScreenBasis& basis, const EffectSet& base, con
   std::vector<double> r_start;
   training_residuals(at, r_start);
   std::vector<std::vector<double>> columns = basis.columns;
+  if (const int c = candidate.row->frees_constant; c >= 0 && !base.calibrated[static_cast<std::size_t>(c)]) {
+    // The constant the candidate's law is referred to moves with it (unbounded, like the basis).
+    EffectSet moved = at;
+    moved.calibration[static_cast<std::size_t>(c)] += kStep;
+    columns.push_back(column(moved, r_start, kStep));
+  }
+  const std::size_t first = columns.size();
   const int p = candidate.row->parameters;
   for (int i = 0; i < p; ++i) {
     // Step into the allowed side of a bound (a delay or a conductance may start on its lower one).
@@ -237,7 +245,7 @@ double EffectFitter::screen(const ScreenBasis& basis, const EffectSet& base, con
     moved.parameters.back()[static_cast<std::size_t>(i)] += h;
     columns.push_back(column(moved, r_start, h));
   }
-  const Eigen::VectorXd delta = bounded_step(columns, r_start, basis.columns.size(), [&](int i) {
+  const Eigen::VectorXd delta = bounded_step(columns, r_start, first, [&](int i) {
     const auto [lo, hi] = parameter_bounds(candidate, context_, i);
     const double value = at.parameters.back()[static_cast<std::size_t>(i)];
     return std::pair{lo - value, hi - value};

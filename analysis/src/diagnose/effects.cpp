@@ -91,6 +91,7 @@ EffectContext EffectContext::of(const LogData& log, const core::MachineSi& machi
     c.max_signed_i_d_A = i_d[i_d.size() - 1 - i_d.size() / 100];
   }
   c.max_speed_rad_s = log.max_speed_rad_s;
+  c.speed_spread_rel = log.speed_spread_rel;
   c.t_start_s = log.t_start_s;
   c.t_span_s = std::max(log.t_end_s - log.t_start_s, 1e-9);
   c.t_winding = winding_column(log);

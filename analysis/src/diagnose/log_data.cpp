@@ -62,6 +62,14 @@ LogData prepare_log(std::vector<io::DriveLogRow> rows, const io::DriveLogLayout&
     u_dc_sum += s.u_dc_V;
   }
   d.mean_u_dc_V = u_dc_sum / static_cast<double>(n);
+  std::vector<double> moving;
+  for (double w : speed) {
+    if (std::abs(w) > 0.05 * d.max_speed_rad_s) moving.push_back(std::abs(w));
+  }
+  if (!moving.empty()) {
+    std::sort(moving.begin(), moving.end());
+    d.speed_spread_rel = (moving[moving.size() * 9 / 10] - moving[moving.size() / 10]) / std::max(d.max_speed_rad_s, 1e-12);
+  }
 
   const double time_constant_s = std::max(machine.l_d_H, machine.l_q_H) / machine.r_s_Ohm;
   d.mode = options.mode.value_or(d.median_dt_s >= kSteadyStateTimeConstants * time_constant_s ? ModelMode::kSteadyState

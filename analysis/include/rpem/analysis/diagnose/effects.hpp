@@ -51,6 +51,7 @@ struct EffectContext {
   double extreme_i_d_A = 0.0;               ///< the logged i_d of largest magnitude, signed
   double min_i_d_A = 0.0, max_signed_i_d_A = 0.0;  ///< the logged i_d's range (1st to 99th percentile)
   double max_speed_rad_s = 0.0;
+  double speed_spread_rel = 0.0;            ///< LogData::speed_spread_rel
   double t_start_s = 0.0, t_span_s = 0.0;
   TemperatureColumn t_winding, t_magnet;
   double reference_C = 20.0;          ///< temperature at which reported drift laws are referred
@@ -79,6 +80,10 @@ struct EffectContext {
 /// this much (docs/diagnose.md, "Drift laws"): copper's 0.39 %/K moves R_s by 3.9 % over it, NdFeB's
 /// −0.1 %/K ψm by 1 %, both well above what the held-out test resolves.
 inline constexpr double kMinDriftSpan_K = 10.0;
+
+/// Effects that are told by their growth with speed (iron loss) are candidates only in a log whose speed in
+/// motion varies by at least this share of its largest (LogData::speed_spread_rel).
+inline constexpr double kMinSpeedSpread = 0.2;
 
 /// A saturation that changes an inductance by less than this over the logged currents is negligible: within
 /// the tolerance of any data sheet and of no consequence to the estimator.
@@ -115,6 +120,10 @@ struct EffectRow {
   std::string_view shows_as;     ///< the residual's signature (report, docs)
   std::string_view enters;       ///< how it enters the model (docs)
   std::vector<Confusion> confusions;
+  /// The calibrated constant (index into kCalibrated) the effect's law is referred to — a drift law holds
+  /// the constant's value at the log's mean temperature (or mid-log) — and that is therefore fitted with the
+  /// effect even where the baseline could not calibrate it alone (a log at one operating point); −1: none.
+  int frees_constant = -1;
   /// Starting points (scaled) for effects whose residual is not convex in their parameters; the
   /// screening tries each and the fit starts from the best. Empty: zero.
   std::vector<std::vector<double>> starts;

@@ -29,6 +29,9 @@ struct LogData {
   double median_dt_s = 0.0;
   double max_current_A = 0.0;   ///< largest measured current amplitude
   double max_speed_rad_s = 0.0; ///< largest |ω_el|
+  /// How far the speed varies in motion: the 10th to 90th percentile of |ω_el| over the samples above 5 %
+  /// of the largest, relative to the largest (0: one speed).
+  double speed_spread_rel = 0.0;
   double mean_u_dc_V = 0.0;
   /// The samples the replay runs on: as logged, but (transient logs) with the electrical speed as the
   /// centred difference of the logged angle over ±speed_half_window samples — no lag, unlike a drive's
