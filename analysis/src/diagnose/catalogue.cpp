@@ -128,20 +128,27 @@ EffectRow saturation() {
 EffectRow cross_saturation() {
   EffectRow r;
   r.name = "cross_saturation";
+  r.parameters = 2;
   r.shows_as = "the d-axis flux falling with the load, L_q changing with i_d: q-axis errors growing with i_q², d-axis ones "
                "with i_d·i_q";
-  // The fit moves c, the lowest-order reciprocal co-energy term; a configuration's c₂ (the next one) is
-  // replayed as it is. Fitting c₂ too traded it against c on logs whose d current hardly varies (the
-  // Beckhoff map at i_d ≈ 0: c lost 90 % of the map's ψ_d change).
-  r.enters = "ψ_d = L_d·i_d + ψm + (c/2 + c₂·i_d)·i_q², ψ_q = (L_q + c·i_d + c₂·i_d²)·i_q (reciprocal co-energy terms even in "
-             "i_q; c fitted, c₂ as configured)";
+  r.enters = "ψ_d = L_d·i_d + ψm + (c/2 + c₂·i_d)·i_q², ψ_q = (L_q + c·i_d + c₂·i_d²)·i_q (the two lowest-order reciprocal "
+             "co-energy terms even in i_q)";
   r.confusions = {{"lq_saturation", "the same q-axis current at two or more d-axis currents"},
                   {"ld_saturation", "the same d-axis current at two or more q-axis currents"},
                   {"psim_drift", "a load change at constant temperature"}};
+  // c₂ only where the log's d current varies (its 1st-99th percentile range at least kMinCrossDRange of the
+  // base current): elsewhere i_d·i_q² is i_q² times a near-constant and c₂ trades against c (the Beckhoff
+  // map at i_d ≈ 0: c lost 90 % of the map's ψ_d change); there c₂ is held at the configuration's.
+  r.bounds = [](const EffectContext& c, int i) {
+    constexpr double kMinCrossDRange = 0.2, kHeld = 1e-9;
+    if (i == 1 && c.max_signed_i_d_A - c.min_i_d_A < kMinCrossDRange * c.base_current_A) return range(-kHeld, kHeld);
+    return range(-kInf, kInf);
+  };
   r.apply = [](const Effect&, const double* p, const EffectContext& c, ExtendedModel& m) {
-    const double i_q = std::max(c.max_i_q_A, 0.05 * c.base_current_A);
-    const double psi = kCrossScale * c.machine.psi_m_Wb;  // the d-axis flux change a scaled 1 makes at the largest i_q
+    const double i_q = std::max(c.max_i_q_A, 0.05 * c.base_current_A), i_d = std::max(c.max_i_d_A, 0.05 * c.base_current_A);
+    const double psi = kCrossScale * c.machine.psi_m_Wb;  // the d-axis flux change a scaled 1 makes at the extremes
     m.extensions.cross_coupling_H_per_A += 2.0 * psi / (i_q * i_q) * p[0];
+    m.extensions.cross_coupling_H_per_A2 += psi / (i_q * i_q * i_d) * p[1];
   };
   r.negligible = [](const Effect&, const ExtendedModel& m, const EffectContext& c) {
     // L_q's change over the logged d currents, and the d-axis flux's under load (as a share of L_d·I).
