@@ -7,7 +7,7 @@
 #include <unsupported/Eigen/MatrixFunctions>
 
 #include "rpem/sim/edge_integrator.hpp"
-#include "support/paper_machine.hpp"
+#include "support/paper_plant.hpp"
 
 namespace rpem::sim {
 namespace {
@@ -15,15 +15,6 @@ namespace {
 using Mat5 = Eigen::Matrix<double, 5, 5>;
 using Vec5 = Eigen::Matrix<double, 5, 1>;
 
-PlantParameters paper_parameters() {
-  const auto m = test::paper_machine_si();
-  PlantParameters p;
-  p.r_s_Ohm = m.r_s_Ohm;
-  p.psi_m_Wb = m.psi_m_Wb;
-  p.l_d_H = m.l_d_H;
-  p.l_q_H = m.l_q_H;
-  return p;
-}
 
 /// ψ(t) from the augmented system d/dt [ψ; u; 1] = [A I c; 0 Ω 0; 0 0 0]·[ψ; u; 1] (docs/derivations.md
 /// §10), its matrix set up here from the plant's equations and exponentiated by Eigen.
@@ -48,7 +39,7 @@ core::Vec2 augmented_exponential(const PlantParameters& p, double omega, const c
 TEST(LinearFlow, EqualsTheMatrixExponentialOfTheAugmentedSystem) {
   for (const double r_fe : {0.0, 800.0}) {
     for (const double omega : {0.0, 120.0, -600.0, 4000.0}) {
-      PlantParameters p = paper_parameters();
+      PlantParameters p = test::paper_plant_parameters();
       p.r_fe_Ohm = r_fe;
       PmsmPlant plant(3, Magnetics(), MechanicsConfig{});
       plant.reset(core::Vec2(-1.5, 4.0), 0.7, omega, p);
@@ -74,7 +65,7 @@ TEST(LinearFlow, EqualsTheMatrixExponentialOfTheAugmentedSystem) {
 }
 
 TEST(LinearFlow, PhaseCurrentRatesAreTheDerivativesOfThePhaseCurrents) {
-  PlantParameters p = paper_parameters();
+  PlantParameters p = test::paper_plant_parameters();
   p.r_fe_Ohm = 900.0;
   PmsmPlant plant(3, Magnetics(), MechanicsConfig{});
   plant.reset(core::Vec2(-1.0, 3.0), 2.1, 300.0, p);
@@ -107,7 +98,7 @@ std::shared_ptr<const FluxMap> linear_map(const PlantParameters& p) {
 }
 
 TEST(MapFlow, OnAMapOfConstantInductancesAgreesWithTheExactSolutionWithinItsTolerance) {
-  const PlantParameters p = paper_parameters();
+  const PlantParameters p = test::paper_plant_parameters();
   for (const double tolerance : {1e-7, 1e-9, 1e-11}) {
     PmsmPlant exact(3, Magnetics(), MechanicsConfig{}), mapped(3, Magnetics(linear_map(p)), MechanicsConfig{});
     for (PmsmPlant* plant : {&exact, &mapped}) {
@@ -137,7 +128,7 @@ TEST(MapFlow, OnAMapOfConstantInductancesAgreesWithTheExactSolutionWithinItsTole
 /// Integrates one carrier period (rising, then falling half) at standstill and returns the mean αβ
 /// voltage from the flux the integrator moved: with ω = 0 and R_s ≈ 0, Δψ = ∫u dt.
 core::Vec2 carrier_period_mean_voltage(const InverterConfig& c, const Duties& d, const core::Vec3& i_abc, double u_dc) {
-  PlantParameters p = paper_parameters();
+  PlantParameters p = test::paper_plant_parameters();
   p.r_s_Ohm = 1e-9;
   p.l_d_H = p.l_q_H = 50.0;  // the currents barely move: no zero crossing
   PmsmPlant plant(3, Magnetics(), MechanicsConfig{});
@@ -179,7 +170,7 @@ TEST(EdgeIntegrator, ACurrentReachingZeroDuringBlankingStaysThereUntilTheLegSwit
   // there both diodes of leg a block and i_a stays at zero to the end.
   InverterConfig c;
   c.dead_time_s = 2e-6;
-  PlantParameters p = paper_parameters();
+  PlantParameters p = test::paper_plant_parameters();
   PmsmPlant plant(3, Magnetics(), MechanicsConfig{}), reference(3, Magnetics(), MechanicsConfig{});
   const core::Vec3 i0(0.002, 0.5, -0.502);
   for (PmsmPlant* pl : {&plant, &reference}) {
@@ -208,7 +199,7 @@ TEST(EdgeIntegrator, ACurrentReachingZeroDuringBlankingStaysThereUntilTheLegSwit
 TEST(EdgeIntegrator, AnEdgeWithinAPicosecondOfTheStartStillEndsTheHalfPeriod) {
   // Duties within 1e-8 of 1 put the falling half's PWM edge 1e-12 s after its start (a hang once, for
   // the flux map: an interval shorter than the integrator's smallest step).
-  const PlantParameters p = paper_parameters();
+  const PlantParameters p = test::paper_plant_parameters();
   for (const bool map : {false, true}) {
     PmsmPlant plant(3, map ? Magnetics(linear_map(p)) : Magnetics(), MechanicsConfig{});
     plant.reset(core::Vec2(-1.0, 3.0), 0.0, 200.0, p);

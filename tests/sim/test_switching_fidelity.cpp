@@ -53,20 +53,26 @@ Deviations against_reference(const Scenario& s) {
   return d;
 }
 
-Scenario paper(double dead_time_s, double drop_V) {
-  Scenario s = paper_scenario();
+/// `s` at a constant operating point, with the inverter's dead time and device drops (diode 0.8× IGBT).
+Scenario with_inverter(Scenario s, const char* machine, double speed_rpm, double torque_Nm, double dead_time_s,
+                       double drop_V, double duration_s) {
   char name[96];
-  std::snprintf(name, sizeof name, "paper IPMSM, dead time %g s, drop %g V", dead_time_s, drop_V);
+  std::snprintf(name, sizeof name, "%s, dead time %g s, drop %g V", machine, dead_time_s, drop_V);
   s.name = name;
-  s.signal(Quantity::kSpeed) = Signal(400.0);
-  s.signal(Quantity::kTorque) = Signal(6.52);
-  s.signal(Quantity::kUdc) = Signal(565.0);
+  s.signal(Quantity::kSpeed) = Signal(speed_rpm);
+  s.signal(Quantity::kTorque) = Signal(torque_Nm);
   s.inverter.dead_time_s = dead_time_s;
   s.inverter.v_igbt_V = drop_V;
   s.inverter.v_diode_V = 0.8 * drop_V;
   s.warmup_s = 0.01;
-  s.duration_s = 0.06;
+  s.duration_s = duration_s;
   return s;
+}
+
+Scenario paper(double dead_time_s, double drop_V) {
+  Scenario s = paper_scenario();
+  s.signal(Quantity::kUdc) = Signal(565.0);
+  return with_inverter(s, "paper IPMSM", 400.0, 6.52, dead_time_s, drop_V, 0.06);
 }
 
 TEST(SwitchingFidelity, IdealInverterEdgeToEdgeIsCloserToTheFineReference) {
@@ -85,18 +91,8 @@ TEST(SwitchingFidelity, DeadTimeAndDropsEdgeToEdgeIsCloserToTheFineReference) {
 
 Scenario beckhoff(double dead_time_s, double drop_V) {
   Scenario s = load_scenario(test::source_dir() + "/scenarios/diagnose-beckhoff.yaml");
-  char name[96];
-  std::snprintf(name, sizeof name, "Beckhoff flux map, dead time %g s, drop %g V", dead_time_s, drop_V);
-  s.name = name;
   s.sensors = SensorConfig{};
-  s.signal(Quantity::kSpeed) = Signal(300.0);
-  s.signal(Quantity::kTorque) = Signal(1.12);
-  s.inverter.dead_time_s = dead_time_s;
-  s.inverter.v_igbt_V = drop_V;
-  s.inverter.v_diode_V = 0.8 * drop_V;
-  s.warmup_s = 0.01;
-  s.duration_s = 0.02;
-  return s;
+  return with_inverter(s, "Beckhoff flux map", 300.0, 1.12, dead_time_s, drop_V, 0.02);
 }
 
 TEST(SwitchingFidelity, FluxMapEdgeToEdgeIsCloserToTheFineReference) {
