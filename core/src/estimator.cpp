@@ -16,6 +16,18 @@ bool finite(const EstimatorSample& s) noexcept {
 /// constant T_0 = T_samp/γ_0 stays fixed in seconds. Capped at 1 (a filter gain above 1 is unstable).
 Vec2 scaled(const Vec2& gamma, double factor) noexcept { return (gamma * factor).cwiseMin(1.0); }
 
+/// Rates [1/s] as the per-sample factors of an interval dt: γ = 1 − e^{−rate·dt}, the exact discrete
+/// counterpart of a first-order filter with that rate, so a time constant holds at any sample rate
+/// (≈ rate·dt for rate·dt ≪ 1, as scaled() gives; never above 1).
+Vec2 per_interval(const Vec2& rate_per_s, double dt_s) noexcept {
+  return {-std::expm1(-rate_per_s[0] * dt_s), -std::expm1(-rate_per_s[1] * dt_s)};
+}
+
+bool finite(const SteadyStateSample& s) noexcept {
+  return std::isfinite(s.dt_s) && std::isfinite(s.n_pu) && s.u_pu.allFinite() && s.i_meas_pu.allFinite() &&
+         std::isfinite(s.x_d_pu) && std::isfinite(s.x_q_pu);
+}
+
 /// The GNA matrix Hessian has one forgetting factor: that of the parameter being estimated
 /// (tab_psimgains gives one per estimation case); outside both regions the slower one.
 double gna_hessian_sequence(const Schedule& active, const Vec2& gamma_r) noexcept {
@@ -57,13 +69,13 @@ void RpemEstimator::reconfigure(const EstimatorConfig& config) noexcept {
   (void)project(config_.bounds, state_.theta_pu);
 }
 
-MachinePu RpemEstimator::model_for(const EstimatorSample& sample) const noexcept {
+MachinePu RpemEstimator::model_for(double x_d_pu, double x_q_pu) const noexcept {
   MachinePu m = config_.model;
   m.psi_m_pu = state_.theta_pu[kPsiM];
   m.r_s_pu = state_.theta_pu[kRs];
-  if (sample.x_d_pu > 0.0 && sample.x_q_pu > 0.0) {
-    m.x_d_pu = sample.x_d_pu;
-    m.x_q_pu = sample.x_q_pu;
+  if (x_d_pu > 0.0 && x_q_pu > 0.0) {
+    m.x_d_pu = x_d_pu;
+    m.x_q_pu = x_q_pu;
   }
   return m;
 }
@@ -102,7 +114,7 @@ EstimatorOutput RpemEstimator::step(const EstimatorSample& sample) noexcept {
     return out;
   }
   const auto& iv = sample.interval;
-  const MachinePu model = model_for(sample);
+  const MachinePu model = model_for(sample.x_d_pu, sample.x_q_pu);
   if (sample.resync || !state_.synchronized || !(iv.dt_s > 0.0) || iv.dt_s > config_.max_sample_interval_s) {
     synchronize(sample, model);
     out.i_hat_pu = state_.predictor.i_hat_pu;
@@ -135,11 +147,47 @@ EstimatorOutput RpemEstimator::step(const EstimatorSample& sample) noexcept {
 
   const double factor = iv.dt_s * inverse_nominal_period_;
   const GainSequences& seq = config_.gains[static_cast<std::size_t>(config_.algorithm)];
-  const Vec2 gamma_r = scaled(seq.hessian, factor);
-  const Vec2 gamma_l = scaled(seq.gain, factor);
+  update(model, iv.n_end_pu, scaled(seq.hessian, factor), scaled(seq.gain, factor), out);
+  return out;
+}
 
+EstimatorOutput RpemEstimator::step_steady_state(const SteadyStateSample& sample,
+                                                 const GainSequences& rates_per_s) noexcept {
+  EstimatorOutput out;
+  out.theta_pu = state_.theta_pu;
+  out.flags = state_.frozen ? step_flag::kFrozen : 0;
+  if (!finite(sample)) {
+    state_.epsilon_valid = false;
+    out.code = StepCode::kRejectedNonFinite;
+    return out;
+  }
+  const MachinePu model = model_for(sample.x_d_pu, sample.x_q_pu);
+  // The steady-state prediction of §1 with the current estimates; D ≥ r̂s² > 0 inside D_M.
+  out.i_hat_pu = steady_state_current(model, sample.n_pu, sample.u_pu);
+  if (!out.i_hat_pu.allFinite() || out.i_hat_pu.lpNorm<Eigen::Infinity>() > config_.max_predicted_current_pu) {
+    state_.epsilon_valid = false;
+    out.code = StepCode::kPredictorDiverged;  // a voltage no machine near the model answers; no update
+    return out;
+  }
+  out.epsilon_pu = sample.i_meas_pu - out.i_hat_pu;
+  state_.predictor.i_hat_pu = out.i_hat_pu;
+  state_.last_epsilon_pu = out.epsilon_pu;
+  state_.epsilon_valid = true;
+  state_.synchronized = true;
+  if (sample.resync || !(sample.dt_s > 0.0)) {
+    out.code = StepCode::kSynchronized;
+    return out;
+  }
+  out.gradient = steady_state_gradients(model, sample.n_pu, out.i_hat_pu);
+  update(model, sample.n_pu, per_interval(rates_per_s.hessian, sample.dt_s), per_interval(rates_per_s.gain, sample.dt_s),
+         out);
+  return out;
+}
+
+void RpemEstimator::update(const MachinePu& model, double n_pu, const Vec2& gamma_r, const Vec2& gamma_l,
+                           EstimatorOutput& out) noexcept {
   // eq:GainSchedule decides which parameters may move in this sample.
-  Schedule active = schedule(config_.scheduler, iv.n_end_pu);
+  Schedule active = schedule(config_.scheduler, n_pu);
   active.psi_m = active.psi_m && config_.adapt_psi_m && !state_.frozen;
   active.r_s = active.r_s && config_.adapt_r_s && !state_.frozen;
 
@@ -153,7 +201,7 @@ EstimatorOutput RpemEstimator::step(const EstimatorSample& sample) noexcept {
                       state_.gna_hessian_pu);
       break;
     case Algorithm::kPhyInt:
-      gain = phyint_gain(model, iv.n_end_pu, i_hat, gamma_l, config_.floors);
+      gain = phyint_gain(model, n_pu, out.i_hat_pu, gamma_l, config_.floors);
       break;
   }
   if (gain.flags & gain_flag::kFloored) out.flags |= step_flag::kGainFloored;
@@ -171,7 +219,6 @@ EstimatorOutput RpemEstimator::step(const EstimatorSample& sample) noexcept {
   out.gain = gain.gain;
   out.theta_pu = state_.theta_pu;
   out.code = StepCode::kAdapted;
-  return out;
 }
 
 }  // namespace rpem::core
