@@ -82,6 +82,18 @@ SteadyStateSample AveragedDriveEstimator::condition(const AveragedSample& a) noe
     const Vec2 di_dt = (s.i_meas_pu - previous_i_pu_) / dc_s;
     s.u_pu -= Vec2(s.x_d_pu * di_dt[0], s.x_q_pu * di_dt[1]) / omega_n;
   }
+  // The instrument: the preceding samples' operating point (this sample enters it only afterwards).
+  if (!contiguous) {
+    instrument_i_pu_ = s.i_meas_pu;
+    instrument_n_pu_ = s.n_pu;
+  }
+  s.i_gradient_pu = instrument_i_pu_;
+  s.n_gradient_pu = instrument_n_pu_;
+  const double w = options_.instrument_time_constant_s > 0.0
+                       ? -std::expm1(-s.dt_s / options_.instrument_time_constant_s)
+                       : 1.0;
+  instrument_i_pu_ += w * (s.i_meas_pu - instrument_i_pu_);
+  instrument_n_pu_ += w * (s.n_pu - instrument_n_pu_);
   if (s.i_meas_pu.allFinite()) {
     has_previous_ = true;
     previous_t_ns_ = a.t_ns;

@@ -25,7 +25,8 @@ Vec2 per_interval(const Vec2& rate_per_s, double dt_s) noexcept {
 
 bool finite(const SteadyStateSample& s) noexcept {
   return std::isfinite(s.dt_s) && std::isfinite(s.n_pu) && s.u_pu.allFinite() && s.i_meas_pu.allFinite() &&
-         std::isfinite(s.x_d_pu) && std::isfinite(s.x_q_pu);
+         std::isfinite(s.x_d_pu) && std::isfinite(s.x_q_pu) && s.i_gradient_pu.allFinite() &&
+         std::isfinite(s.n_gradient_pu);
 }
 
 /// The GNA matrix Hessian has one forgetting factor: that of the parameter being estimated
@@ -147,7 +148,7 @@ EstimatorOutput RpemEstimator::step(const EstimatorSample& sample) noexcept {
 
   const double factor = iv.dt_s * inverse_nominal_period_;
   const GainSequences& seq = config_.gains[static_cast<std::size_t>(config_.algorithm)];
-  update(model, iv.n_end_pu, scaled(seq.hessian, factor), scaled(seq.gain, factor), out);
+  update(model, iv.n_end_pu, i_hat, scaled(seq.hessian, factor), scaled(seq.gain, factor), out);
   return out;
 }
 
@@ -178,14 +179,14 @@ EstimatorOutput RpemEstimator::step_steady_state(const SteadyStateSample& sample
     out.code = StepCode::kSynchronized;
     return out;
   }
-  out.gradient = steady_state_gradients(model, sample.n_pu, out.i_hat_pu);
-  update(model, sample.n_pu, per_interval(rates_per_s.hessian, sample.dt_s), per_interval(rates_per_s.gain, sample.dt_s),
-         out);
+  out.gradient = steady_state_gradients(model, sample.n_gradient_pu, sample.i_gradient_pu);
+  update(model, sample.n_pu, sample.i_gradient_pu, per_interval(rates_per_s.hessian, sample.dt_s),
+         per_interval(rates_per_s.gain, sample.dt_s), out);
   return out;
 }
 
-void RpemEstimator::update(const MachinePu& model, double n_pu, const Vec2& gamma_r, const Vec2& gamma_l,
-                           EstimatorOutput& out) noexcept {
+void RpemEstimator::update(const MachinePu& model, double n_pu, const Vec2& i_gain_pu, const Vec2& gamma_r,
+                           const Vec2& gamma_l, EstimatorOutput& out) noexcept {
   // eq:GainSchedule decides which parameters may move in this sample.
   Schedule active = schedule(config_.scheduler, n_pu);
   active.psi_m = active.psi_m && config_.adapt_psi_m && !state_.frozen;
@@ -201,7 +202,7 @@ void RpemEstimator::update(const MachinePu& model, double n_pu, const Vec2& gamm
                       state_.gna_hessian_pu);
       break;
     case Algorithm::kPhyInt:
-      gain = phyint_gain(model, n_pu, out.i_hat_pu, gamma_l, config_.floors);
+      gain = phyint_gain(model, n_pu, i_gain_pu, gamma_l, config_.floors);
       break;
   }
   if (gain.flags & gain_flag::kFloored) out.flags |= step_flag::kGainFloored;

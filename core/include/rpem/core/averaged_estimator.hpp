@@ -7,6 +7,7 @@
 //
 //   u_eff = ū − (x/ω_n)·(ī_k − ī_{k−1})/(c_k − c_{k−1})     c: window centres (inductive correction)
 //   î = M̂⁻¹·(u_eff − [0, n̄·ψ̂m]ᵀ),  ε = ī − î                 (§1, eq_epsilon_steadystate)
+//   Ψᵀ at the instrument: the current and speed of the preceding samples, low-passed
 //
 // Input corrections from model_extensions act as on the steady state of SampleConditioner (angle offset,
 // dead time as its fundamental, saturation, iron loss) plus the command delay as a rotation by −ω·delay.
@@ -61,6 +62,8 @@ class AveragedDriveEstimator {
   std::int64_t previous_t_ns_ = 0;
   std::int64_t previous_centre2_ns_ = 0;  ///< t_start + t of the previous window (twice its centre)
   Vec2 previous_i_pu_ = Vec2::Zero();
+  Vec2 instrument_i_pu_ = Vec2::Zero();  ///< low-passed current of the samples before this one
+  double instrument_n_pu_ = 0.0;
 };
 
 }  // namespace rpem::core

@@ -18,6 +18,10 @@ struct AveragedSettings {
   double max_interval_s = 0.05;
   /// Subtract L·di/dt estimated from consecutive window means (§10); off: the plain steady state.
   bool inductive_correction = true;
+  /// Time constant of the instrument: Ψᵀ is evaluated at the preceding samples' low-passed current and
+  /// speed, whose noise is independent of the sample's own (§10: a same-sample regressor is biased in
+  /// closed loop, more so the faster the samples come).
+  double instrument_time_constant_s = 0.05;
 };
 
 }  // namespace rpem::core

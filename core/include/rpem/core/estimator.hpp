@@ -61,6 +61,10 @@ struct SteadyStateSample {
   Vec2 u_pu = Vec2::Zero();     ///< rotor-frame voltage, input corrections applied
   Vec2 i_meas_pu = Vec2::Zero();
   double n_pu = 0.0;            ///< mean speed over the sample's window
+  /// Where Ψᵀ (and PhyInt's denominators) are evaluated: an instrument — the operating point of the
+  /// preceding samples, whose noise is independent of this sample's (docs/derivations.md §10).
+  Vec2 i_gradient_pu = Vec2::Zero();
+  double n_gradient_pu = 0.0;
   bool resync = false;          ///< no update: first sample, or samples were lost before this one
   /// Model inductances at this sample's current (the saturation extensions); 0: the configured ones.
   double x_d_pu = 0.0;
@@ -114,8 +118,8 @@ class RpemEstimator {
   EstimatorOutput step(const EstimatorSample& sample) noexcept;
 
   /// One averaged sample with the steady-state model instead of the predictor (docs/derivations.md §10):
-  ///   î = M̂⁻¹·(u − [0, n·ψ̂m]ᵀ)  (§1),  ε = i − î,  Ψᵀ = the steady-state forms (§3),
-  /// then the same gain, eq:GainSchedule and projection as step(). `rates_per_s` are the gain
+  ///   î = M̂⁻¹·(u − [0, n·ψ̂m]ᵀ)  (§1),  ε = i − î,  Ψᵀ = the steady-state forms (§3) at the
+  /// sample's instrument (i_gradient, n_gradient), then the same gain, eq:GainSchedule and projection as step(). `rates_per_s` are the gain
   /// sequences as rates [1/s]; a sample dt_s after the previous one uses γ = 1 − e^{−rate·dt}.
   /// Real-time safe.
   EstimatorOutput step_steady_state(const SteadyStateSample& sample, const GainSequences& rates_per_s) noexcept;
@@ -143,7 +147,8 @@ class RpemEstimator {
   [[nodiscard]] MachinePu model_for(double x_d_pu, double x_q_pu) const noexcept;
   /// The update both sample kinds share: gain (SGA, GNA, PhyInt) from out.gradient, eq:GainSchedule at
   /// speed n, θ̂ += L·ε, projection onto D_M (eq:paramsubset). Fills out's gain, θ̂, flags and code.
-  void update(const MachinePu& model, double n_pu, const Vec2& gamma_r, const Vec2& gamma_l,
+  /// `i_gain_pu` is the current PhyInt's denominators use (the prediction î, or the instrument).
+  void update(const MachinePu& model, double n_pu, const Vec2& i_gain_pu, const Vec2& gamma_r, const Vec2& gamma_l,
               EstimatorOutput& out) noexcept;
   [[nodiscard]] Mat2 select_gradient(const MachinePu& model, double n_pu) const noexcept;
 
