@@ -1,8 +1,10 @@
 // Averaged rotor-frame logs as a user meets them: written by `rpem sim --averaged-out` and by the independent
 // generator's CLI (`indep_drive_log --averaged`), read by `rpem estimate`, which must recover the true ψm and
-// R_s (1 %, 3 %) at 50, 200 and 1000 Hz; and the errors a bad log or an unusable configuration give.
+// R_s (1 %, 3 %) at 50, 200 and 1000 Hz, and by `rpem diagnose`, which must find an effect hidden in one;
+// and the errors a bad log or an unusable configuration give.
 #include <gtest/gtest.h>
 
+#include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
@@ -82,6 +84,38 @@ TEST_P(CliAveraged, EstimateRecoversOurSimulatorsMachine) {
 
 INSTANTIATE_TEST_SUITE_P(Rates, CliAveraged, ::testing::Values(50, 200, 1000),
                          [](const auto& p) { return std::to_string(p.param) + "Hz"; });
+
+TEST(CliAveragedDiagnose, FindsAMagnetDriftHiddenInAnAveragedLog) {
+  // The independent generator's VESC-like averages at 200 Hz of a machine whose ψm follows the magnet
+  // temperature (−0.1 %/K, 25 → 65 °C); the configuration is the true machine at 25 °C otherwise.
+  test::TempFile avg("avg.csv"), truth("truth.json");
+  const std::string dir = avg.path() + ".diag";
+  const std::string gen = test::binary_dir() + "/tests/independent_drive/indep_drive_log --config " + config() +
+                          " --effects psim_drift --nominal --seed 4 --duration-s 30 --averaged --rate-Hz 200"
+                          " --averaged-source drive --out " + avg.path() + " --truth " + truth.path();
+  const test::ProcessResult g = test::run_command(gen);
+  ASSERT_EQ(g.exit_code, 0) << gen << "\n" << g.output;
+  const test::ProcessResult r = test::run_command(rpem() + " diagnose --log " + avg.path() + " --config " + config() +
+                                                  " --reference-temperature-C 25 --out " + dir);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const auto d = nlohmann::json::parse(std::ifstream(dir + "/diagnosis.json"));
+  EXPECT_EQ(d["log"]["model"], "steady_state");
+  EXPECT_EQ(d["log"]["kind"], "averaged");
+  ASSERT_GE(d["effects"].size(), 1U) << d["effects"].dump(2);
+  EXPECT_EQ(d["effects"][0]["name"], "psim_drift") << d["effects"].dump(2);
+  // ±20 % of the hidden coefficient: the steady-state replay leaves the windows around steps out.
+  const double coeff = d["effects"][0]["params"]["coeff_per_K"];
+  EXPECT_LT(coeff, -0.0008);
+  EXPECT_GT(coeff, -0.0012);
+  EXPECT_GT(d["effects"][0]["gain_pct"].get<double>(), 30.0);
+
+  // The transient replay needs phase samples: refused, naming the log.
+  const test::ProcessResult t = test::run_command(rpem() + " diagnose --log " + avg.path() + " --config " + config() +
+                                                  " --model transient --out " + dir);
+  EXPECT_EQ(t.exit_code, 65) << t.output;
+  EXPECT_NE(t.output.find("replays only the steady-state model"), std::string::npos) << t.output;
+  std::filesystem::remove_all(dir);
+}
 
 TEST(CliAveragedErrors, ABadLogNamesFileLineAndColumn) {
   test::TempFile avg("bad.csv"), est("est.csv");
