@@ -1,7 +1,7 @@
 // libFuzzer target for the signal-map decoder (can/include/rpem/can/signal_map.hpp). The first input byte
 // picks a map — rotor-frame values in little-endian standard frames with an instantaneous trigger, or phase
 // values with theta_el in big-endian extended frames, averaged — and the rest is a stream of frames
-//   [id, 4 bytes little endian][flags: bit0 extended, bit1 error][len][len bytes][t step, 2 bytes]
+//   [a frame record, fuzz_frame.hpp][t step, 2 bytes]
 // The decoder must never crash, deliver only finite samples with t_start ≤ t and increasing t, and count
 // every frame once.
 #include <algorithm>
@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <cstdlib>
 
+#include "fuzz_frame.hpp"
 #include "rpem/can/signal_map.hpp"
 
 namespace {
@@ -56,17 +57,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   std::size_t at = 1;
   std::int64_t t = 0, last_t = -1;
   std::uint64_t samples = 0, offered = 0;
-  while (at + 6 <= size) {
-    rpem::can::CanFrame f;
-    f.id = static_cast<std::uint32_t>(data[at]) | (static_cast<std::uint32_t>(data[at + 1]) << 8) |
-           (static_cast<std::uint32_t>(data[at + 2]) << 16) | (static_cast<std::uint32_t>(data[at + 3] & 0x1F) << 24);
-    f.extended = data[at + 4] & 1;
-    f.error = data[at + 4] & 2;
-    f.len = static_cast<std::uint8_t>(std::min<std::size_t>(data[at + 5], 8));
-    at += 6;
-    const std::size_t n = std::min<std::size_t>(f.len, size - at);
-    std::copy_n(data + at, n, f.data.begin());
-    at += n;
+  rpem::can::CanFrame f;
+  while (rpem::can::fuzz::read_frame(data, size, at, f)) {
     if (at + 2 <= size) {
       t += 1 + (data[at] | (data[at + 1] << 8));
       at += 2;

@@ -1,5 +1,5 @@
 // libFuzzer target for the VESC decoder (can/include/rpem/can/vesc.hpp). The input is a stream of records:
-//   [0x00 | 2·k][id, 4 bytes little endian][flags: bit0 extended, bit1 error][len][len bytes]  a raw frame
+//   [0x00 | 2·k][a frame record, fuzz_frame.hpp]        a raw frame
 //   [0x01 | 2·k][n][n bytes]                        a reply payload the harness splits into FILL_RX_BUFFER /
 //                                                    _LONG frames and a PROCESS_RX_BUFFER with its true CRC,
 //                                                    so mutations reach past the CRC into the reply parser
@@ -11,6 +11,7 @@
 #include <cstdint>
 #include <cstdlib>
 
+#include "fuzz_frame.hpp"
 #include "rpem/can/e2e.hpp"
 #include "rpem/can/vesc.hpp"
 
@@ -100,17 +101,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       at += n;
       continue;
     }
-    if (at + 6 > size) break;
     rpem::can::CanFrame f;
-    f.id = static_cast<std::uint32_t>(data[at]) | (static_cast<std::uint32_t>(data[at + 1]) << 8) |
-           (static_cast<std::uint32_t>(data[at + 2]) << 16) | (static_cast<std::uint32_t>(data[at + 3]) << 24);
-    f.extended = data[at + 4] & 1;
-    f.error = data[at + 4] & 2;
-    f.len = static_cast<std::uint8_t>(std::min<std::size_t>(data[at + 5], 8));
-    at += 6;
-    const std::size_t n = std::min<std::size_t>(f.len, size - at);
-    std::copy_n(data + at, n, f.data.begin());
-    at += n;
+    if (!rpem::can::fuzz::read_frame(data, size, at, f)) break;
     h.offer(f);
   }
   const v::VescCounters& c = h.decoder.counters();

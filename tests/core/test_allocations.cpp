@@ -40,6 +40,20 @@ void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
 namespace rpem::core {
 namespace {
 
+/// Steps the estimator over every sample, resets, freezes and steps once more, counting allocations.
+template <typename Estimator, typename Sample>
+void expect_no_allocations(Estimator& est, const std::vector<Sample>& samples) {
+  const long before = g_allocations.load();
+  double sink = 0.0;
+  for (const Sample& s : samples) sink += est.step(s).psi_m_Wb;
+  est.reset();
+  est.set_frozen(true);
+  sink += est.step(samples[0]).r_s_Ohm;
+  const long after = g_allocations.load();
+  EXPECT_EQ(after - before, 0);
+  EXPECT_TRUE(std::isfinite(sink));
+}
+
 struct Case {
   Algorithm algorithm;
   GradientForm form;
@@ -82,15 +96,7 @@ TEST_P(Allocations, NoneAcrossOneHundredThousandSteps) {
   samples[5000].gap_before = true;
   samples[6000].i_A[0] = std::nan("");
 
-  const long before = g_allocations.load();
-  double sink = 0.0;
-  for (const DriveSample& s : samples) sink += est.step(s).psi_m_Wb;
-  est.reset();
-  est.set_frozen(true);
-  sink += est.step(samples[0]).r_s_Ohm;
-  const long after = g_allocations.load();
-  EXPECT_EQ(after - before, 0);
-  EXPECT_TRUE(std::isfinite(sink));
+  expect_no_allocations(est, samples);
 }
 
 INSTANTIATE_TEST_SUITE_P(
@@ -128,15 +134,7 @@ TEST_P(AveragedAllocations, NoneAcrossOneHundredThousandAveragedSteps) {
   samples[5000].gap_before = true;
   samples[6000].i_dq_A[0] = std::nan("");
 
-  const long before = g_allocations.load();
-  double sink = 0.0;
-  for (const AveragedSample& s : samples) sink += est.step(s).psi_m_Wb;
-  est.reset();
-  est.set_frozen(true);
-  sink += est.step(samples[0]).r_s_Ohm;
-  const long after = g_allocations.load();
-  EXPECT_EQ(after - before, 0);
-  EXPECT_TRUE(std::isfinite(sink));
+  expect_no_allocations(est, samples);
 }
 
 INSTANTIATE_TEST_SUITE_P(EveryAlgorithm, AveragedAllocations,
