@@ -8,8 +8,7 @@ namespace {
 
 bool finite(const EstimatorSample& s) noexcept {
   const auto& iv = s.interval;
-  return std::isfinite(iv.dt_s) && std::isfinite(iv.n_start_pu) && std::isfinite(iv.n_end_pu) &&
-         iv.u_start_pu.allFinite() && iv.u_end_pu.allFinite() && s.i_meas_pu.allFinite();
+  return all_finite(iv.dt_s, iv.n_start_pu, iv.n_end_pu, iv.u_start_pu, iv.u_end_pu, s.i_meas_pu);
 }
 
 /// γ_0 are per nominal sample; a longer or shorter interval scales them so that the adaptation time
@@ -39,10 +38,8 @@ double gna_hessian_sequence(const Schedule& active, const Vec2& gamma_r) noexcep
 
 }  // namespace
 
-RpemEstimator::RpemEstimator(const EstimatorConfig& config) noexcept
-    : config_(config),
-      coefficients_(PredictorCoefficients::of(config.model, config.omega_n_rad_s)),
-      inverse_nominal_period_(1.0 / config.nominal_sample_period_s) {
+RpemEstimator::RpemEstimator(const EstimatorConfig& config) noexcept {
+  reconfigure(config);
   reset();
 }
 
@@ -67,18 +64,19 @@ void RpemEstimator::reconfigure(const EstimatorConfig& config) noexcept {
   config_ = config;
   coefficients_ = PredictorCoefficients::of(config.model, config.omega_n_rad_s);
   inverse_nominal_period_ = 1.0 / config.nominal_sample_period_s;
+  // With steady-state forms for both parameters the dynamic gradients would be computed for nothing.
+  gradients_ = config.gradient_psi_m == GradientForm::kDynamic || config.gradient_r_s == GradientForm::kDynamic
+                   ? Gradients::kAdvance
+                   : Gradients::kSkip;
+  scaled_for_dt_s_ = -1.0;
   (void)project(config_.bounds, state_.theta_pu);
 }
 
 MachinePu RpemEstimator::model_for(double x_d_pu, double x_q_pu) const noexcept {
-  MachinePu m = config_.model;
-  m.psi_m_pu = state_.theta_pu[kPsiM];
-  m.r_s_pu = state_.theta_pu[kRs];
-  if (x_d_pu > 0.0 && x_q_pu > 0.0) {
-    m.x_d_pu = x_d_pu;
-    m.x_q_pu = x_q_pu;
-  }
-  return m;
+  const bool own = x_d_pu > 0.0 && x_q_pu > 0.0;
+  // Made whole, not copied and patched: the per-sample path then keeps it in registers.
+  return {state_.theta_pu[kRs], own ? x_d_pu : config_.model.x_d_pu, own ? x_q_pu : config_.model.x_q_pu,
+          state_.theta_pu[kPsiM]};
 }
 
 void RpemEstimator::synchronize(const EstimatorSample& sample, const MachinePu& model) noexcept {
@@ -103,123 +101,120 @@ Mat2 RpemEstimator::select_gradient(const MachinePu& model, double n_pu) const n
   return g;
 }
 
-EstimatorOutput RpemEstimator::step(const EstimatorSample& sample) noexcept {
+EstimatorOutput RpemEstimator::held(StepCode code) const noexcept {
   EstimatorOutput out;
   out.theta_pu = state_.theta_pu;
+  out.i_hat_pu = state_.predictor.i_hat_pu;
+  out.code = code;
   out.flags = state_.frozen ? step_flag::kFrozen : 0;
-
-  if (!finite(sample)) {
-    state_.synchronized = false;
-    state_.epsilon_valid = false;
-    out.code = StepCode::kRejectedNonFinite;
-    return out;
-  }
-  const auto& iv = sample.interval;
-  const MachinePu model = model_for(sample.x_d_pu, sample.x_q_pu);
-  if (sample.resync || !state_.synchronized || !(iv.dt_s > 0.0) || iv.dt_s > config_.max_sample_interval_s) {
-    synchronize(sample, model);
-    out.i_hat_pu = state_.predictor.i_hat_pu;
-    out.code = StepCode::kSynchronized;
-    return out;
-  }
-
-  // Saturation extensions give each sample its own inductances (two divisions); else the cached ones.
-  const PredictorCoefficients coefficients =
-      sample.x_d_pu > 0.0 ? PredictorCoefficients::of(model, config_.omega_n_rad_s) : coefficients_;
-  // With steady-state forms for both parameters the dynamic gradients would be computed for nothing.
-  const bool dynamic = config_.gradient_psi_m == GradientForm::kDynamic || config_.gradient_r_s == GradientForm::kDynamic;
-  predict(model, coefficients, config_.discretization, iv, state_.predictor,
-          dynamic ? Gradients::kAdvance : Gradients::kSkip);
-  const Vec2& i_hat = state_.predictor.i_hat_pu;
-  if (!i_hat.allFinite() || i_hat.lpNorm<Eigen::Infinity>() > config_.max_predicted_current_pu ||
-      !state_.predictor.gradient.allFinite()) {
-    state_.epsilon_valid = false;
-    synchronize(sample, model);
-    out.i_hat_pu = state_.predictor.i_hat_pu;
-    out.code = StepCode::kPredictorDiverged;
-    return out;
-  }
-
-  out.i_hat_pu = i_hat;
-  out.epsilon_pu = sample.i_meas_pu - i_hat;
-  state_.last_epsilon_pu = out.epsilon_pu;
-  state_.epsilon_valid = true;
-  out.gradient = select_gradient(model, iv.n_end_pu);
-
-  const double factor = iv.dt_s * inverse_nominal_period_;
-  const GainSequences& seq = config_.gains[static_cast<std::size_t>(config_.algorithm)];
-  update(model, iv.n_end_pu, i_hat, scaled(seq.hessian, factor), scaled(seq.gain, factor), out);
   return out;
 }
 
-EstimatorOutput RpemEstimator::step_steady_state(const SteadyStateSample& sample,
-                                                 const GainSequences& rates_per_s) noexcept {
-  EstimatorOutput out;
-  out.theta_pu = state_.theta_pu;
-  out.flags = state_.frozen ? step_flag::kFrozen : 0;
-  if (!finite(sample)) {
-    state_.epsilon_valid = false;
-    out.code = StepCode::kRejectedNonFinite;
-    return out;
-  }
-  const MachinePu model = model_for(sample.x_d_pu, sample.x_q_pu);
-  // The steady-state prediction of §1 with the current estimates; D ≥ r̂s² > 0 inside D_M.
-  out.i_hat_pu = steady_state_current(model, sample.n_pu, sample.u_pu);
-  if (!out.i_hat_pu.allFinite() || out.i_hat_pu.lpNorm<Eigen::Infinity>() > config_.max_predicted_current_pu) {
-    state_.epsilon_valid = false;
-    out.code = StepCode::kPredictorDiverged;  // a voltage no machine near the model answers; no update
-    return out;
-  }
-  out.epsilon_pu = sample.i_meas_pu - out.i_hat_pu;
-  state_.predictor.i_hat_pu = out.i_hat_pu;
-  state_.last_epsilon_pu = out.epsilon_pu;
-  state_.epsilon_valid = true;
-  state_.synchronized = true;
-  if (sample.resync || !(sample.dt_s > 0.0)) {
-    out.code = StepCode::kSynchronized;
-    return out;
-  }
-  out.gradient = steady_state_gradients(model, sample.n_gradient_pu, sample.i_gradient_pu);
-  update(model, sample.n_pu, sample.i_gradient_pu, per_interval(rates_per_s.hessian, sample.dt_s),
-         per_interval(rates_per_s.gain, sample.dt_s), out);
-  return out;
-}
-
-void RpemEstimator::update(const MachinePu& model, double n_pu, const Vec2& i_gain_pu, const Vec2& gamma_r,
-                           const Vec2& gamma_l, EstimatorOutput& out) noexcept {
-  // eq:GainSchedule decides which parameters may move in this sample.
-  Schedule active = schedule(config_.scheduler, n_pu);
+// The update both sample kinds share: eq:GainSchedule, the algorithm's gain, θ̂ += L·ε, eq:paramsubset.
+// Inlined into step(): the native per-sample path keeps `model` and the gradient in registers.
+[[gnu::always_inline]] inline EstimatorOutput RpemEstimator::update(const Update& u, const Vec2& gamma_r,
+                                                                    const Vec2& gamma_l) noexcept {
+  Schedule active = schedule(config_.scheduler, u.n_pu);
   active.psi_m = active.psi_m && config_.adapt_psi_m && !state_.frozen;
   active.r_s = active.r_s && config_.adapt_r_s && !state_.frozen;
 
   GainOutput gain;
   switch (config_.algorithm) {
     case Algorithm::kSga:
-      gain = sga_gain(out.gradient, gamma_r, gamma_l, config_.floors, state_.sga_hessian_pu);
+      gain = sga_gain(u.gradient, gamma_r, gamma_l, config_.floors, state_.sga_hessian_pu);
       break;
     case Algorithm::kGna:
-      gain = gna_gain(out.gradient, gna_hessian_sequence(active, gamma_r), gamma_l, config_.floors,
+      gain = gna_gain(u.gradient, gna_hessian_sequence(active, gamma_r), gamma_l, config_.floors,
                       state_.gna_hessian_pu);
       break;
     case Algorithm::kPhyInt:
-      gain = phyint_gain(model, n_pu, i_gain_pu, gamma_l, config_.floors);
+      gain = phyint_gain(MachinePu(u.model), u.n_pu, u.i_gain_pu, gamma_l, config_.floors);  // a copy: `model` stays in registers
       break;
   }
-  if (gain.flags & gain_flag::kFloored) out.flags |= step_flag::kGainFloored;
-  if (gain.flags & gain_flag::kPseudoInverse) out.flags |= step_flag::kPseudoInverse;
-
   apply_schedule(active, gain.gain);
-  if (active.psi_m) out.flags |= step_flag::kPsiMActive;
-  if (active.r_s) out.flags |= step_flag::kRsActive;
-
-  state_.theta_pu += gain.gain * out.epsilon_pu;
+  state_.theta_pu += gain.gain * u.epsilon_pu;
   const std::uint8_t clamped = project(config_.bounds, state_.theta_pu);
-  if (clamped & (1U << kPsiM)) out.flags |= step_flag::kProjectedPsiM;
-  if (clamped & (1U << kRs)) out.flags |= step_flag::kProjectedRs;
 
-  out.gain = gain.gain;
-  out.theta_pu = state_.theta_pu;
-  out.code = StepCode::kAdapted;
+  std::uint16_t flags = state_.frozen ? step_flag::kFrozen : 0;
+  if (gain.flags & gain_flag::kFloored) flags |= step_flag::kGainFloored;
+  if (gain.flags & gain_flag::kPseudoInverse) flags |= step_flag::kPseudoInverse;
+  if (active.psi_m) flags |= step_flag::kPsiMActive;
+  if (active.r_s) flags |= step_flag::kRsActive;
+  if (clamped & (1U << kPsiM)) flags |= step_flag::kProjectedPsiM;
+  if (clamped & (1U << kRs)) flags |= step_flag::kProjectedRs;
+  return {state_.theta_pu, u.epsilon_pu, u.i_hat_pu, u.gradient, gain.gain, StepCode::kAdapted, flags};  // every member: no zero fill
+}
+
+[[gnu::flatten]] EstimatorOutput RpemEstimator::step(const EstimatorSample& sample) noexcept {
+  if (!finite(sample)) {
+    state_.synchronized = false;
+    state_.epsilon_valid = false;
+    return held(StepCode::kRejectedNonFinite);
+  }
+  const auto& iv = sample.interval;
+  const MachinePu model = model_for(sample.x_d_pu, sample.x_q_pu);
+  if (sample.resync || !state_.synchronized || !(iv.dt_s > 0.0) || iv.dt_s > config_.max_sample_interval_s) {
+    synchronize(sample, model);
+    return held(StepCode::kSynchronized);
+  }
+
+  // Saturation extensions give each sample its own inductances (two divisions); else the cached ones.
+  // A branch, not a select: the divisions would otherwise compete with the predictor's for the divider.
+  PredictorCoefficients coefficients = coefficients_;
+  if (sample.x_d_pu > 0.0) [[unlikely]] coefficients = PredictorCoefficients::of(model, config_.omega_n_rad_s);
+  predict(model, coefficients, config_.discretization, iv, state_.predictor, gradients_);
+  const Vec2 i_hat = state_.predictor.i_hat_pu;
+  const double i_max = config_.max_predicted_current_pu;  // a comparison with NaN fails: not finite
+  const Mat2& g = state_.predictor.gradient;
+  if (!(std::abs(i_hat[0]) <= i_max && std::abs(i_hat[1]) <= i_max) ||
+      (gradients_ == Gradients::kAdvance && !all_finite(g.col(0), g.col(1)))) {
+    state_.epsilon_valid = false;
+    synchronize(sample, model);
+    return held(StepCode::kPredictorDiverged);
+  }
+
+  const Vec2 epsilon = sample.i_meas_pu - i_hat;
+  state_.last_epsilon_pu = epsilon;
+  state_.epsilon_valid = true;
+
+  if (iv.dt_s != scaled_for_dt_s_) {  // the same interval sample after sample: scaled once
+    const double factor = iv.dt_s * inverse_nominal_period_;
+    const GainSequences& seq = config_.gains[static_cast<std::size_t>(config_.algorithm)];
+    gamma_r_ = scaled(seq.hessian, factor);
+    gamma_l_ = scaled(seq.gain, factor);
+    scaled_for_dt_s_ = iv.dt_s;
+  }
+  return update({model, iv.n_end_pu, i_hat, epsilon, i_hat, select_gradient(model, iv.n_end_pu)}, gamma_r_, gamma_l_);
+}
+
+EstimatorOutput RpemEstimator::step_steady_state(const SteadyStateSample& sample,
+                                                 const GainSequences& rates_per_s) noexcept {
+  if (!finite(sample)) {
+    state_.epsilon_valid = false;
+    return held(StepCode::kRejectedNonFinite);
+  }
+  const MachinePu model = model_for(sample.x_d_pu, sample.x_q_pu);
+  // The steady-state prediction of §1 with the current estimates; D ≥ r̂s² > 0 inside D_M.
+  const Vec2 i_hat = steady_state_current(model, sample.n_pu, sample.u_pu);
+  if (!i_hat.allFinite() || i_hat.lpNorm<Eigen::Infinity>() > config_.max_predicted_current_pu) {
+    state_.epsilon_valid = false;
+    EstimatorOutput out = held(StepCode::kPredictorDiverged);  // a voltage no machine near the model answers
+    out.i_hat_pu = i_hat;
+    return out;
+  }
+  const Vec2 epsilon = sample.i_meas_pu - i_hat;
+  state_.predictor.i_hat_pu = i_hat;
+  state_.last_epsilon_pu = epsilon;
+  state_.epsilon_valid = true;
+  state_.synchronized = true;
+  if (sample.resync || !(sample.dt_s > 0.0)) {
+    EstimatorOutput out = held(StepCode::kSynchronized);
+    out.epsilon_pu = epsilon;
+    return out;
+  }
+  const Mat2 gradient = steady_state_gradients(model, sample.n_gradient_pu, sample.i_gradient_pu);
+  return update({model, sample.n_pu, sample.i_gradient_pu, epsilon, i_hat, gradient},
+                per_interval(rates_per_s.hessian, sample.dt_s), per_interval(rates_per_s.gain, sample.dt_s));
 }
 
 }  // namespace rpem::core

@@ -1,4 +1,4 @@
-// The averaged-sample estimator (core/averaged_estimator.hpp, docs/derivations.md §10) on windows whose
+// The averaged-sample estimator (core/averaged_estimator.hpp, docs/derivations.md §11) on windows whose
 // means are computed from the machine equations (support/averaged_data.hpp): exact answers where the
 // model is exact, rate-independent time constants, gaps, and the corrections.
 #include <gtest/gtest.h>

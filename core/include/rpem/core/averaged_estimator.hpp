@@ -2,7 +2,7 @@
 // The estimator for averaged rotor-frame samples (VESC, signal maps, averaged drive logs; docs/sources.md):
 // SI averaged samples in, SI and pu estimates out, beside DriveEstimator (which takes phase samples at the
 // control rate). Each sample is predicted with the steady-state model of its window (docs/derivations.md
-// §10), the inductive term estimated from consecutive window means; the gains, eq:GainSchedule and the
+// §11), the inductive term estimated from consecutive window means; the gains, eq:GainSchedule and the
 // projection are RpemEstimator's, its gain sequences applied as rates per second.
 //
 //   u_eff = ū − (x/ω_n)·(ī_k − ī_{k−1})/(c_k − c_{k−1})     c: window centres (inductive correction)

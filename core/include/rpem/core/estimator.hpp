@@ -55,14 +55,14 @@ struct EstimatorSample {
 };
 
 /// One averaged (or slowly sampled) rotor-frame sample for the steady-state model (docs/derivations.md
-/// §10): the voltage as the machine sees it, the measured current, the mean speed, pu.
+/// §11): the voltage as the machine sees it, the measured current, the mean speed, pu.
 struct SteadyStateSample {
   double dt_s = 0.0;            ///< time since the previous sample (scales the gains)
   Vec2 u_pu = Vec2::Zero();     ///< rotor-frame voltage, input corrections applied
   Vec2 i_meas_pu = Vec2::Zero();
   double n_pu = 0.0;            ///< mean speed over the sample's window
   /// Where Ψᵀ (and PhyInt's denominators) are evaluated: an instrument — the operating point of the
-  /// preceding samples, whose noise is independent of this sample's (docs/derivations.md §10).
+  /// preceding samples, whose noise is independent of this sample's (docs/derivations.md §11).
   Vec2 i_gradient_pu = Vec2::Zero();
   double n_gradient_pu = 0.0;
   bool resync = false;          ///< no update: first sample, or samples were lost before this one
@@ -117,7 +117,7 @@ class RpemEstimator {
   /// One sample. Real-time safe.
   EstimatorOutput step(const EstimatorSample& sample) noexcept;
 
-  /// One averaged sample with the steady-state model instead of the predictor (docs/derivations.md §10):
+  /// One averaged sample with the steady-state model instead of the predictor (docs/derivations.md §11):
   ///   î = M̂⁻¹·(u − [0, n·ψ̂m]ᵀ)  (§1),  ε = i − î,  Ψᵀ = the steady-state forms (§3) at the
   /// sample's instrument (i_gradient, n_gradient), then the same gain, eq:GainSchedule and projection as step(). `rates_per_s` are the gain
   /// sequences as rates [1/s]; a sample dt_s after the previous one uses γ = 1 − e^{−rate·dt}.
@@ -145,17 +145,30 @@ class RpemEstimator {
   void synchronize(const EstimatorSample& sample, const MachinePu& model) noexcept;
   /// The configured model with the current estimates and the sample's inductances, if it has any (> 0).
   [[nodiscard]] MachinePu model_for(double x_d_pu, double x_q_pu) const noexcept;
-  /// The update both sample kinds share: gain (SGA, GNA, PhyInt) from out.gradient, eq:GainSchedule at
-  /// speed n, θ̂ += L·ε, projection onto D_M (eq:paramsubset). Fills out's gain, θ̂, flags and code.
-  /// `i_gain_pu` is the current PhyInt's denominators use (the prediction î, or the instrument).
-  void update(const MachinePu& model, double n_pu, const Vec2& i_gain_pu, const Vec2& gamma_r, const Vec2& gamma_l,
-              EstimatorOutput& out) noexcept;
+  /// What one sample brings to the update: the model it was predicted with, the speed eq:GainSchedule
+  /// reads, the current PhyInt's denominators use (the prediction î, or the averaged path's instrument),
+  /// ε, î and the prediction gradient ψ.
+  struct Update {
+    MachinePu model;
+    double n_pu;
+    Vec2 i_gain_pu, epsilon_pu, i_hat_pu;
+    Mat2 gradient;
+  };
+  /// The update both sample kinds share: gain (SGA, GNA, PhyInt), eq:GainSchedule, θ̂ += L·ε, projection
+  /// onto D_M (eq:paramsubset); the sample's output.
+  EstimatorOutput update(const Update& u, const Vec2& gamma_r, const Vec2& gamma_l) noexcept;
   [[nodiscard]] Mat2 select_gradient(const MachinePu& model, double n_pu) const noexcept;
+  /// The output of a sample that made no update: θ̂ and î as they stand.
+  [[nodiscard]] EstimatorOutput held(StepCode code) const noexcept;
 
   EstimatorConfig config_;
   EstimatorState state_;
-  PredictorCoefficients coefficients_;   ///< from config_.model; refreshed by reconfigure()
+  // Decided by reconfigure(), so the per-sample path does not re-derive them.
+  PredictorCoefficients coefficients_;   ///< from config_.model
   double inverse_nominal_period_ = 0.0;  ///< 1/T_samp
+  Gradients gradients_ = Gradients::kSkip;  ///< whether predict() advances the dynamic gradients
+  double scaled_for_dt_s_ = -1.0;        ///< the interval gamma_r_, gamma_l_ were scaled for
+  Vec2 gamma_r_ = Vec2::Zero(), gamma_l_ = Vec2::Zero();
 };
 
 }  // namespace rpem::core
