@@ -116,6 +116,10 @@ bool TelemetryDecoder::accept(core::DriveSample& s) noexcept {
 std::size_t TelemetryDecoder::decode(const CanFrame& f, std::span<core::DriveSample> out) noexcept {
   ++counters_.frames;
   if (f.error) return 0;  // error frames are counted by the transport
+  if (f.extended) {      // telemetry uses standard IDs only; an extended one (e.g. a VESC's) is not ours
+    ++counters_.unknown_id;
+    return 0;
+  }
   if (f.id == p::kFdId) return decode_fd(f, out);
   if (f.id >= p::kClassicFirstId && f.id < p::kClassicFirstId + p::kClassicFrames) return decode_classic(f, out);
   ++counters_.unknown_id;

@@ -173,6 +173,9 @@ std::size_t SocketCanChannel::receive(std::span<ReceivedFrame> out, int timeout_
       r.frame.error = true;
       r.frame.id = raw.can_id & CAN_ERR_MASK;
       count_error_frame(r.frame);
+    } else if (raw.can_id & CAN_EFF_FLAG) {
+      r.frame.extended = true;
+      r.frame.id = raw.can_id & CAN_EFF_MASK;
     } else {
       r.frame.id = raw.can_id & CAN_SFF_MASK;
     }
@@ -188,7 +191,7 @@ bool SocketCanChannel::send(const CanFrame& frame, int timeout_ms) {
     return false;
   }
   canfd_frame raw{};
-  raw.can_id = frame.id & CAN_SFF_MASK;
+  raw.can_id = frame.extended ? (frame.id & CAN_EFF_MASK) | CAN_EFF_FLAG : frame.id & CAN_SFF_MASK;
   raw.len = frame.len;
   if (frame.fd) raw.flags = CANFD_BRS;
   std::memcpy(raw.data, frame.data.data(), frame.len);

@@ -15,6 +15,19 @@ bool finite(const EstimatorSample& s) noexcept {
 /// constant T_0 = T_samp/γ_0 stays fixed in seconds. Capped at 1 (a filter gain above 1 is unstable).
 Vec2 scaled(const Vec2& gamma, double factor) noexcept { return (gamma * factor).cwiseMin(1.0); }
 
+/// Rates [1/s] as the per-sample factors of an interval dt: γ = 1 − e^{−rate·dt}, the exact discrete
+/// counterpart of a first-order filter with that rate, so a time constant holds at any sample rate
+/// (≈ rate·dt for rate·dt ≪ 1, as scaled() gives; never above 1).
+Vec2 per_interval(const Vec2& rate_per_s, double dt_s) noexcept {
+  return {-std::expm1(-rate_per_s[0] * dt_s), -std::expm1(-rate_per_s[1] * dt_s)};
+}
+
+bool finite(const SteadyStateSample& s) noexcept {
+  return std::isfinite(s.dt_s) && std::isfinite(s.n_pu) && s.u_pu.allFinite() && s.i_meas_pu.allFinite() &&
+         std::isfinite(s.x_d_pu) && std::isfinite(s.x_q_pu) && s.i_gradient_pu.allFinite() &&
+         std::isfinite(s.n_gradient_pu);
+}
+
 /// The GNA matrix Hessian has one forgetting factor: that of the parameter being estimated
 /// (tab_psimgains gives one per estimation case); outside both regions the slower one.
 double gna_hessian_sequence(const Schedule& active, const Vec2& gamma_r) noexcept {
@@ -59,10 +72,10 @@ void RpemEstimator::reconfigure(const EstimatorConfig& config) noexcept {
   (void)project(config_.bounds, state_.theta_pu);
 }
 
-MachinePu RpemEstimator::model_for(const EstimatorSample& sample) const noexcept {
-  const bool own = sample.x_d_pu > 0.0 && sample.x_q_pu > 0.0;
+MachinePu RpemEstimator::model_for(double x_d_pu, double x_q_pu) const noexcept {
+  const bool own = x_d_pu > 0.0 && x_q_pu > 0.0;
   // Made whole, not copied and patched: the per-sample path then keeps it in registers.
-  return {state_.theta_pu[kRs], own ? sample.x_d_pu : config_.model.x_d_pu, own ? sample.x_q_pu : config_.model.x_q_pu,
+  return {state_.theta_pu[kRs], own ? x_d_pu : config_.model.x_d_pu, own ? x_q_pu : config_.model.x_q_pu,
           state_.theta_pu[kPsiM]};
 }
 
@@ -97,6 +110,41 @@ EstimatorOutput RpemEstimator::held(StepCode code) const noexcept {
   return out;
 }
 
+// The update both sample kinds share: eq:GainSchedule, the algorithm's gain, θ̂ += L·ε, eq:paramsubset.
+// Inlined into step(): the native per-sample path keeps `model` and the gradient in registers.
+[[gnu::always_inline]] inline EstimatorOutput RpemEstimator::update(const Update& u, const Vec2& gamma_r,
+                                                                    const Vec2& gamma_l) noexcept {
+  Schedule active = schedule(config_.scheduler, u.n_pu);
+  active.psi_m = active.psi_m && config_.adapt_psi_m && !state_.frozen;
+  active.r_s = active.r_s && config_.adapt_r_s && !state_.frozen;
+
+  GainOutput gain;
+  switch (config_.algorithm) {
+    case Algorithm::kSga:
+      gain = sga_gain(u.gradient, gamma_r, gamma_l, config_.floors, state_.sga_hessian_pu);
+      break;
+    case Algorithm::kGna:
+      gain = gna_gain(u.gradient, gna_hessian_sequence(active, gamma_r), gamma_l, config_.floors,
+                      state_.gna_hessian_pu);
+      break;
+    case Algorithm::kPhyInt:
+      gain = phyint_gain(MachinePu(u.model), u.n_pu, u.i_gain_pu, gamma_l, config_.floors);  // a copy: `model` stays in registers
+      break;
+  }
+  apply_schedule(active, gain.gain);
+  state_.theta_pu += gain.gain * u.epsilon_pu;
+  const std::uint8_t clamped = project(config_.bounds, state_.theta_pu);
+
+  std::uint16_t flags = state_.frozen ? step_flag::kFrozen : 0;
+  if (gain.flags & gain_flag::kFloored) flags |= step_flag::kGainFloored;
+  if (gain.flags & gain_flag::kPseudoInverse) flags |= step_flag::kPseudoInverse;
+  if (active.psi_m) flags |= step_flag::kPsiMActive;
+  if (active.r_s) flags |= step_flag::kRsActive;
+  if (clamped & (1U << kPsiM)) flags |= step_flag::kProjectedPsiM;
+  if (clamped & (1U << kRs)) flags |= step_flag::kProjectedRs;
+  return {state_.theta_pu, u.epsilon_pu, u.i_hat_pu, u.gradient, gain.gain, StepCode::kAdapted, flags};  // every member: no zero fill
+}
+
 [[gnu::flatten]] EstimatorOutput RpemEstimator::step(const EstimatorSample& sample) noexcept {
   if (!finite(sample)) {
     state_.synchronized = false;
@@ -104,7 +152,7 @@ EstimatorOutput RpemEstimator::held(StepCode code) const noexcept {
     return held(StepCode::kRejectedNonFinite);
   }
   const auto& iv = sample.interval;
-  const MachinePu model = model_for(sample);
+  const MachinePu model = model_for(sample.x_d_pu, sample.x_q_pu);
   if (sample.resync || !state_.synchronized || !(iv.dt_s > 0.0) || iv.dt_s > config_.max_sample_interval_s) {
     synchronize(sample, model);
     return held(StepCode::kSynchronized);
@@ -128,7 +176,6 @@ EstimatorOutput RpemEstimator::held(StepCode code) const noexcept {
   const Vec2 epsilon = sample.i_meas_pu - i_hat;
   state_.last_epsilon_pu = epsilon;
   state_.epsilon_valid = true;
-  const Mat2 gradient = select_gradient(model, iv.n_end_pu);
 
   if (iv.dt_s != scaled_for_dt_s_) {  // the same interval sample after sample: scaled once
     const double factor = iv.dt_s * inverse_nominal_period_;
@@ -137,37 +184,37 @@ EstimatorOutput RpemEstimator::held(StepCode code) const noexcept {
     gamma_l_ = scaled(seq.gain, factor);
     scaled_for_dt_s_ = iv.dt_s;
   }
+  return update({model, iv.n_end_pu, i_hat, epsilon, i_hat, select_gradient(model, iv.n_end_pu)}, gamma_r_, gamma_l_);
+}
 
-  // eq:GainSchedule decides which parameters may move in this sample.
-  Schedule active = schedule(config_.scheduler, iv.n_end_pu);
-  active.psi_m = active.psi_m && config_.adapt_psi_m && !state_.frozen;
-  active.r_s = active.r_s && config_.adapt_r_s && !state_.frozen;
-
-  GainOutput gain;
-  switch (config_.algorithm) {
-    case Algorithm::kSga:
-      gain = sga_gain(gradient, gamma_r_, gamma_l_, config_.floors, state_.sga_hessian_pu);
-      break;
-    case Algorithm::kGna:
-      gain = gna_gain(gradient, gna_hessian_sequence(active, gamma_r_), gamma_l_, config_.floors,
-                      state_.gna_hessian_pu);
-      break;
-    case Algorithm::kPhyInt:
-      gain = phyint_gain(MachinePu(model), iv.n_end_pu, i_hat, gamma_l_, config_.floors);  // a copy: `model` stays in registers
-      break;
+EstimatorOutput RpemEstimator::step_steady_state(const SteadyStateSample& sample,
+                                                 const GainSequences& rates_per_s) noexcept {
+  if (!finite(sample)) {
+    state_.epsilon_valid = false;
+    return held(StepCode::kRejectedNonFinite);
   }
-  apply_schedule(active, gain.gain);
-  state_.theta_pu += gain.gain * epsilon;
-  const std::uint8_t clamped = project(config_.bounds, state_.theta_pu);
-
-  std::uint16_t flags = state_.frozen ? step_flag::kFrozen : 0;
-  if (gain.flags & gain_flag::kFloored) flags |= step_flag::kGainFloored;
-  if (gain.flags & gain_flag::kPseudoInverse) flags |= step_flag::kPseudoInverse;
-  if (active.psi_m) flags |= step_flag::kPsiMActive;
-  if (active.r_s) flags |= step_flag::kRsActive;
-  if (clamped & (1U << kPsiM)) flags |= step_flag::kProjectedPsiM;
-  if (clamped & (1U << kRs)) flags |= step_flag::kProjectedRs;
-  return {state_.theta_pu, epsilon, i_hat, gradient, gain.gain, StepCode::kAdapted, flags};  // every member: no zero fill
+  const MachinePu model = model_for(sample.x_d_pu, sample.x_q_pu);
+  // The steady-state prediction of §1 with the current estimates; D ≥ r̂s² > 0 inside D_M.
+  const Vec2 i_hat = steady_state_current(model, sample.n_pu, sample.u_pu);
+  if (!i_hat.allFinite() || i_hat.lpNorm<Eigen::Infinity>() > config_.max_predicted_current_pu) {
+    state_.epsilon_valid = false;
+    EstimatorOutput out = held(StepCode::kPredictorDiverged);  // a voltage no machine near the model answers
+    out.i_hat_pu = i_hat;
+    return out;
+  }
+  const Vec2 epsilon = sample.i_meas_pu - i_hat;
+  state_.predictor.i_hat_pu = i_hat;
+  state_.last_epsilon_pu = epsilon;
+  state_.epsilon_valid = true;
+  state_.synchronized = true;
+  if (sample.resync || !(sample.dt_s > 0.0)) {
+    EstimatorOutput out = held(StepCode::kSynchronized);
+    out.epsilon_pu = epsilon;
+    return out;
+  }
+  const Mat2 gradient = steady_state_gradients(model, sample.n_gradient_pu, sample.i_gradient_pu);
+  return update({model, sample.n_pu, sample.i_gradient_pu, epsilon, i_hat, gradient},
+                per_interval(rates_per_s.hessian, sample.dt_s), per_interval(rates_per_s.gain, sample.dt_s));
 }
 
 }  // namespace rpem::core

@@ -11,9 +11,9 @@ EstimateLogWriter::EstimateLogWriter(const std::string& path) : out_(path, std::
           "psi_m_active,r_s_active,code,flags,sga_r_psi_m,sga_r_r_s,gna_det_R\n";
 }
 
-void EstimateLogWriter::write(const core::Estimate& e, const core::DriveEstimator& estimator) {
+void EstimateLogWriter::write(const core::Estimate& e, const core::RpemEstimator& core) {
   const auto& d = e.detail;
-  const auto& st = estimator.core().state();
+  const auto& st = core.state();
   line_.clear();
   append_number(line_, 1e-9 * static_cast<double>(e.t_ns));
   for (double v : {e.psi_m_Wb, e.r_s_Ohm, d.theta_pu[core::kPsiM], d.theta_pu[core::kRs], e.epsilon_A[0],

@@ -113,6 +113,14 @@ core::EstimatorSettings parse_estimator(YamlMap e, const core::MachineSi& machin
   s.floors.gna_eigenvalue_min_pu = floors.number("gna_eigenvalue_min_pu", 0.0, kInf);
   s.floors.phyint_denominator_min_pu = floors.number("phyint_denominator_min_pu", 0.0, kInf);
   floors.finish();
+  if (auto a = e.optional_map("averaged")) {
+    // The averaged-sample estimator (docs/derivations.md §11); its gains are those above, as rates per second.
+    s.averaged.max_interval_s = a->number_or("max_interval_s", s.averaged.max_interval_s, 1e-4, 10.0);
+    s.averaged.inductive_correction = a->boolean_or("inductive_correction", s.averaged.inductive_correction);
+    s.averaged.instrument_time_constant_s =
+        a->number_or("instrument_time_constant_s", s.averaged.instrument_time_constant_s, 0.0, 10.0);
+    a->finish();
+  }
   e.finish();
   return s;
 }

@@ -93,7 +93,9 @@ long YamlMap::integer(const std::string& key, long lo, long hi) {
   if (!n.IsScalar()) fail_at(n, key, "expected an integer");
   const std::string& s = n.Scalar();
   long v = 0;
-  const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
+  const bool hex = s.size() > 2 && s[0] == '0' && (s[1] == 'x' || s[1] == 'X');  // 0x181: CAN ids
+  const char* first = s.data() + (hex ? 2 : 0);
+  const auto [end, ec] = std::from_chars(first, s.data() + s.size(), v, hex ? 16 : 10);
   if (ec != std::errc() || end != s.data() + s.size()) fail_at(n, key, "'" + s + "' is not an integer");
   if (v < lo || v > hi) fail_at(n, key, s + " is outside " + describe_range(static_cast<double>(lo), static_cast<double>(hi)));
   return v;

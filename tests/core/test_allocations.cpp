@@ -1,13 +1,16 @@
 // Zero heap allocations on the per-sample path: 10⁵ DriveEstimator::step() calls (conditioner,
-// predictor, gradients, gains, update) for each algorithm and gradient form, counted by replacing the
-// global allocation functions in this test binary.
+// predictor, gradients, gains, update) for each algorithm and gradient form, and 10⁵
+// AveragedDriveEstimator::step() calls for each algorithm, counted by replacing the global allocation
+// functions in this test binary.
 #include <gtest/gtest.h>
 
 #include <atomic>
 #include <cstdlib>
 #include <new>
 
+#include "rpem/core/averaged_estimator.hpp"
 #include "rpem/core/drive_estimator.hpp"
+#include "support/averaged_data.hpp"
 #include "support/model_data.hpp"
 #include "support/paper_machine.hpp"
 
@@ -36,6 +39,20 @@ void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
 
 namespace rpem::core {
 namespace {
+
+/// Steps the estimator over every sample, resets, freezes and steps once more, counting allocations.
+template <typename Estimator, typename Sample>
+void expect_no_allocations(Estimator& est, const std::vector<Sample>& samples) {
+  const long before = g_allocations.load();
+  double sink = 0.0;
+  for (const Sample& s : samples) sink += est.step(s).psi_m_Wb;
+  est.reset();
+  est.set_frozen(true);
+  sink += est.step(samples[0]).r_s_Ohm;
+  const long after = g_allocations.load();
+  EXPECT_EQ(after - before, 0);
+  EXPECT_TRUE(std::isfinite(sink));
+}
 
 struct Case {
   Algorithm algorithm;
@@ -82,15 +99,7 @@ TEST_P(Allocations, NoneAcrossOneHundredThousandSteps) {
   samples[5000].gap_before = true;
   samples[6000].i_A[0] = std::nan("");
 
-  const long before = g_allocations.load();
-  double sink = 0.0;
-  for (const DriveSample& s : samples) sink += est.step(s).psi_m_Wb;
-  est.reset();
-  est.set_frozen(true);
-  sink += est.step(samples[0]).r_s_Ohm;
-  const long after = g_allocations.load();
-  EXPECT_EQ(after - before, 0);
-  EXPECT_TRUE(std::isfinite(sink));
+  expect_no_allocations(est, samples);
 }
 
 INSTANTIATE_TEST_SUITE_P(
@@ -100,6 +109,39 @@ INSTANTIATE_TEST_SUITE_P(
                       Case{Algorithm::kGna, GradientForm::kSteadyState, Discretization::kTrapezoidal},
                       Case{Algorithm::kGna, GradientForm::kDynamic, Discretization::kExplicitEuler},
                       Case{Algorithm::kPhyInt, GradientForm::kSteadyState, Discretization::kTrapezoidal}));
+
+class AveragedAllocations : public ::testing::TestWithParam<Algorithm> {};
+
+TEST_P(AveragedAllocations, NoneAcrossOneHundredThousandAveragedSteps) {
+  // The averaged-sample path (steady-state model, inductive correction, rates per second) with every
+  // extension it applies on, through gaps, a non-finite sample, standstill and speed.
+  EstimatorSettings settings = test::paper_settings(GetParam());
+  ModelExtensions& x = settings.extensions;
+  x.deadtime_v_err_V = 2.0;
+  x.delay_s = 100e-6;
+  x.theta_offset_rad = 0.02;
+  x.inductance_q = {1.1, -0.002};
+  x.iron_loss_r_fe_Ohm = 3000.0;
+  AveragedDriveEstimator est(test::paper_machine_si(), settings);
+  test::AveragedDataGenerator gen;
+  gen.base = test::paper_base();
+  gen.plant = test::paper_machine_pu();
+  gen.rate_Hz = 1000.0;
+  gen.n_pu = [](double t) { return std::fmod(t, 20.0) < 10.0 ? 0.3 : 0.0; };
+  gen.i_pu = [](double t) { return Vec2(-0.1, 0.3 + 0.1 * std::sin(t)); };
+  gen.di_pu_per_s = [](double t) { return Vec2(0.0, 0.1 * std::cos(t)); };
+  constexpr int kSteps = 100'000;
+  std::vector<AveragedSample> samples;
+  samples.reserve(kSteps);
+  for (int k = 0; k < kSteps; ++k) samples.push_back(gen.next());
+  samples[5000].gap_before = true;
+  samples[6000].i_dq_A[0] = std::nan("");
+
+  expect_no_allocations(est, samples);
+}
+
+INSTANTIATE_TEST_SUITE_P(EveryAlgorithm, AveragedAllocations,
+                         ::testing::Values(Algorithm::kSga, Algorithm::kGna, Algorithm::kPhyInt));
 
 TEST(AllocationCounter, CountsAnAllocation) {
   // Guard against a counter that cannot fail.

@@ -114,6 +114,22 @@ INSTANTIATE_TEST_SUITE_P(
                 "iron_loss.r_fe_Ohm"}),
     [](const auto& p) { return std::string(p.param.name); });
 
+TEST(MachineConfig, AveragedEstimatorOptionsAreReadAndChecked) {
+  EXPECT_DOUBLE_EQ(load_machine_config(test::source_dir() + "/config/paper-ipmsm.yaml").estimator.averaged.max_interval_s, 0.05);
+  const std::string edited = std::regex_replace(
+      paper_text(), std::regex("\n  floors:"),
+      "\n  averaged: {max_interval_s: 0.1, inductive_correction: false, instrument_time_constant_s: 0.02}\n  floors:",
+      std::regex_constants::format_first_only);
+  test::TempFile f("avg.yaml", edited);
+  const core::AveragedSettings a = load_machine_config(f.path()).estimator.averaged;
+  EXPECT_DOUBLE_EQ(a.max_interval_s, 0.1);
+  EXPECT_FALSE(a.inductive_correction);
+  EXPECT_DOUBLE_EQ(a.instrument_time_constant_s, 0.02);
+  EXPECT_NE(error_after_edit("\n  floors:", "\n  averaged: {max_interval_s: 0}\n  floors:").find("averaged.max_interval_s"),
+            std::string::npos);
+  EXPECT_NE(error_after_edit("\n  floors:", "\n  averaged: {rate: 1}\n  floors:").find("rate"), std::string::npos);
+}
+
 TEST(MachineConfig, ModelExtensionsAreRead) {
   const std::string text = paper_text() +
                            "model_extensions:\n"

@@ -1,5 +1,7 @@
 // rpem estimate --log LOG.csv --config CFG.yaml --out EST.csv [--algorithm sga|gna|phyint] [--every N]
-// Runs the estimator offline over a drive log, exactly as rpemd would run it online.
+// Runs the estimator offline over a drive log, exactly as rpemd would run it online: a phase-sample log
+// through DriveEstimator, an averaged log (a t_start column; docs/drive-log.md) through
+// AveragedDriveEstimator.
 
 #include <cstdio>
 #include <optional>
@@ -7,7 +9,9 @@
 
 #include "commands.hpp"
 #include "progress.hpp"
+#include "rpem/core/averaged_estimator.hpp"
 #include "rpem/core/drive_estimator.hpp"
+#include "rpem/io/averaged_log.hpp"
 #include "rpem/io/drive_log.hpp"
 #include "rpem/io/estimate_log.hpp"
 #include "rpem/io/machine_config.hpp"
@@ -23,35 +27,60 @@ struct EstimateOptions {
   long every = 1;
 };
 
+struct Tally {
+  std::uint64_t rows = 0, resyncs = 0;
+  core::Estimate last;
+  void count(const core::Estimate& e) {
+    last = e;
+    ++rows;
+    if (e.detail.code == core::StepCode::kSynchronized || e.detail.code == core::StepCode::kPredictorDiverged) ++resyncs;
+  }
+  [[nodiscard]] std::string summary(core::Algorithm a, const char* kind) const {
+    char text[256];
+    std::snprintf(text, sizeof text, "%llu %s, psi_m = %.5f Wb, r_s = %.5f Ohm (%s), %llu resyncs",
+                  static_cast<unsigned long long>(rows), kind, last.psi_m_Wb, last.r_s_Ohm, io::to_string(a),
+                  static_cast<unsigned long long>(resyncs));
+    return text;
+  }
+};
+
+int run_averaged(const EstimateOptions& o, const io::MachineConfig& cfg, const std::string& config_name) {
+  io::AveragedLogLayout layout;
+  const std::vector<core::AveragedSample> samples = io::read_averaged_log(o.log, &layout);
+  io::check_averaged_supports(cfg, config_name, layout.u_dc, o.log);
+  io::EstimateLogWriter writer(o.out);
+  core::AveragedDriveEstimator estimator(cfg.machine, cfg.estimator);
+  Tally tally;
+  for (const core::AveragedSample& s : samples) {
+    const core::Estimate e = estimator.step(s);
+    if (tally.rows % static_cast<std::uint64_t>(o.every) == 0) writer.write(e, estimator.core());
+    tally.count(e);
+  }
+  std::fprintf(stderr, "rpem estimate: %s\n", tally.summary(cfg.estimator.algorithm, "averaged samples").c_str());
+  return kExitOk;
+}
+
 int run_estimate(const EstimateOptions& o) {
   io::MachineConfig cfg = o.config.empty() ? io::builtin_paper_config() : io::load_machine_config(o.config);
   if (!o.algorithm.empty()) cfg.estimator.algorithm = io::parse_algorithm(o.algorithm);
+  const std::string config_name = o.config.empty() ? "builtin:paper-ipmsm" : o.config;
+  if (io::is_averaged_log(o.log)) return run_averaged(o, cfg, config_name);
 
   io::DriveLogReader reader(o.log);
-  io::check_log_supports(cfg, o.config.empty() ? "builtin:paper-ipmsm" : o.config, reader.layout().u_dc, o.log);
+  io::check_log_supports(cfg, config_name, reader.layout().u_dc, o.log);
   io::EstimateLogWriter writer(o.out);
   core::DriveEstimator estimator(cfg.machine, cfg.estimator);
   Progress progress("rpem estimate");
 
   io::DriveLogRow row;
-  std::uint64_t rows = 0, rejected = 0, resyncs = 0;
-  core::Estimate last;
+  Tally tally;
   while (reader.next(row)) {
-    last = estimator.step(row.sample);
-    if (last.detail.code == core::StepCode::kRejectedNonFinite) ++rejected;
-    if (last.detail.code == core::StepCode::kSynchronized || last.detail.code == core::StepCode::kPredictorDiverged) {
-      ++resyncs;
-    }
-    if (rows % static_cast<std::uint64_t>(o.every) == 0) writer.write(last, estimator);
-    ++rows;
-    if ((rows & 0xFFF) == 0) progress.update(reader.bytes_read(), reader.bytes_total());
+    const core::Estimate e = estimator.step(row.sample);
+    if (tally.rows % static_cast<std::uint64_t>(o.every) == 0) writer.write(e, estimator);
+    tally.count(e);
+    if ((tally.rows & 0xFFF) == 0) progress.update(reader.bytes_read(), reader.bytes_total());
   }
-  char summary[256];
-  std::snprintf(summary, sizeof summary, "%llu samples, psi_m = %.5f Wb, r_s = %.5f Ohm (%s), %llu resyncs",
-                static_cast<unsigned long long>(rows), last.psi_m_Wb, last.r_s_Ohm,
-                io::to_string(cfg.estimator.algorithm), static_cast<unsigned long long>(resyncs));
-  progress.finish(summary);
-  (void)rejected;
+  progress.finish(tally.summary(cfg.estimator.algorithm, "samples"));
   return kExitOk;
 }
 
@@ -60,7 +89,7 @@ int run_estimate(const EstimateOptions& o) {
 Runner add_estimate_command(CLI::App& app) {
   auto opts = std::make_shared<EstimateOptions>();
   CLI::App* cmd = app.add_subcommand("estimate", "Run the RPEM estimator offline over a drive log");
-  cmd->add_option("--log", opts->log, "drive-log CSV (docs/drive-log.md)")->required()->check(CLI::ExistingFile);
+  cmd->add_option("--log", opts->log, "drive-log CSV, phase samples or averaged (docs/drive-log.md)")->required()->check(CLI::ExistingFile);
   cmd->add_option("--config", opts->config, "machine and estimator YAML (default: built-in paper-ipmsm.yaml)")
       ->check(CLI::ExistingFile);
   cmd->add_option("--out", opts->out, "estimate CSV to write")->required();

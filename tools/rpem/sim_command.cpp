@@ -1,6 +1,8 @@
 // rpem sim --scenario FILE.yaml --out LOG.csv [--truth TRUTH.csv] [--estimate EST.csv]
+//          [--averaged-out AVG.csv --averaged-rate HZ --averaged-jitter X --averaged-seed N]
 // Simulates the drive of a scenario and writes what the drive would log, the truth beside it and,
-// optionally, the estimator's output run in the loop.
+// optionally, the estimator's output run in the loop, and the averaged rotor-frame samples a drive that
+// averages every control cycle would report (sim/cycle_average.hpp; docs/drive-log.md, "Averaged logs").
 
 #include <cstdio>
 #include <memory>
@@ -12,6 +14,8 @@
 #include "rpem/can/protocol.hpp"
 #include "progress.hpp"
 #include "rpem/core/drive_estimator.hpp"
+#include "rpem/io/averaged_log.hpp"
+#include "rpem/sim/cycle_average.hpp"
 #include "rpem/io/estimate_log.hpp"
 #include "rpem/sim/drive_simulator.hpp"
 #include "rpem/sim/truth_log.hpp"
@@ -24,6 +28,10 @@ struct SimOptions {
   std::string out;
   std::string truth;
   std::string estimate;
+  std::string averaged_out;
+  double averaged_rate_Hz = 200.0;
+  double averaged_jitter = 0.3;
+  std::uint64_t averaged_seed = 1;
   StreamOptions stream;
 };
 
@@ -33,8 +41,15 @@ int run_sim(const SimOptions& o) {
   if (!o.out.empty()) log.emplace(o.out, simulator.layout());
   std::optional<TelemetryStreamer> streamer;
   if (!o.stream.interface.empty() || !o.stream.candump_out.empty()) streamer.emplace(o.stream);
-  if (!log && !streamer) {
-    std::fprintf(stderr, "rpem sim: give --out LOG.csv, --can IFACE or --candump FILE\n");
+  std::optional<io::AveragedLogWriter> averaged_log;
+  sim::CycleExtractor cycles;
+  sim::WindowAverager windows(o.averaged_rate_Hz, o.averaged_jitter, o.averaged_seed);
+  if (!o.averaged_out.empty()) {
+    const auto& l = simulator.scenario().log;
+    averaged_log.emplace(o.averaged_out, io::AveragedLogLayout{true, l.temperatures, l.temperatures, false});
+  }
+  if (!log && !streamer && !averaged_log) {
+    std::fprintf(stderr, "rpem sim: give --out LOG.csv, --averaged-out AVG.csv, --can IFACE or --candump FILE\n");
     return kExitUsage;
   }
   std::optional<sim::TruthLogWriter> truth;
@@ -54,6 +69,11 @@ int run_sim(const SimOptions& o) {
   const auto total = static_cast<std::uint64_t>(simulator.samples_total());
   while (simulator.next(row, truth_row)) {
     if (log) log->write(row);
+    if (averaged_log) {
+      if (const auto cycle = cycles.add(row)) {
+        if (const auto window = windows.add(*cycle)) averaged_log->write(*window);
+      }
+    }
     if (streamer) streamer->send(row.sample, can::protocol::status::kPwmEnabled | can::protocol::status::kSimulated);
     if (truth) truth->write(truth_row);
     if (estimator) est_log->write(estimator->step(row.sample), *estimator);
@@ -81,6 +101,13 @@ Runner add_sim_command(CLI::App& app) {
   cmd->add_option("--truth", opts->truth, "also write the true parameters and state (CSV)");
   cmd->add_option("--estimate", opts->estimate, "also run the estimator in the loop and write its CSV");
   cmd->add_option("--can", opts->stream.interface, "stream the drive's telemetry on this SocketCAN interface, in real time");
+  cmd->add_option("--averaged-out", opts->averaged_out,
+                  "also write averaged rotor-frame samples as a drive averaging every control cycle reports them");
+  cmd->add_option("--averaged-rate", opts->averaged_rate_Hz, "mean rate of the averaged samples [Hz]")
+      ->check(CLI::Range(50.0, 2000.0));
+  cmd->add_option("--averaged-jitter", opts->averaged_jitter, "window lengths uniform in (1 +- jitter)/rate")
+      ->check(CLI::Range(0.0, 0.9));
+  cmd->add_option("--averaged-seed", opts->averaged_seed, "seed of the window lengths");
   add_stream_options(cmd, opts->stream);
   return [cmd, opts]() { return cmd->parsed() ? run_sim(*opts) : -1; };
 }

@@ -107,6 +107,7 @@ void write_diagnosis_json(const std::string& path, const Diagnosis& d, const std
   for (bool u : log.used) used += u;
   out["log"] = {{"path", log.path},
                 {"model", to_string(log.mode)},
+                {"kind", log.averaged ? "averaged" : "phase_samples"},
                 {"samples", log.rows.size()},
                 {"samples_used", used},
                 {"excluded_idle", log.excluded_idle},

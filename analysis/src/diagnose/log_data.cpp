@@ -5,6 +5,7 @@
 
 #include "rpem/core/conditioner.hpp"
 #include "rpem/core/frames.hpp"
+#include "rpem/io/averaged_log.hpp"
 
 namespace rpem::analysis {
 namespace {
@@ -121,6 +122,23 @@ LogData prepare_log(std::vector<io::DriveLogRow> rows, const io::DriveLogLayout&
 }
 
 LogData load_log(const std::string& path, const core::MachineSi& machine, const LogOptions& options) {
+  if (io::is_averaged_log(path)) {
+    // Window means carry no transient to replay: the steady-state model, whatever the spacing.
+    if (options.mode == ModelMode::kTransient) {
+      throw io::DriveLogError(path, 1, 0, "column t_start",
+                              "an averaged log replays only the steady-state model (give --model auto or steady_state)");
+    }
+    io::AveragedLogLayout averaged;
+    const std::vector<core::AveragedSample> samples = io::read_averaged_log(path, &averaged);
+    std::vector<io::DriveLogRow> rows;
+    rows.reserve(samples.size());
+    for (const core::AveragedSample& s : samples) rows.push_back(io::to_drive_log_row(s));
+    LogOptions steady = options;
+    steady.mode = ModelMode::kSteadyState;
+    LogData d = prepare_log(std::move(rows), io::rotor_frame_layout(averaged), machine, steady, path);
+    d.averaged = true;
+    return d;
+  }
   io::DriveLogReader reader(path);
   std::vector<io::DriveLogRow> rows;
   io::DriveLogRow row;

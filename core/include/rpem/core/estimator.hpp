@@ -54,6 +54,23 @@ struct EstimatorSample {
   double x_q_pu = 0.0;
 };
 
+/// One averaged (or slowly sampled) rotor-frame sample for the steady-state model (docs/derivations.md
+/// §11): the voltage as the machine sees it, the measured current, the mean speed, pu.
+struct SteadyStateSample {
+  double dt_s = 0.0;            ///< time since the previous sample (scales the gains)
+  Vec2 u_pu = Vec2::Zero();     ///< rotor-frame voltage, input corrections applied
+  Vec2 i_meas_pu = Vec2::Zero();
+  double n_pu = 0.0;            ///< mean speed over the sample's window
+  /// Where Ψᵀ (and PhyInt's denominators) are evaluated: an instrument — the operating point of the
+  /// preceding samples, whose noise is independent of this sample's (docs/derivations.md §11).
+  Vec2 i_gradient_pu = Vec2::Zero();
+  double n_gradient_pu = 0.0;
+  bool resync = false;          ///< no update: first sample, or samples were lost before this one
+  /// Model inductances at this sample's current (the saturation extensions); 0: the configured ones.
+  double x_d_pu = 0.0;
+  double x_q_pu = 0.0;
+};
+
 /// Stable result codes; they are published in diagnostics (numbers never change).
 enum class StepCode : std::uint8_t {
   kAdapted = 0,             ///< prediction, gradient and update done (the update may be scheduled out)
@@ -100,6 +117,13 @@ class RpemEstimator {
   /// One sample. Real-time safe.
   EstimatorOutput step(const EstimatorSample& sample) noexcept;
 
+  /// One averaged sample with the steady-state model instead of the predictor (docs/derivations.md §11):
+  ///   î = M̂⁻¹·(u − [0, n·ψ̂m]ᵀ)  (§1),  ε = i − î,  Ψᵀ = the steady-state forms (§3) at the
+  /// sample's instrument (i_gradient, n_gradient), then the same gain, eq:GainSchedule and projection as step(). `rates_per_s` are the gain
+  /// sequences as rates [1/s]; a sample dt_s after the previous one uses γ = 1 − e^{−rate·dt}.
+  /// Real-time safe.
+  EstimatorOutput step_steady_state(const SteadyStateSample& sample, const GainSequences& rates_per_s) noexcept;
+
   /// θ̂ and the Hessians back to their initial values; the predictor resynchronises. Real-time safe.
   void reset() noexcept;
   /// The next sample re-initialises the predictor from the measurement. Real-time safe.
@@ -119,8 +143,20 @@ class RpemEstimator {
   /// Re-anchors the predictor on the measurement. Across a short gap in a running stream it keeps the
   /// last prediction error (î = i − ε), which the open-loop predictor needs a time constant to rebuild.
   void synchronize(const EstimatorSample& sample, const MachinePu& model) noexcept;
-  /// The configured model with the current estimates and the sample's inductances, if it has any.
-  [[nodiscard]] MachinePu model_for(const EstimatorSample& sample) const noexcept;
+  /// The configured model with the current estimates and the sample's inductances, if it has any (> 0).
+  [[nodiscard]] MachinePu model_for(double x_d_pu, double x_q_pu) const noexcept;
+  /// What one sample brings to the update: the model it was predicted with, the speed eq:GainSchedule
+  /// reads, the current PhyInt's denominators use (the prediction î, or the averaged path's instrument),
+  /// ε, î and the prediction gradient ψ.
+  struct Update {
+    MachinePu model;
+    double n_pu;
+    Vec2 i_gain_pu, epsilon_pu, i_hat_pu;
+    Mat2 gradient;
+  };
+  /// The update both sample kinds share: gain (SGA, GNA, PhyInt), eq:GainSchedule, θ̂ += L·ε, projection
+  /// onto D_M (eq:paramsubset); the sample's output.
+  EstimatorOutput update(const Update& u, const Vec2& gamma_r, const Vec2& gamma_l) noexcept;
   [[nodiscard]] Mat2 select_gradient(const MachinePu& model, double n_pu) const noexcept;
   /// The output of a sample that made no update: θ̂ and î as they stand.
   [[nodiscard]] EstimatorOutput held(StepCode code) const noexcept;

@@ -5,6 +5,7 @@
 
 #include <array>
 
+#include "rpem/core/averaged_settings.hpp"
 #include "rpem/core/conditioner.hpp"
 #include "rpem/core/estimator.hpp"
 #include "rpem/core/per_unit.hpp"
@@ -41,6 +42,7 @@ struct EstimatorSettings {
   bool adapt_psi_m = true;
   bool adapt_r_s = true;
   ModelExtensions extensions;  ///< model_extensions (docs/model-extensions.md)
+  AveragedSettings averaged;   ///< the averaged-sample estimator (averaged_estimator.hpp)
 };
 
 [[nodiscard]] MachinePu to_pu(const PerUnitBase& base, const MachineSi& m) noexcept;

@@ -12,7 +12,9 @@ namespace rpem::io {
 class EstimateLogWriter {
  public:
   explicit EstimateLogWriter(const std::string& path);
-  void write(const core::Estimate& e, const core::DriveEstimator& estimator);
+  void write(const core::Estimate& e, const core::DriveEstimator& estimator) { write(e, estimator.core()); }
+  /// The same for any estimator built on RpemEstimator (the averaged one too).
+  void write(const core::Estimate& e, const core::RpemEstimator& core);
 
  private:
   std::ofstream out_;

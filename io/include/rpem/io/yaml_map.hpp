@@ -29,6 +29,7 @@ class YamlMap {
   /// Numbers in [lo, hi]; required unless a default is given.
   [[nodiscard]] double number(const std::string& key, double lo, double hi);
   [[nodiscard]] double number_or(const std::string& key, double fallback, double lo, double hi);
+  /// Decimal, or hexadecimal with a 0x prefix.
   [[nodiscard]] long integer(const std::string& key, long lo, long hi);
   [[nodiscard]] long integer_or(const std::string& key, long fallback, long lo, long hi);
   [[nodiscard]] bool boolean_or(const std::string& key, bool fallback);

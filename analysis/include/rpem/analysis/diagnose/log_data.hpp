@@ -25,6 +25,7 @@ struct LogData {
   std::vector<io::DriveLogRow> rows;
   io::DriveLogLayout layout;
   ModelMode mode = ModelMode::kTransient;
+  bool averaged = false;  ///< an averaged rotor-frame log (docs/drive-log.md, "Averaged logs"): always steady state
   double t_start_s = 0.0, t_end_s = 0.0;
   double median_dt_s = 0.0;
   double max_current_A = 0.0;   ///< largest measured current amplitude
@@ -62,7 +63,7 @@ struct LogOptions {
   int speed_half_window = 4;      ///< transient logs: replay speed from the angle over ±this many samples
 };
 
-/// Loads and characterises a log (throws io::DriveLogError on bad input).
+/// Loads and characterises a log, a phase-sample or an averaged one (throws io::DriveLogError on bad input).
 [[nodiscard]] LogData load_log(const std::string& path, const core::MachineSi& machine, const LogOptions& options);
 
 /// The same from rows already in memory (tests, the simulator).

@@ -1,0 +1,78 @@
+// libFuzzer target for the signal-map decoder (can/include/rpem/can/signal_map.hpp). The first input byte
+// picks a map — rotor-frame values in little-endian standard frames with an instantaneous trigger, or phase
+// values with theta_el in big-endian extended frames, averaged — and the rest is a stream of frames
+//   [a frame record, fuzz_frame.hpp][t step, 2 bytes]
+// The decoder must never crash, deliver only finite samples with t_start ≤ t and increasing t, and count
+// every frame once.
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <cstdlib>
+
+#include "fuzz_frame.hpp"
+#include "rpem/can/signal_map.hpp"
+
+namespace {
+
+using rpem::can::SampleField;
+using rpem::can::SignalSpec;
+
+rpem::can::SignalMap rotor_frame_map() {
+  rpem::can::SignalMap m;
+  m.trigger_id = 0x20;
+  m.frames.push_back({0x10, false, 8, {{SampleField::kIdA, 0, 16, false, true, 0.01, 0.0},
+                                       {SampleField::kIqA, 16, 16, false, true, 0.01, 0.0},
+                                       {SampleField::kUdV, 32, 16, false, true, 0.1, 0.0},
+                                       {SampleField::kUqV, 48, 16, false, true, 0.1, 0.0}}});
+  m.frames.push_back({0x20, false, 6, {{SampleField::kSpeedMechRpm, 0, 32, false, true, 1.0, 0.0},
+                                       {SampleField::kUdcV, 32, 16, false, false, 0.1, -5.0}}});
+  m.pole_pairs = 7;
+  return m;
+}
+
+rpem::can::SignalMap phase_map() {
+  rpem::can::SignalMap m;
+  m.trigger_id = 0x18FF0002;
+  m.trigger_extended = true;
+  m.averaged = true;
+  m.frames.push_back({0x18FF0001, true, 8, {{SampleField::kIaA, 7, 16, true, true, 0.001, 0.0},
+                                            {SampleField::kIbA, 23, 16, true, true, 0.001, 0.0},
+                                            {SampleField::kThetaElRad, 39, 16, true, false, 9.5873799e-5, 0.0},
+                                            {SampleField::kErpm, 55, 16, true, true, 1.0, 0.0}}});
+  m.frames.push_back({0x18FF0002, true, 8, {{SampleField::kUaV, 7, 20, true, true, 0.001, 0.0},
+                                            {SampleField::kUbV, 19, 20, true, true, 0.001, 0.0},
+                                            {SampleField::kUcV, 48, 16, false, true, 0.01, 0.0}}});
+  return m;
+}
+
+}  // namespace
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  if (size < 1) return 0;
+  static const rpem::can::SignalMap maps[2] = {rotor_frame_map(), phase_map()};
+  const rpem::can::SignalMap& map = maps[data[0] & 1];
+  if (!rpem::can::check_layout(map).empty() || !rpem::can::missing_quantities(map).empty()) std::abort();
+  rpem::can::SignalMapDecoder decoder(map);
+  std::size_t at = 1;
+  std::int64_t t = 0, last_t = -1;
+  std::uint64_t samples = 0, offered = 0;
+  rpem::can::CanFrame f;
+  while (rpem::can::fuzz::read_frame(data, size, at, f)) {
+    if (at + 2 <= size) {
+      t += 1 + (data[at] | (data[at + 1] << 8));
+      at += 2;
+    }
+    rpem::core::AveragedSample s;
+    ++offered;
+    if (decoder.decode(f, t, s)) {
+      ++samples;
+      if (!s.i_dq_A.allFinite() || !s.u_dq_V.allFinite() || !std::isfinite(s.omega_el_rad_s)) std::abort();
+      if (s.t_start_ns > s.t_ns || s.t_ns <= last_t) std::abort();
+      last_t = s.t_ns;
+    }
+  }
+  const auto& c = decoder.counters();
+  if (c.samples != samples || c.frames != offered) std::abort();
+  return 0;
+}

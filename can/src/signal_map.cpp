@@ -1,0 +1,203 @@
+#include "rpem/can/signal_map.hpp"
+
+#include <cmath>
+#include <limits>
+#include <numbers>
+#include <utility>
+
+#include "rpem/core/frames.hpp"
+
+namespace rpem::can {
+namespace {
+
+struct FieldInfo {
+  std::string_view name, unit;
+};
+constexpr std::array<FieldInfo, kSampleFieldCount> kFields = {{
+    {"i_d", "A"}, {"i_q", "A"}, {"u_d", "V"}, {"u_q", "V"},
+    {"i_a", "A"}, {"i_b", "A"}, {"i_c", "A"}, {"u_a", "V"}, {"u_b", "V"}, {"u_c", "V"},
+    {"theta_el", "rad"},
+    {"omega_el", "rad/s"}, {"erpm", "rpm"}, {"speed_mech", "rpm"},
+    {"u_dc", "V"}, {"T_winding", "degC"}, {"T_magnet", "degC"}, {"T_drive", "degC"},
+}};
+
+/// DBC bit positions of a signal, MSB first for big endian (the "sawtooth" numbering: bit 7 of byte 0 is
+/// 7, the bit after bit 0 of a byte is bit 7 of the next), LSB first for little endian.
+template <typename Visit>
+bool walk_bits(const SignalSpec& s, int frame_bits, Visit&& visit) noexcept {
+  int pos = s.start_bit;
+  for (int k = 0; k < s.length; ++k) {
+    if (pos < 0 || pos >= frame_bits) return false;
+    visit(pos);
+    if (s.big_endian) {
+      pos = (pos % 8 == 0) ? pos + 15 : pos - 1;
+    } else {
+      ++pos;
+    }
+  }
+  return true;
+}
+
+}  // namespace
+
+std::string_view field_name(SampleField f) noexcept { return kFields[static_cast<std::size_t>(f)].name; }
+std::string_view field_unit(SampleField f) noexcept { return kFields[static_cast<std::size_t>(f)].unit; }
+
+bool parse_field(std::string_view name, SampleField& out) noexcept {
+  for (std::size_t k = 0; k < kFields.size(); ++k) {
+    if (kFields[k].name == name) {
+      out = static_cast<SampleField>(k);
+      return true;
+    }
+  }
+  return false;
+}
+
+std::string check_layout(const SignalMap& map) {
+  for (std::size_t i = 0; i < map.frames.size(); ++i) {
+    const FrameSpec& f = map.frames[i];
+    if (f.length > 64) return "frame " + std::to_string(f.id) + ": length above 64 bytes";
+    for (std::size_t j = 0; j < i; ++j) {
+      if (map.frames[j].id == f.id && map.frames[j].extended == f.extended) {
+        return "frame " + std::to_string(f.id) + " is mapped twice";
+      }
+    }
+    for (const SignalSpec& s : f.signals) {
+      const std::string where = "frame " + std::to_string(f.id) + ", signal " + std::string(field_name(s.field));
+      if (s.length < 1 || s.length > 64) return where + ": length must be 1-64 bits";
+      if (!walk_bits(s, 8 * f.length, [](int) {})) return where + ": bits lie outside the frame's " + std::to_string(f.length) + " bytes";
+      if (!std::isfinite(s.scale) || s.scale == 0.0 || !std::isfinite(s.offset)) return where + ": scale must be finite and non-zero, offset finite";
+    }
+  }
+  bool trigger = false;
+  for (const FrameSpec& f : map.frames) trigger = trigger || (f.id == map.trigger_id && f.extended == map.trigger_extended);
+  if (!trigger) return "the sample trigger " + std::to_string(map.trigger_id) + " is not one of the mapped frames";
+  return {};
+}
+
+std::string missing_quantities(const SignalMap& map) {
+  std::array<bool, kSampleFieldCount> m{};
+  for (const FrameSpec& f : map.frames) {
+    for (const SignalSpec& s : f.signals) m[static_cast<std::size_t>(s.field)] = true;
+  }
+  auto has = [&](SampleField f) { return m[static_cast<std::size_t>(f)]; };
+  using F = SampleField;
+  std::string missing;
+  auto add = [&](const char* what) { missing += (missing.empty() ? "" : "; ") + std::string(what); };
+  const bool phases_i = has(F::kIaA) && has(F::kIbA) && has(F::kThetaElRad);
+  const bool phases_u = has(F::kUaV) && has(F::kUbV) && has(F::kUcV) && has(F::kThetaElRad);
+  if (!(has(F::kIdA) && has(F::kIqA)) && !phases_i) add("current (i_d and i_q, or i_a, i_b and theta_el)");
+  if (!(has(F::kUdV) && has(F::kUqV)) && !phases_u) add("voltage (u_d and u_q, or u_a, u_b, u_c and theta_el)");
+  if (!has(F::kOmegaElRadS) && !has(F::kErpm) && !has(F::kSpeedMechRpm)) add("speed (omega_el, erpm or speed_mech)");
+  if (has(F::kSpeedMechRpm) && !has(F::kOmegaElRadS) && !has(F::kErpm) && map.pole_pairs <= 0) {
+    add("pole_pairs (to turn speed_mech into the electrical speed)");
+  }
+  return missing.empty() ? missing : "the map does not give what the estimator needs: " + missing;
+}
+
+std::int64_t extract_raw(const CanFrame& f, const SignalSpec& s) noexcept {
+  std::uint64_t raw = 0;
+  int k = 0;
+  (void)walk_bits(s, 8 * f.len, [&](int pos) {
+    const std::uint64_t bit = (f.data[static_cast<std::size_t>(pos / 8)] >> (pos % 8)) & 1U;
+    if (s.big_endian) {
+      raw = (raw << 1) | bit;  // MSB first
+    } else {
+      raw |= bit << k;  // LSB first
+    }
+    ++k;
+  });
+  if (s.is_signed && s.length < 64 && (raw >> (s.length - 1)) & 1U) raw |= ~std::uint64_t{0} << s.length;
+  return static_cast<std::int64_t>(raw);
+}
+
+SignalMapDecoder::SignalMapDecoder(SignalMap map) : map_(std::move(map)) {
+  for (const FrameSpec& f : map_.frames) {
+    for (const SignalSpec& s : f.signals) mapped_[static_cast<std::size_t>(s.field)] = true;
+  }
+}
+
+bool SignalMapDecoder::decode(const CanFrame& f, std::int64_t t_ns, core::AveragedSample& out) noexcept {
+  ++counters_.frames;
+  if (f.error) {
+    ++counters_.error_frames;
+    return false;
+  }
+  const FrameSpec* spec = nullptr;
+  for (const FrameSpec& s : map_.frames) {
+    if (s.id == f.id && s.extended == f.extended) {
+      spec = &s;
+      break;
+    }
+  }
+  if (!spec) {
+    ++counters_.unknown_id;
+    return false;
+  }
+  if (f.len < spec->length) {
+    ++counters_.wrong_length;
+    return false;
+  }
+  for (const SignalSpec& s : spec->signals) {
+    const std::int64_t raw = extract_raw(f, s);
+    const double v = (s.is_signed ? static_cast<double>(raw) : static_cast<double>(static_cast<std::uint64_t>(raw))) * s.scale + s.offset;
+    values_[static_cast<std::size_t>(s.field)] = v;
+    fresh_[static_cast<std::size_t>(s.field)] = true;
+  }
+  if (f.id != map_.trigger_id || f.extended != map_.trigger_extended) return false;
+  return complete(t_ns, out);
+}
+
+bool SignalMapDecoder::complete(std::int64_t t_ns, core::AveragedSample& out) noexcept {
+  using F = SampleField;
+  // What arrived since the last sample; the next sample starts afresh either way.
+  const std::array<bool, kSampleFieldCount> got = fresh_;
+  fresh_.fill(false);
+  auto has = [&](F f) { return got[static_cast<std::size_t>(f)]; };
+  auto value = [&](F f) { return values_[static_cast<std::size_t>(f)]; };
+  const bool dq_i = has(F::kIdA) && has(F::kIqA);
+  const bool dq_u = has(F::kUdV) && has(F::kUqV);
+  const bool abc_i = has(F::kIaA) && has(F::kIbA) && (has(F::kIcA) || !mapped_[static_cast<std::size_t>(F::kIcA)]) &&
+                     has(F::kThetaElRad);
+  const bool abc_u = has(F::kUaV) && has(F::kUbV) && has(F::kUcV) && has(F::kThetaElRad);
+  const bool speed = has(F::kOmegaElRadS) || has(F::kErpm) || (has(F::kSpeedMechRpm) && map_.pole_pairs > 0);
+  if (!((dq_i || abc_i) && (dq_u || abc_u) && speed)) {
+    ++counters_.incomplete;
+    has_previous_ = false;  // the next window does not start here
+    return false;
+  }
+  core::AveragedSample s;
+  s.t_ns = t_ns;
+  s.t_start_ns = map_.averaged && has_previous_ ? previous_t_ns_ : t_ns;
+  s.gap_before = !has_previous_;
+  const core::Rotation rot = core::Rotation::of(value(F::kThetaElRad));
+  if (dq_i) {
+    s.i_dq_A = {value(F::kIdA), value(F::kIqA)};
+  } else {
+    const double i_c = has(F::kIcA) ? value(F::kIcA) : -value(F::kIaA) - value(F::kIbA);  // Σi = 0
+    s.i_dq_A = core::park(core::clarke(core::Vec3(value(F::kIaA), value(F::kIbA), i_c)), rot);
+  }
+  s.u_dq_V = dq_u ? core::Vec2(value(F::kUdV), value(F::kUqV))
+                  : core::park(core::clarke(core::Vec3(value(F::kUaV), value(F::kUbV), value(F::kUcV))), rot);
+  constexpr double kRpmToRadS = 2.0 * std::numbers::pi / 60.0;
+  s.omega_el_rad_s = has(F::kOmegaElRadS) ? value(F::kOmegaElRadS)
+                     : has(F::kErpm)      ? value(F::kErpm) * kRpmToRadS
+                                          : value(F::kSpeedMechRpm) * kRpmToRadS * map_.pole_pairs;
+  auto optional = [&](F f) { return has(f) ? value(f) : std::numeric_limits<double>::quiet_NaN(); };
+  s.u_dc_V = optional(F::kUdcV);
+  s.t_winding_C = optional(F::kTWindingC);
+  s.t_magnet_C = optional(F::kTMagnetC);
+  s.t_drive_C = optional(F::kTDriveC);
+  if (!s.i_dq_A.allFinite() || !s.u_dq_V.allFinite() || !std::isfinite(s.omega_el_rad_s)) {
+    ++counters_.non_finite;
+    has_previous_ = false;
+    return false;
+  }
+  has_previous_ = true;
+  previous_t_ns_ = t_ns;
+  out = s;
+  ++counters_.samples;
+  return true;
+}
+
+}  // namespace rpem::can

@@ -1,0 +1,69 @@
+#pragma once
+// The estimator for averaged rotor-frame samples (VESC, signal maps, averaged drive logs; docs/sources.md):
+// SI averaged samples in, SI and pu estimates out, beside DriveEstimator (which takes phase samples at the
+// control rate). Each sample is predicted with the steady-state model of its window (docs/derivations.md
+// §11), the inductive term estimated from consecutive window means; the gains, eq:GainSchedule and the
+// projection are RpemEstimator's, its gain sequences applied as rates per second.
+//
+//   u_eff = ū − (x/ω_n)·(ī_k − ī_{k−1})/(c_k − c_{k−1})     c: window centres (inductive correction)
+//   î = M̂⁻¹·(u_eff − [0, n̄·ψ̂m]ᵀ),  ε = ī − î                 (§1, eq_epsilon_steadystate)
+//   Ψᵀ at the instrument: the current and speed of the preceding samples, low-passed
+//
+// Input corrections from model_extensions act as on the steady state of SampleConditioner (angle offset,
+// dead time as its fundamental, saturation, iron loss) plus the command delay as a rotation by −ω·delay.
+// Per-phase current offsets and gains have no rotor-frame mean and are left out (the tools refuse them).
+
+#include <array>
+#include <cstdint>
+
+#include "rpem/core/averaged_sample.hpp"
+#include "rpem/core/drive_estimator.hpp"
+
+namespace rpem::core {
+
+/// The gain rates [1/s] the averaged estimator uses for each algorithm: `averaged.rates_per_s` where given,
+/// else γ_0/sample_period_s of `gains`.
+[[nodiscard]] std::array<GainSequences, 3> averaged_rates_per_s(const EstimatorSettings& s) noexcept;
+
+class AveragedDriveEstimator {
+ public:
+  AveragedDriveEstimator(const MachineSi& machine, const EstimatorSettings& settings) noexcept;
+
+  /// One averaged sample. Real-time safe.
+  [[nodiscard]] Estimate step(const AveragedSample& sample) noexcept;
+
+  /// θ̂ and the Hessians back to their initial values; the next sample starts a new chain.
+  void reset() noexcept;
+  /// The next sample starts a new chain (adapts nothing).
+  void resynchronize() noexcept { has_previous_ = false; }
+  void set_frozen(bool frozen) noexcept { core_.set_frozen(frozen); }
+  void set_estimates(double psi_m_Wb, double r_s_Ohm) noexcept;
+  /// Reloads gains, limits and model extensions, keeping θ̂ and the Hessians. Not real-time.
+  void reconfigure(const MachineSi& machine, const EstimatorSettings& settings) noexcept;
+
+  [[nodiscard]] const PerUnitBase& base() const noexcept { return base_; }
+  [[nodiscard]] const RpemEstimator& core() const noexcept { return core_; }
+  [[nodiscard]] double psi_m_Wb() const noexcept;
+  [[nodiscard]] double r_s_Ohm() const noexcept;
+
+ private:
+  /// The sample as the steady-state model takes it (pu, corrections applied), and whether it continues
+  /// the chain of the previous one.
+  [[nodiscard]] SteadyStateSample condition(const AveragedSample& a) noexcept;
+  void configure(const EstimatorSettings& settings) noexcept;
+
+  PerUnitBase base_;
+  SampleConditioner conditioner_;
+  RpemEstimator core_;
+  std::array<GainSequences, 3> rates_per_s_{};
+  AveragedSettings options_;
+  double delay_s_ = 0.0;
+  bool has_previous_ = false;
+  std::int64_t previous_t_ns_ = 0;
+  std::int64_t previous_centre2_ns_ = 0;  ///< t_start + t of the previous window (twice its centre)
+  Vec2 previous_i_pu_ = Vec2::Zero();
+  Vec2 instrument_i_pu_ = Vec2::Zero();  ///< low-passed current of the samples before this one
+  double instrument_n_pu_ = 0.0;
+};
+
+}  // namespace rpem::core

@@ -1,0 +1,28 @@
+#pragma once
+// One averaged rotor-frame drive sample in SI, as drives beside which rpemd runs report them (VESC's
+// COMM_GET_VALUES_SELECTIVE, a signal map over a drive's own frames; docs/sources.md) and as averaged
+// drive logs hold them (docs/drive-log.md, "Averaged logs"): the means over the window [t_start, t] of
+// the measured rotor-frame current, the drive's rotor-frame voltage, the electrical speed and the DC link.
+// A source that samples instead of averaging gives t_start = t.
+
+#include <cstdint>
+#include <limits>
+
+#include "rpem/core/types.hpp"
+
+namespace rpem::core {
+
+struct AveragedSample {
+  std::int64_t t_start_ns = 0;    ///< window start (== t_ns: an instantaneous sample)
+  std::int64_t t_ns = 0;          ///< window end: the host time that closed the window
+  Vec2 i_dq_A = Vec2::Zero();     ///< mean measured current, rotor frame
+  Vec2 u_dq_V = Vec2::Zero();     ///< mean voltage the drive reports (its command, or its estimate of the applied voltage)
+  double omega_el_rad_s = 0.0;    ///< mean electrical speed
+  double u_dc_V = std::numeric_limits<double>::quiet_NaN();       ///< mean DC link; NaN: not reported
+  double t_winding_C = std::numeric_limits<double>::quiet_NaN();  ///< NaN: not reported
+  double t_magnet_C = std::numeric_limits<double>::quiet_NaN();   ///< NaN: not reported
+  double t_drive_C = std::numeric_limits<double>::quiet_NaN();    ///< power stage; NaN: not reported
+  bool gap_before = false;        ///< windows were lost immediately before this one
+};
+
+}  // namespace rpem::core

@@ -1,0 +1,27 @@
+#pragma once
+// The averaged-sample estimator's options (`estimator.averaged`, docs/configuration.md): its gains as
+// rates per second, the longest interval it adapts across, and the inductive correction
+// (docs/derivations.md §11).
+
+#include <array>
+
+#include "rpem/core/gain.hpp"
+
+namespace rpem::core {
+
+struct AveragedSettings {
+  /// Gain sequences as rates [1/s], per algorithm, where `rates_given` says so; otherwise the
+  /// estimator takes γ_0/sample_period_s of the native `gains` (the same time constants).
+  std::array<GainSequences, 3> rates_per_s{};
+  std::array<bool, 3> rates_given{};
+  /// A sample more than this after the previous one adapts nothing (the stream was interrupted).
+  double max_interval_s = 0.05;
+  /// Subtract L·di/dt estimated from consecutive window means (§11); off: the plain steady state.
+  bool inductive_correction = true;
+  /// Time constant of the instrument: Ψᵀ is evaluated at the preceding samples' low-passed current and
+  /// speed, whose noise is independent of the sample's own (§11: a same-sample regressor is biased in
+  /// closed loop, more so the faster the samples come).
+  double instrument_time_constant_s = 0.05;
+};
+
+}  // namespace rpem::core

@@ -1,0 +1,61 @@
+#pragma once
+// The averaged drive log (docs/drive-log.md, "Averaged logs"): one row per window of averaged rotor-frame
+// values, as VESC polling, a signal map or the native telemetry averaged by `rpem record` deliver them, and
+// as the independent generator writes them (`indep_drive_log --averaged`).
+//
+//   t, t_start, i_d, i_q, u_d, u_q, omega_el   required: window [t_start, t] [s], means [A, V, rad/s]
+//   u_dc, T_winding, T_magnet, T_drive          optional [V, °C]; a cell "nan" means not reported
+//
+// A header with a t_start column marks the file as an averaged log.
+
+#include <cstdint>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include "rpem/core/averaged_sample.hpp"
+#include "rpem/io/drive_log.hpp"
+#include "rpem/io/machine_config.hpp"
+
+namespace rpem::io {
+
+/// The optional columns a log holds.
+struct AveragedLogLayout {
+  bool u_dc = false;
+  bool t_winding = false;
+  bool t_magnet = false;
+  bool t_drive = false;
+};
+
+/// True if the CSV's header has a t_start column (an averaged log); throws DriveLogError if unreadable.
+[[nodiscard]] bool is_averaged_log(const std::string& path);
+
+/// Reads a whole averaged log. Every problem throws DriveLogError naming file, line and column: a missing
+/// required column, a required cell that is not a finite number, t that does not increase, t_start after t.
+[[nodiscard]] std::vector<core::AveragedSample> read_averaged_log(const std::string& path,
+                                                                  AveragedLogLayout* layout = nullptr);
+
+class AveragedLogWriter {
+ public:
+  AveragedLogWriter(const std::string& path, const AveragedLogLayout& layout);
+  void write(const core::AveragedSample& s);
+  void flush();
+
+ private:
+  std::ofstream out_;
+  AveragedLogLayout layout_;
+  std::string line_;
+};
+
+/// An averaged sample as a rotor-frame-only drive-log row (dq voltage and current, angle 0): the form the
+/// steady-state model of `rpem diagnose` replays. The window's end time stands for the sample.
+[[nodiscard]] DriveLogRow to_drive_log_row(const core::AveragedSample& s);
+/// The drive-log layout of such rows.
+[[nodiscard]] DriveLogLayout rotor_frame_layout(const AveragedLogLayout& layout);
+
+/// Throws ConfigError when the configuration needs what averaged samples cannot carry: per-phase current
+/// offsets and gains (no rotor-frame mean), or a dead time in seconds without the log's u_dc.
+void check_averaged_supports(const MachineConfig& c, const std::string& config_name, bool has_u_dc,
+                             const std::string& log_path);
+
+}  // namespace rpem::io

@@ -1,0 +1,255 @@
+// Conformance of the VESC decoder against frames written byte by byte from docs/can-vesc.md (which cites
+// vedderb/bldc: comm/comm_can.c comm_can_send_buffer, decode_msg, comm_can_send_status1…6; comm/commands.c
+// commands_process_packet, case COMM_GET_VALUES_SELECTIVE; util/buffer.c; util/crc.c crc16). The CRC of
+// the reply vector was computed with Python's binascii.crc_hqx(payload, 0) (CRC-16/XMODEM, check value
+// 0x31C3 for "123456789"), not with our code. Then every kind of bad input, counted by kind.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+#include <vector>
+
+#include "rpem/can/decoder.hpp"
+#include "rpem/can/e2e.hpp"
+#include "rpem/can/protocol.hpp"
+#include "rpem/can/vesc.hpp"
+
+namespace rpem::can::vesc {
+namespace {
+
+constexpr std::uint8_t kController = 17;  // the VESC
+constexpr std::uint8_t kOwn = 0x7D;       // the poller (rpemd)
+
+CanFrame ext(std::uint32_t id, std::vector<std::uint8_t> bytes) {
+  CanFrame f;
+  f.extended = true;
+  f.id = id;
+  f.len = static_cast<std::uint8_t>(bytes.size());
+  std::copy(bytes.begin(), bytes.end(), f.data.begin());
+  return f;
+}
+
+/// The reply to a poll with the estimator's mask 0x001801B3: T_fet 41.3 °C, T_motor 67.8 °C, i_d −3.21 A,
+/// i_q 27.45 A, 21000 ERPM, V_in 48.2 V, v_d −1.234 V, v_q 11.873 V — 31 bytes in five FILL_RX_BUFFER
+/// frames (ID 0x57D: own id 0x7D | 5 << 8) and PROCESS_RX_BUFFER (0x77D) from controller 17, CRC 0x08F7.
+std::vector<CanFrame> reply_frames() {
+  return {ext(0x57D, {0x00, 0x32, 0x00, 0x18, 0x01, 0xB3, 0x01, 0x9D}),
+          ext(0x57D, {0x07, 0x02, 0xA6, 0xFF, 0xFF, 0xFE, 0xBF, 0x00}),
+          ext(0x57D, {0x0E, 0x00, 0x0A, 0xB9, 0x00, 0x00, 0x52, 0x08}),
+          ext(0x57D, {0x15, 0x01, 0xE2, 0xFF, 0xFF, 0xFB, 0x2E, 0x00}),
+          ext(0x57D, {0x1C, 0x00, 0x2E, 0x61}),
+          ext(0x77D, {0x11, 0x01, 0x00, 0x1F, 0x08, 0xF7})};
+}
+
+std::vector<VescDecoder::Event> feed(VescDecoder& dec, const std::vector<CanFrame>& frames) {
+  std::vector<VescDecoder::Event> events;
+  for (const CanFrame& f : frames) events.push_back(dec.decode(f));
+  return events;
+}
+
+TEST(Vesc, PollRequestIsAShortBufferToTheController) {
+  const CanFrame f = values_request(kController, kOwn, kEstimatorMask);
+  EXPECT_TRUE(f.extended);
+  EXPECT_EQ(f.id, 0x811U);  // 17 | CAN_PACKET_PROCESS_SHORT_BUFFER (8) << 8
+  ASSERT_EQ(f.len, 7);
+  const std::vector<std::uint8_t> want = {0x7D, 0x00, 0x32, 0x00, 0x18, 0x01, 0xB3};
+  EXPECT_EQ(std::vector<std::uint8_t>(f.data.begin(), f.data.begin() + 7), want);
+  EXPECT_EQ(kEstimatorMask, 0x001801B3U);
+}
+
+TEST(Vesc, ReassemblesAndDecodesAGetValuesSelectiveReply) {
+  VescDecoder dec(kController, kOwn);
+  const auto events = feed(dec, reply_frames());
+  for (std::size_t k = 0; k + 1 < events.size(); ++k) EXPECT_EQ(events[k], VescDecoder::Event::kNone);
+  ASSERT_EQ(events.back(), VescDecoder::Event::kValues);
+  const Values& v = dec.values();
+  EXPECT_EQ(v.mask, 0x001801B3U);
+  EXPECT_DOUBLE_EQ(v.temp_fet_C, 41.3);
+  EXPECT_DOUBLE_EQ(v.temp_motor_C, 67.8);
+  EXPECT_DOUBLE_EQ(v.i_d_A, -3.21);
+  EXPECT_DOUBLE_EQ(v.i_q_A, 27.45);
+  EXPECT_DOUBLE_EQ(v.erpm, 21000.0);
+  EXPECT_DOUBLE_EQ(v.v_in_V, 48.2);
+  EXPECT_DOUBLE_EQ(v.v_d_V, -1.234);
+  EXPECT_DOUBLE_EQ(v.v_q_V, 11.873);
+  EXPECT_TRUE(std::isnan(v.current_motor_A));  // not asked for
+  EXPECT_EQ(dec.counters().replies, 1U);
+  EXPECT_EQ(dec.counters().frames, 6U);
+
+  const core::AveragedSample s = to_averaged_sample(v, 1'000'000, 6'000'000);
+  EXPECT_EQ(s.t_start_ns, 1'000'000);
+  EXPECT_EQ(s.t_ns, 6'000'000);
+  EXPECT_DOUBLE_EQ(s.omega_el_rad_s, 21000.0 * 2.0 * std::numbers::pi / 60.0);  // ERPM → rad/s
+  EXPECT_DOUBLE_EQ(s.i_dq_A[1], 27.45);
+  EXPECT_DOUBLE_EQ(s.u_dq_V[0], -1.234);
+  EXPECT_DOUBLE_EQ(s.u_dc_V, 48.2);
+  EXPECT_DOUBLE_EQ(s.t_winding_C, 67.8);
+  EXPECT_DOUBLE_EQ(s.t_drive_C, 41.3);
+  EXPECT_TRUE(std::isnan(s.t_magnet_C));
+}
+
+TEST(Vesc, ShortReplyInOneFrame) {
+  // Mask bit 15 (fault code 3): a 6-byte reply, sent as PROCESS_SHORT_BUFFER [sender][commands_send][payload].
+  VescDecoder dec(kController, kOwn, bit(kFault));
+  EXPECT_EQ(dec.decode(ext(0x87D, {0x11, 0x01, 0x32, 0x00, 0x00, 0x80, 0x00, 0x03})), VescDecoder::Event::kValues);
+  EXPECT_EQ(dec.values().mask, 0x8000U);
+  EXPECT_EQ(dec.values().fault, 3);
+}
+
+TEST(Vesc, StatusBroadcasts) {
+  VescDecoder dec(kController, kOwn);
+  // STATUS (9): ERPM −1500, current 12.3 A, duty 0.456.
+  ASSERT_EQ(dec.decode(ext(0x911, {0xFF, 0xFF, 0xFA, 0x24, 0x00, 0x7B, 0x01, 0xC8})), VescDecoder::Event::kStatus);
+  EXPECT_EQ(dec.status().number, 1);
+  EXPECT_DOUBLE_EQ(dec.status().erpm, -1500.0);
+  EXPECT_DOUBLE_EQ(dec.status().current_A, 12.3);
+  EXPECT_DOUBLE_EQ(dec.status().duty, 0.456);
+  // STATUS_4 (16): T_fet 35.5 °C, T_motor 80.1 °C, input current 5.5 A, PID position 90°.
+  ASSERT_EQ(dec.decode(ext(0x1011, {0x01, 0x63, 0x03, 0x21, 0x00, 0x37, 0x11, 0x94})), VescDecoder::Event::kStatus);
+  EXPECT_EQ(dec.status().number, 4);
+  EXPECT_DOUBLE_EQ(dec.status().temp_fet_C, 35.5);
+  EXPECT_DOUBLE_EQ(dec.status().temp_motor_C, 80.1);
+  EXPECT_DOUBLE_EQ(dec.status().current_in_A, 5.5);
+  EXPECT_DOUBLE_EQ(dec.status().pid_pos_deg, 90.0);
+  // STATUS_5 (27): tachometer 123456, V_in 50.4 V, reserved.
+  ASSERT_EQ(dec.decode(ext(0x1B11, {0x00, 0x01, 0xE2, 0x40, 0x01, 0xF8, 0x00, 0x00})), VescDecoder::Event::kStatus);
+  EXPECT_EQ(dec.status().number, 5);
+  EXPECT_EQ(dec.status().tachometer, 123456);
+  EXPECT_DOUBLE_EQ(dec.status().v_in_V, 50.4);
+  // STATUS_2, _3, _6.
+  ASSERT_EQ(dec.decode(ext(0xE11, {0x00, 0x00, 0x30, 0x39, 0x00, 0x00, 0x00, 0x64})), VescDecoder::Event::kStatus);
+  EXPECT_DOUBLE_EQ(dec.status().amp_hours_Ah, 1.2345);
+  EXPECT_DOUBLE_EQ(dec.status().amp_hours_charged_Ah, 0.01);
+  ASSERT_EQ(dec.decode(ext(0xF11, {0x00, 0x01, 0x86, 0xA0, 0x00, 0x00, 0x00, 0x00})), VescDecoder::Event::kStatus);
+  EXPECT_DOUBLE_EQ(dec.status().watt_hours_Wh, 10.0);
+  ASSERT_EQ(dec.decode(ext(0x3A11, {0x0C, 0xE4, 0x00, 0x00, 0x00, 0x00, 0xFC, 0x18})), VescDecoder::Event::kStatus);
+  EXPECT_DOUBLE_EQ(dec.status().adc_V[0], 3.3);
+  EXPECT_DOUBLE_EQ(dec.status().adc_V[3], -1.0);
+  EXPECT_EQ(dec.counters().statuses, 6U);
+}
+
+TEST(VescBadInput, CrcErrorLengthMismatchAndLostFramesAreCountedAndDropped) {
+  VescDecoder dec(kController, kOwn);
+  auto frames = reply_frames();
+  frames[2].data[3] ^= 0x01;  // one bit of i_q
+  EXPECT_EQ(feed(dec, frames).back(), VescDecoder::Event::kNone);
+  EXPECT_EQ(dec.counters().crc_error, 1U);
+
+  frames = reply_frames();
+  frames.erase(frames.begin() + 2);  // a lost frame: the next fill is out of order
+  EXPECT_EQ(feed(dec, frames).back(), VescDecoder::Event::kNone);
+  EXPECT_EQ(dec.counters().out_of_order, 2U);     // offsets 21 and 28 do not continue the buffer
+  EXPECT_EQ(dec.counters().length_mismatch, 1U);  // the PROCESS frame finds an empty buffer
+
+  frames = reply_frames();
+  frames.erase(frames.begin() + 4);  // the last fill lost: 28 bytes against a stated 31
+  EXPECT_EQ(feed(dec, frames).back(), VescDecoder::Event::kNone);
+  EXPECT_EQ(dec.counters().length_mismatch, 2U);
+
+  // And the next complete reply decodes.
+  EXPECT_EQ(feed(dec, reply_frames()).back(), VescDecoder::Event::kValues);
+  EXPECT_EQ(dec.counters().replies, 1U);
+}
+
+TEST(VescBadInput, ForeignFramesAreCountedNotDecoded) {
+  VescDecoder dec(kController, kOwn);
+  CanFrame standard = reply_frames()[0];
+  standard.extended = false;  // a standard ID 0x57D is someone else's protocol
+  EXPECT_EQ(dec.decode(standard), VescDecoder::Event::kNone);
+  CanFrame to_other = reply_frames()[0];
+  to_other.id = 0x57E;  // a fill addressed to another poller
+  EXPECT_EQ(dec.decode(to_other), VescDecoder::Event::kNone);
+  auto frames = reply_frames();
+  frames.back().data[0] = 18;  // the reply of another controller
+  EXPECT_EQ(feed(dec, frames).back(), VescDecoder::Event::kNone);
+  EXPECT_EQ(dec.decode(ext(0x912, {0, 0, 0, 0, 0, 0, 0, 0})), VescDecoder::Event::kNone);  // status of VESC 18
+  EXPECT_EQ(dec.counters().foreign, 4U);
+  EXPECT_EQ(dec.decode(ext(0x17D, {0, 0, 0, 0})), VescDecoder::Event::kNone);  // SET_CURRENT: not read here
+  EXPECT_EQ(dec.decode(ext(0x1FFFFF7D, {0})), VescDecoder::Event::kNone);
+  EXPECT_EQ(dec.counters().unknown_packet, 2U);
+  CanFrame error;
+  error.error = true;
+  EXPECT_EQ(dec.decode(error), VescDecoder::Event::kNone);
+  EXPECT_EQ(dec.counters().error_frames, 1U);
+  EXPECT_EQ(dec.counters().replies + dec.counters().statuses, 0U);
+}
+
+/// A reply payload split as docs/can-vesc.md says (7 bytes per FILL_RX_BUFFER, then PROCESS_RX_BUFFER with
+/// length and CRC), to build the malformed replies below.
+std::vector<CanFrame> frames_of(const std::vector<std::uint8_t>& p) {
+  std::vector<CanFrame> out;
+  for (std::size_t i = 0; i < p.size(); i += 7) {
+    std::vector<std::uint8_t> d = {static_cast<std::uint8_t>(i)};
+    for (std::size_t k = i; k < std::min(p.size(), i + 7); ++k) d.push_back(p[k]);
+    out.push_back(ext(0x57D, d));
+  }
+  const std::uint16_t crc = crc16_ccitt_false(p.data(), p.size(), 0);
+  out.push_back(ext(0x77D, {kController, 1, static_cast<std::uint8_t>(p.size() >> 8), static_cast<std::uint8_t>(p.size()),
+                            static_cast<std::uint8_t>(crc >> 8), static_cast<std::uint8_t>(crc)}));
+  return out;
+}
+
+TEST(VescBadInput, ShortTrailingWrongMaskAndOtherCommandRepliesAreCounted) {
+  VescDecoder dec(kController, kOwn);
+  std::vector<std::uint8_t> good = {0x32, 0x00, 0x18, 0x01, 0xB3, 0x01, 0x9D, 0x02, 0xA6, 0xFF, 0xFF, 0xFE, 0xBF, 0x00, 0x00,
+                                    0x0A, 0xB9, 0x00, 0x00, 0x52, 0x08, 0x01, 0xE2, 0xFF, 0xFF, 0xFB, 0x2E, 0x00, 0x00, 0x2E, 0x61};
+  EXPECT_EQ(feed(dec, frames_of(good)).back(), VescDecoder::Event::kValues);
+  auto shorter = good;
+  shorter.pop_back();
+  EXPECT_EQ(feed(dec, frames_of(shorter)).back(), VescDecoder::Event::kNone);
+  auto longer = good;
+  longer.push_back(0);
+  EXPECT_EQ(feed(dec, frames_of(longer)).back(), VescDecoder::Event::kNone);
+  // Mask without v_q (bit 20) and 4 bytes fewer: well formed, but not what the estimator needs.
+  auto no_vq = good;
+  no_vq[2] = 0x08;
+  no_vq.resize(no_vq.size() - 4);
+  EXPECT_EQ(feed(dec, frames_of(no_vq)).back(), VescDecoder::Event::kNone);
+  auto other = good;
+  other[0] = 4;  // COMM_GET_VALUES
+  EXPECT_EQ(feed(dec, frames_of(other)).back(), VescDecoder::Event::kNone);
+  const VescCounters& c = dec.counters();
+  EXPECT_EQ(c.replies, 1U);
+  EXPECT_EQ(c.short_reply, 1U);
+  EXPECT_EQ(c.trailing, 1U);
+  EXPECT_EQ(c.wrong_mask, 1U);
+  EXPECT_EQ(c.not_values, 1U);
+  EXPECT_EQ(c.crc_error, 0U);
+}
+
+TEST(VescBadInput, TooShortFramesAndOverflow) {
+  VescDecoder dec(kController, kOwn);
+  EXPECT_EQ(dec.decode(ext(0x57D, {0x00})), VescDecoder::Event::kNone);              // fill without data
+  EXPECT_EQ(dec.decode(ext(0x77D, {0x11, 0x01, 0x00})), VescDecoder::Event::kNone);  // process too short
+  EXPECT_EQ(dec.decode(ext(0x87D, {0x11, 0x01})), VescDecoder::Event::kNone);        // short buffer without command
+  EXPECT_EQ(dec.decode(ext(0x911, {0x00, 0x00, 0x00})), VescDecoder::Event::kNone);  // status too short
+  EXPECT_EQ(dec.counters().wrong_length, 4U);
+  // FILL_RX_BUFFER_LONG continues a buffer at a 16-bit offset; past the decoder's buffer it overflows.
+  EXPECT_EQ(dec.decode(ext(0x57D, {0x00, 1, 2, 3, 4, 5, 6, 7})), VescDecoder::Event::kNone);
+  EXPECT_EQ(dec.decode(ext(0x67D, {0x00, 0x07, 8, 9})), VescDecoder::Event::kNone);
+  EXPECT_EQ(dec.counters().out_of_order, 0U);
+  EXPECT_EQ(dec.decode(ext(0x67D, {0x00, 0x09, 1, 2, 3, 4, 5, 6})), VescDecoder::Event::kNone);
+  EXPECT_EQ(dec.decode(ext(0x67D, {0x01, 0xFE, 1, 2, 3})), VescDecoder::Event::kNone);  // offset 510 ≠ fill
+  EXPECT_EQ(dec.counters().out_of_order, 1U);
+  // 6 bytes at offsets 0, 6, …: the one at 510 would end past the 512-byte buffer.
+  for (std::size_t offset = 0; offset <= 510; offset += 6) {
+    EXPECT_EQ(dec.decode(ext(0x67D, {static_cast<std::uint8_t>(offset >> 8), static_cast<std::uint8_t>(offset), 1, 2, 3, 4, 5, 6})),
+              VescDecoder::Event::kNone);
+  }
+  EXPECT_EQ(dec.counters().overflow, 1U);
+  EXPECT_EQ(dec.counters().out_of_order, 1U);
+}
+
+TEST(VescBadInput, TheNativeDecoderIgnoresExtendedFramesOnASharedBus) {
+  // A VESC frame whose low 11 bits equal a telemetry ID must not be read as telemetry.
+  TelemetryDecoder native;
+  std::array<core::DriveSample, 3> out;
+  CanFrame f = ext(protocol::kFdId | (9U << 11), {0, 0, 0, 0, 0, 0, 0, 0});
+  f.id = protocol::kFdId;
+  EXPECT_EQ(native.decode(f, out), 0U);
+  EXPECT_EQ(native.counters().unknown_id, 1U);
+  EXPECT_EQ(native.counters().wrong_dlc, 0U);
+}
+
+}  // namespace
+}  // namespace rpem::can::vesc
