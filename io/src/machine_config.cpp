@@ -1,10 +1,12 @@
 #include "rpem/io/machine_config.hpp"
 
+#include <cstdio>
 #include <limits>
 #include <sstream>
 #include <stdexcept>
 #include <tuple>
 
+#include "rpem/core/per_unit.hpp"
 #include "rpem/io/number_format.hpp"
 
 namespace rpem::io {
@@ -224,6 +226,23 @@ void check_log_supports(const MachineConfig& c, const std::string& config_name, 
                       "a dead time in seconds needs the DC-link voltage, and " + log_path +
                           " has no u_dc column (give the error as v_err_V instead)");
   }
+}
+
+DriveLogLimits machine_limits(const core::MachineSi& machine) {
+  const core::PerUnitBase base = core::PerUnitBase::from_rated(machine.rated);
+  DriveLogLimits limits;
+  auto narrow = [](Bound& bound, double base_value, const char* what, const char* unit) {
+    const double max_abs = kRatedMultipleLimit * base_value;
+    if (!(max_abs < bound.max_abs)) return;
+    char why[160];
+    std::snprintf(why, sizeof why, "%g x the configured machine's %s %.4g %s, machine.rated", kRatedMultipleLimit,
+                  what, base_value, unit);
+    bound = {max_abs, why};
+  };
+  narrow(limits.current_A, base.current_A, "rated peak phase current", "A");
+  narrow(limits.voltage_V, base.voltage_V, "rated peak phase voltage", "V");
+  narrow(limits.speed_rad_s, base.omega_el_rad_s, "rated electrical speed", "rad/s");
+  return limits;
 }
 
 std::string model_extensions_yaml(const MachineConfig& c) {

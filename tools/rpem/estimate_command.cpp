@@ -27,7 +27,7 @@ int run_estimate(const EstimateOptions& o) {
   io::MachineConfig cfg = o.config.empty() ? io::builtin_paper_config() : io::load_machine_config(o.config);
   if (!o.algorithm.empty()) cfg.estimator.algorithm = io::parse_algorithm(o.algorithm);
 
-  io::DriveLogReader reader(o.log);
+  io::DriveLogReader reader(o.log, io::machine_limits(cfg.machine));
   io::check_log_supports(cfg, o.config.empty() ? "builtin:paper-ipmsm" : o.config, reader.layout().u_dc, o.log);
   io::EstimateLogWriter writer(o.out);
   core::DriveEstimator estimator(cfg.machine, cfg.estimator);

@@ -5,6 +5,7 @@
 
 #include "rpem/core/conditioner.hpp"
 #include "rpem/core/frames.hpp"
+#include "rpem/io/machine_config.hpp"
 
 namespace rpem::analysis {
 namespace {
@@ -110,7 +111,7 @@ LogData prepare_log(std::vector<io::DriveLogRow> rows, const io::DriveLogLayout&
 }
 
 LogData load_log(const std::string& path, const core::MachineSi& machine, const LogOptions& options) {
-  io::DriveLogReader reader(path);
+  io::DriveLogReader reader(path, io::machine_limits(machine));
   std::vector<io::DriveLogRow> rows;
   io::DriveLogRow row;
   while (reader.next(row)) rows.push_back(row);
