@@ -1,5 +1,6 @@
 #include "rpem/io/drive_log.hpp"
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <cstdio>
@@ -11,18 +12,24 @@
 namespace rpem::io {
 namespace {
 
+bool blank(char c) { return c == ' ' || c == '\t' || c == '\r'; }
+
+/// Splits a row at commas into trimmed cells; the cells' strings are reused from row to row.
 void split(const std::string& line, std::vector<std::string>& cells) {
-  cells.clear();
+  std::size_t n = 0;
   std::size_t start = 0;
   while (true) {
     const std::size_t comma = line.find(',', start);
-    std::string cell = line.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
-    const auto first = cell.find_first_not_of(" \t\r");
-    const auto last = cell.find_last_not_of(" \t\r");
-    cells.push_back(first == std::string::npos ? std::string() : cell.substr(first, last - first + 1));
+    std::size_t first = start;
+    std::size_t last = comma == std::string::npos ? line.size() : comma;
+    while (first < last && blank(line[first])) ++first;
+    while (last > first && blank(line[last - 1])) --last;
+    if (n == cells.size()) cells.emplace_back();
+    cells[n++].assign(line, first, last - first);
     if (comma == std::string::npos) break;
     start = comma + 1;
   }
+  cells.resize(n);
 }
 
 /// A number for a message (six significant digits).
@@ -160,7 +167,7 @@ bool DriveLogReader::next(DriveLogRow& row) {
   while (std::getline(in_, text)) {
     ++line_;
     bytes_read_ += text.size() + 1;
-    if (text.find_first_not_of(" \t\r") == std::string::npos) continue;  // blank line
+    if (std::all_of(text.begin(), text.end(), blank)) continue;  // blank line
     split(text, cells_);
     if (cells_.size() != header_.size()) {
       fail("*", "row has " + std::to_string(cells_.size()) + " cells, header has " + std::to_string(header_.size()));

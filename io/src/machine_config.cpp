@@ -325,10 +325,14 @@ MachineConfig load_machine_config(const std::string& path) {
 }
 
 MachineConfig builtin_paper_config() {
-  YamlMap root = YamlMap::load_string(builtin_paper_config_text(), "<built-in paper-ipmsm.yaml>");
-  MachineConfig c = parse_machine_config(root);
-  root.finish();
-  return c;
+  // Parsed once: the text is compiled in (every simulated scenario starts from it).
+  static const MachineConfig parsed = [] {
+    YamlMap root = YamlMap::load_string(builtin_paper_config_text(), "<built-in paper-ipmsm.yaml>");
+    MachineConfig c = parse_machine_config(root);
+    root.finish();
+    return c;
+  }();
+  return parsed;
 }
 
 }  // namespace rpem::io

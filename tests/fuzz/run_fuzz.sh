@@ -1,19 +1,62 @@
 #!/usr/bin/env bash
-# Builds the decoder fuzzer with clang (libFuzzer + AddressSanitizer + UndefinedBehaviorSanitizer) and
-# runs it from the committed corpus for a time budget. ctest runs it short; docs/can-protocol.md records
-# a long run.   run_fuzz.sh BUILD_DIR [SECONDS]
+# Builds one libFuzzer target with clang (libFuzzer + AddressSanitizer + UndefinedBehaviorSanitizer, leak
+# detection on) and runs it from its committed seed corpus for a time budget (and any further libFuzzer
+# options, e.g. -runs=10000000). ctest runs each target for 60 s (label fuzz); docs/benchmarks.md
+# ("Fuzzing") records the long runs.
+#   run_fuzz.sh BUILD_DIR TARGET [SECONDS] [libFuzzer options...]
+# The targets, one row each: its entry point, what it links, its seed corpus (and dictionary corpus.dict).
 set -euo pipefail
 build=$(cd "$1" && pwd)
-seconds=${2:-30}
+target=$2
+seconds=${3:-30}
+shift $(($# < 3 ? $# : 3))
 repo=$(cd "$(dirname "$0")/../.." && pwd)
-out=$build/fuzz
-mkdir -p "$out/corpus"
-clang++ -std=c++20 -O1 -g -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=undefined \
-  -I "$repo/can/include" -I "$repo/core/include" -isystem /usr/include/eigen3 \
-  "$repo/can/fuzz/fuzz_decoder.cpp" "$repo/can/src/decoder.cpp" "$repo/can/src/e2e.cpp" \
-  -o "$out/fuzz_decoder"
-cp -n "$repo"/can/fuzz/corpus/* "$out/corpus/" 2>/dev/null || true
-cd "$out"
-"$out/fuzz_decoder" -max_total_time="$seconds" -print_final_stats=1 -artifact_prefix="$out/crash-" \
-  "$out/corpus" 2>&1 | tail -n 25
-echo "run_fuzz: no crash in ${seconds} s"
+
+core=("$repo"/core/src/*.cpp)
+io=("$repo"/io/src/*.cpp "$build/io/builtin_config.cpp")
+case $target in
+  fuzz_decoder)        main=can/fuzz/fuzz_decoder.cpp;        objs=("$repo/can/src/decoder.cpp" "$repo/can/src/e2e.cpp")
+                       corpus=can/fuzz/corpus ;;
+  fuzz_drive_log)      main=io/fuzz/fuzz_drive_log.cpp;       objs=("${io[@]}" "${core[@]}")
+                       corpus=io/fuzz/corpus/drive_log ;;
+  fuzz_machine_config) main=io/fuzz/fuzz_machine_config.cpp;  objs=("${io[@]}" "${core[@]}")
+                       corpus=io/fuzz/corpus/machine_config ;;
+  fuzz_scenario)       main=sim/fuzz/fuzz_scenario.cpp;       objs=("$repo"/sim/src/*.cpp "${io[@]}" "${core[@]}")
+                       corpus=sim/fuzz/corpus ;;
+  *) echo "run_fuzz: unknown target $target" >&2; exit 2 ;;
+esac
+[[ -f $build/io/builtin_config.cpp ]] || { echo "run_fuzz: configure $build first (it generates io/builtin_config.cpp)" >&2; exit 2; }
+
+# A small ninja build under BUILD_DIR/fuzz: each source compiles once (header dependencies tracked) and
+# the targets share the objects; a lock serialises builds when ctest runs targets in parallel.
+dir=$build/fuzz
+mkdir -p "$dir/$target/corpus"
+{
+  echo "cxx = clang++ -std=c++20 -O1 -g -fno-sanitize-recover=undefined -I$repo/can/include -I$repo/core/include" \
+       "-I$repo/io/include -I$repo/sim/include -isystem /usr/include/eigen3"
+  echo "rule cc"
+  echo "  command = \$cxx -fsanitize=fuzzer-no-link,address,undefined -MD -MF \$out.d -c \$in -o \$out"
+  echo "  depfile = \$out.d"
+  echo "  deps = gcc"
+  echo "rule link"
+  echo "  command = \$cxx -fsanitize=fuzzer,address,undefined \$in -lyaml-cpp -o \$out"
+  list=()
+  for src in "$repo/$main" "${objs[@]}"; do
+    rel=${src#"$repo"/}
+    rel=${rel#"$build"/}
+    obj=obj/${rel//\//_}.o
+    echo "build $obj: cc $src"
+    list+=("$obj")
+  done
+  echo "build $target/$target: link ${list[*]}"
+} >"$dir/$target.ninja"
+flock "$dir/.lock" ninja -C "$dir" -f "$target.ninja" "$target/$target" >"$dir/$target.build.log" 2>&1 ||
+  { cat "$dir/$target.build.log"; echo "run_fuzz: $target did not build" >&2; exit 1; }
+
+cp -n "$repo/$corpus"/* "$dir/$target/corpus/" 2>/dev/null || true
+dict=()
+[[ -f $repo/$corpus.dict ]] && dict=(-dict="$repo/$corpus.dict")
+cd "$dir/$target"
+"./$target" -max_total_time="$seconds" -print_final_stats=1 -artifact_prefix="$dir/$target/crash-" "${dict[@]}" "$@" \
+  corpus 2>&1 | tail -n 60
+echo "run_fuzz: $target: no crash, leak or UB report"
