@@ -19,12 +19,27 @@ TEST(PerUnit, PaperBaseMatchesHandComputation) {
   EXPECT_NEAR(b.torque_Nm, 32.6, 0.05);
 }
 
-TEST(PerUnit, PaperFluxInconsistencyIsTheVoltageBase) {
+TEST(PerUnit, EstimatorRunsOnTable1FluxAndSectionVIsPuBelongsToAnotherBase) {
+  // Erratum E4 (docs/derivations.md): tab_machineData's ψm = 1.14 Wb against Section VI's "0.895 pu".
+  // GIVEN the estimator's configuration as the code derives it from the name plate and tab_machineData
+  const EstimatorConfig c = test::paper_config();
   const PerUnitBase b = test::paper_base();
-  // 1.14 Wb in our (peak phase) base:
-  EXPECT_NEAR(b.flux_pu(1.14), 1.0966, 1e-4);
-  // Section VI's 0.895 pu is 1.14 Wb only against ψ_b = U_n/ω_n with U_n the line-to-line rms voltage.
-  EXPECT_NEAR(1.14 / (400.0 / (100.0 * kPi)), 0.895, 5e-4);
+  // THEN the model and the start it runs on hold 1.14 Wb in the peak-phase base: ψ_b = (√2·400/√3 V)/(100π rad/s)
+  // = 1.03960 Wb (hand-worked), so 1.0966 pu, not 0.895 pu.
+  EXPECT_NEAR(c.model.psi_m_pu, 1.14 / 1.03960, 1e-5);
+  EXPECT_NEAR(c.initial_theta_pu[kPsiM], 1.14 / 1.03960, 1e-5);
+  // The paper's 0.895 pu, read in the base the code uses, is 0.9304 Wb: 18.4 % below tab_machineData.
+  EXPECT_NEAR(b.flux_Wb_of(0.895), 0.895 * 1.03960, 1e-4);
+  EXPECT_NEAR(1.0 - b.flux_Wb_of(0.895) / 1.14, 0.184, 1e-3);
+  // It is 1.14 Wb only in the base the code builds when the peak-phase voltage base equals U_n = 400 V, i.e. for a
+  // name plate whose line-to-line rms voltage were 400·√3/√2 V: the line-to-line rms voltage taken as the base.
+  RatedData other = test::paper_machine_si().rated;
+  other.voltage_ll_rms_V = 400.0 * std::sqrt(3.0) / std::sqrt(2.0);
+  const PerUnitBase line_voltage_base = PerUnitBase::from_rated(other);
+  EXPECT_NEAR(line_voltage_base.voltage_V, 400.0, 1e-9);
+  EXPECT_NEAR(line_voltage_base.flux_pu(1.14), 0.895, 5e-4);
+  // That base cannot be the paper's: its torque base is no longer tab_machineData's 32.6 Nm.
+  EXPECT_GT(std::abs(line_voltage_base.torque_Nm - 32.6), 5.0);
 }
 
 TEST(PerUnit, ConversionsRoundTrip) {

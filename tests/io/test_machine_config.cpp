@@ -63,6 +63,16 @@ TEST(MachineConfig, PaperFileMatchesThePaperTables) {
   EXPECT_EQ(e.extensions.theta_offset_rad, 0.0);
 }
 
+TEST(MachineConfig, PaperFileStartsTheEstimatorAtTable1sFluxInPu) {
+  // Erratum E4: the shipped configuration keeps tab_machineData's 1.14 Wb, which the estimator runs on as
+  // 1.0966 pu (ψ_b = 1.03960 Wb, docs/per-unit.md), not Section VI's 0.895 pu.
+  const MachineConfig c = load_machine_config(test::source_dir() + "/config/paper-ipmsm.yaml");
+  const core::EstimatorConfig e =
+      core::make_estimator_config(core::PerUnitBase::from_rated(c.machine.rated), c.machine, c.estimator);
+  EXPECT_NEAR(e.model.psi_m_pu, 1.0966, 1e-4);
+  EXPECT_NEAR(e.initial_theta_pu[core::kPsiM], 1.0966, 1e-4);
+}
+
 TEST(MachineConfig, BuiltInConfigIsThePaperFile) {
   EXPECT_EQ(builtin_paper_config_text(), paper_text());
   const MachineConfig c = builtin_paper_config();
