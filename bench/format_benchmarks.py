@@ -15,6 +15,8 @@ def label(name):
         fidelity = "averaged" if parts.get("averaged") == "1" else "switching (1 µs plant)"
         est = "with estimator" if parts.get("estimator") == "1" else "without estimator"
         return f"simulator, {fidelity}, {est}"
+    if name.startswith("BM_Decode"):
+        return "CAN telemetry decode, " + ("classic" if parts.get("classic") == "1" else "FD")
     if name.startswith("BM_DiagnoseTwentySecondLog"):
         return "rpem diagnose, 20 s log at 8 kHz (read, diagnose, write report)"
     return name
@@ -40,7 +42,10 @@ def main(paths):
     for base, aggs in rows.items():
         med = aggs.get("median")
         mx = aggs.get("max")
-        if "x_real_time" in med:
+        if "samples_per_s" in med:
+            print(f"| {label(base)} | {med['samples_per_s'] / 1e6:.1f} M samples/s | "
+                  f"{aggs['min']['samples_per_s'] / 1e6 if 'min' in aggs else float('nan'):.1f} M samples/s (slowest) | one core |")
+        elif "x_real_time" in med:
             print(f"| {label(base)} | {med['x_real_time']:.0f}× real time | "
                   f"{aggs['min']['x_real_time'] if 'min' in aggs else med['x_real_time']:.0f}× (slowest) | wall {med['real_time']:.1f} ms per simulated s |")
         else:

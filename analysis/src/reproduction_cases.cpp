@@ -201,7 +201,7 @@ std::vector<ReproductionCase> paper_cases() {
                                   "performance differences marginal; speed ripple visible on the estimates"}}) {
     for (const bool hypothesis : {false, true}) {
       auto c = make(std::string("VI_rs_") + r.panel + (hypothesis ? "_gna_sga_settings" : ""),
-                    std::string("Fig_Labrs (") + r.panel + ")" + (hypothesis ? ", hypothesis: GNA with SGA's R_s settings" : ""),
+                    std::string("Fig_Labrs (") + r.panel + ")" + (hypothesis ? ", GNA with SGA's R_s settings" : ""),
                     r.description, rs, CaseKind::kStartWithError, r.n, 0.4, 1.0, bench(r.n, 0.4, 41.0));
       c.scenario.signal(sim::Quantity::kRs) = sim::Signal(0.92 * 2.25);
       if (hypothesis) {

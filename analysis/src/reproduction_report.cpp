@@ -52,6 +52,7 @@ void write_reproduce_json(const std::string& path, const std::vector<Reproductio
                                                                 : nlohmann::json(nullptr);
       j["steady_state_error_pct"] = run.metrics.steady_state_error_pct;
       j["overshoot_pct"] = run.metrics.overshoot_pct;
+      j["wrong_way_pct"] = run.metrics.wrong_way_pct;
       const auto& paper_t = c.paper.convergence_time_s[a];
       j["paper_convergence_time_s"] = paper_t ? nlohmann::json(*paper_t) : nlohmann::json(nullptr);
       out.push_back(j);
@@ -197,11 +198,13 @@ void write_comparison_markdown(const std::string& path, const std::vector<Reprod
   md << "Convergence time: from the step (Section V) or the start of adaptation (Section VI) until the estimate "
         "enters and stays within ±1 % of the true value; disturbance cases: until it is back in the band "
         "(0 = never left). Steady-state error: mean over the last second, % of the true value. Overshoot: largest "
-        "excursion past the true value, %.\n\n";
+        "excursion past the true value, %. Wrong way: largest move from the estimate at the step away from the true value, "
+        "% of the true value.\n\n";
   write_tab_comparison(md, cases, results);
   write_standstill_rs(md, cases, results);
   md << "## Every case\n\n";
-  md << "| Case | Role | Figure | n [pu] | τ [pu] | Param | SGA conv [s] / sse [%] / os [%] | GNA | PhyInt | Paper says |\n";
+  md << "| Case | Role | Figure | n [pu] | τ [pu] | Param | SGA conv [s] / sse [%] / os [%] / wrong way [%] | GNA | PhyInt | "
+        "Paper says |\n";
   md << "|---|---|---|---|---|---|---|---|---|---|\n";
   for (const ReproductionCase& c : cases) {
     const CaseResult& r = result_of(results, c.id);
@@ -209,7 +212,7 @@ void write_comparison_markdown(const std::string& path, const std::vector<Reprod
        << " | " << parameter_name(c.parameter);
     for (const AlgorithmRun& run : r.runs) {
       md << " | " << fmt(run.metrics.convergence_time_s) << " / " << fmt(run.metrics.steady_state_error_pct) << " / "
-         << fmt(run.metrics.overshoot_pct);
+         << fmt(run.metrics.overshoot_pct) << " / " << fmt(run.metrics.wrong_way_pct);
     }
     md << " | " << c.paper.qualitative << " |\n";
   }

@@ -24,6 +24,7 @@ struct Golden {
   std::optional<double> convergence_time_s;
   double steady_state_error_pct;
   double overshoot_pct;
+  double wrong_way_pct;
 };
 
 std::map<std::string, Golden> load_golden() {
@@ -37,6 +38,7 @@ std::map<std::string, Golden> load_golden() {
     if (!e["convergence_time_s"].is_null()) v.convergence_time_s = e["convergence_time_s"].get<double>();
     v.steady_state_error_pct = e["steady_state_error_pct"].get<double>();
     v.overshoot_pct = e["overshoot_pct"].get<double>();
+    v.wrong_way_pct = e["wrong_way_pct"].get<double>();
     g[e["case"].get<std::string>() + "/" + e["algorithm"].get<std::string>()] = v;
   }
   return g;
@@ -93,6 +95,7 @@ TEST_F(Reproduction, MatchesTheGoldenResultsWithinTwoSidedBounds) {
       EXPECT_NEAR(r.metrics.steady_state_error_pct, g.steady_state_error_pct,
                   std::max(0.1, 0.1 * std::abs(g.steady_state_error_pct)));
       EXPECT_NEAR(r.metrics.overshoot_pct, g.overshoot_pct, std::max(0.3, 0.2 * g.overshoot_pct));
+      EXPECT_NEAR(r.metrics.wrong_way_pct, g.wrong_way_pct, std::max(0.3, 0.2 * g.wrong_way_pct));
     }
   }
 }

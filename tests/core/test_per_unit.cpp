@@ -3,6 +3,7 @@
 
 #include <cmath>
 
+#include "rpem/core/machine.hpp"
 #include "rpem/core/per_unit.hpp"
 #include "support/paper_machine.hpp"
 
@@ -38,8 +39,20 @@ TEST(PerUnit, EstimatorRunsOnTable1FluxAndSectionVIsPuBelongsToAnotherBase) {
   const PerUnitBase line_voltage_base = PerUnitBase::from_rated(other);
   EXPECT_NEAR(line_voltage_base.voltage_V, 400.0, 1e-9);
   EXPECT_NEAR(line_voltage_base.flux_pu(1.14), 0.895, 5e-4);
-  // That base cannot be the paper's: its torque base is no longer tab_machineData's 32.6 Nm.
-  EXPECT_GT(std::abs(line_voltage_base.torque_Nm - 32.6), 5.0);
+  EXPECT_NEAR(line_voltage_base.flux_Wb, 1.2732, 1e-4);
+  // That base cannot be the paper's: its torque base is 39.9 Nm, not tab_machineData's 32.6 Nm.
+  EXPECT_NEAR(line_voltage_base.torque_Nm, 39.94, 0.01);
+}
+
+TEST(PerUnit, BenchVoltageAtPointThreePuJustFitsThe220VLink) {
+  // docs/per-unit.md: with ψm = 1.14 Wb, 0.3 pu at 0.4 pu load under MTPA needs |u| = 0.362 pu, and the 220 V
+  // link's linear range is u_dc/√3 = 127 V = 0.389 pu: why Section VI stays at 0.3 pu.
+  const MachinePu m = test::paper_machine_pu();
+  const double u = steady_state_voltage(m, 0.3, mtpa_reference(m, 0.4)).norm();
+  const double available = 220.0 / std::sqrt(3.0) / test::paper_base().voltage_V;
+  EXPECT_NEAR(available, 0.389, 5e-4);
+  EXPECT_NEAR(u, 0.362, 0.001);
+  EXPECT_LT(u, available);
 }
 
 TEST(PerUnit, ConversionsRoundTrip) {

@@ -41,7 +41,7 @@ TEST(CliReproduce, WritesThePlotsTheTableAndReproduceJson) {
   std::map<std::string, int> per_algorithm;
   for (const auto& e : j) {
     for (const char* key : {"case", "role", "algorithm", "parameter", "n_pu", "tau_pu", "convergence_time_s",
-                            "steady_state_error_pct", "overshoot_pct"}) {
+                            "steady_state_error_pct", "overshoot_pct", "wrong_way_pct"}) {
       ASSERT_TRUE(e.contains(key)) << key << " in " << e.dump();
     }
     const std::string algorithm = e["algorithm"].get<std::string>();
