@@ -1,5 +1,6 @@
 #include "rpem/analysis/reproduction_report.hpp"
 
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -96,18 +97,20 @@ void write_tab_comparison(std::ostringstream& md, const std::vector<Reproduction
     if (!c.paper.convergence_time_s[0]) continue;
     const CaseResult& r = result_of(results, c.id);
     const std::string name = role_prefix(c.role) + c.figure + ": " + c.description;
-    md << "| " << name << ", convergence [s] | " << fmt(c.paper.convergence_time_s[0], 1) << " | "
-       << fmt(r.runs[0].metrics.convergence_time_s) << " | "
-       << ratio(r.runs[0].metrics.convergence_time_s, c.paper.convergence_time_s[0]) << " | "
-       << fmt(c.paper.convergence_time_s[1], 1) << " | " << fmt(r.runs[1].metrics.convergence_time_s) << " | "
-       << ratio(r.runs[1].metrics.convergence_time_s, c.paper.convergence_time_s[1]) << " | "
-       << fmt(r.runs[2].metrics.convergence_time_s) << " |\n";
-    md << "| " << name << ", steady-state error [%] | " << fmt(c.paper.steady_state_error_pct[0], 1) << " | "
-       << fmt(r.runs[0].metrics.steady_state_error_pct) << " | "
-       << ratio(r.runs[0].metrics.steady_state_error_pct, c.paper.steady_state_error_pct[0]) << " | "
-       << fmt(c.paper.steady_state_error_pct[1], 1) << " | " << fmt(r.runs[1].metrics.steady_state_error_pct) << " | "
-       << ratio(r.runs[1].metrics.steady_state_error_pct, c.paper.steady_state_error_pct[1]) << " | "
-       << fmt(r.runs[2].metrics.steady_state_error_pct) << " |\n";
+    // One row per figure: the paper's and ours for SGA and GNA with their ratio, ours for PhyInt.
+    using Figures = std::array<std::optional<double>, 3>;
+    auto row = [&](const char* what, const Figures& paper, const Figures& ours) {
+      md << "| " << name << ", " << what;
+      for (std::size_t a = 0; a < 2; ++a) md << " | " << fmt(paper[a], 1) << " | " << fmt(ours[a]) << " | " << ratio(ours[a], paper[a]);
+      md << " | " << fmt(ours[2]) << " |\n";
+    };
+    Figures times, errors;
+    for (std::size_t a = 0; a < 3; ++a) {
+      times[a] = r.runs[a].metrics.convergence_time_s;
+      errors[a] = r.runs[a].metrics.steady_state_error_pct;
+    }
+    row("convergence [s]", c.paper.convergence_time_s, times);
+    row("steady-state error [%]", c.paper.steady_state_error_pct, errors);
     if (c.role != CaseRole::kPaper) continue;
     for (std::size_t a = 0; a < 2; ++a) {
       for (const auto& [ours, paper, what] :

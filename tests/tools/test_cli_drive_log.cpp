@@ -5,6 +5,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <ostream>
 #include <string>
 
 #include "support/process.hpp"
@@ -23,10 +24,12 @@ struct Tool {
   std::string command;
 };
 
+void PrintTo(const Tool& t, std::ostream* os) { *os << t.name; }
+
 class EveryToolReadingADriveLog : public ::testing::TestWithParam<Tool> {
  protected:
   void SetUp() override {
-    dir_ = fs::temp_directory_path() / ("rpem_cli_drive_log_" + std::string(GetParam().name));
+    dir_ = test::temp_path(std::string("cli_drive_log_") + GetParam().name);
     fs::remove_all(dir_);
     fs::create_directories(dir_);
   }
@@ -67,7 +70,7 @@ INSTANTIATE_TEST_SUITE_P(Tools, EveryToolReadingADriveLog,
 TEST(CliDriveLog, ToolsThatKnowTheMachineHoldCurrentsToTenTimesItsRating) {
   // The built-in paper machine: 10·I_b = 10·√2·4.93 A = 69.7 A; 100 A is refused by the tools that know
   // the machine (estimate, diagnose) and passed on by replay, which does not.
-  const fs::path dir = fs::temp_directory_path() / "rpem_cli_drive_log_machine";
+  const fs::path dir = test::temp_path("cli_drive_log_machine");
   fs::create_directories(dir);
   const std::string log = (dir / "amps.csv").string();
   std::ofstream(log) << kHeader << "0,0,0,220,1,2,3,0,100,-100\n";

@@ -17,7 +17,7 @@ namespace {
 namespace fs = std::filesystem;
 
 TEST(CliReproduce, WritesThePlotsTheTableAndReproduceJson) {
-  const fs::path dir = fs::temp_directory_path() / "rpem_cli_reproduce";
+  const fs::path dir = test::temp_path("cli_reproduce");
   fs::remove_all(dir);
   const test::ProcessResult r = test::run_command(test::binary_dir() + "/tools/rpem reproduce --out " + dir.string());
   ASSERT_EQ(r.exit_code, 0) << r.output;
