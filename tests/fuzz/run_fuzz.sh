@@ -50,7 +50,7 @@ mkdir -p "$dir/$target/corpus"
   done
   echo "build $target/$target: link ${list[*]}"
 } >"$dir/$target.ninja"
-flock "$dir/.lock" ninja -C "$dir" -f "$target.ninja" "$target/$target" >"$dir/$target.build.log" 2>&1 ||
+flock "$dir/.lock" ninja -j "$(nproc)" -C "$dir" -f "$target.ninja" "$target/$target" >"$dir/$target.build.log" 2>&1 ||
   { cat "$dir/$target.build.log"; echo "run_fuzz: $target did not build" >&2; exit 1; }
 
 cp -n "$repo/$corpus"/* "$dir/$target/corpus/" 2>/dev/null || true
