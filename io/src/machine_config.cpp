@@ -83,6 +83,17 @@ core::EstimatorSettings parse_estimator(YamlMap e, const core::MachineSi& machin
     s.initial_r_s_Ohm = init->number_or("r_s_Ohm", machine.r_s_Ohm, s.r_s_min_Ohm, s.r_s_max_Ohm);
     init->finish();
   }
+  // A start that estimator.initial does not set is the machine's offline value, which D_M must then hold
+  // too: the estimator would otherwise move it onto the bound without a word.
+  for (const auto& [start, lo, hi, key] : {std::tuple{s.initial_psi_m_Wb, s.psi_m_min_Wb, s.psi_m_max_Wb, "psi_m_Wb"},
+                                           std::tuple{s.initial_r_s_Ohm, s.r_s_min_Ohm, s.r_s_max_Ohm, "r_s_Ohm"}}) {
+    if (start < lo || start > hi) {
+      std::ostringstream why;
+      why << "excludes the estimator's start, machine." << key << " = " << start << " (set estimator.initial." << key
+          << " or widen the bounds)";
+      bounds.fail(key, why.str());
+    }
+  }
 
   YamlMap sched = e.map("scheduler");
   s.psi_m_min_speed_rpm = sched.number("psi_m_min_speed_rpm", 0.0, 1e6);

@@ -107,6 +107,13 @@ INSTANTIATE_TEST_SUITE_P(
         BadEdit{"fractional_pole_pairs", "pole_pairs: 3", "pole_pairs: 3.5", "'3.5' is not an integer"},
         BadEdit{"reversed_bounds", "psi_m_Wb: \\[0.57, 1.71\\]", "psi_m_Wb: [1.71, 0.57]", "min < max"},
         BadEdit{"initial_outside_bounds", "initial: \\{psi_m_Wb: 1.14", "initial: {psi_m_Wb: 2.0", "estimator.initial.psi_m_Wb: 2.0 is outside [0.57, 1.71]"},
+        // Found by fuzz_machine_config: without estimator.initial the start is the machine's value, which D_M must hold.
+        BadEdit{"default_start_outside_bounds",
+                "  initial: \\{psi_m_Wb: 1.14, r_s_Ohm: 2.25\\}\n(.*\n    psi_m_Wb: )\\[0.57", "$1[1.57",
+                "estimator.bounds.psi_m_Wb: excludes the estimator's start, machine.psi_m_Wb = 1.14"},
+        BadEdit{"partial_initial_default_outside_bounds",
+                "initial: \\{psi_m_Wb: 1.14, r_s_Ohm: 2.25\\}(\n.*\n.*\n    r_s_Ohm: )\\[1.0", "initial: {psi_m_Wb: 1.14}$1[2.5",
+                "estimator.bounds.r_s_Ohm: excludes the estimator's start, machine.r_s_Ohm = 2.25"},
         BadEdit{"scheduler_order", "r_s_max_speed_rpm: 10 ", "r_s_max_speed_rpm: 200 ", "must not exceed psi_m_min_speed_rpm"},
         BadEdit{"indefinite_hessian", "gna_pu: \\[1.0, 0.0, 1.0\\]", "gna_pu: [1.0, 2.0, 1.0]", "positive semi-definite"},
         BadEdit{"wrong_length", "sga_pu: \\[100.0, 100.0\\]", "sga_pu: [1.0]", "expected 2 numbers, got 1"},
