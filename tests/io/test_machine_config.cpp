@@ -114,6 +114,9 @@ INSTANTIATE_TEST_SUITE_P(
         BadEdit{"partial_initial_default_outside_bounds",
                 "initial: \\{psi_m_Wb: 1.14, r_s_Ohm: 2.25\\}(\n.*\n.*\n    r_s_Ohm: )\\[1.0", "initial: {psi_m_Wb: 1.14}$1[2.5",
                 "estimator.bounds.r_s_Ohm: excludes the estimator's start, machine.r_s_Ohm = 2.25"},
+        // Found by fuzz_machine_config: a complex key escaped the reader as a yaml-cpp exception.
+        BadEdit{"complex_key", "\n  sample_period_s:", "\n  ? [a, b]\n  : 1\n  sample_period_s:",
+                "estimator: a key must be a name, not a list or mapping"},
         BadEdit{"scheduler_order", "r_s_max_speed_rpm: 10 ", "r_s_max_speed_rpm: 200 ", "must not exceed psi_m_min_speed_rpm"},
         BadEdit{"indefinite_hessian", "gna_pu: \\[1.0, 0.0, 1.0\\]", "gna_pu: [1.0, 2.0, 1.0]", "positive semi-definite"},
         BadEdit{"wrong_length", "sga_pu: \\[100.0, 100.0\\]", "sga_pu: [1.0]", "expected 2 numbers, got 1"},
