@@ -38,6 +38,11 @@ struct ThermalCoupling {
   double psi_m_coeff_per_K = -0.0012;
 };
 
+/// How the plant is integrated at switching fidelity (docs/scenarios.md, `plant.integrator`): from one
+/// switching instant to the next (EdgeIntegrator), or in fixed steps of Heun's method with the
+/// inverter's mean voltage over each step. Averaged fidelity always takes fixed steps.
+enum class PlantIntegrator { kEdges, kFixedStep };
+
 struct LogOptions {
   bool dq_columns = false;
   bool temperatures = false;
@@ -54,7 +59,9 @@ struct Scenario {
   std::uint64_t seed = 1;
   InverterConfig inverter;
   double inverter_delay_s = 0.0;      ///< the command acts this much late, < one period (hidden effect)
-  double plant_step_s = 1e-6;
+  PlantIntegrator integrator = PlantIntegrator::kEdges;  ///< switching fidelity only
+  double plant_step_s = 1e-6;         ///< the fixed-step integrator's step
+  double plant_tolerance = 1e-9;      ///< edges with a flux map: relative local error per step
   std::string flux_map_file;          ///< empty: constant inductances
   MechanicsConfig mechanics;
   FocConfig control;
@@ -76,7 +83,8 @@ struct Scenario {
 [[nodiscard]] Scenario parse_scenario(const std::string& text, const std::string& name, const std::string& base_dir);
 
 /// A scenario with the defaults of the paper's setup (tab_machineData): built-in machine, switching
-/// inverter at 4 kHz with 3rd-harmonic injection, 1 µs plant, 125 µs control, dynamometer, torque mode.
+/// inverter at 4 kHz with 3rd-harmonic injection, edge-to-edge plant, 125 µs control, dynamometer,
+/// torque mode.
 [[nodiscard]] Scenario paper_scenario();
 
 }  // namespace rpem::sim
