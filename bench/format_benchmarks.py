@@ -16,6 +16,8 @@ def label(name):
         fidelity = FIDELITIES[parts["fidelity"]]
         est = "with estimator" if parts.get("estimator") == "1" else "without estimator"
         return f"simulator, {fidelity}, {est}"
+    if name.startswith("BM_Decode"):
+        return "CAN telemetry decode, " + ("classic" if parts.get("classic") == "1" else "FD")
     if name.startswith("BM_SwitchingOverAveraged"):
         return "simulator, switching (edge to edge) over averaged, with estimator, same run"
     if name.startswith("BM_StepOverKernel"):
@@ -47,7 +49,10 @@ def main(paths):
     for base, aggs in rows.items():
         med = aggs.get("median")
         mx = aggs.get("max")
-        if "ratio" in med:
+        if "samples_per_s" in med:
+            print(f"| {label(base)} | {med['samples_per_s'] / 1e6:.1f} M samples/s | "
+                  f"{aggs['min']['samples_per_s'] / 1e6 if 'min' in aggs else float('nan'):.1f} M samples/s (slowest) | one core |")
+        elif "ratio" in med:
             worst = mx["ratio"] if mx else float("nan")
             parts = ", ".join(f"{k} {med[k]:.3g}" for k in ("switching_x_real_time", "averaged_x_real_time",
                                                               "kernel_ns", "step_ns") if k in med)

@@ -20,9 +20,11 @@ ConvergenceMetrics convergence_metrics(const std::vector<TrajectoryPoint>& tr, c
 
   // Direction of approach: the sign of the error at the step.
   double initial_error = 0.0;
+  double start_estimate = 0.0;
   for (const TrajectoryPoint& p : tr) {
     if (p.t_s >= o.step_time_s) {
       initial_error = p.estimate - p.truth;
+      start_estimate = p.estimate;
       break;
     }
   }
@@ -36,6 +38,7 @@ ConvergenceMetrics convergence_metrics(const std::vector<TrajectoryPoint>& tr, c
     const double rel = (p.estimate - p.truth) / p.truth;
     if (std::abs(rel) > o.band) last_outside = p.t_s;
     m.overshoot_pct = std::max(m.overshoot_pct, 100.0 * approach * rel);
+    m.wrong_way_pct = std::max(m.wrong_way_pct, -100.0 * approach * (p.estimate - start_estimate) / p.truth);
     if (p.t_s >= t_end - o.final_window_s) {
       sum += rel;
       ++count;

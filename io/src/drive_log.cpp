@@ -1,7 +1,9 @@
 #include "rpem/io/drive_log.hpp"
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 
 #include "rpem/core/frames.hpp"
@@ -10,28 +12,51 @@
 namespace rpem::io {
 namespace {
 
+bool blank(char c) { return c == ' ' || c == '\t' || c == '\r'; }
+
+/// Splits a row at commas into trimmed cells; the cells' strings are reused from row to row.
 void split(const std::string& line, std::vector<std::string>& cells) {
-  cells.clear();
+  std::size_t n = 0;
   std::size_t start = 0;
   while (true) {
     const std::size_t comma = line.find(',', start);
-    std::string cell = line.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
-    const auto first = cell.find_first_not_of(" \t\r");
-    const auto last = cell.find_last_not_of(" \t\r");
-    cells.push_back(first == std::string::npos ? std::string() : cell.substr(first, last - first + 1));
+    std::size_t first = start;
+    std::size_t last = comma == std::string::npos ? line.size() : comma;
+    while (first < last && blank(line[first])) ++first;
+    while (last > first && blank(line[last - 1])) --last;
+    if (n == cells.size()) cells.emplace_back();
+    cells[n++].assign(line, first, last - first);
     if (comma == std::string::npos) break;
     start = comma + 1;
   }
+  cells.resize(n);
+}
+
+/// A number for a message (six significant digits).
+std::string g6(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.6g", v);
+  return buf;
 }
 
 }  // namespace
 
-DriveLogReader::DriveLogReader(const std::string& path) : path_(path), in_(path, std::ios::binary) {
-  if (!in_) throw DriveLogError(path, 0, 0, "", "cannot open file");
+DriveLogReader::DriveLogReader(const std::string& path, DriveLogLimits limits)
+    : path_(path), file_(path, std::ios::binary), in_(file_), limits_(std::move(limits)) {
+  if (!file_) throw DriveLogError(path, 0, 0, "", "cannot open file");
   std::error_code ec;
   bytes_total_ = std::filesystem::file_size(path, ec);
+  read_header();
+}
+
+DriveLogReader::DriveLogReader(std::istream& in, std::string name, DriveLogLimits limits)
+    : path_(std::move(name)), in_(in), limits_(std::move(limits)) {
+  read_header();
+}
+
+void DriveLogReader::read_header() {
   std::string header_line;
-  if (!std::getline(in_, header_line)) throw DriveLogError(path, 1, 0, "", "empty file: expected a header row");
+  if (!std::getline(in_, header_line)) throw DriveLogError(path_, 1, 0, "", "empty file: expected a header row");
   line_ = 1;
   bytes_read_ = header_line.size() + 1;
   split(header_line, header_);
@@ -93,15 +118,47 @@ void DriveLogReader::fail(const std::string& column, const std::string& reason) 
   throw DriveLogError(path_, line_, 0, "column " + column, reason);
 }
 
+void DriveLogReader::fail(const Column& c, const char* name, const std::string& reason) const {
+  throw DriveLogError(path_, line_, static_cast<std::size_t>(c.index) + 1, std::string("column ") + name, reason);
+}
+
 double DriveLogReader::cell(const Column& c, const char* name) const {
   if (static_cast<std::size_t>(c.index) >= cells_.size()) fail(name, "row has too few cells");
   const std::string& s = cells_[static_cast<std::size_t>(c.index)];
-  if (s.empty()) fail(name, "empty cell");
+  if (s.empty()) fail(c, name, "empty cell");
   double v = 0.0;
   const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
-  if (ec != std::errc() || end != s.data() + s.size()) fail(name, "'" + s + "' is not a number");
-  if (std::isnan(v)) fail(name, "NaN");
-  if (!std::isfinite(v)) fail(name, "'" + s + "' is not finite");
+  if (ec != std::errc() || end != s.data() + s.size()) fail(c, name, "'" + s + "' is not a number");
+  if (std::isnan(v)) fail(c, name, "NaN");
+  if (!std::isfinite(v)) fail(c, name, "'" + s + "' is not finite");
+  return v;
+}
+
+double DriveLogReader::cell(const Column& c, const char* name, const Bound& bound, const char* unit) const {
+  const double v = cell(c, name);
+  if (std::abs(v) > bound.max_abs) {
+    fail(c, name, g6(v) + " " + unit + " is beyond the plausible ±" + g6(bound.max_abs) + " " +
+                      unit + " (" + bound.why + ")");
+  }
+  return v;
+}
+
+double DriveLogReader::temperature(const Column& c, const char* name) const {
+  const double v = cell(c, name);
+  if (v < limits_.temperature_min_C || v > limits_.temperature_max_C) {
+    fail(c, name, g6(v) + " °C is outside the plausible [" + g6(limits_.temperature_min_C) + ", " +
+                      g6(limits_.temperature_max_C) + "] °C");
+  }
+  return v;
+}
+
+double DriveLogReader::command(const Column& c, const char* name, double u_dc_V) const {
+  const double v = cell(c, name, limits_.voltage_V, "V");
+  if (u_dc_V >= 1.0 && std::abs(v) > limits_.command_per_dc_link * u_dc_V) {
+    fail(c, name, g6(v) + " V is more than " + g6(limits_.command_per_dc_link) +
+                      " x this row's u_dc = " + g6(u_dc_V) +
+                      " V (a two-level inverter applies at most u_dc/2 from the link's midpoint)");
+  }
   return v;
 }
 
@@ -110,46 +167,51 @@ bool DriveLogReader::next(DriveLogRow& row) {
   while (std::getline(in_, text)) {
     ++line_;
     bytes_read_ += text.size() + 1;
-    if (text.find_first_not_of(" \t\r") == std::string::npos) continue;  // blank line
+    if (std::all_of(text.begin(), text.end(), blank)) continue;  // blank line
     split(text, cells_);
     if (cells_.size() != header_.size()) {
       fail("*", "row has " + std::to_string(cells_.size()) + " cells, header has " + std::to_string(header_.size()));
     }
     core::DriveSample& s = row.sample;
-    const double t_s = cell(t_, "t");
-    if (previous_t_s_ && !(t_s > *previous_t_s_)) fail("t", "time does not increase");
-    previous_t_s_ = t_s;
-    s.t_ns = std::llround(t_s * 1e9);
-    s.theta_el_rad = theta_.present() ? cell(theta_, "theta_el") : 0.0;
-    s.omega_el_rad_s = cell(omega_, "omega_el");
-    s.u_dc_V = udc_.present() ? cell(udc_, "u_dc") : 0.0;
+    const std::int64_t t_ns = std::llround(cell(t_, "t", limits_.time_s, "s") * 1e9);
+    if (previous_t_ns_ && t_ns <= *previous_t_ns_) fail(t_, "t", "time does not increase (by at least 1 ns)");
+    previous_t_ns_ = t_ns;
+    s.t_ns = t_ns;
+    s.theta_el_rad = theta_.present() ? cell(theta_, "theta_el", limits_.angle_rad, "rad") : 0.0;
+    s.omega_el_rad_s = cell(omega_, "omega_el", limits_.speed_rad_s, "rad/s");
+    s.u_dc_V = udc_.present() ? cell(udc_, "u_dc", limits_.voltage_V, "V") : 0.0;
     s.gap_before = false;
+    const double u_dc = s.u_dc_V;
     if (layout_.voltage_abc) {
       s.voltage_frame = core::Frame::kAbc;
-      s.u_V = {cell(ua_, "u_a"), cell(ub_, "u_b"), cell(uc_, "u_c")};
-      if (layout_.voltage_dq) (void)cell(ud_, "u_d"), (void)cell(uq_, "u_q");  // validate all present cells
+      s.u_V = {command(ua_, "u_a", u_dc), command(ub_, "u_b", u_dc), command(uc_, "u_c", u_dc)};
+      if (layout_.voltage_dq) (void)command(ud_, "u_d", u_dc), (void)command(uq_, "u_q", u_dc);  // validate all cells
     } else {
       s.voltage_frame = core::Frame::kDq;
-      s.u_V = {cell(ud_, "u_d"), cell(uq_, "u_q"), 0.0};
+      s.u_V = {command(ud_, "u_d", u_dc), command(uq_, "u_q", u_dc), 0.0};
     }
+    const Bound& i_max = limits_.current_A;
     if (layout_.current_abc) {
       s.current_frame = core::Frame::kAbc;
-      s.i_A = {cell(ia_, "i_a"), cell(ib_, "i_b"), cell(ic_, "i_c")};
-      if (layout_.current_dq) (void)cell(id_, "i_d"), (void)cell(iq_, "i_q");
+      s.i_A = {cell(ia_, "i_a", i_max, "A"), cell(ib_, "i_b", i_max, "A"), cell(ic_, "i_c", i_max, "A")};
+      if (layout_.current_dq) (void)cell(id_, "i_d", i_max, "A"), (void)cell(iq_, "i_q", i_max, "A");
     } else {
       s.current_frame = core::Frame::kDq;
-      s.i_A = {cell(id_, "i_d"), cell(iq_, "i_q"), 0.0};
+      s.i_A = {cell(id_, "i_d", i_max, "A"), cell(iq_, "i_q", i_max, "A"), 0.0};
     }
-    row.t_winding_C = layout_.t_winding ? std::optional(cell(tw_, "T_winding")) : std::nullopt;
-    row.t_magnet_C = layout_.t_magnet ? std::optional(cell(tm_, "T_magnet")) : std::nullopt;
-    row.torque_cmd_Nm = layout_.torque_cmd ? std::optional(cell(tq_, "torque_cmd")) : std::nullopt;
+    row.t_winding_C = layout_.t_winding ? std::optional(temperature(tw_, "T_winding")) : std::nullopt;
+    row.t_magnet_C = layout_.t_magnet ? std::optional(temperature(tm_, "T_magnet")) : std::nullopt;
+    row.torque_cmd_Nm =
+        layout_.torque_cmd ? std::optional(cell(tq_, "torque_cmd", limits_.torque_Nm, "Nm")) : std::nullopt;
+    ++rows_;
     return true;
   }
+  if (rows_ == 0) throw DriveLogError(path_, line_, 0, "", "no samples: the header is followed by no data rows");
   return false;
 }
 
-std::vector<DriveLogRow> read_drive_log(const std::string& path) {
-  DriveLogReader reader(path);
+std::vector<DriveLogRow> read_drive_log(const std::string& path, const DriveLogLimits& limits) {
+  DriveLogReader reader(path, limits);
   std::vector<DriveLogRow> rows;
   DriveLogRow row;
   while (reader.next(row)) rows.push_back(row);

@@ -1,11 +1,13 @@
 #include "rpem/io/machine_config.hpp"
 
 #include <array>
+#include <cstdio>
 #include <limits>
 #include <sstream>
 #include <stdexcept>
 #include <tuple>
 
+#include "rpem/core/per_unit.hpp"
 #include "rpem/io/number_format.hpp"
 
 namespace rpem::io {
@@ -81,6 +83,17 @@ core::EstimatorSettings parse_estimator(YamlMap e, const core::MachineSi& machin
     s.initial_psi_m_Wb = init->number_or("psi_m_Wb", machine.psi_m_Wb, s.psi_m_min_Wb, s.psi_m_max_Wb);
     s.initial_r_s_Ohm = init->number_or("r_s_Ohm", machine.r_s_Ohm, s.r_s_min_Ohm, s.r_s_max_Ohm);
     init->finish();
+  }
+  // A start that estimator.initial does not set is the machine's offline value, which D_M must then hold
+  // too: the estimator would otherwise move it onto the bound without a word.
+  for (const auto& [start, lo, hi, key] : {std::tuple{s.initial_psi_m_Wb, s.psi_m_min_Wb, s.psi_m_max_Wb, "psi_m_Wb"},
+                                           std::tuple{s.initial_r_s_Ohm, s.r_s_min_Ohm, s.r_s_max_Ohm, "r_s_Ohm"}}) {
+    if (start < lo || start > hi) {
+      std::ostringstream why;
+      why << "excludes the estimator's start, machine." << key << " = " << start << " (set estimator.initial." << key
+          << " or widen the bounds)";
+      bounds.fail(key, why.str());
+    }
   }
 
   YamlMap sched = e.map("scheduler");
@@ -274,6 +287,23 @@ void check_log_supports(const MachineConfig& c, const std::string& config_name, 
   }
 }
 
+DriveLogLimits machine_limits(const core::MachineSi& machine) {
+  const core::PerUnitBase base = core::PerUnitBase::from_rated(machine.rated);
+  DriveLogLimits limits;
+  auto narrow = [](Bound& bound, double base_value, const char* what, const char* unit) {
+    const double max_abs = kRatedMultipleLimit * base_value;
+    if (!(max_abs < bound.max_abs)) return;
+    char why[160];
+    std::snprintf(why, sizeof why, "%g x the configured machine's %s %.4g %s, machine.rated", kRatedMultipleLimit,
+                  what, base_value, unit);
+    bound = {max_abs, why};
+  };
+  narrow(limits.current_A, base.current_A, "rated peak phase current", "A");
+  narrow(limits.voltage_V, base.voltage_V, "rated peak phase voltage", "V");
+  narrow(limits.speed_rad_s, base.omega_el_rad_s, "rated electrical speed", "rad/s");
+  return limits;
+}
+
 std::string model_extensions_yaml(const MachineConfig& c) {
   const core::ModelExtensions& x = c.estimator.extensions;
   std::ostringstream out;
@@ -402,10 +432,14 @@ MachineConfig load_machine_config(const std::string& path) {
 }
 
 MachineConfig builtin_paper_config() {
-  YamlMap root = YamlMap::load_string(builtin_paper_config_text(), "<built-in paper-ipmsm.yaml>");
-  MachineConfig c = parse_machine_config(root);
-  root.finish();
-  return c;
+  // Parsed once: the text is compiled in (every simulated scenario starts from it).
+  static const MachineConfig parsed = [] {
+    YamlMap root = YamlMap::load_string(builtin_paper_config_text(), "<built-in paper-ipmsm.yaml>");
+    MachineConfig c = parse_machine_config(root);
+    root.finish();
+    return c;
+  }();
+  return parsed;
 }
 
 }  // namespace rpem::io

@@ -44,7 +44,10 @@ YamlMap YamlMap::load_string(const std::string& text, const std::string& name) {
 YamlMap::YamlMap(YAML::Node node, std::string file, std::string path)
     : node_(std::move(node)), file_(std::move(file)), path_(std::move(path)) {}
 
-std::string YamlMap::field(const std::string& key) const { return path_.empty() ? key : path_ + "." + key; }
+std::string YamlMap::field(const std::string& key) const {
+  if (key.empty()) return path_;
+  return path_.empty() ? key : path_ + "." + key;
+}
 
 void YamlMap::fail_at(const YAML::Node& node, const std::string& key, const std::string& reason) const {
   const YAML::Mark mark = node.Mark();
@@ -198,7 +201,9 @@ std::vector<YamlMap> YamlMap::maps(const std::string& key) {
 
 void YamlMap::finish() const {
   for (auto it = node_.begin(); it != node_.end(); ++it) {
-    const std::string key = it->first.as<std::string>();
+    // A complex key (`? [a, b]`, `? {a: 1}`) names nothing we read; yaml-cpp would throw on converting it.
+    if (!it->first.IsScalar()) fail_at(it->first, "", "a key must be a name, not a list or mapping");
+    const std::string key = it->first.Scalar();
     if (used_.count(key) == 0) fail_at(it->first, key, "unknown key");
   }
 }

@@ -22,6 +22,22 @@ TEST(Convergence, FirstOrderApproachSettlesAtTheAnalyticTime) {
   EXPECT_EQ(m.overshoot_pct, 0.0);
 }
 
+TEST(Convergence, WrongWayIsTheMoveAwayFromTheTruthBeyondTheStartingEstimate) {
+  // Truth 1.0, the estimate starts at 1.1 (approach: downwards), first rises to 1.15 (t = 1.5), then decays to the
+  // truth from 1.1 at t = 2: 5 % of the true value the wrong way, no overshoot.
+  std::vector<TrajectoryPoint> tr;
+  for (int k = 0; k <= 6000; ++k) {
+    const double t = 1e-3 * k;
+    double est = 1.1;
+    if (t >= 1.0 && t < 2.0) est = 1.1 + 0.05 * std::sin(M_PI * (t - 1.0));
+    if (t >= 2.0) est = 1.0 + 0.1 * std::exp(-3.0 * (t - 2.0));
+    tr.push_back({t, est, 1.0});
+  }
+  const ConvergenceMetrics m = convergence_metrics(tr, {1.0, 0.01, 1.0});
+  EXPECT_NEAR(m.wrong_way_pct, 5.0, 1e-9);
+  EXPECT_EQ(m.overshoot_pct, 0.0);
+}
+
 TEST(Convergence, OvershootAndLateExcursion) {
   std::vector<TrajectoryPoint> tr;
   for (double t = 0.0; t <= 5.0; t += 0.01) {

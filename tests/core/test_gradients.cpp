@@ -113,5 +113,55 @@ TEST(Gradients, DeterminantOfPsiIsMinusNTimesIdOverD) {
   }
 }
 
+/// The ψ̂m at which an algorithm stops moving (r̂s held, as the scheduler holds it at speed) when the plant
+/// receives u + e_u while the model is fed u: SGA where Ψ_ψᵀ·ε = 0, GNA where (Ψᵀ⁻¹·ε)_ψ = 0. Found by
+/// bisection on the exact steady-state prediction error.
+double fixed_point_psi(const MachinePu& plant, double n, const Vec2& u, const Vec2& e_u, bool gna) {
+  auto direction = [&](double psi_hat) {
+    MachinePu model = plant;
+    model.psi_m_pu = psi_hat;
+    const Vec2 i = steady_state_current(plant, n, u + e_u);
+    const Vec2 i_hat = steady_state_current(model, n, u);
+    const Mat2 g = steady_state_gradients(model, n, i_hat);
+    const Vec2 eps = i - i_hat;
+    return gna ? Vec2(g.inverse() * eps)[0] : g.col(0).dot(eps);
+  };
+  double lo = 0.9 * plant.psi_m_pu, hi = 1.1 * plant.psi_m_pu;
+  const bool rising = direction(lo) > 0.0;  // the update moves ψ̂ up at lo
+  for (int k = 0; k < 200; ++k) {
+    const double mid = 0.5 * (lo + hi);
+    ((direction(mid) > 0.0) == rising ? lo : hi) = mid;
+  }
+  return 0.5 * (lo + hi);
+}
+
+TEST(Gradients, SteadyStateBiasOfSgaAndGnaFromAVoltageError) {
+  // docs/reproduction.md, difference 4: a voltage the model does not know (e_u = [δu_d, δu_q], plant side) shifts
+  // the ψ̂m at which each algorithm settles by
+  //   SGA:  δψ̂ = −δu_q/n + r_s·(x_d − x_q)/(n²·x_q² + r_s²)·δu_d
+  //   GNA:  δψ̂ = −δu_q/n + î_q/(n·î_d)·δu_d            (R⁻¹: the ψ row of Ψᵀ⁻¹, orthogonal to the r̂s gradient)
+  // At the bench's 0.3 pu the SGA's δu_d coefficient is −0.205; GNA's is î_q/(0.3·î_d), −14.9 at 0.4 pu load and
+  // growing without bound towards no load (î_d → 0 under MTPA).
+  const MachinePu m = test::paper_machine_pu();
+  const double n = 0.3, e = 1e-8;  // small: GNA's response is large, and its coefficient depends on î_d
+  const double sga_d = m.r_s_pu * (m.x_d_pu - m.x_q_pu) / (n * n * m.x_q_pu * m.x_q_pu + m.r_s_pu * m.r_s_pu);
+  EXPECT_NEAR(sga_d, -0.205, 1e-3);
+  for (const double torque : {0.4, 0.1, 0.02}) {
+    SCOPED_TRACE(torque);
+    const Vec2 i = mtpa_reference(m, torque);
+    const Vec2 u = steady_state_voltage(m, n, i);
+    const double gna_d = i[1] / (n * i[0]);
+    if (torque == 0.4) {
+      EXPECT_NEAR(gna_d, -14.95, 0.01);
+    }
+    for (const bool gna : {false, true}) {
+      SCOPED_TRACE(gna ? "GNA" : "SGA");
+      EXPECT_NEAR(fixed_point_psi(m, n, u, Vec2(0.0, e), gna) - m.psi_m_pu, -e / n, 0.01 * e / n);
+      const double d_coeff = gna ? gna_d : sga_d;
+      EXPECT_NEAR(fixed_point_psi(m, n, u, Vec2(e, 0.0), gna) - m.psi_m_pu, d_coeff * e, 0.02 * std::abs(d_coeff) * e);
+    }
+  }
+}
+
 }  // namespace
 }  // namespace rpem::core

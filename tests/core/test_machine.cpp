@@ -100,6 +100,10 @@ TEST(Mtpa, PrintedReferenceDeliversTorqueAndIsNearMinimumCurrent) {
     // The printed closed form is an approximation: within 1e-4 of the minimum current up to 1.5 pu.
     EXPECT_LE(i.norm(), norm_at(0.5 * (lo + hi)) * (1.0 + 1e-4) + 1e-12) << "tau=" << tau;
     EXPECT_LE(i[0], 1e-15);
+    // docs/derivations.md §7: the printed form's i_d is within 1.0 % of the exact MTPA's up to |τ| = 1.5 pu.
+    if (tau != 0.0) {
+      EXPECT_LT(std::abs(i[0] / (0.5 * (lo + hi)) - 1.0), 0.0105) << "tau=" << tau;
+    }
   }
 }
 

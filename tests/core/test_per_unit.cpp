@@ -3,6 +3,7 @@
 
 #include <cmath>
 
+#include "rpem/core/machine.hpp"
 #include "rpem/core/per_unit.hpp"
 #include "support/paper_machine.hpp"
 
@@ -19,12 +20,39 @@ TEST(PerUnit, PaperBaseMatchesHandComputation) {
   EXPECT_NEAR(b.torque_Nm, 32.6, 0.05);
 }
 
-TEST(PerUnit, PaperFluxInconsistencyIsTheVoltageBase) {
+TEST(PerUnit, EstimatorRunsOnTable1FluxAndSectionVIsPuBelongsToAnotherBase) {
+  // Erratum E4 (docs/derivations.md): tab_machineData's ψm = 1.14 Wb against Section VI's "0.895 pu".
+  // GIVEN the estimator's configuration as the code derives it from the name plate and tab_machineData
+  const EstimatorConfig c = test::paper_config();
   const PerUnitBase b = test::paper_base();
-  // 1.14 Wb in our (peak phase) base:
-  EXPECT_NEAR(b.flux_pu(1.14), 1.0966, 1e-4);
-  // Section VI's 0.895 pu is 1.14 Wb only against ψ_b = U_n/ω_n with U_n the line-to-line rms voltage.
-  EXPECT_NEAR(1.14 / (400.0 / (100.0 * kPi)), 0.895, 5e-4);
+  // THEN the model and the start it runs on hold 1.14 Wb in the peak-phase base: ψ_b = (√2·400/√3 V)/(100π rad/s)
+  // = 1.03960 Wb (hand-worked), so 1.0966 pu, not 0.895 pu.
+  EXPECT_NEAR(c.model.psi_m_pu, 1.14 / 1.03960, 1e-5);
+  EXPECT_NEAR(c.initial_theta_pu[kPsiM], 1.14 / 1.03960, 1e-5);
+  // The paper's 0.895 pu, read in the base the code uses, is 0.9304 Wb: 18.4 % below tab_machineData.
+  EXPECT_NEAR(b.flux_Wb_of(0.895), 0.895 * 1.03960, 1e-4);
+  EXPECT_NEAR(1.0 - b.flux_Wb_of(0.895) / 1.14, 0.184, 1e-3);
+  // It is 1.14 Wb only in the base the code builds when the peak-phase voltage base equals U_n = 400 V, i.e. for a
+  // name plate whose line-to-line rms voltage were 400·√3/√2 V: the line-to-line rms voltage taken as the base.
+  RatedData other = test::paper_machine_si().rated;
+  other.voltage_ll_rms_V = 400.0 * std::sqrt(3.0) / std::sqrt(2.0);
+  const PerUnitBase line_voltage_base = PerUnitBase::from_rated(other);
+  EXPECT_NEAR(line_voltage_base.voltage_V, 400.0, 1e-9);
+  EXPECT_NEAR(line_voltage_base.flux_pu(1.14), 0.895, 5e-4);
+  EXPECT_NEAR(line_voltage_base.flux_Wb, 1.2732, 1e-4);
+  // That base cannot be the paper's: its torque base is 39.9 Nm, not tab_machineData's 32.6 Nm.
+  EXPECT_NEAR(line_voltage_base.torque_Nm, 39.94, 0.01);
+}
+
+TEST(PerUnit, BenchVoltageAtPointThreePuJustFitsThe220VLink) {
+  // docs/per-unit.md: with ψm = 1.14 Wb, 0.3 pu at 0.4 pu load under MTPA needs |u| = 0.362 pu, and the 220 V
+  // link's linear range is u_dc/√3 = 127 V = 0.389 pu: why Section VI stays at 0.3 pu.
+  const MachinePu m = test::paper_machine_pu();
+  const double u = steady_state_voltage(m, 0.3, mtpa_reference(m, 0.4)).norm();
+  const double available = 220.0 / std::sqrt(3.0) / test::paper_base().voltage_V;
+  EXPECT_NEAR(available, 0.389, 5e-4);
+  EXPECT_NEAR(u, 0.362, 0.001);
+  EXPECT_LT(u, available);
 }
 
 TEST(PerUnit, ConversionsRoundTrip) {

@@ -1,27 +1,66 @@
 #!/usr/bin/env bash
-# Builds one CAN decoder fuzzer with clang (libFuzzer + AddressSanitizer + UndefinedBehaviorSanitizer) and
-# runs it from its committed corpus for a time budget (and any further libFuzzer options, e.g.
-# -runs=10000000). ctest runs each 60 s (label fuzz); docs/can-protocol.md, docs/can-vesc.md and
-# docs/sources.md record long runs.
+# Builds one libFuzzer target with clang (libFuzzer + AddressSanitizer + UndefinedBehaviorSanitizer, leak
+# detection on) and runs it from its committed seed corpus for a time budget (and any further libFuzzer
+# options, e.g. -runs=10000000). ctest runs each target for 60 s (label fuzz); docs/benchmarks.md
+# ("Fuzzing") records the long runs.
 #   run_fuzz.sh BUILD_DIR TARGET [SECONDS] [libFuzzer options...]
+# The targets, one row each: its entry point, what it links, its seed corpus (and dictionary corpus.dict).
 set -euo pipefail
 build=$(cd "$1" && pwd)
 target=$2
 seconds=${3:-30}
 shift $(($# < 3 ? $# : 3))
 repo=$(cd "$(dirname "$0")/../.." && pwd)
+
+core=("$repo"/core/src/*.cpp)
+io=("$repo"/io/src/*.cpp "$build/io/builtin_config.cpp" "$repo/can/src/signal_map.cpp")  # io reads signal maps
 case $target in
-  fuzz_decoder)    objs=("$repo/can/src/decoder.cpp" "$repo/can/src/e2e.cpp"); corpus=$repo/can/fuzz/corpus ;;
-  fuzz_vesc)       objs=("$repo/can/src/vesc.cpp" "$repo/can/src/e2e.cpp"); corpus=$repo/can/fuzz/corpus_vesc ;;
-  fuzz_signal_map) objs=("$repo/can/src/signal_map.cpp"); corpus=$repo/can/fuzz/corpus_signal_map ;;
-  *) echo "run_fuzz: unknown target $target (fuzz_decoder, fuzz_vesc, fuzz_signal_map)" >&2; exit 2 ;;
+  fuzz_decoder)        main=can/fuzz/fuzz_decoder.cpp;        objs=("$repo/can/src/decoder.cpp" "$repo/can/src/e2e.cpp")
+                       corpus=can/fuzz/corpus ;;
+  fuzz_vesc)           main=can/fuzz/fuzz_vesc.cpp;           objs=("$repo/can/src/vesc.cpp" "$repo/can/src/e2e.cpp")
+                       corpus=can/fuzz/corpus_vesc ;;
+  fuzz_signal_map)     main=can/fuzz/fuzz_signal_map.cpp;     objs=("$repo/can/src/signal_map.cpp")
+                       corpus=can/fuzz/corpus_signal_map ;;
+  fuzz_drive_log)      main=io/fuzz/fuzz_drive_log.cpp;       objs=("${io[@]}" "${core[@]}")
+                       corpus=io/fuzz/corpus/drive_log ;;
+  fuzz_machine_config) main=io/fuzz/fuzz_machine_config.cpp;  objs=("${io[@]}" "${core[@]}")
+                       corpus=io/fuzz/corpus/machine_config ;;
+  fuzz_scenario)       main=sim/fuzz/fuzz_scenario.cpp;       objs=("$repo"/sim/src/*.cpp "${io[@]}" "${core[@]}")
+                       corpus=sim/fuzz/corpus ;;
+  *) echo "run_fuzz: unknown target $target" >&2; exit 2 ;;
 esac
-out=$build/fuzz/$target
-mkdir -p "$out/corpus"
-clang++ -std=c++20 -O1 -g -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=undefined \
-  -I "$repo/can/include" -I "$repo/core/include" -isystem /usr/include/eigen3 \
-  "$repo/can/fuzz/$target.cpp" "${objs[@]}" -o "$out/$target"
-cp -n "$corpus"/* "$out/corpus/" 2>/dev/null || true
-cd "$out"
-"./$target" -max_total_time="$seconds" -print_final_stats=1 -artifact_prefix="$out/crash-" "$@" corpus 2>&1 | tail -n 25
-echo "run_fuzz: $target: no crash in ${seconds} s"
+[[ -f $build/io/builtin_config.cpp ]] || { echo "run_fuzz: configure $build first (it generates io/builtin_config.cpp)" >&2; exit 2; }
+
+# A small ninja build under BUILD_DIR/fuzz: each source compiles once (header dependencies tracked) and
+# the targets share the objects; a lock serialises builds when ctest runs targets in parallel.
+dir=$build/fuzz
+mkdir -p "$dir/$target/corpus"
+{
+  echo "cxx = clang++ -std=c++20 -O1 -g -fno-sanitize-recover=undefined -I$repo/can/include -I$repo/core/include" \
+       "-I$repo/io/include -I$repo/sim/include -isystem /usr/include/eigen3"
+  echo "rule cc"
+  echo "  command = \$cxx -fsanitize=fuzzer-no-link,address,undefined -MD -MF \$out.d -c \$in -o \$out"
+  echo "  depfile = \$out.d"
+  echo "  deps = gcc"
+  echo "rule link"
+  echo "  command = \$cxx -fsanitize=fuzzer,address,undefined \$in -lyaml-cpp -o \$out"
+  list=()
+  for src in "$repo/$main" "${objs[@]}"; do
+    rel=${src#"$repo"/}
+    rel=${rel#"$build"/}
+    obj=obj/${rel//\//_}.o
+    echo "build $obj: cc $src"
+    list+=("$obj")
+  done
+  echo "build $target/$target: link ${list[*]}"
+} >"$dir/$target.ninja"
+flock "$dir/.lock" ninja -j "$(nproc)" -C "$dir" -f "$target.ninja" "$target/$target" >"$dir/$target.build.log" 2>&1 ||
+  { cat "$dir/$target.build.log"; echo "run_fuzz: $target did not build" >&2; exit 1; }
+
+cp -n "$repo/$corpus"/* "$dir/$target/corpus/" 2>/dev/null || true
+dict=()
+[[ -f $repo/$corpus.dict ]] && dict=(-dict="$repo/$corpus.dict")
+cd "$dir/$target"
+"./$target" -max_total_time="$seconds" -print_final_stats=1 -artifact_prefix="$dir/$target/crash-" "${dict[@]}" "$@" \
+  corpus 2>&1 | tail -n 60
+echo "run_fuzz: $target: no crash, leak or UB report"

@@ -4,9 +4,11 @@
 
 #include <cmath>
 #include <random>
+#include <sstream>
 
 #include "rpem/core/frames.hpp"
 #include "rpem/io/drive_log.hpp"
+#include "rpem/io/machine_config.hpp"
 #include "support/seed.hpp"
 #include "support/temp_file.hpp"
 
@@ -91,16 +93,90 @@ INSTANTIATE_TEST_SUITE_P(
         BadCase{"no_dc_link_with_phases", "t,theta_el,omega_el,u_d,u_q,i_a,i_b,i_c\n", ":1: column u_dc: required"},
         BadCase{"incomplete_abc", "t,theta_el,omega_el,u_dc,u_a,u_b,i_a,i_b,i_c\n", "column u_c: incomplete"},
         BadCase{"duplicate", "t,t,theta_el,omega_el,u_dc,u_a,u_b,u_c,i_a,i_b,i_c\n", "column t: column appears twice"},
-        BadCase{"non_numeric", kHeader + "0,0,0,220,1,2,3,abc,0,0\n", ":2: column i_a: 'abc' is not a number"},
-        BadCase{"trailing_garbage", kHeader + "0,0,0,220,1,2,3,1.5x,0,0\n", ":2: column i_a: '1.5x'"},
-        BadCase{"nan", kHeader + "0,0,0,220,1,2,3,0,0,0\n0.1,0,0,nan,1,2,3,0,0,0\n", ":3: column u_dc: NaN"},
-        BadCase{"inf", kHeader + "0,0,0,220,1,2,inf,0,0,0\n", ":2: column u_c: 'inf' is not finite"},
-        BadCase{"empty_cell", kHeader + "0,0,,220,1,2,3,0,0,0\n", ":2: column omega_el: empty cell"},
+        BadCase{"non_numeric", kHeader + "0,0,0,220,1,2,3,abc,0,0\n", ":2:8: column i_a: 'abc' is not a number"},
+        BadCase{"trailing_garbage", kHeader + "0,0,0,220,1,2,3,1.5x,0,0\n", ":2:8: column i_a: '1.5x'"},
+        BadCase{"nan", kHeader + "0,0,0,220,1,2,3,0,0,0\n0.1,0,0,nan,1,2,3,0,0,0\n", ":3:4: column u_dc: NaN"},
+        BadCase{"inf", kHeader + "0,0,0,220,1,2,inf,0,0,0\n", ":2:7: column u_c: 'inf' is not finite"},
+        BadCase{"empty_cell", kHeader + "0,0,,220,1,2,3,0,0,0\n", ":2:3: column omega_el: empty cell"},
         BadCase{"time_backwards", kHeader + "0.2,0,0,220,1,2,3,0,0,0\n0.1,0,0,220,1,2,3,0,0,0\n",
-                ":3: column t: time does not increase"},
-        BadCase{"time_repeats", kHeader + "0.2,0,0,220,1,2,3,0,0,0\n0.2,0,0,220,1,2,3,0,0,0\n", ":3: column t"},
-        BadCase{"short_row", kHeader + "0,0,0,220,1,2,3,0,0\n", ":2: column *: row has 9 cells, header has 10"}),
+                ":3:1: column t: time does not increase"},
+        BadCase{"time_repeats", kHeader + "0.2,0,0,220,1,2,3,0,0,0\n0.2,0,0,220,1,2,3,0,0,0\n", ":3:1: column t"},
+        // Distinct as doubles, the same integer nanosecond: the sample times would repeat.
+        BadCase{"time_repeats_in_ns", kHeader + "0.2,0,0,220,1,2,3,0,0,0\n0.2000000000001,0,0,220,1,2,3,0,0,0\n",
+                ":3:1: column t: time does not increase (by at least 1 ns)"},
+        BadCase{"short_row", kHeader + "0,0,0,220,1,2,3,0,0\n", ":2: column *: row has 9 cells, header has 10"},
+        // A header and nothing else, or only blank lines after it: no samples (every tool exits 65).
+        BadCase{"header_only", kHeader, "log.csv:1: no samples: the header is followed by no data rows"},
+        BadCase{"header_and_blank_lines", kHeader + "\n  \n\r\n", "log.csv:4: no samples"},
+        // Values no drive produces (DriveLogLimits' absolute bounds), each with file:line:column.
+        BadCase{"voltage_1e308", kHeader + "0,0,0,0,1e308,2,3,0,0,0\n",
+                ":2:5: column u_a: 1e+308 V is beyond the plausible ±100000 V"},
+        BadCase{"current_1e300", kHeader + "0,0,0,220,1,2,3,0,1e300,0\n",
+                ":2:9: column i_b: 1e+300 A is beyond the plausible ±100000 A"},
+        BadCase{"speed", kHeader + "0,0,-3e6,220,1,2,3,0,0,0\n",
+                ":2:3: column omega_el: -3e+06 rad/s is beyond the plausible ±1e+06 rad/s"},
+        BadCase{"dc_link", kHeader + "0,0,0,2e5,1,2,3,0,0,0\n", ":2:4: column u_dc: 200000 V is beyond"},
+        BadCase{"angle", kHeader + "0,1e12,0,220,1,2,3,0,0,0\n", ":2:2: column theta_el: 1e+12 rad is beyond"},
+        BadCase{"time_beyond_int64_ns", kHeader + "1e10,0,0,220,1,2,3,0,0,0\n", ":2:1: column t: 1e+10 s is beyond"},
+        BadCase{"dq_voltage", "t,omega_el,u_d,u_q,i_d,i_q\n0,0,1,-1e20,0,0\n", ":2:4: column u_q: -1e+20 V is beyond"},
+        BadCase{"dq_current_also_given", "t,theta_el,omega_el,u_dc,u_a,u_b,u_c,i_a,i_b,i_c,i_d,i_q\n0,0,0,220,1,2,3,0,0,0,0,1e6\n",
+                ":2:12: column i_q: 1e+06 A is beyond"},
+        BadCase{"temperature_below_absolute_zero", "t,omega_el,u_d,u_q,i_d,i_q,T_magnet\n0,0,1,1,0,0,-300\n",
+                ":2:7: column T_magnet: -300 °C is outside the plausible [-273.15, 1000] °C"},
+        BadCase{"torque", "t,omega_el,u_d,u_q,i_d,i_q,torque_cmd\n0,0,1,1,0,0,1e9\n", ":2:7: column torque_cmd: 1e+09 Nm"},
+        // A command beyond twice the row's DC link (which must be at least 1 V to count).
+        BadCase{"command_beyond_dc_link", kHeader + "0,0,0,220,1,2,3,0,0,0\n0.1,0,0,220,1,-441,3,0,0,0\n",
+                ":3:6: column u_b: -441 V is more than 2 x this row's u_dc = 220 V"}),
     [](const auto& p) { return std::string(p.param.name); });
+
+TEST(DriveLog, ValuesAtTheLimitsAreAccepted) {
+  // Just inside every bound; a command of 2·u_dc where u_dc < 1 V is not held to the DC link.
+  test::TempFile f("log.csv", "t,theta_el,omega_el,u_dc,u_a,u_b,u_c,i_a,i_b,i_c,T_winding,torque_cmd\n"
+                              "-9e9,-1e9,1e6,100000,1e5,-1e5,0,1e5,-1e5,0,-273.15,-1e7\n"
+                              "0,0,0,0.5,200,0,0,0,0,0,1000,0\n"
+                              "1,0,0,220,440,-440,0,0,0,0,25,0\n");
+  EXPECT_EQ(read_drive_log(f.path()).size(), 3U);
+}
+
+TEST(DriveLog, MachineLimitsNarrowTheBoundsToTenTimesTheNamePlate) {
+  // The paper's machine: I_b = √2·4.93 A, U_b = √2·400/√3 V, ω_b = 100π rad/s (docs/per-unit.md).
+  core::MachineSi m;
+  m.rated = {400.0, 4.93, 1000.0, 3};
+  const DriveLogLimits l = machine_limits(m);
+  EXPECT_NEAR(l.current_A.max_abs, 10.0 * std::sqrt(2.0) * 4.93, 1e-12);
+  EXPECT_NEAR(l.voltage_V.max_abs, 10.0 * std::sqrt(2.0) * 400.0 / std::sqrt(3.0), 1e-9);
+  EXPECT_NEAR(l.speed_rad_s.max_abs, 10.0 * 100.0 * M_PI, 1e-9);
+  EXPECT_EQ(l.angle_rad.max_abs, DriveLogLimits{}.angle_rad.max_abs);
+  const std::string row_ok = "0,0,3141,3265,0,0,0,69.7,0,0\n";
+  test::TempFile ok("ok.csv", kHeader + row_ok);
+  EXPECT_EQ(read_drive_log(ok.path(), l).size(), 1U);
+  test::TempFile bad("bad.csv", kHeader + row_ok + "1,0,0,220,0,0,0,0,0,-69.8\n");
+  try {
+    (void)read_drive_log(bad.path(), l);
+    ADD_FAILURE() << "accepted 69.8 A against 10·I_b = 69.72 A";
+  } catch (const DriveLogError& e) {
+    EXPECT_NE(std::string(e.what()).find("bad.csv:3:10: column i_c: -69.8 A is beyond the plausible ±69.7207 A (10 x the "
+                                         "configured machine's rated peak phase current 6.972 A, machine.rated)"),
+              std::string::npos)
+        << e.what();
+  }
+  // A name plate far above the absolute limits never widens them.
+  m.rated = {1e5, 1e5, 1e6, 100};
+  EXPECT_EQ(machine_limits(m).current_A.max_abs, DriveLogLimits{}.current_A.max_abs);
+}
+
+TEST(DriveLog, ReadsFromAStreamUnderAGivenName) {
+  std::istringstream in(kHeader + "0,0,0,220,1,2,3,0,0,0\n0.1,0,0,220,1,2,x,0,0,0\n");
+  DriveLogReader r(in, "memory.csv");
+  DriveLogRow row;
+  ASSERT_TRUE(r.next(row));
+  try {
+    (void)r.next(row);
+    ADD_FAILURE() << "accepted 'x'";
+  } catch (const DriveLogError& e) {
+    EXPECT_EQ(std::string(e.what()), "memory.csv:3:7: column u_c: 'x' is not a number");
+  }
+}
 
 TEST(DriveLog, MissingFileIsReported) {
   EXPECT_THROW((void)read_drive_log("/nonexistent/rpem.csv"), DriveLogError);
@@ -121,7 +197,7 @@ TEST(DriveLog, WriteThenReadIsBitExact) {
       row.sample.theta_el_rad = core::wrap_angle(nd(rng));
       row.sample.omega_el_rad_s = nd(rng);
       row.sample.u_dc_V = 220.0 + nd(rng) * 1e-3;
-      row.sample.u_V = {nd(rng), nd(rng), nd(rng)};
+      row.sample.u_V = {nd(rng) / 2, nd(rng) / 2, nd(rng) / 2};  // within 2·u_dc (DriveLogLimits)
       row.sample.i_A = {nd(rng) / 10, nd(rng) / 10, nd(rng) / 10};
       row.t_magnet_C = 20.0 + k * 1e-3;
       w.write(row);

@@ -63,6 +63,16 @@ TEST(MachineConfig, PaperFileMatchesThePaperTables) {
   EXPECT_EQ(e.extensions.theta_offset_rad, 0.0);
 }
 
+TEST(MachineConfig, PaperFileStartsTheEstimatorAtTable1sFluxInPu) {
+  // Erratum E4: the shipped configuration keeps tab_machineData's 1.14 Wb, which the estimator runs on as
+  // 1.0966 pu (ψ_b = 1.03960 Wb, docs/per-unit.md), not Section VI's 0.895 pu.
+  const MachineConfig c = load_machine_config(test::source_dir() + "/config/paper-ipmsm.yaml");
+  const core::EstimatorConfig e =
+      core::make_estimator_config(core::PerUnitBase::from_rated(c.machine.rated), c.machine, c.estimator);
+  EXPECT_NEAR(e.model.psi_m_pu, 1.0966, 1e-4);
+  EXPECT_NEAR(e.initial_theta_pu[core::kPsiM], 1.0966, 1e-4);
+}
+
 TEST(MachineConfig, BuiltInConfigIsThePaperFile) {
   EXPECT_EQ(builtin_paper_config_text(), paper_text());
   const MachineConfig c = builtin_paper_config();
@@ -97,6 +107,16 @@ INSTANTIATE_TEST_SUITE_P(
         BadEdit{"fractional_pole_pairs", "pole_pairs: 3", "pole_pairs: 3.5", "'3.5' is not an integer"},
         BadEdit{"reversed_bounds", "psi_m_Wb: \\[0.57, 1.71\\]", "psi_m_Wb: [1.71, 0.57]", "min < max"},
         BadEdit{"initial_outside_bounds", "initial: \\{psi_m_Wb: 1.14", "initial: {psi_m_Wb: 2.0", "estimator.initial.psi_m_Wb: 2.0 is outside [0.57, 1.71]"},
+        // Found by fuzz_machine_config: without estimator.initial the start is the machine's value, which D_M must hold.
+        BadEdit{"default_start_outside_bounds",
+                "  initial: \\{psi_m_Wb: 1.14, r_s_Ohm: 2.25\\}\n(.*\n    psi_m_Wb: )\\[0.57", "$1[1.57",
+                "estimator.bounds.psi_m_Wb: excludes the estimator's start, machine.psi_m_Wb = 1.14"},
+        BadEdit{"partial_initial_default_outside_bounds",
+                "initial: \\{psi_m_Wb: 1.14, r_s_Ohm: 2.25\\}(\n.*\n.*\n    r_s_Ohm: )\\[1.0", "initial: {psi_m_Wb: 1.14}$1[2.5",
+                "estimator.bounds.r_s_Ohm: excludes the estimator's start, machine.r_s_Ohm = 2.25"},
+        // Found by fuzz_machine_config: a complex key escaped the reader as a yaml-cpp exception.
+        BadEdit{"complex_key", "\n  sample_period_s:", "\n  ? [a, b]\n  : 1\n  sample_period_s:",
+                "estimator: a key must be a name, not a list or mapping"},
         BadEdit{"scheduler_order", "r_s_max_speed_rpm: 10 ", "r_s_max_speed_rpm: 200 ", "must not exceed psi_m_min_speed_rpm"},
         BadEdit{"indefinite_hessian", "gna_pu: \\[1.0, 0.0, 1.0\\]", "gna_pu: [1.0, 2.0, 1.0]", "positive semi-definite"},
         BadEdit{"wrong_length", "sga_pu: \\[100.0, 100.0\\]", "sga_pu: [1.0]", "expected 2 numbers, got 1"},

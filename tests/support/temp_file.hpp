@@ -8,16 +8,22 @@
 #include <iterator>
 #include <optional>
 #include <string>
+#include <unistd.h>
 
 namespace rpem::test {
+
+/// A path in the temporary directory unique to this process: test runs of several checkouts on one machine
+/// (or ctest -j) never share a file.
+inline std::filesystem::path temp_path(const std::string& name) {
+  return std::filesystem::temp_directory_path() / ("rpem_" + std::to_string(::getpid()) + "_" + name);
+}
 
 class TempFile {
  public:
   /// Reserves a path; the file is created only if `content` is given (even if empty).
   explicit TempFile(const std::string& name, std::optional<std::string> content = std::nullopt) {
     const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    path_ = std::filesystem::temp_directory_path() /
-            (std::string("rpem_") + info->test_suite_name() + "_" + info->name() + "_" + name);
+    path_ = temp_path(std::string(info->test_suite_name()) + "_" + info->name() + "_" + name);
     std::filesystem::create_directories(path_.parent_path());
     if (content) std::ofstream(path_) << *content;
   }

@@ -110,7 +110,7 @@ TEST(CliDiagnose, BadInputGetsAClearErrorAndItsExitCode) {
   std::ofstream(dir + "/bad.csv") << "t,theta_el,omega_el,u_dc,u_a,u_b,u_c,i_a,i_b,i_c\n0,0,0,220,1,2,3,0,0,0\n0.1,0,0,x,1,2,3,0,0,0\n";
   auto r = test::run_command(rpem_tool() + " diagnose --log " + dir + "/bad.csv --out " + dir + "/o");
   EXPECT_EQ(r.exit_code, 65) << r.output;
-  EXPECT_NE(r.output.find("bad.csv:3: column u_dc: 'x' is not a number"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("bad.csv:3:4: column u_dc: 'x' is not a number"), std::string::npos) << r.output;
 
   std::ofstream(dir + "/cfg.yaml") << read(test::source_dir() + "/config/paper-ipmsm.yaml") << "colour: blue\n";
   std::ofstream(dir + "/short.csv") << "t,omega_el,u_d,u_q,i_d,i_q\n0,100,1,2,3,4\n";

@@ -69,7 +69,7 @@ TEST(CliEstimate, BadInputExitsNonZeroWithFileAndLine) {
   test::TempFile est("est.csv");
   const auto r = test::run_command(test::binary_dir() + "/tools/rpem estimate --log " + log.path() + " --out " + est.path());
   EXPECT_EQ(r.exit_code, 65);
-  EXPECT_NE(r.output.find("bad.csv:3: column u_c: 'x' is not a number"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("bad.csv:3:7: column u_c: 'x' is not a number"), std::string::npos) << r.output;
 }
 
 TEST(CliEstimate, BadConfigExits78) {

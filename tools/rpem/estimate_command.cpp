@@ -66,7 +66,7 @@ int run_estimate(const EstimateOptions& o) {
   const std::string config_name = o.config.empty() ? "builtin:paper-ipmsm" : o.config;
   if (io::is_averaged_log(o.log)) return run_averaged(o, cfg, config_name);
 
-  io::DriveLogReader reader(o.log);
+  io::DriveLogReader reader(o.log, io::machine_limits(cfg.machine));
   io::check_log_supports(cfg, config_name, reader.layout().u_dc, o.log);
   io::EstimateLogWriter writer(o.out);
   core::DriveEstimator estimator(cfg.machine, cfg.estimator);

@@ -6,6 +6,7 @@
 #include "rpem/core/conditioner.hpp"
 #include "rpem/core/frames.hpp"
 #include "rpem/io/averaged_log.hpp"
+#include "rpem/io/machine_config.hpp"
 
 namespace rpem::analysis {
 namespace {
@@ -139,7 +140,7 @@ LogData load_log(const std::string& path, const core::MachineSi& machine, const 
     d.averaged = true;
     return d;
   }
-  io::DriveLogReader reader(path);
+  io::DriveLogReader reader(path, io::machine_limits(machine));
   std::vector<io::DriveLogRow> rows;
   io::DriveLogRow row;
   while (reader.next(row)) rows.push_back(row);

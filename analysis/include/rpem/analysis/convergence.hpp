@@ -3,6 +3,8 @@
 //   convergence_time_s     from the step until the estimate enters and stays within ±band of the true value
 //   steady_state_error_pct mean relative error over the final window, signed, in % of the true value
 //   overshoot_pct          largest excursion past the true value, against the direction of approach, in %
+//   wrong_way_pct          largest move from the estimate at the step away from the true value (the wrong
+//                          way), in % of the true value
 
 #include <optional>
 #include <string>
@@ -20,6 +22,7 @@ struct ConvergenceMetrics {
   std::optional<double> convergence_time_s;  ///< empty: never settled within the band
   double steady_state_error_pct = 0.0;
   double overshoot_pct = 0.0;
+  double wrong_way_pct = 0.0;
 };
 
 struct ConvergenceOptions {

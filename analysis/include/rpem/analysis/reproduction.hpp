@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "rpem/analysis/convergence.hpp"
+#include "rpem/analysis/standstill_rs.hpp"
 #include "rpem/core/estimator.hpp"
 #include "rpem/core/settings.hpp"
 #include "rpem/sim/scenario.hpp"
@@ -27,6 +28,15 @@ enum class CaseKind {
   kDisturbance,      ///< Section VI: a speed or load transient at step_time_s; the parameter is constant
 };
 
+/// What a case stands for in the comparison with the paper.
+enum class CaseRole {
+  kPaper,       ///< a panel of the paper, run with the settings the paper states (tab_psimgains)
+  kHypothesis,  ///< a panel run with settings the paper does not state, to test an explanation of its numbers
+  kStudy,       ///< a variant that shows why a result is what it is (a gain, an initial Hessian)
+};
+
+[[nodiscard]] const char* to_string(CaseRole r) noexcept;
+
 /// What the paper reports for a case (tab_comparison), per algorithm (SGA, GNA, PhyInt).
 struct PaperFigures {
   std::array<std::optional<double>, 3> convergence_time_s;
@@ -38,6 +48,8 @@ struct ReproductionCase {
   std::string id;           ///< e.g. "V_psim_a"
   std::string figure;       ///< the paper's \label and panel, e.g. "fig_psim_adapt (a)"
   std::string description;
+  CaseRole role = CaseRole::kPaper;
+  std::string study_figure;  ///< hypothesis and study cases: the PNG they are drawn in (without .png)
   core::Param parameter = core::Param::kPsiM;
   CaseKind kind = CaseKind::kParameterStep;
   double n_pu = 0.0;        ///< operating speed (before a disturbance)
@@ -67,5 +79,14 @@ struct CaseResult {
 [[nodiscard]] CaseResult run_case(const ReproductionCase& c, double decimation_s = 0.01);
 
 [[nodiscard]] const char* parameter_name(core::Param p) noexcept;
+
+/// Where the estimate starts relative to the machine's parameter (r̂/r − 1 or ψ̂/ψ − 1) in a
+/// start-with-error case: the offline value against the scenario's initial one.
+[[nodiscard]] double initial_error(const ReproductionCase& c);
+
+/// An R_s case at standstill as the scalar recursion of standstill_rs.hpp sees it, for SGA or GNA: the
+/// case's R_s gain sequences, and its initial Hessian relative to the settled (i/r_s)² at the load's
+/// MTPA current.
+[[nodiscard]] StandstillRs standstill_rs_model(const ReproductionCase& c, core::Algorithm a);
 
 }  // namespace rpem::analysis

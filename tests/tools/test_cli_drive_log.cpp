@@ -1,0 +1,93 @@
+// Every `rpem` subcommand that reads a drive log, as a user runs it: a log with a header and no rows, and
+// a log with a value no drive produces, are refused with exit 65 (EX_DATAERR) and a message naming the
+// file, line and column. GIVEN such a log WHEN each tool reads it THEN none of them runs on it.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <ostream>
+#include <string>
+
+#include "support/process.hpp"
+#include "support/temp_file.hpp"
+
+namespace rpem {
+namespace {
+
+namespace fs = std::filesystem;
+
+const std::string kHeader = "t,theta_el,omega_el,u_dc,u_a,u_b,u_c,i_a,i_b,i_c\n";
+
+struct Tool {
+  const char* name;
+  /// The command line with LOG and OUT for the log and an output path.
+  std::string command;
+};
+
+void PrintTo(const Tool& t, std::ostream* os) { *os << t.name; }
+
+class EveryToolReadingADriveLog : public ::testing::TestWithParam<Tool> {
+ protected:
+  void SetUp() override {
+    dir_ = test::temp_path(std::string("cli_drive_log_") + GetParam().name);
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  /// Runs the tool on a log holding `content`.
+  test::ProcessResult run_on(const std::string& file, const std::string& content) const {
+    const std::string log = (dir_ / file).string();
+    std::ofstream(log) << content;
+    std::string cmd = GetParam().command;
+    cmd.replace(cmd.find("LOG"), 3, log);
+    cmd.replace(cmd.find("OUT"), 3, (dir_ / "out").string());
+    return test::run_command(test::binary_dir() + "/tools/rpem " + cmd);
+  }
+
+  fs::path dir_;
+};
+
+TEST_P(EveryToolReadingADriveLog, RefusesALogWithoutSamples) {
+  const test::ProcessResult r = run_on("header_only.csv", kHeader);
+  EXPECT_EQ(r.exit_code, 65) << r.output;
+  EXPECT_NE(r.output.find("header_only.csv:1: no samples"), std::string::npos) << r.output;
+  EXPECT_EQ(r.output.find("psi_m ="), std::string::npos) << r.output;  // no estimate printed
+}
+
+TEST_P(EveryToolReadingADriveLog, RefusesAValueNoDriveProduces) {
+  const test::ProcessResult r = run_on("huge.csv", kHeader + "0,0,0,220,1e308,2,3,0,0,0\n");
+  EXPECT_EQ(r.exit_code, 65) << r.output;
+  EXPECT_NE(r.output.find("huge.csv:2:5: column u_a: 1e+308 V is beyond the plausible"), std::string::npos) << r.output;
+}
+
+INSTANTIATE_TEST_SUITE_P(Tools, EveryToolReadingADriveLog,
+                         ::testing::Values(Tool{"estimate", "estimate --log LOG --out OUT"},
+                                           Tool{"diagnose", "diagnose --log LOG --out OUT"},
+                                           Tool{"replay", "replay LOG --candump OUT"}),
+                         [](const auto& p) { return std::string(p.param.name); });
+
+TEST(CliDriveLog, ToolsThatKnowTheMachineHoldCurrentsToTenTimesItsRating) {
+  // The built-in paper machine: 10·I_b = 10·√2·4.93 A = 69.7 A; 100 A is refused by the tools that know
+  // the machine (estimate, diagnose) and passed on by replay, which does not.
+  const fs::path dir = test::temp_path("cli_drive_log_machine");
+  fs::create_directories(dir);
+  const std::string log = (dir / "amps.csv").string();
+  std::ofstream(log) << kHeader << "0,0,0,220,1,2,3,0,100,-100\n";
+  for (const std::string& sub : {"estimate --log " + log + " --out " + (dir / "est.csv").string(),
+                                "diagnose --log " + log + " --out " + (dir / "d").string()}) {
+    const test::ProcessResult r = test::run_command(test::binary_dir() + "/tools/rpem " + sub);
+    EXPECT_EQ(r.exit_code, 65) << sub << "\n" << r.output;
+    EXPECT_NE(r.output.find("amps.csv:2:9: column i_b: 100 A is beyond the plausible ±69.7207 A (10 x the configured "
+                            "machine's rated peak phase current 6.972 A"),
+              std::string::npos)
+        << sub << "\n" << r.output;
+  }
+  const test::ProcessResult r = test::run_command(test::binary_dir() + "/tools/rpem replay " + log + " --candump " +
+                                                  (dir / "frames.log").string());
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace rpem
