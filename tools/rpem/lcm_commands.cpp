@@ -13,6 +13,7 @@
 
 #include "commands.hpp"
 #include "rpem/command_t.hpp"
+#include "rpem/core/clock.hpp"
 #include "rpem/diagnostics_t.hpp"
 #include "rpem/estimate_t.hpp"
 
@@ -121,9 +122,7 @@ int run_command(const CommandOptions& o) {
     return kExitOk;
   }
   rpem::command_t m;
-  timespec ts{};
-  clock_gettime(CLOCK_REALTIME, &ts);
-  m.utime = static_cast<std::int64_t>(ts.tv_sec) * 1'000'000 + ts.tv_nsec / 1000;
+  m.utime = core::now_ns(CLOCK_REALTIME) / 1000;
   m.seq = o.seq;
   m.command = o.action == "reset"      ? rpem::command_t::RESET
               : o.action == "freeze"   ? rpem::command_t::FREEZE
