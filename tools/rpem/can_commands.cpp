@@ -63,8 +63,7 @@ int run_record(const RecordOptions& o) {
   can::require_interface(o.interface);
   can::SocketCanChannel::Options co;
   co.interface = o.interface;
-  co.ids = {can::protocol::kFdId};
-  for (int k = 0; k < can::protocol::kClassicFrames; ++k) co.ids.push_back(can::protocol::kClassicFirstId + static_cast<std::uint32_t>(k));
+  co.ids.assign(can::protocol::kTelemetryIds.begin(), can::protocol::kTelemetryIds.end());
   can::SocketCanChannel channel(co);
   can::TelemetryDecoder decoder;
   io::DriveLogWriter writer(o.out, io::DriveLogLayout{});

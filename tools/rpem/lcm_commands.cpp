@@ -36,19 +36,31 @@ struct Listener {
   std::int64_t estimates = 0, diagnostics = 0;
   bool print_diagnostics = false;
 
+  /// "adapting", "held 28.0 s" (since its last adaptation) or "initial" (never adapted), then
+  /// "valid" and "converged" where they hold.
+  static std::string describe(bool adapting, double age_s, bool valid, bool converged) {
+    char held[32];
+    std::snprintf(held, sizeof held, "held %.1f s", age_s);
+    std::string s = adapting ? "adapting" : age_s >= 0.0 ? held : "initial";
+    if (valid) s += " valid";
+    if (converged) s += " converged";
+    return s;
+  }
+
   void on_estimate(const lcm::ReceiveBuffer*, const std::string&, const rpem::estimate_t* m) {
     ++estimates;
-    std::printf("%.3f s  state %d  n %+.3f pu  psi_m %.5f Wb%s%s  r_s %.5f Ohm%s%s  T_magnet %.1f C  T_winding %.1f C  %s\n",
+    std::printf("%.3f s  state %d  n %+.3f pu  psi_m %.5f Wb %s  r_s %.5f Ohm %s  T_magnet %.1f C  T_winding %.1f C  %s\n",
                 1e-6 * static_cast<double>(m->sample_time_us), m->state, m->speed_pu, m->psi_m_Wb,
-                m->psi_m_valid ? " valid" : "", m->psi_m_converged ? " converged" : "", m->r_s_Ohm,
-                m->r_s_valid ? " valid" : "", m->r_s_converged ? " converged" : "", m->t_magnet_C, m->t_winding_C,
-                m->algorithm.c_str());
+                describe(m->psi_m_adapting, m->psi_m_age_s, m->psi_m_valid, m->psi_m_converged).c_str(), m->r_s_Ohm,
+                describe(m->r_s_adapting, m->r_s_age_s, m->r_s_valid, m->r_s_converged).c_str(), m->t_magnet_C,
+                m->t_winding_C, m->algorithm.c_str());
     std::fflush(stdout);
     if (csv.is_open()) {
       csv << m->utime << ',' << m->sample_time_us << ',' << m->samples << ',' << m->psi_m_Wb << ',' << m->r_s_Ohm << ','
           << m->t_magnet_C << ',' << m->t_winding_C << ',' << m->speed_pu << ',' << int(m->psi_m_valid) << ','
           << int(m->r_s_valid) << ',' << int(m->psi_m_converged) << ',' << int(m->r_s_converged) << ','
-          << int(m->psi_m_adapting) << ',' << int(m->r_s_adapting) << ',' << int(m->frozen) << ',' << int(m->state) << '\n';
+          << int(m->psi_m_adapting) << ',' << int(m->r_s_adapting) << ',' << int(m->frozen) << ',' << int(m->state) << ','
+          << m->psi_m_age_s << ',' << m->r_s_age_s << '\n';
       csv.flush();
     }
   }
@@ -57,7 +69,9 @@ struct Listener {
     if (!print_diagnostics) return;
     std::printf("diag %lld: state %d samples %lld resyncs %lld overruns %lld latency p99 %.1f us max %.1f us | rx->publish p99 %.0f us | can frames %lld "
                 "lost %lld crc %lld dlc %lld unknown %lld gaps %lld kernel drops %lld reopens %lld | queue drops in %lld "
-                "out %lld | publish failures %lld | commands %lld malformed %lld rejected %lld last %lld:%d | state file %d\n",
+                "out %lld | publish failures %lld | commands %lld malformed %lld rejected %lld last %lld:%d | applied %lld "
+                "sequence errors %lld | reload requests %lld reloads %lld invalid %lld restart required %lld busy %lld | "
+                "state file %d\n",
                 static_cast<long long>(m->utime), static_cast<int>(m->state), static_cast<long long>(m->samples),
                 static_cast<long long>(m->resyncs),
                 static_cast<long long>(m->overruns), m->wakeup_latency_p99_us, m->wakeup_latency_max_us,
@@ -69,7 +83,11 @@ struct Listener {
                 static_cast<long long>(m->input_queue_drops), static_cast<long long>(m->output_queue_drops),
                 static_cast<long long>(m->publish_failures), static_cast<long long>(m->commands_received),
                 static_cast<long long>(m->commands_malformed), static_cast<long long>(m->commands_rejected),
-                static_cast<long long>(m->last_command_seq), m->last_command_result, m->state_file_status);
+                static_cast<long long>(m->last_command_seq), m->last_command_result,
+                static_cast<long long>(m->commands_applied), static_cast<long long>(m->command_sequence_errors),
+                static_cast<long long>(m->config_reload_requests), static_cast<long long>(m->config_reloads),
+                static_cast<long long>(m->config_reloads_invalid), static_cast<long long>(m->config_reloads_restart_required),
+                static_cast<long long>(m->config_reloads_busy), m->state_file_status);
     std::fflush(stdout);
   }
 };
@@ -85,7 +103,7 @@ int run_listen(const ListenOptions& o) {
   if (!o.csv.empty()) {
     listener.csv.open(o.csv, std::ios::trunc);
     listener.csv << "utime,sample_time_us,samples,psi_m,r_s,T_magnet,T_winding,n_pu,psi_m_valid,r_s_valid,"
-                    "psi_m_converged,r_s_converged,psi_m_adapting,r_s_adapting,frozen,state\n";
+                    "psi_m_converged,r_s_converged,psi_m_adapting,r_s_adapting,frozen,state,psi_m_age_s,r_s_age_s\n";
   }
   lcm.subscribe(o.prefix + "RPEM_ESTIMATE", &Listener::on_estimate, &listener);
   lcm.subscribe(o.prefix + "RPEM_DIAGNOSTICS", &Listener::on_diagnostics, &listener);
