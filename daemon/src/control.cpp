@@ -27,6 +27,7 @@ constexpr std::array<CounterRow<ReloadCounters>, 4> kReloadRows{{
 }};
 
 constexpr int kMessagesPerWake = 64;  // then the signals get their turn again
+constexpr int kCommandQueueCapacity = 1024;
 
 }  // namespace
 
@@ -68,7 +69,10 @@ void Control::connect_lcm(std::int64_t now_ns) {
   };
   static thread_local Handler handler;
   handler = {&gate_, &report_pending_};
-  lcm_->lcm.subscribe(c.channel_prefix + "RPEM_COMMAND", &Handler::on, &handler);
+  lcm::Subscription* subscription = lcm_->lcm.subscribe(c.channel_prefix + "RPEM_COMMAND", &Handler::on, &handler);
+  // LCM keeps 30 undelivered messages per subscription by default and drops the rest; a reload (a few
+  // milliseconds of YAML) must not cost the commands that arrive meanwhile.
+  if (subscription != nullptr) subscription->setQueueCapacity(kCommandQueueCapacity);
 }
 
 void Control::reload() {
