@@ -62,4 +62,53 @@ stop_rpemd
 kill $sim 2>/dev/null; wait $sim 2>/dev/null
 kill -INT $listen; wait $listen
 cp /tmp/rpemd/estimates.json "$out/restarted_state.json" 2>/dev/null
+
+# All at once, for a fixed number of rounds: SIGHUP at 10 Hz through four configurations (two that load,
+# one that does not, one that changes what only a restart applies), supervisory commands at 100 Hz, and
+# vcan0 going down and up, while the drive streams. Checked: every command accepted applied once and in
+# order, every reload applied or refused with a counted reason, the socket reopened, the state file
+# whole; the loop's overrun rate against the quiet seconds before (tests/vm/check_daemon_suite.py).
+step "storm: SIGHUP 100 x at 10 Hz, 1000 commands at 100 Hz, vcan0 down/up 5 x, all at once"
+rm -rf /tmp/rpemd
+cp $cfg /tmp/storm-a.yaml
+{ cat $cfg; echo "  validity: {max_hold_s: 10}"; echo "  temperature: {reference_C: 25}"; } > /tmp/storm-b.yaml
+{ cat $cfg; echo "  sauce: 1"; } > /tmp/storm-bad.yaml
+{ cat $cfg; echo "  receive_thread: {policy: fifo, priority: 71}"; } > /tmp/storm-restart.yaml
+cp /tmp/storm-a.yaml /tmp/storm.yaml
+rpemd --config /tmp/storm.yaml > "$out/storm_rpemd.txt" 2>&1 &
+pid=$!
+rpem listen --diagnostics --csv "$out/storm_est.csv" > "$out/storm_listen.txt" 2>&1 &
+listen=$!
+sleep 1
+rpem sim --scenario e2e-steady.yaml --can vcan0 --rate $rate 2> "$out/storm_sim.txt" &
+sim=$!
+sleep 15
+echo "$(date +%s) storm start" >> "$out/storm_events.txt"
+rpem command unfreeze --seq 100 --repeat 1000 --interval-ms 10 2> "$out/storm_commands.txt" &
+commands=$!
+(
+  i=0
+  while [ $i -lt 100 ]; do
+    case $((i % 4)) in 0) v=a ;; 1) v=b ;; 2) v=bad ;; *) v=restart ;; esac
+    cp /tmp/storm-$v.yaml /tmp/storm.new && mv /tmp/storm.new /tmp/storm.yaml
+    kill -HUP $pid
+    sleep 0.1
+    i=$((i + 1))
+  done
+) &
+hups=$!
+for k in 1 2 3 4 5; do ip link set vcan0 down; sleep 1.5; ip link set vcan0 up; sleep 1; done
+wait $commands
+wait $hups
+echo "$(date +%s) storm end" >> "$out/storm_events.txt"
+cp /tmp/storm-a.yaml /tmp/storm.new && mv /tmp/storm.new /tmp/storm.yaml
+kill -HUP $pid
+sleep 2
+rpem command set --seq 2000 --psi-m 1.123 --r-s 2.345
+rpem command freeze --seq 2001
+sleep 4
+kill -TERM $pid; wait $pid 2>/dev/null
+kill $sim 2>/dev/null; wait $sim 2>/dev/null
+kill -INT $listen; wait $listen
+cp /tmp/rpemd/estimates.json "$out/storm_state.json" 2>/dev/null
 step "done"

@@ -1,6 +1,7 @@
 // rpem listen [--prefix P] [--duration S] [--csv FILE]      prints (and records) rpemd's estimates
-// rpem command [--prefix P] --seq N reset|freeze|unfreeze|set [--psi-m WB --r-s OHM]
-//                                                          sends a supervisory command to rpemd
+// rpem command [--prefix P] --seq N reset|freeze|unfreeze|set [--psi-m WB --r-s OHM] [--repeat K --interval-ms M]
+//                                                          sends a supervisory command to rpemd (K times:
+//                                                          sequence numbers N … N+K−1, M ms apart)
 
 #include <atomic>
 #include <chrono>
@@ -124,6 +125,8 @@ struct CommandOptions {
   double psi_m_Wb = 0.0;
   double r_s_Ohm = 0.0;
   bool malformed = false;
+  std::int64_t repeat = 1;
+  double interval_ms = 0.0;
 };
 
 int run_command(const CommandOptions& o) {
@@ -139,21 +142,27 @@ int run_command(const CommandOptions& o) {
     std::fprintf(stderr, "rpem command: sent %zu bytes of junk on %s\n", sizeof junk, channel.c_str());
     return kExitOk;
   }
-  rpem::command_t m;
-  m.utime = core::now_ns(CLOCK_REALTIME) / 1000;
-  m.seq = o.seq;
+  rpem::command_t m{};
   m.command = o.action == "reset"      ? rpem::command_t::RESET
               : o.action == "freeze"   ? rpem::command_t::FREEZE
               : o.action == "unfreeze" ? rpem::command_t::UNFREEZE
                                        : rpem::command_t::SET_VALUES;
   m.psi_m_Wb = o.psi_m_Wb;
   m.r_s_Ohm = o.r_s_Ohm;
-  if (lcm.publish(channel, &m) != 0) {
-    std::fprintf(stderr, "rpem command: publish failed\n");
-    return kExitIoError;
+  const std::int64_t period_ns = static_cast<std::int64_t>(o.interval_ms * 1e6);
+  const std::int64_t start_ns = core::now_ns(CLOCK_MONOTONIC);
+  for (std::int64_t k = 0; k < o.repeat; ++k) {
+    if (k > 0) core::sleep_until_ns(CLOCK_MONOTONIC, start_ns + k * period_ns);
+    m.utime = core::now_ns(CLOCK_REALTIME) / 1000;
+    m.seq = o.seq + k;
+    if (lcm.publish(channel, &m) != 0) {
+      std::fprintf(stderr, "rpem command: publish failed\n");
+      return kExitIoError;
+    }
   }
-  std::fprintf(stderr, "rpem command: %s (seq %lld) sent on %s; see RPEM_DIAGNOSTICS for the acknowledgement\n",
-               o.action.c_str(), static_cast<long long>(o.seq), channel.c_str());
+  std::fprintf(stderr, "rpem command: %s (seq %lld%s) sent on %s; see RPEM_DIAGNOSTICS for the acknowledgement\n",
+               o.action.c_str(), static_cast<long long>(o.seq),
+               o.repeat > 1 ? (" to " + std::to_string(o.seq + o.repeat - 1)).c_str() : "", channel.c_str());
   return kExitOk;
 }
 
@@ -181,6 +190,10 @@ Runner add_command_command(CLI::App& app) {
   cmd->add_option("--prefix", opts->prefix, "channel prefix of the rpemd instance");
   cmd->add_option("--lcm-url", opts->url, "LCM URL (default: LCM's default)");
   cmd->add_flag("--malformed", opts->malformed, "send an undecodable message (a test of rpemd's input checks)");
+  cmd->add_option("--repeat", opts->repeat, "send it this many times, with consecutive sequence numbers")
+      ->check(CLI::Range(std::int64_t{1}, std::int64_t{10'000'000}));
+  cmd->add_option("--interval-ms", opts->interval_ms, "with --repeat: this long between sends [ms]")
+      ->check(CLI::Range(0.0, 60'000.0));
   return [cmd, opts]() { return cmd->parsed() ? run_command(*opts) : -1; };
 }
 
