@@ -11,6 +11,15 @@
 namespace rpem::daemon {
 namespace {
 
+Command command(Command::Kind kind, std::int64_t seq, double psi_m_Wb = 0.0, double r_s_Ohm = 0.0) {
+  Command c;
+  c.kind = kind;
+  c.seq = seq;
+  c.psi_m_Wb = psi_m_Wb;
+  c.r_s_Ohm = r_s_Ohm;
+  return c;
+}
+
 struct Rig {
   DaemonConfig config = builtin_daemon_config();
   SpscQueue<core::DriveSample> input{16384};
@@ -149,12 +158,7 @@ TEST(EstimatorLoop, NewInitialValuesStartIdentificationOver) {
   rig.gen.i_ref_pu = core::mtpa_reference(rig.gen.plant, 0.4);
   rig.run(3.0);
   ASSERT_TRUE(rig.last_estimate().r_s_valid);
-  Command set;
-  set.kind = Command::Kind::kSetValues;
-  set.seq = 1;
-  set.psi_m_Wb = 1.1;
-  set.r_s_Ohm = 2.4;
-  ASSERT_TRUE(rig.commands.push(set));
+  ASSERT_TRUE(rig.commands.push(command(Command::Kind::kSetValues, 1, 1.1, 2.4)));
   rig.gen.n_pu = 0.4;  // r_s cannot adapt: it stays at the set value, never adapted
   rig.run(0.5);
   const EstimateReport e = rig.last_estimate();
@@ -219,20 +223,12 @@ TEST(EstimatorLoop, CommandsFreezeSetResetAndReconfigure) {
   rig.gen.plant.psi_m_pu *= 0.9;
   rig.gen.n_pu = 0.4;
   rig.gen.i_ref_pu = core::mtpa_reference(rig.gen.plant, 0.3);
-  Command freeze;
-  freeze.kind = Command::Kind::kFreeze;
-  freeze.seq = 7;
-  ASSERT_TRUE(rig.commands.push(freeze));
+  ASSERT_TRUE(rig.commands.push(command(Command::Kind::kFreeze, 7)));
   rig.run(2.0);
   EstimateReport e = rig.last_estimate();
   EXPECT_TRUE(e.frozen);
   EXPECT_DOUBLE_EQ(e.psi_m_Wb, 1.14);
-  Command set;
-  set.kind = Command::Kind::kSetValues;
-  set.seq = 8;
-  set.psi_m_Wb = 1.0;
-  set.r_s_Ohm = 2.5;
-  ASSERT_TRUE(rig.commands.push(set));
+  ASSERT_TRUE(rig.commands.push(command(Command::Kind::kSetValues, 8, 1.0, 2.5)));
   rig.run(0.2);
   e = rig.last_estimate();
   EXPECT_DOUBLE_EQ(e.psi_m_Wb, 1.0);
@@ -241,20 +237,14 @@ TEST(EstimatorLoop, CommandsFreezeSetResetAndReconfigure) {
   reconfigure.kind = Command::Kind::kReconfigure;
   reconfigure.live = rig.config.live;
   reconfigure.live.machine.estimator.algorithm = core::Algorithm::kGna;
-  Command unfreeze;
-  unfreeze.kind = Command::Kind::kUnfreeze;
-  unfreeze.seq = 9;
   ASSERT_TRUE(rig.commands.push(reconfigure));
-  ASSERT_TRUE(rig.commands.push(unfreeze));
+  ASSERT_TRUE(rig.commands.push(command(Command::Kind::kUnfreeze, 9)));
   rig.run(6.0);
   e = rig.last_estimate();
   EXPECT_EQ(e.algorithm, core::Algorithm::kGna);
   EXPECT_FALSE(e.frozen);
   EXPECT_NEAR(e.psi_m_Wb / (0.9 * 1.14), 1.0, 3e-3);  // the state carried over the reload
-  Command reset;
-  reset.kind = Command::Kind::kReset;
-  reset.seq = 10;
-  ASSERT_TRUE(rig.commands.push(reset));
+  ASSERT_TRUE(rig.commands.push(command(Command::Kind::kReset, 10)));
   rig.idle(0.2);
   e = rig.last_estimate();
   EXPECT_DOUBLE_EQ(e.psi_m_Wb, 1.14);

@@ -6,7 +6,16 @@ out=${1:-/host}
 cfg=rpemd-vcan.yaml
 rate=0.4  # the emulated VM cannot run drive, daemon and listener at 8 kHz in real time
 step() { echo "daemon_suite: $*"; }
-start_rpemd() { rpemd --config $cfg > "$out/$1_rpemd.txt" 2>&1 & echo $! > /tmp/rpemd.pid; }
+start_rpemd() { rpemd --config "${2:-$cfg}" > "$out/$1_rpemd.txt" 2>&1 & echo $! > /tmp/rpemd.pid; }
+# A run with the drive streaming the steady scenario and `rpem listen` recording: start_streaming NAME [CONFIG]
+start_streaming() {
+  start_rpemd "$1" "$2"
+  rpem listen --diagnostics --csv "$out/$1_est.csv" > "$out/$1_listen.txt" 2>&1 &
+  listen=$!
+  sleep 1
+  rpem sim --scenario e2e-steady.yaml --can vcan0 --rate $rate 2> "$out/$1_sim.txt" &
+  sim=$!
+}
 stop_rpemd() { kill -TERM "$(cat /tmp/rpemd.pid)"; wait "$(cat /tmp/rpemd.pid)" 2>/dev/null; }
 
 run_steps() {  # name, extra rpem sim options
@@ -29,12 +38,7 @@ run_steps loss_burst --drop-probability 0.1 --drop-burst 12 --drop-seed 4
 
 step "faults: vcan0 down/up, blocked LCM, malformed frames and commands, SIGKILL and restart"
 rm -rf /tmp/rpemd
-start_rpemd faults
-rpem listen --diagnostics --csv "$out/faults_est.csv" > "$out/faults_listen.txt" 2>&1 &
-listen=$!
-sleep 1
-rpem sim --scenario e2e-steady.yaml --can vcan0 --rate $rate 2> "$out/faults_sim.txt" &
-sim=$!
+start_streaming faults
 sleep 10
 echo "$(date +%s) vcan0 down" >> "$out/faults_events.txt"; ip link set vcan0 down
 sleep 2
@@ -75,13 +79,8 @@ cp $cfg /tmp/storm-a.yaml
 { cat $cfg; echo "  sauce: 1"; } > /tmp/storm-bad.yaml
 { cat $cfg; echo "  receive_thread: {policy: fifo, priority: 71}"; } > /tmp/storm-restart.yaml
 cp /tmp/storm-a.yaml /tmp/storm.yaml
-rpemd --config /tmp/storm.yaml > "$out/storm_rpemd.txt" 2>&1 &
-pid=$!
-rpem listen --diagnostics --csv "$out/storm_est.csv" > "$out/storm_listen.txt" 2>&1 &
-listen=$!
-sleep 1
-rpem sim --scenario e2e-steady.yaml --can vcan0 --rate $rate 2> "$out/storm_sim.txt" &
-sim=$!
+start_streaming storm /tmp/storm.yaml
+pid=$(cat /tmp/rpemd.pid)
 sleep 15
 echo "$(date +%s) storm start" >> "$out/storm_events.txt"
 rpem command unfreeze --seq 100 --repeat 1000 --interval-ms 10 2> "$out/storm_commands.txt" &
@@ -107,7 +106,7 @@ sleep 2
 rpem command set --seq 2000 --psi-m 1.123 --r-s 2.345
 rpem command freeze --seq 2001
 sleep 4
-kill -TERM $pid; wait $pid 2>/dev/null
+stop_rpemd
 kill $sim 2>/dev/null; wait $sim 2>/dev/null
 kill -INT $listen; wait $listen
 cp /tmp/rpemd/estimates.json "$out/storm_state.json" 2>/dev/null
