@@ -1,0 +1,42 @@
+# The CLI as a user runs it: a log, an averaged log, a truth file; usage and configuration errors.
+file(REMOVE_RECURSE "${WORK_DIR}")
+file(MAKE_DIRECTORY "${WORK_DIR}")
+
+function(run expected_code)
+  execute_process(COMMAND "${EXE}" ${ARGN} RESULT_VARIABLE code OUTPUT_VARIABLE out ERROR_VARIABLE err)
+  if(NOT code EQUAL expected_code)
+    message(FATAL_ERROR "indep_drive_log ${ARGN}: exit ${code}, expected ${expected_code}\n${out}${err}")
+  endif()
+  set(last_err "${err}" PARENT_SCOPE)
+endfunction()
+
+run(0 --config "${SOURCE_DIR}/config/paper-ipmsm.yaml" --effects deadtime,delay --seed 7 --duration-s 0.2
+    --out "${WORK_DIR}/log.csv" --truth "${WORK_DIR}/truth.json")
+file(STRINGS "${WORK_DIR}/log.csv" lines)
+list(LENGTH lines n)
+list(GET lines 0 header)
+if(NOT header STREQUAL "t,theta_el,omega_el,u_dc,u_a,u_b,u_c,i_a,i_b,i_c,T_winding,T_magnet,torque_cmd" OR NOT n EQUAL 1601)
+  message(FATAL_ERROR "log.csv: header '${header}', ${n} lines (expected 1601)")
+endif()
+file(READ "${WORK_DIR}/truth.json" truth)
+string(JSON delay_s GET "${truth}" effects delay delay_s)
+string(JSON seed GET "${truth}" seed)
+if(NOT seed EQUAL 7 OR NOT delay_s STREQUAL "0.000125")
+  message(FATAL_ERROR "truth.json: seed ${seed}, delay_s ${delay_s}")
+endif()
+
+run(0 --config "${SOURCE_DIR}/config/beckhoff-am8141.yaml" --effects lq_saturation,cross_saturation --averaged --rate-Hz 500
+    --duration-s 0.2 --out "${WORK_DIR}/avg.csv" --set sensors.current_noise_A=0 --draw-effect-params)
+file(STRINGS "${WORK_DIR}/avg.csv" avg)
+list(GET avg 0 header)
+if(NOT header STREQUAL "t,t_start,i_d,i_q,u_d,u_q,omega_el,u_dc,T_winding,T_magnet")
+  message(FATAL_ERROR "avg.csv: header '${header}'")
+endif()
+
+run(64 --config "${SOURCE_DIR}/config/paper-ipmsm.yaml" --effects dead_time --out "${WORK_DIR}/x.csv")
+if(NOT last_err MATCHES "unknown effect 'dead_time'")
+  message(FATAL_ERROR "unknown effect: ${last_err}")
+endif()
+run(64 --config "${SOURCE_DIR}/config/paper-ipmsm.yaml" --set deadtime.t_dead=1 --out "${WORK_DIR}/x.csv")
+run(78 --config "${WORK_DIR}/missing.yaml" --out "${WORK_DIR}/x.csv")
+run(0 --list-effects)
