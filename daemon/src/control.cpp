@@ -59,20 +59,15 @@ void Control::connect_lcm(std::int64_t now_ns) {
     std::fprintf(stderr, "rpemd: LCM not available for commands (%s); retrying\n", c.url.empty() ? "default URL" : c.url.c_str());
     return;
   }
-  struct Handler {
-    CommandGate* gate;
-    bool* pending;
-    void on(const lcm::ReceiveBuffer* rbuf, const std::string&) {
-      (void)gate->handle(std::span(static_cast<const std::uint8_t*>(rbuf->data), rbuf->data_size));
-      *pending = true;
-    }
-  };
-  static thread_local Handler handler;
-  handler = {&gate_, &report_pending_};
-  lcm::Subscription* subscription = lcm_->lcm.subscribe(c.channel_prefix + "RPEM_COMMAND", &Handler::on, &handler);
+  lcm::Subscription* subscription = lcm_->lcm.subscribe(c.channel_prefix + "RPEM_COMMAND", &Control::on_command, this);
   // LCM keeps 30 undelivered messages per subscription by default and drops the rest; a reload (a few
   // milliseconds of YAML) must not cost the commands that arrive meanwhile.
   if (subscription != nullptr) subscription->setQueueCapacity(kCommandQueueCapacity);
+}
+
+void Control::on_command(const lcm::ReceiveBuffer* message, const std::string&) {
+  (void)gate_.handle(std::span(static_cast<const std::uint8_t*>(message->data), message->data_size));
+  report_pending_ = true;
 }
 
 void Control::reload() {

@@ -50,15 +50,14 @@ EstimatorLoop::EstimatorLoop(const DaemonConfig& config, Queues queues)
 
 void EstimatorLoop::seed(const std::optional<SeedValue>& psi_m, const std::optional<SeedValue>& r_s, std::int64_t now_ns) {
   estimator_.set_estimates(psi_m ? psi_m->value : estimator_.psi_m_Wb(), r_s ? r_s->value : estimator_.r_s_Ohm());
-  const std::optional<SeedValue>* seeds[2] = {&psi_m, &r_s};
-  for (int j = 0; j < 2; ++j) {
-    const auto& s = *seeds[j];
-    if (!s) continue;
-    validity_.seed(j, s->age_s, now_ns);
+  auto keep = [&](int j, const SeedValue& s) {
+    validity_.seed(j, s.age_s, now_ns);
     has_good_[j] = true;
-    good_[j] = s->value;
-    good_ns_[j] = now_ns - static_cast<std::int64_t>(std::max(0.0, s->age_s) * 1e9);
-  }
+    good_[j] = s.value;
+    good_ns_[j] = now_ns - static_cast<std::int64_t>(std::max(0.0, s.age_s) * 1e9);
+  };
+  if (psi_m) keep(core::kPsiM, *psi_m);
+  if (r_s) keep(core::kRs, *r_s);
 }
 
 void EstimatorLoop::push(const Report& r) noexcept {

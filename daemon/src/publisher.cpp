@@ -54,14 +54,16 @@ Publisher::Publisher(const FixedConfig& config, Identity identity, Queues queues
       identity_(std::move(identity)),
       queues_(queues),
       buffer_(8192),
+      estimate_channel_(config.lcm.channel_prefix + "RPEM_ESTIMATE"),
+      measurement_channel_(config.lcm.channel_prefix + "RPEM_MEASUREMENT"),
+      diagnostics_channel_(config.lcm.channel_prefix + "RPEM_DIAGNOSTICS"),
       state_path_(resolve_state_file(config.state)) {}
 
 Publisher::~Publisher() = default;
 
 template <class Message>
-void Publisher::publish(const char* name, const Message& m) {
+void Publisher::publish(const std::string& channel, const Message& m) {
   const int size = m.encode(buffer_.data(), 0, static_cast<int>(buffer_.size()));
-  const std::string channel = config_.lcm.channel_prefix + name;
   if (size < 0 || !lcm_ || !lcm_->lcm.good() ||
       lcm_->lcm.publish(channel, buffer_.data(), static_cast<unsigned>(size)) != 0) {
     ++counters_.publish_failures;
@@ -92,7 +94,7 @@ void Publisher::publish_estimate(const EstimateReport& r) {
   m.state = static_cast<std::int8_t>(r.state);
   m.algorithm = io::to_string(r.algorithm);
   const std::int64_t failures = counters_.publish_failures;
-  publish("RPEM_ESTIMATE", m);
+  publish(estimate_channel_, m);
   if (counters_.publish_failures == failures && r.newest_rx_ns > 0) {
     const double us = 1e-3 * static_cast<double>(unix_us() * 1000 - r.newest_rx_ns);
     rx_to_publish_.add(us);
@@ -113,7 +115,7 @@ void Publisher::publish_measurement(const MeasurementReport& r) {
   m.i_hat_q_A = r.i_hat_q_A;
   m.epsilon_d_A = r.eps_d_A;
   m.epsilon_q_A = r.eps_q_A;
-  publish("RPEM_MEASUREMENT", m);
+  publish(measurement_channel_, m);
 }
 
 void Publisher::publish_diagnostics(const LoopStatsReport& r) {
@@ -139,7 +141,7 @@ void Publisher::publish_diagnostics(const LoopStatsReport& r) {
   m.last_command_seq = control_.last_command_seq;
   m.last_command_result = static_cast<std::int8_t>(control_.last_command_result);
   m.state_file_status = static_cast<std::int8_t>(identity_.state_file_status);
-  publish("RPEM_DIAGNOSTICS", m);
+  publish(diagnostics_channel_, m);
 }
 
 void Publisher::maybe_write_state(bool force) {

@@ -9,12 +9,17 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <string>
 
 #include "rpem/daemon/command_gate.hpp"
 #include "rpem/daemon/daemon_config.hpp"
 #include "rpem/daemon/loop_timer.hpp"
 #include "rpem/daemon/messages.hpp"
 #include "rpem/daemon/spsc_queue.hpp"
+
+namespace lcm {
+class ReceiveBuffer;
+}  // namespace lcm
 
 namespace rpem::daemon {
 
@@ -48,6 +53,7 @@ class Control {
  private:
   struct Lcm;
   void connect_lcm(std::int64_t now_ns);
+  void on_command(const lcm::ReceiveBuffer* message, const std::string& channel);
   void reload();
   void report();
   void watchdog(std::int64_t now_ns);

@@ -61,7 +61,7 @@ class Publisher {
   void maybe_write_state(bool force);
   void print_status(const EstimateReport& r);
   template <class Message>
-  void publish(const char* channel, const Message& m);
+  void publish(const std::string& channel, const Message& m);
 
   const FixedConfig config_;
   const Identity identity_;
@@ -70,6 +70,7 @@ class Publisher {
   std::unique_ptr<Lcm> lcm_;
   std::int64_t next_connect_us_ = 0;
   std::vector<std::uint8_t> buffer_;
+  const std::string estimate_channel_, measurement_channel_, diagnostics_channel_;
   std::string state_path_;
 
   SourceReport source_;    ///< the newest from the source thread
