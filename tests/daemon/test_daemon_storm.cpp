@@ -10,11 +10,8 @@
 //   - the state file, written every 0.1 s throughout, is intact;
 //   - the loop's overruns with and without the storm are printed (a benchmark figure, not asserted:
 //     docs/benchmarks.md). The CAN interface going down and up during the same storm is in the VM suite.
-#include <fcntl.h>
 #include <gtest/gtest.h>
 #include <signal.h>
-#include <spawn.h>
-#include <sys/wait.h>
 
 #include <atomic>
 #include <chrono>
@@ -33,10 +30,9 @@
 #include "rpem/command_t.hpp"
 #include "rpem/diagnostics_t.hpp"
 #include "rpem/estimate_t.hpp"
+#include "support/child_process.hpp"
 #include "support/process.hpp"
 #include "support/temp_file.hpp"
-
-extern char** environ;
 
 namespace rpem {
 namespace {
@@ -49,33 +45,12 @@ constexpr int kCommandsPerRound = 10;   // 1 kHz
 const std::string kUrl = "udpm://239.255.76.67:7817?ttl=0";
 
 /// rpemd as a child process, its output in a file.
-class Rpemd {
+class Rpemd : public test::ChildProcess {
  public:
-  Rpemd(const std::string& config, const std::string& log) {
-    posix_spawn_file_actions_t actions;
-    posix_spawn_file_actions_init(&actions);
-    posix_spawn_file_actions_addopen(&actions, 1, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    posix_spawn_file_actions_adddup2(&actions, 1, 2);
-    std::string binary = test::binary_dir() + "/daemon/rpemd";
-    std::string c = "--config", f = config;
-    char* argv[] = {binary.data(), c.data(), f.data(), nullptr};
-    EXPECT_EQ(posix_spawn(&pid_, binary.c_str(), &actions, nullptr, argv, environ), 0);
-    posix_spawn_file_actions_destroy(&actions);
+  Rpemd(const std::string& config, const std::string& log)
+      : ChildProcess({test::binary_dir() + "/daemon/rpemd", "--config", config}, log) {
+    EXPECT_GT(pid(), 0);
   }
-  ~Rpemd() {
-    if (pid_ > 0) stop();
-  }
-  void signal(int sig) const { ::kill(pid_, sig); }
-  int stop() {
-    ::kill(pid_, SIGTERM);
-    int status = 0;
-    ::waitpid(pid_, &status, 0);
-    pid_ = -1;
-    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  }
-
- private:
-  pid_t pid_ = -1;
 };
 
 /// The newest estimate and diagnostics from LCM.
