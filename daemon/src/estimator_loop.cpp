@@ -31,10 +31,6 @@ std::int64_t interval_ns(double rate_Hz) noexcept {
 
 std::int64_t unix_us() noexcept { return core::now_ns(CLOCK_REALTIME) / 1000; }
 
-double temperature_C(double reference_C, double value, double value_ref, double coeff_per_K) noexcept {
-  return reference_C + (value / value_ref - 1.0) / coeff_per_K;
-}
-
 }  // namespace
 
 EstimatorLoop::EstimatorLoop(const DaemonConfig& config, Queues queues)
@@ -146,8 +142,8 @@ void EstimatorLoop::report_estimate(std::int64_t now_ns) noexcept {
   r.psi_m_pu = estimator_.theta_pu()[core::kPsiM];
   r.r_s_pu = estimator_.theta_pu()[core::kRs];
   const TemperatureModel& t = live_.temperature;
-  r.t_winding_C = temperature_C(t.reference_C, r.r_s_Ohm, t.r_s_ref_Ohm, t.r_s_coeff_per_K);
-  r.t_magnet_C = temperature_C(t.reference_C, r.psi_m_Wb, t.psi_m_ref_Wb, t.psi_m_coeff_per_K);
+  r.t_winding_C = core::thermal_temperature_C(r.r_s_Ohm, t.r_s_ref_Ohm, t.r_s_coeff_per_K, t.reference_C);
+  r.t_magnet_C = core::thermal_temperature_C(r.psi_m_Wb, t.psi_m_ref_Wb, t.psi_m_coeff_per_K, t.reference_C);
   r.speed_pu = last_.speed_pu;
   r.frozen = estimator_.frozen();
   r.state = state_;

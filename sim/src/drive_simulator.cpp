@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "rpem/core/machine.hpp"
+#include "rpem/core/thermal_drift.hpp"
 
 namespace rpem::sim {
 namespace {
@@ -54,8 +55,8 @@ PlantParameters DriveSimulator::parameters_at(double t_s) noexcept {
   const double tw = s.signal(Quantity::kTWinding).at(t_s);
   const double tm = s.signal(Quantity::kTMagnet).at(t_s);
   PlantParameters p;
-  p.r_s_Ohm = s.signal(Quantity::kRs).at(t_s) * (1.0 + s.thermal.r_s_coeff_per_K * (tw - s.thermal.reference_C));
-  p.psi_m_Wb = s.signal(Quantity::kPsiM).at(t_s) * (1.0 + s.thermal.psi_m_coeff_per_K * (tm - s.thermal.reference_C));
+  p.r_s_Ohm = s.signal(Quantity::kRs).at(t_s) * core::thermal_factor(s.thermal.r_s_coeff_per_K, tw, s.thermal.reference_C);
+  p.psi_m_Wb = s.signal(Quantity::kPsiM).at(t_s) * core::thermal_factor(s.thermal.psi_m_coeff_per_K, tm, s.thermal.reference_C);
   p.l_d_H = s.signal(Quantity::kLd).at(t_s);
   p.l_q_H = s.signal(Quantity::kLq).at(t_s);
   p.r_fe_Ohm = s.r_fe_Ohm;

@@ -167,9 +167,9 @@ Scenario parse_scenario(const std::string& text, const std::string& name, const 
   }
   if (auto m = root.optional_map("sensors")) parse_sensors(*m, s);
   if (auto m = root.optional_map("thermal")) {
-    s.thermal.reference_C = m->number_or("reference_C", 20.0, -273.0, 1000.0);
-    s.thermal.r_s_coeff_per_K = m->number_or("r_s_coeff_per_K", 0.00393, -1.0, 1.0);
-    s.thermal.psi_m_coeff_per_K = m->number_or("psi_m_coeff_per_K", -0.0012, -1.0, 1.0);
+    s.thermal.reference_C = m->number_or("reference_C", s.thermal.reference_C, -273.0, 1000.0);
+    s.thermal.r_s_coeff_per_K = m->number_or("r_s_coeff_per_K", s.thermal.r_s_coeff_per_K, -1.0, 1.0);
+    s.thermal.psi_m_coeff_per_K = m->number_or("psi_m_coeff_per_K", s.thermal.psi_m_coeff_per_K, -1.0, 1.0);
     m->finish();
   }
   set_initial_signals(s, root.optional_map("initial"));

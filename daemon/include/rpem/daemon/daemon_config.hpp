@@ -12,6 +12,7 @@
 #include <cstdint>
 #include <string>
 
+#include "rpem/core/thermal_drift.hpp"
 #include "rpem/daemon/realtime.hpp"
 #include "rpem/daemon/source_catalogue.hpp"
 #include "rpem/io/machine_config.hpp"
@@ -20,12 +21,10 @@ namespace rpem::daemon {
 
 enum class RealtimeMode { kRequired, kPreferred, kOff };
 
-struct TemperatureModel {
-  double reference_C = 20.0;
+/// The drift law's coefficients (core/thermal_drift.hpp) and the reference values it is inverted against.
+struct TemperatureModel : core::ThermalCoefficients {
   double r_s_ref_Ohm = 0.0;    ///< r_s at reference_C (default: the machine's offline r_s)
   double psi_m_ref_Wb = 0.0;   ///< ψm at reference_C (default: the machine's offline ψm)
-  double r_s_coeff_per_K = 0.00393;
-  double psi_m_coeff_per_K = -0.0012;
 };
 
 /// When an estimate is valid (docs/rpemd.md, "Validity and age"). A parameter is identified after

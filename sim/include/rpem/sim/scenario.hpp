@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <string>
 
+#include "rpem/core/thermal_drift.hpp"
 #include "rpem/io/machine_config.hpp"
 #include "rpem/sim/foc.hpp"
 #include "rpem/sim/inverter.hpp"
@@ -31,12 +32,8 @@ enum class Quantity : int {
 inline constexpr std::array<const char*, static_cast<int>(Quantity::kCount)> kQuantityNames = {
     "psi_m_Wb", "r_s_Ohm", "l_d_H", "l_q_H", "speed_rpm", "torque_Nm", "u_dc_V", "t_winding_C", "t_magnet_C"};
 
-/// Temperature coupling: r_s = r_s(ref)·(1 + α_Cu·(T_w − T_ref)), ψ_m = ψ_m(ref)·(1 + α_PM·(T_m − T_ref)).
-struct ThermalCoupling {
-  double reference_C = 20.0;
-  double r_s_coeff_per_K = 0.00393;
-  double psi_m_coeff_per_K = -0.0012;
-};
+/// Temperature coupling of r_s and ψm (the law in core/thermal_drift.hpp).
+using ThermalCoupling = core::ThermalCoefficients;
 
 struct LogOptions {
   bool dq_columns = false;
