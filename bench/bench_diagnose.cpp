@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "rpem/analysis/diagnose/diagnose_output.hpp"
-#include "rpem/analysis/diagnose/hidden_effects.hpp"
+#include "hidden_effects/hidden_effects.hpp"
 #include "rpem/io/drive_log.hpp"
 
 namespace {
@@ -26,10 +26,10 @@ struct Fixture {
     fs::create_directories(dir);
     sim::Scenario s = sim::load_scenario(RPEM_SOURCE_DIR "/scenarios/diagnose-bench.yaml");
     s.duration_s = 20.0;
-    analysis::hide(s, {"deadtime", 1.5e-6});
+    test::hide(s, {"deadtime", 1.5e-6});
     config = s.machine;
     io::DriveLogLayout layout;
-    const auto rows = analysis::simulate(s, &layout);
+    const auto rows = test::simulate(s, &layout);
     io::DriveLogWriter w(log, layout);
     for (const auto& r : rows) w.write(r);
   }

@@ -48,9 +48,9 @@ TEST(HiddenEffect, WhatTheDataCannotSeparateIsReportedNotGuessed) {
   s.duration_s = 5.0;
   s.signal(sim::Quantity::kSpeed) = sim::Signal(0.0);
   s.signal(sim::Quantity::kTorque) = sim::Signal(13.0);
-  analysis::hide(s, {"deadtime", 1.5e-6});
+  test::hide(s, {"deadtime", 1.5e-6});
   io::DriveLogLayout layout;
-  analysis::LogData log = analysis::prepare_log(analysis::simulate(s, &layout), layout, s.machine.machine, {});
+  analysis::LogData log = analysis::prepare_log(test::simulate(s, &layout), layout, s.machine.machine, {});
   const analysis::Diagnosis d = analysis::diagnose(std::move(log), s.machine, {});
   EXPECT_TRUE(d.selection.found.empty());
   ASSERT_FALSE(d.selection.not_identifiable.empty());

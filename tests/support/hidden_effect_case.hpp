@@ -13,7 +13,7 @@
 #include <vector>
 
 #include "rpem/analysis/diagnose/diagnose_output.hpp"
-#include "rpem/analysis/diagnose/hidden_effects.hpp"
+#include "hidden_effects/hidden_effects.hpp"
 #include "rpem/sim/flux_map.hpp"
 #include "support/data_file.hpp"
 #include "support/temp_file.hpp"
@@ -57,7 +57,7 @@ inline bool within(double got, double truth, double tolerance = kParameterTolera
 }
 
 /// Judges one found effect against one hidden effect; appends the reason to `why`.
-inline bool matches(const analysis::HiddenEffect& h, const std::vector<analysis::NamedValue>& p, std::string& why) {
+inline bool matches(const test::HiddenEffect& h, const std::vector<analysis::NamedValue>& p, std::string& why) {
   constexpr double kCopper = 0.00393, kMagnet = -0.0012;  // the simulator's thermal coefficients
   double got = std::nan(""), truth = std::nan("");
   std::string phase;
@@ -123,13 +123,13 @@ inline CaseOutcome run_hidden_case(const HiddenCase& c) {
   }
   s.seed = c.seed;
   std::mt19937_64 rng(c.seed);
-  std::vector<analysis::HiddenEffect> hidden;
+  std::vector<test::HiddenEffect> hidden;
   for (const std::string& name : c.effects) {
-    hidden.push_back(analysis::draw_effect(rng, s, name));
-    analysis::hide(s, hidden.back());
+    hidden.push_back(test::draw_effect(rng, s, name));
+    test::hide(s, hidden.back());
   }
   io::DriveLogLayout layout;
-  std::vector<io::DriveLogRow> rows = analysis::simulate(s, &layout);
+  std::vector<io::DriveLogRow> rows = test::simulate(s, &layout);
   analysis::LogData log = analysis::prepare_log(std::move(rows), layout, s.machine.machine, {});
   analysis::DiagnoseOptions options;
   options.switching_frequency_Hz = s.inverter.switching_frequency_Hz;

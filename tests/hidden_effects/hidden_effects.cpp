@@ -1,11 +1,11 @@
-#include "rpem/analysis/diagnose/hidden_effects.hpp"
+#include "hidden_effects/hidden_effects.hpp"
 
 #include <cmath>
 #include <stdexcept>
 
 #include "rpem/sim/drive_simulator.hpp"
 
-namespace rpem::analysis {
+namespace rpem::test {
 namespace {
 
 constexpr double kDeg = 3.14159265358979323846 / 180.0;
@@ -79,4 +79,4 @@ std::vector<io::DriveLogRow> simulate(const sim::Scenario& s, io::DriveLogLayout
   return rows;
 }
 
-}  // namespace rpem::analysis
+}  // namespace rpem::test

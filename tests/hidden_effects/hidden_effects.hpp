@@ -1,5 +1,6 @@
 #pragma once
-// Drive logs with a known effect hidden in them, for testing and demonstrating `rpem diagnose`: a
+// Drive logs with a known effect hidden in them, for the tests and benchmarks of `rpem diagnose` (not part
+// of the product, so not in the analysis library; the library rpem_hidden_effects, tests/hidden_effects): a
 // scenario (scenarios/diagnose-bench.yaml: a test-bench profile that gives every effect a chance to show;
 // scenarios/diagnose-beckhoff.yaml: a motor on its measured flux map) with catalogue effects put into
 // the simulated hardware.
@@ -12,7 +13,7 @@
 #include "rpem/io/drive_log.hpp"
 #include "rpem/sim/scenario.hpp"
 
-namespace rpem::analysis {
+namespace rpem::test {
 
 /// One hidden effect with its true value, in the catalogue's terms (effects.hpp).
 struct HiddenEffect {
@@ -33,4 +34,4 @@ void hide(sim::Scenario& s, const HiddenEffect& e);
 /// Simulates a scenario into drive-log rows (what `rpem sim` would write).
 [[nodiscard]] std::vector<io::DriveLogRow> simulate(const sim::Scenario& s, io::DriveLogLayout* layout = nullptr);
 
-}  // namespace rpem::analysis
+}  // namespace rpem::test
