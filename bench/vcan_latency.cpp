@@ -17,6 +17,7 @@
 namespace {
 
 using rpem::core::now_ns;
+using rpem::core::sleep_until_ns;
 
 void report(const char* what, std::vector<double> v) {
   if (v.empty()) return;
@@ -45,8 +46,7 @@ int main(int argc, char** argv) {
     std::int64_t next = now_ns(CLOCK_MONOTONIC);
     for (std::size_t k = 0; k < total; ++k) {
       next += period;
-      timespec ts{static_cast<time_t>(next / 1'000'000'000), static_cast<long>(next % 1'000'000'000)};
-      clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr);
+      sleep_until_ns(CLOCK_MONOTONIC, next);
       rpem::can::CanFrame f;
       f.id = 0x100;
       f.fd = true;
