@@ -103,8 +103,8 @@ echo "$(date +%s) storm end" >> "$out/storm_events.txt"
 cp /tmp/storm-a.yaml /tmp/storm.new && mv /tmp/storm.new /tmp/storm.yaml
 kill -HUP $pid
 sleep 2
-rpem command set --seq 2000 --psi-m 1.123 --r-s 2.345
-rpem command freeze --seq 2001
+rpem command freeze --seq 2000                       # first: a set before it would adapt until the freeze came
+rpem command set --seq 2001 --psi-m 1.123 --r-s 2.345
 sleep 4
 stop_rpemd
 kill $sim 2>/dev/null; wait $sim 2>/dev/null
