@@ -194,13 +194,14 @@ TEST(DaemonStorm, CommandsAndReloadsUnderContentionKeepOneOrder) {
       std::this_thread::sleep_for(1ms);
     }
   }
-  // Quiet again: configuration a, then a last SET_VALUES and FREEZE that must arrive whole.
+  // Quiet again: configuration a, then a last FREEZE and SET_VALUES that must arrive whole (freeze
+  // first: should the two land in different loop periods, a set before it would adapt in between).
   write_atomically(config, a);
   rpemd.signal(SIGHUP);
   ++hups;
   std::this_thread::sleep_for(300ms);
-  send(command_t::SET_VALUES, 1.123456789, 2.3456789);
   send(command_t::FREEZE);
+  send(command_t::SET_VALUES, 1.123456789, 2.3456789);
   const std::int64_t last = seq;
   const bool settled = listener.wait_for(
       [&](const diagnostics_t& m) {
