@@ -59,6 +59,7 @@ rpem command unfreeze --seq 6
 sleep 2
 echo "$(date +%s) sigkill" >> "$out/faults_events.txt"
 kill -KILL "$(cat /tmp/rpemd.pid)"
+cp /tmp/rpemd/estimates.json "$out/killed_state.json" 2>/dev/null   # what the restart must resume from
 sleep 1
 start_rpemd restarted
 sleep 4
