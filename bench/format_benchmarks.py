@@ -4,6 +4,7 @@ import json
 import sys
 
 ALGORITHMS = {"0": "SGA", "1": "GNA", "2": "PhyInt"}
+FIDELITIES = {"0": "switching (edge to edge)", "1": "switching (1 µs fixed plant step)", "2": "averaged"}
 
 
 def label(name):
@@ -12,9 +13,15 @@ def label(name):
         grad = "dynamic" if parts.get("dynamic_gradient") == "1" else "steady-state"
         return f"estimator step, {ALGORITHMS[parts['algorithm']]}, {grad} gradients"
     if name.startswith("BM_SimulateOneSecond"):
-        fidelity = "averaged" if parts.get("averaged") == "1" else "switching (1 µs plant)"
+        fidelity = FIDELITIES[parts["fidelity"]]
         est = "with estimator" if parts.get("estimator") == "1" else "without estimator"
         return f"simulator, {fidelity}, {est}"
+    if name.startswith("BM_SwitchingOverAveraged"):
+        return "simulator, switching (edge to edge) over averaged, with estimator, same run"
+    if name.startswith("BM_StepOverKernel"):
+        return "estimator step (SGA, steady-state gradients) over the minimal SGA kernel, same run"
+    if name.startswith("BM_SgaKernel"):
+        return "minimal SGA kernel (tests/support/sga_kernel.hpp)"
     if name.startswith("BM_DiagnoseTwentySecondLog"):
         return "rpem diagnose, 20 s log at 8 kHz (read, diagnose, write report)"
     return name
@@ -40,7 +47,12 @@ def main(paths):
     for base, aggs in rows.items():
         med = aggs.get("median")
         mx = aggs.get("max")
-        if "x_real_time" in med:
+        if "ratio" in med:
+            worst = mx["ratio"] if mx else float("nan")
+            parts = ", ".join(f"{k} {med[k]:.3g}" for k in ("switching_x_real_time", "averaged_x_real_time",
+                                                              "kernel_ns", "step_ns") if k in med)
+            print(f"| {label(base)} | ratio {med['ratio']:.3f} | {worst:.3f} | median {parts} |")
+        elif "x_real_time" in med:
             print(f"| {label(base)} | {med['x_real_time']:.0f}× real time | "
                   f"{aggs['min']['x_real_time'] if 'min' in aggs else med['x_real_time']:.0f}× (slowest) | wall {med['real_time']:.1f} ms per simulated s |")
         else:

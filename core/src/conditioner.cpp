@@ -12,8 +12,7 @@ double soft_sign(double x, double band) noexcept {
 }
 
 bool finite(const DriveSample& s) noexcept {
-  return std::isfinite(s.theta_el_rad) && std::isfinite(s.omega_el_rad_s) && std::isfinite(s.u_dc_V) &&
-         s.u_V.allFinite() && s.i_A.allFinite();
+  return all_finite(s.theta_el_rad, s.omega_el_rad_s, s.u_dc_V, s.u_V, s.i_A);
 }
 
 }  // namespace
@@ -44,7 +43,7 @@ Vec3 SampleConditioner::corrected_phases_A(const Vec3& measured_A) const noexcep
   return (measured_A - extensions_.current_offset_A).cwiseProduct(inv_current_gain_);
 }
 
-Vec2 SampleConditioner::current_alphabeta_A(const DriveSample& s, const Rotation& logged) const noexcept {
+inline Vec2 SampleConditioner::current_alphabeta_A(const DriveSample& s, const Rotation& logged) const noexcept {
   if (s.current_frame == Frame::kAbc) return clarke(phase_corrections_ ? corrected_phases_A(s.i_A) : Vec3(s.i_A));
   const Vec2 i_ab = s.current_frame == Frame::kAlphaBeta ? Vec2(s.i_A.head<2>()) : inverse_park(s.i_A.head<2>(), logged);
   // A drive that logs αβ or dq made them from its phase measurements; the corrections act there.
@@ -67,7 +66,7 @@ double SampleConditioner::deadtime_voltage_V(double u_dc_V) const noexcept {
   return extensions_.deadtime_v_err_V + extensions_.deadtime_t_dead_s * extensions_.switching_frequency_Hz * u_dc_V;
 }
 
-Vec2 SampleConditioner::deadtime_error_alphabeta_V(const Vec2& i_ab_A, double u_dc_V) const noexcept {
+inline Vec2 SampleConditioner::deadtime_error_alphabeta_V(const Vec2& i_ab_A, double u_dc_V) const noexcept {
   if (!deadtime_) return Vec2::Zero();
   const double v_err = deadtime_voltage_V(u_dc_V);
   if (v_err == 0.0) return Vec2::Zero();
@@ -77,7 +76,7 @@ Vec2 SampleConditioner::deadtime_error_alphabeta_V(const Vec2& i_ab_A, double u_
   return clarke(leg_error);  // the zero sequence does not reach the machine
 }
 
-SampleConditioner::Measured SampleConditioner::measure(const DriveSample& s, const Rotation& logged) const noexcept {
+inline SampleConditioner::Measured SampleConditioner::measure(const DriveSample& s, const Rotation& logged) const noexcept {
   Measured m;
   m.logged = logged;
   m.rot = angle_offset_ ? compose(m.logged, offset_rotation_) : m.logged;
@@ -148,7 +147,7 @@ Vec2 SampleConditioner::observed_current_dq_A(const DriveSample& s, const Vec2& 
   return park(i_ab_A, logged);
 }
 
-EstimatorSample SampleConditioner::condition(const DriveSample& s) noexcept {
+[[gnu::flatten]] EstimatorSample SampleConditioner::condition(const DriveSample& s) noexcept {
   EstimatorSample out;
   if (!finite(s)) {
     has_previous_ = false;

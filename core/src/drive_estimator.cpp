@@ -7,11 +7,9 @@ DriveEstimator::DriveEstimator(const MachineSi& machine, const EstimatorSettings
       conditioner_(base_, to_pu(base_, machine), settings.extensions),
       core_(make_estimator_config(base_, machine, settings)) {}
 
-Estimate DriveEstimator::step(const DriveSample& sample) noexcept {
+[[gnu::flatten]] Estimate DriveEstimator::step(const DriveSample& sample) noexcept {
   const EstimatorSample conditioned = conditioner_.condition(sample);
-  Estimate e;
-  e.t_ns = sample.t_ns;
-  e.detail = core_.step(conditioned);
+  Estimate e{.t_ns = sample.t_ns, .detail = core_.step(conditioned)};  // the detail made in place
   e.psi_m_Wb = base_.flux_Wb_of(e.detail.theta_pu[kPsiM]);
   e.r_s_Ohm = base_.resistance_Ohm_of(e.detail.theta_pu[kRs]);
   e.epsilon_A = e.detail.epsilon_pu * base_.current_A;

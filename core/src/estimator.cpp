@@ -8,8 +8,7 @@ namespace {
 
 bool finite(const EstimatorSample& s) noexcept {
   const auto& iv = s.interval;
-  return std::isfinite(iv.dt_s) && std::isfinite(iv.n_start_pu) && std::isfinite(iv.n_end_pu) &&
-         iv.u_start_pu.allFinite() && iv.u_end_pu.allFinite() && s.i_meas_pu.allFinite();
+  return all_finite(iv.dt_s, iv.n_start_pu, iv.n_end_pu, iv.u_start_pu, iv.u_end_pu, s.i_meas_pu);
 }
 
 /// γ_0 are per nominal sample; a longer or shorter interval scales them so that the adaptation time
@@ -26,10 +25,8 @@ double gna_hessian_sequence(const Schedule& active, const Vec2& gamma_r) noexcep
 
 }  // namespace
 
-RpemEstimator::RpemEstimator(const EstimatorConfig& config) noexcept
-    : config_(config),
-      coefficients_(PredictorCoefficients::of(config.model, config.omega_n_rad_s)),
-      inverse_nominal_period_(1.0 / config.nominal_sample_period_s) {
+RpemEstimator::RpemEstimator(const EstimatorConfig& config) noexcept {
+  reconfigure(config);
   reset();
 }
 
@@ -54,18 +51,19 @@ void RpemEstimator::reconfigure(const EstimatorConfig& config) noexcept {
   config_ = config;
   coefficients_ = PredictorCoefficients::of(config.model, config.omega_n_rad_s);
   inverse_nominal_period_ = 1.0 / config.nominal_sample_period_s;
+  // With steady-state forms for both parameters the dynamic gradients would be computed for nothing.
+  gradients_ = config.gradient_psi_m == GradientForm::kDynamic || config.gradient_r_s == GradientForm::kDynamic
+                   ? Gradients::kAdvance
+                   : Gradients::kSkip;
+  scaled_for_dt_s_ = -1.0;
   (void)project(config_.bounds, state_.theta_pu);
 }
 
 MachinePu RpemEstimator::model_for(const EstimatorSample& sample) const noexcept {
-  MachinePu m = config_.model;
-  m.psi_m_pu = state_.theta_pu[kPsiM];
-  m.r_s_pu = state_.theta_pu[kRs];
-  if (sample.x_d_pu > 0.0 && sample.x_q_pu > 0.0) {
-    m.x_d_pu = sample.x_d_pu;
-    m.x_q_pu = sample.x_q_pu;
-  }
-  return m;
+  const bool own = sample.x_d_pu > 0.0 && sample.x_q_pu > 0.0;
+  // Made whole, not copied and patched: the per-sample path then keeps it in registers.
+  return {state_.theta_pu[kRs], own ? sample.x_d_pu : config_.model.x_d_pu, own ? sample.x_q_pu : config_.model.x_q_pu,
+          state_.theta_pu[kPsiM]};
 }
 
 void RpemEstimator::synchronize(const EstimatorSample& sample, const MachinePu& model) noexcept {
@@ -90,53 +88,55 @@ Mat2 RpemEstimator::select_gradient(const MachinePu& model, double n_pu) const n
   return g;
 }
 
-EstimatorOutput RpemEstimator::step(const EstimatorSample& sample) noexcept {
+EstimatorOutput RpemEstimator::held(StepCode code) const noexcept {
   EstimatorOutput out;
   out.theta_pu = state_.theta_pu;
+  out.i_hat_pu = state_.predictor.i_hat_pu;
+  out.code = code;
   out.flags = state_.frozen ? step_flag::kFrozen : 0;
+  return out;
+}
 
+[[gnu::flatten]] EstimatorOutput RpemEstimator::step(const EstimatorSample& sample) noexcept {
   if (!finite(sample)) {
     state_.synchronized = false;
     state_.epsilon_valid = false;
-    out.code = StepCode::kRejectedNonFinite;
-    return out;
+    return held(StepCode::kRejectedNonFinite);
   }
   const auto& iv = sample.interval;
   const MachinePu model = model_for(sample);
   if (sample.resync || !state_.synchronized || !(iv.dt_s > 0.0) || iv.dt_s > config_.max_sample_interval_s) {
     synchronize(sample, model);
-    out.i_hat_pu = state_.predictor.i_hat_pu;
-    out.code = StepCode::kSynchronized;
-    return out;
+    return held(StepCode::kSynchronized);
   }
 
   // Saturation extensions give each sample its own inductances (two divisions); else the cached ones.
-  const PredictorCoefficients coefficients =
-      sample.x_d_pu > 0.0 ? PredictorCoefficients::of(model, config_.omega_n_rad_s) : coefficients_;
-  // With steady-state forms for both parameters the dynamic gradients would be computed for nothing.
-  const bool dynamic = config_.gradient_psi_m == GradientForm::kDynamic || config_.gradient_r_s == GradientForm::kDynamic;
-  predict(model, coefficients, config_.discretization, iv, state_.predictor,
-          dynamic ? Gradients::kAdvance : Gradients::kSkip);
-  const Vec2& i_hat = state_.predictor.i_hat_pu;
-  if (!i_hat.allFinite() || i_hat.lpNorm<Eigen::Infinity>() > config_.max_predicted_current_pu ||
-      !state_.predictor.gradient.allFinite()) {
+  // A branch, not a select: the divisions would otherwise compete with the predictor's for the divider.
+  PredictorCoefficients coefficients = coefficients_;
+  if (sample.x_d_pu > 0.0) [[unlikely]] coefficients = PredictorCoefficients::of(model, config_.omega_n_rad_s);
+  predict(model, coefficients, config_.discretization, iv, state_.predictor, gradients_);
+  const Vec2 i_hat = state_.predictor.i_hat_pu;
+  const double i_max = config_.max_predicted_current_pu;  // a comparison with NaN fails: not finite
+  const Mat2& g = state_.predictor.gradient;
+  if (!(std::abs(i_hat[0]) <= i_max && std::abs(i_hat[1]) <= i_max) ||
+      (gradients_ == Gradients::kAdvance && !all_finite(g.col(0), g.col(1)))) {
     state_.epsilon_valid = false;
     synchronize(sample, model);
-    out.i_hat_pu = state_.predictor.i_hat_pu;
-    out.code = StepCode::kPredictorDiverged;
-    return out;
+    return held(StepCode::kPredictorDiverged);
   }
 
-  out.i_hat_pu = i_hat;
-  out.epsilon_pu = sample.i_meas_pu - i_hat;
-  state_.last_epsilon_pu = out.epsilon_pu;
+  const Vec2 epsilon = sample.i_meas_pu - i_hat;
+  state_.last_epsilon_pu = epsilon;
   state_.epsilon_valid = true;
-  out.gradient = select_gradient(model, iv.n_end_pu);
+  const Mat2 gradient = select_gradient(model, iv.n_end_pu);
 
-  const double factor = iv.dt_s * inverse_nominal_period_;
-  const GainSequences& seq = config_.gains[static_cast<std::size_t>(config_.algorithm)];
-  const Vec2 gamma_r = scaled(seq.hessian, factor);
-  const Vec2 gamma_l = scaled(seq.gain, factor);
+  if (iv.dt_s != scaled_for_dt_s_) {  // the same interval sample after sample: scaled once
+    const double factor = iv.dt_s * inverse_nominal_period_;
+    const GainSequences& seq = config_.gains[static_cast<std::size_t>(config_.algorithm)];
+    gamma_r_ = scaled(seq.hessian, factor);
+    gamma_l_ = scaled(seq.gain, factor);
+    scaled_for_dt_s_ = iv.dt_s;
+  }
 
   // eq:GainSchedule decides which parameters may move in this sample.
   Schedule active = schedule(config_.scheduler, iv.n_end_pu);
@@ -146,32 +146,28 @@ EstimatorOutput RpemEstimator::step(const EstimatorSample& sample) noexcept {
   GainOutput gain;
   switch (config_.algorithm) {
     case Algorithm::kSga:
-      gain = sga_gain(out.gradient, gamma_r, gamma_l, config_.floors, state_.sga_hessian_pu);
+      gain = sga_gain(gradient, gamma_r_, gamma_l_, config_.floors, state_.sga_hessian_pu);
       break;
     case Algorithm::kGna:
-      gain = gna_gain(out.gradient, gna_hessian_sequence(active, gamma_r), gamma_l, config_.floors,
+      gain = gna_gain(gradient, gna_hessian_sequence(active, gamma_r_), gamma_l_, config_.floors,
                       state_.gna_hessian_pu);
       break;
     case Algorithm::kPhyInt:
-      gain = phyint_gain(model, iv.n_end_pu, i_hat, gamma_l, config_.floors);
+      gain = phyint_gain(MachinePu(model), iv.n_end_pu, i_hat, gamma_l_, config_.floors);  // a copy: `model` stays in registers
       break;
   }
-  if (gain.flags & gain_flag::kFloored) out.flags |= step_flag::kGainFloored;
-  if (gain.flags & gain_flag::kPseudoInverse) out.flags |= step_flag::kPseudoInverse;
-
   apply_schedule(active, gain.gain);
-  if (active.psi_m) out.flags |= step_flag::kPsiMActive;
-  if (active.r_s) out.flags |= step_flag::kRsActive;
-
-  state_.theta_pu += gain.gain * out.epsilon_pu;
+  state_.theta_pu += gain.gain * epsilon;
   const std::uint8_t clamped = project(config_.bounds, state_.theta_pu);
-  if (clamped & (1U << kPsiM)) out.flags |= step_flag::kProjectedPsiM;
-  if (clamped & (1U << kRs)) out.flags |= step_flag::kProjectedRs;
 
-  out.gain = gain.gain;
-  out.theta_pu = state_.theta_pu;
-  out.code = StepCode::kAdapted;
-  return out;
+  std::uint16_t flags = state_.frozen ? step_flag::kFrozen : 0;
+  if (gain.flags & gain_flag::kFloored) flags |= step_flag::kGainFloored;
+  if (gain.flags & gain_flag::kPseudoInverse) flags |= step_flag::kPseudoInverse;
+  if (active.psi_m) flags |= step_flag::kPsiMActive;
+  if (active.r_s) flags |= step_flag::kRsActive;
+  if (clamped & (1U << kPsiM)) flags |= step_flag::kProjectedPsiM;
+  if (clamped & (1U << kRs)) flags |= step_flag::kProjectedRs;
+  return {state_.theta_pu, epsilon, i_hat, gradient, gain.gain, StepCode::kAdapted, flags};  // every member: no zero fill
 }
 
 }  // namespace rpem::core

@@ -23,16 +23,6 @@ Vec2 steady_state_voltage(const MachinePu& m, double n_pu, const Vec2& i_pu) noe
           m.r_s_pu * i_pu[1] + n_pu * m.x_d_pu * i_pu[0] + n_pu * m.psi_m_pu};
 }
 
-Mat2 steady_state_gradients(const MachinePu& m, double n_pu, const Vec2& i_hat_pu) noexcept {
-  const double d = steady_state_denominator(m, n_pu);
-  Mat2 g;
-  g(0, kPsiM) = -n_pu * n_pu * m.x_q_pu / d;
-  g(1, kPsiM) = -n_pu * m.r_s_pu / d;
-  g(0, kRs) = (-m.r_s_pu * i_hat_pu[0] - n_pu * m.x_q_pu * i_hat_pu[1]) / d;
-  g(1, kRs) = (n_pu * m.x_d_pu * i_hat_pu[0] - m.r_s_pu * i_hat_pu[1]) / d;
-  return g;
-}
-
 Vec2 steady_state_prediction_error(const MachinePu& plant, const MachinePu& model, double n_pu,
                                    const Vec2& u_pu) noexcept {
   return steady_state_current(plant, n_pu, u_pu) - steady_state_current(model, n_pu, u_pu);

@@ -21,6 +21,9 @@ DriveSimulator::DriveSimulator(Scenario scenario)
     : scenario_(std::move(scenario)),
       plant_(scenario_.machine.machine.rated.pole_pairs, make_magnetics(scenario_), scenario_.mechanics),
       inverter_(scenario_.inverter),
+      edges_(scenario_.inverter, scenario_.plant_tolerance),
+      edge_to_edge_(scenario_.inverter.model == InverterModel::kSwitching &&
+                    scenario_.integrator == PlantIntegrator::kEdges),
       foc_(scenario_.control, scenario_.machine.machine),
       sensors_(scenario_.sensors, scenario_.machine.machine.rated.pole_pairs, scenario_.sample_period_s,
                scenario_.seed),
@@ -72,7 +75,8 @@ void DriveSimulator::sample_and_control(double t_s) noexcept {
   parameters_ = parameters_at(t_s);
   const double speed_el = rpm_to_el_rad_s(scenario_.signal(Quantity::kSpeed).at(t_s), p);
   plant_.set_speed(speed_el);
-  plant_.begin_period(parameters_, scenario_.plant_step_s, scenario_.mechanics.dynamometer ? 0.0 : torque_signal_Nm_);
+  plant_.begin_period(parameters_, edge_to_edge_ ? scenario_.sample_period_s : scenario_.plant_step_s,
+                      scenario_.mechanics.dynamometer ? 0.0 : torque_signal_Nm_);
 
   i_meas_A_ = sensors_.currents(plant_.phase_currents());
   theta_meas_rad_ = sensors_.angle(plant_.state().theta_el_rad);
@@ -107,6 +111,10 @@ void DriveSimulator::sample_and_control(double t_s) noexcept {
 void DriveSimulator::integrate(std::int64_t k) noexcept {
   // The carrier valley is at even k (rising half), the peak at odd k.
   const bool rising = (k % 2) == 0;
+  if (edge_to_edge_) {
+    edges_.integrate(plant_, rising, duties_now_, u_dc_V_);
+    return;
+  }
   const double h = scenario_.plant_step_s;
   for (int s = 0; s < substeps_; ++s) {
     const double tau = s * h;

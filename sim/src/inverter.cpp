@@ -25,25 +25,41 @@ Duties modulate(const core::Vec2& u_ab_V, double u_dc_V, bool third_harmonic) no
 Inverter::Inverter(const InverterConfig& config) noexcept
     : config_(config), half_period_s_(0.5 / config.switching_frequency_Hz) {}
 
+LegSchedule Inverter::schedule(bool rising, double d) const noexcept {
+  const double half = half_period_s_;
+  LegSchedule s;
+  if (d <= 0.0 || d >= 1.0) {
+    s.first = s.last = d <= 0.0 ? LegCommand::kLow : LegCommand::kHigh;
+    s.switch_s = s.on_s = half;
+    return s;
+  }
+  // Rising half (carrier 0 → 1): high while the carrier is below d; falling half: high once it is.
+  s.first = rising ? LegCommand::kHigh : LegCommand::kLow;
+  s.last = rising ? LegCommand::kLow : LegCommand::kHigh;
+  s.switch_s = (rising ? d : 1.0 - d) * half;
+  s.on_s = std::min(s.switch_s + config_.dead_time_s, half);
+  return s;
+}
+
+double Inverter::leg_voltage(LegCommand c, int sign, double u_dc_V) const noexcept {
+  if (c == LegCommand::kBlank) c = sign < 0 ? LegCommand::kHigh : LegCommand::kLow;  // the freewheeling diode
+  if (c == LegCommand::kHigh) return sign > 0 ? u_dc_V - config_.v_igbt_V : (sign < 0 ? u_dc_V + config_.v_diode_V : u_dc_V);
+  return sign > 0 ? -config_.v_diode_V : (sign < 0 ? config_.v_igbt_V : 0.0);
+}
+
 double Inverter::high_fraction(bool rising, double tau, double h, double d, double i) const noexcept {
   if (d <= 0.0) return 0.0;
   if (d >= 1.0) return 1.0;
-  const double half = half_period_s_;
-  const double td = config_.dead_time_s;
   if (config_.model == InverterModel::kAveraged) {
     // Mean over the carrier period: one edge per period is delayed by t_dead.
     const double sign = i > 0.0 ? 1.0 : (i < 0.0 ? -1.0 : 0.0);
-    return std::clamp(d - sign * td / (2.0 * half), 0.0, 1.0);
+    return std::clamp(d - sign * config_.dead_time_s / (2.0 * half_period_s_), 0.0, 1.0);
   }
-  // Rising half (carrier 0 → 1): high on [0, d·half], the falling edge is delayed when i < 0.
-  // Falling half (carrier 1 → 0): high on [(1 − d)·half, half], the rising edge is delayed when i > 0.
-  double lo = 0.0, hi = 0.0;
-  if (rising) {
-    hi = std::min(d * half + (i < 0.0 ? td : 0.0), half);
-  } else {
-    lo = std::min((1.0 - d) * half + (i > 0.0 ? td : 0.0), half);
-    hi = half;
-  }
+  // The leg is high on one interval [lo, hi]: blanking belongs to it when the current is negative, to
+  // the low state when it is positive (without current the edge stays where the PWM puts it).
+  const LegSchedule s = schedule(rising, d);
+  const double lo = rising ? 0.0 : (i > 0.0 ? s.on_s : s.switch_s);
+  const double hi = rising ? (i < 0.0 ? s.on_s : s.switch_s) : half_period_s_;
   if (lo <= tau && tau + h <= hi) return 1.0;  // the common cases first: wholly high…
   if (hi <= tau || tau + h <= lo) return 0.0;   // …or wholly low
   return (std::min(hi, tau + h) - std::max(lo, tau)) / h;
@@ -55,10 +71,8 @@ core::Vec2 Inverter::mean_voltage(bool rising, double tau_s, double h_s, const D
   for (int x = 0; x < 3; ++x) {
     const double i = i_abc_A[x];
     const double f = high_fraction(rising, tau_s, h_s, duties.d[x], i);
-    // Conducting device: i > 0 flows through the upper transistor (high) or lower diode (low).
-    const double v_high = i > 0.0 ? u_dc_V - config_.v_igbt_V : (i < 0.0 ? u_dc_V + config_.v_diode_V : u_dc_V);
-    const double v_low = i > 0.0 ? -config_.v_diode_V : (i < 0.0 ? config_.v_igbt_V : 0.0);
-    leg[x] = f * v_high + (1.0 - f) * v_low;
+    const int sign = i > 0.0 ? 1 : (i < 0.0 ? -1 : 0);
+    leg[x] = f * leg_voltage(LegCommand::kHigh, sign, u_dc_V) + (1.0 - f) * leg_voltage(LegCommand::kLow, sign, u_dc_V);
   }
   return core::clarke(leg);  // the isolated neutral removes the zero sequence
 }

@@ -15,6 +15,8 @@ void PmsmPlant::reset(const core::Vec2& i_A, double theta_el_rad, double omega_e
   begin_period(p, h_s_, 0.0);
   state_.psi_Wb = magnetics_.flux(i_A);
   state_.i_A = stator_current(state_.psi_Wb, i_flux_A_, omega_el_rad_s);
+  update_torque();
+  torque_integral_Nms_ = 0.0;
 }
 
 void PmsmPlant::begin_period(const PlantParameters& p, double h_s, double load_torque_Nm) noexcept {
@@ -64,15 +66,45 @@ void PmsmPlant::step(const core::Vec2& u_ab_V) noexcept {
   i_flux_A_ = magnetics_.current(state_.psi_Wb, i_flux_pred);
   state_.i_A = stator_current(state_.psi_Wb, i_flux_A_, omega);
 
-  state_.torque_Nm = 1.5 * pole_pairs_ * (state_.psi_Wb[0] * state_.i_A[1] - state_.psi_Wb[1] * state_.i_A[0]);
-  if (!mechanics_.dynamometer) {
-    const double omega_mech = omega / pole_pairs_;
-    const double accel =
-        (state_.torque_Nm - load_torque_Nm_ - mechanics_.friction_Nms * omega_mech) / mechanics_.inertia_kgm2;
-    state_.omega_el_rad_s += h * accel * pole_pairs_;
-  }
+  update_torque();
+  if (!mechanics_.dynamometer) state_.omega_el_rad_s += h * acceleration(state_.torque_Nm, omega) * pole_pairs_;
   state_.theta_el_rad += omega * h;
   rotation_ = r1;
+}
+
+void PmsmPlant::update_torque() noexcept {
+  state_.torque_Nm = 1.5 * pole_pairs_ * (state_.psi_Wb[0] * state_.i_A[1] - state_.psi_Wb[1] * state_.i_A[0]);
+}
+
+double PmsmPlant::acceleration(double torque_Nm, double omega) const noexcept {
+  const double omega_mech = omega / pole_pairs_;
+  return (torque_Nm - load_torque_Nm_ - mechanics_.friction_Nms * omega_mech) / mechanics_.inertia_kgm2;
+}
+
+void PmsmPlant::move_to(const core::Vec2& psi_Wb, const core::Vec2& i_flux_guess_A, double dt_s) noexcept {
+  const double omega = period_speed();
+  const double torque_before = state_.torque_Nm;
+  state_.psi_Wb = psi_Wb;
+  i_flux_A_ = magnetics_.current(psi_Wb, i_flux_guess_A);
+  state_.i_A = stator_current(psi_Wb, i_flux_A_, omega);
+  update_torque();
+  torque_integral_Nms_ += 0.5 * (torque_before + state_.torque_Nm) * dt_s;
+  const double angle = omega * dt_s;
+  state_.theta_el_rad += angle;
+  rotation_ = core::compose(rotation_, rotation_by(angle));
+}
+
+void PmsmPlant::end_period() noexcept {
+  const double period_s = h_s_;
+  const double torque_mean = torque_integral_Nms_ / period_s;
+  torque_integral_Nms_ = 0.0;
+  if (mechanics_.dynamometer) return;
+  const double omega_before = state_.omega_el_rad_s, turned = period_speed() * period_s;
+  acceleration_el_ = acceleration(torque_mean, omega_before) * pole_pairs_;
+  state_.omega_el_rad_s += period_s * acceleration_el_;
+  const double correction = 0.5 * (omega_before + state_.omega_el_rad_s) * period_s - turned;
+  state_.theta_el_rad += correction;
+  rotation_ = core::compose(rotation_, rotation_by(correction));
 }
 
 core::Vec3 PmsmPlant::phase_currents() const noexcept {

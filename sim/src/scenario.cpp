@@ -32,7 +32,15 @@ void parse_inverter(io::YamlMap m, Scenario& s) {
 
 void parse_plant(io::YamlMap m, Scenario& s, const std::string& base_dir) {
   const bool averaged = s.inverter.model == InverterModel::kAveraged;
-  s.plant_step_s = m.number_or("step_s", averaged ? s.sample_period_s : 1e-6, 1e-8, s.sample_period_s);
+  const std::string integrator = m.choice_or("integrator", averaged ? "fixed" : "edges", {"edges", "fixed"});
+  s.integrator = integrator == "edges" ? PlantIntegrator::kEdges : PlantIntegrator::kFixedStep;
+  if (averaged && s.integrator == PlantIntegrator::kEdges) m.fail("integrator", "edges needs inverter.model: switching");
+  if (s.integrator == PlantIntegrator::kFixedStep) {
+    s.plant_step_s = m.number_or("step_s", averaged ? s.sample_period_s : 1e-6, 1e-9, s.sample_period_s);
+  } else if (m.has("step_s")) {
+    m.fail("step_s", "applies to integrator: fixed (the default, edges, integrates from one switching instant to the next)");
+  }
+  s.plant_tolerance = m.number_or("tolerance", 1e-9, 1e-14, 1e-3);
   s.flux_map_file = resolve(base_dir, m.text_or("flux_map", ""));
   s.r_fe_Ohm = m.number_or("r_fe_Ohm", 0.0, 0.0, 1e9);
   if (auto mech = m.optional_map("mechanics")) {
@@ -153,6 +161,7 @@ Scenario parse_scenario(const std::string& text, const std::string& name, const 
   s.seed = static_cast<std::uint64_t>(root.integer_or("seed", 1, 0, 1L << 62));
   if (auto m = root.optional_map("inverter")) parse_inverter(*m, s);
   s.plant_step_s = s.inverter.model == InverterModel::kAveraged ? s.sample_period_s : 1e-6;
+  s.integrator = s.inverter.model == InverterModel::kAveraged ? PlantIntegrator::kFixedStep : PlantIntegrator::kEdges;
   if (auto m = root.optional_map("plant")) parse_plant(*m, s, base_dir);
   const double steps = s.sample_period_s / s.plant_step_s;
   if (std::abs(steps - std::round(steps)) > 1e-6) root.fail("plant", "step_s must divide sample_period_s");

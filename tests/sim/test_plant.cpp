@@ -6,20 +6,11 @@
 
 #include "rpem/core/machine.hpp"
 #include "rpem/sim/plant.hpp"
-#include "support/paper_machine.hpp"
+#include "support/paper_plant.hpp"
 
 namespace rpem::sim {
 namespace {
 
-PlantParameters paper_parameters() {
-  const auto m = test::paper_machine_si();
-  PlantParameters p;
-  p.r_s_Ohm = m.r_s_Ohm;
-  p.psi_m_Wb = m.psi_m_Wb;
-  p.l_d_H = m.l_d_H;
-  p.l_q_H = m.l_q_H;
-  return p;
-}
 
 core::Vec2 settle(PmsmPlant& plant, const PlantParameters& p, double omega, const core::Vec2& u_dq, double seconds,
                   double h) {
@@ -39,7 +30,7 @@ core::Vec2 settle(PmsmPlant& plant, const PlantParameters& p, double omega, cons
 }
 
 TEST(Plant, SettlesAtTheAnalyticSteadyState) {
-  const PlantParameters p = paper_parameters();
+  const PlantParameters p = test::paper_plant_parameters();
   const core::PerUnitBase base = test::paper_base();
   const core::MachinePu m = test::paper_machine_pu();
   for (double n : {0.0, 0.3, -0.8}) {
@@ -58,7 +49,7 @@ TEST(Plant, SettlesAtTheAnalyticSteadyState) {
 }
 
 TEST(Plant, IronLossDrawsTheInducedVoltageOverRfe) {
-  PlantParameters p = paper_parameters();
+  PlantParameters p = test::paper_plant_parameters();
   p.r_fe_Ohm = 2000.0;
   const core::PerUnitBase base = test::paper_base();
   PmsmPlant plant(3, Magnetics(), MechanicsConfig{});
@@ -73,7 +64,7 @@ TEST(Plant, IronLossDrawsTheInducedVoltageOverRfe) {
 }
 
 TEST(Plant, InertiaModeAcceleratesWithTheTorqueDifference) {
-  const PlantParameters p = paper_parameters();
+  const PlantParameters p = test::paper_plant_parameters();
   MechanicsConfig mech;
   mech.dynamometer = false;
   mech.inertia_kgm2 = 0.02;

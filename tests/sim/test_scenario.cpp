@@ -31,7 +31,13 @@ TEST(Scenario, EventsAndDefaults) {
   EXPECT_DOUBLE_EQ(s.signal(Quantity::kPsiM).events()[0].target, 0.92 * 1.14);
   EXPECT_DOUBLE_EQ(s.signal(Quantity::kSpeed).initial(), 300.0);
   EXPECT_EQ(s.inverter.model, InverterModel::kSwitching);
-  EXPECT_DOUBLE_EQ(s.plant_step_s, 1e-6);
+  EXPECT_EQ(s.integrator, PlantIntegrator::kEdges);
+  const Scenario fixed = parse_scenario("duration_s: 1\nplant: {integrator: fixed}\n", "f.yaml", "");
+  EXPECT_EQ(fixed.integrator, PlantIntegrator::kFixedStep);
+  EXPECT_DOUBLE_EQ(fixed.plant_step_s, 1e-6);
+  const Scenario averaged = parse_scenario("duration_s: 1\ninverter: {model: averaged}\n", "a.yaml", "");
+  EXPECT_EQ(averaged.integrator, PlantIntegrator::kFixedStep);
+  EXPECT_DOUBLE_EQ(averaged.plant_step_s, averaged.sample_period_s);
 }
 
 struct Bad {
@@ -62,7 +68,10 @@ INSTANTIATE_TEST_SUITE_P(
                      "  - {t_s: 1, quantity: r_s_Ohm, kind: step, value: 2}\n",
             "events[1].t_s: events of one quantity must be in time order"},
         Bad{"speed_on_dyno", "duration_s: 1\ncontrol: {mode: speed}\n", "speed control needs plant.mechanics.mode: inertia"},
-        Bad{"step", "duration_s: 1\nplant: {step_s: 3.0e-6}\n", "step_s must divide sample_period_s"},
+        Bad{"step", "duration_s: 1\nplant: {integrator: fixed, step_s: 3.0e-6}\n", "step_s must divide sample_period_s"},
+        Bad{"step_with_edges", "duration_s: 1\nplant: {step_s: 1.0e-6}\n", "plant.step_s: applies to integrator: fixed"},
+        Bad{"edges_averaged", "duration_s: 1\ninverter: {model: averaged}\nplant: {integrator: edges}\n",
+            "plant.integrator: edges needs inverter.model: switching"},
         Bad{"machine", "duration_s: 1\nmachine: nowhere.yaml\n", "nowhere.yaml: cannot open file"}),
     [](const auto& p) { return std::string(p.param.name); });
 

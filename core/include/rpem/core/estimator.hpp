@@ -130,11 +130,17 @@ class RpemEstimator {
   /// The configured model with the current estimates and the sample's inductances, if it has any.
   [[nodiscard]] MachinePu model_for(const EstimatorSample& sample) const noexcept;
   [[nodiscard]] Mat2 select_gradient(const MachinePu& model, double n_pu) const noexcept;
+  /// The output of a sample that made no update: θ̂ and î as they stand.
+  [[nodiscard]] EstimatorOutput held(StepCode code) const noexcept;
 
   EstimatorConfig config_;
   EstimatorState state_;
-  PredictorCoefficients coefficients_;   ///< from config_.model; refreshed by reconfigure()
+  // Decided by reconfigure(), so the per-sample path does not re-derive them.
+  PredictorCoefficients coefficients_;   ///< from config_.model
   double inverse_nominal_period_ = 0.0;  ///< 1/T_samp
+  Gradients gradients_ = Gradients::kSkip;  ///< whether predict() advances the dynamic gradients
+  double scaled_for_dt_s_ = -1.0;        ///< the interval gamma_r_, gamma_l_ were scaled for
+  Vec2 gamma_r_ = Vec2::Zero(), gamma_l_ = Vec2::Zero();
 };
 
 }  // namespace rpem::core

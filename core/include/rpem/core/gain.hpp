@@ -4,6 +4,7 @@
 // (eq_RPEM_intro). `gradient` is Ψᵀ = dî/dθ̂ (rows: î_d, î_q; columns: ψ̂m, r̂s), so Ψ = gradientᵀ.
 // Gain sequences are per nominal sample and per parameter, as in tab_psimgains.
 
+#include <algorithm>
 #include <cstdint>
 
 #include "rpem/core/machine.hpp"
@@ -39,8 +40,20 @@ struct GainOutput {
 
 /// SGA (eq:SGA_full, eq:SGAHessian), one scalar Hessian per parameter:
 ///   r_j[k] = r_j[k−1] + γ_r,j·(tr{Ψ·Ψᵀ} − r_j[k−1]),   L_j = γ_L,j · Ψ_j / max(r_j[k], r_min)
-[[nodiscard]] GainOutput sga_gain(const Mat2& gradient, const Vec2& gamma_hessian, const Vec2& gamma_gain,
-                                  const GainFloors& floors, Vec2& r) noexcept;
+/// Inline: it is on the estimator's per-sample path.
+[[nodiscard]] inline GainOutput sga_gain(const Mat2& gradient, const Vec2& gamma_hessian, const Vec2& gamma_gain,
+                                         const GainFloors& floors, Vec2& r) noexcept {
+  const double trace = gradient.squaredNorm();  // tr{Ψ·Ψᵀ}, eq:traceSGAHessian
+  r += gamma_hessian.cwiseProduct(Vec2(trace, trace) - r);
+  const double floor = floors.sga_hessian_min_pu;
+  const Vec2 scale = gamma_gain.cwiseQuotient(Vec2(std::max(r[0], floor), std::max(r[1], floor)));
+  // Row j of L is scale_j·Ψ_jᵀ. Built a column at a time: Mat2 is column-major, and element-wise
+  // stores would stall the caller's whole-column loads (store forwarding).
+  GainOutput out{Mat2(), std::min(r[0], r[1]) < floor ? gain_flag::kFloored : std::uint8_t{0}};
+  out.gain.col(0) = scale.cwiseProduct(gradient.row(0).transpose());
+  out.gain.col(1) = scale.cwiseProduct(gradient.row(1).transpose());
+  return out;
+}
 
 /// GNA (eq:GNA_full … eq:GNA_GainElements):
 ///   R[k] = R[k−1] + γ_r·(Ψ·Ψᵀ − R[k−1]),   L = diag(γ_L)·R⁻¹·Ψ,

@@ -49,7 +49,16 @@ struct MachinePu {
 /// lacks the square on r̂_s (erratum E2):
 ///   dî_d/dψ̂m = −n²·x_q / D,                 dî_q/dψ̂m = −n·r̂_s / D
 ///   dî_d/dr̂s = (−r̂_s·î_d − n·x_q·î_q) / D,   dî_q/dr̂s = (n·x_d·î_d − r̂_s·î_q) / D
-[[nodiscard]] Mat2 steady_state_gradients(const MachinePu& m, double n_pu, const Vec2& i_hat_pu) noexcept;
+/// Inline: it is on the estimator's per-sample path.
+[[nodiscard]] inline Mat2 steady_state_gradients(const MachinePu& m, double n_pu, const Vec2& i_hat_pu) noexcept {
+  const double inv_d = 1.0 / steady_state_denominator(m, n_pu);
+  // Built a column at a time (Mat2 is column-major: element-wise stores would stall whole-column loads).
+  Mat2 g;
+  g.col(kPsiM) = Vec2(-n_pu * n_pu * m.x_q_pu, -n_pu * m.r_s_pu) * inv_d;
+  g.col(kRs) = Vec2(-m.r_s_pu * i_hat_pu[0] - n_pu * m.x_q_pu * i_hat_pu[1],
+                    n_pu * m.x_d_pu * i_hat_pu[0] - m.r_s_pu * i_hat_pu[1]) * inv_d;
+  return g;
+}
 
 /// Steady-state prediction error ε = i − î (eq_epsilon_steadystate) of a model with parameters `model`
 /// against a machine with parameters `plant`, both driven by the same voltage; exact, not linearised.

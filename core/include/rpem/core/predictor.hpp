@@ -55,8 +55,79 @@ enum class Gradients : std::uint8_t { kAdvance = 0, kSkip = 1 };
 
 /// Advances the predictor and its dynamic gradients by one interval. `model` carries the current
 /// estimates ψ̂m, r̂s and the model inductances x_d, x_q; `c` must be PredictorCoefficients::of(model).
-void predict(const MachinePu& model, const PredictorCoefficients& c, Discretization method,
-             const PredictorInterval& interval, PredictorState& state, Gradients gradients = Gradients::kAdvance) noexcept;
+namespace detail {
+
+/// The model's coefficients for one call.
+struct Coefficients {
+  double wd;  ///< ω_n/x_d
+  double wq;  ///< ω_n/x_q
+  const MachinePu& m;
+
+  /// A(n) of Eq_FullOrderModel: ω_n·[−r/x_d, n·x_q/x_d; −n·x_d/x_q, −r/x_q].
+  [[nodiscard]] Mat2 system(double n) const noexcept {
+    Mat2 a;
+    a.col(0) = Vec2(-wd * m.r_s_pu, -wq * n * m.x_d_pu);
+    a.col(1) = Vec2(wd * n * m.x_q_pu, -wq * m.r_s_pu);
+    return a;
+  }
+  /// Forcing of the current equation: B·u + f(n, ψ̂m).
+  [[nodiscard]] Vec2 current_forcing(double n, const Vec2& u) const noexcept {
+    return {wd * u[0], wq * (u[1] - n * m.psi_m_pu)};
+  }
+  /// Forcing of the ψ̂m-sensitivity: ∂f/∂ψ̂m.
+  [[nodiscard]] Vec2 psi_forcing(double n) const noexcept { return {0.0, -wq * n}; }
+  /// Forcing of the r̂s-sensitivity: (∂A/∂r̂s)·î.
+  [[nodiscard]] Vec2 rs_forcing(const Vec2& i_hat) const noexcept { return {-wd * i_hat[0], -wq * i_hat[1]}; }
+};
+
+/// One trapezoidal step x_k = (I − h/2·A_k)⁻¹·((I + h/2·A_{k−1})·x_{k−1} + w), element by element:
+/// A(n) = [a11, b·n; c·n, a22] has the speed only off the diagonal, and the inverse is the adjugate
+/// over the determinant, whose division overlaps the products.
+struct Trapezoid {
+  double m11, m12, m21, m22;  ///< I − h/2·A(n_end)
+  double n11, n12, n21, n22;  ///< I + h/2·A(n_start)
+  double inv_det;
+
+  Trapezoid(const Coefficients& c, double half_h, double n_start, double n_end) noexcept {
+    const double d11 = half_h * c.wd * c.m.r_s_pu, d22 = half_h * c.wq * c.m.r_s_pu;
+    const double b = half_h * c.wd * c.m.x_q_pu, cc = -half_h * c.wq * c.m.x_d_pu;
+    m11 = 1.0 + d11, m12 = -b * n_end, m21 = -cc * n_end, m22 = 1.0 + d22;
+    n11 = 1.0 - d11, n12 = b * n_start, n21 = cc * n_start, n22 = 1.0 - d22;
+    inv_det = 1.0 / (m11 * m22 - m12 * m21);
+  }
+  /// x_k for the previous value x and the forcing term w (already times h/2).
+  [[nodiscard]] Vec2 step(const Vec2& x, const Vec2& w) const noexcept {
+    const double v0 = n11 * x[0] + n12 * x[1] + w[0], v1 = n21 * x[0] + n22 * x[1] + w[1];
+    return Vec2(m22 * v0 - m12 * v1, m11 * v1 - m21 * v0) * inv_det;
+  }
+};
+
+}  // namespace detail
+
+inline void predict(const MachinePu& model, const PredictorCoefficients& pc, Discretization method,
+             const PredictorInterval& iv, PredictorState& s, Gradients gradients = Gradients::kAdvance) noexcept {
+  const detail::Coefficients c{pc.wd, pc.wq, model};
+  const double h = iv.dt_s;
+  const Vec2 i_prev = s.i_hat_pu;
+
+  if (method == Discretization::kExplicitEuler) {
+    const Mat2 a_start = c.system(iv.n_start_pu);
+    s.i_hat_pu = i_prev + h * (a_start * i_prev + c.current_forcing(iv.n_start_pu, iv.u_start_pu));
+    if (gradients == Gradients::kSkip) return;
+    s.gradient.col(kPsiM) += h * (a_start * s.gradient.col(kPsiM) + c.psi_forcing(iv.n_start_pu));
+    s.gradient.col(kRs) += h * (a_start * s.gradient.col(kRs) + c.rs_forcing(i_prev));
+    return;
+  }
+
+  const double half_h = 0.5 * h;
+  const detail::Trapezoid t(c, half_h, iv.n_start_pu, iv.n_end_pu);
+  s.i_hat_pu = t.step(i_prev, half_h * (c.current_forcing(iv.n_start_pu, iv.u_start_pu) +
+                                        c.current_forcing(iv.n_end_pu, iv.u_end_pu)));
+  if (gradients == Gradients::kSkip) return;
+  s.gradient.col(kPsiM) = t.step(s.gradient.col(kPsiM), half_h * (c.psi_forcing(iv.n_start_pu) + c.psi_forcing(iv.n_end_pu)));
+  s.gradient.col(kRs) = t.step(s.gradient.col(kRs), half_h * (c.rs_forcing(i_prev) + c.rs_forcing(s.i_hat_pu)));
+}
+
 
 /// The same, computing the coefficients on the way.
 inline void predict(const MachinePu& model, double omega_n_rad_s, Discretization method,

@@ -28,12 +28,12 @@ struct Schedule {
 
 /// Zeroes the gain rows of parameters that may not adapt.
 inline void apply_schedule(const Schedule& s, Mat2& gain) noexcept {
-  // A row mask applied column by column: Mat2 is column-major, and zeroing a row element-wise made the
-  // next whole-column loads wait on two scalar stores (store-forwarding stalls on the per-sample path).
-  // A select, not a product: a row that may not adapt is zero even where its gain is not finite.
-  const Eigen::Array<bool, 2, 1> keep(s.psi_m, s.r_s);
-  gain.col(0) = keep.select(gain.col(0).array(), 0.0).matrix();
-  gain.col(1) = keep.select(gain.col(1).array(), 0.0).matrix();
+  // A row mask, each column selected in registers and written whole: Mat2 is column-major, and zeroing
+  // a row element-wise (as Eigen's select() compiles) made the next whole-column loads wait on scalar
+  // stores (store-forwarding stalls on the per-sample path). A select, not a product: a row that may not
+  // adapt is zero even where its gain is not finite.
+  gain.col(0) = Vec2(s.psi_m ? gain(0, 0) : 0.0, s.r_s ? gain(1, 0) : 0.0);
+  gain.col(1) = Vec2(s.psi_m ? gain(0, 1) : 0.0, s.r_s ? gain(1, 1) : 0.0);
 }
 
 /// D_M of eq:paramsubset.

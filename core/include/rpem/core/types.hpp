@@ -18,6 +18,20 @@ enum class Param : int { kPsiM = 0, kRs = 1 };
 inline constexpr int kPsiM = static_cast<int>(Param::kPsiM);
 inline constexpr int kRs = static_cast<int>(Param::kRs);
 
+/// 0 if x is finite, NaN if it is ±∞ or NaN (x·0); for a vector, the sum over its elements.
+[[nodiscard]] inline double finite_probe(double x) noexcept { return x * 0.0; }
+template <typename Derived>
+[[nodiscard]] double finite_probe(const Eigen::MatrixBase<Derived>& v) noexcept {
+  return (v * 0.0).sum();
+}
+
+/// Whether every value (scalars, fixed-size vectors) is finite, with one comparison: the probes sum to 0
+/// exactly when all are finite (they are 0 or NaN, so no sum of them can overflow).
+template <typename... Values>
+[[nodiscard]] bool all_finite(const Values&... x) noexcept {
+  return (finite_probe(x) + ... + 0.0) == 0.0;
+}
+
 /// Determinant of a 2×2 matrix.
 [[nodiscard]] inline double det2(const Mat2& m) noexcept { return m(0, 0) * m(1, 1) - m(0, 1) * m(1, 0); }
 

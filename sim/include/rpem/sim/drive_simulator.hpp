@@ -6,12 +6,14 @@
 //
 // Period k (t_k = k·T): sample the sensors; emit row k with the command that acts over [t_k, t_k+1]
 // (computed in period k − 1); run the FOC on the samples (its command acts in period k + 1);
-// integrate the plant over [t_k, t_k+1] with the inverter's mean voltage per plant step.
+// integrate the plant over [t_k, t_k+1] — at switching fidelity from one switching instant to the next
+// (EdgeIntegrator) or in fixed steps with the inverter's mean voltage over each (Scenario::integrator).
 
 #include <cstdint>
 #include <memory>
 
 #include "rpem/io/drive_log.hpp"
+#include "rpem/sim/edge_integrator.hpp"
 #include "rpem/sim/foc.hpp"
 #include "rpem/sim/inverter.hpp"
 #include "rpem/sim/plant.hpp"
@@ -45,6 +47,8 @@ class DriveSimulator {
   [[nodiscard]] const PmsmPlant& plant() const noexcept { return plant_; }
   [[nodiscard]] std::int64_t period_ns() const noexcept { return period_ns_; }
   [[nodiscard]] std::int64_t samples_total() const noexcept { return samples_total_; }
+  /// The edge-to-edge integrator (its counters); null with fixed steps.
+  [[nodiscard]] const EdgeIntegrator* edge_integrator() const noexcept { return edge_to_edge_ ? &edges_ : nullptr; }
 
  private:
   [[nodiscard]] PlantParameters parameters_at(double t_s) noexcept;
@@ -58,6 +62,8 @@ class DriveSimulator {
   Scenario scenario_;
   PmsmPlant plant_;
   Inverter inverter_;
+  EdgeIntegrator edges_;
+  bool edge_to_edge_;
   FocController foc_;
   Sensors sensors_;
   std::int64_t period_ns_;

@@ -35,6 +35,11 @@ inline constexpr std::array<const char*, static_cast<int>(Quantity::kCount)> kQu
 /// Temperature coupling of r_s and ψm (the law in core/thermal_drift.hpp).
 using ThermalCoupling = core::ThermalCoefficients;
 
+/// How the plant is integrated at switching fidelity (docs/scenarios.md, `plant.integrator`): from one
+/// switching instant to the next (EdgeIntegrator), or in fixed steps of Heun's method with the
+/// inverter's mean voltage over each step. Averaged fidelity always takes fixed steps.
+enum class PlantIntegrator { kEdges, kFixedStep };
+
 struct LogOptions {
   bool dq_columns = false;
   bool temperatures = false;
@@ -51,7 +56,9 @@ struct Scenario {
   std::uint64_t seed = 1;
   InverterConfig inverter;
   double inverter_delay_s = 0.0;      ///< the command acts this much late, < one period (hidden effect)
-  double plant_step_s = 1e-6;
+  PlantIntegrator integrator = PlantIntegrator::kEdges;  ///< switching fidelity only
+  double plant_step_s = 1e-6;         ///< the fixed-step integrator's step
+  double plant_tolerance = 1e-9;      ///< edges with a flux map: relative local error per step
   std::string flux_map_file;          ///< empty: constant inductances
   MechanicsConfig mechanics;
   FocConfig control;
@@ -73,7 +80,8 @@ struct Scenario {
 [[nodiscard]] Scenario parse_scenario(const std::string& text, const std::string& name, const std::string& base_dir);
 
 /// A scenario with the defaults of the paper's setup (tab_machineData): built-in machine, switching
-/// inverter at 4 kHz with 3rd-harmonic injection, 1 µs plant, 125 µs control, dynamometer, torque mode.
+/// inverter at 4 kHz with 3rd-harmonic injection, edge-to-edge plant, 125 µs control, dynamometer,
+/// torque mode.
 [[nodiscard]] Scenario paper_scenario();
 
 }  // namespace rpem::sim
