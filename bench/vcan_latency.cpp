@@ -12,14 +12,12 @@
 #include <vector>
 
 #include "rpem/can/socketcan.hpp"
+#include "rpem/core/clock.hpp"
 
 namespace {
 
-std::int64_t now(clockid_t c) {
-  timespec ts{};
-  clock_gettime(c, &ts);
-  return static_cast<std::int64_t>(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
-}
+using rpem::core::now_ns;
+using rpem::core::sleep_until_ns;
 
 void report(const char* what, std::vector<double> v) {
   if (v.empty()) return;
@@ -45,17 +43,16 @@ int main(int argc, char** argv) {
 
   std::thread sender([&] {
     const auto period = static_cast<std::int64_t>(1e9 / rate);
-    std::int64_t next = now(CLOCK_MONOTONIC);
+    std::int64_t next = now_ns(CLOCK_MONOTONIC);
     for (std::size_t k = 0; k < total; ++k) {
       next += period;
-      timespec ts{static_cast<time_t>(next / 1'000'000'000), static_cast<long>(next % 1'000'000'000)};
-      clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr);
+      sleep_until_ns(CLOCK_MONOTONIC, next);
       rpem::can::CanFrame f;
       f.id = 0x100;
       f.fd = true;
       f.len = 64;
       for (int b = 0; b < 4; ++b) f.data[static_cast<std::size_t>(b)] = static_cast<std::uint8_t>(k >> (8 * b));
-      sent_at[k] = now(CLOCK_REALTIME);
+      sent_at[k] = now_ns(CLOCK_REALTIME);
       tx.send(f, 50);
     }
     done = true;
@@ -67,7 +64,7 @@ int main(int argc, char** argv) {
   std::int64_t idle_since = 0;
   while (true) {
     const std::size_t n = rx.receive(buf, 50);
-    const std::int64_t t_user = now(CLOCK_REALTIME);
+    const std::int64_t t_user = now_ns(CLOCK_REALTIME);
     for (std::size_t i = 0; i < n; ++i) {
       std::size_t k = 0;
       for (int b = 0; b < 4; ++b) k |= static_cast<std::size_t>(buf[i].frame.data[static_cast<std::size_t>(b)]) << (8 * b);
@@ -77,8 +74,8 @@ int main(int argc, char** argv) {
       ++received;
     }
     if (n == 0 && done) {
-      if (idle_since == 0) idle_since = now(CLOCK_MONOTONIC);
-      if (now(CLOCK_MONOTONIC) - idle_since > 500'000'000) break;
+      if (idle_since == 0) idle_since = now_ns(CLOCK_MONOTONIC);
+      if (now_ns(CLOCK_MONOTONIC) - idle_since > 500'000'000) break;
     } else {
       idle_since = 0;
     }

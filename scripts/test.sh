@@ -5,6 +5,9 @@
 #   3. builds the unit tests of core, io, can, sim and analysis with AddressSanitizer +
 #      UndefinedBehaviorSanitizer and runs them (the daemon's real-time loop is covered by its own
 #      allocation and VM tests; rpemd and the rpem tool are left out of this build)
+#   4. builds rpemd and the daemon's tests with ThreadSanitizer and runs them — the storm test drives
+#      the instrumented rpemd with reloads and commands at once — expecting no report (suppressed: only
+#      the uninstrumented LCM/GLib internals, tests/daemon/tsan.supp)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 jobs=$(nproc)
@@ -21,4 +24,11 @@ cmake --build build/sanitize -j "$jobs" --target test_core test_io test_can test
   test_indep_drive indep_drive_log
 UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1 ASAN_OPTIONS=detect_leaks=1 \
   ctest --test-dir build/sanitize --output-on-failure -j "$jobs" -L unit
+cmake -S . -B build/tsan -G Ninja -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS_DEBUG="-O1 -g" -DRPEM_WERROR=ON \
+  -DRPEM_SANITIZE=thread -DRPEM_BUILD_BENCHMARKS=OFF -DRPEM_BUILD_TOOLS=OFF
+cmake --build build/tsan -j "$jobs" --target rpemd test_daemon test_daemon_allocations test_daemon_storm
+for t in test_daemon test_daemon_allocations test_daemon_storm; do
+  TSAN_OPTIONS="suppressions=$PWD/tests/daemon/tsan.supp halt_on_error=1 second_deadlock_stack=1" \
+    "build/tsan/tests/daemon/$t" --gtest_brief=1
+done
 echo "test.sh: all tests passed"

@@ -15,14 +15,10 @@
 #include <ctime>
 #include <stdexcept>
 
+#include "rpem/core/clock.hpp"
+
 namespace rpem::can {
 namespace {
-
-std::int64_t monotonic_ns() {
-  timespec ts{};
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return static_cast<std::int64_t>(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
-}
 
 std::string errno_text(const char* what) { return std::string(what) + ": " + std::strerror(errno); }
 
@@ -35,7 +31,7 @@ SocketCanChannel::~SocketCanChannel() {
 }
 
 bool SocketCanChannel::open() {
-  next_open_attempt_ns_ = monotonic_ns() + static_cast<std::int64_t>(options_.reopen_interval_ms) * 1'000'000;
+  next_open_attempt_ns_ = core::now_ns(CLOCK_MONOTONIC) + static_cast<std::int64_t>(options_.reopen_interval_ms) * 1'000'000;
   const unsigned index = if_nametoindex(options_.interface.c_str());
   if (index == 0) {
     last_error_ = "no interface " + options_.interface;
@@ -93,7 +89,7 @@ void SocketCanChannel::close_socket(const std::string& why) {
   last_error_ = why;
   if (fd_ >= 0) ::close(fd_);
   fd_ = -1;
-  next_open_attempt_ns_ = monotonic_ns() + static_cast<std::int64_t>(options_.reopen_interval_ms) * 1'000'000;
+  next_open_attempt_ns_ = core::now_ns(CLOCK_MONOTONIC) + static_cast<std::int64_t>(options_.reopen_interval_ms) * 1'000'000;
 }
 
 void SocketCanChannel::count_error_frame(const CanFrame& f) {
@@ -113,7 +109,7 @@ void SocketCanChannel::count_error_frame(const CanFrame& f) {
 
 std::size_t SocketCanChannel::receive(std::span<ReceivedFrame> out, int timeout_ms) {
   if (fd_ < 0) {
-    if (monotonic_ns() < next_open_attempt_ns_ || !open()) {
+    if (core::now_ns(CLOCK_MONOTONIC) < next_open_attempt_ns_ || !open()) {
       timespec pause{0, static_cast<long>(std::min(timeout_ms, options_.reopen_interval_ms)) * 1'000'000};
       nanosleep(&pause, nullptr);
       return 0;
@@ -154,11 +150,11 @@ std::size_t SocketCanChannel::receive(std::span<ReceivedFrame> out, int timeout_
       if (c->cmsg_type == SO_TIMESTAMPING) {
         timespec ts[3];
         std::memcpy(ts, CMSG_DATA(c), sizeof ts);
-        r.kernel_rx_ns = static_cast<std::int64_t>(ts[0].tv_sec) * 1'000'000'000 + ts[0].tv_nsec;
+        r.kernel_rx_ns = core::to_ns(ts[0]);
       } else if (c->cmsg_type == SO_TIMESTAMP) {
         timeval tv{};
         std::memcpy(&tv, CMSG_DATA(c), sizeof tv);
-        r.kernel_rx_ns = static_cast<std::int64_t>(tv.tv_sec) * 1'000'000'000 + tv.tv_usec * 1000;
+        r.kernel_rx_ns = core::to_ns(tv);
       } else if (c->cmsg_type == SO_RXQ_OVFL) {
         std::uint32_t overflow = 0;
         std::memcpy(&overflow, CMSG_DATA(c), sizeof overflow);
@@ -186,7 +182,7 @@ std::size_t SocketCanChannel::receive(std::span<ReceivedFrame> out, int timeout_
 }
 
 bool SocketCanChannel::send(const CanFrame& frame, int timeout_ms) {
-  if (fd_ < 0 && (monotonic_ns() < next_open_attempt_ns_ || !open())) {
+  if (fd_ < 0 && (core::now_ns(CLOCK_MONOTONIC) < next_open_attempt_ns_ || !open())) {
     ++counters_.tx_dropped;
     return false;
   }

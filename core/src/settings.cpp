@@ -10,26 +10,14 @@ MachinePu to_pu(const PerUnitBase& base, const MachineSi& m) noexcept {
 EstimatorConfig make_estimator_config(const PerUnitBase& base, const MachineSi& m,
                                       const EstimatorSettings& s) noexcept {
   EstimatorConfig c;
+  static_cast<EstimatorOptions&>(c) = s;
   c.model = to_pu(base, m);
   c.omega_n_rad_s = base.omega_el_rad_s;
-  c.algorithm = s.algorithm;
-  c.discretization = s.discretization;
-  c.gradient_psi_m = s.gradient_psi_m;
-  c.gradient_r_s = s.gradient_r_s;
-  c.gains = s.gains;
-  c.floors = s.floors;
   c.scheduler.psi_m_min_speed_pu = base.mech_speed_rpm_to_pu(s.psi_m_min_speed_rpm);
   c.scheduler.r_s_max_speed_pu = base.mech_speed_rpm_to_pu(s.r_s_max_speed_rpm);
   c.bounds.min_pu = {base.flux_pu(s.psi_m_min_Wb), base.resistance_pu(s.r_s_min_Ohm)};
   c.bounds.max_pu = {base.flux_pu(s.psi_m_max_Wb), base.resistance_pu(s.r_s_max_Ohm)};
   c.initial_theta_pu = {base.flux_pu(s.initial_psi_m_Wb), base.resistance_pu(s.initial_r_s_Ohm)};
-  c.initial_sga_hessian_pu = s.initial_sga_hessian_pu;
-  c.initial_gna_hessian_pu = s.initial_gna_hessian_pu;
-  c.nominal_sample_period_s = s.nominal_sample_period_s;
-  c.max_sample_interval_s = s.max_sample_interval_s;
-  c.max_gap_carry_s = s.max_gap_carry_s;
-  c.adapt_psi_m = s.adapt_psi_m;
-  c.adapt_r_s = s.adapt_r_s;
   return c;
 }
 

@@ -1,70 +1,70 @@
 #include "rpem/daemon/estimator_loop.hpp"
 
 #include <algorithm>
-#include <cerrno>
+#include <array>
 #include <cmath>
-#include <ctime>
 
+#include "rpem/core/clock.hpp"
 #include "rpem/daemon/realtime.hpp"
 
 namespace rpem::daemon {
 namespace {
 
-std::int64_t clock_ns(clockid_t c) noexcept {
-  timespec ts{};
-  clock_gettime(c, &ts);  // vDSO: no system call
-  return static_cast<std::int64_t>(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
-}
+using Diag = rpem::diagnostics_t;
+
+constexpr std::array<CounterRow<LoopCounters>, 9> kLoopRows{{
+    {&LoopCounters::samples, &Diag::samples},
+    {&LoopCounters::resyncs, &Diag::resyncs},
+    {&LoopCounters::rejected_non_finite, &Diag::rejected_non_finite},
+    {&LoopCounters::predictor_resets, &Diag::predictor_resets},
+    {&LoopCounters::projections, &Diag::projections},
+    {&LoopCounters::output_queue_drops, &Diag::output_queue_drops},
+    {&LoopCounters::commands_applied, &Diag::commands_applied},
+    {&LoopCounters::command_sequence_errors, &Diag::command_sequence_errors},
+    {&LoopCounters::config_reloads, &Diag::config_reloads},
+}};
+static_assert(kLoopRows.size() + 3 <= DiagnosticsRows::kMaxCounts);
 
 std::int64_t interval_ns(double rate_Hz) noexcept {
   return rate_Hz > 0.0 ? static_cast<std::int64_t>(1e9 / rate_Hz) : INT64_MAX / 4;
 }
 
+std::int64_t unix_us() noexcept { return core::now_ns(CLOCK_REALTIME) / 1000; }
+
 }  // namespace
 
-EstimatorLoop::EstimatorLoop(const DaemonConfig& config, SpscQueue<core::DriveSample>& input,
-                             SpscQueue<Command>& commands, SpscQueue<Report>& output)
-    : config_(config),
-      input_(input),
-      commands_(commands),
-      output_(output),
-      estimator_(config.machine.machine, config.machine.estimator),
-      period_ns_(static_cast<std::int64_t>(config.loop_period_s * 1e9)),
-      wake_ahead_ns_(static_cast<std::int64_t>(config.loop_wake_ahead_s * 1e9)),
-      wake_ahead_calibration_periods_(config.loop_wake_ahead_auto
-                                          ? std::max<std::int64_t>(1, std::llround(1.0 / config.loop_period_s))
-                                          : 0),
-      wake_ahead_published_ns_(config.loop_wake_ahead_auto ? -1 : wake_ahead_ns_),
-      estimate_interval_ns_(interval_ns(config.estimate_rate_Hz)),
-      measurement_interval_ns_(interval_ns(config.measurement_rate_Hz)),
-      stats_interval_ns_(interval_ns(config.diagnostics_rate_Hz)) {
-  ring_size_ = std::clamp(static_cast<int>(config.validity.convergence_window_s * config.estimate_rate_Hz), 2, 64);
-}
+EstimatorLoop::EstimatorLoop(const DaemonConfig& config, Queues queues)
+    : live_(config.live),
+      loop_config_(config.fixed.loop),
+      queues_(queues),
+      estimator_(config.live.machine.machine, config.live.machine.estimator),
+      validity_(config.live.validity, config.fixed.lcm.estimate_rate_Hz),
+      timer_(config.fixed.loop),
+      estimate_interval_ns_(interval_ns(config.fixed.lcm.estimate_rate_Hz)),
+      measurement_interval_ns_(interval_ns(config.fixed.lcm.measurement_rate_Hz)),
+      stats_interval_ns_(interval_ns(config.fixed.lcm.diagnostics_rate_Hz)) {}
 
-void EstimatorLoop::seed(const std::optional<double>& psi_m_Wb, const std::optional<double>& r_s_Ohm) {
-  estimator_.set_estimates(psi_m_Wb.value_or(estimator_.psi_m_Wb()), r_s_Ohm.value_or(estimator_.r_s_Ohm()));
-  if (psi_m_Wb) {
-    has_good_psi_ = true;
-    good_psi_ = *psi_m_Wb;
-  }
-  if (r_s_Ohm) {
-    has_good_rs_ = true;
-    good_rs_ = *r_s_Ohm;
-    r_s_valid_ = true;  // a persisted converged r_s is valid until a reset
-  }
+void EstimatorLoop::seed(const std::optional<SeedValue>& psi_m, const std::optional<SeedValue>& r_s, std::int64_t now_ns) {
+  estimator_.set_estimates(psi_m ? psi_m->value : estimator_.psi_m_Wb(), r_s ? r_s->value : estimator_.r_s_Ohm());
+  auto keep = [&](int j, const SeedValue& s) {
+    validity_.seed(j, s.age_s, now_ns);
+    has_good_[j] = true;
+    good_[j] = s.value;
+    good_ns_[j] = now_ns - static_cast<std::int64_t>(std::max(0.0, s.age_s) * 1e9);
+  };
+  if (psi_m) keep(core::kPsiM, *psi_m);
+  if (r_s) keep(core::kRs, *r_s);
 }
 
 void EstimatorLoop::push(const Report& r) noexcept {
-  if (!output_.push(r)) ++output_drops_;
+  if (!queues_.reports.push(r)) ++counters_.output_queue_drops;
 }
 
 void EstimatorLoop::apply(const Command& c) noexcept {
   switch (c.kind) {
     case Command::Kind::kReset:
       estimator_.reset();
-      r_s_valid_ = false;
-      r_s_adapted_s_ = psi_m_adapted_s_ = 0.0;
-      ring_count_ = 0;
+      validity_.restart();
       break;
     case Command::Kind::kFreeze:
       estimator_.set_frozen(true);
@@ -72,40 +72,38 @@ void EstimatorLoop::apply(const Command& c) noexcept {
     case Command::Kind::kUnfreeze:
       estimator_.set_frozen(false);
       break;
-    case Command::Kind::kSetValues:
+    case Command::Kind::kSetValues:  // new initial values: identification starts over from them
       estimator_.set_estimates(c.psi_m_Wb, c.r_s_Ohm);
-      ring_count_ = 0;
+      validity_.restart();
       break;
     case Command::Kind::kReconfigure:
-      estimator_.reconfigure(c.machine, c.settings);
-      config_.machine.machine = c.machine;
-      config_.machine.estimator = c.settings;
-      config_.temperature = c.temperature;
-      config_.validity = c.validity;
-      ++config_reloads_;
+      live_ = c.live;
+      estimator_.reconfigure(live_.machine.machine, live_.machine.estimator);
+      validity_.reconfigure(live_.validity);
+      ++counters_.config_reloads;
       break;
   }
   if (c.seq > 0) {
-    last_seq_ = c.seq;
-    last_result_ = CommandResult::kApplied;
-    ++commands_applied_;
+    if (c.seq <= last_applied_seq_) ++counters_.command_sequence_errors;
+    last_applied_seq_ = c.seq;
+    ++counters_.commands_applied;
   }
 }
 
-void EstimatorLoop::step(const core::DriveSample& s) noexcept {
+void EstimatorLoop::step(const core::DriveSample& s, std::int64_t now_ns) noexcept {
   last_ = estimator_.step(s);
   last_sample_ = s;
-  ++samples_;
-  const auto& d = last_.detail;
+  ++counters_.samples;
+  const core::EstimatorOutput& d = last_.detail;
   switch (d.code) {
     case core::StepCode::kSynchronized:
-      ++resyncs_;
+      ++counters_.resyncs;
       break;
     case core::StepCode::kRejectedNonFinite:
-      ++rejected_;
+      ++counters_.rejected_non_finite;
       break;
     case core::StepCode::kPredictorDiverged:
-      ++predictor_resets_;
+      ++counters_.predictor_resets;
       break;
     case core::StepCode::kAdapted:
       eps2_d_ += last_.epsilon_A[0] * last_.epsilon_A[0];
@@ -113,139 +111,113 @@ void EstimatorLoop::step(const core::DriveSample& s) noexcept {
       ++eps_n_;
       break;
   }
-  if (d.flags & (core::step_flag::kProjectedPsiM | core::step_flag::kProjectedRs)) ++projections_;
-  const double dt = estimator_.core().config().nominal_sample_period_s;
-  if (d.flags & core::step_flag::kRsActive) r_s_adapted_s_ += dt;
-  if (r_s_adapted_s_ >= config_.validity.r_s_after_s) r_s_valid_ = true;
-  psi_m_adapted_s_ = (d.flags & core::step_flag::kPsiMActive) ? psi_m_adapted_s_ + dt : 0.0;
+  if (d.flags & (core::step_flag::kProjectedPsiM | core::step_flag::kProjectedRs)) ++counters_.projections;
+  validity_.on_sample(d.flags, live_.machine.estimator.nominal_sample_period_s, now_ns);
 }
 
-bool EstimatorLoop::converged(const std::array<double, 64>& ring, int count) const noexcept {
-  if (count < ring_size_) return false;
-  double lo = ring[0], hi = ring[0];
-  for (int k = 1; k < ring_size_; ++k) {
-    lo = std::min(lo, ring[static_cast<std::size_t>(k)]);
-    hi = std::max(hi, ring[static_cast<std::size_t>(k)]);
-  }
-  return hi - lo <= config_.validity.convergence_band * std::abs(hi);
+void EstimatorLoop::report_measurement(const core::DriveSample& s) noexcept {
+  MeasurementReport m;
+  m.utime_us = unix_us();
+  m.sample_time_us = s.t_ns / 1000;
+  m.theta_el_rad = s.theta_el_rad;
+  m.omega_el_rad_s = s.omega_el_rad_s;
+  m.u_dc_V = s.u_dc_V;
+  m.i_d_A = last_.i_meas_A[0];
+  m.i_q_A = last_.i_meas_A[1];
+  m.i_hat_d_A = last_.i_hat_A[0];
+  m.i_hat_q_A = last_.i_hat_A[1];
+  m.eps_d_A = last_.epsilon_A[0];
+  m.eps_q_A = last_.epsilon_A[1];
+  push(m);
 }
 
-void EstimatorLoop::report_estimate(std::int64_t) noexcept {
+void EstimatorLoop::report_estimate(std::int64_t now_ns) noexcept {
   EstimateReport r;
-  r.utime_us = clock_ns(CLOCK_REALTIME) / 1000;
+  r.utime_us = unix_us();
   r.sample_time_us = last_sample_.t_ns / 1000;
   r.newest_rx_ns = last_sample_.rx_ns;
-  r.samples = samples_;
+  r.samples = counters_.samples;
   r.psi_m_Wb = estimator_.psi_m_Wb();
   r.r_s_Ohm = estimator_.r_s_Ohm();
-  r.psi_m_pu = estimator_.core().state().theta_pu[core::kPsiM];
-  r.r_s_pu = estimator_.core().state().theta_pu[core::kRs];
-  const TemperatureModel& t = config_.temperature;
+  r.psi_m_pu = estimator_.theta_pu()[core::kPsiM];
+  r.r_s_pu = estimator_.theta_pu()[core::kRs];
+  const TemperatureModel& t = live_.temperature;
   r.t_winding_C = t.r_s.temperature_C(r.r_s_Ohm);
   r.t_magnet_C = t.psi_m.temperature_C(r.psi_m_Wb);
   r.speed_pu = last_.speed_pu;
-  r.psi_m_adapting = last_.detail.flags & core::step_flag::kPsiMActive;
-  r.r_s_adapting = last_.detail.flags & core::step_flag::kRsActive;
-  r.frozen = estimator_.core().state().frozen;
+  r.frozen = estimator_.frozen();
   r.state = state_;
-  r.algorithm = estimator_.core().config().algorithm;
+  r.algorithm = live_.machine.estimator.algorithm;
 
-  psi_ring_[static_cast<std::size_t>(ring_head_)] = r.psi_m_Wb;
-  rs_ring_[static_cast<std::size_t>(ring_head_)] = r.r_s_Ohm;
-  ring_head_ = (ring_head_ + 1) % ring_size_;
-  ring_count_ = std::min(ring_count_ + 1, ring_size_);
-  const bool live = state_ == DaemonState::kRunning;
-  r.psi_m_valid = live && r.psi_m_adapting && psi_m_adapted_s_ >= config_.validity.psi_m_after_s;
-  r.r_s_valid = r_s_valid_;
-  r.psi_m_converged = converged(psi_ring_, ring_count_);
-  r.r_s_converged = converged(rs_ring_, ring_count_);
-  if (r.psi_m_valid && r.psi_m_converged) {
-    has_good_psi_ = true;
-    good_psi_ = r.psi_m_Wb;
+  const ValidityTracker::Status psi = validity_.report(core::kPsiM, r.psi_m_Wb, now_ns);
+  const ValidityTracker::Status rs = validity_.report(core::kRs, r.r_s_Ohm, now_ns);
+  r.psi_m_adapting = psi.adapting;
+  r.r_s_adapting = rs.adapting;
+  r.psi_m_valid = psi.valid;
+  r.r_s_valid = rs.valid;
+  r.psi_m_converged = psi.converged;
+  r.r_s_converged = rs.converged;
+  r.psi_m_age_s = psi.age_s;
+  r.r_s_age_s = rs.age_s;
+  const bool good[2] = {psi.good, rs.good};
+  const double value[2] = {r.psi_m_Wb, r.r_s_Ohm};
+  for (int j = 0; j < 2; ++j) {
+    if (!good[j]) continue;
+    has_good_[j] = true;
+    good_[j] = value[j];
+    good_ns_[j] = now_ns;
   }
-  if (r.r_s_valid && r.r_s_converged && r.r_s_adapting) {
-    has_good_rs_ = true;
-    good_rs_ = r.r_s_Ohm;
-  }
-  r.has_good_psi_m = has_good_psi_;
-  r.good_psi_m_Wb = good_psi_;
-  r.has_good_r_s = has_good_rs_;
-  r.good_r_s_Ohm = good_rs_;
+  r.has_good_psi_m = has_good_[core::kPsiM];
+  r.good_psi_m_Wb = good_[core::kPsiM];
+  r.good_psi_m_age_s = 1e-9 * static_cast<double>(now_ns - good_ns_[core::kPsiM]);
+  r.has_good_r_s = has_good_[core::kRs];
+  r.good_r_s_Ohm = good_[core::kRs];
+  r.good_r_s_age_s = 1e-9 * static_cast<double>(now_ns - good_ns_[core::kRs]);
   push(r);
 }
 
-void EstimatorLoop::report_stats(std::int64_t) noexcept {
+void EstimatorLoop::report_stats() noexcept {
   LoopStatsReport r;
-  r.utime_us = clock_ns(CLOCK_REALTIME) / 1000;
+  r.utime_us = unix_us();
   r.state = state_;
-  r.period_ns = period_ns_;
-  r.latency_min_us = latency_.min();
-  r.latency_mean_us = latency_.mean();
-  r.latency_max_us = latency_.max();
-  r.latency_p99_us = latency_.percentile(0.99);
-  r.work_max_us = work_max_us_;
-  r.overruns = overruns_;
-  r.periods = periods_;
-  r.samples = samples_;
-  r.resyncs = resyncs_;
-  r.rejected_non_finite = rejected_;
-  r.predictor_resets = predictor_resets_;
-  r.projections = projections_;
+  r.input_queue_depth = static_cast<std::int32_t>(queues_.samples.size());
+  r.rows.set_all(kLoopRows, counters_);
+  timer_.report(r.rows);
   const double n = eps_n_ > 0 ? static_cast<double>(eps_n_) : 1.0;
-  r.eps_rms_d_A = std::sqrt(eps2_d_ / n);
-  r.eps_rms_q_A = std::sqrt(eps2_q_ / n);
-  r.gain_norm = last_.detail.gain.norm();
-  const auto& st = estimator_.core().state();
-  r.hessian_sga_psi_m = st.sga_hessian_pu[core::kPsiM];
-  r.hessian_sga_r_s = st.sga_hessian_pu[core::kRs];
-  r.hessian_gna_det = core::det2(st.gna_hessian_pu);
-  r.input_queue_depth = static_cast<std::int32_t>(input_.size());
-  r.output_queue_drops = output_drops_;
-  r.commands_applied = commands_applied_;
-  r.last_command_seq = last_seq_;
-  r.last_command_result = last_result_;
-  r.config_reloads = config_reloads_;
+  r.rows.set(&Diag::epsilon_rms_d_A, std::sqrt(eps2_d_ / n));
+  r.rows.set(&Diag::epsilon_rms_q_A, std::sqrt(eps2_q_ / n));
+  r.rows.set(&Diag::gain_norm, last_.detail.gain.norm());
+  r.rows.set(&Diag::hessian_sga_psi_m_pu, estimator_.sga_hessian_pu()[core::kPsiM]);
+  r.rows.set(&Diag::hessian_sga_r_s_pu, estimator_.sga_hessian_pu()[core::kRs]);
+  r.rows.set(&Diag::hessian_gna_det_pu, core::det2(estimator_.gna_hessian_pu()));
   push(r);
-  latency_.reset();
-  work_max_us_ = 0.0;
   eps2_d_ = eps2_q_ = 0.0;
   eps_n_ = 0;
 }
 
 void EstimatorLoop::process(std::int64_t now_ns) noexcept {
   Command c;
-  while (commands_.pop(c)) apply(c);
+  while (queues_.commands.pop(c)) apply(c);
 
   core::DriveSample s;
   bool any = false;
-  while (input_.pop(s)) {
-    step(s);
+  while (queues_.samples.pop(s)) {
+    step(s, now_ns);
     any = true;
     if (now_ns >= next_measurement_ns_) {
       next_measurement_ns_ = now_ns + measurement_interval_ns_;
-      MeasurementReport m;
-      m.utime_us = clock_ns(CLOCK_REALTIME) / 1000;
-      m.sample_time_us = s.t_ns / 1000;
-      m.theta_el_rad = s.theta_el_rad;
-      m.omega_el_rad_s = s.omega_el_rad_s;
-      m.u_dc_V = s.u_dc_V;
-      m.i_d_A = last_.i_meas_A[0];
-      m.i_q_A = last_.i_meas_A[1];
-      m.i_hat_d_A = last_.i_hat_A[0];
-      m.i_hat_q_A = last_.i_hat_A[1];
-      m.eps_d_A = last_.epsilon_A[0];
-      m.eps_q_A = last_.epsilon_A[1];
-      push(m);
+      report_measurement(s);
     }
   }
   if (any) {
     last_sample_mono_ns_ = now_ns;
-    if (state_ != DaemonState::kRunning) state_ = DaemonState::kRunning;
+    state_ = DaemonState::kRunning;
   } else if (state_ == DaemonState::kRunning &&
-             now_ns - last_sample_mono_ns_ > static_cast<std::int64_t>(config_.stale_timeout_s * 1e9)) {
+             now_ns - last_sample_mono_ns_ > static_cast<std::int64_t>(loop_config_.stale_timeout_s * 1e9)) {
     // No samples: hold the estimates, flag them, and start over from the next sample.
     state_ = DaemonState::kStale;
     estimator_.resynchronize();
+    validity_.hold();
   }
   if (now_ns >= next_estimate_ns_) {
     next_estimate_ns_ = now_ns + estimate_interval_ns_;
@@ -253,50 +225,24 @@ void EstimatorLoop::process(std::int64_t now_ns) noexcept {
   }
   if (now_ns >= next_stats_ns_) {
     next_stats_ns_ = now_ns + stats_interval_ns_;
-    report_stats(now_ns);
+    report_stats();
   }
 }
 
-void EstimatorLoop::run(std::atomic<bool>& stop) {
+void EstimatorLoop::run(const std::atomic<bool>& stop) {
   name_thread("rpemd-loop");
-  if (config_.realtime != RealtimeMode::kOff) setup_problems_ = apply_thread_policy(config_.loop_thread);
+  if (loop_config_.realtime != RealtimeMode::kOff) setup_problems_ = apply_thread_policy(loop_config_.thread);
   prefault_stack(256 * 1024);
-  std::int64_t next = clock_ns(CLOCK_MONOTONIC);
-  next_estimate_ns_ = next_measurement_ns_ = next_stats_ns_ = next;
+  const std::int64_t start = timer_.start();
+  next_estimate_ns_ = next_measurement_ns_ = next_stats_ns_ = start;
   started_.store(true, std::memory_order_release);
   while (!stop.load(std::memory_order_relaxed)) {
-    next += period_ns_;
-    const std::int64_t wake = next - wake_ahead_ns_;
-    timespec ts{static_cast<time_t>(wake / 1'000'000'000), static_cast<long>(wake % 1'000'000'000)};
-    while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr) == EINTR) {
-    }
-    std::int64_t woke = clock_ns(CLOCK_MONOTONIC);
-    while (woke < next) {  // timer anticipation (loop.wake_ahead_s): spin to the deadline
-      spin_pause();
-      woke = clock_ns(CLOCK_MONOTONIC);
-    }
-    const double late_us = 1e-3 * static_cast<double>(woke - next);
-    latency_.add(late_us);
-    run_latency_.add(late_us);
+    const std::int64_t woke = timer_.wait();
     process(woke);
-    ++periods_;
-    const std::int64_t done = clock_ns(CLOCK_MONOTONIC);
-    work_max_us_ = std::max(work_max_us_, 1e-3 * static_cast<double>(done - woke));
-    if (done > next + period_ns_) {
-      // The next deadline has passed: count it and restart the schedule from now.
-      ++overruns_;
-      next = done - done % period_ns_;
-    }
-    if (periods_ == wake_ahead_calibration_periods_) {
-      // `wake_ahead_s: auto`: anticipate by the median wake-up latency of the first second (a one-off
-      // scan of the histogram's bins, a few µs).
-      wake_ahead_ns_ = std::min<std::int64_t>(period_ns_ / 2, std::llround(1e3 * run_latency_.percentile(0.5)));
-      wake_ahead_published_ns_.store(wake_ahead_ns_, std::memory_order_release);
-    }
-    heartbeat_.fetch_add(1, std::memory_order_release);
+    timer_.finish(woke);
   }
   state_ = DaemonState::kStopping;
-  report_estimate(clock_ns(CLOCK_MONOTONIC));
+  report_estimate(core::now_ns(CLOCK_MONOTONIC));
 }
 
 }  // namespace rpem::daemon

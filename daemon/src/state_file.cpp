@@ -21,6 +21,8 @@ std::string write_state_file(const std::string& path, const PersistedEstimates& 
   j["written_unix_s"] = e.written_unix_s;
   j["psi_m_Wb"] = e.psi_m_Wb ? nlohmann::json(*e.psi_m_Wb) : nlohmann::json(nullptr);
   j["r_s_Ohm"] = e.r_s_Ohm ? nlohmann::json(*e.r_s_Ohm) : nlohmann::json(nullptr);
+  if (e.psi_m_Wb) j["psi_m_adapted_unix_s"] = e.psi_m_adapted_unix_s;
+  if (e.r_s_Ohm) j["r_s_adapted_unix_s"] = e.r_s_adapted_unix_s;
   const std::string text = j.dump(2) + "\n";
 
   const fs::path target(path);
@@ -68,6 +70,8 @@ LoadedState load_state_file(const std::string& path, double max_age_s, double ps
     s.estimates.written_unix_s = j.at("written_unix_s").get<std::int64_t>();
     if (!j.at("psi_m_Wb").is_null()) s.estimates.psi_m_Wb = j.at("psi_m_Wb").get<double>();
     if (!j.at("r_s_Ohm").is_null()) s.estimates.r_s_Ohm = j.at("r_s_Ohm").get<double>();
+    s.estimates.psi_m_adapted_unix_s = j.value("psi_m_adapted_unix_s", s.estimates.written_unix_s);
+    s.estimates.r_s_adapted_unix_s = j.value("r_s_adapted_unix_s", s.estimates.written_unix_s);
   } catch (const std::exception& e) {
     s.status = StateFileStatus::kCorrupt;
     s.message = path + ": corrupt state file ignored (" + e.what() + ")";

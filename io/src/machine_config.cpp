@@ -46,29 +46,33 @@ core::GainSequences parse_sequences(YamlMap g, bool with_hessian) {
   return s;
 }
 
-core::GradientForm parse_form(YamlMap& m, const char* key) {
-  return m.choice_or(key, "steady_state", {"steady_state", "dynamic"}) == "dynamic" ? core::GradientForm::kDynamic
-                                                                                    : core::GradientForm::kSteadyState;
+core::GradientForm parse_form(YamlMap& m, const char* key, core::GradientForm fallback) {
+  const char* fallback_name = fallback == core::GradientForm::kDynamic ? "dynamic" : "steady_state";
+  return m.choice_or(key, fallback_name, {"steady_state", "dynamic"}) == "dynamic" ? core::GradientForm::kDynamic
+                                                                                   : core::GradientForm::kSteadyState;
 }
 
 core::EstimatorSettings parse_estimator(YamlMap e, const core::MachineSi& machine) {
-  core::EstimatorSettings s;
-  s.algorithm = parse_algorithm(e.choice_or("algorithm", "sga", {"sga", "gna", "phyint"}));
-  s.discretization = e.choice_or("discretization", "trapezoidal", {"trapezoidal", "explicit_euler"}) == "explicit_euler"
+  core::EstimatorSettings s;  // the defaults of every optional key (core/estimator.hpp, EstimatorOptions)
+  s.algorithm = parse_algorithm(e.choice_or("algorithm", to_string(s.algorithm), {"sga", "gna", "phyint"}));
+  const bool euler_default = s.discretization == core::Discretization::kExplicitEuler;
+  s.discretization = e.choice_or("discretization", euler_default ? "explicit_euler" : "trapezoidal",
+                                 {"trapezoidal", "explicit_euler"}) == "explicit_euler"
                          ? core::Discretization::kExplicitEuler
                          : core::Discretization::kTrapezoidal;
   if (auto g = e.optional_map("gradient")) {
-    s.gradient_psi_m = parse_form(*g, "psi_m");
-    s.gradient_r_s = parse_form(*g, "r_s");
+    s.gradient_psi_m = parse_form(*g, "psi_m", s.gradient_psi_m);
+    s.gradient_r_s = parse_form(*g, "r_s", s.gradient_r_s);
     g->finish();
   }
-  s.nominal_sample_period_s = e.number_or("sample_period_s", 125e-6, 1e-6, 1.0);
-  s.max_sample_interval_s = e.number_or("max_sample_interval_s", 8.0 * s.nominal_sample_period_s,
-                                        s.nominal_sample_period_s, 10.0);
-  s.max_gap_carry_s = e.number_or("max_gap_carry_s", 20e-3, 0.0, 1.0);
+  s.nominal_sample_period_s = e.number_or("sample_period_s", s.nominal_sample_period_s, 1e-6, 1.0);
+  s.max_sample_interval_s =
+      e.number_or("max_sample_interval_s", core::EstimatorOptions::kMaxSampleIntervalPeriods * s.nominal_sample_period_s,
+                  s.nominal_sample_period_s, 10.0);
+  s.max_gap_carry_s = e.number_or("max_gap_carry_s", s.max_gap_carry_s, 0.0, 1.0);
   if (auto a = e.optional_map("adapt")) {
-    s.adapt_psi_m = a->boolean_or("psi_m", true);
-    s.adapt_r_s = a->boolean_or("r_s", true);
+    s.adapt_psi_m = a->boolean_or("psi_m", s.adapt_psi_m);
+    s.adapt_r_s = a->boolean_or("r_s", s.adapt_r_s);
     a->finish();
   }
 

@@ -17,6 +17,7 @@
 
 #include "rpem/can/protocol.hpp"
 #include "rpem/can/socketcan.hpp"
+#include "rpem/core/clock.hpp"
 
 namespace rpem::can {
 namespace {
@@ -44,11 +45,7 @@ std::size_t receive_for(SocketCanChannel& ch, std::vector<ReceivedFrame>& out, i
   return total;
 }
 
-std::int64_t realtime_ns() {
-  timespec ts{};
-  clock_gettime(CLOCK_REALTIME, &ts);
-  return static_cast<std::int64_t>(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
-}
+std::int64_t realtime_ns() { return core::now_ns(CLOCK_REALTIME); }
 
 TEST(SocketCan, FdFramesArriveWithKernelTimestamps) {
   SocketCanChannel rx({kIface, true, true, {protocol::kFdId}});

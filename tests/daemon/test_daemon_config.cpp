@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <variant>
 
 #include "rpem/daemon/daemon_config.hpp"
 #include "support/temp_file.hpp"
@@ -10,41 +11,42 @@ namespace {
 
 TEST(DaemonConfig, BuiltInDefaultIsTheSimulatedPaperMachine) {
   const DaemonConfig c = builtin_daemon_config();
-  EXPECT_EQ(c.source, SourceType::kSim);
-  EXPECT_EQ(c.sim_scenario, "builtin:rpemd-demo");
-  EXPECT_DOUBLE_EQ(c.machine.machine.psi_m_Wb, 1.14);
-  EXPECT_DOUBLE_EQ(c.loop_period_s, 125e-6);
-  EXPECT_FALSE(c.commands_enabled);
-  EXPECT_DOUBLE_EQ(c.temperature.r_s.value_ref, 2.25);
+  ASSERT_TRUE(std::holds_alternative<SimSource::Options>(c.fixed.source));
+  EXPECT_EQ(std::get<SimSource::Options>(c.fixed.source).scenario, "builtin:rpemd-demo");
+  EXPECT_DOUBLE_EQ(c.live.machine.machine.psi_m_Wb, 1.14);
+  EXPECT_DOUBLE_EQ(c.fixed.loop.period_s, 125e-6);
+  EXPECT_FALSE(c.live.commands_enabled);
+  EXPECT_DOUBLE_EQ(c.live.temperature.r_s.value_ref, 2.25);
+  EXPECT_DOUBLE_EQ(c.live.validity.max_hold_s, 20.0);
 }
 
 TEST(DaemonConfig, ShippedExamplesLoad) {
   for (const char* f : {"/config/rpemd-sim.yaml", "/config/rpemd-can.yaml", "/config/paper-ipmsm.yaml"}) {
     SCOPED_TRACE(f);
     const DaemonConfig c = load_daemon_config(test::source_dir() + f);
-    EXPECT_GT(c.loop_period_s, 0.0);
+    EXPECT_GT(c.fixed.loop.period_s, 0.0);
   }
   const DaemonConfig can = load_daemon_config(test::source_dir() + "/config/rpemd-can.yaml");
-  EXPECT_EQ(can.source, SourceType::kCan);
-  EXPECT_EQ(can.can_interface, "can0");
+  ASSERT_TRUE(std::holds_alternative<CanSource::Options>(can.fixed.source));
+  EXPECT_EQ(std::get<CanSource::Options>(can.fixed.source).interface, "can0");
 }
 
 TEST(DaemonConfig, WakeAheadIsOffANumberOrAuto) {
-  EXPECT_DOUBLE_EQ(builtin_daemon_config().loop_wake_ahead_s, 0.0);
-  EXPECT_FALSE(builtin_daemon_config().loop_wake_ahead_auto);
+  EXPECT_DOUBLE_EQ(builtin_daemon_config().fixed.loop.wake_ahead_s, 0.0);
+  EXPECT_FALSE(builtin_daemon_config().fixed.loop.wake_ahead_auto);
   const test::TempFile number("wake_number.yaml", "daemon:\n  loop: {period_s: 125.0e-6, wake_ahead_s: 40.0e-6}\n");
   const DaemonConfig n = load_daemon_config(number.path());
-  EXPECT_DOUBLE_EQ(n.loop_wake_ahead_s, 40e-6);
-  EXPECT_FALSE(n.loop_wake_ahead_auto);
+  EXPECT_DOUBLE_EQ(n.fixed.loop.wake_ahead_s, 40e-6);
+  EXPECT_FALSE(n.fixed.loop.wake_ahead_auto);
   const test::TempFile automatic("wake_auto.yaml", "daemon:\n  loop: {wake_ahead_s: auto}\n");
-  EXPECT_TRUE(load_daemon_config(automatic.path()).loop_wake_ahead_auto);
+  EXPECT_TRUE(load_daemon_config(automatic.path()).fixed.loop.wake_ahead_auto);
 }
 
 TEST(DaemonConfig, AMachineFileAloneIsAConfiguration) {
   // rpem diagnose's extended.yaml is a machine file: rpemd must take it as it is.
   const DaemonConfig c = load_daemon_config(test::source_dir() + "/config/paper-ipmsm.yaml");
-  EXPECT_EQ(c.source, SourceType::kSim);
-  EXPECT_DOUBLE_EQ(c.machine.machine.l_q_H, 0.206);
+  EXPECT_TRUE(std::holds_alternative<SimSource::Options>(c.fixed.source));
+  EXPECT_DOUBLE_EQ(c.live.machine.machine.l_q_H, 0.206);
 }
 
 TEST(DaemonConfig, DriftsFoundByDiagnoseCalibrateTheTemperatureModel) {
@@ -56,17 +58,47 @@ TEST(DaemonConfig, DriftsFoundByDiagnoseCalibrateTheTemperatureModel) {
                               "  psim_drift: {coeff_per_K: -0.00105, reference_C: 25}\n";
   test::TempFile f("ext.yaml", machine);
   const DaemonConfig c = load_daemon_config(f.path());
-  EXPECT_DOUBLE_EQ(c.temperature.r_s.reference_C, 25.0);
-  EXPECT_DOUBLE_EQ(c.temperature.r_s.coeff_per_K, 0.0041);
-  EXPECT_DOUBLE_EQ(c.temperature.r_s.value_ref, 2.3);
-  EXPECT_DOUBLE_EQ(c.temperature.psi_m.reference_C, 25.0);
-  EXPECT_DOUBLE_EQ(c.temperature.psi_m.coeff_per_K, -0.00105);
-  EXPECT_DOUBLE_EQ(c.temperature.psi_m.value_ref, 1.14);  // not found: the machine's
+  EXPECT_DOUBLE_EQ(c.live.temperature.r_s.reference_C, 25.0);
+  EXPECT_DOUBLE_EQ(c.live.temperature.psi_m.reference_C, 25.0);
+  EXPECT_DOUBLE_EQ(c.live.temperature.r_s.coeff_per_K, 0.0041);
+  EXPECT_DOUBLE_EQ(c.live.temperature.r_s.value_ref, 2.3);
+  EXPECT_DOUBLE_EQ(c.live.temperature.psi_m.coeff_per_K, -0.00105);
+  EXPECT_DOUBLE_EQ(c.live.temperature.psi_m.value_ref, 1.14);  // not found: the machine's
   test::TempFile g("own.yaml", machine + "daemon:\n  temperature: {r_s_coeff_per_K: 0.00393}\n");
-  EXPECT_DOUBLE_EQ(load_daemon_config(g.path()).temperature.r_s.coeff_per_K, 0.00393);
+  EXPECT_DOUBLE_EQ(load_daemon_config(g.path()).live.temperature.r_s.coeff_per_K, 0.00393);
   test::TempFile h("bad.yaml", test::read_file(test::source_dir() + "/config/paper-ipmsm.yaml") +
                                    "model_extensions:\n  psim_drift: {coeff_per_K: 0.001}\n");
   EXPECT_THROW((void)load_daemon_config(h.path()), io::ConfigError);
+}
+
+TEST(DaemonConfig, SourcesComeFromTheCatalogueAndOnlyTheChosenOneIsKept) {
+  const test::TempFile f("both.yaml",
+                         "daemon:\n  source: {type: can, can: {interface: vcan3}, sim: {scenario: builtin:rpemd-demo, loop: false}}\n");
+  const DaemonConfig c = load_daemon_config(f.path());
+  ASSERT_TRUE(std::holds_alternative<CanSource::Options>(c.fixed.source));
+  EXPECT_EQ(std::get<CanSource::Options>(c.fixed.source).interface, "vcan3");
+  EXPECT_STREQ(SourceCatalogue::type(c.fixed.source), "can");
+  EXPECT_STREQ(SourceCatalogue::type(builtin_daemon_config().fixed.source), "sim");
+}
+
+TEST(DaemonConfig, FixedDifferenceNamesWhatOnlyARestartApplies) {
+  const DaemonConfig a = builtin_daemon_config();
+  DaemonConfig b = a;
+  EXPECT_STREQ(fixed_difference(a.fixed, b.fixed), "");
+  b.live.machine.estimator.algorithm = core::Algorithm::kGna;  // live: a reload applies it
+  b.live.commands_enabled = true;
+  EXPECT_STREQ(fixed_difference(a.fixed, b.fixed), "");
+  b.fixed.lcm.channel_prefix = "X_";
+  EXPECT_STREQ(fixed_difference(a.fixed, b.fixed), "lcm");
+  b = a;
+  b.fixed.source = CanSource::Options{"can1"};
+  EXPECT_STREQ(fixed_difference(a.fixed, b.fixed), "source");
+  b = a;
+  b.fixed.loop.thread.cpu = 1;
+  EXPECT_STREQ(fixed_difference(a.fixed, b.fixed), "loop");
+  b = a;
+  b.fixed.publish_thread.priority = 3;
+  EXPECT_STREQ(fixed_difference(a.fixed, b.fixed), "threads");
 }
 
 struct Bad {

@@ -1,11 +1,14 @@
-// The loop's period work allocates nothing: 20 s of samples at 8 kHz, every kind of command, stale
-// periods and all report kinds, counted by replacing the global allocation functions.
+// The loop's period work allocates nothing: 20 s of samples at 8 kHz, every kind of command (a reload
+// carries the whole live configuration), stale periods, all report kinds with their diagnostics rows,
+// validity and age tracking — counted by replacing the global allocation functions.
 #include <gtest/gtest.h>
 
 #include <atomic>
 #include <cstdlib>
 #include <new>
 
+#include "rpem/command_t.hpp"
+#include "rpem/daemon/command_gate.hpp"
 #include "rpem/daemon/estimator_loop.hpp"
 #include "support/model_data.hpp"
 #include "support/paper_machine.hpp"
@@ -34,7 +37,8 @@ TEST(LoopAllocations, NoneInTheLoopsPeriodWork) {
   SpscQueue<core::DriveSample> input(4096);
   SpscQueue<Command> commands(16);
   SpscQueue<Report> output(1 << 16);
-  EstimatorLoop loop(config, input, commands, output);
+  EstimatorLoop loop(config, EstimatorLoop::Queues{input, commands, output});
+  loop.seed(SeedValue{1.1, 4.0}, SeedValue{2.3, 4.0}, 1'000'000'000);
   test::ModelDataGenerator gen;
   gen.plant = test::paper_machine_pu();
   gen.omega_n_rad_s = test::paper_base().omega_el_rad_s;
@@ -51,9 +55,10 @@ TEST(LoopAllocations, NoneInTheLoopsPeriodWork) {
   cmds[2].psi_m_Wb = 1.1;
   cmds[2].r_s_Ohm = 2.3;
   cmds[3].kind = Command::Kind::kReconfigure;
-  cmds[3].machine = config.machine.machine;
-  cmds[3].settings = config.machine.estimator;
+  cmds[3].live = config.live;
+  cmds[3].live.validity.max_hold_s = 1.0;
   cmds[4].kind = Command::Kind::kReset;
+  for (std::size_t k = 0; k < cmds.size(); ++k) cmds[k].seq = cmds[k].kind == Command::Kind::kReconfigure ? 0 : static_cast<std::int64_t>(k + 1);
 
   const long before = g_allocations.load();
   std::int64_t now = 1'000'000'000;
@@ -71,6 +76,28 @@ TEST(LoopAllocations, NoneInTheLoopsPeriodWork) {
     }
   }
   EXPECT_EQ(g_allocations.load() - before, 0);
+}
+
+// RPEM_COMMAND's entry point (control thread) promises no allocation either, whatever the bytes.
+TEST(LoopAllocations, NoneInCommandAdmission) {
+  rpem::command_t m{};
+  m.seq = 7;
+  m.command = rpem::command_t::SET_VALUES;
+  m.psi_m_Wb = 1.1;
+  m.r_s_Ohm = 2.3;
+  std::vector<std::uint8_t> bytes(static_cast<std::size_t>(m.getEncodedSize()));
+  ASSERT_EQ(m.encode(bytes.data(), 0, static_cast<int>(bytes.size())), static_cast<int>(bytes.size()));
+  std::vector<std::uint8_t> junk(bytes);
+  junk[3] ^= 0x5A;
+  const CommandPolicy policy{true, 0.5, 1.7, 1.0, 4.5};
+  const long before = g_allocations.load();
+  int admitted = 0;
+  for (int k = 0; k < 1000; ++k) {
+    admitted += admit_command(bytes, policy, k % 10).result == CommandResult::kApplied;
+    admitted += admit_command(junk, policy, 0).decoded;
+  }
+  EXPECT_EQ(g_allocations.load() - before, 0);
+  EXPECT_EQ(admitted, 700);  // last accepted 0…6 of every 10: seq 7 is new
 }
 
 }  // namespace

@@ -27,6 +27,10 @@ case $target in
                        corpus=io/fuzz/corpus/machine_config ;;
   fuzz_scenario)       main=sim/fuzz/fuzz_scenario.cpp;       objs=("$repo"/sim/src/*.cpp "${io[@]}" "${core[@]}")
                        corpus=sim/fuzz/corpus ;;
+  fuzz_command)        main=daemon/fuzz/fuzz_command.cpp;     objs=("$repo/daemon/src/command_gate.cpp")
+                       corpus=daemon/fuzz/corpus
+                       # rpemd's RPEM_COMMAND entry point; the LCM types are generated in the build
+                       [[ -f $build/lcm_types/cpp/rpem/command_t.hpp ]] || cmake --build "$build" --target rpem_lcm_cpp >/dev/null ;;
   *) echo "run_fuzz: unknown target $target" >&2; exit 2 ;;
 esac
 [[ -f $build/io/builtin_config.cpp ]] || { echo "run_fuzz: configure $build first (it generates io/builtin_config.cpp)" >&2; exit 2; }
@@ -37,7 +41,8 @@ dir=$build/fuzz
 mkdir -p "$dir/$target/corpus"
 {
   echo "cxx = clang++ -std=c++20 -O1 -g -fno-sanitize-recover=undefined -I$repo/can/include -I$repo/core/include" \
-       "-I$repo/io/include -I$repo/sim/include -isystem /usr/include/eigen3"
+       "-I$repo/io/include -I$repo/sim/include -I$repo/daemon/include -isystem /usr/include/eigen3" \
+       "-isystem $build/lcm_types/cpp"
   echo "rule cc"
   echo "  command = \$cxx -fsanitize=fuzzer-no-link,address,undefined -MD -MF \$out.d -c \$in -o \$out"
   echo "  depfile = \$out.d"

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # The .deb on a clean Debian 12: debootstrap (minbase, cached as a tarball) → fresh root → apt install the
-# package (dependencies from Debian) → the unit verifies and scores ≤ 2.5 → rpemd runs from the
+# package (dependencies from Debian) → the units (rpemd, rpem-can@, rpem-vcan@) verify and score ≤ 2.5 → rpemd runs from the
 # installed configuration as an unprivileged user (the way the service runs it) and estimates.
 #   test_deb.sh BUILD_DIR
 set -euo pipefail
@@ -42,11 +42,17 @@ DEBIAN_FRONTEND=noninteractive in_root apt-get install -y -q --no-install-recomm
 in_root dpkg -s rpem-drive | grep -q "Status: install ok installed"
 [[ -L $root/etc/systemd/system/multi-user.target.wants/rpemd.service ]] || { echo "test_deb: rpemd.service not enabled"; exit 1; }
 
-echo "test_deb: checking the installed unit"
-in_root systemd-analyze verify /usr/lib/systemd/system/rpemd.service
-score=$(in_root systemd-analyze security --offline=yes /usr/lib/systemd/system/rpemd.service 2>&1 | awk '/Overall exposure level/{print $(NF-2)}')
-echo "test_deb: exposure $score"
-awk -v s="$score" 'BEGIN { exit !(s <= 2.5) }' || { echo "test_deb: exposure $score > 2.5"; exit 1; }
+echo "test_deb: checking the installed units (rpemd and the bus bring-up units): verify clean, exposure <= 2.5"
+for unit in rpemd.service rpem-can@.service rpem-vcan@.service; do
+  path=/usr/lib/systemd/system/$unit
+  [[ -f $root$path ]] || { echo "test_deb: $unit not installed"; exit 1; }
+  # verify exits 0 on unknown keys and bad values too: anything it says about the unit is a failure.
+  said=$(in_root systemd-analyze verify "$path" 2>&1 | grep -F "${unit%%@*}" || true)
+  [[ -z $said ]] || { echo "test_deb: systemd-analyze verify $unit:"; echo "$said"; exit 1; }
+  score=$(in_root systemd-analyze security --offline=yes "$path" 2>&1 | awk '/Overall exposure level/{print $(NF-2)}')
+  echo "test_deb: $unit exposure $score"
+  awk -v s="$score" 'BEGIN { exit !(s != "" && s <= 2.5) }' || { echo "test_deb: $unit exposure '$score' > 2.5"; exit 1; }
+done
 
 echo "test_deb: running the installed rpemd with the installed configuration, as an unprivileged user with"
 echo "          the unit's LimitRTPRIO=90 and LimitMEMLOCK=infinity (so SCHED_FIFO and mlockall need no root)"

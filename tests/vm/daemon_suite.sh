@@ -6,7 +6,16 @@ out=${1:-/host}
 cfg=rpemd-vcan.yaml
 rate=0.4  # the emulated VM cannot run drive, daemon and listener at 8 kHz in real time
 step() { echo "daemon_suite: $*"; }
-start_rpemd() { rpemd --config $cfg > "$out/$1_rpemd.txt" 2>&1 & echo $! > /tmp/rpemd.pid; }
+start_rpemd() { rpemd --config "${2:-$cfg}" > "$out/$1_rpemd.txt" 2>&1 & echo $! > /tmp/rpemd.pid; }
+# A run with the drive streaming the steady scenario and `rpem listen` recording: start_streaming NAME [CONFIG]
+start_streaming() {
+  start_rpemd "$1" "$2"
+  rpem listen --diagnostics --csv "$out/$1_est.csv" > "$out/$1_listen.txt" 2>&1 &
+  listen=$!
+  sleep 1
+  rpem sim --scenario e2e-steady.yaml --can vcan0 --rate $rate 2> "$out/$1_sim.txt" &
+  sim=$!
+}
 stop_rpemd() { kill -TERM "$(cat /tmp/rpemd.pid)"; wait "$(cat /tmp/rpemd.pid)" 2>/dev/null; }
 
 run_steps() {  # name, extra rpem sim options
@@ -29,12 +38,7 @@ run_steps loss_burst --drop-probability 0.1 --drop-burst 12 --drop-seed 4
 
 step "faults: vcan0 down/up, blocked LCM, malformed frames and commands, SIGKILL and restart"
 rm -rf /tmp/rpemd
-start_rpemd faults
-rpem listen --diagnostics --csv "$out/faults_est.csv" > "$out/faults_listen.txt" 2>&1 &
-listen=$!
-sleep 1
-rpem sim --scenario e2e-steady.yaml --can vcan0 --rate $rate 2> "$out/faults_sim.txt" &
-sim=$!
+start_streaming faults
 sleep 10
 echo "$(date +%s) vcan0 down" >> "$out/faults_events.txt"; ip link set vcan0 down
 sleep 2
@@ -55,6 +59,7 @@ rpem command unfreeze --seq 6
 sleep 2
 echo "$(date +%s) sigkill" >> "$out/faults_events.txt"
 kill -KILL "$(cat /tmp/rpemd.pid)"
+cp /tmp/rpemd/estimates.json "$out/killed_state.json" 2>/dev/null   # what the restart must resume from
 sleep 1
 start_rpemd restarted
 sleep 4
@@ -62,4 +67,48 @@ stop_rpemd
 kill $sim 2>/dev/null; wait $sim 2>/dev/null
 kill -INT $listen; wait $listen
 cp /tmp/rpemd/estimates.json "$out/restarted_state.json" 2>/dev/null
+
+# All at once, for a fixed number of rounds: SIGHUP at 10 Hz through four configurations (two that load,
+# one that does not, one that changes what only a restart applies), supervisory commands at 100 Hz, and
+# vcan0 going down and up, while the drive streams. Checked: every command accepted applied once and in
+# order, every reload applied or refused with a counted reason, the socket reopened, the state file
+# whole; the loop's overrun rate against the quiet seconds before (tests/vm/check_daemon_suite.py).
+step "storm: SIGHUP 100 x at 10 Hz, 1000 commands at 100 Hz, vcan0 down/up 5 x, all at once"
+rm -rf /tmp/rpemd
+cp $cfg /tmp/storm-a.yaml
+{ cat $cfg; echo "  validity: {max_hold_s: 10}"; echo "  temperature: {reference_C: 25}"; } > /tmp/storm-b.yaml
+{ cat $cfg; echo "  sauce: 1"; } > /tmp/storm-bad.yaml
+{ cat $cfg; echo "  receive_thread: {policy: fifo, priority: 71}"; } > /tmp/storm-restart.yaml
+cp /tmp/storm-a.yaml /tmp/storm.yaml
+start_streaming storm /tmp/storm.yaml
+pid=$(cat /tmp/rpemd.pid)
+sleep 15
+echo "$(date +%s) storm start" >> "$out/storm_events.txt"
+rpem command unfreeze --seq 100 --repeat 1000 --interval-ms 10 2> "$out/storm_commands.txt" &
+commands=$!
+(
+  i=0
+  while [ $i -lt 100 ]; do
+    case $((i % 4)) in 0) v=a ;; 1) v=b ;; 2) v=bad ;; *) v=restart ;; esac
+    cp /tmp/storm-$v.yaml /tmp/storm.new && mv /tmp/storm.new /tmp/storm.yaml
+    kill -HUP $pid
+    sleep 0.1
+    i=$((i + 1))
+  done
+) &
+hups=$!
+for k in 1 2 3 4 5; do ip link set vcan0 down; sleep 1.5; ip link set vcan0 up; sleep 1; done
+wait $commands
+wait $hups
+echo "$(date +%s) storm end" >> "$out/storm_events.txt"
+cp /tmp/storm-a.yaml /tmp/storm.new && mv /tmp/storm.new /tmp/storm.yaml
+kill -HUP $pid
+sleep 2
+rpem command freeze --seq 2000                       # first: a set before it would adapt until the freeze came
+rpem command set --seq 2001 --psi-m 1.123 --r-s 2.345
+sleep 4
+stop_rpemd
+kill $sim 2>/dev/null; wait $sim 2>/dev/null
+kill -INT $listen; wait $listen
+cp /tmp/rpemd/estimates.json "$out/storm_state.json" 2>/dev/null
 step "done"

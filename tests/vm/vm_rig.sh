@@ -3,8 +3,10 @@
 # (TCG) with vcan0 up in CAN FD mode and multicast on loopback (for LCM). Used where the host kernel
 # has no vcan/AF_CAN; on a host that has them the tests run natively (tests/vm/run_vcan_test.sh).
 #
-#   vm_rig.sh run [--timeout S] [--smp N] [--share DIR] [--file SRC[:DEST]]... -- COMMAND...
+#   vm_rig.sh run [--timeout S] [--smp N] [--share DIR] [--can-controller] [--file SRC[:DEST]]... -- COMMAND...
 #
+# --can-controller adds an emulated CAN controller (qemu's Kvaser PCI, an SJA1000: classic CAN) as can0,
+# on a virtual bus of its own.
 # Every ELF given with --file (and busybox, iproute2's ip, can-utils, cyclictest) is copied into an
 # initramfs with the shared libraries ldd names. --share mounts a host directory at /host (virtio-9p)
 # for inputs and results. The command runs in /work; its exit code becomes this script's.
@@ -46,7 +48,9 @@ copy_elf() {
 build_initramfs() {
   local out=$1
   shift
+  umask 022  # the VM's unprivileged processes (tests/vm/bus_units.sh) must read its libraries
   stage=$(mktemp -d)
+  chmod 0755 "$stage"
   trap 'rm -rf "$stage"' RETURN
   mkdir -p "$stage"/{bin,sbin,proc,sys,dev,tmp,run,etc,modules,work,var/lib/rpemd}
   cp /bin/busybox "$stage/bin/busybox"
@@ -72,7 +76,7 @@ build_initramfs() {
     cp "$path" "$stage/modules/"
     echo "$name" >>"$stage/modules/order"
   }
-  for m in can-dev can can-raw vcan virtio_pci 9pnet_virtio 9p; do add_module "$m"; done
+  for m in can-dev can can-raw vcan virtio_pci 9pnet_virtio 9p kvaser_pci; do add_module "$m"; done
   for spec in "${files[@]}"; do
     local src=${spec%%:*} dest=${spec#*:}
     [[ $spec == *:* ]] || dest=/work/$(basename "$src")
@@ -105,7 +109,7 @@ INIT
 }
 
 run() {
-  local timeout=600 smp=2 share=""
+  local timeout=600 smp=2 share="" can_args=()
   files=()
   while [[ $# -gt 0 ]]; do
     case $1 in
@@ -113,6 +117,7 @@ run() {
       --smp) smp=$2; shift 2 ;;
       --file) files+=("$2"); shift 2 ;;
       --share) share=$(cd "$2" && pwd); shift 2 ;;
+      --can-controller) can_args=(-object can-bus,id=canbus0 -device kvaser_pci,canbus=canbus0); shift ;;
       --) shift; break ;;
       *) log "unknown option $1"; exit 2 ;;
     esac
@@ -133,7 +138,7 @@ run() {
   fi
   set +e
   timeout --foreground "$timeout" qemu-system-x86_64 -accel tcg -cpu max -smp "$smp" -m 1G -nographic -no-reboot \
-    "${share_args[@]}" -kernel "$vmlinuz" -initrd "$initrd" -append "console=ttyS0 quiet panic=-1 rdinit=/init" \
+    "${share_args[@]}" "${can_args[@]}" -kernel "$vmlinuz" -initrd "$initrd" -append "console=ttyS0 quiet panic=-1 rdinit=/init" \
     </dev/null >"$console" 2>&1
   local qemu_rc=$?
   set -e

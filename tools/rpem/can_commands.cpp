@@ -12,6 +12,7 @@
 #include "commands.hpp"
 #include "rpem/can/decoder.hpp"
 #include "rpem/can/protocol.hpp"
+#include "rpem/core/clock.hpp"
 #include "rpem/io/drive_log.hpp"
 
 namespace rpem::tools {
@@ -58,18 +59,11 @@ struct RecordOptions {
   bool latency = false;
 };
 
-std::int64_t now_mono_ns() {
-  timespec ts{};
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return static_cast<std::int64_t>(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
-}
-
 int run_record(const RecordOptions& o) {
   can::require_interface(o.interface);
   can::SocketCanChannel::Options co;
   co.interface = o.interface;
-  co.ids = {can::protocol::kFdId};
-  for (int k = 0; k < can::protocol::kClassicFrames; ++k) co.ids.push_back(can::protocol::kClassicFirstId + static_cast<std::uint32_t>(k));
+  co.ids.assign(can::protocol::kTelemetryIds.begin(), can::protocol::kTelemetryIds.end());
   can::SocketCanChannel channel(co);
   can::TelemetryDecoder decoder;
   io::DriveLogWriter writer(o.out, io::DriveLogLayout{});
@@ -81,17 +75,17 @@ int run_record(const RecordOptions& o) {
   std::array<core::DriveSample, 3> samples;
   std::vector<double> latencies_us;
   std::uint64_t written = 0;
-  const std::int64_t start = now_mono_ns();
+  const std::int64_t start = core::now_ns(CLOCK_MONOTONIC);
   std::int64_t last_data = start;
   while (!g_stop) {
-    const std::int64_t now = now_mono_ns();
+    const std::int64_t now = core::now_ns(CLOCK_MONOTONIC);
     if (o.duration_s > 0 && now - start > static_cast<std::int64_t>(o.duration_s * 1e9)) break;
     if (o.idle_timeout_s > 0 && written > 0 && now - last_data > static_cast<std::int64_t>(o.idle_timeout_s * 1e9)) break;
     if (o.samples > 0 && written >= o.samples) break;
     const std::size_t n = channel.receive(frames, 100);
     for (std::size_t f = 0; f < n; ++f) {
       const std::size_t got = decoder.decode(frames[f].frame, samples);
-      if (got > 0) last_data = now_mono_ns();
+      if (got > 0) last_data = core::now_ns(CLOCK_MONOTONIC);
       for (std::size_t k = 0; k < got; ++k) {
         writer.write({samples[k], {}, {}, {}});
         ++written;

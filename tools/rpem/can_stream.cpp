@@ -6,22 +6,10 @@
 #include <cstdio>
 #include <ctime>
 
+#include "rpem/core/clock.hpp"
+
 namespace rpem::tools {
-namespace {
-
-std::int64_t now_ns(clockid_t clock) {
-  timespec ts{};
-  clock_gettime(clock, &ts);
-  return static_cast<std::int64_t>(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
-}
-
-void sleep_until_mono(std::int64_t t_ns) {
-  timespec ts{static_cast<time_t>(t_ns / 1'000'000'000), static_cast<long>(t_ns % 1'000'000'000)};
-  while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr) == EINTR) {
-  }
-}
-
-}  // namespace
+using core::now_ns;
 
 void add_stream_options(CLI::App* cmd, StreamOptions& o) {
   cmd->add_option("--rate", o.rate, "playback speed: 1 real time, 0 as fast as possible")->check(CLI::NonNegativeNumber);
@@ -109,7 +97,7 @@ void TelemetryStreamer::send(core::DriveSample sample, std::uint8_t status) {
   // A frame leaves when its last sample is due (one wake-up per frame, not per sample).
   if (n > 0 && options_.rate > 0.0) {
     const std::int64_t due = start_mono_ns_ + scheduled;
-    sleep_until_mono(due);
+    core::sleep_until_ns(CLOCK_MONOTONIC, due);
     lateness_us_.push_back(1e-3 * static_cast<double>(now_ns(CLOCK_MONOTONIC) - due));
   }
   for (std::size_t k = 0; k < n; ++k) emit(frames[k]);

@@ -4,14 +4,16 @@
 #include <CLI/CLI.hpp>
 #include <functional>
 
+#include "rpem/io/exit_codes.hpp"
+
 namespace rpem::tools {
 
-/// Exit codes (sysexits.h): shared by every subcommand and by rpemd.
-inline constexpr int kExitOk = 0;
-inline constexpr int kExitUsage = 64;      ///< EX_USAGE: bad command line
-inline constexpr int kExitDataError = 65;  ///< EX_DATAERR: malformed drive log or input data
-inline constexpr int kExitIoError = 74;    ///< EX_IOERR: cannot read or write a file
-inline constexpr int kExitConfig = 78;     ///< EX_CONFIG: bad configuration
+/// Exit codes: rpem/io/exit_codes.hpp (shared with rpemd).
+using io::kExitConfig;
+using io::kExitDataError;
+using io::kExitIoError;
+using io::kExitOk;
+using io::kExitUsage;
 
 using Runner = std::function<int()>;
 

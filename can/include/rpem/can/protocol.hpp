@@ -14,6 +14,7 @@
 // Little endian throughout. Reserved raw codes: i16 −32768 and u16 65535 mean "no valid value" (NaN);
 // i16 ±32767 means "saturated" (out of range). Data IDs for the E2E CRC: 0x5100 + (CAN ID − 0x100).
 
+#include <array>
 #include <cmath>
 #include <cstdint>
 
@@ -32,6 +33,10 @@ inline constexpr int kFdMaxSamples = 3;
 inline constexpr std::uint32_t kClassicFirstId = 0x110;
 inline constexpr int kClassicFrames = 5;
 inline constexpr std::uint8_t kClassicLength = 8;
+
+/// Every telemetry CAN ID: what a receiver's kernel filter lets through.
+inline constexpr std::array<std::uint32_t, 1 + kClassicFrames> kTelemetryIds = {
+    kFdId, kClassicFirstId, kClassicFirstId + 1, kClassicFirstId + 2, kClassicFirstId + 3, kClassicFirstId + 4};
 
 [[nodiscard]] constexpr std::uint16_t data_id(std::uint32_t can_id) noexcept {
   return static_cast<std::uint16_t>(0x5100 + (can_id - kFdId));

@@ -40,6 +40,12 @@ class DriveEstimator {
   [[nodiscard]] const RpemEstimator& core() const noexcept { return core_; }
   [[nodiscard]] double psi_m_Wb() const noexcept;
   [[nodiscard]] double r_s_Ohm() const noexcept;
+  /// θ̂ = [ψ̂m, r̂s] in pu now (also after reset(), set_estimates() or reconfigure(), before a step).
+  [[nodiscard]] const Vec2& theta_pu() const noexcept { return core_.state().theta_pu; }
+  [[nodiscard]] bool frozen() const noexcept { return core_.state().frozen; }
+  /// The gains' curvature estimates (SGA's r per parameter, GNA's R), for diagnostics.
+  [[nodiscard]] const Vec2& sga_hessian_pu() const noexcept { return core_.state().sga_hessian_pu; }
+  [[nodiscard]] const Mat2& gna_hessian_pu() const noexcept { return core_.state().gna_hessian_pu; }
 
  private:
   PerUnitBase base_;

@@ -21,26 +21,34 @@ namespace rpem::core {
 
 enum class GradientForm : std::uint8_t { kSteadyState = 0, kDynamic = 1 };
 
-struct EstimatorConfig {
-  MachinePu model;              ///< nominal model; x_d, x_q are used as they are
-  double omega_n_rad_s = 0.0;   ///< ω_n, the electrical base speed
+/// What the user's EstimatorSettings (settings.hpp) and the per-unit EstimatorConfig share, with their
+/// defaults — written once, here; the YAML reader (io) takes its defaults from a default-constructed one.
+struct EstimatorOptions {
+  /// The default max_sample_interval_s in nominal periods (8 × 125 µs = 1 ms).
+  static constexpr double kMaxSampleIntervalPeriods = 8.0;
+
   Algorithm algorithm = Algorithm::kSga;
   Discretization discretization = Discretization::kTrapezoidal;
   GradientForm gradient_psi_m = GradientForm::kSteadyState;
   GradientForm gradient_r_s = GradientForm::kSteadyState;
   std::array<GainSequences, 3> gains{};  ///< indexed by Algorithm
   GainFloors floors;
-  SchedulerConfig scheduler;
-  ParameterBounds bounds;
-  Vec2 initial_theta_pu = Vec2::Zero();
   Vec2 initial_sga_hessian_pu = Vec2::Zero();  ///< r[0] per parameter
   Mat2 initial_gna_hessian_pu = Mat2::Zero();  ///< R[0]
   double nominal_sample_period_s = 125e-6;     ///< the period the γ_0 refer to; γ scales with dt
-  double max_sample_interval_s = 1e-3;         ///< a longer interval resynchronises the predictor
+  double max_sample_interval_s = kMaxSampleIntervalPeriods * 125e-6;  ///< longer: the predictor resynchronises
   double max_gap_carry_s = 20e-3;              ///< across a shorter gap the prediction error is kept
-  double max_predicted_current_pu = 20.0;      ///< |î| beyond this counts as divergence
   bool adapt_psi_m = true;
   bool adapt_r_s = true;
+};
+
+struct EstimatorConfig : EstimatorOptions {
+  MachinePu model;              ///< nominal model; x_d, x_q are used as they are
+  double omega_n_rad_s = 0.0;   ///< ω_n, the electrical base speed
+  SchedulerConfig scheduler;
+  ParameterBounds bounds;
+  Vec2 initial_theta_pu = Vec2::Zero();
+  double max_predicted_current_pu = 20.0;  ///< |î| beyond this counts as divergence
 };
 
 /// One conditioned sample (see conditioner.hpp): the interval since the previous sample and the

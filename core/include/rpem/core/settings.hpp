@@ -21,26 +21,15 @@ struct MachineSi {
   double psi_m_Wb = 0.0;
 };
 
-struct EstimatorSettings {
-  Algorithm algorithm = Algorithm::kSga;
-  Discretization discretization = Discretization::kTrapezoidal;
-  GradientForm gradient_psi_m = GradientForm::kSteadyState;
-  GradientForm gradient_r_s = GradientForm::kSteadyState;
-  std::array<GainSequences, 3> gains{};  ///< indexed by Algorithm
-  GainFloors floors;
+/// The options shared with EstimatorConfig (estimator.hpp, where their defaults are), plus what the
+/// user gives in SI: scheduler speeds, D_M, initial values, model extensions.
+struct EstimatorSettings : EstimatorOptions {
   double psi_m_min_speed_rpm = 0.0;  ///< n_lim,1, mechanical
   double r_s_max_speed_rpm = 0.0;    ///< n_lim,2, mechanical
   double psi_m_min_Wb = 0.0, psi_m_max_Wb = 0.0;
   double r_s_min_Ohm = 0.0, r_s_max_Ohm = 0.0;
   double initial_psi_m_Wb = 0.0;
   double initial_r_s_Ohm = 0.0;
-  Vec2 initial_sga_hessian_pu = Vec2::Zero();
-  Mat2 initial_gna_hessian_pu = Mat2::Zero();
-  double nominal_sample_period_s = 125e-6;
-  double max_sample_interval_s = 1e-3;
-  double max_gap_carry_s = 20e-3;
-  bool adapt_psi_m = true;
-  bool adapt_r_s = true;
   ModelExtensions extensions;  ///< model_extensions (docs/model-extensions.md)
   AveragedSettings averaged;   ///< the averaged-sample estimator (averaged_estimator.hpp)
 };

@@ -11,6 +11,7 @@ struct ThreadPolicy {
   bool fifo = false;  ///< SCHED_FIFO, else SCHED_OTHER
   int priority = 0;   ///< 1–99 for SCHED_FIFO
   int cpu = -1;       ///< pin to this CPU; −1: no pinning
+  bool operator==(const ThreadPolicy&) const = default;
 };
 
 [[nodiscard]] std::string apply_thread_policy(const ThreadPolicy& policy);

@@ -13,6 +13,10 @@ struct PersistedEstimates {
   std::optional<double> psi_m_Wb;  ///< present if ψm had converged
   std::optional<double> r_s_Ohm;   ///< present if r_s had converged
   std::int64_t written_unix_s = 0;
+  /// When each value last adapted (docs/rpemd.md, "Validity and age"); a file without them (older
+  /// rpemd): when it was written.
+  std::int64_t psi_m_adapted_unix_s = 0;
+  std::int64_t r_s_adapted_unix_s = 0;
 };
 
 /// Writes atomically; returns an empty string or the reason it failed.

@@ -1,0 +1,176 @@
+#include "rpem/daemon/daemon.hpp"
+
+#include <signal.h>
+#include <sys/signalfd.h>
+#include <systemd/sd-daemon.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdio>
+#include <ctime>
+
+#include "rpem/core/clock.hpp"
+#include "rpem/daemon/control.hpp"
+#include "rpem/daemon/realtime.hpp"
+#include "rpem/daemon/state_file.hpp"
+#include "rpem/io/exit_codes.hpp"
+
+namespace rpem::daemon {
+namespace {
+
+const char* realtime_name(RealtimeMode m) {
+  return m == RealtimeMode::kRequired ? "required" : m == RealtimeMode::kOff ? "off" : "preferred";
+}
+
+/// SIGTERM, SIGINT and SIGHUP blocked in the calling thread (and every thread it starts later), read
+/// instead from the returned signalfd.
+int block_signals_into_fd() {
+  sigset_t signals;
+  sigemptyset(&signals);
+  for (int s : {SIGTERM, SIGINT, SIGHUP}) sigaddset(&signals, s);
+  pthread_sigmask(SIG_BLOCK, &signals, nullptr);
+  return signalfd(-1, &signals, SFD_NONBLOCK | SFD_CLOEXEC);
+}
+
+}  // namespace
+
+DaemonConfig load_configuration(const DaemonOptions& o) {
+  DaemonConfig c = o.config_path.empty() ? builtin_daemon_config() : load_daemon_config(o.config_path);
+  if (!o.can_interface.empty()) c.fixed.source = CanSource::Options{o.can_interface};
+  return c;
+}
+
+Daemon::Daemon(DaemonOptions options, DaemonConfig config)
+    : options_(std::move(options)), config_(std::move(config)), source_(SourceCatalogue::make(config_.fixed.source)) {
+  source_name_ = source_->name();
+}
+
+Daemon::~Daemon() {
+  if (source_thread_.joinable() || loop_thread_.joinable() || publisher_thread_.joinable()) stop_threads();
+}
+
+void Daemon::seed_from_state_file() {
+  const core::EstimatorSettings& est = config_.live.machine.estimator;
+  const std::string path = resolve_state_file(config_.fixed.state);
+  const LoadedState loaded =
+      load_state_file(path, config_.fixed.state.max_age_s, est.psi_m_min_Wb, est.psi_m_max_Wb, est.r_s_min_Ohm, est.r_s_max_Ohm);
+  state_file_status_ = loaded.status;
+  if (loaded.status != StateFileStatus::kNone) std::fprintf(stderr, "rpemd: %s\n", loaded.message.c_str());
+  if (loaded.status != StateFileStatus::kLoaded) return;
+  const PersistedEstimates& e = loaded.estimates;
+  const std::int64_t now_s = std::time(nullptr);
+  auto seed = [&](const std::optional<double>& v, std::int64_t adapted_s) -> std::optional<SeedValue> {
+    if (!v) return std::nullopt;
+    return SeedValue{*v, static_cast<double>(std::max<std::int64_t>(0, now_s - adapted_s))};
+  };
+  loop_->seed(seed(e.psi_m_Wb, e.psi_m_adapted_unix_s), seed(e.r_s_Ohm, e.r_s_adapted_unix_s),
+              core::now_ns(CLOCK_MONOTONIC));
+}
+
+void Daemon::start_threads() {
+  publisher_thread_ = std::thread([this] { publisher_->run(stop_publisher_); });
+  loop_thread_ = std::thread([this] { loop_->run(stop_acquisition_); });
+}
+
+void Daemon::stop_threads() {
+  stop_acquisition_ = true;
+  if (source_thread_.joinable()) source_thread_.join();
+  if (loop_thread_.joinable()) loop_thread_.join();
+  stop_publisher_ = true;
+  if (publisher_thread_.joinable()) publisher_thread_.join();
+}
+
+int Daemon::run() {
+  // Before any thread exists, so that every thread inherits the mask and the signals arrive as data
+  // on the control thread only.
+  const int signal_fd = block_signals_into_fd();
+  const FixedConfig& fixed = config_.fixed;
+  const bool realtime = fixed.loop.realtime != RealtimeMode::kOff;
+  const bool required = fixed.loop.realtime == RealtimeMode::kRequired;
+  if (fixed.loop.lock_memory && realtime) {
+    const std::string problem = lock_memory();
+    if (!problem.empty()) {
+      std::fprintf(stderr, required ? "rpemd: %s\n" : "rpemd: warning: %s; continuing without locked memory\n", problem.c_str());
+      if (required) return io::kExitSoftware;
+    }
+  }
+  int qos_fd = -1;  // held open while rpemd runs
+  if (fixed.loop.cpu_dma_latency_us >= 0 && realtime) {
+    std::string problem;
+    qos_fd = request_cpu_dma_latency(fixed.loop.cpu_dma_latency_us, problem);
+    if (qos_fd < 0) std::fprintf(stderr, "rpemd: note: %s; deep CPU idle states may add wake-up latency\n", problem.c_str());
+  }
+
+  loop_ = std::make_unique<EstimatorLoop>(config_, EstimatorLoop::Queues{samples_, commands_, reports_});
+  seed_from_state_file();
+  const char* source_type = SourceCatalogue::type(fixed.source);
+  publisher_ = std::make_unique<Publisher>(fixed, Publisher::Identity{source_type, source_name_, state_file_status_},
+                                           Publisher::Queues{reports_, source_reports_, control_reports_});
+  start_threads();
+  while (!loop_->started()) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  if (!loop_->setup_problems().empty()) {
+    if (required) {
+      std::fprintf(stderr, "rpemd: real-time set-up failed: %s\n", loop_->setup_problems().c_str());
+      stop_threads();
+      return io::kExitSoftware;
+    }
+    std::fprintf(stderr, "rpemd: warning: real-time set-up incomplete (%s); running best effort\n",
+                 loop_->setup_problems().c_str());
+  }
+  source_thread_ = std::thread([this, policy = realtime ? fixed.receive_thread : ThreadPolicy{}, source_type] {
+    name_thread((std::string("rpemd-") + source_type).c_str());
+    (void)apply_thread_policy(policy);
+    source_->run(stop_acquisition_, source_output_);
+  });
+
+  char wake_ahead[32];
+  std::snprintf(wake_ahead, sizeof wake_ahead, fixed.loop.wake_ahead_auto ? "auto" : "%.0f µs", fixed.loop.wake_ahead_s * 1e6);
+  std::fprintf(stderr,
+               "rpemd: source %s '%s', loop %.0f µs (realtime %s, wake-ahead %s), machine %s, algorithm %s, LCM %s, "
+               "channels %sRPEM_*, commands %s, state file %s\n",
+               source_type, source_name_.c_str(), fixed.loop.period_s * 1e6, realtime_name(fixed.loop.realtime), wake_ahead,
+               config_.source_file.c_str(), io::to_string(config_.live.machine.estimator.algorithm),
+               fixed.lcm.url.empty() ? "default" : fixed.lcm.url.c_str(), fixed.lcm.channel_prefix.c_str(),
+               config_.live.commands_enabled ? "enabled" : "disabled", resolve_state_file(fixed.state).c_str());
+  sd_notifyf(0, "READY=1\nSTATUS=estimating from %s", source_name_.c_str());
+
+  {
+    Control control(std::move(config_), [this] { return load_configuration(options_); },
+                    Control::Queues{commands_, control_reports_}, loop_->timer());
+    (void)control.run(signal_fd);
+    config_ = control.running();
+  }
+  stop_threads();
+  print_summary();
+  if (qos_fd >= 0) ::close(qos_fd);
+  if (signal_fd >= 0) ::close(signal_fd);
+  std::fprintf(stderr, "rpemd: stopped\n");
+  return io::kExitOk;
+}
+
+void Daemon::print_summary() const {
+  const LoopTimer& t = loop_->timer();
+  const LatencyHistogram& wake = t.run_latency();
+  std::fprintf(stderr,
+               "rpemd: loop wake-up latency over the run [us]: p50 %.0f, p99 %.0f, p99.9 %.0f, max %.1f; "
+               "%lld overruns in %lld periods\n",
+               wake.percentile(0.5), wake.percentile(0.99), wake.percentile(0.999), wake.max(),
+               static_cast<long long>(t.overruns()), static_cast<long long>(t.periods()));
+  if (!options_.histogram_path.empty()) {
+    if (FILE* f = std::fopen(options_.histogram_path.c_str(), "w")) {
+      for (int us = 0; us < LatencyHistogram::kBins; ++us) {
+        if (wake.bin(us) > 0) std::fprintf(f, "%06d %lld\n", us, static_cast<long long>(wake.bin(us)));
+      }
+      std::fprintf(f, "# Histogram Overflows: %lld\n# Max Latencies: %.0f\n",
+                   static_cast<long long>(wake.bin(LatencyHistogram::kBins)), wake.max());
+      std::fclose(f);
+    }
+  }
+  const LatencyHistogram& rx = publisher_->rx_to_publish();
+  if (rx.count() > 0) {
+    std::fprintf(stderr, "rpemd: CAN receive -> LCM publish [us]: p50 %.0f, p99 %.0f, max %.1f (%lld estimates)\n",
+                 rx.percentile(0.5), rx.percentile(0.99), rx.max(), static_cast<long long>(rx.count()));
+  }
+}
+
+}  // namespace rpem::daemon

@@ -1,0 +1,79 @@
+#include "rpem/daemon/validity.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "rpem/core/estimator.hpp"
+
+namespace rpem::daemon {
+
+ValidityTracker::ValidityTracker(const ValidityConfig& config, double report_rate_Hz) noexcept
+    : report_rate_Hz_(report_rate_Hz) {
+  reconfigure(config);
+}
+
+void ValidityTracker::reconfigure(const ValidityConfig& config) noexcept {
+  config_ = config;
+  const int window = std::clamp(static_cast<int>(config.convergence_window_s * report_rate_Hz_), 2, kWindow);
+  if (window != window_) {
+    window_ = window;
+    for (Parameter& p : parameters_) p.count = p.head = 0;
+  }
+}
+
+void ValidityTracker::seed(int parameter, double age_s, std::int64_t now_ns) noexcept {
+  Parameter& p = parameters_[static_cast<std::size_t>(parameter)];
+  p.identified = true;
+  p.last_adapted_ns = now_ns - static_cast<std::int64_t>(std::max(0.0, age_s) * 1e9);
+}
+
+void ValidityTracker::restart() noexcept {
+  for (Parameter& p : parameters_) p = Parameter{};
+}
+
+void ValidityTracker::hold() noexcept {
+  for (Parameter& p : parameters_) p.adapting = false;
+  parameters_[core::kPsiM].adapted_s = 0.0;  // a pause
+}
+
+void ValidityTracker::on_sample(std::uint16_t flags, double dt_s, std::int64_t now_ns) noexcept {
+  const bool active[2] = {(flags & core::step_flag::kPsiMActive) != 0, (flags & core::step_flag::kRsActive) != 0};
+  const double after_s[2] = {config_.psi_m_after_s, config_.r_s_after_s};
+  for (int j = 0; j < 2; ++j) {
+    Parameter& p = parameters_[static_cast<std::size_t>(j)];
+    p.adapting = active[j];
+    if (active[j]) {
+      p.adapted_s += dt_s;
+      p.last_adapted_ns = now_ns;
+    } else if (j == core::kPsiM) {
+      p.adapted_s = 0.0;  // ψm is identified by adaptation without a pause
+    }
+    if (p.adapted_s >= after_s[j]) p.identified = true;
+  }
+}
+
+bool ValidityTracker::converged(const Parameter& p) const noexcept {
+  if (p.count < window_) return false;
+  double lo = p.window[0], hi = p.window[0];
+  for (int k = 1; k < window_; ++k) {
+    lo = std::min(lo, p.window[static_cast<std::size_t>(k)]);
+    hi = std::max(hi, p.window[static_cast<std::size_t>(k)]);
+  }
+  return hi - lo <= config_.convergence_band * std::abs(hi);
+}
+
+ValidityTracker::Status ValidityTracker::report(int parameter, double value, std::int64_t now_ns) noexcept {
+  Parameter& p = parameters_[static_cast<std::size_t>(parameter)];
+  p.window[static_cast<std::size_t>(p.head)] = value;
+  p.head = (p.head + 1) % window_;
+  p.count = std::min(p.count + 1, window_);
+  Status s;
+  s.adapting = p.adapting;
+  s.converged = converged(p);
+  if (p.last_adapted_ns != kNever) s.age_s = 1e-9 * static_cast<double>(std::max<std::int64_t>(0, now_ns - p.last_adapted_ns));
+  s.valid = p.identified && s.age_s >= 0.0 && s.age_s <= config_.max_hold_s;
+  s.good = s.valid && s.converged && s.adapting;
+  return s;
+}
+
+}  // namespace rpem::daemon

@@ -1,0 +1,137 @@
+// A held estimate says how old it is, end to end: the real rpemd on a simulated drive whose speed
+// steps up after a standstill (r_s adapts at standstill and is held at speed by the gain schedule,
+// eq:GainSchedule), heard by `rpem listen` over LCM. Expected from the definitions in docs/rpemd.md
+// ("Validity and age"):
+//   - while held, r_s does not change, and its age grows with rpemd's clock: Δage = Δutime (± 0.05 s:
+//     the age is taken at the newest sample, the time at publication);
+//   - it is valid while its age is within validity.max_hold_s and not after;
+//   - `rpem listen` prints it as "held N.N s" followed by "valid" only while it is, and rpemd's status
+//     line as "held N s", with "?" once it is not valid.
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <regex>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "support/child_process.hpp"
+#include "support/process.hpp"
+#include "support/temp_file.hpp"
+
+namespace rpem {
+namespace {
+
+constexpr double kMaxHold_s = 2.0;
+const std::string kUrl = "udpm://239.255.76.67:7818?ttl=0";
+
+// The built-in demo's drive, shortened: 4 s at standstill under load, then 300 rpm while the winding heats.
+constexpr const char* kScenario = R"(name: held
+machine: builtin:paper-ipmsm
+duration_s: 60
+seed: 5
+inverter: {model: averaged}
+plant:
+  mechanics: {mode: inertia, inertia_kgm2: 0.05, friction_Nms: 0.002}
+control: {mode: speed, speed_bandwidth_Hz: 5}
+sensors: {current_noise_A: 0.02, current_lsb_A: 0.01, encoder_counts: 16384, speed_window: 16}
+initial: {speed_rpm: 0, torque_Nm: 13.04, u_dc_V: 220, t_winding_C: 45, t_magnet_C: 50}
+events:
+  - {t_s: 0, quantity: t_winding_C, kind: thermal, value: 95, tau_s: 400}
+  - {t_s: 4, quantity: speed_rpm, kind: ramp, value: 300, duration_s: 1}
+)";
+
+struct Row {
+  double utime_s, r_s_Ohm, r_s_age_s;
+  bool r_s_valid, r_s_adapting;
+};
+
+/// The rows of `rpem listen --csv` (header: utime,…,r_s,…,r_s_valid,…,r_s_adapting,…,r_s_age_s).
+std::vector<Row> read_rows(const std::string& csv) {
+  std::istringstream in(csv);
+  std::string line;
+  std::getline(in, line);
+  std::vector<std::string> names;
+  for (std::istringstream h(line); std::getline(h, line, ',');) names.push_back(line);
+  auto column = [&](const std::string& name) {
+    for (std::size_t i = 0; i < names.size(); ++i)
+      if (names[i] == name) return i;
+    ADD_FAILURE() << "no column " << name;
+    return std::size_t{0};
+  };
+  const std::size_t utime = column("utime"), r_s = column("r_s"), age = column("r_s_age_s"),
+                    valid = column("r_s_valid"), adapting = column("r_s_adapting");
+  std::vector<Row> rows;
+  while (std::getline(in, line)) {
+    std::vector<std::string> f;
+    for (std::istringstream c(line); std::getline(c, line, ',');) f.push_back(line);
+    if (f.size() != names.size()) continue;
+    rows.push_back({1e-6 * std::stod(f[utime]), std::stod(f[r_s]), std::stod(f[age]), f[valid] == "1", f[adapting] == "1"});
+  }
+  return rows;
+}
+
+TEST(CliListen, AHeldEstimateShowsItsAgeAndLapsesAfterMaxHold) {
+  test::TempFile scenario("scenario.yaml", std::string(kScenario));
+  test::TempFile state("state.json");
+  test::TempFile config("rpemd.yaml", "daemon:\n  source: {type: sim, sim: {scenario: " + scenario.path() +
+                                          ", loop: false}}\n  lcm: {url: \"" + kUrl + "\"}\n  state: {file: " +
+                                          state.path() + "}\n  status_interval_s: 0.5\n  validity: {max_hold_s: " +
+                                          std::to_string(kMaxHold_s) + "}\n");
+  test::TempFile rpemd_log("rpemd.log"), csv("listen.csv");
+  const auto listen = [&] {
+    return test::run_command(test::binary_dir() + "/tools/rpem listen --lcm-url '" + kUrl + "' --duration 10 --csv " + csv.path());
+  };
+  test::ProcessResult heard;
+  {
+    std::thread listener([&] { heard = listen(); });
+    test::ChildProcess rpemd({test::binary_dir() + "/daemon/rpemd", "--config", config.path()}, rpemd_log.path());
+    listener.join();
+    EXPECT_EQ(rpemd.stop(), 0);
+  }
+  ASSERT_EQ(heard.exit_code, 0) << heard.output;
+  const std::vector<Row> rows = read_rows(test::read_file(csv.path()));
+  ASSERT_GT(rows.size(), 50u) << heard.output;
+
+  // Adapting and identified at standstill, then held from the last adapting row on.
+  std::size_t last_adapting = rows.size();
+  for (std::size_t i = 0; i < rows.size(); ++i)
+    if (rows[i].r_s_adapting) last_adapting = i;
+  ASSERT_LT(last_adapting, rows.size()) << "r_s never adapted";
+  ASSERT_LT(last_adapting + 1, rows.size()) << "r_s never held";
+  EXPECT_TRUE(rows[last_adapting].r_s_valid) << "r_s not identified after 4 s at standstill";
+  // It last adapted between the last adapting report and the next (reports are 0.1 s apart).
+  const Row& held = rows[last_adapting + 1];
+  EXPECT_GE(held.r_s_age_s, 0.0);
+  EXPECT_LE(held.r_s_age_s, held.utime_s - rows[last_adapting].utime_s + 0.05);
+  bool saw_valid_held = false, saw_lapsed = false;
+  for (std::size_t i = last_adapting + 1; i < rows.size(); ++i) {
+    const Row& r = rows[i];
+    ASSERT_FALSE(r.r_s_adapting) << "r_s adapted again at speed, row " << i;
+    EXPECT_EQ(r.r_s_Ohm, held.r_s_Ohm) << "a held value does not change, row " << i;
+    EXPECT_NEAR(r.r_s_age_s - held.r_s_age_s, r.utime_s - held.utime_s, 0.05) << "the age runs with the clock, row " << i;
+    if (r.r_s_age_s < kMaxHold_s - 0.05) {
+      EXPECT_TRUE(r.r_s_valid) << "held " << r.r_s_age_s << " s <= max_hold_s, row " << i;
+      saw_valid_held = true;
+    } else if (r.r_s_age_s > kMaxHold_s + 0.05) {
+      EXPECT_FALSE(r.r_s_valid) << "held " << r.r_s_age_s << " s > max_hold_s, row " << i;
+      saw_lapsed = true;
+    }
+  }
+  EXPECT_TRUE(saw_valid_held);
+  EXPECT_TRUE(saw_lapsed);
+  EXPECT_GT(rows.back().r_s_age_s, kMaxHold_s + 2.0) << "the run should hold r_s for several seconds";
+
+  // What a user reads: rpem listen's lines and rpemd's status line.
+  EXPECT_TRUE(std::regex_search(heard.output, std::regex(R"(r_s [0-9.]+ Ohm adapting valid)"))) << heard.output;
+  EXPECT_TRUE(std::regex_search(heard.output, std::regex(R"(r_s [0-9.]+ Ohm held 1\.[0-9] s valid)"))) << heard.output;
+  EXPECT_TRUE(std::regex_search(heard.output, std::regex(R"(r_s [0-9.]+ Ohm held [3-9]\.[0-9] s( converged)?  T_magnet)")))
+      << heard.output;
+  const std::string status = test::read_file(rpemd_log.path());
+  EXPECT_TRUE(std::regex_search(status, std::regex(R"(r_s=[0-9.]+ Ohm held [01] s \(T_winding)"))) << status;
+  EXPECT_TRUE(std::regex_search(status, std::regex(R"(r_s=[0-9.]+ Ohm held [3-9] s\? \(T_winding)"))) << status;
+}
+
+}  // namespace
+}  // namespace rpem
