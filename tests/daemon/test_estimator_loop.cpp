@@ -194,7 +194,7 @@ TEST(EstimatorLoop, AReloadReachesTheLoopAsOneObject) {
   reload.kind = Command::Kind::kReconfigure;
   reload.live = rig.config.live;
   reload.live.validity.max_hold_s = 1.0;
-  reload.live.temperature.reference_C = 40.0;
+  reload.live.temperature.r_s.reference_C = 40.0;
   ASSERT_TRUE(rig.commands.push(reload));
   rig.run(0.2);
   const EstimateReport e = rig.last_estimate();
