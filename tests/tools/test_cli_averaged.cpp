@@ -107,7 +107,10 @@ TEST(CliAveragedDiagnose, FindsAMagnetDriftHiddenInAnAveragedLog) {
   const double coeff = d["effects"][0]["params"]["coeff_per_K"];
   EXPECT_LT(coeff, -0.0008);
   EXPECT_GT(coeff, -0.0012);
-  EXPECT_GT(d["effects"][0]["gain_pct"].get<double>(), 30.0);
+  // The gain is over the calibrated baseline (issue 10), which already takes the mean ψm error (0.35 →
+  // 0.14 A held out on this log); what is left is the drift's own part.
+  EXPECT_GT(d["effects"][0]["gain_pct"].get<double>(), 10.0);
+  EXPECT_LT(d["calibration"]["heldout_rms"].get<double>(), 0.5 * d["baseline"]["heldout_rms"].get<double>());
 
   // The transient replay needs phase samples: refused, naming the log.
   const test::ProcessResult t = test::run_command(rpem() + " diagnose --log " + avg.path() + " --config " + config() +
