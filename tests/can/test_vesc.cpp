@@ -13,33 +13,15 @@
 #include "rpem/can/e2e.hpp"
 #include "rpem/can/protocol.hpp"
 #include "rpem/can/vesc.hpp"
+#include "support/vesc_frames.hpp"
 
 namespace rpem::can::vesc {
 namespace {
 
-constexpr std::uint8_t kController = 17;  // the VESC
-constexpr std::uint8_t kOwn = 0x7D;       // the poller (rpemd)
-
-CanFrame ext(std::uint32_t id, std::vector<std::uint8_t> bytes) {
-  CanFrame f;
-  f.extended = true;
-  f.id = id;
-  f.len = static_cast<std::uint8_t>(bytes.size());
-  std::copy(bytes.begin(), bytes.end(), f.data.begin());
-  return f;
-}
-
-/// The reply to a poll with the estimator's mask 0x001801B3: T_fet 41.3 °C, T_motor 67.8 °C, i_d −3.21 A,
-/// i_q 27.45 A, 21000 ERPM, V_in 48.2 V, v_d −1.234 V, v_q 11.873 V — 31 bytes in five FILL_RX_BUFFER
-/// frames (ID 0x57D: own id 0x7D | 5 << 8) and PROCESS_RX_BUFFER (0x77D) from controller 17, CRC 0x08F7.
-std::vector<CanFrame> reply_frames() {
-  return {ext(0x57D, {0x00, 0x32, 0x00, 0x18, 0x01, 0xB3, 0x01, 0x9D}),
-          ext(0x57D, {0x07, 0x02, 0xA6, 0xFF, 0xFF, 0xFE, 0xBF, 0x00}),
-          ext(0x57D, {0x0E, 0x00, 0x0A, 0xB9, 0x00, 0x00, 0x52, 0x08}),
-          ext(0x57D, {0x15, 0x01, 0xE2, 0xFF, 0xFF, 0xFB, 0x2E, 0x00}),
-          ext(0x57D, {0x1C, 0x00, 0x2E, 0x61}),
-          ext(0x77D, {0x11, 0x01, 0x00, 0x1F, 0x08, 0xF7})};
-}
+using test::vesc_frames::ext;
+using test::vesc_frames::kController;
+using test::vesc_frames::reply_frames;
+constexpr std::uint8_t kOwn = test::vesc_frames::kHost;  // the poller (rpemd)
 
 std::vector<VescDecoder::Event> feed(VescDecoder& dec, const std::vector<CanFrame>& frames) {
   std::vector<VescDecoder::Event> events;
