@@ -114,11 +114,17 @@ void fill_defaults(const io::MachineConfig& machine, TemperatureModel& t) {
 }
 
 /// The machine's model extensions must be ones the source's samples can be corrected for (averaged
-/// samples: no per-phase current errors).
+/// samples: no per-phase current errors; a dead time in seconds: the DC link).
 void check_source_supports(const DaemonConfig& c) {
   const io::MachineConfig& m = c.live.machine;
   if (const auto* v = std::get_if<VescSource::Options>(&c.fixed.source)) {
     io::check_averaged_supports(m, c.source_file, true, "source vesc, controller " + std::to_string(v->controller_id));
+  } else if (const auto* s = std::get_if<SignalMapSource::Options>(&c.fixed.source)) {
+    if (s->kind == SampleKind::kAveraged) {
+      io::check_averaged_supports(m, c.source_file, s->gives_u_dc, s->map);
+    } else {
+      io::check_log_supports(m, c.source_file, s->gives_u_dc, s->map);
+    }
   }
 }
 

@@ -89,6 +89,9 @@ class SignalMapDecoder {
   [[nodiscard]] bool decode(const CanFrame& f, std::int64_t t_ns, core::AveragedSample& out) noexcept;
   [[nodiscard]] const SignalMapCounters& counters() const noexcept { return counters_; }
   [[nodiscard]] const SignalMap& map() const noexcept { return map_; }
+  /// The newest value of a field (0 before its first frame): e.g. the angle of the sample just completed,
+  /// which a phase sample keeps (rpemd's signal_map source).
+  [[nodiscard]] double latest(SampleField f) const noexcept { return values_[static_cast<std::size_t>(f)]; }
 
  private:
   [[nodiscard]] bool complete(std::int64_t t_ns, core::AveragedSample& out) noexcept;

@@ -11,6 +11,7 @@
 #include <variant>
 
 #include "rpem/daemon/can_source.hpp"
+#include "rpem/daemon/signal_map_source.hpp"
 #include "rpem/daemon/sim_source.hpp"
 #include "rpem/daemon/vesc_source.hpp"
 #include "rpem/io/yaml_map.hpp"
@@ -74,7 +75,7 @@ struct Catalogue {
   }
 };
 
-using SourceCatalogue = Catalogue<SimSource, CanSource, VescSource>;
+using SourceCatalogue = Catalogue<SimSource, CanSource, VescSource, SignalMapSource>;
 using SourceConfig = SourceCatalogue::Options;
 
 }  // namespace rpem::daemon
