@@ -7,7 +7,7 @@
 #include "rpem/can/protocol.hpp"
 #include "rpem/can/socketcan.hpp"
 #include "rpem/core/clock.hpp"
-#include "rpem/daemon/can_channel_rows.hpp"
+#include "rpem/daemon/socketcan_source.hpp"
 
 namespace rpem::daemon {
 namespace {
@@ -58,13 +58,7 @@ class CanSampleSource final : public SampleSource {
           out.push(samples[k]);
         }
       }
-      const std::int64_t now = core::now_ns(CLOCK_MONOTONIC);
-      if (out.report_due(now)) {
-        SourceReport r;
-        r.rows.set_all(kDecoderRows, decoder.counters());
-        r.rows.set_all(kChannelRows, channel.counters());
-        out.report(r, now);
-      }
+      report_when_due(out, channel, [&](DiagnosticsRows& rows) { rows.set_all(kDecoderRows, decoder.counters()); });
     }
   }
   [[nodiscard]] std::string name() const override { return options_.interface; }
@@ -77,8 +71,7 @@ class CanSampleSource final : public SampleSource {
 
 CanSource::Options CanSource::parse(io::YamlMap& section, const std::string&) {
   Options o;
-  o.interface = section.text("interface");
-  if (o.interface.empty() || o.interface.size() > 15) section.fail("interface", "not an interface name");
+  o.interface = parse_interface(section);
   section.finish();
   return o;
 }

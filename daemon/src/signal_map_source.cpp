@@ -6,7 +6,7 @@
 
 #include "rpem/can/socketcan.hpp"
 #include "rpem/core/clock.hpp"
-#include "rpem/daemon/can_channel_rows.hpp"
+#include "rpem/daemon/socketcan_source.hpp"
 #include "rpem/io/signal_map_config.hpp"
 
 namespace rpem::daemon {
@@ -47,16 +47,9 @@ class SignalMapSampleSource final : public SampleSource {
       const std::size_t n = channel.receive(frames, 50);
       const std::int64_t now = core::now_ns(CLOCK_REALTIME);
       for (std::size_t f = 0; f < n; ++f) {
-        const std::int64_t rx = frames[f].kernel_rx_ns != 0 ? frames[f].kernel_rx_ns : now;
-        if (sampler_.on_frame(frames[f].frame, rx, sample)) out.push(sample);
+        if (sampler_.on_frame(frames[f].frame, receive_time_ns(frames[f], now), sample)) out.push(sample);
       }
-      const std::int64_t mono = core::now_ns(CLOCK_MONOTONIC);
-      if (out.report_due(mono)) {
-        SourceReport r;
-        sampler_.report(r.rows);
-        r.rows.set_all(kChannelRows, channel.counters());
-        out.report(r, mono);
-      }
+      report_when_due(out, channel, [&](DiagnosticsRows& rows) { sampler_.report(rows); });
     }
   }
   [[nodiscard]] std::string name() const override { return options_.interface + " map " + options_.map; }
@@ -103,8 +96,7 @@ void SignalMapSampler::report(DiagnosticsRows& rows) const noexcept { rows.set_a
 
 SignalMapSource::Options SignalMapSource::parse(io::YamlMap& section, const std::string& base_dir) {
   Options o;
-  o.interface = section.text("interface");
-  if (o.interface.empty() || o.interface.size() > 15) section.fail("interface", "not an interface name");
+  o.interface = parse_interface(section);
   o.map = section.text("map");
   if (std::filesystem::path(o.map).is_relative()) o.map = (std::filesystem::path(base_dir) / o.map).lexically_normal().string();
   section.finish();

@@ -6,7 +6,7 @@
 
 #include "rpem/can/socketcan.hpp"
 #include "rpem/core/clock.hpp"
-#include "rpem/daemon/can_channel_rows.hpp"
+#include "rpem/daemon/socketcan_source.hpp"
 #include "rpem/daemon/vesc_poller.hpp"
 
 namespace rpem::daemon {
@@ -81,16 +81,9 @@ class VescSampleSource final : public SampleSource {
       const std::size_t n = channel.receive_for(frames, wait_ns);
       now = core::now_ns(CLOCK_REALTIME);
       for (std::size_t f = 0; f < n; ++f) {
-        const std::int64_t rx = frames[f].kernel_rx_ns != 0 ? frames[f].kernel_rx_ns : now;
-        if (poller.on_frame(frames[f].frame, rx, sample)) out.push(sample);
+        if (poller.on_frame(frames[f].frame, receive_time_ns(frames[f], now), sample)) out.push(sample);
       }
-      const std::int64_t mono = core::now_ns(CLOCK_MONOTONIC);
-      if (out.report_due(mono)) {
-        SourceReport r;
-        report_vesc_counters(poller, r.rows);
-        r.rows.set_all(kChannelRows, channel.counters());
-        out.report(r, mono);
-      }
+      report_when_due(out, channel, [&](DiagnosticsRows& rows) { report_vesc_counters(poller, rows); });
     }
   }
   [[nodiscard]] std::string name() const override {
@@ -105,8 +98,7 @@ class VescSampleSource final : public SampleSource {
 
 VescSource::Options VescSource::parse(io::YamlMap& section, const std::string&) {
   Options o;
-  o.interface = section.text("interface");
-  if (o.interface.empty() || o.interface.size() > 15) section.fail("interface", "not an interface name");
+  o.interface = parse_interface(section);
   o.controller_id = static_cast<int>(section.integer("controller_id", 0, 254));
   o.host_id = static_cast<int>(section.integer_or("host_id", o.host_id, 0, 254));
   if (o.host_id == o.controller_id) section.fail("host_id", "must differ from controller_id (replies are addressed to it)");

@@ -43,7 +43,7 @@ in_root dpkg -s rpem-drive | grep -q "Status: install ok installed"
 [[ -L $root/etc/systemd/system/multi-user.target.wants/rpemd.service ]] || { echo "test_deb: rpemd.service not enabled"; exit 1; }
 
 echo "test_deb: checking the installed units (rpemd and the bus bring-up units): verify clean, exposure <= 2.5"
-for unit in rpemd.service rpem-can@.service rpem-vcan@.service; do
+for unit in rpemd.service rpemd@.service rpem-can@.service rpem-vcan@.service; do
   path=/usr/lib/systemd/system/$unit
   [[ -f $root$path ]] || { echo "test_deb: $unit not installed"; exit 1; }
   # verify exits 0 on unknown keys and bad values too: anything it says about the unit is a failure.

@@ -1,0 +1,50 @@
+#pragma once
+// What every source that reads a SocketCAN interface (can, vesc, signal_map) shares: its `interface`
+// option, a frame's receive time, and its report — the decoder's rows beside the socket's counters
+// (can_* in diagnostics_t).
+
+#include <array>
+#include <cstdint>
+#include <string>
+
+#include "rpem/can/socketcan.hpp"
+#include "rpem/core/clock.hpp"
+#include "rpem/daemon/diagnostics_rows.hpp"
+#include "rpem/daemon/source.hpp"
+#include "rpem/io/yaml_map.hpp"
+
+namespace rpem::daemon {
+
+inline constexpr std::array<CounterRow<can::ChannelCounters, std::uint64_t>, 6> kChannelRows{{
+    {&can::ChannelCounters::kernel_drops, &rpem::diagnostics_t::can_kernel_drops},
+    {&can::ChannelCounters::reopens, &rpem::diagnostics_t::can_reopens},
+    {&can::ChannelCounters::error_frames, &rpem::diagnostics_t::can_error_frames},
+    {&can::ChannelCounters::bus_off, &rpem::diagnostics_t::can_bus_off},
+    {&can::ChannelCounters::error_passive, &rpem::diagnostics_t::can_error_passive},
+    {&can::ChannelCounters::controller_overflow, &rpem::diagnostics_t::can_controller_overflow},
+}};
+
+/// The section's `interface`: a SocketCAN interface name.
+[[nodiscard]] inline std::string parse_interface(io::YamlMap& section) {
+  std::string name = section.text("interface");
+  if (name.empty() || name.size() > 15) section.fail("interface", "not an interface name");
+  return name;
+}
+
+/// When a frame arrived: the kernel's receive stamp (CLOCK_REALTIME), else `fallback_ns`.
+[[nodiscard]] inline std::int64_t receive_time_ns(const can::ReceivedFrame& f, std::int64_t fallback_ns) noexcept {
+  return f.kernel_rx_ns != 0 ? f.kernel_rx_ns : fallback_ns;
+}
+
+/// Sends the source's report when due: `fill(rows)` adds the decoder's rows, the socket's are added here.
+template <class Fill>
+void report_when_due(SourceOutput& out, const can::SocketCanChannel& channel, Fill&& fill) {
+  const std::int64_t now = core::now_ns(CLOCK_MONOTONIC);
+  if (!out.report_due(now)) return;
+  SourceReport r;
+  fill(r.rows);
+  r.rows.set_all(kChannelRows, channel.counters());
+  out.report(r, now);
+}
+
+}  // namespace rpem::daemon
