@@ -1,6 +1,5 @@
 #include "rpem/can/bus_load.hpp"
 
-#include <algorithm>
 #include <cmath>
 
 #include "rpem/can/protocol.hpp"
@@ -20,21 +19,6 @@ double frame_time_s(bool fd, int n, const BusTiming& t) noexcept {
   const int fixed_stuff = static_cast<int>(std::ceil((4 + crc) / 4.0)) + 1;
   const int data_bits = dynamic + (dynamic - 1) / 4 + 4 + crc + fixed_stuff;
   return nominal_bits / t.nominal_bit_rate + data_bits / t.data_bit_rate;
-}
-
-double extended_frame_time_s(int n, const BusTiming& t) noexcept {
-  const int stuffed = 54 + 8 * n;
-  const int bits = 67 + 8 * n + (stuffed - 1) / 4;
-  return bits / t.nominal_bit_rate;
-}
-
-double vesc_poll_time_s(int reply_bytes, const BusTiming& t) noexcept {
-  double time = extended_frame_time_s(7, t);  // [host id][0][50][mask]
-  if (reply_bytes <= 6) return time + extended_frame_time_s(2 + reply_bytes, t);
-  for (int offset = 0; offset < reply_bytes; offset += 7) {
-    time += extended_frame_time_s(1 + std::min(7, reply_bytes - offset), t);  // [offset][≤ 7 bytes]
-  }
-  return time + extended_frame_time_s(6, t);  // [sender][send][length][CRC]
 }
 
 BusBudget telemetry_budget(bool fd, double rate, int per_frame, const BusTiming& t) noexcept {

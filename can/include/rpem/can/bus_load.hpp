@@ -16,13 +16,6 @@ struct BusTiming {
 
 /// Worst-case duration of one frame with `payload_bytes` of data [s].
 [[nodiscard]] double frame_time_s(bool fd, int payload_bytes, const BusTiming& timing) noexcept;
-/// The same for a classic frame with a 29-bit identifier (VESC's): 67 + 8·n bits, 54 + 8·n stuffed.
-[[nodiscard]] double extended_frame_time_s(int payload_bytes, const BusTiming& timing) noexcept;
-
-/// Bus time of one VESC poll (docs/can-vesc.md): the COMM_GET_VALUES_SELECTIVE request (a 7-byte
-/// PROCESS_SHORT_BUFFER) and its reply of `reply_bytes` (one PROCESS_SHORT_BUFFER up to 6 bytes, else
-/// FILL_RX_BUFFER frames of 7 bytes each and PROCESS_RX_BUFFER), classic frames at the nominal rate.
-[[nodiscard]] double vesc_poll_time_s(int reply_bytes, const BusTiming& timing) noexcept;
 
 /// Telemetry frames per second and bus load for a sample rate.
 struct BusBudget {
