@@ -181,11 +181,20 @@ void Publisher::print_status(const EstimateReport& r) {
   if (source_.has_truth) {
     std::snprintf(truth, sizeof truth, "  [sim truth %.4f Wb %.4f Ohm]", source_.truth_psi_m_Wb, source_.truth_r_s_Ohm);
   }
+  char vesc[192] = "";  // a VESC source's poll counters (docs/rpemd.md, "source: vesc")
+  if (const DiagnosticsRows& s = source_.rows; s.get(&rpem::diagnostics_t::vesc_polls) >= 0) {
+    using D = rpem::diagnostics_t;
+    std::snprintf(vesc, sizeof vesc, "  [vesc polls %lld replies %lld timeouts %lld late %lld unrequested %lld stolen_reads %lld]",
+                  static_cast<long long>(s.get(&D::vesc_polls)), static_cast<long long>(s.get(&D::vesc_replies)),
+                  static_cast<long long>(s.get(&D::vesc_timeouts)), static_cast<long long>(s.get(&D::vesc_late_replies)),
+                  static_cast<long long>(s.get(&D::vesc_unrequested_replies)),
+                  static_cast<long long>(s.get(&D::vesc_stolen_reads)));
+  }
   char psi[32], rs[32];
-  std::printf("rpemd %-8s n=%+.3f pu  psi_m=%.4f Wb%s (T_magnet %5.1f C)  r_s=%.4f Ohm%s (T_winding %5.1f C)%s%s\n",
+  std::printf("rpemd %-8s n=%+.3f pu  psi_m=%.4f Wb%s (T_magnet %5.1f C)  r_s=%.4f Ohm%s (T_winding %5.1f C)%s%s%s\n",
               kStates[static_cast<int>(r.state)], r.speed_pu, r.psi_m_Wb,
               mark(psi, sizeof psi, r.psi_m_adapting, r.psi_m_age_s, r.psi_m_valid), r.t_magnet_C, r.r_s_Ohm,
-              mark(rs, sizeof rs, r.r_s_adapting, r.r_s_age_s, r.r_s_valid), r.t_winding_C, truth,
+              mark(rs, sizeof rs, r.r_s_adapting, r.r_s_age_s, r.r_s_valid), r.t_winding_C, truth, vesc,
               r.frozen ? "  FROZEN" : "");
   std::fflush(stdout);
 }
