@@ -49,6 +49,7 @@ void VescPoller::time_out() noexcept {
   timed_out_unanswered_ = true;
   timed_out_at_ns_ = deadline_ns_;
   decoder_.reset_buffer();
+  gap_before_timeout_ = gap_;
   gap_ = true;  // the controller may have read (and reset) with its reply lost
 }
 
@@ -84,6 +85,7 @@ bool VescPoller::on_frame(const can::CanFrame& f, std::int64_t rx_ns, core::Aver
   } else if (timed_out_unanswered_ && t - timed_out_at_ns_ <= config_.period_ns) {
     ++counters_.late;
     consecutive_timeouts_ = 0;
+    gap_ = gap_before_timeout_;  // the read it feared lost is this one: the chain holds
   } else {
     ++counters_.unrequested;
   }

@@ -105,7 +105,7 @@ VescSource::Options VescSource::parse(io::YamlMap& section, const std::string&) 
   o.poll_rate_Hz = section.number_or("poll_rate_Hz", o.poll_rate_Hz, 1.0, 2000.0);
   o.poll_phase = section.number_or("poll_phase", o.poll_phase, 0.0, 0.999);
   const double period_s = 1.0 / o.poll_rate_Hz;
-  o.reply_timeout_s = section.number_or("reply_timeout_s", std::min(0.5 * period_s, 5e-3), 1e-4, period_s);
+  o.reply_timeout_s = section.number_or("reply_timeout_s", std::min(0.9 * period_s, 20e-3), 1e-4, period_s);
   section.finish();
   return o;
 }

@@ -7,9 +7,13 @@
 #include <cmath>
 #include <numbers>
 #include <optional>
+#include <string>
+#include <variant>
 #include <vector>
 
+#include "rpem/daemon/daemon_config.hpp"
 #include "rpem/daemon/vesc_source.hpp"
+#include "support/temp_file.hpp"
 #include "can/vesc_vectors.hpp"
 
 namespace rpem::daemon {
@@ -126,7 +130,8 @@ TEST(VescPoller, ASilentControllerTimesOutAndTheNextWindowFollowsAGap) {
   EXPECT_FALSE(next->gap_before);
 }
 
-// A reply after its poll timed out is late, and still a window (it ends a read of the controller).
+// A reply after its poll timed out is late, and still a window (it ends a read of the controller); it is
+// the read the timeout feared lost, so the chain holds (no gap).
 TEST(VescPoller, AReplyAfterItsTimeoutIsLateAndStillUsed) {
   VescPoller p = make_poller();
   (void)poll_and_reply(p, kT0);
@@ -138,6 +143,7 @@ TEST(VescPoller, AReplyAfterItsTimeoutIsLateAndStillUsed) {
   EXPECT_EQ(p.counters().late, 1U);
   EXPECT_EQ(p.counters().unrequested, 0U);
   EXPECT_EQ(s->t_start_ns, kT0 + 300'000);
+  EXPECT_FALSE(s->gap_before);
 }
 
 // Another poller reading our controller on the bus (node 0x42, the same poll the docs show for us): its
@@ -206,6 +212,15 @@ TEST(VescPoller, ABrokenReplyIsCountedAndItsPollTimesOut) {
   EXPECT_EQ(rows.get(&diagnostics_t::vesc_timeouts), 1);
   EXPECT_EQ(rows.get(&diagnostics_t::vesc_polls), 2);
   EXPECT_EQ(rows.get(&diagnostics_t::vesc_replies), 0);
+}
+
+TEST(VescPoller, TheDefaultTimeoutLeavesTheReplyMostOfThePeriod) {
+  for (double rate : {50.0, 200.0, 1000.0}) {
+    const test::TempFile config("rpemd-vesc-timeout.yaml", "daemon:\n  source:\n    type: vesc\n    vesc: {interface: can0, "
+                                                           "controller_id: 17, poll_rate_Hz: " + std::to_string(rate) + "}\n");
+    const DaemonConfig c = load_daemon_config(config.path());
+    EXPECT_NEAR(std::get<VescSource::Options>(c.fixed.source).reply_timeout_s, std::min(0.9 / rate, 0.02), 1e-12) << rate;
+  }
 }
 
 TEST(VescPoller, AnUnsentPollIsCountedAndNotAwaited) {

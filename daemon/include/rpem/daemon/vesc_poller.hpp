@@ -18,7 +18,8 @@
 //   unrequested       a values reply to our id with no poll of ours outstanding or timed out unanswered
 //                     in the last period: another poller uses our host id. Its window is still right
 //                     (it ends a read), so it is used.
-//   late              a reply to a poll that had timed out (within one period of the timeout): used.
+//   late              a reply to a poll that had timed out (within one period of the timeout): used, and
+//                     the gap the timeout feared is lifted (this reply is that read).
 //   timeouts          a poll unanswered within reply_timeout_s (silent controller, lost frames). Whether
 //                     the controller read (and reset) is unknown, so the next window follows a gap.
 //   short_windows     a window shorter than kMinWindow: the firmware divides sums of (nearly) no control
@@ -51,7 +52,7 @@ class VescPoller {
     std::uint8_t host_id = 254;
     std::int64_t period_ns = 5'000'000;
     std::int64_t phase_ns = 0;    ///< in [0, period_ns)
-    std::int64_t timeout_ns = 2'500'000;
+    std::int64_t timeout_ns = 4'500'000;
     std::uint32_t mask = can::vesc::kEstimatorMask;
   };
   /// Shorter windows are not measurements (a few of VESC's control cycles at most).
@@ -102,6 +103,7 @@ class VescPoller {
   bool has_window_start_ = false;
   std::int64_t window_start_ns_ = 0;  ///< the newest read of the controller seen
   bool gap_ = true;                   ///< windows before the next may be lost
+  bool gap_before_timeout_ = true;    ///< gap_ as it was before the newest timeout (a late reply restores it)
 };
 
 }  // namespace rpem::daemon
