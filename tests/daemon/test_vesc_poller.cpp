@@ -1,7 +1,7 @@
 // rpemd's VESC source without a socket (VescPoller): the poll schedule, replies turned into averaged
 // windows between the replies' receive times, and what is counted — timeouts of a silent controller, late
 // and unrequested replies, another poller's reads stealing the averages, windows too short to be averages.
-// Frames are written byte by byte from docs/can-vesc.md (can/vesc_vectors.hpp), not by our encoder.
+// Frames are written byte by byte from docs/can-vesc.md (support/vesc_frames.hpp), not by our encoder.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -14,15 +14,15 @@
 #include "rpem/daemon/daemon_config.hpp"
 #include "rpem/daemon/vesc_source.hpp"
 #include "support/temp_file.hpp"
-#include "can/vesc_vectors.hpp"
+#include "support/vesc_frames.hpp"
 
 namespace rpem::daemon {
 namespace {
 
-using test::vesc_vectors::ext;
-using test::vesc_vectors::kController;
-using test::vesc_vectors::reply_frames;
-constexpr std::uint8_t kHost = test::vesc_vectors::kOwn;  // rpemd's host_id
+using test::vesc_frames::ext;
+using test::vesc_frames::kController;
+using test::vesc_frames::kHost;
+using test::vesc_frames::reply_frames;
 
 constexpr std::int64_t kT0 = 1'700'000'000'000'000'000;  // a CLOCK_REALTIME instant [ns]
 constexpr std::int64_t kMs = 1'000'000;
