@@ -13,33 +13,15 @@
 #include "rpem/can/e2e.hpp"
 #include "rpem/can/protocol.hpp"
 #include "rpem/can/vesc.hpp"
+#include "vesc_vectors.hpp"
 
 namespace rpem::can::vesc {
 namespace {
 
-constexpr std::uint8_t kController = 17;  // the VESC
-constexpr std::uint8_t kOwn = 0x7D;       // the poller (rpemd)
-
-CanFrame ext(std::uint32_t id, std::vector<std::uint8_t> bytes) {
-  CanFrame f;
-  f.extended = true;
-  f.id = id;
-  f.len = static_cast<std::uint8_t>(bytes.size());
-  std::copy(bytes.begin(), bytes.end(), f.data.begin());
-  return f;
-}
-
-/// The reply to a poll with the estimator's mask 0x001801B3: T_fet 41.3 °C, T_motor 67.8 °C, i_d −3.21 A,
-/// i_q 27.45 A, 21000 ERPM, V_in 48.2 V, v_d −1.234 V, v_q 11.873 V — 31 bytes in five FILL_RX_BUFFER
-/// frames (ID 0x57D: own id 0x7D | 5 << 8) and PROCESS_RX_BUFFER (0x77D) from controller 17, CRC 0x08F7.
-std::vector<CanFrame> reply_frames() {
-  return {ext(0x57D, {0x00, 0x32, 0x00, 0x18, 0x01, 0xB3, 0x01, 0x9D}),
-          ext(0x57D, {0x07, 0x02, 0xA6, 0xFF, 0xFF, 0xFE, 0xBF, 0x00}),
-          ext(0x57D, {0x0E, 0x00, 0x0A, 0xB9, 0x00, 0x00, 0x52, 0x08}),
-          ext(0x57D, {0x15, 0x01, 0xE2, 0xFF, 0xFF, 0xFB, 0x2E, 0x00}),
-          ext(0x57D, {0x1C, 0x00, 0x2E, 0x61}),
-          ext(0x77D, {0x11, 0x01, 0x00, 0x1F, 0x08, 0xF7})};
-}
+using test::vesc_vectors::ext;
+using test::vesc_vectors::kController;
+using test::vesc_vectors::kOwn;
+using test::vesc_vectors::reply_frames;
 
 std::vector<VescDecoder::Event> feed(VescDecoder& dec, const std::vector<CanFrame>& frames) {
   std::vector<VescDecoder::Event> events;
@@ -99,20 +81,20 @@ TEST(Vesc, ShortReplyInOneFrame) {
 TEST(Vesc, StatusBroadcasts) {
   VescDecoder dec(kController, kOwn);
   // STATUS (9): ERPM −1500, current 12.3 A, duty 0.456.
-  ASSERT_EQ(dec.decode(ext(0x911, {0xFF, 0xFF, 0xFA, 0x24, 0x00, 0x7B, 0x01, 0xC8})), VescDecoder::Event::kStatus);
+  ASSERT_EQ(dec.decode(test::vesc_vectors::status1()), VescDecoder::Event::kStatus);
   EXPECT_EQ(dec.status().number, 1);
   EXPECT_DOUBLE_EQ(dec.status().erpm, -1500.0);
   EXPECT_DOUBLE_EQ(dec.status().current_A, 12.3);
   EXPECT_DOUBLE_EQ(dec.status().duty, 0.456);
   // STATUS_4 (16): T_fet 35.5 °C, T_motor 80.1 °C, input current 5.5 A, PID position 90°.
-  ASSERT_EQ(dec.decode(ext(0x1011, {0x01, 0x63, 0x03, 0x21, 0x00, 0x37, 0x11, 0x94})), VescDecoder::Event::kStatus);
+  ASSERT_EQ(dec.decode(test::vesc_vectors::status4()), VescDecoder::Event::kStatus);
   EXPECT_EQ(dec.status().number, 4);
   EXPECT_DOUBLE_EQ(dec.status().temp_fet_C, 35.5);
   EXPECT_DOUBLE_EQ(dec.status().temp_motor_C, 80.1);
   EXPECT_DOUBLE_EQ(dec.status().current_in_A, 5.5);
   EXPECT_DOUBLE_EQ(dec.status().pid_pos_deg, 90.0);
   // STATUS_5 (27): tachometer 123456, V_in 50.4 V, reserved.
-  ASSERT_EQ(dec.decode(ext(0x1B11, {0x00, 0x01, 0xE2, 0x40, 0x01, 0xF8, 0x00, 0x00})), VescDecoder::Event::kStatus);
+  ASSERT_EQ(dec.decode(test::vesc_vectors::status5()), VescDecoder::Event::kStatus);
   EXPECT_EQ(dec.status().number, 5);
   EXPECT_EQ(dec.status().tachometer, 123456);
   EXPECT_DOUBLE_EQ(dec.status().v_in_V, 50.4);
