@@ -39,7 +39,11 @@ struct SimOptions {
 };
 
 int run_sim(const SimOptions& o) {
-  if (!o.vesc.interface.empty()) return run_vesc_emulator(sim::load_scenario(o.scenario), o.vesc);
+  if (!o.vesc.interface.empty()) {
+    VescEmulatorOptions vesc = o.vesc;
+    vesc.truth = o.truth;
+    return run_vesc_emulator(sim::load_scenario(o.scenario), vesc);
+  }
   sim::DriveSimulator simulator(sim::load_scenario(o.scenario));
   std::optional<io::DriveLogWriter> log;
   if (!o.out.empty()) log.emplace(o.out, simulator.layout());

@@ -6,6 +6,7 @@
 #include <csignal>
 #include <cstdio>
 #include <ctime>
+#include <optional>
 #include <unistd.h>
 
 #include <vector>
@@ -14,6 +15,7 @@
 #include "rpem/can/socketcan.hpp"
 #include "rpem/can/vesc_firmware.hpp"
 #include "rpem/core/clock.hpp"
+#include "rpem/sim/truth_log.hpp"
 #include "rpem/sim/vesc_motor.hpp"
 
 namespace rpem::tools {
@@ -77,15 +79,23 @@ int run_vesc_emulator(sim::Scenario scenario, const VescEmulatorOptions& o) {
   auto send = [&](const can::CanFrame& f) {
     if (!channel.send(f, 10)) ++n.send_failures;
   };
+  std::optional<sim::TruthLogWriter> truth;
+  if (!o.truth.empty()) truth.emplace(o.truth);
+  std::int64_t next_truth_ns = 0;
   bool toggled_silent = false, was_quiet = false;
   std::fprintf(stderr, "rpem sim: VESC %d on %s, drive '%s' (pid %d; SIGUSR1 toggles silence)\n", o.controller_id,
                o.interface.c_str(), name.c_str(), static_cast<int>(getpid()));
   const std::int64_t start_ns = core::now_ns(CLOCK_MONOTONIC);
+  std::fprintf(stderr, "rpem sim: t = 0 at CLOCK_REALTIME %.6f s\n", 1e-9 * static_cast<double>(core::now_ns(CLOCK_REALTIME)));
   while (!g_stop) {
     const std::size_t got = channel.receive(rx, 1);
     const std::int64_t t_ns = core::now_ns(CLOCK_MONOTONIC) - start_ns;
     if (o.duration_s > 0.0 && t_ns > static_cast<std::int64_t>(o.duration_s * 1e9)) break;
     if (!motor.advance_to(t_ns)) break;  // the scenario ended
+    if (truth && motor.time_ns() >= next_truth_ns) {
+      truth->write(motor.truth());
+      next_truth_ns = motor.time_ns() + 10'000'000;
+    }
     if (g_toggle_silence.exchange(false)) toggled_silent = !toggled_silent;
     const double t_s = 1e-9 * static_cast<double>(t_ns);
     const bool quiet = toggled_silent || (o.silent_at_s >= 0.0 && t_s >= o.silent_at_s && t_s < o.silent_at_s + o.silent_for_s);

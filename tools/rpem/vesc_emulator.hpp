@@ -22,6 +22,7 @@ struct VescEmulatorOptions {
   double silent_at_s = -1.0;            ///< go silent (answer nothing, broadcast nothing) at this time…
   double silent_for_s = 0.0;            ///< …for this long; SIGUSR1 also toggles silence
   double duration_s = 0.0;              ///< stop after this long (0: the scenario's duration)
+  std::string truth;                    ///< also write the true state every 10 ms (sim/truth_log.hpp)
 };
 
 void add_vesc_emulator_options(CLI::App* cmd, VescEmulatorOptions& options);

@@ -38,6 +38,8 @@ class VescMotor {
   /// The last complete control cycle (valid after the second step).
   [[nodiscard]] const ControlCycle& last_cycle() const noexcept { return last_cycle_; }
   [[nodiscard]] const DriveSimulator& simulator() const noexcept { return simulator_; }
+  /// The true state at the last cycle's start.
+  [[nodiscard]] const TruthRow& truth() const noexcept { return truth_; }
 
   /// What COMM_GET_VALUES_SELECTIVE reads now, every field filled: the averages since the previous read
   /// (then reset) and the instantaneous filtered values.
