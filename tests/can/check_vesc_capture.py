@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Checks a candump -L capture of the emulated VESC (rpem sim --vesc) polled by cansend, decoding it with
+"""Checks a candump -L capture of the emulated VESC (rpem sim --vesc) polled by cangen, decoding it with
 no project code, from docs/can-vesc.md alone (which cites vedderb/bldc: comm_can.c comm_can_send_buffer,
 decode_msg, comm_can_send_status1..6; commands.c commands_process_packet; buffer.c; crc.c crc16):
 

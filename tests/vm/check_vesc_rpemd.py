@@ -7,7 +7,7 @@
   R_s adapt);
 - it publishes magnet and winding temperatures (finite, within 15 K of the plant's);
 - it survives the silence 45-48 s: estimates keep coming and its sample count grows again after it;
-- it counts the second poller (cansend from 55 s to 60 s) stealing its averages.
+- it counts the second poller (cangen from 55 s to 60 s) stealing its averages.
 
   check_vesc_rpemd.py DIR NAME
 """

@@ -7,8 +7,14 @@ set -euo pipefail
 build=$(cd "$1" && pwd)
 here=$(cd "$(dirname "$0")" && pwd)
 repo=$(cd "$here/../.." && pwd)
-out=$(mktemp -d)
-trap 'rm -rf "$out"' EXIT
+# RPEM_VESC_SUITE_OUT=DIR keeps the outputs there (debugging); otherwise a temporary directory.
+if [[ -n ${RPEM_VESC_SUITE_OUT:-} ]]; then
+  out=$RPEM_VESC_SUITE_OUT
+  mkdir -p "$out"
+else
+  out=$(mktemp -d)
+  trap 'rm -rf "$out"' EXIT
+fi
 cp "$repo/scenarios/can-stream.yaml" "$repo/scenarios/vesc-6374.yaml" "$repo/config/vesc-6374-outrunner.yaml" \
    "$repo/config/signal-maps/rpem-native-classic.yaml" "$out/"
 # The scenario names its machine relative to itself (../config/…): give it that layout.

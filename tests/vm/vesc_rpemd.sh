@@ -1,6 +1,6 @@
 #!/bin/sh
 # rpemd (source: vesc) against the emulated VESC 17 over vcan0, at 200 Hz and at 1 kHz: 70 s each, the
-# emulator silent from 45 s to 48 s, a second poller (cansend, host id 0xC8) stealing averages at
+# emulator silent from 45 s to 48 s, a second poller (cangen, host id 0xC8) stealing averages at
 # 20 Hz from 55 s to 60 s. Outputs in $1; tests/vm/check_vesc_rpemd.py checks them on the host.
 out=${1:-/host}
 fail=0
@@ -17,8 +17,7 @@ run() {  # name poll-rate
   rpem listen --prefix VESC17_ --diagnostics --csv "$out/${name}_est.csv" > "$out/${name}_listen.txt" 2>&1 &
   listen=$!
   sleep 55
-  i=0
-  while [ $i -lt 100 ]; do cansend vcan0 00000811#C80032001801B3; sleep 0.05; i=$((i + 1)); done
+  cangen vcan0 -e -I 811 -L 7 -D C80032001801B3 -g 50 -n 100   # the thief: host id 0xC8, 20 Hz, 5 s
   wait $emu || fail=1
   sleep 1
   kill -TERM $daemon; wait $daemon || fail=1

@@ -1,7 +1,7 @@
 #!/bin/sh
 # The VESC suite, run where vcan0 exists (inside the VM, or natively). Writes its results into $1; the
 # host checks them (tests/vm/run_vesc_suite.sh).
-#   1. the emulated VESC 17 (rpem sim --vesc) polled by cansend — a poller that is not our code — with the
+#   1. the emulated VESC 17 (rpem sim --vesc) polled by cangen at 50 Hz — a poller that is not our code — with the
 #      whole exchange captured by candump; the emulator goes silent from 6 s to 8 s
 #   2. rpem record --averaged-out from native telemetry (rpem sim --can) and through a signal map
 #      (config/signal-maps/rpem-native-classic.yaml over rpem replay --classic)
@@ -11,19 +11,15 @@ fail=0
 step() { echo "vesc_suite: $*"; }
 echo 16777216 > /proc/sys/net/core/rmem_max 2>/dev/null
 
-step "emulated VESC 17, polled by cansend, captured by candump"
+step "emulated VESC 17, polled by cangen, captured by candump"
 candump -r 8388608 -L vcan0 > /tmp/vesc_capture.log &
 dump=$!
 rpem sim --scenario vesc-6374.yaml --vesc vcan0 --controller-id 17 --truth "$out/vesc_truth.csv" \
   --duration 12 --silent-at 6 --silent-for 2 2> "$out/vesc_emulator.txt" &
 emu=$!
 sleep 1
-i=0
-while [ $i -lt 300 ]; do
-  cansend vcan0 00000811#7D0032001801B3   # COMM_GET_VALUES_SELECTIVE, mask 0x001801B3, reply to 0x7D
-  sleep 0.02
-  i=$((i + 1))
-done
+# COMM_GET_VALUES_SELECTIVE, mask 0x001801B3, reply to 0x7D: PROCESS_SHORT_BUFFER to 17, every 20 ms, 10 s
+cangen vcan0 -e -I 811 -L 7 -D 7D0032001801B3 -g 20 -n 500
 wait $emu || fail=1
 sleep 0.2
 kill $dump; wait $dump 2>/dev/null
