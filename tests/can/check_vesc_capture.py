@@ -50,6 +50,37 @@ def decode_reply(p):
                 v_d=v_d / 1000, v_q=v_q / 1000)
 
 
+def check_record(avg_path, truth_path, rate):
+    """Each window of the recorded log against the truth's steady state (speed held from 0 to 12 s)."""
+    errors = []
+    rows = [{k: float(v) for k, v in r.items()} for r in csv.DictReader(open(avg_path))]
+    truth = [{k: float(v) for k, v in r.items()} for r in csv.DictReader(open(truth_path))]
+    steady = [r for r in truth if 1.0 < r['t'] < 11.0]
+    mean = {k: sum(r[k] for r in steady) / len(steady) for k in ('i_q', 'omega_el', 'psi_m', 'r_s', 'l_d', 'T_winding')}
+    span = rows[-1]['t'] - rows[0]['t_start'] if rows else 0.0
+    if len(rows) < 0.8 * span * rate or span < 5.0:
+        errors.append('record: %d windows in %.1f s at %g Hz' % (len(rows), span, rate))
+    lengths = sorted(r['t'] - r['t_start'] for r in rows)
+    median = lengths[len(lengths) // 2] if lengths else 0.0
+    if abs(median - 1 / rate) > 0.2 / rate:
+        errors.append('record: median window %.5f s at %g Hz' % (median, rate))
+    u_q = mean['r_s'] * mean['i_q'] + mean['omega_el'] * mean['psi_m']
+    worst = dict(i_q=0.0, w=0.0, u_q=0.0)
+    for r in rows:
+        worst['i_q'] = max(worst['i_q'], abs(r['i_q'] - mean['i_q']) / abs(mean['i_q']))
+        worst['w'] = max(worst['w'], abs(r['omega_el'] - mean['omega_el']) / abs(mean['omega_el']))
+        worst['u_q'] = max(worst['u_q'], abs(r['u_q'] - u_q) / abs(u_q))
+        if abs(r['T_drive'] - 40.0) > 0.11 or abs(r['T_winding'] - mean['T_winding']) > 1.0 or abs(r['u_dc'] - 48) > 0.5:
+            errors.append('record: temperatures or u_dc off at t %.3f: %s' % (r['t'], r))
+            break
+    for k, lim in (('i_q', 0.05), ('w', 0.02), ('u_q', 0.03)):
+        if worst[k] > lim:
+            errors.append('record: %s off the steady state by %.2f %%' % (k, 100 * worst[k]))
+    print('check_vesc_capture: record %s: %d windows, median %.2f ms; worst i_q %.2f %%, omega %.2f %%, u_q %.2f %%'
+          % (avg_path, len(rows), 1e3 * median, 100 * worst['i_q'], 100 * worst['w'], 100 * worst['u_q']))
+    return errors
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument('capture')
@@ -57,8 +88,13 @@ def main():
     ap.add_argument('--controller', type=int, required=True)
     ap.add_argument('--poller', type=lambda s: int(s, 0), required=True)
     ap.add_argument('--silent', type=float, nargs=2, required=True)
+    ap.add_argument('--record', nargs=2, metavar=('AVG', 'TRUTH'),
+                    help='also check an averaged log rpem record wrote from the emulator at steady speed')
+    ap.add_argument('--record-rate', type=float, default=200.0)
     a = ap.parse_args()
     errors = []
+    if a.record:
+        errors += check_record(a.record[0], a.record[1], a.record_rate)
     cid, me = a.controller, a.poller
     polls, replies, statuses, from_ctrl = [], [], {n: [] for n in range(1, 7)}, []
     buf, fill = bytearray(), 0
@@ -107,8 +143,9 @@ def main():
     quiet = [t for t in from_ctrl if s0 + 0.05 < t - t0 < s1 - 0.05]
     if quiet:
         errors.append('%d frames from the controller while it was silent' % len(quiet))
-    heard = [t for t in polls if not (s0 - 0.05 < t - t0 < s1 + 0.05)]
-    if len(replies) < 0.97 * len(heard) or len(heard) < 100:
+    end = statuses[1][-1][0]  # the emulator's last status: polls after it go unanswered
+    heard = [t for t in polls if not (s0 - 0.05 < t - t0 < s1 + 0.05) and t < end - 0.05]
+    if len(replies) < 0.97 * len(heard) or len(heard) < 100:  # (100 at ~30 Hz under TCG)
         errors.append('%d replies to %d polls outside the silence' % (len(replies), len(heard)))
     after = [t for t, _ in replies if t - t0 > s1 + 0.1]
     if not after:

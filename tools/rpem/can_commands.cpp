@@ -144,6 +144,12 @@ Runner add_record_command(CLI::App& app) {
       ->excludes("--out");
   cmd->add_option("--signal-map", opts->signal_map, "read the drive's own frames through this map (docs/sources.md)")
       ->check(CLI::ExistingFile);
+  cmd->add_option("--vesc-id", opts->vesc_id, "poll this VESC (controller id) with COMM_GET_VALUES_SELECTIVE")
+      ->check(CLI::Range(0, 254))
+      ->excludes("--signal-map");
+  cmd->add_option("--host-id", opts->host_id, "VESC: the id replies are addressed to (no VESC may use it)")
+      ->check(CLI::Range(0, 254));
+  cmd->add_option("--poll-rate", opts->poll_rate_Hz, "VESC: polls per second")->check(CLI::Range(1.0, 2000.0));
   cmd->add_option("--window-rate", opts->window_rate_Hz, "native telemetry: averaging windows per second")
       ->check(CLI::Range(50.0, 2000.0));
   cmd->add_option("--duration", opts->duration_s, "stop after this many seconds");

@@ -86,16 +86,12 @@ int run_vesc_emulator(sim::Scenario scenario, const VescEmulatorOptions& o) {
   std::fprintf(stderr, "rpem sim: VESC %d on %s, drive '%s' (pid %d; SIGUSR1 toggles silence)\n", o.controller_id,
                o.interface.c_str(), name.c_str(), static_cast<int>(getpid()));
   const std::int64_t start_ns = core::now_ns(CLOCK_MONOTONIC);
-  std::fprintf(stderr, "rpem sim: t = 0 at CLOCK_REALTIME %.6f s\n", 1e-9 * static_cast<double>(core::now_ns(CLOCK_REALTIME)));
+  const std::int64_t start_real_ns = core::now_ns(CLOCK_REALTIME);
+  std::fprintf(stderr, "rpem sim: t = 0 at CLOCK_REALTIME %.6f s\n", 1e-9 * static_cast<double>(start_real_ns));
   while (!g_stop) {
     const std::size_t got = channel.receive(rx, 1);
     const std::int64_t t_ns = core::now_ns(CLOCK_MONOTONIC) - start_ns;
     if (o.duration_s > 0.0 && t_ns > static_cast<std::int64_t>(o.duration_s * 1e9)) break;
-    if (!motor.advance_to(t_ns)) break;  // the scenario ended
-    if (truth && motor.time_ns() >= next_truth_ns) {
-      truth->write(motor.truth());
-      next_truth_ns = motor.time_ns() + 10'000'000;
-    }
     if (g_toggle_silence.exchange(false)) toggled_silent = !toggled_silent;
     const double t_s = 1e-9 * static_cast<double>(t_ns);
     const bool quiet = toggled_silent || (o.silent_at_s >= 0.0 && t_s >= o.silent_at_s && t_s < o.silent_at_s + o.silent_for_s);
@@ -106,6 +102,9 @@ int run_vesc_emulator(sim::Scenario scenario, const VescEmulatorOptions& o) {
       const auto request = vesc::parse_request(rx[k].frame, id);
       if (!request) continue;
       ++n.requests;
+      // The firmware reads at the poll's arrival: the cycles up to its kernel receive time (which matters
+      // when this loop was late and several polls wait in the socket).
+      if (rx[k].kernel_rx_ns > 0) (void)motor.advance_to(std::min(rx[k].kernel_rx_ns - start_real_ns, t_ns));
       if (quiet) {  // off the bus: the firmware never sees the poll, and its averages keep running
         ++n.unheard;
         continue;
@@ -122,17 +121,25 @@ int run_vesc_emulator(sim::Scenario scenario, const VescEmulatorOptions& o) {
       ++n.replies;
       n.reply_frames += frames;
     }
+    const bool running = motor.advance_to(t_ns);  // false: the scenario ended
+    if (truth && motor.time_ns() >= next_truth_ns) {
+      truth->write(motor.truth());
+      next_truth_ns = motor.time_ns() + 10'000'000;
+    }
     for (StatusThread& th : threads) {
-      if (th.rate_Hz <= 0.0 || t_ns < th.next_ns) continue;
+      if (th.rate_Hz <= 0.0) continue;
       const auto period_ns = static_cast<std::int64_t>(1e9 / th.rate_Hz);
-      th.next_ns = std::max(th.next_ns + period_ns, t_ns);
-      if (quiet) continue;
-      for (int number = 1; number <= 6; ++number) {
-        if (((th.msgs >> (number - 1)) & 1U) == 0) continue;
-        send(vesc::status_frame(motor.status(number)));
-        ++n.statuses;
+      if (th.next_ns < t_ns - 1'000'000'000) th.next_ns = t_ns;  // after a stall of over 1 s, no burst
+      for (; th.next_ns <= t_ns; th.next_ns += period_ns) {  // late loops catch up: the rate holds on average
+        if (quiet) continue;
+        for (int number = 1; number <= 6; ++number) {
+          if (((th.msgs >> (number - 1)) & 1U) == 0) continue;
+          send(vesc::status_frame(motor.status(number)));
+          ++n.statuses;
+        }
       }
     }
+    if (!running) break;
   }
   std::fprintf(stderr,
                "rpem sim: VESC %d stopped at %.3f s simulated: %llu polls, %llu replies in %llu frames, %llu unheard "
