@@ -10,6 +10,7 @@
 #include <sys/socket.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstring>
 #include <ctime>
@@ -107,16 +108,19 @@ void SocketCanChannel::count_error_frame(const CanFrame& f) {
   }
 }
 
-std::size_t SocketCanChannel::receive(std::span<ReceivedFrame> out, int timeout_ms) {
+std::size_t SocketCanChannel::receive_for(std::span<ReceivedFrame> out, std::int64_t timeout_ns) {
+  timeout_ns = std::max<std::int64_t>(timeout_ns, 0);
   if (fd_ < 0) {
     if (core::now_ns(CLOCK_MONOTONIC) < next_open_attempt_ns_ || !open()) {
-      timespec pause{0, static_cast<long>(std::min(timeout_ms, options_.reopen_interval_ms)) * 1'000'000};
+      const std::int64_t pause_ns = std::min<std::int64_t>(timeout_ns, std::int64_t{options_.reopen_interval_ms} * 1'000'000);
+      timespec pause{static_cast<time_t>(pause_ns / 1'000'000'000), static_cast<long>(pause_ns % 1'000'000'000)};
       nanosleep(&pause, nullptr);
       return 0;
     }
   }
   pollfd pfd{fd_, POLLIN, 0};
-  const int ready = ::poll(&pfd, 1, timeout_ms);
+  const timespec wait{static_cast<time_t>(timeout_ns / 1'000'000'000), static_cast<long>(timeout_ns % 1'000'000'000)};
+  const int ready = ::ppoll(&pfd, 1, &wait, nullptr);
   if (ready <= 0) return 0;
   if (pfd.revents & (POLLERR | POLLHUP | POLLNVAL)) {
     int err = 0;

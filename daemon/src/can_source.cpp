@@ -7,6 +7,7 @@
 #include "rpem/can/protocol.hpp"
 #include "rpem/can/socketcan.hpp"
 #include "rpem/core/clock.hpp"
+#include "rpem/daemon/can_channel_rows.hpp"
 
 namespace rpem::daemon {
 namespace {
@@ -28,14 +29,6 @@ constexpr std::array<CounterRow<can::DecoderCounters, std::uint64_t>, 13> kDecod
     {&can::DecoderCounters::invalid_value, &Diag::can_invalid_value},
     {&can::DecoderCounters::incomplete, &Diag::can_incomplete},
     {&can::DecoderCounters::gaps, &Diag::can_gaps},
-}};
-constexpr std::array<CounterRow<can::ChannelCounters, std::uint64_t>, 6> kChannelRows{{
-    {&can::ChannelCounters::kernel_drops, &Diag::can_kernel_drops},
-    {&can::ChannelCounters::reopens, &Diag::can_reopens},
-    {&can::ChannelCounters::error_frames, &Diag::can_error_frames},
-    {&can::ChannelCounters::bus_off, &Diag::can_bus_off},
-    {&can::ChannelCounters::error_passive, &Diag::can_error_passive},
-    {&can::ChannelCounters::controller_overflow, &Diag::can_controller_overflow},
 }};
 static_assert(kDecoderRows.size() + kChannelRows.size() + 1 <= DiagnosticsRows::kMaxCounts);
 

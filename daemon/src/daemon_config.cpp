@@ -2,6 +2,9 @@
 
 #include <cstdlib>
 #include <filesystem>
+#include <variant>
+
+#include "rpem/io/averaged_log.hpp"
 
 namespace rpem::daemon {
 namespace {
@@ -110,6 +113,15 @@ void fill_defaults(const io::MachineConfig& machine, TemperatureModel& t) {
   if (t.psi_m.value_ref <= 0.0) t.psi_m.value_ref = machine.machine.psi_m_Wb;
 }
 
+/// The machine's model extensions must be ones the source's samples can be corrected for (averaged
+/// samples: no per-phase current errors).
+void check_source_supports(const DaemonConfig& c) {
+  const io::MachineConfig& m = c.live.machine;
+  if (const auto* v = std::get_if<VescSource::Options>(&c.fixed.source)) {
+    io::check_averaged_supports(m, c.source_file, true, "source vesc, controller " + std::to_string(v->controller_id));
+  }
+}
+
 DaemonConfig parse(io::YamlMap& root, const std::string& name, const std::string& base_dir) {
   DaemonConfig c;
   c.source_file = name;
@@ -131,6 +143,7 @@ DaemonConfig parse(io::YamlMap& root, const std::string& name, const std::string
   if (d) parse_daemon(*d, c, base_dir);
   root.finish();
   fill_defaults(machine, c.live.temperature);
+  check_source_supports(c);
   return c;
 }
 

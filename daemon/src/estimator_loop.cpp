@@ -12,10 +12,11 @@ namespace {
 
 using Diag = rpem::diagnostics_t;
 
-constexpr std::array<CounterRow<LoopCounters>, 9> kLoopRows{{
+constexpr std::array<CounterRow<LoopCounters>, 10> kLoopRows{{
     {&LoopCounters::samples, &Diag::samples},
     {&LoopCounters::resyncs, &Diag::resyncs},
     {&LoopCounters::rejected_non_finite, &Diag::rejected_non_finite},
+    {&LoopCounters::wrong_kind, &Diag::samples_wrong_kind},
     {&LoopCounters::predictor_resets, &Diag::predictor_resets},
     {&LoopCounters::projections, &Diag::projections},
     {&LoopCounters::output_queue_drops, &Diag::output_queue_drops},
@@ -37,7 +38,7 @@ EstimatorLoop::EstimatorLoop(const DaemonConfig& config, Queues queues)
     : live_(config.live),
       loop_config_(config.fixed.loop),
       queues_(queues),
-      estimator_(config.live.machine.machine, config.live.machine.estimator),
+      estimator_(SourceCatalogue::sample_kind(config.fixed.source), config.live.machine.machine, config.live.machine.estimator),
       validity_(config.live.validity, config.fixed.lcm.estimate_rate_Hz),
       timer_(config.fixed.loop),
       estimate_interval_ns_(interval_ns(config.fixed.lcm.estimate_rate_Hz)),
@@ -90,9 +91,12 @@ void EstimatorLoop::apply(const Command& c) noexcept {
   }
 }
 
-void EstimatorLoop::step(const core::DriveSample& s, std::int64_t now_ns) noexcept {
-  last_ = estimator_.step(s);
-  last_sample_ = s;
+void EstimatorLoop::step(const SourceSample& s, std::int64_t now_ns) noexcept {
+  double dt_s = 0.0;
+  if (!estimator_.step(s, last_, dt_s, last_sample_)) {
+    ++counters_.wrong_kind;
+    return;
+  }
   ++counters_.samples;
   const core::EstimatorOutput& d = last_.detail;
   switch (d.code) {
@@ -112,10 +116,11 @@ void EstimatorLoop::step(const core::DriveSample& s, std::int64_t now_ns) noexce
       break;
   }
   if (d.flags & (core::step_flag::kProjectedPsiM | core::step_flag::kProjectedRs)) ++counters_.projections;
-  validity_.on_sample(d.flags, live_.machine.estimator.nominal_sample_period_s, now_ns);
+  validity_.on_sample(d.flags, dt_s, now_ns);
 }
 
-void EstimatorLoop::report_measurement(const core::DriveSample& s) noexcept {
+void EstimatorLoop::report_measurement() noexcept {
+  const SampleSummary& s = last_sample_;
   MeasurementReport m;
   m.utime_us = unix_us();
   m.sample_time_us = s.t_ns / 1000;
@@ -128,6 +133,8 @@ void EstimatorLoop::report_measurement(const core::DriveSample& s) noexcept {
   m.i_hat_q_A = last_.i_hat_A[1];
   m.eps_d_A = last_.epsilon_A[0];
   m.eps_q_A = last_.epsilon_A[1];
+  m.t_winding_sensor_C = s.t_winding_sensor_C;
+  m.t_drive_sensor_C = s.t_drive_sensor_C;
   push(m);
 }
 
@@ -139,13 +146,13 @@ void EstimatorLoop::report_estimate(std::int64_t now_ns) noexcept {
   r.samples = counters_.samples;
   r.psi_m_Wb = estimator_.psi_m_Wb();
   r.r_s_Ohm = estimator_.r_s_Ohm();
-  r.psi_m_pu = estimator_.theta_pu()[core::kPsiM];
-  r.r_s_pu = estimator_.theta_pu()[core::kRs];
+  r.psi_m_pu = estimator_.core().state().theta_pu[core::kPsiM];
+  r.r_s_pu = estimator_.core().state().theta_pu[core::kRs];
   const TemperatureModel& t = live_.temperature;
   r.t_winding_C = t.r_s.temperature_C(r.r_s_Ohm);
   r.t_magnet_C = t.psi_m.temperature_C(r.psi_m_Wb);
   r.speed_pu = last_.speed_pu;
-  r.frozen = estimator_.frozen();
+  r.frozen = estimator_.core().state().frozen;
   r.state = state_;
   r.algorithm = live_.machine.estimator.algorithm;
 
@@ -187,9 +194,10 @@ void EstimatorLoop::report_stats() noexcept {
   r.rows.set(&Diag::epsilon_rms_d_A, std::sqrt(eps2_d_ / n));
   r.rows.set(&Diag::epsilon_rms_q_A, std::sqrt(eps2_q_ / n));
   r.rows.set(&Diag::gain_norm, last_.detail.gain.norm());
-  r.rows.set(&Diag::hessian_sga_psi_m_pu, estimator_.sga_hessian_pu()[core::kPsiM]);
-  r.rows.set(&Diag::hessian_sga_r_s_pu, estimator_.sga_hessian_pu()[core::kRs]);
-  r.rows.set(&Diag::hessian_gna_det_pu, core::det2(estimator_.gna_hessian_pu()));
+  const core::EstimatorState& state = estimator_.core().state();
+  r.rows.set(&Diag::hessian_sga_psi_m_pu, state.sga_hessian_pu[core::kPsiM]);
+  r.rows.set(&Diag::hessian_sga_r_s_pu, state.sga_hessian_pu[core::kRs]);
+  r.rows.set(&Diag::hessian_gna_det_pu, core::det2(state.gna_hessian_pu));
   push(r);
   eps2_d_ = eps2_q_ = 0.0;
   eps_n_ = 0;
@@ -199,14 +207,14 @@ void EstimatorLoop::process(std::int64_t now_ns) noexcept {
   Command c;
   while (queues_.commands.pop(c)) apply(c);
 
-  core::DriveSample s;
+  SourceSample s;
   bool any = false;
   while (queues_.samples.pop(s)) {
     step(s, now_ns);
     any = true;
     if (now_ns >= next_measurement_ns_) {
       next_measurement_ns_ = now_ns + measurement_interval_ns_;
-      report_measurement(s);
+      report_measurement();
     }
   }
   if (any) {

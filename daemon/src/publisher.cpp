@@ -115,6 +115,8 @@ void Publisher::publish_measurement(const MeasurementReport& r) {
   m.i_hat_q_A = r.i_hat_q_A;
   m.epsilon_d_A = r.eps_d_A;
   m.epsilon_q_A = r.eps_q_A;
+  m.t_winding_sensor_C = r.t_winding_sensor_C;
+  m.t_drive_sensor_C = r.t_drive_sensor_C;
   publish(measurement_channel_, m);
 }
 

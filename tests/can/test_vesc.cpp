@@ -13,15 +13,15 @@
 #include "rpem/can/e2e.hpp"
 #include "rpem/can/protocol.hpp"
 #include "rpem/can/vesc.hpp"
-#include "vesc_vectors.hpp"
+#include "support/vesc_frames.hpp"
 
 namespace rpem::can::vesc {
 namespace {
 
-using test::vesc_vectors::ext;
-using test::vesc_vectors::kController;
-using test::vesc_vectors::kOwn;
-using test::vesc_vectors::reply_frames;
+using test::vesc_frames::ext;
+using test::vesc_frames::kController;
+using test::vesc_frames::reply_frames;
+constexpr std::uint8_t kOwn = test::vesc_frames::kHost;  // the poller (rpemd)
 
 std::vector<VescDecoder::Event> feed(VescDecoder& dec, const std::vector<CanFrame>& frames) {
   std::vector<VescDecoder::Event> events;
@@ -81,20 +81,20 @@ TEST(Vesc, ShortReplyInOneFrame) {
 TEST(Vesc, StatusBroadcasts) {
   VescDecoder dec(kController, kOwn);
   // STATUS (9): ERPM −1500, current 12.3 A, duty 0.456.
-  ASSERT_EQ(dec.decode(test::vesc_vectors::status1()), VescDecoder::Event::kStatus);
+  ASSERT_EQ(dec.decode(test::vesc_frames::status1()), VescDecoder::Event::kStatus);
   EXPECT_EQ(dec.status().number, 1);
   EXPECT_DOUBLE_EQ(dec.status().erpm, -1500.0);
   EXPECT_DOUBLE_EQ(dec.status().current_A, 12.3);
   EXPECT_DOUBLE_EQ(dec.status().duty, 0.456);
   // STATUS_4 (16): T_fet 35.5 °C, T_motor 80.1 °C, input current 5.5 A, PID position 90°.
-  ASSERT_EQ(dec.decode(test::vesc_vectors::status4()), VescDecoder::Event::kStatus);
+  ASSERT_EQ(dec.decode(test::vesc_frames::status4()), VescDecoder::Event::kStatus);
   EXPECT_EQ(dec.status().number, 4);
   EXPECT_DOUBLE_EQ(dec.status().temp_fet_C, 35.5);
   EXPECT_DOUBLE_EQ(dec.status().temp_motor_C, 80.1);
   EXPECT_DOUBLE_EQ(dec.status().current_in_A, 5.5);
   EXPECT_DOUBLE_EQ(dec.status().pid_pos_deg, 90.0);
   // STATUS_5 (27): tachometer 123456, V_in 50.4 V, reserved.
-  ASSERT_EQ(dec.decode(test::vesc_vectors::status5()), VescDecoder::Event::kStatus);
+  ASSERT_EQ(dec.decode(test::vesc_frames::status5()), VescDecoder::Event::kStatus);
   EXPECT_EQ(dec.status().number, 5);
   EXPECT_EQ(dec.status().tachometer, 123456);
   EXPECT_DOUBLE_EQ(dec.status().v_in_V, 50.4);

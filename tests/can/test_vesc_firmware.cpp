@@ -1,5 +1,5 @@
 // The emulator's protocol side (can/vesc_firmware.hpp) against frames written byte by byte from
-// docs/can-vesc.md (tests/can/vesc_vectors.hpp), not against our own decoder: the reply, the short
+// docs/can-vesc.md (tests/support/vesc_frames.hpp), not against our own decoder: the reply, the short
 // buffer, a reply long enough for FILL_RX_BUFFER_LONG with its CRC computed bit by bit here, the status
 // broadcasts, and the requests a VESC accepts.
 #include <gtest/gtest.h>
@@ -8,14 +8,14 @@
 #include <vector>
 
 #include "rpem/can/vesc_firmware.hpp"
-#include "vesc_vectors.hpp"
+#include "support/vesc_frames.hpp"
 
 namespace rpem::can::vesc {
 namespace {
 
-using test::vesc_vectors::ext;
-using test::vesc_vectors::kController;
-using test::vesc_vectors::kOwn;
+using test::vesc_frames::ext;
+using test::vesc_frames::kController;
+constexpr std::uint8_t kOwn = test::vesc_frames::kHost;
 
 void expect_same(const std::vector<CanFrame>& got, const std::vector<CanFrame>& want) {
   ASSERT_EQ(got.size(), want.size());
@@ -57,7 +57,7 @@ TEST(VescFirmware, TheReplyIsTheDocumentedBytes) {
   std::array<std::uint8_t, kMaxValuesPayload> payload{};
   const std::size_t len = encode_values(v, kEstimatorMask, payload);
   EXPECT_EQ(len, 31U);
-  expect_same(split({payload.data(), len}, kOwn, kController), test::vesc_vectors::reply_frames());
+  expect_same(split({payload.data(), len}, kOwn, kController), test::vesc_frames::reply_frames());
 }
 
 TEST(VescFirmware, ShortRepliesTravelInOneShortBuffer) {
@@ -97,7 +97,7 @@ TEST(VescFirmware, StatusFramesAreTheDocumentedBytes) {
   s1.erpm = -1500.0;
   s1.current_A = 12.3;
   s1.duty = 0.456;
-  expect_same({status_frame(s1)}, {test::vesc_vectors::status1()});
+  expect_same({status_frame(s1)}, {test::vesc_frames::status1()});
   Status s4;
   s4.controller_id = kController;
   s4.number = 4;
@@ -105,13 +105,13 @@ TEST(VescFirmware, StatusFramesAreTheDocumentedBytes) {
   s4.temp_motor_C = 80.1;
   s4.current_in_A = 5.5;
   s4.pid_pos_deg = 90.0;
-  expect_same({status_frame(s4)}, {test::vesc_vectors::status4()});
+  expect_same({status_frame(s4)}, {test::vesc_frames::status4()});
   Status s5;
   s5.controller_id = kController;
   s5.number = 5;
   s5.tachometer = 123456;
   s5.v_in_V = 50.4;
-  expect_same({status_frame(s5)}, {test::vesc_vectors::status5()});
+  expect_same({status_frame(s5)}, {test::vesc_frames::status5()});
 }
 
 TEST(VescFirmware, FloatsConvertAsTheCortexM4Casts) {

@@ -22,7 +22,7 @@ Command command(Command::Kind kind, std::int64_t seq, double psi_m_Wb = 0.0, dou
 
 struct Rig {
   DaemonConfig config = builtin_daemon_config();
-  SpscQueue<core::DriveSample> input{16384};
+  SpscQueue<SourceSample> input{16384};
   SpscQueue<Command> commands{16};
   SpscQueue<Report> output{65536};
   std::unique_ptr<EstimatorLoop> loop;

@@ -10,6 +10,7 @@
 #include "rpem/command_t.hpp"
 #include "rpem/daemon/command_gate.hpp"
 #include "rpem/daemon/estimator_loop.hpp"
+#include "support/averaged_data.hpp"
 #include "support/model_data.hpp"
 #include "support/paper_machine.hpp"
 
@@ -34,7 +35,7 @@ namespace {
 
 TEST(LoopAllocations, NoneInTheLoopsPeriodWork) {
   DaemonConfig config = builtin_daemon_config();
-  SpscQueue<core::DriveSample> input(4096);
+  SpscQueue<SourceSample> input(4096);
   SpscQueue<Command> commands(16);
   SpscQueue<Report> output(1 << 16);
   EstimatorLoop loop(config, EstimatorLoop::Queues{input, commands, output});
@@ -76,6 +77,54 @@ TEST(LoopAllocations, NoneInTheLoopsPeriodWork) {
     }
   }
   EXPECT_EQ(g_allocations.load() - before, 0);
+}
+
+// The averaged path (source: vesc, rotor-frame signal maps): 20 s of windows at 1 kHz with jitter, a
+// silence, commands; nothing allocated either.
+TEST(LoopAllocations, NoneOnTheAveragedPath) {
+  DaemonConfig config = builtin_daemon_config();
+  config.fixed.source = VescSource::Options{};
+  SpscQueue<SourceSample> input(4096);
+  SpscQueue<Command> commands(16);
+  SpscQueue<Report> output(1 << 16);
+  EstimatorLoop loop(config, EstimatorLoop::Queues{input, commands, output});
+  test::AveragedDataGenerator gen;
+  gen.base = test::paper_base();
+  gen.plant = test::paper_machine_pu();
+  gen.rate_Hz = 1000.0;
+  const core::Vec2 i = core::mtpa_reference(gen.plant, 0.4);
+  gen.n_pu = [](double) { return 0.5; };
+  gen.i_pu = [i](double) { return i; };
+  std::vector<core::AveragedSample> samples;
+  while (gen.t_s < 20.0) samples.push_back(gen.next());
+  Command freeze, reset, reload;
+  freeze.kind = Command::Kind::kFreeze;
+  reset.kind = Command::Kind::kReset;
+  reload.kind = Command::Kind::kReconfigure;
+  reload.live = config.live;
+
+  const long before = g_allocations.load();
+  std::int64_t now = 0;
+  std::size_t next = 0;
+  Report drain;
+  for (int period = 0; period < 20'000; ++period) {
+    if (period == 3000) (void)commands.push(freeze);
+    if (period == 6000) (void)commands.push(reload);
+    if (period == 12000) (void)commands.push(reset);
+    now += 1'000'000;
+    const bool silent = period >= 9000 && period < 9500;
+    while (next < samples.size() && samples[next].t_ns <= now) {
+      if (!silent) (void)input.push(samples[next]);
+      ++next;
+    }
+    loop.process(now);
+    if (period % 1000 == 0) {
+      while (output.pop(drain)) {
+      }
+    }
+  }
+  EXPECT_EQ(g_allocations.load() - before, 0);
+  EXPECT_GT(next, 19'000u);
 }
 
 // RPEM_COMMAND's entry point (control thread) promises no allocation either, whatever the bytes.

@@ -11,7 +11,7 @@
 #include <random>
 #include <vector>
 
-#include "can/vesc_vectors.hpp"
+#include "support/vesc_frames.hpp"
 #include "rpem/can/vesc.hpp"
 #include "rpem/can/vesc_firmware.hpp"
 #include "rpem/sim/vesc_motor.hpp"
@@ -58,9 +58,9 @@ Means cycle_means(const io::DriveLogRow& a, const io::DriveLogRow& b) {
 }
 
 TEST(VescEmulator, RepliesCarryTheAveragesOfEveryCycleSinceThePreviousRead) {
-  VescMotor motor(short_vesc_scenario(), {test::vesc_vectors::kController, 40.0});
+  VescMotor motor(short_vesc_scenario(), {test::vesc_frames::kController, 40.0});
   DriveSimulator twin(short_vesc_scenario());  // the same drive, read independently
-  vesc::VescDecoder decoder(test::vesc_vectors::kController, test::vesc_vectors::kOwn);
+  vesc::VescDecoder decoder(test::vesc_frames::kController, test::vesc_frames::kHost);
   std::mt19937_64 rng(5);
   std::uniform_int_distribution<int> cycles_between(1, 120);  // reads 80 µs … 9.6 ms apart, uneven
 
@@ -89,7 +89,7 @@ TEST(VescEmulator, RepliesCarryTheAveragesOfEveryCycleSinceThePreviousRead) {
     ASSERT_EQ(motor.cycles_since_read(), n);
     const std::size_t len = vesc::encode_values(motor.read_values(), vesc::kEstimatorMask, payload);
     frames.resize(vesc::buffer_frame_count(len));
-    frames.resize(vesc::buffer_frames(test::vesc_vectors::kOwn, test::vesc_vectors::kController, 1, {payload.data(), len}, frames));
+    frames.resize(vesc::buffer_frames(test::vesc_frames::kHost, test::vesc_frames::kController, 1, {payload.data(), len}, frames));
     vesc::VescDecoder::Event last = vesc::VescDecoder::Event::kNone;
     for (const auto& f : frames) last = decoder.decode(f);
     ASSERT_EQ(last, vesc::VescDecoder::Event::kValues);

@@ -26,12 +26,12 @@ kill $dump; wait $dump 2>/dev/null
 cp /tmp/vesc_capture.log "$out/vesc_capture.log"
 cat "$out/vesc_emulator.txt"
 
-step "emulated VESC 17 -> rpem record --vesc-id 17 --poll-rate 200 --averaged-out"
+step "emulated VESC 17 -> rpem record --vesc-id 17 --poll-rate 100 --averaged-out"
 rpem sim --scenario vesc-6374.yaml --vesc vcan0 --controller-id 17 --truth "$out/vesc_record_truth.csv" \
   --duration 10 2> "$out/vesc_record_emulator.txt" &
 emu=$!
 sleep 1
-rpem record --can vcan0 --vesc-id 17 --poll-rate 200 --averaged-out "$out/vesc_avg.csv" --duration 8 \
+rpem record --can vcan0 --vesc-id 17 --poll-rate 100 --averaged-out "$out/vesc_avg.csv" --duration 8 \
   > "$out/vesc_avg.txt" 2>&1 || fail=1
 wait $emu || fail=1
 cat "$out/vesc_avg.txt"

@@ -13,7 +13,7 @@
 #include "rpem/can/decoder.hpp"
 #include "rpem/can/signal_map.hpp"
 #include "rpem/can/socketcan.hpp"
-#include "rpem/can/vesc.hpp"
+#include "rpem/daemon/vesc_poller.hpp"
 #include "rpem/core/clock.hpp"
 #include "rpem/io/averaged_log.hpp"
 #include "rpem/io/signal_map_config.hpp"
@@ -93,61 +93,40 @@ class SignalMapFeed final : public Feed {
   can::SignalMapDecoder decoder_;
 };
 
-/// A VESC polled with COMM_GET_VALUES_SELECTIVE every 1/rate, one poll outstanding (docs/can-vesc.md): a
-/// reply's window runs from the previous reply's receive time to its own (VESC's averages run from read to
-/// read). A poll unanswered within half a period times out; whether the VESC read (and reset) is then
-/// unknown, so the next window starts a new chain (gap_before) and is not written.
+/// A VESC polled with COMM_GET_VALUES_SELECTIVE: rpemd's own poller (daemon/vesc_poller.hpp — schedule,
+/// timeouts, windows from read to read, stolen reads), so that a recorded log holds what rpemd estimates from.
 class VescFeed final : public Feed {
  public:
-  VescFeed(std::uint8_t controller_id, std::uint8_t host_id, double rate_Hz)
-      : decoder_(controller_id, host_id),
-        poll_(can::vesc::values_request(controller_id, host_id, can::vesc::kEstimatorMask)),
-        period_ns_(static_cast<std::int64_t>(1e9 / rate_Hz)) {}
+  explicit VescFeed(const daemon::VescPoller::Config& c) : poller_(c) {}
   void on_time(std::int64_t now_ns, can::SocketCanChannel& channel) override {
-    if (outstanding_ && now_ns > polled_ns_ + period_ns_ / 2) {
-      outstanding_ = false;
-      ++timeouts_;
-      previous_rx_ns_ = 0;  // the window of the next reply is unknown
-      decoder_.reset_buffer();
-    }
-    if (outstanding_ || now_ns < next_poll_ns_) return;
-    next_poll_ns_ = std::max(next_poll_ns_ + period_ns_, now_ns);
-    polled_ns_ = now_ns;
-    outstanding_ = channel.send(poll_, 2);
-    ++polls_;
+    poller_.on_time(now_ns);
+    if (poller_.poll_due(now_ns)) poller_.polled(now_ns, channel.send(poller_.poll_frame(), 0));
   }
   bool on_frame(const can::ReceivedFrame& f, std::int64_t rx_ns, core::AveragedSample& out) override {
-    if (decoder_.decode(f.frame) != can::vesc::VescDecoder::Event::kValues) return false;
-    outstanding_ = false;
-    const std::int64_t start = previous_rx_ns_;
-    previous_rx_ns_ = rx_ns;
-    if (start == 0) return false;  // the first reply (or the first after a timeout) only opens a window
-    out = can::vesc::to_averaged_sample(decoder_.values(), start, rx_ns);
-    return true;
+    return poller_.on_frame(f.frame, rx_ns, out);
   }
   [[nodiscard]] std::string summary() const override {
-    const auto& c = decoder_.counters();
-    return "VESC: polls " + std::to_string(polls_) + ", replies " + std::to_string(c.replies) + ", timeouts " +
-           std::to_string(timeouts_) + ", foreign " + std::to_string(c.foreign) + ", crc " +
-           std::to_string(c.crc_error) + ", out of order " + std::to_string(c.out_of_order) + ", wrong mask " +
-           std::to_string(c.wrong_mask) + ", statuses " + std::to_string(c.statuses);
+    const auto& c = poller_.counters();
+    return "VESC: polls " + std::to_string(c.polls) + ", windows " + std::to_string(c.samples) + ", timeouts " +
+           std::to_string(c.timeouts) + ", late " + std::to_string(c.late) + ", unrequested " +
+           std::to_string(c.unrequested) + ", stolen reads " + std::to_string(c.stolen_reads) + ", short windows " +
+           std::to_string(c.short_windows) + ", send failures " + std::to_string(c.send_failures);
   }
   [[nodiscard]] io::AveragedLogLayout layout() const override { return {true, true, false, true}; }
 
  private:
-  can::vesc::VescDecoder decoder_;
-  can::CanFrame poll_;
-  std::int64_t period_ns_;
-  std::int64_t next_poll_ns_ = 0, polled_ns_ = 0, previous_rx_ns_ = 0;
-  bool outstanding_ = false;
-  std::uint64_t polls_ = 0, timeouts_ = 0;
+  daemon::VescPoller poller_;
 };
 
 std::unique_ptr<Feed> make_feed(const RecordOptions& o) {
   if (!o.signal_map.empty()) return std::make_unique<SignalMapFeed>(io::load_signal_map(o.signal_map));
   if (o.vesc_id >= 0) {
-    return std::make_unique<VescFeed>(static_cast<std::uint8_t>(o.vesc_id), static_cast<std::uint8_t>(o.host_id),
-                                      o.poll_rate_Hz);
+    daemon::VescPoller::Config c;
+    c.controller_id = static_cast<std::uint8_t>(o.vesc_id);
+    c.host_id = static_cast<std::uint8_t>(o.host_id);
+    c.period_ns = static_cast<std::int64_t>(1e9 / o.poll_rate_Hz);
+    c.timeout_ns = std::min<std::int64_t>(c.period_ns / 2, 5'000'000);  // as rpemd's default reply_timeout_s
+    return std::make_unique<VescFeed>(c);
   }
   return std::make_unique<NativeFeed>(o.window_rate_Hz);
 }

@@ -55,7 +55,11 @@ class SocketCanChannel {
   /// Waits up to timeout_ms for frames and reads what is available (up to out.size()). Error frames
   /// are counted and also returned (frame.error). Returns 0 on timeout or while the interface is down
   /// (reopening in the background of these calls).
-  [[nodiscard]] std::size_t receive(std::span<ReceivedFrame> out, int timeout_ms);
+  [[nodiscard]] std::size_t receive(std::span<ReceivedFrame> out, int timeout_ms) {
+    return receive_for(out, static_cast<std::int64_t>(timeout_ms) * 1'000'000);
+  }
+  /// As receive(), waiting up to timeout_ns (ppoll(2): sub-millisecond waits for a poll schedule).
+  [[nodiscard]] std::size_t receive_for(std::span<ReceivedFrame> out, std::int64_t timeout_ns);
 
   /// Sends one frame; waits up to timeout_ms for room in the queue. False if dropped.
   bool send(const CanFrame& frame, int timeout_ms = 10);

@@ -18,6 +18,7 @@ struct CanSource {
     bool operator==(const Options&) const = default;
   };
   [[nodiscard]] static Options parse(io::YamlMap& section, const std::string& base_dir);
+  [[nodiscard]] static SampleKind sample_kind(const Options&) noexcept { return SampleKind::kPhase; }
   [[nodiscard]] static std::unique_ptr<SampleSource> make(const Options& options);
 };
 

@@ -54,7 +54,7 @@ class Daemon {
 
   DaemonOptions options_;
   DaemonConfig config_;  ///< until run() hands it to the control thread
-  SpscQueue<core::DriveSample> samples_{8192};
+  SpscQueue<SourceSample> samples_{8192};
   SpscQueue<SourceReport> source_reports_{8};
   SpscQueue<Command> commands_{16};
   SpscQueue<ControlReport> control_reports_{8};

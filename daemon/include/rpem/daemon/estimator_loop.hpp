@@ -2,7 +2,9 @@
 // The fixed-rate estimator loop — rpemd's real-time thread, the owner of the estimator. Each period
 // (LoopTimer) it applies the commands the control thread queued, steps the estimator over every sample
 // that arrived (in order), tracks validity and age (ValidityTracker), and queues reports for the
-// publisher. It never allocates, locks, logs or does I/O once running: everything it touches was
+// publisher. The estimator is the one for the kind of sample the configured source produces
+// (LoopEstimator): phase samples step DriveEstimator, averaged rotor-frame samples AveragedDriveEstimator
+// at their host timestamps. It never allocates, locks, logs or does I/O once running: everything it touches was
 // allocated before; a full output queue drops the report and counts it.
 
 #include <atomic>
@@ -10,8 +12,8 @@
 #include <optional>
 #include <string>
 
-#include "rpem/core/drive_estimator.hpp"
 #include "rpem/daemon/daemon_config.hpp"
+#include "rpem/daemon/loop_estimator.hpp"
 #include "rpem/daemon/loop_timer.hpp"
 #include "rpem/daemon/messages.hpp"
 #include "rpem/daemon/spsc_queue.hpp"
@@ -24,6 +26,7 @@ struct LoopCounters {
   std::int64_t samples = 0;
   std::int64_t resyncs = 0;
   std::int64_t rejected_non_finite = 0;
+  std::int64_t wrong_kind = 0;               ///< samples of the kind the source does not produce (never expected)
   std::int64_t predictor_resets = 0;
   std::int64_t projections = 0;
   std::int64_t output_queue_drops = 0;
@@ -41,7 +44,7 @@ struct SeedValue {
 class EstimatorLoop {
  public:
   struct Queues {
-    SpscQueue<core::DriveSample>& samples;  ///< from the source thread
+    SpscQueue<SourceSample>& samples;  ///< from the source thread
     SpscQueue<Command>& commands;           ///< from the control thread
     SpscQueue<Report>& reports;             ///< to the publisher
   };
@@ -66,8 +69,8 @@ class EstimatorLoop {
 
  private:
   void apply(const Command& c) noexcept;
-  void step(const core::DriveSample& s, std::int64_t now_ns) noexcept;
-  void report_measurement(const core::DriveSample& s) noexcept;
+  void step(const SourceSample& s, std::int64_t now_ns) noexcept;
+  void report_measurement() noexcept;
   void report_estimate(std::int64_t now_ns) noexcept;
   void report_stats() noexcept;
   void push(const Report& r) noexcept;
@@ -75,7 +78,7 @@ class EstimatorLoop {
   LiveConfig live_;
   const LoopConfig loop_config_;
   Queues queues_;
-  core::DriveEstimator estimator_;
+  LoopEstimator estimator_;
   ValidityTracker validity_;
   LoopTimer timer_;
   std::string setup_problems_;
@@ -87,7 +90,7 @@ class EstimatorLoop {
   DaemonState state_ = DaemonState::kStarting;
   std::int64_t last_sample_mono_ns_ = 0;
   core::Estimate last_;
-  core::DriveSample last_sample_;
+  SampleSummary last_sample_;
   LoopCounters counters_;
   double eps2_d_ = 0.0, eps2_q_ = 0.0;
   std::int64_t eps_n_ = 0;

@@ -1,7 +1,7 @@
 #pragma once
 // What crosses rpemd's thread boundaries, each through an SpscQueue with one producer and one consumer
 // (docs/rpemd.md, "Threads"): plain copyable data, no strings, no heap.
-//   source  → loop:       core::DriveSample
+//   source  → loop:       SourceSample (a phase or an averaged sample, source_sample.hpp)
 //   source  → publisher:  SourceReport (source.hpp)
 //   control → loop:       Command (supervisory commands and reloads, in the order they were accepted)
 //   control → publisher:  ControlReport
@@ -63,6 +63,7 @@ struct MeasurementReport {
   std::int64_t sample_time_us = 0;
   double theta_el_rad = 0.0, omega_el_rad_s = 0.0, u_dc_V = 0.0;
   double i_d_A = 0.0, i_q_A = 0.0, i_hat_d_A = 0.0, i_hat_q_A = 0.0, eps_d_A = 0.0, eps_q_A = 0.0;
+  double t_winding_sensor_C = 0.0, t_drive_sensor_C = 0.0;  ///< the drive's own sensors; NaN: not reported
 };
 
 /// The loop's counters (totals) and statistics (the last reporting interval), as diagnostics rows.

@@ -19,6 +19,7 @@ struct SimSource {
     bool operator==(const Options&) const = default;
   };
   [[nodiscard]] static Options parse(io::YamlMap& section, const std::string& base_dir);
+  [[nodiscard]] static SampleKind sample_kind(const Options&) noexcept { return SampleKind::kPhase; }
   /// Loads the scenario: throws io::ConfigError if it is bad.
   [[nodiscard]] static std::unique_ptr<SampleSource> make(const Options& options);
 };

@@ -7,8 +7,8 @@
 #include <cstdint>
 #include <string>
 
-#include "rpem/core/drive_sample.hpp"
 #include "rpem/daemon/diagnostics_rows.hpp"
+#include "rpem/daemon/source_sample.hpp"
 #include "rpem/daemon/spsc_queue.hpp"
 
 namespace rpem::daemon {
@@ -26,11 +26,11 @@ class SourceOutput {
  public:
   static constexpr std::int64_t kReportIntervalNs = 100'000'000;
 
-  SourceOutput(SpscQueue<core::DriveSample>& samples, SpscQueue<SourceReport>& reports) noexcept
+  SourceOutput(SpscQueue<SourceSample>& samples, SpscQueue<SourceReport>& reports) noexcept
       : samples_(samples), reports_(reports) {}
 
   /// Queues a sample for the loop; a full queue drops it (diagnostics_t.input_queue_drops).
-  void push(const core::DriveSample& s) noexcept {
+  void push(const SourceSample& s) noexcept {
     if (!samples_.push(s)) ++queue_drops_;
   }
   /// True when the next report is due (every kReportIntervalNs of `now_ns`, monotonic).
@@ -44,7 +44,7 @@ class SourceOutput {
   }
 
  private:
-  SpscQueue<core::DriveSample>& samples_;
+  SpscQueue<SourceSample>& samples_;
   SpscQueue<SourceReport>& reports_;
   std::int64_t queue_drops_ = 0;
   std::int64_t next_report_ns_ = 0;

@@ -1,8 +1,8 @@
 #pragma once
 // The sample sources rpemd knows. `daemon.source.type` names one; `daemon.source.<type>` holds its
 // options (sections of the other types may be present and are checked too). A new source is one
-// implementation — a struct with kType, Options, parse() and make(), and its SampleSource — and one
-// entry in SourceCatalogue below. The first entry is the default.
+// implementation — a struct with kType, Options, parse(), sample_kind() and make(), and its SampleSource
+// — and one entry in SourceCatalogue below. The first entry is the default.
 
 #include <memory>
 #include <string>
@@ -12,6 +12,7 @@
 
 #include "rpem/daemon/can_source.hpp"
 #include "rpem/daemon/sim_source.hpp"
+#include "rpem/daemon/vesc_source.hpp"
 #include "rpem/io/yaml_map.hpp"
 
 namespace rpem::daemon {
@@ -26,6 +27,10 @@ struct Catalogue {
     return parse(source, base_dir, std::index_sequence_for<Kinds...>{});
   }
   [[nodiscard]] static const char* type(const Options& o) { return type(o, std::index_sequence_for<Kinds...>{}); }
+  /// The kind of sample the configured source produces (which estimator the loop runs).
+  [[nodiscard]] static SampleKind sample_kind(const Options& o) noexcept {
+    return sample_kind(o, std::index_sequence_for<Kinds...>{});
+  }
   /// Builds the configured source (throws io::ConfigError if it cannot be, e.g. a bad scenario).
   [[nodiscard]] static std::unique_ptr<SampleSource> make(const Options& o) {
     return make(o, std::index_sequence_for<Kinds...>{});
@@ -34,6 +39,13 @@ struct Catalogue {
  private:
   template <std::size_t I>
   using Kind = std::tuple_element_t<I, std::tuple<Kinds...>>;
+
+  template <std::size_t... I>
+  static SampleKind sample_kind(const Options& o, std::index_sequence<I...>) noexcept {
+    SampleKind kind = SampleKind::kPhase;
+    ((o.index() == I ? (kind = Kind<I>::sample_kind(*std::get_if<I>(&o)), 0) : 0), ...);
+    return kind;
+  }
 
   template <std::size_t... I>
   static Options parse(io::YamlMap& source, const std::string& base_dir, std::index_sequence<I...>) {
@@ -62,7 +74,7 @@ struct Catalogue {
   }
 };
 
-using SourceCatalogue = Catalogue<SimSource, CanSource>;
+using SourceCatalogue = Catalogue<SimSource, CanSource, VescSource>;
 using SourceConfig = SourceCatalogue::Options;
 
 }  // namespace rpem::daemon

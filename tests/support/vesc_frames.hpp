@@ -1,7 +1,10 @@
 #pragma once
-// VESC frames written byte by byte from docs/can-vesc.md (which cites vedderb/bldc), shared by the
-// decoder's conformance tests (test_vesc.cpp) and the emulator's (tests/sim/test_vesc_emulator.cpp). The
-// CRC of the reply was computed with Python's binascii.crc_hqx(payload, 0), not with our code.
+// VESC frames written byte by byte from docs/can-vesc.md (which cites vedderb/bldc: comm/comm_can.c
+// comm_can_send_buffer, decode_msg; comm/commands.c commands_process_packet, case
+// COMM_GET_VALUES_SELECTIVE; util/buffer.c; util/crc.c crc16), not with rpem's encoder. The reply's CRC was
+// computed with Python's binascii.crc_hqx(payload, 0) (CRC-16/XMODEM). Shared by the decoder's
+// conformance tests (tests/can/test_vesc.cpp), the rpemd source's (tests/daemon/test_vesc_poller.cpp) and
+// the emulator's (tests/can/test_vesc_firmware.cpp, tests/sim/test_vesc_emulator.cpp).
 
 #include <algorithm>
 #include <cstdint>
@@ -9,10 +12,10 @@
 
 #include "rpem/can/frame.hpp"
 
-namespace rpem::test::vesc_vectors {
+namespace rpem::test::vesc_frames {
 
 inline constexpr std::uint8_t kController = 17;  // the VESC
-inline constexpr std::uint8_t kOwn = 0x7D;       // the poller (rpemd)
+inline constexpr std::uint8_t kHost = 0x7D;      // the poller (rpemd)
 
 inline can::CanFrame ext(std::uint32_t id, std::vector<std::uint8_t> bytes) {
   can::CanFrame f;
@@ -25,7 +28,7 @@ inline can::CanFrame ext(std::uint32_t id, std::vector<std::uint8_t> bytes) {
 
 /// The reply to a poll with the estimator's mask 0x001801B3: T_fet 41.3 °C, T_motor 67.8 °C, i_d −3.21 A,
 /// i_q 27.45 A, 21000 ERPM, V_in 48.2 V, v_d −1.234 V, v_q 11.873 V — 31 bytes in five FILL_RX_BUFFER
-/// frames (ID 0x57D: own id 0x7D | 5 << 8) and PROCESS_RX_BUFFER (0x77D) from controller 17, CRC 0x08F7.
+/// frames (ID 0x57D: host id 0x7D | 5 << 8) and PROCESS_RX_BUFFER (0x77D) from controller 17, CRC 0x08F7.
 inline std::vector<can::CanFrame> reply_frames() {
   return {ext(0x57D, {0x00, 0x32, 0x00, 0x18, 0x01, 0xB3, 0x01, 0x9D}),
           ext(0x57D, {0x07, 0x02, 0xA6, 0xFF, 0xFF, 0xFE, 0xBF, 0x00}),
@@ -42,4 +45,4 @@ inline can::CanFrame status4() { return ext(0x1011, {0x01, 0x63, 0x03, 0x21, 0x0
 /// STATUS_5 (27): tachometer 123456, V_in 50.4 V, reserved.
 inline can::CanFrame status5() { return ext(0x1B11, {0x00, 0x01, 0xE2, 0x40, 0x01, 0xF8, 0x00, 0x00}); }
 
-}  // namespace rpem::test::vesc_vectors
+}  // namespace rpem::test::vesc_frames

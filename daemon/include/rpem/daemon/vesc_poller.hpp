@@ -1,0 +1,107 @@
+#pragma once
+// The VESC source's poll schedule and reply state machine, without the socket (docs/rpemd.md,
+// "source: vesc"; the protocol: docs/can-vesc.md). Pure and allocation-free: the source thread gives it
+// the time and every received frame with its kernel receive time; it says when to poll and turns each
+// reply into an averaged rotor-frame sample.
+//
+// Schedule: polls at t = k·T + φ·T on the host's clock (T = 1/poll_rate_Hz, φ = poll_phase), so
+// instances polling drives on one bus interleave instead of colliding. One poll is outstanding at a time;
+// it times out after reply_timeout_s.
+//
+// Windows: VESC's i_d, i_q, v_d, v_q are averages since the previous read by anyone, reset by each read
+// (docs/can-vesc.md, "What the values mean"). A reply's window therefore ends at the receive time of its
+// first frame and starts at the newest earlier read seen: the previous reply, or a read of this
+// controller by another poller seen on the bus. Stealing and the other irregularities are detected so:
+//   stolen_reads      a COMM_GET_VALUES(_SELECTIVE) request to this controller on the bus: never ours (a
+//                     raw socket does not receive its own frames), so another poller reset the averages
+//                     there; the next window starts at it.
+//   unrequested       a values reply to our id with no poll of ours outstanding or timed out unanswered
+//                     in the last period: another poller uses our host id. Its window is still right
+//                     (it ends a read), so it is used.
+//   late              a reply to a poll that had timed out (within one period of the timeout): used.
+//   timeouts          a poll unanswered within reply_timeout_s (silent controller, lost frames). Whether
+//                     the controller read (and reset) is unknown, so the next window follows a gap.
+//   short_windows     a window shorter than kMinWindow: the firmware divides sums of (nearly) no control
+//                     cycles — not a measurement; dropped, the next window follows a gap.
+// Reads by a poller the bus does not show (VESC Tool over USB or UART) shorten windows invisibly: the
+// reply carries no count of the cycles averaged (docs/rpemd.md says what that costs).
+
+#include <cstdint>
+
+#include "rpem/can/vesc.hpp"
+#include "rpem/core/averaged_sample.hpp"
+
+namespace rpem::daemon {
+
+struct VescPollerCounters {
+  std::uint64_t polls = 0;
+  std::uint64_t send_failures = 0;
+  std::uint64_t samples = 0;       ///< windows delivered
+  std::uint64_t timeouts = 0;
+  std::uint64_t late = 0;
+  std::uint64_t unrequested = 0;
+  std::uint64_t stolen_reads = 0;
+  std::uint64_t short_windows = 0;
+};
+
+class VescPoller {
+ public:
+  struct Config {
+    std::uint8_t controller_id = 0;
+    std::uint8_t host_id = 254;
+    std::int64_t period_ns = 5'000'000;
+    std::int64_t phase_ns = 0;    ///< in [0, period_ns)
+    std::int64_t timeout_ns = 2'500'000;
+    std::uint32_t mask = can::vesc::kEstimatorMask;
+  };
+  /// Shorter windows are not measurements (a few of VESC's control cycles at most).
+  static constexpr std::int64_t kMinWindowNs = 200'000;
+  /// COMM_PACKET_IDs whose reply reads and resets the averages (datatypes.h; commands.c).
+  static constexpr std::uint8_t kCommGetValues = 4;
+
+  explicit VescPoller(const Config& config) noexcept;
+
+  /// When the next poll is due (host ns), the first at or after `now_ns` on the schedule.
+  [[nodiscard]] std::int64_t next_poll_ns(std::int64_t now_ns) const noexcept;
+  /// The next moment the poller needs the time — a poll due or an outstanding reply's deadline — and
+  /// `now_ns` when that has passed.
+  [[nodiscard]] std::int64_t wake_ns(std::int64_t now_ns) const noexcept;
+  /// The poll frame (COMM_GET_VALUES_SELECTIVE with the mask, to the controller, from host_id).
+  [[nodiscard]] const can::CanFrame& poll_frame() const noexcept { return poll_; }
+  /// True when a poll is due at `now_ns` (the caller sends poll_frame() and calls polled()).
+  [[nodiscard]] bool poll_due(std::int64_t now_ns) const noexcept { return now_ns >= next_due_ns_; }
+  /// The poll went out at `now_ns` (or could not be sent).
+  void polled(std::int64_t now_ns, bool sent) noexcept;
+  /// Time passes: an outstanding poll past its deadline times out.
+  void on_time(std::int64_t now_ns) noexcept;
+  /// One received frame with its receive time: true when it completes a reply whose window is a
+  /// sample (written to `sample`).
+  [[nodiscard]] bool on_frame(const can::CanFrame& f, std::int64_t rx_ns, core::AveragedSample& sample) noexcept;
+
+  [[nodiscard]] const VescPollerCounters& counters() const noexcept { return counters_; }
+  [[nodiscard]] const can::vesc::VescDecoder& decoder() const noexcept { return decoder_; }
+  /// True while no reply came for the last poll(s): the controller is silent.
+  [[nodiscard]] bool silent() const noexcept { return consecutive_timeouts_ > 0; }
+
+ private:
+  void time_out() noexcept;
+  [[nodiscard]] bool is_values_read_of_controller(const can::CanFrame& f) const noexcept;
+  [[nodiscard]] bool starts_reply(const can::CanFrame& f) const noexcept;
+
+  Config config_;
+  can::CanFrame poll_;
+  can::vesc::VescDecoder decoder_;
+  VescPollerCounters counters_;
+  std::int64_t next_due_ns_ = 0;     ///< 0: the first call to poll_due() is due
+  bool outstanding_ = false;
+  std::int64_t deadline_ns_ = 0;
+  bool timed_out_unanswered_ = false;
+  std::int64_t timed_out_at_ns_ = 0;
+  std::int64_t consecutive_timeouts_ = 0;
+  std::int64_t reply_start_ns_ = 0;   ///< receive time of the reply's first frame
+  bool has_window_start_ = false;
+  std::int64_t window_start_ns_ = 0;  ///< the newest read of the controller seen
+  bool gap_ = true;                   ///< windows before the next may be lost
+};
+
+}  // namespace rpem::daemon

@@ -1,0 +1,41 @@
+#pragma once
+// `source: {type: vesc, vesc: {interface: can0, controller_id: 17, host_id: 125, poll_rate_Hz: 200}}` —
+// a VESC (vedderb/bldc) polled over SocketCAN with COMM_GET_VALUES_SELECTIVE (docs/can-vesc.md): each reply
+// is an averaged rotor-frame sample over [previous reply, this reply] (host receive times), stepped by the
+// averaged estimator (docs/rpemd.md, "source: vesc"). The poll schedule and the reply state machine are
+// VescPoller (vesc_poller.hpp), testable without a socket.
+
+#include <memory>
+#include <string>
+
+#include "rpem/daemon/source.hpp"
+#include "rpem/daemon/vesc_poller.hpp"
+#include "rpem/io/yaml_map.hpp"
+
+namespace rpem::daemon {
+
+struct VescSource {
+  static constexpr const char* kType = "vesc";
+  struct Options {
+    std::string interface = "can0";
+    int controller_id = 0;       ///< the VESC's CAN id (its app configuration's controller_id), 0–254
+    int host_id = 254;           ///< rpemd's node id on the bus, where replies are addressed; no VESC may use it
+    double poll_rate_Hz = 200.0; ///< 1–2000 Hz
+    /// Where in each poll period this instance polls, as a fraction of the period: instances polling
+    /// drives on one bus take different phases (docs/rpemd.md, "Several drives on one bus").
+    double poll_phase = 0.0;
+    /// A reply not complete this long after its poll is a timeout (default: half the poll period, at most 5 ms).
+    double reply_timeout_s = 0.0;
+    bool operator==(const Options&) const = default;
+  };
+  [[nodiscard]] static Options parse(io::YamlMap& section, const std::string& base_dir);
+  [[nodiscard]] static SampleKind sample_kind(const Options&) noexcept { return SampleKind::kAveraged; }
+  [[nodiscard]] static std::unique_ptr<SampleSource> make(const Options& options);
+};
+
+/// The poller's schedule and ids from the options.
+[[nodiscard]] VescPoller::Config poller_config(const VescSource::Options& options) noexcept;
+/// The poller's and its decoder's counters as diagnostics rows (vesc_*, can_*).
+void report_vesc_counters(const VescPoller& poller, DiagnosticsRows& rows) noexcept;
+
+}  // namespace rpem::daemon

@@ -1,0 +1,68 @@
+#include "rpem/daemon/loop_estimator.hpp"
+
+#include <algorithm>
+#include <limits>
+
+namespace rpem::daemon {
+
+LoopEstimator::Estimators LoopEstimator::make(SampleKind kind, const core::MachineSi& machine,
+                                              const core::EstimatorSettings& settings) noexcept {
+  if (kind == SampleKind::kAveraged) return Estimators(std::in_place_index<1>, machine, settings);
+  return Estimators(std::in_place_index<0>, machine, settings);
+}
+
+LoopEstimator::LoopEstimator(SampleKind kind, const core::MachineSi& machine, const core::EstimatorSettings& settings) noexcept
+    : estimator_(make(kind, machine, settings)),
+      nominal_period_s_(settings.nominal_sample_period_s),
+      max_interval_s_(settings.averaged.max_interval_s) {}
+
+bool LoopEstimator::step(const SourceSample& sample, core::Estimate& estimate, double& dt_s, SampleSummary& summary) noexcept {
+  if (sample.index() != estimator_.index()) return false;
+  if (auto* phase = std::get_if<core::DriveEstimator>(&estimator_)) {
+    const core::DriveSample& s = *std::get_if<core::DriveSample>(&sample);
+    estimate = phase->step(s);
+    dt_s = nominal_period_s_;
+    constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+    summary = {s.t_ns, s.rx_ns, s.theta_el_rad, s.omega_el_rad_s, s.u_dc_V, kNaN, kNaN};
+    return true;
+  }
+  const core::AveragedSample& a = *std::get_if<core::AveragedSample>(&sample);
+  estimate = std::get_if<core::AveragedDriveEstimator>(&estimator_)->step(a);
+  // The time this sample stands for: from the previous window's end (a gap or a long silence counts up
+  // to the interval the estimator still adapts across).
+  const double interval_s = has_previous_ ? 1e-9 * static_cast<double>(a.t_ns - previous_t_ns_) : 0.0;
+  dt_s = std::clamp(interval_s, 0.0, max_interval_s_);
+  has_previous_ = true;
+  previous_t_ns_ = a.t_ns;
+  summary = {a.t_ns, a.t_ns, std::numeric_limits<double>::quiet_NaN(), a.omega_el_rad_s, a.u_dc_V, a.t_winding_C, a.t_drive_C};
+  return true;
+}
+
+void LoopEstimator::reset() noexcept {
+  std::visit([](auto& e) { e.reset(); }, estimator_);
+}
+void LoopEstimator::resynchronize() noexcept {
+  std::visit([](auto& e) { e.resynchronize(); }, estimator_);
+}
+void LoopEstimator::set_frozen(bool frozen) noexcept {
+  std::visit([frozen](auto& e) { e.set_frozen(frozen); }, estimator_);
+}
+void LoopEstimator::set_estimates(double psi_m_Wb, double r_s_Ohm) noexcept {
+  std::visit([=](auto& e) { e.set_estimates(psi_m_Wb, r_s_Ohm); }, estimator_);
+}
+void LoopEstimator::reconfigure(const core::MachineSi& machine, const core::EstimatorSettings& settings) noexcept {
+  std::visit([&](auto& e) { e.reconfigure(machine, settings); }, estimator_);
+  nominal_period_s_ = settings.nominal_sample_period_s;
+  max_interval_s_ = settings.averaged.max_interval_s;
+}
+double LoopEstimator::psi_m_Wb() const noexcept {
+  return std::visit([](const auto& e) { return e.psi_m_Wb(); }, estimator_);
+}
+double LoopEstimator::r_s_Ohm() const noexcept {
+  return std::visit([](const auto& e) { return e.r_s_Ohm(); }, estimator_);
+}
+const core::RpemEstimator& LoopEstimator::core() const noexcept {
+  return std::visit([](const auto& e) -> const core::RpemEstimator& { return e.core(); }, estimator_);
+}
+
+}  // namespace rpem::daemon

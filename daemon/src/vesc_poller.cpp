@@ -1,0 +1,112 @@
+#include "rpem/daemon/vesc_poller.hpp"
+
+#include <algorithm>
+
+namespace rpem::daemon {
+
+namespace vesc = can::vesc;
+
+VescPoller::VescPoller(const Config& config) noexcept
+    : config_(config),
+      poll_(vesc::values_request(config.controller_id, config.host_id, config.mask)),
+      decoder_(config.controller_id, config.host_id, config.mask) {}
+
+std::int64_t VescPoller::next_poll_ns(std::int64_t now_ns) const noexcept {
+  const std::int64_t T = config_.period_ns;
+  const std::int64_t since = now_ns - config_.phase_ns;
+  std::int64_t k = since / T;
+  if (k * T < since) ++k;  // ceil, for either sign
+  return k * T + config_.phase_ns;
+}
+
+std::int64_t VescPoller::wake_ns(std::int64_t now_ns) const noexcept {
+  const std::int64_t next = outstanding_ ? std::min(next_due_ns_, deadline_ns_) : next_due_ns_;
+  return std::max(next, now_ns);
+}
+
+void VescPoller::polled(std::int64_t now_ns, bool sent) noexcept {
+  std::int64_t next = next_poll_ns(now_ns);
+  if (next <= now_ns) next += config_.period_ns;
+  next_due_ns_ = next;
+  if (!sent) {
+    ++counters_.send_failures;
+    return;
+  }
+  if (outstanding_) time_out();  // a previous poll still unanswered (reply_timeout_s ≥ the period)
+  ++counters_.polls;
+  outstanding_ = true;
+  deadline_ns_ = now_ns + config_.timeout_ns;
+}
+
+void VescPoller::on_time(std::int64_t now_ns) noexcept {
+  if (outstanding_ && now_ns > deadline_ns_) time_out();
+}
+
+void VescPoller::time_out() noexcept {
+  outstanding_ = false;
+  ++counters_.timeouts;
+  ++consecutive_timeouts_;
+  timed_out_unanswered_ = true;
+  timed_out_at_ns_ = deadline_ns_;
+  decoder_.reset_buffer();
+  gap_ = true;  // the controller may have read (and reset) with its reply lost
+}
+
+bool VescPoller::is_values_read_of_controller(const can::CanFrame& f) const noexcept {
+  if (f.error || !f.extended || f.len < 3) return false;
+  const std::uint32_t addressee = f.id & 0xFF;
+  if (addressee != config_.controller_id && addressee != vesc::kBroadcastId) return false;
+  if ((f.id >> 8) != static_cast<std::uint32_t>(vesc::Packet::kProcessShortBuffer)) return false;
+  // [sender][commands_send][command …]
+  return f.data[2] == kCommGetValues || f.data[2] == vesc::kCommGetValuesSelective;
+}
+
+bool VescPoller::starts_reply(const can::CanFrame& f) const noexcept {
+  if (f.error || !f.extended || (f.id & 0xFF) != config_.host_id) return false;
+  const std::uint32_t packet = f.id >> 8;
+  if (packet == static_cast<std::uint32_t>(vesc::Packet::kProcessShortBuffer)) return true;
+  return packet == static_cast<std::uint32_t>(vesc::Packet::kFillRxBuffer) && f.len >= 1 && f.data[0] == 0;
+}
+
+bool VescPoller::on_frame(const can::CanFrame& f, std::int64_t rx_ns, core::AveragedSample& sample) noexcept {
+  if (is_values_read_of_controller(f)) {
+    ++counters_.stolen_reads;
+    window_start_ns_ = rx_ns;  // the controller's averages restart here
+  }
+  if (starts_reply(f)) reply_start_ns_ = rx_ns;
+  if (decoder_.decode(f) != vesc::VescDecoder::Event::kValues) return false;
+
+  const std::int64_t t = reply_start_ns_ != 0 ? reply_start_ns_ : rx_ns;
+  reply_start_ns_ = 0;
+  if (outstanding_) {
+    outstanding_ = false;
+    consecutive_timeouts_ = 0;
+  } else if (timed_out_unanswered_ && t - timed_out_at_ns_ <= config_.period_ns) {
+    ++counters_.late;
+    consecutive_timeouts_ = 0;
+  } else {
+    ++counters_.unrequested;
+  }
+  timed_out_unanswered_ = false;
+
+  if (!has_window_start_) {  // the first reply only opens the first window
+    has_window_start_ = true;
+    window_start_ns_ = t;
+    gap_ = false;
+    return false;
+  }
+  if (t - window_start_ns_ < kMinWindowNs) {
+    ++counters_.short_windows;
+    window_start_ns_ = t;
+    gap_ = true;
+    return false;
+  }
+  sample = vesc::to_averaged_sample(decoder_.values(), window_start_ns_, t);
+  sample.gap_before = gap_;
+  gap_ = false;
+  window_start_ns_ = t;
+  ++counters_.samples;
+  return true;
+}
+
+}  // namespace rpem::daemon

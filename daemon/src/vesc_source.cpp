@@ -1,0 +1,123 @@
+#include "rpem/daemon/vesc_source.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+
+#include "rpem/can/socketcan.hpp"
+#include "rpem/core/clock.hpp"
+#include "rpem/daemon/can_channel_rows.hpp"
+#include "rpem/daemon/vesc_poller.hpp"
+
+namespace rpem::daemon {
+namespace {
+
+using Diag = rpem::diagnostics_t;
+using can::vesc::VescCounters;
+
+constexpr std::array<CounterRow<VescPollerCounters, std::uint64_t>, 8> kPollerRows{{
+    {&VescPollerCounters::polls, &Diag::vesc_polls},
+    {&VescPollerCounters::send_failures, &Diag::vesc_send_failures},
+    {&VescPollerCounters::samples, &Diag::vesc_replies},
+    {&VescPollerCounters::timeouts, &Diag::vesc_timeouts},
+    {&VescPollerCounters::late, &Diag::vesc_late_replies},
+    {&VescPollerCounters::unrequested, &Diag::vesc_unrequested_replies},
+    {&VescPollerCounters::stolen_reads, &Diag::vesc_stolen_reads},
+    {&VescPollerCounters::short_windows, &Diag::vesc_short_windows},
+}};
+constexpr std::array<CounterRow<VescCounters, std::uint64_t>, 7> kDecoderRows{{
+    {&VescCounters::frames, &Diag::can_frames},
+    {&VescCounters::foreign, &Diag::can_foreign},
+    {&VescCounters::unknown_packet, &Diag::can_unknown_id},
+    {&VescCounters::wrong_length, &Diag::can_wrong_dlc},
+    {&VescCounters::crc_error, &Diag::can_crc_error},
+    {&VescCounters::short_reply, &Diag::vesc_short_replies},
+    {&VescCounters::statuses, &Diag::vesc_statuses},
+}};
+static_assert(kPollerRows.size() + kDecoderRows.size() + kChannelRows.size() + 3 <= DiagnosticsRows::kMaxCounts);
+
+}  // namespace
+
+VescPoller::Config poller_config(const VescSource::Options& o) noexcept {
+  VescPoller::Config c;
+  c.controller_id = static_cast<std::uint8_t>(o.controller_id);
+  c.host_id = static_cast<std::uint8_t>(o.host_id);
+  c.period_ns = std::llround(1e9 / o.poll_rate_Hz);
+  c.phase_ns = std::llround(o.poll_phase * static_cast<double>(c.period_ns));
+  c.timeout_ns = std::llround(o.reply_timeout_s * 1e9);
+  return c;
+}
+
+void report_vesc_counters(const VescPoller& poller, DiagnosticsRows& rows) noexcept {
+  rows.set_all(kPollerRows, poller.counters());
+  const VescCounters& d = poller.decoder().counters();
+  rows.set_all(kDecoderRows, d);
+  rows.set(&Diag::vesc_buffer_errors, static_cast<std::int64_t>(d.out_of_order + d.overflow + d.length_mismatch));
+  rows.set(&Diag::vesc_bad_replies, static_cast<std::int64_t>(d.not_values + d.trailing + d.wrong_mask));
+}
+
+namespace {
+
+class VescSampleSource final : public SampleSource {
+ public:
+  explicit VescSampleSource(VescSource::Options o) : options_(std::move(o)) {}
+
+  void run(const std::atomic<bool>& stop, SourceOutput& out) override {
+    can::SocketCanChannel::Options o;
+    o.interface = options_.interface;
+    o.fd = false;
+    // Every frame: the replies to us, the controller's statuses, and other nodes' reads of it (stolen
+    // averages). The kernel's filters compare 11 bits here, so the poller sorts them.
+    can::SocketCanChannel channel(o);
+    VescPoller poller(poller_config(options_));
+    std::array<can::ReceivedFrame, 64> frames;
+    core::AveragedSample sample;
+    while (!stop.load(std::memory_order_relaxed)) {
+      // The poll schedule and the windows run on CLOCK_REALTIME, the kernel's receive timestamps' clock.
+      std::int64_t now = core::now_ns(CLOCK_REALTIME);
+      poller.on_time(now);
+      if (poller.poll_due(now)) poller.polled(now, channel.send(poller.poll_frame(), 0));
+      const std::int64_t wait_ns = std::clamp<std::int64_t>(poller.wake_ns(now) - now, 0, 50'000'000);
+      const std::size_t n = channel.receive_for(frames, wait_ns);
+      now = core::now_ns(CLOCK_REALTIME);
+      for (std::size_t f = 0; f < n; ++f) {
+        const std::int64_t rx = frames[f].kernel_rx_ns != 0 ? frames[f].kernel_rx_ns : now;
+        if (poller.on_frame(frames[f].frame, rx, sample)) out.push(sample);
+      }
+      const std::int64_t mono = core::now_ns(CLOCK_MONOTONIC);
+      if (out.report_due(mono)) {
+        SourceReport r;
+        report_vesc_counters(poller, r.rows);
+        r.rows.set_all(kChannelRows, channel.counters());
+        out.report(r, mono);
+      }
+    }
+  }
+  [[nodiscard]] std::string name() const override {
+    return options_.interface + " controller " + std::to_string(options_.controller_id);
+  }
+
+ private:
+  VescSource::Options options_;
+};
+
+}  // namespace
+
+VescSource::Options VescSource::parse(io::YamlMap& section, const std::string&) {
+  Options o;
+  o.interface = section.text("interface");
+  if (o.interface.empty() || o.interface.size() > 15) section.fail("interface", "not an interface name");
+  o.controller_id = static_cast<int>(section.integer("controller_id", 0, 254));
+  o.host_id = static_cast<int>(section.integer_or("host_id", o.host_id, 0, 254));
+  if (o.host_id == o.controller_id) section.fail("host_id", "must differ from controller_id (replies are addressed to it)");
+  o.poll_rate_Hz = section.number_or("poll_rate_Hz", o.poll_rate_Hz, 1.0, 2000.0);
+  o.poll_phase = section.number_or("poll_phase", o.poll_phase, 0.0, 0.999);
+  const double period_s = 1.0 / o.poll_rate_Hz;
+  o.reply_timeout_s = section.number_or("reply_timeout_s", std::min(0.5 * period_s, 5e-3), 1e-4, period_s);
+  section.finish();
+  return o;
+}
+
+std::unique_ptr<SampleSource> VescSource::make(const Options& options) { return std::make_unique<VescSampleSource>(options); }
+
+}  // namespace rpem::daemon

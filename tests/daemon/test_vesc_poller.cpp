@@ -1,0 +1,221 @@
+// rpemd's VESC source without a socket (VescPoller): the poll schedule, replies turned into averaged
+// windows between the replies' receive times, and what is counted — timeouts of a silent controller, late
+// and unrequested replies, another poller's reads stealing the averages, windows too short to be averages.
+// Frames are written byte by byte from docs/can-vesc.md (support/vesc_frames.hpp), not by our encoder.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+#include <optional>
+#include <vector>
+
+#include "rpem/daemon/vesc_source.hpp"
+#include "support/vesc_frames.hpp"
+
+namespace rpem::daemon {
+namespace {
+
+using test::vesc_frames::ext;
+using test::vesc_frames::kController;
+using test::vesc_frames::kHost;
+using test::vesc_frames::reply_frames;
+
+constexpr std::int64_t kT0 = 1'700'000'000'000'000'000;  // a CLOCK_REALTIME instant [ns]
+constexpr std::int64_t kMs = 1'000'000;
+
+VescPoller make_poller(double rate_Hz = 200.0, double phase = 0.0) {
+  VescSource::Options o;
+  o.controller_id = kController;
+  o.host_id = kHost;
+  o.poll_rate_Hz = rate_Hz;
+  o.poll_phase = phase;
+  o.reply_timeout_s = std::min(0.5 / rate_Hz, 5e-3);
+  return VescPoller(poller_config(o));
+}
+
+/// The reply's six frames, 20 µs apart from `t_ns`: the sample they complete, if any.
+std::optional<core::AveragedSample> reply(VescPoller& p, std::int64_t t_ns) {
+  core::AveragedSample s;
+  bool got = false;
+  std::int64_t t = t_ns;
+  for (const can::CanFrame& f : reply_frames()) {
+    got = p.on_frame(f, t, s) || got;
+    t += 20'000;
+  }
+  return got ? std::optional(s) : std::nullopt;
+}
+
+/// A poll sent at t, answered 300 µs later.
+std::optional<core::AveragedSample> poll_and_reply(VescPoller& p, std::int64_t t_ns) {
+  p.on_time(t_ns);
+  EXPECT_TRUE(p.poll_due(t_ns));
+  p.polled(t_ns, true);
+  return reply(p, t_ns + 300'000);
+}
+
+TEST(VescPoller, PollsWithTheDocumentedShortBuffer) {
+  const VescPoller p = make_poller();
+  const can::CanFrame& f = p.poll_frame();
+  EXPECT_TRUE(f.extended);
+  EXPECT_EQ(f.id, 0x811U);  // controller 17 | PROCESS_SHORT_BUFFER (8) << 8
+  const std::vector<std::uint8_t> want = {0x7D, 0x00, 0x32, 0x00, 0x18, 0x01, 0xB3};  // host, send 0, cmd 50, mask
+  ASSERT_EQ(f.len, want.size());
+  EXPECT_EQ(std::vector<std::uint8_t>(f.data.begin(), f.data.begin() + f.len), want);
+}
+
+// Polls fall on k·T + φ·T of the host clock, whenever the first one went out: two instances with
+// phases 0 and 0.5 poll half a period apart.
+TEST(VescPoller, PollsFallOnTheScheduleWithTheirPhase) {
+  VescPoller a = make_poller(200.0, 0.0), b = make_poller(200.0, 0.5);
+  const std::int64_t start = kT0 + 1'234'567;
+  for (VescPoller* p : {&a, &b}) {
+    EXPECT_TRUE(p->poll_due(start));
+    p->polled(start, true);
+  }
+  const std::int64_t na = a.next_poll_ns(start + 1), nb = b.next_poll_ns(start + 1);
+  EXPECT_EQ(na % (5 * kMs), 0);
+  EXPECT_EQ((nb - na + 5 * kMs) % (5 * kMs), 5 * kMs / 2);
+  EXPECT_FALSE(a.poll_due(na - 1));
+  EXPECT_TRUE(a.poll_due(na));
+  EXPECT_EQ(a.wake_ns(start + 10), start + 2'500'000);  // the reply's deadline comes before the next poll
+  EXPECT_EQ(a.wake_ns(na + 7), na + 7);                 // a poll overdue: now, never in the past
+}
+
+// Each reply closes the window the previous one opened; the values are VESC's, in SI.
+TEST(VescPoller, RepliesBecomeWindowsBetweenTheirReceiveTimes) {
+  VescPoller p = make_poller();
+  EXPECT_FALSE(poll_and_reply(p, kT0).has_value());  // the first reply only opens a window
+  const auto s = poll_and_reply(p, kT0 + 5 * kMs);
+  ASSERT_TRUE(s.has_value());
+  EXPECT_EQ(s->t_start_ns, kT0 + 300'000);           // the previous reply's first frame
+  EXPECT_EQ(s->t_ns, kT0 + 5 * kMs + 300'000);       // this reply's first frame
+  EXPECT_FALSE(s->gap_before);
+  EXPECT_DOUBLE_EQ(s->i_dq_A[0], -3.21);
+  EXPECT_DOUBLE_EQ(s->i_dq_A[1], 27.45);
+  EXPECT_DOUBLE_EQ(s->u_dq_V[0], -1.234);
+  EXPECT_DOUBLE_EQ(s->u_dq_V[1], 11.873);
+  EXPECT_DOUBLE_EQ(s->omega_el_rad_s, 21000.0 * 2.0 * std::numbers::pi / 60.0);
+  EXPECT_DOUBLE_EQ(s->u_dc_V, 48.2);
+  EXPECT_DOUBLE_EQ(s->t_winding_C, 67.8);
+  EXPECT_DOUBLE_EQ(s->t_drive_C, 41.3);
+  EXPECT_EQ(p.counters().polls, 2U);
+  EXPECT_EQ(p.counters().samples, 1U);
+  EXPECT_EQ(p.counters().timeouts + p.counters().unrequested + p.counters().stolen_reads, 0U);
+}
+
+// A silent controller: every poll times out (counted, and the source is silent); when it answers again
+// the first window follows a gap (its reads may have reset the averages with the replies lost).
+TEST(VescPoller, ASilentControllerTimesOutAndTheNextWindowFollowsAGap) {
+  VescPoller p = make_poller();
+  (void)poll_and_reply(p, kT0);
+  for (int k = 1; k <= 4; ++k) {
+    const std::int64_t t = kT0 + k * 5 * kMs;
+    p.on_time(t);
+    ASSERT_TRUE(p.poll_due(t));
+    p.polled(t, true);
+  }
+  p.on_time(kT0 + 25 * kMs);
+  EXPECT_EQ(p.counters().timeouts, 4U);
+  EXPECT_TRUE(p.silent());
+  const auto s = poll_and_reply(p, kT0 + 25 * kMs);
+  ASSERT_TRUE(s.has_value());
+  EXPECT_TRUE(s->gap_before);
+  EXPECT_FALSE(p.silent());
+  const auto next = poll_and_reply(p, kT0 + 30 * kMs);
+  ASSERT_TRUE(next.has_value());
+  EXPECT_FALSE(next->gap_before);
+}
+
+// A reply after its poll timed out is late, and still a window (it ends a read of the controller).
+TEST(VescPoller, AReplyAfterItsTimeoutIsLateAndStillUsed) {
+  VescPoller p = make_poller();
+  (void)poll_and_reply(p, kT0);
+  p.polled(kT0 + 5 * kMs, true);
+  p.on_time(kT0 + 8 * kMs);  // timeout 2.5 ms
+  EXPECT_EQ(p.counters().timeouts, 1U);
+  const auto s = reply(p, kT0 + 8'500'000);
+  ASSERT_TRUE(s.has_value());
+  EXPECT_EQ(p.counters().late, 1U);
+  EXPECT_EQ(p.counters().unrequested, 0U);
+  EXPECT_EQ(s->t_start_ns, kT0 + 300'000);
+}
+
+// Another poller reading our controller on the bus (node 0x42, the same poll the docs show for us): its
+// read resets the averages, so it is counted and our next window starts at it.
+TEST(VescPoller, AnotherPollersReadIsCountedAndStartsTheWindow) {
+  VescPoller p = make_poller();
+  (void)poll_and_reply(p, kT0);
+  core::AveragedSample unused;
+  const can::CanFrame theirs = ext(0x811, {0x42, 0x00, 0x32, 0x00, 0x00, 0x00, 0x30});  // i_d, i_q only
+  EXPECT_FALSE(p.on_frame(theirs, kT0 + 2 * kMs, unused));
+  // COMM_GET_VALUES (4) resets them too; a read of another controller (18) does not concern us.
+  EXPECT_FALSE(p.on_frame(ext(0x812, {0x42, 0x00, 0x04}), kT0 + 2'100'000, unused));
+  EXPECT_EQ(p.counters().stolen_reads, 1U);
+  EXPECT_FALSE(p.on_frame(ext(0x811, {0x42, 0x00, 0x04}), kT0 + 2'200'000, unused));
+  EXPECT_EQ(p.counters().stolen_reads, 2U);
+  const auto s = poll_and_reply(p, kT0 + 5 * kMs);
+  ASSERT_TRUE(s.has_value());
+  EXPECT_EQ(s->t_start_ns, kT0 + 2'200'000);
+  EXPECT_EQ(s->t_ns, kT0 + 5'300'000);
+  // The other poller's reply goes to its id (0x42 | FILL_RX_BUFFER << 8): foreign, not a reply to us.
+  EXPECT_FALSE(p.on_frame(ext(0x542, {0x00, 0x32, 0x00, 0x00, 0x00, 0x30, 0x00, 0x00}), kT0 + 6 * kMs, unused));
+  EXPECT_GE(p.decoder().counters().foreign, 4U);
+}
+
+// A poller sharing our host id: its replies reach us without a poll of ours outstanding.
+TEST(VescPoller, RepliesWeDidNotAskForAreCountedAndCloseTheirWindow) {
+  VescPoller p = make_poller();
+  (void)poll_and_reply(p, kT0);
+  const auto s = reply(p, kT0 + 2 * kMs);  // no poll of ours
+  EXPECT_EQ(p.counters().unrequested, 1U);
+  ASSERT_TRUE(s.has_value());
+  const auto ours = poll_and_reply(p, kT0 + 5 * kMs);
+  ASSERT_TRUE(ours.has_value());
+  EXPECT_EQ(ours->t_start_ns, kT0 + 2 * kMs);  // since the read that answered the other poller
+  EXPECT_EQ(p.counters().unrequested, 1U);
+}
+
+// A read right before ours leaves (nearly) no control cycles in our window: not an average, dropped.
+TEST(VescPoller, AWindowTooShortToBeAnAverageIsDroppedAndFollowedByAGap) {
+  VescPoller p = make_poller();
+  (void)poll_and_reply(p, kT0);
+  core::AveragedSample unused;
+  EXPECT_FALSE(p.on_frame(ext(0x811, {0x42, 0x00, 0x04}), kT0 + 5'250'000, unused));
+  EXPECT_FALSE(poll_and_reply(p, kT0 + 5 * kMs).has_value());
+  EXPECT_EQ(p.counters().short_windows, 1U);
+  const auto s = poll_and_reply(p, kT0 + 10 * kMs);
+  ASSERT_TRUE(s.has_value());
+  EXPECT_TRUE(s->gap_before);
+}
+
+// A broken reply (its CRC's last byte flipped) is the decoder's crc_error; the poll then times out.
+TEST(VescPoller, ABrokenReplyIsCountedAndItsPollTimesOut) {
+  VescPoller p = make_poller();
+  (void)poll_and_reply(p, kT0);
+  p.polled(kT0 + 5 * kMs, true);
+  std::vector<can::CanFrame> frames = reply_frames();
+  frames.back().data[5] ^= 0x01;
+  core::AveragedSample unused;
+  for (const can::CanFrame& f : frames) EXPECT_FALSE(p.on_frame(f, kT0 + 5'300'000, unused));
+  p.on_time(kT0 + 8 * kMs);
+  EXPECT_EQ(p.decoder().counters().crc_error, 1U);
+  EXPECT_EQ(p.counters().timeouts, 1U);
+  DiagnosticsRows rows;
+  report_vesc_counters(p, rows);
+  EXPECT_EQ(rows.get(&diagnostics_t::can_crc_error), 1);
+  EXPECT_EQ(rows.get(&diagnostics_t::vesc_timeouts), 1);
+  EXPECT_EQ(rows.get(&diagnostics_t::vesc_polls), 2);
+  EXPECT_EQ(rows.get(&diagnostics_t::vesc_replies), 0);
+}
+
+TEST(VescPoller, AnUnsentPollIsCountedAndNotAwaited) {
+  VescPoller p = make_poller();
+  p.polled(kT0, false);
+  p.on_time(kT0 + 10 * kMs);
+  EXPECT_EQ(p.counters().send_failures, 1U);
+  EXPECT_EQ(p.counters().polls, 0U);
+  EXPECT_EQ(p.counters().timeouts, 0U);
+}
+
+}  // namespace
+}  // namespace rpem::daemon
