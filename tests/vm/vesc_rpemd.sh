@@ -4,17 +4,13 @@
 # 20 Hz from 55 s to 60 s. Outputs in $1; tests/vm/check_vesc_rpemd.py checks them on the host.
 out=${1:-/host}
 fail=0
-# Under TCG the emulated drive runs its control at 4 kHz instead of 12.5 kHz (cheaper; the averages are over
-# every control cycle either way), with a 300 Hz current loop (1 kHz is unstable at 4 kHz on this 20 µH motor).
-sed -e 's/^sample_period_s: .*/sample_period_s: 250.0e-6/' -e 's/switching_frequency_Hz: 6250/switching_frequency_Hz: 2000/' \
-  -e 's/current_bandwidth_Hz: [0-9]*/current_bandwidth_Hz: 300/' vesc-6374.yaml > vesc-6374-vm.yaml
 run() {  # name poll-rate reply-timeout
   name=$1
   sed -e "s/poll_rate_Hz: .*/poll_rate_Hz: $2/" -e "s/reply_timeout_s: [0-9.e-]*/reply_timeout_s: $3/" \
     rpemd-vesc-vcan.yaml > "/tmp/$name.yaml"
   cp vesc-6374-outrunner.yaml /tmp/
   rm -rf /tmp/rpemd-vesc
-  rpem sim --scenario vesc-6374-vm.yaml --vesc vcan0 --controller-id 17 --truth "$out/${name}_truth.csv" \
+  rpem sim --scenario vesc-6374.yaml --vesc vcan0 --controller-id 17 --truth "$out/${name}_truth.csv" \
     --duration 70 --silent-at 45 --silent-for 3 2> "$out/${name}_emulator.txt" &
   emu=$!
   rpemd --config "/tmp/$name.yaml" > "$out/${name}_rpemd.txt" 2>&1 &
