@@ -2,7 +2,7 @@
 # ctest entry `vesc_suite` (label vcan): tests/vm/vesc_suite.sh natively where the host has vcan, else in the
 # PREEMPT_RT VM, then checks its outputs on the host (tests/can/check_vesc_capture.py,
 # tests/can/check_averaged_record.py).
-#   run_vesc_suite.sh BUILD_DIR
+#   run_vesc_suite.sh BUILD_DIR [--rpemd]     (--rpemd: also rpemd's source: vesc part, tests/vm/vesc_rpemd.sh)
 set -euo pipefail
 build=$(cd "$1" && pwd)
 here=$(cd "$(dirname "$0")" && pwd)
@@ -23,7 +23,7 @@ sed -i 's|^machine: ../config/|machine: config/|' "$out/vesc-6374.yaml"
 
 # rpemd's part runs where the tree has `source: vesc` (daemon/src/vesc_source.cpp, branch vesc-12).
 rpemd_files=()
-if [[ -f $repo/daemon/src/vesc_source.cpp && -x $build/daemon/rpemd ]]; then
+if [[ ${2:-} == --rpemd && -f $repo/daemon/src/vesc_source.cpp && -x $build/daemon/rpemd ]]; then
   cp "$here/vesc_rpemd.sh" "$here/rpemd-vesc-vcan.yaml" "$out/"
   rpemd_files=(--file "$build/daemon/rpemd" --file "$here/vesc_rpemd.sh" --file "$here/rpemd-vesc-vcan.yaml"
                --file "$repo/config/vesc-6374-outrunner.yaml")
