@@ -20,7 +20,7 @@ ctest --test-dir build/ci --output-on-failure -j "$jobs" --timeout 1800
 
 cmake -S . -B build/sanitize -G Ninja -DCMAKE_BUILD_TYPE=Debug -DRPEM_WERROR=ON \
   -DRPEM_SANITIZE=address,undefined -DRPEM_BUILD_BENCHMARKS=OFF -DRPEM_BUILD_DAEMON=OFF -DRPEM_BUILD_TOOLS=OFF
-cmake --build build/sanitize -j "$jobs" --target test_core test_io test_can test_sim test_analysis \
+cmake --build build/sanitize -j "$jobs" --target test_core test_io test_can test_sim test_sim_vesc test_analysis \
   test_indep_drive indep_drive_log
 UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1 ASAN_OPTIONS=detect_leaks=1 \
   ctest --test-dir build/sanitize --output-on-failure -j "$jobs" -L unit

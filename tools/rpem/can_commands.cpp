@@ -1,5 +1,7 @@
 // rpem replay LOG.csv --can IFACE [--rate X] [--classic] …   streams a drive log as telemetry
 // rpem record --can IFACE --out LOG.csv [--duration S] …     writes received telemetry as a drive log
+// rpem record --can IFACE --averaged-out AVG.csv [--signal-map MAP.yaml | --vesc-id N] …
+//                                                          writes averaged rotor-frame samples (record_averaged.hpp)
 
 #include <algorithm>
 #include <atomic>
@@ -10,6 +12,7 @@
 
 #include "can_stream.hpp"
 #include "commands.hpp"
+#include "record_averaged.hpp"
 #include "rpem/can/decoder.hpp"
 #include "rpem/can/protocol.hpp"
 #include "rpem/core/clock.hpp"
@@ -50,16 +53,12 @@ int run_replay(const ReplayOptions& o) {
   return kExitOk;
 }
 
-struct RecordOptions {
-  std::string interface;
-  std::string out;
-  double duration_s = 0.0;
-  std::uint64_t samples = 0;
-  double idle_timeout_s = 0.0;
-  bool latency = false;
-};
-
 int run_record(const RecordOptions& o) {
+  if (!o.averaged_out.empty()) return run_record_averaged(o);
+  if (o.out.empty()) {
+    std::fprintf(stderr, "rpem record: give --out LOG.csv (native telemetry) or --averaged-out AVG.csv\n");
+    return kExitUsage;
+  }
   can::require_interface(o.interface);
   can::SocketCanChannel::Options co;
   co.interface = o.interface;
@@ -137,9 +136,22 @@ Runner add_replay_command(CLI::App& app) {
 
 Runner add_record_command(CLI::App& app) {
   auto opts = std::make_shared<RecordOptions>();
-  CLI::App* cmd = app.add_subcommand("record", "Write received rpem telemetry as a drive log");
+  CLI::App* cmd = app.add_subcommand("record", "Write what a drive sends on CAN as a drive log or an averaged log");
   cmd->add_option("--can", opts->interface, "SocketCAN interface")->required();
-  cmd->add_option("--out", opts->out, "drive-log CSV to write")->required();
+  cmd->add_option("--out", opts->out, "drive-log CSV to write (rpem's native telemetry, phase samples)");
+  cmd->add_option("--averaged-out", opts->averaged_out,
+                  "averaged rotor-frame log to write (docs/drive-log.md): from --signal-map, --vesc-id or native telemetry")
+      ->excludes("--out");
+  cmd->add_option("--signal-map", opts->signal_map, "read the drive's own frames through this map (docs/sources.md)")
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--vesc-id", opts->vesc_id, "poll this VESC (controller id) with COMM_GET_VALUES_SELECTIVE")
+      ->check(CLI::Range(0, 254))
+      ->excludes("--signal-map");
+  cmd->add_option("--host-id", opts->host_id, "VESC: the id replies are addressed to (no VESC may use it)")
+      ->check(CLI::Range(0, 254));
+  cmd->add_option("--poll-rate", opts->poll_rate_Hz, "VESC: polls per second")->check(CLI::Range(1.0, 2000.0));
+  cmd->add_option("--window-rate", opts->window_rate_Hz, "native telemetry: averaging windows per second")
+      ->check(CLI::Range(50.0, 2000.0));
   cmd->add_option("--duration", opts->duration_s, "stop after this many seconds");
   cmd->add_option("--samples", opts->samples, "stop after this many samples");
   cmd->add_option("--idle-timeout", opts->idle_timeout_s, "stop when no sample arrived for this long (after the first)");

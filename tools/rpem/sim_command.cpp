@@ -1,5 +1,6 @@
 // rpem sim --scenario FILE.yaml --out LOG.csv [--truth TRUTH.csv] [--estimate EST.csv]
 //          [--averaged-out AVG.csv --averaged-rate HZ --averaged-jitter X --averaged-seed N]
+// rpem sim --scenario FILE.yaml --vesc IFACE --controller-id N [--status-rate-1 HZ …]   (vesc_emulator.hpp)
 // Simulates the drive of a scenario and writes what the drive would log, the truth beside it and,
 // optionally, the estimator's output run in the loop, and the averaged rotor-frame samples a drive that
 // averages every control cycle would report (sim/cycle_average.hpp; docs/drive-log.md, "Averaged logs").
@@ -19,6 +20,7 @@
 #include "rpem/io/estimate_log.hpp"
 #include "rpem/sim/drive_simulator.hpp"
 #include "rpem/sim/truth_log.hpp"
+#include "vesc_emulator.hpp"
 
 namespace rpem::tools {
 namespace {
@@ -33,9 +35,15 @@ struct SimOptions {
   double averaged_jitter = 0.3;
   std::uint64_t averaged_seed = 1;
   StreamOptions stream;
+  VescEmulatorOptions vesc;
 };
 
 int run_sim(const SimOptions& o) {
+  if (!o.vesc.interface.empty()) {
+    VescEmulatorOptions vesc = o.vesc;
+    vesc.truth = o.truth;
+    return run_vesc_emulator(sim::load_scenario(o.scenario), vesc);
+  }
   sim::DriveSimulator simulator(sim::load_scenario(o.scenario));
   std::optional<io::DriveLogWriter> log;
   if (!o.out.empty()) log.emplace(o.out, simulator.layout());
@@ -109,6 +117,7 @@ Runner add_sim_command(CLI::App& app) {
       ->check(CLI::Range(0.0, 0.9));
   cmd->add_option("--averaged-seed", opts->averaged_seed, "seed of the window lengths");
   add_stream_options(cmd, opts->stream);
+  add_vesc_emulator_options(cmd, opts->vesc);
   return [cmd, opts]() { return cmd->parsed() ? run_sim(*opts) : -1; };
 }
 

@@ -1,0 +1,108 @@
+#include "rpem/sim/vesc_motor.hpp"
+
+#include <cmath>
+#include <numbers>
+
+namespace rpem::sim {
+namespace {
+
+constexpr double kRadPerSToRpm = 60.0 / (2.0 * std::numbers::pi);
+
+/// Input current from the power balance of a cycle (amplitude-invariant frame: P = 3/2·u·i).
+double input_current_A(const ControlCycle& c) noexcept {
+  return c.u_dc_V > 0.0 ? 1.5 * c.u_dq_V.dot(c.i_dq_A) / c.u_dc_V : 0.0;
+}
+
+}  // namespace
+
+VescMotor::VescMotor(Scenario scenario, Settings settings)
+    : simulator_(std::move(scenario)), settings_(settings) {}
+
+bool VescMotor::step() noexcept {
+  if (!simulator_.next(row_, truth_)) return false;
+  started_ = true;
+  if (const auto c = cycles_.add(row_)) account(*c);
+  return true;
+}
+
+bool VescMotor::advance_to(std::int64_t t_ns) noexcept {
+  while (!started_ || row_.sample.t_ns < t_ns) {
+    if (!step()) return false;
+  }
+  return true;
+}
+
+void VescMotor::account(const ControlCycle& c) noexcept {
+  last_cycle_ = c;
+  sums_.add(c);
+  const double dt_s = 1e-9 * static_cast<double>(c.end_ns - c.t_ns);
+  const double i_in = input_current_A(c);
+  last_input_current_A_ = i_in;
+  input_current_sum_A_ += i_in;
+  const double steps = 6.0 * c.omega_el_rad_s * dt_s / (2.0 * std::numbers::pi);
+  tacho_steps_ += steps;
+  tacho_abs_steps_ += std::abs(steps);
+  const double ah = std::abs(i_in) * dt_s / 3600.0;
+  (i_in >= 0.0 ? amp_hours_ : amp_hours_charged_) += ah;
+  (i_in >= 0.0 ? watt_hours_ : watt_hours_charged_) += ah * c.u_dc_V;
+}
+
+can::vesc::Values VescMotor::read_values() noexcept {
+  can::vesc::Values v;
+  const int n = sums_.cycles();
+  const double inv = n > 0 ? 1.0 / n : std::nan("");  // 0/0 as mc_interface_read_reset_avg_* divides
+  const core::AveragedSample mean = sums_.read_reset();
+  v.mask = (std::uint32_t{1} << can::vesc::kFieldCount) - 1;
+  v.i_d_A = mean.i_dq_A[0];
+  v.i_q_A = mean.i_dq_A[1];
+  v.v_d_V = mean.u_dq_V[0];
+  v.v_q_V = mean.u_dq_V[1];
+  v.current_motor_A = mean.i_dq_A[1];
+  v.current_in_A = input_current_sum_A_ * inv;
+  input_current_sum_A_ = 0.0;
+
+  // The instantaneous (filtered) values are the status broadcasts' (status() fills them all).
+  const can::vesc::Status now = status(0);
+  v.temp_fet_C = now.temp_fet_C;
+  v.temp_mos_C = {now.temp_fet_C, now.temp_fet_C, now.temp_fet_C};
+  v.temp_motor_C = now.temp_motor_C;
+  v.duty = now.duty;
+  v.erpm = now.erpm;
+  v.v_in_V = now.v_in_V;
+  v.amp_hours_Ah = now.amp_hours_Ah;
+  v.amp_hours_charged_Ah = now.amp_hours_charged_Ah;
+  v.watt_hours_Wh = now.watt_hours_Wh;
+  v.watt_hours_charged_Wh = now.watt_hours_charged_Wh;
+  v.tachometer = now.tachometer;
+  v.tachometer_abs = static_cast<std::int32_t>(tacho_abs_steps_);
+  v.fault = 0;
+  v.pid_pos_deg = now.pid_pos_deg;
+  v.controller_id = settings_.controller_id;
+  v.status_bits = 0;
+  return v;
+}
+
+can::vesc::Status VescMotor::status(int number) const noexcept {
+  can::vesc::Status s;
+  s.controller_id = settings_.controller_id;
+  s.number = number;
+  const ControlCycle& c = last_cycle_;
+  const double u_max = c.u_dc_V / std::sqrt(3.0);
+  s.erpm = row_.sample.omega_el_rad_s * kRadPerSToRpm;
+  s.current_A = c.i_dq_A[1];
+  s.duty = u_max > 0.0 ? std::copysign(c.u_dq_V.norm() / u_max, c.u_dq_V[1]) : 0.0;
+  s.amp_hours_Ah = amp_hours_;
+  s.amp_hours_charged_Ah = amp_hours_charged_;
+  s.watt_hours_Wh = watt_hours_;
+  s.watt_hours_charged_Wh = watt_hours_charged_;
+  s.temp_fet_C = settings_.temp_fet_C;
+  s.temp_motor_C = row_.t_winding_C.value_or(settings_.temp_fet_C);
+  s.current_in_A = last_input_current_A_;
+  s.pid_pos_deg = std::remainder(row_.sample.theta_el_rad, 2.0 * std::numbers::pi) * 180.0 / std::numbers::pi;
+  s.tachometer = static_cast<std::int32_t>(tacho_steps_);
+  s.v_in_V = row_.sample.u_dc_V;
+  s.adc_V = {0.0, 0.0, 0.0, 0.0};
+  return s;
+}
+
+}  // namespace rpem::sim

@@ -1,0 +1,90 @@
+#!/usr/bin/env python3
+"""Checks rpemd (source: vesc) against the emulated VESC (tests/vm/vesc_rpemd.sh), run NAME in DIR:
+
+- it starts off the truth (the datasheet configuration; the plant is +6 % ψm, -8 % R_s) and converges:
+  ψm within 1 % of the plant's at the end of the speed phases 20-32 s and 40-52 s (the latter after the
+  emulator's silence), R_s within 3 % at the end of the standstill phase 32-40 s (where the scheduler lets
+  R_s adapt);
+- it publishes magnet and winding temperatures (finite; not compared with the plant's: they follow from the
+  configuration's reference values, which are off the plant's on purpose);
+- it survives the silence 45-48 s: estimates keep coming and its sample count grows again after it;
+- it counts the second poller (cangen from 55 s to 60 s) stealing its averages.
+
+  check_vesc_rpemd.py DIR NAME
+"""
+import bisect
+import csv
+import math
+import re
+import sys
+
+
+def main():
+    d, name = sys.argv[1], sys.argv[2]
+    emu = open('%s/%s_emulator.txt' % (d, name)).read()
+    t0 = float(re.search(r't = 0 at CLOCK_REALTIME ([0-9.]+) s', emu).group(1))
+    truth = [{k: float(v) for k, v in r.items()} for r in csv.DictReader(open('%s/%s_truth.csv' % (d, name)))]
+    tt = [r['t'] for r in truth]
+    est = [{k: float(v) for k, v in r.items()} for r in csv.DictReader(open('%s/%s_est.csv' % (d, name)))]
+    for e in est:
+        e['te'] = e['utime'] * 1e-6 - t0
+    errors = []
+
+    def truth_at(t):
+        return truth[min(bisect.bisect_left(tt, t), len(truth) - 1)]
+
+    def window(a, b):
+        return [e for e in est if a <= e['te'] < b]
+
+    def rel(e, key):
+        tr = truth_at(e['te'])[key]
+        return (e[key] - tr) / tr
+
+    if not est:
+        sys.exit('check_vesc_rpemd %s: no estimates' % name)
+    first = est[0]
+    if abs(rel(first, 'psi_m')) < 0.03:
+        errors.append('the first estimate is already at the truth: ψm %+.2f %%' % (100 * rel(first, 'psi_m')))
+    report = []
+    for a, b in ((30.0, 32.0), (50.0, 52.0)):
+        w = window(a, b)
+        if not w:
+            errors.append('no estimates in %g-%g s' % (a, b))
+            continue
+        worst = max(abs(rel(e, 'psi_m')) for e in w)
+        report.append('ψm %g-%g s: worst %.2f %%' % (a, b, 100 * worst))
+        if worst > 0.01:
+            errors.append('ψm off by %.2f %% in %g-%g s' % (100 * worst, a, b))
+    w = window(38.0, 40.0)
+    if w:
+        worst = max(abs(rel(e, 'r_s')) for e in w)
+        report.append('R_s 38-40 s: worst %.2f %%' % (100 * worst))
+        if worst > 0.03:
+            errors.append('R_s off by %.2f %% in 38-40 s' % (100 * worst))
+    else:
+        errors.append('no estimates in 38-40 s')
+    late = window(40.0, 70.0)
+    for key, tkey in (('T_magnet', 'T_magnet'), ('T_winding', 'T_winding')):
+        bad = [e for e in late if not math.isfinite(e[key])]
+        if bad or not late:
+            errors.append('%s not published (%d of %d estimates not finite)' % (key, len(bad), len(late)))
+        elif late:
+            report.append('%s %.1f C (plant %.1f C)' % (key, late[-1][key], truth_at(late[-1]['te'])[tkey]))
+    before = window(40.0, 45.0)
+    after = window(49.0, 54.0)
+    if not before or not after or after[-1]['samples'] <= before[-1]['samples']:
+        errors.append('no new samples after the silence')
+    text = open('%s/%s_listen.txt' % (d, name)).read() + open('%s/%s_rpemd.txt' % (d, name)).read()
+    stolen = [int(x) for x in re.findall(r'stolen[_ a-z]*[=: ]+(\d+)', text)]
+    report.append('stolen reads counted: %s' % (max(stolen) if stolen else 'none'))
+    if not stolen or max(stolen) == 0:
+        errors.append('the second poller was not counted')
+    print('check_vesc_rpemd %s: %d estimates; %s' % (name, len(est), '; '.join(report)))
+    if errors:
+        print('check_vesc_rpemd %s: FAILED\n  %s' % (name, '\n  '.join(errors)))
+        sys.exit(1)
+    print('check_vesc_rpemd %s: passed' % name)
+
+
+if __name__ == '__main__':
+    main()
