@@ -279,34 +279,6 @@ Selection select_effects(const EffectFitter& fitter, const SelectionOptions& opt
       if (c.gain_pct < options.min_gain_pct || c.p_value > options.max_p || before * before - after * after < min_change2) return false;
       return !(c.effect.row->negligible && c.effect.row->negligible(c.effect, fitted[i].model(context), context));
     };
-    // On averaged steady-state rows the model's own error (a window across a transient, the averages of a
-    // nonlinear machine) is not in the noise floor, and an effect that bends an inductance can take what a
-    // constant the excitation pins down, but whose interval that error had widened at the baseline, would
-    // take: there a candidate is named only if it beats the model with those constants freed instead.
-    std::optional<BlockScores> freed;
-    auto a_constant_instead = [&](std::size_t i) -> std::optional<std::string> {
-      if (fitter.replay().log().mode != ModelMode::kSteadyState) return std::nullopt;
-      EffectSet trial = sel.model;
-      std::string names;
-      for (std::size_t k = 0; k < kCalibrated.size(); ++k) {
-        if (trial.calibrated[k] || !admissible[k]) continue;
-        trial.calibrated[k] = true;
-        names += (names.empty() ? "" : ", ") + std::string(kCalibrated[k]);
-      }
-      if (names.empty()) return std::nullopt;
-      if (!freed) freed = fitter.heldout(fitter.fit(trial));
-      const double gain = gain_pct(*freed, scores[i]);
-      const double p = signed_rank_p(block_log_ratios(*freed, scores[i]));
-      if (gain >= options.min_gain_pct && p <= options.max_p) return std::nullopt;
-      char text[400];
-      std::snprintf(text, sizeof text,
-                    "%s lowers the held-out residual by %.1f %%, but no more than fitting the constant%s %s instead "
-                    "(%.1f %% better than that, p = %.2g): on these averaged steady-state rows the effect is not told "
-                    "from the constant's error",
-                    round[i].effect.label().c_str(), round[i].gain_pct, names.find(',') == std::string::npos ? "" : "s",
-                    names.c_str(), gain, p);
-      return std::string(text);
-    };
     for (std::size_t i : ranked) {
       const CandidateScore& c = round[i];
       if (!passes(i)) continue;  // the best that passes: each is tested on its own
@@ -318,9 +290,7 @@ Selection select_effects(const EffectFitter& fitter, const SelectionOptions& opt
         why = c.effect.row->judge(c.effect, m, context, ci.effect_half_width.back());
       }
       if (!why) {
-        std::optional<std::string> lost = takes_a_constant(fitter, sel.model, fitted[i], c, noise_floor_A);
-        if (!lost) lost = a_constant_instead(i);
-        if (lost) {
+        if (const std::optional<std::string> lost = takes_a_constant(fitter, sel.model, fitted[i], c, noise_floor_A)) {
           sel.not_identifiable.push_back({{c.effect.label()}, *lost});
           excluded.push_back(c.effect);
           set_aside = true;
