@@ -41,6 +41,20 @@ Estimates read_estimates(const std::string& path, double t_rs) {
 std::string rpem() { return test::binary_dir() + "/tools/rpem"; }
 std::string config() { return test::source_dir() + "/config/paper-ipmsm.yaml"; }
 
+/// Every constant the diagnosis lists as identifiable has a cluster-robust 95 % interval within ±10 % of its
+/// value (the identifiability rule, docs/diagnose.md), so positive.
+void expect_identifiable_intervals_narrow(const nlohmann::json& d) {
+  const nlohmann::json& c = d["calibration"];
+  for (const auto& name : c["identifiable"]) {
+    const std::string key = name.get<std::string>();
+    const double v = c[key];
+    ASSERT_TRUE(c[key + "_ci95"].is_array()) << key << "\n" << c.dump(2);
+    const double lo = c[key + "_ci95"][0], hi = c[key + "_ci95"][1];
+    EXPECT_GT(lo, 0.9 * v) << key << "\n" << c.dump(2);
+    EXPECT_LT(hi, 1.1 * v) << key << "\n" << c.dump(2);
+  }
+}
+
 class CliAveraged : public ::testing::TestWithParam<int> {};
 
 TEST_P(CliAveraged, EstimateRecoversTheIndependentGeneratorsMachine) {
@@ -111,6 +125,10 @@ TEST(CliAveragedDiagnose, FindsAMagnetDriftHiddenInAnAveragedLog) {
   // 0.14 A held out on this log); what is left is the drift's own part.
   EXPECT_GT(d["effects"][0]["gain_pct"].get<double>(), 10.0);
   EXPECT_LT(d["calibration"]["heldout_rms"].get<double>(), 0.5 * d["baseline"]["heldout_rms"].get<double>());
+  // Nothing else: an L_d curve that trades against the calibrated L_d (10 % held-out gain on these rows) is
+  // not named, and L_d is listed identifiable only with a narrow interval.
+  EXPECT_EQ(d["effects"].size(), 1U) << d["effects"].dump(2);
+  expect_identifiable_intervals_narrow(d);
 
   // The transient replay needs phase samples: refused, naming the log.
   const test::ProcessResult t = test::run_command(rpem() + " diagnose --log " + avg.path() + " --config " + config() +

@@ -158,7 +158,8 @@ void write_diagnosis_json(const std::string& path, const Diagnosis& d, const std
   out["estimates_method"] = d.estimates.method;
   out["not_identifiable"] = nlohmann::json::array();
   for (const Unidentifiable& u : s.not_identifiable) out["not_identifiable"].push_back({{"effects", u.effects}, {"reason", u.reason}});
-  for (const auto& [key, list] : {std::pair{"implausible", &s.implausible}, std::pair{"negligible", &s.negligible}}) {
+  for (const auto& [key, list] : {std::pair{"implausible", &s.implausible}, std::pair{"negligible", &s.negligible},
+                                 std::pair{"withdrawn", &s.withdrawn}}) {
     out[key] = nlohmann::json::array();
     for (const ImplausibleEffect& i : *list) {
       out[key].push_back({{"effect", i.effect.label()},
@@ -178,6 +179,8 @@ void write_diagnosis_json(const std::string& path, const Diagnosis& d, const std
         cj["gain_pct"] = c.gain_pct;
         cj["p_value"] = c.p_value;
         cj["heldout_block_log_ratios"] = c.block_log_ratio;
+        cj["scaled_start"] = c.start;
+        cj["scaled_parameters"] = c.parameters;
       }
       r.push_back(cj);
     }

@@ -77,6 +77,15 @@ void summary(ReportDocument& doc, const Diagnosis& d, const std::string& config_
     doc.paragraph("Physically implausible, not named:");
     doc.bullets(items);
   }
+  if (!s.withdrawn.empty()) {
+    std::vector<std::string> items;
+    for (const ImplausibleEffect& i : s.withdrawn) {
+      items.push_back("`" + i.effect.label() + "` (" + parameters_text(i.parameters) + ") is not named: " + i.why.reason +
+                      "; " + i.why.more_likely + ".");
+    }
+    doc.paragraph("Withdrawn by the backward step:");
+    doc.bullets(items);
+  }
   if (!s.not_identifiable.empty()) {
     std::vector<std::string> items;
     for (const Unidentifiable& u : s.not_identifiable) {

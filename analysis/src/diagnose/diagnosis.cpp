@@ -61,40 +61,6 @@ std::vector<EstimatorCheck> check_estimator(const Diagnosis& d, std::vector<bool
   return checks;
 }
 
-/// Whether the fitted constant i is identified: its cluster-robust interval narrow, away from the bound.
-bool identified(const EffectSet& set, const CalibrationIntervals& ci, std::size_t i) {
-  return ci.half_width[i] <= kIdentifiedHalfWidth && std::abs(set.calibration[i]) < 0.99 * kCalibrationBound;
-}
-
-/// Constants the excitation pins down but that the uncalibrated effects had pushed away at the start get
-/// another chance with the effects found: freed, the final model refitted, and kept where they are now
-/// identified and the held-out residual is no worse.
-void readmit_constants(const EffectFitter& fitter, double floor, const CalibrationIntervals& excitation, Diagnosis& d) {
-  EffectSet trial = d.selection.model;
-  std::vector<std::size_t> readmitted;
-  for (std::size_t i = 0; i < kCalibrated.size(); ++i) {
-    if (trial.calibrated[i] || excitation.excitation_half_width[i] > kIdentifiableHalfWidth) continue;
-    trial.calibrated[i] = true;
-    readmitted.push_back(i);
-  }
-  if (readmitted.empty()) return;
-  trial = fitter.fit(trial);
-  const CalibrationIntervals ci = fitter.intervals(trial, floor);
-  bool all = true;
-  for (std::size_t i : readmitted) {
-    if (identified(trial, ci, i)) continue;
-    trial.calibrated[i] = false;
-    trial.calibration[i] = 0.0;
-    all = false;
-  }
-  if (!all) trial = fitter.fit(trial);
-  const double heldout = rms(fitter.heldout(trial));
-  if (heldout > d.selection.extended_heldout_rms_A) return;
-  for (std::size_t i : readmitted) d.calibration.identifiable[i] = trial.calibrated[i];
-  d.selection.model = trial;
-  d.selection.extended_heldout_rms_A = heldout;
-}
-
 /// An effect that the readmitted constants leave physically negligible was standing in for them: it is
 /// taken out of the named effects and the model refitted.
 void prune_negligible(const EffectFitter& fitter, Diagnosis& d) {
@@ -180,8 +146,9 @@ Diagnosis diagnose(LogData log, const io::MachineConfig& config, const DiagnoseO
   }
   d.calibration.heldout_rms_A = rms(fitter.heldout(start));
 
-  d.selection = select_effects(fitter, options.selection, start, floor);
-  readmit_constants(fitter, floor, excitation, d);
+  std::array<bool, kCalibrated.size()> admissible{};
+  for (std::size_t i = 0; i < kCalibrated.size(); ++i) admissible[i] = excitation.excitation_half_width[i] <= kIdentifiableHalfWidth;
+  d.selection = select_effects(fitter, options.selection, start, floor, admissible);
   prune_negligible(fitter, d);
   // A drift law found brings the constant it is referred to (EffectRow::frees_constant).
   for (std::size_t i = 0; i < kCalibrated.size(); ++i) d.calibration.identifiable[i] = d.selection.model.calibrated[i];

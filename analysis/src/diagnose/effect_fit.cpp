@@ -5,6 +5,7 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace rpem::analysis {
 namespace {
@@ -120,6 +121,10 @@ Eigen::VectorXd bounded_step(const std::vector<std::vector<double>>& columns, co
 
 }  // namespace
 
+bool identified(const EffectSet& set, const CalibrationIntervals& ci, std::size_t i) {
+  return ci.half_width[i] <= kIdentifiedHalfWidth && std::abs(set.calibration[i]) < 0.99 * kCalibrationBound;
+}
+
 ExtendedModel EffectSet::model(const EffectContext& c) const {
   ExtendedModel m = c.base;
   for (std::size_t i = 0; i < kCalibrated.size(); ++i) {
@@ -219,6 +224,20 @@ ScreenBasis EffectFitter::screen_basis(const EffectSet& base) const {
     moved.calibration[i] += kStep;
     b.columns.push_back(column(moved, b.r0, kStep));
   }
+  // The effects already in the model move with the candidate too: an effect fitted without the one still
+  // missing has taken part of its residual (a dead time fitted without the command delay), and a screening
+  // that held it fixed would credit the missing effect with only what is left (a parameter its bounds pin,
+  // width below kStep, stays where it is).
+  for (std::size_t j = 0; j < base.effects.size(); ++j) {
+    for (std::size_t i = 0; i < base.parameters[j].size(); ++i) {
+      const auto [lo, hi] = parameter_bounds(base.effects[j], context_, static_cast<int>(i));
+      if (hi - lo < kStep) continue;
+      EffectSet moved = base;
+      const double h = hi >= base.parameters[j][i] + kStep ? kStep : -kStep;
+      moved.parameters[j][i] += h;
+      b.columns.push_back(column(moved, b.r0, h));
+    }
+  }
   if (!b.columns.empty()) b.explained = -step_change(b.columns, b.r0, gauss_newton_step(b.columns, b.r0));
   return b;
 }
@@ -260,16 +279,30 @@ std::pair<std::vector<double>, double> EffectFitter::best_start(const ScreenBasi
   const std::vector<std::vector<double>> starts =
       candidate.row->starts.empty() ? std::vector<std::vector<double>>{std::vector<double>(static_cast<std::size_t>(candidate.row->parameters), 0.0)}
                                     : candidate.row->starts;
-  std::pair<std::vector<double>, double> best{starts.front(), -1.0};
+  // The starts are a grid over a residual that is not convex in the candidate's parameters: each is judged
+  // by the training sum of squares at that point, with the calibrated constants and the effects already
+  // found moved to their best (the basis' linear step) — not by the candidate's own first step, which
+  // from a point far from the answer extrapolates (a delay's step from 0 runs to its bound).
+  std::vector<double> best;
+  double best_ssr = std::numeric_limits<double>::infinity();
+  std::vector<double> r;
   for (std::vector<double> s : starts) {
     for (std::size_t i = 0; i < s.size(); ++i) {
       const auto [lo, hi] = parameter_bounds(candidate, context_, static_cast<int>(i));
       s[i] = std::clamp(s[i], lo, hi);
     }
-    const double gain = screen(basis, base, candidate, s);
-    if (gain > best.second) best = {s, gain};
+    double ssr = 0.0;
+    if (starts.size() > 1) {
+      training_residuals(base.with(candidate, context_, s), r);
+      ssr = dot(r, r);
+      if (!basis.columns.empty()) ssr += step_change(basis.columns, r, gauss_newton_step(basis.columns, r));
+    }
+    if (ssr < best_ssr) {
+      best_ssr = ssr;
+      best = s;
+    }
   }
-  return best;
+  return {best, screen(basis, base, candidate, best)};
 }
 
 EffectSet EffectFitter::fit(const EffectSet& start, double* training_ssr) const {

@@ -6,6 +6,8 @@
 #include <cstdio>
 #include <functional>
 #include <numeric>
+#include <optional>
+#include <string>
 #include <thread>
 #include <tuple>
 
@@ -47,6 +49,80 @@ double change_correlation(const EffectFitter& f, const EffectSet& base, const Ef
   return aa > 0.0 && bb > 0.0 ? ab / std::sqrt(aa * bb) : 0.0;
 }
 
+/// An effect whose parameters trade against a calibrated constant the model had identified — with it, the
+/// constant's cluster-robust interval is wider than kIdentifiedHalfWidth — is told from that constant by
+/// nothing in this log: what it lowers the residual by is the model's and the data's error the constant's
+/// freedom already had (an L_d curve on averaged steady-state rows at nearly one d current). The reason,
+/// or nothing when it keeps every constant identified (the constant its law is referred to excepted: a
+/// drift law takes that one's place by design).
+std::optional<std::string> takes_a_constant(const EffectFitter& fitter, const EffectSet& before, const EffectSet& with,
+                                            const CandidateScore& c, double noise_floor_A) {
+  std::optional<CalibrationIntervals> ci_before, ci_with;
+  for (std::size_t k = 0; k < kCalibrated.size(); ++k) {
+    if (!before.calibrated[k] || static_cast<int>(k) == c.effect.row->frees_constant) continue;
+    if (!ci_with) ci_with = fitter.intervals(with, noise_floor_A);
+    if (identified(with, *ci_with, k)) continue;
+    if (!ci_before) ci_before = fitter.intervals(before, noise_floor_A);
+    if (!identified(before, *ci_before, k)) continue;
+    char text[400];
+    std::snprintf(text, sizeof text,
+                  "%s lowers the held-out residual by %.1f %% (p = %.2g), but with it the calibrated %s is no longer "
+                  "identified (95 %% interval ±%.0f %%, ±%.1f %% without it): the log cannot tell the effect from that "
+                  "constant; operation that moves the effect's variable at fixed other conditions would separate them",
+                  c.effect.label().c_str(), c.gain_pct, c.p_value, kCalibrated[k], 100.0 * ci_with->half_width[k],
+                  100.0 * ci_before->half_width[k]);
+    return std::string(text);
+  }
+  return std::nullopt;
+}
+
+/// The backward step: an effect named earlier that, with the effects found since, no longer passes the
+/// acceptance tests against the model without it (refitted) had stood in for one of them — a cross-
+/// coupling taking the voltage rotation of a command delay the round before the delay's fit found it —
+/// and is withdrawn (reported, never named, and not a candidate again). The least useful goes first, one
+/// at a time, each time against the model refitted without the ones withdrawn before.
+void withdraw_explained(const EffectFitter& fitter, const SelectionOptions& options, double min_change2, Selection& sel,
+                        BlockScores& current, std::vector<Effect>& excluded) {
+  const EffectContext& context = fitter.context();
+  while (sel.found.size() >= 2) {
+    std::size_t weakest = sel.found.size();
+    double weakest_gain = 0.0;
+    EffectSet weakest_model;
+    BlockScores weakest_scores;
+    // The last one found has just passed these tests against the model without it.
+    for (std::size_t j = 0; j + 1 < sel.found.size(); ++j) {
+      const EffectSet without = fitter.fit(sel.model.without(sel.found[j].effect));
+      const BlockScores scores = fitter.heldout(without);
+      const double gain = gain_pct(scores, current);
+      const double p = signed_rank_p(block_log_ratios(scores, current));
+      const double change2 = rms(scores) * rms(scores) - rms(current) * rms(current);
+      if (gain >= options.min_gain_pct && p <= options.max_p && change2 >= min_change2) continue;
+      if (weakest == sel.found.size() || gain < weakest_gain) {
+        weakest = j;
+        weakest_gain = gain;
+        weakest_model = without;
+        weakest_scores = scores;
+      }
+    }
+    if (weakest == sel.found.size()) return;
+    const FoundEffect& f = sel.found[weakest];
+    const ExtendedModel m = sel.model.model(context);
+    std::string later;
+    for (std::size_t j = weakest + 1; j < sel.found.size(); ++j) later += (later.empty() ? "" : ", ") + sel.found[j].effect.label();
+    char reason[320];
+    std::snprintf(reason, sizeof reason,
+                  "found first (held-out gain %.1f %%), but with %s found later it no longer lowers the held-out "
+                  "residual significantly (%.1f %% against the model refitted without it)",
+                  f.gain_pct, later.c_str(), weakest_gain);
+    sel.withdrawn.push_back({f.effect, f.effect.row->describe(f.effect, m, context), f.gain_pct,
+                             {reason, "what " + later + " explain; it had stood in for it"}});
+    excluded.push_back(f.effect);
+    sel.found.erase(sel.found.begin() + static_cast<std::ptrdiff_t>(weakest));
+    sel.model = weakest_model;
+    current = weakest_scores;
+  }
+}
+
 }  // namespace
 
 double rms(const BlockScores& b) { return b.samples ? std::sqrt(b.total() / static_cast<double>(b.samples)) : 0.0; }
@@ -86,8 +162,39 @@ double signed_rank_p(const std::vector<double>& values) {
   return tail / std::pow(2.0, static_cast<double>(n));
 }
 
+bool readmit_constants(const EffectFitter& fitter, double noise_floor_A, const std::array<bool, kCalibrated.size()>& admissible,
+                       EffectSet& model, BlockScores& scores) {
+  EffectSet trial = model;
+  std::vector<std::size_t> readmitted;
+  for (std::size_t i = 0; i < kCalibrated.size(); ++i) {
+    if (trial.calibrated[i] || !admissible[i]) continue;
+    trial.calibrated[i] = true;
+    readmitted.push_back(i);
+  }
+  if (readmitted.empty()) return false;
+  trial = fitter.fit(trial);
+  const CalibrationIntervals ci = fitter.intervals(trial, noise_floor_A);
+  bool all = true, any = false;
+  for (std::size_t i : readmitted) {
+    if (identified(trial, ci, i)) {
+      any = true;
+      continue;
+    }
+    trial.calibrated[i] = false;
+    trial.calibration[i] = 0.0;
+    all = false;
+  }
+  if (!any) return false;
+  if (!all) trial = fitter.fit(trial);
+  const BlockScores trial_scores = fitter.heldout(trial);
+  if (rms(trial_scores) > rms(scores)) return false;
+  model = trial;
+  scores = trial_scores;
+  return true;
+}
+
 Selection select_effects(const EffectFitter& fitter, const SelectionOptions& options, const EffectSet& start,
-                         double noise_floor_A) {
+                         double noise_floor_A, const std::array<bool, kCalibrated.size()>& admissible) {
   Selection sel;
   sel.model = start;
   const EffectContext& context = fitter.context();
@@ -153,6 +260,7 @@ Selection select_effects(const EffectFitter& fitter, const SelectionOptions& opt
       round[i].gain_pct = gain_pct(current, scores[i]);
       round[i].block_log_ratio = block_log_ratios(current, scores[i]);
       round[i].p_value = signed_rank_p(round[i].block_log_ratio);
+      round[i].start = starts[i];
       round[i].parameters = fitted[i].parameters.back();
       ranked.push_back(i);
     }
@@ -182,6 +290,12 @@ Selection select_effects(const EffectFitter& fitter, const SelectionOptions& opt
         why = c.effect.row->judge(c.effect, m, context, ci.effect_half_width.back());
       }
       if (!why) {
+        if (const std::optional<std::string> lost = takes_a_constant(fitter, sel.model, fitted[i], c, noise_floor_A)) {
+          sel.not_identifiable.push_back({{c.effect.label()}, *lost});
+          excluded.push_back(c.effect);
+          set_aside = true;
+          continue;
+        }
         best = i;
         break;
       }
@@ -232,6 +346,8 @@ Selection select_effects(const EffectFitter& fitter, const SelectionOptions& opt
     sel.found.push_back({winner.effect, rms(current), rms(scores[best]), winner.gain_pct, winner.p_value});
     sel.model = fitted[best];
     current = scores[best];
+    withdraw_explained(fitter, options, min_change2, sel, current, excluded);
+    readmit_constants(fitter, noise_floor_A, admissible, sel.model, current);
   }
   if (!stand_ins.empty()) {
     EffectSet named = sel.model;
@@ -239,6 +355,7 @@ Selection select_effects(const EffectFitter& fitter, const SelectionOptions& opt
     sel.model = named.effects.empty() ? start : fitter.fit(named);
     current = fitter.heldout(sel.model);
   }
+  readmit_constants(fitter, noise_floor_A, admissible, sel.model, current);
   sel.extended_heldout_rms_A = rms(current);
   for (const Unidentifiable& u : unobservable(context)) sel.not_identifiable.push_back(u);
   return sel;

@@ -24,13 +24,6 @@ struct DiagnoseOptions {
   SelectionOptions selection;
 };
 
-/// A calibrated constant is identifiable when the log's excitation alone (its noise floor and the
-/// replay's sensitivity to the constant) pins it within this relative 95 % half-width …
-inline constexpr double kIdentifiableHalfWidth = 0.01;
-/// … and its fit to the calibrated baseline is pinned within this one by the cluster-robust interval
-/// (which the model's own errors widen), away from the ±50 % bound.
-inline constexpr double kIdentifiedHalfWidth = 0.1;
-
 /// The calibrated baseline (docs/diagnose.md, "The calibrated baseline"), kCalibrated order.
 struct Calibration {
   std::array<double, kCalibrated.size()> configured{};  ///< the configuration's (ψm, R_s at the log's mean temperature under a drift law)

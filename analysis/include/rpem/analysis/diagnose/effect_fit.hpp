@@ -3,8 +3,9 @@
 // minimise the training blocks' squared residuals of the replay (nonlinear least squares, Ceres, forward
 // differences through the replay of the training blocks); the held-out blocks judge the result.
 // Screening ranks candidates cheaply by the first Gauss–Newton step: the reduction r₀ᵀJ(JᵀJ)⁻¹Jᵀr₀ of
-// the training sum of squares it predicts, with the calibrated constants' columns in J, so that what
-// the calibration already explains is not credited to a candidate.
+// the training sum of squares it predicts, with the columns of the calibrated constants and of the effects
+// already in the model in J, so that what they already explain is not credited to a candidate, and what
+// they took of the candidate's residual while it was missing is.
 
 #include <array>
 #include <vector>
@@ -45,10 +46,21 @@ struct CalibrationIntervals {
   std::vector<std::vector<double>> effect_half_width;
 };
 
+/// A calibrated constant is identifiable when the log's excitation alone (its noise floor and the
+/// replay's sensitivity to the constant) pins it within this relative 95 % half-width …
+inline constexpr double kIdentifiableHalfWidth = 0.01;
+/// … and its fit is pinned within this one by the cluster-robust interval (which the model's own errors
+/// widen), away from the ±50 % bound — at the calibrated baseline and with every effect named.
+inline constexpr double kIdentifiedHalfWidth = 0.1;
+
+/// Whether the fitted constant i (kCalibrated order) of `set` is identified by these intervals.
+[[nodiscard]] bool identified(const EffectSet& set, const CalibrationIntervals& ci, std::size_t i);
+
 /// What the screening of one round shares: the starting residuals and the calibration's columns.
 struct ScreenBasis {
   std::vector<double> r0;
-  std::vector<std::vector<double>> columns;  ///< Jacobian columns of the free calibrated constants
+  /// Jacobian columns of the free calibrated constants and of the parameters of the effects in the model
+  std::vector<std::vector<double>> columns;
   double explained = 0.0;                    ///< what those columns alone would remove [A²]
 };
 
@@ -64,7 +76,8 @@ class EffectFitter {
   /// Training sum of squares `base` would lose, to first order, by adding `candidate` at `start`.
   [[nodiscard]] double screen(const ScreenBasis& basis, const EffectSet& base, const Effect& candidate,
                               const std::vector<double>& start) const;
-  /// The candidate's best start (of its row's starts) and what the screening credits it with.
+  /// The candidate's best start (of its row's starts: the lowest training sum of squares there, the basis'
+  /// constants and effects moved to their best) and what the screening credits it with from there.
   [[nodiscard]] std::pair<std::vector<double>, double> best_start(const ScreenBasis& basis, const EffectSet& base,
                                                                   const Effect& candidate) const;
 

@@ -10,7 +10,9 @@
 // little, is not named as an effect. Candidates that explain the same residual equally well and in the
 // same way are reported together as not identifiable instead of one of them being guessed; the best of
 // them stays in the model, unnamed, for the rest of the selection, so that no later candidate is named
-// for that residual either, and is taken out of the final model.
+// for that residual either, and is taken out of the final model. After each effect found, a backward step
+// withdraws an effect named earlier that no longer passes the same tests against the model refitted
+// without it (it had stood in for one found later).
 
 #include <string>
 #include <vector>
@@ -46,7 +48,8 @@ struct CandidateScore {
   bool fitted = false;
   double gain_pct = 0.0;          ///< held-out RMS gain over the round's starting model
   double p_value = 1.0;           ///< signed-rank test of the held-out block improvements
-  std::vector<double> parameters;
+  std::vector<double> start;       ///< the screening's best start (scaled, the catalogue's units)
+  std::vector<double> parameters;  ///< fitted (scaled)
   std::vector<double> block_log_ratio;  ///< ln(SSR before / SSR after) per held-out block
 };
 
@@ -73,15 +76,25 @@ struct Selection {
   std::vector<ImplausibleEffect> implausible;
   /// Found, then negligible once the calibrated constants were refitted with the effects (diagnosis.cpp).
   std::vector<ImplausibleEffect> negligible;
+  /// Found, then withdrawn: with the effects found after it, it no longer passed the acceptance tests
+  /// against the model without it (the backward step after each effect found).
+  std::vector<ImplausibleEffect> withdrawn;
   std::vector<std::vector<CandidateScore>> rounds;
   double start_heldout_rms_A = 0.0;     ///< the model selection started from (the calibrated baseline)
   double extended_heldout_rms_A = 0.0;
 };
 
 /// `start`: the calibrated baseline (its calibrated constants stay free in every fit); `noise_floor_A`:
-/// the log's (verdict.hpp).
+/// the log's (verdict.hpp); `admissible`: the constants the log's excitation pins down (kCalibrated order)
+/// — one the baseline could not calibrate (the model's errors widened its interval) is readmitted after
+/// each effect found, where it is then identified and the held-out residual no worse.
 [[nodiscard]] Selection select_effects(const EffectFitter& fitter, const SelectionOptions& options, const EffectSet& start,
-                                       double noise_floor_A);
+                                       double noise_floor_A, const std::array<bool, kCalibrated.size()>& admissible);
+
+/// Frees the admissible constants `model` does not calibrate, refits, and keeps those then identified if
+/// the held-out residual (`scores`, updated) is no worse; whether any was kept.
+bool readmit_constants(const EffectFitter& fitter, double noise_floor_A, const std::array<bool, kCalibrated.size()>& admissible,
+                       EffectSet& model, BlockScores& scores);
 
 /// Held-out RMS of block scores [A].
 [[nodiscard]] double rms(const BlockScores& b);
