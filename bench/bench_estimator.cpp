@@ -56,24 +56,22 @@ const std::vector<core::EstimatorSample>& conditioned() {
   return c;
 }
 
-/// Replays the samples endlessly: each pass continues the time line.
+/// Replays the samples endlessly: each pass continues the time line. Hands out its own copy by
+/// reference, as the kernel's replay does (a per-sample copy would be timed with the step).
 class Replay {
  public:
   const core::DriveSample& next() noexcept {
-    const auto& s = samples();
-    sample_ = s[k_];
-    sample_.t_ns += t_offset_;
-    if (++k_ == s.size()) {
+    if (k_ == samples_.size()) {  // the next pass, later by one pass
       k_ = 0;
-      t_offset_ += s.back().t_ns + 125'000;
+      const std::int64_t pass_ns = samples_.back().t_ns - samples_.front().t_ns + 125'000;
+      for (core::DriveSample& s : samples_) s.t_ns += pass_ns;
     }
-    return sample_;
+    return samples_[k_++];
   }
 
  private:
-  core::DriveSample sample_;
+  std::vector<core::DriveSample> samples_ = samples();
   std::size_t k_ = 0;
-  std::int64_t t_offset_ = 0;
 };
 
 /// The kernel over the conditioned samples; after the first pass it starts each pass where it is.
@@ -114,6 +112,26 @@ void BM_EstimatorStep(benchmark::State& state) {
   state.SetItemsProcessed(state.iterations());
 }
 
+/// The two halves of DriveEstimator::step alone (SGA, steady-state gradients): the conditioner on the
+/// SI samples, and RpemEstimator::step on the conditioned ones.
+void BM_ConditionerAlone(benchmark::State& state) {
+  core::SampleConditioner conditioner(test::paper_base(), test::paper_machine_pu(), core::ModelExtensions{});
+  Replay replay;
+  for (auto _ : state) benchmark::DoNotOptimize(conditioner.condition(replay.next()));
+  state.SetItemsProcessed(state.iterations());
+}
+
+void BM_CoreStepAlone(benchmark::State& state) {
+  core::RpemEstimator est(test::paper_config(core::Algorithm::kSga));
+  const auto& c = conditioned();
+  std::size_t k = 0;
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(est.step(c[k]));
+    if (++k == c.size()) k = 1;  // the first sample synchronises
+  }
+  state.SetItemsProcessed(state.iterations());
+}
+
 void BM_SgaKernel(benchmark::State& state) {
   (void)conditioned();
   KernelReplay kernel;
@@ -148,6 +166,9 @@ void BM_StepOverKernel(benchmark::State& state) {
 }
 
 BENCHMARK(BM_StepOverKernel)->MinTime(1.0)->Repetitions(10)->ComputeStatistics("max", max_of)->ReportAggregatesOnly(true);
+
+BENCHMARK(BM_ConditionerAlone)->Repetitions(10)->ComputeStatistics("max", max_of)->ReportAggregatesOnly(true);
+BENCHMARK(BM_CoreStepAlone)->Repetitions(10)->ComputeStatistics("max", max_of)->ReportAggregatesOnly(true);
 
 BENCHMARK(BM_SgaKernel)->Repetitions(10)->ComputeStatistics("max", max_of)->ReportAggregatesOnly(true);
 

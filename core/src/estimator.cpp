@@ -95,6 +95,7 @@ void RpemEstimator::synchronize(const EstimatorSample& sample, const MachinePu& 
 
 Mat2 RpemEstimator::select_gradient(const MachinePu& model, double n_pu) const noexcept {
   const Mat2 steady = steady_state_gradients(model, n_pu, state_.predictor.i_hat_pu);
+  if (gradients_ == Gradients::kSkip) return steady;  // both forms steady-state (decided in reconfigure)
   Mat2 g = state_.predictor.gradient;
   if (config_.gradient_psi_m == GradientForm::kSteadyState) g.col(kPsiM) = steady.col(kPsiM);
   if (config_.gradient_r_s == GradientForm::kSteadyState) g.col(kRs) = steady.col(kRs);
@@ -135,13 +136,13 @@ EstimatorOutput RpemEstimator::held(StepCode code) const noexcept {
   state_.theta_pu += gain.gain * u.epsilon_pu;
   const std::uint8_t clamped = project(config_.bounds, state_.theta_pu);
 
-  std::uint16_t flags = state_.frozen ? step_flag::kFrozen : 0;
-  if (gain.flags & gain_flag::kFloored) flags |= step_flag::kGainFloored;
-  if (gain.flags & gain_flag::kPseudoInverse) flags |= step_flag::kPseudoInverse;
-  if (active.psi_m) flags |= step_flag::kPsiMActive;
-  if (active.r_s) flags |= step_flag::kRsActive;
-  if (clamped & (1U << kPsiM)) flags |= step_flag::kProjectedPsiM;
-  if (clamped & (1U << kRs)) flags |= step_flag::kProjectedRs;
+  // The flags by shifts, no branches: the gain's and the projection's bits are laid out as step_flag's.
+  static_assert(step_flag::kGainFloored == gain_flag::kFloored && step_flag::kPseudoInverse == gain_flag::kPseudoInverse);
+  static_assert(step_flag::kProjectedPsiM == 1U << (kPsiM + 2) && step_flag::kProjectedRs == 1U << (kRs + 2));
+  const auto flags = static_cast<std::uint16_t>(
+      (state_.frozen ? step_flag::kFrozen : 0U) | (gain.flags & (gain_flag::kFloored | gain_flag::kPseudoInverse)) |
+      (static_cast<unsigned>(clamped) << 2) | (static_cast<unsigned>(active.psi_m) * step_flag::kPsiMActive) |
+      (static_cast<unsigned>(active.r_s) * step_flag::kRsActive));
   return {state_.theta_pu, u.epsilon_pu, u.i_hat_pu, u.gradient, gain.gain, StepCode::kAdapted, flags};  // every member: no zero fill
 }
 

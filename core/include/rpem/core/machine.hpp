@@ -55,8 +55,9 @@ struct MachinePu {
   // Built a column at a time (Mat2 is column-major: element-wise stores would stall whole-column loads).
   Mat2 g;
   g.col(kPsiM) = Vec2(-n_pu * n_pu * m.x_q_pu, -n_pu * m.r_s_pu) * inv_d;
-  g.col(kRs) = Vec2(-m.r_s_pu * i_hat_pu[0] - n_pu * m.x_q_pu * i_hat_pu[1],
-                    n_pu * m.x_d_pu * i_hat_pu[0] - m.r_s_pu * i_hat_pu[1]) * inv_d;
+  // The r̂s column's coefficients over D first: î (on the estimator's dependency chain) enters last.
+  const double r = m.r_s_pu * inv_d, nxq = n_pu * m.x_q_pu * inv_d, nxd = n_pu * m.x_d_pu * inv_d;
+  g.col(kRs) = Vec2(-r * i_hat_pu[0] - nxq * i_hat_pu[1], nxd * i_hat_pu[0] - r * i_hat_pu[1]);
   return g;
 }
 

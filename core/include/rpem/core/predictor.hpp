@@ -71,34 +71,35 @@ struct Coefficients {
     return a;
   }
   /// Forcing of the current equation: B·u + f(n, ψ̂m).
-  [[nodiscard]] Vec2 current_forcing(double n, const Vec2& u) const noexcept {
-    return {wd * u[0], wq * (u[1] - n * m.psi_m_pu)};
-  }
-  /// Forcing of the ψ̂m-sensitivity: ∂f/∂ψ̂m.
+  [[nodiscard]] Vec2 current_forcing(double n, const Vec2& u) const noexcept { return input(u) + m.psi_m_pu * psi_forcing(n); }
+  /// The voltage's part of the current's forcing: B·u.
+  [[nodiscard]] Vec2 input(const Vec2& u) const noexcept { return {wd * u[0], wq * u[1]}; }
+  /// Forcing of the ψ̂m-sensitivity: ∂f/∂ψ̂m (f is linear in ψ̂m: current_forcing = input + ψ̂m·this).
   [[nodiscard]] Vec2 psi_forcing(double n) const noexcept { return {0.0, -wq * n}; }
   /// Forcing of the r̂s-sensitivity: (∂A/∂r̂s)·î.
   [[nodiscard]] Vec2 rs_forcing(const Vec2& i_hat) const noexcept { return {-wd * i_hat[0], -wq * i_hat[1]}; }
 };
 
 /// One trapezoidal step x_k = (I − h/2·A_k)⁻¹·((I + h/2·A_{k−1})·x_{k−1} + w), element by element:
-/// A(n) = [a11, b·n; c·n, a22] has the speed only off the diagonal, and the inverse is the adjugate
-/// over the determinant, whose division overlaps the products.
+/// A(n) = [a11, b·n; c·n, a22] has the speed only off the diagonal. (I − h/2·A_k)⁻¹ is the adjugate
+/// over the determinant, formed here from r̂s and the speeds alone: the step itself, on the estimator's
+/// sample-to-sample dependency chain (θ̂ → î → Ψ → L → θ̂), is then two products and a sum per element.
 struct Trapezoid {
-  double m11, m12, m21, m22;  ///< I − h/2·A(n_end)
+  double p11, p12, p21, p22;  ///< (I − h/2·A(n_end))⁻¹
   double n11, n12, n21, n22;  ///< I + h/2·A(n_start)
-  double inv_det;
 
   Trapezoid(const Coefficients& c, double half_h, double n_start, double n_end) noexcept {
     const double d11 = half_h * c.wd * c.m.r_s_pu, d22 = half_h * c.wq * c.m.r_s_pu;
     const double b = half_h * c.wd * c.m.x_q_pu, cc = -half_h * c.wq * c.m.x_d_pu;
-    m11 = 1.0 + d11, m12 = -b * n_end, m21 = -cc * n_end, m22 = 1.0 + d22;
+    const double m11 = 1.0 + d11, m12 = -b * n_end, m21 = -cc * n_end, m22 = 1.0 + d22;
+    const double inv_det = 1.0 / (m11 * m22 - m12 * m21);
+    p11 = m22 * inv_det, p12 = -m12 * inv_det, p21 = -m21 * inv_det, p22 = m11 * inv_det;
     n11 = 1.0 - d11, n12 = b * n_start, n21 = cc * n_start, n22 = 1.0 - d22;
-    inv_det = 1.0 / (m11 * m22 - m12 * m21);
   }
-  /// x_k for the previous value x and the forcing term w (already times h/2).
-  [[nodiscard]] Vec2 step(const Vec2& x, const Vec2& w) const noexcept {
-    const double v0 = n11 * x[0] + n12 * x[1] + w[0], v1 = n21 * x[0] + n22 * x[1] + w[1];
-    return Vec2(m22 * v0 - m12 * v1, m11 * v1 - m21 * v0) * inv_det;
+  /// x_k for the previous value x and the forcing term w = [w0, w1] (already times h/2).
+  [[nodiscard]] Vec2 step(const Vec2& x, double w0, double w1) const noexcept {
+    const double v0 = n11 * x[0] + n12 * x[1] + w0, v1 = n21 * x[0] + n22 * x[1] + w1;
+    return {p11 * v0 + p12 * v1, p21 * v0 + p22 * v1};
   }
 };
 
@@ -121,11 +122,17 @@ inline void predict(const MachinePu& model, const PredictorCoefficients& pc, Dis
 
   const double half_h = 0.5 * h;
   const detail::Trapezoid t(c, half_h, iv.n_start_pu, iv.n_end_pu);
-  s.i_hat_pu = t.step(i_prev, half_h * (c.current_forcing(iv.n_start_pu, iv.u_start_pu) +
-                                        c.current_forcing(iv.n_end_pu, iv.u_end_pu)));
+  // The current's forcing at both ends, B·u + ψ̂m·∂f/∂ψ̂m, with ψ̂m entering last (one product and a
+  // sum on the estimator's dependency chain); ∂f/∂ψ̂m is also the ψ̂m-sensitivity's forcing.
+  // Scalars: ∂f/∂ψ̂m = [0, −ω_n/x_q·n] has one element that is not zero, and a Vec2 made of a constant and
+  // a computed element went through the stack (two stores, one wider load: a store-forwarding stall).
+  const double w_psi_q = half_h * (c.psi_forcing(iv.n_start_pu)[1] + c.psi_forcing(iv.n_end_pu)[1]);
+  const Vec2 w_u = half_h * (c.input(iv.u_start_pu) + c.input(iv.u_end_pu));
+  s.i_hat_pu = t.step(i_prev, w_u[0], w_u[1] + model.psi_m_pu * w_psi_q);
   if (gradients == Gradients::kSkip) return;
-  s.gradient.col(kPsiM) = t.step(s.gradient.col(kPsiM), half_h * (c.psi_forcing(iv.n_start_pu) + c.psi_forcing(iv.n_end_pu)));
-  s.gradient.col(kRs) = t.step(s.gradient.col(kRs), half_h * (c.rs_forcing(i_prev) + c.rs_forcing(s.i_hat_pu)));
+  s.gradient.col(kPsiM) = t.step(s.gradient.col(kPsiM), 0.0, w_psi_q);
+  const Vec2 w_rs = half_h * (c.rs_forcing(i_prev) + c.rs_forcing(s.i_hat_pu));
+  s.gradient.col(kRs) = t.step(s.gradient.col(kRs), w_rs[0], w_rs[1]);
 }
 
 
