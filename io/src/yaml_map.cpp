@@ -2,6 +2,8 @@
 
 #include <charconv>
 #include <cmath>
+#include <filesystem>
+#include <ios>
 #include <sstream>
 
 namespace rpem::io {
@@ -21,6 +23,9 @@ YamlMap YamlMap::load_file(const std::string& path) {
     root = YAML::LoadFile(path);
   } catch (const YAML::BadFile&) {
     throw ConfigError(path, 0, 0, "", "cannot open file");
+  } catch (const std::ios_base::failure&) {
+    // A directory (or another unreadable file) opens but fails on the first read (found by fuzz_scenario).
+    throw ConfigError(path, 0, 0, "", std::filesystem::is_directory(path) ? "is a directory, not a file" : "cannot read file");
   } catch (const YAML::ParserException& e) {
     throw ConfigError(path, static_cast<std::size_t>(e.mark.line + 1), static_cast<std::size_t>(e.mark.column + 1),
                       "", "YAML syntax: " + e.msg);
