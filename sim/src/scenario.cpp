@@ -199,6 +199,7 @@ Scenario parse_scenario(const std::string& text, const std::string& name, const 
 }
 
 Scenario load_scenario(const std::string& path) {
+  if (fs::is_directory(path)) throw io::ConfigError(path, 0, 0, "", "is a directory, not a file");
   std::ifstream in(path);
   if (!in) throw io::ConfigError(path, 0, 0, "", "cannot open file");
   std::stringstream text;

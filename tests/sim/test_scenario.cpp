@@ -56,6 +56,15 @@ TEST_P(BadScenario, IsRejectedWithLine) {
   }
 }
 
+TEST(Scenario, ADirectoryIsRefusedByName) {
+  try {
+    (void)load_scenario("/");
+    FAIL() << "accepted";
+  } catch (const io::ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("/: is a directory, not a file"), std::string::npos) << e.what();
+  }
+}
+
 INSTANTIATE_TEST_SUITE_P(
     Cases, BadScenario,
     ::testing::Values(
