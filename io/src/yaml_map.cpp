@@ -2,7 +2,10 @@
 
 #include <charconv>
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <sstream>
+#include <system_error>
 
 namespace rpem::io {
 namespace {
@@ -16,17 +19,16 @@ std::string describe_range(double lo, double hi) {
 }  // namespace
 
 YamlMap YamlMap::load_file(const std::string& path) {
-  YAML::Node root;
-  try {
-    root = YAML::LoadFile(path);
-  } catch (const YAML::BadFile&) {
-    throw ConfigError(path, 0, 0, "", "cannot open file");
-  } catch (const YAML::ParserException& e) {
-    throw ConfigError(path, static_cast<std::size_t>(e.mark.line + 1), static_cast<std::size_t>(e.mark.column + 1),
-                      "", "YAML syntax: " + e.msg);
-  }
-  if (!root.IsMap()) throw ConfigError(path, 1, 1, "", "the document must be a mapping");
-  return YamlMap(root, path, "");
+  // Read here rather than by YAML::LoadFile: a directory opens and then fails on the first read, and
+  // yaml-cpp's stream then throws std::ios_base::failure and leaks its buffer (found by fuzz_scenario).
+  std::error_code ec;  // a name too long or a loop of links: not a directory, and the open below fails
+  if (std::filesystem::is_directory(path, ec)) throw ConfigError(path, 0, 0, "", "is a directory, not a file");
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw ConfigError(path, 0, 0, "", "cannot open file");
+  std::ostringstream text;
+  text << in.rdbuf();
+  if (in.bad()) throw ConfigError(path, 0, 0, "", "cannot read file");
+  return load_string(text.str(), path);
 }
 
 YamlMap YamlMap::load_string(const std::string& text, const std::string& name) {

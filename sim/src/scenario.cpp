@@ -5,6 +5,7 @@
 #include <fstream>
 #include <optional>
 #include <sstream>
+#include <system_error>
 
 namespace rpem::sim {
 namespace {
@@ -199,6 +200,8 @@ Scenario parse_scenario(const std::string& text, const std::string& name, const 
 }
 
 Scenario load_scenario(const std::string& path) {
+  std::error_code ec;
+  if (fs::is_directory(path, ec)) throw io::ConfigError(path, 0, 0, "", "is a directory, not a file");
   std::ifstream in(path);
   if (!in) throw io::ConfigError(path, 0, 0, "", "cannot open file");
   std::stringstream text;

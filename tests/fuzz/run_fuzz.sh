@@ -14,6 +14,16 @@ repo=$(cd "$(dirname "$0")/../.." && pwd)
 
 core=("$repo"/core/src/*.cpp)
 io=("$repo"/io/src/*.cpp "$build/io/builtin_config.cpp" "$repo/can/src/signal_map.cpp")  # io reads signal maps
+# The YAML readers' inputs cost yaml-cpp about one allocation per byte, and under ASan an allocation is most
+# of the cost (docs/benchmarks.md, "Fuzzing"). -max_len: every key of the reader in one file is 2.1 kB
+# (io/fuzz/corpus/machine_config/every-key.yaml, sim/fuzz/corpus/every-key.yaml) and the largest seed 2.9 kB,
+# so 3 kB reaches every check while the longest (and slowest) junk stays bounded. A 16 MB quarantine (ASan's
+# default: 256 MB) still holds every block freed within one input (at most about 1 MB at 3 kB), so a
+# use-after-free inside an input is still caught, while the allocator stops cycling through 256 MB of
+# fresh pages (half the replay's CPU time).
+yaml_opts=(-max_len=3072)
+yaml_asan=quarantine_size_mb=16
+opts=() asan=
 case $target in
   fuzz_decoder)        main=can/fuzz/fuzz_decoder.cpp;        objs=("$repo/can/src/decoder.cpp" "$repo/can/src/e2e.cpp")
                        corpus=can/fuzz/corpus ;;
@@ -24,9 +34,9 @@ case $target in
   fuzz_drive_log)      main=io/fuzz/fuzz_drive_log.cpp;       objs=("${io[@]}" "${core[@]}")
                        corpus=io/fuzz/corpus/drive_log ;;
   fuzz_machine_config) main=io/fuzz/fuzz_machine_config.cpp;  objs=("${io[@]}" "${core[@]}")
-                       corpus=io/fuzz/corpus/machine_config ;;
+                       corpus=io/fuzz/corpus/machine_config; opts=("${yaml_opts[@]}") asan=$yaml_asan ;;
   fuzz_scenario)       main=sim/fuzz/fuzz_scenario.cpp;       objs=("$repo"/sim/src/*.cpp "${io[@]}" "${core[@]}")
-                       corpus=sim/fuzz/corpus ;;
+                       corpus=sim/fuzz/corpus; opts=("${yaml_opts[@]}") asan=$yaml_asan ;;
   fuzz_command)        main=daemon/fuzz/fuzz_command.cpp;     objs=("$repo/daemon/src/command_gate.cpp")
                        corpus=daemon/fuzz/corpus
                        # rpemd's RPEM_COMMAND entry point; the LCM types are generated in the build
@@ -66,6 +76,7 @@ cp -n "$repo/$corpus"/* "$dir/$target/corpus/" 2>/dev/null || true
 dict=()
 [[ -f $repo/$corpus.dict ]] && dict=(-dict="$repo/$corpus.dict")
 cd "$dir/$target"
-"./$target" -max_total_time="$seconds" -print_final_stats=1 -artifact_prefix="$dir/$target/crash-" "${dict[@]}" "$@" \
+[[ -n $asan ]] && export ASAN_OPTIONS=${ASAN_OPTIONS:-$asan}
+"./$target" -max_total_time="$seconds" -print_final_stats=1 -artifact_prefix="$dir/$target/crash-" "${dict[@]}" "${opts[@]}" "$@" \
   corpus 2>&1 | tail -n 60
 echo "run_fuzz: $target: no crash, leak or UB report"

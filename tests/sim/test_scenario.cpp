@@ -56,6 +56,15 @@ TEST_P(BadScenario, IsRejectedWithLine) {
   }
 }
 
+TEST(Scenario, ADirectoryIsRefusedByName) {
+  try {
+    (void)load_scenario("/");
+    FAIL() << "accepted";
+  } catch (const io::ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("/: is a directory, not a file"), std::string::npos) << e.what();
+  }
+}
+
 INSTANTIATE_TEST_SUITE_P(
     Cases, BadScenario,
     ::testing::Values(
@@ -72,7 +81,9 @@ INSTANTIATE_TEST_SUITE_P(
         Bad{"step_with_edges", "duration_s: 1\nplant: {step_s: 1.0e-6}\n", "plant.step_s: applies to integrator: fixed"},
         Bad{"edges_averaged", "duration_s: 1\ninverter: {model: averaged}\nplant: {integrator: edges}\n",
             "plant.integrator: edges needs inverter.model: switching"},
-        Bad{"machine", "duration_s: 1\nmachine: nowhere.yaml\n", "nowhere.yaml: cannot open file"}),
+        Bad{"machine", "duration_s: 1\nmachine: nowhere.yaml\n", "nowhere.yaml: cannot open file"},
+        // A directory opens and then fails to read: it escaped as std::ios_base::failure (fuzz_scenario).
+        Bad{"machine_directory", "duration_s: 1\nmachine: /\n", "/: is a directory, not a file"}),
     [](const auto& p) { return std::string(p.param.name); });
 
 }  // namespace
