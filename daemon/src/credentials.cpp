@@ -18,8 +18,9 @@ DaemonKeys load_credential_keys(const char* directory) {
   if (ec) throw auth::KeyError(std::string(directory) + ": cannot read the credentials directory: " + ec.message());
   std::sort(files.begin(), files.end());
   for (const fs::path& file : files) {
-    const std::string name = file.filename().string();
-    const bool command = name.rfind("rpem_command", 0) == 0, publish = name.rfind("rpem_publish", 0) == 0;
+    std::string name = file.filename().string();
+    if (name.rfind("rpem_", 0) == 0) name.erase(0, 5);  // LoadCredential=rpem:DIR names DIR/x "rpem_x"
+    const bool command = name.rfind("command", 0) == 0, publish = name.rfind("publish", 0) == 0;
     if (!command && !publish) continue;
     const auth::Key key = auth::load_key_file(file.string());
     if (publish) {

@@ -2,8 +2,8 @@
 // rpemd's keys (docs/rpemd.md, "Authentication"): key files (rpem/auth/key_file.hpp) in systemd's
 // credentials directory, $CREDENTIALS_DIRECTORY — rpemd.service loads /etc/rpemd/keys with
 // LoadCredential=rpem:/etc/rpemd/keys, so a file `command.key` there is the credential `rpem_command.key`.
-//   rpem_command*   accepted on RPEM_COMMAND: one, or two while a key is being changed;
-//   rpem_publish*   at most one: signs RPEM_ESTIMATE and RPEM_DIAGNOSTICS (unsigned without it).
+//   [rpem_]command*   accepted on RPEM_COMMAND: one, or two while a key is being changed;
+//   [rpem_]publish*   at most one: signs RPEM_ESTIMATE and RPEM_DIAGNOSTICS (unsigned without it).
 // Read once at start-up; never from the YAML or the command line.
 
 #include <optional>
