@@ -89,21 +89,20 @@ CommandVerdict admit_command(std::span<const std::uint8_t> message, const Comman
   return v;
 }
 
-bool CommandGate::handle(std::span<const std::uint8_t> message) noexcept {
+bool CommandGate::handle(std::span<const std::uint8_t> message, bool commit_now) noexcept {
   ++counters_.received;
   CommandVerdict v = admit_command(message, policy_, keys_.keys, keys_.channel, last_accepted_seq_);
   if (!v.decoded) {
     ++counters_.malformed;
     return false;
   }
-  // 5. Queue: room first (this thread is the one producer, so room stays), then the sequence number
-  // made durable, then the command — a restart can never accept it again.
-  if (v.result == CommandResult::kApplied && to_loop_.size() >= to_loop_.capacity()) v.result = CommandResult::kRejectedBusy;
-  if (v.result == CommandResult::kApplied && store_ != nullptr && !store_->store(v.command.seq)) {
-    v.result = CommandResult::kRejectedNotPersisted;
+  // 5. Queue: room for it beside the pending ones (this thread is the one producer, so room stays).
+  if (v.result == CommandResult::kApplied && to_loop_.size() + n_pending_ >= to_loop_.capacity()) {
+    v.result = CommandResult::kRejectedBusy;
   }
-  if (v.result == CommandResult::kApplied && !to_loop_.push(v.command)) v.result = CommandResult::kRejectedBusy;
   if (v.result == CommandResult::kApplied) {
+    if (n_pending_ == kMaxPending) (void)commit();
+    pending_[n_pending_++] = v.command;
     last_accepted_seq_ = v.command.seq;
   } else {
     ++counters_.rejected;
@@ -115,7 +114,24 @@ bool CommandGate::handle(std::span<const std::uint8_t> message) noexcept {
   last_verdict_seq_ = v.command.seq;
   last_key_id_ = v.key_id;
   last_result_ = v.result;
-  return v.result == CommandResult::kApplied;
+  if (v.result != CommandResult::kApplied) return false;
+  return !commit_now || commit();
+}
+
+bool CommandGate::commit() noexcept {
+  if (n_pending_ == 0) return true;
+  // The sequence number durable first, then the commands: a restart can never accept one again.
+  const bool durable = store_ == nullptr || store_->store(last_accepted_seq_);
+  if (durable) {
+    for (std::size_t k = 0; k < n_pending_; ++k) (void)to_loop_.push(pending_[k]);  // room was checked
+    durable_seq_ = last_accepted_seq_;
+  } else {
+    counters_.rejected += static_cast<std::int64_t>(n_pending_);
+    last_accepted_seq_ = durable_seq_;
+    last_result_ = CommandResult::kRejectedNotPersisted;
+  }
+  n_pending_ = 0;
+  return durable;
 }
 
 void CommandGate::report(DiagnosticsRows& rows) const noexcept { rows.set_all(kGateRows, counters_); }

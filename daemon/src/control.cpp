@@ -104,7 +104,8 @@ void Control::connect_lcm(std::int64_t now_ns) {
 
 void Control::on_command(const lcm::ReceiveBuffer* message, const std::string&) {
   const std::int64_t malformed = gate_.counters().malformed;
-  if (!gate_.handle(std::span(static_cast<const std::uint8_t*>(message->data), message->data_size))) {
+  // Admitted commands wait for commit() after this wake's messages (run()): one write for a burst.
+  if (!gate_.handle(std::span(static_cast<const std::uint8_t*>(message->data), message->data_size), false)) {
     const bool decoded = gate_.counters().malformed == malformed;
     log_rejection(decoded ? gate_.last_result() : CommandResult::kNone, decoded ? gate_.last_seq() : 0,
                   decoded ? gate_.last_key_id() : 0);
@@ -228,6 +229,7 @@ int Control::run(int signal_fd) {
     if (fds[1].fd >= 0 && (fds[1].revents & POLLIN)) {
       for (int k = 0; k < kMessagesPerWake && lcm_->lcm.handleTimeout(0) > 0; ++k) {
       }
+      if (!gate_.commit()) log_rejection(CommandResult::kRejectedNotPersisted, gate_.last_seq(), gate_.last_key_id());
     }
     now = core::now_ns(CLOCK_MONOTONIC);
     watchdog(now);

@@ -8,11 +8,15 @@
 //   4. admit        a sequence number above the last accepted one (ever: persisted before it is
 //                   used), a known command, values inside D_M of the configuration running now;
 //   5. queue        to the loop, which applies it at the start of its next period (a full queue:
-//                   rejected as busy, the sequence number not used up).
+//                   rejected as busy, the sequence number not used up) — once the highest accepted
+//                   sequence number is durable. The control thread admits a whole wake's messages and
+//                   then commits them with one write (handle(…, false) … commit()), so one fsync
+//                   covers a burst.
 // admit_command() is steps 1–4 as a pure, total function of the bytes, the policy, the keys and the
 // last accepted sequence number: no I/O, no allocation, no exception, whatever the bytes — the
 // fuzzer's entry point (daemon/fuzz/fuzz_command.cpp). CommandGate keeps the state between messages.
 
+#include <array>
 #include <cstdint>
 #include <span>
 #include <string>
@@ -75,12 +79,21 @@ class CommandGate {
   /// `last_accepted_seq`: as persisted by `store` (nullptr: not persisted — tests).
   CommandGate(const CommandPolicy& policy, SpscQueue<Command>& to_loop, CommandKeys keys = {},
               std::int64_t last_accepted_seq = 0, SequenceStore* store = nullptr) noexcept
-      : policy_(policy), to_loop_(to_loop), keys_(std::move(keys)), store_(store), last_accepted_seq_(last_accepted_seq) {}
+      : policy_(policy),
+        to_loop_(to_loop),
+        keys_(std::move(keys)),
+        store_(store),
+        last_accepted_seq_(last_accepted_seq),
+        durable_seq_(last_accepted_seq) {}
 
   /// A reload's new policy: every later message is admitted against it.
   void set_policy(const CommandPolicy& policy) noexcept { policy_ = policy; }
-  /// One RPEM_COMMAND message, through every step. True if it was queued for the loop.
-  bool handle(std::span<const std::uint8_t> message) noexcept;
+  /// One RPEM_COMMAND message, through every step. True if it was admitted: queued for the loop, or
+  /// with `commit_now` false pending until commit().
+  bool handle(std::span<const std::uint8_t> message, bool commit_now = true) noexcept;
+  /// Makes the highest admitted sequence number durable, then queues the pending commands in order;
+  /// if it cannot be made durable, rejects them all (kRejectedNotPersisted). False then.
+  bool commit() noexcept;
 
   [[nodiscard]] const CommandPolicy& policy() const noexcept { return policy_; }
   [[nodiscard]] const CommandKeys& keys() const noexcept { return keys_; }
@@ -98,7 +111,11 @@ class CommandGate {
   const CommandKeys keys_;
   SequenceStore* store_;
   Counters counters_;
+  static constexpr std::size_t kMaxPending = 64;
+  std::array<Command, kMaxPending> pending_{};
+  std::size_t n_pending_ = 0;
   std::int64_t last_accepted_seq_ = 0;
+  std::int64_t durable_seq_ = 0;  ///< the last accepted sequence number that is persisted
   std::int64_t last_verdict_seq_ = 0;
   std::int32_t last_key_id_ = 0;
   CommandResult last_result_ = CommandResult::kNone;
