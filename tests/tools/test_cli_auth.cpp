@@ -13,6 +13,8 @@
 #include <stdlib.h>
 
 #include <chrono>
+#include <csignal>
+#include <fstream>
 #include <filesystem>
 #include <lcm/lcm-cpp.hpp>
 #include <optional>
@@ -155,6 +157,24 @@ TEST(CliAuth, AttacksAreRejectedAndCountedForgedEstimatesFlaggedAndReplayProtect
   test::TempFile wide("wide.yaml", "daemon:\n  lcm: {url: \"udpm://239.255.76.67:7823?ttl=1\"}\n  commands: {enabled: true, authentication: none}\n");
   test::ChildProcess widened({test::binary_dir() + "/daemon/rpemd", "--config", wide.path()}, log3.path());
   EXPECT_EQ(widened.wait(), 78);
+  {
+    // A reload that enables commands without a key is refused like an invalid file; rpemd keeps running.
+    test::TempFile reloadable("reloadable.yaml", "daemon:\n  lcm: {url: \"" + kUrl + "\"}\n  commands: {enabled: false}\n  state: {file: " +
+                                                     (dir / "state/estimates.json").string() + "}\n  status_interval_s: 0\n");
+    test::TempFile log4("rpemd4.log");
+    test::ChildProcess rpemd({test::binary_dir() + "/daemon/rpemd", "--config", reloadable.path()}, log4.path());
+    std::this_thread::sleep_for(std::chrono::seconds(1));
+    std::ofstream(reloadable.path()) << "daemon:\n  lcm: {url: \"" << kUrl << "\"}\n  commands: {enabled: true}\n  state: {file: "
+                                     << (dir / "state/estimates.json").string() << "}\n  status_interval_s: 0\n";
+    rpemd.signal(SIGHUP);
+    const Heard h = listen(2.5, publish);
+    EXPECT_EQ(rpemd.stop(), 0);
+    ASSERT_TRUE(h.diagnostics);
+    EXPECT_EQ(h.diagnostics->config_reloads_invalid, 1);
+    EXPECT_FALSE(h.diagnostics->commands_enabled);
+    EXPECT_EQ(h.diagnostics->key_id, 0) << "no publish key: unsigned";
+    EXPECT_NE(test::read_file(log4.path()).find("no command key is configured"), std::string::npos);
+  }
   ::unsetenv("CREDENTIALS_DIRECTORY");
   fs::remove_all(dir);
 }
