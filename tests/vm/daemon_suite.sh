@@ -80,6 +80,7 @@ rpem command --resend $keys/attacker/captured.bin --flip-bit 130
 for i in 1 2 3; do rpem publish-estimate --psi-m 0.6 --r-s 1.2 --key $keys/attacker/publish.key; sleep 0.3; done
 sleep 2
 echo "$(date +%s) attacker end" >> "$out/faults_events.txt"
+sleep 3                                              # diagnostics (1 Hz) after the attacks, before the kill
 echo "$(date +%s) sigkill" >> "$out/faults_events.txt"
 kill -KILL "$(cat /tmp/rpemd.pid)"
 cp /tmp/rpemd/estimates.json "$out/killed_state.json" 2>/dev/null   # what the restart must resume from
