@@ -8,6 +8,8 @@ packages=(
   build-essential cmake ninja-build pkg-config git
   # libraries
   libeigen3-dev libyaml-cpp-dev libceres-dev libcli11-dev nlohmann-json3-dev libsystemd-dev
+  # message authentication (HMAC-SHA256) of rpemd's LCM channels
+  libsodium-dev
   # LCM (C++ headers, lcm-gen, Java jar for lcm-spy) and lcm-spy's chart library
   liblcm-dev liblcm-bin liblcm-java libjchart2d-java default-jdk-headless
   # tests and benchmarks

@@ -2,7 +2,7 @@
 # Sets up a fresh machine and runs the whole test suite, as CI does (.ci/run):
 #   1. installs the Debian packages (scripts/setup.sh, idempotent)
 #   2. builds with warnings as errors and runs every ctest label (unit, cli, slow, vcan, …)
-#   3. builds the unit tests of core, io, can, sim and analysis with AddressSanitizer +
+#   3. builds the unit tests of core, io, can, sim, analysis and auth with AddressSanitizer +
 #      UndefinedBehaviorSanitizer and runs them (the daemon's real-time loop is covered by its own
 #      allocation and VM tests; rpemd and the rpem tool are left out of this build)
 #   4. builds rpemd and the daemon's tests with ThreadSanitizer and runs them — the storm test drives
@@ -20,7 +20,7 @@ ctest --test-dir build/ci --output-on-failure -j "$jobs" --timeout 1800
 
 cmake -S . -B build/sanitize -G Ninja -DCMAKE_BUILD_TYPE=Debug -DRPEM_WERROR=ON \
   -DRPEM_SANITIZE=address,undefined -DRPEM_BUILD_BENCHMARKS=OFF -DRPEM_BUILD_DAEMON=OFF -DRPEM_BUILD_TOOLS=OFF
-cmake --build build/sanitize -j "$jobs" --target test_core test_io test_can test_sim test_sim_vesc test_analysis \
+cmake --build build/sanitize -j "$jobs" --target test_core test_io test_can test_sim test_sim_vesc test_analysis test_auth \
   test_indep_drive indep_drive_log
 UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1 ASAN_OPTIONS=detect_leaks=1 \
   ctest --test-dir build/sanitize --output-on-failure -j "$jobs" -L unit

@@ -13,6 +13,8 @@
 #include <span>
 
 #include "rpem/core/clock.hpp"
+#include "rpem/daemon/credentials.hpp"
+#include "rpem/daemon/state_file.hpp"
 
 namespace rpem::daemon {
 namespace {
@@ -26,6 +28,7 @@ constexpr std::array<CounterRow<ReloadCounters>, 4> kReloadRows{{
     {&ReloadCounters::busy, &Diag::config_reloads_busy},
 }};
 
+constexpr std::int64_t kRejectionLogInterval_ns = 10 * core::kNsPerS;
 constexpr int kMessagesPerWake = 64;  // then the signals get their turn again
 constexpr int kCommandQueueCapacity = 1024;
 
@@ -36,12 +39,46 @@ struct Control::Lcm {
   lcm::LCM lcm;
 };
 
-Control::Control(DaemonConfig running, Reload reload, Queues queues, const LoopTimer& loop)
+namespace {
+
+const char* describe(CommandResult r) {
+  switch (r) {
+    case CommandResult::kNone: return "malformed (not one rpem.command_t)";
+    case CommandResult::kApplied: return "applied";
+    case CommandResult::kRejectedDisabled: return "commands are disabled";
+    case CommandResult::kRejectedOldSequence: return "replayed or stale: sequence number not above the last accepted one";
+    case CommandResult::kRejectedBadValues: return "values outside D_M";
+    case CommandResult::kRejectedUnknown: return "unknown command";
+    case CommandResult::kRejectedBusy: return "busy (the loop's queue is full)";
+    case CommandResult::kRejectedUnauthenticated: return "unauthenticated (no key id, no MAC)";
+    case CommandResult::kRejectedUnknownKey: return "unknown key id";
+    case CommandResult::kRejectedBadMac: return "bad MAC (forged or altered)";
+    case CommandResult::kRejectedNotPersisted: return "its sequence number could not be persisted";
+  }
+  return "?";
+}
+
+}  // namespace
+
+bool Control::FileSequenceStore::store(std::int64_t seq) noexcept {
+  try {
+    const std::string problem = write_command_sequence(path_, seq);
+    if (problem.empty()) return true;
+    std::fprintf(stderr, "rpemd: cannot persist the command sequence number: %s\n", problem.c_str());
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "rpemd: cannot persist the command sequence number: %s\n", e.what());
+  }
+  return false;
+}
+
+Control::Control(DaemonConfig running, Reload reload, Queues queues, const LoopTimer& loop, Commands commands)
     : running_(std::move(running)),
       reload_(std::move(reload)),
       queues_(queues),
       loop_(loop),
-      gate_(CommandPolicy::of(running_.live), queues.to_loop) {
+      sequence_store_(std::move(commands.sequence_file)),
+      gate_(CommandPolicy::of(running_.live), queues.to_loop, std::move(commands.keys), commands.last_accepted_seq,
+            &sequence_store_) {
   std::uint64_t usec = 0;
   watchdog_enabled_ = sd_watchdog_enabled(0, &usec) > 0;
   if (watchdog_enabled_) watchdog_interval_ns_ = static_cast<std::int64_t>(usec) * 1000 / 2;
@@ -66,8 +103,35 @@ void Control::connect_lcm(std::int64_t now_ns) {
 }
 
 void Control::on_command(const lcm::ReceiveBuffer* message, const std::string&) {
-  (void)gate_.handle(std::span(static_cast<const std::uint8_t*>(message->data), message->data_size));
+  const std::int64_t malformed = gate_.counters().malformed;
+  // Admitted commands wait for commit() after this wake's messages (run()): one write for a burst.
+  if (!gate_.handle(std::span(static_cast<const std::uint8_t*>(message->data), message->data_size), false)) {
+    const bool decoded = gate_.counters().malformed == malformed;
+    log_rejection(decoded ? gate_.last_result() : CommandResult::kNone, decoded ? gate_.last_seq() : 0,
+                  decoded ? gate_.last_key_id() : 0);
+  }
   report_pending_ = true;
+}
+
+void Control::log_rejection(CommandResult result, std::int64_t seq, std::int32_t key_id) {
+  const auto k = static_cast<std::size_t>(result);
+  const std::int64_t now = core::now_ns(CLOCK_MONOTONIC);
+  if (now < rejection_log_next_ns_[k]) {
+    ++rejections_unlogged_[k];
+    return;
+  }
+  char more[96] = "";
+  if (rejections_unlogged_[k] > 0) {
+    std::snprintf(more, sizeof more, " (and %lld more such since the last line)", static_cast<long long>(rejections_unlogged_[k]));
+  }
+  if (result == CommandResult::kNone) {
+    std::fprintf(stderr, "rpemd: RPEM_COMMAND message rejected: %s%s\n", describe(result), more);
+  } else {
+    std::fprintf(stderr, "rpemd: RPEM_COMMAND seq %lld, key id %d rejected: %s%s\n", static_cast<long long>(seq), key_id,
+                 describe(result), more);
+  }
+  rejections_unlogged_[k] = 0;
+  rejection_log_next_ns_[k] = now + kRejectionLogInterval_ns;
 }
 
 void Control::reload() {
@@ -76,7 +140,12 @@ void Control::reload() {
   sd_notify(0, "RELOADING=1");
   try {
     const DaemonConfig fresh = reload_();
-    if (const char* part = fixed_difference(running_.fixed, fresh.fixed); *part != '\0') {
+    const std::string key_problem = command_key_problem(fresh.live, gate_.keys().keys);
+    if (!key_problem.empty()) {
+      ++reloads_.invalid;
+      std::fprintf(stderr, "rpemd: SIGHUP: keeping the running configuration: %s: %s\n", fresh.source_file.c_str(),
+                   key_problem.c_str());
+    } else if (const char* part = fixed_difference(running_.fixed, fresh.fixed); *part != '\0') {
       ++reloads_.restart_required;
       std::fprintf(stderr, "rpemd: SIGHUP: %s changes `%s`, which only a restart applies; keeping the running configuration\n",
                    fresh.source_file.c_str(), part);
@@ -160,6 +229,7 @@ int Control::run(int signal_fd) {
     if (fds[1].fd >= 0 && (fds[1].revents & POLLIN)) {
       for (int k = 0; k < kMessagesPerWake && lcm_->lcm.handleTimeout(0) > 0; ++k) {
       }
+      if (!gate_.commit()) log_rejection(CommandResult::kRejectedNotPersisted, gate_.last_seq(), gate_.last_key_id());
     }
     now = core::now_ns(CLOCK_MONOTONIC);
     watchdog(now);

@@ -7,10 +7,12 @@
 
 #include <chrono>
 #include <cstdio>
+#include <cstdlib>
 #include <ctime>
 
 #include "rpem/core/clock.hpp"
 #include "rpem/daemon/control.hpp"
+#include "rpem/daemon/credentials.hpp"
 #include "rpem/daemon/realtime.hpp"
 #include "rpem/daemon/state_file.hpp"
 #include "rpem/io/exit_codes.hpp"
@@ -85,6 +87,24 @@ int Daemon::run() {
   // on the control thread only.
   const int signal_fd = block_signals_into_fd();
   const FixedConfig& fixed = config_.fixed;
+  // Keys and replay protection before anything runs: a configuration that cannot authenticate its
+  // commands, an unusable key file or a lost sequence number is a configuration error (exit 78).
+  DaemonKeys keys;
+  Control::Commands commands;
+  commands.keys.channel = fixed.lcm.channel_prefix + "RPEM_COMMAND";
+  commands.sequence_file = command_sequence_file(resolve_state_file(fixed.state));
+  try {
+    keys = load_credential_keys(std::getenv("CREDENTIALS_DIRECTORY"));
+    if (const std::string problem = command_key_problem(config_.live, keys.command); !problem.empty()) {
+      throw std::runtime_error(problem);
+    }
+    commands.keys.keys = keys.command;
+    commands.last_accepted_seq = load_command_sequence(commands.sequence_file);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "rpemd: configuration error: %s\n", e.what());
+    if (signal_fd >= 0) ::close(signal_fd);
+    return io::kExitConfig;
+  }
   const bool realtime = fixed.loop.realtime != RealtimeMode::kOff;
   const bool required = fixed.loop.realtime == RealtimeMode::kRequired;
   if (fixed.loop.lock_memory && realtime) {
@@ -105,7 +125,7 @@ int Daemon::run() {
   seed_from_state_file();
   const char* source_type = SourceCatalogue::type(fixed.source);
   publisher_ = std::make_unique<Publisher>(fixed, Publisher::Identity{source_type, source_name_, state_file_status_},
-                                           Publisher::Queues{reports_, source_reports_, control_reports_});
+                                           Publisher::Queues{reports_, source_reports_, control_reports_}, keys.publish);
   start_threads();
   while (!loop_->started()) std::this_thread::sleep_for(std::chrono::milliseconds(1));
   if (!loop_->setup_problems().empty()) {
@@ -132,11 +152,20 @@ int Daemon::run() {
                config_.source_file.c_str(), io::to_string(config_.live.machine.estimator.algorithm),
                fixed.lcm.url.empty() ? "default" : fixed.lcm.url.c_str(), fixed.lcm.channel_prefix.c_str(),
                config_.live.commands_enabled ? "enabled" : "disabled", resolve_state_file(fixed.state).c_str());
+  std::string ids;
+  for (int k = 0; k < keys.command.size(); ++k) ids += (k > 0 ? ", " : "") + std::to_string(keys.command[k].id);
+  std::fprintf(stderr, "rpemd: commands %s; last accepted sequence number %lld (%s); estimates and diagnostics %s\n",
+               config_.live.command_authentication == CommandAuthentication::kNone
+                   ? "unauthenticated (authentication: none, local only)"
+                   : (ids.empty() ? std::string("need a key (none loaded)") : "authenticated with key id " + ids).c_str(),
+               static_cast<long long>(commands.last_accepted_seq), commands.sequence_file.c_str(),
+               keys.publish ? ("signed with key id " + std::to_string(keys.publish->id)).c_str()
+                            : "unsigned (no publish key)");
   sd_notifyf(0, "READY=1\nSTATUS=estimating from %s", source_name_.c_str());
 
   {
     Control control(std::move(config_), [this] { return load_configuration(options_); },
-                    Control::Queues{commands_, control_reports_}, loop_->timer());
+                    Control::Queues{commands_, control_reports_}, loop_->timer(), std::move(commands));
     (void)control.run(signal_fd);
     config_ = control.running();
   }

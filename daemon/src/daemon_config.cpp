@@ -1,5 +1,6 @@
 #include "rpem/daemon/daemon_config.hpp"
 
+#include <algorithm>
 #include <cstdlib>
 #include <filesystem>
 #include <variant>
@@ -79,6 +80,14 @@ void parse_daemon(io::YamlMap d, DaemonConfig& c, const std::string& base_dir) {
   if (auto l = d.optional_map("lcm")) parse_lcm(*l, f.lcm);
   if (auto cmd = d.optional_map("commands")) {
     c.live.commands_enabled = cmd->boolean_or("enabled", c.live.commands_enabled);
+    const std::string mode = cmd->choice_or("authentication", "hmac-sha256", {"hmac-sha256", "none"});
+    c.live.command_authentication = mode == "none" ? CommandAuthentication::kNone : CommandAuthentication::kRequired;
+    const std::string url = effective_lcm_url(f.lcm.url);
+    if (c.live.command_authentication == CommandAuthentication::kNone && !lcm_is_local(url)) {
+      cmd->fail("authentication", "`none` is for commands that cannot leave this host, but LCM's URL " + url +
+                                      " reaches the network (ttl > 0 or not udpm/memq); configure a command key instead "
+                                      "(docs/rpemd.md, \"Authentication\")");
+    }
     cmd->finish();
   }
   if (auto t = d.optional_map("temperature")) parse_temperature(*t, c.live.temperature);
@@ -171,6 +180,27 @@ std::string resolve_state_file(const StateConfig& c) {
   if (const char* xdg = std::getenv("XDG_STATE_HOME")) return std::string(xdg) + "/rpemd/estimates.json";
   if (const char* home = std::getenv("HOME")) return std::string(home) + "/.local/state/rpemd/estimates.json";
   return "rpemd-estimates.json";
+}
+
+std::string effective_lcm_url(const std::string& url) {
+  if (!url.empty()) return url;
+  if (const char* env = std::getenv("LCM_DEFAULT_URL"); env != nullptr && *env != '\0') return env;
+  return "udpm://239.255.76.67:7667?ttl=0";
+}
+
+bool lcm_is_local(const std::string& url) {
+  if (url.rfind("memq://", 0) == 0) return true;
+  if (url.rfind("udpm://", 0) != 0) return false;
+  const std::size_t query = url.find('?');
+  if (query == std::string::npos) return true;  // LCM's udpm ttl defaults to 0
+  std::size_t at = query + 1;
+  while (at < url.size()) {
+    const std::size_t end = std::min(url.find('&', at), url.size());
+    const std::string option = url.substr(at, end - at);
+    if (option.rfind("ttl=", 0) == 0) return option == "ttl=0";
+    at = end + 1;
+  }
+  return true;
 }
 
 const char* fixed_difference(const FixedConfig& a, const FixedConfig& b) {

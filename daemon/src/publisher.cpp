@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <ctime>
 #include <lcm/lcm-cpp.hpp>
+#include <span>
 #include <thread>
 
 #include "rpem/core/clock.hpp"
@@ -49,9 +50,10 @@ const char* mark(char* buf, std::size_t size, bool adapting, double age_s, bool 
 
 }  // namespace
 
-Publisher::Publisher(const FixedConfig& config, Identity identity, Queues queues)
+Publisher::Publisher(const FixedConfig& config, Identity identity, Queues queues, std::optional<auth::Key> publish_key)
     : config_(config),
       identity_(std::move(identity)),
+      publish_key_(publish_key),
       queues_(queues),
       buffer_(8192),
       estimate_channel_(config.lcm.channel_prefix + "RPEM_ESTIMATE"),
@@ -62,8 +64,14 @@ Publisher::Publisher(const FixedConfig& config, Identity identity, Queues queues
 Publisher::~Publisher() = default;
 
 template <class Message>
-void Publisher::publish(const std::string& channel, const Message& m) {
+void Publisher::publish(const std::string& channel, Message& m) {
+  constexpr bool kAuthenticated = requires { m.key_id; };
+  if constexpr (kAuthenticated) m.key_id = publish_key_ ? publish_key_->id : 0;
   const int size = m.encode(buffer_.data(), 0, static_cast<int>(buffer_.size()));
+  // Signed in the buffer, on this thread: the tag over the encoding (rpem/auth/mac.hpp), no allocation.
+  if constexpr (kAuthenticated) {
+    if (size > 0 && publish_key_) (void)auth::sign(*publish_key_, channel, std::span(buffer_.data(), static_cast<std::size_t>(size)));
+  }
   if (size < 0 || !lcm_ || !lcm_->lcm.good() ||
       lcm_->lcm.publish(channel, buffer_.data(), static_cast<unsigned>(size)) != 0) {
     ++counters_.publish_failures;

@@ -15,16 +15,11 @@
 namespace rpem::daemon {
 namespace fs = std::filesystem;
 
-std::string write_state_file(const std::string& path, const PersistedEstimates& e) {
-  nlohmann::json j;
-  j["format"] = "rpemd-estimates-1";
-  j["written_unix_s"] = e.written_unix_s;
-  j["psi_m_Wb"] = e.psi_m_Wb ? nlohmann::json(*e.psi_m_Wb) : nlohmann::json(nullptr);
-  j["r_s_Ohm"] = e.r_s_Ohm ? nlohmann::json(*e.r_s_Ohm) : nlohmann::json(nullptr);
-  if (e.psi_m_Wb) j["psi_m_adapted_unix_s"] = e.psi_m_adapted_unix_s;
-  if (e.r_s_Ohm) j["r_s_adapted_unix_s"] = e.r_s_adapted_unix_s;
-  const std::string text = j.dump(2) + "\n";
+namespace {
 
+/// A temporary file in the same directory, fsync, rename, fsync of the directory: a crash leaves the
+/// old or the new file, never a torn one. Returns an empty string or the reason it failed.
+std::string write_atomically(const std::string& path, const std::string& text) {
   const fs::path target(path);
   std::error_code ec;
   if (target.has_parent_path()) fs::create_directories(target.parent_path(), ec);
@@ -52,6 +47,47 @@ std::string write_state_file(const std::string& path, const PersistedEstimates& 
     ::close(dfd);
   }
   return "";
+}
+
+}  // namespace
+
+std::string write_state_file(const std::string& path, const PersistedEstimates& e) {
+  nlohmann::json j;
+  j["format"] = "rpemd-estimates-1";
+  j["written_unix_s"] = e.written_unix_s;
+  j["psi_m_Wb"] = e.psi_m_Wb ? nlohmann::json(*e.psi_m_Wb) : nlohmann::json(nullptr);
+  j["r_s_Ohm"] = e.r_s_Ohm ? nlohmann::json(*e.r_s_Ohm) : nlohmann::json(nullptr);
+  if (e.psi_m_Wb) j["psi_m_adapted_unix_s"] = e.psi_m_adapted_unix_s;
+  if (e.r_s_Ohm) j["r_s_adapted_unix_s"] = e.r_s_adapted_unix_s;
+  return write_atomically(path, j.dump(2) + "\n");
+}
+
+std::string command_sequence_file(const std::string& state_file) {
+  const fs::path p(state_file);
+  return (p.has_parent_path() ? p.parent_path() / "commands.json" : fs::path("commands.json")).string();
+}
+
+std::string write_command_sequence(const std::string& path, std::int64_t last_accepted_seq) {
+  return write_atomically(path, "{\"format\": \"rpemd-commands-1\", \"last_accepted_seq\": " +
+                                    std::to_string(last_accepted_seq) + "}\n");
+}
+
+std::int64_t load_command_sequence(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) {
+    if (!fs::exists(path)) return 0;
+    throw std::runtime_error(path + ": cannot read the last accepted command sequence number");
+  }
+  std::stringstream text;
+  text << in.rdbuf();
+  try {
+    const nlohmann::json j = nlohmann::json::parse(text.str());
+    if (!j.is_object() || j.value("format", "") != "rpemd-commands-1") throw std::runtime_error("not an rpemd commands file");
+    return j.at("last_accepted_seq").get<std::int64_t>();
+  } catch (const std::exception& e) {
+    throw std::runtime_error(path + ": corrupt (" + e.what() + "); it holds the last accepted command's sequence number, "
+                             "which replay protection needs: restore it, or remove it to start again from 0");
+  }
 }
 
 LoadedState load_state_file(const std::string& path, double max_age_s, double psi_min, double psi_max, double rs_min,

@@ -109,7 +109,7 @@ void write_atomically(const std::string& path, const std::string& text) {
 }
 
 std::string daemon_section(const std::string& dir, const std::string& machine, const char* extra) {
-  return "daemon:\n  machine_config: " + machine + "\n  commands: {enabled: true}\n  lcm: {url: \"" + kUrl +
+  return "daemon:\n  machine_config: " + machine + "\n  commands: {enabled: true, authentication: none}\n  lcm: {url: \"" + kUrl +
          "\"}\n  state: {file: " + dir + "/state.json, write_interval_s: 0.1}\n  status_interval_s: 0\n" + extra;
 }
 

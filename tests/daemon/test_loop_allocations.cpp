@@ -127,23 +127,34 @@ TEST(LoopAllocations, NoneOnTheAveragedPath) {
   EXPECT_GT(next, 19'000u);
 }
 
-// RPEM_COMMAND's entry point (control thread) promises no allocation either, whatever the bytes.
+// RPEM_COMMAND's entry point (control thread) promises no allocation either, whatever the bytes —
+// authentication (HMAC-SHA256 over the received bytes) included.
 TEST(LoopAllocations, NoneInCommandAdmission) {
   rpem::command_t m{};
   m.seq = 7;
   m.command = rpem::command_t::SET_VALUES;
   m.psi_m_Wb = 1.1;
   m.r_s_Ohm = 2.3;
+  auth::Key key;
+  key.id = 3;
+  key.bytes.fill(0x42);
+  auth::Keyring keys;
+  ASSERT_TRUE(keys.add(key));
+  m.key_id = key.id;
   std::vector<std::uint8_t> bytes(static_cast<std::size_t>(m.getEncodedSize()));
   ASSERT_EQ(m.encode(bytes.data(), 0, static_cast<int>(bytes.size())), static_cast<int>(bytes.size()));
+  ASSERT_TRUE(auth::sign(key, "RPEM_COMMAND", bytes));
+  std::vector<std::uint8_t> forged(bytes);
+  forged.back() ^= 1;
   std::vector<std::uint8_t> junk(bytes);
   junk[3] ^= 0x5A;
-  const CommandPolicy policy{true, 0.5, 1.7, 1.0, 4.5};
+  const CommandPolicy policy{true, 0.5, 1.7, 1.0, 4.5, CommandAuthentication::kRequired};
   const long before = g_allocations.load();
   int admitted = 0;
   for (int k = 0; k < 1000; ++k) {
-    admitted += admit_command(bytes, policy, k % 10).result == CommandResult::kApplied;
-    admitted += admit_command(junk, policy, 0).decoded;
+    admitted += admit_command(bytes, policy, keys, "RPEM_COMMAND", k % 10).result == CommandResult::kApplied;
+    admitted += admit_command(forged, policy, keys, "RPEM_COMMAND", 0).result == CommandResult::kApplied;
+    admitted += admit_command(junk, policy, keys, "RPEM_COMMAND", 0).decoded;
   }
   EXPECT_EQ(g_allocations.load() - before, 0);
   EXPECT_EQ(admitted, 700);  // last accepted 0…6 of every 10: seq 7 is new

@@ -1,6 +1,7 @@
 // Writes the seed corpus for the RPEM_COMMAND fuzzer (daemon/fuzz/fuzz_command.cpp) in its input
 // format: every command kind, valid and at D_M's edges, old and new sequence numbers, commands on and
-// off, a narrow D_M, junk and a truncated message. Run once; the files are committed under
+// off, a narrow D_M, junk and a truncated message; authentication off, and required with messages
+// signed by the harness under each held key, an unknown key, for another channel, or left unsigned. Run once; the files are committed under
 // daemon/fuzz/corpus.
 #include <cmath>
 #include <cstdint>
@@ -24,9 +25,11 @@ std::vector<std::uint8_t> encode(std::int64_t seq, std::int8_t command, double p
   return bytes;
 }
 
-void write(const std::string& path, std::uint8_t flags, std::int64_t last, const std::vector<std::vector<std::uint8_t>>& messages) {
+void write(const std::string& path, std::uint8_t flags, std::int64_t last, const std::vector<std::vector<std::uint8_t>>& messages,
+           std::uint8_t auth = 0) {
   std::ofstream out(path, std::ios::binary);
   out.put(static_cast<char>(flags));
+  out.put(static_cast<char>(auth));
   for (int k = 0; k < 8; ++k) out.put(static_cast<char>((static_cast<std::uint64_t>(last) >> (8 * k)) & 0xFF));
   for (const auto& m : messages) {
     out.put(static_cast<char>(m.size()));
@@ -53,5 +56,11 @@ int main(int argc, char** argv) {
   write(dir + "/narrow_bounds", 0x07, 0, {set, encode(9, command_t::SET_VALUES, 1.1, 2.2)});
   write(dir + "/malformed", 0xFF, 0, {junk, truncated, set});
   write(dir + "/busy", 0x01, 0, {reset, freeze, unfreeze, set, edge, encode(10, command_t::RESET, 0, 0)});
+  // auth byte: bit 0 required; bits 1-2 signed with key 1, key 2, key 9 (unknown); bit 3 for another channel.
+  write(dir + "/auth_key1", 0xFD, 0, {reset, freeze, unfreeze, set, edge, outside, old}, 0x03);
+  write(dir + "/auth_key2", 0x55, 1, {reset, freeze, set, edge}, 0x05);
+  write(dir + "/auth_unknown_key", 0x01, 0, {reset, set}, 0x07);
+  write(dir + "/auth_other_channel", 0x01, 0, {reset, set}, 0x0B);
+  write(dir + "/auth_unsigned", 0xFF, 0, {reset, junk, truncated, set}, 0x01);
   return 0;
 }

@@ -37,7 +37,7 @@ case $target in
                        corpus=io/fuzz/corpus/machine_config; opts=("${yaml_opts[@]}") asan=$yaml_asan ;;
   fuzz_scenario)       main=sim/fuzz/fuzz_scenario.cpp;       objs=("$repo"/sim/src/*.cpp "${io[@]}" "${core[@]}")
                        corpus=sim/fuzz/corpus; opts=("${yaml_opts[@]}") asan=$yaml_asan ;;
-  fuzz_command)        main=daemon/fuzz/fuzz_command.cpp;     objs=("$repo/daemon/src/command_gate.cpp")
+  fuzz_command)        main=daemon/fuzz/fuzz_command.cpp;     objs=("$repo/daemon/src/command_gate.cpp" "$repo/auth/src/mac.cpp")
                        corpus=daemon/fuzz/corpus
                        # rpemd's RPEM_COMMAND entry point; the LCM types are generated in the build
                        [[ -f $build/lcm_types/cpp/rpem/command_t.hpp ]] || cmake --build "$build" --target rpem_lcm_cpp >/dev/null ;;
@@ -51,14 +51,14 @@ dir=$build/fuzz
 mkdir -p "$dir/$target/corpus"
 {
   echo "cxx = clang++ -std=c++20 -O1 -g -fno-sanitize-recover=undefined -I$repo/can/include -I$repo/core/include" \
-       "-I$repo/io/include -I$repo/sim/include -I$repo/daemon/include -isystem /usr/include/eigen3" \
+       "-I$repo/io/include -I$repo/sim/include -I$repo/daemon/include -I$repo/auth/include -isystem /usr/include/eigen3" \
        "-isystem $build/lcm_types/cpp"
   echo "rule cc"
   echo "  command = \$cxx -fsanitize=fuzzer-no-link,address,undefined -MD -MF \$out.d -c \$in -o \$out"
   echo "  depfile = \$out.d"
   echo "  deps = gcc"
   echo "rule link"
-  echo "  command = \$cxx -fsanitize=fuzzer,address,undefined \$in -lyaml-cpp -o \$out"
+  echo "  command = \$cxx -fsanitize=fuzzer,address,undefined \$in -lyaml-cpp -lsodium -o \$out"
   list=()
   for src in "$repo/$main" "${objs[@]}"; do
     rel=${src#"$repo"/}

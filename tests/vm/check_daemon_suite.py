@@ -8,7 +8,11 @@
    without loss, with 10 % random frame loss, and with 10 % loss in bursts of 12 frames (gaps counted).
 2. Faults: vcan0 down → stale, up → running again without a restart (reopen counted); a blocked LCM
    route → publish failures counted and the loop's overrun rate unchanged; malformed frames and
-   commands counted and ignored, commands acknowledged; SIGKILL and restart resume from the state file.
+   commands counted and ignored, keyed commands acknowledged; an attacker without the keys (unsigned and
+   guessed-key commands with larger sequence numbers, a captured command replayed and bit-flipped,
+   forged estimates) gets nothing applied, each attack counted by its reason, rpemd's estimates kept,
+   the forged ones flagged FORGED by `rpem listen --key`; SIGKILL and restart resume from the state
+   file, and the captured command is still a replay after the restart.
 3. Storm: SIGHUP, commands and vcan0 down/up at once — commands applied once and in order, reloads
    applied or refused with a counted reason, the socket reopened, the state file whole.
 """
@@ -28,7 +32,7 @@ def check(ok, what):
 
 def estimates(path):
     rows = list(csv.DictReader(open(path)))
-    return [{k: float(v) for k, v in r.items()} for r in rows]
+    return [{k: (v if k == "auth" else float(v)) for k, v in r.items()} for r in rows]
 
 
 def truth(path):
@@ -162,13 +166,28 @@ def main(out):
         rate_block = (after[0]["overruns"] - before[-1]["overruns"]) / max(1e-6, (after[0]["utime"] - before[-1]["utime"]) * 1e-6)
         check(rate_block <= 2.0 * rate_before + 5.0,
               f"faults: loop overruns {rate_block:.1f}/s while LCM was blocked, {rate_before:.1f}/s before (emulated VM)")
-    final = [x for x in diag if events["malformed"] < x["utime"] < events["sigkill"]]
+    final = [x for x in diag if events["malformed"] < x["utime"] < events["attacker"]]
     last = final[-1] if final else {}
     check(last.get("crc", 0) >= 1 and last.get("dlc", 0) >= 2, f"faults: malformed frames counted (crc {last.get('crc')}, dlc {last.get('dlc')})")
     check(last.get("malformed", 0) >= 1, "faults: the malformed command counted")
     check(last.get("rejected", 0) >= 1, "faults: the command with an old sequence number rejected")
     check(last.get("last seq") == 6 and last.get("last result") == 1, "faults: the last command (seq 6) acknowledged as applied")
     check(any(e["frozen"] == 1 for e in est if e["utime"] >= events["malformed"]), "faults: freeze applied")
+
+    # The attacker (issue 13): nothing applied, each attack counted by its reason, rpemd's estimates
+    # kept (and verified), the forged ones flagged by `rpem listen --key`.
+    attack = [x for x in diag if events["attacker end"] < x["utime"] < events["sigkill"]]
+    a = attack[-1] if attack else {}
+    check(a.get("applied", -1) == last.get("applied", -2), f"attacker: no command applied ({last.get('applied')} before, {a.get('applied')} after)")
+    check(a.get("unauthenticated", 0) - last.get("unauthenticated", 0) == 1, "attacker: the unsigned command counted as unauthenticated")
+    check(a.get("bad mac", 0) - last.get("bad mac", 0) == 3, f"attacker: the guessed-key commands and the flipped bit counted as bad MAC ({a.get('bad mac')})")
+    check(a.get("replayed", 0) - last.get("replayed", 0) == 1, "attacker: the captured command's replay counted as replayed")
+    ours = [e for e in est if e["utime"] >= events["attacker"] and e.get("auth") == "verified"]
+    forged = [e for e in est if e.get("auth") == "FORGED"]
+    check(len(forged) == 3 and all(abs(e["psi_m"] - 0.6) < 1e-9 for e in forged), f"attacker: rpem listen flagged the 3 forged estimates as FORGED ({len(forged)})")
+    check(bool(ours) and all(abs(e["psi_m"] - 0.6) > 0.1 and e["frozen"] == 0 for e in ours),
+          "attacker: rpemd's own (verified) estimates kept their values and stayed unfrozen")
+    check(all(e.get("auth") in ("verified", "FORGED") for e in est), "attacker: every other estimate verified under the publish key")
 
     restart_log = open(f"{out}/restarted_rpemd.txt").read()
     check("resuming from estimates" in restart_log, "restart: rpemd resumed from its state file after SIGKILL")
@@ -185,6 +204,8 @@ def main(out):
           "not the configured 1.14 Wb")
     after_restart = [x for x in diag if x["utime"] > events["sigkill"]]
     check(bool(after_restart) and after_restart[-1].get("state file") == 1, "restart: diagnostics report the state file loaded")
+    check(bool(after_restart) and after_restart[-1].get("replayed") == 1 and after_restart[-1].get("applied") == 0,
+          "restart: the captured command is still a replay after the restart (sequence number persisted)")
 
     storm(out)
     print("check_daemon_suite: " + ("passed" if not failures else f"{len(failures)} failed"))

@@ -6,11 +6,23 @@ out=${1:-/host}
 cfg=rpemd-vcan.yaml
 rate=0.4  # the emulated VM cannot run drive, daemon and listener at 8 kHz in real time
 step() { echo "daemon_suite: $*"; }
+# Keys (docs/rpemd.md, "Authentication"): rpemd reads them from $CREDENTIALS_DIRECTORY as systemd's
+# LoadCredential= hands them over; the supervisor holds the command key and the publish key, the
+# attacker only keys of its own (one under the command key's id, one under the publish key's).
+keys=/tmp/keys
+rm -rf $keys; mkdir -p -m 700 $keys/credentials $keys/attacker
+rpem keygen --id 1 --out $keys/credentials/command.key
+rpem keygen --id 2 --out $keys/credentials/publish.key
+rpem keygen --id 1 --out $keys/attacker/guess.key
+rpem keygen --id 2 --out $keys/attacker/publish.key
+export CREDENTIALS_DIRECTORY=$keys/credentials
+cmd="rpem command --key $keys/credentials/command.key"
+listen_keyed="rpem listen --key $keys/credentials/publish.key"
 start_rpemd() { rpemd --config "${2:-$cfg}" > "$out/$1_rpemd.txt" 2>&1 & echo $! > /tmp/rpemd.pid; }
 # A run with the drive streaming the steady scenario and `rpem listen` recording: start_streaming NAME [CONFIG]
 start_streaming() {
   start_rpemd "$1" "$2"
-  rpem listen --diagnostics --csv "$out/$1_est.csv" > "$out/$1_listen.txt" 2>&1 &
+  $listen_keyed --diagnostics --csv "$out/$1_est.csv" > "$out/$1_listen.txt" 2>&1 &
   listen=$!
   sleep 1
   rpem sim --scenario e2e-steady.yaml --can vcan0 --rate $rate 2> "$out/$1_sim.txt" &
@@ -23,7 +35,7 @@ run_steps() {  # name, extra rpem sim options
   step "$name: -8 % steps of R_s and psi_m, sim options: $*"
   rm -rf /tmp/rpemd
   start_rpemd "$name"
-  rpem listen --csv "$out/${name}_est.csv" --diagnostics > "$out/${name}_listen.txt" 2>&1 &
+  $listen_keyed --csv "$out/${name}_est.csv" --diagnostics > "$out/${name}_listen.txt" 2>&1 &
   listen=$!
   sleep 2
   rpem sim --scenario e2e-steps.yaml --can vcan0 --rate $rate --truth "$out/${name}_truth.csv" "$@" 2> "$out/${name}_sim.txt"
@@ -53,16 +65,30 @@ cansend vcan0 100##1.00112233                       # CAN FD frame of the wrong 
 cansend vcan0 100##1$(printf '%0128d' 7)             # right length, garbage: CRC mismatch
 cansend vcan0 110#0011223344                         # classic frame of the wrong length
 rpem command --malformed
-rpem command freeze --seq 5
-rpem command unfreeze --seq 5                        # an old sequence number: rejected
-rpem command unfreeze --seq 6
+$cmd freeze --seq 5
+$cmd unfreeze --seq 5                                # an old sequence number: rejected
+$cmd unfreeze --seq 6 --save $keys/attacker/captured.bin   # the attacker captures it on the network
 sleep 2
+# The attacker, without the keys (issue 13): well-formed commands with larger sequence numbers, unsigned
+# and under a guessed key; the captured command replayed and with one bit flipped; forged estimates.
+echo "$(date +%s) attacker" >> "$out/faults_events.txt"
+rpem command set --seq 1000 --psi-m 0.6 --r-s 1.2
+rpem command --key $keys/attacker/guess.key set --seq 1001 --psi-m 0.6 --r-s 1.2
+rpem command --key $keys/attacker/guess.key freeze --seq 1002
+rpem command --resend $keys/attacker/captured.bin
+rpem command --resend $keys/attacker/captured.bin --flip-bit 130
+for i in 1 2 3; do rpem publish-estimate --psi-m 0.6 --r-s 1.2 --key $keys/attacker/publish.key; sleep 0.3; done
+sleep 2
+echo "$(date +%s) attacker end" >> "$out/faults_events.txt"
+sleep 3                                              # diagnostics (1 Hz) after the attacks, before the kill
 echo "$(date +%s) sigkill" >> "$out/faults_events.txt"
 kill -KILL "$(cat /tmp/rpemd.pid)"
 cp /tmp/rpemd/estimates.json "$out/killed_state.json" 2>/dev/null   # what the restart must resume from
 sleep 1
 start_rpemd restarted
-sleep 4
+sleep 2
+rpem command --resend $keys/attacker/captured.bin       # still a replay: the sequence number persisted
+sleep 2
 stop_rpemd
 kill $sim 2>/dev/null; wait $sim 2>/dev/null
 kill -INT $listen; wait $listen
@@ -84,7 +110,7 @@ start_streaming storm /tmp/storm.yaml
 pid=$(cat /tmp/rpemd.pid)
 sleep 15
 echo "$(date +%s) storm start" >> "$out/storm_events.txt"
-rpem command unfreeze --seq 100 --repeat 1000 --interval-ms 10 2> "$out/storm_commands.txt" &
+$cmd unfreeze --seq 100 --repeat 1000 --interval-ms 10 2> "$out/storm_commands.txt" &
 commands=$!
 (
   i=0
@@ -104,8 +130,8 @@ echo "$(date +%s) storm end" >> "$out/storm_events.txt"
 cp /tmp/storm-a.yaml /tmp/storm.new && mv /tmp/storm.new /tmp/storm.yaml
 kill -HUP $pid
 sleep 2
-rpem command freeze --seq 2000                       # first: a set before it would adapt until the freeze came
-rpem command set --seq 2001 --psi-m 1.123 --r-s 2.345
+$cmd freeze --seq 2000                       # first: a set before it would adapt until the freeze came
+$cmd set --seq 2001 --psi-m 1.123 --r-s 2.345
 sleep 4
 stop_rpemd
 kill $sim 2>/dev/null; wait $sim 2>/dev/null

@@ -25,6 +25,8 @@ Runner add_replay_command(CLI::App& app);
 Runner add_record_command(CLI::App& app);
 Runner add_listen_command(CLI::App& app);
 Runner add_command_command(CLI::App& app);
+Runner add_publish_estimate_command(CLI::App& app);
+Runner add_keygen_command(CLI::App& app);
 Runner add_diagnose_command(CLI::App& app);
 
 }  // namespace rpem::tools

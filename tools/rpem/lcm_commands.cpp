@@ -1,7 +1,13 @@
-// rpem listen [--prefix P] [--duration S] [--csv FILE]      prints (and records) rpemd's estimates
-// rpem command [--prefix P] --seq N reset|freeze|unfreeze|set [--psi-m WB --r-s OHM] [--repeat K --interval-ms M]
-//                                                          sends a supervisory command to rpemd (K times:
+// rpem listen [--prefix P] [--duration S] [--csv FILE] [--key FILE]
+//                                                          prints (and records) rpemd's estimates; with a
+//                                                          key, each one verified, FORGED or unverified
+// rpem command [--prefix P] --key FILE --seq N reset|freeze|unfreeze|set [--psi-m WB --r-s OHM]
+//              [--repeat K --interval-ms M] [--save FILE]  sends a supervisory command to rpemd (K times:
 //                                                          sequence numbers N … N+K−1, M ms apart)
+// rpem command --resend FILE [--flip-bit B]                sends saved bytes again (tests of rpemd's checks)
+// rpem publish-estimate --psi-m WB [--key FILE]            publishes one RPEM_ESTIMATE (tests of consumers)
+// rpem keygen --id N --out FILE                            writes a new key file (mode 0600)
+// Keys: rpem/auth/key_file.hpp, docs/rpemd.md "Authentication".
 
 #include <atomic>
 #include <chrono>
@@ -9,10 +15,15 @@
 #include <cstdio>
 #include <ctime>
 #include <fstream>
+#include <iterator>
+#include <optional>
+#include <span>
+#include <vector>
 #include <lcm/lcm-cpp.hpp>
 #include <thread>
 
 #include "commands.hpp"
+#include "rpem/auth/key_file.hpp"
 #include "rpem/command_t.hpp"
 #include "rpem/core/clock.hpp"
 #include "rpem/diagnostics_t.hpp"
@@ -30,12 +41,43 @@ struct ListenOptions {
   double duration_s = 0.0;
   std::string csv;
   bool diagnostics = false;
+  std::string key_file;
 };
+
+/// Loads --key FILE (if given) into a keyring; throws auth::KeyError.
+auth::Keyring keyring_of(const std::string& key_file) {
+  auth::Keyring keys;
+  if (!key_file.empty()) keys.add(auth::load_key_file(key_file));
+  return keys;
+}
+
+/// "verified", "FORGED" (a key this listener holds, a wrong MAC) or "unverified (why)".
+std::string authenticity(const auth::Keyring& keys, const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
+  const std::span bytes(static_cast<const std::uint8_t*>(rbuf->data), rbuf->data_size);
+  const std::int32_t id = auth::key_id_of(bytes);
+  switch (auth::verify(keys, channel, bytes)) {
+    case auth::Verdict::kVerified: return "verified";
+    case auth::Verdict::kBadMac: return "FORGED";
+    case auth::Verdict::kUnsigned: return "unverified (unsigned)";
+    case auth::Verdict::kUnknownKey:
+      return keys.empty() ? "unverified (no --key)" : "unverified (key id " + std::to_string(id) + " not held)";
+    case auth::Verdict::kMalformed: break;
+  }
+  return "unverified (malformed)";
+}
 
 struct Listener {
   std::ofstream csv;
   std::int64_t estimates = 0, diagnostics = 0;
+  std::int64_t verified = 0, forged = 0, unverified = 0;
   bool print_diagnostics = false;
+  auth::Keyring keys;
+
+  std::string check(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
+    std::string verdict = authenticity(keys, rbuf, channel);
+    (verdict == "verified" ? verified : verdict == "FORGED" ? forged : unverified) += 1;
+    return verdict;
+  }
 
   /// "adapting", "held 28.0 s" (since its last adaptation) or "initial" (never adapted), then
   /// "valid" and "converged" where they hold.
@@ -48,31 +90,33 @@ struct Listener {
     return s;
   }
 
-  void on_estimate(const lcm::ReceiveBuffer*, const std::string&, const rpem::estimate_t* m) {
+  void on_estimate(const lcm::ReceiveBuffer* rbuf, const std::string& channel, const rpem::estimate_t* m) {
     ++estimates;
-    std::printf("%.3f s  state %d  n %+.3f pu  psi_m %.5f Wb %s  r_s %.5f Ohm %s  T_magnet %.1f C  T_winding %.1f C  %s\n",
+    const std::string verdict = check(rbuf, channel);
+    std::printf("%.3f s  state %d  n %+.3f pu  psi_m %.5f Wb %s  r_s %.5f Ohm %s  T_magnet %.1f C  T_winding %.1f C  %s  %s\n",
                 1e-6 * static_cast<double>(m->sample_time_us), m->state, m->speed_pu, m->psi_m_Wb,
                 describe(m->psi_m_adapting, m->psi_m_age_s, m->psi_m_valid, m->psi_m_converged).c_str(), m->r_s_Ohm,
                 describe(m->r_s_adapting, m->r_s_age_s, m->r_s_valid, m->r_s_converged).c_str(), m->t_magnet_C,
-                m->t_winding_C, m->algorithm.c_str());
+                m->t_winding_C, m->algorithm.c_str(), verdict.c_str());
     std::fflush(stdout);
     if (csv.is_open()) {
       csv << m->utime << ',' << m->sample_time_us << ',' << m->samples << ',' << m->psi_m_Wb << ',' << m->r_s_Ohm << ','
           << m->t_magnet_C << ',' << m->t_winding_C << ',' << m->speed_pu << ',' << int(m->psi_m_valid) << ','
           << int(m->r_s_valid) << ',' << int(m->psi_m_converged) << ',' << int(m->r_s_converged) << ','
           << int(m->psi_m_adapting) << ',' << int(m->r_s_adapting) << ',' << int(m->frozen) << ',' << int(m->state) << ','
-          << m->psi_m_age_s << ',' << m->r_s_age_s << '\n';
+          << m->psi_m_age_s << ',' << m->r_s_age_s << ',' << verdict.substr(0, verdict.find(' ')) << '\n';
       csv.flush();
     }
   }
-  void on_diagnostics(const lcm::ReceiveBuffer*, const std::string&, const rpem::diagnostics_t* m) {
+  void on_diagnostics(const lcm::ReceiveBuffer* rbuf, const std::string& channel, const rpem::diagnostics_t* m) {
     ++diagnostics;
+    const std::string verdict = check(rbuf, channel);
     if (!print_diagnostics) return;
     std::printf("diag %lld: state %d samples %lld resyncs %lld overruns %lld latency p99 %.1f us max %.1f us | rx->publish p99 %.0f us | can frames %lld "
                 "lost %lld crc %lld dlc %lld unknown %lld gaps %lld kernel drops %lld reopens %lld | queue drops in %lld "
                 "out %lld | publish failures %lld | commands %lld malformed %lld rejected %lld last %lld:%d | applied %lld "
-                "sequence errors %lld | reload requests %lld reloads %lld invalid %lld restart required %lld busy %lld | "
-                "state file %d\n",
+                "sequence errors %lld | unauthenticated %lld unknown key %lld bad mac %lld replayed %lld | reload requests %lld "
+                "reloads %lld invalid %lld restart required %lld busy %lld | state file %d | %s\n",
                 static_cast<long long>(m->utime), static_cast<int>(m->state), static_cast<long long>(m->samples),
                 static_cast<long long>(m->resyncs),
                 static_cast<long long>(m->overruns), m->wakeup_latency_p99_us, m->wakeup_latency_max_us,
@@ -86,9 +130,11 @@ struct Listener {
                 static_cast<long long>(m->commands_malformed), static_cast<long long>(m->commands_rejected),
                 static_cast<long long>(m->last_command_seq), m->last_command_result,
                 static_cast<long long>(m->commands_applied), static_cast<long long>(m->command_sequence_errors),
+                static_cast<long long>(m->commands_unauthenticated), static_cast<long long>(m->commands_unknown_key),
+                static_cast<long long>(m->commands_bad_mac), static_cast<long long>(m->commands_replayed),
                 static_cast<long long>(m->config_reload_requests), static_cast<long long>(m->config_reloads),
                 static_cast<long long>(m->config_reloads_invalid), static_cast<long long>(m->config_reloads_restart_required),
-                static_cast<long long>(m->config_reloads_busy), m->state_file_status);
+                static_cast<long long>(m->config_reloads_busy), m->state_file_status, verdict.c_str());
     if (m->source == "vesc") {
       std::printf("diag %lld vesc: polls %lld replies %lld timeouts %lld late %lld unrequested %lld stolen_reads %lld "
                   "short_windows %lld buffer_errors %lld bad_replies %lld short_replies %lld statuses %lld "
@@ -113,10 +159,16 @@ int run_listen(const ListenOptions& o) {
   }
   Listener listener;
   listener.print_diagnostics = o.diagnostics;
+  try {
+    listener.keys = keyring_of(o.key_file);
+  } catch (const auth::KeyError& e) {
+    std::fprintf(stderr, "rpem listen: %s\n", e.what());
+    return kExitConfig;
+  }
   if (!o.csv.empty()) {
     listener.csv.open(o.csv, std::ios::trunc);
     listener.csv << "utime,sample_time_us,samples,psi_m,r_s,T_magnet,T_winding,n_pu,psi_m_valid,r_s_valid,"
-                    "psi_m_converged,r_s_converged,psi_m_adapting,r_s_adapting,frozen,state,psi_m_age_s,r_s_age_s\n";
+                    "psi_m_converged,r_s_converged,psi_m_adapting,r_s_adapting,frozen,state,psi_m_age_s,r_s_age_s,auth\n";
   }
   lcm.subscribe(o.prefix + "RPEM_ESTIMATE", &Listener::on_estimate, &listener);
   lcm.subscribe(o.prefix + "RPEM_DIAGNOSTICS", &Listener::on_diagnostics, &listener);
@@ -124,8 +176,10 @@ int run_listen(const ListenOptions& o) {
   std::signal(SIGTERM, on_signal);
   const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(o.duration_s > 0 ? o.duration_s : 1e9);
   while (!g_stop && std::chrono::steady_clock::now() < end) lcm.handleTimeout(100);
-  std::fprintf(stderr, "rpem listen: %lld estimates, %lld diagnostics\n", static_cast<long long>(listener.estimates),
-               static_cast<long long>(listener.diagnostics));
+  std::fprintf(stderr, "rpem listen: %lld estimates, %lld diagnostics; %lld verified, %lld FORGED, %lld unverified\n",
+               static_cast<long long>(listener.estimates), static_cast<long long>(listener.diagnostics),
+               static_cast<long long>(listener.verified), static_cast<long long>(listener.forged),
+               static_cast<long long>(listener.unverified));
   return listener.estimates > 0 ? kExitOk : 1;
 }
 
@@ -139,7 +193,25 @@ struct CommandOptions {
   bool malformed = false;
   std::int64_t repeat = 1;
   double interval_ms = 0.0;
+  std::string key_file;
+  std::string save;    ///< also write the (last) message's bytes here
+  std::string resend;  ///< send these saved bytes instead
+  int flip_bit = -1;   ///< with resend: flip this bit (0 = the first byte's lowest) first
 };
+
+/// Encodes `m` (key id from `key`, or 0) and signs it for `channel`.
+template <class Message>
+std::vector<std::uint8_t> encode_signed(Message& m, const std::optional<auth::Key>& key, const std::string& channel) {
+  m.key_id = key ? key->id : 0;
+  std::vector<std::uint8_t> bytes(static_cast<std::size_t>(m.getEncodedSize()));
+  m.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
+  if (key) auth::sign(*key, channel, bytes);
+  return bytes;
+}
+
+std::optional<auth::Key> optional_key(const std::string& file) {
+  return file.empty() ? std::nullopt : std::optional<auth::Key>(auth::load_key_file(file));
+}
 
 int run_command(const CommandOptions& o) {
   lcm::LCM lcm(o.url);
@@ -148,6 +220,29 @@ int run_command(const CommandOptions& o) {
     return kExitIoError;
   }
   const std::string channel = o.prefix + "RPEM_COMMAND";
+  if (!o.resend.empty()) {
+    std::ifstream in(o.resend, std::ios::binary);
+    std::vector<char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    if (!in.good() && !in.eof()) return kExitIoError;
+    if (o.flip_bit >= 0) {
+      if (static_cast<std::size_t>(o.flip_bit / 8) >= bytes.size()) {
+        std::fprintf(stderr, "rpem command: --flip-bit %d is beyond the %zu bytes of %s\n", o.flip_bit, bytes.size(), o.resend.c_str());
+        return kExitUsage;
+      }
+      bytes[static_cast<std::size_t>(o.flip_bit / 8)] ^= static_cast<char>(1 << (o.flip_bit % 8));
+    }
+    lcm.publish(channel, bytes.data(), static_cast<unsigned>(bytes.size()));
+    std::fprintf(stderr, "rpem command: resent %zu bytes of %s%s on %s\n", bytes.size(), o.resend.c_str(),
+                 o.flip_bit >= 0 ? (" with bit " + std::to_string(o.flip_bit) + " flipped").c_str() : "", channel.c_str());
+    return kExitOk;
+  }
+  std::optional<auth::Key> key;
+  try {
+    key = optional_key(o.key_file);
+  } catch (const auth::KeyError& e) {
+    std::fprintf(stderr, "rpem command: %s\n", e.what());
+    return kExitConfig;
+  }
   if (o.malformed) {
     const char junk[] = "this is not an rpem command_t";
     lcm.publish(channel, junk, sizeof junk);
@@ -167,11 +262,14 @@ int run_command(const CommandOptions& o) {
     if (k > 0) core::sleep_until_ns(CLOCK_MONOTONIC, start_ns + k * period_ns);
     m.utime = core::now_ns(CLOCK_REALTIME) / 1000;
     m.seq = o.seq + k;
-    if (lcm.publish(channel, &m) != 0) {
+    const std::vector<std::uint8_t> bytes = encode_signed(m, key, channel);
+    if (lcm.publish(channel, bytes.data(), static_cast<unsigned>(bytes.size())) != 0) {
       std::fprintf(stderr, "rpem command: publish failed\n");
       return kExitIoError;
     }
+    if (!o.save.empty()) std::ofstream(o.save, std::ios::binary | std::ios::trunc).write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
   }
+  if (!key) std::fprintf(stderr, "rpem command: warning: no --key: the command is unsigned, and rpemd applies it only with authentication: none\n");
   std::fprintf(stderr, "rpem command: %s (seq %lld%s) sent on %s; see RPEM_DIAGNOSTICS for the acknowledgement\n",
                o.action.c_str(), static_cast<long long>(o.seq),
                o.repeat > 1 ? (" to " + std::to_string(o.seq + o.repeat - 1)).c_str() : "", channel.c_str());
@@ -188,6 +286,7 @@ Runner add_listen_command(CLI::App& app) {
   cmd->add_option("--duration", opts->duration_s, "stop after this many seconds");
   cmd->add_option("--csv", opts->csv, "also write every estimate to this CSV");
   cmd->add_flag("--diagnostics", opts->diagnostics, "print RPEM_DIAGNOSTICS too");
+  cmd->add_option("--key", opts->key_file, "verify each message with this key file (rpemd's publish key)");
   return [cmd, opts]() { return cmd->parsed() ? run_listen(*opts) : -1; };
 }
 
@@ -196,17 +295,84 @@ Runner add_command_command(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand("command", "Send a supervisory command to rpemd (RPEM_COMMAND)");
   cmd->add_option("action", opts->action, "reset | freeze | unfreeze | set")
       ->check(CLI::IsMember({"reset", "freeze", "unfreeze", "set"}));
+  cmd->callback([cmd, opts] {
+    if (opts->resend.empty() && !opts->malformed && opts->action.empty()) throw CLI::RequiredError("action");
+  });
   cmd->add_option("--seq", opts->seq, "sequence number, larger than the last accepted one");
   cmd->add_option("--psi-m", opts->psi_m_Wb, "set: magnet flux linkage [Wb]");
   cmd->add_option("--r-s", opts->r_s_Ohm, "set: stator resistance [Ohm]");
   cmd->add_option("--prefix", opts->prefix, "channel prefix of the rpemd instance");
   cmd->add_option("--lcm-url", opts->url, "LCM URL (default: LCM's default)");
+  cmd->add_option("--key", opts->key_file, "sign with this key file (one of rpemd's command keys)");
+  cmd->add_option("--save", opts->save, "also write the message's bytes to this file");
+  cmd->add_option("--resend", opts->resend, "send the bytes of a file written by --save instead (a test of rpemd's checks)");
+  cmd->add_option("--flip-bit", opts->flip_bit, "with --resend: flip this bit first (0: the first byte's lowest)")
+      ->check(CLI::Range(0, 1 << 20));
   cmd->add_flag("--malformed", opts->malformed, "send an undecodable message (a test of rpemd's input checks)");
   cmd->add_option("--repeat", opts->repeat, "send it this many times, with consecutive sequence numbers")
       ->check(CLI::Range(std::int64_t{1}, std::int64_t{10'000'000}));
   cmd->add_option("--interval-ms", opts->interval_ms, "with --repeat: this long between sends [ms]")
       ->check(CLI::Range(0.0, 60'000.0));
   return [cmd, opts]() { return cmd->parsed() ? run_command(*opts) : -1; };
+}
+
+Runner add_publish_estimate_command(CLI::App& app) {
+  struct Options {
+    std::string prefix, url, key_file;
+    double psi_m_Wb = 1.0, r_s_Ohm = 1.0;
+  };
+  auto opts = std::make_shared<Options>();
+  CLI::App* cmd = app.add_subcommand("publish-estimate", "Publish one RPEM_ESTIMATE (a test of consumers' verification)");
+  cmd->add_option("--psi-m", opts->psi_m_Wb, "magnet flux linkage [Wb]");
+  cmd->add_option("--r-s", opts->r_s_Ohm, "stator resistance [Ohm]");
+  cmd->add_option("--key", opts->key_file, "sign with this key file (else unsigned)");
+  cmd->add_option("--prefix", opts->prefix, "channel prefix");
+  cmd->add_option("--lcm-url", opts->url, "LCM URL (default: LCM's default)");
+  return [cmd, opts]() {
+    if (!cmd->parsed()) return -1;
+    lcm::LCM lcm(opts->url);
+    if (!lcm.good()) return kExitIoError;
+    std::optional<auth::Key> key;
+    try {
+      key = optional_key(opts->key_file);
+    } catch (const auth::KeyError& e) {
+      std::fprintf(stderr, "rpem publish-estimate: %s\n", e.what());
+      return kExitConfig;
+    }
+    rpem::estimate_t m{};
+    m.utime = core::now_ns(CLOCK_REALTIME) / 1000;
+    m.psi_m_Wb = opts->psi_m_Wb;
+    m.r_s_Ohm = opts->r_s_Ohm;
+    m.psi_m_valid = m.r_s_valid = true;
+    m.state = 1;
+    m.algorithm = "sga";
+    const std::string channel = opts->prefix + "RPEM_ESTIMATE";
+    const std::vector<std::uint8_t> bytes = encode_signed(m, key, channel);
+    return lcm.publish(channel, bytes.data(), static_cast<unsigned>(bytes.size())) == 0 ? kExitOk : kExitIoError;
+  };
+}
+
+Runner add_keygen_command(CLI::App& app) {
+  struct Options {
+    std::int32_t id = 1;
+    std::string out;
+  };
+  auto opts = std::make_shared<Options>();
+  CLI::App* cmd = app.add_subcommand("keygen", "Write a new random key file (mode 0600) for rpemd's channels");
+  cmd->add_option("--id", opts->id, "key id, 1..2147483647 (a new id for each new key: rotation)")
+      ->check(CLI::Range(1, 2147483647));
+  cmd->add_option("--out", opts->out, "the key file to create (never replaced)")->required();
+  return [cmd, opts]() {
+    if (!cmd->parsed()) return -1;
+    try {
+      auth::write_key_file(opts->out, auth::generate_key(opts->id));
+    } catch (const auth::KeyError& e) {
+      std::fprintf(stderr, "rpem keygen: %s\n", e.what());
+      return kExitIoError;
+    }
+    std::fprintf(stderr, "rpem keygen: key id %d written to %s (mode 0600)\n", opts->id, opts->out.c_str());
+    return kExitOk;
+  };
 }
 
 }  // namespace rpem::tools

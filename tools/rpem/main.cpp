@@ -21,6 +21,8 @@ int main(int argc, char** argv) {
   runners.push_back(add_record_command(app));
   runners.push_back(add_listen_command(app));
   runners.push_back(add_command_command(app));
+  runners.push_back(add_publish_estimate_command(app));
+  runners.push_back(add_keygen_command(app));
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -6,6 +6,7 @@
 // the loop will be running when it gets there. It feeds systemd's watchdog while the loop's heartbeat
 // advances, and returns on SIGTERM or SIGINT.
 
+#include <array>
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -39,8 +40,14 @@ class Control {
   };
   /// Reads the configuration again (the file, with the command line's overrides); throws io::InputError.
   using Reload = std::function<DaemonConfig()>;
+  /// Whom commands must come from, and where the last accepted sequence number is kept.
+  struct Commands {
+    CommandKeys keys;
+    std::int64_t last_accepted_seq = 0;
+    std::string sequence_file;  ///< state_file.hpp: command_sequence_file()
+  };
 
-  Control(DaemonConfig running, Reload reload, Queues queues, const LoopTimer& loop);
+  Control(DaemonConfig running, Reload reload, Queues queues, const LoopTimer& loop, Commands commands);
   ~Control();
 
   /// Runs until SIGTERM or SIGINT arrives on `signal_fd` (a signalfd for SIGTERM, SIGINT and SIGHUP,
@@ -54,6 +61,7 @@ class Control {
   struct Lcm;
   void connect_lcm(std::int64_t now_ns);
   void on_command(const lcm::ReceiveBuffer* message, const std::string& channel);
+  void log_rejection(CommandResult result, std::int64_t seq, std::int32_t key_id);
   void reload();
   void report();
   void watchdog(std::int64_t now_ns);
@@ -62,7 +70,18 @@ class Control {
   Reload reload_;
   Queues queues_;
   const LoopTimer& loop_;
+  class FileSequenceStore : public SequenceStore {
+   public:
+    explicit FileSequenceStore(std::string path) : path_(std::move(path)) {}
+    bool store(std::int64_t seq) noexcept override;
+
+   private:
+    std::string path_;
+  } sequence_store_;
   CommandGate gate_;
+  /// Rejections are logged at most once per reason per kRejectionLogInterval; the rest are counted.
+  std::array<std::int64_t, kCommandResults> rejection_log_next_ns_{};
+  std::array<std::int64_t, kCommandResults> rejections_unlogged_{};
   ReloadCounters reloads_;
   std::unique_ptr<Lcm> lcm_;
   std::int64_t next_lcm_attempt_ns_ = 0;

@@ -36,12 +36,17 @@ struct ValidityConfig {
   double convergence_band = 0.002;   ///< relative spread over the window
 };
 
+/// Whether RPEM_COMMAND must be authenticated (docs/rpemd.md, "Authentication"). `none` is accepted
+/// only where LCM cannot leave the host (lcm_is_local).
+enum class CommandAuthentication : std::uint8_t { kRequired, kNone };
+
 /// What SIGHUP reloads.
 struct LiveConfig {
   io::MachineConfig machine;
   TemperatureModel temperature;
   ValidityConfig validity;
   bool commands_enabled = false;
+  CommandAuthentication command_authentication = CommandAuthentication::kRequired;
 };
 
 struct LoopConfig {
@@ -98,6 +103,10 @@ struct DaemonConfig {
 [[nodiscard]] DaemonConfig builtin_daemon_config();
 /// The state file path after defaults.
 [[nodiscard]] std::string resolve_state_file(const StateConfig& c);
+/// The LCM URL rpemd uses: `url`, or LCM's own default ($LCM_DEFAULT_URL, else udpm with ttl 0).
+[[nodiscard]] std::string effective_lcm_url(const std::string& url);
+/// True if messages on `url` cannot leave the host: memq://, or udpm:// with ttl 0 (LCM's default ttl).
+[[nodiscard]] bool lcm_is_local(const std::string& url);
 /// The first part of `b` a restart would change relative to `a` ("source", "loop", …), or "" if none.
 [[nodiscard]] const char* fixed_difference(const FixedConfig& a, const FixedConfig& b);
 

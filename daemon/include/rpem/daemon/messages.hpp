@@ -28,7 +28,12 @@ enum class CommandResult : std::int8_t {
   kRejectedBadValues = 4,
   kRejectedUnknown = 5,
   kRejectedBusy = 6,  ///< the loop's command queue was full; the same sequence number may be sent again
+  kRejectedUnauthenticated = 7,  ///< unsigned (key id 0) while authentication is required
+  kRejectedUnknownKey = 8,       ///< a key id rpemd does not hold
+  kRejectedBadMac = 9,           ///< a known key id, a wrong MAC: forged or altered
+  kRejectedNotPersisted = 10,    ///< the sequence number could not be persisted (replay protection)
 };
+inline constexpr int kCommandResults = 11;
 
 struct Command {
   enum class Kind : std::uint8_t { kReset, kFreeze, kUnfreeze, kSetValues, kReconfigure };

@@ -8,9 +8,11 @@
 #include <atomic>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
+#include "rpem/auth/mac.hpp"
 #include "rpem/daemon/daemon_config.hpp"
 #include "rpem/daemon/latency_histogram.hpp"
 #include "rpem/daemon/messages.hpp"
@@ -41,7 +43,8 @@ class Publisher {
   };
 
   /// `config` is the fixed part: nothing the publisher uses changes on a reload.
-  Publisher(const FixedConfig& config, Identity identity, Queues queues);
+  /// `publish_key`: signs RPEM_ESTIMATE and RPEM_DIAGNOSTICS (rpem/auth/mac.hpp); none: key id 0.
+  Publisher(const FixedConfig& config, Identity identity, Queues queues, std::optional<auth::Key> publish_key = std::nullopt);
   ~Publisher();
 
   /// The thread body; runs until `stop` is set and the loop's queue is drained, then writes the
@@ -61,10 +64,11 @@ class Publisher {
   void maybe_write_state(bool force);
   void print_status(const EstimateReport& r);
   template <class Message>
-  void publish(const std::string& channel, const Message& m);
+  void publish(const std::string& channel, Message& m);
 
   const FixedConfig config_;
   const Identity identity_;
+  const std::optional<auth::Key> publish_key_;
   Queues queues_;
   PublisherCounters counters_;
   std::unique_ptr<Lcm> lcm_;

@@ -22,6 +22,16 @@ struct PersistedEstimates {
 /// Writes atomically; returns an empty string or the reason it failed.
 [[nodiscard]] std::string write_state_file(const std::string& path, const PersistedEstimates& e);
 
+/// The last accepted RPEM_COMMAND sequence number (replay protection across restarts), in its own file
+/// beside the state file — `commands.json` in the same directory — because the control thread owns it
+/// and writes it, durably, before a command is queued; the publisher owns the estimates' file.
+[[nodiscard]] std::string command_sequence_file(const std::string& state_file);
+/// Writes atomically; returns an empty string or the reason it failed.
+[[nodiscard]] std::string write_command_sequence(const std::string& path, std::int64_t last_accepted_seq);
+/// 0 if there is no file; throws std::runtime_error (naming the file) if it is unreadable — replay
+/// protection never silently restarts from 0.
+[[nodiscard]] std::int64_t load_command_sequence(const std::string& path);
+
 enum class StateFileStatus : std::int8_t { kNone = 0, kLoaded = 1, kTooOld = 2, kImplausible = 3, kCorrupt = 4 };
 
 struct LoadedState {

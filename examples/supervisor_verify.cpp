@@ -1,0 +1,40 @@
+// A supervisory controller that acts only on estimates it can verify (docs/rpemd.md, "Authentication";
+// the lines between the markers are quoted there, and test_docs_snippet checks the quote).
+//   example_supervisor_verify PUBLISH_KEY_FILE [SECONDS]
+#include <lcm/lcm-cpp.hpp>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <span>
+#include <string>
+
+#include "rpem/auth/key_file.hpp"
+#include "rpem/estimate_t.hpp"
+
+// [snippet]
+struct Supervisor {
+  rpem::auth::Keyring keys;  // rpemd's publish key: keys.add(rpem::auth::load_key_file(path))
+  void on_estimate(const lcm::ReceiveBuffer* rbuf, const std::string& channel, const rpem::estimate_t* m) {
+    const std::span bytes(static_cast<const std::uint8_t*>(rbuf->data), rbuf->data_size);
+    if (rpem::auth::verify(keys, channel, bytes) != rpem::auth::Verdict::kVerified) {
+      std::printf("ignored: not from rpemd\n");  // forged, altered, unsigned or another key
+      return;
+    }
+    if (m->psi_m_valid) std::printf("T_magnet %.1f C (verified)\n", m->t_magnet_C);  // derate on this
+  }
+};
+// [snippet]
+
+int main(int argc, char** argv) {
+  if (argc < 2) {
+    std::fprintf(stderr, "usage: %s PUBLISH_KEY_FILE [SECONDS]\n", argv[0]);
+    return 64;
+  }
+  Supervisor supervisor;
+  supervisor.keys.add(rpem::auth::load_key_file(argv[1]));
+  lcm::LCM lcm;
+  lcm.subscribe("RPEM_ESTIMATE", &Supervisor::on_estimate, &supervisor);
+  const auto end = std::chrono::steady_clock::now() + std::chrono::seconds(argc > 2 ? std::atoi(argv[2]) : 1000000);
+  while (std::chrono::steady_clock::now() < end) lcm.handleTimeout(100);
+  return 0;
+}
