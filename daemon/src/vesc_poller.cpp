@@ -69,6 +69,24 @@ bool VescPoller::starts_reply(const can::CanFrame& f) const noexcept {
   return packet == static_cast<std::uint32_t>(vesc::Packet::kFillRxBuffer) && f.len >= 1 && f.data[0] == 0;
 }
 
+bool VescPoller::plausible_window(std::int64_t t) noexcept {
+  const std::int64_t window_ns = t - window_start_ns_;
+  if (window_ns < kMinWindowNs) {
+    ++counters_.short_windows;
+    return false;
+  }
+  if (window_ns > 2 * config_.period_ns + config_.timeout_ns) {
+    ++counters_.long_windows;
+    return false;
+  }
+  const vesc::Values& v = decoder_.values();
+  if (v.i_d_A == 0.0 && v.i_q_A == 0.0 && v.v_d_V == 0.0 && v.v_q_V == 0.0) {
+    ++counters_.empty_reads;
+    return false;
+  }
+  return true;
+}
+
 bool VescPoller::on_frame(const can::CanFrame& f, std::int64_t rx_ns, core::AveragedSample& sample) noexcept {
   if (is_values_read_of_controller(f)) {
     ++counters_.stolen_reads;
@@ -97,9 +115,8 @@ bool VescPoller::on_frame(const can::CanFrame& f, std::int64_t rx_ns, core::Aver
     gap_ = false;
     return false;
   }
-  if (t - window_start_ns_ < kMinWindowNs) {
-    ++counters_.short_windows;
-    window_start_ns_ = t;
+  if (!plausible_window(t)) {
+    window_start_ns_ = t;  // the read reset the averages all the same
     gap_ = true;
     return false;
   }

@@ -24,6 +24,16 @@
 //                     the controller read (and reset) is unknown, so the next window follows a gap.
 //   short_windows     a window shorter than kMinWindow: the firmware divides sums of (nearly) no control
 //                     cycles — not a measurement; dropped, the next window follows a gap.
+//   empty_reads       a reply whose i_d, i_q, v_d, v_q are all exactly 0: what the firmware sends for a read
+//                     with no control cycle since the previous one (0/0 in mc_interface_read_reset_avg_*,
+//                     NaN cast to 0 by the Cortex-M4; docs/can-vesc.md). A measured window never gives four
+//                     exact zeros unless the machine stands unexcited, which carries nothing to estimate
+//                     from either; dropped, the next window follows a gap.
+//   long_windows      a window longer than 2·period + timeout: the longest a single lost read explains (a
+//                     reply late by up to a period after its timeout closes a window of at most that), so
+//                     more means the controller went unread (silent, off the bus) and the average spans
+//                     unknown operation — not a sample of the steady-state model; dropped, the next window
+//                     follows a gap.
 // Reads by a poller the bus does not show (VESC Tool over USB or UART) shorten windows invisibly: the
 // reply carries no count of the cycles averaged (docs/rpemd.md says what that costs).
 
@@ -43,6 +53,8 @@ struct VescPollerCounters {
   std::uint64_t unrequested = 0;
   std::uint64_t stolen_reads = 0;
   std::uint64_t short_windows = 0;
+  std::uint64_t empty_reads = 0;
+  std::uint64_t long_windows = 0;
 };
 
 class VescPoller {
@@ -88,6 +100,8 @@ class VescPoller {
   void time_out() noexcept;
   [[nodiscard]] bool is_values_read_of_controller(const can::CanFrame& f) const noexcept;
   [[nodiscard]] bool starts_reply(const can::CanFrame& f) const noexcept;
+  /// Drops a window that is no measurement (counted); true when `t` closes a usable one.
+  [[nodiscard]] bool plausible_window(std::int64_t t) noexcept;
 
   Config config_;
   can::CanFrame poll_;
