@@ -39,7 +39,7 @@ constexpr std::int64_t kIdleChunkNs = 1'000'000;
 }  // namespace
 
 void add_vesc_emulator_options(CLI::App* cmd, VescEmulatorOptions& o) {
-  cmd->add_option("--vesc", o.interface, "answer as a VESC on this SocketCAN interface, in real time (docs/can-vesc.md)");
+  cmd->add_option("--vesc", o.interface, "answer as a VESC on this SocketCAN interface, the drive run on demand up to each poll (docs/can-vesc.md)");
   cmd->add_option("--controller-id", o.controller_id, "the emulated VESC's controller id")->check(CLI::Range(0, 254));
   cmd->add_option("--fet-temperature", o.temp_fet_C, "the emulated power stage's temperature [C]");
   cmd->add_option("--status-rate-1", o.status_rate_1_Hz, "rate of status thread 1 [Hz], 0: off")->check(CLI::Range(0.0, 1000.0));
