@@ -48,7 +48,8 @@ void VescPoller::time_out() noexcept {
   ++consecutive_timeouts_;
   timed_out_unanswered_ = true;
   timed_out_at_ns_ = deadline_ns_;
-  decoder_.reset_buffer();
+  // The decoder's buffer is kept: the reply may be under way (its frames straddling the deadline or the
+  // next poll, as at 1 kHz on a busy bus); a new reply restarts it at offset 0 all the same.
   gap_before_timeout_ = gap_;
   gap_ = true;  // the controller may have read (and reset) with its reply lost
 }
@@ -97,13 +98,18 @@ bool VescPoller::on_frame(const can::CanFrame& f, std::int64_t rx_ns, core::Aver
 
   const std::int64_t t = reply_start_ns_ != 0 ? reply_start_ns_ : rx_ns;
   reply_start_ns_ = 0;
-  if (outstanding_) {
-    outstanding_ = false;
-    consecutive_timeouts_ = 0;
-  } else if (timed_out_unanswered_ && t - timed_out_at_ns_ <= config_.period_ns) {
+  // With reply_timeout_s ≥ the period, polls overlap their predecessors' replies by design: the controller
+  // answers them in turn, so a poll that timed out unanswered takes the first reply, before the poll sent
+  // after it. With a shorter timeout a reply while the next poll is out is that poll's (the timed-out one's
+  // reply was lost, and the window spans its read: a gap).
+  const bool in_turn = config_.timeout_ns >= config_.period_ns || !outstanding_;
+  if (timed_out_unanswered_ && in_turn && t - timed_out_at_ns_ <= config_.period_ns) {
     ++counters_.late;
     consecutive_timeouts_ = 0;
     gap_ = gap_before_timeout_;  // the read it feared lost is this one: the chain holds
+  } else if (outstanding_) {
+    outstanding_ = false;
+    consecutive_timeouts_ = 0;
   } else {
     ++counters_.unrequested;
   }

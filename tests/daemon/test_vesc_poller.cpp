@@ -198,6 +198,51 @@ TEST(VescPoller, AReplyAfterItsTimeoutIsLateAndStillUsed) {
   EXPECT_FALSE(s->gap_before);
 }
 
+// Replies slower than a period (1 kHz, reply_timeout_s = the period): every poll times out when the next
+// goes out, and each reply — its frames straddling that next poll — is the timed-out poll's, answered in
+// turn. No reply is lost to the timeout, and the windows chain without gaps.
+TEST(VescPoller, RepliesSlowerThanAPeriodAreAnsweredInTurnAndChain) {
+  VescSource::Options o;
+  o.controller_id = kController;
+  o.host_id = kHost;
+  o.poll_rate_Hz = 1000.0;
+  o.reply_timeout_s = 1e-3;
+  VescPoller p(poller_config(o));
+  const std::vector<can::CanFrame> frames = reply_frames();
+  std::vector<core::AveragedSample> samples;
+  // Poll k goes out at k ms; its reply's six frames arrive 130 µs apart from 0.8 ms after it: two before
+  // the next poll, four after it.
+  const auto deliver = [&](int poll, std::int64_t from_ns, std::int64_t to_ns) {
+    for (std::size_t i = 0; i < frames.size(); ++i) {
+      const std::int64_t rx = kT0 + poll * kMs + 800'000 + static_cast<std::int64_t>(i) * 130'000;
+      if (rx < from_ns || rx >= to_ns) continue;
+      p.on_time(rx);
+      core::AveragedSample s;
+      if (p.on_frame(frames[i], rx, s)) samples.push_back(s);
+    }
+  };
+  for (int k = 0; k <= 21; ++k) {
+    const std::int64_t t = kT0 + k * kMs;
+    if (k > 0) deliver(k - 1, t - kMs, t);
+    p.on_time(t);
+    ASSERT_TRUE(p.poll_due(t));
+    p.polled(t, true);
+    if (k > 0) deliver(k - 1, t, t + kMs);
+  }
+  EXPECT_EQ(p.counters().polls, 22U);
+  EXPECT_EQ(p.counters().late, 21U);
+  EXPECT_EQ(p.counters().unrequested, 0U);
+  EXPECT_EQ(p.decoder().counters().out_of_order + p.decoder().counters().length_mismatch, 0U);
+  ASSERT_EQ(samples.size(), 20U);  // the first reply opens the first window
+  for (std::size_t i = 0; i < samples.size(); ++i) {
+    EXPECT_EQ(samples[i].t_ns - samples[i].t_start_ns, kMs) << i;
+    if (i > 0) {
+      EXPECT_FALSE(samples[i].gap_before) << i;
+      EXPECT_EQ(samples[i].t_start_ns, samples[i - 1].t_ns) << i;
+    }
+  }
+}
+
 // Another poller reading our controller on the bus (node 0x42, the same poll the docs show for us): its
 // read resets the averages, so it is counted and our next window starts at it.
 TEST(VescPoller, AnotherPollersReadIsCountedAndStartsTheWindow) {

@@ -19,7 +19,13 @@
 //                     in the last period: another poller uses our host id. Its window is still right
 //                     (it ends a read), so it is used.
 //   late              a reply to a poll that had timed out (within one period of the timeout): used, and
-//                     the gap the timeout feared is lifted (this reply is that read).
+//                     the gap the timeout feared is lifted (this reply is that read). A reply under way is
+//                     never discarded by a timeout. With reply_timeout_s ≥ the period (replies slower than
+//                     a period, e.g. 1 kHz on a 1 Mbit/s bus where a reply alone takes 0.9 ms) polls
+//                     overlap replies and are answered in turn: a late reply is the timed-out poll's even
+//                     when the next poll is out — a reply lost outright there lifts that gap wrongly once
+//                     (its successor's window spans the lost read). With a shorter timeout a reply while
+//                     the next poll is out is that poll's.
 //   timeouts          a poll unanswered within reply_timeout_s (silent controller, lost frames). Whether
 //                     the controller read (and reset) is unknown, so the next window follows a gap.
 //   short_windows     a window shorter than kMinWindow: the firmware divides sums of (nearly) no control

@@ -1,0 +1,100 @@
+#!/usr/bin/env python3
+"""Reads bench/vesc_twelve_drives.sh's outputs in DIR: CPU per drive (each rpemd, per thread, and each
+emulated VESC) over the measured window, and the bus load its frames reach on a classic 1 Mbit/s bus.
+
+Frame bits as in can/src/bus_load.cpp (frame_bits, classic): 54 stuffable bits for a 29-bit id plus 8 per
+data byte, worst-case stuffing (n - 1) // 4, 13 bits of tail — the same count as docs/benchmarks.md's
+table, so the load measured here is comparable with its 70 % target.
+
+  vesc_twelve_drives.py DIR [--rate HZ]
+"""
+import argparse
+import collections
+import re
+
+USER_HZ = 100  # /proc/PID/task/TID/stat's utime and stime unit on x86 Linux
+
+
+def snapshot(path):
+    rows = {}
+    for line in open(path):
+        f = line.split()
+        if len(f) != 7:
+            continue
+        role, drive, pid, tid, comm, ut, st = f
+        rows[(role, int(drive), tid)] = (comm.strip('()'), int(ut) + int(st))
+    return rows
+
+
+def frame_bits(extended, data_bytes):
+    stuffable = (54 if extended else 34) + 8 * data_bytes
+    return stuffable + (stuffable - 1) // 4 + 13
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument('dir')
+    ap.add_argument('--rate', type=float, default=56.0)
+    a = ap.parse_args()
+    d = a.dir
+    t0 = float(open(d + '/t_start').read())
+    t1 = float(open(d + '/t_end').read())
+    window = t1 - t0
+    start, end = snapshot(d + '/start.txt'), snapshot(d + '/end.txt')
+    per_thread = collections.defaultdict(list)   # (role, comm) -> [% of a core per drive]
+    per_drive = collections.defaultdict(dict)    # role -> drive -> % of a core
+    for key, (comm, ticks) in end.items():
+        if key not in start:
+            continue
+        pct = 100.0 * (ticks - start[key][1]) / USER_HZ / window
+        role, drive, _ = key
+        per_thread[(role, comm)].append(pct)
+        per_drive[role][drive] = per_drive[role].get(drive, 0.0) + pct
+    where = open(d + '/where').read().strip()
+    cpus = open(d + '/nproc').read().strip() if _exists(d + '/nproc') else '?'
+    print('vesc_twelve_drives: %s, %s CPUs; 12 drives polled at %g Hz each; window %.1f s'
+          % (where, cpus, a.rate, window))
+    for role in ('rpemd', 'sim'):
+        v = sorted(per_drive[role].values())
+        if v:
+            print('  %-6s per drive: mean %.2f %%, min %.2f %%, max %.2f %% of a core; all 12: %.1f %%'
+                  % ('rpemd' if role == 'rpemd' else 'sim', sum(v) / len(v), v[0], v[-1], sum(v)))
+    for (role, comm), v in sorted(per_thread.items()):
+        if role == 'rpemd':
+            print('    thread %-16s mean %.2f %%, max %.2f %% (%d drives)' % (comm, sum(v) / len(v), max(v), len(v)))
+    # The bus over the window: candump -L lines "(t) vcan0 ID#DATA".
+    bits = 0
+    frames = 0
+    polls = collections.Counter()
+    times = []
+    for line in open(d + '/bus.log'):
+        m = re.match(r'\((\d+\.\d+)\) \S+ ([0-9A-Fa-f]+)#([0-9A-Fa-f]*)', line)
+        if not m:
+            continue
+        ident, data = m.group(2), m.group(3)
+        extended = len(ident) == 8
+        bits += frame_bits(extended, len(data) // 2)
+        frames += 1
+        times.append(float(m.group(1)))
+        i = int(ident, 16)
+        if extended and (i >> 8) == 8 and len(data) >= 6 and int(data[4:6], 16) == 50:
+            polls[i & 0xFF] += 1
+    span = times[-1] - times[0] if len(times) > 1 else window
+    print('  bus: %d frames in %.1f s, %.0f frames/s; %.1f %% of a classic 1 Mbit/s bus (worst-case stuffing)'
+          % (frames, span, frames / span, 100.0 * bits / span / 1e6))
+    if polls:
+        rates = sorted(n / span for n in polls.values())
+        print('  polls per controller: %d controllers, %.1f-%.1f Hz (asked %g Hz); %.0f bits per poll and reply'
+              % (len(polls), rates[0], rates[-1], a.rate, bits / sum(polls.values())))
+
+
+def _exists(p):
+    try:
+        open(p).close()
+        return True
+    except OSError:
+        return False
+
+
+if __name__ == '__main__':
+    main()

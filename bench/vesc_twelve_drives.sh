@@ -1,0 +1,98 @@
+#!/usr/bin/env bash
+# Issue 12, item 6: CPU per drive with 12 emulated VESCs on one vcan, one rpemd per drive (rpemd@.service,
+# docs/rpemd.md "Several drives on one bus"), each polling at RATE (default 56 Hz: the highest per-drive
+# rate 12 VESCs share under 70 % of a classic 1 Mbit/s bus, docs/benchmarks.md "Several drives per bus").
+# Runs where vcan0 exists: natively as root with vcan, else in the PREEMPT_RT VM (tests/vm/vm_rig.sh, TCG).
+#
+#   vesc_twelve_drives.sh BUILD_DIR [RATE_HZ] [WINDOW_S]
+#
+# Drive i (1-12): `rpem sim --vesc vcan0 --controller-id i` (scenarios/vesc-6374.yaml, no status
+# broadcasts: VESC's default, and the bus-load table counts none) and rpemd with controller_id i,
+# host_id 100+i, poll_phase (i-1)/12, its own channel prefix and state file. After WARMUP s, each process's
+# threads' CPU time (utime+stime from /proc/PID/task/TID/stat, in USER_HZ = 100 ticks/s on x86) is read at the start and end of a WINDOW_S
+# window, and candump -L records the bus over it; bench/vesc_twelve_drives.py prints CPU per drive (per
+# rpemd thread) and the bus load the frames reached on a 1 Mbit/s classic bus.
+set -euo pipefail
+build=$(cd "$1" && pwd)
+rate=${2:-56}
+window=${3:-30}
+warmup=10
+repo=$(cd "$(dirname "$0")/.." && pwd)
+out=$(mktemp -d)
+trap 'rm -rf "$out"' EXIT
+drives=12
+
+cp "$repo/scenarios/vesc-6374.yaml" "$out/"
+sed -i 's|^machine: ../config/|machine: config/|' "$out/vesc-6374.yaml"
+mkdir -p "$out/config" && cp "$repo/config/vesc-6374-outrunner.yaml" "$out/config/"
+for i in $(seq 1 $drives); do
+  phase=$(python3 -c "print(round(($i - 1) / $drives, 4))")
+  cat >"$out/drive$i.yaml" <<YAML
+daemon:
+  machine_config: vesc-6374-outrunner.yaml
+  source:
+    type: vesc
+    vesc: {interface: vcan0, controller_id: $i, host_id: $((100 + i)), poll_rate_Hz: $rate, poll_phase: $phase}
+  loop: {period_s: 1.0e-3, realtime: off}
+  stale_timeout_s: 0.5
+  lcm: {channel_prefix: "VESC${i}_", estimate_rate_Hz: 10}
+  commands: {enabled: false}
+  state: {file: /tmp/rpemd-$i/estimates.json, write_interval_s: 1}
+  status_interval_s: 1
+YAML
+done
+
+# The run, where vcan0 exists; /proc snapshots and the capture go to $dir.
+cat >"$out/twelve.sh" <<'SH'
+dir=$1; drives=$2; warmup=$3; window=$4
+echo 16777216 > /proc/sys/net/core/rmem_max 2>/dev/null
+cp config/vesc-6374-outrunner.yaml /tmp/
+emus=""; daemons=""
+for i in $(seq 1 $drives); do
+  rpem sim --scenario vesc-6374.yaml --vesc vcan0 --controller-id $i --status-rate-1 0 --status-rate-2 0 \
+    --duration $((warmup + window + 5)) 2> "$dir/emu$i.txt" &
+  emus="$emus $!"
+  cp drive$i.yaml /tmp/
+  rpemd --config /tmp/drive$i.yaml > "$dir/rpemd$i.txt" 2>&1 &
+  daemons="$daemons $!"
+done
+snap() {  # name: one line per thread: role drive pid tid comm utime stime (clock ticks)
+  i=0; for p in $daemons; do i=$((i + 1)); for t in /proc/$p/task/*; do
+    echo "rpemd $i $p ${t##*/} $(awk '{print $2, $14, $15}' $t/stat)"; done; done > "$dir/$1.txt"
+  i=0; for p in $emus; do i=$((i + 1)); for t in /proc/$p/task/*; do
+    echo "sim $i $p ${t##*/} $(awk '{print $2, $14, $15}' $t/stat)"; done; done >> "$dir/$1.txt"
+}
+stamp() { awk '{print $1}' /proc/uptime > "$dir/t_$1"; }
+sleep $warmup
+candump -r 8388608 -L vcan0 > /tmp/bus.log &
+dump=$!
+snap start; stamp start
+sleep $window
+snap end; stamp end
+kill $dump; wait $dump 2>/dev/null
+cp /tmp/bus.log "$dir/bus.log"
+for p in $daemons; do kill -TERM $p; done
+fail=0
+for p in $daemons; do wait $p || fail=1; done
+for p in $emus; do wait $p || fail=1; done
+nproc > "$dir/nproc"
+exit $fail
+SH
+
+host_has_vcan() {
+  [[ $(id -u) -eq 0 ]] && ip link add dev rpemprobe0 type vcan 2>/dev/null && ip link del rpemprobe0
+}
+if host_has_vcan && ip link show vcan0 >/dev/null 2>&1; then
+  echo "vesc_twelve_drives: native vcan0"
+  (cd "$out" && PATH="$build/tools:$build/daemon:$PATH" sh twelve.sh "$out" $drives $warmup "$window")
+  echo native > "$out/where"
+else
+  echo "vesc_twelve_drives: no vcan on this host; running in the PREEMPT_RT VM (TCG: emulated CPUs)"
+  files=(--file "$build/tools/rpem" --file "$build/daemon/rpemd" --file "$out/twelve.sh"
+         --file "$out/vesc-6374.yaml" --file "$out/config/vesc-6374-outrunner.yaml:/work/config/vesc-6374-outrunner.yaml")
+  for i in $(seq 1 $drives); do files+=(--file "$out/drive$i.yaml"); done
+  "$repo/tests/vm/vm_rig.sh" run --timeout $((warmup + window + 600)) --share "$out" "${files[@]}" -- \
+    "sh /work/twelve.sh /host $drives $warmup $window"
+  echo "qemu TCG (emulated)" > "$out/where"
+fi
+python3 "$repo/bench/vesc_twelve_drives.py" "$out" --rate "$rate"
