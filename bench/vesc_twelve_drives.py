@@ -15,14 +15,18 @@ import re
 USER_HZ = 100  # /proc/PID/task/TID/stat's utime and stime unit on x86 Linux
 
 
-def snapshot(path):
+def snapshot(path, roles):
+    """{(role, drive, tid): (comm, ticks)} from lines "/proc/PID/task/TID/stat (comm) utime stime"."""
     rows = {}
     for line in open(path):
         f = line.split()
-        if len(f) != 7:
+        if len(f) != 4:
             continue
-        role, drive, pid, tid, comm, ut, st = f
-        rows[(role, int(drive), tid)] = (comm.strip('()'), int(ut) + int(st))
+        m = re.match(r'/proc/(\d+)/task/(\d+)/stat', f[0])
+        if not m or m.group(1) not in roles:
+            continue
+        role, drive = roles[m.group(1)]
+        rows[(role, drive, m.group(2))] = (f[1].strip('()'), int(f[2]) + int(f[3]))
     return rows
 
 
@@ -40,7 +44,11 @@ def main():
     t0 = float(open(d + '/t_start').read())
     t1 = float(open(d + '/t_end').read())
     window = t1 - t0
-    start, end = snapshot(d + '/start.txt'), snapshot(d + '/end.txt')
+    roles = {}
+    for role, name in (('rpemd', 'rpemd.pids'), ('sim', 'sim.pids')):
+        for i, pid in enumerate(open('%s/%s' % (d, name)).read().split()):
+            roles[pid] = (role, i + 1)
+    start, end = snapshot(d + '/start.txt', roles), snapshot(d + '/end.txt', roles)
     per_thread = collections.defaultdict(list)   # (role, comm) -> [% of a core per drive]
     per_drive = collections.defaultdict(dict)    # role -> drive -> % of a core
     for key, (comm, ticks) in end.items():
@@ -82,6 +90,16 @@ def main():
     span = times[-1] - times[0] if len(times) > 1 else window
     print('  bus: %d frames in %.1f s, %.0f frames/s; %.1f %% of a classic 1 Mbit/s bus (worst-case stuffing)'
           % (frames, span, frames / span, 100.0 * bits / span / 1e6))
+    # Each rpemd's own count of its polls and replies (its last status line).
+    answered = []
+    for i in range(1, 13):
+        lines = [l for l in open('%s/rpemd%d.txt' % (d, i)) if '[vesc polls' in l]
+        if lines:
+            m = re.search(r'vesc polls (\d+) replies (\d+) timeouts (\d+)', lines[-1])
+            answered.append((int(m.group(1)), int(m.group(2)), int(m.group(3))))
+    if answered:
+        p, r, t = (sum(x[k] for x in answered) for k in range(3))
+        print('  rpemd over the run (12 drives): %d polls, %d replies became samples, %d timeouts' % (p, r, t))
     if polls:
         rates = sorted(n / span for n in polls.values())
         print('  polls per controller: %d controllers, %.1f-%.1f Hz (asked %g Hz); %.0f bits per poll and reply'

@@ -18,8 +18,14 @@ rate=${2:-56}
 window=${3:-30}
 warmup=10
 repo=$(cd "$(dirname "$0")/.." && pwd)
-out=$(mktemp -d)
-trap 'rm -rf "$out"' EXIT
+# RPEM_BENCH_OUT=DIR keeps the outputs there; otherwise a temporary directory.
+if [[ -n ${RPEM_BENCH_OUT:-} ]]; then
+  out=$RPEM_BENCH_OUT
+  mkdir -p "$out"
+else
+  out=$(mktemp -d)
+  trap 'rm -rf "$out"' EXIT
+fi
 drives=12
 
 cp "$repo/scenarios/vesc-6374.yaml" "$out/"
@@ -50,31 +56,31 @@ cp config/vesc-6374-outrunner.yaml /tmp/
 emus=""; daemons=""
 for i in $(seq 1 $drives); do
   rpem sim --scenario vesc-6374.yaml --vesc vcan0 --controller-id $i --status-rate-1 0 --status-rate-2 0 \
-    --duration $((warmup + window + 5)) 2> "$dir/emu$i.txt" &
+    --duration $((warmup + window + 120)) 2> "$dir/emu$i.txt" &
   emus="$emus $!"
   cp drive$i.yaml /tmp/
   rpemd --config /tmp/drive$i.yaml > "$dir/rpemd$i.txt" 2>&1 &
   daemons="$daemons $!"
 done
-snap() {  # name: one line per thread: role drive pid tid comm utime stime (clock ticks)
-  i=0; for p in $daemons; do i=$((i + 1)); for t in /proc/$p/task/*; do
-    echo "rpemd $i $p ${t##*/} $(awk '{print $2, $14, $15}' $t/stat)"; done; done > "$dir/$1.txt"
-  i=0; for p in $emus; do i=$((i + 1)); for t in /proc/$p/task/*; do
-    echo "sim $i $p ${t##*/} $(awk '{print $2, $14, $15}' $t/stat)"; done; done >> "$dir/$1.txt"
+snap() {  # name: one line per thread: "/proc/PID/task/TID/stat (comm) utime stime" (clock ticks), one awk
+  files=""
+  for p in $daemons $emus; do files="$files $(ls -d /proc/$p/task/*/stat 2>/dev/null)"; done
+  awk '{print FILENAME, $2, $14, $15}' $files > "$dir/$1.txt"
 }
 stamp() { awk '{print $1}' /proc/uptime > "$dir/t_$1"; }
+echo "$daemons" > "$dir/rpemd.pids"; echo "$emus" > "$dir/sim.pids"
 sleep $warmup
 candump -r 8388608 -L vcan0 > /tmp/bus.log &
 dump=$!
 snap start; stamp start
 sleep $window
-snap end; stamp end
+stamp end; snap end
 kill $dump; wait $dump 2>/dev/null
 cp /tmp/bus.log "$dir/bus.log"
 for p in $daemons; do kill -TERM $p; done
 fail=0
 for p in $daemons; do wait $p || fail=1; done
-for p in $emus; do wait $p || fail=1; done
+for p in $emus; do kill -TERM $p 2>/dev/null; wait $p; done  # their duration outlasts the window
 nproc > "$dir/nproc"
 exit $fail
 SH
