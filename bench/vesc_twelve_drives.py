@@ -30,6 +30,16 @@ def snapshot(path, roles):
     return rows
 
 
+def contexts(path):
+    """{(pid, tid): voluntary context switches} from lines "/proc/PID/task/TID/status N"."""
+    out = {}
+    for line in open(path):
+        m = re.match(r'/proc/(\d+)/task/(\d+)/status (\d+)', line)
+        if m:
+            out[(m.group(1), m.group(2))] = int(m.group(3))
+    return out
+
+
 def frame_bits(extended, data_bytes):
     stuffable = (54 if extended else 34) + 8 * data_bytes
     return stuffable + (stuffable - 1) // 4 + 13
@@ -39,6 +49,7 @@ def main():
     ap = argparse.ArgumentParser()
     ap.add_argument('dir')
     ap.add_argument('--rate', type=float, default=56.0)
+    ap.add_argument('--loop', default='1.0e-3', help="rpemd's loop.period_s (for the report)")
     a = ap.parse_args()
     d = a.dir
     t0 = float(open(d + '/t_start').read())
@@ -60,16 +71,26 @@ def main():
         per_drive[role][drive] = per_drive[role].get(drive, 0.0) + pct
     where = open(d + '/where').read().strip()
     cpus = open(d + '/nproc').read().strip() if _exists(d + '/nproc') else '?'
-    print('vesc_twelve_drives: %s, %s CPUs; 12 drives polled at %g Hz each; window %.1f s'
-          % (where, cpus, a.rate, window))
+    print('vesc_twelve_drives: %s, %s CPUs; 12 drives polled at %g Hz each, rpemd loop %s s; window %.1f s'
+          % (where, cpus, a.rate, a.loop, window))
     for role in ('rpemd', 'sim'):
         v = sorted(per_drive[role].values())
         if v:
             print('  %-6s per drive: mean %.2f %%, min %.2f %%, max %.2f %% of a core; all 12: %.1f %%'
                   % ('rpemd' if role == 'rpemd' else 'sim', sum(v) / len(v), v[0], v[-1], sum(v)))
+    # Wake-ups: voluntary context switches per second, per thread.
+    comm_of = {tid: comm for (role, drive, tid), (comm, _) in end.items()}
+    wakeups = collections.defaultdict(list)
+    c0, c1 = contexts(d + '/start.ctx'), contexts(d + '/end.ctx')
+    for key, n in c1.items():
+        pid, tid = key
+        if key in c0 and pid in roles and roles[pid][0] == 'rpemd':
+            wakeups[comm_of.get(tid, '?')].append((n - c0[key]) / window)
     for (role, comm), v in sorted(per_thread.items()):
         if role == 'rpemd':
-            print('    thread %-16s mean %.2f %%, max %.2f %% (%d drives)' % (comm, sum(v) / len(v), max(v), len(v)))
+            w = wakeups.get(comm, [])
+            print('    thread %-16s mean %.2f %%, max %.2f %% (%d threads); %.0f wake-ups/s each'
+                  % (comm, sum(v) / len(v), max(v), len(v), sum(w) / len(w) if w else float('nan')))
     # The bus over the window: candump -L lines "(t) vcan0 ID#DATA".
     bits = 0
     frames = 0
