@@ -98,10 +98,7 @@ nproc > "$dir/nproc"
 exit $fail
 SH
 
-host_has_vcan() {
-  [[ $(id -u) -eq 0 ]] && ip link add dev rpemprobe0 type vcan 2>/dev/null && ip link del rpemprobe0
-}
-if host_has_vcan && ip link show vcan0 >/dev/null 2>&1; then
+if "$repo/tests/vm/vm_rig.sh" native-vcan; then
   echo "vesc_twelve_drives: native vcan0"
   (cd "$out" && PATH="$build/tools:$build/daemon:$PATH" sh twelve.sh "$out" $drives $warmup "$window")
   echo native > "$out/where"
