@@ -56,6 +56,8 @@ void SampleConditioner::reconfigure(const PerUnitBase& base, const MachinePu& ma
   cross_x_q_pu_per_A_ = x.cross_coupling_H_per_A / base.inductance_H;
   cross_x_q_pu_per_A2_ = x.cross_coupling_H_per_A2 / base.inductance_H;
   delay_ = x.delay_s > 0.0;
+  corrections_ = deadtime_ || inv_r_fe_pu_ > 0.0;
+  emf_ = harmonics_ || cross_;
 }
 
 Vec2 SampleConditioner::inductances_pu(const Vec2& i_dq_pu) const noexcept {
@@ -70,7 +72,7 @@ Vec2 SampleConditioner::inductances_pu(const Vec2& i_dq_pu) const noexcept {
 
 Vec2 SampleConditioner::extra_emf_pu(const Rotation& rot, double n_pu, const Vec2& i_dq_pu, bool harmonics) const noexcept {
   Vec2 e = Vec2::Zero();
-  if (!harmonics_ && !cross_) return e;
+  if (!emf_) return e;
   if (harmonics && harmonics_) {
     for (std::size_t j = 0; j < harmonics_pu_.size(); ++j) {
       const FluxHarmonic& h = harmonics_pu_[j];
@@ -223,8 +225,11 @@ Vec2 SampleConditioner::observed_current_dq_A(const DriveSample& s, const Vec2& 
   // dead-time error, and the resistive drop of the iron-loss current (which the magnetising-current
   // model does not carry).
   const Vec2 command_ab_V = command_alphabeta_V(s, m.logged);
-  Vec2 correction_ab_V = deadtime_error_alphabeta_V(m.i_ab_A, s.u_dc_V);
-  if (inv_r_fe_pu_ > 0.0) correction_ab_V -= inverse_park(m.i_fe_dq_pu, m.rot) * (machine_.r_s_pu * base_.voltage_V);
+  Vec2 correction_ab_V = Vec2::Zero();
+  if (corrections_) {
+    correction_ab_V = deadtime_error_alphabeta_V(m.i_ab_A, s.u_dc_V);
+    if (inv_r_fe_pu_ > 0.0) correction_ab_V -= inverse_park(m.i_fe_dq_pu, m.rot) * (machine_.r_s_pu * base_.voltage_V);
+  }
   const Vec2 emf_pu = extra_emf_pu(m.rot, m.n_pu, m.i_dq_pu, true);
 
   const bool chained = has_previous_ && !s.gap_before;
@@ -234,9 +239,14 @@ Vec2 SampleConditioner::observed_current_dq_A(const DriveSample& s, const Vec2& 
     iv.n_start_pu = previous_n_pu_;
     iv.n_end_pu = m.n_pu;
     const Vec2 command = delay_ && iv.dt_s > 0.0 ? delayed_command_alphabeta_V(iv.dt_s) : commands_[0];
-    const Vec2 u_held_ab_pu = (command + previous_correction_ab_V_) * inv_voltage_V_;
-    iv.u_start_pu = park(u_held_ab_pu, previous_rotation_) - previous_emf_pu_;
-    iv.u_end_pu = park(u_held_ab_pu, m.rot) - emf_pu;
+    // Without the extensions that add to it, the command is what the machine sees (decided in reconfigure).
+    const Vec2 u_held_ab_pu = (corrections_ ? command + previous_correction_ab_V_ : command) * inv_voltage_V_;
+    iv.u_start_pu = park(u_held_ab_pu, previous_rotation_);
+    iv.u_end_pu = park(u_held_ab_pu, m.rot);
+    if (emf_) {
+      iv.u_start_pu -= previous_emf_pu_;
+      iv.u_end_pu -= emf_pu;
+    }
   } else {
     out.resync = true;
     // The gap's length (0 for the first sample) lets the estimator keep ε across a short one.

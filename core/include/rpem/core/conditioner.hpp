@@ -170,6 +170,8 @@ class SampleConditioner {
   // Which extensions are active, decided when configured (the per-sample path tests one flag each).
   bool angle_offset_ = false, phase_corrections_ = false, saturation_ = false, deadtime_ = false;
   bool harmonics_ = false, cross_ = false, delay_ = false;
+  bool corrections_ = false;  ///< dead time or iron loss: the voltage takes a correction
+  bool emf_ = false;          ///< flux harmonics or cross-saturation: extra_emf_pu() is not zero
   bool has_previous_ = false;
   std::int64_t previous_t_ns_ = 0;
   Rotation previous_rotation_;
