@@ -147,13 +147,10 @@ EstimatorOutput RpemEstimator::held(StepCode code) const noexcept {
   // whole-vector store would make the held parameter, which the next sample's predictor reads first,
   // wait for the adapted one at the end of this sample's dependency chain (store forwarding).
   unsigned clamped = 0;
-  if (active.psi_m) {
-    state_.theta_pu[kPsiM] += change[kPsiM];
-    clamped |= static_cast<unsigned>(project(config_.bounds, state_.theta_pu, kPsiM)) << kPsiM;
-  }
-  if (active.r_s) {
-    state_.theta_pu[kRs] += change[kRs];
-    clamped |= static_cast<unsigned>(project(config_.bounds, state_.theta_pu, kRs)) << kRs;
+  for (const int j : {kPsiM, kRs}) {
+    if (!(j == kPsiM ? active.psi_m : active.r_s)) continue;
+    state_.theta_pu[j] += change[j];
+    clamped |= static_cast<unsigned>(project(config_.bounds, state_.theta_pu, j)) << j;
   }
 
   // The flags by shifts, no branches: the gain's and the projection's bits are laid out as step_flag's.
