@@ -146,12 +146,18 @@ EstimatorOutput RpemEstimator::held(StepCode code) const noexcept {
   // parameter held is inside D_M already: every path that sets θ̂ projects it). Element by element: a
   // whole-vector store would make the held parameter, which the next sample's predictor reads first,
   // wait for the adapted one at the end of this sample's dependency chain (store forwarding).
+  // The output's θ̂ is made from scalars kept in registers: a whole-vector load right after element stores
+  // (of the state, or of a local Vec2 on the stack) cannot be forwarded from them and waits for both.
   unsigned clamped = 0;
-  for (const int j : {kPsiM, kRs}) {
-    if (!(j == kPsiM ? active.psi_m : active.r_s)) continue;
-    state_.theta_pu[j] += change[j];
-    clamped |= static_cast<unsigned>(project(config_.bounds, state_.theta_pu, j)) << j;
-  }
+  double psi_m = state_.theta_pu[kPsiM], r_s = state_.theta_pu[kRs];
+  const auto adapt = [&](int j, bool adapts, double& value) {
+    if (!adapts) return;
+    value += change[j];
+    clamped |= static_cast<unsigned>(project(config_.bounds, j, value)) << j;
+    state_.theta_pu[j] = value;
+  };
+  adapt(kPsiM, active.psi_m, psi_m);
+  adapt(kRs, active.r_s, r_s);
 
   // The flags by shifts, no branches: the gain's and the projection's bits are laid out as step_flag's.
   static_assert(step_flag::kGainFloored == gain_flag::kFloored && step_flag::kPseudoInverse == gain_flag::kPseudoInverse);
@@ -160,7 +166,10 @@ EstimatorOutput RpemEstimator::held(StepCode code) const noexcept {
       (state_.frozen ? step_flag::kFrozen : 0U) | (gain.flags & (gain_flag::kFloored | gain_flag::kPseudoInverse)) |
       (clamped << 2) | (static_cast<unsigned>(active.psi_m) * step_flag::kPsiMActive) |
       (static_cast<unsigned>(active.r_s) * step_flag::kRsActive));
-  return {state_.theta_pu, u.epsilon_pu, u.i_hat_pu, u.gradient, gain.gain, StepCode::kAdapted, flags};  // every member: no zero fill
+  Vec2 theta;
+  theta[kPsiM] = psi_m;
+  theta[kRs] = r_s;
+  return {theta, u.epsilon_pu, u.i_hat_pu, u.gradient, gain.gain, StepCode::kAdapted, flags};  // every member: no zero fill
 }
 
 [[gnu::flatten]] EstimatorOutput RpemEstimator::step(const EstimatorSample& sample) noexcept {

@@ -42,18 +42,21 @@ struct ParameterBounds {
   Vec2 max_pu = Vec2::Zero();
 };
 
-/// Projection of one parameter onto its interval of D_M. Returns whether it was clamped.
-[[nodiscard]] inline bool project(const ParameterBounds& b, Vec2& theta, int j) noexcept {
-  if (theta[j] < b.min_pu[j]) {
-    theta[j] = b.min_pu[j];
+/// Projection of parameter j's value onto its interval of D_M. Returns whether it was clamped.
+[[nodiscard]] inline bool project(const ParameterBounds& b, int j, double& value) noexcept {
+  if (value < b.min_pu[j]) {
+    value = b.min_pu[j];
     return true;
   }
-  if (theta[j] > b.max_pu[j]) {
-    theta[j] = b.max_pu[j];
+  if (value > b.max_pu[j]) {
+    value = b.max_pu[j];
     return true;
   }
   return false;
 }
+
+/// Projection of one parameter onto its interval of D_M. Returns whether it was clamped.
+[[nodiscard]] inline bool project(const ParameterBounds& b, Vec2& theta, int j) noexcept { return project(b, j, theta[j]); }
 
 /// Projection onto the box D_M (the Euclidean projection of a box is the clamp). Returns a bit per
 /// parameter that was clamped (bit kPsiM, bit kRs).
