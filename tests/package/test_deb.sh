@@ -15,7 +15,8 @@ if [[ ! -f $base ]]; then
   tmp=$(mktemp -d)
   debootstrap --variant=minbase bookworm "$tmp" http://deb.debian.org/debian >"$cache/debootstrap.log" 2>&1 ||
     { tail -n 20 "$cache/debootstrap.log"; rm -rf "$tmp"; exit 1; }
-  tar -C "$tmp" -cf "$base.part" . && mv "$base.part" "$base"  # never a half-written cache
+  tar -C "$tmp" -cf "$base.part" .
+  mv "$base.part" "$base"  # never a half-written cache
   rm -rf "$tmp"
 fi
 if [[ ${2:-} == --base ]]; then
