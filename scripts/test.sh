@@ -8,6 +8,9 @@
 #   4. builds rpemd and the daemon's tests with ThreadSanitizer and runs them — the storm test drives
 #      the instrumented rpemd with reloads and commands at once — expecting no report (suppressed: only
 #      the uninstrumented LCM/GLib internals, tests/daemon/tsan.supp)
+# The sanitizer trees of 3 and 4 compile at nice 19 while step 2's tests run: they take only the CPU the
+# tests leave idle (the VM suites' real-time pacing, the serial package test, the last test's tail) and
+# yield it otherwise (CFS weight 15 against 1024), so a test's share of the CPU is what it was without them.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 jobs=$(nproc)
@@ -16,17 +19,33 @@ scripts/setup.sh
 
 cmake -S . -B build/ci -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DRPEM_WERROR=ON
 cmake --build build/ci -j "$jobs"
-ctest --test-dir build/ci --output-on-failure -j "$jobs" --timeout 1800
 
-cmake -S . -B build/sanitize -G Ninja -DCMAKE_BUILD_TYPE=Debug -DRPEM_WERROR=ON \
-  -DRPEM_SANITIZE=address,undefined -DRPEM_BUILD_BENCHMARKS=OFF -DRPEM_BUILD_DAEMON=OFF -DRPEM_BUILD_TOOLS=OFF
-cmake --build build/sanitize -j "$jobs" --target test_core test_io test_can test_sim test_sim_vesc test_analysis test_auth \
-  test_indep_drive indep_drive_log
+sanitizer_builds() {
+  cmake -S . -B build/sanitize -G Ninja -DCMAKE_BUILD_TYPE=Debug -DRPEM_WERROR=ON \
+    -DRPEM_SANITIZE=address,undefined -DRPEM_BUILD_BENCHMARKS=OFF -DRPEM_BUILD_DAEMON=OFF -DRPEM_BUILD_TOOLS=OFF
+  cmake --build build/sanitize -j "$jobs" --target test_core test_io test_can test_sim test_sim_vesc test_analysis \
+    test_auth test_indep_drive indep_drive_log
+  cmake -S . -B build/tsan -G Ninja -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS_DEBUG="-O1 -g" -DRPEM_WERROR=ON \
+    -DRPEM_SANITIZE=thread -DRPEM_BUILD_BENCHMARKS=OFF -DRPEM_BUILD_TOOLS=OFF
+  cmake --build build/tsan -j "$jobs" --target rpemd test_daemon test_daemon_allocations test_daemon_storm
+}
+sanitizer_log=build/sanitizer-builds.log
+set -m  # the builds in a process group of their own, so that a failing ctest stops all of them
+(renice -n 19 -p "$BASHPID" >/dev/null && sanitizer_builds) </dev/null >"$sanitizer_log" 2>&1 &
+sanitizer_pid=$!
+set +m
+trap 'kill -- "-$sanitizer_pid" 2>/dev/null || true' EXIT
+ctest --test-dir build/ci --output-on-failure -j "$jobs" --timeout 1800
+echo "test.sh: waiting for the sanitizer builds (log: $sanitizer_log)"
+if ! wait "$sanitizer_pid"; then
+  cat "$sanitizer_log"
+  echo "test.sh: the sanitizer builds failed" >&2
+  exit 1
+fi
+trap - EXIT
+
 UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1 ASAN_OPTIONS=detect_leaks=1 \
   ctest --test-dir build/sanitize --output-on-failure -j "$jobs" -L unit
-cmake -S . -B build/tsan -G Ninja -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS_DEBUG="-O1 -g" -DRPEM_WERROR=ON \
-  -DRPEM_SANITIZE=thread -DRPEM_BUILD_BENCHMARKS=OFF -DRPEM_BUILD_TOOLS=OFF
-cmake --build build/tsan -j "$jobs" --target rpemd test_daemon test_daemon_allocations test_daemon_storm
 for t in test_daemon test_daemon_allocations test_daemon_storm; do
   TSAN_OPTIONS="suppressions=$PWD/tests/daemon/tsan.supp halt_on_error=1 second_deadlock_stack=1" \
     "build/tsan/tests/daemon/$t" --gtest_brief=1

@@ -2,7 +2,9 @@
 # The .deb on a clean Debian 12: debootstrap (minbase, cached as a tarball) → fresh root → apt install the
 # package (dependencies from Debian) → the units (rpemd, rpem-can@, rpem-vcan@) verify and score ≤ 2.5 → rpemd runs from the
 # installed configuration as an unprivileged user (the way the service runs it) and estimates.
-#   test_deb.sh BUILD_DIR
+#   test_deb.sh BUILD_DIR [--base]
+# --base only makes the cached debootstrap (ctest's fixture package_deb_base: it runs beside other tests,
+# while package_deb, whose rpemd shares the host's network, runs alone).
 set -euo pipefail
 build=$(cd "$1" && pwd)
 cache=${RPEM_DEBOOTSTRAP_CACHE:-$build/debootstrap-cache}
@@ -11,9 +13,15 @@ base=$cache/bookworm-minbase.tar
 if [[ ! -f $base ]]; then
   echo "test_deb: debootstrap bookworm (once, cached in $base)"
   tmp=$(mktemp -d)
-  debootstrap --variant=minbase bookworm "$tmp" http://deb.debian.org/debian >"$cache/debootstrap.log" 2>&1
-  tar -C "$tmp" -cf "$base" .
+  debootstrap --variant=minbase bookworm "$tmp" http://deb.debian.org/debian >"$cache/debootstrap.log" 2>&1 ||
+    { tail -n 20 "$cache/debootstrap.log"; rm -rf "$tmp"; exit 1; }
+  tar -C "$tmp" -cf "$base.part" .
+  mv "$base.part" "$base"  # never a half-written cache
   rm -rf "$tmp"
+fi
+if [[ ${2:-} == --base ]]; then
+  echo "test_deb: base ready: $base"
+  exit 0
 fi
 
 # Packed under the strictest umask on purpose: the package's modes must not depend on the builder's.
