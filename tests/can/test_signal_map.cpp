@@ -49,16 +49,23 @@ TEST(SignalMapExamples, CiA402Ax8000PdosGiveTheSample) {
   const SignalMap map = io::load_signal_map(example("beckhoff-ax8000-cia402.yaml"));
   SignalMapDecoder dec(map);
   core::AveragedSample s;
-  // 0x606C INT32 in 0.0001 rpm: 1500 rpm = 15 000 000 = 0x00E4E1C0.
-  EXPECT_FALSE(dec.decode(frame(0x181, {0xC0, 0xE1, 0xE4, 0x00}), 1000, s));
-  // 0x3242:05 Id, :04 Iq as REAL32 (IEEE 754 binary32, little endian), worked by hand:
+  // TxPDO1: 0x606C INT32 in 0.0001 rpm: 1500 rpm = 15 000 000 = 0x00E4E1C0.
+  const CanFrame speed = frame(0x181, {0xC0, 0xE1, 0xE4, 0x00});
+  // TxPDO2: 0x3242:05 Id, :04 Iq as REAL32 (IEEE 754 binary32, little endian), worked by hand:
   //   −2.5 = −1.01b·2^1: sign 1, exponent 127+1 = 0x80, fraction .01b → 0xC0200000 → 00 00 20 C0
   //   12.5 = 1.1001b·2^3: sign 0, exponent 130 = 0x82, fraction .1001b → 0x41480000 → 00 00 48 41
-  EXPECT_FALSE(dec.decode(frame(0x281, {0x00, 0x00, 0x20, 0xC0, 0x00, 0x00, 0x48, 0x41}), 1000, s));
-  // 0x3242:10 Ud, :0F Uq: −20 = −1.01b·2^4 → 0xC1A00000; 150.5 = 1.00101101b·2^7 (exponent 134 = 0x86) → 0x43168000.
-  EXPECT_FALSE(dec.decode(frame(0x381, {0x00, 0x00, 0xA0, 0xC1, 0x00, 0x80, 0x16, 0x43}), 1000, s));
+  const CanFrame currents = frame(0x281, {0x00, 0x00, 0x20, 0xC0, 0x00, 0x00, 0x48, 0x41});
+  // TxPDO3: 0x3242:10 Ud, :0F Uq: −20 = −1.01b·2^4 → 0xC1A00000; 150.5 = 1.00101101b·2^7 (exponent 134 =
+  // 0x86) → 0x43168000.
+  const CanFrame voltages = frame(0x381, {0x00, 0x00, 0xA0, 0xC1, 0x00, 0x80, 0x16, 0x43});
+  // TxPDO4 (the trigger): 0x6079 560 000 mV, a temperature of 725 · 0.1 °C.
+  const CanFrame dc_link = frame(0x481, {0x80, 0x8B, 0x08, 0x00, 0xD5, 0x02});
+
+  EXPECT_FALSE(dec.decode(speed, 1000, s));
+  EXPECT_FALSE(dec.decode(currents, 1000, s));
+  EXPECT_FALSE(dec.decode(voltages, 1000, s));
   EXPECT_FALSE(dec.decode(frame(0x701, {0x05}), 1000, s));  // heartbeat: not mapped, ignored
-  ASSERT_TRUE(dec.decode(frame(0x481, {0x80, 0x8B, 0x08, 0x00, 0xD5, 0x02}), 2000, s));  // 560 V, 72.5 °C
+  ASSERT_TRUE(dec.decode(dc_link, 2000, s));
   EXPECT_DOUBLE_EQ(s.omega_el_rad_s, 1500.0 * 2.0 * std::numbers::pi / 60.0 * 4);
   EXPECT_DOUBLE_EQ(s.i_dq_A[0], -2.5);
   EXPECT_DOUBLE_EQ(s.i_dq_A[1], 12.5);
@@ -75,17 +82,20 @@ TEST(SignalMapExamples, CiA402Ax8000PdosGiveTheSample) {
 
   // A SYNC cycle that lost TxPDO3: the trigger finds no voltage, the sample is incomplete and the next
   // one carries a gap.
-  EXPECT_FALSE(dec.decode(frame(0x181, {0xC0, 0xE1, 0xE4, 0x00}), 3000, s));
-  EXPECT_FALSE(dec.decode(frame(0x281, {0x00, 0x00, 0x20, 0xC0, 0x00, 0x00, 0x48, 0x41}), 3000, s));
-  EXPECT_FALSE(dec.decode(frame(0x481, {0x80, 0x8B, 0x08, 0x00, 0xD5, 0x02}), 3000, s));
+  EXPECT_FALSE(dec.decode(speed, 3000, s));
+  EXPECT_FALSE(dec.decode(currents, 3000, s));
+  EXPECT_FALSE(dec.decode(dc_link, 3000, s));
   EXPECT_EQ(dec.counters().incomplete, 1U);
   EXPECT_FALSE(dec.decode(frame(0x281, {0x00, 0x00, 0x20}), 4000, s));  // too short
   EXPECT_EQ(dec.counters().wrong_length, 1U);
   // An Iq of NaN (quiet NaN 0x7FC00000): the PDO is dropped and counted, the SYNC cycle is incomplete.
-  EXPECT_FALSE(dec.decode(frame(0x181, {0xC0, 0xE1, 0xE4, 0x00}), 5000, s));
-  EXPECT_FALSE(dec.decode(frame(0x281, {0x00, 0x00, 0x20, 0xC0, 0x00, 0x00, 0xC0, 0x7F}), 5000, s));
-  EXPECT_FALSE(dec.decode(frame(0x381, {0x00, 0x00, 0xA0, 0xC1, 0x00, 0x80, 0x16, 0x43}), 5000, s));
-  EXPECT_FALSE(dec.decode(frame(0x481, {0x80, 0x8B, 0x08, 0x00, 0xD5, 0x02}), 5000, s));
+  CanFrame nan_iq = currents;
+  nan_iq.data[6] = 0xC0;
+  nan_iq.data[7] = 0x7F;
+  EXPECT_FALSE(dec.decode(speed, 5000, s));
+  EXPECT_FALSE(dec.decode(nan_iq, 5000, s));
+  EXPECT_FALSE(dec.decode(voltages, 5000, s));
+  EXPECT_FALSE(dec.decode(dc_link, 5000, s));
   EXPECT_EQ(dec.counters().non_finite, 1U);
   EXPECT_EQ(dec.counters().incomplete, 2U);
   EXPECT_EQ(dec.counters().samples, 1U);
