@@ -155,7 +155,8 @@ int Daemon::run() {
   std::string ids;
   for (int k = 0; k < keys.command.size(); ++k) ids += (k > 0 ? ", " : "") + std::to_string(keys.command[k].id);
   std::fprintf(stderr, "rpemd: commands %s; last accepted sequence number %lld (%s); estimates and diagnostics %s\n",
-               config_.live.command_authentication == CommandAuthentication::kNone
+               !config_.live.commands_enabled ? "disabled (commands.enabled: false)"
+               : config_.live.command_authentication == CommandAuthentication::kNone
                    ? "unauthenticated (authentication: none, local only)"
                    : (ids.empty() ? std::string("need a key (none loaded)") : "authenticated with key id " + ids).c_str(),
                static_cast<long long>(commands.last_accepted_seq), commands.sequence_file.c_str(),
