@@ -89,6 +89,7 @@ EffectRow saturation() {
   EffectRow r;
   r.name = kD ? "ld_saturation" : "lq_saturation";
   r.parameters = kD ? 2 : 1;  // the d axis also has the magnet's asymmetry (a slope in i_d)
+  r.shapes_constant = kD ? 2 : 3;  // kCalibrated: l_d_H, l_q_H — the curve's level
   r.shows_as = kD ? "errors growing with |i_d|; transients" : "errors growing with |i_q|; transients";
   r.enters = kD ? "L_d(i_d) = L_d·(level + slope·i_d + curvature·i_d²) at the measured current each sample (the calibrated "
                   "L_d is the level)"

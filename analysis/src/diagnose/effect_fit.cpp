@@ -136,7 +136,7 @@ ExtendedModel EffectSet::model(const EffectContext& c) const {
 
 EffectSet EffectSet::with(const Effect& e, const EffectContext&, const std::vector<double>& start) const {
   EffectSet s = *this;
-  if (e.row->frees_constant >= 0) s.calibrated[static_cast<std::size_t>(e.row->frees_constant)] = true;
+  if (e.row->fitted_constant() >= 0) s.calibrated[static_cast<std::size_t>(e.row->fitted_constant())] = true;
   s.effects.push_back(e);
   s.parameters.push_back(start.empty() ? std::vector<double>(static_cast<std::size_t>(e.row->parameters), 0.0) : start);
   return s;
@@ -248,8 +248,9 @@ double EffectFitter::screen(const ScreenBasis& basis, const EffectSet& base, con
   std::vector<double> r_start;
   training_residuals(at, r_start);
   std::vector<std::vector<double>> columns = basis.columns;
-  if (const int c = candidate.row->frees_constant; c >= 0 && !base.calibrated[static_cast<std::size_t>(c)]) {
-    // The constant the candidate's law is referred to moves with it (unbounded, like the basis).
+  if (const int c = candidate.row->fitted_constant(); c >= 0 && !base.calibrated[static_cast<std::size_t>(c)]) {
+    // The constant the candidate's law is referred to, or its curve multiplies, moves with it (unbounded,
+    // like the basis).
     EffectSet moved = at;
     moved.calibration[static_cast<std::size_t>(c)] += kStep;
     columns.push_back(column(moved, r_start, kStep));

@@ -52,19 +52,33 @@ double change_correlation(const EffectFitter& f, const EffectSet& base, const Ef
 /// An effect whose parameters trade against a calibrated constant the model had identified — with it, the
 /// constant's cluster-robust interval is wider than kIdentifiedHalfWidth — is told from that constant by
 /// nothing in this log: what it lowers the residual by is the model's and the data's error the constant's
-/// freedom already had (an L_d curve on averaged steady-state rows at nearly one d current). The reason,
-/// or nothing when it keeps every constant identified (the constant its law is referred to excepted: a
-/// drift law takes that one's place by design).
+/// freedom already had (an L_d curve on averaged steady-state rows at nearly one d current). An effect
+/// that shapes a constant (EffectRow::shapes_constant: a saturation curve times L_d) is identified only
+/// with that constant, whether or not the baseline could calibrate it: fitted with it, the constant must be
+/// admissible and identified. The reason, or nothing when the effect keeps every constant identified (the
+/// constant a drift law is referred to excepted: the law takes that one's place by design).
 std::optional<std::string> takes_a_constant(const EffectFitter& fitter, const EffectSet& before, const EffectSet& with,
-                                            const CandidateScore& c, double noise_floor_A) {
+                                            const CandidateScore& c, double noise_floor_A,
+                                            const std::array<bool, kCalibrated.size()>& admissible) {
   std::optional<CalibrationIntervals> ci_before, ci_with;
   for (std::size_t k = 0; k < kCalibrated.size(); ++k) {
-    if (!before.calibrated[k] || static_cast<int>(k) == c.effect.row->frees_constant) continue;
+    const bool shaped = static_cast<int>(k) == c.effect.row->shapes_constant;
+    if (!shaped && (!before.calibrated[k] || static_cast<int>(k) == c.effect.row->frees_constant)) continue;
     if (!ci_with) ci_with = fitter.intervals(with, noise_floor_A);
-    if (identified(with, *ci_with, k)) continue;
+    if ((!shaped || admissible[k]) && identified(with, *ci_with, k)) continue;
+    char text[480];
+    if (shaped) {
+      std::snprintf(text, sizeof text,
+                    "%s lowers the held-out residual by %.1f %% (p = %.2g), but its curve multiplies %s, which this log "
+                    "does not identify with it (95 %% interval ±%.0f %%%s): the curve's sensitivities are that "
+                    "constant's, weighted by the logged currents, so the curve is not identifiable either; operation "
+                    "over a wide range of that axis' current would identify both",
+                    c.effect.label().c_str(), c.gain_pct, c.p_value, kCalibrated[k], 100.0 * ci_with->half_width[k],
+                    admissible[k] ? "" : "; the excitation alone cannot pin it");
+      return std::string(text);
+    }
     if (!ci_before) ci_before = fitter.intervals(before, noise_floor_A);
     if (!identified(before, *ci_before, k)) continue;
-    char text[400];
     std::snprintf(text, sizeof text,
                   "%s lowers the held-out residual by %.1f %% (p = %.2g), but with it the calibrated %s is no longer "
                   "identified (95 %% interval ±%.0f %%, ±%.1f %% without it): the log cannot tell the effect from that "
@@ -290,7 +304,7 @@ Selection select_effects(const EffectFitter& fitter, const SelectionOptions& opt
         why = c.effect.row->judge(c.effect, m, context, ci.effect_half_width.back());
       }
       if (!why) {
-        if (const std::optional<std::string> lost = takes_a_constant(fitter, sel.model, fitted[i], c, noise_floor_A)) {
+        if (const std::optional<std::string> lost = takes_a_constant(fitter, sel.model, fitted[i], c, noise_floor_A, admissible)) {
           sel.not_identifiable.push_back({{c.effect.label()}, *lost});
           excluded.push_back(c.effect);
           set_aside = true;

@@ -124,6 +124,15 @@ struct EffectRow {
   /// the constant's value at the log's mean temperature (or mid-log) — and that is therefore fitted with the
   /// effect even where the baseline could not calibrate it alone (a log at one operating point); −1: none.
   int frees_constant = -1;
+  /// The calibrated constant (index into kCalibrated) that the effect's curve multiplies — the level of
+  /// L_d(i) = L_d·f(i) — and that is therefore fitted with it. The curve's columns are that constant's
+  /// column weighted by a factor bounded on the logged currents, so a log that cannot identify the constant
+  /// cannot identify the curve either: the effect is named only if, fitted with it, the constant is
+  /// admissible and identified (docs/diagnose.md, "An effect that shapes a constant"); −1: none.
+  int shapes_constant = -1;
+  /// The constant fitted with the effect whatever the baseline calibrates (frees_constant or
+  /// shapes_constant); −1: none.
+  [[nodiscard]] int fitted_constant() const { return frees_constant >= 0 ? frees_constant : shapes_constant; }
   /// Starting points (scaled) for effects whose residual is not convex in their parameters; the
   /// screening tries each and the fit starts from the best. Empty: zero.
   std::vector<std::vector<double>> starts;
