@@ -26,6 +26,14 @@ CanFrame frame(std::uint32_t id, std::vector<std::uint8_t> bytes) {
   return f;
 }
 
+// The sample's i_d, i_q [A] and u_d, u_q [V]: exact (every value here is a short binary fraction).
+void expect_dq(const core::AveragedSample& s, double i_d, double i_q, double u_d, double u_q) {
+  EXPECT_EQ(s.i_dq_A[0], i_d);
+  EXPECT_EQ(s.i_dq_A[1], i_q);
+  EXPECT_EQ(s.u_dq_V[0], u_d);
+  EXPECT_EQ(s.u_dq_V[1], u_q);
+}
+
 std::string example(const std::string& name) { return test::source_dir() + "/config/signal-maps/" + name; }
 
 TEST(SignalMapBits, IntelAndMotorolaAsDbcDefinesThem) {
@@ -67,10 +75,7 @@ TEST(SignalMapExamples, CiA402Ax8000PdosGiveTheSample) {
   EXPECT_FALSE(dec.decode(frame(0x701, {0x05}), 1000, s));  // heartbeat: not mapped, ignored
   ASSERT_TRUE(dec.decode(dc_link, 2000, s));
   EXPECT_DOUBLE_EQ(s.omega_el_rad_s, 1500.0 * 2.0 * std::numbers::pi / 60.0 * 4);
-  EXPECT_DOUBLE_EQ(s.i_dq_A[0], -2.5);
-  EXPECT_DOUBLE_EQ(s.i_dq_A[1], 12.5);
-  EXPECT_DOUBLE_EQ(s.u_dq_V[0], -20.0);
-  EXPECT_DOUBLE_EQ(s.u_dq_V[1], 150.5);
+  expect_dq(s, -2.5, 12.5, -20.0, 150.5);
   EXPECT_DOUBLE_EQ(s.u_dc_V, 560.0);
   EXPECT_DOUBLE_EQ(s.t_winding_C, 72.5);
   EXPECT_TRUE(std::isnan(s.t_magnet_C));
@@ -170,10 +175,7 @@ TEST(SignalMapFloats, NanAndInfinityAreCountedAndNeverDelivered) {
   };
   EXPECT_FALSE(dec.decode(dc, 0, s));
   ASSERT_TRUE(cycle(i, u, w, 1000));
-  EXPECT_EQ(s.i_dq_A[0], -2.5);
-  EXPECT_EQ(s.i_dq_A[1], 12.5);
-  EXPECT_EQ(s.u_dq_V[0], -20.0);
-  EXPECT_EQ(s.u_dq_V[1], 150.5);
+  expect_dq(s, -2.5, 12.5, -20.0, 150.5);
   EXPECT_EQ(s.omega_el_rad_s, 230.25);
   EXPECT_EQ(s.u_dc_V, 230.25);
   ASSERT_TRUE(cycle(i, u, w, 2000));
