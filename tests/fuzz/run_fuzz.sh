@@ -20,6 +20,10 @@ target=$2
 seconds=${3:-30}
 shift $(($# < 3 ? $# : 3))
 repo=$(cd "$(dirname "$0")/../.." && pwd)
+# The target runs from its own directory: corpus directories given relative to here are made absolute.
+args=()
+for a in "$@"; do [[ $a != -* && -d $a ]] && a=$(cd "$a" && pwd); args+=("$a"); done
+set -- "${args[@]}"
 
 core=("$repo"/core/src/*.cpp)
 io=("$repo"/io/src/*.cpp "$build/io/builtin_config.cpp" "$repo/can/src/signal_map.cpp")  # io reads signal maps
