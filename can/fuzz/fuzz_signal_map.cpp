@@ -1,9 +1,11 @@
 // libFuzzer target for the signal-map decoder (can/include/rpem/can/signal_map.hpp). The first input byte
-// picks a map — rotor-frame values in little-endian standard frames with an instantaneous trigger, or phase
-// values with theta_el in big-endian extended frames, averaged — and the rest is a stream of frames
+// picks a map — rotor-frame values in little-endian standard frames with an instantaneous trigger; phase
+// values with theta_el in big-endian extended frames, averaged; or IEEE 754 floats (binary32 and binary64,
+// both byte orders, averaged) — and the rest is a stream of frames
 //   [a frame record, fuzz_frame.hpp][t step, 2 bytes]
-// The decoder must never crash, deliver only finite samples with t_start ≤ t and increasing t, and count
-// every frame once.
+// The decoder must never crash, deliver only finite samples (optional quantities finite or NaN, "not
+// reported", never ±∞) with t_start ≤ t and increasing t, and count every frame once. The dictionary
+// (corpus_signal_map.dict) holds IEEE NaN, ±∞, −0, subnormals and the largest finite values in both orders.
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
@@ -46,12 +48,34 @@ rpem::can::SignalMap phase_map() {
   return m;
 }
 
+rpem::can::SignalMap float_map() {
+  using rpem::can::ValueType;
+  const auto f = [](SampleField field, int start, int length, bool big, ValueType t, double scale = 1.0, double offset = 0.0) {
+    SignalSpec s{field, start, length, big, false, scale, offset};
+    s.value_type = t;
+    return s;
+  };
+  constexpr ValueType k32 = ValueType::kFloat32, k64 = ValueType::kFloat64;
+  rpem::can::SignalMap m;
+  m.trigger_id = 0x32;
+  m.averaged = true;
+  m.frames.push_back({0x30, false, 8, {f(SampleField::kIdA, 0, 32, false, k32), f(SampleField::kIqA, 39, 32, true, k32)}});
+  m.frames.push_back({0x31, false, 8, {f(SampleField::kUdV, 0, 32, false, k32, 1e3), f(SampleField::kUqV, 32, 32, false, k32, 1e3)}});
+  m.frames.push_back({0x32, false, 8, {f(SampleField::kOmegaElRadS, 7, 64, true, k64)}});
+  m.frames.push_back({0x33, false, 8, {f(SampleField::kUdcV, 0, 64, false, k64, 1e12)}});
+  m.frames.push_back({0x34, false, 4, {f(SampleField::kTWindingC, 7, 32, true, k32, 0.1, -40.0)}});
+  return m;
+}
+
+/// An optional quantity is a number or NaN (not reported), never ±∞.
+bool optional_ok(double v) noexcept { return !std::isinf(v); }
+
 }  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   if (size < 1) return 0;
-  static const rpem::can::SignalMap maps[2] = {rotor_frame_map(), phase_map()};
-  const rpem::can::SignalMap& map = maps[data[0] & 1];
+  static const rpem::can::SignalMap maps[3] = {rotor_frame_map(), phase_map(), float_map()};
+  const rpem::can::SignalMap& map = maps[data[0] % 3];
   if (!rpem::can::check_layout(map).empty() || !rpem::can::missing_quantities(map).empty()) std::abort();
   rpem::can::SignalMapDecoder decoder(map);
   std::size_t at = 1;
@@ -68,6 +92,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     if (decoder.decode(f, t, s)) {
       ++samples;
       if (!s.i_dq_A.allFinite() || !s.u_dq_V.allFinite() || !std::isfinite(s.omega_el_rad_s)) std::abort();
+      if (!optional_ok(s.u_dc_V) || !optional_ok(s.t_winding_C) || !optional_ok(s.t_magnet_C) || !optional_ok(s.t_drive_C)) std::abort();
       if (s.t_start_ns > s.t_ns || s.t_ns <= last_t) std::abort();
       last_t = s.t_ns;
     }

@@ -1,5 +1,6 @@
 #include "rpem/can/signal_map.hpp"
 
+#include <bit>
 #include <cmath>
 #include <limits>
 #include <numbers>
@@ -38,6 +39,24 @@ bool walk_bits(const SignalSpec& s, int frame_bits, Visit&& visit) noexcept {
   return true;
 }
 
+/// What is wrong with a float signal's layout, or "" (integers: nothing). IEEE 754 values are whole bytes
+/// in every format that carries them (CiA 301 REAL32/REAL64 in PDOs, DBC SIG_VALTYPE_ 1/2): a float that
+/// starts inside a byte is a map error, not a layout to decode.
+std::string float_problem(const SignalSpec& s) {
+  if (s.value_type == ValueType::kInteger) return {};
+  const bool single = s.value_type == ValueType::kFloat32;
+  const int bits = single ? 32 : 64;
+  const char* name = single ? "an IEEE 754 binary32 (float)" : "an IEEE 754 binary64 (double)";
+  if (s.length != bits) return std::string(name) + " is " + std::to_string(bits) + " bits, not " + std::to_string(s.length);
+  // Byte-aligned: the LSB at bit 0 of a byte (little endian) or the MSB at bit 7 of a byte (big endian).
+  if (s.start_bit % 8 != (s.big_endian ? 7 : 0)) {
+    return std::string(name) + " must start on a byte boundary (start_bit " + (s.big_endian ? "8k+7 for big_endian" : "8k for little_endian") +
+           ", not " + std::to_string(s.start_bit) + ")";
+  }
+  if (s.is_signed) return std::string(name) + " carries its own sign: leave out `signed`";
+  return {};
+}
+
 }  // namespace
 
 std::string_view field_name(SampleField f) noexcept { return kFields[static_cast<std::size_t>(f)].name; }
@@ -67,6 +86,7 @@ std::string check_layout(const SignalMap& map) {
       if (s.length < 1 || s.length > 64) return where + ": length must be 1-64 bits";
       if (!walk_bits(s, 8 * f.length, [](int) {})) return where + ": bits lie outside the frame's " + std::to_string(f.length) + " bytes";
       if (!std::isfinite(s.scale) || s.scale == 0.0 || !std::isfinite(s.offset)) return where + ": scale must be finite and non-zero, offset finite";
+      if (const std::string e = float_problem(s); !e.empty()) return where + ": " + e;
     }
   }
   bool trigger = false;
@@ -111,6 +131,18 @@ std::int64_t extract_raw(const CanFrame& f, const SignalSpec& s) noexcept {
   return static_cast<std::int64_t>(raw);
 }
 
+double physical_value(const CanFrame& f, const SignalSpec& s) noexcept {
+  const std::int64_t raw = extract_raw(f, s);
+  const auto bits = static_cast<std::uint64_t>(raw);
+  double v = 0.0;
+  switch (s.value_type) {
+    case ValueType::kFloat32: v = static_cast<double>(std::bit_cast<float>(static_cast<std::uint32_t>(bits))); break;
+    case ValueType::kFloat64: v = std::bit_cast<double>(bits); break;
+    case ValueType::kInteger: v = s.is_signed ? static_cast<double>(raw) : static_cast<double>(bits); break;
+  }
+  return v * s.scale + s.offset;
+}
+
 SignalMapDecoder::SignalMapDecoder(SignalMap map) : map_(std::move(map)) {
   for (const FrameSpec& f : map_.frames) {
     for (const SignalSpec& s : f.signals) mapped_[static_cast<std::size_t>(s.field)] = true;
@@ -138,13 +170,24 @@ bool SignalMapDecoder::decode(const CanFrame& f, std::int64_t t_ns, core::Averag
     ++counters_.wrong_length;
     return false;
   }
+  const bool trigger = f.id == map_.trigger_id && f.extended == map_.trigger_extended;
+  // A frame with a NaN or infinite value (an IEEE float signal) is dropped whole: none of its values is
+  // delivered, and a dropped trigger ends the chain as an incomplete sample does.
   for (const SignalSpec& s : spec->signals) {
-    const std::int64_t raw = extract_raw(f, s);
-    const double v = (s.is_signed ? static_cast<double>(raw) : static_cast<double>(static_cast<std::uint64_t>(raw))) * s.scale + s.offset;
-    values_[static_cast<std::size_t>(s.field)] = v;
+    if (!std::isfinite(physical_value(f, s))) {
+      ++counters_.non_finite;
+      if (trigger) {
+        fresh_.fill(false);
+        has_previous_ = false;
+      }
+      return false;
+    }
+  }
+  for (const SignalSpec& s : spec->signals) {
+    values_[static_cast<std::size_t>(s.field)] = physical_value(f, s);
     fresh_[static_cast<std::size_t>(s.field)] = true;
   }
-  if (f.id != map_.trigger_id || f.extended != map_.trigger_extended) return false;
+  if (!trigger) return false;
   return complete(t_ns, out);
 }
 

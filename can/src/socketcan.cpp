@@ -18,6 +18,9 @@
 
 #include "rpem/core/clock.hpp"
 
+static_assert(rpem::can::kEffFlag == CAN_EFF_FLAG && rpem::can::kRtrFlag == CAN_RTR_FLAG &&
+              rpem::can::kEffMask == CAN_EFF_MASK);
+
 namespace rpem::can {
 namespace {
 
@@ -49,9 +52,10 @@ bool SocketCanChannel::open() {
   if (options_.fd) (void)setsockopt(fd, SOL_CAN_RAW, CAN_RAW_FD_FRAMES, &on, sizeof on);
   if (!options_.receive) {
     (void)setsockopt(fd, SOL_CAN_RAW, CAN_RAW_FILTER, nullptr, 0);
-  } else if (!options_.ids.empty()) {
+  } else if (!options_.ids.empty() || !options_.filters.empty()) {
     std::vector<can_filter> filters;
     for (std::uint32_t id : options_.ids) filters.push_back({id, CAN_SFF_MASK | CAN_EFF_FLAG | CAN_RTR_FLAG});
+    for (const KernelFilter& k : options_.filters) filters.push_back({k.id, k.mask});
     (void)setsockopt(fd, SOL_CAN_RAW, CAN_RAW_FILTER, filters.data(),
                      static_cast<socklen_t>(filters.size() * sizeof(can_filter)));
   }

@@ -102,6 +102,12 @@ ParseResult parse_values(std::span<const std::uint8_t> payload, Values& out) noe
   return ParseResult::kOk;
 }
 
+std::array<KernelFilter, 3> kernel_filters(std::uint8_t controller_id, std::uint8_t host_id) noexcept {
+  // The addressee is the ID's low byte (comm_can.c: id | packet << 8); data frames only, extended only.
+  constexpr std::uint32_t kMask = kEffFlag | kRtrFlag | 0xFFU;
+  return {{{kEffFlag | host_id, kMask}, {kEffFlag | controller_id, kMask}, {kEffFlag | kBroadcastId, kMask}}};
+}
+
 VescDecoder::VescDecoder(std::uint8_t controller_id, std::uint8_t own_id, std::uint32_t required_mask) noexcept
     : controller_id_(controller_id), own_id_(own_id), required_mask_(required_mask) {}
 

@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "rpem/can/socketcan.hpp"
+#include "rpem/can/vesc.hpp"
 #include "rpem/core/clock.hpp"
 #include "rpem/daemon/socketcan_source.hpp"
 #include "rpem/daemon/vesc_poller.hpp"
@@ -68,8 +69,11 @@ class VescSampleSource final : public SampleSource {
     can::SocketCanChannel::Options o;
     o.interface = options_.interface;
     o.fd = false;
-    // Every frame: the replies to us, the controller's statuses, and other nodes' reads of it (stolen
-    // averages). The kernel's filters compare 11 bits here, so the poller sorts them.
+    // The kernel passes what the poller reads: replies to us, the controller's statuses, and other nodes'
+    // commands to it or to all (stolen averages); the rest of the bus stays in the kernel.
+    const auto filters = can::vesc::kernel_filters(static_cast<std::uint8_t>(options_.controller_id),
+                                                    static_cast<std::uint8_t>(options_.host_id));
+    o.filters.assign(filters.begin(), filters.end());
     can::SocketCanChannel channel(o);
     VescPoller poller(poller_config(options_));
     std::array<can::ReceivedFrame, 64> frames;

@@ -12,6 +12,12 @@ can::SignalSpec read_signal(YamlMap m) {
   s.start_bit = static_cast<int>(m.integer("start_bit", 0, 511));
   s.length = static_cast<int>(m.integer("length", 1, 64));
   s.big_endian = m.choice_or("byte_order", "little_endian", {"little_endian", "big_endian"}) == "big_endian";
+  // DBC's SIG_VALTYPE_: 0 integer (the default), 1 IEEE float (binary32), 2 IEEE double (binary64).
+  const std::string type = m.choice_or("value_type", "integer", {"integer", "float", "double"});
+  s.value_type = type == "float" ? can::ValueType::kFloat32 : type == "double" ? can::ValueType::kFloat64 : can::ValueType::kInteger;
+  if (s.value_type != can::ValueType::kInteger && m.has("signed")) {
+    m.fail("signed", "a " + type + " signal is an IEEE 754 value, which carries its own sign: leave out `signed`");
+  }
   s.is_signed = m.boolean_or("signed", false);
   s.scale = m.number_or("scale", 1.0, -1e12, 1e12);
   s.offset = m.number_or("offset", 0.0, -1e12, 1e12);

@@ -5,6 +5,8 @@
 // 0x31C3 for "123456789"), not with our code. Then every kind of bad input, counted by kind.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <numbers>
 #include <vector>
@@ -108,6 +110,45 @@ TEST(Vesc, StatusBroadcasts) {
   EXPECT_DOUBLE_EQ(dec.status().adc_V[0], 3.3);
   EXPECT_DOUBLE_EQ(dec.status().adc_V[3], -1.0);
   EXPECT_EQ(dec.counters().statuses, 6U);
+}
+
+// The kernel's rule for CAN_RAW_FILTER (linux Documentation/networking/can.rst, "RAW Socket Option
+// CAN_RAW_FILTER"): a frame is received when <received_can_id> & mask == can_id & mask for any filter; the
+// received can_id has bit 31 (CAN_EFF_FLAG) set for a 29-bit id and bit 30 (CAN_RTR_FLAG) for a remote frame.
+bool kernel_passes(const std::array<KernelFilter, 3>& filters, const CanFrame& f, bool remote = false) {
+  const std::uint32_t can_id = f.id | (f.extended ? 0x80000000U : 0U) | (remote ? 0x40000000U : 0U);
+  return std::any_of(filters.begin(), filters.end(),
+                     [&](const KernelFilter& k) { return (can_id & k.mask) == (k.id & k.mask); });
+}
+
+TEST(Vesc, KernelFiltersPassWhatThePollerReadsAndNothingElse) {
+  const auto filters = kernel_filters(kController, kOwn);
+  // Passed: every frame of a reply to us (FILL_RX_BUFFER 5, PROCESS_RX_BUFFER 7), the other buffer packets
+  // addressed to us (FILL_RX_BUFFER_LONG 6, PROCESS_SHORT_BUFFER 8), the controller's statuses 1-6, a second
+  // poller's read of our controller and a read of every controller (id 255).
+  for (const CanFrame& f : test::vesc_frames::reply_frames()) EXPECT_TRUE(kernel_passes(filters, f)) << std::hex << f.id;
+  EXPECT_TRUE(kernel_passes(filters, ext(0x67D, {0x00, 0x00, 0x32})));
+  EXPECT_TRUE(kernel_passes(filters, ext(0x87D, {0x11, 0x00, 0x32})));
+  for (std::uint32_t status : {9U, 14U, 15U, 16U, 27U, 58U}) {
+    EXPECT_TRUE(kernel_passes(filters, ext((status << 8) | kController, {0, 0, 0, 0, 0, 0, 0, 0}))) << status;
+  }
+  EXPECT_TRUE(kernel_passes(filters, test::vesc_frames::status4()));
+  EXPECT_TRUE(kernel_passes(filters, values_request(kController, 0x42, kEstimatorMask)));  // another host's poll
+  EXPECT_TRUE(kernel_passes(filters, ext(0x8FF, {0x42, 0x00, 0x32, 0x00, 0x18, 0x01, 0xB3})));  // to every VESC
+
+  // Kept in the kernel: replies to another host (0x42), another controller's statuses and replies, our
+  // own ids as standard (11-bit) frames, a remote frame to us, and everything of other protocols.
+  EXPECT_FALSE(kernel_passes(filters, ext(0x542, {0x00, 0x32})));
+  EXPECT_FALSE(kernel_passes(filters, ext(0x742, {0x11, 0x01, 0x00, 0x1F, 0x08, 0xF7})));
+  EXPECT_FALSE(kernel_passes(filters, ext(0x912, {0, 0, 0, 0, 0, 0, 0, 0})));
+  EXPECT_FALSE(kernel_passes(filters, ext(0x1012, {0, 0, 0, 0, 0, 0, 0, 0})));
+  CanFrame standard = ext(0x57D, {0x00, 0x32});
+  standard.extended = false;
+  EXPECT_FALSE(kernel_passes(filters, standard));
+  standard.id = kController;
+  EXPECT_FALSE(kernel_passes(filters, standard));
+  EXPECT_FALSE(kernel_passes(filters, ext(0x57D, {}), /*remote=*/true));
+  EXPECT_FALSE(kernel_passes(filters, ext(0x18FF0001, {1, 2, 3})));  // a J1939-style id of another node
 }
 
 TEST(VescBadInput, CrcErrorLengthMismatchAndLostFramesAreCountedAndDropped) {

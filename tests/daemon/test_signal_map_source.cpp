@@ -31,15 +31,16 @@ can::SignalMap shipped(const char* name) {
   return io::load_signal_map(test::source_dir() + "/config/signal-maps/" + name);
 }
 
-// Beckhoff AX8000 TxPDOs (little endian): 1500 rpm; i_d −2000 mA, i_q 5000 mA; u_d −3500 mV, u_q 24000 mV;
-// u_dc 48000 mV, T_winding 65.3 °C (653 in 0.1 °C). AM8141: 4 pole pairs.
+// Beckhoff AX8000 TxPDOs (little endian): 1500 rpm (15 000 000 in 0.0001 rpm); i_d −2 A (REAL32 0xC0000000),
+// i_q 5 A (0x40A00000); u_d −3.5 V (0xC0600000), u_q 24 V (0x41C00000); u_dc 48000 mV, T_winding 65.3 °C
+// (653 in 0.1 °C). AM8141: 4 pole pairs.
 TEST(SignalMapSource, ARotorFrameMapGivesAveragedSamplesAtTheTriggersTime) {
   SignalMapSampler s(shipped("beckhoff-ax8000-cia402.yaml"));
   ASSERT_EQ(s.kind(), SampleKind::kAveraged);
   SourceSample out;
-  EXPECT_FALSE(s.on_frame(frame(0x181, {0xDC, 0x05, 0x00, 0x00}), 1000, out));
-  EXPECT_FALSE(s.on_frame(frame(0x281, {0x30, 0xF8, 0xFF, 0xFF, 0x88, 0x13, 0x00, 0x00}), 1100, out));
-  EXPECT_FALSE(s.on_frame(frame(0x381, {0x54, 0xF2, 0xFF, 0xFF, 0xC0, 0x5D, 0x00, 0x00}), 1200, out));
+  EXPECT_FALSE(s.on_frame(frame(0x181, {0xC0, 0xE1, 0xE4, 0x00}), 1000, out));
+  EXPECT_FALSE(s.on_frame(frame(0x281, {0x00, 0x00, 0x00, 0xC0, 0x00, 0x00, 0xA0, 0x40}), 1100, out));
+  EXPECT_FALSE(s.on_frame(frame(0x381, {0x00, 0x00, 0x60, 0xC0, 0x00, 0x00, 0xC0, 0x41}), 1200, out));
   EXPECT_FALSE(s.on_frame(frame(0x7E5, {0x01, 0x02}), 1250, out));  // not in the map (an LSS frame)
   ASSERT_TRUE(s.on_frame(frame(0x481, {0x80, 0xBB, 0x00, 0x00, 0x8D, 0x02}), 1300, out));
   const auto* a = std::get_if<core::AveragedSample>(&out);

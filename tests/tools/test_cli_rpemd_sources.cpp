@@ -1,9 +1,13 @@
-// rpemd's sources as a user starts them: the shipped vesc and signal_map configurations check out, and a
-// signal map that lacks a quantity the estimator needs stops rpemd at start with exit 78 (EX_CONFIG) and a
-// message naming the map file and the missing quantity.
+// rpemd's sources as a user starts them: the shipped vesc and signal_map configurations and the configuration
+// docs/rpemd.md gives in each source's section check out, and a
+// signal map that lacks a quantity the estimator needs, or has a float signal that is not a whole IEEE 754
+// value, stops rpemd at start with exit 78 (EX_CONFIG) and a message naming the map file and the reason.
 #include <gtest/gtest.h>
 
+#include <filesystem>
 #include <fstream>
+#include <string>
+#include <utility>
 
 #include "support/process.hpp"
 #include "support/temp_file.hpp"
@@ -18,6 +22,39 @@ TEST(CliRpemdSources, ShippedVescAndSignalMapConfigurationsCheckOut) {
     EXPECT_EQ(r.exit_code, 0) << f << ": " << r.output;
     EXPECT_NE(r.output.find("is valid"), std::string::npos) << r.output;
   }
+}
+
+// Each "### `source: X`" section of docs/rpemd.md gives a complete configuration in its first yaml block; written
+// beside the shipped config/ files (which its relative paths name, as a user's copy in config/ would), rpemd
+// must accept it.
+TEST(CliRpemdSources, EachSourceSectionOfTheDocsGivesAConfigurationThatChecksOut) {
+  namespace fs = std::filesystem;
+  const std::string doc = rpem::test::read_file(rpem::test::source_dir() + "/docs/rpemd.md");
+  ASSERT_FALSE(doc.empty());
+  const fs::path dir = rpem::test::temp_path("docs_source_configs");
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  for (const auto& e : fs::directory_iterator(rpem::test::source_dir() + "/config")) {
+    fs::create_symlink(e.path(), dir / e.path().filename());
+  }
+  for (const char* type : {"can", "vesc", "signal_map", "sim"}) {
+    const std::string heading = std::string("### `source: ") + type + "`";
+    const auto at = doc.find(heading);
+    ASSERT_NE(at, std::string::npos) << heading;
+    const auto next = doc.find("\n### ", at + heading.size());
+    const auto open = doc.find("```yaml\n", at);
+    ASSERT_LT(open, next) << heading << ": no yaml block in the section";
+    const auto body = open + 8;
+    const auto close = doc.find("```", body);
+    ASSERT_NE(close, std::string::npos) << heading;
+    const fs::path file = dir / (std::string("docs-rpemd-") + type + ".yaml");
+    std::ofstream(file) << doc.substr(body, close - body);
+    const auto r = rpem::test::run_command(rpemd() + " --check-config --config " + file.string());
+    EXPECT_EQ(r.exit_code, 0) << heading << ": " << r.output;
+    EXPECT_NE(r.output.find("is valid"), std::string::npos) << heading << ": " << r.output;
+    EXPECT_NE(doc.substr(body, close - body).find(std::string("type: ") + type), std::string::npos) << heading;
+  }
+  fs::remove_all(dir);
 }
 
 TEST(CliRpemdSources, AMapWithoutSpeedStopsRpemdWithExit78NamingMapAndQuantity) {
@@ -36,6 +73,32 @@ TEST(CliRpemdSources, AMapWithoutSpeedStopsRpemdWithExit78NamingMapAndQuantity) 
     EXPECT_EQ(r.exit_code, 78) << r.output;
     EXPECT_NE(r.output.find("rpemd-map-no-speed.yaml"), std::string::npos) << r.output;
     EXPECT_NE(r.output.find("speed (omega_el, erpm or speed_mech)"), std::string::npos) << r.output;
+  }
+}
+
+TEST(CliRpemdSources, AFloatSignalOfTheWrongLengthOrAlignmentStopsRpemdWithExit78) {
+  const std::string rest =
+      "      - {field: u_d, start_bit: 0, length: 32, value_type: float, unit: V}\n"
+      "      - {field: u_q, start_bit: 32, length: 32, value_type: float, unit: V}\n"
+      "  - id: 0x302\n    signals:\n"
+      "      - {field: erpm, start_bit: 0, length: 32, byte_order: little_endian, signed: true, unit: rpm}\n";
+  const std::pair<const char*, const char*> cases[] = {
+      {"      - {field: i_d, start_bit: 0, length: 16, value_type: float, unit: A}\n", "is 32 bits, not 16"},
+      {"      - {field: i_d, start_bit: 4, length: 64, value_type: double, unit: A}\n", "must start on a byte boundary"},
+  };
+  for (const auto& [signal, why] : cases) {
+    const rpem::test::TempFile map("rpemd-map-float.yaml", "name: float\nsample: {trigger: 0x302, averaged: true}\nframes:\n"
+                                                         "  - id: 0x300\n    length: 16\n    signals:\n" +
+                                                             std::string(signal) +
+                                                             "      - {field: i_q, start_bit: 96, length: 32, value_type: float, unit: A}\n"
+                                                             "  - id: 0x301\n    signals:\n" + rest);
+    const rpem::test::TempFile config("rpemd-map-float-config.yaml",
+                                      "daemon:\n  source:\n    type: signal_map\n    signal_map: {interface: vcan0, map: " +
+                                          map.path() + "}\n");
+    const auto r = rpem::test::run_command(rpemd() + " --check-config --config " + config.path());
+    EXPECT_EQ(r.exit_code, 78) << r.output;
+    EXPECT_NE(r.output.find("rpemd-map-float.yaml"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find(why), std::string::npos) << r.output;
   }
 }
 

@@ -24,9 +24,9 @@ sed -i 's|^machine: ../config/|machine: config/|' "$out/vesc-6374.yaml"
 # rpemd's part runs where the tree has `source: vesc` (daemon/src/vesc_source.cpp, branch vesc-12).
 rpemd_files=()
 if [[ ${2:-} == --rpemd && -f $repo/daemon/src/vesc_source.cpp && -x $build/daemon/rpemd ]]; then
-  cp "$here/vesc_rpemd.sh" "$here/rpemd-vesc-vcan.yaml" "$out/"
+  cp "$here/vesc_rpemd.sh" "$here/rpemd-vesc-vcan.yaml" "$here/rpemd-map-vcan.yaml" "$out/"
   rpemd_files=(--file "$build/daemon/rpemd" --file "$here/vesc_rpemd.sh" --file "$here/rpemd-vesc-vcan.yaml"
-               --file "$repo/config/vesc-6374-outrunner.yaml")
+               --file "$here/rpemd-map-vcan.yaml" --file "$repo/config/vesc-6374-outrunner.yaml")
 fi
 
 if "$here/vm_rig.sh" native-vcan; then
@@ -49,6 +49,7 @@ python3 "$repo/tests/can/check_averaged_record.py" "$out/classic_sent.csv" "$out
 if [[ -f $out/rpemd_vesc_skipped ]]; then
   echo "run_vesc_suite: rpemd's 'source: vesc' not in this build — its part did not run"
 else
+  python3 "$here/check_map_rpemd.py" "$out/rpemd_map.txt"
   for run in r200 r1k; do python3 "$here/check_vesc_rpemd.py" "$out" "$run"; done
 fi
 echo "run_vesc_suite: passed"

@@ -5,7 +5,8 @@
 #      whole exchange captured by candump; the emulator goes silent from 6 s to 8 s
 #   2. rpem record --averaged-out from native telemetry (rpem sim --can) and through a signal map
 #      (config/signal-maps/rpem-native-classic.yaml over rpem replay --classic)
-#   3. rpemd (source: vesc) polling the emulated VESC at 200 Hz and at 1 kHz — when rpemd has the source
+#   3. rpemd (source: signal_map) reading those classic frames through the map — when given its configuration
+#   4. rpemd (source: vesc) polling the emulated VESC at 200 Hz and at 1 kHz — when rpemd has the source
 out=${1:-/host}
 fail=0
 step() { echo "vesc_suite: $*"; }
@@ -54,6 +55,17 @@ cp /tmp/classic_sent.csv "$out/classic_sent.csv"
 rpem replay /tmp/classic_sent.csv --can vcan0 --classic --rate 1 || fail=1
 wait $rec || fail=1
 cat "$out/map_avg.txt"
+
+if [ -f ./rpemd-map-vcan.yaml ]; then
+  step "rpemd, source: signal_map (rpem-native-classic.yaml) <- rpem replay --classic"
+  rpemd --config rpemd-map-vcan.yaml > "$out/rpemd_map.txt" 2>&1 &
+  r=$!
+  sleep 2
+  rpem replay "$out/native_sent.csv" --can vcan0 --classic --rate 1 || fail=1
+  sleep 2
+  kill -TERM $r; wait $r || fail=1
+  tail -n 3 "$out/rpemd_map.txt"
+fi
 
 if [ -f ./vesc_rpemd.sh ]; then
   step "rpemd, source: vesc"

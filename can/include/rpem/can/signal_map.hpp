@@ -32,13 +32,18 @@ inline constexpr std::size_t kSampleFieldCount = static_cast<std::size_t>(Sample
 [[nodiscard]] std::string_view field_unit(SampleField f) noexcept;
 [[nodiscard]] bool parse_field(std::string_view name, SampleField& out) noexcept;
 
+/// How a signal's raw bits are read, as DBC's `SIG_VALTYPE_` gives it: an integer (no SIG_VALTYPE_, or 0),
+/// an IEEE 754 binary32 (1: 32 bits) or binary64 (2: 64 bits). Scale and offset apply to all three.
+enum class ValueType : std::uint8_t { kInteger, kFloat32, kFloat64 };
+
 struct SignalSpec {
   SampleField field = SampleField::kIdA;
   int start_bit = 0;        ///< DBC start bit: the LSB (little endian) or the MSB in DBC numbering (big endian)
   int length = 1;           ///< 1–64 bits
   bool big_endian = false;  ///< DBC @0 (Motorola); false: @1 (Intel)
-  bool is_signed = false;   ///< two's complement
+  bool is_signed = false;   ///< two's complement (integers only: an IEEE float carries its own sign)
   double scale = 1.0, offset = 0.0;
+  ValueType value_type = ValueType::kInteger;
 };
 
 struct FrameSpec {
@@ -59,7 +64,8 @@ struct SignalMap {
   int pole_pairs = 0;  ///< for speed_mech_rpm; 0: not given
 };
 
-/// Bits in [start, start+length) fit the frame's length and every signal is well formed: "" or the first
+/// Bits in [start, start+length) fit the frame's length and every signal is well formed (a float is 32 bits
+/// for binary32 and 64 for binary64, starts on a byte boundary and is not `signed`): "" or the first
 /// problem, naming the frame and signal.
 [[nodiscard]] std::string check_layout(const SignalMap& map);
 /// What the estimator needs and the map does not give: "" or a sentence naming the missing quantities
@@ -69,6 +75,9 @@ struct SignalMap {
 
 /// The raw bits of a signal, DBC semantics (sign-extended where signed). The frame must hold them.
 [[nodiscard]] std::int64_t extract_raw(const CanFrame& f, const SignalSpec& s) noexcept;
+/// The physical value: the raw bits as an integer or an IEEE float (value_type), times scale plus offset.
+/// NaN or ±infinity when the frame carries them (or the scaled value overflows); the decoder drops those.
+[[nodiscard]] double physical_value(const CanFrame& f, const SignalSpec& s) noexcept;
 
 struct SignalMapCounters {
   std::uint64_t frames = 0;
@@ -76,7 +85,7 @@ struct SignalMapCounters {
   std::uint64_t unknown_id = 0;    ///< ignored: not in the map
   std::uint64_t wrong_length = 0;  ///< shorter than the map's DLC, or FD where classic is mapped
   std::uint64_t incomplete = 0;    ///< a trigger before every needed quantity arrived since the last sample
-  std::uint64_t non_finite = 0;    ///< a sample that came out non-finite
+  std::uint64_t non_finite = 0;    ///< a frame with a NaN or infinite value (dropped), or a sample that came out so
   std::uint64_t error_frames = 0;
 };
 

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "rpem/can/frame.hpp"
+#include "rpem/can/kernel_filter.hpp"
 
 namespace rpem::can {
 
@@ -41,7 +42,8 @@ class SocketCanChannel {
     std::string interface;
     bool fd = true;                      ///< enable CAN FD frames
     bool receive = true;                 ///< false: a send-only socket (empty kernel filter)
-    std::vector<std::uint32_t> ids;      ///< kernel filter: accept these IDs only (empty: all)
+    std::vector<std::uint32_t> ids;      ///< kernel filter: accept these 11-bit IDs only (empty: all)
+    std::vector<KernelFilter> filters;   ///< further kernel filters (a frame passing any filter or id is read)
     bool receive_errors = true;          ///< subscribe to error frames
     int receive_buffer_bytes = 1 << 20;  ///< SO_RCVBUFFORCE, falling back to SO_RCVBUF
     int reopen_interval_ms = 100;

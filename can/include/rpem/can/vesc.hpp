@@ -13,6 +13,7 @@
 #include <span>
 
 #include "rpem/can/frame.hpp"
+#include "rpem/can/kernel_filter.hpp"
 #include "rpem/core/averaged_sample.hpp"
 
 namespace rpem::can::vesc {
@@ -35,6 +36,12 @@ enum class Packet : std::uint8_t {
 inline constexpr std::uint8_t kCommGetValuesSelective = 50;
 /// The broadcast controller id (comm_can.c, decode_msg: "id == 255").
 inline constexpr std::uint8_t kBroadcastId = 255;
+
+/// The kernel filters for a poller `host_id` of `controller_id` (SocketCanChannel::Options::filters): extended
+/// data frames whose low byte is the host (replies to it), the controller (its status broadcasts, and other
+/// nodes' commands to it: a second poller's reads) or the broadcast id (commands to every controller). Other
+/// controllers' statuses, replies to other hosts and standard frames stay in the kernel.
+[[nodiscard]] std::array<KernelFilter, 3> kernel_filters(std::uint8_t controller_id, std::uint8_t host_id) noexcept;
 
 /// Bits of the COMM_GET_VALUES_SELECTIVE mask (commands.c, commands_process_packet), in reply order.
 enum Field : int {
