@@ -7,6 +7,10 @@
 // model alone measured 405× and 560× within minutes), so only the ratio of interleaved runs compares
 // between runs. Target: switching ≥ 0.3 × averaged.
 // BM_SimulateOneSecond times each configuration alone, the fixed 1 µs plant step among them.
+// BM_EmulatedVescOneSecond: the emulated VESC's drive (`rpem sim --vesc`, scenarios/vesc-6374.yaml, 12.5 kHz
+// control) run on demand by polls at 1 kHz and its statuses, averaged and switching inverter alternately
+// on this thread's CPU clock: its real-time factor (CPU seconds per drive second; under 1 it keeps up)
+// at each fidelity, from the same run.
 
 #include <benchmark/benchmark.h>
 
@@ -16,6 +20,7 @@
 
 #include "rpem/core/drive_estimator.hpp"
 #include "rpem/sim/drive_simulator.hpp"
+#include "rpem/sim/vesc_on_demand.hpp"
 
 namespace {
 
@@ -88,6 +93,48 @@ void BM_SwitchingOverAveraged(benchmark::State& state) {
   state.counters["averaged_x_real_time"] = seconds / averaged_cpu_s;
   state.counters["ratio"] = averaged_cpu_s / switching_cpu_s;
 }
+
+sim::Scenario vesc_scenario(Fidelity fidelity) {
+  sim::Scenario s = sim::load_scenario(RPEM_SOURCE_DIR "/scenarios/vesc-6374.yaml");
+  s.warmup_s = 0.0;
+  s.duration_s = 2.0;
+  if (fidelity != Fidelity::kAveraged) {
+    s.inverter.model = sim::InverterModel::kSwitching;
+    s.integrator = sim::PlantIntegrator::kEdges;
+  }
+  return s;
+}
+
+/// CPU seconds for one second of the emulated drive, polled at 1 kHz.
+double emulate_one_second(const sim::Scenario& s) {
+  sim::OnDemandVesc::Settings settings;
+  settings.motor = {17, 40.0};
+  sim::OnDemandVesc drive(s, settings);
+  double sink = 0.0;
+  auto emit = [&](const can::vesc::Status& st) { sink += st.erpm; };
+  const double t0 = thread_cpu_s();
+  for (std::int64_t t = 1'000'000; t <= 1'000'000'000; t += 1'000'000) {
+    const auto r = drive.poll(t, emit);
+    if (!r) break;
+    sink += r->values.i_q_A;
+  }
+  benchmark::DoNotOptimize(sink);
+  return thread_cpu_s() - t0;
+}
+
+void BM_EmulatedVescOneSecond(benchmark::State& state) {
+  const sim::Scenario averaged = vesc_scenario(Fidelity::kAveraged), switching = vesc_scenario(Fidelity::kSwitchingEdges);
+  double averaged_cpu_s = 0.0, switching_cpu_s = 0.0;
+  for (auto _ : state) {
+    averaged_cpu_s += emulate_one_second(averaged);
+    switching_cpu_s += emulate_one_second(switching);
+  }
+  const auto seconds = static_cast<double>(state.iterations());
+  state.counters["averaged_real_time_factor"] = averaged_cpu_s / seconds;
+  state.counters["switching_real_time_factor"] = switching_cpu_s / seconds;
+}
+
+BENCHMARK(BM_EmulatedVescOneSecond)->Unit(benchmark::kMillisecond)->Iterations(3)->Repetitions(3)->ReportAggregatesOnly(true);
 
 BENCHMARK(BM_SwitchingOverAveraged)
     ->Unit(benchmark::kMillisecond)

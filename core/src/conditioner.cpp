@@ -37,6 +37,8 @@ void SampleConditioner::reconfigure(const PerUnitBase& base, const MachinePu& ma
   inv_current_A_ = 1.0 / base.current_A;
   inv_voltage_V_ = 1.0 / base.voltage_V;
   inv_omega_rad_s_ = 1.0 / base.omega_el_rad_s;
+  current_pu_ = ScaledClarke::of(inv_current_A_);
+  voltage_pu_ = ScaledClarke::of(inv_voltage_V_);
   extensions_ = x;
   inv_current_gain_ = (Vec3::Ones() + x.current_gain_error).cwiseInverse();
   inv_r_fe_pu_ = x.iron_loss_r_fe_Ohm > 0.0 ? base_.impedance_Ohm / x.iron_loss_r_fe_Ohm : 0.0;
@@ -56,6 +58,8 @@ void SampleConditioner::reconfigure(const PerUnitBase& base, const MachinePu& ma
   cross_x_q_pu_per_A_ = x.cross_coupling_H_per_A / base.inductance_H;
   cross_x_q_pu_per_A2_ = x.cross_coupling_H_per_A2 / base.inductance_H;
   delay_ = x.delay_s > 0.0;
+  corrections_ = deadtime_ || inv_r_fe_pu_ > 0.0;
+  emf_ = harmonics_ || cross_;
 }
 
 Vec2 SampleConditioner::inductances_pu(const Vec2& i_dq_pu) const noexcept {
@@ -70,7 +74,7 @@ Vec2 SampleConditioner::inductances_pu(const Vec2& i_dq_pu) const noexcept {
 
 Vec2 SampleConditioner::extra_emf_pu(const Rotation& rot, double n_pu, const Vec2& i_dq_pu, bool harmonics) const noexcept {
   Vec2 e = Vec2::Zero();
-  if (!harmonics_ && !cross_) return e;
+  if (!emf_) return e;
   if (harmonics && harmonics_) {
     for (std::size_t j = 0; j < harmonics_pu_.size(); ++j) {
       const FluxHarmonic& h = harmonics_pu_[j];
@@ -87,7 +91,7 @@ Vec2 SampleConditioner::extra_emf_pu(const Rotation& rot, double n_pu, const Vec
   return n_pu * e;
 }
 
-Vec2 SampleConditioner::delayed_command_alphabeta_V(double dt_s) const noexcept {
+Vec2 SampleConditioner::delayed_command_alphabeta_pu(double dt_s) const noexcept {
   // The command that acts over this interval was issued delay = (m + f)·dt before it: for the first
   // f of the interval the older one of the two issued around that instant still holds (zero-order hold).
   const double periods = std::clamp(extensions_.delay_s / dt_s, 0.0, kMaxDelayPeriods + 0.999999);
@@ -100,23 +104,23 @@ Vec3 SampleConditioner::corrected_phases_A(const Vec3& measured_A) const noexcep
   return (measured_A - extensions_.current_offset_A).cwiseProduct(inv_current_gain_);
 }
 
-inline Vec2 SampleConditioner::current_alphabeta_A(const DriveSample& s, const Rotation& logged) const noexcept {
-  if (s.current_frame == Frame::kAbc) return clarke(phase_corrections_ ? corrected_phases_A(s.i_A) : Vec3(s.i_A));
+inline Vec2 SampleConditioner::current_alphabeta_pu(const DriveSample& s, const Rotation& logged) const noexcept {
+  if (s.current_frame == Frame::kAbc) return current_pu_(phase_corrections_ ? corrected_phases_A(s.i_A) : Vec3(s.i_A));
   const Vec2 i_ab = s.current_frame == Frame::kAlphaBeta ? Vec2(s.i_A.head<2>()) : inverse_park(s.i_A.head<2>(), logged);
   // A drive that logs αβ or dq made them from its phase measurements; the corrections act there.
-  return phase_corrections_ ? clarke(corrected_phases_A(inverse_clarke(i_ab))) : i_ab;
+  return phase_corrections_ ? current_pu_(corrected_phases_A(inverse_clarke(i_ab))) : Vec2(i_ab * inv_current_A_);
 }
 
-Vec2 SampleConditioner::command_alphabeta_V(const DriveSample& s, const Rotation& logged) noexcept {
+inline Vec2 SampleConditioner::command_alphabeta_pu(const DriveSample& s, const Rotation& logged) const noexcept {
   switch (s.voltage_frame) {
     case Frame::kAbc:
-      return clarke(s.u_V);
+      return voltage_pu_(s.u_V);
     case Frame::kAlphaBeta:
-      return s.u_V.head<2>();
+      return s.u_V.head<2>() * inv_voltage_V_;
     case Frame::kDq:
       break;
   }
-  return inverse_park(s.u_V.head<2>(), logged);
+  return inverse_park(s.u_V.head<2>(), logged) * inv_voltage_V_;
 }
 
 double SampleConditioner::deadtime_voltage_V(double u_dc_V) const noexcept {
@@ -137,8 +141,8 @@ inline SampleConditioner::Measured SampleConditioner::measure(const DriveSample&
   Measured m;
   m.logged = logged;
   m.rot = angle_offset_ ? compose(m.logged, offset_rotation_) : m.logged;
-  m.i_ab_A = current_alphabeta_A(s, m.logged);
-  m.i_dq_pu = park(m.i_ab_A, m.rot) * inv_current_A_;
+  m.i_ab_pu = current_alphabeta_pu(s, m.logged);
+  m.i_dq_pu = park(m.i_ab_pu, m.rot);
   m.n_pu = s.omega_el_rad_s * inv_omega_rad_s_;  // base_.speed_pu(), without the division
   const Vec2 x = inductances_pu(m.i_dq_pu);
   m.x_d_pu = x[0];
@@ -156,15 +160,15 @@ inline SampleConditioner::Measured SampleConditioner::measure(const DriveSample&
 SteadyStateInputs SampleConditioner::steady_state(const DriveSample& s) const noexcept {
   SteadyStateInputs out;
   const Measured m = measure(s, Rotation::of(s.theta_el_rad));
-  Vec2 u_dq_V = park(command_alphabeta_V(s, m.logged), m.rot);
-  const double v_err = deadtime_voltage_V(s.u_dc_V);
-  const double i_norm = m.i_ab_A.norm();
-  if (v_err != 0.0 && i_norm > 0.0) {
+  Vec2 u_dq_pu = park(command_alphabeta_pu(s, m.logged), m.rot);
+  const double v_err_pu = deadtime_voltage_V(s.u_dc_V) * inv_voltage_V_;
+  const double i_norm = m.i_ab_pu.norm();
+  if (v_err_pu != 0.0 && i_norm > 0.0) {
     // The six-step leg error's fundamental, opposite to the current: amplitude (4/π)·v_err.
-    u_dq_V -= (4.0 / kPi) * v_err * park(m.i_ab_A, m.rot) / i_norm;
+    u_dq_pu -= (4.0 / kPi) * v_err_pu * park(m.i_ab_pu, m.rot) / i_norm;
   }
   // Flux harmonics average out over the revolution a steady-state row stands for; cross-saturation stays.
-  out.u_pu = u_dq_V * inv_voltage_V_ - machine_.r_s_pu * m.i_fe_dq_pu - extra_emf_pu(m.rot, m.n_pu, m.i_dq_pu, false);
+  out.u_pu = u_dq_pu - machine_.r_s_pu * m.i_fe_dq_pu - extra_emf_pu(m.rot, m.n_pu, m.i_dq_pu, false);
   out.i_pu = m.i_dq_pu;
   out.n_pu = m.n_pu;
   out.x_d_pu = m.x_d_pu;
@@ -222,9 +226,12 @@ Vec2 SampleConditioner::observed_current_dq_A(const DriveSample& s, const Vec2& 
   // The corrections the machine's voltage takes over the coming interval, from the current now: the
   // dead-time error, and the resistive drop of the iron-loss current (which the magnetising-current
   // model does not carry).
-  const Vec2 command_ab_V = command_alphabeta_V(s, m.logged);
-  Vec2 correction_ab_V = deadtime_error_alphabeta_V(m.i_ab_A, s.u_dc_V);
-  if (inv_r_fe_pu_ > 0.0) correction_ab_V -= inverse_park(m.i_fe_dq_pu, m.rot) * (machine_.r_s_pu * base_.voltage_V);
+  const Vec2 command_ab_pu = command_alphabeta_pu(s, m.logged);
+  Vec2 correction_ab_pu = Vec2::Zero();
+  if (corrections_) {
+    correction_ab_pu = deadtime_error_alphabeta_V(m.i_ab_pu * base_.current_A, s.u_dc_V) * inv_voltage_V_;
+    if (inv_r_fe_pu_ > 0.0) correction_ab_pu -= inverse_park(m.i_fe_dq_pu, m.rot) * machine_.r_s_pu;
+  }
   const Vec2 emf_pu = extra_emf_pu(m.rot, m.n_pu, m.i_dq_pu, true);
 
   const bool chained = has_previous_ && !s.gap_before;
@@ -233,10 +240,15 @@ Vec2 SampleConditioner::observed_current_dq_A(const DriveSample& s, const Vec2& 
     iv.dt_s = 1e-9 * static_cast<double>(s.t_ns - previous_t_ns_);
     iv.n_start_pu = previous_n_pu_;
     iv.n_end_pu = m.n_pu;
-    const Vec2 command = delay_ && iv.dt_s > 0.0 ? delayed_command_alphabeta_V(iv.dt_s) : commands_[0];
-    const Vec2 u_held_ab_pu = (command + previous_correction_ab_V_) * inv_voltage_V_;
-    iv.u_start_pu = park(u_held_ab_pu, previous_rotation_) - previous_emf_pu_;
-    iv.u_end_pu = park(u_held_ab_pu, m.rot) - emf_pu;
+    const Vec2 command = delay_ && iv.dt_s > 0.0 ? delayed_command_alphabeta_pu(iv.dt_s) : commands_[0];
+    // Without the extensions that add to it, the command is what the machine sees (decided in reconfigure).
+    const Vec2 u_held_ab_pu = corrections_ ? Vec2(command + previous_correction_ab_pu_) : command;
+    iv.u_start_pu = park(u_held_ab_pu, previous_rotation_);
+    iv.u_end_pu = park(u_held_ab_pu, m.rot);
+    if (emf_) {
+      iv.u_start_pu -= previous_emf_pu_;
+      iv.u_end_pu -= emf_pu;
+    }
   } else {
     out.resync = true;
     // The gap's length (0 for the first sample) lets the estimator keep ε across a short one.
@@ -246,14 +258,14 @@ Vec2 SampleConditioner::observed_current_dq_A(const DriveSample& s, const Vec2& 
   }
 
   if (!delay_) {
-    commands_[0] = command_ab_V;
+    commands_[0] = command_ab_pu;
   } else if (chained) {
     for (std::size_t j = commands_.size() - 1; j > 0; --j) commands_[j] = commands_[j - 1];
-    commands_[0] = command_ab_V;
+    commands_[0] = command_ab_pu;
   } else {
-    commands_.fill(command_ab_V);  // what came before the chain is unknown: the first command stands in
+    commands_.fill(command_ab_pu);  // what came before the chain is unknown: the first command stands in
   }
-  previous_correction_ab_V_ = correction_ab_V;
+  previous_correction_ab_pu_ = correction_ab_pu;
   previous_emf_pu_ = emf_pu;
   previous_rotation_ = m.rot;
   previous_n_pu_ = m.n_pu;

@@ -120,30 +120,56 @@ EstimatorOutput RpemEstimator::held(StepCode code) const noexcept {
   active.r_s = active.r_s && config_.adapt_r_s && !state_.frozen;
 
   GainOutput gain;
+  Vec2 change = Vec2::Zero();  // L·ε, before eq:GainSchedule
   switch (config_.algorithm) {
-    case Algorithm::kSga:
-      gain = sga_gain(u.gradient, gamma_r, gamma_l, config_.floors, state_.sga_hessian_pu);
+    case Algorithm::kSga: {
+      // L·ε = scale ⊙ (Ψ·ε): Ψ·ε is formed while the gain's division runs, and one product follows it
+      // on the sample-to-sample chain; L itself (for the output) is off that chain.
+      const SgaScale s = sga_scale(u.gradient, gamma_r, gamma_l, config_.floors, state_.sga_hessian_pu);
+      const Mat2& g = u.gradient;
+      change = s.scale.cwiseProduct(Vec2(g.col(kPsiM).dot(u.epsilon_pu), g.col(kRs).dot(u.epsilon_pu)));
+      gain = {sga_matrix(s.scale, g), s.flags};
       break;
+    }
     case Algorithm::kGna:
       gain = gna_gain(u.gradient, gna_hessian_sequence(active, gamma_r), gamma_l, config_.floors,
                       state_.gna_hessian_pu);
+      change = gain.gain * u.epsilon_pu;
       break;
     case Algorithm::kPhyInt:
       gain = phyint_gain(MachinePu(u.model), u.n_pu, u.i_gain_pu, gamma_l, config_.floors);  // a copy: `model` stays in registers
+      change = gain.gain * u.epsilon_pu;
       break;
   }
   apply_schedule(active, gain.gain);
-  state_.theta_pu += gain.gain * u.epsilon_pu;
-  const std::uint8_t clamped = project(config_.bounds, state_.theta_pu);
+  // θ̂ += L·ε and eq:paramsubset, a parameter at a time and only where eq:GainSchedule lets it adapt (a
+  // parameter held is inside D_M already: every path that sets θ̂ projects it). Element by element: a
+  // whole-vector store would make the held parameter, which the next sample's predictor reads first,
+  // wait for the adapted one at the end of this sample's dependency chain (store forwarding).
+  // The output's θ̂ is made from scalars kept in registers: a whole-vector load right after element stores
+  // (of the state, or of a local Vec2 on the stack) cannot be forwarded from them and waits for both.
+  unsigned clamped = 0;
+  double psi_m = state_.theta_pu[kPsiM], r_s = state_.theta_pu[kRs];
+  const auto adapt = [&](int j, bool adapts, double& value) {
+    if (!adapts) return;
+    value += change[j];
+    clamped |= static_cast<unsigned>(project(config_.bounds, j, value)) << j;
+    state_.theta_pu[j] = value;
+  };
+  adapt(kPsiM, active.psi_m, psi_m);
+  adapt(kRs, active.r_s, r_s);
 
   // The flags by shifts, no branches: the gain's and the projection's bits are laid out as step_flag's.
   static_assert(step_flag::kGainFloored == gain_flag::kFloored && step_flag::kPseudoInverse == gain_flag::kPseudoInverse);
   static_assert(step_flag::kProjectedPsiM == 1U << (kPsiM + 2) && step_flag::kProjectedRs == 1U << (kRs + 2));
   const auto flags = static_cast<std::uint16_t>(
       (state_.frozen ? step_flag::kFrozen : 0U) | (gain.flags & (gain_flag::kFloored | gain_flag::kPseudoInverse)) |
-      (static_cast<unsigned>(clamped) << 2) | (static_cast<unsigned>(active.psi_m) * step_flag::kPsiMActive) |
+      (clamped << 2) | (static_cast<unsigned>(active.psi_m) * step_flag::kPsiMActive) |
       (static_cast<unsigned>(active.r_s) * step_flag::kRsActive));
-  return {state_.theta_pu, u.epsilon_pu, u.i_hat_pu, u.gradient, gain.gain, StepCode::kAdapted, flags};  // every member: no zero fill
+  Vec2 theta;
+  theta[kPsiM] = psi_m;
+  theta[kRs] = r_s;
+  return {theta, u.epsilon_pu, u.i_hat_pu, u.gradient, gain.gain, StepCode::kAdapted, flags};  // every member: no zero fill
 }
 
 [[gnu::flatten]] EstimatorOutput RpemEstimator::step(const EstimatorSample& sample) noexcept {
@@ -163,10 +189,13 @@ EstimatorOutput RpemEstimator::held(StepCode code) const noexcept {
   // A branch, not a select: the divisions would otherwise compete with the predictor's for the divider.
   PredictorCoefficients coefficients = coefficients_;
   if (sample.x_d_pu > 0.0) [[unlikely]] coefficients = PredictorCoefficients::of(model, config_.omega_n_rad_s);
-  predict(model, coefficients, config_.discretization, iv, state_.predictor, gradients_);
-  const Vec2 i_hat = state_.predictor.i_hat_pu;
+  // Predicted on a local copy, stored once: î, on the dependency chain, stays in registers.
+  PredictorState predictor = state_.predictor;
+  predict(model, coefficients, config_.discretization, iv, predictor, gradients_);
+  state_.predictor = predictor;
+  const Vec2 i_hat = predictor.i_hat_pu;
   const double i_max = config_.max_predicted_current_pu;  // a comparison with NaN fails: not finite
-  const Mat2& g = state_.predictor.gradient;
+  const Mat2& g = predictor.gradient;
   if (!(std::abs(i_hat[0]) <= i_max && std::abs(i_hat[1]) <= i_max) ||
       (gradients_ == Gradients::kAdvance && !all_finite(g.col(0), g.col(1)))) {
     state_.epsilon_valid = false;

@@ -63,10 +63,8 @@ struct Harness {
   [[nodiscard]] bool authentic() const { return (sign_mode == 1 || sign_mode == 2) && !other_channel; }
 };
 
-/// The message as checked: copied, and signed as the header says.
-std::span<const std::uint8_t> prepare(std::span<const std::uint8_t> in, const Harness& h, std::array<std::uint8_t, 256>& buf) {
-  std::memcpy(buf.data(), in.data(), in.size());
-  std::span<std::uint8_t> m(buf.data(), in.size());
+/// The message as checked, signed in place (in the harness's copy of the input) as the header says.
+std::span<const std::uint8_t> prepare(std::span<std::uint8_t> m, const Harness& h) {
   if (h.sign_mode != 0 && m.size() >= rpem::auth::kTrailerBytes) {
     const std::int32_t id = h.sign_mode == 3 ? 9 : h.sign_mode;
     std::uint8_t* p = m.data() + m.size() - rpem::auth::kTrailerBytes;
@@ -133,16 +131,13 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   h.other_channel = (auth & 8) != 0;
   std::int64_t last = 0;
   std::memcpy(&last, data + 2, sizeof last);
-  std::vector<std::array<std::uint8_t, 256>> buffers;
+  // One copy of the input, exactly its size (ASan sees a read past the last message), in which the
+  // messages are signed where they lie; each message is a span of it.
+  std::vector<std::uint8_t> copy(data, data + size);
   std::vector<std::span<const std::uint8_t>> messages;
   for (std::size_t at = 10; at < size;) {
     const std::size_t n = std::min<std::size_t>(data[at], size - at - 1);
-    buffers.emplace_back();
-    at += 1 + n;
-  }
-  for (std::size_t at = 10, k = 0; at < size; ++k) {
-    const std::size_t n = std::min<std::size_t>(data[at], size - at - 1);
-    messages.push_back(prepare(std::span(data + at + 1, n), h, buffers[k]));
+    messages.push_back(prepare(std::span(copy.data() + at + 1, n), h));
     at += 1 + n;
   }
 
@@ -150,12 +145,14 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     check_verdict(message, policy, last, h, rpem::daemon::admit_command(message, policy, h.held, kChannel, last));
   }
 
-  rpem::daemon::SpscQueue<Command> to_loop(4);
+  // The loop's queue is built once (it allocates its Commands, 1 kB each) and is empty between inputs.
+  static rpem::daemon::SpscQueue<Command> to_loop(4);
+  static Command c;
+  require(!to_loop.pop(c));
   rpem::daemon::CommandKeys keys;
   keys.keys = h.held;
   rpem::daemon::CommandGate gate(policy, to_loop, keys);
   std::int64_t queued = 0, previous = INT64_MIN;
-  Command c;
   auto pop = [&] {
     while (to_loop.pop(c)) {
       require(c.seq > previous);

@@ -62,7 +62,7 @@ CommandVerdict admit_command(std::span<const std::uint8_t> message, const Comman
   }
   // 4. Admit.
   if (m.seq <= last_accepted_seq) return refuse(CommandResult::kRejectedOldSequence);
-  Command& c = v.command;
+  AdmittedCommand& c = v.command;
   switch (m.command) {
     case rpem::command_t::RESET:
       c.kind = Command::Kind::kReset;
@@ -123,7 +123,14 @@ bool CommandGate::commit() noexcept {
   // The sequence number durable first, then the commands: a restart can never accept one again.
   const bool durable = store_ == nullptr || store_->store(last_accepted_seq_);
   if (durable) {
-    for (std::size_t k = 0; k < n_pending_; ++k) (void)to_loop_.push(pending_[k]);  // room was checked
+    for (std::size_t k = 0; k < n_pending_; ++k) {
+      const AdmittedCommand& a = pending_[k];
+      queued_.kind = a.kind;
+      queued_.seq = a.seq;
+      queued_.psi_m_Wb = a.psi_m_Wb;
+      queued_.r_s_Ohm = a.r_s_Ohm;
+      (void)to_loop_.push(queued_);  // room was checked
+    }
     durable_seq_ = last_accepted_seq_;
   } else {
     counters_.rejected += static_cast<std::int64_t>(n_pending_);

@@ -48,7 +48,8 @@ void VescPoller::time_out() noexcept {
   ++consecutive_timeouts_;
   timed_out_unanswered_ = true;
   timed_out_at_ns_ = deadline_ns_;
-  decoder_.reset_buffer();
+  // The decoder's buffer is kept: the reply may be under way (its frames straddling the deadline or the
+  // next poll, as at 1 kHz on a busy bus); a new reply restarts it at offset 0 all the same.
   gap_before_timeout_ = gap_;
   gap_ = true;  // the controller may have read (and reset) with its reply lost
 }
@@ -69,6 +70,24 @@ bool VescPoller::starts_reply(const can::CanFrame& f) const noexcept {
   return packet == static_cast<std::uint32_t>(vesc::Packet::kFillRxBuffer) && f.len >= 1 && f.data[0] == 0;
 }
 
+bool VescPoller::plausible_window(std::int64_t t) noexcept {
+  const std::int64_t window_ns = t - window_start_ns_;
+  if (window_ns < kMinWindowNs) {
+    ++counters_.short_windows;
+    return false;
+  }
+  if (window_ns > 2 * config_.period_ns + config_.timeout_ns) {
+    ++counters_.long_windows;
+    return false;
+  }
+  const vesc::Values& v = decoder_.values();
+  if (v.i_d_A == 0.0 && v.i_q_A == 0.0 && v.v_d_V == 0.0 && v.v_q_V == 0.0) {
+    ++counters_.empty_reads;
+    return false;
+  }
+  return true;
+}
+
 bool VescPoller::on_frame(const can::CanFrame& f, std::int64_t rx_ns, core::AveragedSample& sample) noexcept {
   if (is_values_read_of_controller(f)) {
     ++counters_.stolen_reads;
@@ -79,13 +98,18 @@ bool VescPoller::on_frame(const can::CanFrame& f, std::int64_t rx_ns, core::Aver
 
   const std::int64_t t = reply_start_ns_ != 0 ? reply_start_ns_ : rx_ns;
   reply_start_ns_ = 0;
-  if (outstanding_) {
-    outstanding_ = false;
-    consecutive_timeouts_ = 0;
-  } else if (timed_out_unanswered_ && t - timed_out_at_ns_ <= config_.period_ns) {
+  // With reply_timeout_s ≥ the period, polls overlap their predecessors' replies by design: the controller
+  // answers them in turn, so a poll that timed out unanswered takes the first reply, before the poll sent
+  // after it. With a shorter timeout a reply while the next poll is out is that poll's (the timed-out one's
+  // reply was lost, and the window spans its read: a gap).
+  const bool in_turn = config_.timeout_ns >= config_.period_ns || !outstanding_;
+  if (timed_out_unanswered_ && in_turn && t - timed_out_at_ns_ <= config_.period_ns) {
     ++counters_.late;
     consecutive_timeouts_ = 0;
     gap_ = gap_before_timeout_;  // the read it feared lost is this one: the chain holds
+  } else if (outstanding_) {
+    outstanding_ = false;
+    consecutive_timeouts_ = 0;
   } else {
     ++counters_.unrequested;
   }
@@ -97,9 +121,8 @@ bool VescPoller::on_frame(const can::CanFrame& f, std::int64_t rx_ns, core::Aver
     gap_ = false;
     return false;
   }
-  if (t - window_start_ns_ < kMinWindowNs) {
-    ++counters_.short_windows;
-    window_start_ns_ = t;
+  if (!plausible_window(t)) {
+    window_start_ns_ = t;  // the read reset the averages all the same
     gap_ = true;
     return false;
   }

@@ -15,7 +15,7 @@ namespace {
 using Diag = rpem::diagnostics_t;
 using can::vesc::VescCounters;
 
-constexpr std::array<CounterRow<VescPollerCounters, std::uint64_t>, 8> kPollerRows{{
+constexpr std::array<CounterRow<VescPollerCounters, std::uint64_t>, 10> kPollerRows{{
     {&VescPollerCounters::polls, &Diag::vesc_polls},
     {&VescPollerCounters::send_failures, &Diag::vesc_send_failures},
     {&VescPollerCounters::samples, &Diag::vesc_replies},
@@ -24,6 +24,8 @@ constexpr std::array<CounterRow<VescPollerCounters, std::uint64_t>, 8> kPollerRo
     {&VescPollerCounters::unrequested, &Diag::vesc_unrequested_replies},
     {&VescPollerCounters::stolen_reads, &Diag::vesc_stolen_reads},
     {&VescPollerCounters::short_windows, &Diag::vesc_short_windows},
+    {&VescPollerCounters::empty_reads, &Diag::vesc_empty_reads},
+    {&VescPollerCounters::long_windows, &Diag::vesc_long_windows},
 }};
 constexpr std::array<CounterRow<VescCounters, std::uint64_t>, 7> kDecoderRows{{
     {&VescCounters::frames, &Diag::can_frames},

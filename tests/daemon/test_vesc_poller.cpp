@@ -107,9 +107,10 @@ TEST(VescPoller, RepliesBecomeWindowsBetweenTheirReceiveTimes) {
   EXPECT_EQ(p.counters().timeouts + p.counters().unrequested + p.counters().stolen_reads, 0U);
 }
 
-// A silent controller: every poll times out (counted, and the source is silent); when it answers again
-// the first window follows a gap (its reads may have reset the averages with the replies lost).
-TEST(VescPoller, ASilentControllerTimesOutAndTheNextWindowFollowsAGap) {
+// A silent controller: every poll times out (counted, and the source is silent). When it answers again,
+// its first reply averages everything since its last read — 25 ms here, over 2 periods + the timeout
+// (12.5 ms): a long window, dropped; the next window is a sample again and follows a gap.
+TEST(VescPoller, ASilentControllerTimesOutAndItsFirstLongWindowIsDropped) {
   VescPoller p = make_poller();
   (void)poll_and_reply(p, kT0);
   for (int k = 1; k <= 4; ++k) {
@@ -121,13 +122,64 @@ TEST(VescPoller, ASilentControllerTimesOutAndTheNextWindowFollowsAGap) {
   p.on_time(kT0 + 25 * kMs);
   EXPECT_EQ(p.counters().timeouts, 4U);
   EXPECT_TRUE(p.silent());
-  const auto s = poll_and_reply(p, kT0 + 25 * kMs);
+  EXPECT_FALSE(poll_and_reply(p, kT0 + 25 * kMs).has_value());
+  EXPECT_EQ(p.counters().long_windows, 1U);
+  EXPECT_FALSE(p.silent());
+  const auto s = poll_and_reply(p, kT0 + 30 * kMs);
   ASSERT_TRUE(s.has_value());
   EXPECT_TRUE(s->gap_before);
-  EXPECT_FALSE(p.silent());
-  const auto next = poll_and_reply(p, kT0 + 30 * kMs);
+  EXPECT_EQ(s->t_start_ns, kT0 + 25'300'000);
+  const auto next = poll_and_reply(p, kT0 + 35 * kMs);
   ASSERT_TRUE(next.has_value());
   EXPECT_FALSE(next->gap_before);
+}
+
+// One lost reply leaves a window of two periods (≤ 2 periods + the timeout): still a sample, after a gap.
+TEST(VescPoller, AWindowOverOneLostReplyIsStillASample) {
+  VescPoller p = make_poller();
+  (void)poll_and_reply(p, kT0);
+  p.polled(kT0 + 5 * kMs, true);
+  p.on_time(kT0 + 8 * kMs);
+  const auto s = poll_and_reply(p, kT0 + 10 * kMs);
+  ASSERT_TRUE(s.has_value());
+  EXPECT_TRUE(s->gap_before);
+  EXPECT_EQ(s->t_ns - s->t_start_ns, 10 * kMs);
+  EXPECT_EQ(p.counters().long_windows, 0U);
+}
+
+/// The estimator's reply (reply_frames()) with i_d, i_q, v_d, v_q all 0 — what the firmware sends for a
+/// read with no control cycle since the previous one (NaN → 0) — written byte by byte; CRC 0x37B7 from
+/// Python's binascii.crc_hqx over the 31 bytes.
+std::vector<can::CanFrame> empty_reply_frames() {
+  return {ext(0x57D, {0x00, 0x32, 0x00, 0x18, 0x01, 0xB3, 0x01, 0x9D}),
+          ext(0x57D, {0x07, 0x02, 0xA6, 0x00, 0x00, 0x00, 0x00, 0x00}),
+          ext(0x57D, {0x0E, 0x00, 0x00, 0x00, 0x00, 0x00, 0x52, 0x08}),
+          ext(0x57D, {0x15, 0x01, 0xE2, 0x00, 0x00, 0x00, 0x00, 0x00}),
+          ext(0x57D, {0x1C, 0x00, 0x00, 0x00}),
+          ext(0x77D, {0x11, 0x01, 0x00, 0x1F, 0x37, 0xB7})};
+}
+
+// A reply of no control cycle (a firmware that did not run since the previous read, as a stalled
+// emulator would answer) never reaches the estimator, however long its window.
+TEST(VescPoller, AReplyOfNoControlCycleIsCountedAndNeverASample) {
+  VescPoller p = make_poller();
+  (void)poll_and_reply(p, kT0);
+  p.polled(kT0 + 5 * kMs, true);
+  core::AveragedSample s;
+  bool got = false;
+  for (const can::CanFrame& f : empty_reply_frames()) got = p.on_frame(f, kT0 + 5'300'000, s) || got;
+  EXPECT_FALSE(got);
+  EXPECT_EQ(p.counters().empty_reads, 1U);
+  EXPECT_EQ(p.decoder().counters().crc_error, 0U);
+  EXPECT_EQ(p.counters().timeouts, 0U);  // it was a reply: the poll is answered
+  const auto next = poll_and_reply(p, kT0 + 10 * kMs);
+  ASSERT_TRUE(next.has_value());
+  EXPECT_TRUE(next->gap_before);
+  EXPECT_EQ(next->t_start_ns, kT0 + 5'300'000);
+  DiagnosticsRows rows;
+  report_vesc_counters(p, rows);
+  EXPECT_EQ(rows.get(&diagnostics_t::vesc_empty_reads), 1);
+  EXPECT_EQ(rows.get(&diagnostics_t::vesc_long_windows), 0);
 }
 
 // A reply after its poll timed out is late, and still a window (it ends a read of the controller); it is
@@ -144,6 +196,51 @@ TEST(VescPoller, AReplyAfterItsTimeoutIsLateAndStillUsed) {
   EXPECT_EQ(p.counters().unrequested, 0U);
   EXPECT_EQ(s->t_start_ns, kT0 + 300'000);
   EXPECT_FALSE(s->gap_before);
+}
+
+// Replies slower than a period (1 kHz, reply_timeout_s = the period): every poll times out when the next
+// goes out, and each reply — its frames straddling that next poll — is the timed-out poll's, answered in
+// turn. No reply is lost to the timeout, and the windows chain without gaps.
+TEST(VescPoller, RepliesSlowerThanAPeriodAreAnsweredInTurnAndChain) {
+  VescSource::Options o;
+  o.controller_id = kController;
+  o.host_id = kHost;
+  o.poll_rate_Hz = 1000.0;
+  o.reply_timeout_s = 1e-3;
+  VescPoller p(poller_config(o));
+  const std::vector<can::CanFrame> frames = reply_frames();
+  std::vector<core::AveragedSample> samples;
+  // Poll k goes out at k ms; its reply's six frames arrive 130 µs apart from 0.8 ms after it: two before
+  // the next poll, four after it.
+  const auto deliver = [&](int poll, std::int64_t from_ns, std::int64_t to_ns) {
+    for (std::size_t i = 0; i < frames.size(); ++i) {
+      const std::int64_t rx = kT0 + poll * kMs + 800'000 + static_cast<std::int64_t>(i) * 130'000;
+      if (rx < from_ns || rx >= to_ns) continue;
+      p.on_time(rx);
+      core::AveragedSample s;
+      if (p.on_frame(frames[i], rx, s)) samples.push_back(s);
+    }
+  };
+  for (int k = 0; k <= 21; ++k) {
+    const std::int64_t t = kT0 + k * kMs;
+    if (k > 0) deliver(k - 1, t - kMs, t);
+    p.on_time(t);
+    ASSERT_TRUE(p.poll_due(t));
+    p.polled(t, true);
+    if (k > 0) deliver(k - 1, t, t + kMs);
+  }
+  EXPECT_EQ(p.counters().polls, 22U);
+  EXPECT_EQ(p.counters().late, 21U);
+  EXPECT_EQ(p.counters().unrequested, 0U);
+  EXPECT_EQ(p.decoder().counters().out_of_order + p.decoder().counters().length_mismatch, 0U);
+  ASSERT_EQ(samples.size(), 20U);  // the first reply opens the first window
+  for (std::size_t i = 0; i < samples.size(); ++i) {
+    EXPECT_EQ(samples[i].t_ns - samples[i].t_start_ns, kMs) << i;
+    if (i > 0) {
+      EXPECT_FALSE(samples[i].gap_before) << i;
+      EXPECT_EQ(samples[i].t_start_ns, samples[i - 1].t_ns) << i;
+    }
+  }
 }
 
 // Another poller reading our controller on the bus (node 0x42, the same poll the docs show for us): its

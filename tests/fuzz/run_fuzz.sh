@@ -1,9 +1,18 @@
 #!/usr/bin/env bash
-# Builds one libFuzzer target with clang (libFuzzer + AddressSanitizer + UndefinedBehaviorSanitizer, leak
-# detection on) and runs it from its committed seed corpus for a time budget (and any further libFuzzer
-# options, e.g. -runs=10000000). ctest runs each target for 60 s (label fuzz); docs/benchmarks.md
-# ("Fuzzing") records the long runs.
-#   run_fuzz.sh BUILD_DIR TARGET [SECONDS] [libFuzzer options...]
+# Builds one libFuzzer target with clang and runs it from its committed seed corpus for a time budget (and
+# any further libFuzzer options, e.g. -runs=10000000, or more corpus directories). ctest runs each target
+# for 60 s (label fuzz); docs/benchmarks.md ("Fuzzing") records the long runs.
+#   [RPEM_FUZZ_SANITIZERS=asan+ub|ub+leak] run_fuzz.sh BUILD_DIR TARGET [SECONDS] [libFuzzer options...]
+# RPEM_FUZZ_SANITIZERS:
+#   asan+ub  (default) AddressSanitizer + UndefinedBehaviorSanitizer (UB aborts), LeakSanitizer on;
+#            built and run under BUILD_DIR/fuzz.
+#   ub+leak  the long runs' fast build: UndefinedBehaviorSanitizer in trap mode (clang 14 links no UBSan
+#            runtime beside standalone LeakSanitizer; UB kills the run and libFuzzer keeps the input) +
+#            standalone LeakSanitizer, no ASan: several times the executions, memory errors unseen.
+#            Under BUILD_DIR/fuzz-ub+leak. A long run is this build to the count, then every unit of the
+#            corpus it grew replayed under asan+ub:
+#              RPEM_FUZZ_SANITIZERS=ub+leak run_fuzz.sh B T SECONDS -runs=N
+#              run_fuzz.sh B T 0 -runs=0 B/fuzz-ub+leak/T/corpus
 # The targets, one row each: its entry point, what it links, its seed corpus (and dictionary corpus.dict).
 set -euo pipefail
 build=$(cd "$1" && pwd)
@@ -23,7 +32,7 @@ io=("$repo"/io/src/*.cpp "$build/io/builtin_config.cpp" "$repo/can/src/signal_ma
 # fresh pages (half the replay's CPU time).
 yaml_opts=(-max_len=3072)
 yaml_asan=quarantine_size_mb=16
-opts=() asan=
+opts=() asan= lcm=
 case $target in
   fuzz_decoder)        main=can/fuzz/fuzz_decoder.cpp;        objs=("$repo/can/src/decoder.cpp" "$repo/can/src/e2e.cpp")
                        corpus=can/fuzz/corpus ;;
@@ -39,26 +48,35 @@ case $target in
                        corpus=sim/fuzz/corpus; opts=("${yaml_opts[@]}") asan=$yaml_asan ;;
   fuzz_command)        main=daemon/fuzz/fuzz_command.cpp;     objs=("$repo/daemon/src/command_gate.cpp" "$repo/auth/src/mac.cpp")
                        corpus=daemon/fuzz/corpus
-                       # rpemd's RPEM_COMMAND entry point; the LCM types are generated in the build
-                       [[ -f $build/lcm_types/cpp/rpem/command_t.hpp ]] || cmake --build "$build" --target rpem_lcm_cpp >/dev/null ;;
+                       lcm=1 ;;  # rpemd's RPEM_COMMAND entry point: the LCM types are generated in the build
   *) echo "run_fuzz: unknown target $target" >&2; exit 2 ;;
 esac
 [[ -f $build/io/builtin_config.cpp ]] || { echo "run_fuzz: configure $build first (it generates io/builtin_config.cpp)" >&2; exit 2; }
 
-# A small ninja build under BUILD_DIR/fuzz: each source compiles once (header dependencies tracked) and
-# the targets share the objects; a lock serialises builds when ctest runs targets in parallel.
-dir=$build/fuzz
+case ${RPEM_FUZZ_SANITIZERS:-asan+ub} in
+  asan+ub) sanitize=address,undefined trap= dir=$build/fuzz ;;
+  ub+leak) sanitize=undefined,leak trap=-fsanitize-trap=undefined dir=$build/fuzz-ub+leak ;;
+  *) echo "run_fuzz: RPEM_FUZZ_SANITIZERS is asan+ub or ub+leak, not $RPEM_FUZZ_SANITIZERS" >&2; exit 2 ;;
+esac
 mkdir -p "$dir/$target/corpus"
+# Generated LCM types up to date (a no-op when nothing changed): never fuzz against stale ones.
+if [[ -n $lcm ]]; then
+  cmake --build "$build" --target rpem_lcm_cpp >"$dir/$target.lcm.log" 2>&1 ||
+    { cat "$dir/$target.lcm.log"; echo "run_fuzz: the LCM types did not build" >&2; exit 1; }
+fi
+
+# A small ninja build under $dir: each source compiles once (header dependencies tracked) and the
+# targets share the objects; a lock serialises builds when ctest runs targets in parallel.
 {
-  echo "cxx = clang++ -std=c++20 -O1 -g -fno-sanitize-recover=undefined -I$repo/can/include -I$repo/core/include" \
+  echo "cxx = clang++ -std=c++20 -O1 -g -fno-sanitize-recover=undefined $trap -I$repo/can/include -I$repo/core/include" \
        "-I$repo/io/include -I$repo/sim/include -I$repo/daemon/include -I$repo/auth/include -isystem /usr/include/eigen3" \
        "-isystem $build/lcm_types/cpp"
   echo "rule cc"
-  echo "  command = \$cxx -fsanitize=fuzzer-no-link,address,undefined -MD -MF \$out.d -c \$in -o \$out"
+  echo "  command = \$cxx -fsanitize=fuzzer-no-link,$sanitize -MD -MF \$out.d -c \$in -o \$out"
   echo "  depfile = \$out.d"
   echo "  deps = gcc"
   echo "rule link"
-  echo "  command = \$cxx -fsanitize=fuzzer,address,undefined \$in -lyaml-cpp -lsodium -o \$out"
+  echo "  command = \$cxx -fsanitize=fuzzer,$sanitize \$in -lyaml-cpp -lsodium -o \$out"
   list=()
   for src in "$repo/$main" "${objs[@]}"; do
     rel=${src#"$repo"/}

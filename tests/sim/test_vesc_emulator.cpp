@@ -15,6 +15,7 @@
 #include "rpem/can/vesc.hpp"
 #include "rpem/can/vesc_firmware.hpp"
 #include "rpem/sim/vesc_motor.hpp"
+#include "rpem/sim/vesc_on_demand.hpp"
 
 namespace rpem::sim {
 namespace {
@@ -146,6 +147,129 @@ TEST(VescEmulator, StatusBroadcastsCarryTheInstantaneousState) {
   // 0.1 s at 21000 ERPM: 35 electrical revolutions, 6 steps each.
   EXPECT_NEAR(decoder.status().tachometer, 6 * 35, 6);
   EXPECT_EQ(motor.cycles_since_read(), 1250);  // statuses read no average
+}
+
+
+// ---- Drive time on demand (sim/vesc_on_demand.hpp): the reads of OnDemandVesc against the same drive
+// stepped here one cycle at a time, read at the same instants (independent means, as above).
+
+/// The drive read at chosen instants, independently: every cycle whose start row precedes the instant.
+class IndependentReader {
+ public:
+  IndependentReader() : twin_(short_vesc_scenario()) {}
+  /// The means since the previous read (cycles counted in `n`).
+  Means read_at(std::int64_t t_ns, int& n) {
+    Means sum;
+    n = 0;
+    while (!started_ || previous_.sample.t_ns < t_ns) {
+      io::DriveLogRow row;
+      TruthRow truth;
+      EXPECT_TRUE(twin_.next(row, truth));
+      if (started_) {
+        const Means m = cycle_means(previous_, row);
+        sum.i_d += m.i_d, sum.i_q += m.i_q, sum.u_d += m.u_d, sum.u_q += m.u_q;
+        ++n;
+      }
+      started_ = true;
+      previous_ = row;
+    }
+    if (n > 0) sum.i_d /= n, sum.i_q /= n, sum.u_d /= n, sum.u_q /= n;
+    return sum;
+  }
+
+ private:
+  DriveSimulator twin_;
+  io::DriveLogRow previous_;
+  bool started_ = false;
+};
+
+void expect_means(const vesc::Values& v, const Means& m, const char* what) {
+  EXPECT_NEAR(v.i_d_A, m.i_d, 1e-6) << what;
+  EXPECT_NEAR(v.i_q_A, m.i_q, 1e-6) << what;
+  EXPECT_NEAR(v.v_d_V, m.u_d, 1e-6) << what;
+  EXPECT_NEAR(v.v_q_V, m.u_q, 1e-6) << what;
+}
+
+OnDemandVesc::Settings on_demand_settings() {
+  OnDemandVesc::Settings s;
+  s.motor = {17, 40.0};
+  return s;  // statuses 1, 4, 5 at 50 Hz and 2, 3, 6 at 5 Hz
+}
+
+TEST(VescOnDemand, APollAfterALongGapAveragesEveryCycleInTheGap) {
+  OnDemandVesc drive(short_vesc_scenario(), on_demand_settings());
+  IndependentReader reference;
+  int n = 0;
+  std::vector<std::int64_t> status_times;
+  auto emit = [&](const vesc::Status&) { status_times.push_back(drive.time_ns()); };
+  ASSERT_TRUE(drive.poll(5'000'000, emit));
+  (void)reference.read_at(5'000'000, n);
+  // 0.5 s without a poll (a silent bus, or a host that did not run): 6250 cycles of 80 µs.
+  const auto late = drive.poll(505'000'000, emit);
+  ASSERT_TRUE(late);
+  const Means m = reference.read_at(505'000'000, n);
+  EXPECT_EQ(n, 6250);
+  EXPECT_EQ(late->cycles, n);
+  EXPECT_FALSE(late->behind);
+  expect_means(late->values, m, "the 0.5 s gap");
+  EXPECT_GT(std::abs(late->values.i_q_A), 20.0);  // loaded: not a comparison of zeros
+  // Statuses ran on their own drive times through the gap: at 20 ms multiples 1, 4, 5 (25 × 3 up to
+  // 500 ms) and at 200 ms multiples 2, 3, 6 (2 × 3), each with the drive within a cycle of its instant.
+  ASSERT_EQ(status_times.size(), 25U * 3 + 2U * 3);
+  for (const std::int64_t t : status_times) {
+    const std::int64_t nearest = (t + 10'000'000) / 20'000'000 * 20'000'000;
+    EXPECT_GE(t - nearest, 0);
+    EXPECT_LT(t - nearest, 80'000);
+  }
+}
+
+TEST(VescOnDemand, EachPollOfABurstCoversExactlyItsOwnCycles) {
+  // A host that fell behind sees 12 polls at once, sent at 1 kHz: each is read at its own arrival.
+  OnDemandVesc drive(short_vesc_scenario(), on_demand_settings());
+  IndependentReader reference;
+  auto ignore = [](const vesc::Status&) {};
+  int n = 0;
+  ASSERT_TRUE(drive.poll(20'000'000, ignore));
+  (void)reference.read_at(20'000'000, n);
+  int total = 0;
+  for (int k = 1; k <= 12; ++k) {
+    const std::int64_t t = 20'000'000 + k * 1'000'000 + (k % 3) * 37'000;  // jittered arrivals
+    const auto r = drive.poll(t, ignore);
+    ASSERT_TRUE(r);
+    const Means m = reference.read_at(t, n);
+    EXPECT_EQ(r->cycles, n) << "poll " << k;
+    EXPECT_GE(r->cycles, 11);  // ≈ 12.5 cycles per ms, never 0
+    EXPECT_FALSE(r->behind);
+    expect_means(r->values, m, "burst");
+    total += r->cycles;
+  }
+  EXPECT_EQ(total, (12'000'000 + 0 * 37'000) / 80'000);  // the last poll (k = 12) has no jitter
+  EXPECT_EQ(drive.counters().empty_reads, 0U);
+}
+
+TEST(VescOnDemand, APollTheDriveHadPassedIsReadLateButNeverEmpty) {
+  OnDemandVesc drive(short_vesc_scenario(), on_demand_settings());
+  auto ignore = [](const vesc::Status&) {};
+  ASSERT_TRUE(drive.poll(2'000'000, ignore));
+  ASSERT_TRUE(drive.run_to(10'000'000, ignore));  // idle running went past a poll not yet seen
+  const auto first = drive.poll(6'000'000, ignore);
+  ASSERT_TRUE(first);
+  EXPECT_TRUE(first->behind);
+  EXPECT_EQ(first->cycles, 100);  // 2 … 10 ms: every cycle run, none lost
+  const auto second = drive.poll(7'000'000, ignore);  // also behind, and no cycle since the first
+  ASSERT_TRUE(second);
+  EXPECT_TRUE(second->behind);
+  EXPECT_EQ(second->cycles, 1);  // the reply thread waits for the next control interrupt
+  EXPECT_EQ(drive.counters().behind, 2U);
+  EXPECT_EQ(drive.counters().empty_reads, 0U);
+  // Two pollers within one control cycle (the drive reached 20.08 ms for the first), in order: the
+  // firmware's 0/0, faithfully.
+  const auto a = drive.poll(20'040'000, ignore);
+  const auto b = drive.poll(20'050'000, ignore);
+  ASSERT_TRUE(a && b);
+  EXPECT_EQ(b->cycles, 0);
+  EXPECT_FALSE(b->behind);
+  EXPECT_EQ(drive.counters().empty_reads, 1U);
 }
 
 }  // namespace

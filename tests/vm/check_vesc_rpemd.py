@@ -25,7 +25,9 @@ def main():
     t0 = float(re.search(r't = 0 at CLOCK_REALTIME ([0-9.]+) s', emu).group(1))
     truth = [{k: float(v) for k, v in r.items()} for r in csv.DictReader(open('%s/%s_truth.csv' % (d, name)))]
     tt = [r['t'] for r in truth]
-    est = [{k: float(v) for k, v in r.items()} for r in csv.DictReader(open('%s/%s_est.csv' % (d, name)))]
+    # rpem listen's CSV: numeric columns, and `auth` (verified / unverified / FORGED), which is text.
+    est = [{k: (v if k == 'auth' else float(v)) for k, v in r.items()}
+           for r in csv.DictReader(open('%s/%s_est.csv' % (d, name)))]
     for e in est:
         e['te'] = e['utime'] * 1e-6 - t0
     errors = []

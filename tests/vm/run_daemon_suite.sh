@@ -10,7 +10,7 @@ out=$(mktemp -d)
 trap 'rm -rf "$out"' EXIT
 files=("$build/tools/rpem" "$build/daemon/rpemd" "$here/daemon_suite.sh" "$here/rpemd-vcan.yaml"
        "$repo/scenarios/e2e-steps.yaml" "$repo/scenarios/e2e-steady.yaml")
-if [[ $(id -u) -eq 0 ]] && ip link add dev rpemprobe0 type vcan 2>/dev/null && ip link del rpemprobe0 && ip link show vcan0 >/dev/null 2>&1; then
+if "$here/vm_rig.sh" native-vcan; then
   echo "run_daemon_suite: native vcan0"
   work=$(mktemp -d)
   cp "${files[@]}" "$work/"

@@ -13,11 +13,7 @@ out=$(mktemp -d)
 trap 'rm -rf "$out"' EXIT
 cp "$repo/scenarios/can-stream.yaml" "$out/"
 
-host_has_vcan() {
-  [[ $(id -u) -eq 0 ]] && ip link add dev rpemprobe0 type vcan 2>/dev/null && ip link del rpemprobe0
-}
-
-if host_has_vcan && ip link show vcan0 >/dev/null 2>&1; then
+if "$here/vm_rig.sh" native-vcan; then
   echo "run_vcan_suite: native vcan0"
   (cd "$out" && PATH="$build/tools:$build/tests/can:$PATH" sh "$here/vcan_suite.sh" "$out")
   sh "$here/bus_units.sh" "$repo/systemd" | tee "$out/bus_units.txt"

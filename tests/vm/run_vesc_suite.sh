@@ -29,11 +29,7 @@ if [[ ${2:-} == --rpemd && -f $repo/daemon/src/vesc_source.cpp && -x $build/daem
                --file "$repo/config/vesc-6374-outrunner.yaml")
 fi
 
-host_has_vcan() {
-  [[ $(id -u) -eq 0 ]] && ip link add dev rpemprobe0 type vcan 2>/dev/null && ip link del rpemprobe0
-}
-
-if host_has_vcan && ip link show vcan0 >/dev/null 2>&1; then
+if "$here/vm_rig.sh" native-vcan; then
   echo "run_vesc_suite: native vcan0"
   (cd "$out" && PATH="$build/tools:$build/daemon:$PATH" sh "$here/vesc_suite.sh" "$out")
 else

@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # The vcan test rig: runs a command inside a VM that boots Debian's PREEMPT_RT kernel under qemu
 # (TCG) with vcan0 up in CAN FD mode and multicast on loopback (for LCM). Used where the host kernel
-# has no vcan/AF_CAN; on a host that has them the tests run natively (tests/vm/run_vcan_test.sh).
+# has no vcan/AF_CAN; on a host that has them the tests run natively (tests/vm/run_*_suite.sh, `vm_rig.sh native-vcan`).
 #
+#   vm_rig.sh native-vcan    (exit 0: run natively, the host has vcan0)
 #   vm_rig.sh run [--timeout S] [--smp N] [--share DIR] [--can-controller] [--file SRC[:DEST]]... -- COMMAND...
 #
 # --can-controller adds an emulated CAN controller (qemu's Kvaser PCI, an SJA1000: classic CAN) as can0,
@@ -153,8 +154,15 @@ run() {
   exit "$rc"
 }
 
+# native-vcan: exit 0 where the tests can run natively instead (root, the kernel has vcan, vcan0 is up).
+native_vcan() {
+  [[ $(id -u) -eq 0 ]] && ip link add dev rpemprobe0 type vcan 2>/dev/null && ip link del rpemprobe0 &&
+    ip link show vcan0 >/dev/null 2>&1
+}
+
 case ${1:-} in
   run) shift; run "$@" ;;
+  native-vcan) native_vcan ;;
   prepare) prepare_kernel ;;
   *) echo "usage: $0 run [--timeout S] [--smp N] [--file SRC[:DEST]]... -- COMMAND..." >&2; exit 2 ;;
 esac

@@ -137,12 +137,13 @@ struct Listener {
                 static_cast<long long>(m->config_reloads_busy), m->state_file_status, verdict.c_str());
     if (m->source == "vesc") {
       std::printf("diag %lld vesc: polls %lld replies %lld timeouts %lld late %lld unrequested %lld stolen_reads %lld "
-                  "short_windows %lld buffer_errors %lld bad_replies %lld short_replies %lld statuses %lld "
+                  "short_windows %lld empty_reads %lld long_windows %lld buffer_errors %lld bad_replies %lld short_replies %lld statuses %lld "
                   "send_failures %lld foreign %lld\n",
                   static_cast<long long>(m->utime), static_cast<long long>(m->vesc_polls),
                   static_cast<long long>(m->vesc_replies), static_cast<long long>(m->vesc_timeouts),
                   static_cast<long long>(m->vesc_late_replies), static_cast<long long>(m->vesc_unrequested_replies),
                   static_cast<long long>(m->vesc_stolen_reads), static_cast<long long>(m->vesc_short_windows),
+                  static_cast<long long>(m->vesc_empty_reads), static_cast<long long>(m->vesc_long_windows),
                   static_cast<long long>(m->vesc_buffer_errors), static_cast<long long>(m->vesc_bad_replies),
                   static_cast<long long>(m->vesc_short_replies), static_cast<long long>(m->vesc_statuses),
                   static_cast<long long>(m->vesc_send_failures), static_cast<long long>(m->can_foreign));

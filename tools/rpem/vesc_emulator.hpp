@@ -1,7 +1,7 @@
 #pragma once
 // `rpem sim --vesc IFACE --controller-id N`: the simulated drive answers on a SocketCAN interface as a VESC
-// does (docs/can-vesc.md, "Emulator"). Physics: sim/vesc_motor.hpp; protocol: can/vesc_firmware.hpp; this
-// file only paces the simulation in real time and moves frames.
+// does (docs/can-vesc.md, "Emulator"). Physics: sim/vesc_motor.hpp; drive time on demand:
+// sim/vesc_on_demand.hpp; protocol: can/vesc_firmware.hpp; this file only moves frames and time stamps.
 
 #include <CLI/CLI.hpp>
 #include <cstdint>

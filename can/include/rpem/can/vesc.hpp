@@ -151,8 +151,6 @@ class VescDecoder {
   /// The last status delivered (valid after kStatus).
   [[nodiscard]] const Status& status() const noexcept { return status_; }
   [[nodiscard]] const VescCounters& counters() const noexcept { return counters_; }
-  /// Drops a partly filled buffer (e.g. after a poll timed out).
-  void reset_buffer() noexcept { fill_ = 0; }
 
   /// Bytes the reassembly buffer holds (VESC's own RX_BUFFER_SIZE is larger; replies used here are < 100).
   static constexpr std::size_t kBufferSize = 512;

@@ -131,7 +131,7 @@ class SampleConditioner {
   struct Measured {
     Rotation logged;       ///< at the logged angle
     Rotation rot;          ///< at the corrected angle
-    Vec2 i_ab_A;           ///< corrected phase currents, stator frame (before iron loss)
+    Vec2 i_ab_pu;          ///< corrected phase currents, stator frame (before iron loss)
     Vec2 i_dq_pu;          ///< magnetising current, rotor frame (iron-loss current removed)
     Vec2 i_fe_dq_pu;       ///< iron-loss current
     double n_pu;
@@ -140,8 +140,10 @@ class SampleConditioner {
   [[nodiscard]] Measured measure(const DriveSample& s, const Rotation& logged) const noexcept;
   /// The true phase currents from measured ones: (measured − offset)/(1 + gain error).
   [[nodiscard]] Vec3 corrected_phases_A(const Vec3& measured_A) const noexcept;
-  [[nodiscard]] Vec2 current_alphabeta_A(const DriveSample& s, const Rotation& logged) const noexcept;
-  [[nodiscard]] static Vec2 command_alphabeta_V(const DriveSample& s, const Rotation& logged) noexcept;
+  /// The corrected phase currents, stator frame [pu].
+  [[nodiscard]] Vec2 current_alphabeta_pu(const DriveSample& s, const Rotation& logged) const noexcept;
+  /// The command issued with the sample, stator frame [pu].
+  [[nodiscard]] Vec2 command_alphabeta_pu(const DriveSample& s, const Rotation& logged) const noexcept;
   [[nodiscard]] double deadtime_voltage_V(double u_dc_V) const noexcept;
   [[nodiscard]] Vec2 deadtime_error_alphabeta_V(const Vec2& i_ab_A, double u_dc_V) const noexcept;
   /// The voltage the flux harmonics and the cross-saturation's d-axis flux induce at this sample, rotor
@@ -150,15 +152,16 @@ class SampleConditioner {
   [[nodiscard]] Vec2 extra_emf_pu(const Rotation& rot, double n_pu, const Vec2& i_dq_pu, bool harmonics) const noexcept;
   /// x_d, x_q at a rotor-frame current [pu]: the saturation curves and the cross-coupling's L_q(i_d).
   [[nodiscard]] Vec2 inductances_pu(const Vec2& i_dq_pu) const noexcept;
-  /// The command the machine sees over the interval ending now, stator frame [V]: the command issued
+  /// The command the machine sees over the interval ending now, stator frame [pu]: the command issued
   /// `delay` earlier, blended between the two issued around that instant.
-  [[nodiscard]] Vec2 delayed_command_alphabeta_V(double dt_s) const noexcept;
+  [[nodiscard]] Vec2 delayed_command_alphabeta_pu(double dt_s) const noexcept;
 
   PerUnitBase base_;
   MachinePu machine_;
   ModelExtensions extensions_;
   // Reciprocals, so the per-sample path multiplies instead of dividing.
   double inv_current_A_ = 0.0, inv_voltage_V_ = 0.0, inv_omega_rad_s_ = 0.0;
+  ScaledClarke current_pu_, voltage_pu_;     ///< phase samples [A], [V] → stator frame [pu], one step
   double inv_r_fe_pu_ = 0.0;                 ///< 1/r_fe in pu; 0 without iron loss
   Vec3 inv_current_gain_ = Vec3::Ones();     ///< 1/(1 + gain error) per phase
   Rotation offset_rotation_;                 ///< by theta_offset_rad
@@ -170,14 +173,16 @@ class SampleConditioner {
   // Which extensions are active, decided when configured (the per-sample path tests one flag each).
   bool angle_offset_ = false, phase_corrections_ = false, saturation_ = false, deadtime_ = false;
   bool harmonics_ = false, cross_ = false, delay_ = false;
+  bool corrections_ = false;  ///< dead time or iron loss: the voltage takes a correction
+  bool emf_ = false;          ///< flux harmonics or cross-saturation: extra_emf_pu() is not zero
   bool has_previous_ = false;
   std::int64_t previous_t_ns_ = 0;
   Rotation previous_rotation_;
   double previous_n_pu_ = 0.0;
-  Vec2 previous_correction_ab_V_ = Vec2::Zero();  ///< inverter and iron-loss corrections at the previous sample
+  Vec2 previous_correction_ab_pu_ = Vec2::Zero();  ///< inverter and iron-loss corrections at the previous sample
   Vec2 previous_emf_pu_ = Vec2::Zero();           ///< extra_emf_pu() at the previous sample
   RotationTracker logged_rotation_;      ///< at the logged angle, incremental between consecutive samples
-  /// The last commands issued, stator frame [V], newest first (commands_[0] is the previous sample's).
+  /// The last commands issued, stator frame [pu], newest first (commands_[0] is the previous sample's).
   std::array<Vec2, kMaxDelayPeriods + 2> commands_{};
 };
 

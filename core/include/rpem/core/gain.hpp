@@ -38,21 +38,39 @@ struct GainOutput {
   std::uint8_t flags = 0;
 };
 
+/// SGA's gain as one factor per parameter, L = diag(scale)·Ψ: row j of L is scale_j·Ψ_jᵀ.
+struct SgaScale {
+  Vec2 scale = Vec2::Zero();  ///< γ_L,j / max(r_j[k], r_min)
+  std::uint8_t flags = 0;
+};
+
 /// SGA (eq:SGA_full, eq:SGAHessian), one scalar Hessian per parameter:
 ///   r_j[k] = r_j[k−1] + γ_r,j·(tr{Ψ·Ψᵀ} − r_j[k−1]),   L_j = γ_L,j · Ψ_j / max(r_j[k], r_min)
-/// Inline: it is on the estimator's per-sample path.
-[[nodiscard]] inline GainOutput sga_gain(const Mat2& gradient, const Vec2& gamma_hessian, const Vec2& gamma_gain,
-                                         const GainFloors& floors, Vec2& r) noexcept {
+/// Inline: it is on the estimator's per-sample path, which forms L·ε as scale ⊙ (Ψ·ε) (one product after
+/// the division) rather than through L.
+[[nodiscard]] inline SgaScale sga_scale(const Mat2& gradient, const Vec2& gamma_hessian, const Vec2& gamma_gain,
+                                        const GainFloors& floors, Vec2& r) noexcept {
   const double trace = gradient.squaredNorm();  // tr{Ψ·Ψᵀ}, eq:traceSGAHessian
   r += gamma_hessian.cwiseProduct(Vec2(trace, trace) - r);
   const double floor = floors.sga_hessian_min_pu;
-  const Vec2 scale = gamma_gain.cwiseQuotient(Vec2(std::max(r[0], floor), std::max(r[1], floor)));
-  // Row j of L is scale_j·Ψ_jᵀ. Built a column at a time: Mat2 is column-major, and element-wise
-  // stores would stall the caller's whole-column loads (store forwarding).
-  GainOutput out{Mat2(), std::min(r[0], r[1]) < floor ? gain_flag::kFloored : std::uint8_t{0}};
-  out.gain.col(0) = scale.cwiseProduct(gradient.row(0).transpose());
-  out.gain.col(1) = scale.cwiseProduct(gradient.row(1).transpose());
-  return out;
+  return {gamma_gain.cwiseQuotient(Vec2(std::max(r[0], floor), std::max(r[1], floor))),
+          std::min(r[0], r[1]) < floor ? gain_flag::kFloored : std::uint8_t{0}};
+}
+
+/// L = diag(scale)·Ψ for Ψᵀ = `gradient`. Built a column at a time: Mat2 is column-major, and element-wise
+/// stores would stall the caller's whole-column loads (store forwarding).
+[[nodiscard]] inline Mat2 sga_matrix(const Vec2& scale, const Mat2& gradient) noexcept {
+  Mat2 l;
+  l.col(0) = scale.cwiseProduct(gradient.row(0).transpose());
+  l.col(1) = scale.cwiseProduct(gradient.row(1).transpose());
+  return l;
+}
+
+/// The SGA gain matrix L with its flags (sga_scale() and sga_matrix()).
+[[nodiscard]] inline GainOutput sga_gain(const Mat2& gradient, const Vec2& gamma_hessian, const Vec2& gamma_gain,
+                                         const GainFloors& floors, Vec2& r) noexcept {
+  const SgaScale s = sga_scale(gradient, gamma_hessian, gamma_gain, floors, r);
+  return {sga_matrix(s.scale, gradient), s.flags};
 }
 
 /// GNA (eq:GNA_full … eq:GNA_GainElements):

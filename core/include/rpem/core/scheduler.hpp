@@ -42,19 +42,27 @@ struct ParameterBounds {
   Vec2 max_pu = Vec2::Zero();
 };
 
+/// Projection of parameter j's value onto its interval of D_M. Returns whether it was clamped.
+[[nodiscard]] inline bool project(const ParameterBounds& b, int j, double& value) noexcept {
+  if (value < b.min_pu[j]) {
+    value = b.min_pu[j];
+    return true;
+  }
+  if (value > b.max_pu[j]) {
+    value = b.max_pu[j];
+    return true;
+  }
+  return false;
+}
+
+/// Projection of one parameter onto its interval of D_M. Returns whether it was clamped.
+[[nodiscard]] inline bool project(const ParameterBounds& b, Vec2& theta, int j) noexcept { return project(b, j, theta[j]); }
+
 /// Projection onto the box D_M (the Euclidean projection of a box is the clamp). Returns a bit per
 /// parameter that was clamped (bit kPsiM, bit kRs).
 [[nodiscard]] inline std::uint8_t project(const ParameterBounds& b, Vec2& theta) noexcept {
   std::uint8_t clamped = 0;
-  for (int j = 0; j < 2; ++j) {
-    if (theta[j] < b.min_pu[j]) {
-      theta[j] = b.min_pu[j];
-      clamped |= static_cast<std::uint8_t>(1U << j);
-    } else if (theta[j] > b.max_pu[j]) {
-      theta[j] = b.max_pu[j];
-      clamped |= static_cast<std::uint8_t>(1U << j);
-    }
-  }
+  for (int j = 0; j < 2; ++j) clamped |= static_cast<std::uint8_t>(static_cast<unsigned>(project(b, theta, j)) << j);
   return clamped;
 }
 

@@ -45,11 +45,21 @@ struct CommandKeys {
   std::string channel = "RPEM_COMMAND";
 };
 
+/// A command as admission decides it: the fields of the loop's Command that an RPEM_COMMAND sets. (A
+/// Command also carries a reload's whole LiveConfig, about 1 kB, which no RPEM_COMMAND uses: verdicts
+/// and the gate's pending commands stay small, and the gate builds a Command only to queue one.)
+struct AdmittedCommand {
+  Command::Kind kind = Command::Kind::kReset;
+  std::int64_t seq = 0;
+  double psi_m_Wb = 0.0;  ///< kSetValues
+  double r_s_Ohm = 0.0;
+};
+
 struct CommandVerdict {
   bool decoded = false;                         ///< false: not an rpem.command_t (malformed)
   CommandResult result = CommandResult::kNone;  ///< decoded: kApplied if admitted, else why not
   std::int32_t key_id = 0;                      ///< decoded: the key id it names
-  Command command;                              ///< decoded: its seq; admitted: the command for the loop
+  AdmittedCommand command;                      ///< decoded: its seq; admitted: the command for the loop
 };
 
 [[nodiscard]] CommandVerdict admit_command(std::span<const std::uint8_t> message, const CommandPolicy& policy,
@@ -112,8 +122,9 @@ class CommandGate {
   SequenceStore* store_;
   Counters counters_;
   static constexpr std::size_t kMaxPending = 64;
-  std::array<Command, kMaxPending> pending_{};
+  std::array<AdmittedCommand, kMaxPending> pending_{};
   std::size_t n_pending_ = 0;
+  Command queued_;  ///< what commit() pushes, one pending command at a time
   std::int64_t last_accepted_seq_ = 0;
   std::int64_t durable_seq_ = 0;  ///< the last accepted sequence number that is persisted
   std::int64_t last_verdict_seq_ = 0;

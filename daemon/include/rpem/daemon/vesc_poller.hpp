@@ -19,11 +19,27 @@
 //                     in the last period: another poller uses our host id. Its window is still right
 //                     (it ends a read), so it is used.
 //   late              a reply to a poll that had timed out (within one period of the timeout): used, and
-//                     the gap the timeout feared is lifted (this reply is that read).
+//                     the gap the timeout feared is lifted (this reply is that read). A reply under way is
+//                     never discarded by a timeout. With reply_timeout_s ≥ the period (replies slower than
+//                     a period, e.g. 1 kHz on a 1 Mbit/s bus where a reply alone takes 0.9 ms) polls
+//                     overlap replies and are answered in turn: a late reply is the timed-out poll's even
+//                     when the next poll is out — a reply lost outright there lifts that gap wrongly once
+//                     (its successor's window spans the lost read). With a shorter timeout a reply while
+//                     the next poll is out is that poll's.
 //   timeouts          a poll unanswered within reply_timeout_s (silent controller, lost frames). Whether
 //                     the controller read (and reset) is unknown, so the next window follows a gap.
 //   short_windows     a window shorter than kMinWindow: the firmware divides sums of (nearly) no control
 //                     cycles — not a measurement; dropped, the next window follows a gap.
+//   empty_reads       a reply whose i_d, i_q, v_d, v_q are all exactly 0: what the firmware sends for a read
+//                     with no control cycle since the previous one (0/0 in mc_interface_read_reset_avg_*,
+//                     NaN cast to 0 by the Cortex-M4; docs/can-vesc.md). A measured window never gives four
+//                     exact zeros unless the machine stands unexcited, which carries nothing to estimate
+//                     from either; dropped, the next window follows a gap.
+//   long_windows      a window longer than 2·period + timeout: the longest a single lost read explains (a
+//                     reply late by up to a period after its timeout closes a window of at most that), so
+//                     more means the controller went unread (silent, off the bus) and the average spans
+//                     unknown operation — not a sample of the steady-state model; dropped, the next window
+//                     follows a gap.
 // Reads by a poller the bus does not show (VESC Tool over USB or UART) shorten windows invisibly: the
 // reply carries no count of the cycles averaged (docs/rpemd.md says what that costs).
 
@@ -43,6 +59,8 @@ struct VescPollerCounters {
   std::uint64_t unrequested = 0;
   std::uint64_t stolen_reads = 0;
   std::uint64_t short_windows = 0;
+  std::uint64_t empty_reads = 0;
+  std::uint64_t long_windows = 0;
 };
 
 class VescPoller {
@@ -88,6 +106,8 @@ class VescPoller {
   void time_out() noexcept;
   [[nodiscard]] bool is_values_read_of_controller(const can::CanFrame& f) const noexcept;
   [[nodiscard]] bool starts_reply(const can::CanFrame& f) const noexcept;
+  /// Drops a window that is no measurement (counted); true when `t` closes a usable one.
+  [[nodiscard]] bool plausible_window(std::int64_t t) noexcept;
 
   Config config_;
   can::CanFrame poll_;
