@@ -36,22 +36,6 @@ nlohmann::json drift_json(const io::ParameterDrift& d) {
   return nullptr;
 }
 
-/// The model mismatch allowance of calibrated constant i, relative (docs/diagnose.md, "The calibrated
-/// baseline"): the change of the constant, the others refitted, that moves the model's training currents
-/// by as much as the misfit the final model still leaves above the noise floor — which is also the
-/// largest bias a misfit of that size could put into the constant (Cauchy–Schwarz on (JᵀJ)⁻¹Jᵀe). With
-/// σ² = floor²/2 per residual component the excitation's half-width is z·σ·√((JᵀJ)⁻¹ₖₖ); the misfit over
-/// the N training samples is |e|² = N·floor²·(ρ² − 1), ρ the held-out ratio to the floor; so the
-/// allowance √((JᵀJ)⁻¹ₖₖ)·|e| is the excitation's half-width times √(2N(ρ² − 1))/z.
-double mismatch_half_width(const Diagnosis& d, std::size_t i) {
-  constexpr double kZ = 1.959964;
-  const double excitation = d.calibration.intervals.excitation_half_width[i];
-  if (!std::isfinite(excitation) || d.verdict.ratio <= 1.0) return 0.0;
-  std::size_t n = 0;
-  for (std::size_t k = 0; k < d.log->rows.size(); ++k) n += d.log->training(k) ? 1 : 0;
-  return excitation * std::sqrt(2.0 * static_cast<double>(n) * (d.verdict.ratio * d.verdict.ratio - 1.0)) / kZ;
-}
-
 nlohmann::json calibration_json(const Diagnosis& d) {
   const Calibration& c = d.calibration;
   nlohmann::json j;
@@ -101,6 +85,21 @@ const EstimatorCheck* estimator_check(const Diagnosis& d, std::size_t j) {
     if (c.effect == e) return &c;
   }
   return nullptr;
+}
+
+// The allowance (docs/diagnose.md, "The calibrated baseline"): the change of the constant, the others refitted, that moves the model's training currents
+// by as much as the misfit the final model still leaves above the noise floor — which is also the
+// largest bias a misfit of that size could put into the constant (Cauchy–Schwarz on (JᵀJ)⁻¹Jᵀe). With
+// σ² = floor²/2 per residual component the excitation's half-width is z·σ·√((JᵀJ)⁻¹ₖₖ); the misfit over
+// the N training samples is |e|² = N·floor²·(ρ² − 1), ρ the held-out ratio to the floor; so the
+// allowance √((JᵀJ)⁻¹ₖₖ)·|e| is the excitation's half-width times √(2N(ρ² − 1))/z.
+double mismatch_half_width(const Diagnosis& d, std::size_t i) {
+  constexpr double kZ = 1.959964;
+  const double excitation = d.calibration.intervals.excitation_half_width[i];
+  if (!std::isfinite(excitation) || d.verdict.ratio <= 1.0) return 0.0;
+  std::size_t n = 0;
+  for (std::size_t k = 0; k < d.log->rows.size(); ++k) n += d.log->training(k) ? 1 : 0;
+  return excitation * std::sqrt(2.0 * static_cast<double>(n) * (d.verdict.ratio * d.verdict.ratio - 1.0)) / kZ;
 }
 
 std::vector<std::string> calibration_findings(const Diagnosis& d) {
