@@ -188,10 +188,9 @@ Vec2 SampleConditioner::logged_current_dq_A(const DriveSample& s) const noexcept
   return s.i_A.head<2>();
 }
 
-Vec2 SampleConditioner::observed_current_dq_A(const DriveSample& s, const Vec2& i_model_pu) const noexcept {
+Vec2 SampleConditioner::observed_current_dq_A(const DriveSample& s, const Rotation& logged, const Vec2& i_model_pu) const noexcept {
   // Without observation-side extensions the log's dq frame is the model's.
   if (!angle_offset_ && !phase_corrections_ && inv_r_fe_pu_ == 0.0) return i_model_pu * base_.current_A;
-  const Rotation logged = Rotation::of(s.theta_el_rad);
   const Rotation rot = angle_offset_ ? compose(logged, offset_rotation_) : logged;
   Vec2 i_pu = i_model_pu;
   if (inv_r_fe_pu_ > 0.0) {

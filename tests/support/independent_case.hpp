@@ -28,6 +28,9 @@ struct IndependentCase {
   double duration_s = 8.0;
   /// Effect parameters set instead of drawn (the generator's keys, e.g. {"delay.periods", 2}).
   std::vector<std::pair<std::string, double>> set;
+  /// The generator's own profile (`indep_drive_log` without `--profile`, as a user runs it) instead of the
+  /// tests' commissioning profile (independent_profile).
+  bool generator_profile = false;
 };
 
 struct IndependentOutcome {
@@ -232,7 +235,7 @@ inline IndependentOutcome run_independent_case(const IndependentCase& ic) {
   c.seed = ic.seed;
   c.duration_s = ic.duration_s;
   c.keep_plant_rows = false;
-  c.profile.points = independent_profile(c.machine, ic.duration_s);
+  if (!ic.generator_profile) c.profile.points = independent_profile(c.machine, ic.duration_s);
   std::string names;
   for (const std::string& e : ic.effects) names += (names.empty() ? "" : ",") + e;
   indep::enable_effects(c.effects, names.empty() ? "none" : names);

@@ -80,7 +80,11 @@ TEST(CliDiagnose, FindsAHiddenDeadTimeAndTheExtendedModelCarriesIntoTheTools) {
     ASSERT_TRUE(ci.is_array()) << key;
     EXPECT_LE(ci[0].get<double>(), d["calibration"]["configured"][key].get<double>() * 1.005) << key;
     EXPECT_GE(ci[1].get<double>(), d["calibration"]["configured"][key].get<double>() * 0.995) << key;
+    EXPECT_GE(d["calibration"][std::string(key) + "_mismatch_rel"].get<double>(), 0.0) << key;
   }
+  // The mismatch allowance is shown where the findings are: the terminal and the report's table.
+  EXPECT_NE(r.output.find("(mismatch ±"), std::string::npos) << r.output;
+  EXPECT_NE(read(out + "/report.md").find("| mismatch allowance |"), std::string::npos);
   EXPECT_TRUE(d["calibration"]["findings"].empty()) << d["calibration"].dump(2);
   EXPECT_NEAR(d["noise_floor_A"].get<double>(), 0.023, 0.003);  // σ = 0.02 A per phase: √(4/3)·σ in dq
   EXPECT_EQ(d["verdict"], "explained");

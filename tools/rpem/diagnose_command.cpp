@@ -66,7 +66,10 @@ int run_diagnose(const DiagnoseCliOptions& o) {
   std::printf("baseline (the configuration as it is): held-out residual %.4g A RMS\n", d.baseline_heldout_rms_A);
   std::printf("calibrated baseline: held-out residual %.4g A RMS", d.calibration.heldout_rms_A);
   for (std::size_t i = 0; i < analysis::kCalibrated.size(); ++i) {
-    if (d.calibration.identifiable[i]) std::printf(" %s=%.6g", analysis::kCalibrated[i], d.calibration.value[i]);
+    if (d.calibration.identifiable[i]) {
+      std::printf(" %s=%.6g (mismatch ±%.2g %%)", analysis::kCalibrated[i], d.calibration.value[i],
+                  100.0 * analysis::mismatch_half_width(d, i));
+    }
   }
   std::printf("\n");
   for (const std::string& f : analysis::calibration_findings(d)) std::printf("calibration: %s\n", f.c_str());

@@ -46,6 +46,7 @@ nlohmann::json calibration_json(const Diagnosis& d) {
     const double hw = c.intervals.half_width[i] * c.value[i];
     j[key + "_ci95"] = c.identifiable[i] && std::isfinite(hw) ? nlohmann::json({c.value[i] - hw, c.value[i] + hw}) : nlohmann::json(nullptr);
     j[key + "_excitation_ci95_rel"] = finite_json(c.intervals.excitation_half_width[i]);
+    j[key + "_mismatch_rel"] = c.identifiable[i] ? nlohmann::json(mismatch_half_width(d, i)) : nlohmann::json(nullptr);
     configured[key] = c.configured[i];
     if (c.identifiable[i]) identifiable.push_back(key);
   }
@@ -86,14 +87,31 @@ const EstimatorCheck* estimator_check(const Diagnosis& d, std::size_t j) {
   return nullptr;
 }
 
+// The allowance (docs/diagnose.md, "The calibrated baseline"): the change of the constant, the others refitted, that moves the model's training currents
+// by as much as the misfit the final model still leaves above the noise floor — which is also the
+// largest bias a misfit of that size could put into the constant (Cauchy–Schwarz on (JᵀJ)⁻¹Jᵀe). With
+// σ² = floor²/2 per residual component the excitation's half-width is z·σ·√((JᵀJ)⁻¹ₖₖ); the misfit over
+// the N training samples is |e|² = N·floor²·(ρ² − 1), ρ the held-out ratio to the floor; so the
+// allowance √((JᵀJ)⁻¹ₖₖ)·|e| is the excitation's half-width times √(2N(ρ² − 1))/z.
+double mismatch_half_width(const Diagnosis& d, std::size_t i) {
+  constexpr double kZ = 1.959964;
+  const double excitation = d.calibration.intervals.excitation_half_width[i];
+  if (!std::isfinite(excitation) || d.verdict.ratio <= 1.0) return 0.0;
+  std::size_t n = 0;
+  for (std::size_t k = 0; k < d.log->rows.size(); ++k) n += d.log->training(k) ? 1 : 0;
+  return excitation * std::sqrt(2.0 * static_cast<double>(n) * (d.verdict.ratio * d.verdict.ratio - 1.0)) / kZ;
+}
+
 std::vector<std::string> calibration_findings(const Diagnosis& d) {
   std::vector<std::string> out;
   const Calibration& c = d.calibration;
   for (std::size_t i = 0; i < kCalibrated.size(); ++i) {
     if (!c.identifiable[i]) continue;
     const double rel = c.configured[i] / c.value[i] - 1.0;  // the configuration against the calibrated value
+    // Within its interval widened by the model mismatch allowance (or 0.5 %): not told from the configuration.
     const double hw = std::isfinite(c.intervals.half_width[i]) ? c.intervals.half_width[i] : 0.0;
-    if (std::abs(c.value[i] / c.configured[i] - 1.0) <= std::max(hw, 0.005)) continue;  // within its interval (or 0.5 %)
+    const double mismatch = mismatch_half_width(d, i);
+    if (std::abs(c.value[i] / c.configured[i] - 1.0) <= std::max(hw + mismatch, 0.005)) continue;
     out.push_back(std::string("the configuration's ") + kCalibratedText[i] + " is " + pct(rel) + " % " + (rel > 0.0 ? "high" : "low"));
   }
   return out;

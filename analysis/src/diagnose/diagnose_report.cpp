@@ -114,9 +114,15 @@ void calibration(ReportDocument& doc, const Diagnosis& d) {
     if (i == 1 && d.estimates.method == "rpem") rpem = num(d.estimates.nominal_summary.r_s_Ohm);
     rows.push_back({kCalibratedText[i], num(c.configured[i]), c.identifiable[i] ? num(c.value[i]) : "not identifiable",
                     c.identifiable[i] && std::isfinite(hw) ? "[" + num(c.value[i] - hw) + ", " + num(c.value[i] + hw) + "]" : "—",
+                    c.identifiable[i] ? "±" + pct(100.0 * mismatch_half_width(d, i)) : "—",
                     c.identifiable[i] ? pct(100.0 * (c.configured[i] / c.value[i] - 1.0)) : "—", rpem});
   }
-  doc.table({"constant", "configured", "calibrated", "95 % interval", "configuration off by", "RPEM estimate"}, rows);
+  doc.table({"constant", "configured", "calibrated", "95 % interval", "mismatch allowance", "configuration off by",
+             "RPEM estimate"},
+            rows);
+  doc.paragraph("The mismatch allowance is the largest bias the misfit the final model still leaves above the noise floor "
+                "could put into a constant (0 when the model explains the log down to the floor); a configured value "
+                "within the interval widened by it is not stated as off.");
   std::string temps;
   if (d.context.t_magnet.logged) temps += " ψm at the log's mean magnet temperature, " + num(d.context.t_magnet.mean_C, 3) + " °C.";
   if (d.context.t_winding.logged) temps += " R_s at the mean winding temperature, " + num(d.context.t_winding.mean_C, 3) + " °C.";

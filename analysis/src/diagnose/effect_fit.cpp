@@ -357,6 +357,12 @@ EffectSet EffectFitter::fit(const EffectSet& start, double* training_ssr) const 
   options.parameter_tolerance = 1e-6;
   options.logging_type = ceres::SILENT;
   options.minimizer_progress_to_stdout = false;
+  // With bounds, each accepted trust-region step is followed by Ceres' projected Armijo line search; its
+  // default cubic interpolation evaluates the gradient at every trial step — here a numeric Jacobian, one
+  // replay per parameter. Quadratic interpolation asks for the cost alone: the same sufficient-decrease
+  // test, a fraction of the replays (docs/benchmarks.md, rpem diagnose).
+  options.line_search_interpolation_type = ceres::QUADRATIC;
+  options.max_num_line_search_step_size_iterations = 0;
   ceres::Solver::Summary summary;
   ceres::Solve(options, &problem, &summary);
   if (training_ssr) *training_ssr = 2.0 * summary.final_cost;  // Ceres' cost is half the sum of squares

@@ -19,6 +19,10 @@ constexpr std::size_t kWarmup = core::kMaxDelayPeriods + 3;
 ModelReplay::ModelReplay(const LogData& log, const core::RatedData& rated)
     : log_(log), base_(core::PerUnitBase::from_rated(rated)), max_interval_s_(kMaxIntervals * log.median_dt_s) {
   const std::size_t n = log.rows.size();
+  if (log.mode == ModelMode::kTransient) {
+    logged_rotation_.resize(log.replay_samples.size());
+    for (std::size_t k = 0; k < logged_rotation_.size(); ++k) logged_rotation_[k] = core::Rotation::of(log.replay_samples[k].theta_el_rad);
+  }
   for (std::size_t k = 0; k < n; ++k) {
     if (!log.block_start(k)) continue;
     if (!blocks_.empty()) blocks_.back().end = k;
@@ -88,7 +92,7 @@ void ModelReplay::run_transient(const ExtendedModel& model, ReplayOutput& out, B
       }
       core::predict(m, coefficients, core::Discretization::kTrapezoidal, iv, state, core::Gradients::kSkip);
       if (!log_.used[k]) continue;
-      out.model_A[k] = conditioner.observed_current_dq_A(s, state.i_hat_pu);
+      out.model_A[k] = conditioner.observed_current_dq_A(s, logged_rotation_[k], state.i_hat_pu);
       out.residual_A[k] = log_.logged_i_dq_A[k] - out.model_A[k];
       out.valid[k] = out.residual_A[k].allFinite();
     }

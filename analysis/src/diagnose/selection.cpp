@@ -137,6 +137,44 @@ void withdraw_explained(const EffectFitter& fitter, const SelectionOptions& opti
   }
 }
 
+/// Whether `set` leaves an admissible constant configured.
+bool leaves_configured(const EffectSet& set, const std::array<bool, kCalibrated.size()>& admissible) {
+  for (std::size_t i = 0; i < kCalibrated.size(); ++i) {
+    if (admissible[i] && !set.calibrated[i]) return true;
+  }
+  return false;
+}
+
+/// `set` with the admissible constants it leaves configured freed and refitted from its values (a warm
+/// start), keeping those the fit then identifies (refitted without the others); `set` itself when it keeps
+/// none (`kept` false).
+EffectSet with_admissible_constants(const EffectFitter& fitter, double noise_floor_A,
+                                    const std::array<bool, kCalibrated.size()>& admissible, const EffectSet& set, bool& kept) {
+  kept = false;
+  EffectSet trial = set;
+  std::vector<std::size_t> freed;
+  for (std::size_t i = 0; i < kCalibrated.size(); ++i) {
+    if (trial.calibrated[i] || !admissible[i]) continue;
+    trial.calibrated[i] = true;
+    freed.push_back(i);
+  }
+  if (freed.empty()) return set;
+  trial = fitter.fit(trial);  // from `set`'s fitted values: a warm start
+  const CalibrationIntervals ci = fitter.intervals(trial, noise_floor_A);
+  bool all = true;
+  for (std::size_t i : freed) {
+    if (identified(trial, ci, i)) {
+      kept = true;
+      continue;
+    }
+    trial.calibrated[i] = false;
+    trial.calibration[i] = 0.0;
+    all = false;
+  }
+  if (!kept) return set;
+  return all ? trial : fitter.fit(trial);
+}
+
 }  // namespace
 
 double rms(const BlockScores& b) { return b.samples ? std::sqrt(b.total() / static_cast<double>(b.samples)) : 0.0; }
@@ -178,28 +216,9 @@ double signed_rank_p(const std::vector<double>& values) {
 
 bool readmit_constants(const EffectFitter& fitter, double noise_floor_A, const std::array<bool, kCalibrated.size()>& admissible,
                        EffectSet& model, BlockScores& scores) {
-  EffectSet trial = model;
-  std::vector<std::size_t> readmitted;
-  for (std::size_t i = 0; i < kCalibrated.size(); ++i) {
-    if (trial.calibrated[i] || !admissible[i]) continue;
-    trial.calibrated[i] = true;
-    readmitted.push_back(i);
-  }
-  if (readmitted.empty()) return false;
-  trial = fitter.fit(trial);
-  const CalibrationIntervals ci = fitter.intervals(trial, noise_floor_A);
-  bool all = true, any = false;
-  for (std::size_t i : readmitted) {
-    if (identified(trial, ci, i)) {
-      any = true;
-      continue;
-    }
-    trial.calibrated[i] = false;
-    trial.calibration[i] = 0.0;
-    all = false;
-  }
-  if (!any) return false;
-  if (!all) trial = fitter.fit(trial);
+  bool kept = false;
+  const EffectSet trial = with_admissible_constants(fitter, noise_floor_A, admissible, model, kept);
+  if (!kept) return false;
   const BlockScores trial_scores = fitter.heldout(trial);
   if (rms(trial_scores) > rms(scores)) return false;
   model = trial;
@@ -268,24 +287,29 @@ Selection select_effects(const EffectFitter& fitter, const SelectionOptions& opt
       if (round[i].screen_ssr >= options.rival_share * achieved) rivals.push_back(i);
     }
     parallel_for(rivals.size(), options.threads, [&](std::size_t j) { fit(rivals[j]); });
+    // The candidates are judged against `reference`: the model as it is, or after a second look (below).
+    BlockScores reference = current;
     std::vector<std::size_t> ranked;
-    for (std::size_t i = 0; i < shortlisted; ++i) {
-      if (!round[i].fitted) continue;
-      round[i].gain_pct = gain_pct(current, scores[i]);
-      round[i].block_log_ratio = block_log_ratios(current, scores[i]);
-      round[i].p_value = signed_rank_p(round[i].block_log_ratio);
-      round[i].start = starts[i];
-      round[i].parameters = fitted[i].parameters.back();
-      ranked.push_back(i);
-    }
-    std::sort(ranked.begin(), ranked.end(), [&](std::size_t a, std::size_t b) { return scores[a].total() < scores[b].total(); });
-    sel.rounds.push_back(round);
+    auto rank = [&] {
+      ranked.clear();
+      for (std::size_t i = 0; i < shortlisted; ++i) {
+        if (!round[i].fitted) continue;
+        round[i].gain_pct = gain_pct(reference, scores[i]);
+        round[i].block_log_ratio = block_log_ratios(reference, scores[i]);
+        round[i].p_value = signed_rank_p(round[i].block_log_ratio);
+        round[i].start = starts[i];
+        round[i].parameters = fitted[i].parameters.back();
+        ranked.push_back(i);
+      }
+      std::sort(ranked.begin(), ranked.end(), [&](std::size_t a, std::size_t b) { return scores[a].total() < scores[b].total(); });
+    };
+    rank();
     // The best plausible candidate; implausible ones that would have passed are reported and set aside.
     std::size_t best = shortlisted;
     bool set_aside = false;
     // Accepted only if large, consistent, and standing out of the noise: the model change it brings (the
     // held-out RMS² it removes) must be at least (min_change_of_floor × the noise floor)².
-    const double before = rms(current);
+    double before = rms(reference);
     const double min_change2 = std::pow(options.min_change_of_floor * noise_floor_A, 2);
     auto passes = [&](std::size_t i) {
       const CandidateScore& c = round[i];
@@ -293,6 +317,41 @@ Selection select_effects(const EffectFitter& fitter, const SelectionOptions& opt
       if (c.gain_pct < options.min_gain_pct || c.p_value > options.max_p || before * before - after * after < min_change2) return false;
       return !(c.effect.row->negligible && c.effect.row->negligible(c.effect, fitted[i].model(context), context));
     };
+    // The second look (docs/diagnose.md, "Constants a missing effect hid"): a constant the excitation
+    // pins but the calibration left configured — its cluster-robust interval widened by the residual of an
+    // effect still missing — held at a wrong value while a candidate is fitted, biases the candidate and
+    // makes the blocks disagree. When no candidate passes but one lowers the held-out residual by
+    // min_gain_pct, the leaders are fitted again with those constants free (kept only if then identified),
+    // from their fits; the reference is the better of the model as it is and the model with the same
+    // constants free, so that what the constants' freedom alone brings is not credited to an effect.
+    if (std::none_of(ranked.begin(), ranked.end(), passes) && !ranked.empty() &&
+        round[ranked.front()].gain_pct >= options.min_gain_pct &&
+        leaves_configured(sel.model, admissible)) {
+      std::vector<std::size_t> again;
+      for (std::size_t i : ranked) {
+        if (again.size() < leaders && round[i].gain_pct >= options.min_gain_pct) again.push_back(i);
+      }
+      EffectSet freed_model = sel.model;
+      bool freed_kept = false;
+      parallel_for(again.size() + 1, options.threads, [&](std::size_t j) {
+        bool kept = false;
+        if (j == again.size()) {
+          freed_model = with_admissible_constants(fitter, noise_floor_A, admissible, sel.model, kept);
+          freed_kept = kept;
+          return;
+        }
+        const std::size_t i = again[j];
+        fitted[i] = with_admissible_constants(fitter, noise_floor_A, admissible, fitted[i], kept);
+        if (kept) scores[i] = fitter.heldout(fitted[i]);
+      });
+      if (freed_kept) {
+        const BlockScores freed_scores = fitter.heldout(freed_model);
+        if (freed_scores.total() < reference.total()) reference = freed_scores;
+      }
+      rank();
+      before = rms(reference);
+    }
+    sel.rounds.push_back(round);
     for (std::size_t i : ranked) {
       const CandidateScore& c = round[i];
       if (!passes(i)) continue;  // the best that passes: each is tested on its own
@@ -357,7 +416,7 @@ Selection select_effects(const EffectFitter& fitter, const SelectionOptions& opt
       continue;
     }
 
-    sel.found.push_back({winner.effect, rms(current), rms(scores[best]), winner.gain_pct, winner.p_value});
+    sel.found.push_back({winner.effect, rms(reference), rms(scores[best]), winner.gain_pct, winner.p_value});
     sel.model = fitted[best];
     current = scores[best];
     withdraw_explained(fitter, options, min_change2, sel, current, excluded);

@@ -116,7 +116,12 @@ class SampleConditioner {
   /// observation model — iron-loss current added, per-phase gain and offset applied — as dq at the
   /// logged angle [A]. The inverse of the corrections condition() applies; `rpem diagnose` compares
   /// models in this measured space.
-  [[nodiscard]] Vec2 observed_current_dq_A(const DriveSample& s, const Vec2& i_model_pu) const noexcept;
+  [[nodiscard]] Vec2 observed_current_dq_A(const DriveSample& s, const Vec2& i_model_pu) const noexcept {
+    return observed_current_dq_A(s, Rotation::of(s.theta_el_rad), i_model_pu);
+  }
+  /// The same with the logged angle's rotation, Rotation::of(s.theta_el_rad), computed by the caller
+  /// (a replay of many models over one log computes it once per sample).
+  [[nodiscard]] Vec2 observed_current_dq_A(const DriveSample& s, const Rotation& logged, const Vec2& i_model_pu) const noexcept;
 
   /// Forgets the previous sample: the next one starts a new interval chain (resynchronises).
   void reset() noexcept { has_previous_ = false; }

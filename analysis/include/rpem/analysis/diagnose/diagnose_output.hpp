@@ -23,8 +23,12 @@ void write_diagnose_report(const std::string& dir, const Diagnosis& d, const std
 /// The found effect j's parameters in SI (its row's describe() of the final joint fit).
 [[nodiscard]] std::vector<NamedValue> found_parameters(const Diagnosis& d, std::size_t j);
 
+/// The model mismatch allowance of calibrated constant i, relative (e.g. 0.10 for ±10 %): the largest bias
+/// the misfit the final model leaves above the noise floor could put into it (`<key>_mismatch_rel`).
+[[nodiscard]] double mismatch_half_width(const Diagnosis& d, std::size_t i);
+
 /// What the calibration says about the configuration, one sentence per identifiable constant whose
-/// configured value lies outside the calibrated 95 % interval (e.g. "the configuration's ψm is 5.1 % high").
+/// configured value lies outside the calibrated 95 % interval widened by its mismatch allowance (e.g. "the configuration's ψm is 5.1 % high").
 [[nodiscard]] std::vector<std::string> calibration_findings(const Diagnosis& d);
 
 /// The estimator check of the found effect j (nullptr if none).

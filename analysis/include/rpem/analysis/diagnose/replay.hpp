@@ -14,6 +14,7 @@
 
 #include "rpem/analysis/diagnose/effects.hpp"
 #include "rpem/analysis/diagnose/log_data.hpp"
+#include "rpem/core/frames.hpp"
 #include "rpem/core/types.hpp"
 
 namespace rpem::analysis {
@@ -51,6 +52,7 @@ class ModelReplay {
   core::PerUnitBase base_;
   double max_interval_s_;
   std::vector<Stretch> blocks_;  ///< one per block, in order
+  std::vector<core::Rotation> logged_rotation_;  ///< transient logs: each sample's logged angle, once
 };
 
 }  // namespace rpem::analysis
