@@ -36,8 +36,8 @@ int main(int argc, char** argv) {
   const std::string iface = argv[1];
   const double rate = std::atof(argv[2]);
   const auto total = static_cast<std::size_t>(rate * std::atof(argv[3]));
-  rpem::can::SocketCanChannel rx({iface, true, true, {0x100}});
-  rpem::can::SocketCanChannel tx({iface, true, false, {}, false});
+  rpem::can::SocketCanChannel rx(rpem::can::SocketCanChannel::Options::receiver(iface, {0x100}));
+  rpem::can::SocketCanChannel tx(rpem::can::SocketCanChannel::Options::sender(iface));
   std::vector<std::int64_t> sent_at(total, 0);
   std::atomic<bool> done{false};
 

@@ -48,8 +48,8 @@ std::size_t receive_for(SocketCanChannel& ch, std::vector<ReceivedFrame>& out, i
 std::int64_t realtime_ns() { return core::now_ns(CLOCK_REALTIME); }
 
 TEST(SocketCan, FdFramesArriveWithKernelTimestamps) {
-  SocketCanChannel rx({kIface, true, true, {protocol::kFdId}});
-  SocketCanChannel tx({kIface, true, false, {}, false});
+  SocketCanChannel rx(SocketCanChannel::Options::receiver(kIface, {protocol::kFdId}));
+  SocketCanChannel tx(SocketCanChannel::Options::sender(kIface));
   ASSERT_TRUE(rx.is_open()) << rx.last_error();
   ASSERT_TRUE(tx.is_open()) << tx.last_error();
   const std::int64_t before = realtime_ns();
@@ -70,8 +70,8 @@ TEST(SocketCan, FdFramesArriveWithKernelTimestamps) {
 }
 
 TEST(SocketCan, KernelFilterPassesOnlyTelemetryIds) {
-  SocketCanChannel rx({kIface, true, true, {protocol::kFdId, 0x110}});
-  SocketCanChannel tx({kIface, true, false, {}, false});
+  SocketCanChannel rx(SocketCanChannel::Options::receiver(kIface, {protocol::kFdId, 0x110}));
+  SocketCanChannel tx(SocketCanChannel::Options::sender(kIface));
   tx.send(fd_frame(0x101, 1));
   tx.send(fd_frame(protocol::kFdId, 2));
   CanFrame classic;
@@ -89,10 +89,10 @@ TEST(SocketCan, KernelFilterPassesOnlyTelemetryIds) {
 }
 
 TEST(SocketCan, KernelDropCounterCountsWhatTheSocketQueueLost) {
-  SocketCanChannel::Options o{kIface, true, true, {protocol::kFdId}};
+  auto o = SocketCanChannel::Options::receiver(kIface, {protocol::kFdId});
   o.receive_buffer_bytes = 4096;  // tiny: the queue overflows while nobody reads
   SocketCanChannel rx(o);
-  SocketCanChannel tx({kIface, true, false, {}, false});
+  SocketCanChannel tx(SocketCanChannel::Options::sender(kIface));
   constexpr int kSent = 2000;
   for (int k = 0; k < kSent; ++k) ASSERT_TRUE(tx.send(fd_frame(protocol::kFdId, 0)));
   std::vector<ReceivedFrame> got;
@@ -105,7 +105,7 @@ TEST(SocketCan, KernelDropCounterCountsWhatTheSocketQueueLost) {
 
 TEST(SocketCan, ErrorFramesAreDecodedIntoCounters) {
   // A raw socket may put error frames on a virtual bus; the receiver subscribed to them decodes them.
-  SocketCanChannel rx({kIface, true, true, {protocol::kFdId}});
+  SocketCanChannel rx(SocketCanChannel::Options::receiver(kIface, {protocol::kFdId}));
   const int fd = ::socket(PF_CAN, SOCK_RAW, CAN_RAW);
   ASSERT_GE(fd, 0);
   sockaddr_can addr{};
@@ -132,8 +132,8 @@ TEST(SocketCan, ErrorFramesAreDecodedIntoCounters) {
 }
 
 TEST(SocketCan, SurvivesTheInterfaceGoingDownAndUp) {
-  SocketCanChannel rx({kIface, true, true, {protocol::kFdId}});
-  SocketCanChannel tx({kIface, true, false, {}, false});
+  SocketCanChannel rx(SocketCanChannel::Options::receiver(kIface, {protocol::kFdId}));
+  SocketCanChannel tx(SocketCanChannel::Options::sender(kIface));
   std::vector<ReceivedFrame> got;
   tx.send(fd_frame(protocol::kFdId, 1));
   receive_for(rx, got, 100);
@@ -153,7 +153,7 @@ TEST(SocketCan, SurvivesTheInterfaceGoingDownAndUp) {
 
 TEST(SocketCan, ReopensWhenTheInterfaceIsRecreated) {
   ASSERT_EQ(std::system("ip link add dev rpemtest0 type vcan && ip link set rpemtest0 mtu 72 && ip link set rpemtest0 up"), 0);
-  SocketCanChannel rx({"rpemtest0", true, true, {protocol::kFdId}});
+  SocketCanChannel rx(SocketCanChannel::Options::receiver("rpemtest0", {protocol::kFdId}));
   ASSERT_TRUE(rx.is_open());
   ASSERT_EQ(std::system("ip link del rpemtest0"), 0);
   std::vector<ReceivedFrame> got;
@@ -162,7 +162,7 @@ TEST(SocketCan, ReopensWhenTheInterfaceIsRecreated) {
   ASSERT_EQ(std::system("ip link add dev rpemtest0 type vcan && ip link set rpemtest0 mtu 72 && ip link set rpemtest0 up"), 0);
   receive_for(rx, got, 400);
   EXPECT_TRUE(rx.is_open());
-  SocketCanChannel tx({"rpemtest0", true, false, {}, false});
+  SocketCanChannel tx(SocketCanChannel::Options::sender("rpemtest0"));
   tx.send(fd_frame(protocol::kFdId, 9));
   receive_for(rx, got, 200);
   ASSERT_EQ(got.size(), 1U);

@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <span>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "rpem/can/frame.hpp"
@@ -47,6 +48,22 @@ class SocketCanChannel {
     bool receive_errors = true;          ///< subscribe to error frames
     int receive_buffer_bytes = 1 << 20;  ///< SO_RCVBUFFORCE, falling back to SO_RCVBUF
     int reopen_interval_ms = 100;
+
+    /// A CAN FD socket reading only `ids` (and error frames).
+    static Options receiver(std::string interface, std::vector<std::uint32_t> ids) {
+      Options o;
+      o.interface = std::move(interface);
+      o.ids = std::move(ids);
+      return o;
+    }
+    /// A send-only CAN FD socket: it reads nothing, error frames included.
+    static Options sender(std::string interface) {
+      Options o;
+      o.interface = std::move(interface);
+      o.receive = false;
+      o.receive_errors = false;
+      return o;
+    }
   };
 
   explicit SocketCanChannel(Options options);
