@@ -359,8 +359,9 @@ EffectSet EffectFitter::fit(const EffectSet& start, double* training_ssr) const 
   options.minimizer_progress_to_stdout = false;
   // With bounds, each accepted trust-region step is followed by Ceres' projected Armijo line search; its
   // default cubic interpolation evaluates the gradient at every trial step — here a numeric Jacobian, one
-  // replay per parameter. Quadratic interpolation asks for the cost alone: the same sufficient-decrease
-  // test, a fraction of the replays (docs/benchmarks.md, rpem diagnose).
+  // replay per parameter. The search is switched off (zero step-size iterations: the trust region alone
+  // keeps the step inside the bounds); were it on, quadratic interpolation would ask for the cost alone
+  // (docs/benchmarks.md, rpem diagnose).
   options.line_search_interpolation_type = ceres::QUADRATIC;
   options.max_num_line_search_step_size_iterations = 0;
   ceres::Solver::Summary summary;
