@@ -80,11 +80,15 @@ TEST(BusLoad, NativeAndCia402ByHand) {
   EXPECT_NEAR(max_sample_rate_Hz(native_traffic(false, 3), 12, 0.7, {1e6, 1e6}), 0.7e6 / 8100.0, 1e-9);
   // Native FD 1/5: a 169.8 µs frame per 3 samples → 0.7 / (12·56.6 µs) = 1030.6 Hz.
   EXPECT_NEAR(max_sample_rate_Hz(native_traffic(true, 3), 12, 0.7, {1e6, 5e6}), 0.7 / (12 * 169.8e-6 / 3), 1e-6);
-  // The AX8000 map's four PDOs (4, 8, 8, 6 bytes: 95 + 135 + 135 + 115 bits) and one SYNC (55) per bus.
+  // The AX8000 map's four PDOs (4, 8, 8, 8 bytes: 95 + 135 + 135 + 135 bits) and one SYNC (55) per bus:
+  //   4 bytes: 47 + 32 = 79 bits + (34 + 32 − 1)/4 = 16 stuff bits = 95; 8 bytes: 111 + 97/4 = 24 → 135;
+  //   SYNC (no data): 47 + (34 − 1)/4 = 8 → 55. 12 drives: 12·500 + 55 = 6055 µs per sample period, at 70 %
+  //   0.7/6055 µs = 115.6 Hz.
   const Traffic t = signal_map_traffic(io::load_signal_map(std::string(RPEM_TEST_SOURCE_DIR) +
                                                            "/config/signal-maps/beckhoff-ax8000-cia402.yaml"),
                                        false, true);
-  EXPECT_NEAR(time_per_sample_s(t, 12, {1e6, 1e6}), (12 * 480 + 55) * 1e-6, 1e-12);
+  EXPECT_NEAR(time_per_sample_s(t, 12, {1e6, 1e6}), (12 * 500 + 55) * 1e-6, 1e-12);
+  EXPECT_NEAR(max_sample_rate_Hz(t, 12, 0.7, {1e6, 1e6}), 0.7e6 / 6055.0, 1e-9);
 }
 
 /// The table of docs/benchmarks.md ("Several drives per bus"), printed.
@@ -101,7 +105,10 @@ TEST(BusLoad, TwelveDrivesUnderSeventyPercent) {
                          "VESC COMM_GET_VALUES_SELECTIVE poll + reply (7 classic 29-bit frames)",
                          "CiA 402 PDO set (AX8000 map: 4 PDOs + 1 SYNC per bus)",
                          "VESC, averages and ERPM only (mask 0x1800B0: 25-byte reply, 6 frames)",
-                         "CiA 402, the map's 26 bytes packed in one PDO (CANopen FD: one 32-byte FD frame)"};
+                         "CiA 402, the map's 28 bytes packed in one PDO (CANopen FD: one 32-byte FD frame)"};
+  int map_bytes = 0;  // every PDO of the map in one FD frame
+  for (const FrameSpec& f : map.frames) map_bytes += f.length;
+  EXPECT_EQ(map_bytes, 4 + 8 + 8 + 8);
   double vesc_1m = 0;
   for (int s = 0; s < 5; ++s) {
     std::printf("| %s |", names[s]);
@@ -112,7 +119,7 @@ TEST(BusLoad, TwelveDrivesUnderSeventyPercent) {
                   : s == 3 ? vesc_poll_traffic(vesc::bit(vesc::kId) | vesc::bit(vesc::kIq) | vesc::bit(vesc::kRpm) |
                                                vesc::bit(vesc::kVd) | vesc::bit(vesc::kVq))
                            : signal_map_traffic(map, b.fd, true);
-      if (s == 4) t.per_drive = {{b.fd, false, 26, 1.0}};  // 4 + 8 + 8 + 6 bytes in one frame
+      if (s == 4) t.per_drive = {{b.fd, false, map_bytes, 1.0}};
       if (s == 4 && !b.fd) {
         std::printf(" — (8 bytes at most) |");
         continue;

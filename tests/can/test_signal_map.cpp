@@ -66,8 +66,9 @@ TEST(SignalMapExamples, CiA402Ax8000PdosGiveTheSample) {
   // TxPDO3: 0x3242:10 Ud, :0F Uq: −20 = −1.01b·2^4 → 0xC1A00000; 150.5 = 1.00101101b·2^7 (exponent 134 =
   // 0x86) → 0x43168000.
   const CanFrame voltages = frame(0x381, {0x00, 0x00, 0xA0, 0xC1, 0x00, 0x80, 0x16, 0x43});
-  // TxPDO4 (the trigger): 0x6079 560 000 mV, a temperature of 725 · 0.1 °C.
-  const CanFrame dc_link = frame(0x481, {0x80, 0x8B, 0x08, 0x00, 0xD5, 0x02});
+  // TxPDO4 (the trigger): 0x6079 UINT32 560 000 mV = 0x00088B80 → 80 8B 08 00; 0x32C1:06 REAL32 72.5 °C =
+  // 1001000.1b = 1.0010001b·2^6 (exponent 127+6 = 133 = 0x85) → 0 10000101 0010001 0… = 0x42910000 → 00 00 91 42.
+  const CanFrame dc_link = frame(0x481, {0x80, 0x8B, 0x08, 0x00, 0x00, 0x00, 0x91, 0x42});
 
   EXPECT_FALSE(dec.decode(speed, 1000, s));
   EXPECT_FALSE(dec.decode(currents, 1000, s));

@@ -32,8 +32,9 @@ can::SignalMap shipped(const char* name) {
 }
 
 // Beckhoff AX8000 TxPDOs (little endian): 1500 rpm (15 000 000 in 0.0001 rpm); i_d −2 A (REAL32 0xC0000000),
-// i_q 5 A (0x40A00000); u_d −3.5 V (0xC0600000), u_q 24 V (0x41C00000); u_dc 48000 mV, T_winding 65.3 °C
-// (653 in 0.1 °C). AM8141: 4 pole pairs.
+// i_q 5 A (0x40A00000); u_d −3.5 V (0xC0600000), u_q 24 V (0x41C00000); u_dc 48000 mV (UINT32 0x0000BB80),
+// T_winding 65.25 °C (REAL32: 1000001.01b = 1.00000101b·2^6, exponent 133 = 0x85 → 0 10000101 00000101 0… =
+// 0x42828000). AM8141: 4 pole pairs.
 TEST(SignalMapSource, ARotorFrameMapGivesAveragedSamplesAtTheTriggersTime) {
   SignalMapSampler s(shipped("beckhoff-ax8000-cia402.yaml"));
   ASSERT_EQ(s.kind(), SampleKind::kAveraged);
@@ -42,7 +43,7 @@ TEST(SignalMapSource, ARotorFrameMapGivesAveragedSamplesAtTheTriggersTime) {
   EXPECT_FALSE(s.on_frame(frame(0x281, {0x00, 0x00, 0x00, 0xC0, 0x00, 0x00, 0xA0, 0x40}), 1100, out));
   EXPECT_FALSE(s.on_frame(frame(0x381, {0x00, 0x00, 0x60, 0xC0, 0x00, 0x00, 0xC0, 0x41}), 1200, out));
   EXPECT_FALSE(s.on_frame(frame(0x7E5, {0x01, 0x02}), 1250, out));  // not in the map (an LSS frame)
-  ASSERT_TRUE(s.on_frame(frame(0x481, {0x80, 0xBB, 0x00, 0x00, 0x8D, 0x02}), 1300, out));
+  ASSERT_TRUE(s.on_frame(frame(0x481, {0x80, 0xBB, 0x00, 0x00, 0x00, 0x80, 0x82, 0x42}), 1300, out));
   const auto* a = std::get_if<core::AveragedSample>(&out);
   ASSERT_NE(a, nullptr);
   EXPECT_EQ(a->t_ns, 1300);
@@ -53,7 +54,7 @@ TEST(SignalMapSource, ARotorFrameMapGivesAveragedSamplesAtTheTriggersTime) {
   EXPECT_NEAR(a->u_dq_V[0], -3.5, 1e-12);
   EXPECT_NEAR(a->u_dq_V[1], 24.0, 1e-12);
   EXPECT_NEAR(a->u_dc_V, 48.0, 1e-12);
-  EXPECT_NEAR(a->t_winding_C, 65.3, 1e-12);
+  EXPECT_EQ(a->t_winding_C, 65.25);  // exact in binary32
   EXPECT_EQ(s.counters().unknown_id, 1U);
   DiagnosticsRows rows;
   s.report(rows);

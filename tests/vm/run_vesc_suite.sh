@@ -2,7 +2,9 @@
 # ctest entry `vesc_suite` (label vcan): tests/vm/vesc_suite.sh natively where the host has vcan, else in the
 # PREEMPT_RT VM, then checks its outputs on the host (tests/can/check_vesc_capture.py,
 # tests/can/check_averaged_record.py).
-#   run_vesc_suite.sh BUILD_DIR [--rpemd]     (--rpemd: also rpemd's source: vesc part, tests/vm/vesc_rpemd.sh)
+#   run_vesc_suite.sh BUILD_DIR [--rpemd]     (--rpemd: also rpemd's parts: source: signal_map with the AX8000
+#                                             map, tests/vm/check_ax8000_rpemd.py, and source: vesc,
+#                                             tests/vm/vesc_rpemd.sh)
 set -euo pipefail
 build=$(cd "$1" && pwd)
 here=$(cd "$(dirname "$0")" && pwd)
@@ -27,6 +29,15 @@ if [[ ${2:-} == --rpemd && -f $repo/daemon/src/vesc_source.cpp && -x $build/daem
   cp "$here/vesc_rpemd.sh" "$here/rpemd-vesc-vcan.yaml" "$here/rpemd-map-vcan.yaml" "$out/"
   rpemd_files=(--file "$build/daemon/rpemd" --file "$here/vesc_rpemd.sh" --file "$here/rpemd-vesc-vcan.yaml"
                --file "$here/rpemd-map-vcan.yaml" --file "$repo/config/vesc-6374-outrunner.yaml")
+  # The AX8000 part: its drive simulated and its TxPDOs built here (the VM has no python), replayed there.
+  echo "run_vesc_suite: simulating the AX8000 drive (tests/vm/ax8000-vcan.yaml) and building its TxPDOs"
+  "$build/tools/rpem" sim --scenario "$here/ax8000-vcan.yaml" --out "$out/ax8000_drive.csv" \
+    --truth "$out/ax8000_truth.csv" 2> /dev/null
+  python3 "$here/ax8000_pdos.py" "$out/ax8000_drive.csv" "$out/ax8000_pdos.log" --expect "$out/ax8000_pdos.json"
+  cp "$here/rpemd-ax8000-vcan.yaml" "$repo/config/beckhoff-am8141.yaml" \
+     "$repo/config/signal-maps/beckhoff-ax8000-cia402.yaml" "$out/"
+  rpemd_files+=(--file "$here/rpemd-ax8000-vcan.yaml" --file "$repo/config/beckhoff-am8141.yaml"
+                --file "$repo/config/signal-maps/beckhoff-ax8000-cia402.yaml")
 fi
 
 if "$here/vm_rig.sh" native-vcan; then
@@ -50,6 +61,7 @@ if [[ -f $out/rpemd_vesc_skipped ]]; then
   echo "run_vesc_suite: rpemd's 'source: vesc' not in this build — its part did not run"
 else
   python3 "$here/check_map_rpemd.py" "$out/rpemd_map.txt"
+  python3 "$here/check_ax8000_rpemd.py" "$out"
   for run in r200 r1k; do python3 "$here/check_vesc_rpemd.py" "$out" "$run"; done
 fi
 echo "run_vesc_suite: passed"

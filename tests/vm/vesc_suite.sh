@@ -6,6 +6,8 @@
 #   2. rpem record --averaged-out from native telemetry (rpem sim --can) and through a signal map
 #      (config/signal-maps/rpem-native-classic.yaml over rpem replay --classic)
 #   3. rpemd (source: signal_map) reading those classic frames through the map — when given its configuration
+#   3b. rpemd (source: signal_map) reading AX8000 TxPDOs (beckhoff-ax8000-cia402.yaml) replayed by canplayer
+#      from ax8000_pdos.log (tests/vm/ax8000_pdos.py, on the host), heard by rpem listen — when given
 #   4. rpemd (source: vesc) polling the emulated VESC at 200 Hz and at 1 kHz — when rpemd has the source
 out=${1:-/host}
 fail=0
@@ -65,6 +67,23 @@ if [ -f ./rpemd-map-vcan.yaml ]; then
   sleep 2
   kill -TERM $r; wait $r || fail=1
   tail -n 3 "$out/rpemd_map.txt"
+fi
+
+if [ -f ./rpemd-ax8000-vcan.yaml ] && [ -f "$out/ax8000_pdos.log" ]; then
+  step "rpemd, source: signal_map (beckhoff-ax8000-cia402.yaml) <- canplayer, AX8000 TxPDOs"
+  rm -rf /tmp/rpemd-ax8000
+  cp "$out/ax8000_pdos.log" /tmp/ax8000_pdos.log
+  rpemd --config rpemd-ax8000-vcan.yaml > "$out/ax8000_rpemd.txt" 2>&1 &
+  r=$!
+  rpem listen --prefix AX8000_ --diagnostics --csv "$out/ax8000_est.csv" > "$out/ax8000_listen.txt" 2>&1 &
+  l=$!
+  sleep 2
+  canplayer -I /tmp/ax8000_pdos.log vcan0=vcan0 || fail=1
+  sleep 3
+  kill -TERM $r; wait $r || fail=1
+  kill -INT $l; wait $l
+  tail -n 2 "$out/ax8000_rpemd.txt"
+  grep 'signal_map:' "$out/ax8000_listen.txt" | tail -n 1
 fi
 
 if [ -f ./vesc_rpemd.sh ]; then

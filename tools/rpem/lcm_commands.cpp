@@ -148,6 +148,14 @@ struct Listener {
                   static_cast<long long>(m->vesc_short_replies), static_cast<long long>(m->vesc_statuses),
                   static_cast<long long>(m->vesc_send_failures), static_cast<long long>(m->can_foreign));
     }
+    if (m->source == "signal_map") {  // the map decoder's counters (docs/sources.md, "Counted")
+      std::printf("diag %lld signal_map: frames %lld unknown_id %lld wrong_length %lld incomplete %lld non_finite %lld "
+                  "kernel_drops %lld\n",
+                  static_cast<long long>(m->utime), static_cast<long long>(m->can_frames),
+                  static_cast<long long>(m->can_unknown_id), static_cast<long long>(m->can_wrong_dlc),
+                  static_cast<long long>(m->can_incomplete), static_cast<long long>(m->can_invalid_value),
+                  static_cast<long long>(m->can_kernel_drops));
+    }
     std::fflush(stdout);
   }
 };
