@@ -101,14 +101,16 @@ TEST(BusLoad, TwelveDrivesUnderSeventyPercent) {
   };
   const Bus buses[] = {{"classic 1 Mbit/s", false, {1e6, 1e6}}, {"FD 1M/1M", true, {1e6, 1e6}}, {"FD 1M/5M", true, {1e6, 5e6}}};
   std::printf("| source (12 drives, 70 %% load, worst-case stuffing) | classic 1 Mbit/s | CAN FD 1 Mbit/s data | CAN FD 5 Mbit/s data |\n|---|---|---|---|\n");
-  const char* names[] = {"rpem native telemetry (classic: 5×8 B/sample; FD: 64 B per 3 samples)",
-                         "VESC COMM_GET_VALUES_SELECTIVE poll + reply (7 classic 29-bit frames)",
-                         "CiA 402 PDO set (AX8000 map: 4 PDOs + 1 SYNC per bus)",
-                         "VESC, averages and ERPM only (mask 0x1800B0: 25-byte reply, 6 frames)",
-                         "CiA 402, the map's 28 bytes packed in one PDO (CANopen FD: one 32-byte FD frame)"};
   int map_bytes = 0;  // every PDO of the map in one FD frame
   for (const FrameSpec& f : map.frames) map_bytes += f.length;
   EXPECT_EQ(map_bytes, 4 + 8 + 8 + 8);
+  const std::string packed = "CiA 402, the map's " + std::to_string(map_bytes) +
+                             " bytes packed in one PDO (CANopen FD: one " + std::to_string(fd_padded_length(map_bytes)) +
+                             "-byte FD frame)";
+  const char* names[] = {"rpem native telemetry (classic: 5×8 B/sample; FD: 64 B per 3 samples)",
+                         "VESC COMM_GET_VALUES_SELECTIVE poll + reply (7 classic 29-bit frames)",
+                         "CiA 402 PDO set (AX8000 map: 4 PDOs + 1 SYNC per bus)",
+                         "VESC, averages and ERPM only (mask 0x1800B0: 25-byte reply, 6 frames)", packed.c_str()};
   double vesc_1m = 0;
   for (int s = 0; s < 5; ++s) {
     std::printf("| %s |", names[s]);

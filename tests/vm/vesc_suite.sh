@@ -6,9 +6,9 @@
 #   2. rpem record --averaged-out from native telemetry (rpem sim --can) and through a signal map
 #      (config/signal-maps/rpem-native-classic.yaml over rpem replay --classic)
 #   3. rpemd (source: signal_map) reading those classic frames through the map — when given its configuration
-#   3b. rpemd (source: signal_map) reading AX8000 TxPDOs (beckhoff-ax8000-cia402.yaml) replayed by canplayer
-#      from ax8000_pdos.log (tests/vm/ax8000_pdos.py, on the host), heard by rpem listen — when given
-#   4. rpemd (source: vesc) polling the emulated VESC at 200 Hz and at 1 kHz — when rpemd has the source
+#   4. rpemd (source: signal_map) reading AX8000 TxPDOs (beckhoff-ax8000-cia402.yaml) replayed by canplayer
+#      from ax8000_pdos.log (tests/vm/ax8000_pdos.py, on the host), heard by rpem listen — when given them
+#   5. rpemd (source: vesc) polling the emulated VESC at 200 Hz and at 1 kHz — when rpemd has the source
 out=${1:-/host}
 fail=0
 step() { echo "vesc_suite: $*"; }
