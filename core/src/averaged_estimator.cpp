@@ -68,6 +68,13 @@ SteadyStateSample AveragedDriveEstimator::condition(const AveragedSample& a) noe
     const Rotation back = Rotation::of(-s.n_pu * omega_n * delay_s_);
     s.u_pu = Vec2(back.cos * s.u_pu[0] - back.sin * s.u_pu[1], back.sin * s.u_pu[0] + back.cos * s.u_pu[1]);
   }
+  if (options_.control_period_s > 0.0) {
+    // Sampled means (§11): ī = i_sample + c·ω·T_c²·L⁻¹·J·ū, c = (a − ½)²/2 − 1/24; in pu c·n·(ω_n·T_c)²·J·u/x.
+    const double a_half = options_.current_sample_at - 0.5;
+    const double wt = omega_n * options_.control_period_s;
+    const double k = (0.5 * a_half * a_half - 1.0 / 24.0) * s.n_pu * wt * wt;
+    s.i_meas_pu += Vec2(-k * s.u_pu[1] / s.x_d_pu, k * s.u_pu[0] / s.x_q_pu);
+  }
 
   const std::int64_t centre2_ns = a.t_start_ns + a.t_ns;
   const std::int64_t window_ns = a.t_ns - a.t_start_ns;

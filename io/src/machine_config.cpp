@@ -136,6 +136,8 @@ core::EstimatorSettings parse_estimator(YamlMap e, const core::MachineSi& machin
     s.averaged.inductive_correction = a->boolean_or("inductive_correction", s.averaged.inductive_correction);
     s.averaged.instrument_time_constant_s =
         a->number_or("instrument_time_constant_s", s.averaged.instrument_time_constant_s, 0.0, 10.0);
+    s.averaged.control_period_s = a->number_or("control_period_s", s.averaged.control_period_s, 0.0, 1e-2);
+    s.averaged.current_sample_at = a->number_or("current_sample_at", s.averaged.current_sample_at, 0.0, 1.0);
     a->finish();
   }
   e.finish();

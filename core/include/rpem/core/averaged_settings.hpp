@@ -1,7 +1,7 @@
 #pragma once
 // The averaged-sample estimator's options (`estimator.averaged`, docs/configuration.md): its gains as
-// rates per second, the longest interval it adapts across, and the inductive correction
-// (docs/derivations.md §11).
+// rates per second, the longest interval it adapts across, the inductive correction and the correction
+// of per-cycle current samples to cycle means (docs/derivations.md §11).
 
 #include <array>
 
@@ -22,6 +22,12 @@ struct AveragedSettings {
   /// speed, whose noise is independent of the sample's own (§11: a same-sample regressor is biased in
   /// closed loop, more so the faster the samples come).
   double instrument_time_constant_s = 0.05;
+  /// The drive's control period T_c [s] (one current sample and one held voltage per cycle): its means of
+  /// per-cycle current samples are turned into means of the current (§11, "Sampled means"); 0: not done.
+  double control_period_s = 0.0;
+  /// Where in the interval over which the drive holds a voltage it samples the current, as a fraction of
+  /// T_c: 0 at the instant the voltage takes effect (a PWM update at the sampling instant), 0.5 in its middle.
+  double current_sample_at = 0.0;
 };
 
 }  // namespace rpem::core
