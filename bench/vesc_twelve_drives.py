@@ -1,12 +1,15 @@
 #!/usr/bin/env python3
 """Reads bench/vesc_twelve_drives.sh's outputs in DIR: CPU per drive (each rpemd, per thread, and each
-emulated VESC) over the measured window, and the bus load its frames reach on a classic 1 Mbit/s bus.
+emulated VESC) over the measured window; each drive's poll and sample rates over the window from rpemd's own
+counters (its status lines at the window's start and end, so each rate is uncertain by about one status
+interval, 1 s, over the window); how far each emulator's drive time ended behind the host; and the bus load
+the frames captured after the window reach on a classic 1 Mbit/s bus.
 
 Frame bits as in can/src/bus_load.cpp (frame_bits, classic): 54 stuffable bits for a 29-bit id plus 8 per
 data byte, worst-case stuffing (n - 1) // 4, 13 bits of tail — the same count as docs/benchmarks.md's
 table, so the load measured here is comparable with its 70 % target.
 
-  vesc_twelve_drives.py DIR [--rate HZ]
+  vesc_twelve_drives.py DIR [--rate HZ] [--loop S] [--measurement-rate HZ] [--idle-step S]
 """
 import argparse
 import collections
@@ -40,6 +43,18 @@ def contexts(path):
     return out
 
 
+VESC_COUNTERS = re.compile(r'vesc polls (\d+) replies (\d+) timeouts (\d+) late (\d+)')
+
+
+def vesc_counters(path):
+    """[(polls, samples, timeouts, late) or None] per drive, from a file of rpemd status lines."""
+    out = []
+    for line in open(path):
+        m = VESC_COUNTERS.search(line)
+        out.append(tuple(int(g) for g in m.groups()) if m else None)
+    return out
+
+
 def frame_bits(extended, data_bytes):
     stuffable = (54 if extended else 34) + 8 * data_bytes
     return stuffable + (stuffable - 1) // 4 + 13
@@ -49,7 +64,9 @@ def main():
     ap = argparse.ArgumentParser()
     ap.add_argument('dir')
     ap.add_argument('--rate', type=float, default=56.0)
-    ap.add_argument('--loop', default='1.0e-3', help="rpemd's loop.period_s (for the report)")
+    ap.add_argument('--loop', default='5.0e-3', help="rpemd's loop.period_s (for the report)")
+    ap.add_argument('--measurement-rate', default='10', help="rpemd's lcm.measurement_rate_Hz (for the report)")
+    ap.add_argument('--idle-step', default='0.01', help="the emulators' --idle-step (for the report)")
     a = ap.parse_args()
     d = a.dir
     t0 = float(open(d + '/t_start').read())
@@ -71,8 +88,10 @@ def main():
         per_drive[role][drive] = per_drive[role].get(drive, 0.0) + pct
     where = open(d + '/where').read().strip()
     cpus = open(d + '/nproc').read().strip() if _exists(d + '/nproc') else '?'
-    print('vesc_twelve_drives: %s, %s CPUs; 12 drives polled at %g Hz each, rpemd loop %s s; window %.1f s'
-          % (where, cpus, a.rate, a.loop, window))
+    clock = open(d + '/clocksource').read().strip() if _exists(d + '/clocksource') else '?'
+    print('vesc_twelve_drives: %s, %s CPUs, clocksource %s; 12 drives polled at %g Hz each; rpemd loop %s s, '
+          'measurements %s Hz; emulator idle step %s s; window %.1f s'
+          % (where, cpus, clock, a.rate, a.loop, a.measurement_rate, a.idle_step, window))
     for role in ('rpemd', 'sim'):
         v = sorted(per_drive[role].values())
         if v:
@@ -84,14 +103,13 @@ def main():
     c0, c1 = contexts(d + '/start.ctx'), contexts(d + '/end.ctx')
     for key, n in c1.items():
         pid, tid = key
-        if key in c0 and pid in roles and roles[pid][0] == 'rpemd':
-            wakeups[comm_of.get(tid, '?')].append((n - c0[key]) / window)
+        if key in c0 and pid in roles:
+            wakeups[(roles[pid][0], comm_of.get(tid, '?'))].append((n - c0[key]) / window)
     for (role, comm), v in sorted(per_thread.items()):
-        if role == 'rpemd':
-            w = wakeups.get(comm, [])
-            print('    thread %-16s mean %.2f %%, max %.2f %% (%d threads); %.0f wake-ups/s each'
-                  % (comm, sum(v) / len(v), max(v), len(v), sum(w) / len(w) if w else float('nan')))
-    # The bus over the window: candump -L lines "(t) vcan0 ID#DATA".
+        w = wakeups.get((role, comm), [])
+        print('    %-5s thread %-16s mean %.2f %%, max %.2f %% (%d threads); %.0f wake-ups/s each'
+              % (role, comm, sum(v) / len(v), max(v), len(v), sum(w) / len(w) if w else float('nan')))
+    # The bus after the window: candump -L lines "(t) vcan0 ID#DATA".
     bits = 0
     frames = 0
     polls = collections.Counter()
@@ -109,22 +127,51 @@ def main():
         if extended and (i >> 8) == 8 and len(data) >= 6 and int(data[4:6], 16) == 50:
             polls[i & 0xFF] += 1
     span = times[-1] - times[0] if len(times) > 1 else window
-    print('  bus: %d frames in %.1f s, %.0f frames/s; %.1f %% of a classic 1 Mbit/s bus (worst-case stuffing)'
+    print('  bus (captured after the window): %d frames in %.1f s, %.0f frames/s; %.1f %% of a classic 1 Mbit/s '
+          'bus (worst-case stuffing)'
           % (frames, span, frames / span, 100.0 * bits / span / 1e6))
-    # Each rpemd's own count of its polls and replies (its last status line).
+    # Each rpemd's own counts over the window; in time = samples less late replies (after reply_timeout_s).
+    if _exists(d + '/start.vesc') and _exists(d + '/end.vesc'):
+        c0, c1 = vesc_counters(d + '/start.vesc'), vesc_counters(d + '/end.vesc')
+        rows = []
+        for i, (x, y) in enumerate(zip(c0, c1)):
+            if x is None or y is None:
+                print('  drive %d: no rpemd status line at the window\'s start or end' % (i + 1))
+                continue
+            polls, samples, timeouts, late = (y[k] - x[k] for k in range(4))
+            rows.append((i + 1, polls / window, (samples - late) / window, timeouts / window, late / window))
+        for drive, p, ok, t, late in rows:
+            print('  drive %2d: polls %.1f Hz, samples in time %.1f Hz (%.1f %% of polls), timeouts %.1f Hz, '
+                  'late %.1f Hz' % (drive, p, ok, 100.0 * ok / p if p else float('nan'), t, late))
+        if rows:
+            p = [r[1] for r in rows]
+            ok = [r[2] for r in rows]
+            print('  per drive over the window: polls %.1f-%.1f Hz (asked %g Hz), samples in time %.1f-%.1f Hz '
+                  '(mean %.1f Hz, %.1f %% of all polls)'
+                  % (min(p), max(p), a.rate, min(ok), max(ok), sum(ok) / len(ok), 100.0 * sum(ok) / sum(p)))
+    # Each rpemd's totals over its whole run (its last status line).
     answered = []
     for i in range(1, 13):
-        lines = [l for l in open('%s/rpemd%d.txt' % (d, i)) if '[vesc polls' in l]
-        if lines:
-            m = re.search(r'vesc polls (\d+) replies (\d+) timeouts (\d+)', lines[-1])
-            answered.append((int(m.group(1)), int(m.group(2)), int(m.group(3))))
+        c = [x for x in vesc_counters('%s/rpemd%d.txt' % (d, i)) if x]
+        if c:
+            answered.append(c[-1])
     if answered:
-        p, r, t = (sum(x[k] for x in answered) for k in range(3))
-        print('  rpemd over the run (12 drives): %d polls, %d replies became samples, %d timeouts' % (p, r, t))
+        p, r, t, late = (sum(x[k] for x in answered) for k in range(4))
+        print('  rpemd over the whole run (12 drives): %d polls, %d samples (%d of them late replies), %d timeouts'
+              % (p, r, late, t))
+    # How far each emulator's drive time ended behind the host (its exit line).
+    lags = []
+    for i in range(1, 13):
+        if _exists('%s/emu%d.txt' % (d, i)):
+            m = re.search(r'\(([-0-9.]+) s behind the host\)', open('%s/emu%d.txt' % (d, i)).read())
+            if m:
+                lags.append(float(m.group(1)))
+    if lags:
+        print('  emulators: drive time ended %.3f-%.3f s behind the host (%d emulators)' % (min(lags), max(lags), len(lags)))
     if polls:
         rates = sorted(n / span for n in polls.values())
-        print('  polls per controller: %d controllers, %.1f-%.1f Hz (asked %g Hz); %.0f bits per poll and reply'
-              % (len(polls), rates[0], rates[-1], a.rate, bits / sum(polls.values())))
+        print('  captured polls per controller: %d controllers, %.1f-%.1f Hz (asked %g Hz); %.0f bits per poll '
+              'and reply' % (len(polls), rates[0], rates[-1], a.rate, bits / sum(polls.values())))
 
 
 def _exists(p):

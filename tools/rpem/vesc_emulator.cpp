@@ -3,6 +3,7 @@
 #include <array>
 #include <algorithm>
 #include <atomic>
+#include <cmath>
 #include <csignal>
 #include <cstdio>
 #include <ctime>
@@ -33,8 +34,6 @@ struct EmulatorCounters {
 /// A poll timestamped longer ago than this is in the socket's queue: the drive may run up to now minus
 /// this while idle without passing a poll not yet read (vcan timestamps in netif_rx, queues in softirq).
 constexpr std::int64_t kSettleNs = 2'000'000;
-/// Idle simulation between two looks at the socket (drive time), so that a poll waits little.
-constexpr std::int64_t kIdleChunkNs = 1'000'000;
 
 }  // namespace
 
@@ -51,6 +50,10 @@ void add_vesc_emulator_options(CLI::App* cmd, VescEmulatorOptions& o) {
       ->check(CLI::NonNegativeNumber);
   cmd->add_option("--duration", o.duration_s, "stop after this long [s] (default: the scenario's duration)")
       ->check(CLI::NonNegativeNumber);
+  cmd->add_option("--idle-step", o.idle_step_s,
+                  "while no poll is pending: drive time run ahead per look at the socket, and the longest wait "
+                  "for a poll between looks [s] (default 1e-3)")
+      ->check(CLI::Range(1.0e-4, 1.0));
 }
 
 int run_vesc_emulator(sim::Scenario scenario, const VescEmulatorOptions& o) {
@@ -60,6 +63,10 @@ int run_vesc_emulator(sim::Scenario scenario, const VescEmulatorOptions& o) {
   co.interface = o.interface;
   co.fd = false;  // VESC speaks classic CAN
   co.receive_errors = false;
+  // Only polls to this controller or to all reach the socket: one of twelve emulators on a bus is not woken
+  // by the other eleven's polls, nor by any reply or status.
+  const auto filters = vesc::controller_kernel_filters(static_cast<std::uint8_t>(o.controller_id));
+  co.filters.assign(filters.begin(), filters.end());
   can::SocketCanChannel channel(co);
   const auto id = static_cast<std::uint8_t>(o.controller_id);
   const std::string name = scenario.name;
@@ -88,6 +95,8 @@ int run_vesc_emulator(sim::Scenario scenario, const VescEmulatorOptions& o) {
   const std::int64_t origin_ns = core::now_ns(CLOCK_REALTIME);
   std::fprintf(stderr, "rpem sim: t = 0 at CLOCK_REALTIME %.6f s\n", 1e-9 * static_cast<double>(origin_ns));
   auto host_now = [&] { return core::now_ns(CLOCK_REALTIME) - origin_ns; };
+  // Idle simulation between two looks at the socket (drive time), and the longest wait for a poll.
+  const auto idle_step_ns = static_cast<std::int64_t>(std::llround(o.idle_step_s * 1e9));
   while (running && !g_stop) {
     const std::int64_t now = host_now();
     if (o.duration_s > 0.0 && now > static_cast<std::int64_t>(o.duration_s * 1e9)) break;
@@ -102,9 +111,9 @@ int run_vesc_emulator(sim::Scenario scenario, const VescEmulatorOptions& o) {
     const std::int64_t idle_to = now - kSettleNs;
     std::int64_t wait_ns = 0;
     if (drive.time_ns() < idle_to) {
-      running = drive.run_to(std::min(idle_to, drive.time_ns() + kIdleChunkNs), emit);
+      running = drive.run_to(std::min(idle_to, drive.time_ns() + idle_step_ns), emit);
     } else {
-      wait_ns = std::clamp<std::int64_t>(drive.time_ns() + kIdleChunkNs - idle_to, 0, kIdleChunkNs);
+      wait_ns = std::clamp<std::int64_t>(drive.time_ns() + idle_step_ns - idle_to, 0, idle_step_ns);
     }
     const std::size_t got = channel.receive_for(rx, wait_ns);
     for (std::size_t k = 0; k < got && running; ++k) {
