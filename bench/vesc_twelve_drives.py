@@ -43,11 +43,12 @@ def contexts(path):
     return out
 
 
-VESC_COUNTERS = re.compile(r'vesc polls (\d+) replies (\d+) timeouts (\d+) late (\d+)')
+VESC_COUNTERS = re.compile(r'vesc polls (\d+) replies (\d+) timeouts (\d+) late (\d+) unrequested (\d+)')
 
 
 def vesc_counters(path):
-    """[(polls, samples, timeouts, late) or None] per drive, from a file of rpemd status lines."""
+    """[(polls, samples, timeouts, late, unrequested) or None] per drive, from rpemd status lines
+    (docs/rpemd.md: "replies" there are the samples delivered)."""
     out = []
     for line in open(path):
         m = VESC_COUNTERS.search(line)
@@ -112,7 +113,7 @@ def main():
     # The bus after the window: candump -L lines "(t) vcan0 ID#DATA".
     bits = 0
     frames = 0
-    polls = collections.Counter()
+    captured_polls = collections.Counter()
     times = []
     for line in open(d + '/bus.log'):
         m = re.match(r'\((\d+\.\d+)\) \S+ ([0-9A-Fa-f]+)#([0-9A-Fa-f]*)', line)
@@ -125,30 +126,38 @@ def main():
         times.append(float(m.group(1)))
         i = int(ident, 16)
         if extended and (i >> 8) == 8 and len(data) >= 6 and int(data[4:6], 16) == 50:
-            polls[i & 0xFF] += 1
+            captured_polls[i & 0xFF] += 1
     span = times[-1] - times[0] if len(times) > 1 else window
     print('  bus (captured after the window): %d frames in %.1f s, %.0f frames/s; %.1f %% of a classic 1 Mbit/s '
           'bus (worst-case stuffing)'
           % (frames, span, frames / span, 100.0 * bits / span / 1e6))
-    # Each rpemd's own counts over the window; in time = samples less late replies (after reply_timeout_s).
+    # Each rpemd's own counts over the window. A poll is answered in time or times out (reply_timeout_s,
+    # 0.9 periods): in time = polls - timeouts. Samples also count replies after a timeout (late, or taken
+    # as a later poll's when the controller answers seconds behind: unrequested or unnoticed).
     if _exists(d + '/start.vesc') and _exists(d + '/end.vesc'):
+        span_c = float(open(d + '/t_vesc_end').read()) - float(open(d + '/t_vesc_start').read())
         c0, c1 = vesc_counters(d + '/start.vesc'), vesc_counters(d + '/end.vesc')
         rows = []
         for i, (x, y) in enumerate(zip(c0, c1)):
             if x is None or y is None:
                 print('  drive %d: no rpemd status line at the window\'s start or end' % (i + 1))
                 continue
-            polls, samples, timeouts, late = (y[k] - x[k] for k in range(4))
-            rows.append((i + 1, polls / window, (samples - late) / window, timeouts / window, late / window))
-        for drive, p, ok, t, late in rows:
-            print('  drive %2d: polls %.1f Hz, samples in time %.1f Hz (%.1f %% of polls), timeouts %.1f Hz, '
-                  'late %.1f Hz' % (drive, p, ok, 100.0 * ok / p if p else float('nan'), t, late))
+            n_polls, n_samples, n_timeouts, n_late, n_unrequested = (y[k] - x[k] for k in range(5))
+            rows.append((i + 1, n_polls / span_c, (n_polls - n_timeouts) / span_c, n_samples / span_c,
+                         n_late / span_c, n_unrequested / span_c))
+        print('  rpemd counters over %.1f s (status lines read just before and after the window):' % span_c)
+        for drive, p, ok, smp, late, unreq in rows:
+            print('  drive %2d: polls %.1f Hz, answered in time %.1f Hz (%.1f %%), samples %.1f Hz '
+                  '(late %.1f Hz, unrequested %.1f Hz)' % (drive, p, ok, 100.0 * ok / p if p else float('nan'),
+                                                           smp, late, unreq))
         if rows:
             p = [r[1] for r in rows]
             ok = [r[2] for r in rows]
-            print('  per drive over the window: polls %.1f-%.1f Hz (asked %g Hz), samples in time %.1f-%.1f Hz '
-                  '(mean %.1f Hz, %.1f %% of all polls)'
-                  % (min(p), max(p), a.rate, min(ok), max(ok), sum(ok) / len(ok), 100.0 * sum(ok) / sum(p)))
+            smp = [r[3] for r in rows]
+            print('  per drive: polls %.1f-%.1f Hz (asked %g Hz), answered in time %.1f-%.1f Hz (mean %.1f Hz, '
+                  '%.1f %% of all polls), samples %.1f-%.1f Hz'
+                  % (min(p), max(p), a.rate, min(ok), max(ok), sum(ok) / len(ok), 100.0 * sum(ok) / sum(p),
+                     min(smp), max(smp)))
     # Each rpemd's totals over its whole run (its last status line).
     answered = []
     for i in range(1, 13):
@@ -156,9 +165,9 @@ def main():
         if c:
             answered.append(c[-1])
     if answered:
-        p, r, t, late = (sum(x[k] for x in answered) for k in range(4))
-        print('  rpemd over the whole run (12 drives): %d polls, %d samples (%d of them late replies), %d timeouts'
-              % (p, r, late, t))
+        p, r, t, late, unreq = (sum(x[k] for x in answered) for k in range(5))
+        print('  rpemd over the whole run (12 drives): %d polls, %d answered in time, %d timeouts; %d samples '
+              '(%d late, %d unrequested)' % (p, p - t, t, r, late, unreq))
     # How far each emulator's drive time ended behind the host (its exit line).
     lags = []
     for i in range(1, 13):
@@ -168,10 +177,32 @@ def main():
                 lags.append(float(m.group(1)))
     if lags:
         print('  emulators: drive time ended %.3f-%.3f s behind the host (%d emulators)' % (min(lags), max(lags), len(lags)))
-    if polls:
-        rates = sorted(n / span for n in polls.values())
+    # The emulators' own reply delays over their run (poll's kernel receive time to the reply's last frame).
+    classes = collections.Counter()
+    latest = 0.0
+    for i in range(1, 13):
+        if not _exists('%s/emu%d.txt' % (d, i)):
+            continue
+        text = open('%s/emu%d.txt' % (d, i)).read()
+        for edge, n in re.findall(r'<=(\d+) ms (\d+),', text):
+            classes[int(edge)] += int(n)
+        m = re.search(r'later (\d+); the latest ([0-9.]+) s', text)
+        if m:
+            classes['later'] += int(m.group(1))
+            latest = max(latest, float(m.group(2)))
+    total = sum(classes.values())
+    if total:
+        cumulative = 0
+        parts = []
+        for edge in sorted(k for k in classes if k != 'later'):
+            cumulative += classes[edge]
+            parts.append('<=%d ms %.1f %%' % (edge, 100.0 * cumulative / total))
+        print('  emulators\' replies (%d over the whole run), sent after the poll arrived: %s; the latest %.3f s'
+              % (total, ', '.join(parts), latest))
+    if captured_polls:
+        rates = sorted(n / span for n in captured_polls.values())
         print('  captured polls per controller: %d controllers, %.1f-%.1f Hz (asked %g Hz); %.0f bits per poll '
-              'and reply' % (len(polls), rates[0], rates[-1], a.rate, bits / sum(polls.values())))
+              'and reply' % (len(captured_polls), rates[0], rates[-1], a.rate, bits / sum(captured_polls.values())))
 
 
 def _exists(p):

@@ -19,10 +19,10 @@
 # host_id 100+i, poll_phase (i-1)/12, its own channel prefix and state file. After WARMUP s, each process's
 # threads' CPU time (utime+stime from /proc/PID/task/TID/stat, in USER_HZ = 100 ticks/s on x86) and
 # voluntary context switches (its wake-ups, /proc/PID/task/TID/status) is read at the start and end of a WINDOW_S
-# window, with each rpemd's last status line (its poll counters). After the window, candump -L records the
+# window, and each rpemd's last status line (its poll counters) just before and after. After the window, candump -L records the
 # bus for CAPTURE_S (not during it: under TCG candump's own wake-ups would be in the measured CPU).
 # bench/vesc_twelve_drives.py prints CPU per drive (per rpemd thread, per emulator), each drive's poll and
-# sample rates over the window (samples arriving in time: replies used, less those after their timeout), how
+# rates over the window (polls, replies in time = polls less timeouts, samples the estimator got), how
 # far each emulator's drive time fell behind, and the bus load the captured frames reach on 1 Mbit/s.
 set -euo pipefail
 build=$(cd "$1" && pwd)
@@ -93,14 +93,17 @@ snap() {  # name: one line per thread: "/proc/PID/task/TID/stat (comm) utime sti
   awk '/^voluntary_ctxt_switches/{print FILENAME, $2}' $(echo "$files" | sed 's|/stat|/status|g') > "$dir/$1.ctx"
 }
 stamp() { awk '{print $1}' /proc/uptime > "$dir/t_$1"; }
-counters() {  # name: each rpemd's newest status line (cumulative poll counters), drive 1 first
-  for i in $(seq 1 $drives); do
-    grep '\[vesc polls' "$dir/rpemd$i.txt" | tail -n1 | grep . || echo "no status line"
-  done > "$dir/$1.vesc"
+counters() {  # name: each rpemd's newest status line (cumulative poll counters), drive 1 first, one awk
+  files=""
+  for i in $(seq 1 $drives); do files="$files $dir/rpemd$i.txt"; done
+  awk '/\[vesc polls/ { last[FILENAME] = $0 }
+       END { for (i = 1; i < ARGC; i++) print ((ARGV[i] in last) ? last[ARGV[i]] : "no status line") }' $files \
+    > "$dir/$1.vesc"
+  stamp "vesc_$1"
 }
 echo "$daemons" > "$dir/rpemd.pids"; echo "$emus" > "$dir/sim.pids"
 sleep $warmup
-snap start; stamp start; counters start
+counters start; snap start; stamp start
 sleep $window
 stamp end; snap end; counters end
 candump -r 8388608 -L vcan0 > /tmp/bus.log &

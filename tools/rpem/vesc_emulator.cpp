@@ -27,8 +27,21 @@ std::atomic<bool> g_toggle_silence{false};
 void on_stop(int) { g_stop = true; }
 void on_usr1(int) { g_toggle_silence = true; }
 
+/// Upper edges of the reply-delay classes [ms]: a reply's last frame sent this long after its poll's kernel
+/// receive time, at most (the last class: later).
+constexpr std::array<std::int64_t, 7> kDelayEdgesMs{1, 2, 5, 10, 20, 100, 1000};
+
 struct EmulatorCounters {
   std::uint64_t requests = 0, replies = 0, reply_frames = 0, unsupported = 0, unheard = 0, send_failures = 0;
+  std::array<std::uint64_t, kDelayEdgesMs.size() + 1> reply_delay{};  ///< replies per delay class
+  std::int64_t reply_delay_max_ns = 0;
+
+  void add_delay(std::int64_t ns) noexcept {
+    std::size_t k = 0;
+    while (k < kDelayEdgesMs.size() && ns > kDelayEdgesMs[k] * 1'000'000) ++k;
+    ++reply_delay[k];
+    reply_delay_max_ns = std::max(reply_delay_max_ns, ns);
+  }
 };
 
 /// A poll timestamped longer ago than this is in the socket's queue: the drive may run up to now minus
@@ -139,6 +152,7 @@ int run_vesc_emulator(sim::Scenario scenario, const VescEmulatorOptions& o) {
       // send_packet_wrapper → comm_can_send_buffer(rx_buffer_last_id, …, rx_buffer_response_type = 1)
       const std::size_t frames = vesc::buffer_frames(request->sender, id, 1, {payload.data(), len}, tx);
       for (std::size_t f = 0; f < frames; ++f) send(tx[f]);
+      n.add_delay(host_now() - arrived_ns);
       ++n.replies;
       n.reply_frames += frames;
     }
@@ -156,6 +170,13 @@ int run_vesc_emulator(sim::Scenario scenario, const VescEmulatorOptions& o) {
                static_cast<unsigned long long>(n.unsupported), static_cast<unsigned long long>(d.empty_reads),
                static_cast<unsigned long long>(d.behind), static_cast<unsigned long long>(d.statuses),
                static_cast<unsigned long long>(n.send_failures));
+  std::fprintf(stderr, "rpem sim: VESC %d replies sent after their poll's arrival:", o.controller_id);
+  for (std::size_t k = 0; k < kDelayEdgesMs.size(); ++k) {
+    std::fprintf(stderr, " <=%lld ms %llu,", static_cast<long long>(kDelayEdgesMs[k]),
+                 static_cast<unsigned long long>(n.reply_delay[k]));
+  }
+  std::fprintf(stderr, " later %llu; the latest %.3f s\n", static_cast<unsigned long long>(n.reply_delay.back()),
+               1e-9 * static_cast<double>(n.reply_delay_max_ns));
   return kExitOk;
 }
 
