@@ -169,14 +169,18 @@ def main():
         print('  rpemd over the whole run (12 drives): %d polls, %d answered in time, %d timeouts; %d samples '
               '(%d late, %d unrequested)' % (p, p - t, t, r, late, unreq))
     # How far each emulator's drive time ended behind the host (its exit line).
-    lags = []
+    lags, pace = [], []
     for i in range(1, 13):
         if _exists('%s/emu%d.txt' % (d, i)):
-            m = re.search(r'\(([-0-9.]+) s behind the host\)', open('%s/emu%d.txt' % (d, i)).read())
+            m = re.search(r'stopped at ([0-9.]+) s drive time \(([-0-9.]+) s behind the host\)',
+                          open('%s/emu%d.txt' % (d, i)).read())
             if m:
-                lags.append(float(m.group(1)))
+                drive_s, lag_s = float(m.group(1)), float(m.group(2))
+                lags.append(lag_s)
+                pace.append(drive_s / (drive_s + lag_s))
     if lags:
-        print('  emulators: drive time ended %.3f-%.3f s behind the host (%d emulators)' % (min(lags), max(lags), len(lags)))
+        print('  emulators: drive time ended %.3f-%.3f s behind the host; their drives ran at %.2f-%.2f of real '
+              'time over their run (%d emulators)' % (min(lags), max(lags), min(pace), max(pace), len(lags)))
     # The emulators' own reply delays over their run (poll's kernel receive time to the reply's last frame).
     classes = collections.Counter()
     latest = 0.0
