@@ -90,14 +90,24 @@ def main():
     where = open(d + '/where').read().strip()
     cpus = open(d + '/nproc').read().strip() if _exists(d + '/nproc') else '?'
     clock = open(d + '/clocksource').read().strip() if _exists(d + '/clocksource') else '?'
-    print('vesc_twelve_drives: %s, %s CPUs, clocksource %s; 12 drives polled at %g Hz each; rpemd loop %s s, '
+    drives = len(open(d + '/rpemd.pids').read().split())
+    print('vesc_twelve_drives: %s, %s CPUs, clocksource %s; %d drives polled at %g Hz each; rpemd loop %s s, '
           'measurements %s Hz; emulator idle step %s s; window %.1f s'
-          % (where, cpus, clock, a.rate, a.loop, a.measurement_rate, a.idle_step, window))
+          % (where, cpus, clock, drives, a.rate, a.loop, a.measurement_rate, a.idle_step, window))
+    # All CPUs over the window (/proc/stat's first line): what the measured processes leave.
+    if _exists(d + '/start.stat') and _exists(d + '/end.stat'):
+        s0 = [int(x) for x in open(d + '/start.stat').read().split()[1:]]
+        s1 = [int(x) for x in open(d + '/end.stat').read().split()[1:]]
+        delta = [y - x for x, y in zip(s0, s1)]
+        total = sum(delta[:8])
+        names = ('user', 'nice', 'system', 'idle', 'iowait', 'irq', 'softirq', 'steal')
+        print('  all CPUs over the window: ' + ', '.join('%s %.1f %%' % (n, 100.0 * v / total)
+                                                      for n, v in zip(names, delta[:8]) if v))
     for role in ('rpemd', 'sim'):
         v = sorted(per_drive[role].values())
         if v:
-            print('  %-6s per drive: mean %.2f %%, min %.2f %%, max %.2f %% of a core; all 12: %.1f %%'
-                  % ('rpemd' if role == 'rpemd' else 'sim', sum(v) / len(v), v[0], v[-1], sum(v)))
+            print('  %-6s per drive: mean %.2f %%, min %.2f %%, max %.2f %% of a core; all %d: %.1f %%'
+                  % ('rpemd' if role == 'rpemd' else 'sim', sum(v) / len(v), v[0], v[-1], len(v), sum(v)))
     # Wake-ups: voluntary context switches per second, per thread.
     comm_of = {tid: comm for (role, drive, tid), (comm, _) in end.items()}
     wakeups = collections.defaultdict(list)
@@ -160,17 +170,17 @@ def main():
                      min(smp), max(smp)))
     # Each rpemd's totals over its whole run (its last status line).
     answered = []
-    for i in range(1, 13):
+    for i in range(1, drives + 1):
         c = [x for x in vesc_counters('%s/rpemd%d.txt' % (d, i)) if x]
         if c:
             answered.append(c[-1])
     if answered:
         p, r, t, late, unreq = (sum(x[k] for x in answered) for k in range(5))
-        print('  rpemd over the whole run (12 drives): %d polls, %d answered in time, %d timeouts; %d samples '
-              '(%d late, %d unrequested)' % (p, p - t, t, r, late, unreq))
+        print('  rpemd over the whole run (%d drives): %d polls, %d answered in time, %d timeouts; %d samples '
+              '(%d late, %d unrequested)' % (drives, p, p - t, t, r, late, unreq))
     # How far each emulator's drive time ended behind the host (its exit line).
     lags, pace = [], []
-    for i in range(1, 13):
+    for i in range(1, drives + 1):
         if _exists('%s/emu%d.txt' % (d, i)):
             m = re.search(r'stopped at ([0-9.]+) s drive time \(([-0-9.]+) s behind the host\)',
                           open('%s/emu%d.txt' % (d, i)).read())
@@ -184,7 +194,7 @@ def main():
     # The emulators' own reply delays over their run (poll's kernel receive time to the reply's last frame).
     classes = collections.Counter()
     latest = 0.0
-    for i in range(1, 13):
+    for i in range(1, drives + 1):
         if not _exists('%s/emu%d.txt' % (d, i)):
             continue
         text = open('%s/emu%d.txt' % (d, i)).read()

@@ -4,7 +4,7 @@
 # rate 12 VESCs share under 70 % of a classic 1 Mbit/s bus, docs/benchmarks.md "Several drives per bus").
 # Runs where vcan0 exists: natively as root with vcan, else in the PREEMPT_RT VM (tests/vm/vm_rig.sh, TCG).
 #
-#   [MEASUREMENT_RATE_HZ=10] [IDLE_STEP_S=0.01] [CAPTURE_S=10] \
+#   [DRIVES=12] [MEASUREMENT_RATE_HZ=10] [IDLE_STEP_S=0.01] [CAPTURE_S=10] \
 #   vesc_twelve_drives.sh BUILD_DIR [RATE_HZ] [WINDOW_S] [LOOP_PERIOD_S]
 #
 # LOOP_PERIOD_S: rpemd's loop.period_s (default 5e-3, docs/rpemd.md "Several drives on one bus": at 56 Hz a
@@ -42,7 +42,7 @@ else
   out=$(mktemp -d)
   trap 'rm -rf "$out"' EXIT
 fi
-drives=12
+drives=${DRIVES:-12}  # DRIVES=N: fewer (or more) drives, the same per-drive setup
 
 # The emulators' drive: scenarios/vesc-6374.yaml made cheap enough for 12 emulators beside 12 rpemd on two
 # emulated CPUs — control at 1 kHz instead of 12.5 kHz (with its inverter at 500 Hz and a 50 Hz current
@@ -90,6 +90,7 @@ snap() {  # name: one line per thread: "/proc/PID/task/TID/stat (comm) utime sti
   files=""
   for p in $daemons $emus; do files="$files $(ls -d /proc/$p/task/*/stat 2>/dev/null)"; done
   awk '{print FILENAME, $2, $14, $15}' $files > "$dir/$1.txt"
+  head -n1 /proc/stat > "$dir/$1.stat"  # all CPUs: user nice system idle iowait irq softirq steal (ticks)
   awk '/^voluntary_ctxt_switches/{print FILENAME, $2}' $(echo "$files" | sed 's|/stat|/status|g') > "$dir/$1.ctx"
 }
 stamp() { awk '{print $1}' /proc/uptime > "$dir/t_$1"; }
