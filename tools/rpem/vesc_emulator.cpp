@@ -65,8 +65,9 @@ void add_vesc_emulator_options(CLI::App* cmd, VescEmulatorOptions& o) {
       ->check(CLI::NonNegativeNumber);
   cmd->add_option("--idle-step", o.idle_step_s,
                   "while no poll is pending: drive time run ahead per look at the socket, and the longest wait "
-                  "for a poll between looks [s] (default 1e-3)")
-      ->check(CLI::Range(1.0e-4, 1.0));
+                  "for a poll between looks [s]")
+      ->check(CLI::Range(1.0e-4, 1.0))
+      ->capture_default_str();
 }
 
 int run_vesc_emulator(sim::Scenario scenario, const VescEmulatorOptions& o) {
