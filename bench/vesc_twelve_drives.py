@@ -141,9 +141,10 @@ def main():
     print('  bus (captured after the window): %d frames in %.1f s, %.0f frames/s; %.1f %% of a classic 1 Mbit/s '
           'bus (worst-case stuffing)'
           % (frames, span, frames / span, 100.0 * bits / span / 1e6))
-    # Each rpemd's own counts over the window. A poll is answered in time or times out (reply_timeout_s,
-    # 0.9 periods): in time = polls - timeouts. Samples also count replies after a timeout (late, or taken
-    # as a later poll's when the controller answers seconds behind: unrequested or unnoticed).
+    # Each rpemd's own counts over the window. A poll is answered within reply_timeout_s (0.9 periods) or
+    # times out: not timed out = polls - timeouts. That is not "in time" when the controller answers seconds
+    # behind: a stale reply arriving while a later poll is out counts as that poll's answer (the emulators'
+    # reply delays below are the measure). Samples also count replies after a timeout (late, unrequested).
     if _exists(d + '/start.vesc') and _exists(d + '/end.vesc'):
         span_c = float(open(d + '/t_vesc_end').read()) - float(open(d + '/t_vesc_start').read())
         c0, c1 = vesc_counters(d + '/start.vesc'), vesc_counters(d + '/end.vesc')
@@ -157,14 +158,14 @@ def main():
                          n_late / span_c, n_unrequested / span_c))
         print('  rpemd counters over %.1f s (status lines read just before and after the window):' % span_c)
         for drive, p, ok, smp, late, unreq in rows:
-            print('  drive %2d: polls %.1f Hz, answered in time %.1f Hz (%.1f %%), samples %.1f Hz '
+            print('  drive %2d: polls %.1f Hz, not timed out %.1f Hz (%.1f %%), samples %.1f Hz '
                   '(late %.1f Hz, unrequested %.1f Hz)' % (drive, p, ok, 100.0 * ok / p if p else float('nan'),
                                                            smp, late, unreq))
         if rows:
             p = [r[1] for r in rows]
             ok = [r[2] for r in rows]
             smp = [r[3] for r in rows]
-            print('  per drive: polls %.1f-%.1f Hz (asked %g Hz), answered in time %.1f-%.1f Hz (mean %.1f Hz, '
+            print('  per drive: polls %.1f-%.1f Hz (asked %g Hz), not timed out %.1f-%.1f Hz (mean %.1f Hz, '
                   '%.1f %% of all polls), samples %.1f-%.1f Hz'
                   % (min(p), max(p), a.rate, min(ok), max(ok), sum(ok) / len(ok), 100.0 * sum(ok) / sum(p),
                      min(smp), max(smp)))
@@ -176,7 +177,7 @@ def main():
             answered.append(c[-1])
     if answered:
         p, r, t, late, unreq = (sum(x[k] for x in answered) for k in range(5))
-        print('  rpemd over the whole run (%d drives): %d polls, %d answered in time, %d timeouts; %d samples '
+        print('  rpemd over the whole run (%d drives): %d polls, %d not timed out, %d timeouts; %d samples '
               '(%d late, %d unrequested)' % (drives, p, p - t, t, r, late, unreq))
     # How far each emulator's drive time ended behind the host (its exit line).
     lags, pace = [], []

@@ -11,19 +11,21 @@
 # sample arrives every 18 ms, so a slower loop only delays each by up to its period). MEASUREMENT_RATE_HZ:
 # rpemd's lcm.measurement_rate_Hz (10, the same advice). IDLE_STEP_S: the emulators' --idle-step (drive time
 # run ahead per look at the socket while no poll is pending, docs/can-vesc.md). In the VM the guest kernel
-# boots with tsc=reliable (RPEM_VM_KERNEL_ARGS, tests/vm/vm_rig.sh): its default HPET clocksource makes every
-# clock read an emulated MMIO access; the clocksource used is recorded.
+# boots with RPEM_VM_KERNEL_ARGS (tests/vm/vm_rig.sh), default tsc=reliable, instead of its default HPET
+# clocksource, an emulated MMIO device (clocksource=hpet: no measurable difference here on 2026-11-25,
+# docs/benchmarks.md); the clocksource used is recorded.
 #
 # Drive i (1-12): `rpem sim --vesc vcan0 --controller-id i` (scenarios/vesc-6374.yaml, no status
 # broadcasts: VESC's default, and the bus-load table counts none) and rpemd with controller_id i,
 # host_id 100+i, poll_phase (i-1)/12, its own channel prefix and state file. After WARMUP s, each process's
-# threads' CPU time (utime+stime from /proc/PID/task/TID/stat, in USER_HZ = 100 ticks/s on x86) and
-# voluntary context switches (its wake-ups, /proc/PID/task/TID/status) is read at the start and end of a WINDOW_S
-# window, and each rpemd's last status line (its poll counters) just before and after. After the window, candump -L records the
-# bus for CAPTURE_S (not during it: under TCG candump's own wake-ups would be in the measured CPU).
-# bench/vesc_twelve_drives.py prints CPU per drive (per rpemd thread, per emulator), each drive's poll and
-# rates over the window (polls, replies in time = polls less timeouts, samples the estimator got), how
-# far each emulator's drive time fell behind, and the bus load the captured frames reach on 1 Mbit/s.
+# threads' CPU time (utime+stime from /proc/PID/task/TID/stat, in USER_HZ = 100 ticks/s on x86), voluntary
+# context switches (its wake-ups, /proc/PID/task/TID/status) and all CPUs' time (/proc/stat) are read at the
+# start and end of a WINDOW_S window, and each rpemd's last status line (its poll counters) just before and
+# after. After the window, candump -L records the bus for CAPTURE_S (not during it: under TCG candump's own
+# wake-ups would be in the measured CPU). bench/vesc_twelve_drives.py prints CPU per drive (per rpemd thread,
+# per emulator), each drive's rates over the window (polls, polls not timed out, samples the estimator got),
+# each emulator's reply delays (its exit line) and how far its drive time fell behind, and the bus load the
+# captured frames reach on 1 Mbit/s.
 set -euo pipefail
 build=$(cd "$1" && pwd)
 rate=${2:-56}

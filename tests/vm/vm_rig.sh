@@ -13,7 +13,7 @@
 # for inputs and results. The command runs in /work; its exit code becomes this script's.
 # The kernel package is fetched with apt-get download into $RPEM_VM_CACHE (default build/vm-cache).
 # RPEM_VM_KERNEL_ARGS is appended to the guest kernel's command line (e.g. `tsc=reliable`: the guest otherwise
-# picks the HPET clocksource, every read of which is a slow emulated MMIO access under TCG).
+# picks the HPET clocksource, an emulated MMIO device, and does not offer the TSC).
 set -euo pipefail
 
 here=$(cd "$(dirname "$0")" && pwd)
