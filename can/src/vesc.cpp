@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <optional>
 
 #include "rpem/can/e2e.hpp"
 
@@ -74,6 +75,14 @@ void read_field(Reader& r, Field f, Values& v) noexcept {
   }
 }
 
+/// The one rule both sides' kernel filters share: extended data frames (no remote frames) whose addressee, the
+/// ID's low byte (comm_can.c: id | packet << 8), is `addressee`; with `packet`, only that packet, the whole
+/// 29-bit ID then matched.
+KernelFilter addressed_to(std::uint8_t addressee, std::optional<Packet> packet = std::nullopt) noexcept {
+  if (!packet) return {kEffFlag | addressee, kEffFlag | kRtrFlag | 0xFFU};
+  return {kEffFlag | extended_id(addressee, *packet), kEffFlag | kRtrFlag | kEffMask};
+}
+
 }  // namespace
 
 CanFrame values_request(std::uint8_t controller_id, std::uint8_t own_id, std::uint32_t mask) noexcept {
@@ -103,9 +112,12 @@ ParseResult parse_values(std::span<const std::uint8_t> payload, Values& out) noe
 }
 
 std::array<KernelFilter, 3> kernel_filters(std::uint8_t controller_id, std::uint8_t host_id) noexcept {
-  // The addressee is the ID's low byte (comm_can.c: id | packet << 8); data frames only, extended only.
-  constexpr std::uint32_t kMask = kEffFlag | kRtrFlag | 0xFFU;
-  return {{{kEffFlag | host_id, kMask}, {kEffFlag | controller_id, kMask}, {kEffFlag | kBroadcastId, kMask}}};
+  return {{addressed_to(host_id), addressed_to(controller_id), addressed_to(kBroadcastId)}};
+}
+
+std::array<KernelFilter, 2> controller_kernel_filters(std::uint8_t controller_id) noexcept {
+  return {{addressed_to(controller_id, Packet::kProcessShortBuffer),
+           addressed_to(kBroadcastId, Packet::kProcessShortBuffer)}};
 }
 
 VescDecoder::VescDecoder(std::uint8_t controller_id, std::uint8_t own_id, std::uint32_t required_mask) noexcept

@@ -2,8 +2,10 @@
 
 #include <poll.h>
 
+#include <algorithm>
 #include <array>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <ctime>
 #include <lcm/lcm-cpp.hpp>
@@ -49,6 +51,13 @@ const char* mark(char* buf, std::size_t size, bool adapting, double age_s, bool 
 }
 
 }  // namespace
+
+std::int64_t publisher_idle_ns(const LcmConfig& lcm) noexcept {
+  constexpr std::int64_t kMinNs = 1'000'000, kMaxNs = 20'000'000;
+  const double fastest_Hz = std::max({lcm.estimate_rate_Hz, lcm.measurement_rate_Hz, lcm.diagnostics_rate_Hz});
+  if (!(fastest_Hz > 0.0)) return kMaxNs;
+  return std::clamp(static_cast<std::int64_t>(std::llround(0.5e9 / fastest_Hz)), kMinNs, kMaxNs);
+}
 
 Publisher::Publisher(const FixedConfig& config, Identity identity, Queues queues, std::optional<auth::Key> publish_key)
     : config_(config),
@@ -230,6 +239,7 @@ void Publisher::run(const std::atomic<bool>& stop) {
   name_thread("rpemd-publish");
   (void)apply_thread_policy(config_.loop.realtime == RealtimeMode::kOff ? ThreadPolicy{} : config_.publish_thread);
   connect();
+  const std::chrono::nanoseconds idle(publisher_idle_ns(config_.lcm));
   Report report;
   while (true) {
     drain_reports();
@@ -251,7 +261,7 @@ void Publisher::run(const std::atomic<bool>& stop) {
     maybe_write_state(false);
     if (stop.load(std::memory_order_relaxed) && !any) break;
     connect();
-    if (!any) std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    if (!any) std::this_thread::sleep_for(idle);
   }
   maybe_write_state(true);
 }

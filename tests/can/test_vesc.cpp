@@ -9,6 +9,7 @@
 #include <array>
 #include <cmath>
 #include <numbers>
+#include <span>
 #include <vector>
 
 #include "rpem/can/decoder.hpp"
@@ -115,7 +116,7 @@ TEST(Vesc, StatusBroadcasts) {
 // The kernel's rule for CAN_RAW_FILTER (linux Documentation/networking/can.rst, "RAW Socket Option
 // CAN_RAW_FILTER"): a frame is received when <received_can_id> & mask == can_id & mask for any filter; the
 // received can_id has bit 31 (CAN_EFF_FLAG) set for a 29-bit id and bit 30 (CAN_RTR_FLAG) for a remote frame.
-bool kernel_passes(const std::array<KernelFilter, 3>& filters, const CanFrame& f, bool remote = false) {
+bool kernel_passes(std::span<const KernelFilter> filters, const CanFrame& f, bool remote = false) {
   const std::uint32_t can_id = f.id | (f.extended ? 0x80000000U : 0U) | (remote ? 0x40000000U : 0U);
   return std::any_of(filters.begin(), filters.end(),
                      [&](const KernelFilter& k) { return (can_id & k.mask) == (k.id & k.mask); });
@@ -149,6 +150,53 @@ TEST(Vesc, KernelFiltersPassWhatThePollerReadsAndNothingElse) {
   EXPECT_FALSE(kernel_passes(filters, standard));
   EXPECT_FALSE(kernel_passes(filters, ext(0x57D, {}), /*remote=*/true));
   EXPECT_FALSE(kernel_passes(filters, ext(0x18FF0001, {1, 2, 3})));  // a J1939-style id of another node
+}
+
+// The controller's side. VESC's id layout (vedderb/bldc comm/comm_can.c: comm_can_send_buffer sends
+// `controller_id | (CAN_PACKET_PROCESS_SHORT_BUFFER << 8)`, decode_msg reads `id = eid & 0xFF`, `cmd = eid >> 8`
+// and answers `id == app controller id || id == 255`; datatypes.h: CAN_PACKET_PROCESS_SHORT_BUFFER = 8): the
+// addressee in bits 0-7, the packet in bits 8-15. Every (packet, addressee) pair is built by hand from that
+// layout and put through the kernel's arithmetic; only PROCESS_SHORT_BUFFER to the controller or to 255 passes.
+TEST(Vesc, ControllerKernelFiltersPassCommandsToItOrToAllAndNothingElse) {
+  constexpr std::uint32_t kShortBuffer = 8;
+  for (const std::uint32_t controller : {1U, 7U, 12U, 254U}) {
+    const auto filters = controller_kernel_filters(static_cast<std::uint8_t>(controller));
+    int passed = 0;
+    for (std::uint32_t packet = 0; packet <= 0xFF; ++packet) {
+      for (std::uint32_t addressee = 0; addressee <= 0xFF; ++addressee) {
+        const CanFrame f = ext(addressee | (packet << 8), {0x65, 0x00, 0x32, 0x00, 0x18, 0x01, 0xB3});
+        const bool expected = packet == kShortBuffer && (addressee == controller || addressee == 255);
+        ASSERT_EQ(kernel_passes(filters, f), expected) << "controller " << controller << std::hex << " id 0x" << f.id;
+        passed += expected;
+      }
+    }
+    EXPECT_EQ(passed, 2);
+  }
+  // Twelve drives on one bus: controller 7 is woken by its own poll (0x807) and a poll of all (0x8FF), not by
+  // the other eleven's (0x801-0x80C), their replies to hosts 101-112 (0x865-0x870, FILL 0x565, PROCESS 0x765),
+  // its own statuses (0x907 …, which carry its id), nor by these as standard, remote or >16-bit ids.
+  const auto filters = controller_kernel_filters(7);
+  EXPECT_TRUE(kernel_passes(filters, ext(0x807, {0x6B, 0x00, 0x32})));
+  EXPECT_TRUE(kernel_passes(filters, ext(0x8FF, {0x6B, 0x00, 0x32})));
+  for (std::uint32_t other = 1; other <= 12; ++other) {
+    if (other != 7) {
+      EXPECT_FALSE(kernel_passes(filters, ext(0x800 | other, {0x6B, 0x00, 0x32}))) << other;
+    }
+  }
+  for (std::uint32_t host = 101; host <= 112; ++host) {
+    EXPECT_FALSE(kernel_passes(filters, ext(0x800 | host, {0x07, 0x01, 0x32})));
+    EXPECT_FALSE(kernel_passes(filters, ext(0x500 | host, {0x00, 0x32})));
+    EXPECT_FALSE(kernel_passes(filters, ext(0x700 | host, {0x07, 0x01, 0x00, 0x1F, 0x08, 0xF7})));
+  }
+  for (std::uint32_t status : {9U, 14U, 15U, 16U, 27U, 58U}) {
+    EXPECT_FALSE(kernel_passes(filters, ext((status << 8) | 7U, {0, 0, 0, 0, 0, 0, 0, 0}))) << status;
+  }
+  CanFrame standard = ext(0x007, {0x6B, 0x00, 0x32});
+  standard.extended = false;
+  EXPECT_FALSE(kernel_passes(filters, standard));
+  EXPECT_FALSE(kernel_passes(filters, ext(0x807, {}), /*remote=*/true));
+  EXPECT_FALSE(kernel_passes(filters, ext(0x10807, {0x6B, 0x00, 0x32})));
+  EXPECT_FALSE(kernel_passes(filters, ext(0x1FFFF8FF, {0x6B, 0x00, 0x32})));
 }
 
 TEST(VescBadInput, CrcErrorLengthMismatchAndLostFramesAreCountedAndDropped) {

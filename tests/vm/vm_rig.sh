@@ -12,6 +12,8 @@
 # initramfs with the shared libraries ldd names. --share mounts a host directory at /host (virtio-9p)
 # for inputs and results. The command runs in /work; its exit code becomes this script's.
 # The kernel package is fetched with apt-get download into $RPEM_VM_CACHE (default build/vm-cache).
+# RPEM_VM_KERNEL_ARGS is appended to the guest kernel's command line (e.g. `tsc=reliable`: the guest otherwise
+# picks the HPET clocksource, an emulated MMIO device, and does not offer the TSC).
 set -euo pipefail
 
 here=$(cd "$(dirname "$0")" && pwd)
@@ -130,7 +132,7 @@ run() {
   console=$(mktemp)
   trap 'rm -f "$initrd" "$console"' EXIT
   build_initramfs "$initrd"
-  log "booting $(cat "$cache/kernel.ready") (TCG, $smp cpus) for: ${command[*]}"
+  log "booting $(cat "$cache/kernel.ready") (TCG, $smp cpus${RPEM_VM_KERNEL_ARGS:+; kernel args: $RPEM_VM_KERNEL_ARGS}) for: ${command[*]}"
   local vmlinuz
   vmlinuz=$(ls "$cache"/root/boot/vmlinuz-*)
   local share_args=()
@@ -139,7 +141,7 @@ run() {
   fi
   set +e
   timeout --foreground "$timeout" qemu-system-x86_64 -accel tcg -cpu max -smp "$smp" -m 1G -nographic -no-reboot \
-    "${share_args[@]}" "${can_args[@]}" -kernel "$vmlinuz" -initrd "$initrd" -append "console=ttyS0 quiet panic=-1 rdinit=/init" \
+    "${share_args[@]}" "${can_args[@]}" -kernel "$vmlinuz" -initrd "$initrd" -append "console=ttyS0 quiet panic=-1 rdinit=/init${RPEM_VM_KERNEL_ARGS:+ $RPEM_VM_KERNEL_ARGS}" \
     </dev/null >"$console" 2>&1
   local qemu_rc=$?
   set -e

@@ -3,6 +3,7 @@
 #include <array>
 #include <algorithm>
 #include <atomic>
+#include <cmath>
 #include <csignal>
 #include <cstdio>
 #include <ctime>
@@ -26,15 +27,26 @@ std::atomic<bool> g_toggle_silence{false};
 void on_stop(int) { g_stop = true; }
 void on_usr1(int) { g_toggle_silence = true; }
 
+/// Upper edges of the reply-delay classes [ms]: a reply's last frame sent this long after its poll's kernel
+/// receive time, at most (the last class: later).
+constexpr std::array<std::int64_t, 7> kDelayEdgesMs{1, 2, 5, 10, 20, 100, 1000};
+
 struct EmulatorCounters {
   std::uint64_t requests = 0, replies = 0, reply_frames = 0, unsupported = 0, unheard = 0, send_failures = 0;
+  std::array<std::uint64_t, kDelayEdgesMs.size() + 1> reply_delay{};  ///< replies per delay class
+  std::int64_t reply_delay_max_ns = 0;
+
+  void add_delay(std::int64_t ns) noexcept {
+    std::size_t k = 0;
+    while (k < kDelayEdgesMs.size() && ns > kDelayEdgesMs[k] * 1'000'000) ++k;
+    ++reply_delay[k];
+    reply_delay_max_ns = std::max(reply_delay_max_ns, ns);
+  }
 };
 
 /// A poll timestamped longer ago than this is in the socket's queue: the drive may run up to now minus
 /// this while idle without passing a poll not yet read (vcan timestamps in netif_rx, queues in softirq).
 constexpr std::int64_t kSettleNs = 2'000'000;
-/// Idle simulation between two looks at the socket (drive time), so that a poll waits little.
-constexpr std::int64_t kIdleChunkNs = 1'000'000;
 
 }  // namespace
 
@@ -51,6 +63,11 @@ void add_vesc_emulator_options(CLI::App* cmd, VescEmulatorOptions& o) {
       ->check(CLI::NonNegativeNumber);
   cmd->add_option("--duration", o.duration_s, "stop after this long [s] (default: the scenario's duration)")
       ->check(CLI::NonNegativeNumber);
+  cmd->add_option("--idle-step", o.idle_step_s,
+                  "while no poll is pending: drive time run ahead per look at the socket, and the longest wait "
+                  "for a poll between looks [s]")
+      ->check(CLI::Range(1.0e-4, 1.0))
+      ->capture_default_str();
 }
 
 int run_vesc_emulator(sim::Scenario scenario, const VescEmulatorOptions& o) {
@@ -60,6 +77,10 @@ int run_vesc_emulator(sim::Scenario scenario, const VescEmulatorOptions& o) {
   co.interface = o.interface;
   co.fd = false;  // VESC speaks classic CAN
   co.receive_errors = false;
+  // Only polls to this controller or to all reach the socket: one of twelve emulators on a bus is not woken
+  // by the other eleven's polls, nor by any reply or status.
+  const auto filters = vesc::controller_kernel_filters(static_cast<std::uint8_t>(o.controller_id));
+  co.filters.assign(filters.begin(), filters.end());
   can::SocketCanChannel channel(co);
   const auto id = static_cast<std::uint8_t>(o.controller_id);
   const std::string name = scenario.name;
@@ -88,6 +109,8 @@ int run_vesc_emulator(sim::Scenario scenario, const VescEmulatorOptions& o) {
   const std::int64_t origin_ns = core::now_ns(CLOCK_REALTIME);
   std::fprintf(stderr, "rpem sim: t = 0 at CLOCK_REALTIME %.6f s\n", 1e-9 * static_cast<double>(origin_ns));
   auto host_now = [&] { return core::now_ns(CLOCK_REALTIME) - origin_ns; };
+  // Idle simulation between two looks at the socket (drive time), and the longest wait for a poll.
+  const auto idle_step_ns = static_cast<std::int64_t>(std::llround(o.idle_step_s * 1e9));
   while (running && !g_stop) {
     const std::int64_t now = host_now();
     if (o.duration_s > 0.0 && now > static_cast<std::int64_t>(o.duration_s * 1e9)) break;
@@ -102,9 +125,9 @@ int run_vesc_emulator(sim::Scenario scenario, const VescEmulatorOptions& o) {
     const std::int64_t idle_to = now - kSettleNs;
     std::int64_t wait_ns = 0;
     if (drive.time_ns() < idle_to) {
-      running = drive.run_to(std::min(idle_to, drive.time_ns() + kIdleChunkNs), emit);
+      running = drive.run_to(std::min(idle_to, drive.time_ns() + idle_step_ns), emit);
     } else {
-      wait_ns = std::clamp<std::int64_t>(drive.time_ns() + kIdleChunkNs - idle_to, 0, kIdleChunkNs);
+      wait_ns = std::clamp<std::int64_t>(drive.time_ns() + idle_step_ns - idle_to, 0, idle_step_ns);
     }
     const std::size_t got = channel.receive_for(rx, wait_ns);
     for (std::size_t k = 0; k < got && running; ++k) {
@@ -130,6 +153,7 @@ int run_vesc_emulator(sim::Scenario scenario, const VescEmulatorOptions& o) {
       // send_packet_wrapper → comm_can_send_buffer(rx_buffer_last_id, …, rx_buffer_response_type = 1)
       const std::size_t frames = vesc::buffer_frames(request->sender, id, 1, {payload.data(), len}, tx);
       for (std::size_t f = 0; f < frames; ++f) send(tx[f]);
+      n.add_delay(host_now() - arrived_ns);
       ++n.replies;
       n.reply_frames += frames;
     }
@@ -147,6 +171,13 @@ int run_vesc_emulator(sim::Scenario scenario, const VescEmulatorOptions& o) {
                static_cast<unsigned long long>(n.unsupported), static_cast<unsigned long long>(d.empty_reads),
                static_cast<unsigned long long>(d.behind), static_cast<unsigned long long>(d.statuses),
                static_cast<unsigned long long>(n.send_failures));
+  std::fprintf(stderr, "rpem sim: VESC %d replies sent after their poll's arrival:", o.controller_id);
+  for (std::size_t k = 0; k < kDelayEdgesMs.size(); ++k) {
+    std::fprintf(stderr, " <=%lld ms %llu,", static_cast<long long>(kDelayEdgesMs[k]),
+                 static_cast<unsigned long long>(n.reply_delay[k]));
+  }
+  std::fprintf(stderr, " later %llu; the latest %.3f s\n", static_cast<unsigned long long>(n.reply_delay.back()),
+               1e-9 * static_cast<double>(n.reply_delay_max_ns));
   return kExitOk;
 }
 

@@ -22,6 +22,9 @@ struct VescEmulatorOptions {
   double silent_at_s = -1.0;            ///< go silent (answer nothing, broadcast nothing) at this time…
   double silent_for_s = 0.0;            ///< …for this long; SIGUSR1 also toggles silence
   double duration_s = 0.0;              ///< stop after this long (0: the scenario's duration)
+  /// While no poll is pending: run the drive ahead this much drive time per look at the socket, and wait up
+  /// to this long for a poll between looks (docs/can-vesc.md, "Drive time, on demand").
+  double idle_step_s = 1.0e-3;
   std::string truth;                    ///< also write the true state every 10 ms (sim/truth_log.hpp)
 };
 

@@ -43,6 +43,13 @@ inline constexpr std::uint8_t kBroadcastId = 255;
 /// controllers' statuses, replies to other hosts and standard frames stay in the kernel.
 [[nodiscard]] std::array<KernelFilter, 3> kernel_filters(std::uint8_t controller_id, std::uint8_t host_id) noexcept;
 
+/// The kernel filters for a *controller* `controller_id` (an emulated VESC, tools/rpem/vesc_emulator.cpp):
+/// extended data frames of the one packet it handles, PROCESS_SHORT_BUFFER (vesc_firmware.hpp, parse_request),
+/// addressed to it or to every controller (kBroadcastId; comm_can.c, decode_msg). The whole 29-bit ID is
+/// matched, so other controllers' commands, every reply and status, and ids above VESC's 16 bits stay in the
+/// kernel: twelve controllers on one bus are each woken only by their own polls.
+[[nodiscard]] std::array<KernelFilter, 2> controller_kernel_filters(std::uint8_t controller_id) noexcept;
+
 /// Bits of the COMM_GET_VALUES_SELECTIVE mask (commands.c, commands_process_packet), in reply order.
 enum Field : int {
   kTempFet = 0,

@@ -29,6 +29,12 @@ struct PublisherCounters {
   std::int64_t state_write_failures = 0;
 };
 
+/// How long the publisher thread sleeps when its queues are empty: half the period of its fastest publication,
+///   idle = clamp(0.5 / max(estimate_rate_Hz, measurement_rate_Hz, diagnostics_rate_Hz), 1 ms, 20 ms),
+/// 5 ms at the default rates (measurement 100 Hz). A report then waits at most half a publication period, and a
+/// slowly publishing rpemd (several per host, docs/rpemd.md) wakes up less often.
+[[nodiscard]] std::int64_t publisher_idle_ns(const LcmConfig& lcm) noexcept;
+
 class Publisher {
  public:
   struct Queues {
