@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <ctime>
 
 #include "rpem/can/socketcan.hpp"
 #include "rpem/can/vesc.hpp"
@@ -51,6 +52,10 @@ VescPoller::Config poller_config(const VescSource::Options& o) noexcept {
   return c;
 }
 
+std::int64_t reply_gather_ns(std::int64_t poll_period_ns) noexcept {
+  return std::min<std::int64_t>(1'000'000, poll_period_ns / 16);
+}
+
 void report_vesc_counters(const VescPoller& poller, DiagnosticsRows& rows) noexcept {
   rows.set_all(kPollerRows, poller.counters());
   const VescCounters& d = poller.decoder().counters();
@@ -78,6 +83,8 @@ class VescSampleSource final : public SampleSource {
     VescPoller poller(poller_config(options_));
     std::array<can::ReceivedFrame, 64> frames;
     core::AveragedSample sample;
+    const std::int64_t gather_ns = reply_gather_ns(poller_config(options_).period_ns);
+    const timespec gather{0, static_cast<long>(gather_ns)};
     while (!stop.load(std::memory_order_relaxed)) {
       // The poll schedule and the windows run on CLOCK_REALTIME, the kernel's receive timestamps' clock.
       std::int64_t now = core::now_ns(CLOCK_REALTIME);
@@ -86,9 +93,15 @@ class VescSampleSource final : public SampleSource {
       const std::int64_t wait_ns = std::clamp<std::int64_t>(poller.wake_ns(now) - now, 0, 50'000'000);
       const std::size_t n = channel.receive_for(frames, wait_ns);
       now = core::now_ns(CLOCK_REALTIME);
+      bool completed = false;
       for (std::size_t f = 0; f < n; ++f) {
-        if (poller.on_frame(frames[f].frame, receive_time_ns(frames[f], now), sample)) out.push(sample);
+        if (poller.on_frame(frames[f].frame, receive_time_ns(frames[f], now), sample)) {
+          out.push(sample);
+          completed = true;
+        }
       }
+      // Frames but no complete reply: the rest of it is on its way — take it in one wake-up, not one per frame.
+      if (n > 0 && !completed) nanosleep(&gather, nullptr);
       report_when_due(out, channel, [&](DiagnosticsRows& rows) { report_vesc_counters(poller, rows); });
     }
   }

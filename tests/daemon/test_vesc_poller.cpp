@@ -331,3 +331,16 @@ TEST(VescPoller, AnUnsentPollIsCountedAndNotAwaited) {
 
 }  // namespace
 }  // namespace rpem::daemon
+
+namespace rpem::daemon {
+namespace {
+
+TEST(VescSource, ReplyGatherIsASixteenthOfThePollPeriodAtMostOneMillisecond) {
+  EXPECT_EQ(reply_gather_ns(17'857'143), 1'000'000);  // 56 Hz: 1/16 would be 1.12 ms
+  EXPECT_EQ(reply_gather_ns(16'000'000), 1'000'000);  // 62.5 Hz: exactly 1 ms either way
+  EXPECT_EQ(reply_gather_ns(1'000'000), 62'500);      // 1 kHz
+  EXPECT_EQ(reply_gather_ns(500'000), 31'250);        // 2 kHz, the highest poll rate
+}
+
+}  // namespace
+}  // namespace rpem::daemon

@@ -36,6 +36,11 @@ struct VescSource {
 
 /// The poller's schedule and ids from the options.
 [[nodiscard]] VescPoller::Config poller_config(const VescSource::Options& options) noexcept;
+/// How long the source waits, once a reply has begun to arrive, before it reads the bus again: a reply is
+/// several frames (six for the estimator's mask), so it wakes once for them instead of once per frame. The
+/// frames keep their kernel receive times, so only the hand-over to the loop waits:
+///   gather = min(1 ms, poll period / 16)     (1 ms at 56 Hz, 62.5 µs at 1 kHz)
+[[nodiscard]] std::int64_t reply_gather_ns(std::int64_t poll_period_ns) noexcept;
 /// The poller's and its decoder's counters as diagnostics rows (vesc_*, can_*).
 void report_vesc_counters(const VescPoller& poller, DiagnosticsRows& rows) noexcept;
 
