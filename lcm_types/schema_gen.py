@@ -71,9 +71,9 @@ class Comment:
         self.text, self.line, self.standalone = text, line, standalone
 
 
-TOKEN = re.compile(r"\s*(?:(?P<comment>//[^\n]*|/\*.*?\*/)|(?P<ident>[A-Za-z_][A-Za-z0-9_]*)|"
+TOKEN = re.compile(r"(?P<comment>//[^\n]*|/\*.*?\*/)|(?P<ident>[A-Za-z_][A-Za-z0-9_]*)|"
                    r"(?P<number>-?(?:0[xX][0-9a-fA-F]+|[0-9]+(?:\.[0-9]*)?(?:[eE][-+]?[0-9]+)?))|"
-                   r"(?P<punct>[{}\[\];=,.]))", re.S)
+                   r"(?P<punct>[{}\[\];=,.])", re.S)
 
 
 def tokenize(path, text):
@@ -82,29 +82,23 @@ def tokenize(path, text):
     pos, line, line_start = 0, 1, 0
     code_on_line = False
     while True:
-        m = TOKEN.match(text, pos)
-        skipped = text[pos:m.start(m.lastgroup)] if m else text[pos:]
-        for k, ch in enumerate(skipped):
-            if ch == "\n":
-                line += 1
-                line_start = pos + k + 1
-                code_on_line = False
-        if not m:
-            rest = text[pos:].strip()
-            if rest:
-                col = pos + (len(text[pos:]) - len(text[pos:].lstrip())) - line_start + 1
-                raise SchemaError(f"{path}:{line}:{col}: unexpected '{rest[0]}'")
+        while pos < len(text) and text[pos].isspace():
+            if text[pos] == "\n":
+                line, line_start, code_on_line = line + 1, pos + 1, False
+            pos += 1
+        if pos == len(text):
             return tokens, comments
-        start = m.start(m.lastgroup)
-        col = start - line_start + 1
+        m = TOKEN.match(text, pos)
+        col = pos - line_start + 1
+        if not m:
+            raise SchemaError(f"{path}:{line}:{col}: unexpected '{text[pos]}'")
         value = m.group(m.lastgroup)
         if m.lastgroup == "comment":
             body = value[2:] if value.startswith("//") else value[2:-2]
             comments.append(Comment(body, line, not code_on_line))
-            newlines = value.count("\n")
-            if newlines:
-                line += newlines
-                line_start = start + value.rfind("\n") + 1
+            if "\n" in value:
+                line += value.count("\n")
+                line_start = pos + value.rfind("\n") + 1
         else:
             tokens.append(Token(m.lastgroup, value, line, col))
             code_on_line = True
@@ -329,7 +323,11 @@ def main():
             target = os.path.join(directory, struct.name + ".hpp")
             text = generate(struct, os.path.basename(path))
             # Rewritten only when it changes: what includes it is not rebuilt for nothing.
-            if not os.path.exists(target) or open(target, encoding="utf-8").read() != text:
+            old = None
+            if os.path.exists(target):
+                with open(target, encoding="utf-8") as f:
+                    old = f.read()
+            if old != text:
                 with open(target, "w", encoding="utf-8") as f:
                     f.write(text)
     except (SchemaError, OSError) as e:
