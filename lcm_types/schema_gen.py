@@ -10,8 +10,11 @@ header rpem/mirror/<struct>.hpp with
     as generic code (for_each_field, copy, format_fields, csv_header, csv_row).
 
 So the .lcm file is the one definition of a message: adding a field is its line there (and the code that
-computes its value). Why a generator of ours, and what it makes of a field: docs/architecture.md, "One
-definition per message".
+computes its value). Why a generator of ours: lcm-gen writes classes, not field lists, and drops field
+comments (units, labels, groups); parsing its C++ output would read a format that is no interface; X-macros
+would make the C++ side one list but leave the .lcm file a second one, kept in step by hand. Per field this
+writes a member and a table row only; what is done to fields is C++ templates over the table, written once.
+More, and what it makes of a field: docs/architecture.md, "One definition per message".
 
     schema_gen.py --out DIR FILE.lcm...
 
