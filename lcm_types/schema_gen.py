@@ -234,12 +234,12 @@ class Parser:
         s.fields.append(Field(lcm_type, name_token.text, size, name_token.line, doc, label, group))
 
     def check_authentication(self, s):
-        names = [f.name for f in s.fields]
-        if not any(n in names for n, _, _ in AUTH_FIELDS):
+        auth_names = {name for name, _, _ in AUTH_FIELDS}
+        if not any(f.name in auth_names for f in s.fields):
             return
         tail = [(f.name, f.lcm_type, f.size) for f in s.fields[-len(AUTH_FIELDS):]]
         if tail != AUTH_FIELDS:
-            bad = next(f for f in s.fields if f.name in dict((n, 0) for n, _, _ in AUTH_FIELDS))
+            bad = next(f for f in s.fields if f.name in auth_names)
             raise SchemaError(f"{self.path}:{bad.line}:1: the authentication fields must be the last two, "
                               "'int32_t key_id; byte mac[32];' (auth/ signs the encoding up to the MAC)")
         s.fields = s.fields[:-len(AUTH_FIELDS)]
