@@ -193,7 +193,7 @@ void Control::watchdog(std::int64_t now_ns) {
   if (beat != last_heartbeat_) {
     if (watchdog_enabled_) sd_notify(0, "WATCHDOG=1");
   } else {
-    std::fprintf(stderr, "rpemd: the estimator loop has not run for %.1f s\n", 1e-9 * static_cast<double>(watchdog_interval_ns_));
+    std::fprintf(stderr, "rpemd: the estimator loop has not run for %.1f s\n", core::to_seconds(watchdog_interval_ns_));
   }
   last_heartbeat_ = beat;
 }

@@ -174,10 +174,10 @@ void EstimatorLoop::report_estimate(std::int64_t now_ns) noexcept {
   }
   r.has_good_psi_m = has_good_[core::kPsiM];
   r.good_psi_m_Wb = good_[core::kPsiM];
-  r.good_psi_m_age_s = 1e-9 * static_cast<double>(now_ns - good_ns_[core::kPsiM]);
+  r.good_psi_m_age_s = core::to_seconds(now_ns - good_ns_[core::kPsiM]);
   r.has_good_r_s = has_good_[core::kRs];
   r.good_r_s_Ohm = good_[core::kRs];
-  r.good_r_s_age_s = 1e-9 * static_cast<double>(now_ns - good_ns_[core::kRs]);
+  r.good_r_s_age_s = core::to_seconds(now_ns - good_ns_[core::kRs]);
   push(r);
 }
 

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <limits>
 
+#include "rpem/core/clock.hpp"
+
 namespace rpem::daemon {
 
 LoopEstimator::Estimators LoopEstimator::make(SampleKind kind, const core::MachineSi& machine,
@@ -30,7 +32,7 @@ bool LoopEstimator::step(const SourceSample& sample, core::Estimate& estimate, d
   estimate = std::get_if<core::AveragedDriveEstimator>(&estimator_)->step(a);
   // The time this sample stands for: from the previous window's end (a gap or a long silence counts up
   // to the interval the estimator still adapts across).
-  const double interval_s = has_previous_ ? 1e-9 * static_cast<double>(a.t_ns - previous_t_ns_) : 0.0;
+  const double interval_s = has_previous_ ? core::to_seconds(a.t_ns - previous_t_ns_) : 0.0;
   dt_s = std::clamp(interval_s, 0.0, max_interval_s_);
   has_previous_ = true;
   previous_t_ns_ = a.t_ns;

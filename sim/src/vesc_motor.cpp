@@ -3,6 +3,8 @@
 #include <cmath>
 #include <numbers>
 
+#include "rpem/core/clock.hpp"
+
 namespace rpem::sim {
 namespace {
 
@@ -35,7 +37,7 @@ bool VescMotor::advance_to(std::int64_t t_ns) noexcept {
 void VescMotor::account(const ControlCycle& c) noexcept {
   last_cycle_ = c;
   sums_.add(c);
-  const double dt_s = 1e-9 * static_cast<double>(c.end_ns - c.t_ns);
+  const double dt_s = core::to_seconds(c.end_ns - c.t_ns);
   const double i_in = input_current_A(c);
   last_input_current_A_ = i_in;
   input_current_sum_A_ += i_in;

@@ -6,6 +6,7 @@
 
 #include <cmath>
 
+#include "rpem/core/clock.hpp"
 #include "rpem/daemon/estimator_loop.hpp"
 #include "support/averaged_data.hpp"
 #include "support/model_data.hpp"
@@ -64,7 +65,7 @@ struct AveragedRig {
       now_ns += 1'000'000;
       loop->process(now_ns);
     }
-    while (gen.t_s + 1.0 < 1e-9 * static_cast<double>(now_ns)) (void)gen.next();
+    while (gen.t_s + 1.0 < core::to_seconds(now_ns)) (void)gen.next();
     have_next = false;
   }
   EstimateReport estimate;
