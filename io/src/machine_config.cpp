@@ -167,7 +167,7 @@ ParameterDrift parse_drift(YamlMap m, const char* ref_key, double ref_min, doubl
   if (m.has("coeff_per_K")) {
     core::DriftLaw law;
     law.coeff_per_K = m.number("coeff_per_K", -0.1, 0.1);
-    law.reference_C = m.number_or("reference_C", 20.0, -273.0, 500.0);
+    law.reference_C = m.number_or("reference_C", law.reference_C, -273.0, 500.0);
     law.value_ref = m.number_or(ref_key, 0.0, ref_min, ref_max);
     d.law = law;
   } else {
