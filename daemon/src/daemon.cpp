@@ -121,11 +121,12 @@ int Daemon::run() {
     if (qos_fd < 0) std::fprintf(stderr, "rpemd: note: %s; deep CPU idle states may add wake-up latency\n", problem.c_str());
   }
 
-  loop_ = std::make_unique<EstimatorLoop>(config_, EstimatorLoop::Queues{samples_, commands_, reports_});
+  loop_ = std::make_unique<LoopThread>(config_, LoopThread::Queues{samples_, commands_, reports_});
   seed_from_state_file();
   const char* source_type = SourceCatalogue::type(fixed.source);
-  publisher_ = std::make_unique<Publisher>(fixed, Publisher::Identity{source_type, source_name_, state_file_status_},
-                                           Publisher::Queues{reports_, source_reports_, control_reports_}, keys.publish);
+  publisher_ = std::make_unique<PersistingPublisher>(
+      fixed, PersistingPublisher::Identity{source_type, source_name_, state_file_status_},
+      PersistingPublisher::Queues{reports_, source_reports_, control_reports_}, keys.publish);
   start_threads();
   while (!loop_->started()) std::this_thread::sleep_for(std::chrono::milliseconds(1));
   if (!loop_->setup_problems().empty()) {

@@ -7,7 +7,7 @@
 #include <cmath>
 
 #include "rpem/core/clock.hpp"
-#include "rpem/daemon/estimator_loop.hpp"
+#include "rpem/daemon/loop_thread.hpp"
 #include "support/averaged_data.hpp"
 #include "support/model_data.hpp"
 #include "support/paper_machine.hpp"
@@ -20,7 +20,7 @@ struct AveragedRig {
   SpscQueue<SourceSample> input{16384};
   SpscQueue<Command> commands{16};
   SpscQueue<Report> output{65536};
-  std::unique_ptr<EstimatorLoop> loop;
+  std::unique_ptr<LoopThread> loop;
   test::AveragedDataGenerator gen;
   std::int64_t now_ns = 1'000'000'000;
   std::int64_t pushed = 0;
@@ -29,7 +29,7 @@ struct AveragedRig {
 
   explicit AveragedRig(double rate_Hz, double psi_scale = 1.0) {
     config.fixed.source = VescSource::Options{};
-    loop = std::make_unique<EstimatorLoop>(config, EstimatorLoop::Queues{input, commands, output});
+    loop = std::make_unique<LoopThread>(config, LoopThread::Queues{input, commands, output});
     gen.base = test::paper_base();
     gen.plant = test::paper_machine_pu();
     gen.plant.psi_m_pu *= psi_scale;

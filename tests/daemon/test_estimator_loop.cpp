@@ -4,7 +4,7 @@
 
 #include <cmath>
 
-#include "rpem/daemon/estimator_loop.hpp"
+#include "rpem/daemon/loop_thread.hpp"
 #include "support/model_data.hpp"
 #include "support/paper_machine.hpp"
 
@@ -25,7 +25,7 @@ struct Rig {
   SpscQueue<SourceSample> input{16384};
   SpscQueue<Command> commands{16};
   SpscQueue<Report> output{65536};
-  std::unique_ptr<EstimatorLoop> loop;
+  std::unique_ptr<LoopThread> loop;
   test::ModelDataGenerator gen;
   core::PerUnitBase base = test::paper_base();
   std::int64_t t_ns = 0;
@@ -37,7 +37,7 @@ struct Rig {
     gen.omega_n_rad_s = base.omega_el_rad_s;
   }
   /// A new loop with the (changed) configuration.
-  void rebuild() { loop = std::make_unique<EstimatorLoop>(config, EstimatorLoop::Queues{input, commands, output}); }
+  void rebuild() { loop = std::make_unique<LoopThread>(config, LoopThread::Queues{input, commands, output}); }
   /// Feeds `seconds` of samples, processing every millisecond as the loop would.
   void run(double seconds) {
     const int ms = static_cast<int>(seconds * 1000);

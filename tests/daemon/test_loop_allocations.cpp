@@ -9,7 +9,7 @@
 
 #include "rpem/command_t.hpp"
 #include "rpem/daemon/command_gate.hpp"
-#include "rpem/daemon/estimator_loop.hpp"
+#include "rpem/daemon/loop_thread.hpp"
 #include "support/averaged_data.hpp"
 #include "support/model_data.hpp"
 #include "support/paper_machine.hpp"
@@ -38,7 +38,7 @@ TEST(LoopAllocations, NoneInTheLoopsPeriodWork) {
   SpscQueue<SourceSample> input(4096);
   SpscQueue<Command> commands(16);
   SpscQueue<Report> output(1 << 16);
-  EstimatorLoop loop(config, EstimatorLoop::Queues{input, commands, output});
+  LoopThread loop(config, LoopThread::Queues{input, commands, output});
   loop.seed(SeedValue{1.1, 4.0}, SeedValue{2.3, 4.0}, 1'000'000'000);
   test::ModelDataGenerator gen;
   gen.plant = test::paper_machine_pu();
@@ -87,7 +87,7 @@ TEST(LoopAllocations, NoneOnTheAveragedPath) {
   SpscQueue<SourceSample> input(4096);
   SpscQueue<Command> commands(16);
   SpscQueue<Report> output(1 << 16);
-  EstimatorLoop loop(config, EstimatorLoop::Queues{input, commands, output});
+  LoopThread loop(config, LoopThread::Queues{input, commands, output});
   test::AveragedDataGenerator gen;
   gen.base = test::paper_base();
   gen.plant = test::paper_machine_pu();

@@ -14,7 +14,7 @@
 #include <thread>
 
 #include "rpem/daemon/daemon_config.hpp"
-#include "rpem/daemon/estimator_loop.hpp"
+#include "rpem/daemon/loop_thread.hpp"
 #include "rpem/daemon/messages.hpp"
 #include "rpem/daemon/publisher.hpp"
 #include "rpem/daemon/source.hpp"
@@ -62,8 +62,8 @@ class Daemon {
   std::unique_ptr<SampleSource> source_;
   std::string source_name_;
   StateFileStatus state_file_status_ = StateFileStatus::kNone;
-  std::unique_ptr<EstimatorLoop> loop_;
-  std::unique_ptr<Publisher> publisher_;
+  std::unique_ptr<LoopThread> loop_;
+  std::unique_ptr<PersistingPublisher> publisher_;
   SourceOutput source_output_{samples_, source_reports_};
   std::atomic<bool> stop_acquisition_{false}, stop_publisher_{false};
   std::thread source_thread_, loop_thread_, publisher_thread_;
