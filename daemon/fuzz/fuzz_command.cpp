@@ -146,15 +146,15 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   }
 
   // The loop's queue is built once (it allocates its Commands, 1 kB each) and is empty between inputs.
-  static rpem::daemon::SpscQueue<Command> to_loop(4);
+  static auto to_loop = rpem::daemon::SpscQueue<Command>::make(4);
   static Command c;
-  require(!to_loop.pop(c));
+  require(!to_loop.consumer.pop(c));
   rpem::daemon::CommandKeys keys;
   keys.keys = h.held;
-  rpem::daemon::CommandGate gate(policy, to_loop, keys);
+  rpem::daemon::CommandGate gate(policy, to_loop.producer, keys);
   std::int64_t queued = 0, previous = INT64_MIN;
   auto pop = [&] {
-    while (to_loop.pop(c)) {
+    while (to_loop.consumer.pop(c)) {
       require(c.seq > previous);
       previous = c.seq;
     }

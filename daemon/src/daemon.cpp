@@ -121,12 +121,15 @@ int Daemon::run() {
     if (qos_fd < 0) std::fprintf(stderr, "rpemd: note: %s; deep CPU idle states may add wake-up latency\n", problem.c_str());
   }
 
-  loop_ = std::make_unique<LoopThread>(config_, LoopThread::Queues{samples_, commands_, reports_});
+  loop_ = std::make_unique<LoopThread>(
+      config_, LoopThread::Queues{std::move(samples_.consumer), std::move(commands_.consumer), std::move(reports_.producer)});
   seed_from_state_file();
   const char* source_type = SourceCatalogue::type(fixed.source);
   publisher_ = std::make_unique<PersistingPublisher>(
       fixed, PersistingPublisher::Identity{source_type, source_name_, state_file_status_},
-      PersistingPublisher::Queues{reports_, source_reports_, control_reports_}, keys.publish);
+      PersistingPublisher::Queues{std::move(reports_.consumer), std::move(source_reports_.consumer),
+                                  std::move(control_reports_.consumer)},
+      keys.publish);
   start_threads();
   while (!loop_->started()) std::this_thread::sleep_for(std::chrono::milliseconds(1));
   if (!loop_->setup_problems().empty()) {
@@ -167,7 +170,8 @@ int Daemon::run() {
 
   {
     Control control(std::move(config_), [this] { return load_configuration(options_); },
-                    Control::Queues{commands_, control_reports_}, loop_->timer(), std::move(commands));
+                    Control::Queues{std::move(commands_.producer), std::move(control_reports_.producer)}, loop_->timer(),
+                    std::move(commands));
     (void)control.run(signal_fd);
     config_ = control.running();
   }

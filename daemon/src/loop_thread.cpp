@@ -35,7 +35,7 @@ std::int64_t interval_ns(double rate_Hz) noexcept {
 LoopThread::LoopThread(const DaemonConfig& config, Queues queues)
     : live_(config.live),
       loop_config_(config.fixed.loop),
-      queues_(queues),
+      queues_(std::move(queues)),
       estimator_(SourceCatalogue::sample_kind(config.fixed.source), config.live.machine.machine, config.live.machine.estimator),
       validity_(config.live.validity, config.fixed.lcm.estimate_rate_Hz),
       timer_(config.fixed.loop),

@@ -64,7 +64,7 @@ PersistingPublisher::PersistingPublisher(const FixedConfig& config, Identity ide
     : config_(config),
       identity_(std::move(identity)),
       publish_key_(publish_key),
-      queues_(queues),
+      queues_(std::move(queues)),
       buffer_(8192),
       estimate_channel_(config.lcm.channel_prefix + "RPEM_ESTIMATE"),
       measurement_channel_(config.lcm.channel_prefix + "RPEM_MEASUREMENT"),

@@ -17,9 +17,11 @@ namespace {
 
 struct AveragedRig {
   DaemonConfig config = builtin_daemon_config();
-  SpscQueue<SourceSample> input{16384};
-  SpscQueue<Command> commands{16};
-  SpscQueue<Report> output{65536};
+  SpscQueue<SourceSample>::Ends samples = SpscQueue<SourceSample>::make(16384);
+  SpscQueue<Command>::Ends to_loop = SpscQueue<Command>::make(16);
+  SpscQueue<Report>::Ends reports = SpscQueue<Report>::make(65536);
+  SpscQueue<SourceSample>::Producer& input = samples.producer;
+  SpscQueue<Report>::Consumer& output = reports.consumer;
   std::unique_ptr<LoopThread> loop;
   test::AveragedDataGenerator gen;
   std::int64_t now_ns = 1'000'000'000;
@@ -29,7 +31,8 @@ struct AveragedRig {
 
   explicit AveragedRig(double rate_Hz, double psi_scale = 1.0) {
     config.fixed.source = VescSource::Options{};
-    loop = std::make_unique<LoopThread>(config, LoopThread::Queues{input, commands, output});
+    loop = std::make_unique<LoopThread>(config, LoopThread::Queues{std::move(samples.consumer), std::move(to_loop.consumer),
+                                                                   std::move(reports.producer)});
     gen.base = test::paper_base();
     gen.plant = test::paper_machine_pu();
     gen.plant.psi_m_pu *= psi_scale;

@@ -74,7 +74,7 @@ TEST(CommandAuth, TheGateRefusesEachAttackForItsReasonAndCountsIt) {
   const auth::Key k1 = key(1, 0x11), stranger = key(1, 0x99), k9 = key(9, 0x11);
   CommandKeys keys;
   ASSERT_TRUE(keys.keys.add(k1));
-  SpscQueue<Command> to_loop(16);
+  auto [to_loop, loop_side] = SpscQueue<Command>::make(16);
   CommandGate gate(kRequired, to_loop, keys);
   const std::vector<std::uint8_t> valid = command(5, &k1);
   EXPECT_TRUE(gate.handle(valid));
@@ -111,7 +111,7 @@ TEST(CommandAuth, TheGateRefusesEachAttackForItsReasonAndCountsIt) {
 }
 
 TEST(CommandAuth, AuthenticationNoneAdmitsUnsignedCommands) {
-  SpscQueue<Command> to_loop(4);
+  auto [to_loop, loop_side] = SpscQueue<Command>::make(4);
   CommandPolicy none = kRequired;
   none.authentication = CommandAuthentication::kNone;
   CommandGate gate(none, to_loop);
@@ -133,12 +133,12 @@ TEST(CommandAuth, AReplayIsRejectedAfterARestart) {
   ASSERT_TRUE(keys.keys.add(k1));
   const std::vector<std::uint8_t> valid = command(41, &k1);
   {
-    SpscQueue<Command> to_loop(4);
+    auto [to_loop, loop_side] = SpscQueue<Command>::make(4);
     CommandGate gate(kRequired, to_loop, keys, load_command_sequence(store.path), &store);
     EXPECT_TRUE(gate.handle(valid));
   }
   EXPECT_EQ(load_command_sequence(store.path), 41);
-  SpscQueue<Command> to_loop(4);
+  auto [to_loop, loop_side] = SpscQueue<Command>::make(4);
   CommandGate restarted(kRequired, to_loop, keys, load_command_sequence(store.path), &store);
   EXPECT_FALSE(restarted.handle(valid));
   EXPECT_EQ(restarted.last_result(), CommandResult::kRejectedOldSequence);
@@ -153,7 +153,7 @@ TEST(CommandAuth, AnUnpersistableSequenceNumberIsNotAccepted) {
   const auth::Key k1 = key(1, 0x11);
   CommandKeys keys;
   ASSERT_TRUE(keys.keys.add(k1));
-  SpscQueue<Command> to_loop(4);
+  auto [to_loop, loop_side] = SpscQueue<Command>::make(4);
   CommandGate gate(kRequired, to_loop, keys, 0, &failing);
   EXPECT_FALSE(gate.handle(command(1, &k1)));
   EXPECT_EQ(gate.last_result(), CommandResult::kRejectedNotPersisted);

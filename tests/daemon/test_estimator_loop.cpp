@@ -22,9 +22,9 @@ Command command(Command::Kind kind, std::int64_t seq, double psi_m_Wb = 0.0, dou
 
 struct Rig {
   DaemonConfig config = builtin_daemon_config();
-  SpscQueue<SourceSample> input{16384};
-  SpscQueue<Command> commands{16};
-  SpscQueue<Report> output{65536};
+  SpscQueue<SourceSample>::Producer input;
+  SpscQueue<Command>::Producer commands;
+  SpscQueue<Report>::Consumer output;
   std::unique_ptr<LoopThread> loop;
   test::ModelDataGenerator gen;
   core::PerUnitBase base = test::paper_base();
@@ -36,8 +36,17 @@ struct Rig {
     gen.plant = test::paper_machine_pu();
     gen.omega_n_rad_s = base.omega_el_rad_s;
   }
-  /// A new loop with the (changed) configuration.
-  void rebuild() { loop = std::make_unique<LoopThread>(config, LoopThread::Queues{input, commands, output}); }
+  /// A new loop with the (changed) configuration, and new queues to it.
+  void rebuild() {
+    auto samples = SpscQueue<SourceSample>::make(16384);
+    auto to_loop = SpscQueue<Command>::make(16);
+    auto reports = SpscQueue<Report>::make(65536);
+    loop = std::make_unique<LoopThread>(
+        config, LoopThread::Queues{std::move(samples.consumer), std::move(to_loop.consumer), std::move(reports.producer)});
+    input = std::move(samples.producer);
+    commands = std::move(to_loop.producer);
+    output = std::move(reports.consumer);
+  }
   /// Feeds `seconds` of samples, processing every millisecond as the loop would.
   void run(double seconds) {
     const int ms = static_cast<int>(seconds * 1000);

@@ -35,10 +35,14 @@ namespace {
 
 TEST(LoopAllocations, NoneInTheLoopsPeriodWork) {
   DaemonConfig config = builtin_daemon_config();
-  SpscQueue<SourceSample> input(4096);
-  SpscQueue<Command> commands(16);
-  SpscQueue<Report> output(1 << 16);
-  LoopThread loop(config, LoopThread::Queues{input, commands, output});
+  auto samples = SpscQueue<SourceSample>::make(4096);
+  auto to_loop = SpscQueue<Command>::make(16);
+  auto reports = SpscQueue<Report>::make(1 << 16);
+  auto& input = samples.producer;
+  auto& commands = to_loop.producer;
+  auto& output = reports.consumer;
+  LoopThread loop(config,
+                  LoopThread::Queues{std::move(samples.consumer), std::move(to_loop.consumer), std::move(reports.producer)});
   loop.seed(SeedValue{1.1, 4.0}, SeedValue{2.3, 4.0}, 1'000'000'000);
   test::ModelDataGenerator gen;
   gen.plant = test::paper_machine_pu();
@@ -84,10 +88,14 @@ TEST(LoopAllocations, NoneInTheLoopsPeriodWork) {
 TEST(LoopAllocations, NoneOnTheAveragedPath) {
   DaemonConfig config = builtin_daemon_config();
   config.fixed.source = VescSource::Options{};
-  SpscQueue<SourceSample> input(4096);
-  SpscQueue<Command> commands(16);
-  SpscQueue<Report> output(1 << 16);
-  LoopThread loop(config, LoopThread::Queues{input, commands, output});
+  auto samples = SpscQueue<SourceSample>::make(4096);
+  auto to_loop = SpscQueue<Command>::make(16);
+  auto reports = SpscQueue<Report>::make(1 << 16);
+  auto& input = samples.producer;
+  auto& commands = to_loop.producer;
+  auto& output = reports.consumer;
+  LoopThread loop(config,
+                  LoopThread::Queues{std::move(samples.consumer), std::move(to_loop.consumer), std::move(reports.producer)});
   test::AveragedDataGenerator gen;
   gen.base = test::paper_base();
   gen.plant = test::paper_machine_pu();

@@ -87,7 +87,7 @@ class CommandGate {
   };
 
   /// `last_accepted_seq`: as persisted by `store` (nullptr: not persisted — tests).
-  CommandGate(const CommandPolicy& policy, SpscQueue<Command>& to_loop, CommandKeys keys = {},
+  CommandGate(const CommandPolicy& policy, SpscQueue<Command>::Producer& to_loop, CommandKeys keys = {},
               std::int64_t last_accepted_seq = 0, SequenceStore* store = nullptr) noexcept
       : policy_(policy),
         to_loop_(to_loop),
@@ -117,7 +117,7 @@ class CommandGate {
 
  private:
   CommandPolicy policy_;
-  SpscQueue<Command>& to_loop_;
+  SpscQueue<Command>::Producer& to_loop_;  ///< the control thread's (Control holds it)
   const CommandKeys keys_;
   SequenceStore* store_;
   Counters counters_;

@@ -44,9 +44,9 @@ struct SeedValue {
 class LoopThread {
  public:
   struct Queues {
-    SpscQueue<SourceSample>& samples;  ///< from the source thread
-    SpscQueue<Command>& commands;           ///< from the control thread
-    SpscQueue<Report>& reports;             ///< to the publisher
+    SpscQueue<SourceSample>::Consumer samples;  ///< from the source thread
+    SpscQueue<Command>::Consumer commands;      ///< from the control thread
+    SpscQueue<Report>::Producer reports;        ///< to the publisher
   };
 
   LoopThread(const DaemonConfig& config, Queues queues);

@@ -39,9 +39,9 @@ struct PublisherCounters {
 class PersistingPublisher {
  public:
   struct Queues {
-    SpscQueue<Report>& loop;
-    SpscQueue<SourceReport>& source;
-    SpscQueue<ControlReport>& control;
+    SpscQueue<Report>::Consumer loop;
+    SpscQueue<SourceReport>::Consumer source;
+    SpscQueue<ControlReport>::Consumer control;
   };
   struct Identity {
     std::string source_type;  ///< diagnostics_t.source

@@ -1,8 +1,14 @@
 #pragma once
-// Lock-free single-producer single-consumer ring buffer: the only way data crosses between rpemd's
-// threads. Capacity fixed at construction (a power of two), storage allocated once; push and pop are
-// wait-free, noexcept, allocation-free and real-time safe. A full queue refuses the item (the caller
-// counts the drop): a slow consumer never blocks the producer.
+// Lock-free single-producer single-consumer ring buffer: how rpemd's threads hand each other samples,
+// commands and reports (beside it only a few atomics cross: the stop flags, the loop's heartbeat and
+// calibrated wake-ahead, its started flag; docs/rpemd.md, "Threads").
+// A queue is made with its two ends, and only so: SpscQueue<T>::make(capacity) returns one Producer and
+// one Consumer, each move-only. Whoever holds the producer is the queue's one producer, whoever holds the
+// consumer its one consumer; a second producer or consumer of a queue does not compile (copying an end
+// is deleted; tests/compile_fail/). The ends share the storage: it lives until both are gone.
+// Capacity fixed at construction (a power of two), storage allocated once; push and pop are wait-free,
+// noexcept, allocation-free and real-time safe. A full queue refuses the item (the caller counts the
+// drop): a slow consumer never blocks the producer.
 
 #include <atomic>
 #include <cstddef>
@@ -19,11 +25,66 @@ class SpscQueue {
   static_assert(std::is_copy_assignable_v<T>, "items are copied in and out");
 
  public:
-  /// Capacity is rounded up to a power of two. Allocates; call at start-up only.
-  explicit SpscQueue(std::size_t capacity)
-      : mask_(round_up(capacity) - 1), slots_(std::make_unique<T[]>(mask_ + 1)) {}
+  /// The end that pushes. Default-constructed or moved from: the end of no queue.
+  class Producer {
+   public:
+    Producer() noexcept = default;
+    Producer(Producer&&) noexcept = default;
+    Producer& operator=(Producer&&) noexcept = default;
+    Producer(const Producer&) = delete;             // one producer per queue
+    Producer& operator=(const Producer&) = delete;  // one producer per queue
 
-  /// Producer side. False if the queue is full (the item is not stored).
+    /// False if the queue is full (the item is not stored).
+    bool push(const T& item) noexcept { return queue_->push(item); }
+    /// Items in the queue (approximate while the consumer pops).
+    [[nodiscard]] std::size_t size() const noexcept { return queue_->size(); }
+    [[nodiscard]] std::size_t capacity() const noexcept { return queue_->capacity(); }
+
+   private:
+    friend SpscQueue;
+    explicit Producer(std::shared_ptr<SpscQueue> queue) noexcept : queue_(std::move(queue)) {}
+    std::shared_ptr<SpscQueue> queue_;
+  };
+
+  /// The end that pops. Default-constructed or moved from: the end of no queue.
+  class Consumer {
+   public:
+    Consumer() noexcept = default;
+    Consumer(Consumer&&) noexcept = default;
+    Consumer& operator=(Consumer&&) noexcept = default;
+    Consumer(const Consumer&) = delete;             // one consumer per queue
+    Consumer& operator=(const Consumer&) = delete;  // one consumer per queue
+
+    /// False if the queue is empty.
+    bool pop(T& item) noexcept { return queue_->pop(item); }
+    /// Items in the queue (approximate while the producer pushes).
+    [[nodiscard]] std::size_t size() const noexcept { return queue_->size(); }
+    [[nodiscard]] std::size_t capacity() const noexcept { return queue_->capacity(); }
+
+   private:
+    friend SpscQueue;
+    explicit Consumer(std::shared_ptr<SpscQueue> queue) noexcept : queue_(std::move(queue)) {}
+    std::shared_ptr<SpscQueue> queue_;
+  };
+
+  struct Ends {
+    Producer producer;
+    Consumer consumer;
+  };
+
+  /// A queue of `capacity` items (rounded up to a power of two) and its two ends. Allocates; call at
+  /// start-up only.
+  [[nodiscard]] static Ends make(std::size_t capacity) {
+    const std::shared_ptr<SpscQueue> queue(new SpscQueue(capacity));
+    return {Producer(queue), Consumer(queue)};
+  }
+
+  SpscQueue(const SpscQueue&) = delete;
+  SpscQueue& operator=(const SpscQueue&) = delete;
+
+ private:
+  explicit SpscQueue(std::size_t capacity) : mask_(round_up(capacity) - 1), slots_(std::make_unique<T[]>(mask_ + 1)) {}
+
   bool push(const T& item) noexcept {
     const std::size_t head = head_.load(std::memory_order_relaxed);
     if (head - tail_cache_ > mask_) {
@@ -35,7 +96,6 @@ class SpscQueue {
     return true;
   }
 
-  /// Consumer side. False if the queue is empty.
   bool pop(T& item) noexcept {
     const std::size_t tail = tail_.load(std::memory_order_relaxed);
     if (tail == head_cache_) {
@@ -47,13 +107,11 @@ class SpscQueue {
     return true;
   }
 
-  /// Items in the queue (approximate while the other side runs).
   [[nodiscard]] std::size_t size() const noexcept {
     return head_.load(std::memory_order_acquire) - tail_.load(std::memory_order_acquire);
   }
   [[nodiscard]] std::size_t capacity() const noexcept { return mask_ + 1; }
 
- private:
   static std::size_t round_up(std::size_t n) {
     std::size_t c = 2;
     while (c < n) c <<= 1;
