@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 
+#include "rpem/core/assert.hpp"
 #include "rpem/core/clock.hpp"
 #include "rpem/daemon/realtime.hpp"
 
@@ -83,6 +84,8 @@ void LoopThread::apply(const Command& c) noexcept {
       break;
   }
   if (c.seq > 0) {
+    // Counted where assertions are off: the control thread admits commands in increasing order only.
+    RPEM_ASSERT(c.seq > last_applied_seq_, "commands arrive in the order the control thread admitted them");
     if (c.seq <= last_applied_seq_) ++counters_.command_sequence_errors;
     last_applied_seq_ = c.seq;
     ++counters_.commands_applied;

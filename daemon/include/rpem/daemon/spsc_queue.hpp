@@ -5,7 +5,9 @@
 // A queue is made with its two ends, and only so: SpscQueue<T>::make(capacity) returns one Producer and
 // one Consumer, each move-only. Whoever holds the producer is the queue's one producer, whoever holds the
 // consumer its one consumer; a second producer or consumer of a queue does not compile (copying an end
-// is deleted; tests/compile_fail/). The ends share the storage: it lives until both are gone.
+// is deleted; tests/compile_fail/). The ends share the storage: it lives until both are gone. Where
+// assertions are on (rpem/core/assert.hpp), each end also checks that one thread uses it: the first to
+// push (pop) after it was made or handed over.
 // Capacity fixed at construction (a power of two), storage allocated once; push and pop are wait-free,
 // noexcept, allocation-free and real-time safe. A full queue refuses the item (the caller counts the
 // drop): a slow consumer never blocks the producer.
@@ -15,7 +17,10 @@
 #include <cstdint>
 #include <memory>
 #include <new>
+#include <thread>
 #include <type_traits>
+
+#include "rpem/core/assert.hpp"
 
 namespace rpem::daemon {
 
@@ -24,18 +29,44 @@ class SpscQueue {
   // Items are copied in and out; fixed-size Eigen members copy without allocating or throwing.
   static_assert(std::is_copy_assignable_v<T>, "items are copied in and out");
 
+  /// Where assertions are on: the thread that uses an end — the first to use it after it was made or
+  /// handed over — and the check that every later use is on it. Empty, and no check, elsewhere.
+  class OneThread {
+   public:
+    void check() noexcept {
+#if RPEM_ASSERTIONS
+      const std::thread::id me = std::this_thread::get_id();
+      if (id_ == std::thread::id()) id_ = me;
+      RPEM_ASSERT(id_ == me, "an end of an SpscQueue is used by one thread: the queue's one producer (consumer)");
+#endif
+    }
+
+#if RPEM_ASSERTIONS
+   private:
+    std::thread::id id_;
+#endif
+  };
+
  public:
   /// The end that pushes. Default-constructed or moved from: the end of no queue.
   class Producer {
    public:
     Producer() noexcept = default;
-    Producer(Producer&&) noexcept = default;
-    Producer& operator=(Producer&&) noexcept = default;
+    Producer(Producer&& other) noexcept : queue_(std::move(other.queue_)) {}
+    Producer& operator=(Producer&& other) noexcept {
+      queue_ = std::move(other.queue_);
+      user_ = {};
+      return *this;
+    }
     Producer(const Producer&) = delete;             // one producer per queue
     Producer& operator=(const Producer&) = delete;  // one producer per queue
 
     /// False if the queue is full (the item is not stored).
-    bool push(const T& item) noexcept { return queue_->push(item); }
+    bool push(const T& item) noexcept {
+      RPEM_ASSERT(queue_ != nullptr, "push through the producer of a queue, not a default-constructed or moved-from one");
+      user_.check();
+      return queue_->push(item);
+    }
     /// Items in the queue (approximate while the consumer pops).
     [[nodiscard]] std::size_t size() const noexcept { return queue_->size(); }
     [[nodiscard]] std::size_t capacity() const noexcept { return queue_->capacity(); }
@@ -44,19 +75,28 @@ class SpscQueue {
     friend SpscQueue;
     explicit Producer(std::shared_ptr<SpscQueue> queue) noexcept : queue_(std::move(queue)) {}
     std::shared_ptr<SpscQueue> queue_;
+    [[no_unique_address]] OneThread user_;
   };
 
   /// The end that pops. Default-constructed or moved from: the end of no queue.
   class Consumer {
    public:
     Consumer() noexcept = default;
-    Consumer(Consumer&&) noexcept = default;
-    Consumer& operator=(Consumer&&) noexcept = default;
+    Consumer(Consumer&& other) noexcept : queue_(std::move(other.queue_)) {}
+    Consumer& operator=(Consumer&& other) noexcept {
+      queue_ = std::move(other.queue_);
+      user_ = {};
+      return *this;
+    }
     Consumer(const Consumer&) = delete;             // one consumer per queue
     Consumer& operator=(const Consumer&) = delete;  // one consumer per queue
 
     /// False if the queue is empty.
-    bool pop(T& item) noexcept { return queue_->pop(item); }
+    bool pop(T& item) noexcept {
+      RPEM_ASSERT(queue_ != nullptr, "pop from the consumer of a queue, not a default-constructed or moved-from one");
+      user_.check();
+      return queue_->pop(item);
+    }
     /// Items in the queue (approximate while the producer pushes).
     [[nodiscard]] std::size_t size() const noexcept { return queue_->size(); }
     [[nodiscard]] std::size_t capacity() const noexcept { return queue_->capacity(); }
@@ -65,6 +105,7 @@ class SpscQueue {
     friend SpscQueue;
     explicit Consumer(std::shared_ptr<SpscQueue> queue) noexcept : queue_(std::move(queue)) {}
     std::shared_ptr<SpscQueue> queue_;
+    [[no_unique_address]] OneThread user_;
   };
 
   struct Ends {
