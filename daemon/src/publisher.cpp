@@ -63,7 +63,7 @@ PersistingPublisher::PersistingPublisher(const FixedConfig& config, Identity ide
                                          std::optional<auth::Key> publish_key)
     : config_(config),
       identity_(std::move(identity)),
-      publish_key_(publish_key),
+      publish_key_(std::move(publish_key)),
       queues_(std::move(queues)),
       buffer_(8192),
       estimate_channel_(config.lcm.channel_prefix + "RPEM_ESTIMATE"),
@@ -76,7 +76,7 @@ PersistingPublisher::~PersistingPublisher() = default;
 template <class Message>
 void PersistingPublisher::publish(const std::string& channel, Message& m) {
   constexpr bool kAuthenticated = requires { m.key_id; };
-  if constexpr (kAuthenticated) m.key_id = publish_key_ ? publish_key_->id : 0;
+  if constexpr (kAuthenticated) m.key_id = publish_key_ ? publish_key_->id() : 0;
   const int size = m.encode(buffer_.data(), 0, static_cast<int>(buffer_.size()));
   // Signed in the buffer, on this thread: the tag over the encoding (rpem/auth/mac.hpp), no allocation.
   if constexpr (kAuthenticated) {

@@ -3,6 +3,7 @@
 // validity and age tracking — counted by replacing the global allocation functions.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <atomic>
 #include <cstdlib>
 #include <new>
@@ -143,12 +144,12 @@ TEST(LoopAllocations, NoneInCommandAdmission) {
   m.command = rpem::command_t::SET_VALUES;
   m.psi_m_Wb = 1.1;
   m.r_s_Ohm = 2.3;
-  auth::Key key;
-  key.id = 3;
-  key.bytes.fill(0x42);
+  std::array<std::uint8_t, auth::kKeyBytes> key_bytes{};
+  key_bytes.fill(0x42);
+  const auth::Key key(3, key_bytes);  // the supervisor's
   auth::Keyring keys;
-  ASSERT_TRUE(keys.add(key));
-  m.key_id = key.id;
+  ASSERT_TRUE(keys.add(auth::Key(3, key_bytes)));  // rpemd's
+  m.key_id = key.id();
   std::vector<std::uint8_t> bytes(static_cast<std::size_t>(m.getEncodedSize()));
   ASSERT_EQ(m.encode(bytes.data(), 0, static_cast<int>(bytes.size())), static_cast<int>(bytes.size()));
   ASSERT_TRUE(auth::sign(key, "RPEM_COMMAND", bytes));

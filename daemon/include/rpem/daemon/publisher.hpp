@@ -76,7 +76,7 @@ class PersistingPublisher {
 
   const FixedConfig config_;
   const Identity identity_;
-  const std::optional<auth::Key> publish_key_;
+  const std::optional<auth::Key> publish_key_;  ///< the one copy, in locked memory (rpem/auth/key.hpp)
   Queues queues_;
   PublisherCounters counters_;
   std::unique_ptr<Lcm> lcm_;
