@@ -9,6 +9,7 @@
 #include "rpem/core/clock.hpp"
 #include "rpem/daemon/loop_thread.hpp"
 #include "support/averaged_data.hpp"
+#include "support/loop_queues.hpp"
 #include "support/model_data.hpp"
 #include "support/paper_machine.hpp"
 
@@ -17,11 +18,9 @@ namespace {
 
 struct AveragedRig {
   DaemonConfig config = builtin_daemon_config();
-  SpscQueue<SourceSample>::Ends samples = SpscQueue<SourceSample>::make(16384);
-  SpscQueue<Command>::Ends to_loop = SpscQueue<Command>::make(16);
-  SpscQueue<Report>::Ends reports = SpscQueue<Report>::make(65536);
-  SpscQueue<SourceSample>::Producer& input = samples.producer;
-  SpscQueue<Report>::Consumer& output = reports.consumer;
+  test::LoopQueues queues = test::loop_queues(16384, 16, 65536);
+  SpscQueue<SourceSample>::Producer& input = queues.input;
+  SpscQueue<Report>::Consumer& output = queues.output;
   std::unique_ptr<LoopThread> loop;
   test::AveragedDataGenerator gen;
   std::int64_t now_ns = 1'000'000'000;
@@ -31,8 +30,7 @@ struct AveragedRig {
 
   explicit AveragedRig(double rate_Hz, double psi_scale = 1.0) {
     config.fixed.source = VescSource::Options{};
-    loop = std::make_unique<LoopThread>(config, LoopThread::Queues{std::move(samples.consumer), std::move(to_loop.consumer),
-                                                                   std::move(reports.producer)});
+    loop = std::make_unique<LoopThread>(config, std::move(queues.loop));
     gen.base = test::paper_base();
     gen.plant = test::paper_machine_pu();
     gen.plant.psi_m_pu *= psi_scale;

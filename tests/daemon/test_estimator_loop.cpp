@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "rpem/daemon/loop_thread.hpp"
+#include "support/loop_queues.hpp"
 #include "support/model_data.hpp"
 #include "support/paper_machine.hpp"
 
@@ -38,14 +39,11 @@ struct Rig {
   }
   /// A new loop with the (changed) configuration, and new queues to it.
   void rebuild() {
-    auto samples = SpscQueue<SourceSample>::make(16384);
-    auto to_loop = SpscQueue<Command>::make(16);
-    auto reports = SpscQueue<Report>::make(65536);
-    loop = std::make_unique<LoopThread>(
-        config, LoopThread::Queues{std::move(samples.consumer), std::move(to_loop.consumer), std::move(reports.producer)});
-    input = std::move(samples.producer);
-    commands = std::move(to_loop.producer);
-    output = std::move(reports.consumer);
+    test::LoopQueues queues = test::loop_queues(16384, 16, 65536);
+    loop = std::make_unique<LoopThread>(config, std::move(queues.loop));
+    input = std::move(queues.input);
+    commands = std::move(queues.commands);
+    output = std::move(queues.output);
   }
   /// Feeds `seconds` of samples, processing every millisecond as the loop would.
   void run(double seconds) {

@@ -12,6 +12,7 @@
 #include "rpem/daemon/command_gate.hpp"
 #include "rpem/daemon/loop_thread.hpp"
 #include "support/averaged_data.hpp"
+#include "support/loop_queues.hpp"
 #include "support/model_data.hpp"
 #include "support/paper_machine.hpp"
 
@@ -36,14 +37,8 @@ namespace {
 
 TEST(LoopAllocations, NoneInTheLoopsPeriodWork) {
   DaemonConfig config = builtin_daemon_config();
-  auto samples = SpscQueue<SourceSample>::make(4096);
-  auto to_loop = SpscQueue<Command>::make(16);
-  auto reports = SpscQueue<Report>::make(1 << 16);
-  auto& input = samples.producer;
-  auto& commands = to_loop.producer;
-  auto& output = reports.consumer;
-  LoopThread loop(config,
-                  LoopThread::Queues{std::move(samples.consumer), std::move(to_loop.consumer), std::move(reports.producer)});
+  auto [input, commands, output, ends] = test::loop_queues(4096, 16, 1 << 16);
+  LoopThread loop(config, std::move(ends));
   loop.seed(SeedValue{1.1, 4.0}, SeedValue{2.3, 4.0}, 1'000'000'000);
   test::ModelDataGenerator gen;
   gen.plant = test::paper_machine_pu();
@@ -89,14 +84,8 @@ TEST(LoopAllocations, NoneInTheLoopsPeriodWork) {
 TEST(LoopAllocations, NoneOnTheAveragedPath) {
   DaemonConfig config = builtin_daemon_config();
   config.fixed.source = VescSource::Options{};
-  auto samples = SpscQueue<SourceSample>::make(4096);
-  auto to_loop = SpscQueue<Command>::make(16);
-  auto reports = SpscQueue<Report>::make(1 << 16);
-  auto& input = samples.producer;
-  auto& commands = to_loop.producer;
-  auto& output = reports.consumer;
-  LoopThread loop(config,
-                  LoopThread::Queues{std::move(samples.consumer), std::move(to_loop.consumer), std::move(reports.producer)});
+  auto [input, commands, output, ends] = test::loop_queues(4096, 16, 1 << 16);
+  LoopThread loop(config, std::move(ends));
   test::AveragedDataGenerator gen;
   gen.base = test::paper_base();
   gen.plant = test::paper_machine_pu();

@@ -29,83 +29,70 @@ class SpscQueue {
   // Items are copied in and out; fixed-size Eigen members copy without allocating or throwing.
   static_assert(std::is_copy_assignable_v<T>, "items are copied in and out");
 
-  /// Where assertions are on: the thread that uses an end — the first to use it after it was made or
-  /// handed over — and the check that every later use is on it. Empty, and no check, elsewhere.
-  class OneThread {
+  /// What both ends are: a share of the queue, move-only (copying one would make a second producer or
+  /// consumer), and — where assertions are on (rpem/core/assert.hpp) — used by one thread: the first to
+  /// use it after it was made or handed over. Default-constructed or moved from: the end of no queue.
+  class End {
    public:
-    void check() noexcept {
+    End() noexcept = default;
+    End(End&& other) noexcept : queue_(std::move(other.queue_)) {}  // handed over: a new first user
+    End& operator=(End&& other) noexcept {
+      queue_ = std::move(other.queue_);
+#if RPEM_ASSERTIONS
+      user_ = {};
+#endif
+      return *this;
+    }
+    End(const End&) = delete;
+    End& operator=(const End&) = delete;
+
+    /// Items in the queue (approximate while the other end runs).
+    [[nodiscard]] std::size_t size() const noexcept { return queue_->size(); }
+    [[nodiscard]] std::size_t capacity() const noexcept { return queue_->capacity(); }
+
+   protected:
+    explicit End(std::shared_ptr<SpscQueue> queue) noexcept : queue_(std::move(queue)) {}
+    /// The queue, for this end's one thread.
+    SpscQueue& use() noexcept {
+      RPEM_ASSERT(queue_ != nullptr, "an end of a queue is used, not a default-constructed or moved-from one");
 #if RPEM_ASSERTIONS
       const std::thread::id me = std::this_thread::get_id();
-      if (id_ == std::thread::id()) id_ = me;
-      RPEM_ASSERT(id_ == me, "an end of an SpscQueue is used by one thread: the queue's one producer (consumer)");
+      if (user_ == std::thread::id()) user_ = me;
+      RPEM_ASSERT(user_ == me, "an end of an SpscQueue is used by one thread: the queue's one producer (consumer)");
 #endif
+      return *queue_;
     }
 
-#if RPEM_ASSERTIONS
    private:
-    std::thread::id id_;
+    std::shared_ptr<SpscQueue> queue_;
+#if RPEM_ASSERTIONS
+    std::thread::id user_;  ///< the end's one thread, once it has been used
 #endif
   };
 
  public:
-  /// The end that pushes. Default-constructed or moved from: the end of no queue.
-  class Producer {
+  /// The end that pushes: the queue's one producer.
+  class Producer : public End {
    public:
     Producer() noexcept = default;
-    Producer(Producer&& other) noexcept : queue_(std::move(other.queue_)) {}
-    Producer& operator=(Producer&& other) noexcept {
-      queue_ = std::move(other.queue_);
-      user_ = {};
-      return *this;
-    }
-    Producer(const Producer&) = delete;             // one producer per queue
-    Producer& operator=(const Producer&) = delete;  // one producer per queue
-
     /// False if the queue is full (the item is not stored).
-    bool push(const T& item) noexcept {
-      RPEM_ASSERT(queue_ != nullptr, "push through the producer of a queue, not a default-constructed or moved-from one");
-      user_.check();
-      return queue_->push(item);
-    }
-    /// Items in the queue (approximate while the consumer pops).
-    [[nodiscard]] std::size_t size() const noexcept { return queue_->size(); }
-    [[nodiscard]] std::size_t capacity() const noexcept { return queue_->capacity(); }
+    bool push(const T& item) noexcept { return this->use().push(item); }
 
    private:
     friend SpscQueue;
-    explicit Producer(std::shared_ptr<SpscQueue> queue) noexcept : queue_(std::move(queue)) {}
-    std::shared_ptr<SpscQueue> queue_;
-    [[no_unique_address]] OneThread user_;
+    explicit Producer(std::shared_ptr<SpscQueue> queue) noexcept : End(std::move(queue)) {}
   };
 
-  /// The end that pops. Default-constructed or moved from: the end of no queue.
-  class Consumer {
+  /// The end that pops: the queue's one consumer.
+  class Consumer : public End {
    public:
     Consumer() noexcept = default;
-    Consumer(Consumer&& other) noexcept : queue_(std::move(other.queue_)) {}
-    Consumer& operator=(Consumer&& other) noexcept {
-      queue_ = std::move(other.queue_);
-      user_ = {};
-      return *this;
-    }
-    Consumer(const Consumer&) = delete;             // one consumer per queue
-    Consumer& operator=(const Consumer&) = delete;  // one consumer per queue
-
     /// False if the queue is empty.
-    bool pop(T& item) noexcept {
-      RPEM_ASSERT(queue_ != nullptr, "pop from the consumer of a queue, not a default-constructed or moved-from one");
-      user_.check();
-      return queue_->pop(item);
-    }
-    /// Items in the queue (approximate while the producer pushes).
-    [[nodiscard]] std::size_t size() const noexcept { return queue_->size(); }
-    [[nodiscard]] std::size_t capacity() const noexcept { return queue_->capacity(); }
+    bool pop(T& item) noexcept { return this->use().pop(item); }
 
    private:
     friend SpscQueue;
-    explicit Consumer(std::shared_ptr<SpscQueue> queue) noexcept : queue_(std::move(queue)) {}
-    std::shared_ptr<SpscQueue> queue_;
-    [[no_unique_address]] OneThread user_;
+    explicit Consumer(std::shared_ptr<SpscQueue> queue) noexcept : End(std::move(queue)) {}
   };
 
   struct Ends {
