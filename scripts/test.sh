@@ -8,14 +8,19 @@
 #   4. builds rpemd and the daemon's tests with ThreadSanitizer and runs them — the storm test drives
 #      the instrumented rpemd with reloads and commands at once — expecting no report (suppressed: only
 #      the uninstrumented LCM/GLib internals, tests/daemon/tsan.supp)
+#   5. the format and lint gates (scripts/lint.py; docs/architecture.md, "Format and lint"): clang-format
+#      first (seconds), clang-tidy over the project's own translation units of build/ci last
 # The sanitizer trees of 3 and 4 compile at nice 19 while step 2's tests run: they take only the CPU the
 # tests leave idle (the VM suites' real-time pacing, the serial package test, the last test's tail) and
 # yield it otherwise (CFS weight 15 against 1024), so a test's share of the CPU is what it was without them.
+# clang-tidy (about 25 min of CPU, docs/benchmarks.md) follows them at nice 19 too: it takes what the ctest
+# stage, the sanitizer builds and their tests leave idle, and nothing from a test.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 jobs=$(nproc)
 
 scripts/setup.sh
+scripts/lint.py --format
 
 cmake -S . -B build/ci -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DRPEM_WERROR=ON
 cmake --build build/ci -j "$jobs"
@@ -30,19 +35,23 @@ sanitizer_builds() {
   cmake --build build/tsan -j "$jobs" --target rpemd test_daemon test_daemon_allocations test_daemon_storm
 }
 sanitizer_log=build/sanitizer-builds.log
+tidy_log=build/lint-tidy.log
 set -m  # the builds in a process group of their own, so that a failing ctest stops all of them
 (renice -n 19 -p "$BASHPID" >/dev/null && sanitizer_builds) </dev/null >"$sanitizer_log" 2>&1 &
 sanitizer_pid=$!
+# clang-tidy once the sanitizer builds are done (they gate the sanitizer tests; it gates nothing)
+(renice -n 19 -p "$BASHPID" >/dev/null && while kill -0 "$sanitizer_pid" 2>/dev/null; do sleep 5; done &&
+  scripts/lint.py --tidy -p build/ci -j "$jobs") </dev/null >"$tidy_log" 2>&1 &
+tidy_pid=$!
 set +m
-trap 'kill -- "-$sanitizer_pid" 2>/dev/null || true' EXIT
-ctest --test-dir build/ci --output-on-failure -j "$jobs" --timeout 1800
+trap 'kill -- "-$sanitizer_pid" "-$tidy_pid" 2>/dev/null || true' EXIT
+ctest --test-dir build/ci --output-on-failure -j "$jobs" --timeout 1800 -LE lint
 echo "test.sh: waiting for the sanitizer builds (log: $sanitizer_log)"
 if ! wait "$sanitizer_pid"; then
   cat "$sanitizer_log"
   echo "test.sh: the sanitizer builds failed" >&2
   exit 1
 fi
-trap - EXIT
 
 UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1 ASAN_OPTIONS=detect_leaks=1 \
   ctest --test-dir build/sanitize --output-on-failure -j "$jobs" -L unit
@@ -50,4 +59,12 @@ for t in test_daemon test_daemon_allocations test_daemon_storm; do
   TSAN_OPTIONS="suppressions=$PWD/tests/daemon/tsan.supp halt_on_error=1 second_deadlock_stack=1" \
     "build/tsan/tests/daemon/$t" --gtest_brief=1
 done
+echo "test.sh: waiting for clang-tidy (log: $tidy_log)"
+if ! wait "$tidy_pid"; then
+  cat "$tidy_log"
+  echo "test.sh: clang-tidy found something (scripts/lint.py --tidy -p build/ci lists it)" >&2
+  exit 1
+fi
+trap - EXIT
+tail -n 1 "$tidy_log"
 echo "test.sh: all tests passed"
