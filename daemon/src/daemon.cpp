@@ -54,8 +54,8 @@ Daemon::~Daemon() {
 void Daemon::seed_from_state_file() {
   const core::EstimatorSettings& est = config_.live.machine.estimator;
   const std::string path = resolve_state_file(config_.fixed.state);
-  const LoadedState loaded =
-      load_state_file(path, config_.fixed.state.max_age_s, est.psi_m_min_Wb, est.psi_m_max_Wb, est.r_s_min_Ohm, est.r_s_max_Ohm);
+  const LoadedState loaded = load_state_file(path, config_.fixed.state.max_age_s, est.psi_m_min_Wb, est.psi_m_max_Wb,
+                                             est.r_s_min_Ohm, est.r_s_max_Ohm);
   state_file_status_ = loaded.status;
   if (loaded.status != StateFileStatus::kNone) std::fprintf(stderr, "rpemd: %s\n", loaded.message.c_str());
   if (loaded.status != StateFileStatus::kLoaded) return;
@@ -111,7 +111,8 @@ int Daemon::run() {
   if (fixed.loop.lock_memory && realtime) {
     const std::string problem = lock_memory();
     if (!problem.empty()) {
-      std::fprintf(stderr, required ? "rpemd: %s\n" : "rpemd: warning: %s; continuing without locked memory\n", problem.c_str());
+      std::fprintf(stderr, required ? "rpemd: %s\n" : "rpemd: warning: %s; continuing without locked memory\n",
+                   problem.c_str());
       if (required) return io::kExitSoftware;
     }
   }
@@ -125,7 +126,8 @@ int Daemon::run() {
   const std::string signing =
       keys.publish ? "signed with key id " + std::to_string(keys.publish->id()) : std::string("unsigned (no publish key)");
   loop_ = std::make_unique<LoopThread>(
-      config_, LoopThread::Queues{std::move(samples_.consumer), std::move(commands_.consumer), std::move(reports_.producer)});
+      config_,
+      LoopThread::Queues{std::move(samples_.consumer), std::move(commands_.consumer), std::move(reports_.producer)});
   seed_from_state_file();
   const char* source_type = SourceCatalogue::type(fixed.source);
   publisher_ = std::make_unique<PersistingPublisher>(
@@ -151,7 +153,8 @@ int Daemon::run() {
   });
 
   char wake_ahead[32];
-  std::snprintf(wake_ahead, sizeof wake_ahead, fixed.loop.wake_ahead_auto ? "auto" : "%.0f µs", fixed.loop.wake_ahead_s * 1e6);
+  std::snprintf(wake_ahead, sizeof wake_ahead, fixed.loop.wake_ahead_auto ? "auto" : "%.0f µs",
+                fixed.loop.wake_ahead_s * 1e6);
   std::fprintf(stderr,
                "rpemd: source %s '%s', loop %.0f µs (realtime %s, wake-ahead %s), machine %s, algorithm %s, LCM %s, "
                "channels %sRPEM_*, commands %s, state file %s\n",
@@ -171,9 +174,10 @@ int Daemon::run() {
   sd_notifyf(0, "READY=1\nSTATUS=estimating from %s", source_name_.c_str());
 
   {
-    Control control(std::move(config_), [this] { return load_configuration(options_); },
-                    Control::Queues{std::move(commands_.producer), std::move(control_reports_.producer)}, loop_->timer(),
-                    std::move(commands));
+    Control control(
+        std::move(config_), [this] { return load_configuration(options_); },
+        Control::Queues{std::move(commands_.producer), std::move(control_reports_.producer)}, loop_->timer(),
+        std::move(commands));
     (void)control.run(signal_fd);
     config_ = control.running();
   }
