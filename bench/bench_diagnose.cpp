@@ -11,8 +11,8 @@
 #include <vector>
 
 #include "rpem/analysis/diagnose/diagnose_output.hpp"
-#include "rpem/io/drive_log.hpp"
 #include "support/hidden_effects.hpp"
+#include "rpem/io/drive_log.hpp"
 
 namespace {
 

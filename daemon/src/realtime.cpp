@@ -1,8 +1,8 @@
 #include "rpem/daemon/realtime.hpp"
 
-#include <fcntl.h>
 #include <pthread.h>
 #include <sched.h>
+#include <fcntl.h>
 #include <sys/mman.h>
 #include <unistd.h>
 
@@ -34,8 +34,7 @@ std::string apply_thread_policy(const ThreadPolicy& p) {
 
 std::string lock_memory() {
   if (mlockall(MCL_CURRENT | MCL_FUTURE) != 0) {
-    return std::string("mlockall: ") + std::strerror(errno) +
-           (errno == ENOMEM || errno == EPERM ? " (needs LimitMEMLOCK)" : "");
+    return std::string("mlockall: ") + std::strerror(errno) + (errno == ENOMEM || errno == EPERM ? " (needs LimitMEMLOCK)" : "");
   }
   return "";
 }

@@ -23,7 +23,8 @@ void FocController::reset() noexcept {
   rotation_.reset();
 }
 
-core::Vec2 FocController::field_weaken(core::Vec2 i_ref, double torque_Nm, double omega, double u_limit) const noexcept {
+core::Vec2 FocController::field_weaken(core::Vec2 i_ref, double torque_Nm, double omega,
+                                       double u_limit) const noexcept {
   // Voltage ellipse of the nominal model (R neglected; the margin covers it):
   //   (ω·L_q·i_q)² + (ω·(L_d·i_d + ψ_m))² ≤ u_limit²
   const double l_d = nominal_.l_d_H, l_q = nominal_.l_q_H, psi = nominal_.psi_m_Wb;
@@ -85,7 +86,8 @@ FocOutput FocController::step(const FocInput& in) noexcept {
   const double ki = wc * nominal_.r_s_Ohm;
   const core::Vec2 error = i_ref - i_dq;
   // Decoupling from the references: no extra feedback path through the measured currents.
-  const core::Vec2 feedforward(-omega * nominal_.l_q_H * i_ref[1], omega * (nominal_.l_d_H * i_ref[0] + nominal_.psi_m_Wb));
+  const core::Vec2 feedforward(-omega * nominal_.l_q_H * i_ref[1],
+                               omega * (nominal_.l_d_H * i_ref[0] + nominal_.psi_m_Wb));
   const core::Vec2 candidate_integral = integral_V_ + ki * t * error;
   core::Vec2 u_dq = kp.cwiseProduct(error) + candidate_integral + feedforward;
 

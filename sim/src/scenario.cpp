@@ -20,7 +20,7 @@ std::string resolve(const std::string& base_dir, const std::string& path) {
 
 void parse_inverter(io::YamlMap m, Scenario& s) {
   s.inverter.model = m.choice_or("model", "switching", {"switching", "averaged"}) == "averaged" ? InverterModel::kAveraged
-                                                                                                : InverterModel::kSwitching;
+                                                                                               : InverterModel::kSwitching;
   s.inverter.switching_frequency_Hz = m.number_or("switching_frequency_Hz", 4000.0, 100.0, 1e6);
   s.inverter.dead_time_s = m.number_or("dead_time_s", 0.0, 0.0, 1e-4);
   s.inverter.v_igbt_V = m.number_or("v_igbt_V", 0.0, 0.0, 100.0);
@@ -87,8 +87,8 @@ void parse_sensors(io::YamlMap m, Scenario& s) {
 }
 
 Quantity parse_quantity(io::YamlMap& m, const std::string& key) {
-  const std::string name = m.choice(
-      key, {"psi_m_Wb", "r_s_Ohm", "l_d_H", "l_q_H", "speed_rpm", "torque_Nm", "u_dc_V", "t_winding_C", "t_magnet_C"});
+  const std::string name = m.choice(key, {"psi_m_Wb", "r_s_Ohm", "l_d_H", "l_q_H", "speed_rpm", "torque_Nm", "u_dc_V",
+                                          "t_winding_C", "t_magnet_C"});
   for (std::size_t q = 0; q < kQuantityNames.size(); ++q) {
     if (name == kQuantityNames[q]) return static_cast<Quantity>(q);
   }

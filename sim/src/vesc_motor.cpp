@@ -15,7 +15,8 @@ double input_current_A(const ControlCycle& c) noexcept {
 
 }  // namespace
 
-VescMotor::VescMotor(Scenario scenario, Settings settings) : simulator_(std::move(scenario)), settings_(settings) {}
+VescMotor::VescMotor(Scenario scenario, Settings settings)
+    : simulator_(std::move(scenario)), settings_(settings) {}
 
 bool VescMotor::step() noexcept {
   if (!simulator_.next(row_, truth_)) return false;

@@ -102,13 +102,13 @@ TEST_P(Allocations, NoneAcrossOneHundredThousandSteps) {
   expect_no_allocations(est, samples);
 }
 
-INSTANTIATE_TEST_SUITE_P(EveryPath, Allocations,
-                         ::testing::Values(Case{Algorithm::kSga, GradientForm::kSteadyState, Discretization::kTrapezoidal},
-                                           Case{Algorithm::kSga, GradientForm::kDynamic, Discretization::kTrapezoidal},
-                                           Case{Algorithm::kGna, GradientForm::kSteadyState, Discretization::kTrapezoidal},
-                                           Case{Algorithm::kGna, GradientForm::kDynamic, Discretization::kExplicitEuler},
-                                           Case{Algorithm::kPhyInt, GradientForm::kSteadyState,
-                                                Discretization::kTrapezoidal}));
+INSTANTIATE_TEST_SUITE_P(
+    EveryPath, Allocations,
+    ::testing::Values(Case{Algorithm::kSga, GradientForm::kSteadyState, Discretization::kTrapezoidal},
+                      Case{Algorithm::kSga, GradientForm::kDynamic, Discretization::kTrapezoidal},
+                      Case{Algorithm::kGna, GradientForm::kSteadyState, Discretization::kTrapezoidal},
+                      Case{Algorithm::kGna, GradientForm::kDynamic, Discretization::kExplicitEuler},
+                      Case{Algorithm::kPhyInt, GradientForm::kSteadyState, Discretization::kTrapezoidal}));
 
 class AveragedAllocations : public ::testing::TestWithParam<Algorithm> {};
 

@@ -192,8 +192,8 @@ TEST(Conditioner, ObservationModelInvertsTheCorrections) {
   x.current_gain_error = Vec3(0.0, 0.03, -0.01);
   SampleConditioner c(b, test::paper_machine_pu(), x);
   const Vec3 i_true(2.0, -0.7, -1.3);  // a three-wire machine: no zero sequence
-  const DriveSample s =
-      sample(0, 2.1, Vec3::Zero(), i_true.cwiseProduct(Vec3::Ones() + x.current_gain_error) + x.current_offset_A);
+  const DriveSample s = sample(0, 2.1, Vec3::Zero(),
+                               i_true.cwiseProduct(Vec3::Ones() + x.current_gain_error) + x.current_offset_A);
   const EstimatorSample out = c.condition(s);
   EXPECT_LT((c.observed_current_dq_A(s, out.i_meas_pu) - c.logged_current_dq_A(s)).norm(), 1e-13);
   EXPECT_LT((c.logged_current_dq_A(s) - park(clarke(s.i_A), Rotation::of(2.1))).norm(), 1e-15);

@@ -59,8 +59,7 @@ TEST(LoopAllocations, NoneInTheLoopsPeriodWork) {
   cmds[3].live = config.live;
   cmds[3].live.validity.max_hold_s = 1.0;
   cmds[4].kind = Command::Kind::kReset;
-  for (std::size_t k = 0; k < cmds.size(); ++k)
-    cmds[k].seq = cmds[k].kind == Command::Kind::kReconfigure ? 0 : static_cast<std::int64_t>(k + 1);
+  for (std::size_t k = 0; k < cmds.size(); ++k) cmds[k].seq = cmds[k].kind == Command::Kind::kReconfigure ? 0 : static_cast<std::int64_t>(k + 1);
 
   const long before = g_allocations.load();
   std::int64_t now = 1'000'000'000;

@@ -104,8 +104,7 @@ void expect_copied_every_field() {
       EXPECT_TRUE((to.*f.member).empty()) << f.info.name << ": a string is the caller's";
     }
   });
-  EXPECT_EQ(static_cast<std::size_t>(checked),
-            schema::kFieldCount<typename Mirror::Message> - schema::spelled_count<typename Mirror::Message>());
+  EXPECT_EQ(static_cast<std::size_t>(checked), schema::kFieldCount<typename Mirror::Message> - schema::spelled_count<typename Mirror::Message>());
 }
 
 TEST(Schema, CopyWritesEveryFieldOfTheMirrorAndLeavesStringsAndKeysToTheCaller) {

@@ -12,12 +12,12 @@
 
 #include "can_stream.hpp"
 #include "commands.hpp"
-#include "progress.hpp"
 #include "rpem/can/protocol.hpp"
+#include "progress.hpp"
 #include "rpem/core/drive_estimator.hpp"
 #include "rpem/io/averaged_log.hpp"
-#include "rpem/io/estimate_log.hpp"
 #include "rpem/sim/cycle_average.hpp"
+#include "rpem/io/estimate_log.hpp"
 #include "rpem/sim/drive_simulator.hpp"
 #include "rpem/sim/truth_log.hpp"
 #include "vesc_emulator.hpp"
@@ -69,9 +69,7 @@ int run_sim(const SimOptions& o) {
     const auto& cfg = simulator.scenario().machine;
     estimator = std::make_unique<core::DriveEstimator>(cfg.machine, cfg.estimator);
   }
-  if (streamer && o.stream.rate > 0)
-    std::fprintf(stderr, "rpem sim: streaming '%s' on %s at %.3g× real time\n", simulator.scenario().name.c_str(),
-                 o.stream.interface.empty() ? o.stream.candump_out.c_str() : o.stream.interface.c_str(), o.stream.rate);
+  if (streamer && o.stream.rate > 0) std::fprintf(stderr, "rpem sim: streaming '%s' on %s at %.3g× real time\n", simulator.scenario().name.c_str(), o.stream.interface.empty() ? o.stream.candump_out.c_str() : o.stream.interface.c_str(), o.stream.rate);
   Progress progress("rpem sim");
   io::DriveLogRow row;
   sim::TruthRow truth_row;
@@ -94,12 +92,10 @@ int run_sim(const SimOptions& o) {
   if (log) summary += " written to " + o.out;
   if (streamer) {
     summary += ", streamed as " + std::to_string(streamer->frames_sent()) + " frames";
-    if (streamer->frames_dropped() > 0)
-      summary += " (" + std::to_string(streamer->frames_dropped()) + " dropped on purpose)";
+    if (streamer->frames_dropped() > 0) summary += " (" + std::to_string(streamer->frames_dropped()) + " dropped on purpose)";
   }
   progress.finish(summary);
-  if (streamer && !streamer->lateness_summary().empty())
-    std::fprintf(stderr, "rpem sim: %s\n", streamer->lateness_summary().c_str());
+  if (streamer && !streamer->lateness_summary().empty()) std::fprintf(stderr, "rpem sim: %s\n", streamer->lateness_summary().c_str());
   return kExitOk;
 }
 

@@ -8,10 +8,10 @@
 namespace rpem::io {
 
 inline constexpr int kExitOk = EX_OK;
-inline constexpr int kExitUsage = EX_USAGE;        ///< 64: bad command line
-inline constexpr int kExitDataError = EX_DATAERR;  ///< 65: malformed drive log or input data
-inline constexpr int kExitSoftware = EX_SOFTWARE;  ///< 70: rpemd's required real-time set-up failed
-inline constexpr int kExitIoError = EX_IOERR;      ///< 74: cannot read or write a file, or reach LCM
-inline constexpr int kExitConfig = EX_CONFIG;      ///< 78: bad configuration
+inline constexpr int kExitUsage = EX_USAGE;          ///< 64: bad command line
+inline constexpr int kExitDataError = EX_DATAERR;    ///< 65: malformed drive log or input data
+inline constexpr int kExitSoftware = EX_SOFTWARE;    ///< 70: rpemd's required real-time set-up failed
+inline constexpr int kExitIoError = EX_IOERR;        ///< 74: cannot read or write a file, or reach LCM
+inline constexpr int kExitConfig = EX_CONFIG;        ///< 78: bad configuration
 
 }  // namespace rpem::io

@@ -68,7 +68,7 @@ class DriveSimulator {
   Sensors sensors_;
   std::int64_t period_ns_;
   std::int64_t samples_total_;
-  std::int64_t k_ = 0;  ///< index of the next logged sample
+  std::int64_t k_ = 0;             ///< index of the next logged sample
   std::int64_t warmup_periods_ = 0;
   int substeps_ = 1;
 

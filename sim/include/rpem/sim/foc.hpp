@@ -16,11 +16,11 @@ struct FocConfig {
   double period_s = 125e-6;
   double current_bandwidth_Hz = 400.0;
   double speed_bandwidth_Hz = 5.0;
-  double max_current_A = 0.0;    ///< |i| limit; 0: √2 × rated rms current
-  double voltage_margin = 0.95;  ///< field weakening keeps the steady-state |u| below this × u_dc/√3
+  double max_current_A = 0.0;     ///< |i| limit; 0: √2 × rated rms current
+  double voltage_margin = 0.95;   ///< field weakening keeps the steady-state |u| below this × u_dc/√3
   bool field_weakening = true;
-  bool speed_control = false;  ///< false: torque mode (the scenario commands torque)
-  double inertia_kgm2 = 0.01;  ///< for tuning the speed loop
+  bool speed_control = false;     ///< false: torque mode (the scenario commands torque)
+  double inertia_kgm2 = 0.01;     ///< for tuning the speed loop
 };
 
 struct FocInput {
@@ -47,7 +47,8 @@ class FocController {
 
  private:
   /// Field weakening on the nominal model's voltage ellipse, then the current limit.
-  [[nodiscard]] core::Vec2 field_weaken(core::Vec2 i_ref, double torque_Nm, double omega, double u_limit) const noexcept;
+  [[nodiscard]] core::Vec2 field_weaken(core::Vec2 i_ref, double torque_Nm, double omega,
+                                        double u_limit) const noexcept;
 
   FocConfig config_;
   core::MachineSi nominal_;
@@ -56,9 +57,9 @@ class FocController {
   double i_max_A_;
   core::Vec2 integral_V_ = core::Vec2::Zero();
   double speed_integral_Nm_ = 0.0;
-  double mtpa_torque_Nm_ = 0.0;  ///< torque of the cached MTPA references
+  double mtpa_torque_Nm_ = 0.0;                   ///< torque of the cached MTPA references
   core::Vec2 mtpa_i_A_ = core::Vec2::Zero();
-  core::RotationTracker rotation_;  ///< at the measured angle
+  core::RotationTracker rotation_;                ///< at the measured angle
 };
 
 }  // namespace rpem::sim
