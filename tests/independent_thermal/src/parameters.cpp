@@ -25,8 +25,8 @@ constexpr double kStatorToRotorDiameter = 1.6;
 constexpr double kCopperShareOfStatorAnnulus = 0.12;
 constexpr double kIronShareOfStatorAnnulus = 0.55;
 constexpr double kInsulationCapacityShare = 0.15;       // impregnation and liners, on top of the copper
-constexpr double kWindingOverIronRise_K = 30.0;         // at the rated copper loss
-constexpr double kIronOverCoolantRise_K = 35.0;         // at the rated copper and stator iron loss
+constexpr double kWindingOverIronRise_K = 40.0;         // at the rated copper loss
+constexpr double kIronOverCoolantRise_K = 45.0;         // at the rated copper and stator iron loss
 constexpr double kLoopRise_K = 15.0;                    // coolant over ambient at the rated losses
 constexpr double kLoopTimeConstant_s = 600.0;
 
@@ -36,8 +36,10 @@ using E = CatalogueEntry;
 
 const std::vector<CatalogueEntry>& catalogue() {
   static const std::vector<CatalogueEntry> table = {
-      {"electrical.reference_C", &Parameters::reference_C, "°C", Draw::fixed, 0, 0,
-       "temperature at which R_s and ψm are the configuration's"},
+      {"electrical.r_s_reference_C", &Parameters::r_s_reference_C, "°C", Draw::fixed, 0, 0,
+       "winding temperature at which R_s is the configuration's"},
+      {"electrical.psi_m_reference_C", &Parameters::psi_m_reference_C, "°C", Draw::fixed, 0, 0,
+       "magnet temperature at which ψm is the configuration's"},
       {"electrical.r_s_ref_Ohm", &Parameters::r_s_ref_Ohm, "Ω", Draw::electrical_factor, 0.9, 1.1,
        "R_s (DC) at the reference temperature"},
       {"electrical.psi_m_ref_Wb", &Parameters::psi_m_ref_Wb, "Wb", Draw::electrical_factor, 0.95, 1.05,
@@ -148,7 +150,8 @@ double rated_copper_loss_W(const Parameters& p) {
 
 Parameters nominal_parameters(const Machine& m) {
   Parameters p;
-  p.reference_C = 20.0;
+  p.r_s_reference_C = 20.0;
+  p.psi_m_reference_C = 20.0;
   p.r_s_ref_Ohm = m.r_s_Ohm;
   p.psi_m_ref_Wb = m.psi_m_Wb;
   p.l_d_H = m.l_d_H;

@@ -175,9 +175,9 @@ nlohmann::json parameters_json(const Case& c, const Result& result, LogColumns c
       {"time_constants_s_at_standstill", time_constants_s(p, 0.0)},
       {"time_constants_s_at_rated_speed", time_constants_s(p, w_n)}};
   j["laws"] = {
-      {"r_s", "R_s(T_w) = r_s_ref*(K + T_w)/(K + T_ref), K = 1/alpha20_copper - 20 degC (DC; the log's voltages "
-              "use R_s*(1 + k_ac*(f/f_n)^2))"},
-      {"psi_m", "psi_m(T_m) = psi_m_ref*(1 + alpha20_magnet*(T_m - 20))/(1 + alpha20_magnet*(T_ref - 20))"},
+      {"r_s", "R_s(T_w) = r_s_ref*(K + T_w)/(K + r_s_reference_C), K = 1/alpha20_copper - 20 degC (DC; the "
+              "log's voltages use R_s*(1 + k_ac*(f/f_n)^2))"},
+      {"psi_m", "psi_m(T_m) = psi_m_ref*(1 + alpha20_magnet*(T_m - 20))/(1 + alpha20_magnet*(psi_m_reference_C - 20))"},
       {"voltages", "steady state: u_d = R*i_d - w*L_q*i_q, u_q = R*i_q + w*(L_d*i_d + psi_m)"},
       {"magnet_temperature", "T_magnet is the rotor node (rotor iron, magnets, shaft)"}};
 

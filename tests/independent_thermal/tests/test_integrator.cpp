@@ -52,7 +52,7 @@ TEST(IndepThermalIntegrator, LinearPlantAgainstExactSolution) {
 
   const Conductances g = conductances(p, 0.0);
   const double k = 1.0 / p.copper_alpha20_per_K - 20.0;
-  const double a = 1.5 * p.r_s_ref_Ohm * i_q * i_q / (k + p.reference_C);
+  const double a = 1.5 * p.r_s_ref_Ohm * i_q * i_q / (k + p.r_s_reference_C);
   Eigen::Matrix3d mat = g.matrix();
   mat(0, 0) -= a;
   const double t_c = p.coolant_start_C;

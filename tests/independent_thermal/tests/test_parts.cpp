@@ -31,7 +31,7 @@ TEST(IndepThermalMaterials, CopperIsLinearWithItsCoefficientAt20C) {
                 1e-14 * p.r_s_ref_Ohm);
   }
   // Reference 115 °C: the configured value holds there, and R(20) = R_ref/(1 + α20·95).
-  p.reference_C = 115.0;
+  p.r_s_reference_C = 115.0;
   EXPECT_NEAR(copper_resistance_Ohm(p, 115.0), p.r_s_ref_Ohm, 1e-15);
   EXPECT_NEAR(copper_resistance_Ohm(p, 20.0), p.r_s_ref_Ohm / (1.0 + p.copper_alpha20_per_K * 95.0), 1e-14);
   // Annealed copper: zero resistance of the linear law at −234.5 °C (α20 = 3.93e-3: −234.45 °C).
@@ -41,7 +41,7 @@ TEST(IndepThermalMaterials, CopperIsLinearWithItsCoefficientAt20C) {
 
 TEST(IndepThermalMaterials, MagnetFluxFollowsRemanence) {
   Parameters p = nominal_parameters(test::paper_machine());
-  p.reference_C = 60.0;
+  p.psi_m_reference_C = 60.0;
   EXPECT_NEAR(magnet_flux_Wb(p, 60.0), p.psi_m_ref_Wb, 1e-15);
   // Br(T)/Br(20) = 1 + α·(T − 20): the ratio of two temperatures is the remanence ratio.
   const double a = p.magnet_alpha20_per_K;
@@ -120,7 +120,7 @@ TEST(IndepThermalLosses, RatedPointGivesTheRatedLosses) {
   p.l_q_H = 0.0;
   const double w = 2.0 * kPi * p.rated_frequency_Hz;
   const double i = p.rated_current_A;
-  const Losses l = compute_losses(p, {w, 0.6 * i, -0.8 * i}, p.reference_C, p.reference_C);
+  const Losses l = compute_losses(p, {w, 0.6 * i, -0.8 * i}, p.r_s_reference_C, p.psi_m_reference_C);
   EXPECT_NEAR(l.flux_rel, 1.0, 1e-14);
   EXPECT_NEAR(l.iron(), p.stator_iron_rated_W, 1e-9 * p.stator_iron_rated_W);
   EXPECT_NEAR(l.rotor_iron, p.rotor_iron_rated_W, 1e-9 * p.rotor_iron_rated_W);
@@ -136,14 +136,14 @@ TEST(IndepThermalLosses, FrequencyAndFluxLaws) {
   const double w = 2.0 * kPi * p.rated_frequency_Hz * 0.4;
   const OperatingPoint op1{w, -30.0, 40.0};
   const OperatingPoint op2{2.0 * w, -30.0, 40.0};
-  const Losses a = compute_losses(p, op1, 60.0, p.reference_C);
-  const Losses b = compute_losses(p, op2, 60.0, p.reference_C);
+  const Losses a = compute_losses(p, op1, 60.0, p.psi_m_reference_C);
+  const Losses b = compute_losses(p, op2, 60.0, p.psi_m_reference_C);
   EXPECT_NEAR(b.stator_hysteresis / a.stator_hysteresis, 2.0, 1e-12);  // ∝ f
   EXPECT_NEAR(b.stator_eddy / a.stator_eddy, 4.0, 1e-12);              // ∝ f²
   EXPECT_NEAR(b.stator_excess / a.stator_excess, std::pow(2.0, 1.5), 1e-12);
   EXPECT_NEAR(b.magnet / a.magnet, 4.0, 1e-12);
   // Flux: B from the stator flux linkage; hysteresis ∝ B^β, eddy ∝ B².
-  const double psi_d = magnet_flux_Wb(p, p.reference_C) + p.l_d_H * -30.0;
+  const double psi_d = magnet_flux_Wb(p, p.psi_m_reference_C) + p.l_d_H * -30.0;
   const double bb = std::hypot(psi_d, p.l_q_H * 40.0) / p.psi_m_ref_Wb;
   EXPECT_NEAR(a.flux_rel, bb, 1e-14);
   const double x = 0.4;
@@ -348,7 +348,7 @@ TEST(IndepThermalParameters, SetGetAndValidateNameTheKey) {
     set_parameter(p, "capacity.rotor", 1.0);
     FAIL();
   } catch (const UsageError& e) {
-    EXPECT_NE(std::string(e.what()).find("unknown parameter 'capacity.rotor' (known: electrical.reference_C"),
+    EXPECT_NE(std::string(e.what()).find("unknown parameter 'capacity.rotor' (known: electrical.r_s_reference_C"),
               std::string::npos);
   }
   set_parameter(p, "conductance.shaft_W_K", -1.0);

@@ -24,7 +24,7 @@ Eigen::Vector3d analytic_steady_state(const Parameters& p, const OperatingPoint&
   const double f = std::abs(op.omega_el_rad_s) / (2.0 * kPi);
   const double x = f / p.rated_frequency_Hz;
   const double i2 = op.i_d_A * op.i_d_A + op.i_q_A * op.i_q_A;
-  const double a = 1.5 * p.r_s_ref_Ohm * (1.0 + p.ac_factor_at_rated * x * x) * i2 / (k + p.reference_C);
+  const double a = 1.5 * p.r_s_ref_Ohm * (1.0 + p.ac_factor_at_rated * x * x) * i2 / (k + p.r_s_reference_C);
   const Losses l = compute_losses(p, op, 0.0, 0.0);  // iron and rotor: independent of the temperatures here
   Eigen::Matrix3d m = g.matrix();
   m(0, 0) -= a;

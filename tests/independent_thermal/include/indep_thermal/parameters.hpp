@@ -11,8 +11,9 @@
 namespace indep_thermal {
 
 struct Parameters {
-  // Electrical, at the reference temperature (default: the configuration's values at 20 °C).
-  double reference_C = 20.0;
+  // Electrical: R_s at its reference temperature, ψm at its own (default: the configuration's values at 20 °C).
+  double r_s_reference_C = 20.0;
+  double psi_m_reference_C = 20.0;
   double r_s_ref_Ohm = 0.0;
   double psi_m_ref_Wb = 0.0;
   double l_d_H = 0.0;
