@@ -2,7 +2,7 @@
 //   indep_thermal_plant --config CFG --seed N --duration-s X --rate-Hz 2 --out log.csv --truth truth.csv
 //                       [--parameters params.json] [--profile drive-cycle|heat-cool|FILE]
 //                       [--load-scale X] [--coolant loop|constant] [--no-coolant] [--no-winding-sensor]
-//                       [--nominal] [--draw-electrical] [--set key=value]... [--exact]
+//                       [--nominal] [--draw-electrical] [--set key=value]... [--exact] [--averaged]
 // Exit codes: 0; 64 usage; 65 bad profile file; 73 an output cannot be written; 78 configuration.
 #include <CLI/CLI.hpp>
 #include <charconv>
@@ -40,12 +40,14 @@ void parse_set(indep_thermal::Parameters& p, const std::string& assignment) {
   indep_thermal::set_parameter(p, key, value);
 }
 
-template <class Write>
-void write_file(const std::string& path, Write&& write) {
+std::ofstream open_output(const std::string& path) {
   std::ofstream out(path);
   if (!out) throw CantCreate(path + ": cannot be written");
-  write(out);
-  out.flush();
+  return out;
+}
+
+void close_output(std::ofstream& out, const std::string& path) {
+  out.close();
   if (!out) throw CantCreate(path + ": write failed");
 }
 
@@ -68,8 +70,9 @@ int main(int argc, char** argv) {
   std::string config, out, truth, parameters_out, profile_name = "drive-cycle", coolant = "loop";
   std::uint64_t seed = 1;
   double duration_s = 7200.0, rate_Hz = 2.0, rtol = 1e-8, max_step_s = 0.25, load_scale = 1.0;
+  std::size_t truth_every = 1;
   bool no_coolant = false, no_winding = false, nominal = false, draw_electrical = false, exact = false,
-       list = false;
+       averaged = false, list = false;
   std::vector<std::string> sets;
   app.add_option("--config", config, "configuration YAML (only machine: is read)");
   app.add_option("--seed", seed, "seed of the parameter draw, the drive cycle and the noise (default 1)");
@@ -78,6 +81,8 @@ int main(int argc, char** argv) {
   app.add_option("--out", out, "drive log CSV");
   app.add_option("--truth", truth, "truth CSV (one row per log row)");
   app.add_option("--parameters", parameters_out, "parameters and summary JSON");
+  app.add_option("--truth-every", truth_every, "write every N-th row to the truth CSV (default 1: all)")
+      ->check(CLI::PositiveNumber);
   app.add_option("--profile", profile_name, "drive-cycle (default), heat-cool, or a CSV t_s,speed_rpm,i_q_A[,i_d_A]");
   app.add_option("--load-scale", load_scale, "multiplies the drive cycle's q currents (default 1)");
   app.add_option("--coolant", coolant, "loop (default: the coolant heats with the load) or constant")
@@ -88,6 +93,8 @@ int main(int argc, char** argv) {
   app.add_flag("--draw-electrical", draw_electrical, "draw R_s, psi_m, L_d, L_q off the configuration too");
   app.add_option("--set", sets, "key=value for any parameter (repeatable; --list-parameters)");
   app.add_flag("--exact", exact, "no measurement noise and no quantisation in the log");
+  app.add_flag("--averaged", averaged,
+               "write the averaged log: t,t_start and window means over [t_k-1, t_k] (docs/drive-log.md)");
   app.add_option("--rtol", rtol, "relative tolerance of the integrator (default 1e-8)");
   app.add_option("--max-step-s", max_step_s, "largest integration step [s] (default 0.25)");
   app.add_flag("--list-parameters", list, "print the parameter catalogue and exit");
@@ -121,14 +128,25 @@ int main(int argc, char** argv) {
     c.control.atol = rtol;
     c.control.max_step = max_step_s;
     c.noise = !exact;
+    c.averaged = averaged;
+    c.keep_rows = false;
     c.profile = indep_thermal::make_profile(profile_name, c.machine, duration_s, seed, load_scale);
-    const indep_thermal::Result r = indep_thermal::generate(c);
-    const indep_thermal::LogColumns columns{!no_coolant, !no_winding};
-    write_file(out, [&](std::ostream& o) { indep_thermal::write_log_csv(o, r, columns); });
-    write_file(truth, [&](std::ostream& o) { indep_thermal::write_truth_csv(o, r); });
+    const indep_thermal::LogColumns columns{!no_coolant, !no_winding, averaged};
+    std::ofstream log_file = open_output(out);
+    std::ofstream truth_file = open_output(truth);
+    indep_thermal::write_log_header(log_file, columns);
+    indep_thermal::write_truth_header(truth_file);
+    std::size_t row_index = 0;
+    const indep_thermal::Result r = indep_thermal::generate(c, [&](const indep_thermal::Row& row) {
+      indep_thermal::write_log_row(log_file, row, columns);
+      if (row_index++ % truth_every == 0) indep_thermal::write_truth_row(truth_file, row);
+    });
+    close_output(log_file, out);
+    close_output(truth_file, truth);
     if (!parameters_out.empty()) {
-      write_file(parameters_out,
-                 [&](std::ostream& o) { o << indep_thermal::parameters_json(c, r, columns).dump(2) << '\n'; });
+      std::ofstream json = open_output(parameters_out);
+      json << indep_thermal::parameters_json(c, r, columns).dump(2) << '\n';
+      close_output(json, parameters_out);
     }
     return 0;
   } catch (const indep_thermal::UsageError& e) {

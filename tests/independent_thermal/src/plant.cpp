@@ -66,6 +66,11 @@ Snapshot Plant::evaluate(double t, const State& y, bool left_limit) const {
   s.dydt(kEIron) = losses(kIron);
   s.dydt(kERotor) = losses(kRotor);
   s.dydt(kECoolant) = s.heat_to_coolant_W;
+  s.dydt(kIdIntegral) = s.op.i_d_A;
+  s.dydt(kIqIntegral) = s.op.i_q_A;
+  s.dydt(kUdIntegral) = s.u.u_d_V;
+  s.dydt(kUqIntegral) = s.u.u_q_V;
+  s.dydt(kOmegaIntegral) = s.op.omega_el_rad_s;
   return s;
 }
 

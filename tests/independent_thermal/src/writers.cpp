@@ -57,7 +57,9 @@ nlohmann::json parameter_values(const Parameters& p) {
 }  // namespace
 
 std::vector<std::string> log_header(LogColumns columns) {
-  std::vector<std::string> h = {"t", "i_d", "i_q", "u_d", "u_q", "omega_el"};
+  std::vector<std::string> h = {"t"};
+  if (columns.averaged) h.emplace_back("t_start");
+  for (const char* name : {"i_d", "i_q", "u_d", "u_q", "omega_el"}) h.emplace_back(name);
   if (columns.coolant) h.emplace_back("T_coolant");
   if (columns.winding_sensor) h.emplace_back("T_winding");
   return h;
@@ -71,66 +73,47 @@ const std::vector<std::string>& truth_header() {
       "P_stator_eddy", "P_stator_excess", "P_rotor_iron", "P_magnet", "P_mechanical", "P_winding",
       "P_iron",      "P_rotor",     "P_total",     "Q_coolant",    "G_winding_iron", "G_iron_coolant",
       "G_airgap",    "G_winding_rotor", "G_winding_coolant", "G_rotor_coolant", "E_losses", "E_coolant",
-      "E_stored",    "E_residual"};
+      "E_stored",    "E_residual",  "t_start",     "i_d_mean",     "i_q_mean",      "u_d_mean",
+      "u_q_mean",    "omega_el_mean"};
   return h;
 }
 
+void write_log_header(std::ostream& out, LogColumns columns) { write_header(out, log_header(columns)); }
+
+void write_log_row(std::ostream& out, const Row& r, LogColumns columns) {
+  std::vector<double> v = {r.truth.t_s};
+  if (columns.averaged) v.push_back(r.t_start_s);
+  v.insert(v.end(), {r.i_d_A, r.i_q_A, r.u_d_V, r.u_q_V, r.omega_el_rad_s});
+  if (columns.coolant) v.push_back(r.t_coolant_C);
+  if (columns.winding_sensor) v.push_back(r.t_winding_C);
+  write_row(out, v);
+}
+
+void write_truth_header(std::ostream& out) { write_header(out, truth_header()); }
+
+void write_truth_row(std::ostream& out, const Row& r) {
+  const Snapshot& s = r.truth;
+  const Losses& l = s.losses;
+  const double e_losses = s.y(kEWinding) + s.y(kEIron) + s.y(kERotor);
+  write_row(out, {s.t_s,          s.y(kTWinding),  s.y(kTIron),         s.y(kTRotor),     s.y(kTCoolant),
+                  s.sensor_reading_C, s.r_s_dc_Ohm, s.r_s_ac_Ohm,       s.psi_m_Wb,       s.op.omega_el_rad_s,
+                  s.speed_rpm,    s.op.i_d_A,      s.op.i_q_A,          s.u.u_d_V,        s.u.u_q_V,
+                  l.flux_rel,     l.copper,        l.stator_hysteresis, l.stator_eddy,    l.stator_excess,
+                  l.rotor_iron,   l.magnet,        l.mechanical,        l.winding(),      l.iron(),
+                  l.rotor(),      l.total(),       s.heat_to_coolant_W, s.g.winding_iron, s.g.iron_coolant,
+                  s.g.airgap,     s.g.winding_rotor, s.g.winding_coolant, s.g.rotor_coolant, e_losses,
+                  s.y(kECoolant), r.stored_J,      r.residual_J,        r.t_start_s,      r.i_d_mean_A,
+                  r.i_q_mean_A,   r.u_d_mean_V,    r.u_q_mean_V,        r.omega_el_mean_rad_s});
+}
+
 void write_log_csv(std::ostream& out, const Result& result, LogColumns columns) {
-  write_header(out, log_header(columns));
-  std::vector<double> v;
-  for (const Row& r : result.rows) {
-    v = {r.truth.t_s, r.i_d_A, r.i_q_A, r.u_d_V, r.u_q_V, r.omega_el_rad_s};
-    if (columns.coolant) v.push_back(r.t_coolant_C);
-    if (columns.winding_sensor) v.push_back(r.t_winding_C);
-    write_row(out, v);
-  }
+  write_log_header(out, columns);
+  for (const Row& r : result.rows) write_log_row(out, r, columns);
 }
 
 void write_truth_csv(std::ostream& out, const Result& result) {
-  write_header(out, truth_header());
-  for (const Row& r : result.rows) {
-    const Snapshot& s = r.truth;
-    const Losses& l = s.losses;
-    const double e_losses = s.y(kEWinding) + s.y(kEIron) + s.y(kERotor);
-    write_row(out, {s.t_s,
-                    s.y(kTWinding),
-                    s.y(kTIron),
-                    s.y(kTRotor),
-                    s.y(kTCoolant),
-                    s.sensor_reading_C,
-                    s.r_s_dc_Ohm,
-                    s.r_s_ac_Ohm,
-                    s.psi_m_Wb,
-                    s.op.omega_el_rad_s,
-                    s.speed_rpm,
-                    s.op.i_d_A,
-                    s.op.i_q_A,
-                    s.u.u_d_V,
-                    s.u.u_q_V,
-                    l.flux_rel,
-                    l.copper,
-                    l.stator_hysteresis,
-                    l.stator_eddy,
-                    l.stator_excess,
-                    l.rotor_iron,
-                    l.magnet,
-                    l.mechanical,
-                    l.winding(),
-                    l.iron(),
-                    l.rotor(),
-                    l.total(),
-                    s.heat_to_coolant_W,
-                    s.g.winding_iron,
-                    s.g.iron_coolant,
-                    s.g.airgap,
-                    s.g.winding_rotor,
-                    s.g.winding_coolant,
-                    s.g.rotor_coolant,
-                    e_losses,
-                    s.y(kECoolant),
-                    r.stored_J,
-                    r.residual_J});
-  }
+  write_truth_header(out);
+  for (const Row& r : result.rows) write_truth_row(out, r);
 }
 
 nlohmann::json parameters_json(const Case& c, const Result& result, LogColumns columns) {
@@ -143,8 +126,9 @@ nlohmann::json parameters_json(const Case& c, const Result& result, LogColumns c
   j["coolant_mode"] = c.coolant == CoolantMode::loop ? "loop" : "constant";
   j["duration_s"] = c.duration_s;
   j["rate_Hz"] = c.rate_Hz;
-  j["rows"] = result.rows.size();
+  j["rows"] = result.summary.rows;
   j["noise"] = c.noise;
+  j["averaged"] = c.averaged;
   j["log_columns"] = log_header(columns);
   j["truth_columns"] = truth_header();
   j["configured_machine"] = {{"r_s_Ohm", c.machine.r_s_Ohm},
@@ -181,23 +165,15 @@ nlohmann::json parameters_json(const Case& c, const Result& result, LogColumns c
       {"voltages", "steady state: u_d = R*i_d - w*L_q*i_q, u_q = R*i_q + w*(L_d*i_d + psi_m)"},
       {"magnet_temperature", "T_magnet is the rotor node (rotor iron, magnets, shaft)"}};
 
-  double t_w_max = -1e300, t_s_max = -1e300, t_r_max = -1e300, t_c_min = 1e300, t_c_max = -1e300;
-  for (const Row& r : result.rows) {
-    t_w_max = std::max(t_w_max, r.truth.y(kTWinding));
-    t_s_max = std::max(t_s_max, r.truth.y(kTIron));
-    t_r_max = std::max(t_r_max, r.truth.y(kTRotor));
-    t_c_min = std::min(t_c_min, r.truth.y(kTCoolant));
-    t_c_max = std::max(t_c_max, r.truth.y(kTCoolant));
-  }
-  const State& y_end = result.rows.back().truth.y;
-  j["summary"] = {{"T_winding_max_C", t_w_max},
-                  {"T_iron_max_C", t_s_max},
-                  {"T_magnet_max_C", t_r_max},
-                  {"T_coolant_min_C", t_c_min},
-                  {"T_coolant_max_C", t_c_max},
-                  {"E_losses_J", y_end(kEWinding) + y_end(kEIron) + y_end(kERotor)},
-                  {"E_coolant_J", y_end(kECoolant)},
-                  {"energy_residual_max_abs_J", result.max_abs_residual_J},
+  const Summary& sum = result.summary;
+  j["summary"] = {{"T_winding_max_C", sum.t_winding_max_C},
+                  {"T_iron_max_C", sum.t_iron_max_C},
+                  {"T_magnet_max_C", sum.t_magnet_max_C},
+                  {"T_coolant_min_C", sum.t_coolant_min_C},
+                  {"T_coolant_max_C", sum.t_coolant_max_C},
+                  {"E_losses_J", sum.e_losses_J},
+                  {"E_coolant_J", sum.e_coolant_J},
+                  {"energy_residual_max_abs_J", sum.max_abs_residual_J},
                   {"integrator_steps_accepted", result.stats.accepted},
                   {"integrator_steps_rejected", result.stats.rejected},
                   {"integrator_evaluations", result.stats.evaluations}};

@@ -58,7 +58,7 @@ TEST(IndepThermalEnergy, AccumulatorsBalanceToRounding) {
   const double losses = r.rows.back().truth.y(kEWinding) + r.rows.back().truth.y(kEIron) + r.rows.back().truth.y(kERotor);
   ASSERT_GT(losses, 1e6);
   // Rounding: ~1e-16 relative per operation on energies of this size, over ~3e4 steps.
-  EXPECT_LT(r.max_abs_residual_J, 1e-11 * losses);
+  EXPECT_LT(r.summary.max_abs_residual_J, 1e-11 * losses);
 }
 
 // A 20 Hz run of the profile described above (speed [rpm], i_q, i_d [A]).

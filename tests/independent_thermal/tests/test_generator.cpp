@@ -136,7 +136,60 @@ TEST(IndepThermalGenerator, ParametersJsonCarriesEveryKeyAndTheLaws) {
   EXPECT_EQ(j["rows"], r.rows.size());
   EXPECT_EQ(j["derived"]["time_constants_s_at_standstill"].size(), 3u);
   EXPECT_TRUE(j["laws"].contains("r_s"));
-  EXPECT_EQ(j["summary"]["energy_residual_max_abs_J"].get<double>(), r.max_abs_residual_J);
+  EXPECT_EQ(j["summary"]["energy_residual_max_abs_J"].get<double>(), r.summary.max_abs_residual_J);
+  EXPECT_EQ(j["summary"]["T_winding_max_C"].get<double>(), r.summary.t_winding_max_C);
+}
+
+TEST(IndepThermalGenerator, AveragedRowsAreWindowMeans) {
+  // Window means from the integrals the plant carries, against the trapezoid rule over a 100 Hz run of the
+  // same case (the truth at t), both for [t_k−1, t_k] of a 2 Hz averaged run; the trapezoid's error over a
+  // window is bounded by the difference between its 100 Hz and 50 Hz estimates (order 2: the profile's
+  // knots lie on the rows and it gives i_d, so no field-weakening square-root point is inside a window).
+  const Machine m = test::paderborn_machine();
+  Profile profile;
+  profile.gives_i_d = true;
+  profile.points = {{0, 0, 0, 0}, {20, 0, 100, -20}, {200, 0, 100, -20}, {220, 4000, 60, -120}, {600, 5000, 20, -80}};
+  Case c = test::exact_case(m, draw_parameters(m, 70), profile, 600, 2);
+  c.averaged = true;
+  const Result avg = generate(c);
+  Case fine = c;
+  fine.averaged = false;
+  fine.rate_Hz = 100.0;
+  const Result inst = generate(fine);
+  ASSERT_EQ(avg.rows.size(), 1201u);
+  EXPECT_EQ(avg.rows[0].t_start_s, 0.0);
+  EXPECT_EQ(avg.rows[0].u_q_V, avg.rows[0].truth.u.u_q_V);
+  std::size_t checked = 0;
+  for (std::size_t k = 1; k < avg.rows.size(); ++k) {
+    const Row& a = avg.rows[k];
+    EXPECT_EQ(a.t_start_s, avg.rows[k - 1].truth.t_s);
+    double q100 = 0.0, q50 = 0.0;
+    const std::size_t j0 = 50 * (k - 1);
+    for (std::size_t j = j0; j < j0 + 50; ++j) q100 += 0.5 * (inst.rows[j].truth.u.u_q_V + inst.rows[j + 1].truth.u.u_q_V) / 50.0;
+    for (std::size_t j = j0; j < j0 + 50; j += 2) q50 += (inst.rows[j].truth.u.u_q_V + inst.rows[j + 2].truth.u.u_q_V) / 50.0;
+    EXPECT_NEAR(a.u_q_V, q100, std::abs(q50 - q100) + 1e-6 * (1.0 + std::abs(q100))) << a.truth.t_s;
+    EXPECT_EQ(a.u_q_V, a.u_q_mean_V);
+    checked += std::abs(a.truth.u.u_q_V - avg.rows[k - 1].truth.u.u_q_V) > 0.1;  // windows where u_q moved
+  }
+  EXPECT_GT(checked, 50u);
+  std::ostringstream o;
+  write_log_csv(o, avg, {true, true, true});
+  EXPECT_EQ(o.str().substr(0, o.str().find('\n')), "t,t_start,i_d,i_q,u_d,u_q,omega_el,T_coolant,T_winding");
+}
+
+TEST(IndepThermalGenerator, SinkSeesEveryRowWithoutKeepingThem) {
+  Case c = drive_cycle(71, 100);
+  c.keep_rows = false;
+  std::size_t n = 0;
+  double last_t = -1.0;
+  const Result r = generate(c, [&](const Row& row) {
+    ++n;
+    EXPECT_GT(row.truth.t_s, last_t);
+    last_t = row.truth.t_s;
+  });
+  EXPECT_EQ(n, 201u);
+  EXPECT_TRUE(r.rows.empty());
+  EXPECT_EQ(r.summary.rows, 201u);
 }
 
 TEST(IndepThermalGenerator, BadCasesAreRefused) {

@@ -1,9 +1,10 @@
 #pragma once
 // The plant as one ODE (README.md, "Plant"): the three node temperatures, the winding sensor's lag, the
-// coolant (a boundary of the network; constant or a loop with its own heat balance) and four energy
+// coolant (a boundary of the network; constant or a loop with its own heat balance), four energy
 // accumulators (losses per node, heat into the coolant) integrated with the same stages, so that
 //   Σ C_i·(T_i(t) − T_i(0)) = E_winding + E_iron + E_rotor − E_coolant
-// is an invariant of the discrete solution (Runge-Kutta methods keep linear invariants).
+// is an invariant of the discrete solution (Runge-Kutta methods keep linear invariants), and the time
+// integrals of the logged electrical quantities (for window means: the averaged log).
 #include <Eigen/Dense>
 
 #include "indep_thermal/electrical.hpp"
@@ -28,7 +29,12 @@ enum StateIndex : int {
   kEIron = 6,
   kERotor = 7,
   kECoolant = 8,    // ∫ heat into the coolant [J]
-  kStateSize = 9,
+  kIdIntegral = 9,  // ∫ i_d dt, ∫ i_q dt [A·s], ∫ u_d dt, ∫ u_q dt [V·s], ∫ ω_el dt [rad]
+  kIqIntegral = 10,
+  kUdIntegral = 11,
+  kUqIntegral = 12,
+  kOmegaIntegral = 13,
+  kStateSize = 14,
   kTemperatureStates = 5,  // the states the step control watches
 };
 
