@@ -64,4 +64,20 @@ LogSource log_source(const std::string& log_path, const std::string& map_path) {
   return {log_path, drive_log_map(), "drive log"};
 }
 
+std::string describe(const TimeRepairs& r) {
+  std::string s;
+  if (r.wraps > 0) s += "; " + std::to_string(r.wraps) + (r.wraps == 1 ? " wrap" : " wraps") + " of the time column (midnight)";
+  if (r.tied_rows > 0) {
+    s += "; " + std::to_string(r.tied_rows) + " rows shared their time stamp with the row before (spread over its resolution)";
+  }
+  return s;
+}
+
+std::string describe(const LogSource& source, const AveragedLogRead& read) {
+  std::string s = source.path + " as " + source.format + ": " + std::to_string(read.rows) + " rows, " +
+                  std::to_string(read.rows - read.opening_rows) + " averaged samples";
+  if (read.opening_rows > 0) s += " (the first row opens the first window: its own began before the log)";
+  return s + describe(read.repairs);
+}
+
 }  // namespace rpem::io

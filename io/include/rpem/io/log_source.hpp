@@ -6,7 +6,9 @@
 
 #include <string>
 
+#include "rpem/io/averaged_log.hpp"
 #include "rpem/io/log_map.hpp"
+#include "rpem/io/mapped_log.hpp"
 
 namespace rpem::io {
 
@@ -23,5 +25,12 @@ struct LogSource {
 /// VESC Tool 1.11–1.16's log without header), a header with t_start our averaged log, any other our
 /// drive log. Throws DriveLogError if the file cannot be read.
 [[nodiscard]] LogSource log_source(const std::string& log_path, const std::string& map_path = "");
+
+/// One line for the tools: what was read as what, how many rows and samples, and what the time rules did
+/// ("vesc.csv as VESC Tool realtime log (…): 8567 rows, 8566 averaged samples (the first row opens the
+/// first window); 1 midnight wrap; 12 rows shared their millisecond with the row before").
+[[nodiscard]] std::string describe(const LogSource& source, const AveragedLogRead& read);
+/// The time rules' part of it (empty when they did nothing).
+[[nodiscard]] std::string describe(const TimeRepairs& repairs);
 
 }  // namespace rpem::io
