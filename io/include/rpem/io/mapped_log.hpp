@@ -41,6 +41,8 @@ class MappedLogReader {
   MappedLogReader(const std::string& path, LogMap map, DriveLogLimits limits = {});
   /// Reads from `in`, which must outlive the reader; `name` stands for the file in messages.
   MappedLogReader(std::istream& in, std::string name, LogMap map, DriveLogLimits limits = {});
+  MappedLogReader(const MappedLogReader&) = delete;  // holds its stream and pointers into its map
+  MappedLogReader& operator=(const MappedLogReader&) = delete;
 
   /// The next row; false at the end of the file (after at least one row: a file without rows throws).
   bool next(MappedRow& row);
