@@ -21,6 +21,14 @@ SegmentKind App::kind_now() const {
   return done_ || !started_ ? SegmentKind::off : segments_[index_].kind;
 }
 
+double App::external_torque_Nm() const {
+  return done_ || !started_ ? 0.0 : segments_[index_].external_Nm;
+}
+
+double App::added_friction_Nm() const {
+  return done_ || !started_ ? 0.0 : segments_[index_].friction_Nm;
+}
+
 void App::begin(std::size_t index, double t_s, VescFirmware& fw) {
   index_ = index;
   t_begin_ = t_s;
@@ -168,7 +176,7 @@ bool App::run_flux_measurement(double t_s, VescFirmware& fw) {
       }
       return true;
     case Flux::undriven: {
-      const double w = fw.pll_speed_rad_s();
+      const double w = fw.speed_faster_rad_s();  // mcpwm_foc_get_rpm_faster
       if (std::fabs(fw.duty_now()) < 0.02 || flux_ms_ >= 200 || w == 0.0) {
         end_flux_measurement(fw);
         return false;

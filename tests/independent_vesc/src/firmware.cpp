@@ -209,6 +209,7 @@ void VescFirmware::speed_and_tachometer(double phase) {
   pll_.update(phase, dt);  // FOC_SPEED_SRC_CORRECTED: the PLL follows the angle in use
   const double diff = std::clamp(wrap_pi(phase - phase_before_), -kPi / 3.0, kPi / 3.0);
   speed_est_fast_ += 0.01 * (diff / dt - speed_est_fast_);
+  speed_est_faster_ += 0.2 * (diff / dt - speed_est_faster_);
   pll_.clamp_speed(3.0 * std::fabs(speed_est_fast_));
   phase_before_ = phase;
   int step = static_cast<int>(std::floor((wrap_pi(phase) + kPi) / (2.0 * kPi) * 6.0));

@@ -20,7 +20,7 @@ struct Window {
   double w_sum = 0.0, w_first = 0.0, w_last = 0.0;
   Vec2 i_sum;
   double i2_sum = 0.0;
-  Vec2 u_sum;
+  Vec2 u_sum, i_time_sum;
   double u_time = 0.0;
   double psi_sum = 0.0, r_sum = 0.0, tw_sum = 0.0, tm_sum = 0.0;
 
@@ -64,6 +64,8 @@ struct Window {
     if (u_time > 0.0) {
       t.u_d_mean_V = u_sum.x / u_time;
       t.u_q_mean_V = u_sum.y / u_time;
+      t.i_d_avg_A = i_time_sum.x / u_time;
+      t.i_q_avg_A = i_time_sum.y / u_time;
     }
     t.psi_m_Wb = psi_sum / n;
     t.r_s_Ohm = r_sum / n;
@@ -163,7 +165,8 @@ Result generate(const Case& input) {
   for (double& o : adc_offset) o = c.sensors.current_offset_residual_lsb * normal(offsets_rng);
 
   const double rated_erpm = c.machine.rated.speed_rpm * mp.pole_pairs;
-  App app(c.scenario.empty() ? builtin_scenario(c.duration_s, c.firmware.l_current_max_A, rated_erpm, c.seed)
+  App app(c.scenario.empty() ? builtin_scenario(c.duration_s, c.firmware.l_current_max_A, rated_erpm,
+                                                0.9 * c.mechanics.coulomb_Nm, 1.5 * mp.pole_pairs * mp.psi_m_Wb, c.seed)
                              : c.scenario);
   const std::vector<ReadEvent> reads = poll_schedule(c.poller, c.duration_s, c.seed);
   std::mt19937_64 adc_rng = stream_rng(c.seed, Stream::adc);
@@ -190,6 +193,8 @@ Result generate(const Case& input) {
     // The millisecond threads: app, foc timer, mc_interface (temperatures).
     while (static_cast<double>(ms) * 1e-3 <= t + 1e-12) {
       app.step_1ms(static_cast<double>(ms) * 1e-3, fw);
+      plant.set_external_torque(c.mechanics.external_Nm + app.external_torque_Nm());
+      plant.set_coulomb(c.mechanics.coulomb_Nm + app.added_friction_Nm());
       fw.timer_1ms();
       const double fet = c.sensors.fet_temp_start_C + 0.3 * (t_w - th.winding_start_C);
       fw.temperatures_1ms(t_w + c.sensors.motor_temp_noise_K * normal(adc_rng), fet);
@@ -265,6 +270,7 @@ Result generate(const Case& input) {
     }
     const IntervalResult second = bridge_on ? plant.step_on(x, half, legs(), v_dc) : plant.step_off(x, half);
     window.u_sum = window.u_sum + half * (first.v_dq_mean_V + second.v_dq_mean_V);
+    window.i_time_sum = window.i_time_sum + half * (first.i_dq_mean_A + second.i_dq_mean_A);
     window.u_time += period;
 
     // Temperatures and the battery.

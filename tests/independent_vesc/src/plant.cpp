@@ -62,6 +62,7 @@ Plant::Rate Plant::rate_on(const PlantState& x, const std::array<double, 3>& leg
   const double t_l = load_torque_Nm(x.omega_m_rad_s);
   r.domega = (t_e - t_l) / p_.inertia_kgm2;
   r.v_dq = {c * v_ab.x + s * v_ab.y, -s * v_ab.x + c * v_ab.y};
+  r.i_dq = i_dq;
   r.p_in = 1.5 * v_ab.dot(i_ab);
   r.p_cu = 1.5 * p_.r_s_Ohm * i_ab.dot(i_ab);
   r.p_load = t_l * x.omega_m_rad_s;
@@ -99,6 +100,7 @@ IntervalResult Plant::rk4(PlantState& x, double h, const F& rate) const {
   IntervalResult out;
   // Stage values weighted 1, 2, 2, 1: Simpson's rule on the interval (k2 and k3 both approximate the middle).
   out.v_dq_mean_V = (1.0 / 6.0) * (k1.v_dq + 2.0 * k2.v_dq + 2.0 * k3.v_dq + k4.v_dq);
+  out.i_dq_mean_A = (1.0 / 6.0) * (k1.i_dq + 2.0 * k2.i_dq + 2.0 * k3.i_dq + k4.i_dq);
   out.energy_in_J = w * (k1.p_in + 2.0 * k2.p_in + 2.0 * k3.p_in + k4.p_in);
   out.energy_cu_J = w * (k1.p_cu + 2.0 * k2.p_cu + 2.0 * k3.p_cu + k4.p_cu);
   out.energy_load_J = w * (k1.p_load + 2.0 * k2.p_load + 2.0 * k3.p_load + k4.p_load);

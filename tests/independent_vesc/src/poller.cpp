@@ -16,11 +16,26 @@ double timer_period_s(double rate_Hz) { return std::floor(1000.0 / rate_Hz) * 1e
 }  // namespace
 
 double rtt_median_s(const Poller& p) {
-  // A reply that comes back after a round trip r is followed by the next request at the next timer tick, on
-  // average half a period later: mean interval ≈ E[r] + P/2, and E[r] = median·e^{σ²/2}.
+  // Per request: the round trip r = max(r_min, m·e^{σZ}), then the wait for the timer's next tick (P/2 on
+  // average) and the event loop (0.5 ms); a stall adds U[0.3, stall_max]; a loss replaces the cycle by the 1 s
+  // time-out and costs its row. Mean row interval = (time per request) / (1 − p_loss), solved for the median m.
   const double period = timer_period_s(p.poll_rate_Hz);
-  const double mean_rtt = std::max(1.0 / p.rate_Hz - 0.5 * period, p.rtt_min_s);
-  return mean_rtt / std::exp(0.5 * p.rtt_sigma_log * p.rtt_sigma_log);
+  const double s = std::max(p.rtt_sigma_log, 1e-9);
+  auto phi = [](double z) { return 0.5 * std::erfc(-z / std::sqrt(2.0)); };
+  auto mean_interval = [&](double m) {
+    const double z = std::log(p.rtt_min_s > 0.0 ? p.rtt_min_s / m : 1e-300) / s;
+    const double rtt = p.rtt_min_s * phi(z) + m * std::exp(0.5 * s * s) * phi(s - z);
+    const double cycle = (1.0 - p.loss_probability) * (rtt + 0.5 * period + 5e-4) +
+                         p.loss_probability * (1.0 + 0.5 * period) +
+                         p.stall_probability * 0.5 * (0.3 + p.stall_max_s);
+    return cycle / (1.0 - p.loss_probability);
+  };
+  double lo = 1e-4, hi = 10.0;
+  for (int k = 0; k < 100; ++k) {
+    const double mid = std::sqrt(lo * hi);
+    (mean_interval(mid) < 1.0 / p.rate_Hz ? lo : hi) = mid;
+  }
+  return std::sqrt(lo * hi);
 }
 
 std::vector<ReadEvent> poll_schedule(const Poller& p, double duration_s, std::uint64_t seed) {
@@ -56,6 +71,7 @@ std::vector<ReadEvent> poll_schedule(const Poller& p, double duration_s, std::ui
     const double split = 0.3 + 0.4 * unit(rng);  // the request's share of the round trip
     if (u_loss < 0.5 * p.loss_probability) continue;  // the request was lost: no read, no reply
     ReadEvent e;
+    e.t_request_s = t;
     e.t_read_s = t + split * rtt;
     e.t_reply_s = t + rtt;
     e.t_setup_reply_s = e.t_reply_s + p.setup_reply_delay_s;

@@ -21,7 +21,7 @@ const char* to_string(SegmentKind k) {
 }
 
 std::vector<Segment> builtin_scenario(double duration_s, double l_current_max_A, double rated_erpm,
-                                      std::uint64_t seed) {
+                                      double creep_torque_Nm, double torque_per_A_Nm, std::uint64_t seed) {
   std::mt19937_64 rng = stream_rng(seed, Stream::scenario);
   auto u = [&](double lo, double hi) { return std::uniform_real_distribution<double>(lo, hi)(rng); };
   const double i_max = l_current_max_A;
@@ -40,9 +40,18 @@ std::vector<Segment> builtin_scenario(double duration_s, double l_current_max_A,
   }
   for (int episode = 0; total < duration_s; ++episode) {
     const double sign = episode % 3 == 2 ? -1.0 : 1.0;
+    if (episode % 3 != 0) {  // after a stop: a hand turns the rotor a little, unseen
+      Segment creep{SegmentKind::off, u(0.8, 1.5)};
+      creep.external_Nm = (u(0.0, 1.0) < 0.5 ? -1.0 : 1.0) * creep_torque_Nm;
+      add(creep);
+      add({SegmentKind::off, 0.5});
+    }
     // From standstill or a slow roll: the sensorless open-loop start-up, then closed loop (an app's ramp or a
     // step).
-    add({SegmentKind::current, u(1.0, 2.0), sign * u(0.2, 0.35) * i_max, u(0.0, 0.3), u(0.15, 0.25) * rated_erpm});
+    Segment start{SegmentKind::current, u(1.0, 2.0), sign * u(0.2, 0.35) * i_max, u(0.0, 0.3),
+                  u(0.15, 0.25) * rated_erpm};
+    start.friction_Nm = u(0.3, 0.7) * torque_per_A_Nm * std::fabs(start.current_A);  // a load to start against
+    add(start);
     // A hard acceleration: a current step, over within a read or two.
     add({SegmentKind::current, u(0.15, 0.4), sign * u(0.6, 0.9) * i_max, 0.0, u(0.35, 0.45) * rated_erpm});
     add({SegmentKind::current, u(15.0, 40.0), sign * u(0.03, 0.07) * i_max});
@@ -85,7 +94,8 @@ std::vector<Segment> read_scenario_csv(const std::string& path) {
   int n = 0;
   std::vector<std::string> header;
   std::vector<Segment> segments;
-  const std::vector<std::string> known = {"kind", "duration_s", "current_A", "ramp_s", "until_erpm", "erpm_per_s"};
+  const std::vector<std::string> known = {"kind",       "duration_s", "current_A",   "ramp_s",
+                                          "until_erpm", "erpm_per_s", "external_Nm", "friction_Nm"};
   while (std::getline(in, line)) {
     ++n;
     if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
@@ -114,7 +124,8 @@ std::vector<Segment> read_scenario_csv(const std::string& path) {
     else if (kind == "brake") seg.kind = SegmentKind::brake;
     else if (kind == "flux_measurement") seg.kind = SegmentKind::flux_measurement;
     else fail(path, n, "kind '" + kind + "' (known: off, current, coast, brake, flux_measurement)");
-    double* fields[] = {&seg.duration_s, &seg.current_A, &seg.ramp_s, &seg.until_erpm, &seg.erpm_per_s};
+    double* fields[] = {&seg.duration_s, &seg.current_A, &seg.ramp_s,     &seg.until_erpm,
+                        &seg.erpm_per_s, &seg.external_Nm, &seg.friction_Nm};
     for (std::size_t c = 1; c < cells.size(); ++c) {
       double v = 0.0;
       try {
@@ -128,8 +139,8 @@ std::vector<Segment> read_scenario_csv(const std::string& path) {
       *fields[c - 1] = v;
     }
     if (seg.duration_s <= 0.0) fail(path, n, "duration_s must be positive");
-    if (seg.ramp_s < 0.0 || seg.until_erpm < 0.0 || seg.erpm_per_s <= 0.0) {
-      fail(path, n, "ramp_s and until_erpm must be >= 0, erpm_per_s > 0");
+    if (seg.ramp_s < 0.0 || seg.until_erpm < 0.0 || seg.erpm_per_s <= 0.0 || seg.friction_Nm < 0.0) {
+      fail(path, n, "ramp_s, until_erpm and friction_Nm must be >= 0, erpm_per_s > 0");
     }
     segments.push_back(seg);
   }

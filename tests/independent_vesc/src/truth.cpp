@@ -76,6 +76,8 @@ nlohmann::json row_json(const LogRow& row, int line) {
           {"omega_el_end_rad_s", t.omega_el_end_rad_s},
           {"i_d_mean_A", t.i_d_mean_A},
           {"i_q_mean_A", t.i_q_mean_A},
+          {"i_d_avg_A", t.i_d_avg_A},
+          {"i_q_avg_A", t.i_q_avg_A},
           {"i_dev_rms_A", t.i_dev_rms_A},
           {"u_d_mean_V", t.u_d_mean_V},
           {"u_q_mean_V", t.u_q_mean_V},

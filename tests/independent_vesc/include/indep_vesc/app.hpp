@@ -34,6 +34,9 @@ class App {
   [[nodiscard]] const std::vector<SegmentSpan>& spans() const { return spans_; }
   /// The running segment's kind (off after the last segment).
   [[nodiscard]] SegmentKind kind_now() const;
+  /// The running segment's torque on the shaft and its added friction [Nm].
+  [[nodiscard]] double external_torque_Nm() const;
+  [[nodiscard]] double added_friction_Nm() const;
   /// What the emulated flux measurement found, if it ran to its end.
   [[nodiscard]] std::optional<double> measured_flux_linkage_Wb() const { return flux_; }
 

@@ -106,7 +106,7 @@ struct Poller {
   double rate_Hz = 11.0;              // mean row rate the link allows (8–15 Hz in the field)
   double poll_rate_Hz = 50.0;         // VESC Tool's "poll_rate_rt_data" (its timer: int(1000/rate) ms)
   double rtt_sigma_log = 0.25;        // log-normal spread of the round trip
-  double rtt_min_s = 0.025;
+  double rtt_min_s = 0.04;
   double loss_probability = 0.004;    // a request or a reply lost: the next after VESC Tool's 1 s time-out
   double stall_probability = 0.003;   // a link stall that delays one reply by U[0.3, stall_max_s]
   double stall_max_s = 1.5;

@@ -103,6 +103,8 @@ class VescFirmware {
   [[nodiscard]] double duty_now() const { return duty_now_; }
   [[nodiscard]] double erpm() const;  // the PLL's speed, as reported (direction applied)
   [[nodiscard]] double pll_speed_rad_s() const { return pll_.speed_rad_s(); }
+  /// mcpwm_foc_get_rpm_faster's speed: the angle's differences low-passed with 0.2 per cycle [rad/s].
+  [[nodiscard]] double speed_faster_rad_s() const { return speed_est_faster_; }
   [[nodiscard]] bool startup_override() const { return override_; }
   [[nodiscard]] double psi_Wb() const { return psi_; }
   [[nodiscard]] const FirmwareParams& params() const { return p_; }
@@ -138,7 +140,7 @@ class VescFirmware {
   double mod_d_ = 0.0, mod_q_ = 0.0, mod_q_filter_ = 0.0, duty_now_ = 0.0;
   Vec2 mod_measured_ab_, mod_filter_ab_, v_ab_;
   double i_bus_ = 0.0, i_abs_filter_ = 0.0;
-  double phase_ = 0.0, phase_observer_ = 0.0, phase_before_ = 0.0, speed_est_fast_ = 0.0;
+  double phase_ = 0.0, phase_observer_ = 0.0, phase_before_ = 0.0, speed_est_fast_ = 0.0, speed_est_faster_ = 0.0;
 
   // Open-loop start-up (timer_update).
   double hyst_timer_ = 0.0, min_rpm_timer_ = 0.0, phase_override_ = 0.0, override_observer_angle_ = 0.0;

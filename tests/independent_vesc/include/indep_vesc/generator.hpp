@@ -28,7 +28,9 @@ struct RowTruth {
   double frame_error_mean_rad = 0.0;              // mean of wrap(frame − true d axis)
   double frame_error_max_abs_rad = 0.0;
   double omega_el_mean_rad_s = 0.0, omega_el_start_rad_s = 0.0, omega_el_end_rad_s = 0.0;
-  double i_d_mean_A = 0.0, i_q_mean_A = 0.0;      // the true current in the true rotor frame, at the samples
+  double i_d_mean_A = 0.0, i_q_mean_A = 0.0;      // the true current in the true rotor frame, mean of the samples
+  double i_d_avg_A = 0.0, i_q_avg_A = 0.0;        // ... and its mean over time (the two differ by the ripple
+                                                  //     the held voltage makes within each period)
   double i_dev_rms_A = 0.0;                       // rms of the current vector about its window mean
   double u_d_mean_V = 0.0, u_q_mean_V = 0.0;      // the voltage at the terminals in the true rotor frame
   double psi_m_Wb = 0.0, r_s_Ohm = 0.0, T_winding_C = 0.0, T_magnet_C = 0.0;

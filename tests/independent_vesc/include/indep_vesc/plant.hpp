@@ -38,6 +38,7 @@ struct PlantState {
 /// What one held interval did: means and integrals over it (RK4's weights 1, 2, 2, 1: Simpson's rule).
 struct IntervalResult {
   Vec2 v_dq_mean_V;            // the applied voltage in the true rotor frame, mean over the interval
+  Vec2 i_dq_mean_A;            // the current in the true rotor frame, mean over the interval
   double energy_in_J = 0.0;    // ∫1.5·v·i dt at the terminals (after the dead-time error)
   double energy_cu_J = 0.0;    // ∫1.5·R_s·|i|² dt
   double energy_load_J = 0.0;  // ∫T_load·ω_m dt (friction, drag, external)
@@ -52,6 +53,8 @@ class Plant {
   /// The temperature-dependent values, changed between intervals (thermal model).
   void set_r_s(double r_s_Ohm) { p_.r_s_Ohm = r_s_Ohm; }
   void set_psi_m(double psi_m_Wb);
+  void set_external_torque(double t_Nm) { p_.external_Nm = t_Nm; }
+  void set_coulomb(double t_Nm) { p_.coulomb_Nm = t_Nm; }
 
   [[nodiscard]] Vec2 current_dq(const PlantState& x) const;
   [[nodiscard]] Vec2 current_ab(const PlantState& x) const;
@@ -72,7 +75,7 @@ class Plant {
   struct Rate {
     Vec2 dpsi;
     double dtheta = 0.0, domega = 0.0;
-    Vec2 v_dq;
+    Vec2 v_dq, i_dq;
     double p_in = 0.0, p_cu = 0.0, p_load = 0.0, p_shaft = 0.0;
   };
   [[nodiscard]] Rate rate_on(const PlantState& x, const std::array<double, 3>& leg_V, double dead_V) const;

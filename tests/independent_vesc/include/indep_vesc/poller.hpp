@@ -16,6 +16,7 @@
 namespace indep::vesc {
 
 struct ReadEvent {
+  double t_request_s = 0.0;      // VESC Tool sends COMM_GET_VALUES
   double t_read_s = 0.0;         // the request reaches the VESC: averages read and reset
   bool logged = true;            // false: the reply was lost
   double t_reply_s = 0.0;        // the reply reaches VESC Tool: the row's timestamp
