@@ -182,7 +182,7 @@ std::string truth_json(const Result& r) {
   }
   j["counts"] = counts;
   j["rows"] = rows;
-  return j.dump(1);
+  return j.dump();
 }
 
 }  // namespace indep::vesc
