@@ -82,7 +82,8 @@ int main(int argc, char** argv) {
   app.add_option("--start-time", start_time, "logger clock at the start, HH:MM:SS[.mmm] (default: drawn)");
   app.add_flag("--midnight", midnight, "start so that ms_today wraps at a third of the log");
   app.add_flag("--crlf", crlf, "Windows line ends");
-  app.add_option("--scenario", scenario, "scenario CSV (kind,duration_s,current_A[,ramp_s,until_erpm,erpm_per_s])");
+  app.add_option("--scenario", scenario,
+                 "scenario CSV (kind,duration_s,current_A[,ramp_s,until_erpm,erpm_per_s,external_Nm,friction_Nm])");
   app.add_option("--off-voltage", off_voltage, "what v_d, v_q report with the bridge off: measured (firmware) or zero")
       ->check(CLI::IsMember({"measured", "zero"}));
   app.add_flag("--isothermal", isothermal, "constant temperatures (R_s and psi_m stay at their start values)");
