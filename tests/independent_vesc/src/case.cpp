@@ -117,6 +117,8 @@ Case resolve_defaults(Case c) {
   in_range(p.stall_probability, 0.0, 0.5, "poller.stall_probability");
   in_range(p.stall_max_s, 0.3, 10.0, "poller.stall_max_s");
 
+  require(c.trace_every >= 1, "trace_every must be at least 1");
+
   LogFormat& fmt = c.format;
   require(fmt.header_version >= 0 && fmt.header_version <= 3, "format.header_version must be 0, 1, 2 or 3");
   if (std::isnan(fmt.start_ms_today)) {
