@@ -13,15 +13,16 @@ double wrap_pi(double a) {
 
 void FluxObserver::update(Vec2 v_ab_V, Vec2 i_ab_A, double dt_s, double gamma) {
   const Vec2 eta = x_ - l_ * i_ab_A;
-  const double mismatch = psi_ * psi_ - eta.dot(eta);
+  const double mismatch = psi_hat_ * psi_hat_ - eta.dot(eta);
   const Vec2 dx = v_ab_V - r_ * i_ab_A + (0.5 * gamma * mismatch) * eta;
   x_ = x_ + dt_s * dx;
+  psi_hat_ = std::clamp(psi_hat_ - dt_s * 0.1 * 0.5 * gamma * psi_hat_ * mismatch, 0.3 * psi_, 2.5 * psi_);
   if (!std::isfinite(x_.x) || !std::isfinite(x_.y)) x_ = {0.0, 0.0};
   eta_ = x_ - l_ * i_ab_A;
 }
 
 void FluxObserver::force(double angle_rad, Vec2 i_ab_A) {
-  eta_ = {psi_ * std::cos(angle_rad), psi_ * std::sin(angle_rad)};
+  eta_ = {psi_hat_ * std::cos(angle_rad), psi_hat_ * std::sin(angle_rad)};
   x_ = eta_ + l_ * i_ab_A;
 }
 
