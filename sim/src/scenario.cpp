@@ -114,7 +114,10 @@ void parse_events(std::vector<io::YamlMap> events, Scenario& s) {
     if (ev.t_s < last) e.fail("t_s", "events of one quantity must be in time order");
     last = ev.t_s;
     s.signal(q).add(ev);
-    if (q == Quantity::kLoadTorque) s.separate_load = true;
+    if (q == Quantity::kLoadTorque) {
+      if (s.mechanics.dynamometer) e.fail("quantity", "load_torque_Nm needs plant.mechanics.mode: inertia (a dynamometer imposes the speed)");
+      s.separate_load = true;
+    }
   }
 }
 
@@ -188,6 +191,9 @@ void set_initial_signals(Scenario& s, std::optional<io::YamlMap> init) {
   s.signal(Quantity::kTMagnet) = Signal(value("t_magnet_C", s.thermal.psi_m.reference_C, -273.0, 1000.0));
   s.signal(Quantity::kLoadTorque) = Signal(value("load_torque_Nm", 0.0, -1e6, 1e6));
   s.separate_load = init && init->has("load_torque_Nm");
+  if (s.separate_load && s.mechanics.dynamometer) {
+    init->fail("load_torque_Nm", "needs plant.mechanics.mode: inertia (a dynamometer imposes the speed)");
+  }
   if (init) init->finish();
 }
 
@@ -246,7 +252,6 @@ Scenario parse_scenario(const std::string& text, const std::string& name, const 
   } else {
     (void)root.optional_map("events");
   }
-  if (s.separate_load && s.mechanics.dynamometer) root.fail("plant", "load_torque_Nm needs plant.mechanics.mode: inertia (a dynamometer imposes the speed)");
   if (root.has("regimes")) {
     parse_regimes(root.maps("regimes"), s);
   } else {

@@ -158,15 +158,17 @@ bool VescToolSession::next(VescToolRow& row, VescToolTruth& truth) {
       ++lost_;
       continue;
     }
-    // The firmware reads: the averages since the previous read, then resets them.
+    // The firmware reads, at the end of the control cycle the poll arrived in: the averages since the
+    // previous read, then resets them.
+    const std::int64_t read_ns = motor_.time_ns();
     const vesc::Values values = motor_.read_values();
-    truth = summarize(window_, t);
+    truth = summarize(window_, read_ns);
     window_ = Window{};
-    window_start_ns_ = t;
+    window_start_ns_ = read_ns;
     const std::int32_t previous_setup_ms = setup_ms_;
     const VescSetupValues previous_setup = setup_;
     setup_ = read_setup(values);
-    setup_ms_ = ms_today(t);
+    setup_ms_ = ms_today(read_ns);
     if (lost) {  // the reply never reached VESC Tool
       ++counters_.lost_replies;
       ++lost_;

@@ -29,7 +29,7 @@ namespace rpem::sim {
 struct VescToolLink {
   double rate_Hz = 11.0;   ///< mean rows per second
   double jitter = 0.5;     ///< intervals uniform in (1 ± jitter)/rate
-  double loss = 0.01;      ///< probability that a poll is lost
+  double loss = 0.002;     ///< probability that a poll is lost
   double timeout_s = 1.0;  ///< VESC Tool's wait before it polls again (mTimeoutCount 100 × the 10 ms timer)
   std::uint64_t seed = 1;
   std::int64_t start_ms_today = 12 * 3'600'000;  ///< UTC time of day at drive time 0 [ms]
