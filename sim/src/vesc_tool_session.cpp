@@ -41,8 +41,6 @@ double battery_level(const VescConfig& c, double v_in_V, double& wh_left) noexce
   return wh_left / (ah_total * 0.5 * (3.2 + 4.2) * cells);
 }
 
-const char* const kRegimeNames[] = {"closed_loop", "open_loop", "bridge_off"};
-
 }  // namespace
 
 VescToolSession::VescToolSession(Scenario scenario, const VescToolLink& link)
@@ -209,7 +207,7 @@ void VescToolTruthWriter::write(const VescToolTruth& t) {
   for (unsigned r = 0; r < 3; ++r) {
     if ((t.regimes >> r & 1U) == 0) continue;
     if (!first) line_ += '+';
-    line_ += kRegimeNames[r];
+    line_ += regime_name(static_cast<DriveRegime>(r));
     first = false;
   }
   for (double v : {t.omega_el_start_rad_s, t.omega_el_end_rad_s, t.omega_el_mean_rad_s, t.i_dq_A[0], t.i_dq_A[1],
