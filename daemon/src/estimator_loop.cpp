@@ -30,8 +30,6 @@ std::int64_t interval_ns(double rate_Hz) noexcept {
   return rate_Hz > 0.0 ? static_cast<std::int64_t>(1e9 / rate_Hz) : INT64_MAX / 4;
 }
 
-std::int64_t unix_us() noexcept { return core::now_ns(CLOCK_REALTIME) / 1000; }
-
 }  // namespace
 
 EstimatorLoop::EstimatorLoop(const DaemonConfig& config, Queues queues)
@@ -122,7 +120,7 @@ void EstimatorLoop::step(const SourceSample& s, std::int64_t now_ns) noexcept {
 void EstimatorLoop::report_measurement() noexcept {
   const SampleSummary& s = last_sample_;
   MeasurementReport m;
-  m.utime_us = unix_us();
+  m.utime = core::unix_us();
   m.sample_time_us = s.t_ns / 1000;
   m.theta_el_rad = s.theta_el_rad;
   m.omega_el_rad_s = s.omega_el_rad_s;
@@ -131,8 +129,8 @@ void EstimatorLoop::report_measurement() noexcept {
   m.i_q_A = last_.i_meas_A[1];
   m.i_hat_d_A = last_.i_hat_A[0];
   m.i_hat_q_A = last_.i_hat_A[1];
-  m.eps_d_A = last_.epsilon_A[0];
-  m.eps_q_A = last_.epsilon_A[1];
+  m.epsilon_d_A = last_.epsilon_A[0];
+  m.epsilon_q_A = last_.epsilon_A[1];
   m.t_winding_sensor_C = s.t_winding_sensor_C;
   m.t_drive_sensor_C = s.t_drive_sensor_C;
   push(m);
@@ -140,7 +138,7 @@ void EstimatorLoop::report_measurement() noexcept {
 
 void EstimatorLoop::report_estimate(std::int64_t now_ns) noexcept {
   EstimateReport r;
-  r.utime_us = unix_us();
+  r.utime = core::unix_us();
   r.sample_time_us = last_sample_.t_ns / 1000;
   r.newest_rx_ns = last_sample_.rx_ns;
   r.samples = counters_.samples;
@@ -153,7 +151,7 @@ void EstimatorLoop::report_estimate(std::int64_t now_ns) noexcept {
   r.t_magnet_C = t.psi_m.temperature_C(r.psi_m_Wb);
   r.speed_pu = last_.speed_pu;
   r.frozen = estimator_.core().state().frozen;
-  r.state = state_;
+  r.state = static_cast<std::int8_t>(state_);
   r.algorithm = live_.machine.estimator.algorithm;
 
   const ValidityTracker::Status psi = validity_.report(core::kPsiM, r.psi_m_Wb, now_ns);
@@ -185,7 +183,7 @@ void EstimatorLoop::report_estimate(std::int64_t now_ns) noexcept {
 
 void EstimatorLoop::report_stats() noexcept {
   LoopStatsReport r;
-  r.utime_us = unix_us();
+  r.utime_us = core::unix_us();
   r.state = state_;
   r.input_queue_depth = static_cast<std::int32_t>(queues_.samples.size());
   r.rows.set_all(kLoopRows, counters_);

@@ -32,6 +32,9 @@ inline constexpr std::int64_t kNsPerS = 1'000'000'000;
   return to_ns(ts);
 }
 
+/// The time since the Unix epoch [µs]: LCM's `utime`, rpemd's publication times. Real-time safe (as now_ns).
+[[nodiscard]] inline std::int64_t unix_us() noexcept { return now_ns(CLOCK_REALTIME) / 1000; }
+
 /// Sleeps until `t_ns` on `clock` (clock_nanosleep, TIMER_ABSTIME), resuming after a signal handler
 /// interrupted it: an absolute deadline does not drift however often that happens.
 inline void sleep_until_ns(clockid_t clock, std::int64_t t_ns) noexcept {

@@ -2,8 +2,10 @@
 // How a thread's counters and statistics reach RPEM_DIAGNOSTICS. Each value has one writer, the thread
 // that counts it; that thread sends a DiagnosticsRows through its queue to the publisher, which writes
 // the rows into diagnostics_t knowing nothing of what they mean. A thread lists its counters in a
-// table of CounterRow — where it counts, which diagnostics_t field — so adding a counter is one row
-// (and its field in lcm_types/rpem_diagnostics_t.lcm). Plain data, fixed size: real-time safe.
+// table of CounterRow — where it counts, which diagnostics_t field — so adding a counter is its line in
+// lcm_types/rpem_diagnostics_t.lcm (the one definition of the message: lcm-gen's class, the field list
+// that `rpem listen --diagnostics` prints from; docs/architecture.md, "One definition per message") and
+// one row here. Plain data, fixed size: real-time safe.
 
 #include <array>
 #include <cstddef>
