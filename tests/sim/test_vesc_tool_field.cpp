@@ -62,7 +62,7 @@ TEST(VescToolField, HoldsEveryRegimeOfARealDrive) {
   EXPECT_GE(min_gap_ms, 45.0);
   EXPECT_GT(max_gap_ms, 1000.0);  // at least one lost poll and VESC Tool's 1 s timeout
   EXPECT_GT(off_back_emf, 500);   // 55 s of freewheeling with the firmware's back-EMF report
-  EXPECT_GT(off_zero, 150);       // 20 s reported as the recorded log shows it
+  EXPECT_GT(off_zero, 350);       // 45 s reported as the recorded log shows it
   EXPECT_GT(open_forward, 50);
   EXPECT_GT(open_backward, 5);
   EXPECT_GE(released, 1);
