@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "rpem/core/machine.hpp"
+#include "rpem/core/units.hpp"
 
 namespace rpem::sim {
 namespace {
@@ -13,7 +14,7 @@ Magnetics make_magnetics(const Scenario& s) {
   return Magnetics(std::make_shared<const FluxMap>(FluxMap::load_csv(s.flux_map_file)));
 }
 
-double rpm_to_el_rad_s(double rpm, int pole_pairs) { return rpm * (2.0 * core::kPi / 60.0) * pole_pairs; }
+double rpm_to_el_rad_s(double rpm, int pole_pairs) { return core::rpm_to_rad_s(rpm) * pole_pairs; }
 
 }  // namespace
 

@@ -51,7 +51,7 @@ case $target in
                        corpus=io/fuzz/corpus/machine_config; opts=("${yaml_opts[@]}") asan=$yaml_asan ;;
   fuzz_scenario)       main=sim/fuzz/fuzz_scenario.cpp;       objs=("$repo"/sim/src/*.cpp "${io[@]}" "${core[@]}")
                        corpus=sim/fuzz/corpus; opts=("${yaml_opts[@]}") asan=$yaml_asan ;;
-  fuzz_command)        main=daemon/fuzz/fuzz_command.cpp;     objs=("$repo/daemon/src/command_gate.cpp" "$repo/auth/src/mac.cpp")
+  fuzz_command)        main=daemon/fuzz/fuzz_command.cpp;     objs=("$repo/daemon/src/command_gate.cpp" "$repo/auth/src/mac.cpp" "$repo/auth/src/key.cpp")
                        corpus=daemon/fuzz/corpus
                        lcm=1 ;;  # rpemd's RPEM_COMMAND entry point: the LCM types are generated in the build
   *) echo "run_fuzz: unknown target $target" >&2; exit 2 ;;

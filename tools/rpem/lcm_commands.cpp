@@ -201,7 +201,7 @@ struct CommandOptions {
 /// Encodes `m` (key id from `key`, or 0) and signs it for `channel`.
 template <class Message>
 std::vector<std::uint8_t> encode_signed(Message& m, const std::optional<auth::Key>& key, const std::string& channel) {
-  m.key_id = key ? key->id : 0;
+  m.key_id = key ? key->id() : 0;
   std::vector<std::uint8_t> bytes(static_cast<std::size_t>(m.getEncodedSize()));
   m.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
   if (key) auth::sign(*key, channel, bytes);

@@ -1,9 +1,10 @@
-#include "rpem/daemon/estimator_loop.hpp"
+#include "rpem/daemon/loop_thread.hpp"
 
 #include <algorithm>
 #include <array>
 #include <cmath>
 
+#include "rpem/core/assert.hpp"
 #include "rpem/core/clock.hpp"
 #include "rpem/daemon/realtime.hpp"
 
@@ -32,10 +33,10 @@ std::int64_t interval_ns(double rate_Hz) noexcept {
 
 }  // namespace
 
-EstimatorLoop::EstimatorLoop(const DaemonConfig& config, Queues queues)
+LoopThread::LoopThread(const DaemonConfig& config, Queues queues)
     : live_(config.live),
       loop_config_(config.fixed.loop),
-      queues_(queues),
+      queues_(std::move(queues)),
       estimator_(SourceCatalogue::sample_kind(config.fixed.source), config.live.machine.machine, config.live.machine.estimator),
       validity_(config.live.validity, config.fixed.lcm.estimate_rate_Hz),
       timer_(config.fixed.loop),
@@ -43,7 +44,7 @@ EstimatorLoop::EstimatorLoop(const DaemonConfig& config, Queues queues)
       measurement_interval_ns_(interval_ns(config.fixed.lcm.measurement_rate_Hz)),
       stats_interval_ns_(interval_ns(config.fixed.lcm.diagnostics_rate_Hz)) {}
 
-void EstimatorLoop::seed(const std::optional<SeedValue>& psi_m, const std::optional<SeedValue>& r_s, std::int64_t now_ns) {
+void LoopThread::seed(const std::optional<SeedValue>& psi_m, const std::optional<SeedValue>& r_s, std::int64_t now_ns) {
   estimator_.set_estimates(psi_m ? psi_m->value : estimator_.psi_m_Wb(), r_s ? r_s->value : estimator_.r_s_Ohm());
   auto keep = [&](int j, const SeedValue& s) {
     validity_.seed(j, s.age_s, now_ns);
@@ -55,11 +56,11 @@ void EstimatorLoop::seed(const std::optional<SeedValue>& psi_m, const std::optio
   if (r_s) keep(core::kRs, *r_s);
 }
 
-void EstimatorLoop::push(const Report& r) noexcept {
+void LoopThread::push(const Report& r) noexcept {
   if (!queues_.reports.push(r)) ++counters_.output_queue_drops;
 }
 
-void EstimatorLoop::apply(const Command& c) noexcept {
+void LoopThread::apply(const Command& c) noexcept {
   switch (c.kind) {
     case Command::Kind::kReset:
       estimator_.reset();
@@ -83,13 +84,15 @@ void EstimatorLoop::apply(const Command& c) noexcept {
       break;
   }
   if (c.seq > 0) {
+    // Counted where assertions are off: the control thread admits commands in increasing order only.
+    RPEM_ASSERT(c.seq > last_applied_seq_, "commands arrive in the order the control thread admitted them");
     if (c.seq <= last_applied_seq_) ++counters_.command_sequence_errors;
     last_applied_seq_ = c.seq;
     ++counters_.commands_applied;
   }
 }
 
-void EstimatorLoop::step(const SourceSample& s, std::int64_t now_ns) noexcept {
+void LoopThread::step(const SourceSample& s, std::int64_t now_ns) noexcept {
   double dt_s = 0.0;
   if (!estimator_.step(s, last_, dt_s, last_sample_)) {
     ++counters_.wrong_kind;
@@ -117,7 +120,7 @@ void EstimatorLoop::step(const SourceSample& s, std::int64_t now_ns) noexcept {
   validity_.on_sample(d.flags, dt_s, now_ns);
 }
 
-void EstimatorLoop::report_measurement() noexcept {
+void LoopThread::report_measurement() noexcept {
   const SampleSummary& s = last_sample_;
   MeasurementReport m;
   m.utime = core::unix_us();
@@ -136,7 +139,7 @@ void EstimatorLoop::report_measurement() noexcept {
   push(m);
 }
 
-void EstimatorLoop::report_estimate(std::int64_t now_ns) noexcept {
+void LoopThread::report_estimate(std::int64_t now_ns) noexcept {
   EstimateReport r;
   r.utime = core::unix_us();
   r.sample_time_us = last_sample_.t_ns / 1000;
@@ -174,14 +177,14 @@ void EstimatorLoop::report_estimate(std::int64_t now_ns) noexcept {
   }
   r.has_good_psi_m = has_good_[core::kPsiM];
   r.good_psi_m_Wb = good_[core::kPsiM];
-  r.good_psi_m_age_s = 1e-9 * static_cast<double>(now_ns - good_ns_[core::kPsiM]);
+  r.good_psi_m_age_s = core::to_seconds(now_ns - good_ns_[core::kPsiM]);
   r.has_good_r_s = has_good_[core::kRs];
   r.good_r_s_Ohm = good_[core::kRs];
-  r.good_r_s_age_s = 1e-9 * static_cast<double>(now_ns - good_ns_[core::kRs]);
+  r.good_r_s_age_s = core::to_seconds(now_ns - good_ns_[core::kRs]);
   push(r);
 }
 
-void EstimatorLoop::report_stats() noexcept {
+void LoopThread::report_stats() noexcept {
   LoopStatsReport r;
   r.utime_us = core::unix_us();
   r.state = state_;
@@ -201,7 +204,7 @@ void EstimatorLoop::report_stats() noexcept {
   eps_n_ = 0;
 }
 
-void EstimatorLoop::process(std::int64_t now_ns) noexcept {
+void LoopThread::process(std::int64_t now_ns) noexcept {
   Command c;
   while (queues_.commands.pop(c)) apply(c);
 
@@ -235,7 +238,7 @@ void EstimatorLoop::process(std::int64_t now_ns) noexcept {
   }
 }
 
-void EstimatorLoop::run(const std::atomic<bool>& stop) {
+void LoopThread::run(const std::atomic<bool>& stop) {
   name_thread("rpemd-loop");
   if (loop_config_.realtime != RealtimeMode::kOff) setup_problems_ = apply_thread_policy(loop_config_.thread);
   prefault_stack(256 * 1024);
