@@ -2,11 +2,13 @@
 // temperatures from rpemd's estimates — only verified, fresh and newer ones (docs/supervisor.md; the lines
 // between the markers are quoted there, and test_docs_supervisor_md_snippet checks the quote).
 //   example_supervisor CONFIG PUBLISH_KEY_FILE [SECONDS]
-// LCM's URL: LCM_DEFAULT_URL (LCM's own variable). Prints a line per estimate and whenever I_max changes
-// without one (report.hpp). Exit codes: 64 usage, 78 configuration or key, 74 no LCM.
+// LCM's URL: LCM_DEFAULT_URL (LCM's own variable). Prints a line at start, per estimate, and between
+// estimates when the last one ages out or I_max moves by 0.1 A (report.hpp).
+// Exit codes: 64 usage, 78 configuration or key, 74 no LCM.
 #include <lcm/lcm-cpp.hpp>
 
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <span>
@@ -59,15 +61,15 @@ int main(int argc, char** argv) {
   lcm.subscribe("RPEM_ESTIMATE", &Handler::on_message, &handler);
   std::setvbuf(stdout, nullptr, _IOLBF, 0);
   const auto end = std::chrono::steady_clock::now() + std::chrono::seconds(argc > 3 ? std::atoi(argv[3]) : 1000000);
-  double printed_A = -1.0;
+  // Between messages: a line when the estimate ages out, or I_max moves by 0.1 A (held values heating).
+  supervisor::CurrentLimit printed = supervisor.current_limit(core::unix_us());
+  std::printf("%s\n", supervisor::limit_line(core::unix_us(), printed).c_str());
   while (std::chrono::steady_clock::now() < end) {
-    if (lcm.handleTimeout(100) > 0) {
-      printed_A = supervisor.current_limit(core::unix_us()).current_A;
-      continue;
-    }
+    const bool handled = lcm.handleTimeout(100) > 0;
     const supervisor::CurrentLimit limit = supervisor.current_limit(core::unix_us());
-    if (limit.current_A != printed_A) std::printf("%s\n", supervisor::limit_line(core::unix_us(), limit).c_str());
-    printed_A = limit.current_A;
+    const bool moved = limit.fresh != printed.fresh || std::abs(limit.current_A - printed.current_A) >= 0.1;
+    if (!handled && moved) std::printf("%s\n", supervisor::limit_line(core::unix_us(), limit).c_str());
+    if (handled || moved) printed = limit;
   }
   return io::kExitOk;
 }
