@@ -5,9 +5,10 @@
 //   2. rpemd gone, a publisher signing with auth/ under the same key sends a magnet heating up: the
 //      supervisor's I_max follows the derating law — 120 A cold, 79.5 A at 110 °C, 34.5 A at 130 °C,
 //      nothing at 150 °C (T⁺ = T + 2·4 K; examples/supervisor/supervisor.yaml);
-//   3. an eavesdropper who captured those messages off the network re-sends them: a recent hot one at
-//      once (not newer), the cold one (stale) — then, with nothing fresh, the supervisor falls to the
-//      floor, 30 A, never back to 120 A.
+//   3. an eavesdropper who captured those messages off the network sends one altered so that lcm-gen's
+//      decoder would throw (a bad MAC: never decoded), then re-sends them: a recent hot one at once (not
+//      newer), the cold one (stale) — then, with nothing fresh, the supervisor falls to the floor, 30 A,
+//      never back to 120 A.
 #include <gtest/gtest.h>
 #include <stdlib.h>
 
@@ -106,6 +107,13 @@ TEST(SupervisorLcm, DeratesOnVerifiedEstimatesFromRpemdAndTheAuthLibraryAndIgnor
   const auto resend = [&](const std::vector<std::uint8_t>& b) {
     ASSERT_EQ(eavesdropper_lcm.publish("RPEM_ESTIMATE", b.data(), static_cast<unsigned>(b.size())), 0);
   };
+  // A crafted message first: a string length of 0, on which lcm-gen's decoder throws — it would end a
+  // typed subscriber; the supervisor checks the MAC before it decodes anything.
+  std::vector<std::uint8_t> crafted = eve.captured[11];
+  const std::size_t length_at = crafted.size() - auth::kTrailerBytes - (6 * 8 + 3) - 4 - 4;  // before "sga\0"
+  ASSERT_EQ(crafted[length_at + 3], 4);
+  crafted[length_at + 3] = 0;
+  resend(crafted);
   resend(eve.captured[10]);  // the second of the 150 °C ones, within the freshness window
   resend(eve.captured[0]);   // the cold magnet, 1.2 s ago
   std::this_thread::sleep_for(std::chrono::milliseconds(1000));
@@ -128,22 +136,25 @@ TEST(SupervisorLcm, DeratesOnVerifiedEstimatesFromRpemdAndTheAuthLibraryAndIgnor
   for (std::size_t k = from_rpemd; k < lines.size(); ++k) {
     if (lines[k].what.rfind("limit", 0) != 0) ours.push_back(lines[k]);
   }
-  ASSERT_EQ(ours.size(), sent_utimes.size() + 3) << out;
+  ASSERT_EQ(ours.size(), sent_utimes.size() + 4) << out;
   const double expected_A[] = {120.0, 120.0 - 90.0 * 18.0 / 40.0, 120.0 - 90.0 * 38.0 / 40.0, 0.0};
   for (std::size_t k = 0; k < sent_utimes.size(); ++k) {
     EXPECT_EQ(ours[k].what, "accepted") << out;
     EXPECT_EQ(ours[k].utime, sent_utimes[k]);
     EXPECT_NEAR(ours[k].current_A, expected_A[k / 3], 0.01) << "message " << k << "\n" << out;
   }
-  // 3. The replays: ignored, and the limit stays where the newest genuine estimate put it.
-  EXPECT_EQ(ours[12].what, "ignored (not newer (replayed or reordered))") << out;
-  EXPECT_EQ(ours[12].utime, sent_utimes[10]);
-  EXPECT_EQ(ours[12].current_A, 0.0);
-  EXPECT_EQ(ours[13].what, "ignored (stale)") << out;
-  EXPECT_EQ(ours[13].utime, sent_utimes[0]);
+  // 3. The crafted message (not decoded: no utime) and the replays: ignored, the supervisor still running,
+  // and the limit stays where the newest genuine estimate put it.
+  EXPECT_EQ(ours[12].what, "ignored (bad MAC)") << out;
+  EXPECT_EQ(ours[12].utime, -1);
+  EXPECT_EQ(ours[13].what, "ignored (not newer (replayed or reordered))") << out;
+  EXPECT_EQ(ours[13].utime, sent_utimes[10]);
   EXPECT_EQ(ours[13].current_A, 0.0);
   EXPECT_EQ(ours[14].what, "ignored (stale)") << out;
-  EXPECT_EQ(ours[14].current_A, 30.0);  // nothing fresh: the floor, not the replayed cold 120 A
+  EXPECT_EQ(ours[14].utime, sent_utimes[0]);
+  EXPECT_EQ(ours[14].current_A, 0.0);
+  EXPECT_EQ(ours[15].what, "ignored (stale)") << out;
+  EXPECT_EQ(ours[15].current_A, 30.0);  // nothing fresh: the floor, not the replayed cold 120 A
   // From the first 150 °C estimate on, I_max is 0 (fresh and too hot) or the 30 A floor (aged out), and
   // the supervisor said when it fell to the floor.
   bool fell_to_floor = false;
