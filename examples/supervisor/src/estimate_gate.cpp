@@ -51,11 +51,11 @@ Admission EstimateGate::admit(std::string_view channel, std::span<const std::uin
     if (!decode_exactly(encoded, out)) return Admission::kMalformed;
     const Stamp stamp{out.utime, out.sample_time_us};
     const std::int64_t age_us = now_unix_us - stamp.utime_us;
-    if (age_us > freshness_.max_age_us + freshness_.max_skew_us) return Admission::kStale;
-    if (-age_us > freshness_.max_skew_us) return Admission::kFromFuture;
+    if (freshness_.stale(age_us)) return Admission::kStale;
+    if (freshness_.from_future(age_us)) return Admission::kFromFuture;
     Stamp& last = last_of(auth::key_id_of(encoded));
     if (stamp.utime_us <= last.utime_us) return Admission::kNotNewer;
-    const bool silence = now_unix_us - last.utime_us > freshness_.max_age_us + freshness_.max_skew_us;
+    const bool silence = freshness_.stale(now_unix_us - last.utime_us);  // rpemd may have restarted
     if (!silence && stamp.sample_time_us <= last.sample_time_us) return Admission::kNotNewer;
     last = stamp;
     return Admission::kAccepted;

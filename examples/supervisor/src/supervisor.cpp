@@ -41,7 +41,7 @@ Received Supervisor::on_message(std::string_view channel, std::span<const std::u
 CurrentLimit Supervisor::current_limit(std::int64_t now_unix_us) const noexcept {
   CurrentLimit out;
   const std::int64_t age_us = last_ ? now_unix_us - last_->utime_us : 0;
-  out.fresh = last_ && age_us <= config_.freshness.max_age_us + config_.freshness.max_skew_us;
+  out.fresh = last_ && !config_.freshness.stale(age_us);
   const double message_age_s = 1e-6 * static_cast<double>(std::max<std::int64_t>(age_us, 0));
   const auto upper = [&](const std::optional<TemperatureEstimate>& t, const PartLimits& part) -> std::optional<double> {
     if (!out.fresh || !t) return std::nullopt;

@@ -25,6 +25,11 @@ namespace rpem::supervisor {
 struct Freshness {
   std::int64_t max_age_us = 0;   ///< > 0: older estimates are stale (and so is the output built on them)
   std::int64_t max_skew_us = 0;  ///< ≥ 0: how far the two clocks may disagree
+
+  /// An estimate `age_us` = now − utime old is stale: older than max_age, even allowing for the skew.
+  [[nodiscard]] constexpr bool stale(std::int64_t age_us) const noexcept { return age_us > max_age_us + max_skew_us; }
+  /// … or from the future: newer than now, beyond the skew.
+  [[nodiscard]] constexpr bool from_future(std::int64_t age_us) const noexcept { return -age_us > max_skew_us; }
 };
 
 /// The gate's verdict on one message (stable numbers: counted and printed).
