@@ -10,6 +10,7 @@
 
 #include "rpem/auth/key_file.hpp"
 #include "rpem/estimate_t.hpp"
+#include "rpem/schema/decode.hpp"
 #include "rpem/supervisor/estimate_gate.hpp"
 
 // [snippet]
@@ -24,7 +25,7 @@ struct Supervisor {
       return;
     }
     rpem::estimate_t m;
-    if (!rpem::supervisor::decode_exactly(bytes, m)) return;
+    if (!rpem::schema::decode_exactly(bytes, m)) return;
     if (m.psi_m_valid) std::printf("T_magnet %.1f C (verified)\n", m.t_magnet_C);  // derate: docs/supervisor.md
   }
 };

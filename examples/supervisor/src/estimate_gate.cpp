@@ -1,21 +1,9 @@
 #include "rpem/supervisor/estimate_gate.hpp"
 
-#include <climits>
-#include <exception>
-
 #include "rpem/core/assert.hpp"
+#include "rpem/schema/decode.hpp"
 
 namespace rpem::supervisor {
-
-bool decode_exactly(std::span<const std::uint8_t> encoded, rpem::estimate_t& out) noexcept {
-  if (encoded.size() > static_cast<std::size_t>(INT32_MAX)) return false;
-  const int size = static_cast<int>(encoded.size());
-  try {
-    return out.decode(encoded.data(), 0, size) == size;
-  } catch (const std::exception&) {  // lcm-gen's string decode: a length field < 1 throws from std::string
-    return false;
-  }
-}
 
 const char* to_string(Admission a) noexcept {
   switch (a) {
@@ -48,7 +36,7 @@ Admission EstimateGate::admit(std::string_view channel, std::span<const std::uin
       case auth::Verdict::kBadMac: return Admission::kBadMac;
       case auth::Verdict::kMalformed: return Admission::kMalformed;
     }
-    if (!decode_exactly(encoded, out)) return Admission::kMalformed;
+    if (!schema::decode_exactly(encoded, out)) return Admission::kMalformed;
     const Stamp stamp{out.utime, out.sample_time_us};
     const std::int64_t age_us = now_unix_us - stamp.utime_us;
     if (freshness_.stale(age_us)) return Admission::kStale;

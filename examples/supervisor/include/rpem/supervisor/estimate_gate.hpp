@@ -54,10 +54,6 @@ struct Stamp {
   std::int64_t sample_time_us = 0;
 };
 
-/// Decodes `encoded` into `out` if it is exactly one estimate_t; false for anything else — including
-/// what makes lcm-gen's decoder throw (a string length below 1), which is caught here.
-[[nodiscard]] bool decode_exactly(std::span<const std::uint8_t> encoded, rpem::estimate_t& out) noexcept;
-
 class EstimateGate {
  public:
   EstimateGate(const auth::Keyring& keys, Freshness freshness) noexcept : keys_(keys), freshness_(freshness) {}
