@@ -124,22 +124,25 @@ TEST(NoiseFloor, SecondDifferencesRecoverTheWhiteNoiseUnderASmoothError) {
     const double smooth = 0.1 * std::sin(2.0 * core::kPi * 270.0 * t) + 0.5 * t + (k > 20000 ? 0.3 : 0.0);
     r.residual_A[k] = core::Vec2(smooth + noise(rng), -smooth + noise(rng));
   }
-  EXPECT_NEAR(noise_floor_A(log, r), std::sqrt(2.0) * 0.02, 0.03 * std::sqrt(2.0) * 0.02);
+  EXPECT_NEAR(measure_noise_floor(log, r).value_A.value(), std::sqrt(2.0) * 0.02, 0.03 * std::sqrt(2.0) * 0.02);
 }
 
 TEST(Verdict, ExplainedUpToTheBoundAndOtherwiseWhereTheResidualLives) {
   ResidualStatistics st;
   st.standstill_rms_A = {1.0, 0.05};
   st.motion_rms_A = {1.0, 0.2};
+  st.standstill_samples = 100;
+  st.motion_samples = 1000;
   st.regions = {{"n ≥ 0.5 pu", "i_q > 0", 1000, {1.0, 0.3}, {0.0, 0.1}, {0.0, -0.2}}};
   st.harmonics = {{0, {0.1, 0.01}}, {6, {0.5, 0.15}}, {12, {0.1, 0.02}}};
   st.correlations = {{"|speed| [pu]", {0.1, 0.6}, {0.1, 0.2}}};
-  const Verdict explained = verdict(0.029, 0.02, st);
-  EXPECT_TRUE(explained.explained);  // 1.45 ≤ 1.5
+  const NoiseFloor floor{0.02, 1000, ""};
+  const Verdict explained = verdict(0.029, floor, st);
+  EXPECT_TRUE(explained.explained());  // 1.45 ≤ 1.5
   EXPECT_TRUE(explained.findings.empty());
-  const Verdict v = verdict(0.2, 0.02, st);
-  EXPECT_FALSE(v.explained);
-  EXPECT_DOUBLE_EQ(v.ratio, 10.0);
+  const Verdict v = verdict(0.2, floor, st);
+  EXPECT_EQ(v.kind, VerdictKind::kUnexplained);
+  EXPECT_DOUBLE_EQ(v.ratio.value(), 10.0);
   std::string all;
   for (const std::string& f : v.findings) all += f + "\n";
   EXPECT_NE(all.find("harmonic 6"), std::string::npos) << all;

@@ -295,7 +295,7 @@ inline IndependentOutcome run_independent_case(const IndependentCase& ic) {
       parameters_ok = parameters_ok && x.within();
     }
   }
-  std::snprintf(buf, sizeof buf, " verdict %s (%.2f× the floor)", d.verdict.explained ? "explained" : "unexplained", d.verdict.ratio);
+  std::snprintf(buf, sizeof buf, " verdict %s (%.2f× the floor)", analysis::to_string(d.verdict.kind), d.verdict.ratio.value_or(0.0));
   out.detail += buf;
   out.correct = names_ok && parameters_ok && psi_ok && rs_ok;
   return out;

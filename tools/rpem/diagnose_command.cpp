@@ -72,7 +72,14 @@ int run_diagnose(const DiagnoseCliOptions& o) {
     }
   }
   std::printf("\n");
+  for (const std::string& f : analysis::calibrated_despite_mismatch(d)) std::printf("calibrated despite a large mismatch: %s\n", f.c_str());
   for (const std::string& f : analysis::calibration_findings(d)) std::printf("calibration: %s\n", f.c_str());
+  if (d.least_squares) {
+    std::printf("outliers: %zu of %zu training samples beyond %.3g A moved the least-squares fit (%s by %.2g times its 95 %% "
+                "half-width): fitted again under Huber's loss\n",
+                d.outliers.test.beyond, d.outliers.test.samples, d.outliers.loss.threshold_A, d.outliers.parameter.c_str(),
+                d.outliers.largest_shift);
+  }
   if (s.found.empty()) std::printf("effects: none\n");
   for (std::size_t j = 0; j < s.found.size(); ++j) {
     std::printf("effect %s:", s.found[j].effect.label().c_str());
@@ -95,8 +102,12 @@ int run_diagnose(const DiagnoseCliOptions& o) {
     std::printf("not identifiable: %s\n", names.c_str());
   }
   std::printf("extended model: held-out residual %.4g A RMS\n", s.extended_heldout_rms_A);
-  std::printf("verdict: %s (%.3g times the noise floor of %.3g A)\n", d.verdict.explained ? "explained" : "unexplained",
-              d.verdict.ratio, d.verdict.noise_floor_A);
+  if (d.verdict.ratio) {
+    std::printf("verdict: %s (%.3g times the noise floor of %.3g A)\n", analysis::to_string(d.verdict.kind), *d.verdict.ratio,
+                d.verdict.noise_floor_A.value_or(0.0));
+  } else {
+    std::printf("verdict: %s (noise floor unknown)\n", analysis::to_string(d.verdict.kind));
+  }
   for (const std::string& f : d.verdict.findings) std::printf("  %s\n", f.c_str());
   std::printf("wrote %s/report.html, report.md, diagnosis.json, extended.yaml (%.2f s)\n", o.out.c_str(), d.elapsed_s);
   return kExitOk;

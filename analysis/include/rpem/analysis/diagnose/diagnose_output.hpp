@@ -27,6 +27,10 @@ void write_diagnose_report(const std::string& dir, const Diagnosis& d, const std
 /// the misfit the final model leaves above the noise floor could put into it (`<key>_mismatch_rel`).
 [[nodiscard]] double mismatch_half_width(const Diagnosis& d, std::size_t i);
 
+/// One sentence per constant calibrated despite a large mismatch (Identification::kRejectsConfiguration): its
+/// interval wider than ±10 % but excluding the configured value ("calibrated despite a large mismatch: …").
+[[nodiscard]] std::vector<std::string> calibrated_despite_mismatch(const Diagnosis& d);
+
 /// What the calibration says about the configuration, one sentence per identifiable constant whose
 /// configured value lies outside the calibrated 95 % interval widened by its mismatch allowance (e.g. "the configuration's ψm is 5.1 % high").
 [[nodiscard]] std::vector<std::string> calibration_findings(const Diagnosis& d);
