@@ -18,6 +18,7 @@
 #include "indep_drive/profile.hpp"
 #include "rpem/analysis/diagnose/diagnose_output.hpp"
 #include "rpem/io/machine_config.hpp"
+#include "support/diagnosis_detail.hpp"
 #include "support/temp_file.hpp"
 
 namespace rpem::test {
@@ -297,6 +298,7 @@ inline IndependentOutcome run_independent_case(const IndependentCase& ic) {
   }
   std::snprintf(buf, sizeof buf, " verdict %s (%.2f× the floor)", analysis::to_string(d.verdict.kind), d.verdict.ratio.value_or(0.0));
   out.detail += buf;
+  out.detail += fitting_detail(d);
   out.correct = names_ok && parameters_ok && psi_ok && rs_ok;
   return out;
 }
