@@ -17,7 +17,7 @@ namespace rpem::tools {
 namespace {
 
 struct DiagnoseCliOptions {
-  std::string log, config, out, truth, model = "auto";
+  std::string log, log_map, config, out, truth, model = "auto";
   double reference_C = 20.0;
   double switching_frequency_Hz = 0.0;
   analysis::SelectionOptions selection;
@@ -39,11 +39,13 @@ int run_diagnose(const DiagnoseCliOptions& o) {
 
   analysis::LogOptions log_options;
   log_options.blocks = o.blocks;
+  log_options.log_map = o.log_map;
   if (o.model != "auto") {
     log_options.mode = o.model == "transient" ? analysis::ModelMode::kTransient : analysis::ModelMode::kSteadyState;
   }
   std::fprintf(stderr, "rpem diagnose: reading %s\n", o.log.c_str());
   analysis::LogData log = analysis::load_log(o.log, config.machine, log_options);
+  std::fprintf(stderr, "rpem diagnose: read %s\n", log.format.c_str());
   io::check_log_supports(config, config_name, log.layout.u_dc, o.log);
   const analysis::ParameterTrack truth = o.truth.empty() ? analysis::ParameterTrack{} : analysis::load_truth(o.truth);
 
@@ -119,7 +121,13 @@ Runner add_diagnose_command(CLI::App& app) {
   auto o = std::make_shared<DiagnoseCliOptions>();
   CLI::App* cmd = app.add_subcommand(
       "diagnose", "Show what the model gets wrong on measured data, name the cause, extend the model, measure the gain");
-  cmd->add_option("--log", o->log, "drive-log CSV (docs/drive-log.md)")->required()->check(CLI::ExistingFile);
+  cmd->add_option("--log", o->log,
+                  "drive log, averaged log or VESC Tool realtime log (detected by its header), or any CSV with --log-map "
+                  "(docs/drive-log.md)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--log-map", o->log_map, "column map (YAML) saying how to read --log (docs/drive-log.md, \"Column maps\")")
+      ->check(CLI::ExistingFile);
   cmd->add_option("--config", o->config,
                   "machine configuration YAML, the baseline: its whole model, extensions and drift laws (default: built-in "
                   "paper-ipmsm); an extended.yaml of another recording is one")

@@ -6,6 +6,7 @@
 #include "rpem/core/conditioner.hpp"
 #include "rpem/core/frames.hpp"
 #include "rpem/io/averaged_log.hpp"
+#include "rpem/io/log_source.hpp"
 #include "rpem/io/machine_config.hpp"
 
 namespace rpem::analysis {
@@ -123,28 +124,34 @@ LogData prepare_log(std::vector<io::DriveLogRow> rows, const io::DriveLogLayout&
 }
 
 LogData load_log(const std::string& path, const core::MachineSi& machine, const LogOptions& options) {
-  if (io::is_averaged_log(path)) {
+  const io::LogSource source = io::log_source(path, options.log_map);
+  const io::DriveLogLimits limits = io::machine_limits(machine);
+  if (source.averaged()) {
     // Window means carry no transient to replay: the steady-state model, whatever the spacing.
     if (options.mode == ModelMode::kTransient) {
       throw io::DriveLogError(path, 1, 0, "column t_start",
                               "an averaged log replays only the steady-state model (give --model auto or steady_state)");
     }
-    io::AveragedLogLayout averaged;
-    const std::vector<core::AveragedSample> samples = io::read_averaged_log(path, &averaged);
+    io::AveragedLogRead read;
+    const std::vector<core::AveragedSample> samples = io::read_averaged_log(path, source.map, limits, &read);
     std::vector<io::DriveLogRow> rows;
     rows.reserve(samples.size());
     for (const core::AveragedSample& s : samples) rows.push_back(io::to_drive_log_row(s));
     LogOptions steady = options;
     steady.mode = ModelMode::kSteadyState;
-    LogData d = prepare_log(std::move(rows), io::rotor_frame_layout(averaged), machine, steady, path);
+    LogData d = prepare_log(std::move(rows), io::rotor_frame_layout(read.layout), machine, steady, path);
     d.averaged = true;
+    d.format = io::describe(source, read);
     return d;
   }
-  io::DriveLogReader reader(path, io::machine_limits(machine));
+  io::DriveLogReader reader(path, source.map, limits);
   std::vector<io::DriveLogRow> rows;
   io::DriveLogRow row;
   while (reader.next(row)) rows.push_back(row);
-  return prepare_log(std::move(rows), reader.layout(), machine, options, path);
+  LogData d = prepare_log(std::move(rows), reader.layout(), machine, options, path);
+  d.format = path + " as " + source.format + ": " + std::to_string(d.rows.size()) + " rows" +
+             io::describe(reader.reader().repairs());
+  return d;
 }
 
 }  // namespace rpem::analysis

@@ -22,6 +22,7 @@ enum class ModelMode { kTransient, kSteadyState };
 
 struct LogData {
   std::string path;
+  std::string format;  ///< what the log was read as, and what reading it did (io::describe)
   std::vector<io::DriveLogRow> rows;
   io::DriveLogLayout layout;
   ModelMode mode = ModelMode::kTransient;
@@ -61,9 +62,11 @@ struct LogOptions {
   std::optional<ModelMode> mode;  ///< empty: decided from the sample interval
   int blocks = 40;                ///< training and held-out blocks, alternating, equal in time
   int speed_half_window = 4;      ///< transient logs: replay speed from the angle over ±this many samples
+  std::string log_map;            ///< a column map (YAML) to read the log with; empty: detected (io::log_source)
 };
 
-/// Loads and characterises a log, a phase-sample or an averaged one (throws io::DriveLogError on bad input).
+/// Loads and characterises a log, a phase-sample or an averaged one, in any format io::log_source reads
+/// (throws io::DriveLogError on bad input, io::ConfigError on a bad map).
 [[nodiscard]] LogData load_log(const std::string& path, const core::MachineSi& machine, const LogOptions& options);
 
 /// The same from rows already in memory (tests, the simulator).
