@@ -1,5 +1,6 @@
 #include "rpem/core/regime.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -68,7 +69,10 @@ void RegimeClassifier::learn(const RegimeInput& in, double t_s) noexcept {
     }
     track_resolution(s.measured_resolution_pu[2], in.n_pu - s.n_pu[0]);
   }
-  if (s.points == 2) {
+  // Only a chain's samples are close enough for their second difference to be noise: a standalone
+  // sample's neighbours are other operating points.
+  const bool chain = in.timing == SampleTiming::kDense || in.timing == SampleTiming::kContiguous;
+  if (s.points == 2 && chain && s.chained >= 1) {
     // The middle sample against the line through its neighbours, r = x₁ − (w·x₂ + (1 − w)·x₀) with
     // w = (t₁ − t₀)/(t₂ − t₀): zero for a ramp at any spacing; for white noise of σ its variance is
     // σ²·(1 + w² + (1 − w)²), which the factor below removes.
@@ -95,6 +99,7 @@ void RegimeClassifier::learn(const RegimeInput& in, double t_s) noexcept {
   s.t_s[0] = t_s;
   s.previous_window_s = in.window_s;
   if (s.points < 2) ++s.points;
+  s.chained = chain ? std::min(s.chained + 1, 2) : 0;
 }
 
 std::uint8_t RegimeClassifier::transient_bits(const RegimeInput& in, double dt_s, const RegimeNoise& v) noexcept {
@@ -169,14 +174,16 @@ Classification RegimeClassifier::step(const RegimeInput& in) noexcept {
   const double z2 = c.z * c.z;
   std::uint8_t bits = 0;
 
-  // Bridge off: the reported voltage and the current are zero within their noise, where a modulating
-  // bridge applying zero volts would drive the short-circuit current |i_sc| = |n|·ψ·√(r² + n²x_q²)/D.
+  // Bridge off: the reported voltage and the current are zero within their noise where a modulating bridge
+  // could not hold a zero current: with |u| inside the voltage's zero band √c₂·σ_u the machine would carry
+  // |i| = |M⁻¹·(u − e)| ≥ (|n|·ψ_min − √c₂·σ_u)/‖M‖, ‖M‖ ≤ ‖M‖_F = √(2·r² + n²·(x_d² + x_q²)) at D_M's largest r,
+  // beyond the current's zero band √c₂·σ_i.
   const double i_sq = in.i_pu.squaredNorm();
   if (in.u_reported_sq_pu <= c.chi2 * v.u_sq && i_sq <= c.chi2 * v.i_sq) [[unlikely]] {
-    const double n2 = in.n_pu * in.n_pu;
-    const double d = c.r_pu * c.r_pu + n2 * c.x_d_pu * c.x_q_pu;
-    const double i_sc_sq = n2 * c.psi_min_pu * c.psi_min_pu * (c.r_pu * c.r_pu + n2 * c.x_q_pu * c.x_q_pu) / (d * d);
-    if (i_sc_sq > c.chi2 * v.i_sq) bits |= regime_bit::kBridgeOff;
+    const double n2 = in.n_pu * in.n_pu, r = c.r_pu + c.dr_pu;
+    const double emf_margin = std::abs(in.n_pu) * c.psi_min_pu - std::sqrt(c.chi2 * v.u_sq);
+    const double m_sq = 2.0 * r * r + n2 * (c.x_d_pu * c.x_d_pu + c.x_q_pu * c.x_q_pu);
+    if (emf_margin > 0.0 && emf_margin * emf_margin > c.chi2 * v.i_sq * m_sq) bits |= regime_bit::kBridgeOff;
   }
 
   // Angle locked: e, what the model leaves to the magnet, lies in the cone of half-angle δ_tol about
@@ -228,8 +235,8 @@ Classification RegimeClassifier::step(const RegimeInput& in) noexcept {
     if (term > 0.0 && term * term > z2 * h_sq[1] * noise) bits |= regime_bit::kExcitesRs;
   }
 
-  // Before the data have shown their noise, nothing is excluded on a threshold made of it.
-  if (!s.noise_known) bits &= static_cast<std::uint8_t>(~regime_bit::kExcluded);
+  // Before a chain has shown the data's noise, nothing in it is excluded on a threshold made of it.
+  if (!s.noise_known && in.timing != SampleTiming::kStandalone) bits &= static_cast<std::uint8_t>(~regime_bit::kExcluded);
   learn(in, t_s);
   return Classification::of(bits);
 }

@@ -119,7 +119,7 @@ struct RegimeSettings {
 /// The classifier's configuration, per unit (make_regime_config() in settings.hpp builds it).
 struct RegimeConfig {
   double z = 4.0;                ///< significance of the one-dimensional tests
-  double chi2 = 19.35;           ///< c₂ = −2·ln α: the same significance for a two-dimensional zero test
+  double chi2 = 19.334;           ///< c₂ = −2·ln α: the same significance for a two-dimensional zero test
   double omega_n_rad_s = 1.0;
   double r_pu = 0.0, r_min_pu = 0.0, dr_pu = 0.0;          ///< nominal r_s, D_M's smallest, largest deviation
   double psi_min_pu = 0.0, psi_max_pu = 0.0, dpsi_pu = 0.0;  ///< D_M's ψm range, largest deviation from nominal
@@ -159,14 +159,16 @@ struct RegimeState {
   /// σ = median/0.6745), and the smallest nonzero change seen (its resolution; +∞: none yet).
   std::array<double, 3> noise_median_pu{};
   std::array<double, 3> measured_resolution_pu{};
-  /// Whether a second difference has been seen: before, no test that excludes a sample can be judged.
+  /// Whether a second difference of a chain has been seen: before, no test that excludes a chain's sample
+  /// can be judged (a standalone sample is judged on the resolution at least).
   bool noise_known = false;
   /// The chain's last two samples: u, i, n and the time of each [s, relative to t_origin_ns].
   std::array<Vec2, 2> u_pu{}, i_pu{};
   std::array<double, 2> n_pu{}, t_s{};
   std::int64_t t_origin_ns = 0;       ///< the first sample's time (times are kept relative to it)
   bool has_origin = false;
-  int points = 0;                      ///< samples of the chain held (0–2)
+  int points = 0;                      ///< samples held (0–2)
+  int chained = 0;                     ///< of those, how many a chain joins to this one (dense, contiguous)
   double previous_window_s = 0.0;
   Vec2 slope_pu_s = Vec2::Zero();      ///< di/dt the sample's inductive correction takes (0: none)
   Vec2 previous_slope_pu_s = Vec2::Zero();
@@ -187,7 +189,10 @@ class RegimeClassifier {
   [[nodiscard]] Classification step(const RegimeInput& in) noexcept;
 
   /// Forgets the chain (the next sample has no predecessor); the noise and resolution learnt are kept.
-  void break_chain() noexcept { state_.points = 0; state_.slope_valid = state_.previous_slope_valid = false; }
+  void break_chain() noexcept {
+    state_.points = state_.chained = 0;
+    state_.slope_valid = state_.previous_slope_valid = false;
+  }
   /// Everything learnt back to the start.
   void reset() noexcept;
   /// New configuration; what was learnt is kept. Not real-time.
