@@ -112,13 +112,18 @@ struct Listener {
     ++diagnostics;
     const std::string verdict = check(rbuf, channel);
     if (!print_diagnostics) return;
-    std::printf("diag %lld: state %d samples %lld resyncs %lld overruns %lld latency p99 %.1f us max %.1f us | rx->publish p99 %.0f us | can frames %lld "
+    std::printf("diag %lld: state %d samples %lld resyncs %lld outliers %lld regimes %lld/%lld/%lld/%lld/%lld/%lld/%lld/%lld "
+                "(both/psi_m/r_s/unexcited/transient/not_locked/bridge_off/invalid) overruns %lld latency p99 %.1f us max %.1f us | rx->publish p99 %.0f us | can frames %lld "
                 "lost %lld crc %lld dlc %lld unknown %lld gaps %lld kernel drops %lld reopens %lld | queue drops in %lld "
                 "out %lld | publish failures %lld | commands %lld malformed %lld rejected %lld last %lld:%d | applied %lld "
                 "sequence errors %lld | unauthenticated %lld unknown key %lld bad mac %lld replayed %lld | reload requests %lld "
                 "reloads %lld invalid %lld restart required %lld busy %lld | state file %d | %s\n",
                 static_cast<long long>(m->utime), static_cast<int>(m->state), static_cast<long long>(m->samples),
-                static_cast<long long>(m->resyncs),
+                static_cast<long long>(m->resyncs), static_cast<long long>(m->outliers),
+                static_cast<long long>(m->regime_excites_both), static_cast<long long>(m->regime_excites_psi_m),
+                static_cast<long long>(m->regime_excites_r_s), static_cast<long long>(m->regime_unexcited),
+                static_cast<long long>(m->regime_transient), static_cast<long long>(m->regime_not_locked),
+                static_cast<long long>(m->regime_bridge_off), static_cast<long long>(m->regime_invalid),
                 static_cast<long long>(m->overruns), m->wakeup_latency_p99_us, m->wakeup_latency_max_us,
                 m->rx_to_publish_p99_us,
                 static_cast<long long>(m->can_frames), static_cast<long long>(m->can_frames_lost),

@@ -9,6 +9,7 @@
 #include "rpem/core/conditioner.hpp"
 #include "rpem/core/estimator.hpp"
 #include "rpem/core/per_unit.hpp"
+#include "rpem/core/regime.hpp"
 
 namespace rpem::core {
 
@@ -32,10 +33,14 @@ struct EstimatorSettings : EstimatorOptions {
   double initial_r_s_Ohm = 0.0;
   ModelExtensions extensions;  ///< model_extensions (docs/model-extensions.md)
   AveragedSettings averaged;   ///< the averaged-sample estimator (averaged_estimator.hpp)
+  RegimeSettings regimes;      ///< the regime classification (regime.hpp)
 };
 
 [[nodiscard]] MachinePu to_pu(const PerUnitBase& base, const MachineSi& m) noexcept;
 [[nodiscard]] EstimatorConfig make_estimator_config(const PerUnitBase& base, const MachineSi& m,
                                                     const EstimatorSettings& s) noexcept;
+/// The classifier's configuration: the nominal machine, D_M, the tolerances and resolutions, per unit.
+[[nodiscard]] RegimeConfig make_regime_config(const PerUnitBase& base, const MachineSi& m,
+                                              const EstimatorSettings& s) noexcept;
 
 }  // namespace rpem::core
