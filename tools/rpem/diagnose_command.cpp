@@ -12,6 +12,7 @@
 #include "commands.hpp"
 #include "rpem/analysis/diagnose/diagnose_output.hpp"
 #include "rpem/io/errors.hpp"
+#include "rpem/io/sample_counts.hpp"
 
 namespace rpem::tools {
 namespace {
@@ -56,6 +57,8 @@ int run_diagnose(const DiagnoseCliOptions& o) {
   std::fprintf(stderr, "rpem diagnose: %zu samples, %s model; fitting the catalogue's effects\n", log.rows.size(),
                analysis::to_string(log.mode));
   const analysis::Diagnosis d = analysis::diagnose(std::move(log), config, options, truth);
+  std::fprintf(stderr, "rpem diagnose: %s\n", io::regime_summary(d.regimes.counts).c_str());
+  for (const std::string& why : d.regimes.explanations) std::fprintf(stderr, "rpem diagnose: %s\n", why.c_str());
 
   std::error_code ec;
   std::filesystem::create_directories(o.out, ec);
@@ -78,9 +81,9 @@ int run_diagnose(const DiagnoseCliOptions& o) {
   for (const std::string& f : analysis::calibration_findings(d)) std::printf("calibration: %s\n", f.c_str());
   if (d.least_squares) {
     std::printf("outliers: %zu of %zu training samples beyond %.3g A moved the least-squares fit (%s by %.2g times its 95 %% "
-                "half-width): fitted again under Huber's loss\n",
-                d.outliers.test.beyond, d.outliers.test.samples, d.outliers.loss.threshold_A, d.outliers.parameter.c_str(),
-                d.outliers.largest_shift);
+                "half-width): diagnosed again under Huber's loss, b = %.3g A after %d run%s\n",
+                d.outliers.test.beyond, d.outliers.test.samples, d.outliers.test.threshold_A, d.outliers.parameter.c_str(),
+                d.outliers.largest_shift, d.outliers.loss.threshold_A, d.outliers.robust_runs, d.outliers.robust_runs == 1 ? "" : "s");
   }
   if (s.found.empty()) std::printf("effects: none\n");
   for (std::size_t j = 0; j < s.found.size(); ++j) {

@@ -65,6 +65,13 @@ nlohmann::json calibration_json(const Diagnosis& d) {
   return j;
 }
 
+/// Samples per regime (core::kRegimes' names).
+nlohmann::json regimes_json(const LogRegimes& r) {
+  nlohmann::json j = nlohmann::json::object();
+  for (const core::RegimeInfo& info : core::kRegimes) j[info.name] = r.counts.regimes[info.regime];
+  return j;
+}
+
 /// Which loss the fits minimised, and why (docs/diagnose.md, "Outliers and the robust loss").
 nlohmann::json loss_json(const Diagnosis& d) {
   const OutlierCheck& o = d.outliers;
@@ -79,6 +86,7 @@ nlohmann::json loss_json(const Diagnosis& d) {
                       {"largest_shift_parameter", o.parameter.empty() ? nlohmann::json(nullptr) : nlohmann::json(o.parameter)}};
   if (d.least_squares) {
     j["huber_threshold_A"] = o.loss.threshold_A;
+    j["robust_runs"] = o.robust_runs;
     nlohmann::json ls = {{"effects", d.least_squares->found}, {"heldout_rms", d.least_squares->extended_heldout_rms_A}};
     for (std::size_t i = 0; i < kCalibrated.size(); ++i) {
       ls[kCalibrated[i]] = d.least_squares->identifiable[i] ? nlohmann::json(d.least_squares->value[i]) : nlohmann::json(nullptr);
@@ -179,7 +187,12 @@ void write_diagnosis_json(const std::string& path, const Diagnosis& d, const std
                 {"i_d_range_A", {d.context.min_i_d_A, d.context.max_signed_i_d_A}},
                 {"max_i_q_A", d.context.max_i_q_A},
                 {"t_winding_span_K", d.context.t_winding.logged ? nlohmann::json(d.context.t_winding.span_K) : nlohmann::json(nullptr)},
-                {"t_magnet_span_K", d.context.t_magnet.logged ? nlohmann::json(d.context.t_magnet.span_K) : nlohmann::json(nullptr)}};
+                {"t_magnet_span_K", d.context.t_magnet.logged ? nlohmann::json(d.context.t_magnet.span_K) : nlohmann::json(nullptr)},
+                {"regimes", regimes_json(d.regimes)},
+                {"excluded_regime", d.regimes.excluded_used},
+                {"estimator_resyncs", d.regimes.counts.resyncs},
+                {"estimator_outliers", d.regimes.counts.outliers},
+                {"exclusion_explanations", d.regimes.explanations}};
   out["machine_config"] = config_path;
   out["verdict"] = to_string(d.verdict.kind);
   out["noise_floor_A"] = optional_json(d.verdict.noise_floor_A);

@@ -103,6 +103,32 @@ void summary(ReportDocument& doc, const Diagnosis& d, const std::string& config_
   }
 }
 
+void regimes(ReportDocument& doc, const Diagnosis& d) {
+  const LogRegimes& r = d.regimes;
+  doc.heading(1, "Regimes: what the fits take and what they leave out");
+  doc.paragraph("Each sample's regime as the estimator decides it (`rpem estimate` and rpemd run the same classifier; "
+                "docs/derivations.md §13): the samples with the bridge off, with the dq frame not the rotor's, in a "
+                "transient the model does not represent, or not finite enter no fit (" + std::to_string(r.excluded_used) +
+                " here, besides " + std::to_string(d.log->excluded_idle + d.log->excluded_transitional) +
+                " rows the steady-state replay leaves out as idle or in transition). The estimator over the log "
+                "resynchronised " + std::to_string(r.counts.resyncs) + " times and skipped " +
+                std::to_string(r.counts.outliers) + " samples as outliers.");
+  std::vector<std::vector<std::string>> rows;
+  const double total = static_cast<double>(std::max<std::uint64_t>(r.counts.samples, 1));
+  for (const core::RegimeInfo& info : core::kRegimes) {
+    const std::uint64_t n = r.counts.regimes[info.regime];
+    if (n == 0) continue;
+    rows.push_back({info.name, std::to_string(n), pct(100.0 * static_cast<double>(n) / total), info.excluded ? "no (excluded)" : "yes"});
+  }
+  doc.table({"regime", "samples", "share", "in the fits"}, rows);
+  if (!r.explanations.empty()) {
+    doc.paragraph("More than " + num(100.0 * io::kExplainedShare, 2) + " % of the samples were left out by a rule; which, and "
+                  "what changes it:");
+    doc.bullets(r.explanations);
+  }
+  doc.figure("regimes.png", "The log against time, coloured by regime: speed and current amplitude of each regime's samples.");
+}
+
 void calibration(ReportDocument& doc, const Diagnosis& d) {
   const Calibration& c = d.calibration;
   doc.heading(1, "The calibrated baseline");
@@ -155,7 +181,9 @@ void loss(ReportDocument& doc, const Diagnosis& d) {
     return;
   }
   text += ": the tail decided the least-squares fit, so calibration and every effect fit were run again minimising "
-          "Huber's loss at b (squares within b, linear beyond); the held-out residuals in this report are √(mean ρ). ";
+          "Huber's loss (squares within b, linear beyond), b re-estimated from each run's residuals: " +
+          num(o.loss.threshold_A, 3) + " A after " + std::to_string(o.robust_runs) + " run" + (o.robust_runs == 1 ? "" : "s") +
+          ". The held-out residuals in this report are √(mean ρ). ";
   std::string ls;
   for (const std::string& e : d.least_squares->found) ls += (ls.empty() ? "" : ", ") + e;
   text += "Least squares had found " + (ls.empty() ? std::string("no effect") : ls) + " (held-out " +
@@ -316,6 +344,7 @@ void write_diagnose_report(const std::string& dir, const Diagnosis& d, const std
   const std::vector<std::string> figures = write_diagnose_figures(dir, d);
   ReportDocument doc("Diagnosis of " + d.log->path);
   summary(doc, d, config_path);
+  regimes(doc, d);
   calibration(doc, d);
   loss(doc, d);
   effects_table(doc, d);

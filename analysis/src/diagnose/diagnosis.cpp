@@ -152,6 +152,10 @@ Diagnosis diagnose(LogData log, const io::MachineConfig& config, const DiagnoseO
   d.options = options;
   d.log = std::make_unique<LogData>(std::move(log));
   d.config = config;
+  // Each sample's regime, as the estimator decides it; the excluded ones enter no fit.
+  d.regimes = classify_regimes(*d.log, config);
+  exclude_regimes(*d.log, d.regimes);
+  for (std::string& why : left_out_explanations(*d.log)) d.regimes.explanations.push_back(std::move(why));
   const double f_sw = options.switching_frequency_Hz > 0.0 ? options.switching_frequency_Hz
                                                           : config.estimator.extensions.switching_frequency_Hz;
   const ExtendedModel base = make_base_model(config.machine, config.estimator.extensions, config.rs_drift.law,
@@ -178,9 +182,20 @@ Diagnosis diagnose(LogData log, const io::MachineConfig& config, const DiagnoseO
     ls.identifiable = d.calibration.identifiable;
     ls.extended_heldout_rms_A = d.selection.extended_heldout_rms_A;
     d.least_squares = ls;
-    robust.emplace(least_squares.with_loss(d.outliers.loss));
-    d.baseline_heldout_rms_A = rms(robust->heldout(EffectSet{}));
-    calibrate_and_select(*robust, floor, d);
+    // b from the least-squares model's residuals is too wide where the outliers pulled it (its bulk then misfits
+    // too): re-estimated from each robust diagnosis' own residuals until it settles within 10 %.
+    for (int run = 1; run <= kRobustRuns; ++run) {
+      robust.emplace(least_squares.with_loss(d.outliers.loss));
+      d.baseline_heldout_rms_A = rms(robust->heldout(EffectSet{}));
+      calibrate_and_select(*robust, floor, d);
+      d.outliers.robust_runs = run;
+      std::vector<double> r;
+      least_squares.training_residuals(d.selection.model, r);
+      const OutlierTest t = test_outliers(r);
+      const double previous = d.outliers.loss.threshold_A;
+      if (std::abs(t.threshold_A / previous - 1.0) < 0.1 || run == kRobustRuns) break;
+      d.outliers.loss.threshold_A = t.threshold_A;
+    }
   }
 
   std::vector<bool> keep;

@@ -2,12 +2,14 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 
 #include "rpem/core/conditioner.hpp"
 #include "rpem/core/frames.hpp"
 #include "rpem/io/averaged_log.hpp"
 #include "rpem/io/log_source.hpp"
 #include "rpem/io/machine_config.hpp"
+#include "rpem/io/sample_counts.hpp"
 
 namespace rpem::analysis {
 namespace {
@@ -123,6 +125,31 @@ LogData prepare_log(std::vector<io::DriveLogRow> rows, const io::DriveLogLayout&
   return d;
 }
 
+std::vector<std::string> left_out_explanations(const LogData& log) {
+  std::vector<std::string> out;
+  const double n = static_cast<double>(log.rows.size());
+  auto explain = [&](std::size_t count, const std::string& what) {
+    if (static_cast<double>(count) <= io::kExplainedShare * n) return;
+    char head[96];
+    std::snprintf(head, sizeof head, "%zu of %zu rows (%.1f %%) ", count, log.rows.size(), 100.0 * static_cast<double>(count) / n);
+    out.push_back(head + what);
+  };
+  char text[512];
+  std::snprintf(text, sizeof text,
+                "were left out of the steady-state replay as in transition: their current or speed differs from a "
+                "neighbour's by more than %.0f %% of the log's range, so they are not at a steady operating point. "
+                "Keys: none — a log of samples at the control rate replays the transient model (--model transient), "
+                "and a faster logger gives rows a neighbour at the same operating point",
+                100.0 * kTransitionShare);
+  explain(log.excluded_transitional, text);
+  std::snprintf(text, sizeof text,
+                "were left out as idle: current and speed both below %.0f %% of their largest, where the model "
+                "predicts nothing a constant could be fitted to. Keys: none (nothing to fit there)",
+                100.0 * kIdleShare);
+  explain(log.excluded_idle, text);
+  return out;
+}
+
 LogData load_log(const std::string& path, const core::MachineSi& machine, const LogOptions& options) {
   const io::LogSource source = io::log_source(path, options.log_map);
   const io::DriveLogLimits limits = io::machine_limits(machine);
@@ -135,12 +162,18 @@ LogData load_log(const std::string& path, const core::MachineSi& machine, const 
     io::AveragedLogRead read;
     const std::vector<core::AveragedSample> samples = io::read_averaged_log(path, source.map, limits, &read);
     std::vector<io::DriveLogRow> rows;
+    std::vector<std::int64_t> starts;
     rows.reserve(samples.size());
-    for (const core::AveragedSample& s : samples) rows.push_back(io::to_drive_log_row(s));
+    starts.reserve(samples.size());
+    for (const core::AveragedSample& s : samples) {
+      rows.push_back(io::to_drive_log_row(s));
+      starts.push_back(s.t_start_ns);
+    }
     LogOptions steady = options;
     steady.mode = ModelMode::kSteadyState;
     LogData d = prepare_log(std::move(rows), io::rotor_frame_layout(read.layout), machine, steady, path);
     d.averaged = true;
+    d.window_start_ns = std::move(starts);
     d.format = io::describe(source, read);
     return d;
   }

@@ -13,6 +13,7 @@
 #include "rpem/analysis/diagnose/estimator_comparison.hpp"
 #include "rpem/analysis/diagnose/log_data.hpp"
 #include "rpem/analysis/diagnose/outliers.hpp"
+#include "rpem/analysis/diagnose/regimes.hpp"
 #include "rpem/analysis/diagnose/residual_statistics.hpp"
 #include "rpem/analysis/diagnose/selection.hpp"
 #include "rpem/analysis/diagnose/verdict.hpp"
@@ -59,6 +60,7 @@ struct LeastSquaresResult {
 struct Diagnosis {
   DiagnoseOptions options;
   std::unique_ptr<LogData> log;         ///< owned: the replays refer to it
+  LogRegimes regimes;                   ///< each sample's regime; the excluded ones are out of log->used
   io::MachineConfig config;             ///< as given
   io::MachineConfig extended_config;    ///< calibrated constants and the kept effects (extended.yaml)
   EffectContext context;

@@ -4,6 +4,7 @@
 // training and held-out blocks.
 
 #include <algorithm>
+#include <cstdint>
 #include <optional>
 #include <string>
 #include <vector>
@@ -27,6 +28,8 @@ struct LogData {
   io::DriveLogLayout layout;
   ModelMode mode = ModelMode::kTransient;
   bool averaged = false;  ///< an averaged rotor-frame log (docs/drive-log.md, "Averaged logs"): always steady state
+  /// Averaged logs: each row's window start (its t is the window's end); empty for phase-sample logs.
+  std::vector<std::int64_t> window_start_ns;
   double t_start_s = 0.0, t_end_s = 0.0;
   double median_dt_s = 0.0;
   double max_current_A = 0.0;   ///< largest measured current amplitude
@@ -41,7 +44,8 @@ struct LogData {
   std::vector<core::DriveSample> replay_samples;
   /// The logged current as dq at the logged angle [A]: what every model is compared with.
   std::vector<core::Vec2> logged_i_dq_A;
-  /// Samples that take part (steady state leaves out idle and transitional rows).
+  /// Samples that take part (steady state leaves out idle and transitional rows; every log the samples its
+  /// regime excludes, regimes.hpp).
   std::vector<bool> used;
   std::size_t excluded_idle = 0, excluded_transitional = 0;
   /// Block index of each sample; even blocks train, odd blocks are held out.
@@ -64,6 +68,10 @@ struct LogOptions {
   int speed_half_window = 4;      ///< transient logs: replay speed from the angle over ±this many samples
   std::string log_map;            ///< a column map (YAML) to read the log with; empty: detected (io::log_source)
 };
+
+/// Where the steady-state replay left out more than io::kExplainedShare of the rows as idle or in transition:
+/// one sentence per rule, how many, why, and what changes it (docs/diagnose.md, "The replay").
+[[nodiscard]] std::vector<std::string> left_out_explanations(const LogData& log);
 
 /// Loads and characterises a log, a phase-sample or an averaged one, in any format io::log_source reads
 /// (throws io::DriveLogError on bad input, io::ConfigError on a bad map).
