@@ -28,19 +28,6 @@ DriveSample as_dq_sample(const AveragedSample& a) noexcept {
 
 }  // namespace
 
-std::array<GainSequences, 3> averaged_rates_per_s(const EstimatorSettings& s) noexcept {
-  std::array<GainSequences, 3> rates{};
-  const double per_s = 1.0 / s.nominal_sample_period_s;
-  for (std::size_t a = 0; a < rates.size(); ++a) {
-    if (s.averaged.rates_given[a]) {
-      rates[a] = s.averaged.rates_per_s[a];
-    } else {
-      rates[a] = {s.gains[a].hessian * per_s, s.gains[a].gain * per_s};
-    }
-  }
-  return rates;
-}
-
 AveragedDriveEstimator::AveragedDriveEstimator(const MachineSi& machine, const EstimatorSettings& settings) noexcept
     : base_(PerUnitBase::from_rated(machine.rated)),
       conditioner_(base_, to_pu(base_, machine), rotor_frame_extensions(settings.extensions)),
@@ -120,7 +107,7 @@ Estimate AveragedDriveEstimator::step(const AveragedSample& sample) noexcept {
   const GainSequences& rates = rates_per_s_[static_cast<std::size_t>(core_.config().algorithm)];
   // Windows carry their length's worth of data (per_interval); instantaneous samples one observation each.
   const bool point = sample.t_ns == sample.t_start_ns;
-  const GainSequences gains = point ? point_gains_.next(rates, s.dt_s)
+  const GainSequences gains = point ? point_gains_.at(rates, sample.t_ns)
                                     : GainSequences{per_interval(rates.hessian, s.dt_s), per_interval(rates.gain, s.dt_s)};
 
   RegimeInput in;
@@ -145,6 +132,7 @@ Estimate AveragedDriveEstimator::step(const AveragedSample& sample) noexcept {
   Estimate e;
   e.t_ns = sample.t_ns;
   e.detail = core_.step_steady_state(s, gains.hessian, gains.gain, admission);
+  if (point && e.detail.code == StepCode::kAdapted) point_gains_.count(gains, sample.t_ns);
   e.psi_m_Wb = base_.flux_Wb_of(e.detail.theta_pu[kPsiM]);
   e.r_s_Ohm = base_.resistance_Ohm_of(e.detail.theta_pu[kRs]);
   e.epsilon_A = e.detail.epsilon_pu * base_.current_A;

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 
-#include "rpem/core/averaged_estimator.hpp"
 #include "rpem/core/frames.hpp"
 
 namespace rpem::core {
@@ -83,7 +82,7 @@ Estimate DriveEstimator::step_sparse(const DriveSample& sample, const EstimatorS
   s.n_gradient_pu = own.n_pu;
   s.x_d_pu = own.x_d_pu;
   s.x_q_pu = own.x_q_pu;
-  const GainSequences gains = point_gains_.next(rates_per_s_, s.dt_s);
+  const GainSequences gains = point_gains_.at(rates_per_s_, sample.t_ns);
 
   RegimeInput in;
   in.timing = SampleTiming::kStandalone;
@@ -98,6 +97,7 @@ Estimate DriveEstimator::step_sparse(const DriveSample& sample, const EstimatorS
   const Admission admission{!regime.excluded(), regime.excites_psi_m(), regime.excites_r_s(), true,
                             noise.u_sq,          noise.i_sq,             noise.n_sq};
   const EstimatorOutput detail = core_.step_steady_state(s, gains.hessian, gains.gain, admission);
+  if (detail.code == StepCode::kAdapted) point_gains_.count(gains, sample.t_ns);
   return estimate(sample, detail, own.i_pu, own.n_pu, regime);
 }
 

@@ -40,14 +40,23 @@ Vec2 per_interval(const Vec2& rate_per_s, double dt_s) noexcept {
 void PointGains::start(const GainSequences& rates_per_s, double nominal_period_s) noexcept {
   weight.hessian = per_interval(rates_per_s.hessian, nominal_period_s).cwiseInverse();
   weight.gain = per_interval(rates_per_s.gain, nominal_period_s).cwiseInverse();
+  counted = false;
 }
 
-GainSequences PointGains::next(const GainSequences& rates_per_s, double dt_s) noexcept {
-  const auto advance = [dt_s](Vec2& s, const Vec2& rate) {
-    for (int j = 0; j < 2; ++j) s[j] = 1.0 + std::exp(-rate[j] * dt_s) * s[j];  // a rate of 0: S = ∞, γ = 0
-    return s.cwiseInverse();
+GainSequences PointGains::at(const GainSequences& rates_per_s, std::int64_t t_ns) const noexcept {
+  const double dt_s = counted ? std::max(0.0, 1e-9 * static_cast<double>(t_ns - last_ns)) : 0.0;
+  const auto gains = [dt_s](const Vec2& s, const Vec2& rate) {
+    Vec2 g;
+    for (int j = 0; j < 2; ++j) g[j] = 1.0 / (1.0 + std::exp(-rate[j] * dt_s) * s[j]);  // a rate of 0: S = ∞, γ = 0
+    return g;
   };
-  return {advance(weight.hessian, rates_per_s.hessian), advance(weight.gain, rates_per_s.gain)};
+  return {gains(weight.hessian, rates_per_s.hessian), gains(weight.gain, rates_per_s.gain)};
+}
+
+void PointGains::count(const GainSequences& gains, std::int64_t t_ns) noexcept {
+  weight = {gains.hessian.cwiseInverse(), gains.gain.cwiseInverse()};
+  last_ns = t_ns;
+  counted = true;
 }
 
 RpemEstimator::RpemEstimator(const EstimatorConfig& config) noexcept {

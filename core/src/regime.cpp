@@ -43,14 +43,23 @@ std::uint64_t RegimeCounts::excluded() const noexcept {
 
 double chi2_bound(double z) noexcept { return -2.0 * std::log(std::erfc(z / std::sqrt(2.0))); }
 
-RegimeClassifier::RegimeClassifier(const RegimeConfig& config) noexcept : config_(config) { reset(); }
+RegimeClassifier::RegimeClassifier(const RegimeConfig& config) noexcept {
+  reconfigure(config);
+  reset();
+}
+
+void RegimeClassifier::reconfigure(const RegimeConfig& config) noexcept {
+  config_ = config;
+  inv_omega_n_ = 1.0 / config.omega_n_rad_s;
+}
 
 void RegimeClassifier::reset() noexcept {
   state_ = RegimeState{};
   state_.measured_resolution_pu.fill(kInf);
+  noise_ = RegimeNoise{};
 }
 
-RegimeNoise RegimeClassifier::noise() const noexcept {
+RegimeNoise RegimeClassifier::current_noise() const noexcept {
   const auto variance = [this](std::size_t q) {
     const double sigma = state_.noise_median_pu[q] * kSigmaPerMedian;
     double res = config_.resolution_pu[q] > 0.0 ? config_.resolution_pu[q] : state_.measured_resolution_pu[q];
@@ -76,10 +85,15 @@ void RegimeClassifier::learn(const RegimeInput& in, double t_s) noexcept {
     // The middle sample against the line through its neighbours, r = x₁ − (w·x₂ + (1 − w)·x₀) with
     // w = (t₁ − t₀)/(t₂ − t₀): zero for a ramp at any spacing; for white noise of σ its variance is
     // σ²·(1 + w² + (1 − w)²), which the factor below removes.
-    const double span = t_s - s.t_s[1];
+    const double span = t_s - s.t_s[1], first = s.t_s[0] - s.t_s[1];
     if (span > 0.0) {
-      const double w = (s.t_s[0] - s.t_s[1]) / span;
-      const double norm = 1.0 / std::sqrt(1.0 + w * w + (1.0 - w) * (1.0 - w));
+      if (span != spacing_span_s_ || first != spacing_first_s_) {
+        spacing_span_s_ = span;
+        spacing_first_s_ = first;
+        spacing_w_ = first / span;
+        spacing_norm_ = 1.0 / std::sqrt(1.0 + spacing_w_ * spacing_w_ + (1.0 - spacing_w_) * (1.0 - spacing_w_));
+      }
+      const double w = spacing_w_, norm = spacing_norm_;
       const auto second = [&](double x2, double x1, double x0) { return norm * std::abs(x1 - (w * x2 + (1.0 - w) * x0)); };
       for (int c = 0; c < 2; ++c) {
         s.noise_median_pu[0] = track_median(s.noise_median_pu[0], second(in.u_pu[c], s.u_pu[0][c], s.u_pu[1][c]));
@@ -97,7 +111,6 @@ void RegimeClassifier::learn(const RegimeInput& in, double t_s) noexcept {
   s.i_pu[0] = in.i_pu;
   s.n_pu[0] = in.n_pu;
   s.t_s[0] = t_s;
-  s.previous_window_s = in.window_s;
   if (s.points < 2) ++s.points;
   s.chained = chain ? std::min(s.chained + 1, 2) : 0;
 }
@@ -122,7 +135,7 @@ std::uint8_t RegimeClassifier::transient_bits(const RegimeInput& in, double dt_s
   //   x_o·|Δn|·|Δi_o|/4          mean(n·x·i) − n̄·x·ī, bounded by the ranges' product over 4
   // against the row's noise and the slope change's own noise.
   if (!s.slope_valid) return 0;
-  const double inv_w = 1.0 / c.omega_n_rad_s;
+  const double inv_w = inv_omega_n_;
   const double dn = std::abs(in.n_pu - s.n_pu[0]);
   const Vec2 di = (in.i_pu - s.i_pu[0]).cwiseAbs();
   const Vec2 x(c.x_d_pu, c.x_q_pu), dx(c.dx_d_pu, c.dx_q_pu);
@@ -170,7 +183,8 @@ Classification RegimeClassifier::step(const RegimeInput& in) noexcept {
   s.slope_pu_s = s.slope_valid ? Vec2((in.i_pu - s.i_pu[0]) / dt_s) : Vec2::Zero();
   if (!s.slope_valid) s.previous_transient = false;
 
-  const RegimeNoise v = noise();
+  noise_ = current_noise();
+  const RegimeNoise& v = noise_;
   const double z2 = c.z * c.z;
   std::uint8_t bits = 0;
 
@@ -189,7 +203,7 @@ Classification RegimeClassifier::step(const RegimeInput& in) noexcept {
   // Angle locked: e, what the model leaves to the magnet, lies in the cone of half-angle δ_tol about
   // sgn(n)·q, widened by what the configuration's uncertainty (r within D_M, x within its tolerance) and
   // the noise can put there. Independent of ψm's magnitude.
-  const double inv_w = 1.0 / c.omega_n_rad_s;
+  const double inv_w = inv_omega_n_;
   const Vec2& i = in.i_pu;
   const Vec2& sl = s.slope_pu_s;
   const double n = in.n_pu;

@@ -24,6 +24,19 @@ EstimatorConfig make_estimator_config(const PerUnitBase& base, const MachineSi& 
   return c;
 }
 
+std::array<GainSequences, 3> averaged_rates_per_s(const EstimatorSettings& s) noexcept {
+  std::array<GainSequences, 3> rates{};
+  const double per_s = 1.0 / s.nominal_sample_period_s;
+  for (std::size_t a = 0; a < rates.size(); ++a) {
+    if (s.averaged.rates_given[a]) {
+      rates[a] = s.averaged.rates_per_s[a];
+    } else {
+      rates[a] = {s.gains[a].hessian * per_s, s.gains[a].gain * per_s};
+    }
+  }
+  return rates;
+}
+
 RegimeConfig make_regime_config(const PerUnitBase& base, const MachineSi& m, const EstimatorSettings& s) noexcept {
   const RegimeSettings& g = s.regimes;
   RegimeConfig c;

@@ -310,7 +310,7 @@ TEST(Regime, NoiseAndResolutionAreMeasuredFromTheData) {
     in.u_reported_sq_pu = in.u_pu.squaredNorm();
     (void)k.step(in);
     if (j >= 2000) {
-      const RegimeNoise v = k.noise();
+      const RegimeNoise v = k.current_noise();
       mean_u += std::sqrt(v.u_sq), mean_i += std::sqrt(v.i_sq), mean_n += std::sqrt(v.n_sq);
       ++counted;
     }
@@ -335,8 +335,8 @@ TEST(Regime, NoiseAndResolutionAreMeasuredFromTheData) {
     (void)q.step(in);
   }
   EXPECT_NEAR(q.state().measured_resolution_pu[0] / quantum, 1.0, 1e-9);
-  EXPECT_GE(q.noise().u_sq, quantum * quantum / 12.0);
-  EXPECT_LT(q.noise().u_sq, 2.0 * quantum * quantum / 12.0 + 4.0 * quantum * quantum);
+  EXPECT_GE(q.current_noise().u_sq, quantum * quantum / 12.0);
+  EXPECT_LT(q.current_noise().u_sq, 2.0 * quantum * quantum / 12.0 + 4.0 * quantum * quantum);
 }
 
 TEST(Regime, LockedSteadyNoisyDataIsExcludedNoMoreOftenThanTheFalseRate) {

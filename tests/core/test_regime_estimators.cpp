@@ -158,17 +158,28 @@ TEST(RegimeEstimators, SparseRowsAreSteadyStateObservationsAndPsiMAdapts) {
 
 TEST(RegimeEstimators, ObservationGainsWeighEachSparseRowOnceAndForgetByTime) {
   // γ_k = 1/S_k, S_k = 1 + e^{−rate·Δt}·S_{k−1}: evenly spaced it is 1 − e^{−rate·Δt} (the windows' gain);
-  // far beyond 1/rate, 1; after a short interval following a long one, 1/(1 + e^{−rate·Δt}).
+  // far beyond 1/rate, 1; after a short interval following a long one, 1/(1 + e^{−rate·Δt}); an observation
+  // not counted (it adapted nothing) leaves the weights as they were.
   const GainSequences rates{Vec2(5.0, 0.5), Vec2(2.6, 0.5)};
   PointGains g;
   g.start(rates, 125e-6);
   EXPECT_NEAR(g.weight.gain[0], 1.0 / (-std::expm1(-2.6 * 125e-6)), 1e-6);
+  EXPECT_NEAR(g.at(rates, 0).gain[0], -std::expm1(-2.6 * 125e-6) / (1.0 - std::expm1(-2.6 * 125e-6)), 1e-12);
   GainSequences last{};
-  for (int k = 0; k < 20000; ++k) last = g.next(rates, 0.01);
+  std::int64_t t_ns = 0;
+  for (int k = 0; k < 20000; ++k) {
+    t_ns += 10'000'000;
+    last = g.at(rates, t_ns);
+    g.count(last, t_ns);
+  }
   EXPECT_NEAR(last.gain[0], -std::expm1(-2.6 * 0.01), 1e-12);
   EXPECT_NEAR(last.hessian[1], -std::expm1(-0.5 * 0.01), 1e-12);
-  EXPECT_NEAR(g.next(rates, 100.0).gain[0], 1.0, 1e-12);
-  EXPECT_NEAR(g.next(rates, 0.1).gain[0], 1.0 / (1.0 + std::exp(-0.26)), 1e-12);
+  t_ns += 100'000'000'000;
+  last = g.at(rates, t_ns);
+  EXPECT_NEAR(last.gain[0], 1.0, 1e-12);
+  EXPECT_EQ(g.at(rates, t_ns).gain, last.gain);  // at() changes nothing
+  g.count(last, t_ns);
+  EXPECT_NEAR(g.at(rates, t_ns + 100'000'000).gain[0], 1.0 / (1.0 + std::exp(-0.26)), 1e-12);
 }
 
 }  // namespace

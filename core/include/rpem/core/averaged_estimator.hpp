@@ -22,10 +22,6 @@
 
 namespace rpem::core {
 
-/// The gain rates [1/s] the averaged estimator uses for each algorithm: `averaged.rates_per_s` where given,
-/// else γ_0/sample_period_s of `gains`.
-[[nodiscard]] std::array<GainSequences, 3> averaged_rates_per_s(const EstimatorSettings& s) noexcept;
-
 class AveragedDriveEstimator {
  public:
   AveragedDriveEstimator(const MachineSi& machine, const EstimatorSettings& settings) noexcept;

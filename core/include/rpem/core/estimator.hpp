@@ -139,14 +139,19 @@ struct EstimatorOutput {
 
 /// Gains for point observations at uneven intervals (docs/derivations.md §13, "Sparse samples"):
 /// exponentially weighted least squares that weighs each observation 1 and the past by e^{−rate·dt},
-///   γ_k = 1/S_k,   S_k = 1 + e^{−rate·dt_k}·S_{k−1},   S_0 = 1/(1 − e^{−rate·T_nom})
-/// (the start weighs a full memory of nominal samples). Evenly spaced: γ → 1 − e^{−rate·dt}, per_interval()'s;
-/// spaced far beyond the time constant 1/rate: γ → 1. Per parameter, for the Hessian's and the step's rates.
+///   γ_k = 1/S_k,   S_k = 1 + e^{−rate·(t_k − t_{k−1})}·S_{k−1},   S_0 = 1/(1 − e^{−rate·T_nom})
+/// over the observations that adapted (the start weighs a full memory of nominal samples). Evenly spaced:
+/// γ → 1 − e^{−rate·dt}, per_interval()'s; spaced far beyond the time constant 1/rate: γ → 1. Per parameter,
+/// for the Hessian's and the step's rates.
 struct PointGains {
-  GainSequences weight;  ///< S per rate (the observations' summed weight)
+  GainSequences weight;      ///< S per rate (the counted observations' decayed weight)
+  std::int64_t last_ns = 0;  ///< the last counted observation
+  bool counted = false;
   void start(const GainSequences& rates_per_s, double nominal_period_s) noexcept;
-  /// The gains of an observation dt after the previous one. Real-time safe.
-  [[nodiscard]] GainSequences next(const GainSequences& rates_per_s, double dt_s) noexcept;
+  /// The gains of an observation at t_ns; nothing changes until count(). Real-time safe.
+  [[nodiscard]] GainSequences at(const GainSequences& rates_per_s, std::int64_t t_ns) const noexcept;
+  /// Counts the observation at t_ns that took `gains` (from at()). Real-time safe.
+  void count(const GainSequences& gains, std::int64_t t_ns) noexcept;
 };
 
 class RpemEstimator {

@@ -169,7 +169,6 @@ struct RegimeState {
   bool has_origin = false;
   int points = 0;                      ///< samples held (0–2)
   int chained = 0;                     ///< of those, how many a chain joins to this one (dense, contiguous)
-  double previous_window_s = 0.0;
   Vec2 slope_pu_s = Vec2::Zero();      ///< di/dt the sample's inductive correction takes (0: none)
   Vec2 previous_slope_pu_s = Vec2::Zero();
   bool slope_valid = false, previous_slope_valid = false;
@@ -196,12 +195,14 @@ class RegimeClassifier {
   /// Everything learnt back to the start.
   void reset() noexcept;
   /// New configuration; what was learnt is kept. Not real-time.
-  void reconfigure(const RegimeConfig& config) noexcept { config_ = config; }
+  void reconfigure(const RegimeConfig& config) noexcept;
 
   [[nodiscard]] const RegimeConfig& config() const noexcept { return config_; }
   [[nodiscard]] const RegimeState& state() const noexcept { return state_; }
-  /// The noise now (measured and resolution).
-  [[nodiscard]] RegimeNoise noise() const noexcept;
+  /// The noise the last sample was judged against (measured before it, and the resolution).
+  [[nodiscard]] const RegimeNoise& noise() const noexcept { return noise_; }
+  /// The noise with everything learnt so far, the last sample included.
+  [[nodiscard]] RegimeNoise current_noise() const noexcept;
   /// di/dt the last sample's inductive correction should take [pu/s] (zero where there is none).
   [[nodiscard]] const Vec2& slope_pu_s() const noexcept { return state_.slope_pu_s; }
 
@@ -211,6 +212,10 @@ class RegimeClassifier {
 
   RegimeConfig config_;
   RegimeState state_;
+  RegimeNoise noise_;
+  double inv_omega_n_ = 0.0;  ///< 1/ω_n
+  // The second difference's weights for the last spacing (a control-rate stream repeats it).
+  double spacing_first_s_ = -1.0, spacing_span_s_ = -1.0, spacing_w_ = 0.0, spacing_norm_ = 0.0;
 };
 
 /// The significance's two-dimensional bound: c₂ = −2·ln(erfc(z/√2)), so that |v|²/σ² ~ χ²₂ exceeds it with the
