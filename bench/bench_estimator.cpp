@@ -236,7 +236,7 @@ void BM_AveragedClassificationOverStep(benchmark::State& state) {
   gen.plant.psi_m_pu *= 0.95;
   const core::Vec2 i = core::mtpa_reference(gen.plant, 0.4);
   gen.n_pu = [](double) { return 0.4; };
-  gen.i_pu = [i](double t) { return i + core::Vec2(0.0, 0.01 * std::sin(7.0 * t)); };
+  gen.i_pu = [i](double t) -> core::Vec2 { return i + core::Vec2(0.0, 0.01 * std::sin(7.0 * t)); };
   std::vector<core::AveragedSample> windows;
   for (int k = 0; k < kSamples; ++k) windows.push_back(gen.next());
   std::vector<core::RegimeInput> inputs;
