@@ -129,6 +129,30 @@ void calibrate_and_select(const EffectFitter& fitter, double floor, Diagnosis& d
   for (std::size_t i = 0; i < kCalibrated.size(); ++i) d.calibration.value[i] = d.extended_model.machine.*kCalibratedFields[i];
 }
 
+/// The diagnosis again under Huber's loss (docs/diagnose.md, "Outliers and the robust loss"), after the
+/// least-squares one (kept in d.least_squares for the report). b from the least-squares model's residuals is
+/// too wide where the outliers pulled its bulk too: it is re-estimated from each robust diagnosis' own final
+/// residuals until it settles within 10 % (at most kRobustRuns).
+void diagnose_robustly(const EffectFitter& least_squares, double floor, Diagnosis& d) {
+  LeastSquaresResult ls;
+  for (const FoundEffect& f : d.selection.found) ls.found.push_back(f.effect.label());
+  ls.value = d.calibration.value;
+  ls.identifiable = d.calibration.identifiable;
+  ls.extended_heldout_rms_A = d.selection.extended_heldout_rms_A;
+  d.least_squares = ls;
+  for (int run = 1; run <= kRobustRuns; ++run) {
+    const EffectFitter robust = least_squares.with_loss(d.outliers.loss);
+    d.baseline_heldout_rms_A = rms(robust.heldout(EffectSet{}));
+    calibrate_and_select(robust, floor, d);
+    d.outliers.robust_runs = run;
+    std::vector<double> r;
+    least_squares.training_residuals(d.selection.model, r);
+    const double settled = test_outliers(r).threshold_A;
+    if (std::abs(settled / d.outliers.loss.threshold_A - 1.0) < 0.1 || run == kRobustRuns) break;
+    d.outliers.loss.threshold_A = settled;
+  }
+}
+
 }  // namespace
 
 io::MachineConfig config_of(const io::MachineConfig& input, const ExtendedModel& model,
@@ -174,29 +198,7 @@ Diagnosis diagnose(LogData log, const io::MachineConfig& config, const DiagnoseO
   calibrate_and_select(least_squares, floor, d);
   // Outliers that move the least-squares fit: everything again under the robust loss.
   d.outliers = check_outliers(least_squares, d.selection.model, d.calibration.intervals);
-  std::optional<EffectFitter> robust;
-  if (d.outliers.influential) {
-    LeastSquaresResult ls;
-    for (const FoundEffect& f : d.selection.found) ls.found.push_back(f.effect.label());
-    ls.value = d.calibration.value;
-    ls.identifiable = d.calibration.identifiable;
-    ls.extended_heldout_rms_A = d.selection.extended_heldout_rms_A;
-    d.least_squares = ls;
-    // b from the least-squares model's residuals is too wide where the outliers pulled it (its bulk then misfits
-    // too): re-estimated from each robust diagnosis' own residuals until it settles within 10 %.
-    for (int run = 1; run <= kRobustRuns; ++run) {
-      robust.emplace(least_squares.with_loss(d.outliers.loss));
-      d.baseline_heldout_rms_A = rms(robust->heldout(EffectSet{}));
-      calibrate_and_select(*robust, floor, d);
-      d.outliers.robust_runs = run;
-      std::vector<double> r;
-      least_squares.training_residuals(d.selection.model, r);
-      const OutlierTest t = test_outliers(r);
-      const double previous = d.outliers.loss.threshold_A;
-      if (std::abs(t.threshold_A / previous - 1.0) < 0.1 || run == kRobustRuns) break;
-      d.outliers.loss.threshold_A = t.threshold_A;
-    }
-  }
+  if (d.outliers.influential) diagnose_robustly(least_squares, floor, d);
 
   std::vector<bool> keep;
   d.estimator_checks = check_estimator(d, keep);
