@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include "rpem/core/clock.hpp"
+
 namespace rpem::core {
 namespace {
 
@@ -66,7 +68,7 @@ SteadyStateSample AveragedDriveEstimator::condition(const AveragedSample& a) noe
   }
 
   const std::int64_t window_ns = a.t_ns - a.t_start_ns;
-  s.dt_s = has_previous_ ? 1e-9 * static_cast<double>(a.t_ns - previous_t_ns_) : 0.0;
+  s.dt_s = has_previous_ ? to_seconds(a.t_ns - *previous_t_ns_) : 0.0;
   // How the sample continues the previous one (docs/derivations.md §13, "Contiguity"): a window is
   // adjacent when it starts where the previous one ended — not later by more than half its own length (or
   // windows were lost) — whatever its length; an instantaneous sample when it follows within
@@ -75,7 +77,7 @@ SteadyStateSample AveragedDriveEstimator::condition(const AveragedSample& a) noe
   if (!follows) {
     timing_ = SampleTiming::kFirst;
   } else if (window_ns > 0) {
-    timing_ = 2 * (a.t_start_ns - previous_t_ns_) <= window_ns ? SampleTiming::kContiguous : SampleTiming::kFirst;
+    timing_ = 2 * (a.t_start_ns - *previous_t_ns_) <= window_ns ? SampleTiming::kContiguous : SampleTiming::kFirst;
   } else {
     timing_ = s.dt_s <= options_.max_interval_s ? SampleTiming::kContiguous : SampleTiming::kStandalone;
   }
@@ -93,12 +95,8 @@ SteadyStateSample AveragedDriveEstimator::condition(const AveragedSample& a) noe
                        : 1.0;
   instrument_i_pu_ += w * (s.i_meas_pu - instrument_i_pu_);
   instrument_n_pu_ += w * (s.n_pu - instrument_n_pu_);
-  if (s.i_meas_pu.allFinite()) {
-    has_previous_ = true;
-    previous_t_ns_ = a.t_ns;
-  } else {
-    has_previous_ = false;
-  }
+  previous_t_ns_ = a.t_ns;
+  has_previous_ = s.i_meas_pu.allFinite();
   return s;
 }
 
@@ -113,7 +111,7 @@ Estimate AveragedDriveEstimator::step(const AveragedSample& sample) noexcept {
   RegimeInput in;
   in.timing = timing_;
   in.t_ns = sample.t_ns;
-  in.window_s = 1e-9 * static_cast<double>(sample.t_ns - sample.t_start_ns);
+  in.window_s = to_seconds(sample.t_ns - sample.t_start_ns);
   in.u_pu = s.u_pu;
   in.i_pu = s.i_meas_pu;
   in.n_pu = s.n_pu;

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <limits>
 
+#include "rpem/core/clock.hpp"
 #include "rpem/io/number_format.hpp"
 
 namespace rpem::io {
@@ -106,8 +107,8 @@ AveragedLogWriter::AveragedLogWriter(const std::string& path, const AveragedLogL
 
 void AveragedLogWriter::write(const core::AveragedSample& s) {
   line_.clear();
-  append_number(line_, 1e-9 * static_cast<double>(s.t_ns));
-  append_number(line_ += ',', 1e-9 * static_cast<double>(s.t_start_ns));
+  append_number(line_, core::to_seconds(s.t_ns));
+  append_number(line_ += ',', core::to_seconds(s.t_start_ns));
   for (double v : {s.i_dq_A[0], s.i_dq_A[1], s.u_dq_V[0], s.u_dq_V[1], s.omega_el_rad_s}) append_number(line_ += ',', v);
   if (layout_.u_dc) append_number(line_ += ',', s.u_dc_V);
   if (layout_.t_winding) append_number(line_ += ',', s.t_winding_C);

@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <filesystem>
 
+#include "rpem/core/clock.hpp"
 #include "rpem/core/frames.hpp"
 #include "rpem/io/number_format.hpp"
 
@@ -115,7 +116,7 @@ void DriveLogWriter::write(const DriveLogRow& row) {
     return core::park(ab, rot);
   };
   line_.clear();
-  append_number(line_, 1e-9 * static_cast<double>(s.t_ns));
+  append_number(line_, core::to_seconds(s.t_ns));
   for (double v : {s.theta_el_rad, s.omega_el_rad_s, s.u_dc_V}) append_number(line_ += ',', v);
   if (layout_.voltage_abc) {
     const core::Vec3 u = to_abc(s.voltage_frame, s.u_V);

@@ -12,6 +12,7 @@
 #include "commands.hpp"
 #include "rpem/analysis/diagnose/diagnose_output.hpp"
 #include "rpem/io/errors.hpp"
+#include "rpem/io/number_format.hpp"
 #include "rpem/io/sample_counts.hpp"
 
 namespace rpem::tools {
@@ -19,7 +20,7 @@ namespace {
 
 struct DiagnoseCliOptions {
   std::string log, log_map, config, out, truth, model = "auto";
-  double reference_C = 20.0;
+  double reference_C = analysis::DiagnoseOptions{}.reference_C;
   double switching_frequency_Hz = 0.0;
   analysis::SelectionOptions selection;
   int blocks = 40;
@@ -141,8 +142,9 @@ Runner add_diagnose_command(CLI::App& app) {
       ->check(CLI::ExistingFile);
   cmd->add_option("--model", o->model, "replay model: auto (from the sample interval), transient, steady_state")
       ->check(CLI::IsMember({"auto", "transient", "steady_state"}));
-  cmd->add_option("--reference-temperature-C", o->reference_C,
-                  "temperature to which found drift laws are referred (default 20)");
+  std::string reference_help = "temperature to which found drift laws are referred (default ";
+  io::append_number(reference_help, o->reference_C);
+  cmd->add_option("--reference-temperature-C", o->reference_C, reference_help + ")");
   cmd->add_option("--switching-frequency-Hz", o->switching_frequency_Hz,
                   "PWM frequency, to report dead time in seconds (default: model_extensions.deadtime's)")
       ->check(CLI::PositiveNumber);

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "rpem/core/clock.hpp"
 #include "rpem/core/conditioner.hpp"
 #include "rpem/core/frames.hpp"
 #include "rpem/io/averaged_log.hpp"
@@ -43,12 +44,12 @@ LogData prepare_log(std::vector<io::DriveLogRow> rows, const io::DriveLogLayout&
     throw io::DriveLogError(path, n + 1, 0, "", "a log to diagnose needs at least " +
                                                     std::to_string(2 * std::max(2, options.blocks)) + " rows");
   }
-  d.t_start_s = 1e-9 * static_cast<double>(d.rows.front().sample.t_ns);
-  d.t_end_s = 1e-9 * static_cast<double>(d.rows.back().sample.t_ns);
+  d.t_start_s = core::to_seconds(d.rows.front().sample.t_ns);
+  d.t_end_s = core::to_seconds(d.rows.back().sample.t_ns);
 
   std::vector<double> dts;
   dts.reserve(n - 1);
-  for (std::size_t k = 1; k < n; ++k) dts.push_back(1e-9 * static_cast<double>(d.rows[k].sample.t_ns - d.rows[k - 1].sample.t_ns));
+  for (std::size_t k = 1; k < n; ++k) dts.push_back(core::to_seconds(d.rows[k].sample.t_ns - d.rows[k - 1].sample.t_ns));
   d.median_dt_s = median(dts);
 
   // The measured current's amplitude, the same in every frame (amplitude-invariant).
@@ -86,7 +87,7 @@ LogData prepare_log(std::vector<io::DriveLogRow> rows, const io::DriveLogLayout&
     const std::size_t w = static_cast<std::size_t>(options.speed_half_window);
     for (std::size_t k = w; k + w < n; ++k) {
       const core::DriveSample &a = d.rows[k - w].sample, &b = d.rows[k + w].sample;
-      const double dt = 1e-9 * static_cast<double>(b.t_ns - a.t_ns);
+      const double dt = core::to_seconds(b.t_ns - a.t_ns);
       // Only across a gap-free stretch; else the logged speed stays.
       bool gap = false;
       for (std::size_t j = k - w + 1; j <= k + w && !gap; ++j) gap = d.rows[j].sample.gap_before;
@@ -119,7 +120,7 @@ LogData prepare_log(std::vector<io::DriveLogRow> rows, const io::DriveLogLayout&
   d.block.resize(n);
   const double span = std::max(d.t_end_s - d.t_start_s, 1e-12);
   for (std::size_t k = 0; k < n; ++k) {
-    const double t = 1e-9 * static_cast<double>(d.rows[k].sample.t_ns) - d.t_start_s;
+    const double t = core::to_seconds(d.rows[k].sample.t_ns) - d.t_start_s;
     d.block[k] = std::min(d.blocks - 1, static_cast<int>(t / span * d.blocks));
   }
   return d;

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "rpem/core/clock.hpp"
 #include "rpem/core/settings.hpp"
 #include "rpem/core/types.hpp"
 #include "rpem/io/drive_log.hpp"
@@ -54,7 +55,7 @@ struct LogData {
 
   /// Where sample k lies in the log's time span, 0 … 1.
   [[nodiscard]] double time_fraction(std::size_t k) const noexcept {
-    return (1e-9 * static_cast<double>(rows[k].sample.t_ns) - t_start_s) / std::max(t_end_s - t_start_s, 1e-12);
+    return (core::to_seconds(rows[k].sample.t_ns) - t_start_s) / std::max(t_end_s - t_start_s, 1e-12);
   }
   [[nodiscard]] bool training(std::size_t k) const noexcept { return used[k] && block[k] % 2 == 0; }
   [[nodiscard]] bool heldout(std::size_t k) const noexcept { return used[k] && block[k] % 2 == 1; }
