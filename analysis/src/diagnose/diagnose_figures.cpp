@@ -24,14 +24,13 @@ struct SampleView {
 };
 
 /// Per-sample operating point of the log, SI.
-std::vector<SampleView> operating_points(const Diagnosis& d) {
+std::vector<SampleView> operating_points(const LogData& log, int pole_pairs) {
   std::vector<SampleView> v;
-  v.reserve(d.log->rows.size());
-  for (std::size_t k = 0; k < d.log->rows.size(); ++k) {
-    const core::DriveSample& s = d.log->rows[k].sample;
-    const core::Vec2& i = d.log->logged_i_dq_A[k];
-    v.push_back({core::to_seconds(s.t_ns), core::rad_s_to_rpm(s.omega_el_rad_s) / d.context.machine.rated.pole_pairs,
-                 i[0], i[1]});
+  v.reserve(log.rows.size());
+  for (std::size_t k = 0; k < log.rows.size(); ++k) {
+    const core::DriveSample& s = log.rows[k].sample;
+    const core::Vec2& i = log.logged_i_dq_A[k];
+    v.push_back({core::to_seconds(s.t_ns), core::rad_s_to_rpm(s.omega_el_rad_s) / pole_pairs, i[0], i[1]});
   }
   return v;
 }
@@ -270,16 +269,16 @@ std::string overlay(const std::string& dir, const Diagnosis& d, const std::vecto
 constexpr std::array<const char*, core::kRegimeCount> kRegimeColour{"#2ca02c", "#1f77b4", "#17becf", "#9a9a9a",
                                                                     "#ff7f0e", "#9467bd", "#d62728", "#000000"};
 
-std::string regime_timeline(const std::string& dir, const Diagnosis& d, const std::vector<SampleView>& ops) {
+std::string regime_timeline(const std::string& dir, const LogRegimes& regimes, const std::vector<SampleView>& ops) {
   // Per time bin and regime, the mean speed and current amplitude of that regime's samples in the bin: a short
   // stretch in one regime shows however long the log.
-  const std::size_t n = d.log->rows.size();
+  const std::size_t n = ops.size();
   const std::size_t per_bin = std::max<std::size_t>(1, n / kTimeBins);
   DataBlock b{"reg", std::vector<std::vector<double>>(4)};  // t, speed, |i|, regime
   for (std::size_t start = 0; start < n; start += per_bin) {
     std::array<std::array<double, 4>, core::kRegimeCount> sums{};  // count, t, speed, |i|
     for (std::size_t k = start; k < std::min(n, start + per_bin); ++k) {
-      auto& s = sums[static_cast<std::size_t>(d.regimes.regime[k])];
+      auto& s = sums[static_cast<std::size_t>(regimes.regime[k])];
       s[0] += 1.0;
       s[1] += ops[k].t_s;
       s[2] += ops[k].speed_rpm;
@@ -293,7 +292,7 @@ std::string regime_timeline(const std::string& dir, const Diagnosis& d, const st
   }
   std::string speed_plot, current_plot;
   for (const core::RegimeInfo& info : core::kRegimes) {
-    const std::uint64_t count = d.regimes.counts.regimes[info.regime];
+    const std::uint64_t count = regimes.counts.regimes[info.regime];
     if (count == 0) continue;
     const std::string r = std::to_string(static_cast<int>(info.regime));
     const std::string style = std::string(" w p pt 7 ps 0.5 lc rgb '") + kRegimeColour[static_cast<std::size_t>(info.regime)] + "'";
@@ -351,14 +350,18 @@ std::string estimates(const std::string& dir, const Diagnosis& d) {
 }  // namespace
 
 std::vector<std::string> write_diagnose_figures(const std::string& dir, const Diagnosis& d) {
-  const std::vector<SampleView> ops = operating_points(d);
-  std::vector<std::string> out = {residual_time(dir, d, ops), regime_timeline(dir, d, ops), residual_map(dir, d, ops),
+  const std::vector<SampleView> ops = operating_points(*d.log, d.context.machine.rated.pole_pairs);
+  std::vector<std::string> out = {residual_time(dir, d, ops), regime_timeline(dir, d.regimes, ops), residual_map(dir, d, ops),
                                   overlay(dir, d, ops)};
   if (!d.statistics.harmonics.empty()) out.push_back(harmonics(dir, d));
   if (!d.statistics.phase_signs.empty()) out.push_back(phase_sign(dir, d));
   if (temperature_varies(d)) out.push_back(residual_vs_temperature(dir, d));  // a constant axis shows nothing
   if (!d.estimates.nominal.empty()) out.push_back(estimates(dir, d));
   return out;
+}
+
+std::string write_regime_timeline(const std::string& dir, const LogData& log, const LogRegimes& regimes, int pole_pairs) {
+  return regime_timeline(dir, regimes, operating_points(log, pole_pairs));
 }
 
 }  // namespace rpem::analysis

@@ -11,6 +11,7 @@
 #include "rpem/io/log_source.hpp"
 #include "rpem/io/machine_config.hpp"
 #include "rpem/io/sample_counts.hpp"
+#include "rpem/io/vesc_tool_log.hpp"
 
 namespace rpem::analysis {
 namespace {
@@ -151,6 +152,46 @@ std::vector<std::string> left_out_explanations(const LogData& log) {
   return out;
 }
 
+core::Vec2 applied_mean_V(const core::Vec2& command_V, double omega_el_rad_s, double control_period_s,
+                          double delay_periods) noexcept {
+  const double wt = omega_el_rad_s * control_period_s;
+  const double half = 0.5 * wt;
+  const double sinc = std::abs(half) < 1e-6 ? 1.0 - half * half / 6.0 : std::sin(half) / half;
+  // Turned by −d·ω·T_c: the Park transform by the angle the rotor advances before the hold's centre.
+  return sinc * core::park(command_V, core::Rotation::of(delay_periods * wt));
+}
+
+namespace {
+
+/// Turns a drive's reported command into the applied mean, sample by sample, where the drive reports its
+/// command; returns what it did, for the log's description ("" where nothing).
+std::string apply_reported_voltage(std::vector<core::AveragedSample>& samples, const io::LogSource& source,
+                                   const LogOptions& options) {
+  const bool vesc_tool = source.map.name == io::vesc_tool_log_map().name;
+  const bool command = options.reported_voltage == ReportedVoltage::kCommand ||
+                       (options.reported_voltage == ReportedVoltage::kDetected && vesc_tool);
+  if (!command) return "";
+  if (options.control_period_s <= 0.0) {
+    return "; its voltages are the drive's command, left as they are: estimator.averaged.control_period_s is 0 "
+           "(set the drive's control period to turn them into the applied mean: up to ω·T_c of the back EMF "
+           "stands on the d axis otherwise)";
+  }
+  // Every sample: at VESC Tool's 0.01 A a modulating bridge at zero current (coasting) reads i = 0 as the
+  // undriven one does, so the two cannot be told apart here; the undriven branch's measured back EMF is the
+  // rotor's voltage, and turning it too moves ψm by 1 − cos·sinc of its rows (docs/derivations.md §16).
+  for (core::AveragedSample& s : samples) {
+    s.u_dq_V = applied_mean_V(s.u_dq_V, s.omega_el_rad_s, options.control_period_s, options.command_delay_periods);
+  }
+  char text[240];
+  std::snprintf(text, sizeof text,
+                "; voltages reported as the drive's command, turned into the applied mean (by −%.3g·ω·T_c, times "
+                "sinc(ω·T_c/2), T_c = %.3g µs)",
+                options.command_delay_periods, 1e6 * options.control_period_s);
+  return text;
+}
+
+}  // namespace
+
 LogData load_log(const std::string& path, const core::MachineSi& machine, const LogOptions& options) {
   const io::LogSource source = io::log_source(path, options.log_map);
   const io::DriveLogLimits limits = io::machine_limits(machine);
@@ -161,7 +202,8 @@ LogData load_log(const std::string& path, const core::MachineSi& machine, const 
                               "an averaged log replays only the steady-state model (give --model auto or steady_state)");
     }
     io::AveragedLogRead read;
-    const std::vector<core::AveragedSample> samples = io::read_averaged_log(path, source.map, limits, &read);
+    std::vector<core::AveragedSample> samples = io::read_averaged_log(path, source.map, limits, &read);
+    const std::string voltage = apply_reported_voltage(samples, source, options);
     std::vector<io::DriveLogRow> rows;
     std::vector<std::int64_t> starts;
     rows.reserve(samples.size());
@@ -175,7 +217,7 @@ LogData load_log(const std::string& path, const core::MachineSi& machine, const 
     LogData d = prepare_log(std::move(rows), io::rotor_frame_layout(read.layout), machine, steady, path);
     d.averaged = true;
     d.window_start_ns = std::move(starts);
-    d.format = io::describe(source, read);
+    d.format = io::describe(source, read) + voltage;
     return d;
   }
   io::DriveLogReader reader(path, source.map, limits);

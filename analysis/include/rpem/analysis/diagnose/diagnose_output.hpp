@@ -18,6 +18,10 @@ void write_extended_yaml(const std::string& path, const Diagnosis& d, const std:
 /// The figures; returns their file names (relative to `dir`).
 [[nodiscard]] std::vector<std::string> write_diagnose_figures(const std::string& dir, const Diagnosis& d);
 
+/// The log's timeline coloured by regime (speed and current amplitude against time), `dir`/regimes.png, as
+/// the diagnosis draws it; `rpem figures --log` draws it without a diagnosis. Returns the file name.
+std::string write_regime_timeline(const std::string& dir, const LogData& log, const LogRegimes& regimes, int pole_pairs);
+
 void write_diagnose_report(const std::string& dir, const Diagnosis& d, const std::string& config_path);
 
 /// The found effect j's parameters in SI (its row's describe() of the final joint fit).
