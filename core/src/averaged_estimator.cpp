@@ -40,6 +40,7 @@ AveragedDriveEstimator::AveragedDriveEstimator(const MachineSi& machine, const E
 void AveragedDriveEstimator::configure(const EstimatorSettings& settings) noexcept {
   rates_per_s_ = averaged_rates_per_s(settings);
   options_ = settings.averaged;
+  options_classify_ = settings.regimes.enabled;
   delay_s_ = settings.extensions.delay_s;
 }
 
@@ -110,6 +111,17 @@ Estimate AveragedDriveEstimator::step(const AveragedSample& sample) noexcept {
   const GainSequences gains = point ? point_gains_.at(rates, sample.t_ns)
                                     : GainSequences{per_interval(rates.hessian, s.dt_s), per_interval(rates.gain, s.dt_s)};
 
+  if (!options_classify_) [[unlikely]] {
+    if (options_.inductive_correction && timing_ == SampleTiming::kContiguous) {
+      // What the classifier would have taken: the slope between the window centres (§11).
+      const double dc_s = 0.5e-9 * static_cast<double>((sample.t_start_ns + sample.t_ns) - previous_centre2_ns_);
+      const Vec2 di_dt = (s.i_meas_pu - previous_i_pu_) / dc_s;
+      s.u_pu -= Vec2(s.x_d_pu * di_dt[0], s.x_q_pu * di_dt[1]) / base_.omega_el_rad_s;
+    }
+    previous_centre2_ns_ = sample.t_start_ns + sample.t_ns;
+    previous_i_pu_ = s.i_meas_pu;
+    return finish(sample, s, core_.step_steady_state(s, gains.hessian, gains.gain, Admission{}), kUnclassified, point, gains);
+  }
   RegimeInput in;
   in.timing = timing_;
   in.t_ns = sample.t_ns;
@@ -129,9 +141,14 @@ Estimate AveragedDriveEstimator::step(const AveragedSample& sample) noexcept {
   const RegimeNoise noise = classifier_.noise();
   const Admission admission{!regime.excluded(), regime.excites_psi_m(), regime.excites_r_s(), true,
                             noise.u_sq,          noise.i_sq,             noise.n_sq};
+  return finish(sample, s, core_.step_steady_state(s, gains.hessian, gains.gain, admission), regime, point, gains);
+}
+
+Estimate AveragedDriveEstimator::finish(const AveragedSample& sample, const SteadyStateSample& s, const EstimatorOutput& detail,
+                                        Classification regime, bool point, const GainSequences& gains) noexcept {
   Estimate e;
   e.t_ns = sample.t_ns;
-  e.detail = core_.step_steady_state(s, gains.hessian, gains.gain, admission);
+  e.detail = detail;
   if (point && e.detail.code == StepCode::kAdapted) point_gains_.count(gains, sample.t_ns);
   e.psi_m_Wb = base_.flux_Wb_of(e.detail.theta_pu[kPsiM]);
   e.r_s_Ohm = base_.resistance_Ohm_of(e.detail.theta_pu[kRs]);

@@ -144,6 +144,7 @@ core::EstimatorSettings parse_estimator(YamlMap e, const core::MachineSi& machin
   if (auto g = e.optional_map("regimes")) {
     // The regime classification (core/regime.hpp, docs/derivations.md §13).
     core::RegimeSettings& r = s.regimes;
+    r.enabled = g->boolean_or("enabled", r.enabled);
     r.significance_sigma = g->number_or("significance_sigma", r.significance_sigma, 1.0, 10.0);
     r.voltage_resolution_V = g->number_or("voltage_resolution_V", r.voltage_resolution_V, 0.0, 1e3);
     r.current_resolution_A = g->number_or("current_resolution_A", r.current_resolution_A, 0.0, 1e3);
