@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include "rpem/core/clock.hpp"
+
 namespace rpem::core {
 namespace {
 
@@ -58,6 +60,14 @@ SteadyStateSample AveragedDriveEstimator::condition(const AveragedSample& a) noe
     const Rotation back = Rotation::of(-s.n_pu * omega_n * delay_s_);
     s.u_pu = Vec2(back.cos * s.u_pu[0] - back.sin * s.u_pu[1], back.sin * s.u_pu[0] + back.cos * s.u_pu[1]);
   }
+  if (options_.voltage_is_command && options_.control_period_s > 0.0) {
+    // Reported command (§11): held over one period from the delay on, its mean in the rotor frame at the
+    // sample is the command turned by −ω·(delay + T_c/2) and shortened by sinc(ω·T_c/2); the delay's turn is above.
+    const double half = 0.5 * s.n_pu * omega_n * options_.control_period_s;
+    const double sinc = std::abs(half) < 1e-4 ? 1.0 - half * half / 6.0 : std::sin(half) / half;
+    const Rotation back = Rotation::of(-half);
+    s.u_pu = sinc * Vec2(back.cos * s.u_pu[0] - back.sin * s.u_pu[1], back.sin * s.u_pu[0] + back.cos * s.u_pu[1]);
+  }
   if (options_.control_period_s > 0.0) {
     // Sampled means (§11): ī = i_sample + c·ω·T_c²·L⁻¹·J·ū, c = (a − ½)²/2 − 1/24; in pu c·n·(ω_n·T_c)²·J·u/x.
     const double a_half = options_.current_sample_at - 0.5;
@@ -67,7 +77,7 @@ SteadyStateSample AveragedDriveEstimator::condition(const AveragedSample& a) noe
   }
 
   const std::int64_t window_ns = a.t_ns - a.t_start_ns;
-  s.dt_s = has_previous_ ? 1e-9 * static_cast<double>(a.t_ns - previous_t_ns_) : 0.0;
+  s.dt_s = has_previous_ ? to_seconds(a.t_ns - *previous_t_ns_) : 0.0;
   // How the sample continues the previous one (docs/derivations.md §13, "Contiguity"): a window is
   // adjacent when it starts where the previous one ended — not later by more than half its own length (or
   // windows were lost) — whatever its length; an instantaneous sample when it follows within
@@ -76,7 +86,7 @@ SteadyStateSample AveragedDriveEstimator::condition(const AveragedSample& a) noe
   if (!follows) {
     timing_ = SampleTiming::kFirst;
   } else if (window_ns > 0) {
-    timing_ = 2 * (a.t_start_ns - previous_t_ns_) <= window_ns ? SampleTiming::kContiguous : SampleTiming::kFirst;
+    timing_ = 2 * (a.t_start_ns - *previous_t_ns_) <= window_ns ? SampleTiming::kContiguous : SampleTiming::kFirst;
   } else {
     timing_ = s.dt_s <= options_.max_interval_s ? SampleTiming::kContiguous : SampleTiming::kStandalone;
   }
@@ -94,12 +104,8 @@ SteadyStateSample AveragedDriveEstimator::condition(const AveragedSample& a) noe
                        : 1.0;
   instrument_i_pu_ += w * (s.i_meas_pu - instrument_i_pu_);
   instrument_n_pu_ += w * (s.n_pu - instrument_n_pu_);
-  if (s.i_meas_pu.allFinite()) {
-    has_previous_ = true;
-    previous_t_ns_ = a.t_ns;
-  } else {
-    has_previous_ = false;
-  }
+  previous_t_ns_ = a.t_ns;
+  has_previous_ = s.i_meas_pu.allFinite();
   return s;
 }
 
@@ -114,7 +120,7 @@ Estimate AveragedDriveEstimator::step(const AveragedSample& sample) noexcept {
   if (!options_classify_) [[unlikely]] {
     if (options_.inductive_correction && timing_ == SampleTiming::kContiguous) {
       // What the classifier would have taken: the slope between the window centres (§11).
-      const double dc_s = 0.5e-9 * static_cast<double>((sample.t_start_ns + sample.t_ns) - previous_centre2_ns_);
+      const double dc_s = 0.5 * to_seconds((sample.t_start_ns + sample.t_ns) - previous_centre2_ns_);
       const Vec2 di_dt = (s.i_meas_pu - previous_i_pu_) / dc_s;
       s.u_pu -= Vec2(s.x_d_pu * di_dt[0], s.x_q_pu * di_dt[1]) / base_.omega_el_rad_s;
     }
@@ -125,7 +131,7 @@ Estimate AveragedDriveEstimator::step(const AveragedSample& sample) noexcept {
   RegimeInput in;
   in.timing = timing_;
   in.t_ns = sample.t_ns;
-  in.window_s = 1e-9 * static_cast<double>(sample.t_ns - sample.t_start_ns);
+  in.window_s = to_seconds(sample.t_ns - sample.t_start_ns);
   in.u_pu = s.u_pu;
   in.i_pu = s.i_meas_pu;
   in.n_pu = s.n_pu;

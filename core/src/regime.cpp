@@ -4,6 +4,9 @@
 #include <cmath>
 #include <limits>
 
+#include "rpem/core/assert.hpp"
+#include "rpem/core/clock.hpp"
+
 namespace rpem::core {
 namespace {
 
@@ -168,7 +171,7 @@ Classification RegimeClassifier::step(const RegimeInput& in) noexcept {
     s.has_origin = true;
   }
   // Times are window centres (a mean stands for its centre), relative to the first sample.
-  const double t_s = 1e-9 * static_cast<double>(in.t_ns - s.t_origin_ns) - 0.5 * in.window_s;
+  const double t_s = to_seconds(in.t_ns - s.t_origin_ns) - 0.5 * in.window_s;
   const double dt_s = s.points >= 1 ? t_s - s.t_s[0] : 0.0;
 
   // The current's slope: given (a block's end points), or between consecutive samples of a chain.
@@ -293,6 +296,7 @@ Classification StreamClassifier::start(const RegimeInput& in) noexcept {
 }
 
 Classification StreamClassifier::close_block(std::int64_t t_ns, const Vec2& i_pu) noexcept {
+  RPEM_ASSERT(count_ >= 1, "a block closes on the sample step_dense() has just added");
   if (!has_start_) {  // dense samples before any chain start (a caller's misuse): classified alone
     RegimeInput in;
     in.timing = SampleTiming::kFirst;
@@ -309,11 +313,12 @@ Classification StreamClassifier::close_block(std::int64_t t_ns, const Vec2& i_pu
   RegimeInput b;
   b.timing = SampleTiming::kDense;
   b.t_ns = t_ns;
-  b.window_s = 1e-9 * static_cast<double>(t_ns - start_ns_);
+  b.window_s = to_seconds(t_ns - start_ns_);
   b.u_pu = u_sum_ * inv_count;
   b.i_pu = i_sum_ * inv_count;
   b.n_pu = n_sum_ * inv_count;
   b.u_reported_sq_pu = u_reported_sum_ * inv_count;
+  RPEM_ASSERT(b.window_s >= 0.0, "dense samples come in time order (the conditioner resynchronises otherwise)");
   b.di_dt_pu_s = (i_pu - i_start_) / b.window_s;
   b.weight = (gain_rate_per_s_ * b.window_s).cwiseMin(1.0);  // the block's share of each estimate: its γ_L summed
   held_ = classifier_.step(b);

@@ -1,5 +1,6 @@
 #include "rpem/io/estimate_log.hpp"
 
+#include "rpem/core/clock.hpp"
 #include "rpem/io/errors.hpp"
 #include "rpem/io/number_format.hpp"
 
@@ -15,7 +16,7 @@ void EstimateLogWriter::write(const core::Estimate& e, const core::RpemEstimator
   const auto& d = e.detail;
   const auto& st = core.state();
   line_.clear();
-  append_number(line_, 1e-9 * static_cast<double>(e.t_ns));
+  append_number(line_, core::to_seconds(e.t_ns));
   for (double v : {e.psi_m_Wb, e.r_s_Ohm, d.theta_pu[core::kPsiM], d.theta_pu[core::kRs], e.epsilon_A[0],
                    e.epsilon_A[1], e.i_hat_A[0], e.i_hat_A[1], e.i_meas_A[0], e.i_meas_A[1], e.speed_pu}) {
     append_number(line_ += ',', v);

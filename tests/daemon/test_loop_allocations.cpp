@@ -3,14 +3,16 @@
 // validity and age tracking — counted by replacing the global allocation functions.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <atomic>
 #include <cstdlib>
 #include <new>
 
 #include "rpem/command_t.hpp"
 #include "rpem/daemon/command_gate.hpp"
-#include "rpem/daemon/estimator_loop.hpp"
+#include "rpem/daemon/loop_thread.hpp"
 #include "support/averaged_data.hpp"
+#include "support/loop_queues.hpp"
 #include "support/model_data.hpp"
 #include "support/paper_machine.hpp"
 
@@ -35,10 +37,8 @@ namespace {
 
 TEST(LoopAllocations, NoneInTheLoopsPeriodWork) {
   DaemonConfig config = builtin_daemon_config();
-  SpscQueue<SourceSample> input(4096);
-  SpscQueue<Command> commands(16);
-  SpscQueue<Report> output(1 << 16);
-  EstimatorLoop loop(config, EstimatorLoop::Queues{input, commands, output});
+  auto [input, commands, output, ends] = test::loop_queues(4096, 16, 1 << 16);
+  LoopThread loop(config, std::move(ends));
   loop.seed(SeedValue{1.1, 4.0}, SeedValue{2.3, 4.0}, 1'000'000'000);
   test::ModelDataGenerator gen;
   gen.plant = test::paper_machine_pu();
@@ -84,10 +84,8 @@ TEST(LoopAllocations, NoneInTheLoopsPeriodWork) {
 TEST(LoopAllocations, NoneOnTheAveragedPath) {
   DaemonConfig config = builtin_daemon_config();
   config.fixed.source = VescSource::Options{};
-  SpscQueue<SourceSample> input(4096);
-  SpscQueue<Command> commands(16);
-  SpscQueue<Report> output(1 << 16);
-  EstimatorLoop loop(config, EstimatorLoop::Queues{input, commands, output});
+  auto [input, commands, output, ends] = test::loop_queues(4096, 16, 1 << 16);
+  LoopThread loop(config, std::move(ends));
   test::AveragedDataGenerator gen;
   gen.base = test::paper_base();
   gen.plant = test::paper_machine_pu();
@@ -135,12 +133,12 @@ TEST(LoopAllocations, NoneInCommandAdmission) {
   m.command = rpem::command_t::SET_VALUES;
   m.psi_m_Wb = 1.1;
   m.r_s_Ohm = 2.3;
-  auth::Key key;
-  key.id = 3;
-  key.bytes.fill(0x42);
+  std::array<std::uint8_t, auth::kKeyBytes> key_bytes{};
+  key_bytes.fill(0x42);
+  const auth::Key key(3, key_bytes);  // the supervisor's
   auth::Keyring keys;
-  ASSERT_TRUE(keys.add(key));
-  m.key_id = key.id;
+  ASSERT_TRUE(keys.add(auth::Key(3, key_bytes)));  // rpemd's
+  m.key_id = key.id();
   std::vector<std::uint8_t> bytes(static_cast<std::size_t>(m.getEncodedSize()));
   ASSERT_EQ(m.encode(bytes.data(), 0, static_cast<int>(bytes.size())), static_cast<int>(bytes.size()));
   ASSERT_TRUE(auth::sign(key, "RPEM_COMMAND", bytes));

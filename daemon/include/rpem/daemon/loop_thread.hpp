@@ -1,5 +1,5 @@
 #pragma once
-// The fixed-rate estimator loop — rpemd's real-time thread, the owner of the estimator. Each period
+// The loop thread — rpemd's fixed-rate, real-time estimator loop, the owner of the estimator. Each period
 // (LoopTimer) it applies the commands the control thread queued, steps the estimator over every sample
 // that arrived (in order), tracks validity and age (ValidityTracker), and queues reports for the
 // publisher. The estimator is the one for the kind of sample the configured source produces
@@ -22,7 +22,7 @@
 
 namespace rpem::daemon {
 
-/// The loop's counters: it is their one writer (published through a table in estimator_loop.cpp).
+/// The loop's counters: it is their one writer (published through a table in loop_thread.cpp).
 struct LoopCounters {
   std::int64_t samples = 0;
   std::int64_t resyncs = 0;
@@ -44,15 +44,15 @@ struct SeedValue {
   double age_s = 0.0;
 };
 
-class EstimatorLoop {
+class LoopThread {
  public:
   struct Queues {
-    SpscQueue<SourceSample>& samples;  ///< from the source thread
-    SpscQueue<Command>& commands;           ///< from the control thread
-    SpscQueue<Report>& reports;             ///< to the publisher
+    SpscQueue<SourceSample>::Consumer samples;  ///< from the source thread
+    SpscQueue<Command>::Consumer commands;      ///< from the control thread
+    SpscQueue<Report>::Producer reports;        ///< to the publisher
   };
 
-  EstimatorLoop(const DaemonConfig& config, Queues queues);
+  LoopThread(const DaemonConfig& config, Queues queues);
 
   /// Seeds the estimates (from the state file) before the loop runs; `now_ns` on the loop's clock.
   void seed(const std::optional<SeedValue>& psi_m_Wb, const std::optional<SeedValue>& r_s_Ohm, std::int64_t now_ns);
