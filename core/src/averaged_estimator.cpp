@@ -42,6 +42,7 @@ AveragedDriveEstimator::AveragedDriveEstimator(const MachineSi& machine, const E
 void AveragedDriveEstimator::configure(const EstimatorSettings& settings) noexcept {
   rates_per_s_ = averaged_rates_per_s(settings);
   options_ = settings.averaged;
+  options_classify_ = settings.regimes.enabled;
   delay_s_ = settings.extensions.delay_s;
 }
 
@@ -58,6 +59,14 @@ SteadyStateSample AveragedDriveEstimator::condition(const AveragedSample& a) noe
     // A command acting `delay` late is, in the rotor frame at constant speed, the logged one turned by −ω·delay.
     const Rotation back = Rotation::of(-s.n_pu * omega_n * delay_s_);
     s.u_pu = Vec2(back.cos * s.u_pu[0] - back.sin * s.u_pu[1], back.sin * s.u_pu[0] + back.cos * s.u_pu[1]);
+  }
+  if (options_.voltage_is_command && options_.control_period_s > 0.0) {
+    // Reported command (§11): held over one period from the delay on, its mean in the rotor frame at the
+    // sample is the command turned by −ω·(delay + T_c/2) and shortened by sinc(ω·T_c/2); the delay's turn is above.
+    const double half = 0.5 * s.n_pu * omega_n * options_.control_period_s;
+    const double sinc = std::abs(half) < 1e-4 ? 1.0 - half * half / 6.0 : std::sin(half) / half;
+    const Rotation back = Rotation::of(-half);
+    s.u_pu = sinc * Vec2(back.cos * s.u_pu[0] - back.sin * s.u_pu[1], back.sin * s.u_pu[0] + back.cos * s.u_pu[1]);
   }
   if (options_.control_period_s > 0.0) {
     // Sampled means (§11): ī = i_sample + c·ω·T_c²·L⁻¹·J·ū, c = (a − ½)²/2 − 1/24; in pu c·n·(ω_n·T_c)²·J·u/x.
@@ -108,6 +117,17 @@ Estimate AveragedDriveEstimator::step(const AveragedSample& sample) noexcept {
   const GainSequences gains = point ? point_gains_.at(rates, sample.t_ns)
                                     : GainSequences{per_interval(rates.hessian, s.dt_s), per_interval(rates.gain, s.dt_s)};
 
+  if (!options_classify_) [[unlikely]] {
+    if (options_.inductive_correction && timing_ == SampleTiming::kContiguous) {
+      // What the classifier would have taken: the slope between the window centres (§11).
+      const double dc_s = 0.5 * to_seconds((sample.t_start_ns + sample.t_ns) - previous_centre2_ns_);
+      const Vec2 di_dt = (s.i_meas_pu - previous_i_pu_) / dc_s;
+      s.u_pu -= Vec2(s.x_d_pu * di_dt[0], s.x_q_pu * di_dt[1]) / base_.omega_el_rad_s;
+    }
+    previous_centre2_ns_ = sample.t_start_ns + sample.t_ns;
+    previous_i_pu_ = s.i_meas_pu;
+    return finish(sample, s, core_.step_steady_state(s, gains.hessian, gains.gain, Admission{}), kUnclassified, point, gains);
+  }
   RegimeInput in;
   in.timing = timing_;
   in.t_ns = sample.t_ns;
@@ -127,9 +147,14 @@ Estimate AveragedDriveEstimator::step(const AveragedSample& sample) noexcept {
   const RegimeNoise noise = classifier_.noise();
   const Admission admission{!regime.excluded(), regime.excites_psi_m(), regime.excites_r_s(), true,
                             noise.u_sq,          noise.i_sq,             noise.n_sq};
+  return finish(sample, s, core_.step_steady_state(s, gains.hessian, gains.gain, admission), regime, point, gains);
+}
+
+Estimate AveragedDriveEstimator::finish(const AveragedSample& sample, const SteadyStateSample& s, const EstimatorOutput& detail,
+                                        Classification regime, bool point, const GainSequences& gains) noexcept {
   Estimate e;
   e.t_ns = sample.t_ns;
-  e.detail = core_.step_steady_state(s, gains.hessian, gains.gain, admission);
+  e.detail = detail;
   if (point && e.detail.code == StepCode::kAdapted) point_gains_.count(gains, sample.t_ns);
   e.psi_m_Wb = base_.flux_Wb_of(e.detail.theta_pu[kPsiM]);
   e.r_s_Ohm = base_.resistance_Ohm_of(e.detail.theta_pu[kRs]);

@@ -10,7 +10,7 @@ DriveEstimator::DriveEstimator(const MachineSi& machine, const EstimatorSettings
     : base_(PerUnitBase::from_rated(machine.rated)),
       conditioner_(base_, to_pu(base_, machine), settings.extensions),
       core_(make_estimator_config(base_, machine, settings)),
-      classifier_(make_regime_config(base_, machine, settings)) {
+      regimes_(make_regime_config(base_, machine, settings)) {
   configure(settings);
   point_gains_.start(rates_per_s_, settings.nominal_sample_period_s);
 }
@@ -18,6 +18,10 @@ DriveEstimator::DriveEstimator(const MachineSi& machine, const EstimatorSettings
 void DriveEstimator::configure(const EstimatorSettings& settings) noexcept {
   rates_per_s_ = averaged_rates_per_s(settings)[static_cast<std::size_t>(settings.algorithm)];
   sparse_after_s_ = std::max(settings.max_sample_interval_s, settings.max_gap_carry_s);
+  classify_ = settings.regimes.enabled;
+  // RpemEstimator's per-sample γ_L = γ_0·Δt/T_samp.
+  dense_rates_per_s_ = settings.gains[static_cast<std::size_t>(settings.algorithm)].gain / settings.nominal_sample_period_s;
+  regimes_.set_gain_rates(dense_rates_per_s_);
   inv_voltage_sq_ = 1.0 / (base_.voltage_V * base_.voltage_V);
 }
 
@@ -47,23 +51,28 @@ Estimate DriveEstimator::estimate(const DriveSample& sample, const EstimatorOutp
   const PredictorInterval& iv = conditioned.interval;
   if (iv.dt_s > sparse_after_s_ && !conditioned.resync) [[unlikely]] return step_sparse(sample, conditioned);
 
-  RegimeInput in;
-  in.t_ns = sample.t_ns;
-  in.u_reported_sq_pu = reported_voltage_sq_pu(sample);
+  if (!classify_) [[unlikely]] {
+    const EstimatorOutput detail = core_.step(conditioned);
+    return estimate(sample, detail, conditioned.i_meas_pu, iv.n_end_pu, kUnclassified);
+  }
+  Classification regime;
   if (conditioned.resync || !(iv.dt_s <= core_.config().max_sample_interval_s)) [[unlikely]] {
     // A new chain: the voltage that acted before this sample is unknown; its own command stands in.
-    const SteadyStateInputs own = conditioner_.steady_state(sample);
+    RegimeInput in;
     in.timing = SampleTiming::kFirst;
-    in.u_pu = own.u_pu;
+    in.t_ns = sample.t_ns;
+    in.u_pu = conditioner_.steady_state(sample).u_pu;
+    in.i_pu = conditioned.i_meas_pu;
+    in.n_pu = iv.n_end_pu;
+    in.u_reported_sq_pu = reported_voltage_sq_pu(sample);
+    in.weight = (dense_rates_per_s_ * iv.dt_s).cwiseMin(1.0);  // γ_L as RpemEstimator scales it
+    regime = regimes_.step(in);
   } else {
-    in.timing = SampleTiming::kDense;
-    in.u_pu = 0.5 * (iv.u_start_pu + iv.u_end_pu);  // the interval's mean voltage (trapezoidal)
+    // The interval's mean voltage (trapezoidal).
+    regime = regimes_.step_dense(sample.t_ns, 0.5 * (iv.u_start_pu + iv.u_end_pu), conditioned.i_meas_pu, iv.n_end_pu,
+                                 reported_voltage_sq_pu(sample));
   }
-  in.i_pu = conditioned.i_meas_pu;
-  in.n_pu = iv.n_end_pu;
-  in.weight = (rates_per_s_.gain * iv.dt_s).cwiseMin(1.0);  // γ_L as RpemEstimator scales it
-  const Classification regime = classifier_.step(in);
-  const RegimeNoise noise = classifier_.noise();
+  const RegimeNoise& noise = regimes_.noise();
   const Admission admission{!regime.excluded(), regime.excites_psi_m(), regime.excites_r_s(), true,
                             noise.u_sq,          noise.i_sq,             noise.n_sq};
   const EstimatorOutput detail = core_.step(conditioned, admission);
@@ -83,6 +92,11 @@ Estimate DriveEstimator::step_sparse(const DriveSample& sample, const EstimatorS
   s.x_d_pu = own.x_d_pu;
   s.x_q_pu = own.x_q_pu;
   const GainSequences gains = point_gains_.at(rates_per_s_, sample.t_ns);
+  if (!classify_) [[unlikely]] {
+    const EstimatorOutput detail = core_.step_steady_state(s, gains.hessian, gains.gain, Admission{});
+    if (detail.code == StepCode::kAdapted) point_gains_.count(gains, sample.t_ns);
+    return estimate(sample, detail, own.i_pu, own.n_pu, kUnclassified);
+  }
 
   RegimeInput in;
   in.timing = SampleTiming::kStandalone;
@@ -92,8 +106,8 @@ Estimate DriveEstimator::step_sparse(const DriveSample& sample, const EstimatorS
   in.n_pu = own.n_pu;
   in.u_reported_sq_pu = reported_voltage_sq_pu(sample);
   in.weight = gains.gain;
-  const Classification regime = classifier_.step(in);
-  const RegimeNoise noise = classifier_.noise();
+  const Classification regime = regimes_.step(in);
+  const RegimeNoise& noise = regimes_.noise();
   const Admission admission{!regime.excluded(), regime.excites_psi_m(), regime.excites_r_s(), true,
                             noise.u_sq,          noise.i_sq,             noise.n_sq};
   const EstimatorOutput detail = core_.step_steady_state(s, gains.hessian, gains.gain, admission);
@@ -104,14 +118,14 @@ Estimate DriveEstimator::step_sparse(const DriveSample& sample, const EstimatorS
 void DriveEstimator::reset() noexcept {
   conditioner_.reset();
   core_.reset();
-  classifier_.reset();
+  regimes_.reset();
   point_gains_.start(rates_per_s_, core_.config().nominal_sample_period_s);
 }
 
 void DriveEstimator::resynchronize() noexcept {
   conditioner_.reset();
   core_.resynchronize();
-  classifier_.break_chain();
+  regimes_.break_chain();
 }
 
 void DriveEstimator::set_estimates(double psi_m_Wb, double r_s_Ohm) noexcept {
@@ -122,7 +136,7 @@ void DriveEstimator::reconfigure(const MachineSi& machine, const EstimatorSettin
   base_ = PerUnitBase::from_rated(machine.rated);
   conditioner_.reconfigure(base_, to_pu(base_, machine), settings.extensions);
   core_.reconfigure(make_estimator_config(base_, machine, settings));
-  classifier_.reconfigure(make_regime_config(base_, machine, settings));
+  regimes_.reconfigure(make_regime_config(base_, machine, settings));
   configure(settings);
 }
 

@@ -87,6 +87,7 @@ void RpemEstimator::reconfigure(const EstimatorConfig& config) noexcept {
   config_ = config;
   coefficients_ = PredictorCoefficients::of(config.model, config.omega_n_rad_s);
   inverse_nominal_period_ = 1.0 / config.nominal_sample_period_s;
+  inverse_r_min_ = 1.0 / config.bounds.min_pu[kRs];
   // With steady-state forms for both parameters the dynamic gradients would be computed for nothing.
   gradients_ = config.gradient_psi_m == GradientForm::kDynamic || config.gradient_r_s == GradientForm::kDynamic
                    ? Gradients::kAdvance
@@ -139,7 +140,7 @@ bool RpemEstimator::outlier(const Update& u, const Admission& admission) const n
   const Vec2& th = state_.theta_pu;
   const ParameterBounds& b = config_.bounds;
   const double d_psi = std::max(th[kPsiM] - b.min_pu[kPsiM], b.max_pu[kPsiM] - th[kPsiM]);
-  const double d_r = std::max(th[kRs] - b.min_pu[kRs], b.max_pu[kRs] - th[kRs]) * std::max(1.0, th[kRs] / b.min_pu[kRs]);
+  const double d_r = std::max(th[kRs] - b.min_pu[kRs], b.max_pu[kRs] - th[kRs]) * std::max(1.0, th[kRs] * inverse_r_min_);
   const Vec2 beyond = u.epsilon_pu.cwiseAbs() - (u.gradient.col(kPsiM).cwiseAbs() * d_psi + u.gradient.col(kRs).cwiseAbs() * d_r);
   if (!(beyond.maxCoeff() > 0.0)) return false;
   // ε's noise: the current's, and the voltage's and the speed's (through n·ψ̂m) through the steady state,

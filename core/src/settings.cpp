@@ -59,6 +59,10 @@ RegimeConfig make_regime_config(const PerUnitBase& base, const MachineSi& m, con
                      base.speed_pu(g.speed_resolution_rad_s)};
   // The slowest decay of Eq_FullOrderModel: Re λ ≥ −ω_n·r/x per axis, slowest with D_M's smallest r_s.
   c.electrical_time_constant_s = std::max(nominal.x_d_pu, nominal.x_q_pu) / (base.omega_el_rad_s * c.r_min_pu);
+  // A control-rate stream is classified a block at a time: a change of regime reaches the adaptation at most
+  // a block late, and the samples of one block carry N·γ_L ≤ 1 % of the estimate (§13, "Control-rate streams").
+  const double gamma = s.gains[static_cast<std::size_t>(s.algorithm)].gain.maxCoeff();
+  c.stream_block = gamma > 0.0 ? static_cast<int>(std::clamp(std::floor(0.01 / gamma), 1.0, 64.0)) : 64;
   return c;
 }
 

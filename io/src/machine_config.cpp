@@ -139,11 +139,16 @@ core::EstimatorSettings parse_estimator(YamlMap e, const core::MachineSi& machin
         a->number_or("instrument_time_constant_s", s.averaged.instrument_time_constant_s, 0.0, 10.0);
     s.averaged.control_period_s = a->number_or("control_period_s", s.averaged.control_period_s, 0.0, 1e-2);
     s.averaged.current_sample_at = a->number_or("current_sample_at", s.averaged.current_sample_at, 0.0, 1.0);
+    s.averaged.voltage_is_command = a->choice_or("voltage_reported", "mean", {"mean", "command"}) == "command";
+    if (s.averaged.voltage_is_command && !(s.averaged.control_period_s > 0.0)) {
+      a->fail("voltage_reported", "command needs control_period_s (the period the command is held)");
+    }
     a->finish();
   }
   if (auto g = e.optional_map("regimes")) {
     // The regime classification (core/regime.hpp, docs/derivations.md §13).
     core::RegimeSettings& r = s.regimes;
+    r.enabled = g->boolean_or("enabled", r.enabled);
     r.significance_sigma = g->number_or("significance_sigma", r.significance_sigma, 1.0, 10.0);
     r.voltage_resolution_V = g->number_or("voltage_resolution_V", r.voltage_resolution_V, 0.0, 1e3);
     r.current_resolution_A = g->number_or("current_resolution_A", r.current_resolution_A, 0.0, 1e3);

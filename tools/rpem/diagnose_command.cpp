@@ -19,7 +19,7 @@ namespace rpem::tools {
 namespace {
 
 struct DiagnoseCliOptions {
-  std::string log, log_map, config, out, truth, model = "auto", reported_voltage = "auto";
+  std::string log, log_map, config, out, truth, model = "auto";
   double reference_C = analysis::DiagnoseOptions{}.reference_C;
   double switching_frequency_Hz = 0.0;
   analysis::SelectionOptions selection;
@@ -42,10 +42,9 @@ int run_diagnose(const DiagnoseCliOptions& o) {
   analysis::LogOptions log_options;
   log_options.blocks = o.blocks;
   log_options.log_map = o.log_map;
+  log_options.voltage_is_command = config.estimator.averaged.voltage_is_command;
   log_options.control_period_s = config.estimator.averaged.control_period_s;
-  if (o.reported_voltage != "auto") {
-    log_options.reported_voltage = o.reported_voltage == "command" ? analysis::ReportedVoltage::kCommand : analysis::ReportedVoltage::kMean;
-  }
+  log_options.command_delay_s = config.estimator.extensions.delay_s;
   if (o.model != "auto") {
     log_options.mode = o.model == "transient" ? analysis::ModelMode::kTransient : analysis::ModelMode::kSteadyState;
   }
@@ -149,11 +148,6 @@ Runner add_diagnose_command(CLI::App& app) {
   std::string reference_help = "temperature to which found drift laws are referred (default ";
   io::append_number(reference_help, o->reference_C);
   cmd->add_option("--reference-temperature-C", o->reference_C, reference_help + ")");
-  cmd->add_option("--reported-voltage", o->reported_voltage,
-                  "an averaged log's voltage: auto (a VESC Tool log's is the firmware's command, any other the mean), "
-                  "mean, or command (turned into the applied mean with estimator.averaged.control_period_s; "
-                  "docs/drive-log.md, \"Reported voltage\")")
-      ->check(CLI::IsMember({"auto", "mean", "command"}));
   cmd->add_option("--switching-frequency-Hz", o->switching_frequency_Hz,
                   "PWM frequency, to report dead time in seconds (default: model_extensions.deadtime's)")
       ->check(CLI::PositiveNumber);

@@ -31,7 +31,9 @@ int run_figures(const FiguresOptions& o) {
   if (!o.log.empty()) {
     analysis::LogOptions options;
     options.log_map = o.log_map;
+    options.voltage_is_command = cfg.estimator.averaged.voltage_is_command;
     options.control_period_s = cfg.estimator.averaged.control_period_s;
+    options.command_delay_s = cfg.estimator.extensions.delay_s;
     log = analysis::load_log(o.log, cfg.machine, options);
     std::fprintf(stderr, "rpem figures: read %s\n", log->format.c_str());
     regimes = analysis::classify_regimes(*log, cfg);

@@ -11,7 +11,6 @@
 #include "rpem/io/log_source.hpp"
 #include "rpem/io/machine_config.hpp"
 #include "rpem/io/sample_counts.hpp"
-#include "rpem/io/vesc_tool_log.hpp"
 
 namespace rpem::analysis {
 namespace {
@@ -163,30 +162,19 @@ core::Vec2 applied_mean_V(const core::Vec2& command_V, double omega_el_rad_s, do
 
 namespace {
 
-/// Turns a drive's reported command into the applied mean, sample by sample, where the drive reports its
-/// command; returns what it did, for the log's description ("" where nothing).
-std::string apply_reported_voltage(std::vector<core::AveragedSample>& samples, const io::LogSource& source,
-                                   const LogOptions& options) {
-  const bool vesc_tool = source.map.name == io::vesc_tool_log_map().name;
-  const bool command = options.reported_voltage == ReportedVoltage::kCommand ||
-                       (options.reported_voltage == ReportedVoltage::kDetected && vesc_tool);
-  if (!command) return "";
-  if (options.control_period_s <= 0.0) {
-    return "; its voltages are the drive's command, left as they are: estimator.averaged.control_period_s is 0 "
-           "(set the drive's control period to turn them into the applied mean: up to ω·T_c of the back EMF "
-           "stands on the d axis otherwise)";
-  }
-  // Every sample: at VESC Tool's 0.01 A a modulating bridge at zero current (coasting) reads i = 0 as the
-  // undriven one does, so the two cannot be told apart here; the undriven branch's measured back EMF is the
-  // rotor's voltage, and turning it too moves ψm by 1 − cos·sinc of its rows (docs/derivations.md §16).
-  for (core::AveragedSample& s : samples) {
-    s.u_dq_V = applied_mean_V(s.u_dq_V, s.omega_el_rad_s, options.control_period_s, options.command_delay_periods);
-  }
-  char text[240];
+/// Turns a drive's reported commands into the applied means (LogOptions::voltage_is_command); returns what it
+/// did, for the log's description.
+std::string apply_reported_command(std::vector<core::AveragedSample>& samples, const LogOptions& options) {
+  // Held one period from the delay on: its centre d·T_c = delay + T_c/2 after the sample. Every sample, the
+  // bridge-off ones too: at VESC Tool's 0.01 A a modulating bridge at zero current reads i = 0 as well, and the
+  // undriven branch's measured back EMF is then turned too (docs/drive-log.md, "The voltage is the command").
+  const double d = (options.command_delay_s + 0.5 * options.control_period_s) / options.control_period_s;
+  for (core::AveragedSample& s : samples) s.u_dq_V = applied_mean_V(s.u_dq_V, s.omega_el_rad_s, options.control_period_s, d);
+  char text[200];
   std::snprintf(text, sizeof text,
                 "; voltages reported as the drive's command, turned into the applied mean (by −%.3g·ω·T_c, times "
                 "sinc(ω·T_c/2), T_c = %.3g µs)",
-                options.command_delay_periods, 1e6 * options.control_period_s);
+                d, 1e6 * options.control_period_s);
   return text;
 }
 
@@ -203,7 +191,8 @@ LogData load_log(const std::string& path, const core::MachineSi& machine, const 
     }
     io::AveragedLogRead read;
     std::vector<core::AveragedSample> samples = io::read_averaged_log(path, source.map, limits, &read);
-    const std::string voltage = apply_reported_voltage(samples, source, options);
+    const bool turn = options.voltage_is_command && options.control_period_s > 0.0;
+    const std::string voltage = turn ? apply_reported_command(samples, options) : "";
     std::vector<io::DriveLogRow> rows;
     std::vector<std::int64_t> starts;
     rows.reserve(samples.size());
@@ -218,6 +207,7 @@ LogData load_log(const std::string& path, const core::MachineSi& machine, const 
     d.averaged = true;
     d.window_start_ns = std::move(starts);
     d.format = io::describe(source, read) + voltage;
+    d.voltage_applied = turn;
     return d;
   }
   io::DriveLogReader reader(path, source.map, limits);

@@ -41,7 +41,13 @@ LogRegimes classify_regimes(const LogData& log, const io::MachineConfig& config)
   };
   if (log.averaged) {
     assert(log.window_start_ns.size() == n);
-    core::AveragedDriveEstimator estimator(config.machine, config.estimator);
+    // Commands already turned into applied means at reading are not turned again.
+    core::EstimatorSettings settings = config.estimator;
+    if (log.voltage_applied) {
+      settings.averaged.voltage_is_command = false;
+      settings.extensions.delay_s = 0.0;
+    }
+    core::AveragedDriveEstimator estimator(config.machine, settings);
     for (std::size_t k = 0; k < n; ++k) record(k, estimator.step(window_of(log, k)));
   } else {
     core::DriveEstimator estimator(config.machine, config.estimator);

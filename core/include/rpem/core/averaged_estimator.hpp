@@ -59,6 +59,9 @@ class AveragedDriveEstimator {
   /// correction), and how it continues the chain of the previous one (timing_).
   [[nodiscard]] SteadyStateSample condition(const AveragedSample& a) noexcept;
   void configure(const EstimatorSettings& settings) noexcept;
+  /// The estimate of a stepped sample (and the count of its observation, where an instantaneous one adapted).
+  [[nodiscard]] Estimate finish(const AveragedSample& sample, const SteadyStateSample& s, const EstimatorOutput& detail,
+                                Classification regime, bool point, const GainSequences& gains) noexcept;
 
   PerUnitBase base_;
   SampleConditioner conditioner_;
@@ -67,6 +70,10 @@ class AveragedDriveEstimator {
   PointGains point_gains_;  ///< the gains of instantaneous samples (one observation each)
   std::array<GainSequences, 3> rates_per_s_{};
   AveragedSettings options_;
+  bool options_classify_ = true;  ///< estimator.regimes.enabled
+  // Without classification the inductive correction's slope is taken here (the classifier takes it otherwise).
+  std::int64_t previous_centre2_ns_ = 0;  ///< t_start + t of the previous window (twice its centre)
+  Vec2 previous_i_pu_ = Vec2::Zero();
   double delay_s_ = 0.0;
   bool has_previous_ = false;  ///< the next sample continues the chain of the previous one
   std::optional<std::int64_t> previous_t_ns_;

@@ -45,7 +45,7 @@ class DriveEstimator {
 
   [[nodiscard]] const PerUnitBase& base() const noexcept { return base_; }
   [[nodiscard]] const RpemEstimator& core() const noexcept { return core_; }
-  [[nodiscard]] const RegimeClassifier& classifier() const noexcept { return classifier_; }
+  [[nodiscard]] const RegimeClassifier& classifier() const noexcept { return regimes_.classifier(); }
   [[nodiscard]] double psi_m_Wb() const noexcept;
   [[nodiscard]] double r_s_Ohm() const noexcept;
   /// θ̂ = [ψ̂m, r̂s] in pu now (also after reset(), set_estimates() or reconfigure(), before a step).
@@ -67,10 +67,12 @@ class DriveEstimator {
   PerUnitBase base_;
   SampleConditioner conditioner_;
   RpemEstimator core_;
-  RegimeClassifier classifier_;
+  StreamClassifier regimes_;
   PointGains point_gains_;               ///< the sparse samples' gains
-  GainSequences rates_per_s_;            ///< the configured algorithm's gain rates [1/s]
+  GainSequences rates_per_s_;            ///< the configured algorithm's gain rates [1/s] (sparse samples)
+  Vec2 dense_rates_per_s_ = Vec2::Zero();  ///< γ_0/T_samp of the step (dense samples)
   double sparse_after_s_ = 0.0;          ///< max(max_sample_interval_s, max_gap_carry_s)
+  bool classify_ = true;                 ///< estimator.regimes.enabled
   double inv_voltage_sq_ = 0.0;          ///< 1/U_b²
 };
 

@@ -222,6 +222,7 @@ class RpemEstimator {
   // Decided by reconfigure(), so the per-sample path does not re-derive them.
   PredictorCoefficients coefficients_;   ///< from config_.model
   double inverse_nominal_period_ = 0.0;  ///< 1/T_samp
+  double inverse_r_min_ = 0.0;           ///< 1/r_min of D_M (the outlier bound)
   Gradients gradients_ = Gradients::kSkip;  ///< whether predict() advances the dynamic gradients
   double scaled_for_dt_s_ = -1.0;        ///< the interval gamma_r_, gamma_l_ were scaled for
   Vec2 gamma_r_ = Vec2::Zero(), gamma_l_ = Vec2::Zero();

@@ -20,6 +20,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 
 #include "rpem/core/types.hpp"
 
@@ -71,6 +72,10 @@ struct Classification {
   [[nodiscard]] constexpr bool excites_r_s() const noexcept { return !excluded() && (bits & regime_bit::kExcitesRs); }
 };
 
+/// What a sample carries where classification is off (estimator.regimes.enabled: false): admitted as
+/// exciting both.
+inline constexpr Classification kUnclassified = Classification::of(regime_bit::kExcitesPsiM | regime_bit::kExcitesRs);
+
 /// One row of the regime catalogue: its name (CSV, counters, reports) and whether it is excluded.
 struct RegimeInfo {
   Regime regime;
@@ -100,6 +105,9 @@ struct RegimeCounts {
 
 /// The classification's keys as users give them (`estimator.regimes`, docs/configuration.md), SI.
 struct RegimeSettings {
+  /// false: no sample is classified (every one admitted as exciting both parameters, none judged as an
+  /// outlier): the estimator as the paper states it, for comparison.
+  bool enabled = true;
   /// z of every test: a term counts as present beyond z standard deviations of its noise (two-sided
   /// false rate erfc(z/√2): 6.3e-5 at 4).
   double significance_sigma = 4.0;
@@ -130,6 +138,8 @@ struct RegimeConfig {
   std::array<double, 3> resolution_pu{};
   /// τ_el = max(x)/(ω_n·r_min) [s]: the slowest decay of the electrical transient the model admits.
   double electrical_time_constant_s = 0.0;
+  /// A control-rate stream is classified in blocks of this many samples (StreamClassifier): N·γ_L,max ≤ 1 %.
+  int stream_block = 1;
 };
 
 /// How a sample relates to the one before it; the estimator decides.
@@ -149,6 +159,9 @@ struct RegimeInput {
   Vec2 i_pu = Vec2::Zero();       ///< measured current (window mean)
   double n_pu = 0.0;              ///< speed (window mean)
   double u_reported_sq_pu = 0.0;  ///< |u|² as the drive reports it, before corrections (bridge off)
+  /// The current's slope over the sample's window where the caller knows it (a block of a control-rate
+  /// stream: its end points); otherwise (NaN) the classifier takes it between consecutive samples.
+  Vec2 di_dt_pu_s = Vec2::Constant(std::numeric_limits<double>::quiet_NaN());
   /// The estimator's gain for this sample per parameter, γ_L (a batch fit over N samples: 1/N): how much
   /// of one sample's noise its estimate keeps, h² = γ/(2 − γ).
   Vec2 weight = Vec2::Ones();
@@ -171,6 +184,7 @@ struct RegimeState {
   int chained = 0;                     ///< of those, how many a chain joins to this one (dense, contiguous)
   Vec2 slope_pu_s = Vec2::Zero();      ///< di/dt the sample's inductive correction takes (0: none)
   Vec2 previous_slope_pu_s = Vec2::Zero();
+  double inv_dt = 0.0, previous_inv_dt = 0.0;  ///< 1/Δt between window centres, this sample's and the one before
   bool slope_valid = false, previous_slope_valid = false;
   bool previous_transient = false;     ///< the previous sample's own slope test failed (the junction straddles)
 };
@@ -214,8 +228,65 @@ class RegimeClassifier {
   RegimeState state_;
   RegimeNoise noise_;
   double inv_omega_n_ = 0.0;  ///< 1/ω_n
-  // The second difference's weights for the last spacing (a control-rate stream repeats it).
-  double spacing_first_s_ = -1.0, spacing_span_s_ = -1.0, spacing_w_ = 0.0, spacing_norm_ = 0.0;
+};
+
+/// The classification of a control-rate stream (DriveEstimator's dense samples): the samples' means over
+/// blocks of RegimeConfig::stream_block, each block classified as one sample with the slope of its end
+/// points; every sample carries the latest block's classification (docs/derivations.md §13, "Control-rate
+/// streams"). A chain's first sample is classified on its own. Real-time safe.
+class StreamClassifier {
+ public:
+  explicit StreamClassifier(const RegimeConfig& config) noexcept : classifier_(config) { reset(); }
+
+  /// One sample (timing kDense, or kFirst where a chain starts; a dense one's weight comes from
+  /// set_gain_rates()). Real-time safe.
+  [[nodiscard]] Classification step(const RegimeInput& in) noexcept {
+    if (in.timing == SampleTiming::kDense) return step_dense(in.t_ns, in.u_pu, in.i_pu, in.n_pu, in.u_reported_sq_pu);
+    return start(in);
+  }
+  /// A dense sample without building its RegimeInput (the per-sample path: a few sums; every
+  /// stream_block-th sample classifies the block). Real-time safe.
+  [[nodiscard]] Classification step_dense(std::int64_t t_ns, const Vec2& u_pu, const Vec2& i_pu, double n_pu,
+                                          double u_reported_sq_pu) noexcept {
+    u_sum_ += u_pu;
+    i_sum_ += i_pu;
+    n_sum_ += n_pu;
+    u_reported_sum_ += u_reported_sq_pu;
+    if (++count_ < classifier_.config().stream_block && has_start_) [[likely]] return held_;
+    return close_block(t_ns, i_pu);
+  }
+  /// The dense samples' gain rates [1/s] (γ_L = rate·Δt per sample): a block's weight is rate·span.
+  void set_gain_rates(const Vec2& rate_per_s) noexcept { gain_rate_per_s_ = rate_per_s; }
+
+  void break_chain() noexcept {
+    classifier_.break_chain();
+    count_ = 0;
+    has_start_ = false;
+  }
+  void reset() noexcept;
+  void reconfigure(const RegimeConfig& config) noexcept;
+
+  [[nodiscard]] const RegimeClassifier& classifier() const noexcept { return classifier_; }
+  [[nodiscard]] const RegimeNoise& noise() const noexcept { return classifier_.noise(); }
+  /// The classification the samples carry now.
+  [[nodiscard]] Classification held() const noexcept { return held_; }
+
+ private:
+  /// A chain's first sample (or a standalone one), judged on its own; the next block starts after it.
+  [[nodiscard]] Classification start(const RegimeInput& in) noexcept;
+  /// The block ending with this sample, as one sample.
+  [[nodiscard]] Classification close_block(std::int64_t t_ns, const Vec2& i_pu) noexcept;
+  void clear_sums() noexcept;
+
+  RegimeClassifier classifier_;
+  Classification held_;
+  int count_ = 0;
+  Vec2 u_sum_ = Vec2::Zero(), i_sum_ = Vec2::Zero();
+  Vec2 gain_rate_per_s_ = Vec2::Zero();
+  double n_sum_ = 0.0, u_reported_sum_ = 0.0;
+  Vec2 i_start_ = Vec2::Zero();   ///< the current at the block's start (the previous block's last sample)
+  std::int64_t start_ns_ = 0;
+  bool has_start_ = false;
 };
 
 /// The significance's two-dimensional bound: c₂ = −2·ln(erfc(z/√2)), so that |v|²/σ² ~ χ²₂ exceeds it with the

@@ -25,6 +25,9 @@ enum class ModelMode { kTransient, kSteadyState };
 struct LogData {
   std::string path;
   std::string format;  ///< what the log was read as, and what reading it did (io::describe)
+  /// The drive's reported commands were turned into the applied means at reading (LogOptions::voltage_is_command):
+  /// whatever runs over the rows must not turn them again.
+  bool voltage_applied = false;
   std::vector<io::DriveLogRow> rows;
   io::DriveLogLayout layout;
   ModelMode mode = ModelMode::kTransient;
@@ -63,23 +66,19 @@ struct LogData {
   [[nodiscard]] bool block_start(std::size_t k) const noexcept { return k == 0 || block[k] != block[k - 1]; }
 };
 
-/// What an averaged log's voltage is (docs/drive-log.md, "Reported voltage"): the mean the machine received, or
-/// the drive's command in the frame of its current samples (VESC: held from half a period after the sample for
-/// one period), which reading turns into the applied mean (applied_mean_V).
-enum class ReportedVoltage { kDetected, kMean, kCommand };
-
 /// The mean a reported command applies in the rotor frame over the period it is held (docs/derivations.md
-/// §16): the command v, computed at the current sample's angle and held fixed in the stator frame over
-/// [d − ½, d + ½]·T_c after it, arrives turned by −ω·d·T_c and shortened by sinc(ω·T_c/2).
+/// §11, "Reported command"): the command v, computed at the current sample's angle and held fixed in the
+/// stator frame over [d − ½, d + ½]·T_c after it, arrives turned by −ω·d·T_c and shortened by sinc(ω·T_c/2).
 [[nodiscard]] core::Vec2 applied_mean_V(const core::Vec2& command_V, double omega_el_rad_s, double control_period_s,
                                         double delay_periods) noexcept;
 
 struct LogOptions {
   std::optional<ModelMode> mode;  ///< empty: decided from the sample interval
-  /// kDetected: a VESC Tool realtime log reports the firmware's command, every other log the mean.
-  ReportedVoltage reported_voltage = ReportedVoltage::kDetected;
-  double control_period_s = 0.0;     ///< the drive's T_c (estimator.averaged.control_period_s); 0: unknown
-  double command_delay_periods = 1.0;  ///< d: the hold's centre after the sample, in T_c (VESC: 1)
+  /// An averaged log whose voltages are the drive's command (estimator.averaged.voltage_reported: command): its
+  /// T_c and the delay before the hold (model_extensions.delay), which reading turns into the applied mean.
+  bool voltage_is_command = false;
+  double control_period_s = 0.0;
+  double command_delay_s = 0.0;
   int blocks = 40;                ///< training and held-out blocks, alternating, equal in time
   int speed_half_window = 4;      ///< transient logs: replay speed from the angle over ±this many samples
   std::string log_map;            ///< a column map (YAML) to read the log with; empty: detected (io::log_source)
