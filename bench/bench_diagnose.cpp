@@ -14,6 +14,7 @@
 #include <filesystem>
 #include <fstream>
 #include <random>
+#include <sstream>
 #include <vector>
 
 #include "rpem/analysis/diagnose/diagnose_output.hpp"
@@ -76,7 +77,11 @@ struct VescToolLog {
   std::string dir = (fs::temp_directory_path() / "rpem_bench_diagnose_vesc").string();
   std::string log = dir + "/vesc_tool.csv";
   io::MachineConfig config = io::load_machine_config(RPEM_SOURCE_DIR "/config/vesc-6374-outrunner.yaml");
+  std::string config_text;  ///< the file's text, in which extended.yaml replaces the calibrated constants
   explicit VescToolLog(int rows) {
+    std::ostringstream text;
+    text << std::ifstream(RPEM_SOURCE_DIR "/config/vesc-6374-outrunner.yaml").rdbuf();
+    config_text = text.str();
     fs::create_directories(dir);
     const double psi = 0.8 * config.machine.psi_m_Wb, r = 1.2 * config.machine.r_s_Ohm, l = config.machine.l_q_H;
     std::mt19937_64 rng(23);
@@ -119,7 +124,7 @@ void BM_DiagnoseVescToolLog(benchmark::State& state) {
     analysis::LogData log = analysis::load_log(f.log, f.config.machine, {});
     const analysis::Diagnosis d = analysis::diagnose(std::move(log), f.config, {});
     analysis::write_diagnosis_json(f.dir + "/diagnosis.json", d, "config/vesc-6374-outrunner.yaml");
-    analysis::write_extended_yaml(f.dir + "/extended.yaml", d, "machine: {}\n");
+    analysis::write_extended_yaml(f.dir + "/extended.yaml", d, f.config_text);
     analysis::write_diagnose_report(f.dir, d, "config/vesc-6374-outrunner.yaml");
     if (d.log->rows.size() != 10'000) state.SkipWithError("not every row was read");
     if (!d.calibration.identifiable[0] || std::abs(d.calibration.value[0] / (0.8 * f.config.machine.psi_m_Wb) - 1.0) > 0.02) {
