@@ -13,7 +13,7 @@ namespace {
 
 using Diag = rpem::diagnostics_t;
 
-constexpr std::array<CounterRow<LoopCounters>, 10> kLoopRows{{
+constexpr std::array<CounterRow<LoopCounters>, 11> kLoopRows{{
     {&LoopCounters::samples, &Diag::samples},
     {&LoopCounters::resyncs, &Diag::resyncs},
     {&LoopCounters::rejected_non_finite, &Diag::rejected_non_finite},
@@ -24,8 +24,13 @@ constexpr std::array<CounterRow<LoopCounters>, 10> kLoopRows{{
     {&LoopCounters::commands_applied, &Diag::commands_applied},
     {&LoopCounters::command_sequence_errors, &Diag::command_sequence_errors},
     {&LoopCounters::config_reloads, &Diag::config_reloads},
+    {&LoopCounters::outliers, &Diag::outliers},
 }};
-static_assert(kLoopRows.size() + 3 <= DiagnosticsRows::kMaxCounts);
+/// The field of each regime's count, in core::kRegimes' order.
+constexpr std::array<DiagnosticsCount, core::kRegimeCount> kRegimeFields{
+    &Diag::regime_excites_both, &Diag::regime_excites_psi_m, &Diag::regime_excites_r_s, &Diag::regime_unexcited,
+    &Diag::regime_transient,    &Diag::regime_not_locked,    &Diag::regime_bridge_off,  &Diag::regime_invalid};
+static_assert(kLoopRows.size() + kRegimeFields.size() + 3 <= DiagnosticsRows::kMaxCounts);
 
 std::int64_t interval_ns(double rate_Hz) noexcept {
   return rate_Hz > 0.0 ? static_cast<std::int64_t>(1e9 / rate_Hz) : INT64_MAX / 4;
@@ -110,12 +115,18 @@ void LoopThread::step(const SourceSample& s, std::int64_t now_ns) noexcept {
     case core::StepCode::kPredictorDiverged:
       ++counters_.predictor_resets;
       break;
+    case core::StepCode::kOutlier:
+      ++counters_.outliers;
+      break;
+    case core::StepCode::kExcluded:  // counted by its regime below
+      break;
     case core::StepCode::kAdapted:
       eps2_d_ += last_.epsilon_A[0] * last_.epsilon_A[0];
       eps2_q_ += last_.epsilon_A[1] * last_.epsilon_A[1];
       ++eps_n_;
       break;
   }
+  counters_.regimes.add(last_.regime);
   if (d.flags & (core::step_flag::kProjectedPsiM | core::step_flag::kProjectedRs)) ++counters_.projections;
   validity_.on_sample(d.flags, dt_s, now_ns);
 }
@@ -190,6 +201,9 @@ void LoopThread::report_stats() noexcept {
   r.state = state_;
   r.input_queue_depth = static_cast<std::int32_t>(queues_.samples.size());
   r.rows.set_all(kLoopRows, counters_);
+  for (std::size_t k = 0; k < core::kRegimeCount; ++k) {
+    r.rows.set(kRegimeFields[k], static_cast<std::int64_t>(counters_.regimes.n[k]));
+  }
   timer_.report(r.rows);
   const double n = eps_n_ > 0 ? static_cast<double>(eps_n_) : 1.0;
   r.rows.set(&Diag::epsilon_rms_d_A, std::sqrt(eps2_d_ / n));

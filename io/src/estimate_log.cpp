@@ -9,7 +9,7 @@ namespace rpem::io {
 EstimateLogWriter::EstimateLogWriter(const std::string& path) : out_(path, std::ios::binary | std::ios::trunc) {
   if (!out_) throw InputError(path, 0, 0, "", "cannot create file");
   out_ << "t,psi_m,r_s,psi_m_pu,r_s_pu,eps_d,eps_q,i_hat_d,i_hat_q,i_d,i_q,n_pu,"
-          "psi_m_active,r_s_active,code,flags,sga_r_psi_m,sga_r_r_s,gna_det_R\n";
+          "psi_m_active,r_s_active,code,flags,sga_r_psi_m,sga_r_r_s,gna_det_R,regime,regime_bits\n";
 }
 
 void EstimateLogWriter::write(const core::Estimate& e, const core::RpemEstimator& core) {
@@ -28,6 +28,8 @@ void EstimateLogWriter::write(const core::Estimate& e, const core::RpemEstimator
   for (double v : {st.sga_hessian_pu[0], st.sga_hessian_pu[1], core::det2(st.gna_hessian_pu)}) {
     append_number(line_ += ',', v);
   }
+  line_ += ',' + std::to_string(static_cast<int>(e.regime.regime));
+  line_ += ',' + std::to_string(e.regime.bits);
   line_ += '\n';
   out_ << line_;
 }

@@ -17,6 +17,7 @@
 #include "rpem/io/estimate_log.hpp"
 #include "rpem/io/log_source.hpp"
 #include "rpem/io/machine_config.hpp"
+#include "rpem/io/sample_counts.hpp"
 
 namespace rpem::tools {
 namespace {
@@ -30,20 +31,25 @@ struct EstimateOptions {
   long every = 1;
 };
 
+/// What the run did, for its summary on stderr: the last estimate and the samples per regime.
 struct Tally {
-  std::uint64_t rows = 0, resyncs = 0;
+  io::SampleCounts counts;
   core::Estimate last;
   void count(const core::Estimate& e) {
     last = e;
-    ++rows;
-    if (e.detail.code == core::StepCode::kSynchronized || e.detail.code == core::StepCode::kPredictorDiverged) ++resyncs;
+    counts.add(e);
   }
   [[nodiscard]] std::string summary(core::Algorithm a, const char* kind) const {
     char text[256];
     std::snprintf(text, sizeof text, "%llu %s, psi_m = %.5f Wb, r_s = %.5f Ohm (%s), %llu resyncs",
-                  static_cast<unsigned long long>(rows), kind, last.psi_m_Wb, last.r_s_Ohm, io::to_string(a),
-                  static_cast<unsigned long long>(resyncs));
+                  static_cast<unsigned long long>(counts.samples), kind, last.psi_m_Wb, last.r_s_Ohm, io::to_string(a),
+                  static_cast<unsigned long long>(counts.resyncs));
     return text;
+  }
+  /// The regimes' counts, and why, where more than a tenth of the samples adapted nothing.
+  void explain() const {
+    std::fprintf(stderr, "rpem estimate: %s\n", io::regime_summary(counts).c_str());
+    for (const std::string& why : io::exclusion_explanations(counts)) std::fprintf(stderr, "rpem estimate: %s\n", why.c_str());
   }
 };
 
@@ -57,12 +63,14 @@ int run_averaged(const EstimateOptions& o, const io::LogSource& source, const io
   io::EstimateLogWriter writer(o.out);
   core::AveragedDriveEstimator estimator(cfg.machine, cfg.estimator);
   Tally tally;
+  tally.counts.averaged = true;
   for (const core::AveragedSample& s : samples) {
     const core::Estimate e = estimator.step(s);
-    if (tally.rows % static_cast<std::uint64_t>(o.every) == 0) writer.write(e, estimator.core());
+    if (tally.counts.samples % static_cast<std::uint64_t>(o.every) == 0) writer.write(e, estimator.core());
     tally.count(e);
   }
   std::fprintf(stderr, "rpem estimate: %s\n", tally.summary(cfg.estimator.algorithm, "averaged samples").c_str());
+  tally.explain();
   return kExitOk;
 }
 
@@ -84,11 +92,12 @@ int run_estimate(const EstimateOptions& o) {
   Tally tally;
   while (reader.next(row)) {
     const core::Estimate e = estimator.step(row.sample);
-    if (tally.rows % static_cast<std::uint64_t>(o.every) == 0) writer.write(e, estimator);
+    if (tally.counts.samples % static_cast<std::uint64_t>(o.every) == 0) writer.write(e, estimator);
     tally.count(e);
-    if ((tally.rows & 0xFFF) == 0) progress.update(reader.bytes_read(), reader.bytes_total());
+    if ((tally.counts.samples & 0xFFF) == 0) progress.update(reader.bytes_read(), reader.bytes_total());
   }
   progress.finish(tally.summary(cfg.estimator.algorithm, "samples") + io::describe(reader.reader().repairs()));
+  tally.explain();
   return kExitOk;
 }
 

@@ -12,6 +12,7 @@
 #include <optional>
 #include <string>
 
+#include "rpem/core/regime.hpp"
 #include "rpem/daemon/daemon_config.hpp"
 #include "rpem/daemon/loop_estimator.hpp"
 #include "rpem/daemon/loop_timer.hpp"
@@ -33,6 +34,8 @@ struct LoopCounters {
   std::int64_t commands_applied = 0;         ///< supervisory commands (seq > 0)
   std::int64_t command_sequence_errors = 0;  ///< an applied command not after the previous one (never expected)
   std::int64_t config_reloads = 0;           ///< reloads applied
+  std::int64_t outliers = 0;                 ///< samples skipped by the outlier bound
+  core::RegimeCounts regimes;                ///< samples per regime (core/regime.hpp)
 };
 
 /// A value from the state file and how long ago it last adapted.
