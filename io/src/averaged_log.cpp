@@ -60,6 +60,7 @@ std::vector<core::AveragedSample> read_averaged_log(const std::string& path, Ave
   layout.t_winding = table.has("T_winding");
   layout.t_magnet = table.has("T_magnet");
   layout.t_drive = table.has("T_drive");
+  layout.t_coolant = table.has("T_coolant");
   auto optional = [&](bool present, const char* name, std::size_t k) { return present ? table.column(name)[k] : kNaN; };
   if (table.rows() == 0) throw DriveLogError(path, 2, 0, "", "no samples");
 
@@ -81,6 +82,7 @@ std::vector<core::AveragedSample> read_averaged_log(const std::string& path, Ave
     s.t_winding_C = optional(layout.t_winding, "T_winding", k);
     s.t_magnet_C = optional(layout.t_magnet, "T_magnet", k);
     s.t_drive_C = optional(layout.t_drive, "T_drive", k);
+    s.t_coolant_C = optional(layout.t_coolant, "T_coolant", k);
   }
   if (layout_out) *layout_out = layout;
   return out;
@@ -94,6 +96,7 @@ AveragedLogWriter::AveragedLogWriter(const std::string& path, const AveragedLogL
   if (layout_.t_winding) h += ",T_winding";
   if (layout_.t_magnet) h += ",T_magnet";
   if (layout_.t_drive) h += ",T_drive";
+  if (layout_.t_coolant) h += ",T_coolant";
   out_ << h << '\n';
 }
 
@@ -106,6 +109,7 @@ void AveragedLogWriter::write(const core::AveragedSample& s) {
   if (layout_.t_winding) append_number(line_ += ',', s.t_winding_C);
   if (layout_.t_magnet) append_number(line_ += ',', s.t_magnet_C);
   if (layout_.t_drive) append_number(line_ += ',', s.t_drive_C);
+  if (layout_.t_coolant) append_number(line_ += ',', s.t_coolant_C);
   line_ += '\n';
   out_ << line_;
 }
@@ -125,6 +129,7 @@ DriveLogRow to_drive_log_row(const core::AveragedSample& s) {
   r.sample.gap_before = s.gap_before;
   if (!std::isnan(s.t_winding_C)) r.t_winding_C = s.t_winding_C;
   if (!std::isnan(s.t_magnet_C)) r.t_magnet_C = s.t_magnet_C;
+  if (!std::isnan(s.t_coolant_C)) r.t_coolant_C = s.t_coolant_C;
   return r;
 }
 
@@ -136,6 +141,7 @@ DriveLogLayout rotor_frame_layout(const AveragedLogLayout& a) {
   l.voltage_dq = l.current_dq = true;
   l.t_winding = a.t_winding;
   l.t_magnet = a.t_magnet;
+  l.t_coolant = a.t_coolant;
   return l;
 }
 

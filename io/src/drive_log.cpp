@@ -78,7 +78,7 @@ void DriveLogReader::read_header() {
   ud_ = find("u_d"), uq_ = find("u_q");
   ia_ = find("i_a"), ib_ = find("i_b"), ic_ = find("i_c");
   id_ = find("i_d"), iq_ = find("i_q");
-  tw_ = find("T_winding"), tm_ = find("T_magnet"), tq_ = find("torque_cmd");
+  tw_ = find("T_winding"), tm_ = find("T_magnet"), tc_ = find("T_coolant"), tq_ = find("torque_cmd");
 
   for (auto [col, name] : {std::pair{t_, "t"}, {omega_, "omega_el"}}) {
     if (!col.present()) fail(name, "required column is missing from the header");
@@ -111,6 +111,7 @@ void DriveLogReader::read_header() {
   layout_.u_dc = udc_.present();
   layout_.t_winding = tw_.present();
   layout_.t_magnet = tm_.present();
+  layout_.t_coolant = tc_.present();
   layout_.torque_cmd = tq_.present();
 }
 
@@ -201,6 +202,7 @@ bool DriveLogReader::next(DriveLogRow& row) {
     }
     row.t_winding_C = layout_.t_winding ? std::optional(temperature(tw_, "T_winding")) : std::nullopt;
     row.t_magnet_C = layout_.t_magnet ? std::optional(temperature(tm_, "T_magnet")) : std::nullopt;
+    row.t_coolant_C = layout_.t_coolant ? std::optional(temperature(tc_, "T_coolant")) : std::nullopt;
     row.torque_cmd_Nm =
         layout_.torque_cmd ? std::optional(cell(tq_, "torque_cmd", limits_.torque_Nm, "Nm")) : std::nullopt;
     ++rows_;
@@ -228,6 +230,7 @@ DriveLogWriter::DriveLogWriter(const std::string& path, const DriveLogLayout& la
   if (layout_.current_dq) h += ",i_d,i_q";
   if (layout_.t_winding) h += ",T_winding";
   if (layout_.t_magnet) h += ",T_magnet";
+  if (layout_.t_coolant) h += ",T_coolant";
   if (layout_.torque_cmd) h += ",torque_cmd";
   out_ << h << '\n';
 }
@@ -266,6 +269,7 @@ void DriveLogWriter::write(const DriveLogRow& row) {
   }
   if (layout_.t_winding) append_number(line_ += ',', row.t_winding_C.value_or(std::nan("")));
   if (layout_.t_magnet) append_number(line_ += ',', row.t_magnet_C.value_or(std::nan("")));
+  if (layout_.t_coolant) append_number(line_ += ',', row.t_coolant_C.value_or(std::nan("")));
   if (layout_.torque_cmd) append_number(line_ += ',', row.torque_cmd_Nm.value_or(std::nan("")));
   line_ += '\n';
   out_ << line_;

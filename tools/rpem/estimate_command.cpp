@@ -1,9 +1,12 @@
 // rpem estimate --log LOG.csv --config CFG.yaml --out EST.csv [--algorithm sga|gna|phyint] [--every N]
+//               [--thermal THERMAL.yaml]
 // Runs the estimator offline over a drive log, exactly as rpemd would run it online: a phase-sample log
 // through DriveEstimator, an averaged log (a t_start column; docs/drive-log.md) through
-// AveragedDriveEstimator.
+// AveragedDriveEstimator. With --thermal, the thermal network's filter runs beside it as in rpemd
+// (core::ThermalFusion, docs/thermal.md) and the estimate CSV gains the fused temperatures.
 
 #include <cstdio>
+#include <limits>
 #include <optional>
 #include <string>
 
@@ -15,6 +18,7 @@
 #include "rpem/io/drive_log.hpp"
 #include "rpem/io/estimate_log.hpp"
 #include "rpem/io/machine_config.hpp"
+#include "rpem/io/thermal_config.hpp"
 
 namespace rpem::tools {
 namespace {
@@ -24,7 +28,36 @@ struct EstimateOptions {
   std::string config;
   std::string out;
   std::string algorithm;
+  std::string thermal;
   long every = 1;
+};
+
+/// The thermal filter beside the estimator, when --thermal is given.
+class ThermalRun {
+ public:
+  ThermalRun(const EstimateOptions& o, const io::MachineConfig& cfg, const core::PerUnitBase& base) {
+    if (o.thermal.empty()) return;
+    const io::ThermalConfig t = io::load_thermal_config(o.thermal, cfg);
+    for (int i = 0; i < t.fusion.filter.network.nodes; ++i) names_.push_back(t.node_names[static_cast<std::size_t>(i)]);
+    fusion_.emplace(t.fusion, base, cfg.machine);
+  }
+  [[nodiscard]] const std::vector<std::string>& node_names() const { return names_; }
+  /// The sample's temperatures; `t_ns` its time (the interval since the previous sample is the time it stands for).
+  void step(const core::Estimate& e, std::int64_t t_ns, double coolant_C, double winding_C) {
+    if (!fusion_) return;
+    core::ThermalSample s;
+    s.dt_s = previous_ns_ ? 1e-9 * static_cast<double>(t_ns - *previous_ns_) : 0.0;
+    s.coolant_C = coolant_C;
+    s.winding_sensor_C = winding_C;
+    previous_ns_ = t_ns;
+    fusion_->step(e, s);
+  }
+  [[nodiscard]] const core::ThermalEstimate* estimate() const { return fusion_ ? &fusion_->estimate() : nullptr; }
+
+ private:
+  std::vector<std::string> names_;
+  std::optional<core::ThermalFusion> fusion_;
+  std::optional<std::int64_t> previous_ns_;
 };
 
 struct Tally {
@@ -48,12 +81,14 @@ int run_averaged(const EstimateOptions& o, const io::MachineConfig& cfg, const s
   io::AveragedLogLayout layout;
   const std::vector<core::AveragedSample> samples = io::read_averaged_log(o.log, &layout);
   io::check_averaged_supports(cfg, config_name, layout.u_dc, o.log);
-  io::EstimateLogWriter writer(o.out);
   core::AveragedDriveEstimator estimator(cfg.machine, cfg.estimator);
+  ThermalRun thermal(o, cfg, estimator.base());
+  io::EstimateLogWriter writer(o.out, thermal.node_names());
   Tally tally;
   for (const core::AveragedSample& s : samples) {
     const core::Estimate e = estimator.step(s);
-    if (tally.rows % static_cast<std::uint64_t>(o.every) == 0) writer.write(e, estimator.core());
+    thermal.step(e, s.t_ns, s.t_coolant_C, s.t_winding_C);
+    if (tally.rows % static_cast<std::uint64_t>(o.every) == 0) writer.write(e, estimator.core(), thermal.estimate());
     tally.count(e);
   }
   std::fprintf(stderr, "rpem estimate: %s\n", tally.summary(cfg.estimator.algorithm, "averaged samples").c_str());
@@ -68,15 +103,18 @@ int run_estimate(const EstimateOptions& o) {
 
   io::DriveLogReader reader(o.log, io::machine_limits(cfg.machine));
   io::check_log_supports(cfg, config_name, reader.layout().u_dc, o.log);
-  io::EstimateLogWriter writer(o.out);
   core::DriveEstimator estimator(cfg.machine, cfg.estimator);
+  ThermalRun thermal(o, cfg, estimator.base());
+  io::EstimateLogWriter writer(o.out, thermal.node_names());
   Progress progress("rpem estimate");
 
   io::DriveLogRow row;
   Tally tally;
+  constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
   while (reader.next(row)) {
     const core::Estimate e = estimator.step(row.sample);
-    if (tally.rows % static_cast<std::uint64_t>(o.every) == 0) writer.write(e, estimator);
+    thermal.step(e, row.sample.t_ns, row.t_coolant_C.value_or(kNaN), row.t_winding_C.value_or(kNaN));
+    if (tally.rows % static_cast<std::uint64_t>(o.every) == 0) writer.write(e, estimator, thermal.estimate());
     tally.count(e);
     if ((tally.rows & 0xFFF) == 0) progress.update(reader.bytes_read(), reader.bytes_total());
   }
@@ -96,6 +134,8 @@ Runner add_estimate_command(CLI::App& app) {
   cmd->add_option("--algorithm", opts->algorithm, "override the configured gain algorithm")
       ->check(CLI::IsMember({"sga", "gna", "phyint"}));
   cmd->add_option("--every", opts->every, "write every N-th sample")->check(CLI::PositiveNumber);
+  cmd->add_option("--thermal", opts->thermal, "thermal.yaml: run the thermal network's filter beside the estimator (docs/thermal.md)")
+      ->check(CLI::ExistingFile);
   return [cmd, opts]() { return cmd->parsed() ? run_estimate(*opts) : -1; };
 }
 

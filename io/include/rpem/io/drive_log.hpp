@@ -2,7 +2,7 @@
 // The drive-log CSV: the project's measured-data format (docs/drive-log.md).
 // One header row; SI units; required columns t, theta_el, omega_el, u_dc, a voltage command
 // (u_a,u_b,u_c and/or u_d,u_q) and a measured current (i_a,i_b,i_c and/or i_d,i_q); optional
-// T_winding, T_magnet [°C], torque_cmd [Nm]. Extra columns are ignored. A log whose voltage and current
+// T_winding, T_magnet, T_coolant [°C], torque_cmd [Nm]. Extra columns are ignored. A log whose voltage and current
 // are both in the rotor frame only may omit theta_el and u_dc. A log must hold at least one row, and every
 // cell must lie within the plausibility limits below.
 
@@ -22,6 +22,7 @@ struct DriveLogRow {
   core::DriveSample sample;
   std::optional<double> t_winding_C;
   std::optional<double> t_magnet_C;
+  std::optional<double> t_coolant_C;
   std::optional<double> torque_cmd_Nm;
 };
 
@@ -35,6 +36,7 @@ struct DriveLogLayout {
   bool current_dq = false;
   bool t_winding = false;
   bool t_magnet = false;
+  bool t_coolant = false;
   bool torque_cmd = false;
 };
 
@@ -102,7 +104,7 @@ class DriveLogReader {
   DriveLogLayout layout_;
   std::vector<std::string> header_;
   std::vector<std::string> cells_;
-  Column t_, theta_, omega_, udc_, ua_, ub_, uc_, ud_, uq_, ia_, ib_, ic_, id_, iq_, tw_, tm_, tq_;
+  Column t_, theta_, omega_, udc_, ua_, ub_, uc_, ud_, uq_, ia_, ib_, ic_, id_, iq_, tw_, tm_, tc_, tq_;
   std::optional<std::int64_t> previous_t_ns_;
 };
 

@@ -1,0 +1,174 @@
+#include "rpem/core/thermal_fusion.hpp"
+
+#include <cmath>
+
+namespace rpem::core {
+namespace {
+
+/// Value and slope of a law, written as θ(T) = slope·T + at_0C.
+struct Line {
+  double slope;
+  double at_0C;
+};
+Line line_of(const DriftLaw& law) noexcept {
+  const double slope = law.value_ref * law.coeff_per_K;
+  return {slope, law.value_ref - slope * law.reference_C};
+}
+
+/// The law's calibration variance at T [K²] (docs/derivations.md §12, eq. 12.10).
+double calibration_K2(const DriftLaw& law, double rel_sigma, double reference_sigma_K, double t_C) noexcept {
+  const double span = (t_C - law.reference_C) * rel_sigma;
+  return span * span + reference_sigma_K * reference_sigma_K;
+}
+
+}  // namespace
+
+LossBase loss_base_of(const PerUnitBase& base, const MachineSi& machine) noexcept {
+  return {base.omega_el_rad_s, machine.psi_m_Wb, base.current_A};
+}
+
+StepObservations step_observations(const ThermalFusionConfig& c, const ThermalStepData& s, const ThermalVec& t_C,
+                                   const ThermalVec& dt_dt_K_per_s) noexcept {
+  const ThermalNetwork& n = c.filter.network;
+  const ThermalLaws& laws = c.laws;
+  const Line magnet = line_of(laws.magnet), copper = line_of(n.copper);
+  const int m = n.magnet, w = n.winding;
+  StepObservations out;
+  // [node of the parameter's own temperature, the other node], its law and the other's.
+  struct Row {
+    int own, other;
+    Line own_law, other_law;
+    const DriftLaw* law;
+    double rel_sigma;
+  };
+  const Row rows[2] = {{m, w, magnet, copper, &laws.magnet, laws.magnet_coeff_rel_sigma},
+                       {w, m, copper, magnet, &n.copper, laws.copper_coeff_rel_sigma}};
+  for (std::size_t j = 0; j < 2; ++j) {
+    const ParameterObservation& p = s.parameter[j];
+    if (!p.valid) continue;
+    const Row& r = rows[j];
+    ThermalObservation& o = out.item[j];
+    o.h[r.own] = r.own_law.slope;
+    o.h[r.other] = p.cross * r.other_law.slope;
+    o.offset = r.own_law.at_0C + p.cross * (r.other_law.at_0C - p.other_held);
+    o.value = p.value;
+    const double t = t_C[r.own];
+    const double lag_K = dt_dt_K_per_s[r.own] * p.time_constant_s;
+    const double in_K2 = calibration_K2(*r.law, r.rel_sigma, laws.reference_sigma_K, t) + lag_K * lag_K;
+    o.variance = p.variance + r.own_law.slope * r.own_law.slope * in_K2;
+    out.present[j] = true;
+  }
+  if (c.winding_sensor_sigma_K > 0.0 && std::isfinite(s.winding_sensor_C)) {
+    ThermalObservation& o = out.item[2];
+    o.h[w] = 1.0;
+    o.value = s.winding_sensor_C;
+    o.variance = c.winding_sensor_sigma_K * c.winding_sensor_sigma_K;
+    out.present[2] = true;
+  }
+  return out;
+}
+
+ThermalFusion::ThermalFusion(const ThermalFusionConfig& config, const PerUnitBase& base, const MachineSi& machine) noexcept
+    : config_(config),
+      observer_(config.observer, base, machine, config.filter.network.base, config.coolant_C),
+      filter_(config.filter) {
+  out_.nodes = config.filter.network.nodes;
+  out_.winding = config.filter.network.winding;
+  out_.magnet = config.filter.network.magnet;
+}
+
+void ThermalFusion::reconfigure(const ThermalFusionConfig& config, const PerUnitBase& base, const MachineSi& machine) noexcept {
+  config_ = config;
+  observer_.reconfigure(config.observer, base, machine, config.filter.network.base, config.coolant_C);
+  filter_.reconfigure(config.filter);
+  out_.nodes = config.filter.network.nodes;
+  out_.winding = config.filter.network.winding;
+  out_.magnet = config.filter.network.magnet;
+}
+
+void ThermalFusion::start(const ThermalStepData& s) noexcept {
+  // A soaked machine at the coolant's temperature, the winding at its sensor if there is one.
+  filter_.reset(s.load.coolant_C, config_.initial_sigma_K);
+  if (config_.winding_sensor_sigma_K > 0.0 && std::isfinite(s.winding_sensor_C)) {
+    ThermalVec t = filter_.temperature_C();
+    t[config_.filter.network.winding] = s.winding_sensor_C;
+    filter_.set_temperatures(t, filter_.covariance().topLeftCorner<kMaxThermalNodes, kMaxThermalNodes>());
+  }
+  out_.started = true;
+}
+
+void ThermalFusion::step(const Estimate& e, const ThermalSample& s) noexcept {
+  if (observer_.add(e, s)) apply(observer_.step());
+}
+
+void ThermalFusion::apply(const ThermalStepData& d) noexcept {
+  if (!out_.started) start(d);
+  filter_.predict(d.load);
+  last_load_ = d.load;
+  finish_step(d, d.load.dt_s);
+}
+
+void ThermalFusion::coast(double dt_s) noexcept {
+  if (!out_.started || !(dt_s > 0.0)) return;
+  ThermalLoad l = last_load_;
+  l.dt_s = dt_s;
+  filter_.predict(l);
+  ThermalStepData none;
+  none.t_ns = out_.t_ns + static_cast<std::int64_t>(dt_s * 1e9);
+  none.load = l;
+  none.psi_m_Wb = last_psi_m_Wb_;
+  none.r_s_Ohm = last_r_s_Ohm_;
+  finish_step(none, dt_s);
+}
+
+void ThermalFusion::finish_step(const ThermalStepData& d, double dt_s) noexcept {
+  const ThermalNetwork& n = config_.filter.network;
+  const ThermalRates rates = thermal_rates(n, d.load);
+  const ThermalVec slope = rates.a * filter_.temperature_C() + rates.u;
+  const StepObservations obs = step_observations(config_, d, filter_.temperature_C(), slope);
+  const int node_of[3] = {n.magnet, n.winding, n.winding};
+  std::array<bool, kMaxThermalNodes> observed{};
+  for (std::size_t k = 0; k < obs.item.size(); ++k) {
+    reports_[k] = ObservationReport{};
+    if (!obs.present[k]) continue;
+    ObservationResult result = filter_.observe(obs.item[k]);
+    reports_[k] = {true, result, filter_.last_innovation(), filter_.last_innovation_variance()};
+    const int reset_after = config_.filter.gate_reset_after;
+    if (result == ObservationResult::kRejectedGate && reset_after > 0 && ++rejected_in_a_row_[k] >= reset_after) {
+      // The observations keep disagreeing: the model has drifted. Open the node's variance to the miss.
+      const double h = obs.item[k].h[node_of[k]];
+      filter_.inflate(node_of[k], filter_.last_innovation() * filter_.last_innovation() / (h * h));
+      result = filter_.observe(obs.item[k]);
+      ++out_.gate_resets;
+    }
+    if (result != ObservationResult::kRejectedGate) rejected_in_a_row_[k] = 0;
+    if (result == ObservationResult::kAccepted) {
+      ++out_.observations_accepted;
+      observed[static_cast<std::size_t>(node_of[k])] = true;
+    } else {
+      ++out_.observations_rejected;
+    }
+  }
+  last_psi_m_Wb_ = d.psi_m_Wb;
+  last_r_s_Ohm_ = d.r_s_Ohm;
+  out_.t_ns = d.t_ns;
+  out_.coolant_C = d.load.coolant_C;
+  for (int i = 0; i < kMaxThermalNodes; ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    ThermalNodeEstimate& node = out_.node[k];
+    node.t_C = filter_.temperature_C()[i];
+    node.sigma_K = filter_.sigma_K(i);
+    node.observed = observed[k];
+    if (observed[k]) {
+      ever_observed_[k] = true;
+      since_observed_s_[k] = 0.0;
+    } else {
+      since_observed_s_[k] += dt_s;
+    }
+    node.age_s = ever_observed_[k] ? since_observed_s_[k] : -1.0;
+  }
+  out_.t_magnet_rpem_C = config_.laws.magnet.temperature_C(d.psi_m_Wb);
+  out_.t_winding_rpem_C = n.copper.temperature_C(d.r_s_Ohm);
+}
+
+}  // namespace rpem::core
