@@ -15,12 +15,6 @@ Line line_of(const DriftLaw& law) noexcept {
   return {slope, law.value_ref - slope * law.reference_C};
 }
 
-/// The law's calibration variance at T [K²] (docs/derivations.md §12, eq. 12.10).
-double calibration_K2(const DriftLaw& law, double rel_sigma, double reference_sigma_K, double t_C) noexcept {
-  const double span = (t_C - law.reference_C) * rel_sigma;
-  return span * span + reference_sigma_K * reference_sigma_K;
-}
-
 }  // namespace
 
 LossBase loss_base_of(const PerUnitBase& base, const MachineSi& machine) noexcept {
@@ -30,19 +24,18 @@ LossBase loss_base_of(const PerUnitBase& base, const MachineSi& machine) noexcep
 StepObservations step_observations(const ThermalFusionConfig& c, const ThermalStepData& s, const ThermalVec& t_C,
                                    const ThermalVec& dt_dt_K_per_s) noexcept {
   const ThermalNetwork& n = c.filter.network;
-  const ThermalLaws& laws = c.laws;
-  const Line magnet = line_of(laws.magnet), copper = line_of(n.copper);
+  const Line magnet = line_of(c.magnet_law), copper = line_of(n.copper);
   const int m = n.magnet, w = n.winding;
   StepObservations out;
-  // [node of the parameter's own temperature, the other node], its law and the other's.
+  // [node of the parameter's own temperature, the other node], the laws, the law's calibration states.
   struct Row {
     int own, other;
     Line own_law, other_law;
-    const DriftLaw* law;
-    double rel_sigma;
+    double reference_C;
+    Calibration offset, coefficient;
   };
-  const Row rows[2] = {{m, w, magnet, copper, &laws.magnet, laws.magnet_coeff_rel_sigma},
-                       {w, m, copper, magnet, &n.copper, laws.copper_coeff_rel_sigma}};
+  const Row rows[2] = {{m, w, magnet, copper, c.magnet_law.reference_C, Calibration::kMagnetOffset, Calibration::kMagnetCoefficient},
+                       {w, m, copper, magnet, n.copper.reference_C, Calibration::kCopperOffset, Calibration::kCopperCoefficient}};
   for (std::size_t j = 0; j < 2; ++j) {
     const ParameterObservation& p = s.parameter[j];
     if (!p.valid) continue;
@@ -52,10 +45,11 @@ StepObservations step_observations(const ThermalFusionConfig& c, const ThermalSt
     o.h[r.other] = p.cross * r.other_law.slope;
     o.offset = r.own_law.at_0C + p.cross * (r.other_law.at_0C - p.other_held);
     o.value = p.value;
-    const double t = t_C[r.own];
+    // T' = T + e_ref + e_α·(T − T_ref), linearised at T̂ (eq. 12.10).
+    o.h_c[static_cast<int>(r.offset)] = r.own_law.slope;
+    o.h_c[static_cast<int>(r.coefficient)] = r.own_law.slope * (t_C[r.own] - r.reference_C);
     const double lag_K = dt_dt_K_per_s[r.own] * p.time_constant_s;
-    const double in_K2 = calibration_K2(*r.law, r.rel_sigma, laws.reference_sigma_K, t) + lag_K * lag_K;
-    o.variance = p.variance + r.own_law.slope * r.own_law.slope * in_K2;
+    o.variance = p.variance + r.own_law.slope * r.own_law.slope * lag_K * lag_K;
     out.present[j] = true;
   }
   if (c.winding_sensor_sigma_K > 0.0 && std::isfinite(s.winding_sensor_C)) {
@@ -167,7 +161,7 @@ void ThermalFusion::finish_step(const ThermalStepData& d, double dt_s) noexcept 
     }
     node.age_s = ever_observed_[k] ? since_observed_s_[k] : -1.0;
   }
-  out_.t_magnet_rpem_C = config_.laws.magnet.temperature_C(d.psi_m_Wb);
+  out_.t_magnet_rpem_C = config_.magnet_law.temperature_C(d.psi_m_Wb);
   out_.t_winding_rpem_C = n.copper.temperature_C(d.r_s_Ohm);
 }
 

@@ -57,8 +57,8 @@ ThermalLoad LossAccumulator::take() noexcept {
 ThermalRates thermal_rates(const ThermalNetwork& n, const ThermalLoad& l) noexcept {
   // Copper (eq. 12.2): (3/2)·R_ref·(1 + α·(T_w − T_ref))·i² = a + b·T_w.
   const DriftLaw& r = n.copper;
-  const double copper_per_K = 1.5 * l.current_sq_A2 * r.value_ref * r.coeff_per_K;
-  const double copper_at_0C = 1.5 * l.current_sq_A2 * r.value_ref * (1.0 - r.coeff_per_K * r.reference_C);
+  const double copper_per_K = n.copper_scale * 1.5 * l.current_sq_A2 * r.value_ref * r.coeff_per_K;
+  const double copper_at_0C = n.copper_scale * 1.5 * l.current_sq_A2 * r.value_ref * (1.0 - r.coeff_per_K * r.reference_C);
   ThermalRates out;
   for (int i = 0; i < n.nodes; ++i) {
     double loss = 0.0;
@@ -87,7 +87,7 @@ ThermalVec node_losses_W(const ThermalNetwork& n, const ThermalLoad& l, const Th
   for (int i = 0; i < n.nodes; ++i) {
     for (int f = 0; f < kLossForms; ++f) p[i] += n.loss_at_base_W(f, i) * l.basis[static_cast<std::size_t>(f)];
   }
-  p[n.winding] += 1.5 * l.current_sq_A2 * n.copper.at(t_C[n.winding]);
+  p[n.winding] += n.copper_scale * 1.5 * l.current_sq_A2 * n.copper.at(t_C[n.winding]);
   return p;
 }
 

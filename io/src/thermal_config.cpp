@@ -16,18 +16,30 @@ std::string num(double v) {
   return s;
 }
 
-/// A temperature law (core/thermal.hpp) and its uncertainties; `loss_rel_sigma`: the copper law's also
-/// gives the copper loss's relative uncertainty.
-core::DriftLaw parse_law(YamlMap m, const char* ref_key, core::DriftLaw law, double ref_max, bool rising, double& rel_sigma,
-                         double* loss_rel_sigma) {
+/// A temperature law (core/thermal.hpp) and its calibration's σ (`offset`, `coefficient`: the filter's
+/// calibration states); the copper law's also gives the copper loss's scale and relative uncertainty.
+core::DriftLaw parse_law(YamlMap m, const char* ref_key, core::DriftLaw law, double ref_max, bool rising,
+                         core::CalibrationVec& sigma, core::Calibration offset, core::Calibration coefficient,
+                         double* loss_rel_sigma, double* loss_scale) {
   law.value_ref = m.number_or(ref_key, law.value_ref, 1e-9, ref_max);
   law.reference_C = m.number_or("reference_C", law.reference_C, -273.0, 500.0);
   law.coeff_per_K = rising ? m.number_or("coeff_per_K", law.coeff_per_K, 1e-6, 0.1)
                            : m.number_or("coeff_per_K", law.coeff_per_K, -0.1, -1e-6);
-  rel_sigma = m.number_or("coeff_rel_sigma", rel_sigma, 0.0, 1.0);
+  double& s_offset = sigma[static_cast<int>(offset)];
+  double& s_coefficient = sigma[static_cast<int>(coefficient)];
+  s_offset = m.number_or("reference_sigma_K", s_offset, 0.0, 100.0);
+  s_coefficient = m.number_or("coeff_rel_sigma", s_coefficient, 0.0, 1.0);
   if (loss_rel_sigma) *loss_rel_sigma = m.number_or("loss_rel_sigma", *loss_rel_sigma, 0.0, 10.0);
+  if (loss_scale) *loss_scale = m.number_or("loss_scale", *loss_scale, 1e-3, 1e3);
   m.finish();
   return law;
+}
+
+/// σ of a law's coefficient relative to it: the spread of the material whose range holds it (core/thermal.hpp).
+template <std::size_t N>
+double coefficient_rel_sigma(const std::array<core::MaterialCoefficient, N>& materials, double alpha) {
+  const auto m = core::material_of(materials, alpha);
+  return m ? m->rel_sigma() : 0.1;
 }
 
 }  // namespace
@@ -50,9 +62,12 @@ ThermalConfig default_thermal_config(const MachineConfig& machine) {
   n.base = core::loss_base_of(core::PerUnitBase::from_rated(machine.machine.rated), machine.machine);
   n.copper = machine.rs_drift.law.value_or(core::DriftLaw{core::kCopper.typical_per_K, core::kMaterialReference_C, 0.0});
   if (n.copper.value_ref <= 0.0) n.copper.value_ref = machine.machine.r_s_Ohm;
-  core::DriftLaw& m = c.fusion.laws.magnet;
+  core::DriftLaw& m = c.fusion.magnet_law;
   m = machine.psim_drift.law.value_or(core::DriftLaw{core::kNdFeB.typical_per_K, core::kMaterialReference_C, 0.0});
   if (m.value_ref <= 0.0) m.value_ref = machine.machine.psi_m_Wb;
+  core::CalibrationVec& sigma = c.fusion.filter.calibration_sigma;
+  sigma[static_cast<int>(core::Calibration::kMagnetCoefficient)] = coefficient_rel_sigma(core::kMagnetMaterials, m.coeff_per_K);
+  sigma[static_cast<int>(core::Calibration::kCopperCoefficient)] = coefficient_rel_sigma(core::kWindingMaterials, n.copper.coeff_per_K);
   return c;
 }
 
@@ -171,12 +186,13 @@ ThermalConfig parse_thermal_config(YamlMap& t, const MachineConfig& machine, Net
     b->finish();
   }
   if (auto m = t.optional_map("copper")) {
-    n.copper = parse_law(*m, "r_s_ref_Ohm", n.copper, 1e4, true, f.laws.copper_coeff_rel_sigma, &f.filter.copper_rel_sigma);
+    n.copper = parse_law(*m, "r_s_ref_Ohm", n.copper, 1e4, true, f.filter.calibration_sigma, core::Calibration::kCopperOffset,
+                         core::Calibration::kCopperCoefficient, &f.filter.copper_rel_sigma, &n.copper_scale);
   }
   if (auto m = t.optional_map("magnet_law")) {
-    f.laws.magnet = parse_law(*m, "psi_m_ref_Wb", f.laws.magnet, 100.0, false, f.laws.magnet_coeff_rel_sigma, nullptr);
+    f.magnet_law = parse_law(*m, "psi_m_ref_Wb", f.magnet_law, 100.0, false, f.filter.calibration_sigma,
+                             core::Calibration::kMagnetOffset, core::Calibration::kMagnetCoefficient, nullptr, nullptr);
   }
-  f.laws.reference_sigma_K = t.number_or("reference_sigma_K", f.laws.reference_sigma_K, 0.0, 100.0);
   f.coolant_C = t.number_or("coolant_C", f.coolant_C, -60.0, 300.0);
   if (auto s = t.optional_map("winding_sensor")) {
     f.winding_sensor_sigma_K = s->number("sigma_K", 1e-3, 100.0);
@@ -234,13 +250,16 @@ std::string thermal_config_yaml(const ThermalConfig& c) {
   if (!losses.empty()) o << "  losses:\n" << losses;
   o << "  loss_base: {omega_el_rad_s: " << num(n.base.omega_el_rad_s) << ", psi_Wb: " << num(n.base.psi_Wb)
     << ", current_A: " << num(n.base.current_A) << "}\n";
+  const core::CalibrationVec& sigma = f.filter.calibration_sigma;
+  auto s = [&](core::Calibration k) { return num(sigma[static_cast<int>(k)]); };
   o << "  copper: {r_s_ref_Ohm: " << num(n.copper.value_ref) << ", reference_C: " << num(n.copper.reference_C)
-    << ", coeff_per_K: " << num(n.copper.coeff_per_K) << ", coeff_rel_sigma: " << num(f.laws.copper_coeff_rel_sigma)
+    << ", coeff_per_K: " << num(n.copper.coeff_per_K) << ", reference_sigma_K: " << s(core::Calibration::kCopperOffset)
+    << ", coeff_rel_sigma: " << s(core::Calibration::kCopperCoefficient) << ", loss_scale: " << num(n.copper_scale)
     << ", loss_rel_sigma: " << num(f.filter.copper_rel_sigma) << "}\n";
-  const core::DriftLaw& m = f.laws.magnet;
+  const core::DriftLaw& m = f.magnet_law;
   o << "  magnet_law: {psi_m_ref_Wb: " << num(m.value_ref) << ", reference_C: " << num(m.reference_C)
-    << ", coeff_per_K: " << num(m.coeff_per_K) << ", coeff_rel_sigma: " << num(f.laws.magnet_coeff_rel_sigma) << "}\n";
-  o << "  reference_sigma_K: " << num(f.laws.reference_sigma_K) << "\n";
+    << ", coeff_per_K: " << num(m.coeff_per_K) << ", reference_sigma_K: " << s(core::Calibration::kMagnetOffset)
+    << ", coeff_rel_sigma: " << s(core::Calibration::kMagnetCoefficient) << "}\n";
   o << "  coolant_C: " << num(f.coolant_C) << "\n";
   if (f.winding_sensor_sigma_K > 0.0) o << "  winding_sensor: {sigma_K: " << num(f.winding_sensor_sigma_K) << "}\n";
   o << "  filter: {period_s: " << num(f.observer.period_s) << ", initial_sigma_K: " << num(f.initial_sigma_K)

@@ -1,7 +1,7 @@
 // Zero heap allocations on the per-sample path: 10⁵ DriveEstimator::step() calls (conditioner,
 // predictor, gradients, gains, update) for each algorithm and gradient form, and 10⁵
-// AveragedDriveEstimator::step() calls for each algorithm, counted by replacing the global allocation
-// functions in this test binary.
+// AveragedDriveEstimator::step() calls for each algorithm, and 10⁵ ThermalFusion::step() calls, counted by
+// replacing the global allocation functions in this test binary.
 #include <gtest/gtest.h>
 
 #include <atomic>
@@ -10,6 +10,7 @@
 
 #include "rpem/core/averaged_estimator.hpp"
 #include "rpem/core/drive_estimator.hpp"
+#include "rpem/core/thermal_fusion.hpp"
 #include "support/averaged_data.hpp"
 #include "support/model_data.hpp"
 #include "support/paper_machine.hpp"
@@ -142,6 +143,64 @@ TEST_P(AveragedAllocations, NoneAcrossOneHundredThousandAveragedSteps) {
 
 INSTANTIATE_TEST_SUITE_P(EveryAlgorithm, AveragedAllocations,
                          ::testing::Values(Algorithm::kSga, Algorithm::kGna, Algorithm::kPhyInt));
+
+TEST(ThermalAllocations, NoneAcrossOneHundredThousandFusedSteps) {
+  // The thermal fusion beside the estimator (rpemd's loop and `rpem estimate --thermal`): loss accumulation,
+  // observations, a 3-node network's exact step every 1 ms (so the filter steps 10⁴ times), gate resets,
+  // coasting without samples, a reload and a non-finite sample.
+  const MachineSi machine = test::paper_machine_si();
+  AveragedDriveEstimator est(machine, test::paper_settings());
+  ThermalFusionConfig c;
+  ThermalNetwork& n = c.filter.network;
+  n.nodes = 3;
+  n.winding = 0, n.magnet = 2;
+  n.capacitance_J_per_K << 3000.0, 12000.0, 7000.0, 1.0;
+  n.to_coolant_W_per_K << 2.0, 90.0, 4.0, 0.0;
+  n.between_W_per_K(0, 1) = n.between_W_per_K(1, 0) = 40.0;
+  n.between_W_per_K(1, 2) = n.between_W_per_K(2, 1) = 12.0;
+  n.copper = {0.00393, 20.0, 2.25};
+  n.base = loss_base_of(test::paper_base(), machine);
+  n.loss_at_base_W(static_cast<int>(LossForm::kIronEddy), 1) = 100.0;
+  n.loss_at_base_W(static_cast<int>(LossForm::kMagnetEddy), 2) = 20.0;
+  c.filter.loss_rel_sigma.setConstant(0.5);
+  c.filter.process_noise_K2_per_s.setConstant(1e-3);
+  c.filter.disturbance_W2_per_s.setConstant(1.0);
+  c.filter.gate_sigma = 1.0;  // tight: gate resets happen
+  c.magnet_law = {-0.0012, 20.0, 1.14};
+  c.observer.period_s = 0.01;
+  c.observer.settle_time_constants = 1.0;
+  c.winding_sensor_sigma_K = 1.0;
+  ThermalFusion fusion(c, test::paper_base(), machine);
+  test::AveragedDataGenerator gen;
+  gen.base = test::paper_base();
+  gen.plant = test::paper_machine_pu();
+  gen.rate_Hz = 1000.0;
+  gen.n_pu = [](double t) { return std::fmod(t, 20.0) < 10.0 ? 0.8 : 0.0; };
+  gen.i_pu = [](double t) { return Vec2(-0.2, 0.6 + 0.1 * std::sin(t)); };
+  constexpr int kSteps = 100'000;
+  std::vector<AveragedSample> samples;
+  samples.reserve(kSteps);
+  for (int k = 0; k < kSteps; ++k) samples.push_back(gen.next());
+  samples[6000].i_dq_A[0] = std::nan("");
+  const long before = g_allocations.load();
+  double sink = 0.0;
+  std::int64_t previous = samples.front().t_ns;
+  for (std::size_t k = 0; k < samples.size(); ++k) {
+    const Estimate e = est.step(samples[k]);
+    ThermalSample s;
+    s.dt_s = 1e-9 * static_cast<double>(samples[k].t_ns - previous);
+    s.winding_sensor_C = k % 50 == 0 ? 60.0 + 1e-4 * static_cast<double>(k) : std::nan("");
+    s.coolant_C = 40.0;
+    previous = samples[k].t_ns;
+    fusion.step(e, s);
+    if (k == 50'000) fusion.reconfigure(c, test::paper_base(), machine);
+    if (k % 20'000 == 0) fusion.coast(0.5);
+    sink += fusion.estimate().magnet_node().t_C;
+  }
+  EXPECT_EQ(g_allocations.load() - before, 0);
+  EXPECT_TRUE(std::isfinite(sink));
+  EXPECT_GT(fusion.estimate().observations_accepted, 1000);
+}
 
 TEST(AllocationCounter, CountsAnAllocation) {
   // Guard against a counter that cannot fail.

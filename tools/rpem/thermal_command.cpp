@@ -46,7 +46,7 @@ int run_thermal_fit(const ThermalFitCliOptions& o) {
   const io::ThermalConfig start = laws.has_network ? laws : analysis::default_topology(laws, record, o.nodes);
   analysis::ThermalFitOptions options;
   options.fit_until_s = o.fit_until_s;
-  options.fit_magnet_reference = !o.keep_magnet_reference;
+  options.anchor_magnet_reference = !o.keep_magnet_reference;
   std::fprintf(stderr, "rpem thermal fit: %zu steps of %.3g s; fitting a %d-node network\n", record.steps.size(),
                start.fusion.observer.period_s, start.fusion.filter.network.nodes);
   const analysis::ThermalFitResult fit = analysis::fit_thermal(record, start, options);
@@ -65,8 +65,12 @@ int run_thermal_fit(const ThermalFitCliOptions& o) {
                 s.heldout_worst_K);
   }
   for (const analysis::FittedParameter& p : fit.parameters) {
-    std::printf("%s = %.5g %s (±%.3g %%%s)\n", p.name.c_str(), p.value, p.unit.c_str(), 100.0 * p.half_width_rel,
-                p.identified ? "" : ", not identified");
+    if (p.half_width_rel <= 10.0) {
+      std::printf("%s = %.5g %s (±%.3g %%%s)\n", p.name.c_str(), p.value, p.unit.c_str(), 100.0 * p.half_width_rel,
+                  p.identified ? "" : ", not identified");
+    } else {
+      std::printf("%s = %.5g %s (not identified: the log does not bound it)\n", p.name.c_str(), p.value, p.unit.c_str());
+    }
   }
   for (const std::string& s : fit.not_identifiable) std::printf("not identifiable together: %s\n", s.c_str());
   for (const std::string& s : fit.notes) std::printf("note: %s\n", s.c_str());
@@ -96,7 +100,7 @@ Runner add_thermal_command(CLI::App& app) {
       ->check(CLI::Range(1e-3, 100.0));
   fit->add_option("--period-s", opts->period_s, "the filter's step (default: thermal.yaml's, 1 s)")->check(CLI::Range(1e-3, 3600.0));
   fit->add_flag("--keep-magnet-reference", opts->keep_magnet_reference,
-                "keep the magnet law's psi_m_ref as given (--start or the machine's) instead of fitting it");
+                "keep the magnet law's psi_m_ref as given (--start or the machine's) instead of anchoring it at the soaked start");
   fit->add_option("--report", opts->report, "directory for report.md, fit.json and predictions.csv");
   return [fit, opts]() { return fit->parsed() ? run_thermal_fit(*opts) : -1; };
 }

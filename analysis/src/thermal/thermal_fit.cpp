@@ -14,17 +14,17 @@ namespace {
 
 constexpr double kZ = 1.959964;  // two-sided 95 %
 constexpr double kInf = std::numeric_limits<double>::infinity();
-/// The fitted magnet reference is x = (ψ_ref/ψ_ref,start − 1)/kRefScale: 1 = 0.1 %.
-constexpr double kRefScale = 1e-3;
 /// The floor of an observation's σ in the fit's weights: temperatures are not resolved finer [K].
 constexpr double kSigmaFloor_K = 0.5;
 /// Each log parameter stays within e^±this of its start (a factor of 3·10⁴): finite simulations only.
 constexpr double kLogRange = 10.3;
 /// The prior of each logarithmic parameter: normal about the start with a standard deviation of one decade
-/// (docs/thermal.md, "The fit"): it decides only where the log leaves a direction undetermined.
+/// (docs/thermal.md, "The fit"): it decides only where the log leaves a direction undetermined. The copper
+/// loss's scale is known better: (3/2)·R_s·|i|² within a factor of 2 (AC resistance, stray load losses).
 constexpr double kPriorSigmaLog = 2.302585092994046;
+constexpr double kPriorSigmaLogCopper = 0.6931471805599453;
 
-enum class SlotKind { kCapacitance, kToCoolant, kBetween, kLoss, kMagnetReference };
+enum class SlotKind { kCapacitance, kToCoolant, kBetween, kLoss, kCopperScale };
 
 struct Slot {
   SlotKind kind;
@@ -44,10 +44,11 @@ struct LossTie {
 /// Where each fitted quantity lives in the network, and how the parameter vector maps onto a configuration.
 class Layout {
  public:
-  Layout(const io::ThermalConfig& start, const std::vector<LossTie>& ties, bool magnet_reference) : start_(start) {
+  Layout(const io::ThermalConfig& start, const std::vector<LossTie>& ties) : start_(start) {
     const core::ThermalNetwork& n = start.fusion.filter.network;
     auto name = [&](int i) { return start.node_names[static_cast<std::size_t>(i)]; };
     for (int i = 0; i < n.nodes; ++i) slots_.push_back({SlotKind::kCapacitance, i, 0, "C " + name(i), "J/K"});
+    slots_.push_back({SlotKind::kCopperScale, n.winding, 0, "copper loss scale", "1"});
     for (int i = 0; i < n.nodes; ++i) {
       if (n.to_coolant_W_per_K[i] > 0.0) slots_.push_back({SlotKind::kToCoolant, i, 0, "G " + name(i) + "–coolant", "W/K"});
     }
@@ -77,16 +78,15 @@ class Layout {
         slots_.push_back(s);
       }
     }
-    if (magnet_reference) slots_.push_back({SlotKind::kMagnetReference, 0, 0, "psi_m_ref", "Wb"});
   }
 
   [[nodiscard]] const std::vector<Slot>& slots() const { return slots_; }
   [[nodiscard]] std::size_t size() const { return slots_.size(); }
 
-  /// The parameter vector of a configuration (log values; the magnet reference relative to the start).
+  /// The parameter vector of a configuration (log values).
   [[nodiscard]] std::vector<double> values(const io::ThermalConfig& c) const {
     std::vector<double> x;
-    for (const Slot& s : slots_) x.push_back(s.kind == SlotKind::kMagnetReference ? 0.0 : std::log(quantity(c, s)));
+    for (const Slot& s : slots_) x.push_back(std::log(quantity(c, s)));
     return x;
   }
 
@@ -98,15 +98,13 @@ class Layout {
       const double v = std::exp(x[k]);
       switch (s.kind) {
         case SlotKind::kCapacitance: n.capacitance_J_per_K[s.i] = v; break;
+        case SlotKind::kCopperScale: n.copper_scale = v; break;
         case SlotKind::kToCoolant: n.to_coolant_W_per_K[s.i] = v; break;
         case SlotKind::kBetween: n.between_W_per_K(s.i, s.j) = n.between_W_per_K(s.j, s.i) = v; break;
         case SlotKind::kLoss:
           for (int f = 0; f < core::kLossForms; ++f) {
             if (s.share[static_cast<std::size_t>(f)] > 0.0) n.loss_at_base_W(f, s.i) = v * s.share[static_cast<std::size_t>(f)];
           }
-          break;
-        case SlotKind::kMagnetReference:
-          c.fusion.laws.magnet.value_ref = start_.fusion.laws.magnet.value_ref * (1.0 + kRefScale * x[k]);
           break;
       }
     }
@@ -118,10 +116,10 @@ class Layout {
     const core::ThermalNetwork& n = c.fusion.filter.network;
     switch (s.kind) {
       case SlotKind::kCapacitance: return n.capacitance_J_per_K[s.i];
+      case SlotKind::kCopperScale: return n.copper_scale;
       case SlotKind::kToCoolant: return n.to_coolant_W_per_K[s.i];
       case SlotKind::kBetween: return n.between_W_per_K(s.i, s.j);
       case SlotKind::kLoss: return n.loss_at_base_W(s.j, s.i);  // the first form's
-      case SlotKind::kMagnetReference: return c.fusion.laws.magnet.value_ref;
     }
     return 0.0;
   }
@@ -174,8 +172,8 @@ class Cost {
   bool operator()(double const* const* x, double* out) const {
     residuals(layout_.apply(x[0]), record_, steps_, points_, out);
     for (std::size_t k = 0; k < prior_.size(); ++k) {
-      const bool log_parameter = layout_.slots()[k].kind != SlotKind::kMagnetReference;
-      out[points_.size() + k] = log_parameter ? (x[0][k] - prior_[k]) / kPriorSigmaLog : 0.0;
+      const double sigma = layout_.slots()[k].kind == SlotKind::kCopperScale ? kPriorSigmaLogCopper : kPriorSigmaLog;
+      out[points_.size() + k] = (x[0][k] - prior_[k]) / sigma;
     }
     return true;
   }
@@ -293,9 +291,8 @@ Solved solve(const Layout& layout, const ThermalRecord& r, std::size_t steps, co
   problem.AddResidualBlock(cost, nullptr, x.data());
   const std::vector<double> x0 = x;
   for (std::size_t k = 0; k < x.size(); ++k) {
-    const bool ref = layout.slots()[k].kind == SlotKind::kMagnetReference;
-    problem.SetParameterLowerBound(x.data(), static_cast<int>(k), ref ? -100.0 : x0[k] - kLogRange);
-    problem.SetParameterUpperBound(x.data(), static_cast<int>(k), ref ? 100.0 : x0[k] + kLogRange);
+    problem.SetParameterLowerBound(x.data(), static_cast<int>(k), x0[k] - kLogRange);
+    problem.SetParameterUpperBound(x.data(), static_cast<int>(k), x0[k] + kLogRange);
   }
   ceres::Solver::Options options;
   options.linear_solver_type = ceres::DENSE_QR;
@@ -368,7 +365,7 @@ void intervals(const Layout& layout, const ThermalRecord& r, std::size_t steps, 
     auto rel = [&](double variance) {
       if (!excited) return kInf;
       const double half = kZ * std::sqrt(std::max(variance, 0.0));
-      return s.kind == SlotKind::kMagnetReference ? half * kRefScale / (1.0 + kRefScale * x[k]) : std::expm1(half);
+      return std::expm1(half);
     };
     p.half_width_rel = rel(robust(kk, kk));
     p.excitation_half_width_rel = rel(h_inv(kk, kk));
@@ -376,11 +373,16 @@ void intervals(const Layout& layout, const ThermalRecord& r, std::size_t steps, 
     out.parameters.push_back(p);
     // A loss term's relative uncertainty for the filter's disturbance (thermal_filter.hpp): its robust
     // standard deviation, at most 1 (a term the log cannot pin is uncertain by its own size).
+    const double sigma = excited ? std::min(1.0, std::expm1(std::sqrt(std::max(robust(kk, kk), 0.0)))) : 1.0;
     if (s.kind == SlotKind::kLoss) {
-      const double sigma = excited ? std::min(1.0, std::expm1(std::sqrt(std::max(robust(kk, kk), 0.0)))) : 1.0;
       for (int f = 0; f < core::kLossForms; ++f) {
         if (s.share[static_cast<std::size_t>(f)] > 0.0) out.config.fusion.filter.loss_rel_sigma(f, s.i) = sigma;
       }
+    }
+    // The copper loss's: its scale's, at least the winding law's coefficient spread (R_s at a temperature).
+    if (s.kind == SlotKind::kCopperScale) {
+      const double law = out.config.fusion.filter.calibration_sigma[static_cast<int>(core::Calibration::kCopperCoefficient)];
+      out.config.fusion.filter.copper_rel_sigma = std::max(sigma, law);
     }
   }
   // Weak directions: eigenvectors of the correlation form of JᵀJ with eigenvalues below 10⁻⁴ of the largest.
@@ -460,6 +462,35 @@ double maximum_likelihood(io::ThermalConfig& c, const ThermalRecord& r, std::siz
   return q;
 }
 
+/// The magnet law's reference from the soaked start (docs/thermal.md, "The magnet's reference"): the mean of
+/// the first kAnchorSteps magnet observations, each corrected for the held R_s (κ·(R_s(T_w) − r̂s)), at the
+/// magnet temperatures `t_magnet_C` of those steps (the soak's, or the network's prediction of the small rise
+/// since), referred to the law's reference temperature. Returns the steps used (0: none within the first
+/// kAnchorWithin_s).
+std::size_t anchor_magnet_reference(io::ThermalConfig& c, const ThermalRecord& r, const std::vector<double>& t_magnet_C,
+                                    const std::vector<double>& t_winding_C, std::vector<std::string>& notes) {
+  constexpr std::size_t kAnchorSteps = 4;
+  constexpr double kAnchorWithin_s = 300.0;
+  core::DriftLaw& law = c.fusion.magnet_law;
+  const core::DriftLaw& copper = c.fusion.filter.network.copper;
+  double sum = 0.0;
+  std::size_t used = 0;
+  for (std::size_t k = 0; k < r.steps.size() && used < kAnchorSteps && r.t_s[k] - r.t_s.front() <= kAnchorWithin_s; ++k) {
+    const core::ParameterObservation& p = r.steps[k].parameter[core::kPsiM];
+    if (!p.valid) continue;
+    const double psi = p.value - p.cross * (copper.at(t_winding_C[k]) - p.other_held);
+    sum += psi / (1.0 + law.coeff_per_K * (t_magnet_C[k] - law.reference_C));  // ψ at the reference temperature
+    ++used;
+  }
+  if (used == 0) {
+    notes.push_back("no magnet observation within the first 300 s: the magnet law's reference is kept as configured (" +
+                    std::to_string(law.value_ref) + " Wb at " + std::to_string(law.reference_C) + " °C)");
+    return 0;
+  }
+  law.value_ref = sum / static_cast<double>(used);
+  return used;
+}
+
 }  // namespace
 
 io::ThermalConfig default_topology(const io::ThermalConfig& laws, const ThermalRecord& r, int nodes) {
@@ -527,26 +558,43 @@ ThermalFitResult fit_thermal(const ThermalRecord& record, const io::ThermalConfi
 
   io::ThermalConfig start = start_config;
   const std::vector<LossTie> ties = tie_collinear_losses(start, record, training, out.notes);
-  const std::vector<Point> points = training_points(start, record, training);
-  if (points.empty()) {
-    throw std::invalid_argument("the training part holds no temperature the network can be fitted to (no winding sensor, "
-                                "and ψm and R_s never adapt and settle)");
-  }
-  const Layout layout(start, ties, options.fit_magnet_reference && std::any_of(points.begin(), points.end(), [](const Point& p) { return p.kind == 0; }));
-  // Three starts: the topology's time constants as they are, three times shorter and three times longer.
-  Solved best;
+  const Layout layout(start, ties);
   const std::vector<double> prior = layout.values(start);
-  for (double scale : {1.0, 1.0 / 3.0, 3.0}) {
-    std::vector<double> x = prior;
-    for (std::size_t k = 0; k < layout.size(); ++k) {
-      if (layout.slots()[k].kind == SlotKind::kCapacitance) x[k] += std::log(scale);
+  // The magnet's reference: first at the soak temperature, then once more at the fitted network's magnet
+  // temperatures of the anchor's steps (the rise since the soak), and the network fitted again.
+  const core::ThermalVec soak = soaked_start(start.fusion, record);
+  std::vector<double> t_magnet(record.steps.size(), soak[start.fusion.filter.network.magnet]);
+  std::vector<double> t_winding(record.steps.size(), soak[start.fusion.filter.network.winding]);
+  Solved best;
+  std::vector<Point> points;
+  for (int pass = 0; pass < (options.anchor_magnet_reference ? 2 : 1); ++pass) {
+    if (options.anchor_magnet_reference) anchor_magnet_reference(start, record, t_magnet, t_winding, out.notes);
+    points = training_points(start, record, training);
+    if (points.empty()) {
+      throw std::invalid_argument("the training part holds no temperature the network can be fitted to (no winding sensor, "
+                                  "and ψm and R_s never adapt and settle)");
     }
-    Solved s = solve(layout, record, training, points, prior, x, options.max_iterations);
-    if (s.cost < best.cost) best = s;
+    const Layout pass_layout(start, ties);
+    // Three starts: the topology's time constants as they are, three times shorter and three times longer.
+    best = Solved{};
+    for (double scale : {1.0, 1.0 / 3.0, 3.0}) {
+      std::vector<double> x = prior;
+      for (std::size_t k = 0; k < layout.size(); ++k) {
+        if (layout.slots()[k].kind == SlotKind::kCapacitance) x[k] += std::log(scale);
+      }
+      Solved s = solve(pass_layout, record, training, points, prior, x, options.max_iterations);
+      if (s.cost < best.cost) best = s;
+    }
+    const std::vector<core::ThermalVec> model = simulate_open_loop(pass_layout.apply(best.x.data()).fusion, record);
+    for (std::size_t k = 0; k < model.size(); ++k) {
+      t_magnet[k] = model[k][start.fusion.filter.network.magnet];
+      t_winding[k] = model[k][start.fusion.filter.network.winding];
+    }
   }
+  const Layout fitted_layout(start, ties);
   out.training_cost = best.cost;
-  out.config = layout.apply(best.x.data());
-  intervals(layout, record, training, points, best.x, options.blocks, out);
+  out.config = fitted_layout.apply(best.x.data());
+  intervals(fitted_layout, record, training, points, best.x, options.blocks, out);
   // The filter's noise: the temperatures' white noise, then the disturbances' drift, each the most likely.
   out.config.fusion.filter.disturbance_W2_per_s.setZero();
   out.process_noise_K2_per_s =

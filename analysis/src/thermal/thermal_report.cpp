@@ -25,7 +25,11 @@ std::string fmt(double v, int digits = 3) {
   return buf;
 }
 
-std::string percent(double rel) { return std::isfinite(rel) ? fmt(100.0 * rel) + " %" : std::string("not excited"); }
+/// A relative half-width as text; beyond ±1000 % the log does not bound the parameter at all.
+std::string percent(double rel) {
+  if (!std::isfinite(rel)) return "not excited";
+  return rel > 10.0 ? std::string("unbounded (> 1000 %)") : fmt(100.0 * rel) + " %";
+}
 
 nlohmann::json number_or_null(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); }
 
@@ -132,7 +136,7 @@ void write_thermal_predictions(const std::string& path, const ThermalFitResult& 
     const core::ParameterObservation& pm = s.parameter[core::kPsiM];
     const core::ParameterObservation& pr = s.parameter[core::kRs];
     line += ',';
-    if (pm.valid) io::append_number(line, c.fusion.laws.magnet.temperature_C(pm.value));
+    if (pm.valid) io::append_number(line, c.fusion.magnet_law.temperature_C(pm.value));
     line += ',';
     if (pr.valid) io::append_number(line, n.copper.temperature_C(pr.value));
     line += ',';

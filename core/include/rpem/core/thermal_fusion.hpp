@@ -6,12 +6,12 @@
 // `rpem estimate --thermal`.
 //
 // The observations through the temperature laws (core/thermal.hpp; docs/derivations.md §12, eq. 12.5–12.8):
-//   ψ̂m = ψ_ref·(1 + α_m·(T_m − T_ref)) + κ_ψ·(R_s(T_w) − r̂s)     while ψ̂m adapts (r̂s held)
-//   r̂s = R_ref·(1 + α_cu·(T_w − T_ref)) + κ_r·(ψm(T_m) − ψ̂m)     while r̂s adapts (ψ̂m held)
+//   ψ̂m = ψ_ref·(1 + α_m·(T_m' − T_ref)) + κ_ψ·(R_s(T_w) − r̂s)    while ψ̂m adapts (r̂s held)
+//   r̂s = R_ref·(1 + α_cu·(T_w' − T_ref)) + κ_r·(ψm(T_m) − ψ̂m)    while r̂s adapts (ψ̂m held)
 //   T_sensor = T_w
-// with the variance of the estimator's own state (σ²_noise + σ²_model) plus the laws' calibration:
-//   σ²_T,cal = (σ_α/α)²·(T̂ − T_ref)² + σ²_ref   and the tracking lag σ_T,lag = |dT̂/dt|·τ,
-// both through the law's slope (∂θ/∂T)². Real-time safe.
+// where T' = T + e_ref + e_α·(T − T_ref) is what a law with calibration errors e reads (the filter's consider
+// states), with the variance of the estimator's own state (σ²_noise + σ²_model) and of the tracking lag
+// σ_T,lag = |dT̂/dt|·τ through the law's slope. Real-time safe.
 
 #include <array>
 #include <cstdint>
@@ -21,17 +21,9 @@
 
 namespace rpem::core {
 
-/// The temperature laws the observations go through, and how well they are known.
-struct ThermalLaws {
-  DriftLaw magnet;                     ///< ψm(T_magnet) [Wb]
-  double magnet_coeff_rel_sigma = 0.1;  ///< σ_α/|α| of the magnet's coefficient
-  double copper_coeff_rel_sigma = 0.05; ///< σ_α/α of the winding's (the copper law is the network's)
-  double reference_sigma_K = 1.0;       ///< σ of the temperature at which each law's reference value holds
-};
-
 struct ThermalFusionConfig {
-  ThermalFilterConfig filter;
-  ThermalLaws laws;
+  ThermalFilterConfig filter;  ///< the network (its copper law is R_s's), the noises, the laws' calibration σ
+  DriftLaw magnet_law;         ///< ψm(T_magnet) [Wb]
   ThermalObserverConfig observer;
   double coolant_C = 25.0;             ///< where the samples carry no coolant temperature
   double winding_sensor_sigma_K = 0.0;  ///< a winding sensor's σ; 0: sensor not used

@@ -4,7 +4,7 @@
 // a heat capacity each, heated by the losses:
 //
 //   C_i·dT_i/dt = P_i − Σ_j G_ij·(T_i − T_j) − G_i0·(T_i − T_coolant)                    (eq. 12.1)
-//   P_winding  += (3/2)·R_s(T_winding)·|i_dq|²      copper, R_s's own law (core/thermal.hpp)  (eq. 12.2)
+//   P_winding  += s_cu·(3/2)·R_s(T_winding)·|i_dq|²   copper, R_s's own law (core/thermal.hpp)  (eq. 12.2)
 //   P_i        += Σ_forms k_form,i·basis_form(ω, ψ_s, |i|)     iron and magnet losses         (eq. 12.3)
 //
 // The loss forms are a catalogue (thermal_network.cpp, kLossForms): hysteresis ∝ f·B², eddy currents
@@ -67,6 +67,8 @@ struct ThermalNetwork {
   Eigen::Matrix<double, kLossForms, kMaxThermalNodes> loss_at_base_W =
       Eigen::Matrix<double, kLossForms, kMaxThermalNodes>::Zero();
   DriftLaw copper;  ///< R_s(T_winding) [Ω] (value_ref set)
+  /// s_cu: the copper loss relative to (3/2)·R_s·|i|² (AC resistance, stray load losses that go with i²); 1 nominal.
+  double copper_scale = 1.0;
   LossBase base;
 };
 

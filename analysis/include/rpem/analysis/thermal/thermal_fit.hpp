@@ -1,6 +1,6 @@
 #pragma once
 // `rpem thermal fit` (docs/thermal.md): the thermal network's capacitances, conductances and loss
-// coefficients, and the magnet law's reference value, fitted to what a log shows of the temperatures — a
+// coefficients fitted, with the magnet law's reference value anchored at the soaked start, to what a log shows of the temperatures — a
 // winding sensor, the magnet temperature from ψ̂m, the winding's from r̂s (thermal_record.hpp) — by
 // weighted nonlinear least squares of the open-loop network (Ceres), every positive quantity as its
 // logarithm (positive by construction). The part of the log after `fit_until_s` is held out and judged.
@@ -22,7 +22,8 @@ struct ThermalFitOptions {
   /// Steps ending at or before this time train; the rest is held out. NaN: the first 75 % of the log's time.
   double fit_until_s = std::numeric_limits<double>::quiet_NaN();
   int blocks = 8;                     ///< clusters of the training part for the robust intervals
-  bool fit_magnet_reference = true;   ///< the magnet law's ψ_ref (its anchor: the soaked start)
+  /// The magnet law's ψ_ref from the first magnet observations at the soaked start (else as configured).
+  bool anchor_magnet_reference = true;
   int max_iterations = 200;
 };
 
