@@ -20,9 +20,13 @@ void ThermalObserver::reconfigure(const ThermalObserverConfig& config, const Per
 
 void ThermalObserver::restart() noexcept {
   settled_ = {};
-  eps_started_ = false;
+  eps_started_ = batch_started_ = false;
   eps_mean_.setZero();
   eps_cov_.setZero();
+  batch_sum_.setZero();
+  batch_mean_.setZero();
+  batch_dt_s_ = 0.0;
+  batch_count_ = 0;
 }
 
 void ThermalObserver::add_parameter(int j, const Estimate& e, double dt_s) noexcept {
@@ -74,16 +78,27 @@ bool ThermalObserver::add(const Estimate& e, const ThermalSample& s) noexcept {
 
   if (e.detail.code == StepCode::kAdapted && all_finite(e.epsilon_A)) {
     const Vec2 eps = e.detail.epsilon_pu;
-    if (!eps_started_) {
-      eps_mean_ = eps;
-      eps_cov_.setZero();
-      eps_started_ = true;
-    } else {
-      // Exponentially weighted mean and covariance (West's update): weight w of this sample.
-      const double w = -std::expm1(-dt / config_.residual_time_constant_s);
-      const Vec2 delta = eps - eps_mean_;
-      eps_mean_ += w * delta;
-      eps_cov_ = (1.0 - w) * (eps_cov_ + w * delta * delta.transpose());
+    const double tau = config_.residual_time_constant_s;
+    eps_mean_ = eps_started_ ? Vec2(eps_mean_ - std::expm1(-dt / tau) * (eps - eps_mean_)) : eps;
+    eps_started_ = true;
+    batch_sum_ += eps;
+    batch_dt_s_ += dt;
+    if (++batch_count_ == kBatch) {
+      // Batch means, exponentially weighted (West's update), weight w of this batch.
+      const Vec2 b = batch_sum_ / kBatch;
+      if (!batch_started_) {
+        batch_mean_ = b;
+        eps_cov_.setZero();
+        batch_started_ = true;
+      } else {
+        const double w = -std::expm1(-batch_dt_s_ / tau);
+        const Vec2 delta = b - batch_mean_;
+        batch_mean_ += w * delta;
+        eps_cov_ = (1.0 - w) * (eps_cov_ + (w * kBatch) * delta * delta.transpose());
+      }
+      batch_sum_.setZero();
+      batch_dt_s_ = 0.0;
+      batch_count_ = 0;
     }
   }
   for (int j = 0; j < 2; ++j) add_parameter(j, e, dt);

@@ -5,6 +5,8 @@
 
 #include <cmath>
 
+#include <Eigen/LU>
+
 #include "rpem/core/matrix_exponential.hpp"
 #include "rpem/core/thermal_network.hpp"
 

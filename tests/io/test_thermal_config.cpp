@@ -104,7 +104,7 @@ TEST(ThermalConfig, DefaultsComeFromTheMachineAndTheMaterials) {
 
 TEST(ThermalConfig, BadSectionsNameFileLineKeyAndReason) {
   EXPECT_NE(error_of("name: magnet", "name: rotor").find("a node named 'magnet' is required"), std::string::npos);
-  EXPECT_NE(error_of("name: stator_iron", "name: winding").find(":4:13: thermal.nodes.name: node 'winding' appears twice"),
+  EXPECT_NE(error_of("name: stator_iron", "name: winding").find(":4:14: thermal.nodes[1].name: node 'winding' appears twice"),
             std::string::npos)
       << error_of("name: stator_iron", "name: winding");
   EXPECT_NE(error_of("form: magnet_eddy", "form: magnet_hysteresis")
@@ -115,7 +115,7 @@ TEST(ThermalConfig, BadSectionsNameFileLineKeyAndReason) {
   // The magnet without a conductance of its own to the coolant still reaches it through the stator iron.
   EXPECT_EQ(error_of("capacitance_J_per_K: 6500, to_coolant_W_per_K: 2.5", "capacitance_J_per_K: 6500, to_coolant_W_per_K: 0"), "");
   EXPECT_NE(error_of("capacitance_J_per_K: 6500, to_coolant_W_per_K: 2.5", "capacitance_J_per_K: -1")
-                .find("thermal.nodes.capacitance_J_per_K: -1 is outside"),
+                .find("thermal.nodes[2].capacitance_J_per_K: -1 is outside"),
             std::string::npos);
   EXPECT_NE(error_of("coolant_C: 35", "coolant_C: 35\n  coolnat: 3").find("thermal.coolnat"), std::string::npos);
   EXPECT_NE(error_of("coeff_per_K: -0.00105", "coeff_per_K: 0.00105").find("thermal.magnet_law.coeff_per_K"),

@@ -9,11 +9,14 @@
 //   a = l·g                          the fraction of its error the update removes (contraction)
 //   settled:   Σ a ≥ settle_time_constants over uninterrupted adaptation (the start's error below e^−Σa)
 //   κ = (l·g_o)/a                    θ̂_j − θ_j = κ·(θ_o − θ̂_o) at the update's equilibrium l·ε = 0 (eq. 12.6)
-//   σ²_noise = l·Σ_ε·lᵀ / (a·(2 − a))  the stationary variance of θ̂_j under white residuals Σ_ε (eq. 12.7)
+//   σ²_noise = l·Σ_ε·lᵀ / (a·(2 − a))  the stationary variance of θ̂_j, Σ_ε the residuals' long-run covariance
+//                                      (their spectral density at zero: the update is a low-pass) (eq. 12.7)
 //   σ²_model = |ε̄_⊥|²·|l|²/a²        the bias a model error as large as the mean residual the update cannot
 //                                      remove (ε̄_⊥ ⊥ l), in the direction it would remove, causes (eq. 12.8)
 //   τ = Δt/a                          the tracking time constant
-// ε̄ and Σ_ε are exponentially weighted over residual_time_constant_s. A step's observation is the mean of its
+// ε̄ and Σ_ε are exponentially weighted over residual_time_constant_s, Σ_ε by batch means: kBatch times the
+// covariance of the means of kBatch consecutive residuals (a differenced noise, which the averaged path's
+// inductive correction puts into ε and which the update does not see, keeps 2/kBatch of its variance). A step's observation is the mean of its
 // adapted samples' values, κ, variances and τ; nothing here depends on the thermal model. Real-time safe.
 
 #include <array>
@@ -85,9 +88,14 @@ class ThermalObserver {
   LossBase loss_base_;
   double coolant_C_;
   LossAccumulator losses_;
-  Vec2 eps_mean_ = Vec2::Zero();
-  Mat2 eps_cov_ = Mat2::Zero();
-  bool eps_started_ = false;
+  static constexpr int kBatch = 32;
+  Vec2 eps_mean_ = Vec2::Zero();   ///< ε̄, per sample
+  Vec2 batch_sum_ = Vec2::Zero();  ///< the current batch's residuals
+  double batch_dt_s_ = 0.0;
+  int batch_count_ = 0;
+  Vec2 batch_mean_ = Vec2::Zero(); ///< the batch means' mean
+  Mat2 eps_cov_ = Mat2::Zero();    ///< Σ_ε = kBatch·Cov(batch means)
+  bool eps_started_ = false, batch_started_ = false;
   std::array<double, 2> settled_{};  ///< Σa over the current uninterrupted adaptation
   std::array<Accumulated, 2> acc_{};
   double sensor_sum_ = 0.0, sensor_time_ = 0.0;
