@@ -1,5 +1,6 @@
 #include "rpem/core/thermal_observer.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 namespace rpem::core {
@@ -25,7 +26,7 @@ void ThermalObserver::restart() noexcept {
   eps_cov_.setZero();
   batch_sum_.setZero();
   batch_mean_.setZero();
-  batch_dt_s_ = 0.0;
+  batch_dt_s_ = batch_a_ = 0.0;
   batch_count_ = 0;
 }
 
@@ -83,9 +84,14 @@ bool ThermalObserver::add(const Estimate& e, const ThermalSample& s) noexcept {
     eps_started_ = true;
     batch_sum_ += eps;
     batch_dt_s_ += dt;
-    if (++batch_count_ == kBatch) {
-      // Batch means, exponentially weighted (West's update), weight w of this batch.
-      const Vec2 b = batch_sum_ / kBatch;
+    const EstimatorOutput& d = e.detail;
+    double a = 0.0;
+    for (int j = 0; j < 2; ++j) a = std::max(a, d.gain.row(j).dot(d.gradient.col(j)));
+    batch_a_ += a;
+    if (++batch_count_ >= kMaxBatch || batch_a_ >= 0.25) {
+      // Batch means, exponentially weighted (West's update), weight w of this batch of M samples.
+      const double m = batch_count_;
+      const Vec2 b = batch_sum_ / m;
       if (!batch_started_) {
         batch_mean_ = b;
         eps_cov_.setZero();
@@ -94,10 +100,10 @@ bool ThermalObserver::add(const Estimate& e, const ThermalSample& s) noexcept {
         const double w = -std::expm1(-batch_dt_s_ / tau);
         const Vec2 delta = b - batch_mean_;
         batch_mean_ += w * delta;
-        eps_cov_ = (1.0 - w) * (eps_cov_ + (w * kBatch) * delta * delta.transpose());
+        eps_cov_ = (1.0 - w) * (eps_cov_ + (w * m) * delta * delta.transpose());
       }
       batch_sum_.setZero();
-      batch_dt_s_ = 0.0;
+      batch_dt_s_ = batch_a_ = 0.0;
       batch_count_ = 0;
     }
   }

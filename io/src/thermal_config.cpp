@@ -22,7 +22,10 @@ core::DriftLaw parse_law(YamlMap m, const char* ref_key, core::DriftLaw law, dou
                          core::CalibrationVec& sigma, core::Calibration offset, core::Calibration coefficient,
                          double* loss_rel_sigma, double* loss_scale) {
   law.value_ref = m.number_or(ref_key, law.value_ref, 1e-9, ref_max);
-  law.reference_C = m.number_or("reference_C", law.reference_C, -273.0, 500.0);
+  // A reference temperature without a coefficient: the default coefficient referred to it (the same line).
+  const double reference_C = m.number_or("reference_C", law.reference_C, -273.0, 500.0);
+  law.coeff_per_K = law.referred_to(reference_C).coeff_per_K;
+  law.reference_C = reference_C;
   law.coeff_per_K = rising ? m.number_or("coeff_per_K", law.coeff_per_K, 1e-6, 0.1)
                            : m.number_or("coeff_per_K", law.coeff_per_K, -0.1, -1e-6);
   double& s_offset = sigma[static_cast<int>(offset)];

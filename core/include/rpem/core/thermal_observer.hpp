@@ -14,9 +14,11 @@
 //   σ²_model = |ε̄_⊥|²·|l|²/a²        the bias a model error as large as the mean residual the update cannot
 //                                      remove (ε̄_⊥ ⊥ l), in the direction it would remove, causes (eq. 12.8)
 //   τ = Δt/a                          the tracking time constant
-// ε̄ and Σ_ε are exponentially weighted over residual_time_constant_s, Σ_ε by batch means: kBatch times the
-// covariance of the means of kBatch consecutive residuals (a differenced noise, which the averaged path's
-// inductive correction puts into ε and which the update does not see, keeps 2/kBatch of its variance). A step's observation is the mean of its
+// ε̄ and Σ_ε are exponentially weighted over residual_time_constant_s, Σ_ε by batch means: M times the
+// covariance of the means of M consecutive residuals, a batch closing after a quarter of the estimator's time
+// constant (Σa ≥ ¼) or kMaxBatch samples — long against the noise's correlation, short against what the
+// estimator itself moves (a differenced noise, which the averaged path's inductive correction puts into ε
+// and which the update does not see, keeps 2/M of its variance; rows seconds apart, a ≈ 1: M = 1). A step's observation is the mean of its
 // adapted samples' values, κ, variances and τ; nothing here depends on the thermal model. Real-time safe.
 
 #include <array>
@@ -88,10 +90,10 @@ class ThermalObserver {
   LossBase loss_base_;
   double coolant_C_;
   LossAccumulator losses_;
-  static constexpr int kBatch = 32;
+  static constexpr int kMaxBatch = 32;
   Vec2 eps_mean_ = Vec2::Zero();   ///< ε̄, per sample
   Vec2 batch_sum_ = Vec2::Zero();  ///< the current batch's residuals
-  double batch_dt_s_ = 0.0;
+  double batch_dt_s_ = 0.0, batch_a_ = 0.0;
   int batch_count_ = 0;
   Vec2 batch_mean_ = Vec2::Zero(); ///< the batch means' mean
   Mat2 eps_cov_ = Mat2::Zero();    ///< Σ_ε = kBatch·Cov(batch means)
