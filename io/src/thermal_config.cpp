@@ -56,6 +56,7 @@ int node_index(const ThermalConfig& c, const std::string& name) {
 
 ThermalConfig default_thermal_config(const MachineConfig& machine) {
   ThermalConfig c;
+  c.has_network = false;  // the laws only: a fit gives the network
   core::ThermalNetwork& n = c.fusion.filter.network;
   n.nodes = 2;
   n.winding = 0;

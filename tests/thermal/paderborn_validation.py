@@ -16,28 +16,13 @@ Bounds. Issue 24's acceptance is fused <= 3 K RMS and <= 6 K worst on both, the 
 of the measured points. What is met is asserted as that; what is not (docs/thermal.md says why) is asserted
 as the figures measured, two-sided, so that a change in either direction is seen."""
 import argparse
-import csv
 import json
-import math
 import os
-import subprocess
 import sys
 
+from thermal_judge import Bounds, judge, print_table, read, run
+
 SPLIT_S = 4400.0  # the load change: heat-up before, cool-down after (docs/diagnose.md)
-
-
-def run(cmd):
-    print("+ " + " ".join(cmd), flush=True)
-    r = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
-    print(r.stdout, end="")
-    if r.returncode != 0:
-        sys.exit(f"command failed with exit code {r.returncode}")
-
-
-def stats(pairs):
-    e = [a - b for a, b in pairs if not (math.isnan(a) or math.isnan(b))]
-    return {"n": len(e), "rms_K": math.sqrt(sum(x * x for x in e) / len(e)), "worst_K": max(abs(x) for x in e),
-            "mean_K": sum(e) / len(e)}
 
 
 def main() -> int:
@@ -66,48 +51,23 @@ def main() -> int:
     run([a.rpem, "estimate", "--log", w("honest.csv"), "--config", cfg, "--thermal", w("thermal.yaml"), "--out", w("honest_est.csv")])
     run([a.rpem, "estimate", "--log", w("full.csv"), "--config", cfg, "--thermal", w("thermal.yaml"), "--out", w("full_est.csv")])
 
-    truth = list(csv.DictReader(open(src)))
-    model = list(csv.DictReader(open(w("fit/predictions.csv"))))
-    honest = list(csv.DictReader(open(w("honest_est.csv"))))
-    full = list(csv.DictReader(open(w("full_est.csv"))))
-    if not (len(truth) == len(honest) == len(full) == len(model) + 1):
-        sys.exit(f"row counts differ: {len(truth)} {len(honest)} {len(full)} {len(model)}")
-    result = {}
-    for node, column in (("magnet", "pm"), ("winding", "stator_winding")):
-        r = {}
-        judged = [k for k in range(len(truth)) if float(honest[k]["t"]) > SPLIT_S]
-        T = lambda k: float(truth[k][column])
-        # model's rows are the filter's steps, one per log row from the second on
-        r["model"] = stats([(float(model[k - 1][f"T_{node}_model"]), T(k)) for k in judged])
-        r["rpem"] = stats([(float(honest[k][f"T_{node}_rpem"]), T(k)) for k in judged])
-        for name, est in (("fused", honest), ("fused_with_sensor", full)):
-            s = stats([(float(est[k][f"T_{node}"]), T(k)) for k in judged])
-            s["cover_2sigma"] = sum(abs(float(est[k][f"T_{node}"]) - T(k)) <= 2.0 * float(est[k][f"sigma_{node}"])
-                                    for k in judged) / len(judged)
-            r[name] = s
-        result[node] = r
+    truth = read(src)
+    model = read(w("fit/predictions.csv"))
+    estimates = {"fused": read(w("honest_est.csv")), "fused_with_sensor": read(w("full_est.csv"))}
+    if not all(len(e) == len(truth) for e in estimates.values()):
+        sys.exit("the estimate CSVs do not have a row per profile row")
+    result = {node: judge(truth, column, estimates, model, node, SPLIT_S)
+              for node, column in (("magnet", "pm"), ("winding", "stator_winding"))}
+    print_table(f"cool-down (t > {SPLIT_S:g} s, {result['magnet']['fused']['n']} rows) against pm and stator_winding:",
+                result, ("model", "rpem", "fused", "fused_with_sensor"))
     fit = json.load(open(w("fit/fit.json")))
     result["fit"] = {"signals": fit["signals"], "process_noise_K2_per_s": fit["process_noise_K2_per_s"]}
-
-    print(f"\ncool-down (t > {SPLIT_S:g} s, {result['magnet']['fused']['n']} rows) against pm and stator_winding:")
-    print(f"{'':28s} {'RMS [K]':>8s} {'worst [K]':>9s} {'mean [K]':>9s} {'2σ cover':>9s}")
-    for node in ("magnet", "winding"):
-        for name in ("model", "rpem", "fused", "fused_with_sensor"):
-            s = result[node][name]
-            cover = f"{100 * s['cover_2sigma']:8.1f}%" if "cover_2sigma" in s else ""
-            print(f"{node + ' ' + name:28s} {s['rms_K']:8.2f} {s['worst_K']:9.2f} {s['mean_K']:+9.2f} {cover:>9s}")
     if a.json:
         with open(a.json, "w") as f:
             json.dump(result, f, indent=2)
 
-    failures = []
-
-    def check(what, value, lo, hi):
-        ok = lo <= value <= hi
-        print(f"{'ok  ' if ok else 'MISS'} {what}: {value:.3f} in [{lo}, {hi}]")
-        if not ok:
-            failures.append(what)
-
+    bounds = Bounds()
+    check = bounds.check
     m, wd = result["magnet"], result["winding"]
     # Met: the acceptance's coverage, on both; the winding with its sensor (circular, stated).
     check("magnet fused 2σ coverage (acceptance >= 0.9)", m["fused"]["cover_2sigma"], 0.9, 1.0)
@@ -121,10 +81,7 @@ def main() -> int:
     # What the fusion must never do: be worse than what it fuses.
     check("magnet: fused RMS minus RPEM alone [K]", m["fused"]["rms_K"] - m["rpem"]["rms_K"], -3.0, 0.3)
     check("winding: fused RMS minus the model alone, no sensor [K]", wd["fused"]["rms_K"] - wd["model"]["rms_K"], -60.0, 0.0)
-    if failures:
-        print(f"{len(failures)} bound(s) missed: " + "; ".join(failures))
-        return 1
-    return 0
+    return bounds.exit_code()
 
 
 if __name__ == "__main__":

@@ -145,6 +145,11 @@ double miss_K(const core::StepObservations& o, int kind, const core::ThermalVec&
 int own_node(const core::ThermalNetwork& n, int kind) { return kind == 0 ? n.magnet : n.winding; }
 
 /// Residuals of a configuration at the given points: the open-loop network against each observation, weighted.
+/// A network whose temperatures leave this band has run away (a copper loss growing faster with the
+/// winding's temperature than its conductances carry it off): its remaining residuals are kRunaway.
+constexpr double kRunawayBand_K = 2000.0;
+constexpr double kRunaway = 1e6;
+
 void residuals(const io::ThermalConfig& c, const ThermalRecord& r, std::size_t steps, const std::vector<Point>& points,
                double* out) {
   const core::ThermalFusionConfig& f = c.fusion;
@@ -154,13 +159,15 @@ void residuals(const io::ThermalConfig& c, const ThermalRecord& r, std::size_t s
     const core::ThermalStepData& s = r.steps[k];
     const core::ThermalTransition tr = core::thermal_transition(f.filter.network, s.load);
     t = tr.phi * t + tr.gamma;
+    if (!(t.cwiseAbs().maxCoeff() < kRunawayBand_K)) break;
     if (points[p].step != k) continue;
     const core::StepObservations o = core::step_observations(f, s, t, core::ThermalVec::Zero());
     for (; p < points.size() && points[p].step == k; ++p) {
       const double m = miss_K(o, points[p].kind, t, own_node(f.filter.network, points[p].kind));
-      out[p] = std::isfinite(m) ? m / points[p].sigma_K : 1e6;
+      out[p] = std::isfinite(m) ? std::clamp(m / points[p].sigma_K, -kRunaway, kRunaway) : kRunaway;
     }
   }
+  for (; p < points.size(); ++p) out[p] = kRunaway;
 }
 
 /// The weighted residuals and, after them, the prior's: (x − x_prior)/σ_prior per logarithmic parameter.
@@ -497,9 +504,10 @@ io::ThermalConfig default_topology(const io::ThermalConfig& laws, const ThermalR
   io::ThermalConfig c = laws;
   core::ThermalNetwork& n = c.fusion.filter.network;
   // Scales from the record: the mean copper loss at the reference resistance and a temperature rise.
-  double i2 = 0.0, iron = 0.0, magnet_eddy = 0.0;
+  double i2 = 0.0, iron = 0.0, magnet_eddy = 0.0, i2_max = 0.0;
   for (const core::ThermalStepData& s : r.steps) {
     i2 += s.load.current_sq_A2;
+    i2_max = std::max(i2_max, s.load.current_sq_A2);
     iron += s.load.basis[static_cast<std::size_t>(core::LossForm::kIronEddy)];
     magnet_eddy += s.load.basis[static_cast<std::size_t>(core::LossForm::kMagnetEddy)];
   }
@@ -508,7 +516,10 @@ io::ThermalConfig default_topology(const io::ThermalConfig& laws, const ThermalR
   const double iron_basis = std::max(iron / count, 1e-3);
   const double magnet_basis = std::max(magnet_eddy / count, 1e-3);
   const double rise_K = 60.0;                   // a machine near its rating
-  const double g_W_per_K = copper_W / rise_K;   // total conductance to the coolant
+  // The winding's conductance: the mean copper loss over a typical rise, at least three times the copper loss's
+  // own growth with temperature at the largest current ((3/2)·R_ref·α·i²_max: below it the network runs away).
+  const double feedback_W_per_K = 1.5 * n.copper.value_ref * n.copper.coeff_per_K * i2_max;
+  const double g_W_per_K = std::max(copper_W / rise_K, 3.0 * feedback_W_per_K);
   n.nodes = nodes;
   n.between_W_per_K.setZero();
   n.loss_at_base_W.setZero();
@@ -592,6 +603,10 @@ ThermalFitResult fit_thermal(const ThermalRecord& record, const io::ThermalConfi
     }
   }
   const Layout fitted_layout(start, ties);
+  if (!std::isfinite(best.cost) || best.cost >= kRunaway * kRunaway) {
+    throw std::invalid_argument("the fit did not converge to a network that follows the log (it runs away or is not "
+                                "finite); start it from another network (--start) or another topology (--nodes)");
+  }
   out.training_cost = best.cost;
   out.config = fitted_layout.apply(best.x.data());
   intervals(fitted_layout, record, training, points, best.x, options.blocks, out);

@@ -32,7 +32,7 @@ enum class NetworkRequired : bool { kNo = false, kYes = true };
 [[nodiscard]] ThermalConfig load_thermal_config(const std::string& path, const MachineConfig& machine,
                                                 NetworkRequired network = NetworkRequired::kYes);
 
-/// The defaults a fit starts from (docs/thermal.md): nodes winding and magnet, the laws of the machine's
+/// The defaults a fit starts from (docs/thermal.md; no network: has_network false): the laws of the machine's
 /// drifts or of copper and NdFeB (core/thermal.hpp) about the machine's values at 20 °C, the loss base
 /// of the machine (core::loss_base_of).
 [[nodiscard]] ThermalConfig default_thermal_config(const MachineConfig& machine);
