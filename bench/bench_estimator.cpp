@@ -15,6 +15,7 @@
 #include <ctime>
 #include <vector>
 
+#include "rpem/core/clock.hpp"
 #include "rpem/core/drive_estimator.hpp"
 #include "support/model_data.hpp"
 #include "support/paper_machine.hpp"
@@ -96,7 +97,7 @@ class KernelReplay {
 double thread_cpu_s() {
   timespec ts{};
   clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
+  return static_cast<double>(ts.tv_sec) + rpem::core::to_seconds(ts.tv_nsec);
 }
 
 double max_of(const std::vector<double>& v) { return *std::max_element(v.begin(), v.end()); }

@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include "rpem/core/clock.hpp"
+
 namespace rpem::core {
 namespace {
 
@@ -78,14 +80,14 @@ SteadyStateSample AveragedDriveEstimator::condition(const AveragedSample& a) noe
 
   const std::int64_t centre2_ns = a.t_start_ns + a.t_ns;
   const std::int64_t window_ns = a.t_ns - a.t_start_ns;
-  s.dt_s = has_previous_ ? 1e-9 * static_cast<double>(a.t_ns - previous_t_ns_) : 0.0;
+  s.dt_s = has_previous_ ? to_seconds(a.t_ns - *previous_t_ns_) : 0.0;
   // A window that starts later than the previous one ended by more than half its own length follows lost ones.
   const bool contiguous = has_previous_ && !a.gap_before && s.dt_s > 0.0 && s.dt_s <= options_.max_interval_s &&
-                          (window_ns <= 0 || 2 * (a.t_start_ns - previous_t_ns_) <= window_ns);
+                          (window_ns <= 0 || 2 * (a.t_start_ns - *previous_t_ns_) <= window_ns);
   s.resync = !contiguous;
   if (contiguous && options_.inductive_correction && centre2_ns > previous_centre2_ns_) {
     // (x/ω_n)·di/dt with di/dt from the means of consecutive windows, between their centres.
-    const double dc_s = 0.5e-9 * static_cast<double>(centre2_ns - previous_centre2_ns_);
+    const double dc_s = 0.5 * to_seconds(centre2_ns - previous_centre2_ns_);
     const Vec2 di_dt = (s.i_meas_pu - previous_i_pu_) / dc_s;
     s.u_pu -= Vec2(s.x_d_pu * di_dt[0], s.x_q_pu * di_dt[1]) / omega_n;
   }
@@ -101,9 +103,9 @@ SteadyStateSample AveragedDriveEstimator::condition(const AveragedSample& a) noe
                        : 1.0;
   instrument_i_pu_ += w * (s.i_meas_pu - instrument_i_pu_);
   instrument_n_pu_ += w * (s.n_pu - instrument_n_pu_);
+  previous_t_ns_ = a.t_ns;
   if (s.i_meas_pu.allFinite()) {
     has_previous_ = true;
-    previous_t_ns_ = a.t_ns;
     previous_centre2_ns_ = centre2_ns;
     previous_i_pu_ = s.i_meas_pu;
   } else {

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "rpem/core/assert.hpp"
+
 namespace rpem::core {
 namespace {
 
@@ -151,6 +153,8 @@ EstimatorOutput RpemEstimator::held(StepCode code) const noexcept {
   unsigned clamped = 0;
   double psi_m = state_.theta_pu[kPsiM], r_s = state_.theta_pu[kRs];
   const auto adapt = [&](int j, bool adapts, double& value) {
+    RPEM_ASSERT(adapts || !(value < config_.bounds.min_pu[j] || value > config_.bounds.max_pu[j]),
+                "a held parameter is inside D_M: every path that sets theta projects it");
     if (!adapts) return;
     value += change[j];
     clamped |= static_cast<unsigned>(project(config_.bounds, j, value)) << j;

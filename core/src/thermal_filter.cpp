@@ -78,7 +78,7 @@ ObservationResult ThermalFilter::observe(const ThermalObservation& o) noexcept {
   innovation_ = nu;
   innovation_variance_ = s;
   if (nu * nu > config_.gate_sigma * config_.gate_sigma * s) return ObservationResult::kRejectedGate;
-  // Schmidt's update: K = P·Hᵀ/s on T and d, zero on the calibration states (eq. 12.11). With a = P·Hᵀ:
+  // Schmidt's update: K = P·Hᵀ/s on T and d, zero on the calibration states (eq. 14.11). With a = P·Hᵀ:
   //   P_xx −= a_x·a_xᵀ/s,  P_xc −= a_x·a_cᵀ/s,  P_cc unchanged.
   const Eigen::Matrix<double, kDynamic, 1> a_x = ph.head<kDynamic>();
   x_.head<kDynamic>() += a_x * (nu / s);

@@ -1,6 +1,10 @@
 #include "rpem/core/thermal_fusion.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
+
+#include "rpem/core/clock.hpp"
 
 namespace rpem::core {
 namespace {
@@ -19,6 +23,20 @@ Line line_of(const DriftLaw& law) noexcept {
 
 LossBase loss_base_of(const PerUnitBase& base, const MachineSi& machine) noexcept {
   return {base.omega_el_rad_s, machine.psi_m_Wb, base.current_A};
+}
+
+ThermalNodeReport report_node(const ThermalEstimate& e, int node, std::int64_t t_ns) noexcept {
+  ThermalNodeReport r;
+  if (!e.started || node < 0 || node >= e.nodes) {
+    r.t_C = r.sd_K = std::numeric_limits<double>::quiet_NaN();
+    return r;
+  }
+  const ThermalNodeEstimate& n = e.node[static_cast<std::size_t>(node)];
+  r.t_C = n.t_C;
+  r.sd_K = n.sigma_K;
+  r.source = static_cast<std::int8_t>(n.observed ? 1 : 2);
+  if (n.age_s >= 0.0) r.observed_age_s = n.age_s + std::max(0.0, to_seconds(t_ns - e.t_ns));
+  return r;
 }
 
 StepObservations step_observations(const ThermalFusionConfig& c, const ThermalStepData& s, const ThermalVec& t_C,
@@ -45,7 +63,7 @@ StepObservations step_observations(const ThermalFusionConfig& c, const ThermalSt
     o.h[r.other] = p.cross * r.other_law.slope;
     o.offset = r.own_law.at_0C + p.cross * (r.other_law.at_0C - p.other_held);
     o.value = p.value;
-    // T' = T + e_ref + e_α·(T − T_ref), linearised at T̂ (eq. 12.10).
+    // T' = T + e_ref + e_α·(T − T_ref), linearised at T̂ (eq. 14.10).
     o.h_c[static_cast<int>(r.offset)] = r.own_law.slope;
     o.h_c[static_cast<int>(r.coefficient)] = r.own_law.slope * (t_C[r.own] - r.reference_C);
     const double lag_K = dt_dt_K_per_s[r.own] * p.time_constant_s;

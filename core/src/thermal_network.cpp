@@ -8,7 +8,7 @@
 namespace rpem::core {
 namespace {
 
-// The loss forms (docs/derivations.md §12, "Losses"): B ∝ |ψ_s| at a given geometry, f ∝ |ω|.
+// The loss forms (docs/derivations.md §14, "Losses"): B ∝ |ψ_s| at a given geometry, f ∝ |ω|.
 double hysteresis(const LossPoint& p) noexcept { return p.f_rel * p.psi_rel * p.psi_rel; }
 double eddy(const LossPoint& p) noexcept { return p.f_rel * p.f_rel * p.psi_rel * p.psi_rel; }
 double magnet_eddy(const LossPoint& p) noexcept { return p.f_rel * p.f_rel * p.i_rel * p.i_rel; }
@@ -55,7 +55,7 @@ ThermalLoad LossAccumulator::take() noexcept {
 }
 
 ThermalRates thermal_rates(const ThermalNetwork& n, const ThermalLoad& l) noexcept {
-  // Copper (eq. 12.2): (3/2)·R_ref·(1 + α·(T_w − T_ref))·i² = a + b·T_w.
+  // Copper (eq. 14.2): (3/2)·R_ref·(1 + α·(T_w − T_ref))·i² = a + b·T_w.
   const DriftLaw& r = n.copper;
   const double copper_per_K = n.copper_scale * 1.5 * l.current_sq_A2 * r.value_ref * r.coeff_per_K;
   const double copper_at_0C = n.copper_scale * 1.5 * l.current_sq_A2 * r.value_ref * (1.0 - r.coeff_per_K * r.reference_C);

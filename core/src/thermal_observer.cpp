@@ -43,12 +43,12 @@ void ThermalObserver::add_parameter(int j, const Estimate& e, double dt_s) noexc
     return;
   }
   settled_[jj] += a;
-  // κ (eq. 12.6): zero when the other parameter adapted too (their joint equilibrium has no bias).
+  // κ (eq. 14.6): zero when the other parameter adapted too (their joint equilibrium has no bias).
   const bool other_adapting = (d.flags & flag[1 - jj]) != 0;
   const double kappa_pu = other_adapting ? 0.0 : l.dot(d.gradient.col(o)) / a;
   const double base_j = j == kPsiM ? base_.flux_Wb : base_.impedance_Ohm;
   const double base_o = j == kPsiM ? base_.impedance_Ohm : base_.flux_Wb;
-  // σ² (eq. 12.7, 12.8), pu, then SI.
+  // σ² (eq. 14.7, 14.8), pu, then SI.
   const double noise = (l * eps_cov_ * l.transpose())(0, 0) / (a * (2.0 - a));
   const double l2 = l.squaredNorm();
   const Vec2 eps_perp = l2 > 0.0 ? Vec2(eps_mean_ - (l.dot(eps_mean_) / l2) * l.transpose()) : eps_mean_;
@@ -69,7 +69,7 @@ bool ThermalObserver::add(const Estimate& e, const ThermalSample& s) noexcept {
   const double coolant = std::isfinite(s.coolant_C) ? s.coolant_C : coolant_C_;
   const Vec2 i = e.i_meas_A;
   const double omega = base_.omega_el_rad_s_of(e.speed_pu);
-  // The stator flux linkage of the dq model with the current ψ̂m (docs/derivations.md §12, "Losses").
+  // The stator flux linkage of the dq model with the current ψ̂m (docs/derivations.md §14, "Losses").
   const Vec2 psi(e.psi_m_Wb + machine_.l_d_H * i[0], machine_.l_q_H * i[1]);
   if (all_finite(i, omega, psi, coolant)) losses_.add(loss_base_, dt, i, omega, psi, coolant);
   if (std::isfinite(s.winding_sensor_C)) {

@@ -17,10 +17,12 @@
 #include "rpem/estimate_t.hpp"
 #include "rpem/io/machine_config.hpp"
 #include "rpem/measurement_t.hpp"
+#include "rpem/mirror/diagnostics_t.hpp"
+#include "rpem/schema/field.hpp"
 
 namespace rpem::daemon {
 
-struct Publisher::Lcm {
+struct PersistingPublisher::Lcm {
   explicit Lcm(const std::string& url) : lcm(url) {}
   lcm::LCM lcm;
 };
@@ -34,8 +36,6 @@ constexpr std::array<CounterRow<PublisherCounters>, 3> kPublisherRows{{
     {&PublisherCounters::state_writes, &Diag::state_writes},
     {&PublisherCounters::state_write_failures, &Diag::state_write_failures},
 }};
-
-std::int64_t unix_us() { return core::now_ns(CLOCK_REALTIME) / 1000; }
 
 /// After a parameter's value on the status line: "*" adapting, " held N s" held since its last
 /// adaptation; "?" when not valid.
@@ -59,23 +59,24 @@ std::int64_t publisher_idle_ns(const LcmConfig& lcm) noexcept {
   return std::clamp(static_cast<std::int64_t>(std::llround(0.5e9 / fastest_Hz)), kMinNs, kMaxNs);
 }
 
-Publisher::Publisher(const FixedConfig& config, Identity identity, Queues queues, std::optional<auth::Key> publish_key)
+PersistingPublisher::PersistingPublisher(const FixedConfig& config, Identity identity, Queues queues,
+                                         std::optional<auth::Key> publish_key)
     : config_(config),
       identity_(std::move(identity)),
-      publish_key_(publish_key),
-      queues_(queues),
+      publish_key_(std::move(publish_key)),
+      queues_(std::move(queues)),
       buffer_(8192),
       estimate_channel_(config.lcm.channel_prefix + "RPEM_ESTIMATE"),
       measurement_channel_(config.lcm.channel_prefix + "RPEM_MEASUREMENT"),
       diagnostics_channel_(config.lcm.channel_prefix + "RPEM_DIAGNOSTICS"),
       state_path_(resolve_state_file(config.state)) {}
 
-Publisher::~Publisher() = default;
+PersistingPublisher::~PersistingPublisher() = default;
 
 template <class Message>
-void Publisher::publish(const std::string& channel, Message& m) {
+void PersistingPublisher::publish(const std::string& channel, Message& m) {
   constexpr bool kAuthenticated = requires { m.key_id; };
-  if constexpr (kAuthenticated) m.key_id = publish_key_ ? publish_key_->id : 0;
+  if constexpr (kAuthenticated) m.key_id = publish_key_ ? publish_key_->id() : 0;
   const int size = m.encode(buffer_.data(), 0, static_cast<int>(buffer_.size()));
   // Signed in the buffer, on this thread: the tag over the encoding (rpem/auth/mac.hpp), no allocation.
   if constexpr (kAuthenticated) {
@@ -87,60 +88,34 @@ void Publisher::publish(const std::string& channel, Message& m) {
   }
 }
 
-void Publisher::publish_estimate(const EstimateReport& r) {
+// Every field of the mirror, generically (rpem/schema/field.hpp); the strings, which the mirror does not
+// carry, by hand: a new string field fails the static_assert until it is spelled here.
+void PersistingPublisher::publish_estimate(const EstimateReport& r) {
   rpem::estimate_t m{};
-  m.utime = r.utime_us;
-  m.sample_time_us = r.sample_time_us;
-  m.samples = r.samples;
-  m.psi_m_Wb = r.psi_m_Wb;
-  m.r_s_Ohm = r.r_s_Ohm;
-  m.psi_m_pu = r.psi_m_pu;
-  m.r_s_pu = r.r_s_pu;
-  m.t_magnet_C = r.t_magnet_C;
-  m.t_winding_C = r.t_winding_C;
-  m.speed_pu = r.speed_pu;
-  m.psi_m_valid = r.psi_m_valid;
-  m.r_s_valid = r.r_s_valid;
-  m.psi_m_converged = r.psi_m_converged;
-  m.r_s_converged = r.r_s_converged;
-  m.psi_m_adapting = r.psi_m_adapting;
-  m.r_s_adapting = r.r_s_adapting;
-  m.psi_m_age_s = r.psi_m_age_s;
-  m.r_s_age_s = r.r_s_age_s;
-  m.frozen = r.frozen;
-  m.state = static_cast<std::int8_t>(r.state);
+  schema::copy(r, m);
+  static_assert(schema::spelled_count<rpem::estimate_t>() == 1, "estimate_t's strings: algorithm");
   m.algorithm = io::to_string(r.algorithm);
   const std::int64_t failures = counters_.publish_failures;
   publish(estimate_channel_, m);
   if (counters_.publish_failures == failures && r.newest_rx_ns > 0) {
-    const double us = 1e-3 * static_cast<double>(unix_us() * 1000 - r.newest_rx_ns);
+    const double us = 1e-3 * static_cast<double>(core::unix_us() * 1000 - r.newest_rx_ns);
     rx_to_publish_.add(us);
     rx_to_publish_run_.add(us);
   }
 }
 
-void Publisher::publish_measurement(const MeasurementReport& r) {
+void PersistingPublisher::publish_measurement(const MeasurementReport& r) {
   rpem::measurement_t m{};
-  m.utime = r.utime_us;
-  m.sample_time_us = r.sample_time_us;
-  m.theta_el_rad = r.theta_el_rad;
-  m.omega_el_rad_s = r.omega_el_rad_s;
-  m.u_dc_V = r.u_dc_V;
-  m.i_d_A = r.i_d_A;
-  m.i_q_A = r.i_q_A;
-  m.i_hat_d_A = r.i_hat_d_A;
-  m.i_hat_q_A = r.i_hat_q_A;
-  m.epsilon_d_A = r.eps_d_A;
-  m.epsilon_q_A = r.eps_q_A;
-  m.t_winding_sensor_C = r.t_winding_sensor_C;
-  m.t_drive_sensor_C = r.t_drive_sensor_C;
+  schema::copy(r, m);
+  static_assert(schema::spelled_count<rpem::measurement_t>() == 0);
   publish(measurement_channel_, m);
 }
 
-void Publisher::publish_diagnostics(const LoopStatsReport& r) {
+void PersistingPublisher::publish_diagnostics(const LoopStatsReport& r) {
   rpem::diagnostics_t m{};
   m.utime = r.utime_us;
   m.state = static_cast<std::int8_t>(r.state);
+  static_assert(schema::spelled_count<rpem::diagnostics_t>() == 2, "diagnostics_t's strings: source, source_name");
   m.source = identity_.source_type;
   m.source_name = identity_.source_name;
   // Every counter and figure, from the thread that owns it.
@@ -163,14 +138,14 @@ void Publisher::publish_diagnostics(const LoopStatsReport& r) {
   publish(diagnostics_channel_, m);
 }
 
-void Publisher::maybe_write_state(bool force) {
+void PersistingPublisher::maybe_write_state(bool force) {
   if (!have_estimate_) return;
   const EstimateReport& r = last_estimate_;
   if (!r.has_good_psi_m && !r.has_good_r_s) return;
   const std::int64_t now_s = std::time(nullptr);
   if (!force && now_s < next_state_write_s_) return;
   next_state_write_s_ = now_s + static_cast<std::int64_t>(config_.state.write_interval_s);
-  const double report_s = 1e-6 * static_cast<double>(r.utime_us);
+  const double report_s = 1e-6 * static_cast<double>(r.utime);
   PersistedEstimates e;
   e.written_unix_s = now_s;
   if (r.has_good_psi_m) {
@@ -190,9 +165,9 @@ void Publisher::maybe_write_state(bool force) {
   }
 }
 
-void Publisher::print_status(const EstimateReport& r) {
-  if (config_.status_interval_s <= 0.0 || r.utime_us < next_status_us_) return;
-  next_status_us_ = r.utime_us + static_cast<std::int64_t>(config_.status_interval_s * 1e6);
+void PersistingPublisher::print_status(const EstimateReport& r) {
+  if (config_.status_interval_s <= 0.0 || r.utime < next_status_us_) return;
+  next_status_us_ = r.utime + static_cast<std::int64_t>(config_.status_interval_s * 1e6);
   static const char* kStates[] = {"starting", "running", "STALE", "stopping"};
   char truth[96] = "";
   if (source_.has_truth) {
@@ -216,9 +191,9 @@ void Publisher::print_status(const EstimateReport& r) {
   std::fflush(stdout);
 }
 
-void Publisher::connect() {
+void PersistingPublisher::connect() {
   if (lcm_ && lcm_->lcm.good()) return;
-  const std::int64_t now = unix_us();
+  const std::int64_t now = core::unix_us();
   if (now < next_connect_us_) return;
   next_connect_us_ = now + 1'000'000;
   lcm_ = std::make_unique<Lcm>(config_.lcm.url);
@@ -228,14 +203,14 @@ void Publisher::connect() {
   }
 }
 
-void Publisher::drain_reports() {
+void PersistingPublisher::drain_reports() {
   SourceReport s;
   while (queues_.source.pop(s)) source_ = s;
   ControlReport c;
   while (queues_.control.pop(c)) control_ = c;
 }
 
-void Publisher::run(const std::atomic<bool>& stop) {
+void PersistingPublisher::run(const std::atomic<bool>& stop) {
   name_thread("rpemd-publish");
   (void)apply_thread_policy(config_.loop.realtime == RealtimeMode::kOff ? ThreadPolicy{} : config_.publish_thread);
   connect();

@@ -2,6 +2,7 @@
 
 #include <limits>
 
+#include "rpem/core/clock.hpp"
 #include "rpem/io/errors.hpp"
 #include "rpem/io/number_format.hpp"
 
@@ -14,7 +15,10 @@ EstimateLogWriter::EstimateLogWriter(const std::string& path, const std::vector<
           "psi_m_active,r_s_active,code,flags,sga_r_psi_m,sga_r_r_s,gna_det_R";
   if (!thermal_nodes.empty()) {
     out_ << ",T_magnet_rpem,T_winding_rpem,T_coolant";
-    for (const std::string& n : thermal_nodes) out_ << ",T_" << n << ",sigma_" << n << ",observed_" << n << ",age_" << n;
+    // Per node RPEM_ESTIMATE's columns (rpem listen's CSV names them so for the magnet and the winding).
+    for (const std::string& n : thermal_nodes) {
+      out_ << ",T_" << n << ",t_" << n << "_fused_sd_C,t_" << n << "_source,t_" << n << "_observed_age_s";
+    }
   }
   out_ << '\n';
 }
@@ -23,7 +27,7 @@ void EstimateLogWriter::write(const core::Estimate& e, const core::RpemEstimator
   const auto& d = e.detail;
   const auto& st = core.state();
   line_.clear();
-  append_number(line_, 1e-9 * static_cast<double>(e.t_ns));
+  append_number(line_, core::to_seconds(e.t_ns));
   for (double v : {e.psi_m_Wb, e.r_s_Ohm, d.theta_pu[core::kPsiM], d.theta_pu[core::kRs], e.epsilon_A[0],
                    e.epsilon_A[1], e.i_hat_A[0], e.i_hat_A[1], e.i_meas_A[0], e.i_meas_A[1], e.speed_pu}) {
     append_number(line_ += ',', v);
@@ -39,15 +43,17 @@ void EstimateLogWriter::write(const core::Estimate& e, const core::RpemEstimator
     // Before the filter's first step: nan (not yet estimated).
     constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
     const bool on = thermal != nullptr && thermal->started;
+    static const core::ThermalEstimate kNotStarted{};
     for (double v : {on ? thermal->t_magnet_rpem_C : kNaN, on ? thermal->t_winding_rpem_C : kNaN, on ? thermal->coolant_C : kNaN}) {
       append_number(line_ += ',', v);
     }
     for (std::size_t i = 0; i < thermal_nodes_; ++i) {
-      const core::ThermalNodeEstimate* n = on ? &thermal->node[i] : nullptr;
-      append_number(line_ += ',', n ? n->t_C : kNaN);
-      append_number(line_ += ',', n ? n->sigma_K : kNaN);
-      line_ += n && n->observed ? ",1" : ",0";
-      append_number(line_ += ',', n ? n->age_s : kNaN);
+      const core::ThermalNodeReport n = core::report_node(on ? *thermal : kNotStarted, static_cast<int>(i), e.t_ns);
+      append_number(line_ += ',', n.t_C);
+      append_number(line_ += ',', n.sd_K);
+      line_ += static_cast<char>(',');
+      line_ += static_cast<char>('0' + n.source);
+      append_number(line_ += ',', n.observed_age_s);
     }
   }
   line_ += '\n';

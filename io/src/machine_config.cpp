@@ -153,10 +153,10 @@ std::array<std::pair<const char*, double*>, 4> harmonic_fields(core::FluxHarmoni
 }
 
 core::InductanceCurve parse_inductance_curve(YamlMap m) {
-  core::InductanceCurve c;
-  c.level = m.number_or("level", 1.0, 0.05, 20.0);
-  c.curvature_per_A2 = m.number_or("curvature_per_A2", 0.0, -1e3, 1e3);
-  c.slope_per_A = m.number_or("slope_per_A", 0.0, -1e3, 1e3);
+  core::InductanceCurve c;  // a key left out keeps the nominal curve's value
+  c.level = m.number_or("level", c.level, 0.05, 20.0);
+  c.curvature_per_A2 = m.number_or("curvature_per_A2", c.curvature_per_A2, -1e3, 1e3);
+  c.slope_per_A = m.number_or("slope_per_A", c.slope_per_A, -1e3, 1e3);
   m.finish();
   return c;
 }
@@ -167,8 +167,8 @@ ParameterDrift parse_drift(YamlMap m, const char* ref_key, double ref_min, doubl
   if (m.has("coeff_per_K")) {
     core::DriftLaw law;
     law.coeff_per_K = m.number("coeff_per_K", -0.1, 0.1);
-    law.reference_C = m.number_or("reference_C", 20.0, -273.0, 500.0);
-    law.value_ref = m.number_or(ref_key, 0.0, ref_min, ref_max);
+    law.reference_C = m.number_or("reference_C", law.reference_C, -273.0, 500.0);
+    law.value_ref = m.number_or(ref_key, law.value_ref, ref_min, ref_max);
     d.law = law;
   } else {
     for (const char* key : {"reference_C", ref_key}) {
@@ -182,11 +182,12 @@ ParameterDrift parse_drift(YamlMap m, const char* ref_key, double ref_min, doubl
 
 void parse_extensions(YamlMap x, MachineConfig& config) {
   core::ModelExtensions& c = config.estimator.extensions;
+  const core::ModelExtensions nominal;  // a key left out: its value in the nominal model
   if (auto d = x.optional_map("deadtime")) {
-    c.deadtime_t_dead_s = d->number_or("t_dead_s", 0.0, 0.0, 1e-3);
-    c.switching_frequency_Hz = d->number_or("switching_frequency_Hz", 0.0, 0.0, 1e6);
-    c.deadtime_v_err_V = d->number_or("v_err_V", 0.0, -1e4, 1e4);
-    c.deadtime_current_band_A = d->number_or("current_band_A", 0.0, 0.0, 1e4);
+    c.deadtime_t_dead_s = d->number_or("t_dead_s", nominal.deadtime_t_dead_s, 0.0, 1e-3);
+    c.switching_frequency_Hz = d->number_or("switching_frequency_Hz", nominal.switching_frequency_Hz, 0.0, 1e6);
+    c.deadtime_v_err_V = d->number_or("v_err_V", nominal.deadtime_v_err_V, -1e4, 1e4);
+    c.deadtime_current_band_A = d->number_or("current_band_A", nominal.deadtime_current_band_A, 0.0, 1e4);
     if (c.deadtime_t_dead_s > 0.0 && c.switching_frequency_Hz <= 0.0) {
       d->fail("switching_frequency_Hz", "t_dead_s needs the switching frequency");
     }
@@ -219,14 +220,15 @@ void parse_extensions(YamlMap x, MachineConfig& config) {
     d->finish();
   }
   if (auto k = x.optional_map("cross_saturation")) {
-    c.cross_coupling_H_per_A = k->number_or("coupling_H_per_A", 0.0, -10.0, 10.0);
-    c.cross_coupling_H_per_A2 = k->number_or("coupling_H_per_A2", 0.0, -10.0, 10.0);
+    c.cross_coupling_H_per_A = k->number_or("coupling_H_per_A", nominal.cross_coupling_H_per_A, -10.0, 10.0);
+    c.cross_coupling_H_per_A2 = k->number_or("coupling_H_per_A2", nominal.cross_coupling_H_per_A2, -10.0, 10.0);
     k->finish();
   }
   for (std::size_t j = 0; j < core::kFluxHarmonicOrders.size(); ++j) {
     if (auto h = x.optional_map(harmonic_key(j))) {
       core::FluxHarmonic& f = c.flux_harmonics[j];
-      for (auto [key, value] : harmonic_fields(f)) *value = h->number_or(key, 0.0, -100.0, 100.0);
+      f = nominal.flux_harmonics[j];
+      for (auto [key, value] : harmonic_fields(f)) *value = h->number_or(key, *value, -100.0, 100.0);
       h->finish();
     }
   }

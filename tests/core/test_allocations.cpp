@@ -14,6 +14,7 @@
 #include "support/averaged_data.hpp"
 #include "support/model_data.hpp"
 #include "support/paper_machine.hpp"
+#include "support/paper_thermal.hpp"
 
 namespace {
 std::atomic<long> g_allocations{0};
@@ -150,26 +151,7 @@ TEST(ThermalAllocations, NoneAcrossOneHundredThousandFusedSteps) {
   // coasting without samples, a reload and a non-finite sample.
   const MachineSi machine = test::paper_machine_si();
   AveragedDriveEstimator est(machine, test::paper_settings());
-  ThermalFusionConfig c;
-  ThermalNetwork& n = c.filter.network;
-  n.nodes = 3;
-  n.winding = 0, n.magnet = 2;
-  n.capacitance_J_per_K << 3000.0, 12000.0, 7000.0, 1.0;
-  n.to_coolant_W_per_K << 2.0, 90.0, 4.0, 0.0;
-  n.between_W_per_K(0, 1) = n.between_W_per_K(1, 0) = 40.0;
-  n.between_W_per_K(1, 2) = n.between_W_per_K(2, 1) = 12.0;
-  n.copper = {0.00393, 20.0, 2.25};
-  n.base = loss_base_of(test::paper_base(), machine);
-  n.loss_at_base_W(static_cast<int>(LossForm::kIronEddy), 1) = 100.0;
-  n.loss_at_base_W(static_cast<int>(LossForm::kMagnetEddy), 2) = 20.0;
-  c.filter.loss_rel_sigma.setConstant(0.5);
-  c.filter.process_noise_K2_per_s.setConstant(1e-3);
-  c.filter.disturbance_W2_per_s.setConstant(1.0);
-  c.filter.gate_sigma = 1.0;  // tight: gate resets happen
-  c.magnet_law = {-0.0012, 20.0, 1.14};
-  c.observer.period_s = 0.01;
-  c.observer.settle_time_constants = 1.0;
-  c.winding_sensor_sigma_K = 1.0;
+  const ThermalFusionConfig c = test::paper_thermal_fusion();
   ThermalFusion fusion(c, test::paper_base(), machine);
   test::AveragedDataGenerator gen;
   gen.base = test::paper_base();

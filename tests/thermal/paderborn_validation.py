@@ -18,6 +18,7 @@ as the figures measured, two-sided, so that a change in either direction is seen
 import argparse
 import json
 import os
+import re
 import sys
 
 from thermal_judge import Bounds, judge, print_table, read, run
@@ -60,6 +61,12 @@ def main() -> int:
               for node, column in (("magnet", "pm"), ("winding", "stator_winding"))}
     print_table(f"cool-down (t > {SPLIT_S:g} s, {result['magnet']['fused']['n']} rows) against pm and stator_winding:",
                 result, ("model", "rpem", "fused", "fused_with_sensor"))
+    # The figure (docs/thermal.md, "Figures"): measured pm only here, for the plot; its coverage is computed
+    # apart (interpolated at the measured times) and must agree with the table's.
+    run([sys.executable, conv, src, w("measured.csv"), "--pole-pairs", "4", "--averaged", "--coolant"])
+    fig_out = run([a.rpem, "figures", "--out", w("figures"), "--thermal-estimate", w("honest_est.csv"),
+                   "--measured", w("measured.csv"), "--judged-after-s", str(SPLIT_S)])
+    fig_cover = re.search(r"magnet ([0-9.]+) %, winding ([0-9.]+) %", fig_out)
     fit = json.load(open(w("fit/fit.json")))
     result["fit"] = {"signals": fit["signals"], "process_noise_K2_per_s": fit["process_noise_K2_per_s"]}
     if a.json:
@@ -81,6 +88,8 @@ def main() -> int:
     # What the fusion must never do: be worse than what it fuses.
     check("magnet: fused RMS minus RPEM alone [K]", m["fused"]["rms_K"] - m["rpem"]["rms_K"], -3.0, 0.3)
     check("winding: fused RMS minus the model alone, no sensor [K]", wd["fused"]["rms_K"] - wd["model"]["rms_K"], -60.0, 0.0)
+    check("figure's magnet 2σ coverage minus the table's", float(fig_cover.group(1)) / 100 - m["fused"]["cover_2sigma"], -0.01, 0.01)
+    check("figure's winding 2σ coverage minus the table's", float(fig_cover.group(2)) / 100 - wd["fused"]["cover_2sigma"], -0.01, 0.01)
     return bounds.exit_code()
 
 

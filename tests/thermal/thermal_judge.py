@@ -41,7 +41,7 @@ def judge(truth, truth_column, estimates, predictions, node, after_s):
            "rpem": stats([(float(first[k][f"T_{node}_rpem"]), T(k)) for k in judged])}
     for name, est in estimates.items():
         s = stats([(float(est[k][f"T_{node}"]), T(k)) for k in judged])
-        s["cover_2sigma"] = sum(abs(float(est[k][f"T_{node}"]) - T(k)) <= 2.0 * float(est[k][f"sigma_{node}"])
+        s["cover_2sigma"] = sum(abs(float(est[k][f"T_{node}"]) - T(k)) <= 2.0 * float(est[k][f"t_{node}_fused_sd_C"])
                                 for k in judged) / len(judged)
         out[name] = s
     return out

@@ -12,13 +12,14 @@
 #include "commands.hpp"
 #include "rpem/analysis/diagnose/diagnose_output.hpp"
 #include "rpem/io/errors.hpp"
+#include "rpem/io/number_format.hpp"
 
 namespace rpem::tools {
 namespace {
 
 struct DiagnoseCliOptions {
-  std::string log, config, out, truth, model = "auto";
-  double reference_C = 20.0;
+  std::string log, log_map, config, out, truth, model = "auto";
+  double reference_C = analysis::DiagnoseOptions{}.reference_C;
   double switching_frequency_Hz = 0.0;
   analysis::SelectionOptions selection;
   int blocks = 40;
@@ -39,11 +40,13 @@ int run_diagnose(const DiagnoseCliOptions& o) {
 
   analysis::LogOptions log_options;
   log_options.blocks = o.blocks;
+  log_options.log_map = o.log_map;
   if (o.model != "auto") {
     log_options.mode = o.model == "transient" ? analysis::ModelMode::kTransient : analysis::ModelMode::kSteadyState;
   }
   std::fprintf(stderr, "rpem diagnose: reading %s\n", o.log.c_str());
   analysis::LogData log = analysis::load_log(o.log, config.machine, log_options);
+  std::fprintf(stderr, "rpem diagnose: read %s\n", log.format.c_str());
   io::check_log_supports(config, config_name, log.layout.u_dc, o.log);
   const analysis::ParameterTrack truth = o.truth.empty() ? analysis::ParameterTrack{} : analysis::load_truth(o.truth);
 
@@ -108,7 +111,13 @@ Runner add_diagnose_command(CLI::App& app) {
   auto o = std::make_shared<DiagnoseCliOptions>();
   CLI::App* cmd = app.add_subcommand(
       "diagnose", "Show what the model gets wrong on measured data, name the cause, extend the model, measure the gain");
-  cmd->add_option("--log", o->log, "drive-log CSV (docs/drive-log.md)")->required()->check(CLI::ExistingFile);
+  cmd->add_option("--log", o->log,
+                  "drive log, averaged log or VESC Tool realtime log (detected by its header), or any CSV with --log-map "
+                  "(docs/drive-log.md)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--log-map", o->log_map, "column map (YAML) saying how to read --log (docs/drive-log.md, \"Column maps\")")
+      ->check(CLI::ExistingFile);
   cmd->add_option("--config", o->config,
                   "machine configuration YAML, the baseline: its whole model, extensions and drift laws (default: built-in "
                   "paper-ipmsm); an extended.yaml of another recording is one")
@@ -119,8 +128,9 @@ Runner add_diagnose_command(CLI::App& app) {
       ->check(CLI::ExistingFile);
   cmd->add_option("--model", o->model, "replay model: auto (from the sample interval), transient, steady_state")
       ->check(CLI::IsMember({"auto", "transient", "steady_state"}));
-  cmd->add_option("--reference-temperature-C", o->reference_C,
-                  "temperature to which found drift laws are referred (default 20)");
+  std::string reference_help = "temperature to which found drift laws are referred (default ";
+  io::append_number(reference_help, o->reference_C);
+  cmd->add_option("--reference-temperature-C", o->reference_C, reference_help + ")");
   cmd->add_option("--switching-frequency-Hz", o->switching_frequency_Hz,
                   "PWM frequency, to report dead time in seconds (default: model_extensions.deadtime's)")
       ->check(CLI::PositiveNumber);

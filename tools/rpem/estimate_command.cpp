@@ -1,9 +1,10 @@
-// rpem estimate --log LOG.csv --config CFG.yaml --out EST.csv [--algorithm sga|gna|phyint] [--every N]
-//               [--thermal THERMAL.yaml]
-// Runs the estimator offline over a drive log, exactly as rpemd would run it online: a phase-sample log
-// through DriveEstimator, an averaged log (a t_start column; docs/drive-log.md) through
-// AveragedDriveEstimator. With --thermal, the thermal network's filter runs beside it as in rpemd
-// (core::ThermalFusion, docs/thermal.md) and the estimate CSV gains the fused temperatures.
+// rpem estimate --log LOG.csv [--log-map MAP.yaml] --config CFG.yaml --out EST.csv [--algorithm sga|gna|phyint]
+//              [--every N] [--thermal THERMAL.yaml]
+// Runs the estimator offline over a drive log, exactly as rpemd would run it online: a log of instantaneous
+// samples through DriveEstimator, a log of averaged samples (our averaged log, VESC Tool's realtime log, a
+// map of averaged samples; docs/drive-log.md) through AveragedDriveEstimator. With --thermal, the thermal
+// network's filter runs beside it as in rpemd (core::ThermalFusion, docs/thermal.md) and the estimate CSV
+// gains the fused temperatures.
 
 #include <cstdio>
 #include <limits>
@@ -17,6 +18,7 @@
 #include "rpem/io/averaged_log.hpp"
 #include "rpem/io/drive_log.hpp"
 #include "rpem/io/estimate_log.hpp"
+#include "rpem/io/log_source.hpp"
 #include "rpem/io/machine_config.hpp"
 #include "rpem/io/thermal_config.hpp"
 
@@ -25,6 +27,7 @@ namespace {
 
 struct EstimateOptions {
   std::string log;
+  std::string log_map;
   std::string config;
   std::string out;
   std::string algorithm;
@@ -77,10 +80,13 @@ struct Tally {
   }
 };
 
-int run_averaged(const EstimateOptions& o, const io::MachineConfig& cfg, const std::string& config_name) {
-  io::AveragedLogLayout layout;
-  const std::vector<core::AveragedSample> samples = io::read_averaged_log(o.log, &layout);
-  io::check_averaged_supports(cfg, config_name, layout.u_dc, o.log);
+int run_averaged(const EstimateOptions& o, const io::LogSource& source, const io::MachineConfig& cfg,
+                 const std::string& config_name) {
+  io::AveragedLogRead read;
+  const std::vector<core::AveragedSample> samples =
+      io::read_averaged_log(o.log, source.map, io::machine_limits(cfg.machine), &read);
+  std::fprintf(stderr, "rpem estimate: %s\n", io::describe(source, read).c_str());
+  io::check_averaged_supports(cfg, config_name, read.layout.u_dc, o.log);
   core::AveragedDriveEstimator estimator(cfg.machine, cfg.estimator);
   ThermalRun thermal(o, cfg, estimator.base());
   io::EstimateLogWriter writer(o.out, thermal.node_names());
@@ -99,9 +105,11 @@ int run_estimate(const EstimateOptions& o) {
   io::MachineConfig cfg = o.config.empty() ? io::builtin_paper_config() : io::load_machine_config(o.config);
   if (!o.algorithm.empty()) cfg.estimator.algorithm = io::parse_algorithm(o.algorithm);
   const std::string config_name = o.config.empty() ? "builtin:paper-ipmsm" : o.config;
-  if (io::is_averaged_log(o.log)) return run_averaged(o, cfg, config_name);
+  const io::LogSource source = io::log_source(o.log, o.log_map);
+  if (source.averaged()) return run_averaged(o, source, cfg, config_name);
 
-  io::DriveLogReader reader(o.log, io::machine_limits(cfg.machine));
+  io::DriveLogReader reader(o.log, source.map, io::machine_limits(cfg.machine));
+  if (!source.map.columns_optional) std::fprintf(stderr, "rpem estimate: reading %s as %s\n", o.log.c_str(), source.format.c_str());
   io::check_log_supports(cfg, config_name, reader.layout().u_dc, o.log);
   core::DriveEstimator estimator(cfg.machine, cfg.estimator);
   ThermalRun thermal(o, cfg, estimator.base());
@@ -118,7 +126,7 @@ int run_estimate(const EstimateOptions& o) {
     tally.count(e);
     if ((tally.rows & 0xFFF) == 0) progress.update(reader.bytes_read(), reader.bytes_total());
   }
-  progress.finish(tally.summary(cfg.estimator.algorithm, "samples"));
+  progress.finish(tally.summary(cfg.estimator.algorithm, "samples") + io::describe(reader.reader().repairs()));
   return kExitOk;
 }
 
@@ -127,7 +135,13 @@ int run_estimate(const EstimateOptions& o) {
 Runner add_estimate_command(CLI::App& app) {
   auto opts = std::make_shared<EstimateOptions>();
   CLI::App* cmd = app.add_subcommand("estimate", "Run the RPEM estimator offline over a drive log");
-  cmd->add_option("--log", opts->log, "drive-log CSV, phase samples or averaged (docs/drive-log.md)")->required()->check(CLI::ExistingFile);
+  cmd->add_option("--log", opts->log,
+                  "drive log, averaged log or VESC Tool realtime log (detected by its header), or any CSV with --log-map "
+                  "(docs/drive-log.md)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--log-map", opts->log_map, "column map (YAML) saying how to read --log (docs/drive-log.md, \"Column maps\")")
+      ->check(CLI::ExistingFile);
   cmd->add_option("--config", opts->config, "machine and estimator YAML (default: built-in paper-ipmsm.yaml)")
       ->check(CLI::ExistingFile);
   cmd->add_option("--out", opts->out, "estimate CSV to write")->required();

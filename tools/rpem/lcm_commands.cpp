@@ -9,6 +9,7 @@
 // rpem keygen --id N --out FILE                            writes a new key file (mode 0600)
 // Keys: rpem/auth/key_file.hpp, docs/rpemd.md "Authentication".
 
+#include <array>
 #include <atomic>
 #include <chrono>
 #include <csignal>
@@ -18,6 +19,7 @@
 #include <iterator>
 #include <optional>
 #include <span>
+#include <string_view>
 #include <vector>
 #include <lcm/lcm-cpp.hpp>
 #include <thread>
@@ -26,8 +28,10 @@
 #include "rpem/auth/key_file.hpp"
 #include "rpem/command_t.hpp"
 #include "rpem/core/clock.hpp"
-#include "rpem/diagnostics_t.hpp"
-#include "rpem/estimate_t.hpp"
+#include "rpem/daemon/signal_map_source.hpp"
+#include "rpem/mirror/diagnostics_t.hpp"
+#include "rpem/mirror/estimate_t.hpp"
+#include "rpem/schema/text.hpp"
 
 namespace rpem::tools {
 namespace {
@@ -66,6 +70,34 @@ std::string authenticity(const auth::Keyring& keys, const lcm::ReceiveBuffer* rb
   return "unverified (malformed)";
 }
 
+// What `rpem listen` prints is every field of each message, as the schema prints it (rpem/schema/text.hpp),
+// after a head that shows some in its own words: a new field of a .lcm file reaches the line and the CSV
+// without code here.
+
+/// The fields the head of an estimate's line shows: each parameter with its status, then the temperatures.
+constexpr std::array<std::string_view, 16> kEstimateHead{
+    "sample_time_us", "state", "speed_pu", "psi_m_Wb", "psi_m_adapting", "psi_m_age_s", "psi_m_valid", "psi_m_converged",
+    "r_s_Ohm", "r_s_adapting", "r_s_age_s", "r_s_valid", "r_s_converged", "t_magnet_C", "t_winding_C", "algorithm"};
+static_assert(schema::has_fields<rpem::estimate_t>(kEstimateHead));
+/// A diagnostics line starts "diag UTIME:".
+constexpr std::array<std::string_view, 1> kDiagnosticsHead{"utime"};
+static_assert(schema::has_fields<rpem::diagnostics_t>(kDiagnosticsHead));
+
+/// A signal_map source's decoder counters in its own terms (SignalMapCounters, docs/sources.md "Counted"),
+/// which rpemd publishes in the can_* fields: printed as a line of their own for that source.
+struct SourceCounter {
+  std::string_view label;
+  std::int64_t rpem::diagnostics_t::*field;
+};
+constexpr std::array<SourceCounter, 6> kSignalMapCounters{{
+    {"frames", &rpem::diagnostics_t::can_frames},
+    {"unknown_id", &rpem::diagnostics_t::can_unknown_id},
+    {"wrong_length", &rpem::diagnostics_t::can_wrong_dlc},
+    {"incomplete", &rpem::diagnostics_t::can_incomplete},
+    {"non_finite", &rpem::diagnostics_t::can_invalid_value},
+    {"kernel_drops", &rpem::diagnostics_t::can_kernel_drops},
+}};
+
 struct Listener {
   std::ofstream csv;
   std::int64_t estimates = 0, diagnostics = 0;
@@ -93,18 +125,14 @@ struct Listener {
   void on_estimate(const lcm::ReceiveBuffer* rbuf, const std::string& channel, const rpem::estimate_t* m) {
     ++estimates;
     const std::string verdict = check(rbuf, channel);
-    std::printf("%.3f s  state %d  n %+.3f pu  psi_m %.5f Wb %s  r_s %.5f Ohm %s  T_magnet %.1f C  T_winding %.1f C  %s  %s\n",
+    std::printf("%.3f s  state %d  n %+.3f pu  psi_m %.5f Wb %s  r_s %.5f Ohm %s  T_magnet %.1f C  T_winding %.1f C  %s  %s | %s\n",
                 1e-6 * static_cast<double>(m->sample_time_us), m->state, m->speed_pu, m->psi_m_Wb,
                 describe(m->psi_m_adapting, m->psi_m_age_s, m->psi_m_valid, m->psi_m_converged).c_str(), m->r_s_Ohm,
                 describe(m->r_s_adapting, m->r_s_age_s, m->r_s_valid, m->r_s_converged).c_str(), m->t_magnet_C,
-                m->t_winding_C, m->algorithm.c_str(), verdict.c_str());
+                m->t_winding_C, m->algorithm.c_str(), verdict.c_str(), schema::format_fields(*m, kEstimateHead).c_str());
     std::fflush(stdout);
     if (csv.is_open()) {
-      csv << m->utime << ',' << m->sample_time_us << ',' << m->samples << ',' << m->psi_m_Wb << ',' << m->r_s_Ohm << ','
-          << m->t_magnet_C << ',' << m->t_winding_C << ',' << m->speed_pu << ',' << int(m->psi_m_valid) << ','
-          << int(m->r_s_valid) << ',' << int(m->psi_m_converged) << ',' << int(m->r_s_converged) << ','
-          << int(m->psi_m_adapting) << ',' << int(m->r_s_adapting) << ',' << int(m->frozen) << ',' << int(m->state) << ','
-          << m->psi_m_age_s << ',' << m->r_s_age_s << ',' << verdict.substr(0, verdict.find(' ')) << '\n';
+      csv << schema::csv_row(*m) << ',' << verdict.substr(0, verdict.find(' ')) << '\n';
       csv.flush();
     }
   }
@@ -112,49 +140,12 @@ struct Listener {
     ++diagnostics;
     const std::string verdict = check(rbuf, channel);
     if (!print_diagnostics) return;
-    std::printf("diag %lld: state %d samples %lld resyncs %lld overruns %lld latency p99 %.1f us max %.1f us | rx->publish p99 %.0f us | can frames %lld "
-                "lost %lld crc %lld dlc %lld unknown %lld gaps %lld kernel drops %lld reopens %lld | queue drops in %lld "
-                "out %lld | publish failures %lld | commands %lld malformed %lld rejected %lld last %lld:%d | applied %lld "
-                "sequence errors %lld | unauthenticated %lld unknown key %lld bad mac %lld replayed %lld | reload requests %lld "
-                "reloads %lld invalid %lld restart required %lld busy %lld | state file %d | %s\n",
-                static_cast<long long>(m->utime), static_cast<int>(m->state), static_cast<long long>(m->samples),
-                static_cast<long long>(m->resyncs),
-                static_cast<long long>(m->overruns), m->wakeup_latency_p99_us, m->wakeup_latency_max_us,
-                m->rx_to_publish_p99_us,
-                static_cast<long long>(m->can_frames), static_cast<long long>(m->can_frames_lost),
-                static_cast<long long>(m->can_crc_error), static_cast<long long>(m->can_wrong_dlc),
-                static_cast<long long>(m->can_unknown_id), static_cast<long long>(m->can_gaps),
-                static_cast<long long>(m->can_kernel_drops), static_cast<long long>(m->can_reopens),
-                static_cast<long long>(m->input_queue_drops), static_cast<long long>(m->output_queue_drops),
-                static_cast<long long>(m->publish_failures), static_cast<long long>(m->commands_received),
-                static_cast<long long>(m->commands_malformed), static_cast<long long>(m->commands_rejected),
-                static_cast<long long>(m->last_command_seq), m->last_command_result,
-                static_cast<long long>(m->commands_applied), static_cast<long long>(m->command_sequence_errors),
-                static_cast<long long>(m->commands_unauthenticated), static_cast<long long>(m->commands_unknown_key),
-                static_cast<long long>(m->commands_bad_mac), static_cast<long long>(m->commands_replayed),
-                static_cast<long long>(m->config_reload_requests), static_cast<long long>(m->config_reloads),
-                static_cast<long long>(m->config_reloads_invalid), static_cast<long long>(m->config_reloads_restart_required),
-                static_cast<long long>(m->config_reloads_busy), m->state_file_status, verdict.c_str());
-    if (m->source == "vesc") {
-      std::printf("diag %lld vesc: polls %lld replies %lld timeouts %lld late %lld unrequested %lld stolen_reads %lld "
-                  "short_windows %lld empty_reads %lld long_windows %lld buffer_errors %lld bad_replies %lld short_replies %lld statuses %lld "
-                  "send_failures %lld foreign %lld\n",
-                  static_cast<long long>(m->utime), static_cast<long long>(m->vesc_polls),
-                  static_cast<long long>(m->vesc_replies), static_cast<long long>(m->vesc_timeouts),
-                  static_cast<long long>(m->vesc_late_replies), static_cast<long long>(m->vesc_unrequested_replies),
-                  static_cast<long long>(m->vesc_stolen_reads), static_cast<long long>(m->vesc_short_windows),
-                  static_cast<long long>(m->vesc_empty_reads), static_cast<long long>(m->vesc_long_windows),
-                  static_cast<long long>(m->vesc_buffer_errors), static_cast<long long>(m->vesc_bad_replies),
-                  static_cast<long long>(m->vesc_short_replies), static_cast<long long>(m->vesc_statuses),
-                  static_cast<long long>(m->vesc_send_failures), static_cast<long long>(m->can_foreign));
-    }
-    if (m->source == "signal_map") {  // the map decoder's counters (docs/sources.md, "Counted")
-      std::printf("diag %lld signal_map: frames %lld unknown_id %lld wrong_length %lld incomplete %lld non_finite %lld "
-                  "kernel_drops %lld\n",
-                  static_cast<long long>(m->utime), static_cast<long long>(m->can_frames),
-                  static_cast<long long>(m->can_unknown_id), static_cast<long long>(m->can_wrong_dlc),
-                  static_cast<long long>(m->can_incomplete), static_cast<long long>(m->can_invalid_value),
-                  static_cast<long long>(m->can_kernel_drops));
+    const auto utime = static_cast<long long>(m->utime);
+    std::printf("diag %lld: %s | %s\n", utime, schema::format_fields(*m, kDiagnosticsHead).c_str(), verdict.c_str());
+    if (m->source == daemon::SignalMapSource::kType) {
+      std::string counters;
+      for (const SourceCounter& c : kSignalMapCounters) counters += " " + std::string(c.label) + " " + std::to_string(m->*c.field);
+      std::printf("diag %lld %s:%s\n", utime, daemon::SignalMapSource::kType, counters.c_str());
     }
     std::fflush(stdout);
   }
@@ -176,8 +167,7 @@ int run_listen(const ListenOptions& o) {
   }
   if (!o.csv.empty()) {
     listener.csv.open(o.csv, std::ios::trunc);
-    listener.csv << "utime,sample_time_us,samples,psi_m,r_s,T_magnet,T_winding,n_pu,psi_m_valid,r_s_valid,"
-                    "psi_m_converged,r_s_converged,psi_m_adapting,r_s_adapting,frozen,state,psi_m_age_s,r_s_age_s,auth\n";
+    listener.csv << schema::csv_header<rpem::estimate_t>() << ",auth\n";
   }
   lcm.subscribe(o.prefix + "RPEM_ESTIMATE", &Listener::on_estimate, &listener);
   lcm.subscribe(o.prefix + "RPEM_DIAGNOSTICS", &Listener::on_diagnostics, &listener);
@@ -211,7 +201,7 @@ struct CommandOptions {
 /// Encodes `m` (key id from `key`, or 0) and signs it for `channel`.
 template <class Message>
 std::vector<std::uint8_t> encode_signed(Message& m, const std::optional<auth::Key>& key, const std::string& channel) {
-  m.key_id = key ? key->id : 0;
+  m.key_id = key ? key->id() : 0;
   std::vector<std::uint8_t> bytes(static_cast<std::size_t>(m.getEncodedSize()));
   m.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
   if (key) auth::sign(*key, channel, bytes);
@@ -269,7 +259,7 @@ int run_command(const CommandOptions& o) {
   const std::int64_t start_ns = core::now_ns(CLOCK_MONOTONIC);
   for (std::int64_t k = 0; k < o.repeat; ++k) {
     if (k > 0) core::sleep_until_ns(CLOCK_MONOTONIC, start_ns + k * period_ns);
-    m.utime = core::now_ns(CLOCK_REALTIME) / 1000;
+    m.utime = core::unix_us();
     m.seq = o.seq + k;
     const std::vector<std::uint8_t> bytes = encode_signed(m, key, channel);
     if (lcm.publish(channel, bytes.data(), static_cast<unsigned>(bytes.size())) != 0) {
@@ -349,7 +339,7 @@ Runner add_publish_estimate_command(CLI::App& app) {
       return kExitConfig;
     }
     rpem::estimate_t m{};
-    m.utime = core::now_ns(CLOCK_REALTIME) / 1000;
+    m.utime = core::unix_us();
     m.psi_m_Wb = opts->psi_m_Wb;
     m.r_s_Ohm = opts->r_s_Ohm;
     m.psi_m_valid = m.r_s_valid = true;

@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "commands.hpp"
+#include "rpem/auth/key.hpp"
 #include "rpem/io/errors.hpp"
 
 int main(int argc, char** argv) {
@@ -31,6 +32,7 @@ int main(int argc, char** argv) {
     return code == 0 ? kExitOk : kExitUsage;
   }
   try {
+    rpem::auth::initialise();  // libsodium, once, before any key exists
     for (const Runner& run : runners) {
       const int code = run();
       if (code >= 0) return code;

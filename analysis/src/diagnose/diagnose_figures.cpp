@@ -9,7 +9,9 @@
 
 #include "rpem/analysis/diagnose/diagnose_output.hpp"
 #include "rpem/analysis/gnuplot.hpp"
+#include "rpem/core/clock.hpp"
 #include "rpem/core/conditioner.hpp"
+#include "rpem/core/units.hpp"
 
 namespace rpem::analysis {
 namespace {
@@ -28,7 +30,7 @@ std::vector<SampleView> operating_points(const Diagnosis& d) {
   for (std::size_t k = 0; k < d.log->rows.size(); ++k) {
     const core::DriveSample& s = d.log->rows[k].sample;
     const core::Vec2& i = d.log->logged_i_dq_A[k];
-    v.push_back({1e-9 * static_cast<double>(s.t_ns), s.omega_el_rad_s * 60.0 / (2.0 * core::kPi * d.context.machine.rated.pole_pairs),
+    v.push_back({core::to_seconds(s.t_ns), core::rad_s_to_rpm(s.omega_el_rad_s) / d.context.machine.rated.pole_pairs,
                  i[0], i[1]});
   }
   return v;

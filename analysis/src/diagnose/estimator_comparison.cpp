@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "rpem/core/clock.hpp"
 #include "rpem/core/drive_estimator.hpp"
 #include "rpem/io/csv_table.hpp"
 
@@ -56,7 +57,7 @@ ParameterTrack run_rpem(const LogData& log, const io::MachineConfig& config) {
   const std::size_t every = std::max<std::size_t>(1, log.rows.size() / kTrackPoints);
   for (std::size_t k = 0; k < log.rows.size(); ++k) {
     const core::Estimate e = estimator.step(log.rows[k].sample);
-    if (k % every == 0) track.add(1e-9 * static_cast<double>(e.t_ns), e.psi_m_Wb, e.r_s_Ohm);
+    if (k % every == 0) track.add(core::to_seconds(e.t_ns), e.psi_m_Wb, e.r_s_Ohm);
   }
   return track;
 }
@@ -75,7 +76,7 @@ void steady_state_tracks(const LogData& log, const EffectContext& context, const
     const double r_model = r_s_at(model, log, k), psi_model = psi_m_at(model, log, k);
     const double r_implied = (in.u_pu[0] + in.n_pu * in.x_q_pu * in.i_pu[1]) / in.i_pu[0];
     const double psi_implied = (in.u_pu[1] - base.resistance_pu(r_model) * in.i_pu[1]) / in.n_pu - in.x_d_pu * in.i_pu[0];
-    const double t = 1e-9 * static_cast<double>(row.sample.t_ns);
+    const double t = core::to_seconds(row.sample.t_ns);
     c.truth.add(t, base.flux_Wb_of(psi_implied), base.resistance_Ohm_of(r_implied));
     c.nominal.add(t, psi_m_at(context.base, log, k), r_s_at(context.base, log, k));
     c.extended.add(t, psi_model, r_model);

@@ -3,9 +3,11 @@
 #include <algorithm>
 #include <cmath>
 
+#include "rpem/core/clock.hpp"
 #include "rpem/core/conditioner.hpp"
 #include "rpem/core/frames.hpp"
 #include "rpem/io/averaged_log.hpp"
+#include "rpem/io/log_source.hpp"
 #include "rpem/io/machine_config.hpp"
 
 namespace rpem::analysis {
@@ -40,12 +42,12 @@ LogData prepare_log(std::vector<io::DriveLogRow> rows, const io::DriveLogLayout&
     throw io::DriveLogError(path, n + 1, 0, "", "a log to diagnose needs at least " +
                                                     std::to_string(2 * std::max(2, options.blocks)) + " rows");
   }
-  d.t_start_s = 1e-9 * static_cast<double>(d.rows.front().sample.t_ns);
-  d.t_end_s = 1e-9 * static_cast<double>(d.rows.back().sample.t_ns);
+  d.t_start_s = core::to_seconds(d.rows.front().sample.t_ns);
+  d.t_end_s = core::to_seconds(d.rows.back().sample.t_ns);
 
   std::vector<double> dts;
   dts.reserve(n - 1);
-  for (std::size_t k = 1; k < n; ++k) dts.push_back(1e-9 * static_cast<double>(d.rows[k].sample.t_ns - d.rows[k - 1].sample.t_ns));
+  for (std::size_t k = 1; k < n; ++k) dts.push_back(core::to_seconds(d.rows[k].sample.t_ns - d.rows[k - 1].sample.t_ns));
   d.median_dt_s = median(dts);
 
   // The measured current's amplitude, the same in every frame (amplitude-invariant).
@@ -83,7 +85,7 @@ LogData prepare_log(std::vector<io::DriveLogRow> rows, const io::DriveLogLayout&
     const std::size_t w = static_cast<std::size_t>(options.speed_half_window);
     for (std::size_t k = w; k + w < n; ++k) {
       const core::DriveSample &a = d.rows[k - w].sample, &b = d.rows[k + w].sample;
-      const double dt = 1e-9 * static_cast<double>(b.t_ns - a.t_ns);
+      const double dt = core::to_seconds(b.t_ns - a.t_ns);
       // Only across a gap-free stretch; else the logged speed stays.
       bool gap = false;
       for (std::size_t j = k - w + 1; j <= k + w && !gap; ++j) gap = d.rows[j].sample.gap_before;
@@ -116,35 +118,41 @@ LogData prepare_log(std::vector<io::DriveLogRow> rows, const io::DriveLogLayout&
   d.block.resize(n);
   const double span = std::max(d.t_end_s - d.t_start_s, 1e-12);
   for (std::size_t k = 0; k < n; ++k) {
-    const double t = 1e-9 * static_cast<double>(d.rows[k].sample.t_ns) - d.t_start_s;
+    const double t = core::to_seconds(d.rows[k].sample.t_ns) - d.t_start_s;
     d.block[k] = std::min(d.blocks - 1, static_cast<int>(t / span * d.blocks));
   }
   return d;
 }
 
 LogData load_log(const std::string& path, const core::MachineSi& machine, const LogOptions& options) {
-  if (io::is_averaged_log(path)) {
+  const io::LogSource source = io::log_source(path, options.log_map);
+  const io::DriveLogLimits limits = io::machine_limits(machine);
+  if (source.averaged()) {
     // Window means carry no transient to replay: the steady-state model, whatever the spacing.
     if (options.mode == ModelMode::kTransient) {
       throw io::DriveLogError(path, 1, 0, "column t_start",
                               "an averaged log replays only the steady-state model (give --model auto or steady_state)");
     }
-    io::AveragedLogLayout averaged;
-    const std::vector<core::AveragedSample> samples = io::read_averaged_log(path, &averaged);
+    io::AveragedLogRead read;
+    const std::vector<core::AveragedSample> samples = io::read_averaged_log(path, source.map, limits, &read);
     std::vector<io::DriveLogRow> rows;
     rows.reserve(samples.size());
     for (const core::AveragedSample& s : samples) rows.push_back(io::to_drive_log_row(s));
     LogOptions steady = options;
     steady.mode = ModelMode::kSteadyState;
-    LogData d = prepare_log(std::move(rows), io::rotor_frame_layout(averaged), machine, steady, path);
+    LogData d = prepare_log(std::move(rows), io::rotor_frame_layout(read.layout), machine, steady, path);
     d.averaged = true;
+    d.format = io::describe(source, read);
     return d;
   }
-  io::DriveLogReader reader(path, io::machine_limits(machine));
+  io::DriveLogReader reader(path, source.map, limits);
   std::vector<io::DriveLogRow> rows;
   io::DriveLogRow row;
   while (reader.next(row)) rows.push_back(row);
-  return prepare_log(std::move(rows), reader.layout(), machine, options, path);
+  LogData d = prepare_log(std::move(rows), reader.layout(), machine, options, path);
+  d.format = path + " as " + source.format + ": " + std::to_string(d.rows.size()) + " rows" +
+             io::describe(reader.reader().repairs());
+  return d;
 }
 
 }  // namespace rpem::analysis

@@ -5,6 +5,7 @@
 #include <complex>
 #include <functional>
 
+#include "rpem/core/clock.hpp"
 #include "rpem/core/conditioner.hpp"
 
 namespace rpem::analysis {
@@ -88,7 +89,7 @@ ResidualStatistics residual_statistics(const LogData& log, const EffectContext& 
       {"i_q [A]", [](std::size_t, const core::Vec2& i, double) { return i[1]; }},
       {"speed [pu]", [](std::size_t, const core::Vec2&, double n) { return n; }},
       {"|speed| [pu]", [](std::size_t, const core::Vec2&, double n) { return std::abs(n); }},
-      {"time [s]", [&](std::size_t k, const core::Vec2&, double) { return 1e-9 * static_cast<double>(log.rows[k].sample.t_ns); }},
+      {"time [s]", [&](std::size_t k, const core::Vec2&, double) { return core::to_seconds(log.rows[k].sample.t_ns); }},
   };
   if (log.layout.t_winding) {
     regressors.push_back({"T_winding [°C]", [&](std::size_t k, const core::Vec2&, double) { return log.rows[k].t_winding_C.value_or(0.0); }});

@@ -15,6 +15,7 @@
 
 #include <array>
 #include <cstdint>
+#include <optional>
 
 #include "rpem/core/averaged_sample.hpp"
 #include "rpem/core/drive_estimator.hpp"
@@ -27,6 +28,8 @@ namespace rpem::core {
 
 class AveragedDriveEstimator {
  public:
+  using Sample = AveragedSample;
+
   AveragedDriveEstimator(const MachineSi& machine, const EstimatorSettings& settings) noexcept;
 
   /// One averaged sample. Real-time safe.
@@ -45,6 +48,10 @@ class AveragedDriveEstimator {
   [[nodiscard]] const RpemEstimator& core() const noexcept { return core_; }
   [[nodiscard]] double psi_m_Wb() const noexcept;
   [[nodiscard]] double r_s_Ohm() const noexcept;
+  /// The time of the newest sample stepped, whatever became of it (rejected, or the first of a new
+  /// chain), kept across reset() and resynchronize(); none before the first. rpemd's loop measures the
+  /// time each sample stands for from it.
+  [[nodiscard]] std::optional<std::int64_t> previous_t_ns() const noexcept { return previous_t_ns_; }
 
  private:
   /// The sample as the steady-state model takes it (pu, corrections applied), and whether it continues
@@ -58,8 +65,8 @@ class AveragedDriveEstimator {
   std::array<GainSequences, 3> rates_per_s_{};
   AveragedSettings options_;
   double delay_s_ = 0.0;
-  bool has_previous_ = false;
-  std::int64_t previous_t_ns_ = 0;
+  bool has_previous_ = false;  ///< the next sample continues the chain of the previous one
+  std::optional<std::int64_t> previous_t_ns_;
   std::int64_t previous_centre2_ns_ = 0;  ///< t_start + t of the previous window (twice its centre)
   Vec2 previous_i_pu_ = Vec2::Zero();
   Vec2 instrument_i_pu_ = Vec2::Zero();  ///< low-passed current of the samples before this one

@@ -24,6 +24,8 @@ struct Estimate {
 
 class DriveEstimator {
  public:
+  using Sample = DriveSample;
+
   DriveEstimator(const MachineSi& machine, const EstimatorSettings& settings) noexcept;
 
   /// One sample. Real-time safe.

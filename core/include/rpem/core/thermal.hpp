@@ -17,10 +17,14 @@
 
 namespace rpem::core {
 
+/// The temperature the materials' coefficients below refer to (α relative to the value there), and the
+/// reference of a drift law unless it names another.
+inline constexpr double kMaterialReference_C = 20.0;
+
 /// A parameter's linear drift with temperature.
 struct DriftLaw {
   double coeff_per_K = 0.0;  ///< α, relative to the value at reference_C [1/K]
-  double reference_C = 20.0;
+  double reference_C = kMaterialReference_C;
   double value_ref = 0.0;    ///< the value at reference_C in SI (Ω or Wb); 0: the machine's configured value
 
   /// value(T)/value_ref.
@@ -38,9 +42,6 @@ struct DriftLaw {
     return {coeff_per_K / f, t_C, value_ref * f};
   }
 };
-
-/// The temperature the materials' coefficients below refer to (α relative to the value there).
-inline constexpr double kMaterialReference_C = 20.0;
 
 /// A material's range of temperature coefficients [1/K], relative to the value at kMaterialReference_C.
 struct MaterialCoefficient {
@@ -66,8 +67,8 @@ inline constexpr std::array<MaterialCoefficient, 3> kMagnetMaterials{kNdFeB, kSm
 /// The machine's thermal model: stator resistance against the winding temperature, magnet flux linkage
 /// against the magnet temperature. The defaults are a copper winding and NdFeB magnets.
 struct ThermalModel {
-  DriftLaw r_s{kCopper.typical_per_K, 20.0, 0.0};
-  DriftLaw psi_m{kNdFeB.typical_per_K, 20.0, 0.0};
+  DriftLaw r_s{kCopper.typical_per_K, kMaterialReference_C, 0.0};
+  DriftLaw psi_m{kNdFeB.typical_per_K, kMaterialReference_C, 0.0};
 };
 
 /// The material whose range holds α, if any.

@@ -1,17 +1,17 @@
 #pragma once
-// The Kalman filter of the node temperatures (docs/derivations.md §12, "Fusion"): the thermal network as its
+// The Kalman filter of the node temperatures (docs/derivations.md §14, "Fusion"): the thermal network as its
 // process model, augmented by each node's heat disturbance d [W] — what the loss model gets wrong — and by
 // the temperature laws' calibration errors c, which it carries but does not estimate (Schmidt's "consider"
 // states: nothing in the data tells a calibration error from a model error), corrected by scalar linear
 // observations (a parameter estimate through its temperature law, a sensor).
 //
-//   state x = [T; d; c],  T⁺ = Φ·T + γ + Γ_d·d,  d⁺ = d + v,  c⁺ = c                    (eq. 12.4, 12.9)
+//   state x = [T; d; c],  T⁺ = Φ·T + γ + Γ_d·d,  d⁺ = d + v,  c⁺ = c                    (eq. 14.4, 14.9)
 //   c = [e_ref,magnet, e_α,magnet, e_ref,copper, e_α,copper]: a law's temperature reads T + e_ref + e_α·(T − T_ref)
 //   Var(v_i) = q_d,i·Δt + Σ_terms (σ_rel,term·ΔP_term,i)²: a loss model's error moves with the loss it
 //   models, so each change ΔP of a modelled loss term between steps adds its relative uncertainty squared
 //   P⁺ = F·P·Fᵀ + Q_d,  F = [Φ Γ_d 0; 0 I 0; 0 0 I],  Q_d = (Δt/2)·(Φ·Q_T·Φᵀ + Q_T) on T (trapezoidal rule)
 //   observe:  y = h·T + h_c·c + offset + v_y,  v_y ~ N(0, r);  ν = y − ŷ,  s = H·P·Hᵀ + r
-//             K = [P_xx·Hᵀ/s on T and d; 0 on c],  x += K·ν,  P −= rank-one terms of that gain (eq. 12.11)
+//             K = [P_xx·Hᵀ/s on T and d; 0 on c],  x += K·ν,  P −= rank-one terms of that gain (eq. 14.11)
 //
 // An observation whose innovation lies beyond `gate_sigma`·√s is rejected (counted by the caller), so one
 // wild estimate cannot pull the state. Real-time safe: fixed size, noexcept, no allocation.

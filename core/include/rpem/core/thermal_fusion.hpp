@@ -5,7 +5,7 @@
 // and has settled — and by a winding sensor where there is one. The same block runs in rpemd's loop and in
 // `rpem estimate --thermal`.
 //
-// The observations through the temperature laws (core/thermal.hpp; docs/derivations.md §12, eq. 12.5–12.8):
+// The observations through the temperature laws (core/thermal.hpp; docs/derivations.md §14, eq. 14.5–14.8):
 //   ψ̂m = ψ_ref·(1 + α_m·(T_m' − T_ref)) + κ_ψ·(R_s(T_w) − r̂s)    while ψ̂m adapts (r̂s held)
 //   r̂s = R_ref·(1 + α_cu·(T_w' − T_ref)) + κ_r·(ψm(T_m) − ψ̂m)    while r̂s adapts (ψ̂m held)
 //   T_sensor = T_w
@@ -52,6 +52,18 @@ struct ThermalEstimate {
   [[nodiscard]] const ThermalNodeEstimate& magnet_node() const noexcept { return node[static_cast<std::size_t>(magnet)]; }
   [[nodiscard]] const ThermalNodeEstimate& winding_node() const noexcept { return node[static_cast<std::size_t>(winding)]; }
 };
+
+/// What RPEM_ESTIMATE and `rpem estimate --thermal` report of a node at `t_ns` (the newest sample, at or after
+/// the filter's newest step): source 0 none (the filter has not stepped), 1 observed in the newest step,
+/// 2 predicted; the age of the last observation run on to t_ns, −1: never observed; NaN values before the
+/// first step.
+struct ThermalNodeReport {
+  double t_C = 0.0;
+  double sd_K = 0.0;
+  std::int8_t source = 0;
+  double observed_age_s = -1.0;
+};
+[[nodiscard]] ThermalNodeReport report_node(const ThermalEstimate& e, int node, std::int64_t t_ns) noexcept;
 
 /// The observations of one step as the filter takes them, from a step's data and the state they linearise at.
 struct StepObservations {

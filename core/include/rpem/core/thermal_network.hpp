@@ -1,11 +1,11 @@
 #pragma once
-// The machine's lumped-parameter thermal network (LPTN; docs/derivations.md §12): 2–4 nodes — at least the
+// The machine's lumped-parameter thermal network (LPTN; docs/derivations.md §14): 2–4 nodes — at least the
 // winding and the magnet — joined by thermal conductances, each node tied to the coolant by another, with
 // a heat capacity each, heated by the losses:
 //
-//   C_i·dT_i/dt = P_i − Σ_j G_ij·(T_i − T_j) − G_i0·(T_i − T_coolant)                    (eq. 12.1)
-//   P_winding  += s_cu·(3/2)·R_s(T_winding)·|i_dq|²   copper, R_s's own law (core/thermal.hpp)  (eq. 12.2)
-//   P_i        += Σ_forms k_form,i·basis_form(ω, ψ_s, |i|)     iron and magnet losses         (eq. 12.3)
+//   C_i·dT_i/dt = P_i − Σ_j G_ij·(T_i − T_j) − G_i0·(T_i − T_coolant)                    (eq. 14.1)
+//   P_winding  += s_cu·(3/2)·R_s(T_winding)·|i_dq|²   copper, R_s's own law (core/thermal.hpp)  (eq. 14.2)
+//   P_i        += Σ_forms k_form,i·basis_form(ω, ψ_s, |i|)     iron and magnet losses         (eq. 14.3)
 //
 // The loss forms are a catalogue (thermal_network.cpp, kLossForms): hysteresis ∝ f·B², eddy currents
 // ∝ f²·B² (B ∝ |ψ_s|, the stator flux linkage), and magnet eddy currents from the armature's harmonics
@@ -13,7 +13,7 @@
 // Since R_s is linear in T_winding the network is linear in T: dT/dt = A·T + u + C⁻¹·d with A and u
 // constant over a step whose inputs are held (their means), so the step is exact (zero-order hold), also
 // for a heat d [W] held over it (the filter's disturbance, thermal_filter.hpp):
-//   T⁺ = Φ·T + γ + Γ_d·d,   Φ = e^{A·Δt},  γ = Δt·φ₁(A·Δt)·u,  Γ_d = Δt·φ₁(A·Δt)·C⁻¹          (eq. 12.4)
+//   T⁺ = Φ·T + γ + Γ_d·d,   Φ = e^{A·Δt},  γ = Δt·φ₁(A·Δt)·u,  Γ_d = Δt·φ₁(A·Δt)·C⁻¹          (eq. 14.4)
 // Nodes past `nodes` are unused: their rows are zero, they keep their value. Real-time safe.
 
 #include <array>
@@ -29,7 +29,7 @@ inline constexpr int kMaxThermalNodes = 4;
 using ThermalVec = Eigen::Matrix<double, kMaxThermalNodes, 1>;
 using ThermalMat = Eigen::Matrix<double, kMaxThermalNodes, kMaxThermalNodes>;
 
-/// The loss forms of eq. 12.3 (stable numbers: they index thermal.yaml's `losses` and the tables).
+/// The loss forms of eq. 14.3 (stable numbers: they index thermal.yaml's `losses` and the tables).
 enum class LossForm : std::uint8_t { kIronHysteresis = 0, kIronEddy = 1, kMagnetEddy = 2 };
 inline constexpr int kLossForms = 3;
 
@@ -72,7 +72,7 @@ struct ThermalNetwork {
   LossBase base;
 };
 
-/// The inputs of one step, held over it (their means over the step): eq. 12.4's zero-order hold.
+/// The inputs of one step, held over it (their means over the step): eq. 14.4's zero-order hold.
 struct ThermalLoad {
   double dt_s = 0.0;
   double current_sq_A2 = 0.0;  ///< mean of i_d² + i_q²
@@ -99,7 +99,7 @@ class LossAccumulator {
 [[nodiscard]] std::array<double, kLossForms> loss_basis(const LossBase& base, const Vec2& i_dq_A, double omega_el_rad_s,
                                                         const Vec2& psi_dq_Wb) noexcept;
 
-/// dT/dt = A·T + u over a step with load `l` (eq. 12.1–12.3).
+/// dT/dt = A·T + u over a step with load `l` (eq. 14.1–14.3).
 struct ThermalRates {
   ThermalMat a = ThermalMat::Zero();
   ThermalVec u = ThermalVec::Zero();
@@ -109,7 +109,7 @@ struct ThermalRates {
 /// The node losses [W] at temperatures T under load `l` (copper at T_winding).
 [[nodiscard]] ThermalVec node_losses_W(const ThermalNetwork& n, const ThermalLoad& l, const ThermalVec& t_C) noexcept;
 
-/// T⁺ = Φ·T + γ + Γ_d·d over l.dt_s, exact for the held load and heat d (eq. 12.4).
+/// T⁺ = Φ·T + γ + Γ_d·d over l.dt_s, exact for the held load and heat d (eq. 14.4).
 struct ThermalTransition {
   ThermalMat phi = ThermalMat::Identity();
   ThermalVec gamma = ThermalVec::Zero();

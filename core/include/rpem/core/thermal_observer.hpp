@@ -1,5 +1,5 @@
 #pragma once
-// What the estimator tells the thermal filter (docs/derivations.md §12, "Observations"): per step of the
+// What the estimator tells the thermal filter (docs/derivations.md §14, "Observations"): per step of the
 // filter, the load the network is driven by (thermal_network.hpp) and, for ψ̂m and r̂s each, whether it is an
 // observation — it adapted through at least half of the step and has settled — with its value, its
 // variance from the estimator's own state, its sensitivity to the other, held parameter and its lag.
@@ -8,11 +8,11 @@
 // gradient column, g_o the other parameter's, ε the prediction error (all pu):
 //   a = l·g                          the fraction of its error the update removes (contraction)
 //   settled:   Σ a ≥ settle_time_constants over uninterrupted adaptation (the start's error below e^−Σa)
-//   κ = (l·g_o)/a                    θ̂_j − θ_j = κ·(θ_o − θ̂_o) at the update's equilibrium l·ε = 0 (eq. 12.6)
+//   κ = (l·g_o)/a                    θ̂_j − θ_j = κ·(θ_o − θ̂_o) at the update's equilibrium l·ε = 0 (eq. 14.6)
 //   σ²_noise = l·Σ_ε·lᵀ / (a·(2 − a))  the stationary variance of θ̂_j, Σ_ε the residuals' long-run covariance
-//                                      (their spectral density at zero: the update is a low-pass) (eq. 12.7)
+//                                      (their spectral density at zero: the update is a low-pass) (eq. 14.7)
 //   σ²_model = |ε̄_⊥|²·|l|²/a²        the bias a model error as large as the mean residual the update cannot
-//                                      remove (ε̄_⊥ ⊥ l), in the direction it would remove, causes (eq. 12.8)
+//                                      remove (ε̄_⊥ ⊥ l), in the direction it would remove, causes (eq. 14.8)
 //   τ = Δt/a                          the tracking time constant
 // ε̄ and Σ_ε are exponentially weighted over residual_time_constant_s, Σ_ε by batch means: M times the
 // covariance of the means of M consecutive residuals, a batch closing after a quarter of the estimator's time

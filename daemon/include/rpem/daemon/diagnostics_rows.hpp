@@ -2,13 +2,16 @@
 // How a thread's counters and statistics reach RPEM_DIAGNOSTICS. Each value has one writer, the thread
 // that counts it; that thread sends a DiagnosticsRows through its queue to the publisher, which writes
 // the rows into diagnostics_t knowing nothing of what they mean. A thread lists its counters in a
-// table of CounterRow — where it counts, which diagnostics_t field — so adding a counter is one row
-// (and its field in lcm_types/rpem_diagnostics_t.lcm). Plain data, fixed size: real-time safe.
+// table of CounterRow — where it counts, which diagnostics_t field — so adding a counter is its line in
+// lcm_types/rpem_diagnostics_t.lcm (the one definition of the message: lcm-gen's class, the field list
+// that `rpem listen --diagnostics` prints from; docs/architecture.md, "One definition per message") and
+// one row here. Plain data, fixed size: real-time safe.
 
 #include <array>
 #include <cstddef>
 #include <cstdint>
 
+#include "rpem/core/assert.hpp"
 #include "rpem/diagnostics_t.hpp"
 
 namespace rpem::daemon {
@@ -28,8 +31,8 @@ class DiagnosticsRows {
   static constexpr std::size_t kMaxCounts = 32;
   static constexpr std::size_t kMaxFigures = 16;
 
-  /// Sets a field (replacing an earlier row for it). Rows beyond the capacity are dropped; the tables
-  /// are checked against it at compile time where they are defined.
+  /// Sets a field (replacing an earlier row for it). Rows beyond the capacity are dropped (an assertion
+  /// where assertions are on); the tables are checked against it at compile time where they are defined.
   void set(DiagnosticsCount field, std::int64_t value) noexcept { put(counts_, n_counts_, field, value); }
   void set(DiagnosticsFigure field, double value) noexcept { put(figures_, n_figures_, field, value); }
 
@@ -67,6 +70,7 @@ class DiagnosticsRows {
         return;
       }
     }
+    RPEM_ASSERT(n < N, "a thread's rows fit DiagnosticsRows (kMaxCounts, kMaxFigures)");
     if (n < N) rows[n++] = {field, value};
   }
   template <class Field, class T, std::size_t N>

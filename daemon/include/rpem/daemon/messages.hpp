@@ -1,6 +1,7 @@
 #pragma once
 // What crosses rpemd's thread boundaries, each through an SpscQueue with one producer and one consumer
-// (docs/rpemd.md, "Threads"): plain copyable data, no strings, no heap.
+// (docs/rpemd.md, "Threads"): plain copyable data, no strings, no heap. An LCM message's fields travel as
+// its mirror, generated from its .lcm file (rpem/mirror/<struct>.hpp): the .lcm file is their one definition.
 //   source  → loop:       SourceSample (a phase or an averaged sample, source_sample.hpp)
 //   source  → publisher:  SourceReport (source.hpp)
 //   control → loop:       Command (supervisory commands and reloads, in the order they were accepted)
@@ -14,10 +15,14 @@
 #include "rpem/core/settings.hpp"
 #include "rpem/daemon/daemon_config.hpp"
 #include "rpem/daemon/diagnostics_rows.hpp"
+#include "rpem/mirror/estimate_t.hpp"
+#include "rpem/mirror/measurement_t.hpp"
 
 namespace rpem::daemon {
 
 enum class DaemonState : std::int8_t { kStarting = 0, kRunning = 1, kStale = 2, kStopping = 3 };
+/// estimate_t.state and diagnostics_t.state carry a DaemonState's number.
+[[nodiscard]] constexpr bool operator==(std::int8_t state, DaemonState s) noexcept { return state == static_cast<std::int8_t>(s); }
 
 /// The verdict on an RPEM_COMMAND message (diagnostics_t.last_command_result; numbers never change).
 enum class CommandResult : std::int8_t {
@@ -44,18 +49,11 @@ struct Command {
   LiveConfig live;        ///< kReconfigure: the whole reloaded configuration, as one object
 };
 
-struct EstimateReport {
-  std::int64_t utime_us = 0;
-  std::int64_t sample_time_us = 0;
+/// RPEM_ESTIMATE's fields (the mirror of lcm_types/rpem_estimate_t.lcm; the publisher copies them all), and
+/// what the publisher needs besides.
+struct EstimateReport : mirror::estimate_t {
   std::int64_t newest_rx_ns = 0;  ///< kernel receive time of the newest sample (CAN), 0 otherwise
-  std::int64_t samples = 0;
-  double psi_m_Wb = 0.0, r_s_Ohm = 0.0, psi_m_pu = 0.0, r_s_pu = 0.0;
-  double t_magnet_C = 0.0, t_winding_C = 0.0, speed_pu = 0.0;
-  bool psi_m_valid = false, r_s_valid = false, psi_m_converged = false, r_s_converged = false;
-  bool psi_m_adapting = false, r_s_adapting = false, frozen = false;
-  double psi_m_age_s = -1.0, r_s_age_s = -1.0;  ///< since the last adaptation; −1: never adapted
-  DaemonState state = DaemonState::kStarting;
-  core::Algorithm algorithm = core::Algorithm::kSga;
+  core::Algorithm algorithm = core::Algorithm::kSga;  ///< estimate_t.algorithm, which the publisher spells
   // The last values that were valid, converged and adapting (persisted by the publisher), and how long
   // ago they adapted.
   bool has_good_psi_m = false, has_good_r_s = false;
@@ -63,13 +61,8 @@ struct EstimateReport {
   double good_psi_m_age_s = 0.0, good_r_s_age_s = 0.0;
 };
 
-struct MeasurementReport {
-  std::int64_t utime_us = 0;
-  std::int64_t sample_time_us = 0;
-  double theta_el_rad = 0.0, omega_el_rad_s = 0.0, u_dc_V = 0.0;
-  double i_d_A = 0.0, i_q_A = 0.0, i_hat_d_A = 0.0, i_hat_q_A = 0.0, eps_d_A = 0.0, eps_q_A = 0.0;
-  double t_winding_sensor_C = 0.0, t_drive_sensor_C = 0.0;  ///< the drive's own sensors; NaN: not reported
-};
+/// RPEM_MEASUREMENT's fields (the mirror of lcm_types/rpem_measurement_t.lcm).
+using MeasurementReport = mirror::measurement_t;
 
 /// The loop's counters (totals) and statistics (the last reporting interval), as diagnostics rows.
 struct LoopStatsReport {

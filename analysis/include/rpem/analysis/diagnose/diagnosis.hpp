@@ -14,12 +14,13 @@
 #include "rpem/analysis/diagnose/residual_statistics.hpp"
 #include "rpem/analysis/diagnose/selection.hpp"
 #include "rpem/analysis/diagnose/verdict.hpp"
+#include "rpem/core/thermal.hpp"
 #include "rpem/io/machine_config.hpp"
 
 namespace rpem::analysis {
 
 struct DiagnoseOptions {
-  double reference_C = 20.0;            ///< temperature to which found drift laws are referred
+  double reference_C = core::kMaterialReference_C;  ///< temperature to which found drift laws are referred
   double switching_frequency_Hz = 0.0;  ///< for t_dead_s (0: the configuration's, else unknown)
   SelectionOptions selection;
 };

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "rpem/core/clock.hpp"
 #include "rpem/core/settings.hpp"
 #include "rpem/core/types.hpp"
 #include "rpem/io/drive_log.hpp"
@@ -22,6 +23,7 @@ enum class ModelMode { kTransient, kSteadyState };
 
 struct LogData {
   std::string path;
+  std::string format;  ///< what the log was read as, and what reading it did (io::describe)
   std::vector<io::DriveLogRow> rows;
   io::DriveLogLayout layout;
   ModelMode mode = ModelMode::kTransient;
@@ -49,7 +51,7 @@ struct LogData {
 
   /// Where sample k lies in the log's time span, 0 … 1.
   [[nodiscard]] double time_fraction(std::size_t k) const noexcept {
-    return (1e-9 * static_cast<double>(rows[k].sample.t_ns) - t_start_s) / std::max(t_end_s - t_start_s, 1e-12);
+    return (core::to_seconds(rows[k].sample.t_ns) - t_start_s) / std::max(t_end_s - t_start_s, 1e-12);
   }
   [[nodiscard]] bool training(std::size_t k) const noexcept { return used[k] && block[k] % 2 == 0; }
   [[nodiscard]] bool heldout(std::size_t k) const noexcept { return used[k] && block[k] % 2 == 1; }
@@ -61,9 +63,11 @@ struct LogOptions {
   std::optional<ModelMode> mode;  ///< empty: decided from the sample interval
   int blocks = 40;                ///< training and held-out blocks, alternating, equal in time
   int speed_half_window = 4;      ///< transient logs: replay speed from the angle over ±this many samples
+  std::string log_map;            ///< a column map (YAML) to read the log with; empty: detected (io::log_source)
 };
 
-/// Loads and characterises a log, a phase-sample or an averaged one (throws io::DriveLogError on bad input).
+/// Loads and characterises a log, a phase-sample or an averaged one, in any format io::log_source reads
+/// (throws io::DriveLogError on bad input, io::ConfigError on a bad map).
 [[nodiscard]] LogData load_log(const std::string& path, const core::MachineSi& machine, const LogOptions& options);
 
 /// The same from rows already in memory (tests, the simulator).
