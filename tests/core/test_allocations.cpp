@@ -1,7 +1,7 @@
 // Zero heap allocations on the per-sample path: 10⁵ DriveEstimator::step() calls (conditioner,
 // predictor, gradients, gains, update) for each algorithm and gradient form, and 10⁵
-// AveragedDriveEstimator::step() calls for each algorithm, counted by replacing the global allocation
-// functions in this test binary.
+// AveragedDriveEstimator::step() calls for each algorithm, and 10⁵ ThermalFusion::step() calls, counted by
+// replacing the global allocation functions in this test binary.
 #include <gtest/gtest.h>
 
 #include <atomic>
@@ -10,11 +10,13 @@
 
 #include "rpem/core/averaged_estimator.hpp"
 #include "rpem/core/drive_estimator.hpp"
+#include "rpem/core/thermal_fusion.hpp"
 #include "support/averaged_data.hpp"
 #include "support/model_data.hpp"
 #include "support/outrunner_machine.hpp"
 #include "support/regime_drive.hpp"
 #include "support/paper_machine.hpp"
+#include "support/paper_thermal.hpp"
 
 namespace {
 std::atomic<long> g_allocations{0};
@@ -210,6 +212,45 @@ TEST(RegimeAllocations, NoneThroughEveryRegimeAndTheSparsePath) {
   }
   DriveEstimator sparse(test::paper_machine_si(), test::paper_settings());
   expect_no_allocations(sparse, rows);
+}
+
+TEST(ThermalAllocations, NoneAcrossOneHundredThousandFusedSteps) {
+  // The thermal fusion beside the estimator (rpemd's loop and `rpem estimate --thermal`): loss accumulation,
+  // observations, a 3-node network's exact step every 1 ms (so the filter steps 10⁴ times), gate resets,
+  // coasting without samples, a reload and a non-finite sample.
+  const MachineSi machine = test::paper_machine_si();
+  AveragedDriveEstimator est(machine, test::paper_settings());
+  const ThermalFusionConfig c = test::paper_thermal_fusion();
+  ThermalFusion fusion(c, test::paper_base(), machine);
+  test::AveragedDataGenerator gen;
+  gen.base = test::paper_base();
+  gen.plant = test::paper_machine_pu();
+  gen.rate_Hz = 1000.0;
+  gen.n_pu = [](double t) { return std::fmod(t, 20.0) < 10.0 ? 0.8 : 0.0; };
+  gen.i_pu = [](double t) { return Vec2(-0.2, 0.6 + 0.1 * std::sin(t)); };
+  constexpr int kSteps = 100'000;
+  std::vector<AveragedSample> samples;
+  samples.reserve(kSteps);
+  for (int k = 0; k < kSteps; ++k) samples.push_back(gen.next());
+  samples[6000].i_dq_A[0] = std::nan("");
+  const long before = g_allocations.load();
+  double sink = 0.0;
+  std::int64_t previous = samples.front().t_ns;
+  for (std::size_t k = 0; k < samples.size(); ++k) {
+    const Estimate e = est.step(samples[k]);
+    ThermalSample s;
+    s.dt_s = 1e-9 * static_cast<double>(samples[k].t_ns - previous);
+    s.winding_sensor_C = k % 50 == 0 ? 60.0 + 1e-4 * static_cast<double>(k) : std::nan("");
+    s.coolant_C = 40.0;
+    previous = samples[k].t_ns;
+    fusion.step(e, s);
+    if (k == 50'000) fusion.reconfigure(c, test::paper_base(), machine);
+    if (k % 20'000 == 0) fusion.coast(0.5);
+    sink += fusion.estimate().magnet_node().t_C;
+  }
+  EXPECT_EQ(g_allocations.load() - before, 0);
+  EXPECT_TRUE(std::isfinite(sink));
+  EXPECT_GT(fusion.estimate().observations_accepted, 1000);
 }
 
 TEST(AllocationCounter, CountsAnAllocation) {

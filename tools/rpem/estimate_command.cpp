@@ -1,10 +1,13 @@
 // rpem estimate --log LOG.csv [--log-map MAP.yaml] --config CFG.yaml --out EST.csv [--algorithm sga|gna|phyint]
-//              [--every N]
+//              [--every N] [--thermal THERMAL.yaml]
 // Runs the estimator offline over a drive log, exactly as rpemd would run it online: a log of instantaneous
 // samples through DriveEstimator, a log of averaged samples (our averaged log, VESC Tool's realtime log, a
-// map of averaged samples; docs/drive-log.md) through AveragedDriveEstimator.
+// map of averaged samples; docs/drive-log.md) through AveragedDriveEstimator. With --thermal, the thermal
+// network's filter runs beside it as in rpemd (core::ThermalFusion, docs/thermal.md) and the estimate CSV
+// gains the fused temperatures.
 
 #include <cstdio>
+#include <limits>
 #include <optional>
 #include <string>
 
@@ -18,6 +21,7 @@
 #include "rpem/io/log_source.hpp"
 #include "rpem/io/machine_config.hpp"
 #include "rpem/io/sample_counts.hpp"
+#include "rpem/io/thermal_config.hpp"
 
 namespace rpem::tools {
 namespace {
@@ -28,7 +32,36 @@ struct EstimateOptions {
   std::string config;
   std::string out;
   std::string algorithm;
+  std::string thermal;
   long every = 1;
+};
+
+/// The thermal filter beside the estimator, when --thermal is given.
+class ThermalRun {
+ public:
+  ThermalRun(const EstimateOptions& o, const io::MachineConfig& cfg, const core::PerUnitBase& base) {
+    if (o.thermal.empty()) return;
+    const io::ThermalConfig t = io::load_thermal_config(o.thermal, cfg);
+    for (int i = 0; i < t.fusion.filter.network.nodes; ++i) names_.push_back(t.node_names[static_cast<std::size_t>(i)]);
+    fusion_.emplace(t.fusion, base, cfg.machine);
+  }
+  [[nodiscard]] const std::vector<std::string>& node_names() const { return names_; }
+  /// The sample's temperatures; `t_ns` its time (the interval since the previous sample is the time it stands for).
+  void step(const core::Estimate& e, std::int64_t t_ns, double coolant_C, double winding_C) {
+    if (!fusion_) return;
+    core::ThermalSample s;
+    s.dt_s = previous_ns_ ? 1e-9 * static_cast<double>(t_ns - *previous_ns_) : 0.0;
+    s.coolant_C = coolant_C;
+    s.winding_sensor_C = winding_C;
+    previous_ns_ = t_ns;
+    fusion_->step(e, s);
+  }
+  [[nodiscard]] const core::ThermalEstimate* estimate() const { return fusion_ ? &fusion_->estimate() : nullptr; }
+
+ private:
+  std::vector<std::string> names_;
+  std::optional<core::ThermalFusion> fusion_;
+  std::optional<std::int64_t> previous_ns_;
 };
 
 /// What the run did, for its summary on stderr: the last estimate and the samples per regime.
@@ -60,13 +93,15 @@ int run_averaged(const EstimateOptions& o, const io::LogSource& source, const io
       io::read_averaged_log(o.log, source.map, io::machine_limits(cfg.machine), &read);
   std::fprintf(stderr, "rpem estimate: %s\n", io::describe(source, read).c_str());
   io::check_averaged_supports(cfg, config_name, read.layout.u_dc, o.log);
-  io::EstimateLogWriter writer(o.out);
   core::AveragedDriveEstimator estimator(cfg.machine, cfg.estimator);
+  ThermalRun thermal(o, cfg, estimator.base());
+  io::EstimateLogWriter writer(o.out, thermal.node_names());
   Tally tally;
   tally.counts.averaged = true;
   for (const core::AveragedSample& s : samples) {
     const core::Estimate e = estimator.step(s);
-    if (tally.counts.samples % static_cast<std::uint64_t>(o.every) == 0) writer.write(e, estimator.core());
+    thermal.step(e, s.t_ns, s.t_coolant_C, s.t_winding_C);
+    if (tally.counts.samples % static_cast<std::uint64_t>(o.every) == 0) writer.write(e, estimator.core(), thermal.estimate());
     tally.count(e);
   }
   std::fprintf(stderr, "rpem estimate: %s\n", tally.summary(cfg.estimator.algorithm, "averaged samples").c_str());
@@ -84,15 +119,18 @@ int run_estimate(const EstimateOptions& o) {
   io::DriveLogReader reader(o.log, source.map, io::machine_limits(cfg.machine));
   if (!source.map.columns_optional) std::fprintf(stderr, "rpem estimate: reading %s as %s\n", o.log.c_str(), source.format.c_str());
   io::check_log_supports(cfg, config_name, reader.layout().u_dc, o.log);
-  io::EstimateLogWriter writer(o.out);
   core::DriveEstimator estimator(cfg.machine, cfg.estimator);
+  ThermalRun thermal(o, cfg, estimator.base());
+  io::EstimateLogWriter writer(o.out, thermal.node_names());
   Progress progress("rpem estimate");
 
   io::DriveLogRow row;
   Tally tally;
+  constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
   while (reader.next(row)) {
     const core::Estimate e = estimator.step(row.sample);
-    if (tally.counts.samples % static_cast<std::uint64_t>(o.every) == 0) writer.write(e, estimator);
+    thermal.step(e, row.sample.t_ns, row.t_coolant_C.value_or(kNaN), row.t_winding_C.value_or(kNaN));
+    if (tally.counts.samples % static_cast<std::uint64_t>(o.every) == 0) writer.write(e, estimator, thermal.estimate());
     tally.count(e);
     if ((tally.counts.samples & 0xFFF) == 0) progress.update(reader.bytes_read(), reader.bytes_total());
   }
@@ -119,6 +157,8 @@ Runner add_estimate_command(CLI::App& app) {
   cmd->add_option("--algorithm", opts->algorithm, "override the configured gain algorithm")
       ->check(CLI::IsMember({"sga", "gna", "phyint"}));
   cmd->add_option("--every", opts->every, "write every N-th sample")->check(CLI::PositiveNumber);
+  cmd->add_option("--thermal", opts->thermal, "thermal.yaml: run the thermal network's filter beside the estimator (docs/thermal.md)")
+      ->check(CLI::ExistingFile);
   return [cmd, opts]() { return cmd->parsed() ? run_estimate(*opts) : -1; };
 }
 

@@ -1,7 +1,11 @@
 // rpem figures --out DIR [--config CFG.yaml] [--log LOG.csv [--log-map MAP.yaml]]
+// rpem figures --out DIR --thermal-estimate EST.csv [--measured CSV [--magnet-column C] [--winding-column C]]
+//              [--judged-after-s T]
 // The paper's analysis figures (Fig_EigenTraj, Fig_sensitivity, fig_PEG_analytical, fig_hesscompstatic)
 // for the configured machine; with --log also the log's timeline coloured by regime (regimes.png, as
-// `rpem diagnose` draws it), for any log `rpem estimate` and `rpem diagnose` read (io::log_source).
+// `rpem diagnose` draws it), for any log `rpem estimate` and `rpem diagnose` read (io::log_source); or,
+// with --thermal-estimate, the fused temperatures of `rpem estimate --thermal` against measured ones with
+// the ±2σ band (thermal_fused.png; docs/thermal.md, "Figures").
 
 #include <cstdio>
 #include <filesystem>
@@ -11,6 +15,7 @@
 #include "rpem/analysis/analysis_figures.hpp"
 #include "rpem/analysis/diagnose/diagnose_output.hpp"
 #include "rpem/analysis/diagnose/regimes.hpp"
+#include "rpem/analysis/thermal/thermal_figure.hpp"
 #include "rpem/io/machine_config.hpp"
 
 namespace rpem::tools {
@@ -21,9 +26,21 @@ struct FiguresOptions {
   std::string config;
   std::string log;
   std::string log_map;
+  analysis::ThermalFigureInput thermal;
 };
 
 int run_figures(const FiguresOptions& o) {
+  if (!o.thermal.estimate_csv.empty()) {
+    std::filesystem::create_directories(o.out);
+    const std::string png = o.out + "/thermal_fused.png";
+    const analysis::ThermalFigureCoverage c = analysis::write_thermal_figure(png, o.thermal);
+    std::fprintf(stderr, "rpem figures: wrote %s", png.c_str());
+    if (!o.thermal.measured_csv.empty()) {
+      std::fprintf(stderr, " (measured inside ±2σ: magnet %.1f %%, winding %.1f %%)", 100.0 * c.magnet, 100.0 * c.winding);
+    }
+    std::fprintf(stderr, "\n");
+    return kExitOk;
+  }
   const io::MachineConfig cfg = o.config.empty() ? io::builtin_paper_config() : io::load_machine_config(o.config);
   // The log first: a log that cannot be read fails before any figure is drawn.
   std::optional<analysis::LogData> log;
@@ -61,6 +78,14 @@ Runner add_figures_command(CLI::App& app) {
   cmd->add_option("--log-map", opts->log_map, "column map (YAML) saying how to read --log (docs/drive-log.md, \"Column maps\")")
       ->check(CLI::ExistingFile)
       ->needs("--log");
+  cmd->add_option("--thermal-estimate", opts->thermal.estimate_csv,
+                  "instead: plot this `rpem estimate --thermal` CSV's fused temperatures with their ±2σ band")
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--measured", opts->thermal.measured_csv, "CSV with t [s] and measured temperatures [°C] to plot against")
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--magnet-column", opts->thermal.magnet_column, "the measured magnet temperature's column (default T_magnet)");
+  cmd->add_option("--winding-column", opts->thermal.winding_column, "the measured winding temperature's column (default T_winding)");
+  cmd->add_option("--judged-after-s", opts->thermal.judged_after_s, "mark where a held-out part begins; coverage counted after it");
   return [cmd, opts]() { return cmd->parsed() ? run_figures(*opts) : -1; };
 }
 
