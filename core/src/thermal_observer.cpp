@@ -34,6 +34,9 @@ void ThermalObserver::add_parameter(int j, const Estimate& e, double dt_s) noexc
   const auto jj = static_cast<std::size_t>(j);
   const std::uint16_t flag[2] = {step_flag::kPsiMActive, step_flag::kRsActive};
   const EstimatorOutput& d = e.detail;
+  // An excluded or skipped sample (regime.hpp, the outlier test) is predicted and changes nothing: the
+  // settling pauses over it. Anything else that does not adapt j (resync, scheduled out) restarts it.
+  if (d.code == StepCode::kExcluded || d.code == StepCode::kOutlier) return;
   const bool adapting = d.code == StepCode::kAdapted && (d.flags & flag[jj]) != 0;
   const int o = 1 - j;
   const Eigen::Matrix<double, 1, 2> l = d.gain.row(j);
