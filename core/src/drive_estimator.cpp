@@ -56,7 +56,13 @@ Estimate DriveEstimator::estimate(const DriveSample& sample, const EstimatorOutp
     return estimate(sample, detail, conditioned.i_meas_pu, iv.n_end_pu, kUnclassified);
   }
   Classification regime;
-  if (conditioned.resync || !(iv.dt_s <= core_.config().max_sample_interval_s)) [[unlikely]] {
+  const bool short_loss = conditioned.resync && regimes_.started() && iv.dt_s > 0.0 &&
+                          iv.dt_s <= core_.config().max_sample_interval_s;
+  if (short_loss) [[unlikely]] {
+    // Samples lost on the way (the source saw a gap) but the stream goes on within the predictor's interval:
+    // the open block spans the loss and its classification holds (the estimator resynchronises on this one).
+    regime = regimes_.held();
+  } else if (conditioned.resync || !(iv.dt_s <= core_.config().max_sample_interval_s)) [[unlikely]] {
     // A new chain: the voltage that acted before this sample is unknown; its own command stands in.
     RegimeInput in;
     in.timing = SampleTiming::kFirst;

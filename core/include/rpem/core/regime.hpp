@@ -270,6 +270,8 @@ class StreamClassifier {
   [[nodiscard]] const RegimeNoise& noise() const noexcept { return classifier_.noise(); }
   /// The classification the samples carry now.
   [[nodiscard]] Classification held() const noexcept { return held_; }
+  /// Whether a chain has started (a block is open whose classification holds).
+  [[nodiscard]] bool started() const noexcept { return has_start_; }
 
  private:
   /// A chain's first sample (or a standalone one), judged on its own; the next block starts after it.
