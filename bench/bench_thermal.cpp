@@ -18,6 +18,7 @@
 #include "rpem/core/clock.hpp"
 #include "rpem/core/drive_estimator.hpp"
 #include "rpem/core/thermal_fusion.hpp"
+#include "bench_support.hpp"
 #include "support/model_data.hpp"
 #include "support/paper_machine.hpp"
 #include "support/paper_thermal.hpp"
@@ -30,20 +31,7 @@ constexpr int kSamples = 8 * 8000;  // 8 s at 8 kHz: eight filter steps per pass
 constexpr double kPeriod_s = 125e-6;
 
 const std::vector<core::DriveSample>& samples() {
-  static const std::vector<core::DriveSample> s = [] {
-    const core::PerUnitBase base = test::paper_base();
-    test::ModelDataGenerator gen;
-    gen.plant = test::paper_machine_pu();
-    gen.plant.psi_m_pu *= 0.95;
-    gen.omega_n_rad_s = base.omega_el_rad_s;
-    gen.n_pu = 0.4;
-    gen.i_ref_pu = core::mtpa_reference(gen.plant, 0.4);
-    gen.current_noise_pu = 0.002;
-    std::vector<core::DriveSample> v;
-    std::int64_t t_ns = 0;
-    for (int k = 0; k < kSamples; ++k) v.push_back(gen.next_si(base, t_ns));
-    return v;
-  }();
+  static const std::vector<core::DriveSample> s = bench::paper_drive_samples(kSamples);
   return s;
 }
 
@@ -66,13 +54,8 @@ core::ThermalFusionConfig loop_config() {
   return c;
 }
 
-double thread_cpu_s() {
-  timespec ts{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-  return static_cast<double>(ts.tv_sec) + core::to_seconds(ts.tv_nsec);
-}
-
-double max_of(const std::vector<double>& v) { return *std::max_element(v.begin(), v.end()); }
+using bench::max_of;
+using bench::thread_cpu_s;
 
 core::ThermalSample sample() {
   core::ThermalSample s;

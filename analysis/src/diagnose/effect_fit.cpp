@@ -7,6 +7,8 @@
 #include <cmath>
 #include <limits>
 
+#include "rpem/analysis/cluster_robust.hpp"
+
 namespace rpem::analysis {
 namespace {
 
@@ -415,19 +417,6 @@ CalibrationIntervals EffectFitter::intervals(const EffectSet& set, double noise_
   for (Eigen::Index i = 0; i < n; ++i) {
     for (Eigen::Index j = 0; j <= i; ++j) h(i, j) = h(j, i) = dot(columns[static_cast<std::size_t>(i)], columns[static_cast<std::size_t>(j)]);
   }
-  // A constant the log does not excite has a vanishing column: a pseudo-inverse leaves it infinitely uncertain.
-  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(h);
-  const double floor = 1e-12 * std::max(eig.eigenvalues().maxCoeff(), 1e-300);
-  Eigen::MatrixXd h_inv = Eigen::MatrixXd::Zero(n, n);
-  Eigen::VectorXd unexcited = Eigen::VectorXd::Zero(n);
-  for (Eigen::Index k = 0; k < n; ++k) {
-    const Eigen::VectorXd v = eig.eigenvectors().col(k);
-    if (eig.eigenvalues()[k] > floor) {
-      h_inv += v * v.transpose() / eig.eigenvalues()[k];
-    } else {
-      unexcited += v.cwiseAbs2();
-    }
-  }
   // Cluster-robust "meat": the training blocks' score vectors g_b = J_bᵀ·r_b.
   const LogData& log = replay_.log();
   const std::size_t clusters = static_cast<std::size_t>(log.blocks / 2 + 1);
@@ -439,10 +428,11 @@ CalibrationIntervals EffectFitter::intervals(const EffectSet& set, double noise_
       g(c, b) += col[2 * j] * r0[2 * j] + col[2 * j + 1] * r0[2 * j + 1];
     }
   }
-  Eigen::Index used_clusters = 0;
-  for (Eigen::Index b = 0; b < g.cols(); ++b) used_clusters += g.col(b).squaredNorm() > 0.0 ? 1 : 0;
-  const double correction = used_clusters > 1 ? static_cast<double>(used_clusters) / static_cast<double>(used_clusters - 1) : 1.0;
-  const Eigen::MatrixXd robust = correction * h_inv * (g * g.transpose()) * h_inv;
+  // A constant the log does not excite has a vanishing column: the pseudo-inverse leaves it infinitely uncertain.
+  const ClusterRobustCovariance cov = cluster_robust_covariance(h, g);
+  const Eigen::MatrixXd& h_inv = cov.excitation;
+  const Eigen::MatrixXd& robust = cov.robust;
+  const Eigen::VectorXd& unexcited = cov.unexcited;
   const double sigma2 = 0.5 * noise_floor_A * noise_floor_A;  // per residual component
   CalibrationIntervals out;
   constexpr double kZ = 1.959964;
