@@ -221,13 +221,37 @@ class RegimeClassifier {
   [[nodiscard]] const Vec2& slope_pu_s() const noexcept { return state_.slope_pu_s; }
 
  private:
-  void learn(const RegimeInput& in, double t_s) noexcept;
-  [[nodiscard]] std::uint8_t transient_bits(const RegimeInput& in, double dt_s, const RegimeNoise& s) noexcept;
+  /// What the tests take from the configuration alone, computed once by reconfigure(): each the product a
+  /// test formed per sample, in the same order of operations, so that every decision is bit-identical.
+  /// The pairs are vectors here because a Vec2 built from two scalars per sample goes through memory (two
+  /// 8-byte stores, one 16-byte load: a failed store forward, the largest cost the profile showed).
+  struct Constants {
+    double z_sq = 0.0;                       ///< z²
+    double r_sq = 0.0;                       ///< r²
+    double r_min_sq = 0.0;                   ///< r_min²
+    double r_max = 0.0;                      ///< D_M's largest r
+    double psi_max_sq = 0.0;                 ///< ψ_max²
+    double inv_omega_n = 0.0;                ///< 1/ω_n
+    double inv_omega_n_sq = 0.0;             ///< 1/ω_n²
+    Vec2 x = Vec2::Zero(), x_swapped = Vec2::Zero();    ///< (x_d, x_q), (x_q, x_d)
+    Vec2 dx = Vec2::Zero(), dx_swapped = Vec2::Zero();  ///< (Δx_d, Δx_q), (Δx_q, Δx_d)
+    Vec2 x_over_omega_n = Vec2::Zero();      ///< (x_d, x_q)/ω_n
+    Vec2 dx_over_omega_n = Vec2::Zero();     ///< (Δx_d, Δx_q)/ω_n
+    Vec2 x_sq = Vec2::Zero();                ///< (x_d², x_q²)
+    Vec2 slope_var_x_sq = Vec2::Zero();      ///< (x_d², x_q²)/ω_n²
+    double x_max = 0.0, dx_max = 0.0;        ///< the larger inductance and tolerance
+  };
+
+  /// Recomputes quantisation_var_ (after a resolution changed or the configuration did).
+  void update_quantisation() noexcept;
 
   RegimeConfig config_;
+  Constants k_;
   RegimeState state_;
   RegimeNoise noise_;
-  double inv_omega_n_ = 0.0;  ///< 1/ω_n
+  /// q²/12 of u, i, n with q the configured resolution, else the measured one (0 while none is): the
+  /// quantisation's share of each σ², kept here since it changes only where a resolution does.
+  std::array<double, 3> quantisation_var_{};
 };
 
 /// The classification of a control-rate stream (DriveEstimator's dense samples): the samples' means over
