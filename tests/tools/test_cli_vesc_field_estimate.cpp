@@ -73,7 +73,9 @@ Final estimate(const std::string& log, const std::string& cfg) {
 void expect_field_accuracy(const Final& f, const Truth& truth, const std::string& what, bool r_s_required = false) {
   EXPECT_NEAR(f.psi_m_Wb / truth.psi_m_Wb, 1.0, 0.02) << what << "\n" << f.output;
   const bool declared = f.output.find("r_s not identifiable") != std::string::npos;
-  if (declared) EXPECT_NE(f.output.find("its start still decides"), std::string::npos) << f.output;
+  if (declared) {
+    EXPECT_NE(f.output.find("its start still decides"), std::string::npos) << f.output;
+  }
   if (!declared || r_s_required) {
     EXPECT_NEAR(f.r_s_Ohm / truth.r_s_Ohm, 1.0, 0.05) << what << "\n" << f.output;
   }

@@ -104,12 +104,11 @@ struct Identifiability {
 };
 
 void check_identifiable(const std::vector<core::AveragedSample>& samples, const io::MachineConfig& cfg,
-                        const core::Estimate& last, std::uint64_t adapted_r_s, std::uint64_t adapted_psi_m) {
+                        const core::Estimate& last, const std::array<std::uint64_t, 2>& adapted) {
   const core::EstimatorSettings& e = cfg.estimator;
   std::array<Identifiability, 2> p{{{"psi_m", "Wb", 0.02, e.psi_m_min_Wb, e.psi_m_max_Wb},
                                     {"r_s", "Ohm", 0.05, e.r_s_min_Ohm, e.r_s_max_Ohm}}};
   const std::array<double, 2> estimate{last.psi_m_Wb, last.r_s_Ohm};
-  const std::array<std::uint64_t, 2> adapted{adapted_psi_m, adapted_r_s};
   for (std::size_t k = 0; k < p.size(); ++k) {
     for (const bool high : {false, true}) {
       core::EstimatorSettings s = e;
@@ -149,7 +148,7 @@ int run_averaged(const EstimateOptions& o, const io::LogSource& source, const io
   }
   std::fprintf(stderr, "rpem estimate: %s\n", tally.summary(cfg.estimator.algorithm, "averaged samples").c_str());
   tally.explain();
-  if (!samples.empty()) check_identifiable(samples, cfg, tally.last, tally.adapted[1], tally.adapted[0]);
+  if (!samples.empty()) check_identifiable(samples, cfg, tally.last, tally.adapted);
   return kExitOk;
 }
 
