@@ -281,6 +281,19 @@ Classification RegimeClassifier::step(const RegimeInput& in) noexcept {
 
   // Before a chain has shown the data's noise, nothing in it is excluded on a threshold made of it.
   if (!s.noise_known && in.timing != SampleTiming::kStandalone) bits &= static_cast<std::uint8_t>(~regime_bit::kExcluded);
+
+  // Mixed windows (§13): a bridge state change falls inside the window between the last one of the old
+  // state and the first of the new (a read instant holds it with probability zero), whose means then mix
+  // both states. The take-over: this window follows a bridge-off one; the release: this one is bridge off
+  // and the one before was not — that one is mixed, which only this one shows.
+  const bool window = in.window_s > 0.0;
+  const bool off = (bits & regime_bit::kBridgeOff) != 0;
+  if (window && in.timing == SampleTiming::kContiguous && s.previous_window) {
+    if (s.previous_bridge_off && !off) bits |= regime_bit::kTransient;
+    if (!s.previous_bridge_off && off) bits |= regime_bit::kPreviousMixed;
+  }
+  s.previous_window = window;
+  s.previous_bridge_off = off;
   if (learn(s, in, t_s)) [[unlikely]] update_quantisation();
   return Classification::of(bits);
 }

@@ -12,7 +12,9 @@
 //   bridge off   |u_reported|² ≤ c₂·σ_u²  and  |i|² ≤ c₂·σ_i²        c₂ = −2·ln α, α = erfc(z/√2)
 //   not locked   |e_d| − tan δ_tol·sgn(n)·e_q − B_d > z·σ_L         (e outside a cone about ±q: §13)
 //   transient    a term the steady state leaves out (slope change, speed-current covariance; a
-//                standalone sample: the decayed remnant e^{−Δt/τ_el}·|Δi|) beyond z·σ of its row
+//                standalone sample: the decayed remnant e^{−Δt/τ_el}·|Δi|) beyond z·σ of its row;
+//                a mixed window: the bridge was released or took over inside it (the window next to a
+//                bridge-off one; the release shows one window late: kPreviousMixed)
 //   excites ψm   |n|·ψ_min − Δr·|i_q| − |n|·Δx_d·|i_d| > z·h_ψ·N_ψ   (h² = γ/(2 − γ): the estimator's averaging)
 //   excites r_s  r_min·|i| − |n|·(Δψ + Δx·|i|)       > z·h_r·N_r
 // Real-time safe: noexcept, no allocation, fixed size.
@@ -48,6 +50,10 @@ inline constexpr std::uint8_t kTransient = 1U << 2;
 inline constexpr std::uint8_t kExcitesPsiM = 1U << 3;
 inline constexpr std::uint8_t kExcitesRs = 1U << 4;
 inline constexpr std::uint8_t kInvalid = 1U << 5;
+/// Not this sample's: the window before it (its chain's, adjacent) held the bridge's release — this one is
+/// bridge off, that one was not — so that one is mixed, transient from now on (docs/derivations.md §13,
+/// "Mixed windows"). An online consumer retracts what it adapted there; counts move it (RegimeCounts).
+inline constexpr std::uint8_t kPreviousMixed = 1U << 6;
 inline constexpr std::uint8_t kExcluded = kBridgeOff | kNotLocked | kTransient | kInvalid;
 }  // namespace regime_bit
 
@@ -94,10 +100,25 @@ inline constexpr std::array<RegimeInfo, kRegimeCount> kRegimes{{
 }};
 [[nodiscard]] constexpr const RegimeInfo& info(Regime r) noexcept { return kRegimes[static_cast<std::size_t>(r)]; }
 
-/// Samples per regime. Real-time safe.
+/// The regime of a sample found mixed afterwards (kPreviousMixed on the next): transient, unless a test of
+/// higher precedence already excluded it.
+[[nodiscard]] constexpr Regime as_mixed(Regime r) noexcept { return info(r).excluded ? r : Regime::kTransient; }
+
+/// Samples per regime; a sample found mixed by the next one's kPreviousMixed moves to its regime as_mixed().
+/// Real-time safe.
 struct RegimeCounts {
   std::array<std::uint64_t, kRegimeCount> n{};
-  void add(Classification c) noexcept { ++n[static_cast<std::size_t>(c.regime)]; }
+  Regime last = Regime::kInvalid;  ///< the regime the last sample counted in
+  bool has_last = false;
+  void add(Classification c) noexcept {
+    if ((c.bits & regime_bit::kPreviousMixed) && has_last) {
+      --n[static_cast<std::size_t>(last)];
+      ++n[static_cast<std::size_t>(as_mixed(last))];
+    }
+    ++n[static_cast<std::size_t>(c.regime)];
+    last = c.regime;
+    has_last = true;
+  }
   [[nodiscard]] std::uint64_t operator[](Regime r) const noexcept { return n[static_cast<std::size_t>(r)]; }
   [[nodiscard]] std::uint64_t total() const noexcept;
   [[nodiscard]] std::uint64_t excluded() const noexcept;
@@ -187,6 +208,8 @@ struct RegimeState {
   double inv_dt = 0.0, previous_inv_dt = 0.0;  ///< 1/Δt between window centres, this sample's and the one before
   bool slope_valid = false, previous_slope_valid = false;
   bool previous_transient = false;     ///< the previous sample's own slope test failed (the junction straddles)
+  /// The chain's previous sample: a window (averaged), and whether it was bridge off (mixed windows).
+  bool previous_window = false, previous_bridge_off = false;
 };
 
 /// The noise of a quantity [pu]: σ² = (median/0.6745)² + q²/12 (the measured noise and the quantisation).
@@ -205,6 +228,7 @@ class RegimeClassifier {
   void break_chain() noexcept {
     state_.points = state_.chained = 0;
     state_.slope_valid = state_.previous_slope_valid = false;
+    state_.previous_window = state_.previous_bridge_off = false;
   }
   /// Everything learnt back to the start.
   void reset() noexcept;
