@@ -32,7 +32,7 @@ template <int N>
   Mat phi = Mat::Identity();
   Mat term = Mat::Identity();
   for (int k = 1; k <= kMaxTerms; ++k) {
-    term = (term * x) / static_cast<double>(k + 1);
+    term = (term * x) * (1.0 / static_cast<double>(k + 1));  // one division, not one per coefficient
     phi += term;
     if (term.cwiseAbs().maxCoeff() <= 1e-17 * phi.cwiseAbs().maxCoeff()) break;
   }
