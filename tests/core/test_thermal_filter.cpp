@@ -1,7 +1,8 @@
-// The thermal Kalman filter (core/thermal_filter.hpp, docs/derivations.md §13) against hand-worked updates
+// The thermal Kalman filter (core/thermal_filter.hpp, docs/derivations.md §14) against hand-worked updates
 // and closed-form limits: the scalar update, a correlated update, Schmidt's consider states (the calibration
 // bounds what observations can teach), the gate, the prediction's covariance, and a heat disturbance the
-// filter learns from observations of one node.
+// filter learns from observations of one node; the blockwise prediction and sparse update against the dense
+// forms on all twelve states.
 #include <gtest/gtest.h>
 
 #include <cmath>
