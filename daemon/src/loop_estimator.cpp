@@ -31,12 +31,13 @@ bool LoopEstimator::step(const SourceSample& sample, core::Estimate& estimate, d
   }
   const core::AveragedSample& a = *std::get_if<core::AveragedSample>(&sample);
   core::AveragedDriveEstimator& averaged = *std::get_if<core::AveragedDriveEstimator>(&estimator_);
-  // The time this sample stands for: from the previous window's end (a gap or a long silence counts up
-  // to the interval the estimator still adapts across).
+  // The time this sample stands for: from the previous window's end — all of it for a window (however
+  // long: a window after a gap adapts nothing and is credited nothing); an instantaneous sample stands for
+  // at most the interval across which it continues a chain.
   const std::optional<std::int64_t> previous_t_ns = averaged.previous_t_ns();
   estimate = averaged.step(a);
   const double interval_s = previous_t_ns ? core::to_seconds(a.t_ns - *previous_t_ns) : 0.0;
-  dt_s = std::clamp(interval_s, 0.0, max_interval_s_);
+  dt_s = a.t_start_ns < a.t_ns ? std::max(interval_s, 0.0) : std::clamp(interval_s, 0.0, max_interval_s_);
   summary = {a.t_ns, a.t_ns, std::numeric_limits<double>::quiet_NaN(), a.omega_el_rad_s, a.u_dc_V, a.t_winding_C, a.t_drive_C};
   return true;
 }

@@ -13,7 +13,7 @@ namespace {
 
 using Diag = rpem::diagnostics_t;
 
-constexpr std::array<CounterRow<LoopCounters>, 10> kLoopRows{{
+constexpr std::array<CounterRow<LoopCounters>, 11> kLoopRows{{
     {&LoopCounters::samples, &Diag::samples},
     {&LoopCounters::resyncs, &Diag::resyncs},
     {&LoopCounters::rejected_non_finite, &Diag::rejected_non_finite},
@@ -24,8 +24,13 @@ constexpr std::array<CounterRow<LoopCounters>, 10> kLoopRows{{
     {&LoopCounters::commands_applied, &Diag::commands_applied},
     {&LoopCounters::command_sequence_errors, &Diag::command_sequence_errors},
     {&LoopCounters::config_reloads, &Diag::config_reloads},
+    {&LoopCounters::outliers, &Diag::outliers},
 }};
-static_assert(kLoopRows.size() + 3 <= DiagnosticsRows::kMaxCounts);
+/// The field of each regime's count, in core::kRegimes' order.
+constexpr std::array<DiagnosticsCount, core::kRegimeCount> kRegimeFields{
+    &Diag::regime_excites_both, &Diag::regime_excites_psi_m, &Diag::regime_excites_r_s, &Diag::regime_unexcited,
+    &Diag::regime_transient,    &Diag::regime_not_locked,    &Diag::regime_bridge_off,  &Diag::regime_invalid};
+static_assert(kLoopRows.size() + kRegimeFields.size() + 3 <= DiagnosticsRows::kMaxCounts);
 
 std::int64_t interval_ns(double rate_Hz) noexcept {
   return rate_Hz > 0.0 ? static_cast<std::int64_t>(1e9 / rate_Hz) : INT64_MAX / 4;
@@ -39,6 +44,7 @@ LoopThread::LoopThread(const DaemonConfig& config, Queues queues)
       queues_(std::move(queues)),
       estimator_(SourceCatalogue::sample_kind(config.fixed.source), config.live.machine.machine, config.live.machine.estimator),
       validity_(config.live.validity, config.fixed.lcm.estimate_rate_Hz),
+      thermal_(config.live.thermal, core::PerUnitBase::from_rated(config.live.machine.machine.rated), config.live.machine.machine),
       timer_(config.fixed.loop),
       estimate_interval_ns_(interval_ns(config.fixed.lcm.estimate_rate_Hz)),
       measurement_interval_ns_(interval_ns(config.fixed.lcm.measurement_rate_Hz)),
@@ -65,6 +71,7 @@ void LoopThread::apply(const Command& c) noexcept {
     case Command::Kind::kReset:
       estimator_.reset();
       validity_.restart();
+      thermal_.restart_observations();
       break;
     case Command::Kind::kFreeze:
       estimator_.set_frozen(true);
@@ -75,11 +82,14 @@ void LoopThread::apply(const Command& c) noexcept {
     case Command::Kind::kSetValues:  // new initial values: identification starts over from them
       estimator_.set_estimates(c.psi_m_Wb, c.r_s_Ohm);
       validity_.restart();
+      thermal_.restart_observations();
       break;
     case Command::Kind::kReconfigure:
       live_ = c.live;
       estimator_.reconfigure(live_.machine.machine, live_.machine.estimator);
       validity_.reconfigure(live_.validity);
+      // The temperatures and their covariance are kept (a new network starts from the old one's state).
+      thermal_.reconfigure(live_.thermal, core::PerUnitBase::from_rated(live_.machine.machine.rated), live_.machine.machine);
       ++counters_.config_reloads;
       break;
   }
@@ -110,14 +120,26 @@ void LoopThread::step(const SourceSample& s, std::int64_t now_ns) noexcept {
     case core::StepCode::kPredictorDiverged:
       ++counters_.predictor_resets;
       break;
+    case core::StepCode::kOutlier:
+      ++counters_.outliers;
+      break;
+    case core::StepCode::kExcluded:  // counted by its regime below
+      break;
     case core::StepCode::kAdapted:
       eps2_d_ += last_.epsilon_A[0] * last_.epsilon_A[0];
       eps2_q_ += last_.epsilon_A[1] * last_.epsilon_A[1];
       ++eps_n_;
       break;
   }
+  counters_.regimes.add(last_.regime);
   if (d.flags & (core::step_flag::kProjectedPsiM | core::step_flag::kProjectedRs)) ++counters_.projections;
   validity_.on_sample(d.flags, dt_s, now_ns);
+  if (live_.thermal_active) {
+    core::ThermalSample t;
+    t.dt_s = dt_s;
+    t.winding_sensor_C = last_sample_.t_winding_sensor_C;  // NaN: none (the filter uses it if configured)
+    thermal_.step(last_, t);
+  }
 }
 
 void LoopThread::report_measurement() noexcept {
@@ -178,10 +200,27 @@ void LoopThread::report_estimate(std::int64_t now_ns) noexcept {
   r.has_good_psi_m = has_good_[core::kPsiM];
   r.good_psi_m_Wb = good_[core::kPsiM];
   r.good_psi_m_age_s = core::to_seconds(now_ns - good_ns_[core::kPsiM]);
+  report_thermal(r);
   r.has_good_r_s = has_good_[core::kRs];
   r.good_r_s_Ohm = good_[core::kRs];
   r.good_r_s_age_s = core::to_seconds(now_ns - good_ns_[core::kRs]);
   push(r);
+}
+
+void LoopThread::report_thermal(EstimateReport& r) const noexcept {
+  const core::ThermalEstimate& e = thermal_.estimate();
+  r.thermal_active = live_.thermal_active && e.started;
+  const std::int64_t t_ns = last_sample_.t_ns;
+  const core::ThermalNodeReport m = core::report_node(e, r.thermal_active ? e.magnet : -1, t_ns);
+  const core::ThermalNodeReport w = core::report_node(e, r.thermal_active ? e.winding : -1, t_ns);
+  r.t_magnet_fused_C = m.t_C;
+  r.t_magnet_fused_sd_C = m.sd_K;
+  r.t_magnet_source = m.source;
+  r.t_magnet_observed_age_s = m.observed_age_s;
+  r.t_winding_fused_C = w.t_C;
+  r.t_winding_fused_sd_C = w.sd_K;
+  r.t_winding_source = w.source;
+  r.t_winding_observed_age_s = w.observed_age_s;
 }
 
 void LoopThread::report_stats() noexcept {
@@ -190,6 +229,9 @@ void LoopThread::report_stats() noexcept {
   r.state = state_;
   r.input_queue_depth = static_cast<std::int32_t>(queues_.samples.size());
   r.rows.set_all(kLoopRows, counters_);
+  for (std::size_t k = 0; k < core::kRegimeCount; ++k) {
+    r.rows.set(kRegimeFields[k], static_cast<std::int64_t>(counters_.regimes.n[k]));
+  }
   timer_.report(r.rows);
   const double n = eps_n_ > 0 ? static_cast<double>(eps_n_) : 1.0;
   r.rows.set(&Diag::epsilon_rms_d_A, std::sqrt(eps2_d_ / n));

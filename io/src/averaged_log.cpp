@@ -4,19 +4,9 @@
 #include <limits>
 
 #include "rpem/core/clock.hpp"
-#include "rpem/io/csv_table.hpp"
 #include "rpem/io/number_format.hpp"
 
 namespace rpem::io {
-namespace {
-
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-
-/// Data rows start at line 2; CsvTable skips blank lines, so line numbers of later rows are approximate
-/// only for logs with blank lines inside.
-std::size_t line_of(std::size_t row) { return row + 2; }
-
-}  // namespace
 
 bool is_averaged_log(const std::string& path) {
   std::ifstream in(path);
@@ -36,54 +26,73 @@ bool is_averaged_log(const std::string& path) {
 }
 
 std::vector<core::AveragedSample> read_averaged_log(const std::string& path, AveragedLogLayout* layout_out) {
-  CsvTable table = [&] {
-    try {
-      return CsvTable::read(path, /*allow_nan=*/true);
-    } catch (const DriveLogError&) {
-      throw;
-    } catch (const InputError& e) {
-      throw DriveLogError(e.file(), e.line(), 0, e.field(), e.reason());
-    }
-  }();
-  auto required = [&](const char* name) -> const std::vector<double>& {
-    if (!table.has(name)) throw DriveLogError(path, 1, 0, std::string("column ") + name, "required column is missing from the header");
-    return table.column(name);
-  };
-  const auto& t = required("t");
-  const auto& t_start = required("t_start");
-  const auto& i_d = required("i_d");
-  const auto& i_q = required("i_q");
-  const auto& u_d = required("u_d");
-  const auto& u_q = required("u_q");
-  const auto& omega = required("omega_el");
-  AveragedLogLayout layout;
-  layout.u_dc = table.has("u_dc");
-  layout.t_winding = table.has("T_winding");
-  layout.t_magnet = table.has("T_magnet");
-  layout.t_drive = table.has("T_drive");
-  auto optional = [&](bool present, const char* name, std::size_t k) { return present ? table.column(name)[k] : kNaN; };
-  if (table.rows() == 0) throw DriveLogError(path, 2, 0, "", "no samples");
+  AveragedLogRead read;
+  std::vector<core::AveragedSample> samples = read_averaged_log(path, averaged_log_map(), DriveLogLimits{}, &read);
+  if (layout_out) *layout_out = read.layout;
+  return samples;
+}
 
-  std::vector<core::AveragedSample> out(table.rows());
-  for (std::size_t k = 0; k < table.rows(); ++k) {
-    for (const auto& [col, name] : {std::pair{&t, "t"}, {&t_start, "t_start"}, {&i_d, "i_d"}, {&i_q, "i_q"},
-                                    {&u_d, "u_d"}, {&u_q, "u_q"}, {&omega, "omega_el"}}) {
-      if (!std::isfinite((*col)[k])) throw DriveLogError(path, line_of(k), 0, std::string("column ") + name, "NaN in a required column");
-    }
-    core::AveragedSample& s = out[k];
-    s.t_ns = std::llround(t[k] * 1e9);
-    s.t_start_ns = std::llround(t_start[k] * 1e9);
-    if (k > 0 && s.t_ns <= out[k - 1].t_ns) throw DriveLogError(path, line_of(k), 0, "column t", "time does not increase");
-    if (s.t_start_ns > s.t_ns) throw DriveLogError(path, line_of(k), 0, "column t_start", "window starts after it ends (t_start > t)");
-    s.i_dq_A = {i_d[k], i_q[k]};
-    s.u_dq_V = {u_d[k], u_q[k]};
-    s.omega_el_rad_s = omega[k];
-    s.u_dc_V = optional(layout.u_dc, "u_dc", k);
-    s.t_winding_C = optional(layout.t_winding, "T_winding", k);
-    s.t_magnet_C = optional(layout.t_magnet, "T_magnet", k);
-    s.t_drive_C = optional(layout.t_drive, "T_drive", k);
+std::vector<core::AveragedSample> read_averaged_log(const std::string& path, const LogMap& map,
+                                                    const DriveLogLimits& limits, AveragedLogRead* read_out) {
+  if (!map.averaged()) {
+    throw ConfigError(map.name, 0, 0, "samples", "a map of instantaneous samples does not give averaged samples");
   }
-  if (layout_out) *layout_out = layout;
+  MappedLogReader reader(path, map, limits);
+  if (map.columns_optional) {
+    // Our own format names its quantities in the header: what an averaged log needs is checked here.
+    if (map.window == Window::kStartColumn && !reader.has(Quantity::kTStart)) {
+      reader.fail_at(reader.line(), "t_start", "required column is missing from the header");
+    }
+    if (const std::optional<LayoutProblem> p = averaged_log_layout_problem(reader.present())) {
+      reader.fail_at(reader.line(), p->column,
+                     p->reason == "required" ? "required column is missing from the header" : p->reason);
+    }
+  }
+  AveragedLogRead read;
+  read.layout.u_dc = reader.has(Quantity::kUDc);
+  read.layout.t_winding = reader.has(Quantity::kTWinding);
+  read.layout.t_magnet = reader.has(Quantity::kTMagnet);
+  read.layout.t_drive = reader.has(Quantity::kTDrive);
+  read.layout.t_coolant = reader.has(Quantity::kTCoolant);
+
+  std::vector<core::AveragedSample> out;
+  MappedRow r;
+  std::optional<std::int64_t> previous_t_ns;
+  std::size_t first_line = 0;
+  while (reader.next(r)) {
+    ++read.rows;
+    core::AveragedSample s;
+    s.t_ns = r.t_ns;
+    if (map.window == Window::kStartColumn) {
+      s.t_start_ns = std::llround(r[Quantity::kTStart] * 1e9);
+      if (s.t_start_ns > s.t_ns) reader.fail_at(r.line, Quantity::kTStart, "window starts after it ends (t_start > t)");
+    } else if (!previous_t_ns) {
+      // The means of the first row ran since a read before the log began: an unknown window.
+      previous_t_ns = r.t_ns;
+      first_line = r.line;
+      ++read.opening_rows;
+      continue;
+    } else {
+      s.t_start_ns = *previous_t_ns;
+    }
+    previous_t_ns = r.t_ns;
+    s.i_dq_A = {r[Quantity::kID], r[Quantity::kIQ]};
+    s.u_dq_V = {r[Quantity::kUD], r[Quantity::kUQ]};
+    s.omega_el_rad_s = r[Quantity::kOmegaEl];
+    s.u_dc_V = r[Quantity::kUDc];
+    s.t_winding_C = r[Quantity::kTWinding];
+    s.t_magnet_C = r[Quantity::kTMagnet];
+    s.t_drive_C = r[Quantity::kTDrive];
+    s.t_coolant_C = r[Quantity::kTCoolant];
+    out.push_back(s);
+  }
+  if (out.empty()) {
+    throw DriveLogError(path, first_line, 0, "",
+                        "no samples: the only row holds means since a read before the log began (an unknown window); "
+                        "a sample needs the row before it");
+  }
+  read.repairs = reader.repairs();
+  if (read_out) *read_out = read;
   return out;
 }
 
@@ -95,6 +104,7 @@ AveragedLogWriter::AveragedLogWriter(const std::string& path, const AveragedLogL
   if (layout_.t_winding) h += ",T_winding";
   if (layout_.t_magnet) h += ",T_magnet";
   if (layout_.t_drive) h += ",T_drive";
+  if (layout_.t_coolant) h += ",T_coolant";
   out_ << h << '\n';
 }
 
@@ -107,6 +117,7 @@ void AveragedLogWriter::write(const core::AveragedSample& s) {
   if (layout_.t_winding) append_number(line_ += ',', s.t_winding_C);
   if (layout_.t_magnet) append_number(line_ += ',', s.t_magnet_C);
   if (layout_.t_drive) append_number(line_ += ',', s.t_drive_C);
+  if (layout_.t_coolant) append_number(line_ += ',', s.t_coolant_C);
   line_ += '\n';
   out_ << line_;
 }
@@ -126,6 +137,7 @@ DriveLogRow to_drive_log_row(const core::AveragedSample& s) {
   r.sample.gap_before = s.gap_before;
   if (!std::isnan(s.t_winding_C)) r.t_winding_C = s.t_winding_C;
   if (!std::isnan(s.t_magnet_C)) r.t_magnet_C = s.t_magnet_C;
+  if (!std::isnan(s.t_coolant_C)) r.t_coolant_C = s.t_coolant_C;
   return r;
 }
 
@@ -137,6 +149,7 @@ DriveLogLayout rotor_frame_layout(const AveragedLogLayout& a) {
   l.voltage_dq = l.current_dq = true;
   l.t_winding = a.t_winding;
   l.t_magnet = a.t_magnet;
+  l.t_coolant = a.t_coolant;
   return l;
 }
 

@@ -11,204 +11,75 @@
 #include "rpem/io/number_format.hpp"
 
 namespace rpem::io {
-namespace {
-
-bool blank(char c) { return c == ' ' || c == '\t' || c == '\r'; }
-
-/// Splits a row at commas into trimmed cells; the cells' strings are reused from row to row.
-void split(const std::string& line, std::vector<std::string>& cells) {
-  std::size_t n = 0;
-  std::size_t start = 0;
-  while (true) {
-    const std::size_t comma = line.find(',', start);
-    std::size_t first = start;
-    std::size_t last = comma == std::string::npos ? line.size() : comma;
-    while (first < last && blank(line[first])) ++first;
-    while (last > first && blank(line[last - 1])) --last;
-    if (n == cells.size()) cells.emplace_back();
-    cells[n++].assign(line, first, last - first);
-    if (comma == std::string::npos) break;
-    start = comma + 1;
-  }
-  cells.resize(n);
-}
-
-/// A number for a message (six significant digits).
-std::string g6(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.6g", v);
-  return buf;
-}
-
-}  // namespace
-
 DriveLogReader::DriveLogReader(const std::string& path, DriveLogLimits limits)
-    : path_(path), file_(path, std::ios::binary), in_(file_), limits_(std::move(limits)) {
-  if (!file_) throw DriveLogError(path, 0, 0, "", "cannot open file");
-  std::error_code ec;
-  bytes_total_ = std::filesystem::file_size(path, ec);
-  read_header();
+    : reader_(path, drive_log_map(), std::move(limits)) {
+  check_layout();
 }
 
 DriveLogReader::DriveLogReader(std::istream& in, std::string name, DriveLogLimits limits)
-    : path_(std::move(name)), in_(in), limits_(std::move(limits)) {
-  read_header();
+    : reader_(in, std::move(name), drive_log_map(), std::move(limits)) {
+  check_layout();
 }
 
-void DriveLogReader::read_header() {
-  std::string header_line;
-  if (!std::getline(in_, header_line)) throw DriveLogError(path_, 1, 0, "", "empty file: expected a header row");
-  line_ = 1;
-  bytes_read_ = header_line.size() + 1;
-  split(header_line, header_);
-  auto find = [&](const char* name) {
-    Column c;
-    for (std::size_t k = 0; k < header_.size(); ++k) {
-      if (header_[k] == name) {
-        if (c.present()) fail(name, "column appears twice in the header");
-        c.index = static_cast<int>(k);
-      }
-    }
-    return c;
-  };
-  t_ = find("t");
-  theta_ = find("theta_el");
-  omega_ = find("omega_el");
-  udc_ = find("u_dc");
-  ua_ = find("u_a"), ub_ = find("u_b"), uc_ = find("u_c");
-  ud_ = find("u_d"), uq_ = find("u_q");
-  ia_ = find("i_a"), ib_ = find("i_b"), ic_ = find("i_c");
-  id_ = find("i_d"), iq_ = find("i_q");
-  tw_ = find("T_winding"), tm_ = find("T_magnet"), tq_ = find("torque_cmd");
-
-  for (auto [col, name] : {std::pair{t_, "t"}, {omega_, "omega_el"}}) {
-    if (!col.present()) fail(name, "required column is missing from the header");
+DriveLogReader::DriveLogReader(const std::string& path, LogMap map, DriveLogLimits limits)
+    : reader_(path, std::move(map), std::move(limits)) {
+  if (reader_.map().averaged()) {
+    throw ConfigError(reader_.map().name, 0, 0, "samples", "a map of averaged samples does not give drive-log rows");
   }
-  auto group = [&](std::initializer_list<std::pair<Column, const char*>> cols, const char* what) {
-    int present = 0;
-    for (const auto& [c, n] : cols) present += c.present() ? 1 : 0;
-    if (present != 0 && present != static_cast<int>(cols.size())) {
-      for (const auto& [c, n] : cols) {
-        if (!c.present()) fail(n, std::string("incomplete ") + what + " column group");
-      }
-    }
-    return present != 0;
-  };
-  layout_.voltage_abc = group({{ua_, "u_a"}, {ub_, "u_b"}, {uc_, "u_c"}}, "phase-voltage");
-  layout_.voltage_dq = group({{ud_, "u_d"}, {uq_, "u_q"}}, "rotor-frame voltage");
-  layout_.current_abc = group({{ia_, "i_a"}, {ib_, "i_b"}, {ic_, "i_c"}}, "phase-current");
-  layout_.current_dq = group({{id_, "i_d"}, {iq_, "i_q"}}, "rotor-frame current");
-  if (!layout_.voltage_abc && !layout_.voltage_dq) fail("u_a,u_b,u_c|u_d,u_q", "no voltage-command columns");
-  if (!layout_.current_abc && !layout_.current_dq) fail("i_a,i_b,i_c|i_d,i_q", "no current columns");
-  // A log entirely in the rotor frame needs no angle, and may not know its DC link (docs/drive-log.md).
-  const bool rotor_frame_only = !layout_.voltage_abc && !layout_.current_abc;
-  for (auto [col, name] : {std::pair{theta_, "theta_el"}, {udc_, "u_dc"}}) {
-    if (!col.present() && !rotor_frame_only) {
-      fail(name, "required column is missing from the header (optional only when voltage and current are both "
-                 "given as u_d,u_q and i_d,i_q only)");
-    }
+  check_layout();
+}
+
+void DriveLogReader::check_layout() {
+  // Our own format names its quantities in the header, so what a drive log needs is checked here; a map
+  // was checked when it was loaded.
+  if (const std::optional<LayoutProblem> p = drive_log_layout_problem(reader_.present())) {
+    const std::string reason = p->reason.rfind("required", 0) == 0
+                                   ? "required column is missing from the header" + p->reason.substr(8)
+                                   : p->reason;
+    reader_.fail_at(reader_.line(), p->column, reason);
   }
-  layout_.angle = theta_.present();
-  layout_.u_dc = udc_.present();
-  layout_.t_winding = tw_.present();
-  layout_.t_magnet = tm_.present();
-  layout_.torque_cmd = tq_.present();
-}
-
-void DriveLogReader::fail(const std::string& column, const std::string& reason) const {
-  throw DriveLogError(path_, line_, 0, "column " + column, reason);
-}
-
-void DriveLogReader::fail(const Column& c, const char* name, const std::string& reason) const {
-  throw DriveLogError(path_, line_, static_cast<std::size_t>(c.index) + 1, std::string("column ") + name, reason);
-}
-
-double DriveLogReader::cell(const Column& c, const char* name) const {
-  if (static_cast<std::size_t>(c.index) >= cells_.size()) fail(name, "row has too few cells");
-  const std::string& s = cells_[static_cast<std::size_t>(c.index)];
-  if (s.empty()) fail(c, name, "empty cell");
-  double v = 0.0;
-  const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
-  if (ec != std::errc() || end != s.data() + s.size()) fail(c, name, "'" + s + "' is not a number");
-  if (std::isnan(v)) fail(c, name, "NaN");
-  if (!std::isfinite(v)) fail(c, name, "'" + s + "' is not finite");
-  return v;
-}
-
-double DriveLogReader::cell(const Column& c, const char* name, const Bound& bound, const char* unit) const {
-  const double v = cell(c, name);
-  if (std::abs(v) > bound.max_abs) {
-    fail(c, name, g6(v) + " " + unit + " is beyond the plausible ±" + g6(bound.max_abs) + " " +
-                      unit + " (" + bound.why + ")");
-  }
-  return v;
-}
-
-double DriveLogReader::temperature(const Column& c, const char* name) const {
-  const double v = cell(c, name);
-  if (v < limits_.temperature_min_C || v > limits_.temperature_max_C) {
-    fail(c, name, g6(v) + " °C is outside the plausible [" + g6(limits_.temperature_min_C) + ", " +
-                      g6(limits_.temperature_max_C) + "] °C");
-  }
-  return v;
-}
-
-double DriveLogReader::command(const Column& c, const char* name, double u_dc_V) const {
-  const double v = cell(c, name, limits_.voltage_V, "V");
-  if (u_dc_V >= 1.0 && std::abs(v) > limits_.command_per_dc_link * u_dc_V) {
-    fail(c, name, g6(v) + " V is more than " + g6(limits_.command_per_dc_link) +
-                      " x this row's u_dc = " + g6(u_dc_V) +
-                      " V (a two-level inverter applies at most u_dc/2 from the link's midpoint)");
-  }
-  return v;
+  auto has = [&](Quantity q) { return reader_.has(q); };
+  layout_.angle = has(Quantity::kThetaEl);
+  layout_.u_dc = has(Quantity::kUDc);
+  layout_.voltage_abc = has(Quantity::kUA);
+  layout_.voltage_dq = has(Quantity::kUD);
+  layout_.current_abc = has(Quantity::kIA);
+  layout_.current_dq = has(Quantity::kID);
+  layout_.t_winding = has(Quantity::kTWinding);
+  layout_.t_magnet = has(Quantity::kTMagnet);
+  layout_.t_coolant = has(Quantity::kTCoolant);
+  layout_.torque_cmd = has(Quantity::kTorqueCmd);
 }
 
 bool DriveLogReader::next(DriveLogRow& row) {
-  std::string text;
-  while (std::getline(in_, text)) {
-    ++line_;
-    bytes_read_ += text.size() + 1;
-    if (std::all_of(text.begin(), text.end(), blank)) continue;  // blank line
-    split(text, cells_);
-    if (cells_.size() != header_.size()) {
-      fail("*", "row has " + std::to_string(cells_.size()) + " cells, header has " + std::to_string(header_.size()));
-    }
-    core::DriveSample& s = row.sample;
-    const std::int64_t t_ns = std::llround(cell(t_, "t", limits_.time_s, "s") * 1e9);
-    if (previous_t_ns_ && t_ns <= *previous_t_ns_) fail(t_, "t", "time does not increase (by at least 1 ns)");
-    previous_t_ns_ = t_ns;
-    s.t_ns = t_ns;
-    s.theta_el_rad = theta_.present() ? cell(theta_, "theta_el", limits_.angle_rad, "rad") : 0.0;
-    s.omega_el_rad_s = cell(omega_, "omega_el", limits_.speed_rad_s, "rad/s");
-    s.u_dc_V = udc_.present() ? cell(udc_, "u_dc", limits_.voltage_V, "V") : 0.0;
-    s.gap_before = false;
-    const double u_dc = s.u_dc_V;
-    if (layout_.voltage_abc) {
-      s.voltage_frame = core::Frame::kAbc;
-      s.u_V = {command(ua_, "u_a", u_dc), command(ub_, "u_b", u_dc), command(uc_, "u_c", u_dc)};
-      if (layout_.voltage_dq) (void)command(ud_, "u_d", u_dc), (void)command(uq_, "u_q", u_dc);  // validate all cells
-    } else {
-      s.voltage_frame = core::Frame::kDq;
-      s.u_V = {command(ud_, "u_d", u_dc), command(uq_, "u_q", u_dc), 0.0};
-    }
-    const Bound& i_max = limits_.current_A;
-    if (layout_.current_abc) {
-      s.current_frame = core::Frame::kAbc;
-      s.i_A = {cell(ia_, "i_a", i_max, "A"), cell(ib_, "i_b", i_max, "A"), cell(ic_, "i_c", i_max, "A")};
-      if (layout_.current_dq) (void)cell(id_, "i_d", i_max, "A"), (void)cell(iq_, "i_q", i_max, "A");
-    } else {
-      s.current_frame = core::Frame::kDq;
-      s.i_A = {cell(id_, "i_d", i_max, "A"), cell(iq_, "i_q", i_max, "A"), 0.0};
-    }
-    row.t_winding_C = layout_.t_winding ? std::optional(temperature(tw_, "T_winding")) : std::nullopt;
-    row.t_magnet_C = layout_.t_magnet ? std::optional(temperature(tm_, "T_magnet")) : std::nullopt;
-    row.torque_cmd_Nm =
-        layout_.torque_cmd ? std::optional(cell(tq_, "torque_cmd", limits_.torque_Nm, "Nm")) : std::nullopt;
-    ++rows_;
-    return true;
+  if (!reader_.next(row_)) return false;
+  const MappedRow& r = row_;
+  core::DriveSample& s = row.sample;
+  s.t_ns = r.t_ns;
+  s.theta_el_rad = layout_.angle ? r[Quantity::kThetaEl] : 0.0;
+  s.omega_el_rad_s = r[Quantity::kOmegaEl];
+  s.u_dc_V = layout_.u_dc ? r[Quantity::kUDc] : 0.0;
+  s.gap_before = false;
+  if (layout_.voltage_abc) {
+    s.voltage_frame = core::Frame::kAbc;
+    s.u_V = {r[Quantity::kUA], r[Quantity::kUB], r[Quantity::kUC]};
+  } else {
+    s.voltage_frame = core::Frame::kDq;
+    s.u_V = {r[Quantity::kUD], r[Quantity::kUQ], 0.0};
   }
-  if (rows_ == 0) throw DriveLogError(path_, line_, 0, "", "no samples: the header is followed by no data rows");
-  return false;
+  if (layout_.current_abc) {
+    s.current_frame = core::Frame::kAbc;
+    s.i_A = {r[Quantity::kIA], r[Quantity::kIB], r[Quantity::kIC]};
+  } else {
+    s.current_frame = core::Frame::kDq;
+    s.i_A = {r[Quantity::kID], r[Quantity::kIQ], 0.0};
+  }
+  auto optional = [&](bool present, Quantity q) { return present ? std::optional(r[q]) : std::nullopt; };
+  row.t_winding_C = optional(layout_.t_winding, Quantity::kTWinding);
+  row.t_magnet_C = optional(layout_.t_magnet, Quantity::kTMagnet);
+  row.t_coolant_C = optional(layout_.t_coolant, Quantity::kTCoolant);
+  row.torque_cmd_Nm = optional(layout_.torque_cmd, Quantity::kTorqueCmd);
+  return true;
 }
 
 std::vector<DriveLogRow> read_drive_log(const std::string& path, const DriveLogLimits& limits) {
@@ -229,6 +100,7 @@ DriveLogWriter::DriveLogWriter(const std::string& path, const DriveLogLayout& la
   if (layout_.current_dq) h += ",i_d,i_q";
   if (layout_.t_winding) h += ",T_winding";
   if (layout_.t_magnet) h += ",T_magnet";
+  if (layout_.t_coolant) h += ",T_coolant";
   if (layout_.torque_cmd) h += ",torque_cmd";
   out_ << h << '\n';
 }
@@ -267,6 +139,7 @@ void DriveLogWriter::write(const DriveLogRow& row) {
   }
   if (layout_.t_winding) append_number(line_ += ',', row.t_winding_C.value_or(std::nan("")));
   if (layout_.t_magnet) append_number(line_ += ',', row.t_magnet_C.value_or(std::nan("")));
+  if (layout_.t_coolant) append_number(line_ += ',', row.t_coolant_C.value_or(std::nan("")));
   if (layout_.torque_cmd) append_number(line_ += ',', row.torque_cmd_Nm.value_or(std::nan("")));
   line_ += '\n';
   out_ << line_;

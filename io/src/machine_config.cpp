@@ -70,6 +70,7 @@ core::EstimatorSettings parse_estimator(YamlMap e, const core::MachineSi& machin
       e.number_or("max_sample_interval_s", core::EstimatorOptions::kMaxSampleIntervalPeriods * s.nominal_sample_period_s,
                   s.nominal_sample_period_s, 10.0);
   s.max_gap_carry_s = e.number_or("max_gap_carry_s", s.max_gap_carry_s, 0.0, 1.0);
+  s.outlier_bound_sigma = e.number_or("outlier_bound_sigma", s.outlier_bound_sigma, 0.0, 100.0);
   if (auto a = e.optional_map("adapt")) {
     s.adapt_psi_m = a->boolean_or("psi_m", s.adapt_psi_m);
     s.adapt_r_s = a->boolean_or("r_s", s.adapt_r_s);
@@ -138,7 +139,23 @@ core::EstimatorSettings parse_estimator(YamlMap e, const core::MachineSi& machin
         a->number_or("instrument_time_constant_s", s.averaged.instrument_time_constant_s, 0.0, 10.0);
     s.averaged.control_period_s = a->number_or("control_period_s", s.averaged.control_period_s, 0.0, 1e-2);
     s.averaged.current_sample_at = a->number_or("current_sample_at", s.averaged.current_sample_at, 0.0, 1.0);
+    s.averaged.voltage_is_command = a->choice_or("voltage_reported", "mean", {"mean", "command"}) == "command";
+    if (s.averaged.voltage_is_command && !(s.averaged.control_period_s > 0.0)) {
+      a->fail("voltage_reported", "command needs control_period_s (the period the command is held)");
+    }
     a->finish();
+  }
+  if (auto g = e.optional_map("regimes")) {
+    // The regime classification (core/regime.hpp, docs/derivations.md §13).
+    core::RegimeSettings& r = s.regimes;
+    r.enabled = g->boolean_or("enabled", r.enabled);
+    r.significance_sigma = g->number_or("significance_sigma", r.significance_sigma, 1.0, 10.0);
+    r.voltage_resolution_V = g->number_or("voltage_resolution_V", r.voltage_resolution_V, 0.0, 1e3);
+    r.current_resolution_A = g->number_or("current_resolution_A", r.current_resolution_A, 0.0, 1e3);
+    r.speed_resolution_rad_s = g->number_or("speed_resolution_rad_s", r.speed_resolution_rad_s, 0.0, 1e4);
+    r.inductance_tolerance = g->number_or("inductance_tolerance", r.inductance_tolerance, 0.0, 10.0);
+    r.angle_tolerance_rad = g->number_or("angle_tolerance_rad", r.angle_tolerance_rad, 0.0, 1.5);
+    g->finish();
   }
   e.finish();
   return s;

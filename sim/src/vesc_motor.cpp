@@ -5,6 +5,8 @@
 #include "rpem/core/clock.hpp"
 #include "rpem/core/units.hpp"
 
+#include "rpem/core/frames.hpp"
+
 namespace rpem::sim {
 namespace {
 
@@ -19,10 +21,30 @@ VescMotor::VescMotor(Scenario scenario, Settings settings)
     : simulator_(std::move(scenario)), settings_(settings) {}
 
 bool VescMotor::step() noexcept {
+  const TruthRow at_start = truth_;  // the start of the cycle the next row completes
   if (!simulator_.next(row_, truth_)) return false;
   started_ = true;
-  if (const auto c = cycles_.add(row_)) account(*c);
+  if (const auto c = cycles_.add(row_)) account(firmware_view(*c, at_start));
   return true;
+}
+
+ControlCycle VescMotor::firmware_view(ControlCycle c, const TruthRow& at_start) noexcept {
+  if (at_start.modulating()) {
+    v_dq_filter_V_ = c.u_dq_V;
+    return c;
+  }
+  c.i_dq_A.setZero();  // "The current is 0 when the motor is undriven"
+  if (at_start.off_report == OffVoltageReport::kZero) {
+    v_dq_filter_V_.setZero();
+  } else {
+    // No current: the terminal voltage is the back EMF, (0, ω·ψm) in the rotor frame; the firmware Parks it
+    // at its observer's angle (the measured one here) and low-passes it (UTILS_LP_FAST, 0.2).
+    const core::Vec2 e(0.0, at_start.omega_el_rad_s * at_start.parameters.psi_m_Wb);
+    const core::Vec2 sensed = core::park(e, core::Rotation::of(core::wrap_angle(c.theta_el_rad - at_start.theta_el_rad)));
+    v_dq_filter_V_ += 0.2 * (sensed - v_dq_filter_V_);
+  }
+  c.u_dq_V = v_dq_filter_V_;
+  return c;
 }
 
 bool VescMotor::advance_to(std::int64_t t_ns) noexcept {

@@ -8,6 +8,9 @@
 out=${1:-/host}
 fail=0
 step() { echo "vcan_suite: $*"; }
+# A recorder is ready once it says it listens (its socket is open): a fixed sleep loses the first frames
+# under a loaded emulator.
+wait_listening() { i=0; until grep -q "listening on" "$1" 2>/dev/null || [ $i -ge 600 ]; do sleep 0.1; i=$((i + 1)); done; }
 
 step "SocketCAN tests"
 test_socketcan --gtest_color=no || fail=1
@@ -21,7 +24,7 @@ candump -r 8388608 -L vcan0,100:7FF > /tmp/capture.log &
 dump=$!
 rpem record --can vcan0 --out "$out/recorded.csv" --idle-timeout 1.5 > "$out/record.txt" 2>&1 &
 rec=$!
-sleep 0.5
+wait_listening "$out/record.txt"
 rpem sim --scenario can-stream.yaml --can vcan0 --out "$out/sent.csv" 2> "$out/sim.txt" || fail=1
 wait $rec || fail=1
 kill $dump; wait $dump 2>/dev/null
@@ -31,7 +34,7 @@ cat "$out/record.txt"
 step "canplayer -> record"
 rpem record --can vcan0 --out "$out/replayed.csv" --idle-timeout 1.5 > "$out/record2.txt" 2>&1 &
 rec=$!
-sleep 0.5
+wait_listening "$out/record2.txt"
 canplayer -I /tmp/capture.log vcan0=vcan0 || fail=1
 wait $rec || fail=1
 cat "$out/record2.txt"
@@ -39,7 +42,7 @@ cat "$out/record2.txt"
 step "replay -> record (classic CAN)"
 rpem record --can vcan0 --out "$out/classic_recorded.csv" --idle-timeout 1.5 > "$out/record3.txt" 2>&1 &
 rec=$!
-sleep 0.5
+wait_listening "$out/record3.txt"
 head -n 2001 "$out/sent.csv" > "$out/classic_sent.csv"
 rpem replay "$out/classic_sent.csv" --can vcan0 --classic --rate 4 || fail=1
 wait $rec || fail=1

@@ -12,6 +12,9 @@
 out=${1:-/host}
 fail=0
 step() { echo "vesc_suite: $*"; }
+# A recorder is ready once it says it listens (its socket is open): a fixed sleep loses the first frames
+# under a loaded emulator.
+wait_listening() { i=0; until grep -q "listening on" "$1" 2>/dev/null || [ $i -ge 600 ]; do sleep 0.1; i=$((i + 1)); done; }
 echo 16777216 > /proc/sys/net/core/rmem_max 2>/dev/null
 
 step "emulated VESC 17, polled by cangen, captured by candump"
@@ -42,7 +45,7 @@ cat "$out/vesc_avg.txt"
 step "native telemetry -> rpem record --averaged-out"
 rpem record --can vcan0 --averaged-out "$out/native_avg.csv" --window-rate 200 --idle-timeout 1.5 > "$out/native_avg.txt" 2>&1 &
 rec=$!
-sleep 0.5
+wait_listening "$out/native_avg.txt"
 rpem sim --scenario can-stream.yaml --can vcan0 --out "$out/native_sent.csv" 2> /dev/null || fail=1
 wait $rec || fail=1
 cat "$out/native_avg.txt"
@@ -51,7 +54,7 @@ step "signal map over classic frames -> rpem record --averaged-out"
 rpem record --can vcan0 --signal-map rpem-native-classic.yaml --averaged-out "$out/map_avg.csv" --idle-timeout 1.5 \
   > "$out/map_avg.txt" 2>&1 &
 rec=$!
-sleep 0.5
+wait_listening "$out/map_avg.txt"
 head -n 2001 "$out/native_sent.csv" > /tmp/classic_sent.csv
 cp /tmp/classic_sent.csv "$out/classic_sent.csv"
 rpem replay /tmp/classic_sent.csv --can vcan0 --classic --rate 1 || fail=1

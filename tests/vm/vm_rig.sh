@@ -130,7 +130,8 @@ run() {
   local initrd console
   initrd=$(mktemp --suffix=.gz)
   console=$(mktemp)
-  trap 'rm -f "$initrd" "$console"' EXIT
+  # Expanded now: a signal (ctest's timeout) runs the trap where these locals are out of scope.
+  trap "rm -f $(printf %q "$initrd") $(printf %q "$console")" EXIT
   build_initramfs "$initrd"
   log "booting $(cat "$cache/kernel.ready") (TCG, $smp cpus${RPEM_VM_KERNEL_ARGS:+; kernel args: $RPEM_VM_KERNEL_ARGS}) for: ${command[*]}"
   local vmlinuz

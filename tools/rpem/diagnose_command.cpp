@@ -13,12 +13,13 @@
 #include "rpem/analysis/diagnose/diagnose_output.hpp"
 #include "rpem/io/errors.hpp"
 #include "rpem/io/number_format.hpp"
+#include "rpem/io/sample_counts.hpp"
 
 namespace rpem::tools {
 namespace {
 
 struct DiagnoseCliOptions {
-  std::string log, config, out, truth, model = "auto";
+  std::string log, log_map, config, out, truth, model = "auto";
   double reference_C = analysis::DiagnoseOptions{}.reference_C;
   double switching_frequency_Hz = 0.0;
   analysis::SelectionOptions selection;
@@ -40,11 +41,16 @@ int run_diagnose(const DiagnoseCliOptions& o) {
 
   analysis::LogOptions log_options;
   log_options.blocks = o.blocks;
+  log_options.log_map = o.log_map;
+  log_options.voltage_is_command = config.estimator.averaged.voltage_is_command;
+  log_options.control_period_s = config.estimator.averaged.control_period_s;
+  log_options.command_delay_s = config.estimator.extensions.delay_s;
   if (o.model != "auto") {
     log_options.mode = o.model == "transient" ? analysis::ModelMode::kTransient : analysis::ModelMode::kSteadyState;
   }
   std::fprintf(stderr, "rpem diagnose: reading %s\n", o.log.c_str());
   analysis::LogData log = analysis::load_log(o.log, config.machine, log_options);
+  std::fprintf(stderr, "rpem diagnose: read %s\n", log.format.c_str());
   io::check_log_supports(config, config_name, log.layout.u_dc, o.log);
   const analysis::ParameterTrack truth = o.truth.empty() ? analysis::ParameterTrack{} : analysis::load_truth(o.truth);
 
@@ -55,6 +61,8 @@ int run_diagnose(const DiagnoseCliOptions& o) {
   std::fprintf(stderr, "rpem diagnose: %zu samples, %s model; fitting the catalogue's effects\n", log.rows.size(),
                analysis::to_string(log.mode));
   const analysis::Diagnosis d = analysis::diagnose(std::move(log), config, options, truth);
+  std::fprintf(stderr, "rpem diagnose: %s\n", io::regime_summary(d.regimes.counts).c_str());
+  for (const std::string& why : d.regimes.explanations) std::fprintf(stderr, "rpem diagnose: %s\n", why.c_str());
 
   std::error_code ec;
   std::filesystem::create_directories(o.out, ec);
@@ -73,7 +81,14 @@ int run_diagnose(const DiagnoseCliOptions& o) {
     }
   }
   std::printf("\n");
+  for (const std::string& f : analysis::calibrated_despite_mismatch(d)) std::printf("calibrated despite a large mismatch: %s\n", f.c_str());
   for (const std::string& f : analysis::calibration_findings(d)) std::printf("calibration: %s\n", f.c_str());
+  if (d.least_squares) {
+    std::printf("outliers: %zu of %zu training samples beyond %.3g A moved the least-squares fit (%s by %.2g times its 95 %% "
+                "half-width): diagnosed again under Huber's loss, b = %.3g A after %d run%s\n",
+                d.outliers.test.beyond, d.outliers.test.samples, d.outliers.test.threshold_A, d.outliers.parameter.c_str(),
+                d.outliers.largest_shift, d.outliers.loss.threshold_A, d.outliers.robust_runs, d.outliers.robust_runs == 1 ? "" : "s");
+  }
   if (s.found.empty()) std::printf("effects: none\n");
   for (std::size_t j = 0; j < s.found.size(); ++j) {
     std::printf("effect %s:", s.found[j].effect.label().c_str());
@@ -96,8 +111,12 @@ int run_diagnose(const DiagnoseCliOptions& o) {
     std::printf("not identifiable: %s\n", names.c_str());
   }
   std::printf("extended model: held-out residual %.4g A RMS\n", s.extended_heldout_rms_A);
-  std::printf("verdict: %s (%.3g times the noise floor of %.3g A)\n", d.verdict.explained ? "explained" : "unexplained",
-              d.verdict.ratio, d.verdict.noise_floor_A);
+  if (d.verdict.ratio) {
+    std::printf("verdict: %s (%.3g times the noise floor of %.3g A)\n", analysis::to_string(d.verdict.kind), *d.verdict.ratio,
+                d.verdict.noise_floor_A.value_or(0.0));
+  } else {
+    std::printf("verdict: %s (noise floor unknown)\n", analysis::to_string(d.verdict.kind));
+  }
   for (const std::string& f : d.verdict.findings) std::printf("  %s\n", f.c_str());
   std::printf("wrote %s/report.html, report.md, diagnosis.json, extended.yaml (%.2f s)\n", o.out.c_str(), d.elapsed_s);
   return kExitOk;
@@ -109,7 +128,13 @@ Runner add_diagnose_command(CLI::App& app) {
   auto o = std::make_shared<DiagnoseCliOptions>();
   CLI::App* cmd = app.add_subcommand(
       "diagnose", "Show what the model gets wrong on measured data, name the cause, extend the model, measure the gain");
-  cmd->add_option("--log", o->log, "drive-log CSV (docs/drive-log.md)")->required()->check(CLI::ExistingFile);
+  cmd->add_option("--log", o->log,
+                  "drive log, averaged log or VESC Tool realtime log (detected by its header), or any CSV with --log-map "
+                  "(docs/drive-log.md)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--log-map", o->log_map, "column map (YAML) saying how to read --log (docs/drive-log.md, \"Column maps\")")
+      ->check(CLI::ExistingFile);
   cmd->add_option("--config", o->config,
                   "machine configuration YAML, the baseline: its whole model, extensions and drift laws (default: built-in "
                   "paper-ipmsm); an extended.yaml of another recording is one")

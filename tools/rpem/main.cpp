@@ -18,6 +18,7 @@ int main(int argc, char** argv) {
   runners.push_back(add_reproduce_command(app));
   runners.push_back(add_figures_command(app));
   runners.push_back(add_diagnose_command(app));
+  runners.push_back(add_thermal_command(app));
   runners.push_back(add_replay_command(app));
   runners.push_back(add_record_command(app));
   runners.push_back(add_listen_command(app));

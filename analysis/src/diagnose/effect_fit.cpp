@@ -7,6 +7,8 @@
 #include <cmath>
 #include <limits>
 
+#include "rpem/analysis/cluster_robust.hpp"
+
 namespace rpem::analysis {
 namespace {
 
@@ -125,6 +127,20 @@ bool identified(const EffectSet& set, const CalibrationIntervals& ci, std::size_
   return ci.half_width[i] <= kIdentifiedHalfWidth && std::abs(set.calibration[i]) < 0.99 * kCalibrationBound;
 }
 
+double misfit_norm_A(std::size_t training_samples, double heldout_rms_A, double noise_floor_A) {
+  if (heldout_rms_A <= noise_floor_A) return 0.0;
+  return std::sqrt(static_cast<double>(training_samples) * (heldout_rms_A * heldout_rms_A - noise_floor_A * noise_floor_A));
+}
+
+Identification identification(const EffectSet& set, const CalibrationIntervals& ci, std::size_t i, double misfit_A) {
+  if (identified(set, ci, i)) return Identification::kNarrow;
+  if (!(std::abs(set.calibration[i]) < 0.99 * kCalibrationBound)) return Identification::kNot;
+  // The configured value θ_c outside θ̂·(1 ± (h + m)), with θ̂ = θ_c·(1 + s·δ): |s·δ| > (h + m)·(1 + s·δ).
+  const double moved = kCalibrationScale * set.calibration[i];
+  const double widened = ci.half_width[i] + ci.change_per_A[i] * misfit_A;
+  return std::abs(moved) > widened * (1.0 + moved) ? Identification::kRejectsConfiguration : Identification::kNot;
+}
+
 ExtendedModel EffectSet::model(const EffectContext& c) const {
   ExtendedModel m = c.base;
   for (std::size_t i = 0; i < kCalibrated.size(); ++i) {
@@ -175,6 +191,12 @@ EffectFitter::EffectFitter(const ModelReplay& replay, const EffectContext& conte
   }
 }
 
+EffectFitter EffectFitter::with_loss(const RobustLoss& loss) const {
+  EffectFitter f = *this;
+  f.loss_ = loss;
+  return f;
+}
+
 void EffectFitter::training_residuals(const EffectSet& set, std::vector<double>& out) const {
   ReplayOutput r;
   replay_.run(set.model(context_), r, Blocks::kTraining);
@@ -182,7 +204,8 @@ void EffectFitter::training_residuals(const EffectSet& set, std::vector<double>&
   for (std::size_t j = 0; j < training_.size(); ++j) {
     const std::size_t k = training_[j];
     // A sample that stops being valid (non-finite) counts as a large miss rather than vanishing.
-    const core::Vec2 e = r.valid[k] ? r.residual_A[k] : core::Vec2::Constant(1e3);
+    core::Vec2 e = r.valid[k] ? r.residual_A[k] : core::Vec2::Constant(1e3);
+    e *= loss_.residual_scale(e.squaredNorm());
     out[2 * j] = e[0];
     out[2 * j + 1] = e[1];
   }
@@ -202,7 +225,7 @@ BlockScores EffectFitter::heldout(const EffectSet& set) const {
   b.ssr.assign(static_cast<std::size_t>(log.blocks / 2), 0.0);
   for (std::size_t k = 0; k < log.rows.size(); ++k) {
     if (!log.heldout(k) || !r.valid[k]) continue;
-    b.ssr[static_cast<std::size_t>(log.block[k] / 2)] += r.residual_A[k].squaredNorm();
+    b.ssr[static_cast<std::size_t>(log.block[k] / 2)] += loss_.rho(r.residual_A[k].squaredNorm());
     ++b.samples;
   }
   return b;
@@ -394,19 +417,6 @@ CalibrationIntervals EffectFitter::intervals(const EffectSet& set, double noise_
   for (Eigen::Index i = 0; i < n; ++i) {
     for (Eigen::Index j = 0; j <= i; ++j) h(i, j) = h(j, i) = dot(columns[static_cast<std::size_t>(i)], columns[static_cast<std::size_t>(j)]);
   }
-  // A constant the log does not excite has a vanishing column: a pseudo-inverse leaves it infinitely uncertain.
-  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(h);
-  const double floor = 1e-12 * std::max(eig.eigenvalues().maxCoeff(), 1e-300);
-  Eigen::MatrixXd h_inv = Eigen::MatrixXd::Zero(n, n);
-  Eigen::VectorXd unexcited = Eigen::VectorXd::Zero(n);
-  for (Eigen::Index k = 0; k < n; ++k) {
-    const Eigen::VectorXd v = eig.eigenvectors().col(k);
-    if (eig.eigenvalues()[k] > floor) {
-      h_inv += v * v.transpose() / eig.eigenvalues()[k];
-    } else {
-      unexcited += v.cwiseAbs2();
-    }
-  }
   // Cluster-robust "meat": the training blocks' score vectors g_b = J_bᵀ·r_b.
   const LogData& log = replay_.log();
   const std::size_t clusters = static_cast<std::size_t>(log.blocks / 2 + 1);
@@ -418,10 +428,11 @@ CalibrationIntervals EffectFitter::intervals(const EffectSet& set, double noise_
       g(c, b) += col[2 * j] * r0[2 * j] + col[2 * j + 1] * r0[2 * j + 1];
     }
   }
-  Eigen::Index used_clusters = 0;
-  for (Eigen::Index b = 0; b < g.cols(); ++b) used_clusters += g.col(b).squaredNorm() > 0.0 ? 1 : 0;
-  const double correction = used_clusters > 1 ? static_cast<double>(used_clusters) / static_cast<double>(used_clusters - 1) : 1.0;
-  const Eigen::MatrixXd robust = correction * h_inv * (g * g.transpose()) * h_inv;
+  // A constant the log does not excite has a vanishing column: the pseudo-inverse leaves it infinitely uncertain.
+  const ClusterRobustCovariance cov = cluster_robust_covariance(h, g);
+  const Eigen::MatrixXd& h_inv = cov.excitation;
+  const Eigen::MatrixXd& robust = cov.robust;
+  const Eigen::VectorXd& unexcited = cov.unexcited;
   const double sigma2 = 0.5 * noise_floor_A * noise_floor_A;  // per residual component
   CalibrationIntervals out;
   constexpr double kZ = 1.959964;
@@ -431,6 +442,7 @@ CalibrationIntervals EffectFitter::intervals(const EffectSet& set, double noise_
     const double factor = 1.0 + kCalibrationScale * set.calibration[i];
     const bool excited = unexcited[k] < 0.5;
     out.half_width[i] = excited ? kZ * kCalibrationScale * std::sqrt(std::max(robust(k, k), 0.0)) / factor : kInf;
+    out.change_per_A[i] = excited ? kCalibrationScale * std::sqrt(std::max(h_inv(k, k), 0.0)) / factor : kInf;
     out.excitation_half_width[i] = excited ? kZ * kCalibrationScale * std::sqrt(sigma2 * h_inv(k, k)) / factor : kInf;
   }
   auto k = static_cast<Eigen::Index>(kCalibrated.size());

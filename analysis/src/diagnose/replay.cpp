@@ -91,7 +91,12 @@ void ModelReplay::run_transient(const ExtendedModel& model, ReplayOutput& out, B
         coefficients = core::PredictorCoefficients::of(m, base_.omega_el_rad_s);
       }
       core::predict(m, coefficients, core::Discretization::kTrapezoidal, iv, state, core::Gradients::kSkip);
-      if (!log_.used[k]) continue;
+      if (!log_.used[k]) {
+        // Left out (its regime excluded it: bridge off, not locked): the model does not describe it, so the
+        // prediction starts again from the measurement after it.
+        synchronized = false;
+        continue;
+      }
       out.model_A[k] = conditioner.observed_current_dq_A(s, logged_rotation_[k], state.i_hat_pu);
       out.residual_A[k] = log_.logged_i_dq_A[k] - out.model_A[k];
       out.valid[k] = out.residual_A[k].allFinite();

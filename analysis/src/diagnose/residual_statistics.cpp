@@ -148,6 +148,8 @@ ResidualStatistics residual_statistics(const LogData& log, const EffectContext& 
   out.rms_A = {all_before.rms(), all_after.rms()};
   out.standstill_rms_A = {still_before.rms(), still_after.rms()};
   out.motion_rms_A = {moving_before.rms(), moving_after.rms()};
+  out.standstill_samples = still_before.n;
+  out.motion_samples = moving_before.n;
   for (int sr = 0; sr < 5; ++sr) {
     for (int lr = 0; lr < 3; ++lr) {
       const Moments& b = region_before[sr][lr];

@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <limits>
 
 namespace rpem::analysis {
 namespace {
@@ -47,7 +46,16 @@ std::string regressor_meaning(const std::string& r) {
 
 }  // namespace
 
-double noise_floor_A(const LogData& log, const ReplayOutput& replay) {
+const char* to_string(VerdictKind k) noexcept {
+  switch (k) {
+    case VerdictKind::kExplained: return "explained";
+    case VerdictKind::kUnexplained: return "unexplained";
+    case VerdictKind::kUndetermined: return "undetermined";
+  }
+  return "undetermined";
+}
+
+NoiseFloor measure_noise_floor(const LogData& log, const ReplayOutput& replay) {
   std::vector<double> d2, q2;
   const std::size_t n = log.rows.size();
   for (std::size_t k = 1; k + 1 < n; ++k) {
@@ -57,21 +65,55 @@ double noise_floor_A(const LogData& log, const ReplayOutput& replay) {
     d2.push_back(e[0] * e[0]);
     q2.push_back(e[1] * e[1]);
   }
-  if (d2.size() < 10) return 0.0;
+  NoiseFloor f;
+  f.differences = d2.size();
+  if (d2.size() < kMinNoiseDifferences) {
+    const std::size_t valid = static_cast<std::size_t>(std::count(replay.valid.begin(), replay.valid.end(), true));
+    f.unknown_reason = "only " + std::to_string(d2.size()) + " of the " + std::to_string(n) + " samples have replayed neighbours "
+                       "on both sides within their block (" + std::to_string(kMinNoiseDifferences) + " are needed): ";
+    if (log.mode == ModelMode::kSteadyState) {
+      f.unknown_reason += std::to_string(log.excluded_transitional) + " rows are in transition between operating points and " +
+                          std::to_string(log.excluded_idle) + " idle, so no stretch of rows repeats an operating point " +
+                          "(standstill under current included) and " + std::to_string(valid) + " rows are replayed";
+    } else {
+      f.unknown_reason += "gaps and left-out samples leave " + std::to_string(valid) + " replayed samples without runs of three";
+    }
+    return f;
+  }
   const double scale = 1.0 / (kSecondDifferenceGain * kMedianChiSquare1);
-  return std::sqrt(scale * (median(std::move(d2)) + median(std::move(q2))));
+  const double value = std::sqrt(scale * (median(std::move(d2)) + median(std::move(q2))));
+  if (!(value > 0.0)) {
+    f.unknown_reason = "the residual does not change between neighbouring samples (below the log's resolution)";
+    return f;
+  }
+  f.value_A = value;
+  return f;
 }
 
-Verdict verdict(double final_heldout_rms_A, double floor_A, const ResidualStatistics& st) {
+Verdict verdict(double final_heldout_rms_A, const NoiseFloor& floor, const ResidualStatistics& st) {
   Verdict v;
-  v.noise_floor_A = floor_A;
-  v.ratio = floor_A > 0.0 ? final_heldout_rms_A / floor_A : std::numeric_limits<double>::infinity();
-  v.explained = v.ratio <= kExplainedRatio;
-  if (v.explained) return v;
+  v.noise_floor_A = floor.value_A;
+  if (floor.value_A) {
+    v.ratio = final_heldout_rms_A / *floor.value_A;
+    v.kind = *v.ratio <= kExplainedRatio ? VerdictKind::kExplained : VerdictKind::kUnexplained;
+    if (v.explained()) return v;
+  } else {
+    v.kind = VerdictKind::kUndetermined;
+    v.findings.push_back("the noise floor cannot be measured on this log: " + floor.unknown_reason);
+    v.findings.push_back("the final model's held-out residual is " + num(final_heldout_rms_A) +
+                         " A RMS; whether that is the sensors' noise or a model error cannot be told without it");
+  }
+  const std::string floor_text = floor.value_A ? "noise floor " + num(*floor.value_A) + " A" : "noise floor unknown";
 
   // Where it lives: standstill against motion, and the region that carries the most.
-  v.findings.push_back("at standstill " + num(st.standstill_rms_A.after) + " A RMS, in motion " + num(st.motion_rms_A.after) +
-                       " A RMS (noise floor " + num(floor_A) + " A)");
+  if (st.standstill_samples == 0) {
+    v.findings.push_back("no samples at standstill; in motion " + num(st.motion_rms_A.after) + " A RMS (" + floor_text + ")");
+  } else if (st.motion_samples == 0) {
+    v.findings.push_back("at standstill " + num(st.standstill_rms_A.after) + " A RMS, no samples in motion (" + floor_text + ")");
+  } else {
+    v.findings.push_back("at standstill " + num(st.standstill_rms_A.after) + " A RMS, in motion " + num(st.motion_rms_A.after) +
+                         " A RMS (" + floor_text + ")");
+  }
   const RegionStatistics* worst = nullptr;
   for (const RegionStatistics& r : st.regions) {
     if (!worst || r.rms_A.after > worst->rms_A.after) worst = &r;
@@ -80,12 +122,12 @@ Verdict verdict(double final_heldout_rms_A, double floor_A, const ResidualStatis
     v.findings.push_back("largest in the region " + worst->speed + ", " + worst->load + ": " + num(worst->rms_A.after) +
                          " A RMS, mean ε_d " + num(worst->mean_d_A.after) + " A, ε_q " + num(worst->mean_q_A.after) + " A");
   }
-  // Against the electrical angle: the strongest harmonic, if it stands out.
+  // Against the electrical angle: the strongest harmonic, if it stands out of the noise.
   const HarmonicContent* strongest = nullptr;
   for (const HarmonicContent& h : st.harmonics) {
     if (!strongest || h.amplitude_A.after > strongest->amplitude_A.after) strongest = &h;
   }
-  if (strongest && strongest->amplitude_A.after > floor_A) {
+  if (strongest && floor.value_A && strongest->amplitude_A.after > *floor.value_A) {
     v.findings.push_back("against the electrical angle the residual is strongest at harmonic " + std::to_string(strongest->order) +
                          " (" + num(strongest->amplitude_A.after) + " A): most often " + harmonic_meaning(strongest->order));
   }
@@ -101,6 +143,10 @@ Verdict verdict(double final_heldout_rms_A, double floor_A, const ResidualStatis
   }
   if (best && best_r >= 0.3) {
     v.findings.push_back("it correlates with " + best->regressor + " (" + num(best_r) + "): " + regressor_meaning(best->regressor));
+  }
+  if (!floor.value_A) {
+    v.findings.push_back("three or more consecutive samples at one operating point (a steady stretch, or standstill under "
+                         "current) in several blocks would measure the noise floor");
   }
   v.findings.push_back("a log with more operating points — standstill at several currents of both signs, several speeds at "
                        "several loads, temperatures that span tens of kelvin — would tell more effects apart");

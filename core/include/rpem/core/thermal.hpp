@@ -50,6 +50,10 @@ struct MaterialCoefficient {
   double min_per_K;
   double max_per_K;
   [[nodiscard]] constexpr bool contains(double alpha) const noexcept { return alpha >= min_per_K && alpha <= max_per_K; }
+  /// The standard deviation of α over the range, uniform, relative to the typical value: (max − min)/(√12·|typical|).
+  [[nodiscard]] constexpr double rel_sigma() const noexcept {
+    return (max_per_K - min_per_K) / (3.4641016151377544 * (typical_per_K < 0.0 ? -typical_per_K : typical_per_K));
+  }
 };
 
 inline constexpr MaterialCoefficient kCopper{"copper", 0.00393, 0.00393 * 0.85, 0.00393 * 1.15};

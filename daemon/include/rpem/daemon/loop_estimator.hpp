@@ -39,8 +39,8 @@ class LoopEstimator {
 
   /// Steps one sample of this estimator's kind: true, with the estimate, the time it stands for (for the
   /// validity tracker: the nominal period of a phase sample, the interval since the previous averaged
-  /// sample up to estimator.averaged.max_interval_s) and its summary. A sample of the other kind is not
-  /// stepped (false).
+  /// window — for an instantaneous averaged sample up to estimator.averaged.max_interval_s) and its
+  /// summary. A sample of the other kind is not stepped (false).
   bool step(const SourceSample& sample, core::Estimate& estimate, double& dt_s, SampleSummary& summary) noexcept;
 
   void reset() noexcept;

@@ -4,7 +4,8 @@
 // that arrived (in order), tracks validity and age (ValidityTracker), and queues reports for the
 // publisher. The estimator is the one for the kind of sample the configured source produces
 // (LoopEstimator): phase samples step DriveEstimator, averaged rotor-frame samples AveragedDriveEstimator
-// at their host timestamps. It never allocates, locks, logs or does I/O once running: everything it touches was
+// at their host timestamps. With a thermal network configured, its Kalman filter (core::ThermalFusion) steps
+// beside the estimator on every sample and RPEM_ESTIMATE carries the fused temperatures. It never allocates, locks, logs or does I/O once running: everything it touches was
 // allocated before; a full output queue drops the report and counts it.
 
 #include <atomic>
@@ -12,6 +13,8 @@
 #include <optional>
 #include <string>
 
+#include "rpem/core/regime.hpp"
+#include "rpem/core/thermal_fusion.hpp"
 #include "rpem/daemon/daemon_config.hpp"
 #include "rpem/daemon/loop_estimator.hpp"
 #include "rpem/daemon/loop_timer.hpp"
@@ -33,6 +36,8 @@ struct LoopCounters {
   std::int64_t commands_applied = 0;         ///< supervisory commands (seq > 0)
   std::int64_t command_sequence_errors = 0;  ///< an applied command not after the previous one (never expected)
   std::int64_t config_reloads = 0;           ///< reloads applied
+  std::int64_t outliers = 0;                 ///< samples skipped by the outlier bound
+  core::RegimeCounts regimes;                ///< samples per regime (core/regime.hpp)
 };
 
 /// A value from the state file and how long ago it last adapted.
@@ -72,6 +77,7 @@ class LoopThread {
   void step(const SourceSample& s, std::int64_t now_ns) noexcept;
   void report_measurement() noexcept;
   void report_estimate(std::int64_t now_ns) noexcept;
+  void report_thermal(EstimateReport& r) const noexcept;
   void report_stats() noexcept;
   void push(const Report& r) noexcept;
 
@@ -80,6 +86,7 @@ class LoopThread {
   Queues queues_;
   LoopEstimator estimator_;
   ValidityTracker validity_;
+  core::ThermalFusion thermal_;  ///< stepped only while live_.thermal_active
   LoopTimer timer_;
   std::string setup_problems_;
   std::atomic<bool> started_{false};

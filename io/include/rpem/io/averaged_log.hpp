@@ -4,9 +4,10 @@
 // as the independent generator writes them (`indep_drive_log --averaged`).
 //
 //   t, t_start, i_d, i_q, u_d, u_q, omega_el   required: window [t_start, t] [s], means [A, V, rad/s]
-//   u_dc, T_winding, T_magnet, T_drive          optional [V, °C]; a cell "nan" means not reported
+//   u_dc, T_winding, T_magnet, T_drive, T_coolant   optional [V, °C]; a cell "nan" means not reported
 //
-// A header with a t_start column marks the file as an averaged log.
+// A header with a t_start column marks the file as an averaged log. Any CSV of window means reads into the
+// same samples through a column map (log_map.hpp): VESC Tool's realtime log is one (vesc_tool_log.hpp).
 
 #include <cstdint>
 #include <fstream>
@@ -15,7 +16,9 @@
 
 #include "rpem/core/averaged_sample.hpp"
 #include "rpem/io/drive_log.hpp"
+#include "rpem/io/log_map.hpp"
 #include "rpem/io/machine_config.hpp"
+#include "rpem/io/mapped_log.hpp"
 
 namespace rpem::io {
 
@@ -25,6 +28,7 @@ struct AveragedLogLayout {
   bool t_winding = false;
   bool t_magnet = false;
   bool t_drive = false;
+  bool t_coolant = false;
 };
 
 /// True if the CSV's header has a t_start column (an averaged log); throws DriveLogError if unreadable.
@@ -34,6 +38,23 @@ struct AveragedLogLayout {
 /// required column, a required cell that is not a finite number, t that does not increase, t_start after t.
 [[nodiscard]] std::vector<core::AveragedSample> read_averaged_log(const std::string& path,
                                                                   AveragedLogLayout* layout = nullptr);
+
+/// What reading an averaged log through a map did besides delivering samples.
+struct AveragedLogRead {
+  AveragedLogLayout layout;
+  std::uint64_t rows = 0;  ///< data rows read
+  /// Rows that only open the first window (window: previous_row: the first row, whose own window began at
+  /// a read before the log started; it is read and checked, but is no sample).
+  std::uint64_t opening_rows = 0;
+  TimeRepairs repairs;
+};
+
+/// Reads a whole log of averaged samples as `map` describes it (our averaged log: averaged_log_map();
+/// VESC Tool's realtime log: vesc_tool_log_map(); a user's map), each cell held to `limits`. With
+/// window: previous_row each row's window starts at the previous row's t, and the first row is no sample.
+[[nodiscard]] std::vector<core::AveragedSample> read_averaged_log(const std::string& path, const LogMap& map,
+                                                                  const DriveLogLimits& limits,
+                                                                  AveragedLogRead* read = nullptr);
 
 class AveragedLogWriter {
  public:

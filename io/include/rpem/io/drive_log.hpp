@@ -1,8 +1,9 @@
 #pragma once
-// The drive-log CSV: the project's measured-data format (docs/drive-log.md).
+// The drive-log CSV: the project's measured-data format (docs/drive-log.md); any CSV of instantaneous
+// samples through a column map reads into the same rows.
 // One header row; SI units; required columns t, theta_el, omega_el, u_dc, a voltage command
 // (u_a,u_b,u_c and/or u_d,u_q) and a measured current (i_a,i_b,i_c and/or i_d,i_q); optional
-// T_winding, T_magnet [°C], torque_cmd [Nm]. Extra columns are ignored. A log whose voltage and current
+// T_winding, T_magnet, T_coolant [°C], torque_cmd [Nm]. Extra columns are ignored. A log whose voltage and current
 // are both in the rotor frame only may omit theta_el and u_dc. A log must hold at least one row, and every
 // cell must lie within the plausibility limits below.
 
@@ -15,6 +16,9 @@
 
 #include "rpem/core/drive_sample.hpp"
 #include "rpem/io/errors.hpp"
+#include "rpem/io/log_limits.hpp"
+#include "rpem/io/log_map.hpp"
+#include "rpem/io/mapped_log.hpp"
 
 namespace rpem::io {
 
@@ -22,6 +26,7 @@ struct DriveLogRow {
   core::DriveSample sample;
   std::optional<double> t_winding_C;
   std::optional<double> t_magnet_C;
+  std::optional<double> t_coolant_C;
   std::optional<double> torque_cmd_Nm;
 };
 
@@ -35,75 +40,36 @@ struct DriveLogLayout {
   bool current_dq = false;
   bool t_winding = false;
   bool t_magnet = false;
+  bool t_coolant = false;
   bool torque_cmd = false;
 };
 
-/// A magnitude no drive produces, and where the figure comes from (quoted in the error message).
-struct Bound {
-  double max_abs = 0.0;
-  std::string why;
-};
-
-/// What a drive-log cell may hold (docs/drive-log.md, "Plausibility limits"). The defaults are absolute:
-/// no drive, whatever its machine, produces a value beyond them. A tool that knows the machine narrows
-/// them to a multiple of its name plate (io::machine_limits). A cell beyond its bound, like a NaN, stops
-/// the reader with file:line:column.
-struct DriveLogLimits {
-  Bound time_s{9.0e9, "t is kept in integer nanoseconds, which 64 bits hold up to 9.2e9 s"};
-  Bound angle_rad{1.0e9, "beyond 1e9 rad a double resolves the angle no finer than 1.2e-7 rad"};
-  Bound speed_rad_s{1.0e6, "10x the fastest electric machines (1e5 rad/s electrical)"};
-  Bound voltage_V{1.0e5, "beyond the highest drive DC links (tens of kV)"};
-  Bound current_A{1.0e5, "beyond the largest drives' phase currents (tens of kA)"};
-  Bound torque_Nm{1.0e7, "beyond the largest machines' torque (MN m)"};
-  double temperature_min_C = -273.15;  ///< absolute zero
-  double temperature_max_C = 1000.0;   ///< every winding insulation and magnet has failed long before
-  /// A voltage command may be at most this multiple of the same row's u_dc (when u_dc ≥ 1 V): a two-level
-  /// inverter applies at most u_dc/2 from the link's midpoint, and 2·u_dc/π as a six-step fundamental.
-  double command_per_dc_link = 2.0;
-};
-
-/// Streams a drive log row by row. Every problem throws DriveLogError naming file, line and column;
-/// a log without a single row is refused ("no samples") when its end is reached.
+/// Streams a drive log row by row: our drive-log CSV, or any CSV through a map of instantaneous samples
+/// (log_map.hpp; read by MappedLogReader, which checks every cell). Every problem throws DriveLogError
+/// naming file, line and column; a log without a single row is refused ("no samples") when its end is reached.
 class DriveLogReader {
  public:
   explicit DriveLogReader(const std::string& path, DriveLogLimits limits = {});
   /// Reads from `in`, which must outlive the reader; `name` stands for the file in messages.
   DriveLogReader(std::istream& in, std::string name, DriveLogLimits limits = {});
+  /// Reads `path` as `map` describes it (a map of instantaneous samples).
+  DriveLogReader(const std::string& path, LogMap map, DriveLogLimits limits);
 
   /// Reads the next row; false at end of file (after at least one row: an empty log throws).
   bool next(DriveLogRow& row);
 
   [[nodiscard]] const DriveLogLayout& layout() const noexcept { return layout_; }
-  [[nodiscard]] std::size_t line() const noexcept { return line_; }
-  [[nodiscard]] std::uint64_t bytes_total() const noexcept { return bytes_total_; }
-  [[nodiscard]] std::uint64_t bytes_read() const noexcept { return bytes_read_; }
+  [[nodiscard]] std::size_t line() const noexcept { return reader_.line(); }
+  [[nodiscard]] std::uint64_t bytes_total() const noexcept { return reader_.bytes_total(); }
+  [[nodiscard]] std::uint64_t bytes_read() const noexcept { return reader_.bytes_read(); }
+  [[nodiscard]] const MappedLogReader& reader() const noexcept { return reader_; }
 
  private:
-  struct Column {
-    int index = -1;
-    [[nodiscard]] bool present() const noexcept { return index >= 0; }
-  };
-  void read_header();
-  [[nodiscard]] double cell(const Column& c, const char* name) const;
-  [[nodiscard]] double cell(const Column& c, const char* name, const Bound& bound, const char* unit) const;
-  [[nodiscard]] double temperature(const Column& c, const char* name) const;
-  [[nodiscard]] double command(const Column& c, const char* name, double u_dc_V) const;
-  [[noreturn]] void fail(const std::string& column, const std::string& reason) const;
-  [[noreturn]] void fail(const Column& c, const char* name, const std::string& reason) const;
+  void check_layout();
 
-  std::string path_;
-  std::ifstream file_;
-  std::istream& in_;
-  DriveLogLimits limits_;
-  std::size_t line_ = 0;
-  std::uint64_t rows_ = 0;
-  std::uint64_t bytes_total_ = 0;
-  std::uint64_t bytes_read_ = 0;
+  MappedLogReader reader_;
   DriveLogLayout layout_;
-  std::vector<std::string> header_;
-  std::vector<std::string> cells_;
-  Column t_, theta_, omega_, udc_, ua_, ub_, uc_, ud_, uq_, ia_, ib_, ic_, id_, iq_, tw_, tm_, tq_;
-  std::optional<std::int64_t> previous_t_ns_;
+  MappedRow row_;
 };
 
 /// Reads a whole log.

@@ -12,6 +12,7 @@
 
 #include "rpem/analysis/diagnose/effects.hpp"
 #include "rpem/analysis/diagnose/replay.hpp"
+#include "rpem/analysis/diagnose/robust_loss.hpp"
 
 namespace rpem::analysis {
 
@@ -42,6 +43,11 @@ struct CalibrationIntervals {
   std::array<double, kCalibrated.size()> half_width{};
   /// What the log's excitation alone allows (σ²·(JᵀJ)⁻¹ with σ the noise floor), relative.
   std::array<double, kCalibrated.size()> excitation_half_width{};
+  /// √((JᵀJ)⁻¹ₖₖ), relative: the change of constant k, the others refitted, that moves the model's training
+  /// currents by 1 A in Euclidean norm over all samples (the excitation's half-width is z·σ times it). Times a
+  /// misfit |e| it is the largest bias that misfit could put into the constant (Cauchy–Schwarz on
+  /// Δθ = (JᵀJ)⁻¹Jᵀe): the model mismatch allowance (misfit_norm_A).
+  std::array<double, kCalibrated.size()> change_per_A{};
   /// The effects' scaled parameters, cluster-robust (same order as the set's).
   std::vector<std::vector<double>> effect_half_width;
 };
@@ -53,8 +59,28 @@ inline constexpr double kIdentifiableHalfWidth = 0.01;
 /// widen), away from the ±50 % bound — at the calibrated baseline and with every effect named.
 inline constexpr double kIdentifiedHalfWidth = 0.1;
 
-/// Whether the fitted constant i (kCalibrated order) of `set` is identified by these intervals.
+/// Whether the fitted constant i (kCalibrated order) of `set` is identified by these intervals (narrow).
 [[nodiscard]] bool identified(const EffectSet& set, const CalibrationIntervals& ci, std::size_t i);
+
+/// The misfit a model leaves above the noise floor, as a norm over the N training samples [A]:
+/// |e| = √(N·(rms² − floor²)) with rms its held-out RMS (0 at or below the floor; floor 0 where unknown: the
+/// whole residual may be misfit). The model mismatch allowance of constant k is change_per_A[k]·|e|.
+[[nodiscard]] double misfit_norm_A(std::size_t training_samples, double heldout_rms_A, double noise_floor_A);
+
+/// Why the calibration keeps a fitted constant.
+enum class Identification {
+  kNot,                   ///< at the bound, or its configured value within the interval widened by the allowance
+  kNarrow,                ///< identified(): its cluster-robust interval within ±kIdentifiedHalfWidth
+  kRejectsConfiguration,  ///< a wider interval, but the configured value lies outside it widened by the allowance
+};
+
+/// The calibration's rule (docs/diagnose.md, "Calibrated despite a large mismatch"): a constant the log's
+/// excitation admits is calibrated when identified() — or, its interval wider, when the log rejects the
+/// configured value even granting the model's misfit its largest bias: the configured value lies outside the
+/// cluster-robust interval widened by the mismatch allowance, exactly where the report states the
+/// configuration off (calibration_findings). Away from the ±50 % bound in both cases.
+/// `misfit_A`: misfit_norm_A of the set.
+[[nodiscard]] Identification identification(const EffectSet& set, const CalibrationIntervals& ci, std::size_t i, double misfit_A);
 
 /// What the screening of one round shares: the starting residuals and the calibration's columns.
 struct ScreenBasis {
@@ -67,6 +93,11 @@ struct ScreenBasis {
 class EffectFitter {
  public:
   EffectFitter(const ModelReplay& replay, const EffectContext& context);
+
+  /// The same fitter minimising `loss` (robust_loss.hpp) in every fit, screening, interval and held-out
+  /// score: each sample's residual vector is scaled by √(ρ(|r|²)/|r|²), so that its squared norm is ρ.
+  [[nodiscard]] EffectFitter with_loss(const RobustLoss& loss) const;
+  [[nodiscard]] const RobustLoss& loss() const noexcept { return loss_; }
 
   /// Fits every free parameter of `start` jointly from its values; returns the fitted set (and, if
   /// asked, its training sum of squares).
@@ -81,18 +112,20 @@ class EffectFitter {
   [[nodiscard]] std::pair<std::vector<double>, double> best_start(const ScreenBasis& basis, const EffectSet& base,
                                                                   const Effect& candidate) const;
 
-  /// Training sum of squares [A²].
+  /// Training sum of ρ(|r|²) [A²] (the sum of squares under least squares).
   [[nodiscard]] double training_ssr(const EffectSet& set) const;
-  /// Sums of squares per held-out block.
+  /// Sums of ρ(|r|²) per held-out block (sums of squares under least squares).
   [[nodiscard]] BlockScores heldout(const EffectSet& set) const;
 
   /// The calibrated constants' intervals for a fitted set; `noise_floor_A` scales the excitation's.
   [[nodiscard]] CalibrationIntervals intervals(const EffectSet& set, double noise_floor_A) const;
 
   [[nodiscard]] const ModelReplay& replay() const noexcept { return replay_; }
+  /// Samples the fits see (training blocks, replayed).
+  [[nodiscard]] std::size_t training_samples() const noexcept { return training_.size(); }
   [[nodiscard]] const EffectContext& context() const noexcept { return context_; }
 
-  /// The training residuals of a set, d and q interleaved (fixed length).
+  /// The training residuals of a set, d and q interleaved (fixed length), each sample's scaled by the loss.
   void training_residuals(const EffectSet& set, std::vector<double>& out) const;
 
  private:
@@ -102,6 +135,7 @@ class EffectFitter {
   const ModelReplay& replay_;
   EffectContext context_;
   std::vector<std::size_t> training_;  ///< samples with a prediction in training blocks (baseline replay)
+  RobustLoss loss_;                     ///< least squares unless outliers remain (diagnosis.cpp)
 };
 
 }  // namespace rpem::analysis

@@ -4,6 +4,7 @@
 // training and held-out blocks.
 
 #include <algorithm>
+#include <cstdint>
 #include <optional>
 #include <string>
 #include <vector>
@@ -23,10 +24,16 @@ enum class ModelMode { kTransient, kSteadyState };
 
 struct LogData {
   std::string path;
+  std::string format;  ///< what the log was read as, and what reading it did (io::describe)
+  /// The drive's reported commands were turned into the applied means at reading (LogOptions::voltage_is_command):
+  /// whatever runs over the rows must not turn them again.
+  bool voltage_applied = false;
   std::vector<io::DriveLogRow> rows;
   io::DriveLogLayout layout;
   ModelMode mode = ModelMode::kTransient;
   bool averaged = false;  ///< an averaged rotor-frame log (docs/drive-log.md, "Averaged logs"): always steady state
+  /// Averaged logs: each row's window start (its t is the window's end); empty for phase-sample logs.
+  std::vector<std::int64_t> window_start_ns;
   double t_start_s = 0.0, t_end_s = 0.0;
   double median_dt_s = 0.0;
   double max_current_A = 0.0;   ///< largest measured current amplitude
@@ -41,7 +48,8 @@ struct LogData {
   std::vector<core::DriveSample> replay_samples;
   /// The logged current as dq at the logged angle [A]: what every model is compared with.
   std::vector<core::Vec2> logged_i_dq_A;
-  /// Samples that take part (steady state leaves out idle and transitional rows).
+  /// Samples that take part (steady state leaves out idle and transitional rows; every log the samples its
+  /// regime excludes, regimes.hpp).
   std::vector<bool> used;
   std::size_t excluded_idle = 0, excluded_transitional = 0;
   /// Block index of each sample; even blocks train, odd blocks are held out.
@@ -58,13 +66,30 @@ struct LogData {
   [[nodiscard]] bool block_start(std::size_t k) const noexcept { return k == 0 || block[k] != block[k - 1]; }
 };
 
+/// The mean a reported command applies in the rotor frame over the period it is held (docs/derivations.md
+/// §11, "Reported command"): the command v, computed at the current sample's angle and held fixed in the
+/// stator frame over [d − ½, d + ½]·T_c after it, arrives turned by −ω·d·T_c and shortened by sinc(ω·T_c/2).
+[[nodiscard]] core::Vec2 applied_mean_V(const core::Vec2& command_V, double omega_el_rad_s, double control_period_s,
+                                        double delay_periods) noexcept;
+
 struct LogOptions {
   std::optional<ModelMode> mode;  ///< empty: decided from the sample interval
+  /// An averaged log whose voltages are the drive's command (estimator.averaged.voltage_reported: command): its
+  /// T_c and the delay before the hold (model_extensions.delay), which reading turns into the applied mean.
+  bool voltage_is_command = false;
+  double control_period_s = 0.0;
+  double command_delay_s = 0.0;
   int blocks = 40;                ///< training and held-out blocks, alternating, equal in time
   int speed_half_window = 4;      ///< transient logs: replay speed from the angle over ±this many samples
+  std::string log_map;            ///< a column map (YAML) to read the log with; empty: detected (io::log_source)
 };
 
-/// Loads and characterises a log, a phase-sample or an averaged one (throws io::DriveLogError on bad input).
+/// Where the steady-state replay left out more than io::kExplainedShare of the rows as idle or in transition:
+/// one sentence per rule, how many, why, and what changes it (docs/diagnose.md, "The replay").
+[[nodiscard]] std::vector<std::string> left_out_explanations(const LogData& log);
+
+/// Loads and characterises a log, a phase-sample or an averaged one, in any format io::log_source reads
+/// (throws io::DriveLogError on bad input, io::ConfigError on a bad map).
 [[nodiscard]] LogData load_log(const std::string& path, const core::MachineSi& machine, const LogOptions& options);
 
 /// The same from rows already in memory (tests, the simulator).

@@ -1,0 +1,96 @@
+#include "rpem/core/thermal_filter.hpp"
+
+#include <cmath>
+
+namespace rpem::core {
+namespace {
+
+constexpr int kN = kMaxThermalNodes;
+constexpr int kDynamic = 2 * kN;  ///< T and d: what the model moves and the filter estimates
+
+}  // namespace
+
+void ThermalFilter::reset(double t_C, double sigma_K) noexcept {
+  set_temperatures(ThermalVec::Constant(t_C), ThermalMat::Identity() * (sigma_K * sigma_K));
+}
+
+void ThermalFilter::set_temperatures(const ThermalVec& t_C, const ThermalMat& p) noexcept {
+  x_.setZero();
+  x_.head<kN>() = t_C;
+  p_.setZero();
+  p_.topLeftCorner<kN, kN>() = p;
+  for (int i = config_.network.nodes; i < kN; ++i) p_(i, i) = 0.0;
+  p_.bottomRightCorner<kCalibrationStates, kCalibrationStates>().diagonal() = config_.calibration_sigma.cwiseAbs2();
+  previous_terms_.setZero();
+}
+
+ThermalFilter::LossTerms ThermalFilter::loss_terms(const ThermalLoad& l) const noexcept {
+  const ThermalNetwork& n = config_.network;
+  LossTerms terms = LossTerms::Zero();
+  terms(0, n.winding) = n.copper_scale * 1.5 * l.current_sq_A2 * n.copper.at(x_[n.winding]);
+  for (int f = 0; f < kLossForms; ++f) terms.row(f + 1) = n.loss_at_base_W.row(f) * l.basis[static_cast<std::size_t>(f)];
+  return terms;
+}
+
+void ThermalFilter::predict(const ThermalLoad& load) noexcept {
+  if (!(load.dt_s > 0.0)) return;
+  const ThermalNetwork& n = config_.network;
+  const ThermalTransition tr = thermal_transition(n, load);
+  // The disturbances' increments: their drift, and each modelled loss term's change times its uncertainty.
+  const LossTerms terms = loss_terms(load);
+  const LossTerms change = terms - previous_terms_;
+  previous_terms_ = terms;
+  ThermalVec d_var = config_.disturbance_W2_per_s * load.dt_s;
+  for (int i = 0; i < n.nodes; ++i) {
+    const double cu = config_.copper_rel_sigma * change(0, i);
+    d_var[i] += cu * cu;
+    for (int f = 0; f < kLossForms; ++f) {
+      const double v = config_.loss_rel_sigma(f, i) * change(f + 1, i);
+      d_var[i] += v * v;
+    }
+  }
+  for (int i = n.nodes; i < kN; ++i) d_var[i] = 0.0;
+
+  // x⁺ = F·x + [γ; 0; 0]: only the rows of T change, through G = [Φ Γ_d] acting on [T; d].
+  Eigen::Matrix<double, kN, kDynamic> g;
+  g << tr.phi, tr.gamma_d;
+  x_.head<kN>() = g * x_.head<kDynamic>() + tr.gamma;  // a product that may alias: Eigen evaluates it first
+  // P⁺ = F·P·Fᵀ + Q_d blockwise (docs/derivations.md §14, eq. 14.12): d and c are random walks, so only the
+  // rows and columns of T change — the rows of T become G·P[T,d rows], the columns their transpose, P_TT
+  // those rows times Gᵀ. Small fixed sizes: coefficient-wise products, no blocking.
+  const Eigen::Matrix<double, kN, kThermalStates> rows = g.lazyProduct(p_.topRows<kDynamic>());
+  p_.topRows<kN>() = rows;
+  p_.leftCols<kN>() = rows.transpose();
+  ThermalVec q = ThermalVec::Zero();  // Q_T, on the nodes in use
+  for (int i = 0; i < n.nodes; ++i) q[i] = config_.process_noise_K2_per_s[i];
+  ThermalMat p_tt = rows.leftCols<kDynamic>().lazyProduct(g.transpose());
+  p_tt += 0.5 * load.dt_s * ((tr.phi * q.asDiagonal()).lazyProduct(tr.phi.transpose()) + ThermalMat(q.asDiagonal()));
+  // Rounding must not make P asymmetric: P_TT is the only block not symmetric by construction.
+  p_.topLeftCorner<kN, kN>() = 0.5 * (p_tt + p_tt.transpose());
+  p_.block<kN, kN>(kN, kN).diagonal() += d_var;
+}
+
+ObservationResult ThermalFilter::observe(const ThermalObservation& o) noexcept {
+  if (!all_finite(o.h, o.h_c, o.offset, o.value, o.variance) || !(o.variance > 0.0)) return ObservationResult::kRejectedInvalid;
+  // H = [h, 0, h_c]: no observation sees a disturbance, so a = P·Hᵀ takes the columns of T and c only.
+  const ThermalStateVec a = p_.leftCols<kN>().lazyProduct(o.h) + p_.rightCols<kCalibrationStates>().lazyProduct(o.h_c);
+  const double s = o.h.dot(a.head<kN>()) + o.h_c.dot(a.tail<kCalibrationStates>()) + o.variance;
+  const double nu = o.value - o.h.dot(x_.head<kN>()) - o.h_c.dot(x_.tail<kCalibrationStates>()) - o.offset;
+  innovation_ = nu;
+  innovation_variance_ = s;
+  if (nu * nu > config_.gate_sigma * config_.gate_sigma * s) return ObservationResult::kRejectedGate;
+  // Schmidt's update: K = a_x/s on T and d, zero on the calibration states (eq. 14.11):
+  //   P_xx −= a_x·a_xᵀ/s,  P_xc −= a_x·a_cᵀ/s,  P_cc unchanged.
+  // Only the rows of x change; each column j loses (a_x·a_j)·(1/s), the same product for (i, j) and (j, i),
+  // so P_xx stays exactly symmetric, and P_cx is P_xc's transpose.
+  const Eigen::Matrix<double, kDynamic, 1> a_x = a.head<kDynamic>();
+  x_.head<kDynamic>() += a_x * (nu / s);
+  const double inv_s = 1.0 / s;
+  for (int j = 0; j < kThermalStates; ++j) p_.col(j).head<kDynamic>() -= (a_x * a[j]) * inv_s;
+  p_.bottomLeftCorner<kCalibrationStates, kDynamic>() = p_.topRightCorner<kDynamic, kCalibrationStates>().transpose();
+  return ObservationResult::kAccepted;
+}
+
+double ThermalFilter::sigma_K(int node) const noexcept { return std::sqrt(std::max(p_(node, node), 0.0)); }
+
+}  // namespace rpem::core

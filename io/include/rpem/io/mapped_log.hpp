@@ -1,0 +1,102 @@
+#pragma once
+// The one CSV reader of drive data (docs/drive-log.md): reads a file as a LogMap describes it — our drive
+// log, our averaged log, VESC Tool's realtime log, a user's map — and delivers each row's quantities in SI
+// with its time in integer nanoseconds. Every cell is checked where it is read: a number, finite, within
+// the plausibility limits of its quantity (DriveLogLimits), a voltage command within 2·u_dc of its row;
+// time increasing (after the map's wrap and tie rules). Every problem throws DriveLogError naming the file,
+// line and column. Consumers (DriveLogReader, read_averaged_log) turn rows into samples.
+
+#include <array>
+#include <cstdint>
+#include <deque>
+#include <fstream>
+#include <istream>
+#include <limits>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "rpem/io/errors.hpp"
+#include "rpem/io/log_limits.hpp"
+#include "rpem/io/log_map.hpp"
+
+namespace rpem::io {
+
+struct MappedRow {
+  std::int64_t t_ns = 0;
+  /// SI values by Quantity; NaN where the quantity is absent (or, for nan_is_missing columns, not reported).
+  std::array<double, kQuantityCount> value{};
+  std::size_t line = 0;  ///< the file's line the row came from
+  [[nodiscard]] double operator[](Quantity q) const noexcept { return value[static_cast<std::size_t>(q)]; }
+};
+
+/// What the time rules did while reading (for the tools' summary lines).
+struct TimeRepairs {
+  std::uint64_t wraps = 0;       ///< the time column wrapped (ms_today at midnight)
+  std::uint64_t tied_rows = 0;   ///< rows that shared their stamp with the row before, spread over its resolution
+};
+
+class MappedLogReader {
+ public:
+  MappedLogReader(const std::string& path, LogMap map, DriveLogLimits limits = {});
+  /// Reads from `in`, which must outlive the reader; `name` stands for the file in messages.
+  MappedLogReader(std::istream& in, std::string name, LogMap map, DriveLogLimits limits = {});
+  MappedLogReader(const MappedLogReader&) = delete;  // holds its stream and pointers into its map
+  MappedLogReader& operator=(const MappedLogReader&) = delete;
+
+  /// The next row; false at the end of the file (after at least one row: a file without rows throws).
+  bool next(MappedRow& row);
+
+  [[nodiscard]] bool has(Quantity q) const noexcept { return index_[static_cast<std::size_t>(q)] >= 0; }
+  [[nodiscard]] QuantitySet present() const noexcept;
+  [[nodiscard]] const LogMap& map() const noexcept { return map_; }
+  [[nodiscard]] const std::string& path() const noexcept { return path_; }
+  [[nodiscard]] std::size_t line() const noexcept { return line_; }
+  [[nodiscard]] std::uint64_t bytes_total() const noexcept { return bytes_total_; }
+  [[nodiscard]] std::uint64_t bytes_read() const noexcept { return bytes_read_; }
+  [[nodiscard]] const TimeRepairs& repairs() const noexcept { return repairs_; }
+
+  /// The message's name of a quantity's column ("i_q"; "q_axis_current (i_q)" where a map renames it).
+  [[nodiscard]] std::string label(Quantity q) const;
+  /// Throws DriveLogError at `line` and the quantity's cell (its column; 0 for a header-level problem).
+  [[noreturn]] void fail_at(std::size_t line, Quantity q, const std::string& reason) const;
+  [[noreturn]] void fail_at(std::size_t line, const std::string& column, const std::string& reason) const;
+
+ private:
+  void read_header();
+  bool next_line(std::string& text);
+  bool read_raw(MappedRow& row);
+  void split(const std::string& line);
+  [[nodiscard]] double cell(int index, const std::string& label, const MappedColumn& c, bool allow_nan) const;
+  void check(const MappedRow& row, int index, const std::string& label, Quantity q, double v) const;
+  [[noreturn]] void fail_cell(int index, const std::string& label, const std::string& reason) const;
+
+  std::string path_;
+  std::ifstream file_;
+  std::istream& in_;
+  LogMap map_;
+  DriveLogLimits limits_;
+  std::size_t line_ = 0;
+  std::uint64_t rows_ = 0;
+  std::uint64_t bytes_total_ = 0;
+  std::uint64_t bytes_read_ = 0;
+  std::vector<std::string> header_;
+  std::size_t width_ = 0;  ///< cells per row (the header's, or a headerless file's first row's)
+  bool trailing_separator_ = false;
+  std::vector<std::string> cells_;
+  std::array<int, kQuantityCount> index_{};  ///< 0-based cell of each quantity; −1 absent
+  std::array<const MappedColumn*, kQuantityCount> column_{};
+  int time_index_ = -1;
+  std::string time_label_;
+
+  // Time: the previous raw (unwrapped, untied) stamp, the wraps so far, rows held to spread a tie.
+  std::optional<std::int64_t> previous_raw_ns_;
+  std::optional<double> previous_cell_s_;
+  double wrap_offset_s_ = 0.0;
+  std::optional<MappedRow> lookahead_;
+  std::deque<MappedRow> ready_;
+  std::uint64_t data_rows_ = 0;
+  TimeRepairs repairs_;
+};
+
+}  // namespace rpem::io

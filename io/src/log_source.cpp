@@ -1,0 +1,83 @@
+#include "rpem/io/log_source.hpp"
+
+#include <fstream>
+#include <vector>
+
+#include "rpem/io/errors.hpp"
+#include "rpem/io/vesc_tool_log.hpp"
+
+namespace rpem::io {
+namespace {
+
+/// Cells of a header line split at `separator`, trimmed of blanks and quotes; the empty cell after a
+/// trailing separator dropped.
+std::vector<std::string> header_cells(const std::string& line, char separator) {
+  std::vector<std::string> cells;
+  std::size_t start = 0;
+  while (true) {
+    const std::size_t sep = line.find(separator, start);
+    std::string cell = line.substr(start, sep == std::string::npos ? std::string::npos : sep - start);
+    const auto first = cell.find_first_not_of(" \t\r\"");
+    const auto last = cell.find_last_not_of(" \t\r\"");
+    cells.push_back(first == std::string::npos ? std::string() : cell.substr(first, last - first + 1));
+    if (sep == std::string::npos) break;
+    start = sep + 1;
+  }
+  if (cells.size() > 1 && cells.back().empty()) cells.pop_back();
+  return cells;
+}
+
+}  // namespace
+
+LogSource log_source(const std::string& log_path, const std::string& map_path) {
+  if (!map_path.empty()) return {log_path, load_log_map(map_path), "CSV read through the map " + map_path};
+
+  std::ifstream in(log_path, std::ios::binary);
+  if (!in) throw DriveLogError(log_path, 0, 0, "", "cannot open file");
+  std::string line;
+  std::size_t line_no = 0;
+  while (std::getline(in, line)) {
+    ++line_no;
+    if (line.rfind("\xEF\xBB\xBF", 0) == 0) line.erase(0, 3);  // a UTF-8 byte-order mark
+    if (line.find_first_not_of(" \t\r") != std::string::npos) break;
+  }
+  for (char separator : {';', ','}) {
+    const std::vector<std::string> cells = header_cells(line, separator);
+    if (cells.size() < 2 || cells.front() != "ms_today") continue;
+    check_vesc_tool_header(log_path, line_no, cells);
+    LogMap map = vesc_tool_log_map();
+    map.separator = separator;  // VESC Tool writes ';' (and reads ',' too)
+    const VescToolHeader* version = identify_vesc_tool_header(cells);
+    return {log_path, std::move(map),
+            version ? std::string("VESC Tool realtime log (the header of VESC Tool ") + version->versions + ")"
+                    : std::string("VESC Tool realtime log (a header of no VESC Tool version known: columns read by name)")};
+  }
+  if (is_headerless_vesc_tool_row(line)) {
+    throw DriveLogError(log_path, line_no, 0, "",
+                        "a VESC Tool realtime log without header (VESC Tool 1.11 to 1.16, vedderb/vesc_tool 2323a806): "
+                        "its 22 values per row hold no d_axis_voltage, q_axis_voltage, which rpem needs; VESC Tool 1.20 "
+                        "added them (vedderb/vesc_tool 5986063b)");
+  }
+  for (const std::string& cell : header_cells(line, ',')) {
+    if (cell == "t_start") return {log_path, averaged_log_map(), "averaged log"};
+  }
+  return {log_path, drive_log_map(), "drive log"};
+}
+
+std::string describe(const TimeRepairs& r) {
+  std::string s;
+  if (r.wraps > 0) s += "; " + std::to_string(r.wraps) + (r.wraps == 1 ? " wrap" : " wraps") + " of the time column (midnight)";
+  if (r.tied_rows > 0) {
+    s += "; " + std::to_string(r.tied_rows) + " rows shared their time stamp with the row before (spread over its resolution)";
+  }
+  return s;
+}
+
+std::string describe(const LogSource& source, const AveragedLogRead& read) {
+  std::string s = source.path + " as " + source.format + ": " + std::to_string(read.rows) + " rows, " +
+                  std::to_string(read.rows - read.opening_rows) + " averaged samples";
+  if (read.opening_rows > 0) s += " (the first row opens the first window: its own began before the log)";
+  return s + describe(read.repairs);
+}
+
+}  // namespace rpem::io

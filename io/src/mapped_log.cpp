@@ -1,0 +1,314 @@
+#include "rpem/io/mapped_log.hpp"
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+
+namespace rpem::io {
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+bool blank(char c) { return c == ' ' || c == '\t' || c == '\r'; }
+
+/// A number for a message (six significant digits).
+std::string g6(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.6g", v);
+  return buf;
+}
+
+}  // namespace
+
+MappedLogReader::MappedLogReader(const std::string& path, LogMap map, DriveLogLimits limits)
+    : path_(path), file_(path, std::ios::binary), in_(file_), map_(std::move(map)), limits_(std::move(limits)) {
+  if (!file_) throw DriveLogError(path, 0, 0, "", "cannot open file");
+  std::error_code ec;
+  bytes_total_ = std::filesystem::file_size(path, ec);
+  read_header();
+}
+
+MappedLogReader::MappedLogReader(std::istream& in, std::string name, LogMap map, DriveLogLimits limits)
+    : path_(std::move(name)), in_(in), map_(std::move(map)), limits_(std::move(limits)) {
+  read_header();
+}
+
+void MappedLogReader::fail_at(std::size_t line, const std::string& column, const std::string& reason) const {
+  throw DriveLogError(path_, line, 0, "column " + column, reason);
+}
+
+void MappedLogReader::fail_at(std::size_t line, Quantity q, const std::string& reason) const {
+  const int index = index_[static_cast<std::size_t>(q)];
+  throw DriveLogError(path_, line, index >= 0 ? static_cast<std::size_t>(index) + 1 : 0, "column " + label(q), reason);
+}
+
+void MappedLogReader::fail_cell(int index, const std::string& label, const std::string& reason) const {
+  throw DriveLogError(path_, line_, static_cast<std::size_t>(index) + 1, "column " + label, reason);
+}
+
+std::string MappedLogReader::label(Quantity q) const {
+  const MappedColumn* c = column_[static_cast<std::size_t>(q)];
+  const std::string name = info(q).name;
+  if (c == nullptr || c->column.name == name) return name;
+  return c->column.label() + " (" + name + ")";
+}
+
+QuantitySet MappedLogReader::present() const noexcept {
+  QuantitySet p{};
+  for (std::size_t k = 0; k < kQuantityCount; ++k) p[k] = index_[k] >= 0;
+  return p;
+}
+
+bool MappedLogReader::next_line(std::string& text) {
+  while (std::getline(in_, text)) {
+    ++line_;
+    bytes_read_ += text.size() + 1;
+    const auto first = std::find_if_not(text.begin(), text.end(), blank);
+    if (first == text.end()) continue;                              // blank line
+    if (map_.comment != '\0' && *first == map_.comment) continue;  // comment line
+    return true;
+  }
+  return false;
+}
+
+void MappedLogReader::split(const std::string& line) {
+  std::size_t n = 0;
+  std::size_t start = 0;
+  while (true) {
+    const std::size_t sep = line.find(map_.separator, start);
+    std::size_t first = start;
+    std::size_t last = sep == std::string::npos ? line.size() : sep;
+    while (first < last && blank(line[first])) ++first;
+    while (last > first && blank(line[last - 1])) --last;
+    if (last - first >= 2 && line[first] == '"' && line[last - 1] == '"') ++first, --last;  // a quoted cell
+    if (n == cells_.size()) cells_.emplace_back();
+    cells_[n++].assign(line, first, last - first);
+    if (sep == std::string::npos) break;
+    start = sep + 1;
+  }
+  cells_.resize(n);
+  // VESC Tool ends every line with its separator: the empty cell after it is no column.
+  if (trailing_separator_ && cells_.size() == width_ + 1 && cells_.back().empty()) cells_.pop_back();
+}
+
+void MappedLogReader::read_header() {
+  index_.fill(-1);
+  column_.fill(nullptr);
+  for (std::size_t k = 0; k < map_.skip_lines; ++k) {
+    std::string skipped;
+    if (!std::getline(in_, skipped)) break;
+    ++line_;
+    bytes_read_ += skipped.size() + 1;
+  }
+  if (!map_.header) {
+    // Positions are checked against the first row's width when it is read.
+    for (const MappedColumn& c : map_.columns) {
+      index_[static_cast<std::size_t>(c.quantity)] = static_cast<int>(c.column.position) - 1;
+      column_[static_cast<std::size_t>(c.quantity)] = &c;
+    }
+    if (map_.time) time_index_ = static_cast<int>(map_.time->column.position) - 1;
+    if (map_.time) time_label_ = map_.time->column.label() + " (t)";
+    return;
+  }
+  std::string header_line;
+  if (!next_line(header_line)) throw DriveLogError(path_, line_ == 0 ? 1 : line_, 0, "", "empty file: expected a header row");
+  if (header_line.rfind("\xEF\xBB\xBF", 0) == 0) header_line.erase(0, 3);  // a UTF-8 byte-order mark
+  const auto last = std::find_if_not(header_line.rbegin(), header_line.rend(),
+                                     [&](char c) { return blank(c) && c != map_.separator; });
+  trailing_separator_ = last != header_line.rend() && *last == map_.separator;
+  width_ = std::numeric_limits<std::size_t>::max();  // no trailing cell dropped from the header itself
+  split(header_line);
+  if (trailing_separator_ && !cells_.empty() && cells_.back().empty()) cells_.pop_back();
+  header_ = cells_;
+  width_ = header_.size();
+
+  auto find = [&](const std::string& name, const std::string& label) {
+    int index = -1;
+    for (std::size_t k = 0; k < header_.size(); ++k) {
+      if (header_[k] != name) continue;
+      if (index >= 0) fail_at(line_, label, "column appears twice in the header");
+      index = static_cast<int>(k);
+    }
+    return index;
+  };
+  auto missing = [&](const std::string& label) {
+    fail_at(line_, label, map_.columns_optional ? "required column is missing from the header"
+                                                : "is missing from the header (the map " + map_.name + " reads it)");
+  };
+  if (map_.time) {
+    time_label_ = map_.time->column.name == "t" ? "t" : map_.time->column.name + " (t)";
+    time_index_ = find(map_.time->column.name, time_label_);
+    if (time_index_ < 0) missing(time_label_);
+  }
+  for (const MappedColumn& c : map_.columns) {
+    const std::size_t q = static_cast<std::size_t>(c.quantity);
+    column_[q] = &c;
+    index_[q] = find(c.column.name, label(c.quantity));
+    if (index_[q] < 0) {
+      column_[q] = nullptr;
+      if (!map_.columns_optional) {
+        column_[q] = &c;
+        missing(label(c.quantity));
+      }
+    }
+  }
+}
+
+double MappedLogReader::cell(int index, const std::string& label, const MappedColumn& c, bool allow_nan) const {
+  const std::string& s = cells_[static_cast<std::size_t>(index)];
+  if (s.empty()) fail_cell(index, label, "empty cell");
+  double v = 0.0;
+  const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
+  if (ec != std::errc() || end != s.data() + s.size()) fail_cell(index, label, "'" + s + "' is not a number");
+  if (std::isnan(v)) {
+    if (allow_nan) return kNaN;
+    fail_cell(index, label, "NaN");
+  }
+  if (!std::isfinite(v)) fail_cell(index, label, "'" + s + "' is not finite");
+  const double si = c.unit_factor * (v * c.scale + c.offset) + c.unit_offset;
+  if (!std::isfinite(si)) fail_cell(index, label, "'" + s + "' is not finite in SI (" + c.unit + ")");
+  return si;
+}
+
+void MappedLogReader::check(const MappedRow& row, int index, const std::string& label, Quantity q, double v) const {
+  const QuantityInfo& i = info(q);
+  const char* unit = "";
+  const Bound* bound = nullptr;
+  switch (i.kind) {
+    case QuantityKind::kTime: bound = &limits_.time_s, unit = "s"; break;
+    case QuantityKind::kAngle: bound = &limits_.angle_rad, unit = "rad"; break;
+    case QuantityKind::kSpeed: bound = &limits_.speed_rad_s, unit = "rad/s"; break;
+    case QuantityKind::kVoltage: bound = &limits_.voltage_V, unit = "V"; break;
+    case QuantityKind::kCurrent: bound = &limits_.current_A, unit = "A"; break;
+    case QuantityKind::kTorque: bound = &limits_.torque_Nm, unit = "Nm"; break;
+    case QuantityKind::kTemperature:
+      if (v < limits_.temperature_min_C || v > limits_.temperature_max_C) {
+        fail_cell(index, label, g6(v) + " °C is outside the plausible [" + g6(limits_.temperature_min_C) + ", " +
+                                    g6(limits_.temperature_max_C) + "] °C");
+      }
+      return;
+  }
+  if (std::abs(v) > bound->max_abs) {
+    fail_cell(index, label, g6(v) + " " + unit + " is beyond the plausible ±" + g6(bound->max_abs) + " " + unit + " (" +
+                                bound->why + ")");
+  }
+  const double u_dc = row[Quantity::kUDc];
+  if (i.voltage_command && u_dc >= 1.0 && std::abs(v) > limits_.command_per_dc_link * u_dc) {
+    fail_cell(index, label, g6(v) + " V is more than " + g6(limits_.command_per_dc_link) + " x this row's u_dc = " +
+                                g6(u_dc) + " V (a two-level inverter applies at most u_dc/2 from the link's midpoint)");
+  }
+}
+
+bool MappedLogReader::read_raw(MappedRow& row) {
+  std::string text;
+  if (!next_line(text)) return false;
+  split(text);
+  if (!map_.header && width_ == 0) {
+    width_ = cells_.size();
+    for (std::size_t q = 0; q < kQuantityCount; ++q) {
+      if (index_[q] >= static_cast<int>(width_)) {
+        fail_at(line_, static_cast<Quantity>(q), "the map reads cell " + std::to_string(index_[q] + 1) + ", the row has " +
+                                                    std::to_string(width_) + " cells");
+      }
+    }
+    if (time_index_ >= static_cast<int>(width_)) {
+      fail_at(line_, time_label_, "the map reads cell " + std::to_string(time_index_ + 1) + ", the row has " +
+                                      std::to_string(width_) + " cells");
+    }
+  }
+  if (cells_.size() != width_) {
+    fail_at(line_, "*", "row has " + std::to_string(cells_.size()) + " cells, " +
+                            (map_.header ? "header has " : "the first row has ") + std::to_string(width_));
+  }
+  row.line = line_;
+  row.value.fill(kNaN);
+
+  // Time: the column's value (unwrapped), or the row's index times the period.
+  std::int64_t t_ns = 0;
+  if (map_.time) {
+    double t_s = cell(time_index_, time_label_, *map_.time, false);
+    if (std::abs(t_s) > limits_.time_s.max_abs) {
+      fail_cell(time_index_, time_label_, g6(t_s) + " s is beyond the plausible ±" + g6(limits_.time_s.max_abs) + " s (" +
+                                              limits_.time_s.why + ")");
+    }
+    if (previous_cell_s_ && map_.wrap_s > 0.0 && t_s < *previous_cell_s_ - 0.5 * map_.wrap_s) {
+      // A step back by more than half the period is the column wrapping (ms_today at midnight): the
+      // shorter way round the clock is forward. A shorter step back is time going back.
+      wrap_offset_s_ += map_.wrap_s;
+      ++repairs_.wraps;
+    }
+    previous_cell_s_ = t_s;
+    t_ns = std::llround((t_s + wrap_offset_s_) * 1e9);
+  } else {
+    t_ns = std::llround(static_cast<double>(data_rows_) * map_.period_s * 1e9);
+  }
+  ++data_rows_;
+  if (previous_raw_ns_ && t_ns <= *previous_raw_ns_) {
+    if (!(t_ns == *previous_raw_ns_ && map_.resolution_s > 0.0)) {
+      std::string reason = "time does not increase (by at least 1 ns)";
+      if (map_.wrap_s > 0.0 && t_ns < *previous_raw_ns_) {
+        reason = "time goes back by " + g6(1e-9 * static_cast<double>(*previous_raw_ns_ - t_ns)) +
+                 " s (the column wraps every " + g6(map_.wrap_s) + " s; a wrap steps back by more than half of that)";
+      }
+      fail_cell(time_index_, time_label_, reason);
+    }
+  }
+  previous_raw_ns_ = t_ns;
+  row.t_ns = t_ns;
+
+  for (std::size_t q = 0; q < kQuantityCount; ++q) {
+    if (index_[q] < 0) continue;
+    const MappedColumn& c = *column_[q];
+    const bool allow_nan = map_.nan_is_missing && (c.quantity == Quantity::kUDc || info(c.quantity).kind == QuantityKind::kTemperature);
+    row.value[q] = cell(index_[q], label(c.quantity), c, allow_nan);
+  }
+  // Checked after every cell is read: a command is held to its row's u_dc.
+  for (std::size_t q = 0; q < kQuantityCount; ++q) {
+    if (index_[q] >= 0 && !std::isnan(row.value[q])) check(row, index_[q], label(static_cast<Quantity>(q)), static_cast<Quantity>(q), row.value[q]);
+  }
+  return true;
+}
+
+bool MappedLogReader::next(MappedRow& row) {
+  if (ready_.empty()) {
+    MappedRow first;
+    if (lookahead_) {
+      first = *lookahead_;
+      lookahead_.reset();
+    } else if (!read_raw(first)) {
+      if (rows_ == 0) throw DriveLogError(path_, line_, 0, "", "no samples: the header is followed by no data rows");
+      return false;
+    }
+    ready_.push_back(first);
+    if (map_.resolution_s > 0.0) {
+      // Rows stamped alike (VESC Tool handled several replies within its clock's millisecond) are spread
+      // evenly over the stamp's resolution: each stays inside the interval its stamp stands for.
+      MappedRow r;
+      while (read_raw(r)) {
+        if (r.t_ns != first.t_ns) {
+          lookahead_ = r;
+          break;
+        }
+        ready_.push_back(r);
+      }
+      const double n = static_cast<double>(ready_.size());
+      for (std::size_t j = 1; j < ready_.size(); ++j) {
+        ready_[j].t_ns += std::llround(static_cast<double>(j) / n * map_.resolution_s * 1e9);
+        ++repairs_.tied_rows;
+      }
+      if (lookahead_ && ready_.back().t_ns >= lookahead_->t_ns) {
+        fail_at(lookahead_->line, time_label_, "stamped within the resolution (" + g6(map_.resolution_s) +
+                                                   " s) of a run of equal stamps before it: the column is finer than the "
+                                                   "map's time.resolution");
+      }
+    }
+  }
+  row = ready_.front();
+  ready_.pop_front();
+  ++rows_;
+  return true;
+}
+
+}  // namespace rpem::io

@@ -1,0 +1,243 @@
+// Column maps (docs/drive-log.md, "Column maps"): a bad map is refused with file:line:column (ConfigError,
+// exit 78 in the tools); a CSV read through a map gives the rows its own format's reader would give; the
+// example maps read their formats: the Paderborn bench data as published (against the independent
+// conversion script), and SimpleFOC's monitor output as FOCMotor::monitor() prints it.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <numbers>
+#include <string>
+
+#include "rpem/io/averaged_log.hpp"
+#include "rpem/io/csv_table.hpp"
+#include "rpem/io/drive_log.hpp"
+#include "rpem/io/log_map.hpp"
+#include "rpem/io/log_source.hpp"
+#include "support/temp_file.hpp"
+
+namespace rpem::io {
+namespace {
+
+std::string source_dir() {
+  const char* env = std::getenv("RPEM_SOURCE_DIR");
+  return env ? env : RPEM_TEST_SOURCE_DIR;
+}
+
+std::string map_error(const std::string& yaml) {
+  try {
+    (void)parse_log_map(yaml, "map.yaml");
+  } catch (const ConfigError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+const std::string kMinimal =
+    "samples: instantaneous\ntime: {column: time, unit: ms}\ncolumns:\n"
+    "  omega_el: {column: w}\n  u_d: {column: ud}\n  u_q: {column: uq}\n  i_d: {column: id}\n  i_q: {column: iq}\n";
+
+TEST(LogMap, TheMinimalMapReads) {
+  const LogMap m = parse_log_map(kMinimal, "map.yaml");
+  EXPECT_FALSE(m.averaged());
+  EXPECT_EQ(m.separator, ',');
+  ASSERT_TRUE(m.time.has_value());
+  EXPECT_DOUBLE_EQ(m.time->unit_factor, 1e-3);
+  EXPECT_EQ(m.columns.size(), 5U);
+}
+
+struct BadMap {
+  const char* name;
+  std::string yaml;
+  const char* expected;  ///< the whole message after "map.yaml:"
+};
+
+class MalformedMap : public ::testing::TestWithParam<BadMap> {};
+
+TEST_P(MalformedMap, IsRefusedWithLineColumnAndKey) {
+  const std::string msg = map_error(GetParam().yaml);
+  EXPECT_EQ(msg, std::string("map.yaml:") + GetParam().expected);
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Cases, MalformedMap,
+    ::testing::Values(
+        BadMap{"unknown_top_key", kMinimal + "rate: 5\n", "9:1: rate: unknown key"},
+        BadMap{"unknown_quantity", kMinimal + "  i_x: {column: ix}\n", "9:3: columns.i_x: unknown key"},
+        BadMap{"unknown_column_key", kMinimal + "  T_magnet: {column: pm, gain: 2}\n",
+               "9:26: columns.T_magnet.gain: unknown key"},
+        BadMap{"unit_of_another_quantity", kMinimal + "  u_dc: {column: vdc, unit: A}\n",
+               "9:29: columns.u_dc.unit: 'A' is not a unit of this quantity (one of V, mV, kV)"},
+        BadMap{"mechanical_without_pole_pairs",
+               "samples: instantaneous\ntime: {period_s: 1}\ncolumns:\n  omega_el: {column: n, unit: rpm}\n"
+               "  u_d: {column: ud}\n  u_q: {column: uq}\n  i_d: {column: id}\n  i_q: {column: iq}\n",
+               "4:31: columns.omega_el.unit: 'rpm' is mechanical: the map needs pole_pairs to make it electrical"},
+        BadMap{"pole_pairs_unused", kMinimal + "pole_pairs: 4\n",
+               "9:13: pole_pairs: no column is in a mechanical unit (rpm, rad/s_mech, Hz_mech, rad_mech, deg_mech)"},
+        BadMap{"no_current",
+               "samples: instantaneous\ntime: {period_s: 1}\ncolumns:\n  omega_el: {column: w}\n  u_d: {column: ud}\n"
+               "  u_q: {column: uq}\n",
+               "4:3: columns: i_a,i_b,i_c|i_d,i_q: no current columns in a drive log, which this map gives"},
+        BadMap{"averaged_without_i_q",
+               "samples: averaged\nwindow: previous_row\ntime: {period_s: 1}\ncolumns:\n  omega_el: {column: w}\n"
+               "  u_d: {column: ud}\n  u_q: {column: uq}\n  i_d: {column: id}\n",
+               "5:3: columns: i_q: required in an averaged log, which this map gives"},
+        BadMap{"averaged_phase_current",
+               "samples: averaged\nwindow: previous_row\ntime: {period_s: 1}\ncolumns:\n  omega_el: {column: w}\n"
+               "  u_d: {column: ud}\n  u_q: {column: uq}\n  i_d: {column: id}\n  i_q: {column: iq}\n  i_a: {column: ia}\n",
+               "5:3: columns: i_a: not a quantity of averaged samples (their means are rotor-frame: i_d, i_q, u_d, u_q, "
+               "omega_el, u_dc, T_winding, T_magnet, T_drive) in an averaged log, which this map gives"},
+        BadMap{"averaged_without_window",
+               "samples: averaged\ntime: {period_s: 1}\ncolumns: {omega_el: {column: w}}\n",
+               "1:1: window: required key is missing"},
+        BadMap{"window_t_start_without_column",
+               "samples: averaged\nwindow: t_start\ntime: {column: t}\ncolumns:\n  omega_el: {column: w}\n"
+               "  u_d: {column: ud}\n  u_q: {column: uq}\n  i_d: {column: id}\n  i_q: {column: iq}\n",
+               "5:3: columns: window: t_start needs a t_start column"},
+        BadMap{"instantaneous_with_window", "window: previous_row\n" + kMinimal,
+               "1:9: window: only averaged samples have windows"},
+        BadMap{"separator_of_two_characters", "separator: ';;'\n" + kMinimal,
+               "1:12: separator: must be one character (a tab: \"\\t\")"},
+        BadMap{"time_neither_column_nor_period", "samples: instantaneous\ntime: {unit: s}\ncolumns: {}\n",
+               "2:7: time: give the time column (column, unit) or evenly spaced rows (period_s)"},
+        BadMap{"period_and_column", "samples: instantaneous\ntime: {period_s: 1, column: t}\ncolumns: {}\n",
+               "2:29: time.column: rows are timed by period_s; a time column is not read as well"},
+        BadMap{"headerless_column_by_name",
+               "header: false\nsamples: instantaneous\ntime: {period_s: 1}\ncolumns:\n  omega_el: {column: w}\n",
+               "5:22: columns.omega_el.column: 'w' is not an integer"},
+        BadMap{"zero_scale", kMinimal + "  T_winding: {column: tw, scale: 0}\n",
+               "9:34: columns.T_winding.scale: 0 would make every value the offset"},
+        BadMap{"samples_missing", "time: {period_s: 1}\ncolumns: {}\n", "1:1: samples: required key is missing"}),
+    [](const auto& p) { return std::string(p.param.name); });
+
+TEST(LogMap, ADriveLogThroughAMapReadsAsTheDriveLogItself) {
+  // The same data in our format and in a logger's own (';', a comment line, ms, mA, rpm, kelvin).
+  test::TempFile ours("ours.csv",
+                      "t,omega_el,u_d,u_q,i_d,i_q,T_winding\n0.5,104.71975511965977,-1.5,12,-0.25,3,40\n"
+                      "0.75,209.43951023931953,-1.5,13,-0.5,3.5,41\n");
+  test::TempFile theirs("theirs.csv",
+                        "# bench 3, logger v2\nms;speed_rpm;vd;vq;id_mA;iq_mA;Tw_K\n500;250;-1.5;12;-250;3000;313.15\n"
+                        "750;500;-1.5;13;-500;3500;314.15\n");
+  test::TempFile map("map.yaml",
+                     "separator: ';'\ncomment: '#'\nsamples: instantaneous\npole_pairs: 4\ntime: {column: ms, unit: ms}\n"
+                     "columns:\n  omega_el: {column: speed_rpm, unit: rpm}\n  u_d: {column: vd}\n  u_q: {column: vq}\n"
+                     "  i_d: {column: id_mA, unit: mA}\n  i_q: {column: iq_mA, unit: mA}\n"
+                     "  T_winding: {column: Tw_K, unit: K}\n");
+  const auto a = read_drive_log(ours.path());
+  DriveLogReader reader(theirs.path(), load_log_map(map.path()), DriveLogLimits{});
+  EXPECT_FALSE(reader.layout().angle);
+  for (const DriveLogRow& expected : a) {
+    DriveLogRow r;
+    ASSERT_TRUE(reader.next(r));
+    EXPECT_EQ(r.sample.t_ns, expected.sample.t_ns);
+    EXPECT_NEAR(r.sample.omega_el_rad_s, expected.sample.omega_el_rad_s, 1e-12);
+    for (int k = 0; k < 2; ++k) {
+      EXPECT_NEAR(r.sample.u_V[k], expected.sample.u_V[k], 1e-12);
+      EXPECT_NEAR(r.sample.i_A[k], expected.sample.i_A[k], 1e-12);
+    }
+    EXPECT_NEAR(*r.t_winding_C, *expected.t_winding_C, 1e-9);
+  }
+  DriveLogRow r;
+  EXPECT_FALSE(reader.next(r));
+}
+
+std::string data_error(const std::string& map_yaml, const std::string& csv) {
+  test::TempFile map("map.yaml", map_yaml), log("log.csv", csv);
+  try {
+    const LogSource s = log_source(log.path(), map.path());
+    DriveLogReader reader(log.path(), s.map, DriveLogLimits{});
+    DriveLogRow r;
+    while (reader.next(r)) {
+    }
+  } catch (const DriveLogError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(LogMap, DataErrorsNameTheFilesColumnAndTheQuantity) {
+  EXPECT_NE(data_error(kMinimal, "time,w,ud,uq,id\n").find("log.csv:1: column iq (i_q): is missing from the header (the "
+                                                           "map "),
+            std::string::npos);
+  EXPECT_NE(data_error(kMinimal, "time,w,ud,uq,id,iq\n0,1,2,3,4,5\n1,1,2,3,4,5e6\n")
+                .find("log.csv:3:6: column iq (i_q): 5e+06 A is beyond the plausible ±100000 A"),
+            std::string::npos);
+  const std::string headerless =
+      "header: false\nseparator: \"\\t\"\nsamples: instantaneous\ntime: {period_s: 0.1}\ncolumns:\n"
+      "  omega_el: {column: 1}\n  u_d: {column: 2}\n  u_q: {column: 3}\n  i_d: {column: 4}\n  i_q: {column: 9}\n";
+  EXPECT_NE(data_error(headerless, "1\t2\t3\t4\t5\n").find("log.csv:1:9: column 9 (i_q): the map reads cell 9, the row has 5 cells"),
+            std::string::npos)
+      << data_error(headerless, "1\t2\t3\t4\t5\n");
+  const std::string wide = "header: false\nseparator: \"\\t\"\nsamples: instantaneous\ntime: {period_s: 0.1}\ncolumns:\n"
+                           "  omega_el: {column: 1}\n  u_d: {column: 2}\n  u_q: {column: 3}\n  i_d: {column: 4}\n"
+                           "  i_q: {column: 5}\n";
+  EXPECT_NE(data_error(wide, "1\t2\t3\t4\t5\n1\t2\t3\t4\n").find("log.csv:2: column *: row has 4 cells, the first row has 5"),
+            std::string::npos);
+}
+
+TEST(LogMap, EqualStampsAreAnErrorWithoutAResolution) {
+  EXPECT_NE(data_error(kMinimal, "time,w,ud,uq,id,iq\n5,1,2,3,4,5\n5,1,2,3,4,5\n")
+                .find("log.csv:3:1: column time (t): time does not increase (by at least 1 ns)"),
+            std::string::npos);
+}
+
+TEST(LogMapExamples, EveryCommittedMapLoads) {
+  for (const char* name : {"vesc-tool", "paderborn-motor-temperature", "simplefoc-monitor"}) {
+    EXPECT_NO_THROW((void)load_log_map(source_dir() + "/config/log-maps/" + name + ".yaml")) << name;
+  }
+}
+
+TEST(LogMapExamples, PaderbornAsPublishedEqualsTheConversionScript) {
+  // The bench data read through the map, and converted by scripts/paderborn_to_drive_log.py (Python's csv
+  // module, its own arithmetic): the same rows.
+  const std::string data = source_dir() + "/data/paderborn-motor-temperature/profile_A_every5th.csv";
+  test::TempFile converted("converted.csv");
+  ASSERT_EQ(std::system(("python3 " + source_dir() + "/scripts/paderborn_to_drive_log.py " + data + " " +
+                         converted.path() + " --pole-pairs 4 --sample-period-s 2.5")
+                            .c_str()),
+            0);
+  const auto expected = read_drive_log(converted.path());
+  const LogSource s = log_source(data, source_dir() + "/config/log-maps/paderborn-motor-temperature.yaml");
+  DriveLogReader reader(data, s.map, DriveLogLimits{});
+  std::size_t n = 0;
+  DriveLogRow r;
+  while (reader.next(r)) {
+    ASSERT_LT(n, expected.size());
+    const DriveLogRow& e = expected[n++];
+    ASSERT_EQ(r.sample.t_ns, e.sample.t_ns) << n;
+    ASSERT_NEAR(r.sample.omega_el_rad_s, e.sample.omega_el_rad_s, 1e-12 * std::abs(e.sample.omega_el_rad_s) + 1e-15) << n;
+    for (int k = 0; k < 2; ++k) {
+      ASSERT_EQ(r.sample.u_V[k], e.sample.u_V[k]) << n;
+      ASSERT_EQ(r.sample.i_A[k], e.sample.i_A[k]) << n;
+    }
+    ASSERT_EQ(r.t_winding_C, e.t_winding_C) << n;
+    ASSERT_EQ(r.t_magnet_C, e.t_magnet_C) << n;
+  }
+  EXPECT_EQ(n, 3003U);
+  EXPECT_EQ(n, expected.size());
+}
+
+TEST(LogMapExamples, SimpleFocMonitorOutputAsFocMotorPrintsIt) {
+  // FOCMotor::monitor() with every variable on, monitor_decimals 4, monitor_separator '\t', no start or
+  // end character, println's "\r\n": target, Uq, Ud, Iq [mA], Id [mA], shaft velocity, shaft angle.
+  test::TempFile log("monitor.txt",
+                     "2.0000\t1.2345\t-0.1234\t512.3400\t-12.5000\t20.0000\t3.1416\r\n"
+                     "2.0000\t1.2400\t-0.1250\t515.0000\t-13.0000\t20.1000\t3.3426\r\n");
+  const LogSource s = log_source(log.path(), source_dir() + "/config/log-maps/simplefoc-monitor.yaml");
+  DriveLogReader reader(log.path(), s.map, DriveLogLimits{});
+  DriveLogRow r;
+  ASSERT_TRUE(reader.next(r));
+  EXPECT_EQ(r.sample.t_ns, 0);
+  EXPECT_EQ(r.sample.voltage_frame, core::Frame::kDq);
+  EXPECT_DOUBLE_EQ(r.sample.u_V[0], -0.1234);
+  EXPECT_DOUBLE_EQ(r.sample.u_V[1], 1.2345);
+  EXPECT_NEAR(r.sample.i_A[0], -0.0125, 1e-15);
+  EXPECT_NEAR(r.sample.i_A[1], 0.51234, 1e-15);
+  EXPECT_NEAR(r.sample.omega_el_rad_s, 7 * 20.0, 1e-12);  // pole_pairs 7
+  ASSERT_TRUE(reader.next(r));
+  EXPECT_EQ(r.sample.t_ns, 10'000'000);  // period_s 0.01
+  EXPECT_FALSE(reader.next(r));
+}
+
+}  // namespace
+}  // namespace rpem::io

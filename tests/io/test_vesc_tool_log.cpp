@@ -1,0 +1,174 @@
+// VESC Tool's realtime-data log read as VESC Tool writes it: headers and rows from VESC Tool's own source
+// (tests/support/vesc_tool_vectors.hpp), none produced by our code.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+#include <string>
+
+#include "rpem/io/averaged_log.hpp"
+#include "rpem/io/log_source.hpp"
+#include "rpem/io/vesc_tool_log.hpp"
+#include "support/temp_file.hpp"
+#include "support/vesc_tool_vectors.hpp"
+
+namespace rpem::io {
+namespace {
+
+using namespace test::vesc_tool;
+
+std::string error_of(const std::string& content) {
+  test::TempFile f("vesc.csv", content);
+  try {
+    const LogSource s = log_source(f.path());
+    (void)read_averaged_log(f.path(), s.map, DriveLogLimits{});
+  } catch (const DriveLogError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(VescToolLog, EveryHeaderVersionIsIdentified) {
+  const std::vector<std::pair<std::string, std::string>> cases{
+      {kHeader117, "1.17 to 1.19"}, {kHeader120Test, "1.20 test builds"}, {kHeader120, "1.20 and later"}};
+  ASSERT_EQ(vesc_tool_headers().size(), cases.size());
+  for (const auto& [header, versions] : cases) {
+    std::vector<std::string> cells;
+    std::string h = header.substr(0, header.size() - 2);  // without the trailing ";\n"
+    for (std::size_t start = 0;;) {
+      const std::size_t sep = h.find(';', start);
+      cells.push_back(h.substr(start, sep - start));
+      if (sep == std::string::npos) break;
+      start = sep + 1;
+    }
+    const VescToolHeader* v = identify_vesc_tool_header(cells);
+    ASSERT_NE(v, nullptr) << versions;
+    EXPECT_EQ(std::string(v->versions), versions);
+  }
+}
+
+TEST(VescToolLog, ReadsTheCurrentHeaderAsAveragedSamplesSinceThePreviousRow) {
+  // GIVEN three reads 90 and 110 ms apart WHEN read THEN the first row opens the window and each sample
+  // holds the means since the previous row, the speed electrical (erpm·2π/60).
+  test::TempFile f("vesc.csv", kHeader120 + row120(45000000, -0.5, 3.2, 6000, -0.31, 8.7) +
+                                   row120(45000090, -1.25, 10.5, 6100, -0.9, 9.25) +
+                                   row120(45000200, -1.5, 11.0, 6200, -1.0, 9.5));
+  const LogSource source = log_source(f.path());
+  EXPECT_TRUE(source.averaged());
+  EXPECT_NE(source.format.find("VESC Tool 1.20 and later"), std::string::npos) << source.format;
+  AveragedLogRead read;
+  const auto s = read_averaged_log(f.path(), source.map, DriveLogLimits{}, &read);
+  ASSERT_EQ(s.size(), 2U);
+  EXPECT_EQ(read.rows, 3U);
+  EXPECT_EQ(read.opening_rows, 1U);
+  EXPECT_EQ(s[0].t_start_ns, 45'000'000'000'000);
+  EXPECT_EQ(s[0].t_ns, 45'000'090'000'000);
+  EXPECT_EQ(s[1].t_start_ns, s[0].t_ns);
+  EXPECT_DOUBLE_EQ(s[0].i_dq_A[0], -1.25);
+  EXPECT_DOUBLE_EQ(s[0].i_dq_A[1], 10.5);
+  EXPECT_DOUBLE_EQ(s[0].u_dq_V[0], -0.9);
+  EXPECT_DOUBLE_EQ(s[0].u_dq_V[1], 9.25);
+  EXPECT_NEAR(s[0].omega_el_rad_s, 6100.0 * 2.0 * std::numbers::pi / 60.0, 1e-9);
+  EXPECT_DOUBLE_EQ(s[0].u_dc_V, 40.1);
+  EXPECT_DOUBLE_EQ(s[0].t_winding_C, 55.0);
+  EXPECT_DOUBLE_EQ(s[0].t_drive_C, 41.3);
+  EXPECT_TRUE(std::isnan(s[0].t_magnet_C));
+  EXPECT_TRUE(read.layout.u_dc && read.layout.t_winding && read.layout.t_drive && !read.layout.t_magnet);
+}
+
+TEST(VescToolLog, ReadsTheTestBuildHeaderOfVersion120) {
+  test::TempFile f("vesc.csv", kHeader120Test + row120test(1000, 0, 1, 100, 0, 0.5) + row120test(1100, 0, 2, 200, 0, 1.0));
+  const LogSource source = log_source(f.path());
+  EXPECT_NE(source.format.find("1.20 test builds"), std::string::npos) << source.format;
+  const auto s = read_averaged_log(f.path(), source.map, DriveLogLimits{});
+  ASSERT_EQ(s.size(), 1U);
+  EXPECT_DOUBLE_EQ(s[0].u_dq_V[1], 1.0);
+}
+
+TEST(VescToolLog, AHeaderWithoutDqVoltagesNamesTheVersionThatAddedThem) {
+  const std::string msg = error_of(kHeader117 + values22(1000, 40, 50, 0, 1, 100) + "\n");
+  EXPECT_NE(msg.find("vesc.csv:1: column d_axis_voltage: not in this VESC Tool realtime log (the header of VESC Tool "
+                     "1.17 to 1.19)"),
+            std::string::npos)
+      << msg;
+  EXPECT_NE(msg.find("VESC Tool 1.20 test builds added it (vedderb/vesc_tool 5986063b"), std::string::npos) << msg;
+}
+
+TEST(VescToolLog, TheHeaderlessLogOfVersions111To116IsRefusedWithWhy) {
+  // 2323a806 (VESC Tool 1.11, 2019-05-06) wrote the 22 values with no header.
+  const std::string msg = error_of(values22(1000, 40, 50, 0, 1, 100) + "\n" + values22(1100, 40, 50, 0, 1, 100) + "\n");
+  EXPECT_NE(msg.find("vesc.csv:1: a VESC Tool realtime log without header (VESC Tool 1.11 to 1.16"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("d_axis_voltage, q_axis_voltage"), std::string::npos) << msg;
+}
+
+TEST(VescToolLog, MidnightWrapKeepsTimeMonotonic) {
+  // 23:59:59.950 → 00:00:00.030: ms_today wraps; the window of the row after midnight is 80 ms.
+  test::TempFile f("vesc.csv", kHeader120 + row120(86399870, 0, 1, 100, 0, 1) + row120(86399950, 0, 1, 100, 0, 1) +
+                                   row120(30, 0, 1, 100, 0, 1) + row120(120, 0, 1, 100, 0, 1));
+  AveragedLogRead read;
+  const auto s = read_averaged_log(f.path(), log_source(f.path()).map, DriveLogLimits{}, &read);
+  ASSERT_EQ(s.size(), 3U);
+  EXPECT_EQ(read.repairs.wraps, 1U);
+  EXPECT_EQ(s[1].t_start_ns, 86'399'950'000'000);
+  EXPECT_EQ(s[1].t_ns, 86'400'030'000'000);
+  EXPECT_EQ(s[2].t_ns, 86'400'120'000'000);
+}
+
+TEST(VescToolLog, AStepBackShorterThanHalfADayIsAnErrorNotAWrap) {
+  const std::string msg = error_of(kHeader120 + row120(50000000, 0, 1, 100, 0, 1) + row120(49995000, 0, 1, 100, 0, 1));
+  EXPECT_NE(msg.find("vesc.csv:3:1: column ms_today (t): time goes back by 5 s (the column wraps every 86400 s"),
+            std::string::npos)
+      << msg;
+}
+
+TEST(VescToolLog, RowsInTheSameMillisecondAreSpreadOverIt) {
+  // VESC Tool stamps a reply when it handles it, to the millisecond: three replies handled in one
+  // millisecond keep their order inside it.
+  test::TempFile f("vesc.csv", kHeader120 + row120(1000, 0, 1, 100, 0, 1) + row120(1020, 0, 1, 100, 0, 1) +
+                                   row120(1020, 0, 1, 100, 0, 1) + row120(1020, 0, 1, 100, 0, 1) +
+                                   row120(1040, 0, 1, 100, 0, 1));
+  AveragedLogRead read;
+  const auto s = read_averaged_log(f.path(), log_source(f.path()).map, DriveLogLimits{}, &read);
+  ASSERT_EQ(s.size(), 4U);
+  EXPECT_EQ(read.repairs.tied_rows, 2U);
+  EXPECT_EQ(s[0].t_ns, 1'020'000'000);
+  EXPECT_EQ(s[1].t_ns, 1'020'333'333);
+  EXPECT_EQ(s[2].t_ns, 1'020'666'667);
+  EXPECT_EQ(s[2].t_start_ns, s[1].t_ns);
+  EXPECT_EQ(s[3].t_ns, 1'040'000'000);
+}
+
+TEST(VescToolLog, ABadCellNamesTheFilesColumnAndTheQuantity) {
+  std::string bad = row120(1100, 0, 1, 100, 0, 1);
+  bad.replace(bad.find(";1.000000;100"), 9, ";x");  // q_axis_current, the 11th cell
+  const std::string msg = error_of(kHeader120 + row120(1000, 0, 1, 100, 0, 1) + bad);
+  EXPECT_NE(msg.find("vesc.csv:3:11: column q_axis_current (i_q): 'x' is not a number"), std::string::npos) << msg;
+}
+
+TEST(VescToolLog, OneRowHoldsNoSample) {
+  const std::string msg = error_of(kHeader120 + row120(1000, 0, 1, 100, 0, 1));
+  EXPECT_NE(msg.find("vesc.csv:2: no samples: the only row holds means since a read before the log began"),
+            std::string::npos)
+      << msg;
+}
+
+TEST(VescToolLog, ACommaSeparatedCopyAndAnUnknownVariantAreReadByName) {
+  // VESC Tool's own loader also splits at ','; a third-party logger writing the same names in another
+  // order (and without the trailing separator) is read by name.
+  std::string comma = kHeader120 + row120(1000, 0, 1, 100, 0, 1) + row120(1100, 0, 2, 100, 0, 2);
+  std::replace(comma.begin(), comma.end(), ';', ',');
+  test::TempFile f("vesc.csv", comma);
+  const auto s = read_averaged_log(f.path(), log_source(f.path()).map, DriveLogLimits{});
+  ASSERT_EQ(s.size(), 1U);
+  EXPECT_DOUBLE_EQ(s[0].u_dq_V[1], 2.0);
+
+  test::TempFile g("other.csv",
+                   "ms_today;erpm;d_axis_current;q_axis_current;d_axis_voltage;q_axis_voltage;input_voltage;temp_motor;"
+                   "temp_mos_max\n10;600;0;1;0;0.5;40;30;30\n20;600;0;1;0;0.5;40;30;30\n");
+  const LogSource other = log_source(g.path());
+  EXPECT_NE(other.format.find("no VESC Tool version known"), std::string::npos) << other.format;
+  EXPECT_EQ(read_averaged_log(g.path(), other.map, DriveLogLimits{}).size(), 1U);
+}
+
+}  // namespace
+}  // namespace rpem::io

@@ -1,0 +1,207 @@
+// The logs people have, as a user runs the tools on them (docs/drive-log.md): a VESC Tool realtime log
+// (detected by its header, no flag), the Paderborn bench data as published and SimpleFOC's monitor output
+// (through their maps in config/log-maps/), each read end to end by `rpem estimate`, `rpem diagnose` and
+// `rpem figures --log`;
+// and the exit codes and messages of a bad map (78) and of a log a map cannot read (65).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <numbers>
+#include <sstream>
+#include <string>
+
+#include "support/process.hpp"
+#include "support/temp_file.hpp"
+#include "support/vesc_tool_vectors.hpp"
+
+namespace rpem {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string rpem() { return test::binary_dir() + "/tools/rpem"; }
+std::string maps() { return test::source_dir() + "/config/log-maps/"; }
+
+class CliLogFormats : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = test::temp_path(std::string("cli_log_formats_") + ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+  [[nodiscard]] std::string path(const std::string& name) const { return (dir_ / name).string(); }
+
+  /// A VESC Tool 1.20+ log of the 6374 outrunner at steady states (u_q = R i_q + ω ψm, u_d = −ω L i_q),
+  /// one read every 90 ms.
+  std::string vesc_log(int rows) const {
+    const std::string p = path("2026-11-26_10-15-02.csv");
+    std::ofstream out(p);
+    out << test::vesc_tool::kHeader120;
+    for (int k = 0; k < rows; ++k) {
+      const double erpm = 6000.0 + 4000.0 * (k / 10 % 3), i_q = 5.0 + 2.5 * (k / 7 % 4);
+      const double w = erpm * 2.0 * std::numbers::pi / 60.0;
+      out << test::vesc_tool::row120(36'000'000 + 90 * k, 0.0, i_q, erpm, -w * 20e-6 * i_q, 0.025 * i_q + w * 0.004633);
+    }
+    return p;
+  }
+
+  fs::path dir_;
+};
+
+std::string vesc_config() { return test::source_dir() + "/config/vesc-6374-outrunner.yaml"; }
+
+TEST_F(CliLogFormats, AVescToolLogIsReadWithoutAFlag) {
+  const std::string log = vesc_log(120);
+  const test::ProcessResult e = test::run_command(rpem() + " estimate --log " + log + " --config " + vesc_config() +
+                                                  " --out " + path("est.csv"));
+  EXPECT_EQ(e.exit_code, 0) << e.output;
+  EXPECT_NE(e.output.find("as VESC Tool realtime log (the header of VESC Tool 1.20 and later): 120 rows, 119 averaged "
+                          "samples (the first row opens the first window"),
+            std::string::npos)
+      << e.output;
+  EXPECT_NE(e.output.find("119 averaged samples, psi_m ="), std::string::npos) << e.output;
+  const test::ProcessResult d = test::run_command(rpem() + " diagnose --log " + log + " --config " + vesc_config() +
+                                                  " --blocks 4 --out " + path("diag"));
+  EXPECT_EQ(d.exit_code, 0) << d.output;
+  EXPECT_NE(d.output.find("as VESC Tool realtime log"), std::string::npos) << d.output;
+  EXPECT_NE(d.output.find("119 samples, steady_state model"), std::string::npos) << d.output;
+}
+
+TEST_F(CliLogFormats, FiguresDrawAVescToolLogsRegimes) {
+  // Every row modulates at a locked angle and excites ψm (ω·ψm ≈ 3–7 V against VESC Tool's 10 mV): nothing is
+  // bridge off or not locked, and the timeline is drawn.
+  const std::string log = vesc_log(120);
+  const test::ProcessResult r = test::run_command(rpem() + " figures --log " + log + " --config " + vesc_config() +
+                                                  " --out " + path("fig"));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("rpem figures: read " + log + " as VESC Tool realtime log"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("not_locked 0, bridge_off 0,"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("rpem figures: wrote " + path("fig") + "/regimes.png"), std::string::npos) << r.output;
+  EXPECT_GT(fs::file_size(path("fig/regimes.png")), 10'000u);
+  EXPECT_TRUE(fs::exists(path("fig/Fig_EigenTraj.png")));
+}
+
+TEST_F(CliLogFormats, FiguresReadAMappedLogAndRefuseABadOneBeforeDrawing) {
+  // The first 101 rows of the carried profile (header + 100; a log needs at least 80).
+  const std::string log = path("profile.csv");
+  {
+    std::ifstream in(test::source_dir() + "/data/paderborn-motor-temperature/profile_A_every5th.csv");
+    std::ofstream out(log);
+    std::string line;
+    for (int k = 0; k < 101 && std::getline(in, line); ++k) out << line << "\n";
+  }
+  const std::string map = " --log-map " + maps() + "paderborn-motor-temperature.yaml";
+  const std::string config = " --config " + test::source_dir() + "/config/paderborn-pmsm.yaml";
+  const test::ProcessResult r = test::run_command(rpem() + " figures --log " + log + map + config + " --out " + path("fig"));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("read through the map"), std::string::npos) << r.output;
+  EXPECT_TRUE(fs::exists(path("fig/regimes.png")));
+  // A row the map cannot read: exit 65 with the file and line, and no figure drawn.
+  std::ofstream(log, std::ios::app) << "not,a,row\n";
+  const test::ProcessResult bad = test::run_command(rpem() + " figures --log " + log + map + config + " --out " + path("bad"));
+  EXPECT_EQ(bad.exit_code, 65) << bad.output;
+  EXPECT_NE(bad.output.find("profile.csv:102"), std::string::npos) << bad.output;
+  EXPECT_FALSE(fs::exists(path("bad")));
+  // --log-map without --log is a usage error.
+  EXPECT_EQ(test::run_command(rpem() + " figures" + map + " --out " + path("bad")).exit_code, 64);
+}
+
+TEST_F(CliLogFormats, AVescToolLogWithoutDqVoltagesIsRefusedWithTheVersion) {
+  const std::string log = path("old.csv");
+  std::ofstream(log) << test::vesc_tool::kHeader117 << test::vesc_tool::values22(1000, 40, 50, 0, 1, 100) << "\n";
+  for (const std::string sub : {"estimate", "diagnose", "figures"}) {
+    const test::ProcessResult r = test::run_command(rpem() + " " + sub + " --log " + log + " --out " + path("o"));
+    EXPECT_EQ(r.exit_code, 65) << sub << r.output;
+    EXPECT_NE(r.output.find("old.csv:1: column d_axis_voltage: not in this VESC Tool realtime log (the header of VESC "
+                            "Tool 1.17 to 1.19)"),
+              std::string::npos)
+        << sub << r.output;
+  }
+}
+
+TEST_F(CliLogFormats, ABadCellOfAVescToolLogExits65WithFileLineColumn) {
+  const std::string log = path("bad.csv");
+  std::string row = test::vesc_tool::row120(1100, 0, 1, 100, 0, 1);
+  row.replace(row.find(";1.000000;100"), 9, ";nan");
+  std::ofstream(log) << test::vesc_tool::kHeader120 << test::vesc_tool::row120(1000, 0, 1, 100, 0, 1) << row;
+  const test::ProcessResult r = test::run_command(rpem() + " estimate --log " + log + " --out " + path("o"));
+  EXPECT_EQ(r.exit_code, 65) << r.output;
+  EXPECT_NE(r.output.find("bad.csv:3:11: column q_axis_current (i_q): NaN"), std::string::npos) << r.output;
+}
+
+TEST_F(CliLogFormats, ThePaderbornDataAsPublishedThroughItsMap) {
+  // The first 41 rows of the carried profile (header + 40), read as they are.
+  const std::string log = path("profile.csv");
+  {
+    std::ifstream in(test::source_dir() + "/data/paderborn-motor-temperature/profile_A_every5th.csv");
+    std::ofstream out(log);
+    std::string line;
+    for (int k = 0; k < 41 && std::getline(in, line); ++k) out << line << "\n";
+  }
+  const std::string args = " --log " + log + " --log-map " + maps() + "paderborn-motor-temperature.yaml --config " +
+                           test::source_dir() + "/config/paderborn-pmsm.yaml";
+  const test::ProcessResult e = test::run_command(rpem() + " estimate" + args + " --out " + path("est.csv"));
+  EXPECT_EQ(e.exit_code, 0) << e.output;
+  EXPECT_NE(e.output.find("40 samples, psi_m ="), std::string::npos) << e.output;
+  const test::ProcessResult d = test::run_command(rpem() + " diagnose" + args + " --blocks 4 --out " + path("diag"));
+  EXPECT_EQ(d.exit_code, 0) << d.output;
+  EXPECT_NE(d.output.find("40 samples, steady_state model"), std::string::npos) << d.output;
+}
+
+TEST_F(CliLogFormats, SimpleFocMonitorOutputThroughItsMap) {
+  // FOCMotor::monitor() with every variable on (target, Uq, Ud, Iq mA, Id mA, velocity, angle; '\t', 4
+  // decimals, "\r\n"), a gimbal motor at 20 rad/s mechanical.
+  const std::string log = path("monitor.txt");
+  {
+    std::ofstream out(log);
+    for (int k = 0; k < 40; ++k) {
+      char line[160];
+      std::snprintf(line, sizeof line, "20.0000\t%.4f\t%.4f\t%.4f\t%.4f\t%.4f\t%.4f\r\n", 1.2 + 0.01 * (k % 5),
+                    -0.1 - 0.002 * (k % 3), 500.0 + 3.0 * (k % 4), -10.0 + 0.5 * (k % 2), 20.0 + 0.05 * (k % 6),
+                    std::fmod(0.2 * k, 2 * std::numbers::pi));
+      out << line;
+    }
+  }
+  const std::string args = " --log " + log + " --log-map " + maps() + "simplefoc-monitor.yaml";
+  const test::ProcessResult e = test::run_command(rpem() + " estimate" + args + " --out " + path("est.csv"));
+  EXPECT_EQ(e.exit_code, 0) << e.output;
+  EXPECT_NE(e.output.find("reading " + log + " as CSV read through the map"), std::string::npos) << e.output;
+  EXPECT_NE(e.output.find("40 samples, psi_m ="), std::string::npos) << e.output;
+  const test::ProcessResult d = test::run_command(rpem() + " diagnose" + args + " --blocks 4 --out " + path("diag"));
+  EXPECT_EQ(d.exit_code, 0) << d.output;
+}
+
+TEST_F(CliLogFormats, ABadMapExits78WithFileLineColumn) {
+  const std::string map = path("map.yaml"), log = path("log.csv");
+  std::ofstream(map) << "samples: instantaneous\ntime: {column: t}\ncolumns:\n  omega_el: {column: w, unit: rpm}\n";
+  std::ofstream(log) << "t,w\n0,1\n";
+  for (const std::string sub : {"estimate", "diagnose"}) {
+    const test::ProcessResult r =
+        test::run_command(rpem() + " " + sub + " --log " + log + " --log-map " + map + " --out " + path("o"));
+    EXPECT_EQ(r.exit_code, 78) << sub << r.output;
+    EXPECT_NE(r.output.find("map.yaml:4:31: columns.omega_el.unit: 'rpm' is mechanical"), std::string::npos)
+        << sub << r.output;
+  }
+}
+
+TEST_F(CliLogFormats, ALogItsMapCannotReadExits65) {
+  const std::string map = path("map.yaml"), log = path("log.csv");
+  std::ofstream(map) << "samples: averaged\nwindow: previous_row\ntime: {column: ms, unit: ms, resolution: 1}\n"
+                        "columns:\n  omega_el: {column: erpm, unit: erpm}\n  u_d: {column: vd}\n  u_q: {column: vq}\n"
+                        "  i_d: {column: id}\n  i_q: {column: iq}\n";
+  std::ofstream(log) << "ms,erpm,vd,vq,id\n0,100,0,1,0\n";
+  for (const std::string sub : {"estimate", "diagnose"}) {
+    const test::ProcessResult r =
+        test::run_command(rpem() + " " + sub + " --log " + log + " --log-map " + map + " --out " + path("o"));
+    EXPECT_EQ(r.exit_code, 65) << sub << r.output;
+    EXPECT_NE(r.output.find("log.csv:1: column iq (i_q): is missing from the header (the map " + map + " reads it)"),
+              std::string::npos)
+        << sub << r.output;
+  }
+}
+
+}  // namespace
+}  // namespace rpem
