@@ -9,7 +9,7 @@
 #      the instrumented rpemd with reloads and commands at once — expecting no report (suppressed: only
 #      the uninstrumented LCM/GLib internals, tests/daemon/tsan.supp)
 #   5. the format and lint gates (scripts/lint.py; docs/architecture.md, "Format and lint"): clang-format
-#      first (seconds), clang-tidy over the project's own translation units of build/ci last
+#      first (seconds), clang-tidy over the production translation units of build/ci last
 # The sanitizer trees of 3 and 4 compile at nice 19 while step 2's tests run: they take only the CPU the
 # tests leave idle (the VM suites' real-time pacing, the serial package test, the last test's tail) and
 # yield it otherwise (CFS weight 15 against 1024), so a test's share of the CPU is what it was without them.
@@ -20,7 +20,10 @@ cd "$(dirname "$0")/.."
 jobs=$(nproc)
 
 scripts/setup.sh
-scripts/lint.py --format
+if ! scripts/lint.py --format; then
+  echo "test.sh: the format gate failed: scripts/lint.py --fix-format rewrites the files listed above" >&2
+  exit 1
+fi
 
 cmake -S . -B build/ci -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DRPEM_WERROR=ON
 cmake --build build/ci -j "$jobs"
