@@ -121,6 +121,45 @@ Eigen::VectorXd bounded_step(const std::vector<std::vector<double>>& columns, co
   return delta;
 }
 
+// The bounds of fit()'s parameter blocks: the calibrated constants' block first (when any is free), then
+// one block per effect, in the order blocks holds them.
+void bound_parameters(ceres::Problem& problem, const std::vector<double*>& blocks, std::size_t free_calibrated,
+                      const EffectSet& set, const EffectContext& context) {
+  std::size_t block = 0;
+  if (free_calibrated > 0) {
+    for (std::size_t j = 0; j < free_calibrated; ++j) {
+      problem.SetParameterLowerBound(blocks[0], static_cast<int>(j), -kCalibrationBound);
+      problem.SetParameterUpperBound(blocks[0], static_cast<int>(j), kCalibrationBound);
+    }
+    block = 1;
+  }
+  for (std::size_t j = 0; j < set.effects.size(); ++j, ++block) {
+    for (int i = 0; i < set.effects[j].row->parameters; ++i) {
+      const auto [lo, hi] = parameter_bounds(set.effects[j], context, i);
+      if (std::isfinite(lo)) problem.SetParameterLowerBound(blocks[block], i, lo);
+      if (std::isfinite(hi)) problem.SetParameterUpperBound(blocks[block], i, hi);
+    }
+  }
+}
+
+ceres::Solver::Options fit_options() {
+  ceres::Solver::Options options;
+  options.linear_solver_type = ceres::DENSE_QR;
+  options.max_num_iterations = 20;
+  options.function_tolerance = 1e-5;  // relative: far below what the held-out test resolves
+  options.parameter_tolerance = 1e-6;
+  options.logging_type = ceres::SILENT;
+  options.minimizer_progress_to_stdout = false;
+  // With bounds, each accepted trust-region step is followed by Ceres' projected Armijo line search; its
+  // default cubic interpolation evaluates the gradient at every trial step — here a numeric Jacobian, one
+  // replay per parameter. The search is switched off (zero step-size iterations: the trust region alone
+  // keeps the step inside the bounds); were it on, quadratic interpolation would ask for the cost alone
+  // (docs/benchmarks.md, rpem diagnose).
+  options.line_search_interpolation_type = ceres::QUADRATIC;
+  options.max_num_line_search_step_size_iterations = 0;
+  return options;
+}
+
 }  // namespace
 
 bool identified(const EffectSet& set, const CalibrationIntervals& ci, std::size_t i) {
@@ -358,37 +397,9 @@ EffectSet EffectFitter::fit(const EffectSet& start, double* training_ssr) const 
   cost->SetNumResiduals(static_cast<int>(2 * training_.size()));
   ceres::Problem problem;
   problem.AddResidualBlock(cost, nullptr, blocks);
-  std::size_t block = 0;
-  if (!calibration.empty()) {
-    for (std::size_t j = 0; j < calibration.size(); ++j) {
-      problem.SetParameterLowerBound(blocks[0], static_cast<int>(j), -kCalibrationBound);
-      problem.SetParameterUpperBound(blocks[0], static_cast<int>(j), kCalibrationBound);
-    }
-    block = 1;
-  }
-  for (std::size_t j = 0; j < set.effects.size(); ++j, ++block) {
-    for (int i = 0; i < set.effects[j].row->parameters; ++i) {
-      const auto [lo, hi] = parameter_bounds(set.effects[j], context_, i);
-      if (std::isfinite(lo)) problem.SetParameterLowerBound(blocks[block], i, lo);
-      if (std::isfinite(hi)) problem.SetParameterUpperBound(blocks[block], i, hi);
-    }
-  }
-  ceres::Solver::Options options;
-  options.linear_solver_type = ceres::DENSE_QR;
-  options.max_num_iterations = 20;
-  options.function_tolerance = 1e-5;  // relative: far below what the held-out test resolves
-  options.parameter_tolerance = 1e-6;
-  options.logging_type = ceres::SILENT;
-  options.minimizer_progress_to_stdout = false;
-  // With bounds, each accepted trust-region step is followed by Ceres' projected Armijo line search; its
-  // default cubic interpolation evaluates the gradient at every trial step — here a numeric Jacobian, one
-  // replay per parameter. The search is switched off (zero step-size iterations: the trust region alone
-  // keeps the step inside the bounds); were it on, quadratic interpolation would ask for the cost alone
-  // (docs/benchmarks.md, rpem diagnose).
-  options.line_search_interpolation_type = ceres::QUADRATIC;
-  options.max_num_line_search_step_size_iterations = 0;
+  bound_parameters(problem, blocks, calibration.size(), set, context_);
   ceres::Solver::Summary summary;
-  ceres::Solve(options, &problem, &summary);
+  ceres::Solve(fit_options(), &problem, &summary);
   if (training_ssr) *training_ssr = 2.0 * summary.final_cost;  // Ceres' cost is half the sum of squares
   for (std::size_t j = 0; j < layout.free.size(); ++j) set.calibration[layout.free[j]] = calibration[j];
   return set;
@@ -419,7 +430,7 @@ CalibrationIntervals EffectFitter::intervals(const EffectSet& set, double noise_
   }
   // Cluster-robust "meat": the training blocks' score vectors g_b = J_bᵀ·r_b.
   const LogData& log = replay_.log();
-  const std::size_t clusters = static_cast<std::size_t>(log.blocks / 2 + 1);
+  const std::size_t clusters = static_cast<std::size_t>(log.blocks) / 2 + 1;
   Eigen::MatrixXd g = Eigen::MatrixXd::Zero(n, static_cast<Eigen::Index>(clusters));
   for (std::size_t j = 0; j < training_.size(); ++j) {
     const auto b = static_cast<Eigen::Index>(log.block[training_[j]] / 2);
