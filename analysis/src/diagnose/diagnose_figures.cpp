@@ -65,8 +65,9 @@ DataBlock time_bins(const Diagnosis& d, const std::vector<SampleView>& ops) {
       mq += d.baseline_replay.residual_A[k][1];
       cnt += 1;
     }
-    const double values[8] = {t / all, sp / all, iq / all, cnt ? std::sqrt(sb / cnt) : kNaN, cnt ? std::sqrt(sa / cnt) : kNaN,
-                              cnt ? md / cnt : kNaN, cnt ? mq / cnt : kNaN, temp / all};
+    const bool any = cnt != 0.0;
+    const double values[8] = {t / all, sp / all, iq / all, any ? std::sqrt(sb / cnt) : kNaN, any ? std::sqrt(sa / cnt) : kNaN,
+                              any ? md / cnt : kNaN, any ? mq / cnt : kNaN, temp / all};
     for (int c = 0; c < 8; ++c) b.columns[static_cast<std::size_t>(c)].push_back(values[c]);
   }
   return b;
@@ -104,7 +105,8 @@ std::string residual_map(const std::string& dir, const Diagnosis& d, const std::
   }
   if (s_hi <= s_lo) s_hi = s_lo + 1.0;
   if (q_hi <= q_lo) q_hi = q_lo + 1.0;
-  std::vector<double> sb(kX * kY, 0.0), sa(kX * kY, 0.0), cnt(kX * kY, 0.0);
+  const auto cells = static_cast<std::size_t>(kX * kY);
+  std::vector<double> sb(cells, 0.0), sa(cells, 0.0), cnt(cells, 0.0);
   for (std::size_t k = 0; k < ops.size(); ++k) {
     if (!d.baseline_replay.valid[k] || !d.extended_replay.valid[k]) continue;
     const int x = std::min(kX - 1, static_cast<int>((ops[k].speed_rpm - s_lo) / (s_hi - s_lo) * kX));
@@ -117,7 +119,7 @@ std::string residual_map(const std::string& dir, const Diagnosis& d, const std::
   DataBlock b{"map", std::vector<std::vector<double>>(4)};
   double lo = 1e300, hi = 0.0;  // one colour scale for both maps, so the improvement shows
   for (int c = 0; c < kX * kY; ++c) {
-    if (!cnt[c]) continue;
+    if (cnt[c] == 0.0) continue;
     for (double v : {std::sqrt(sb[c] / cnt[c]), std::sqrt(sa[c] / cnt[c])}) {
       if (v > 0.0) lo = std::min(lo, v);
       hi = std::max(hi, v);
@@ -128,8 +130,8 @@ std::string residual_map(const std::string& dir, const Diagnosis& d, const std::
       const int c = y * kX + x;
       b.columns[0].push_back(s_lo + (x + 0.5) * (s_hi - s_lo) / kX);
       b.columns[1].push_back(q_lo + (y + 0.5) * (q_hi - q_lo) / kY);
-      b.columns[2].push_back(cnt[c] ? std::sqrt(sb[c] / cnt[c]) : kNaN);
-      b.columns[3].push_back(cnt[c] ? std::sqrt(sa[c] / cnt[c]) : kNaN);
+      b.columns[2].push_back(cnt[c] != 0.0 ? std::sqrt(sb[c] / cnt[c]) : kNaN);
+      b.columns[3].push_back(cnt[c] != 0.0 ? std::sqrt(sa[c] / cnt[c]) : kNaN);
     }
   }
   GnuplotFigure fig(dir + "/residual_map.png", 1400, 600);
@@ -297,8 +299,10 @@ std::string regime_timeline(const std::string& dir, const LogRegimes& regimes, c
     const std::string r = std::to_string(static_cast<int>(info.regime));
     const std::string style = std::string(" w p pt 7 ps 0.5 lc rgb '") + kRegimeColour[static_cast<std::size_t>(info.regime)] + "'";
     const std::string title = std::string(" t '") + info.name + (info.excluded ? ", excluded" : "") + " (" + std::to_string(count) + ")'";
-    speed_plot += std::string(speed_plot.empty() ? "plot" : ",") + " $reg u 1:($4==" + r + "?$2:NaN)" + style + title;
-    current_plot += std::string(current_plot.empty() ? "plot" : ",") + " $reg u 1:($4==" + r + "?$3:NaN)" + style + " notitle";
+    speed_plot.append(speed_plot.empty() ? "plot" : ",").append(" $reg u 1:($4==").append(r).append("?$2:NaN)");
+    speed_plot.append(style).append(title);
+    current_plot.append(current_plot.empty() ? "plot" : ",").append(" $reg u 1:($4==").append(r).append("?$3:NaN)");
+    current_plot.append(style).append(" notitle");
   }
   GnuplotFigure fig(dir + "/regimes.png", 1400, 800);
   fig.add_data(std::move(b));
