@@ -29,6 +29,77 @@ double median(std::vector<double> v) {
   return *mid;
 }
 
+/// The measured current's amplitude and the speed per row, their largest values, the mean DC voltage and
+/// the spread of the moving speeds.
+void measure_amplitudes(LogData& d, const core::MachineSi& machine, std::vector<double>& current,
+                        std::vector<double>& speed) {
+  const std::size_t n = d.rows.size();
+  // The measured current's amplitude, the same in every frame (amplitude-invariant).
+  const core::PerUnitBase base = core::PerUnitBase::from_rated(machine.rated);
+  const core::SampleConditioner raw(base, core::to_pu(base, machine), {});
+  d.logged_i_dq_A.resize(n);
+  double u_dc_sum = 0.0;
+  for (std::size_t k = 0; k < n; ++k) {
+    const core::DriveSample& s = d.rows[k].sample;
+    d.logged_i_dq_A[k] = raw.logged_current_dq_A(s);
+    current[k] = d.logged_i_dq_A[k].norm();
+    speed[k] = s.omega_el_rad_s;
+    d.max_current_A = std::max(d.max_current_A, current[k]);
+    d.max_speed_rad_s = std::max(d.max_speed_rad_s, std::abs(speed[k]));
+    u_dc_sum += s.u_dc_V;
+  }
+  d.mean_u_dc_V = u_dc_sum / static_cast<double>(n);
+  std::vector<double> moving;
+  for (double w : speed) {
+    if (std::abs(w) > 0.05 * d.max_speed_rad_s) moving.push_back(std::abs(w));
+  }
+  if (!moving.empty()) {
+    std::sort(moving.begin(), moving.end());
+    d.speed_spread_rel = (moving[moving.size() * 9 / 10] - moving[moving.size() / 10]) / std::max(d.max_speed_rad_s, 1e-12);
+  }
+}
+
+/// The samples the replay runs on: the logged ones; in the transient mode with the speed taken from the
+/// angle's change over ±half_window rows where that stretch has no gap.
+void replay_samples(LogData& d, int half_window) {
+  const std::size_t n = d.rows.size();
+  d.replay_samples.resize(n);
+  for (std::size_t k = 0; k < n; ++k) d.replay_samples[k] = d.rows[k].sample;
+  if (d.mode != ModelMode::kTransient || half_window <= 0) return;
+  const std::size_t w = static_cast<std::size_t>(half_window);
+  for (std::size_t k = w; k + w < n; ++k) {
+    const core::DriveSample &a = d.rows[k - w].sample, &b = d.rows[k + w].sample;
+    const double dt = core::to_seconds(b.t_ns - a.t_ns);
+    // Only across a gap-free stretch; else the logged speed stays.
+    bool gap = false;
+    for (std::size_t j = k - w + 1; j <= k + w && !gap; ++j) gap = d.rows[j].sample.gap_before;
+    if (!gap && dt > 0.0) d.replay_samples[k].omega_el_rad_s = core::wrap_angle(b.theta_el_rad - a.theta_el_rad) / dt;
+  }
+}
+
+/// The steady-state replay leaves out idle rows and rows whose neighbour's current or speed differs by
+/// more than kTransitionShare of the log's range.
+void exclude_idle_and_transitional(LogData& d, const std::vector<double>& current, const std::vector<double>& speed) {
+  const std::size_t n = d.rows.size();
+  const double i_span = std::max(d.max_current_A, 1e-9), n_span = std::max(d.max_speed_rad_s, 1e-9);
+  for (std::size_t k = 0; k < n; ++k) {
+    if (current[k] < kIdleShare * i_span && std::abs(speed[k]) < kIdleShare * n_span) {
+      d.used[k] = false;
+      ++d.excluded_idle;
+      continue;
+    }
+    for (std::size_t j : {k - 1, k + 1}) {
+      if (j >= n) continue;  // k − 1 wraps for k = 0
+      if (std::abs(current[j] - current[k]) > kTransitionShare * i_span ||
+          std::abs(speed[j] - speed[k]) > kTransitionShare * n_span) {
+        d.used[k] = false;
+        ++d.excluded_transitional;
+        break;
+      }
+    }
+  }
+}
+
 }  // namespace
 
 const char* to_string(ModelMode m) noexcept { return m == ModelMode::kTransient ? "transient" : "steady_state"; }
@@ -52,69 +123,16 @@ LogData prepare_log(std::vector<io::DriveLogRow> rows, const io::DriveLogLayout&
   for (std::size_t k = 1; k < n; ++k) dts.push_back(core::to_seconds(d.rows[k].sample.t_ns - d.rows[k - 1].sample.t_ns));
   d.median_dt_s = median(dts);
 
-  // The measured current's amplitude, the same in every frame (amplitude-invariant).
-  const core::PerUnitBase base = core::PerUnitBase::from_rated(machine.rated);
-  const core::SampleConditioner raw(base, core::to_pu(base, machine), {});
   std::vector<double> current(n), speed(n);
-  d.logged_i_dq_A.resize(n);
-  double u_dc_sum = 0.0;
-  for (std::size_t k = 0; k < n; ++k) {
-    const core::DriveSample& s = d.rows[k].sample;
-    d.logged_i_dq_A[k] = raw.logged_current_dq_A(s);
-    current[k] = d.logged_i_dq_A[k].norm();
-    speed[k] = s.omega_el_rad_s;
-    d.max_current_A = std::max(d.max_current_A, current[k]);
-    d.max_speed_rad_s = std::max(d.max_speed_rad_s, std::abs(speed[k]));
-    u_dc_sum += s.u_dc_V;
-  }
-  d.mean_u_dc_V = u_dc_sum / static_cast<double>(n);
-  std::vector<double> moving;
-  for (double w : speed) {
-    if (std::abs(w) > 0.05 * d.max_speed_rad_s) moving.push_back(std::abs(w));
-  }
-  if (!moving.empty()) {
-    std::sort(moving.begin(), moving.end());
-    d.speed_spread_rel = (moving[moving.size() * 9 / 10] - moving[moving.size() / 10]) / std::max(d.max_speed_rad_s, 1e-12);
-  }
+  measure_amplitudes(d, machine, current, speed);
 
   const double time_constant_s = std::max(machine.l_d_H, machine.l_q_H) / machine.r_s_Ohm;
   d.mode = options.mode.value_or(d.median_dt_s >= kSteadyStateTimeConstants * time_constant_s ? ModelMode::kSteadyState
                                                                                                : ModelMode::kTransient);
 
-  d.replay_samples.resize(n);
-  for (std::size_t k = 0; k < n; ++k) d.replay_samples[k] = d.rows[k].sample;
-  if (d.mode == ModelMode::kTransient && options.speed_half_window > 0) {
-    const std::size_t w = static_cast<std::size_t>(options.speed_half_window);
-    for (std::size_t k = w; k + w < n; ++k) {
-      const core::DriveSample &a = d.rows[k - w].sample, &b = d.rows[k + w].sample;
-      const double dt = core::to_seconds(b.t_ns - a.t_ns);
-      // Only across a gap-free stretch; else the logged speed stays.
-      bool gap = false;
-      for (std::size_t j = k - w + 1; j <= k + w && !gap; ++j) gap = d.rows[j].sample.gap_before;
-      if (!gap && dt > 0.0) d.replay_samples[k].omega_el_rad_s = core::wrap_angle(b.theta_el_rad - a.theta_el_rad) / dt;
-    }
-  }
-
+  replay_samples(d, options.speed_half_window);
   d.used.assign(n, true);
-  if (d.mode == ModelMode::kSteadyState) {
-    const double i_span = std::max(d.max_current_A, 1e-9), n_span = std::max(d.max_speed_rad_s, 1e-9);
-    for (std::size_t k = 0; k < n; ++k) {
-      if (current[k] < kIdleShare * i_span && std::abs(speed[k]) < kIdleShare * n_span) {
-        d.used[k] = false;
-        ++d.excluded_idle;
-        continue;
-      }
-      for (std::size_t j : {k - 1, k + 1}) {
-        if (j >= n) continue;  // k − 1 wraps for k = 0
-        if (std::abs(current[j] - current[k]) > kTransitionShare * i_span ||
-            std::abs(speed[j] - speed[k]) > kTransitionShare * n_span) {
-          d.used[k] = false;
-          ++d.excluded_transitional;
-          break;
-        }
-      }
-    }
-  }
+  if (d.mode == ModelMode::kSteadyState) exclude_idle_and_transitional(d, current, speed);
 
   d.blocks = std::max(2, options.blocks);
   d.block.resize(n);
