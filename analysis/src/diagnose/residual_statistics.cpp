@@ -65,6 +65,75 @@ int load_region(double i_q_A, double base_current_A) {
   return i_q_A > 0.0 ? 2 : 0;
 }
 
+/// The residuals' harmonics of the electrical angle (in motion) and their means by the sign of each phase
+/// current: the transient mode's statistics.
+struct TransientSums {
+  std::array<std::array<std::complex<double>, 2>, kMaxHarmonic + 1> harm_before{}, harm_after{};
+  std::size_t harmonic_samples = 0;
+  std::array<Moments, 3> pos_before{}, pos_after{}, neg_before{}, neg_after{};
+
+  void add(double theta_el_rad, bool still, const core::Vec2& i, const core::Vec2& rb, const core::Vec2& ra) {
+    const core::Rotation rot = core::Rotation::of(theta_el_rad);
+    if (!still) {
+      ++harmonic_samples;
+      for (int h = 0; h <= kMaxHarmonic; ++h) {
+        const std::complex<double> e = std::polar(1.0, -h * theta_el_rad);
+        harm_before[h][0] += rb[0] * e;
+        harm_before[h][1] += rb[1] * e;
+        harm_after[h][0] += ra[0] * e;
+        harm_after[h][1] += ra[1] * e;
+      }
+    }
+    const core::Vec3 i_abc = core::inverse_clarke(core::inverse_park(i, rot));
+    const core::Vec3 r_abc_b = core::inverse_clarke(core::inverse_park(rb, rot));
+    const core::Vec3 r_abc_a = core::inverse_clarke(core::inverse_park(ra, rot));
+    for (int x = 0; x < 3; ++x) {
+      (i_abc[x] > 0.0 ? pos_before : neg_before)[x].add({r_abc_b[x], 0.0});
+      (i_abc[x] > 0.0 ? pos_after : neg_after)[x].add({r_abc_a[x], 0.0});
+    }
+  }
+
+  void write(ResidualStatistics& out) const {
+    if (harmonic_samples == 0) return;
+    const double scale = 2.0 / static_cast<double>(harmonic_samples);
+    for (int h = 0; h <= kMaxHarmonic; ++h) {
+      // Amplitude of the residual vector's component at h·ϑ (the mean for h = 0).
+      const double f = h == 0 ? 0.5 * scale : scale;
+      const double before = f * std::hypot(std::abs(harm_before[h][0]), std::abs(harm_before[h][1]));
+      const double after = f * std::hypot(std::abs(harm_after[h][0]), std::abs(harm_after[h][1]));
+      out.harmonics.push_back({h, {before, after}});
+    }
+    for (int x = 0; x < 3; ++x) {
+      out.phase_signs.push_back({static_cast<char>('a' + x), {pos_before[x].mean()[0], pos_after[x].mean()[0]},
+                                 {neg_before[x].mean()[0], neg_after[x].mean()[0]}});
+    }
+  }
+};
+
+/// A quantity the residuals are correlated with.
+struct Regressor {
+  std::string name;
+  std::function<double(std::size_t, const core::Vec2&, double)> value;  ///< sample, logged i_dq, n_pu
+};
+
+std::vector<Regressor> regressors_of(const LogData& log) {
+  std::vector<Regressor> regressors = {
+      {"|i| [A]", [](std::size_t, const core::Vec2& i, double) { return i.norm(); }},
+      {"i_d [A]", [](std::size_t, const core::Vec2& i, double) { return i[0]; }},
+      {"i_q [A]", [](std::size_t, const core::Vec2& i, double) { return i[1]; }},
+      {"speed [pu]", [](std::size_t, const core::Vec2&, double n) { return n; }},
+      {"|speed| [pu]", [](std::size_t, const core::Vec2&, double n) { return std::abs(n); }},
+      {"time [s]", [&log](std::size_t k, const core::Vec2&, double) { return core::to_seconds(log.rows[k].sample.t_ns); }},
+  };
+  if (log.layout.t_winding) {
+    regressors.push_back({"T_winding [°C]", [&log](std::size_t k, const core::Vec2&, double) { return log.rows[k].t_winding_C.value_or(0.0); }});
+  }
+  if (log.layout.t_magnet) {
+    regressors.push_back({"T_magnet [°C]", [&log](std::size_t k, const core::Vec2&, double) { return log.rows[k].t_magnet_C.value_or(0.0); }});
+  }
+  return regressors;
+}
+
 }  // namespace
 
 ResidualStatistics residual_statistics(const LogData& log, const EffectContext& context, const ReplayOutput& nominal,
@@ -75,28 +144,8 @@ ResidualStatistics residual_statistics(const LogData& log, const EffectContext& 
 
   std::array<std::array<Moments, 3>, 5> region_before{}, region_after{};
   Moments all_before, all_after, still_before, still_after, moving_before, moving_after;
-  std::array<std::array<std::complex<double>, 2>, kMaxHarmonic + 1> harm_before{}, harm_after{};
-  std::size_t harmonic_samples = 0;
-  std::array<Moments, 3> pos_before{}, pos_after{}, neg_before{}, neg_after{};
-
-  struct Regressor {
-    std::string name;
-    std::function<double(std::size_t, const core::Vec2&, double)> value;  ///< sample, logged i_dq, n_pu
-  };
-  std::vector<Regressor> regressors = {
-      {"|i| [A]", [](std::size_t, const core::Vec2& i, double) { return i.norm(); }},
-      {"i_d [A]", [](std::size_t, const core::Vec2& i, double) { return i[0]; }},
-      {"i_q [A]", [](std::size_t, const core::Vec2& i, double) { return i[1]; }},
-      {"speed [pu]", [](std::size_t, const core::Vec2&, double n) { return n; }},
-      {"|speed| [pu]", [](std::size_t, const core::Vec2&, double n) { return std::abs(n); }},
-      {"time [s]", [&](std::size_t k, const core::Vec2&, double) { return core::to_seconds(log.rows[k].sample.t_ns); }},
-  };
-  if (log.layout.t_winding) {
-    regressors.push_back({"T_winding [°C]", [&](std::size_t k, const core::Vec2&, double) { return log.rows[k].t_winding_C.value_or(0.0); }});
-  }
-  if (log.layout.t_magnet) {
-    regressors.push_back({"T_magnet [°C]", [&](std::size_t k, const core::Vec2&, double) { return log.rows[k].t_magnet_C.value_or(0.0); }});
-  }
+  TransientSums transient_sums;
+  const std::vector<Regressor> regressors = regressors_of(log);
   std::vector<std::array<Pearson, 4>> corr(regressors.size());  // d before, q before, d after, q after
 
   for (std::size_t k = 0; k < log.rows.size(); ++k) {
@@ -115,26 +164,7 @@ ResidualStatistics residual_statistics(const LogData& log, const EffectContext& 
     region_before[sr][lr].add(rb);
     region_after[sr][lr].add(ra);
 
-    if (transient) {
-      const core::Rotation rot = core::Rotation::of(s.theta_el_rad);
-      if (!still) {
-        ++harmonic_samples;
-        for (int h = 0; h <= kMaxHarmonic; ++h) {
-          const std::complex<double> e = std::polar(1.0, -h * s.theta_el_rad);
-          harm_before[h][0] += rb[0] * e;
-          harm_before[h][1] += rb[1] * e;
-          harm_after[h][0] += ra[0] * e;
-          harm_after[h][1] += ra[1] * e;
-        }
-      }
-      const core::Vec3 i_abc = core::inverse_clarke(core::inverse_park(i, rot));
-      const core::Vec3 r_abc_b = core::inverse_clarke(core::inverse_park(rb, rot));
-      const core::Vec3 r_abc_a = core::inverse_clarke(core::inverse_park(ra, rot));
-      for (int x = 0; x < 3; ++x) {
-        (i_abc[x] > 0.0 ? pos_before : neg_before)[x].add({r_abc_b[x], 0.0});
-        (i_abc[x] > 0.0 ? pos_after : neg_after)[x].add({r_abc_a[x], 0.0});
-      }
-    }
+    if (transient) transient_sums.add(s.theta_el_rad, still, i, rb, ra);
     for (std::size_t j = 0; j < regressors.size(); ++j) {
       const double v = regressors[j].value(k, i, n);
       corr[j][0].add(v, rb[0]);
@@ -160,20 +190,7 @@ ResidualStatistics residual_statistics(const LogData& log, const EffectContext& 
                              {b.mean()[1], a.mean()[1]}});
     }
   }
-  if (harmonic_samples > 0) {
-    const double scale = 2.0 / static_cast<double>(harmonic_samples);
-    for (int h = 0; h <= kMaxHarmonic; ++h) {
-      // Amplitude of the residual vector's component at h·ϑ (the mean for h = 0).
-      const double f = h == 0 ? 0.5 * scale : scale;
-      const double before = f * std::hypot(std::abs(harm_before[h][0]), std::abs(harm_before[h][1]));
-      const double after = f * std::hypot(std::abs(harm_after[h][0]), std::abs(harm_after[h][1]));
-      out.harmonics.push_back({h, {before, after}});
-    }
-    for (int x = 0; x < 3; ++x) {
-      out.phase_signs.push_back({static_cast<char>('a' + x), {pos_before[x].mean()[0], pos_after[x].mean()[0]},
-                                 {neg_before[x].mean()[0], neg_after[x].mean()[0]}});
-    }
-  }
+  transient_sums.write(out);
   for (std::size_t j = 0; j < regressors.size(); ++j) {
     out.correlations.push_back({regressors[j].name, {corr[j][0].value(), corr[j][2].value()},
                                 {corr[j][1].value(), corr[j][3].value()}});
