@@ -227,6 +227,211 @@ bool readmit_constants(const EffectFitter& fitter, double noise_floor_A, const s
   return true;
 }
 
+namespace {
+
+/// One round of the forward selection: the candidates, screened and ordered best first, the shortlist's
+/// fits and held-out scores, and their ranking against `reference`.
+struct Round {
+  std::vector<CandidateScore> candidates;
+  std::vector<std::vector<double>> starts;  ///< each candidate's best start (EffectFitter::best_start)
+  std::size_t shortlisted = 0;
+  std::size_t leaders = 0;
+  std::vector<EffectSet> fitted;
+  std::vector<BlockScores> scores;
+  /// The candidates are judged against this: the model as it is, or after a second look (second_look).
+  BlockScores reference;
+  std::vector<std::size_t> ranked;  ///< the fitted ones, best held-out score first
+
+  void rank() {
+    ranked.clear();
+    for (std::size_t i = 0; i < shortlisted; ++i) {
+      if (!candidates[i].fitted) continue;
+      candidates[i].gain_pct = gain_pct(reference, scores[i]);
+      candidates[i].block_log_ratio = block_log_ratios(reference, scores[i]);
+      candidates[i].p_value = signed_rank_p(candidates[i].block_log_ratio);
+      candidates[i].start = starts[i];
+      candidates[i].parameters = fitted[i].parameters.back();
+      ranked.push_back(i);
+    }
+    std::sort(ranked.begin(), ranked.end(), [&](std::size_t a, std::size_t b) { return scores[a].total() < scores[b].total(); });
+  }
+};
+
+/// The effects not in the model and not excluded, unscored.
+std::vector<CandidateScore> open_candidates(const EffectContext& context, const EffectSet& model,
+                                            const std::vector<Effect>& excluded) {
+  std::vector<CandidateScore> round;
+  for (const Effect& e : candidates(context)) {
+    if (model.contains(e) || std::find(excluded.begin(), excluded.end(), e) != excluded.end()) continue;
+    CandidateScore candidate;
+    candidate.effect = e;
+    round.push_back(candidate);
+  }
+  return round;
+}
+
+/// Screens the round's candidates from their best starts and orders them by the screening, best first.
+void screen(const EffectFitter& fitter, const SelectionOptions& options, const ScreenBasis& basis, const EffectSet& model,
+            Round& r) {
+  std::vector<CandidateScore>& round = r.candidates;
+  std::vector<std::vector<double>> starts(round.size());
+  parallel_for(round.size(), options.threads, [&](std::size_t i) {
+    std::tie(starts[i], round[i].screen_ssr) = fitter.best_start(basis, model, round[i].effect);
+  });
+  std::vector<std::size_t> order(round.size());
+  for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return round[a].screen_ssr > round[b].screen_ssr; });
+  std::vector<CandidateScore> sorted;
+  std::vector<std::vector<double>> sorted_starts;
+  for (std::size_t i : order) {
+    sorted.push_back(round[i]);
+    sorted_starts.push_back(starts[i]);
+  }
+  round = std::move(sorted);
+  r.starts = std::move(sorted_starts);
+}
+
+/// Fits the shortlist: the best few of the screening, without those it credits with less than a small
+/// share of the best (they cannot win unless the screening's first step misleads by that much); the
+/// leaders first, a later one only if its screening could rival what the leaders' fits achieved.
+void fit_shortlist(const EffectFitter& fitter, const SelectionOptions& options, const ScreenBasis& basis,
+                   const EffectSet& model, Round& r) {
+  std::vector<CandidateScore>& round = r.candidates;
+  std::size_t shortlisted = std::min<std::size_t>(round.size(), static_cast<std::size_t>(options.shortlist));
+  while (shortlisted > 2 && round[shortlisted - 1].screen_ssr < options.shortlist_share * round.front().screen_ssr) --shortlisted;
+  r.shortlisted = shortlisted;
+  r.fitted.assign(shortlisted, EffectSet{});
+  r.scores.assign(shortlisted, BlockScores{});
+  std::vector<double> reduction(shortlisted, 0.0);
+  const double ssr_now = std::inner_product(basis.r0.begin(), basis.r0.end(), basis.r0.begin(), 0.0);
+  const EffectContext& context = fitter.context();
+  auto fit = [&](std::size_t i) {
+    double ssr = 0.0;
+    r.fitted[i] = fitter.fit(model.with(round[i].effect, context, r.starts[i]), &ssr);
+    reduction[i] = ssr_now - ssr;
+    r.scores[i] = fitter.heldout(r.fitted[i]);
+    round[i].fitted = true;
+  };
+  r.leaders = std::min<std::size_t>(shortlisted, static_cast<std::size_t>(std::max(options.threads, 1)));
+  parallel_for(r.leaders, options.threads, fit);
+  const double achieved = *std::max_element(reduction.begin(), reduction.begin() + static_cast<std::ptrdiff_t>(r.leaders));
+  std::vector<std::size_t> rivals;
+  for (std::size_t i = r.leaders; i < shortlisted; ++i) {
+    if (round[i].screen_ssr >= options.rival_share * achieved) rivals.push_back(i);
+  }
+  parallel_for(rivals.size(), options.threads, [&](std::size_t j) { fit(rivals[j]); });
+}
+
+/// Accepted only if large, consistent, and standing out of the noise: the model change a candidate brings
+/// (the held-out RMS² it removes against the round's reference) must be at least
+/// (min_change_of_floor × the noise floor)²; and not negligible by its row's own measure.
+bool passes(const Round& r, std::size_t i, const SelectionOptions& options, double min_change2,
+            const EffectContext& context) {
+  const CandidateScore& c = r.candidates[i];
+  const double before = rms(r.reference);
+  const double after = rms(r.scores[i]);
+  if (c.gain_pct < options.min_gain_pct || c.p_value > options.max_p || before * before - after * after < min_change2) return false;
+  return !(c.effect.row->negligible && c.effect.row->negligible(c.effect, r.fitted[i].model(context), context));
+}
+
+/// The second look (docs/diagnose.md, "Constants a missing effect hid"): a constant the excitation pins but
+/// the calibration left configured — its cluster-robust interval widened by the residual of an effect still
+/// missing — held at a wrong value while a candidate is fitted, biases the candidate and makes the blocks
+/// disagree. When no candidate passes but one lowers the held-out residual by min_gain_pct, the leaders are
+/// fitted again with those constants free (kept only if then identified), from their fits; the reference
+/// is the better of the model as it is and the model with the same constants free, so that what the
+/// constants' freedom alone brings is not credited to an effect.
+void second_look(const EffectFitter& fitter, const SelectionOptions& options, double noise_floor_A,
+                 const std::array<bool, kCalibrated.size()>& admissible, const EffectSet& model, Round& r) {
+  std::vector<std::size_t> again;
+  for (std::size_t i : r.ranked) {
+    if (again.size() < r.leaders && r.candidates[i].gain_pct >= options.min_gain_pct) again.push_back(i);
+  }
+  EffectSet freed_model = model;
+  bool freed_kept = false;
+  parallel_for(again.size() + 1, options.threads, [&](std::size_t j) {
+    bool kept = false;
+    if (j == again.size()) {
+      freed_model = with_admissible_constants(fitter, noise_floor_A, admissible, model, kept);
+      freed_kept = kept;
+      return;
+    }
+    const std::size_t i = again[j];
+    r.fitted[i] = with_admissible_constants(fitter, noise_floor_A, admissible, r.fitted[i], kept);
+    if (kept) r.scores[i] = fitter.heldout(r.fitted[i]);
+  });
+  if (freed_kept) {
+    const BlockScores freed_scores = fitter.heldout(freed_model);
+    if (freed_scores.total() < r.reference.total()) r.reference = freed_scores;
+  }
+  r.rank();
+}
+
+/// The best ranked candidate that passes and is plausible and identifiable (each tested on its own);
+/// implausible ones and those that take a constant's place are reported, excluded, and `set_aside` set.
+/// r.shortlisted when none.
+std::size_t best_plausible(const EffectFitter& fitter, const SelectionOptions& options, double noise_floor_A,
+                           const std::array<bool, kCalibrated.size()>& admissible, double min_change2, const Round& r,
+                           Selection& sel, std::vector<Effect>& excluded, bool& set_aside) {
+  const EffectContext& context = fitter.context();
+  for (std::size_t i : r.ranked) {
+    const CandidateScore& c = r.candidates[i];
+    if (!passes(r, i, options, min_change2, context)) continue;
+    const ExtendedModel m = r.fitted[i].model(context);
+    std::optional<Implausibility> why;
+    if (c.effect.row->judge && c.effect.row->judge(c.effect, m, context, {})) {
+      // Judged again within the fitted parameter's own uncertainty.
+      const CalibrationIntervals ci = fitter.intervals(r.fitted[i], noise_floor_A);
+      why = c.effect.row->judge(c.effect, m, context, ci.effect_half_width.back());
+    }
+    if (!why) {
+      if (const std::optional<std::string> lost = takes_a_constant(fitter, sel.model, r.fitted[i], c, noise_floor_A, admissible)) {
+        sel.not_identifiable.push_back({{c.effect.label()}, *lost});
+        excluded.push_back(c.effect);
+        set_aside = true;
+        continue;
+      }
+      return i;
+    }
+    sel.implausible.push_back({c.effect, c.effect.row->describe(c.effect, m, context), c.gain_pct, *why});
+    excluded.push_back(c.effect);
+    set_aside = true;
+  }
+  return r.shortlisted;
+}
+
+/// Rivals that pass too, that the held-out blocks do not tell from the winner, and that change the model in
+/// the same way, make the winner a guess: the group (the winner first) and why; the rivals are excluded.
+std::vector<std::string> ambiguous_group(const EffectFitter& fitter, const SelectionOptions& options, double min_change2,
+                                         const Round& r, std::size_t best, const EffectSet& model,
+                                         std::vector<Effect>& excluded, std::string& reason) {
+  const CandidateScore& winner = r.candidates[best];
+  std::vector<std::string> group = {winner.effect.label()};
+  for (std::size_t i : r.ranked) {
+    const CandidateScore& rival = r.candidates[i];
+    if (i == best || rival.effect.name() == winner.effect.name()) continue;
+    if (!passes(r, i, options, min_change2, fitter.context())) continue;
+    if (std::find(excluded.begin(), excluded.end(), rival.effect) != excluded.end()) continue;
+    const double p_preferred = signed_rank_p(block_log_ratios(r.scores[i], r.scores[best]));
+    if (p_preferred <= options.ambiguity_p) continue;
+    const double corr = change_correlation(fitter, model, r.fitted[best], r.fitted[i]);
+    if (std::abs(corr) < options.ambiguity_correlation) continue;
+    char text[640];
+    std::snprintf(text, sizeof text,
+                  "%s%s and %s change the model's currents the same way in this log (correlation %.3f) and lower "
+                  "the held-out residual alike (%.1f %% and %.1f %%; the held-out blocks prefer neither, p = %.2f); a "
+                  "log with %s would separate them",
+                  reason.empty() ? "" : "; ", winner.effect.label().c_str(), rival.effect.label().c_str(), corr,
+                  winner.gain_pct, rival.gain_pct, p_preferred, separating_data(winner.effect, rival.effect).c_str());
+    reason += text;
+    group.push_back(rival.effect.label());
+    excluded.push_back(rival.effect);
+  }
+  return group;
+}
+
+}  // namespace
+
 Selection select_effects(const EffectFitter& fitter, const SelectionOptions& options, const EffectSet& start,
                          double noise_floor_A, const std::array<bool, kCalibrated.size()>& admissible) {
   Selection sel;
@@ -235,191 +440,46 @@ Selection select_effects(const EffectFitter& fitter, const SelectionOptions& opt
   BlockScores current = fitter.heldout(sel.model);
   sel.start_heldout_rms_A = rms(current);
   std::vector<Effect> excluded, stand_ins;
+  const double min_change2 = std::pow(options.min_change_of_floor * noise_floor_A, 2);
 
   while (static_cast<int>(sel.found.size() + stand_ins.size()) < options.max_effects) {
-    std::vector<CandidateScore> round;
-    for (const Effect& e : candidates(context)) {
-      if (sel.model.contains(e) || std::find(excluded.begin(), excluded.end(), e) != excluded.end()) continue;
-      CandidateScore candidate;
-      candidate.effect = e;
-      round.push_back(candidate);
-    }
-    if (round.empty()) break;
+    Round r;
+    r.candidates = open_candidates(context, sel.model, excluded);
+    if (r.candidates.empty()) break;
     const ScreenBasis basis = fitter.screen_basis(sel.model);
-    std::vector<std::vector<double>> starts(round.size());
-    parallel_for(round.size(), options.threads, [&](std::size_t i) {
-      std::tie(starts[i], round[i].screen_ssr) = fitter.best_start(basis, sel.model, round[i].effect);
-    });
-    std::vector<std::size_t> order(round.size());
-    for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
-    std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return round[a].screen_ssr > round[b].screen_ssr; });
-    {
-      std::vector<CandidateScore> sorted;
-      std::vector<std::vector<double>> sorted_starts;
-      for (std::size_t i : order) {
-        sorted.push_back(round[i]);
-        sorted_starts.push_back(starts[i]);
-      }
-      round = std::move(sorted);
-      starts = std::move(sorted_starts);
+    screen(fitter, options, basis, sel.model, r);
+    fit_shortlist(fitter, options, basis, sel.model, r);
+    r.reference = current;
+    r.rank();
+    const auto pass = [&](std::size_t i) { return passes(r, i, options, min_change2, context); };
+    if (std::none_of(r.ranked.begin(), r.ranked.end(), pass) && !r.ranked.empty() &&
+        r.candidates[r.ranked.front()].gain_pct >= options.min_gain_pct && leaves_configured(sel.model, admissible)) {
+      second_look(fitter, options, noise_floor_A, admissible, sel.model, r);
     }
-
-    // The shortlist: the best few, without those the screening credits with less than a small share of
-    // the best (they cannot win unless the screening's first step misleads by that much).
-    std::size_t shortlisted = std::min<std::size_t>(round.size(), static_cast<std::size_t>(options.shortlist));
-    while (shortlisted > 2 && round[shortlisted - 1].screen_ssr < options.shortlist_share * round.front().screen_ssr) --shortlisted;
-    std::vector<EffectSet> fitted(shortlisted);
-    std::vector<BlockScores> scores(shortlisted);
-    std::vector<double> reduction(shortlisted, 0.0);
-    const double ssr_now = std::inner_product(basis.r0.begin(), basis.r0.end(), basis.r0.begin(), 0.0);
-    auto fit = [&](std::size_t i) {
-      double ssr = 0.0;
-      fitted[i] = fitter.fit(sel.model.with(round[i].effect, context, starts[i]), &ssr);
-      reduction[i] = ssr_now - ssr;
-      scores[i] = fitter.heldout(fitted[i]);
-      round[i].fitted = true;
-    };
-    // The leaders first; a later one only if its screening could rival what the leaders' fits achieved.
-    const std::size_t leaders = std::min<std::size_t>(shortlisted, static_cast<std::size_t>(std::max(options.threads, 1)));
-    parallel_for(leaders, options.threads, fit);
-    const double achieved = *std::max_element(reduction.begin(), reduction.begin() + static_cast<std::ptrdiff_t>(leaders));
-    std::vector<std::size_t> rivals;
-    for (std::size_t i = leaders; i < shortlisted; ++i) {
-      if (round[i].screen_ssr >= options.rival_share * achieved) rivals.push_back(i);
-    }
-    parallel_for(rivals.size(), options.threads, [&](std::size_t j) { fit(rivals[j]); });
-    // The candidates are judged against `reference`: the model as it is, or after a second look (below).
-    BlockScores reference = current;
-    std::vector<std::size_t> ranked;
-    auto rank = [&] {
-      ranked.clear();
-      for (std::size_t i = 0; i < shortlisted; ++i) {
-        if (!round[i].fitted) continue;
-        round[i].gain_pct = gain_pct(reference, scores[i]);
-        round[i].block_log_ratio = block_log_ratios(reference, scores[i]);
-        round[i].p_value = signed_rank_p(round[i].block_log_ratio);
-        round[i].start = starts[i];
-        round[i].parameters = fitted[i].parameters.back();
-        ranked.push_back(i);
-      }
-      std::sort(ranked.begin(), ranked.end(), [&](std::size_t a, std::size_t b) { return scores[a].total() < scores[b].total(); });
-    };
-    rank();
-    // The best plausible candidate; implausible ones that would have passed are reported and set aside.
-    std::size_t best = shortlisted;
+    sel.rounds.push_back(r.candidates);
     bool set_aside = false;
-    // Accepted only if large, consistent, and standing out of the noise: the model change it brings (the
-    // held-out RMS² it removes) must be at least (min_change_of_floor × the noise floor)².
-    double before = rms(reference);
-    const double min_change2 = std::pow(options.min_change_of_floor * noise_floor_A, 2);
-    auto passes = [&](std::size_t i) {
-      const CandidateScore& c = round[i];
-      const double after = rms(scores[i]);
-      if (c.gain_pct < options.min_gain_pct || c.p_value > options.max_p || before * before - after * after < min_change2) return false;
-      return !(c.effect.row->negligible && c.effect.row->negligible(c.effect, fitted[i].model(context), context));
-    };
-    // The second look (docs/diagnose.md, "Constants a missing effect hid"): a constant the excitation
-    // pins but the calibration left configured — its cluster-robust interval widened by the residual of an
-    // effect still missing — held at a wrong value while a candidate is fitted, biases the candidate and
-    // makes the blocks disagree. When no candidate passes but one lowers the held-out residual by
-    // min_gain_pct, the leaders are fitted again with those constants free (kept only if then identified),
-    // from their fits; the reference is the better of the model as it is and the model with the same
-    // constants free, so that what the constants' freedom alone brings is not credited to an effect.
-    if (std::none_of(ranked.begin(), ranked.end(), passes) && !ranked.empty() &&
-        round[ranked.front()].gain_pct >= options.min_gain_pct &&
-        leaves_configured(sel.model, admissible)) {
-      std::vector<std::size_t> again;
-      for (std::size_t i : ranked) {
-        if (again.size() < leaders && round[i].gain_pct >= options.min_gain_pct) again.push_back(i);
-      }
-      EffectSet freed_model = sel.model;
-      bool freed_kept = false;
-      parallel_for(again.size() + 1, options.threads, [&](std::size_t j) {
-        bool kept = false;
-        if (j == again.size()) {
-          freed_model = with_admissible_constants(fitter, noise_floor_A, admissible, sel.model, kept);
-          freed_kept = kept;
-          return;
-        }
-        const std::size_t i = again[j];
-        fitted[i] = with_admissible_constants(fitter, noise_floor_A, admissible, fitted[i], kept);
-        if (kept) scores[i] = fitter.heldout(fitted[i]);
-      });
-      if (freed_kept) {
-        const BlockScores freed_scores = fitter.heldout(freed_model);
-        if (freed_scores.total() < reference.total()) reference = freed_scores;
-      }
-      rank();
-      before = rms(reference);
-    }
-    sel.rounds.push_back(round);
-    for (std::size_t i : ranked) {
-      const CandidateScore& c = round[i];
-      if (!passes(i)) continue;  // the best that passes: each is tested on its own
-      const ExtendedModel m = fitted[i].model(context);
-      std::optional<Implausibility> why;
-      if (c.effect.row->judge && c.effect.row->judge(c.effect, m, context, {})) {
-        // Judged again within the fitted parameter's own uncertainty.
-        const CalibrationIntervals ci = fitter.intervals(fitted[i], noise_floor_A);
-        why = c.effect.row->judge(c.effect, m, context, ci.effect_half_width.back());
-      }
-      if (!why) {
-        if (const std::optional<std::string> lost = takes_a_constant(fitter, sel.model, fitted[i], c, noise_floor_A, admissible)) {
-          sel.not_identifiable.push_back({{c.effect.label()}, *lost});
-          excluded.push_back(c.effect);
-          set_aside = true;
-          continue;
-        }
-        best = i;
-        break;
-      }
-      sel.implausible.push_back({c.effect, c.effect.row->describe(c.effect, m, context), c.gain_pct, *why});
-      excluded.push_back(c.effect);
-      set_aside = true;
-    }
-    if (best == shortlisted) {
+    const std::size_t best =
+        best_plausible(fitter, options, noise_floor_A, admissible, min_change2, r, sel, excluded, set_aside);
+    if (best == r.shortlisted) {
       if (set_aside) continue;  // only implausible ones passed: the next round looks again without them
       break;
     }
-    const CandidateScore winner = round[best];
-
-    // Rivals that pass too, that the held-out blocks do not tell from the winner, and that change the
-    // model in the same way, make the winner a guess: the group is reported, nobody is named.
-    std::vector<std::string> group = {winner.effect.label()};
+    const CandidateScore winner = r.candidates[best];
     std::string reason;
-    for (std::size_t i : ranked) {
-      const CandidateScore& rival = round[i];
-      if (i == best || rival.effect.name() == winner.effect.name()) continue;
-      if (!passes(i)) continue;
-      if (std::find(excluded.begin(), excluded.end(), rival.effect) != excluded.end()) continue;
-      const double p_preferred = signed_rank_p(block_log_ratios(scores[i], scores[best]));
-      if (p_preferred <= options.ambiguity_p) continue;
-      const double corr = change_correlation(fitter, sel.model, fitted[best], fitted[i]);
-      if (std::abs(corr) < options.ambiguity_correlation) continue;
-      char text[640];
-      std::snprintf(text, sizeof text,
-                    "%s%s and %s change the model's currents the same way in this log (correlation %.3f) and lower "
-                    "the held-out residual alike (%.1f %% and %.1f %%; the held-out blocks prefer neither, p = %.2f); a "
-                    "log with %s would separate them",
-                    reason.empty() ? "" : "; ", winner.effect.label().c_str(), rival.effect.label().c_str(), corr,
-                    winner.gain_pct, rival.gain_pct, p_preferred, separating_data(winner.effect, rival.effect).c_str());
-      reason += text;
-      group.push_back(rival.effect.label());
-      excluded.push_back(rival.effect);
-    }
+    std::vector<std::string> group = ambiguous_group(fitter, options, min_change2, r, best, sel.model, excluded, reason);
     if (group.size() > 1) {
       // The winner stays in the model as an unnamed stand-in, so that no later candidate is named for the
       // residual the group explains; it is taken out again at the end.
       sel.not_identifiable.push_back({group, reason});
       stand_ins.push_back(winner.effect);
-      sel.model = fitted[best];
-      current = scores[best];
+      sel.model = r.fitted[best];
+      current = r.scores[best];
       continue;
     }
 
-    sel.found.push_back({winner.effect, rms(reference), rms(scores[best]), winner.gain_pct, winner.p_value});
-    sel.model = fitted[best];
-    current = scores[best];
+    sel.found.push_back({winner.effect, rms(r.reference), rms(r.scores[best]), winner.gain_pct, winner.p_value});
+    sel.model = r.fitted[best];
+    current = r.scores[best];
     withdraw_explained(fitter, options, min_change2, sel, current, excluded);
     readmit_constants(fitter, noise_floor_A, admissible, sel.model, current);
   }

@@ -145,10 +145,10 @@ Verdict verdict(double final_heldout_rms_A, const NoiseFloor& floor, const Resid
     v.findings.push_back("it correlates with " + best->regressor + " (" + num(best_r) + "): " + regressor_meaning(best->regressor));
   }
   if (!floor.value_A) {
-    v.findings.push_back("three or more consecutive samples at one operating point (a steady stretch, or standstill under "
+    v.findings.emplace_back("three or more consecutive samples at one operating point (a steady stretch, or standstill under "
                          "current) in several blocks would measure the noise floor");
   }
-  v.findings.push_back("a log with more operating points — standstill at several currents of both signs, several speeds at "
+  v.findings.emplace_back("a log with more operating points — standstill at several currents of both signs, several speeds at "
                        "several loads, temperatures that span tens of kelvin — would tell more effects apart");
   return v;
 }
