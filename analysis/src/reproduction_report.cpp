@@ -236,7 +236,9 @@ std::vector<std::string> plot_reproduction(const std::string& dir, const std::ve
   for (const auto& [name, members] : figures) {
     const int panels = static_cast<int>(members.size());
     const int cols = panels > 1 ? 2 : 1, rows = (panels + cols - 1) / cols;
-    GnuplotFigure fig(dir + "/" + name + ".png", 560 * cols, 380 * rows);
+    std::string png = dir;
+    png.append("/").append(name).append(".png");
+    GnuplotFigure fig(png, 560 * cols, 380 * rows);
     fig.add_line("set multiplot layout " + std::to_string(rows) + "," + std::to_string(cols) + " title " +
                  gp_quote(name + ": estimates of SGA, GNA, PhyInt on the simulated drive (rpem reproduce)") +
                  " noenhanced");
@@ -266,7 +268,7 @@ std::vector<std::string> plot_reproduction(const std::string& dir, const std::ve
     }
     fig.add_line("unset multiplot");
     fig.render();
-    written.push_back(dir + "/" + name + ".png");
+    written.push_back(png);
   }
   return written;
 }
