@@ -11,6 +11,8 @@
 #include <limits>
 #include <string_view>
 
+#include "rpem/core/errno_text.hpp"
+
 namespace rpem::auth {
 namespace {
 
@@ -85,12 +87,12 @@ std::string format_key(const Key& key) {
 
 Key load_key_file(const std::string& path) {
   const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NOFOLLOW);
-  if (fd < 0) throw KeyError(path + ": cannot open the key file: " + std::strerror(errno));
+  if (fd < 0) throw KeyError(path + ": cannot open the key file: " + core::errno_text(errno));
   struct stat st {};
   std::string text;
   std::string problem;
   if (::fstat(fd, &st) != 0) {
-    problem = std::string("stat: ") + std::strerror(errno);
+    problem = std::string("stat: ") + core::errno_text(errno);
   } else if (!S_ISREG(st.st_mode)) {
     problem = "not a regular file";
   } else if ((st.st_mode & 077) != 0) {
@@ -123,7 +125,7 @@ Key generate_key(std::int32_t id) {
 
 void write_key_file(const std::string& path, const Key& key) {
   const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0600);
-  if (fd < 0) throw KeyError(path + ": cannot create the key file: " + std::strerror(errno));
+  if (fd < 0) throw KeyError(path + ": cannot create the key file: " + core::errno_text(errno));
   std::string text = format_key(key);
   const WipeOnExit wipe{text};
   const bool ok = ::write(fd, text.data(), text.size()) == static_cast<ssize_t>(text.size()) && ::fsync(fd) == 0;

@@ -17,6 +17,7 @@
 #include <stdexcept>
 
 #include "rpem/core/clock.hpp"
+#include "rpem/core/errno_text.hpp"
 
 static_assert(rpem::can::kEffFlag == CAN_EFF_FLAG && rpem::can::kRtrFlag == CAN_RTR_FLAG &&
               rpem::can::kEffMask == CAN_EFF_MASK);
@@ -24,7 +25,7 @@ static_assert(rpem::can::kEffFlag == CAN_EFF_FLAG && rpem::can::kRtrFlag == CAN_
 namespace rpem::can {
 namespace {
 
-std::string errno_text(const char* what) { return std::string(what) + ": " + std::strerror(errno); }
+std::string errno_text(const char* what) { return std::string(what) + ": " + core::errno_text(errno); }
 
 }  // namespace
 
@@ -130,7 +131,7 @@ std::size_t SocketCanChannel::receive_for(std::span<ReceivedFrame> out, std::int
     int err = 0;
     socklen_t len = sizeof err;
     (void)getsockopt(fd_, SOL_SOCKET, SO_ERROR, &err, &len);
-    close_socket(std::string("socket error: ") + std::strerror(err));
+    close_socket(std::string("socket error: ") + core::errno_text(err));
     return 0;
   }
   std::size_t n = 0;

@@ -12,6 +12,8 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "rpem/core/errno_text.hpp"
+
 namespace rpem::daemon {
 namespace fs = std::filesystem;
 
@@ -25,22 +27,22 @@ std::string write_atomically(const std::string& path, const std::string& text) {
   if (target.has_parent_path()) fs::create_directories(target.parent_path(), ec);
   const std::string tmp = path + ".tmp";
   const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0600);
-  if (fd < 0) return "open " + tmp + ": " + std::strerror(errno);
+  if (fd < 0) return "open " + tmp + ": " + core::errno_text(errno);
   const char* p = text.data();
   std::size_t left = text.size();
   while (left > 0) {
     const ssize_t n = ::write(fd, p, left);
     if (n < 0) {
       if (errno == EINTR) continue;
-      const std::string why = std::strerror(errno);
+      const std::string why = core::errno_text(errno);
       ::close(fd);
       return "write " + tmp + ": " + why;
     }
     p += n;
     left -= static_cast<std::size_t>(n);
   }
-  if (::fsync(fd) != 0 || ::close(fd) != 0) return "fsync " + tmp + ": " + std::strerror(errno);
-  if (::rename(tmp.c_str(), path.c_str()) != 0) return "rename to " + path + ": " + std::strerror(errno);
+  if (::fsync(fd) != 0 || ::close(fd) != 0) return "fsync " + tmp + ": " + core::errno_text(errno);
+  if (::rename(tmp.c_str(), path.c_str()) != 0) return "rename to " + path + ": " + core::errno_text(errno);
   const std::string dir = target.has_parent_path() ? target.parent_path().string() : ".";
   if (const int dfd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC); dfd >= 0) {
     (void)::fsync(dfd);
