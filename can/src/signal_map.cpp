@@ -86,7 +86,7 @@ std::string check_layout(const SignalMap& map) {
       if (s.length < 1 || s.length > 64) return where + ": length must be 1-64 bits";
       if (!walk_bits(s, 8 * f.length, [](int) {})) return where + ": bits lie outside the frame's " + std::to_string(f.length) + " bytes";
       if (!std::isfinite(s.scale) || s.scale == 0.0 || !std::isfinite(s.offset)) return where + ": scale must be finite and non-zero, offset finite";
-      if (const std::string e = float_problem(s); !e.empty()) return where + ": " + e;
+      if (const std::string e = float_problem(s); !e.empty()) return std::string(where).append(": ").append(e);
     }
   }
   bool trigger = false;

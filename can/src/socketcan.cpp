@@ -27,6 +27,24 @@ namespace {
 
 std::string errno_text(const char* what) { return std::string(what) + ": " + core::errno_text(errno); }
 
+/// The frame a raw socket read: classic or FD (by the read's size), error, extended or standard.
+CanFrame to_can_frame(const canfd_frame& raw, bool fd) {
+  CanFrame frame{};
+  frame.fd = fd;
+  frame.len = std::min<std::uint8_t>(raw.len, frame.fd ? 64 : 8);
+  std::memcpy(frame.data.data(), raw.data, frame.len);
+  if (raw.can_id & CAN_ERR_FLAG) {
+    frame.error = true;
+    frame.id = raw.can_id & CAN_ERR_MASK;
+  } else if (raw.can_id & CAN_EFF_FLAG) {
+    frame.extended = true;
+    frame.id = raw.can_id & CAN_EFF_MASK;
+  } else {
+    frame.id = raw.can_id & CAN_SFF_MASK;
+  }
+  return frame;
+}
+
 }  // namespace
 
 SocketCanChannel::SocketCanChannel(Options options) : options_(std::move(options)) { (void)open(); }
@@ -113,6 +131,28 @@ void SocketCanChannel::count_error_frame(const CanFrame& f) {
   }
 }
 
+std::int64_t SocketCanChannel::read_ancillary(msghdr& msg) {
+  std::int64_t kernel_rx_ns = 0;
+  for (cmsghdr* c = CMSG_FIRSTHDR(&msg); c != nullptr; c = CMSG_NXTHDR(&msg, c)) {
+    if (c->cmsg_level != SOL_SOCKET) continue;
+    if (c->cmsg_type == SO_TIMESTAMPING) {
+      timespec ts[3];
+      std::memcpy(ts, CMSG_DATA(c), sizeof ts);
+      kernel_rx_ns = core::to_ns(ts[0]);
+    } else if (c->cmsg_type == SO_TIMESTAMP) {
+      timeval tv{};
+      std::memcpy(&tv, CMSG_DATA(c), sizeof tv);
+      kernel_rx_ns = core::to_ns(tv);
+    } else if (c->cmsg_type == SO_RXQ_OVFL) {
+      std::uint32_t overflow = 0;
+      std::memcpy(&overflow, CMSG_DATA(c), sizeof overflow);
+      counters_.kernel_drops += static_cast<std::uint32_t>(overflow - last_overflow_);  // wraps with it
+      last_overflow_ = overflow;
+    }
+  }
+  return kernel_rx_ns;
+}
+
 std::size_t SocketCanChannel::receive_for(std::span<ReceivedFrame> out, std::int64_t timeout_ns) {
   timeout_ns = std::max<std::int64_t>(timeout_ns, 0);
   if (fd_ < 0) {
@@ -152,38 +192,9 @@ std::size_t SocketCanChannel::receive_for(std::span<ReceivedFrame> out, std::int
       break;
     }
     ReceivedFrame& r = out[n];
-    r.frame = CanFrame{};
-    r.kernel_rx_ns = 0;
-    for (cmsghdr* c = CMSG_FIRSTHDR(&msg); c != nullptr; c = CMSG_NXTHDR(&msg, c)) {
-      if (c->cmsg_level != SOL_SOCKET) continue;
-      if (c->cmsg_type == SO_TIMESTAMPING) {
-        timespec ts[3];
-        std::memcpy(ts, CMSG_DATA(c), sizeof ts);
-        r.kernel_rx_ns = core::to_ns(ts[0]);
-      } else if (c->cmsg_type == SO_TIMESTAMP) {
-        timeval tv{};
-        std::memcpy(&tv, CMSG_DATA(c), sizeof tv);
-        r.kernel_rx_ns = core::to_ns(tv);
-      } else if (c->cmsg_type == SO_RXQ_OVFL) {
-        std::uint32_t overflow = 0;
-        std::memcpy(&overflow, CMSG_DATA(c), sizeof overflow);
-        counters_.kernel_drops += static_cast<std::uint32_t>(overflow - last_overflow_);  // wraps with it
-        last_overflow_ = overflow;
-      }
-    }
-    r.frame.fd = got == static_cast<ssize_t>(CANFD_MTU);
-    r.frame.len = std::min<std::uint8_t>(raw.len, r.frame.fd ? 64 : 8);
-    std::memcpy(r.frame.data.data(), raw.data, r.frame.len);
-    if (raw.can_id & CAN_ERR_FLAG) {
-      r.frame.error = true;
-      r.frame.id = raw.can_id & CAN_ERR_MASK;
-      count_error_frame(r.frame);
-    } else if (raw.can_id & CAN_EFF_FLAG) {
-      r.frame.extended = true;
-      r.frame.id = raw.can_id & CAN_EFF_MASK;
-    } else {
-      r.frame.id = raw.can_id & CAN_SFF_MASK;
-    }
+    r.kernel_rx_ns = read_ancillary(msg);
+    r.frame = to_can_frame(raw, got == static_cast<ssize_t>(CANFD_MTU));
+    if (r.frame.error) count_error_frame(r.frame);
     ++counters_.rx_frames;
     ++n;
   }

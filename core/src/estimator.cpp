@@ -118,7 +118,7 @@ void RpemEstimator::synchronize(const EstimatorSample& sample, const MachinePu& 
 }
 
 Mat2 RpemEstimator::select_gradient(const MachinePu& model, double n_pu) const noexcept {
-  const Mat2 steady = steady_state_gradients(model, n_pu, state_.predictor.i_hat_pu);
+  Mat2 steady = steady_state_gradients(model, n_pu, state_.predictor.i_hat_pu);  // not const: returned by move
   if (gradients_ == Gradients::kSkip) return steady;  // both forms steady-state (decided in reconfigure)
   Mat2 g = state_.predictor.gradient;
   if (config_.gradient_psi_m == GradientForm::kSteadyState) g.col(kPsiM) = steady.col(kPsiM);

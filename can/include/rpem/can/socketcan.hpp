@@ -13,6 +13,8 @@
 #include "rpem/can/frame.hpp"
 #include "rpem/can/kernel_filter.hpp"
 
+struct msghdr;  // <sys/socket.h>, kept out of this header
+
 namespace rpem::can {
 
 struct ReceivedFrame {
@@ -93,6 +95,9 @@ class SocketCanChannel {
   bool open();
   void close_socket(const std::string& why);
   void count_error_frame(const CanFrame& f);
+  /// The kernel's receive time from a received message's ancillary data (0 without one); counts the
+  /// socket's overflow drops (SO_RXQ_OVFL) on the way.
+  std::int64_t read_ancillary(::msghdr& msg);
 
   Options options_;
   int fd_ = -1;
