@@ -148,6 +148,87 @@ RegimeNoise RegimeClassifier::current_noise() const noexcept {
   return {variance(0), variance(1), variance(2)};
 }
 
+std::uint8_t RegimeClassifier::transient_bits(const RegimeInput& in, double dt_s) noexcept {
+  const RegimeConfig& c = config_;
+  const Constants& k = k_;
+  const RegimeNoise& v = noise_;
+  const Vec2& i = in.i_pu;
+  const double n = in.n_pu, n2 = n * n;
+  RegimeState& s = state_;
+  const Vec2& sl = s.slope_pu_s;
+  const Vec2 abs_sl = sl.cwiseAbs();
+  const double n2_xq2 = n2 * c.x_q_pu * c.x_q_pu, n2_xd2 = n2 * c.x_d_pu * c.x_d_pu;
+  std::uint8_t bits = 0;
+  if (in.timing == SampleTiming::kStandalone && s.points >= 1) [[unlikely]] {
+    // A sample far from the previous one: the change of operating point between them excited a transient
+    // that has decayed to e^{−Δt/τ_el} of |Δi| (τ_el the slowest the model admits). Steady if that
+    // remnant is within the current's noise (its own estimate's noise, 2·decay²·σ_i², included).
+    const double decay = std::exp(-dt_s / c.electrical_time_constant_s);
+    const Vec2 remnant = decay * (i - s.i_pu[0]).cwiseAbs();
+    const double bound = k.z_sq * v.i_sq * (1.0 + 2.0 * decay * decay);
+    if (remnant.squaredNorm() > 0.0 && remnant.cwiseProduct(remnant).maxCoeff() > bound) bits |= regime_bit::kTransient;
+  } else if (in.timing == SampleTiming::kContiguous && s.slope_valid) {
+    // Consecutive windows: what the steady state and the inductive correction (the slope between window
+    // centres) leave out, per row (d, q) in voltage:
+    //   (x/ω_n)·|s_k − s_{k−1}|   the slope changed: the correction is exact only for a ramp
+    //   (Δx/ω_n)·|s_k|            the inductance's tolerance on the correction
+    //   x_o·|Δn|·|Δi_o|/4          mean(n·x·i) − n̄·x·ī, bounded by the ranges' product over 4
+    // against the row's noise and the slope change's own noise.
+    const double dn = std::abs(n - s.n_pu[0]);
+    const Vec2 di = (i - s.i_pu[0]).cwiseAbs();
+    Vec2 t = k.inv_omega_n * k.dx.cwiseProduct(abs_sl) + (0.25 * dn) * k.x_swapped.cwiseProduct(di.reverse());
+    double slope_noise_sq = 0.0;  // Var(s_k − s_{k−1}) per σ_i²
+    if (s.previous_slope_valid) {
+      t += k.inv_omega_n * k.x.cwiseProduct((sl - s.previous_slope_pu_s).cwiseAbs());
+      const double a = s.inv_dt, p = s.previous_inv_dt;
+      slope_noise_sq = a * a + (a + p) * (a + p) + p * p;
+    }
+    const double slope_var = k.inv_omega_n_sq * slope_noise_sq * v.i_sq;
+    const double row_d = v.u_sq + (k.r_sq + n2_xq2) * v.i_sq + k.x_sq[0] * slope_var;
+    const double row_q = v.u_sq + (k.r_sq + n2_xd2) * v.i_sq + k.x_sq[1] * slope_var;
+    const bool own = t[0] * t[0] > k.z_sq * row_d || t[1] * t[1] > k.z_sq * row_q;
+    // A slope change shows only once both windows around the junction are in: the window after one is
+    // corrected with a slope that straddles it.
+    if (own || s.previous_transient) bits |= regime_bit::kTransient;
+    s.previous_transient = own;
+  }
+  return bits;
+}
+
+std::uint8_t RegimeClassifier::excitation_bits(const RegimeInput& in) const noexcept {
+  const RegimeConfig& c = config_;
+  const Constants& k = k_;
+  const RegimeNoise& v = noise_;
+  const Vec2& i = in.i_pu;
+  const double n = in.n_pu, n2 = n * n;
+  const double abs_n = std::abs(n);
+  const Vec2 abs_i = i.cwiseAbs();
+  const double n2_xd2 = n2 * c.x_d_pu * c.x_d_pu;
+  const double i_sq = i.squaredNorm();
+  std::uint8_t bits = 0;
+  // Excitation: the parameter's term, at its smallest inside D_M, less what the other terms' uncertainty
+  // can put in its place, against its noise as the estimator's averaging leaves it: h² = γ/(2 − γ) of
+  // one sample's variance (an exponential filter of gain γ).
+  const double psi_term = abs_n * c.psi_min_pu - c.dr_pu * abs_i[1] - abs_n * c.dx_d_pu * abs_i[0];
+  if (psi_term > 0.0) {
+    const double h_sq = in.weight[0] / (2.0 - in.weight[0]);
+    const double noise = v.u_sq + (k.r_sq + n2_xd2) * v.i_sq + k.psi_max_sq * v.n_sq;
+    if (psi_term * psi_term > k.z_sq * h_sq * noise) bits |= regime_bit::kExcitesPsiM;
+  }
+  // r_min·|i| must at least exceed |n|·Δψ: checked on the squares before |i| is taken.
+  if (k.r_min_sq * i_sq > n2 * c.dpsi_pu * c.dpsi_pu) {
+    const double i_abs = std::sqrt(i_sq);
+    const double term = c.r_min_pu * i_abs - abs_n * (c.dpsi_pu + k.dx_max * i_abs);
+    if (term > 0.0) {
+      const double h_sq = in.weight[1] / (2.0 - in.weight[1]);
+      const double flux = c.psi_max_pu + k.x_max * i_abs;
+      const double noise = v.u_sq + (k.r_sq + n2 * k.x_max * k.x_max) * v.i_sq + flux * flux * v.n_sq;
+      if (term * term > k.z_sq * h_sq * noise) bits |= regime_bit::kExcitesRs;
+    }
+  }
+  return bits;
+}
+
 Classification RegimeClassifier::step(const RegimeInput& in) noexcept {
   const RegimeConfig& c = config_;
   const Constants& k = k_;
@@ -224,60 +305,9 @@ Classification RegimeClassifier::step(const RegimeInput& in) noexcept {
     if (lock * lock > k.z_sq * (var_d + c.tan_angle * c.tan_angle * var_q)) bits |= regime_bit::kNotLocked;
   }
 
-  if (in.timing == SampleTiming::kStandalone && s.points >= 1) [[unlikely]] {
-    // A sample far from the previous one: the change of operating point between them excited a transient
-    // that has decayed to e^{−Δt/τ_el} of |Δi| (τ_el the slowest the model admits). Steady if that
-    // remnant is within the current's noise (its own estimate's noise, 2·decay²·σ_i², included).
-    const double decay = std::exp(-dt_s / c.electrical_time_constant_s);
-    const Vec2 remnant = decay * (i - s.i_pu[0]).cwiseAbs();
-    const double bound = k.z_sq * v.i_sq * (1.0 + 2.0 * decay * decay);
-    if (remnant.squaredNorm() > 0.0 && remnant.cwiseProduct(remnant).maxCoeff() > bound) bits |= regime_bit::kTransient;
-  } else if (in.timing == SampleTiming::kContiguous && s.slope_valid) {
-    // Consecutive windows: what the steady state and the inductive correction (the slope between window
-    // centres) leave out, per row (d, q) in voltage:
-    //   (x/ω_n)·|s_k − s_{k−1}|   the slope changed: the correction is exact only for a ramp
-    //   (Δx/ω_n)·|s_k|            the inductance's tolerance on the correction
-    //   x_o·|Δn|·|Δi_o|/4          mean(n·x·i) − n̄·x·ī, bounded by the ranges' product over 4
-    // against the row's noise and the slope change's own noise.
-    const double dn = std::abs(n - s.n_pu[0]);
-    const Vec2 di = (i - s.i_pu[0]).cwiseAbs();
-    Vec2 t = k.inv_omega_n * k.dx.cwiseProduct(abs_sl) + (0.25 * dn) * k.x_swapped.cwiseProduct(di.reverse());
-    double slope_noise_sq = 0.0;  // Var(s_k − s_{k−1}) per σ_i²
-    if (s.previous_slope_valid) {
-      t += k.inv_omega_n * k.x.cwiseProduct((sl - s.previous_slope_pu_s).cwiseAbs());
-      const double a = s.inv_dt, p = s.previous_inv_dt;
-      slope_noise_sq = a * a + (a + p) * (a + p) + p * p;
-    }
-    const double slope_var = k.inv_omega_n_sq * slope_noise_sq * v.i_sq;
-    const double row_d = v.u_sq + (k.r_sq + n2_xq2) * v.i_sq + k.x_sq[0] * slope_var;
-    const double row_q = v.u_sq + (k.r_sq + n2_xd2) * v.i_sq + k.x_sq[1] * slope_var;
-    const bool own = t[0] * t[0] > k.z_sq * row_d || t[1] * t[1] > k.z_sq * row_q;
-    // A slope change shows only once both windows around the junction are in: the window after one is
-    // corrected with a slope that straddles it.
-    if (own || s.previous_transient) bits |= regime_bit::kTransient;
-    s.previous_transient = own;
-  }
+  bits |= transient_bits(in, dt_s);
 
-  // Excitation: the parameter's term, at its smallest inside D_M, less what the other terms' uncertainty
-  // can put in its place, against its noise as the estimator's averaging leaves it: h² = γ/(2 − γ) of
-  // one sample's variance (an exponential filter of gain γ).
-  const double psi_term = abs_n * c.psi_min_pu - c.dr_pu * abs_i[1] - abs_n * c.dx_d_pu * abs_i[0];
-  if (psi_term > 0.0) {
-    const double h_sq = in.weight[0] / (2.0 - in.weight[0]);
-    const double noise = v.u_sq + (k.r_sq + n2_xd2) * v.i_sq + k.psi_max_sq * v.n_sq;
-    if (psi_term * psi_term > k.z_sq * h_sq * noise) bits |= regime_bit::kExcitesPsiM;
-  }
-  // r_min·|i| must at least exceed |n|·Δψ: checked on the squares before |i| is taken.
-  if (k.r_min_sq * i_sq > n2 * c.dpsi_pu * c.dpsi_pu) {
-    const double i_abs = std::sqrt(i_sq);
-    const double term = c.r_min_pu * i_abs - abs_n * (c.dpsi_pu + k.dx_max * i_abs);
-    if (term > 0.0) {
-      const double h_sq = in.weight[1] / (2.0 - in.weight[1]);
-      const double flux = c.psi_max_pu + k.x_max * i_abs;
-      const double noise = v.u_sq + (k.r_sq + n2 * k.x_max * k.x_max) * v.i_sq + flux * flux * v.n_sq;
-      if (term * term > k.z_sq * h_sq * noise) bits |= regime_bit::kExcitesRs;
-    }
-  }
+  bits |= excitation_bits(in);
 
   // Before a chain has shown the data's noise, nothing in it is excluded on a threshold made of it.
   if (!s.noise_known && in.timing != SampleTiming::kStandalone) bits &= static_cast<std::uint8_t>(~regime_bit::kExcluded);

@@ -103,7 +103,7 @@ class ThermalFusion {
 
  private:
   void start(const ThermalStepData& s) noexcept;
-  void finish_step(const ThermalStepData& s, double dt_s) noexcept;
+  void finish_step(const ThermalStepData& d, double dt_s) noexcept;
 
   ThermalFusionConfig config_;
   ThermalObserver observer_;
