@@ -1,13 +1,13 @@
 #include "rpem/daemon/control.hpp"
 
 #include <poll.h>
-#include <signal.h>
 #include <sys/signalfd.h>
 #include <systemd/sd-daemon.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <array>
+#include <csignal>
 #include <cstdio>
 #include <lcm/lcm-cpp.hpp>
 #include <span>

@@ -283,7 +283,7 @@ void LoopThread::process(std::int64_t now_ns) noexcept {
 void LoopThread::run(const std::atomic<bool>& stop) {
   name_thread("rpemd-loop");
   if (loop_config_.realtime != RealtimeMode::kOff) setup_problems_ = apply_thread_policy(loop_config_.thread);
-  prefault_stack(256 * 1024);
+  prefault_stack(std::size_t{256} * 1024);
   const std::int64_t start = timer_.start();
   next_estimate_ns_ = next_measurement_ns_ = next_stats_ns_ = start;
   started_.store(true, std::memory_order_release);

@@ -131,7 +131,7 @@ void PersistingPublisher::publish_diagnostics(const LoopStatsReport& r) {
   rx_to_publish_.reset();
   m.input_queue_depth = r.input_queue_depth;
   m.output_queue_depth = static_cast<std::int32_t>(queues_.loop.size());
-  m.commands_enabled = control_.commands_enabled;
+  m.commands_enabled = static_cast<std::int8_t>(control_.commands_enabled ? 1 : 0);
   m.last_command_seq = control_.last_command_seq;
   m.last_command_result = static_cast<std::int8_t>(control_.last_command_result);
   m.state_file_status = static_cast<std::int8_t>(identity_.state_file_status);
@@ -184,7 +184,7 @@ void PersistingPublisher::print_status(const EstimateReport& r) {
   }
   char psi[32], rs[32];
   std::printf("rpemd %-8s n=%+.3f pu  psi_m=%.4f Wb%s (T_magnet %5.1f C)  r_s=%.4f Ohm%s (T_winding %5.1f C)%s%s%s\n",
-              kStates[static_cast<int>(r.state)], r.speed_pu, r.psi_m_Wb,
+              kStates[static_cast<std::uint8_t>(r.state)], r.speed_pu, r.psi_m_Wb,
               mark(psi, sizeof psi, r.psi_m_adapting, r.psi_m_age_s, r.psi_m_valid), r.t_magnet_C, r.r_s_Ohm,
               mark(rs, sizeof rs, r.r_s_adapting, r.r_s_age_s, r.r_s_valid), r.t_winding_C, truth, vesc,
               r.frozen ? "  FROZEN" : "");
