@@ -36,7 +36,7 @@ std::string write_atomically(const std::string& path, const std::string& text) {
       if (errno == EINTR) continue;
       const std::string why = core::errno_text(errno);
       ::close(fd);
-      return "write " + tmp + ": " + why;
+      return std::string("write ").append(tmp).append(": ").append(why);
     }
     p += n;
     left -= static_cast<std::size_t>(n);
