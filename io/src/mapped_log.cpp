@@ -50,7 +50,7 @@ void MappedLogReader::fail_cell(int index, const std::string& label, const std::
 
 std::string MappedLogReader::label(Quantity q) const {
   const MappedColumn* c = column_[static_cast<std::size_t>(q)];
-  const std::string name = info(q).name;
+  std::string name = info(q).name;  // not const: returned by move
   if (c == nullptr || c->column.name == name) return name;
   return c->column.label() + " (" + name + ")";
 }

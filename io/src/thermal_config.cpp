@@ -77,8 +77,8 @@ ThermalConfig default_thermal_config(const MachineConfig& machine) {
 
 namespace {
 
-/// `nodes`, `conductances` and `losses`.
-void parse_network(YamlMap& t, ThermalConfig& c) {
+/// `nodes`: their names, capacities, coolant conductances and noises; winding and magnet among them.
+void parse_nodes(YamlMap& t, ThermalConfig& c) {
   core::ThermalFusionConfig& f = c.fusion;
   core::ThermalNetwork& n = f.filter.network;
   std::vector<YamlMap> nodes = t.maps("nodes");
@@ -112,7 +112,13 @@ void parse_network(YamlMap& t, ThermalConfig& c) {
   }
   if (n.winding < 0) t.fail("nodes", "a node named 'winding' is required (the copper loss heats it, R_s follows it)");
   if (n.magnet < 0) t.fail("nodes", "a node named 'magnet' is required (ψm follows it)");
+}
 
+/// `nodes`, `conductances` and `losses`.
+void parse_network(YamlMap& t, ThermalConfig& c) {
+  parse_nodes(t, c);
+  core::ThermalFusionConfig& f = c.fusion;
+  core::ThermalNetwork& n = f.filter.network;
   n.between_W_per_K.setZero();
   if (t.has("conductances")) {
     for (YamlMap& m : t.maps("conductances")) {
@@ -121,7 +127,7 @@ void parse_network(YamlMap& t, ThermalConfig& c) {
       if (a < 0) m.fail("from", "no node named '" + from + "'");
       if (b < 0) m.fail("to", "no node named '" + to + "'");
       if (a == b) m.fail("to", "a conductance joins two different nodes");
-      if (n.between_W_per_K(a, b) != 0.0) m.fail("to", "the conductance " + from + "–" + to + " is given twice");
+      if (n.between_W_per_K(a, b) != 0.0) m.fail("to", std::string("the conductance ").append(from).append("–").append(to).append(" is given twice"));
       n.between_W_per_K(a, b) = n.between_W_per_K(b, a) = m.number("W_per_K", 1e-9, 1e6);
       m.finish();
     }
@@ -155,13 +161,13 @@ void parse_network(YamlMap& t, ThermalConfig& c) {
       }
       if (fi < 0) {
         std::string names;
-        for (const core::LossFormRow& row : core::loss_forms()) names += (names.empty() ? "" : ", ") + std::string(row.name);
+        for (const core::LossFormRow& row : core::loss_forms()) names.append(names.empty() ? "" : ", ").append(row.name);
         m.fail("form", "unknown loss form '" + form + "' (one of " + names + ")");
       }
       const std::string node = m.text("node");
       const int i = node_index(c, node);
       if (i < 0) m.fail("node", "no node named '" + node + "'");
-      if (n.loss_at_base_W(fi, i) != 0.0) m.fail("node", "loss " + form + " at " + node + " is given twice");
+      if (n.loss_at_base_W(fi, i) != 0.0) m.fail("node", std::string("loss ").append(form).append(" at ").append(node).append(" is given twice"));
       n.loss_at_base_W(fi, i) = m.number("at_base_W", 0.0, 1e9);
       f.filter.loss_rel_sigma(fi, i) = m.number_or("rel_sigma", 0.5, 0.0, 10.0);
       m.finish();
@@ -171,38 +177,38 @@ void parse_network(YamlMap& t, ThermalConfig& c) {
 
 }  // namespace
 
-ThermalConfig parse_thermal_config(YamlMap& t, const MachineConfig& machine, NetworkRequired network) {
+ThermalConfig parse_thermal_config(YamlMap& section, const MachineConfig& machine, NetworkRequired network) {
   ThermalConfig c = default_thermal_config(machine);
   core::ThermalFusionConfig& f = c.fusion;
   core::ThermalNetwork& n = f.filter.network;
-  c.has_network = network == NetworkRequired::kYes || t.has("nodes");
+  c.has_network = network == NetworkRequired::kYes || section.has("nodes");
   if (c.has_network) {
-    parse_network(t, c);
+    parse_network(section, c);
   } else {
     for (const char* key : {"conductances", "losses"}) {
-      if (t.has(key)) t.fail(key, "belongs to a network: give `nodes` too");
+      if (section.has(key)) section.fail(key, "belongs to a network: give `nodes` too");
     }
   }
-  if (auto b = t.optional_map("loss_base")) {
+  if (auto b = section.optional_map("loss_base")) {
     n.base.omega_el_rad_s = b->number_or("omega_el_rad_s", n.base.omega_el_rad_s, 1e-3, 1e7);
     n.base.psi_Wb = b->number_or("psi_Wb", n.base.psi_Wb, 1e-9, 100.0);
     n.base.current_A = b->number_or("current_A", n.base.current_A, 1e-6, 1e6);
     b->finish();
   }
-  if (auto m = t.optional_map("copper")) {
+  if (auto m = section.optional_map("copper")) {
     n.copper = parse_law(*m, "r_s_ref_Ohm", n.copper, 1e4, true, f.filter.calibration_sigma, core::Calibration::kCopperOffset,
                          core::Calibration::kCopperCoefficient, &f.filter.copper_rel_sigma, &n.copper_scale);
   }
-  if (auto m = t.optional_map("magnet_law")) {
+  if (auto m = section.optional_map("magnet_law")) {
     f.magnet_law = parse_law(*m, "psi_m_ref_Wb", f.magnet_law, 100.0, false, f.filter.calibration_sigma,
                              core::Calibration::kMagnetOffset, core::Calibration::kMagnetCoefficient, nullptr, nullptr);
   }
-  f.coolant_C = t.number_or("coolant_C", f.coolant_C, -60.0, 300.0);
-  if (auto s = t.optional_map("winding_sensor")) {
+  f.coolant_C = section.number_or("coolant_C", f.coolant_C, -60.0, 300.0);
+  if (auto s = section.optional_map("winding_sensor")) {
     f.winding_sensor_sigma_K = s->number("sigma_K", 1e-3, 100.0);
     s->finish();
   }
-  if (auto m = t.optional_map("filter")) {
+  if (auto m = section.optional_map("filter")) {
     f.observer.period_s = m->number_or("period_s", f.observer.period_s, 1e-3, 3600.0);
     f.initial_sigma_K = m->number_or("initial_sigma_K", f.initial_sigma_K, 1e-3, 1000.0);
     f.filter.gate_sigma = m->number_or("gate_sigma", f.filter.gate_sigma, 1.0, kInf);
@@ -212,7 +218,7 @@ ThermalConfig parse_thermal_config(YamlMap& t, const MachineConfig& machine, Net
     f.observer.settle_time_constants = m->number_or("settle_time_constants", f.observer.settle_time_constants, 0.0, 100.0);
     m->finish();
   }
-  t.finish();
+  section.finish();
   return c;
 }
 

@@ -43,8 +43,8 @@ YamlMap YamlMap::load_string(const std::string& text, const std::string& name) {
   return YamlMap(root, name, "");
 }
 
-YamlMap::YamlMap(YAML::Node node, std::string file, std::string path)
-    : node_(std::move(node)), file_(std::move(file)), path_(std::move(path)) {}
+YamlMap::YamlMap(const YAML::Node& node, std::string file, std::string path)
+    : node_(node), file_(std::move(file)), path_(std::move(path)) {}
 
 std::string YamlMap::field(const std::string& key) const {
   if (key.empty()) return path_;
@@ -143,7 +143,7 @@ std::string YamlMap::text_or(const std::string& key, const std::string& fallback
 }
 
 std::string YamlMap::choice(const std::string& key, std::initializer_list<const char*> choices) {
-  const std::string v = text(key);
+  std::string v = text(key);  // not const: returned by move
   std::string list;
   for (const char* c : choices) {
     if (v == c) return v;
