@@ -105,7 +105,7 @@ std::string residual_map(const std::string& dir, const Diagnosis& d, const std::
   }
   if (s_hi <= s_lo) s_hi = s_lo + 1.0;
   if (q_hi <= q_lo) q_hi = q_lo + 1.0;
-  const auto cells = static_cast<std::size_t>(kX * kY);
+  const std::size_t cells = static_cast<std::size_t>(kX) * static_cast<std::size_t>(kY);
   std::vector<double> sb(cells, 0.0), sa(cells, 0.0), cnt(cells, 0.0);
   for (std::size_t k = 0; k < ops.size(); ++k) {
     if (!d.baseline_replay.valid[k] || !d.extended_replay.valid[k]) continue;
