@@ -13,9 +13,10 @@
 # The sanitizer trees of 3 and 4 compile at nice 19 while step 2's tests run: they take only the CPU the
 # tests leave idle (the VM suites' real-time pacing, the serial package test, the last test's tail) and
 # yield it otherwise (CFS weight 15 against 1024), so a test's share of the CPU is what it was without them.
-# clang-tidy on the production units (the chosen checks: ≈ 8 min of CPU on two quiet cores, docs/benchmarks.md,
-# "Format and lint gates") follows them at nice 19 too: it yields to the sanitizer tests and delays nothing a
-# test waits for; as no stage but the serial TSan tests leaves a core idle, it adds ≈ its CPU over two cores.
+# clang-tidy on the production units (the chosen checks: ≈ 970 s of CPU, ≈ 8 min at -j2 on two quiet cores;
+# docs/benchmarks.md, "Format and lint gates") follows them at nice 19 too: it yields to the sanitizer tests
+# and delays nothing a test waits for; as no stage but the serial TSan tests leaves a core idle, it adds
+# about its CPU over two cores to the wall time.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 jobs=$(nproc)
