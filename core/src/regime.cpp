@@ -229,6 +229,39 @@ std::uint8_t RegimeClassifier::excitation_bits(const RegimeInput& in) const noex
   return bits;
 }
 
+std::uint8_t RegimeClassifier::lock_bits(const RegimeInput& in) const noexcept {
+  const RegimeConfig& c = config_;
+  const Constants& k = k_;
+  const RegimeState& s = state_;
+  const RegimeNoise& v = noise_;
+  const Vec2& i = in.i_pu;
+  const double n = in.n_pu, n2 = n * n, abs_n = std::abs(n);
+  const Vec2 abs_i = i.cwiseAbs();
+  // n²·x_q², n²·x_d² as every test forms them (n²·x·x).
+  const double n2_xq2 = n2 * c.x_q_pu * c.x_q_pu, n2_xd2 = n2 * c.x_d_pu * c.x_d_pu;
+  // Angle locked: e, what the model leaves to the magnet, lies in the cone of half-angle δ_tol about
+  // sgn(n)·q, widened by what the configuration's uncertainty (r within D_M, x within its tolerance) and
+  // the noise can put there. Independent of ψm's magnitude. Both axes at once: (d, q) in one vector.
+  const Vec2& sl = s.slope_pu_s;
+  const Vec2 abs_sl = sl.cwiseAbs();
+  const Vec2 rotation = (n * k.x_swapped).cwiseProduct(i.reverse()).cwiseProduct(Vec2(1.0, -1.0));  // −n·J·x·i
+  const Vec2 e = ((in.u_pu - c.r_pu * i) - k.x_over_omega_n.cwiseProduct(sl)) + rotation;
+  const Vec2 b = (c.dr_pu * abs_i + (abs_n * k.dx_swapped).cwiseProduct(abs_i.reverse())) +
+                 k.dx_over_omega_n.cwiseProduct(abs_sl);
+  // The speed's sign where it stands out of its noise; else either direction of q.
+  const double along = n2 > k.z_sq * v.n_sq ? (n > 0.0 ? e[1] : -e[1]) : std::abs(e[1]);
+  const double lock = std::abs(e[0]) - c.tan_angle * (along + b[1]) - b[0];
+  if (lock > 0.0) [[unlikely]] {
+    const double slope_sq = 2.0 * s.inv_dt * s.inv_dt;  // Var(s) per σ_i²
+    const double var_d = v.u_sq + (k.r_sq + n2_xq2 + k.slope_var_x_sq[0] * slope_sq) * v.i_sq +
+                         c.x_q_pu * c.x_q_pu * i[1] * i[1] * v.n_sq;
+    const double flux_q = c.psi_max_pu + c.x_d_pu * abs_i[0];
+    const double var_q = v.u_sq + (k.r_sq + n2_xd2 + k.slope_var_x_sq[1] * slope_sq) * v.i_sq + flux_q * flux_q * v.n_sq;
+    if (lock * lock > k.z_sq * (var_d + c.tan_angle * c.tan_angle * var_q)) return regime_bit::kNotLocked;
+  }
+  return 0;
+}
+
 Classification RegimeClassifier::step(const RegimeInput& in) noexcept {
   const RegimeConfig& c = config_;
   const Constants& k = k_;
@@ -267,9 +300,6 @@ Classification RegimeClassifier::step(const RegimeInput& in) noexcept {
   const RegimeNoise& v = noise_;
   const Vec2& i = in.i_pu;
   const double n = in.n_pu, n2 = n * n, abs_n = std::abs(n);
-  const Vec2 abs_i = i.cwiseAbs();
-  // n²·x_q², n²·x_d² as every test forms them (n²·x·x).
-  const double n2_xq2 = n2 * c.x_q_pu * c.x_q_pu, n2_xd2 = n2 * c.x_d_pu * c.x_d_pu;
   std::uint8_t bits = 0;
 
   // Bridge off: the reported voltage and the current are zero within their noise where a modulating bridge
@@ -284,27 +314,7 @@ Classification RegimeClassifier::step(const RegimeInput& in) noexcept {
     if (emf_margin > 0.0 && emf_margin * emf_margin > c.chi2 * v.i_sq * m_sq) bits |= regime_bit::kBridgeOff;
   }
 
-  // Angle locked: e, what the model leaves to the magnet, lies in the cone of half-angle δ_tol about
-  // sgn(n)·q, widened by what the configuration's uncertainty (r within D_M, x within its tolerance) and
-  // the noise can put there. Independent of ψm's magnitude. Both axes at once: (d, q) in one vector.
-  const Vec2& sl = s.slope_pu_s;
-  const Vec2 abs_sl = sl.cwiseAbs();
-  const Vec2 rotation = (n * k.x_swapped).cwiseProduct(i.reverse()).cwiseProduct(Vec2(1.0, -1.0));  // −n·J·x·i
-  const Vec2 e = ((in.u_pu - c.r_pu * i) - k.x_over_omega_n.cwiseProduct(sl)) + rotation;
-  const Vec2 b = (c.dr_pu * abs_i + (abs_n * k.dx_swapped).cwiseProduct(abs_i.reverse())) +
-                 k.dx_over_omega_n.cwiseProduct(abs_sl);
-  // The speed's sign where it stands out of its noise; else either direction of q.
-  const double along = n2 > k.z_sq * v.n_sq ? (n > 0.0 ? e[1] : -e[1]) : std::abs(e[1]);
-  const double lock = std::abs(e[0]) - c.tan_angle * (along + b[1]) - b[0];
-  if (lock > 0.0) [[unlikely]] {
-    const double slope_sq = 2.0 * s.inv_dt * s.inv_dt;  // Var(s) per σ_i²
-    const double var_d = v.u_sq + (k.r_sq + n2_xq2 + k.slope_var_x_sq[0] * slope_sq) * v.i_sq +
-                         c.x_q_pu * c.x_q_pu * i[1] * i[1] * v.n_sq;
-    const double flux_q = c.psi_max_pu + c.x_d_pu * abs_i[0];
-    const double var_q = v.u_sq + (k.r_sq + n2_xd2 + k.slope_var_x_sq[1] * slope_sq) * v.i_sq + flux_q * flux_q * v.n_sq;
-    if (lock * lock > k.z_sq * (var_d + c.tan_angle * c.tan_angle * var_q)) bits |= regime_bit::kNotLocked;
-  }
-
+  bits |= lock_bits(in);
   bits |= transient_bits(in, dt_s);
 
   bits |= excitation_bits(in);

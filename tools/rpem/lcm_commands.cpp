@@ -250,7 +250,8 @@ int run_command(const CommandOptions& o) {
         std::fprintf(stderr, "rpem command: --flip-bit %d is beyond the %zu bytes of %s\n", o.flip_bit, bytes.size(), o.resend.c_str());
         return kExitUsage;
       }
-      bytes[static_cast<std::size_t>(o.flip_bit / 8)] ^= static_cast<char>(1 << (o.flip_bit % 8));
+      char& byte = bytes[static_cast<std::size_t>(o.flip_bit / 8)];
+      byte = static_cast<char>(byte ^ (1 << (o.flip_bit % 8)));
     }
     lcm.publish(channel, bytes.data(), static_cast<unsigned>(bytes.size()));
     std::fprintf(stderr, "rpem command: resent %zu bytes of %s%s on %s\n", bytes.size(), o.resend.c_str(),

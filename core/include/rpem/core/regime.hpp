@@ -269,9 +269,10 @@ class RegimeClassifier {
   /// Recomputes quantisation_var_ (after a resolution changed or the configuration did).
   void update_quantisation() noexcept;
   /// step()'s parts: the transient bit of a standalone or contiguous sample (dt_s from the chain's last
-  /// sample), and the excitation bits of ψm and Rs — against noise_, with the slope step() has just taken.
+  /// sample), the excitation bits of ψm and Rs, and the angle-lock test — against noise_, with the slope step() has just taken.
   [[nodiscard]] std::uint8_t transient_bits(const RegimeInput& in, double dt_s) noexcept;
   [[nodiscard]] std::uint8_t excitation_bits(const RegimeInput& in) const noexcept;
+  [[nodiscard]] std::uint8_t lock_bits(const RegimeInput& in) const noexcept;  ///< kNotLocked or 0
 
   RegimeConfig config_;
   Constants k_;
