@@ -48,7 +48,7 @@ void BM_DiagnoseTwentySecondLog(benchmark::State& state) {
     analysis::write_extended_yaml(f.dir + "/extended.yaml", d, io::builtin_paper_config_text());
     analysis::write_diagnose_report(f.dir, d, "builtin:paper-ipmsm");
     if (d.selection.found.size() != 1) state.SkipWithError("the dead time was not found");
-    state.counters["samples"] = static_cast<double>(d.log->rows.size());
+    state.counters["samples"] = static_cast<double>(d.log->size());
   }
 }
 BENCHMARK(BM_DiagnoseTwentySecondLog)

@@ -97,8 +97,7 @@ double mismatch_half_width(const Diagnosis& d, std::size_t i) {
   constexpr double kZ = 1.959964;
   const double excitation = d.calibration.intervals.excitation_half_width[i];
   if (!std::isfinite(excitation) || d.verdict.ratio <= 1.0) return 0.0;
-  std::size_t n = 0;
-  for (std::size_t k = 0; k < d.log->rows.size(); ++k) n += d.log->training(k) ? 1 : 0;
+  const std::size_t n = d.log->training_count();
   return excitation * std::sqrt(2.0 * static_cast<double>(n) * (d.verdict.ratio * d.verdict.ratio - 1.0)) / kZ;
 }
 
@@ -121,12 +120,11 @@ void write_diagnosis_json(const std::string& path, const Diagnosis& d, const std
   const LogData& log = *d.log;
   const Selection& s = d.selection;
   nlohmann::json out;
-  std::size_t used = 0;
-  for (bool u : log.used) used += u;
+  const std::size_t used = log.used_count();
   out["log"] = {{"path", log.path},
                 {"model", to_string(log.mode)},
                 {"kind", log.averaged ? "averaged" : "phase_samples"},
-                {"samples", log.rows.size()},
+                {"samples", log.size()},
                 {"samples_used", used},
                 {"excluded_idle", log.excluded_idle},
                 {"excluded_transitional", log.excluded_transitional},

@@ -1,5 +1,6 @@
 #include "rpem/analysis/diagnose/diagnosis.hpp"
 
+#include <algorithm>
 #include <chrono>
 
 #include "rpem/analysis/diagnose/replay.hpp"
@@ -31,7 +32,7 @@ EffectSet subset(const EffectSet& set, const std::vector<bool>& keep) {
 
 /// Greedy, in the order found: an effect stays in extended.yaml only if the RPEM estimator with it (and
 /// the effects kept before it) predicts the held-out blocks at least as well as without it.
-std::vector<EstimatorCheck> check_estimator(const Diagnosis& d, std::vector<bool>& keep) {
+std::vector<EstimatorCheck> check_estimator(const Diagnosis& d, const WorkPool& pool, std::vector<bool>& keep) {
   constexpr double kTolerance = 1e-3;  // "at least as well": within rounding of the RMS
   std::vector<EstimatorCheck> checks;
   const EffectSet& model = d.selection.model;
@@ -43,12 +44,21 @@ std::vector<EstimatorCheck> check_estimator(const Diagnosis& d, std::vector<bool
   std::vector<bool> trial(model.effects.size(), false);
   auto rms_with = [&](const std::vector<bool>& k) {
     const ExtendedModel m = subset(model, k).model(d.context);
-    return estimator_heldout_rms_A(*d.log, config_of(d.config, m, d.calibration.identifiable, d.context.reference_C));
+    return estimator_heldout_rms_A(*d.log, config_of(d.config, m, d.calibration.identifiable, d.context.reference_C),
+                                   d.options.monitor);
   };
-  double current = rms_with(trial);
+  // The model without any and with the first: both needed whatever is kept, so at once.
+  double current = 0.0, first_with = 0.0;
+  if (!model.effects.empty()) {
+    pool.parallel_for(2, [&](std::size_t i) {
+      std::vector<bool> k(model.effects.size(), false);
+      k[0] = i == 1;
+      (i == 0 ? current : first_with) = rms_with(k);
+    });
+  }
   for (std::size_t j = 0; j < model.effects.size(); ++j) {
     trial[j] = true;
-    const double with = rms_with(trial);
+    const double with = j == 0 ? first_with : rms_with(trial);
     EstimatorCheck c{model.effects[j], true, with, current, with <= current * (1.0 + kTolerance)};
     if (c.kept) {
       current = with;
@@ -108,21 +118,27 @@ Diagnosis diagnose(LogData log, const io::MachineConfig& config, const DiagnoseO
   d.options = options;
   d.log = std::make_unique<LogData>(std::move(log));
   d.config = config;
+  Monitor none;
+  Monitor& monitor = options.monitor ? *options.monitor : none;
   const double f_sw = options.switching_frequency_Hz > 0.0 ? options.switching_frequency_Hz
                                                           : config.estimator.extensions.switching_frequency_Hz;
   const ExtendedModel base = make_base_model(config.machine, config.estimator.extensions, config.rs_drift.law,
                                              config.psim_drift.law, *d.log);
   d.context = EffectContext::of(*d.log, config.machine, base, options.reference_C, f_sw);
 
-  const ModelReplay replay(*d.log, config.machine.rated);
+  const WorkPool pool(std::max(1, options.jobs));
+  const ModelReplay replay(*d.log, config.machine.rated, pool, options.monitor);
+  const std::uint64_t n = d.log->size();
+  monitor.stage("replaying the configuration", 2 * n);
   const EffectFitter fitter(replay, d.context);
 
   // The configuration as it is, and the noise floor of its residual (the same for every model).
-  replay.run(base, d.baseline_replay);
+  const BaselinePass baseline = baseline_pass(replay, d.context, base);
   d.baseline_heldout_rms_A = rms(fitter.heldout(EffectSet{}));
-  const double floor = noise_floor_A(*d.log, d.baseline_replay);
+  const double floor = baseline.noise_floor_A;
 
   // The calibrated baseline: the constants the log's excitation pins down, fitted on the training blocks.
+  monitor.stage("calibrating the configuration's constants", 0);
   EffectSet start;
   const CalibrationIntervals excitation = fitter.intervals(start, floor);
   for (std::size_t i = 0; i < kCalibrated.size(); ++i) {
@@ -149,6 +165,7 @@ Diagnosis diagnose(LogData log, const io::MachineConfig& config, const DiagnoseO
   std::array<bool, kCalibrated.size()> admissible{};
   for (std::size_t i = 0; i < kCalibrated.size(); ++i) admissible[i] = excitation.excitation_half_width[i] <= kIdentifiableHalfWidth;
   d.selection = select_effects(fitter, options.selection, start, floor, admissible);
+  monitor.stage("refitting the model found", 0);
   prune_negligible(fitter, d);
   // A drift law found brings the constant it is referred to (EffectRow::frees_constant).
   for (std::size_t i = 0; i < kCalibrated.size(); ++i) d.calibration.identifiable[i] = d.selection.model.calibrated[i];
@@ -156,17 +173,24 @@ Diagnosis diagnose(LogData log, const io::MachineConfig& config, const DiagnoseO
   d.extended_model = d.selection.model.model(d.context);
   for (std::size_t i = 0; i < kCalibrated.size(); ++i) d.calibration.value[i] = d.extended_model.machine.*kCalibratedFields[i];
 
+  const bool transient = d.log->mode == ModelMode::kTransient;
+  monitor.stage("checking the effects on the estimator", transient ? (d.selection.model.effects.size() + 1) * n : 0);
   std::vector<bool> keep;
-  d.estimator_checks = check_estimator(d, keep);
+  d.estimator_checks = check_estimator(d, pool, keep);
   d.extended_config = config_of(config, subset(d.selection.model, keep).model(d.context), d.calibration.identifiable,
                                 options.reference_C);
 
-  replay.run(d.extended_model, d.extended_replay);
-  d.statistics = residual_statistics(*d.log, d.context, d.baseline_replay, d.extended_replay);
+  // The estimator's two runs and the whole-log comparison, at once.
+  monitor.stage("comparing the models over the whole log", (transient ? 2 * n : 0) + 2 * n);
+  pool.parallel_for(2, [&](std::size_t i) {
+    if (i == 0) {
+      d.estimates = compare_estimates(*d.log, config, d.extended_config, d.extended_model, d.context, truth, pool, options.monitor);
+    } else {
+      comparison_pass(replay, d.context, base, d.extended_model, baseline, d.statistics, d.figures);
+    }
+  });
   d.verdict = verdict(d.selection.extended_heldout_rms_A, floor, d.statistics);
-  d.estimates = compare_estimates(*d.log, config, d.extended_config, d.extended_model, d.context, truth);
   d.elapsed_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_time).count();
-
   return d;
 }
 

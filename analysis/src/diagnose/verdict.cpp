@@ -47,19 +47,38 @@ std::string regressor_meaning(const std::string& r) {
 
 }  // namespace
 
-double noise_floor_A(const LogData& log, const ReplayOutput& replay) {
-  std::vector<double> d2, q2;
-  const std::size_t n = log.rows.size();
-  for (std::size_t k = 1; k + 1 < n; ++k) {
-    if (!replay.valid[k - 1] || !replay.valid[k] || !replay.valid[k + 1]) continue;
-    if (log.block[k - 1] != log.block[k + 1] || log.rows[k].sample.gap_before || log.rows[k + 1].sample.gap_before) continue;
-    const core::Vec2 e = replay.residual_A[k + 1] - 2.0 * replay.residual_A[k] + replay.residual_A[k - 1];
-    d2.push_back(e[0] * e[0]);
-    q2.push_back(e[1] * e[1]);
+void SecondDifferences::add(const LogData& log, std::size_t k, const ModelSample& m) {
+  // A difference needs three consecutive predicted samples of one block with no gap before the last two.
+  if (previous_.valid && last_.valid && m.valid && previous_.k + 1 == last_.k && last_.k + 1 == k &&
+      !log.samples.gap_before(last_.k) && !log.samples.gap_before(k)) {
+    const core::Vec2 e = m.residual_A - 2.0 * last_.r + previous_.r;
+    d2_.push_back(e[0] * e[0]);
+    q2_.push_back(e[1] * e[1]);
   }
-  if (d2.size() < 10) return 0.0;
+  previous_ = last_;
+  last_ = {k, m.residual_A, m.valid};
+}
+
+void SecondDifferences::append(const SecondDifferences& other) {
+  d2_.insert(d2_.end(), other.d2_.begin(), other.d2_.end());
+  q2_.insert(q2_.end(), other.q2_.begin(), other.q2_.end());
+}
+
+double SecondDifferences::noise_floor_A() && {
+  if (d2_.size() < 10) return 0.0;
   const double scale = 1.0 / (kSecondDifferenceGain * kMedianChiSquare1);
-  return std::sqrt(scale * (median(std::move(d2)) + median(std::move(q2))));
+  return std::sqrt(scale * (median(std::move(d2_)) + median(std::move(q2_))));
+}
+
+double noise_floor_A(const LogData& log, const ReplayOutput& replay) {
+  SecondDifferences all;
+  for (int b = 0; b < log.blocks; ++b) {
+    all.start();
+    for (std::size_t k = log.block_first[static_cast<std::size_t>(b)]; k < log.block_first[static_cast<std::size_t>(b) + 1]; ++k) {
+      all.add(log, k, ModelSample{replay.residual_A[k], replay.model_A.empty() ? core::Vec2::Zero() : replay.model_A[k], replay.valid[k]});
+    }
+  }
+  return std::move(all).noise_floor_A();
 }
 
 Verdict verdict(double final_heldout_rms_A, double floor_A, const ResidualStatistics& st) {

@@ -24,7 +24,30 @@ namespace rpem::analysis {
 /// A residual up to this many times the noise floor counts as explained (docs/diagnose.md).
 inline constexpr double kExplainedRatio = 1.5;
 
-/// The noise floor of a replay's residual [A] (see above); 0 if too few consecutive valid samples.
+/// The squared second differences of a replay's residual, per axis, as a replay streams through the
+/// blocks (what the floor's medians are taken of: their order does not matter).
+class SecondDifferences {
+ public:
+  /// Sample k of a block, in order (the samples a replay visits); a new block starts with start().
+  void add(const LogData& log, std::size_t k, const ModelSample& m);
+  void start() noexcept { last_ = previous_ = Last{}; }
+  /// Another block's differences.
+  void append(const SecondDifferences& other);
+  [[nodiscard]] std::size_t size() const noexcept { return d2_.size(); }
+  /// The noise floor [A] (see above); 0 if too few differences.
+  [[nodiscard]] double noise_floor_A() &&;
+
+ private:
+  struct Last {
+    std::size_t k = static_cast<std::size_t>(-1);
+    core::Vec2 r = core::Vec2::Zero();
+    bool valid = false;
+  };
+  Last last_, previous_;
+  std::vector<double> d2_, q2_;
+};
+
+/// The noise floor of a whole replay's residual [A] (tests); 0 if too few consecutive valid samples.
 [[nodiscard]] double noise_floor_A(const LogData& log, const ReplayOutput& replay);
 
 struct Verdict {
