@@ -1,9 +1,10 @@
 // rpem estimate --log LOG.csv [--log-map MAP.yaml] --config CFG.yaml --out EST.csv [--algorithm sga|gna|phyint]
-//              [--every N]
+//              [--every N | --rate HZ]
 // Runs the estimator offline over a drive log, exactly as rpemd would run it online: a log of instantaneous
 // samples through DriveEstimator, a log of averaged samples (our averaged log, VESC Tool's realtime log, a
 // map of averaged samples; docs/drive-log.md) through AveragedDriveEstimator.
 
+#include <cmath>
 #include <cstdio>
 #include <optional>
 #include <string>
@@ -28,6 +29,29 @@ struct EstimateOptions {
   std::string out;
   std::string algorithm;
   long every = 1;
+  double rate_Hz = 0.0;
+};
+
+/// Which estimates --out gets (docs/drive-log.md, "Estimate CSV"): every N-th sample (--every), or the first
+/// sample at or after each point of a grid 1/rate apart in the log's time, from its first sample (--rate; a
+/// gap in the log skips the grid's points inside it).
+class Decimation {
+ public:
+  explicit Decimation(const EstimateOptions& o)
+      : every_(static_cast<std::uint64_t>(o.every)), period_ns_(o.rate_Hz > 0.0 ? std::llround(1e9 / o.rate_Hz) : 0) {}
+  /// Whether the estimate of the sample at t_ns is written.
+  bool take(std::int64_t t_ns) {
+    if (period_ns_ <= 0) return seen_++ % every_ == 0;
+    if (seen_++ > 0 && t_ns < next_ns_) return false;
+    next_ns_ = seen_ == 1 ? t_ns + period_ns_ : next_ns_ + period_ns_;
+    if (next_ns_ <= t_ns) next_ns_ = t_ns + period_ns_;  // across a gap: the grid starts again here
+    return true;
+  }
+
+ private:
+  std::uint64_t every_, seen_ = 0;
+  std::int64_t period_ns_;
+  std::int64_t next_ns_ = 0;  ///< the grid's next point (--rate), once a sample was seen
 };
 
 struct Tally {
@@ -57,9 +81,10 @@ int run_averaged(const EstimateOptions& o, const io::LogSource& source, const io
   io::EstimateLogWriter writer(o.out);
   core::AveragedDriveEstimator estimator(cfg.machine, cfg.estimator);
   Tally tally;
+  Decimation decimation(o);
   for (const core::AveragedSample& s : samples) {
     const core::Estimate e = estimator.step(s);
-    if (tally.rows % static_cast<std::uint64_t>(o.every) == 0) writer.write(e, estimator.core());
+    if (decimation.take(e.t_ns)) writer.write(e, estimator.core());
     tally.count(e);
   }
   std::fprintf(stderr, "rpem estimate: %s\n", tally.summary(cfg.estimator.algorithm, "averaged samples").c_str());
@@ -82,9 +107,10 @@ int run_estimate(const EstimateOptions& o) {
 
   io::DriveLogRow row;
   Tally tally;
+  Decimation decimation(o);
   while (reader.next(row)) {
     const core::Estimate e = estimator.step(row.sample);
-    if (tally.rows % static_cast<std::uint64_t>(o.every) == 0) writer.write(e, estimator);
+    if (decimation.take(e.t_ns)) writer.write(e, estimator);
     tally.count(e);
     if ((tally.rows & 0xFFF) == 0) progress.update(reader.bytes_read(), reader.bytes_total());
   }
@@ -109,7 +135,13 @@ Runner add_estimate_command(CLI::App& app) {
   cmd->add_option("--out", opts->out, "estimate CSV to write")->required();
   cmd->add_option("--algorithm", opts->algorithm, "override the configured gain algorithm")
       ->check(CLI::IsMember({"sga", "gna", "phyint"}));
-  cmd->add_option("--every", opts->every, "write every N-th sample")->check(CLI::PositiveNumber);
+  CLI::Option* every = cmd->add_option("--every", opts->every, "write every N-th sample's estimate (default 1: all)")
+                           ->check(CLI::PositiveNumber);
+  cmd->add_option("--rate", opts->rate_Hz,
+                  "write estimates at this rate [Hz] of the log's time (the first sample at or after each 1/rate), "
+                  "e.g. 100 for an 8 kHz log: 1/80 of the file (docs/drive-log.md, \"Estimate CSV\")")
+      ->check(CLI::PositiveNumber)
+      ->excludes(every);
   return [cmd, opts]() { return cmd->parsed() ? run_estimate(*opts) : -1; };
 }
 
