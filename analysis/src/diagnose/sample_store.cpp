@@ -76,9 +76,10 @@ void SampleStore::finish() {
   if (finished_) return;
   if (!staged_t_.empty()) store_chunk();
   finished_ = true;
-  staged_t_ = {};
-  staged_marks_ = {};
-  for (auto& c : staged_) c = {};
+  // Released, not only cleared (`v = {}` would assign an empty list and keep the capacity).
+  staged_t_ = std::vector<std::int64_t>();
+  staged_marks_ = std::vector<std::uint8_t>();
+  for (auto& c : staged_) c = std::vector<double>();
 }
 
 core::DriveSample SampleStore::sample(std::size_t k) const noexcept {
