@@ -3,6 +3,7 @@
 // round's model and its columns (the free calibrated constants, the parameters of the effects in it) — is
 // replayed in both, so that no column is stored: the first pass judges the candidates' starts, the second
 // takes the chosen starts' columns together with the basis'.
+#include <cassert>
 #include <limits>
 
 #include "least_squares.hpp"
@@ -60,42 +61,29 @@ std::vector<std::vector<double>> starts_of(const Effect& candidate, const Effect
   return starts;
 }
 
+/// Columns a screening's sums take at most (the basis' and a candidate's).
+constexpr Eigen::Index kMaxColumns = 64;
+
 /// The models of a pass: the basis (the round's model, then its columns) and after it whatever the pass
-/// adds; each sample's basis columns are computed once for all.
+/// adds; each sample's basis columns are computed once for all. After the first pass: the basis' sums.
 struct Pass {
   std::vector<ExtendedModel> models;
   std::vector<double> basis_steps;
+  double baseline_after = 0.0;  ///< training sum of squares once the basis' columns moved to their best [A²]
   [[nodiscard]] std::size_t basis_end() const noexcept { return 1 + basis_steps.size(); }
+  [[nodiscard]] Eigen::Index basis_size() const noexcept { return static_cast<Eigen::Index>(basis_steps.size()); }
   /// The basis columns at one sample, axis by axis.
   void basis_columns(std::span<const core::Vec2> r, int axis, double* c) const {
+    assert(basis_steps.size() <= static_cast<std::size_t>(kMaxColumns));
     for (std::size_t i = 0; i < basis_steps.size(); ++i) c[i] = (r[i + 1][axis] - r[0][axis]) / basis_steps[i];
   }
 };
 
-}  // namespace
-
-Screening EffectFitter::screen(const EffectSet& base, const std::vector<Effect>& candidates) const {
-  Pass pass;
-  pass.models.push_back(base.model(context_));
-  for (Column& c : basis_columns(base, context_)) {
-    pass.models.push_back(std::move(c.moved));
-    pass.basis_steps.push_back(c.h);
-  }
-  const auto nb = static_cast<Eigen::Index>(pass.basis_steps.size());
-  constexpr Eigen::Index kMaxColumns = 64;
-
-  if (Monitor* monitor = replay_.monitor()) {
-    // Both passes' models: the basis twice, the starts of candidates with several, each candidate at its
-    // start with its columns.
-    std::uint64_t models = 2 * (1 + static_cast<std::uint64_t>(nb));
-    for (const Effect& e : candidates) {
-      const std::size_t starts = e.row->starts.size();
-      models += (starts > 1 ? starts : 0) + 1 + static_cast<std::uint64_t>(e.row->parameters) +
-                (e.row->fitted_constant() >= 0 && !base.calibrated[static_cast<std::size_t>(e.row->fitted_constant())] ? 1 : 0);
-    }
-    monitor->add_work(models * training_block_samples_);
-  }
-
+/// The screening's first pass: the round's model's sums and each candidate's best start (out.ssr, out.starts).
+template <class OverTraining>
+void judge_starts(const OverTraining& over_training, const EffectContext& context, Pass& pass, const EffectSet& base,
+                  const std::vector<Effect>& candidates, Screening& out) {
+  const Eigen::Index nb = pass.basis_size();
   // Pass 1: the basis' own sums, and at each start of a candidate with several its sum of squares and its
   // residual's products with the basis' columns. The starts are a grid over a residual that is not convex in
   // the candidate's parameters: each is judged by the training sum of squares at that point, with the
@@ -105,10 +93,10 @@ Screening EffectFitter::screen(const EffectSet& base, const std::vector<Effect>&
   std::vector<std::vector<std::vector<double>>> starts(candidates.size());
   std::vector<std::size_t> first_start(candidates.size(), 0);  // index of the candidate's first start model
   for (std::size_t c = 0; c < candidates.size(); ++c) {
-    starts[c] = starts_of(candidates[c], context_);
+    starts[c] = starts_of(candidates[c], context);
     first_start[c] = pass.models.size();
     if (starts[c].size() < 2) continue;
-    for (const std::vector<double>& s : starts[c]) pass.models.push_back(base.with(candidates[c], context_, s).model(context_));
+    for (const std::vector<double>& s : starts[c]) pass.models.push_back(base.with(candidates[c], context, s).model(context));
   }
   struct First {
     least_squares::Gram basis;
@@ -141,7 +129,7 @@ Screening EffectFitter::screen(const EffectSet& base, const std::vector<Effect>&
   const Eigen::MatrixXd basis_jj = sum.basis.symmetric();
   const double explained =
       nb > 0 ? -least_squares::step_change(basis_jj, sum.basis.jr, least_squares::gauss_newton_step(basis_jj, sum.basis.jr)) : 0.0;
-  Screening out;
+  pass.baseline_after = sum.basis.rr - explained;
   out.ssr = sum.basis.rr;
   out.starts.resize(candidates.size());
   for (std::size_t c = 0; c < candidates.size(); ++c) {
@@ -160,7 +148,13 @@ Screening EffectFitter::screen(const EffectSet& base, const std::vector<Effect>&
       }
     }
   }
+}
 
+/// The second: each candidate's credited gain from its start (out.gain).
+template <class OverTraining>
+void credit_gains(const OverTraining& over_training, const EffectContext& context, Pass& pass, const EffectSet& base,
+                  const std::vector<Effect>& candidates, Screening& out) {
+  const Eigen::Index nb = pass.basis_size();
   // Pass 2: each candidate at its start, its columns — the constant its law is referred to, or its curve
   // multiplies, where the base does not calibrate it (unbounded, like the basis), then its parameters,
   // stepped into the allowed side of a bound (a delay or a conductance may start on its lower one) — with
@@ -174,23 +168,23 @@ Screening EffectFitter::screen(const EffectSet& base, const std::vector<Effect>&
   std::vector<Candidate> layout(candidates.size());
   for (std::size_t c = 0; c < candidates.size(); ++c) {
     const Effect& e = candidates[c];
-    const EffectSet at = base.with(e, context_, out.starts[c]);
+    const EffectSet at = base.with(e, context, out.starts[c]);
     Candidate& l = layout[c];
     l.model = pass.models.size();
-    pass.models.push_back(at.model(context_));
+    pass.models.push_back(at.model(context));
     if (const int k = e.row->fitted_constant(); k >= 0 && !base.calibrated[static_cast<std::size_t>(k)]) {
       EffectSet moved = at;
       moved.calibration[static_cast<std::size_t>(k)] += kStep;
-      pass.models.push_back(moved.model(context_));
+      pass.models.push_back(moved.model(context));
       l.steps.push_back(kStep);
       l.constant = 1;
     }
     for (int i = 0; i < e.row->parameters; ++i) {
       const double value = at.parameters.back()[static_cast<std::size_t>(i)];
-      const double h = parameter_bounds(e, context_, i).second >= value + kStep ? kStep : -kStep;
+      const double h = parameter_bounds(e, context, i).second >= value + kStep ? kStep : -kStep;
       EffectSet moved = at;
       moved.parameters.back()[static_cast<std::size_t>(i)] += h;
-      pass.models.push_back(moved.model(context_));
+      pass.models.push_back(moved.model(context));
       l.steps.push_back(h);
     }
   }
@@ -213,7 +207,7 @@ Screening EffectFitter::screen(const EffectSet& base, const std::vector<Effect>&
         }
       });
   out.gain.resize(candidates.size());
-  const double baseline_after = sum.basis.rr - explained;
+  const double baseline_after = pass.baseline_after;
   for (std::size_t j = 0; j < candidates.size(); ++j) {
     least_squares::Gram g = init2[j];
     for (const auto& block : second) g.add(block[j]);
@@ -221,13 +215,41 @@ Screening EffectFitter::screen(const EffectSet& base, const std::vector<Effect>&
     const Effect& e = candidates[j];
     const Eigen::Index first_parameter = nb + layout[j].constant;
     const Eigen::VectorXd delta = least_squares::bounded_step(jj, g.jr, first_parameter, [&](int i) {
-      const auto [lo, hi] = parameter_bounds(e, context_, i);
+      const auto [lo, hi] = parameter_bounds(e, context, i);
       const double value = out.starts[j][static_cast<std::size_t>(i)];
       return std::pair{lo - value, hi - value};
     });
     const double after = g.rr + least_squares::step_change(jj, g.jr, delta);
     out.gain[j] = std::max(0.0, baseline_after - after);
   }
+}
+
+}  // namespace
+
+Screening EffectFitter::screen(const EffectSet& base, const std::vector<Effect>& candidates) const {
+  Pass pass;
+  pass.models.push_back(base.model(context_));
+  for (Column& c : basis_columns(base, context_)) {
+    pass.models.push_back(std::move(c.moved));
+    pass.basis_steps.push_back(c.h);
+  }
+  if (Monitor* monitor = replay_.monitor()) {
+    // Both passes' models: the basis twice, the starts of candidates with several, each candidate at its
+    // start with its columns.
+    std::uint64_t models = 2 * (1 + static_cast<std::uint64_t>(pass.basis_size()));
+    for (const Effect& e : candidates) {
+      const std::size_t starts = e.row->starts.size();
+      models += (starts > 1 ? starts : 0) + 1 + static_cast<std::uint64_t>(e.row->parameters) +
+                (e.row->fitted_constant() >= 0 && !base.calibrated[static_cast<std::size_t>(e.row->fitted_constant())] ? 1 : 0);
+    }
+    monitor->add_work(models * training_block_samples_);
+  }
+  const auto over = [this](const std::vector<ExtendedModel>& models, const auto& init, const auto& add) {
+    return over_training(models, init, add);
+  };
+  Screening out;
+  judge_starts(over, context_, pass, base, candidates, out);
+  credit_gains(over, context_, pass, base, candidates, out);
   return out;
 }
 
