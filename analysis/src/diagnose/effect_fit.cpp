@@ -4,6 +4,7 @@
 
 #include <Eigen/Dense>
 #include <algorithm>
+#include <cassert>
 #include <cmath>
 #include <limits>
 
@@ -16,6 +17,9 @@ namespace {
 /// Forward-difference step on the scaled parameters (1 = a typical magnitude): the intervals' absolute
 /// step, and the fit's relative one (Ceres' relative_step_size, with its floor √ε).
 constexpr double kStep = 1e-3;
+/// Columns a fit's or the intervals' per-sample rows hold at most (the calibrated constants and every
+/// effect's parameters; four effects of at most a few parameters use a fraction of it).
+constexpr int kMaxColumns = 64;
 
 }  // namespace
 
@@ -35,6 +39,7 @@ class EffectFitter::FitCost final : public ceres::CostFunction {
   bool Evaluate(double const* const* parameters, double* residuals, double** jacobians) const override {
     const EffectSet set = at(parameters);
     const int p = parameters_;
+    assert(p < kMaxColumns);  // the row below holds the P columns and the residual
     if (jacobians == nullptr) {
       std::fill(residuals, residuals + p, 0.0);
       residuals[p] = std::sqrt(fitter_.training_ssr(set));
@@ -57,7 +62,7 @@ class EffectFitter::FitCost final : public ceres::CostFunction {
     }
     std::vector<least_squares::TriangularFactor> factors =
         fitter_.over_training(models, least_squares::TriangularFactor(p + 1), [&](least_squares::TriangularFactor& f, std::span<const core::Vec2> r) {
-          double row[64];
+          double row[kMaxColumns];
           for (int axis = 0; axis < 2; ++axis) {
             for (int j = 0; j < p; ++j) row[j] = (r[static_cast<std::size_t>(j) + 1][axis] - r[0][axis]) * inverse_step[static_cast<std::size_t>(j)];
             row[p] = r[0][axis];
@@ -258,6 +263,7 @@ CalibrationIntervals EffectFitter::intervals(const EffectSet& set, double noise_
     }
   }
   const auto n = static_cast<Eigen::Index>(steps.size());
+  assert(n <= kMaxColumns);
   // Per training block: JᵀJ, and the block's score vector g_b = J_bᵀ·r_b (the cluster-robust "meat").
   struct Block {
     least_squares::Gram gram;
@@ -265,7 +271,7 @@ CalibrationIntervals EffectFitter::intervals(const EffectSet& set, double noise_
   };
   const std::vector<Block> blocks =
       over_training(models, Block{least_squares::Gram(n), Eigen::VectorXd::Zero(n)}, [&](Block& b, std::span<const core::Vec2> r) {
-        double c[2][64];
+        double c[2][kMaxColumns];
         for (Eigen::Index i = 0; i < n; ++i) {
           const std::size_t m = static_cast<std::size_t>(i) + 1;
           c[0][i] = (r[m][0] - r[0][0]) / steps[static_cast<std::size_t>(i)];
