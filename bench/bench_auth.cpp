@@ -5,6 +5,7 @@
 // key id and MAC trailer).
 #include <benchmark/benchmark.h>
 
+#include <array>
 #include <vector>
 
 #include "rpem/auth/mac.hpp"
@@ -15,10 +16,9 @@
 namespace {
 
 rpem::auth::Key key() {
-  rpem::auth::Key k;
-  k.id = 1;
-  k.bytes.fill(0x5A);
-  return k;
+  std::array<std::uint8_t, rpem::auth::kKeyBytes> bytes{};
+  bytes.fill(0x5A);
+  return {1, bytes};
 }
 
 template <class Message>

@@ -18,6 +18,7 @@
 #include <ctime>
 #include <vector>
 
+#include "rpem/core/clock.hpp"
 #include "rpem/core/drive_estimator.hpp"
 #include "rpem/sim/drive_simulator.hpp"
 #include "rpem/sim/vesc_on_demand.hpp"
@@ -60,7 +61,7 @@ void simulate(const sim::Scenario& s, bool with_estimator) {
 double thread_cpu_s() {
   timespec ts{};
   clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
+  return static_cast<double>(ts.tv_sec) + rpem::core::to_seconds(ts.tv_nsec);
 }
 
 double min_of(const std::vector<double>& v) { return *std::min_element(v.begin(), v.end()); }

@@ -10,17 +10,23 @@
 
 #include "rpem/auth/key_file.hpp"
 #include "rpem/estimate_t.hpp"
+#include "rpem/schema/decode.hpp"
+#include "rpem/supervisor/estimate_gate.hpp"
 
 // [snippet]
 struct Supervisor {
   rpem::auth::Keyring keys;  // rpemd's publish key: keys.add(rpem::auth::load_key_file(path))
-  void on_estimate(const lcm::ReceiveBuffer* rbuf, const std::string& channel, const rpem::estimate_t* m) {
+  // The bytes as received, verified before they are decoded: LCM's typed subscription decodes first, and
+  // lcm-gen's decoder throws on a crafted string length, which ends the process.
+  void on_estimate(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
     const std::span bytes(static_cast<const std::uint8_t*>(rbuf->data), rbuf->data_size);
     if (rpem::auth::verify(keys, channel, bytes) != rpem::auth::Verdict::kVerified) {
       std::printf("ignored: not from rpemd\n");  // forged, altered, unsigned or another key
       return;
     }
-    if (m->psi_m_valid) std::printf("T_magnet %.1f C (verified)\n", m->t_magnet_C);  // derate on this
+    rpem::estimate_t m;
+    if (!rpem::schema::decode_exactly(bytes, m)) return;
+    if (m.psi_m_valid) std::printf("T_magnet %.1f C (verified)\n", m.t_magnet_C);  // derate: docs/supervisor.md
   }
 };
 // [snippet]

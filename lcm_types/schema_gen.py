@@ -27,7 +27,8 @@ What the comments mean here:
   - a comment on a line of its own inside the struct opens a group (its first line, up to a colon, is the
     group's title): `rpem listen` separates groups with " | ";
   - a field's trailing comment documents it; a leading [label] there is the short name `rpem listen` shows
-    and its CSV column (else the field's name);
+    and its CSV column (else the field's name) — unless an earlier field of the struct has that label: a
+    key is unique, so the later field keeps its name (with a warning);
   - the unit is the name's suffix (_V _A _Wb _Ohm _rad _rad_s _Hz _C _s _us _ns _pu: the project's rule that
     every quantity names its unit).
 Strings are not mirrored: each of ours names a configuration the real-time thread holds as an enum (the
@@ -231,6 +232,12 @@ class Parser:
             label, doc = m.group(1).strip(), m.group(2)
         if any(f.name == name_token.text for f in s.fields):
             self.error(name_token, f"field '{name_token.text}' declared twice")
+        if label and any(f.label == label for f in s.fields):
+            # A label is a key of `rpem listen`'s line and a column of its CSV, which readers look up by
+            # name: the first field to claim it keeps it, a later one is shown by its own name.
+            print(f"{self.path}:{name_token.line}:{name_token.col}: warning: label [{label}] is taken by an "
+                  f"earlier field; '{name_token.text}' keeps its name", file=sys.stderr)
+            label = ""
         s.fields.append(Field(lcm_type, name_token.text, size, name_token.line, doc, label, group))
 
     def check_authentication(self, s):

@@ -24,7 +24,7 @@ sanitizer_builds() {
   cmake -S . -B build/sanitize -G Ninja -DCMAKE_BUILD_TYPE=Debug -DRPEM_WERROR=ON \
     -DRPEM_SANITIZE=address,undefined -DRPEM_BUILD_BENCHMARKS=OFF -DRPEM_BUILD_DAEMON=OFF -DRPEM_BUILD_TOOLS=OFF
   cmake --build build/sanitize -j "$jobs" --target test_core test_io test_can test_sim test_sim_vesc test_analysis \
-    test_auth test_indep_drive indep_drive_log
+    test_auth test_indep_drive indep_drive_log test_indep_thermal indep_thermal_plant
   cmake -S . -B build/tsan -G Ninja -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS_DEBUG="-O1 -g" -DRPEM_WERROR=ON \
     -DRPEM_SANITIZE=thread -DRPEM_BUILD_BENCHMARKS=OFF -DRPEM_BUILD_TOOLS=OFF
   cmake --build build/tsan -j "$jobs" --target rpemd test_daemon test_daemon_allocations test_daemon_storm

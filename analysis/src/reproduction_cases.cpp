@@ -66,6 +66,7 @@ ReproductionCase make(std::string id, std::string figure, std::string descriptio
   c.step_time_s = step_s;
   c.scenario = std::move(s);
   c.estimator = c.scenario.machine.estimator;
+  c.estimator.regimes.enabled = false;  // the paper's estimator as it states it: no sample classified or skipped (regime.hpp)
   return c;
 }
 

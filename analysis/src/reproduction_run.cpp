@@ -1,6 +1,7 @@
 #include <memory>
 
 #include "rpem/analysis/reproduction.hpp"
+#include "rpem/core/clock.hpp"
 #include "rpem/core/drive_estimator.hpp"
 #include "rpem/sim/drive_simulator.hpp"
 
@@ -35,7 +36,7 @@ CaseResult run_case(const ReproductionCase& c, double decimation_s) {
   sim::TruthRow truth;
   std::int64_t k = 0;
   while (simulator.next(row, truth)) {
-    const double t = 1e-9 * static_cast<double>(row.sample.t_ns);
+    const double t = core::to_seconds(row.sample.t_ns);
     if (!estimators[0] && t >= c.step_time_s) make_estimators();
     if (estimators[0]) {
       const double true_value = c.parameter == core::Param::kPsiM ? truth.parameters.psi_m_Wb : truth.parameters.r_s_Ohm;

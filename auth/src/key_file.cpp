@@ -5,10 +5,11 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <cctype>
 #include <cerrno>
 #include <cstring>
 #include <limits>
-#include <sstream>
+#include <string_view>
 
 namespace rpem::auth {
 namespace {
@@ -23,6 +24,24 @@ int hex_digit(char c) {
   return -1;
 }
 
+/// The next whitespace-separated word of `rest`, a view into it (no copy: a key file's text is the key).
+std::string_view next_word(std::string_view& rest) {
+  const auto space = [](char c) { return std::isspace(static_cast<unsigned char>(c)) != 0; };
+  std::size_t begin = 0;
+  while (begin < rest.size() && space(rest[begin])) ++begin;
+  std::size_t end = begin;
+  while (end < rest.size() && !space(rest[end])) ++end;
+  const std::string_view word = rest.substr(begin, end - begin);
+  rest.remove_prefix(end);
+  return word;
+}
+
+/// Wipes a string that held a key's text when it goes.
+struct WipeOnExit {
+  std::string& text;
+  ~WipeOnExit() { sodium_memzero(text.data(), text.size()); }
+};
+
 }  // namespace
 
 Key parse_key(const std::string& text, const std::string& where) {
@@ -30,33 +49,38 @@ Key parse_key(const std::string& text, const std::string& where) {
     return KeyError(where + ": not a key file (" + why + "); expected one line `" + kMagic +
                     " <key id 1..2147483647> <64 hex digits>`, as `rpem keygen` writes");
   };
-  std::istringstream in(text);
-  std::string magic, id_text, hex, extra;
-  if (!(in >> magic >> id_text >> hex) || magic != kMagic) throw fail("no `" + std::string(kMagic) + "` header");
-  if (in >> extra) throw fail("text after the key");
-  Key key;
+  std::string_view rest = text;
+  const std::string_view magic = next_word(rest), id_word = next_word(rest), hex = next_word(rest);
+  if (hex.empty() || magic != kMagic) throw fail("no `" + std::string(kMagic) + "` header");
+  if (!next_word(rest).empty()) throw fail("text after the key");
+  const std::string id_text(id_word);
+  std::int32_t id = 0;
   try {
     std::size_t used = 0;
-    const long long id = std::stoll(id_text, &used);
-    if (used != id_text.size() || id <= 0 || id > std::numeric_limits<std::int32_t>::max()) throw std::out_of_range("");
-    key.id = static_cast<std::int32_t>(id);
+    const long long value = std::stoll(id_text, &used);
+    if (used != id_text.size() || value <= 0 || value > std::numeric_limits<std::int32_t>::max()) throw std::out_of_range("");
+    id = static_cast<std::int32_t>(value);
   } catch (const std::exception&) {
     throw fail("key id `" + id_text + "` is not a whole number in 1..2147483647");
   }
   if (hex.size() != 2 * kKeyBytes) throw fail("the key has " + std::to_string(hex.size()) + " hex digits, not 64");
-  for (std::size_t k = 0; k < kKeyBytes; ++k) {
-    const int hi = hex_digit(hex[2 * k]), lo = hex_digit(hex[2 * k + 1]);
-    if (hi < 0 || lo < 0) throw fail("a non-hex digit in the key");
-    key.bytes[k] = static_cast<std::uint8_t>(hi * 16 + lo);
-  }
-  return key;
+  // Decoded straight into the key's locked memory.
+  return Key::filled(id, [&](std::span<std::uint8_t, kKeyBytes> bytes) {
+    for (std::size_t k = 0; k < kKeyBytes; ++k) {
+      const int hi = hex_digit(hex[2 * k]), lo = hex_digit(hex[2 * k + 1]);
+      if (hi < 0 || lo < 0) throw fail("a non-hex digit in the key");
+      bytes[k] = static_cast<std::uint8_t>(hi * 16 + lo);
+    }
+  });
 }
 
 std::string format_key(const Key& key) {
-  std::string hex(2 * kKeyBytes + 1, '\0');
-  sodium_bin2hex(hex.data(), hex.size(), key.bytes.data(), key.bytes.size());
-  hex.pop_back();
-  return std::string(kMagic) + " " + std::to_string(key.id) + " " + hex + "\n";
+  std::string text = std::string(kMagic) + " " + std::to_string(key.id()) + " ";
+  const std::size_t at = text.size();
+  text.resize(at + 2 * kKeyBytes + 1);  // the hex written in place, with sodium_bin2hex's terminating NUL
+  sodium_bin2hex(text.data() + at, 2 * kKeyBytes + 1, key.bytes().data(), key.bytes().size());
+  text.back() = '\n';
+  return text;
 }
 
 Key load_key_file(const std::string& path) {
@@ -87,25 +111,21 @@ Key load_key_file(const std::string& path) {
     text.resize(got);
   }
   ::close(fd);
+  const WipeOnExit wipe{text};
   if (!problem.empty()) throw KeyError(path + ": refused: " + problem);
-  Key key = parse_key(text, path);
-  sodium_memzero(text.data(), text.size());
-  return key;
+  return parse_key(text, path);
 }
 
 Key generate_key(std::int32_t id) {
-  if (sodium_init() < 0) throw KeyError("libsodium could not be initialised");
   if (id <= 0) throw KeyError("a key id is a whole number in 1..2147483647");
-  Key key;
-  key.id = id;
-  randombytes_buf(key.bytes.data(), key.bytes.size());
-  return key;
+  return Key::filled(id, [](std::span<std::uint8_t, kKeyBytes> bytes) { randombytes_buf(bytes.data(), bytes.size()); });
 }
 
 void write_key_file(const std::string& path, const Key& key) {
   const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0600);
   if (fd < 0) throw KeyError(path + ": cannot create the key file: " + std::strerror(errno));
-  const std::string text = format_key(key);
+  std::string text = format_key(key);
+  const WipeOnExit wipe{text};
   const bool ok = ::write(fd, text.data(), text.size()) == static_cast<ssize_t>(text.size()) && ::fsync(fd) == 0;
   ::close(fd);
   if (!ok) throw KeyError(path + ": cannot write the key file");

@@ -2,25 +2,30 @@
 
 #include <sodium.h>
 
+#include <utility>
+
+#include "rpem/core/assert.hpp"
+
 namespace rpem::auth {
 
-bool Keyring::add(const Key& key) noexcept {
-  if (n_ >= kMaxKeys || key.id <= 0 || find(key.id) != nullptr) return false;
-  keys_[static_cast<std::size_t>(n_++)] = key;
+bool Keyring::add(Key&& key) noexcept {
+  if (n_ >= kMaxKeys || key.id() <= 0 || key.empty() || find(key.id()) != nullptr) return false;
+  keys_[static_cast<std::size_t>(n_++)] = std::move(key);
   return true;
 }
 
 const Key* Keyring::find(std::int32_t id) const noexcept {
   for (int k = 0; k < n_; ++k) {
-    if (keys_[static_cast<std::size_t>(k)].id == id) return &keys_[static_cast<std::size_t>(k)];
+    if (keys_[static_cast<std::size_t>(k)].id() == id) return &keys_[static_cast<std::size_t>(k)];
   }
   return nullptr;
 }
 
 Tag compute_tag(const Key& key, std::string_view channel, std::span<const std::uint8_t> covered) noexcept {
+  RPEM_ASSERT(!key.empty(), "a tag is computed with a key, not an empty or moved-from one");
   static constexpr unsigned char kZero = 0;
   crypto_auth_hmacsha256_state state;
-  crypto_auth_hmacsha256_init(&state, key.bytes.data(), key.bytes.size());
+  crypto_auth_hmacsha256_init(&state, key.bytes().data(), key.bytes().size());
   crypto_auth_hmacsha256_update(&state, reinterpret_cast<const unsigned char*>(kDomain.data()), kDomain.size());
   crypto_auth_hmacsha256_update(&state, &kZero, 1);
   crypto_auth_hmacsha256_update(&state, reinterpret_cast<const unsigned char*>(channel.data()), channel.size());
@@ -40,7 +45,7 @@ std::int32_t key_id_of(std::span<const std::uint8_t> encoded) noexcept {
 }
 
 bool sign(const Key& key, std::string_view channel, std::span<std::uint8_t> encoded) noexcept {
-  if (encoded.size() < kTrailerBytes || key_id_of(encoded) != key.id) return false;
+  if (encoded.size() < kTrailerBytes || key_id_of(encoded) != key.id()) return false;
   const std::size_t covered = encoded.size() - kMacBytes;
   const Tag tag = compute_tag(key, channel, encoded.first(covered));
   std::copy(tag.begin(), tag.end(), encoded.begin() + static_cast<std::ptrdiff_t>(covered));

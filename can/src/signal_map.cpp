@@ -3,10 +3,10 @@
 #include <bit>
 #include <cmath>
 #include <limits>
-#include <numbers>
 #include <utility>
 
 #include "rpem/core/frames.hpp"
+#include "rpem/core/units.hpp"
 
 namespace rpem::can {
 namespace {
@@ -222,10 +222,9 @@ bool SignalMapDecoder::complete(std::int64_t t_ns, core::AveragedSample& out) no
   }
   s.u_dq_V = dq_u ? core::Vec2(value(F::kUdV), value(F::kUqV))
                   : core::park(core::clarke(core::Vec3(value(F::kUaV), value(F::kUbV), value(F::kUcV))), rot);
-  constexpr double kRpmToRadS = 2.0 * std::numbers::pi / 60.0;
   s.omega_el_rad_s = has(F::kOmegaElRadS) ? value(F::kOmegaElRadS)
-                     : has(F::kErpm)      ? value(F::kErpm) * kRpmToRadS
-                                          : value(F::kSpeedMechRpm) * kRpmToRadS * map_.pole_pairs;
+                     : has(F::kErpm)      ? core::rpm_to_rad_s(value(F::kErpm))
+                                          : core::rpm_to_rad_s(value(F::kSpeedMechRpm)) * map_.pole_pairs;
   auto optional = [&](F f) { return has(f) ? value(f) : std::numeric_limits<double>::quiet_NaN(); };
   s.u_dc_V = optional(F::kUdcV);
   s.t_winding_C = optional(F::kTWindingC);

@@ -2,10 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
-#include <numbers>
 #include <optional>
 
 #include "rpem/can/e2e.hpp"
+#include "rpem/core/units.hpp"
 
 namespace rpem::can::vesc {
 namespace {
@@ -317,7 +317,7 @@ core::AveragedSample to_averaged_sample(const Values& v, std::int64_t t_start_ns
   s.t_ns = t_ns;
   s.i_dq_A = {v.i_d_A, v.i_q_A};
   s.u_dq_V = {v.v_d_V, v.v_q_V};
-  s.omega_el_rad_s = v.erpm * (2.0 * std::numbers::pi / 60.0);
+  s.omega_el_rad_s = core::rpm_to_rad_s(v.erpm);
   s.u_dc_V = v.v_in_V;
   s.t_winding_C = v.temp_motor_C;
   s.t_drive_C = v.temp_fet_C;

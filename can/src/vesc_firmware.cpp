@@ -114,6 +114,14 @@ std::optional<Request> parse_request(const CanFrame& f, std::uint8_t controller_
   return r;
 }
 
+double wire_float32(double value, float scale) noexcept {
+  return arm_int32(static_cast<float>(value) * scale) / static_cast<double>(scale);
+}
+
+double wire_float16(double value, float scale) noexcept {
+  return arm_int16(static_cast<float>(value) * scale) / static_cast<double>(scale);
+}
+
 std::size_t encode_values(const Values& v, std::uint32_t mask, std::span<std::uint8_t> out) noexcept {
   Writer w(out);
   w.u8(kCommGetValuesSelective);

@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include "rpem/core/clock.hpp"
+
 namespace rpem::core {
 namespace {
 
@@ -28,29 +30,19 @@ DriveSample as_dq_sample(const AveragedSample& a) noexcept {
 
 }  // namespace
 
-std::array<GainSequences, 3> averaged_rates_per_s(const EstimatorSettings& s) noexcept {
-  std::array<GainSequences, 3> rates{};
-  const double per_s = 1.0 / s.nominal_sample_period_s;
-  for (std::size_t a = 0; a < rates.size(); ++a) {
-    if (s.averaged.rates_given[a]) {
-      rates[a] = s.averaged.rates_per_s[a];
-    } else {
-      rates[a] = {s.gains[a].hessian * per_s, s.gains[a].gain * per_s};
-    }
-  }
-  return rates;
-}
-
 AveragedDriveEstimator::AveragedDriveEstimator(const MachineSi& machine, const EstimatorSettings& settings) noexcept
     : base_(PerUnitBase::from_rated(machine.rated)),
       conditioner_(base_, to_pu(base_, machine), rotor_frame_extensions(settings.extensions)),
-      core_(make_estimator_config(base_, machine, settings)) {
+      core_(make_estimator_config(base_, machine, settings)),
+      classifier_(make_regime_config(base_, machine, settings)) {
   configure(settings);
+  point_gains_.start(rates_per_s_[static_cast<std::size_t>(core_.config().algorithm)], settings.nominal_sample_period_s);
 }
 
 void AveragedDriveEstimator::configure(const EstimatorSettings& settings) noexcept {
   rates_per_s_ = averaged_rates_per_s(settings);
   options_ = settings.averaged;
+  options_classify_ = settings.regimes.enabled;
   delay_s_ = settings.extensions.delay_s;
 }
 
@@ -68,6 +60,14 @@ SteadyStateSample AveragedDriveEstimator::condition(const AveragedSample& a) noe
     const Rotation back = Rotation::of(-s.n_pu * omega_n * delay_s_);
     s.u_pu = Vec2(back.cos * s.u_pu[0] - back.sin * s.u_pu[1], back.sin * s.u_pu[0] + back.cos * s.u_pu[1]);
   }
+  if (options_.voltage_is_command && options_.control_period_s > 0.0) {
+    // Reported command (§11): held over one period from the delay on, its mean in the rotor frame at the
+    // sample is the command turned by −ω·(delay + T_c/2) and shortened by sinc(ω·T_c/2); the delay's turn is above.
+    const double half = 0.5 * s.n_pu * omega_n * options_.control_period_s;
+    const double sinc = std::abs(half) < 1e-4 ? 1.0 - half * half / 6.0 : std::sin(half) / half;
+    const Rotation back = Rotation::of(-half);
+    s.u_pu = sinc * Vec2(back.cos * s.u_pu[0] - back.sin * s.u_pu[1], back.sin * s.u_pu[0] + back.cos * s.u_pu[1]);
+  }
   if (options_.control_period_s > 0.0) {
     // Sampled means (§11): ī = i_sample + c·ω·T_c²·L⁻¹·J·ū, c = (a − ½)²/2 − 1/24; in pu c·n·(ω_n·T_c)²·J·u/x.
     const double a_half = options_.current_sample_at - 0.5;
@@ -76,19 +76,22 @@ SteadyStateSample AveragedDriveEstimator::condition(const AveragedSample& a) noe
     s.i_meas_pu += Vec2(-k * s.u_pu[1] / s.x_d_pu, k * s.u_pu[0] / s.x_q_pu);
   }
 
-  const std::int64_t centre2_ns = a.t_start_ns + a.t_ns;
   const std::int64_t window_ns = a.t_ns - a.t_start_ns;
-  s.dt_s = has_previous_ ? 1e-9 * static_cast<double>(a.t_ns - previous_t_ns_) : 0.0;
-  // A window that starts later than the previous one ended by more than half its own length follows lost ones.
-  const bool contiguous = has_previous_ && !a.gap_before && s.dt_s > 0.0 && s.dt_s <= options_.max_interval_s &&
-                          (window_ns <= 0 || 2 * (a.t_start_ns - previous_t_ns_) <= window_ns);
-  s.resync = !contiguous;
-  if (contiguous && options_.inductive_correction && centre2_ns > previous_centre2_ns_) {
-    // (x/ω_n)·di/dt with di/dt from the means of consecutive windows, between their centres.
-    const double dc_s = 0.5e-9 * static_cast<double>(centre2_ns - previous_centre2_ns_);
-    const Vec2 di_dt = (s.i_meas_pu - previous_i_pu_) / dc_s;
-    s.u_pu -= Vec2(s.x_d_pu * di_dt[0], s.x_q_pu * di_dt[1]) / omega_n;
+  s.dt_s = has_previous_ ? to_seconds(a.t_ns - *previous_t_ns_) : 0.0;
+  // How the sample continues the previous one (docs/derivations.md §13, "Contiguity"): a window is
+  // adjacent when it starts where the previous one ended — not later by more than half its own length (or
+  // windows were lost) — whatever its length; an instantaneous sample when it follows within
+  // averaged.max_interval_s, and otherwise stands alone, a steady-state observation of its own.
+  const bool follows = has_previous_ && !a.gap_before && s.dt_s > 0.0;
+  if (!follows) {
+    timing_ = SampleTiming::kFirst;
+  } else if (window_ns > 0) {
+    timing_ = 2 * (a.t_start_ns - *previous_t_ns_) <= window_ns ? SampleTiming::kContiguous : SampleTiming::kFirst;
+  } else {
+    timing_ = s.dt_s <= options_.max_interval_s ? SampleTiming::kContiguous : SampleTiming::kStandalone;
   }
+  const bool contiguous = timing_ == SampleTiming::kContiguous;
+  s.resync = timing_ == SampleTiming::kFirst;
   // The instrument: the preceding samples' operating point (this sample enters it only afterwards).
   if (!contiguous) {
     instrument_i_pu_ = s.i_meas_pu;
@@ -96,39 +99,78 @@ SteadyStateSample AveragedDriveEstimator::condition(const AveragedSample& a) noe
   }
   s.i_gradient_pu = instrument_i_pu_;
   s.n_gradient_pu = instrument_n_pu_;
-  const double w = options_.instrument_time_constant_s > 0.0
+  const double w = options_.instrument_time_constant_s > 0.0 && contiguous
                        ? -std::expm1(-s.dt_s / options_.instrument_time_constant_s)
                        : 1.0;
   instrument_i_pu_ += w * (s.i_meas_pu - instrument_i_pu_);
   instrument_n_pu_ += w * (s.n_pu - instrument_n_pu_);
-  if (s.i_meas_pu.allFinite()) {
-    has_previous_ = true;
-    previous_t_ns_ = a.t_ns;
-    previous_centre2_ns_ = centre2_ns;
-    previous_i_pu_ = s.i_meas_pu;
-  } else {
-    has_previous_ = false;
-  }
+  previous_t_ns_ = a.t_ns;
+  has_previous_ = s.i_meas_pu.allFinite();
   return s;
 }
 
 Estimate AveragedDriveEstimator::step(const AveragedSample& sample) noexcept {
-  const SteadyStateSample s = condition(sample);
+  SteadyStateSample s = condition(sample);
+  const GainSequences& rates = rates_per_s_[static_cast<std::size_t>(core_.config().algorithm)];
+  // Windows carry their length's worth of data (per_interval); instantaneous samples one observation each.
+  const bool point = sample.t_ns == sample.t_start_ns;
+  const GainSequences gains = point ? point_gains_.at(rates, sample.t_ns)
+                                    : GainSequences{per_interval(rates.hessian, s.dt_s), per_interval(rates.gain, s.dt_s)};
+
+  if (!options_classify_) [[unlikely]] {
+    if (options_.inductive_correction && timing_ == SampleTiming::kContiguous) {
+      // What the classifier would have taken: the slope between the window centres (§11).
+      const double dc_s = 0.5 * to_seconds((sample.t_start_ns + sample.t_ns) - previous_centre2_ns_);
+      const Vec2 di_dt = (s.i_meas_pu - previous_i_pu_) / dc_s;
+      s.u_pu -= Vec2(s.x_d_pu * di_dt[0], s.x_q_pu * di_dt[1]) / base_.omega_el_rad_s;
+    }
+    previous_centre2_ns_ = sample.t_start_ns + sample.t_ns;
+    previous_i_pu_ = s.i_meas_pu;
+    return finish(sample, s, core_.step_steady_state(s, gains.hessian, gains.gain, Admission{}), kUnclassified, point, gains);
+  }
+  RegimeInput in;
+  in.timing = timing_;
+  in.t_ns = sample.t_ns;
+  in.window_s = to_seconds(sample.t_ns - sample.t_start_ns);
+  in.u_pu = s.u_pu;
+  in.i_pu = s.i_meas_pu;
+  in.n_pu = s.n_pu;
+  in.u_reported_sq_pu = sample.u_dq_V.squaredNorm() / (base_.voltage_V * base_.voltage_V);
+  in.weight = gains.gain;
+  const Classification regime = classifier_.step(in);
+  if (options_.inductive_correction && timing_ == SampleTiming::kContiguous) {
+    // (x/ω_n)·di/dt with di/dt from the means of consecutive windows, between their centres (§11).
+    const Vec2& di_dt = classifier_.slope_pu_s();
+    s.u_pu -= Vec2(s.x_d_pu * di_dt[0], s.x_q_pu * di_dt[1]) / base_.omega_el_rad_s;
+  }
+
+  const RegimeNoise noise = classifier_.noise();
+  const Admission admission{!regime.excluded(), regime.excites_psi_m(), regime.excites_r_s(), true,
+                            noise.u_sq,          noise.i_sq,             noise.n_sq};
+  return finish(sample, s, core_.step_steady_state(s, gains.hessian, gains.gain, admission), regime, point, gains);
+}
+
+Estimate AveragedDriveEstimator::finish(const AveragedSample& sample, const SteadyStateSample& s, const EstimatorOutput& detail,
+                                        Classification regime, bool point, const GainSequences& gains) noexcept {
   Estimate e;
   e.t_ns = sample.t_ns;
-  e.detail = core_.step_steady_state(s, rates_per_s_[static_cast<std::size_t>(core_.config().algorithm)]);
+  e.detail = detail;
+  if (point && e.detail.code == StepCode::kAdapted) point_gains_.count(gains, sample.t_ns);
   e.psi_m_Wb = base_.flux_Wb_of(e.detail.theta_pu[kPsiM]);
   e.r_s_Ohm = base_.resistance_Ohm_of(e.detail.theta_pu[kRs]);
   e.epsilon_A = e.detail.epsilon_pu * base_.current_A;
   e.i_hat_A = e.detail.i_hat_pu * base_.current_A;
   e.i_meas_A = s.i_meas_pu * base_.current_A;
   e.speed_pu = s.n_pu;
+  e.regime = regime;
   return e;
 }
 
 void AveragedDriveEstimator::reset() noexcept {
   has_previous_ = false;
   core_.reset();
+  classifier_.reset();
+  point_gains_.start(rates_per_s_[static_cast<std::size_t>(core_.config().algorithm)], core_.config().nominal_sample_period_s);
 }
 
 void AveragedDriveEstimator::set_estimates(double psi_m_Wb, double r_s_Ohm) noexcept {
@@ -139,6 +181,7 @@ void AveragedDriveEstimator::reconfigure(const MachineSi& machine, const Estimat
   base_ = PerUnitBase::from_rated(machine.rated);
   conditioner_.reconfigure(base_, to_pu(base_, machine), rotor_frame_extensions(settings.extensions));
   core_.reconfigure(make_estimator_config(base_, machine, settings));
+  classifier_.reconfigure(make_regime_config(base_, machine, settings));
   configure(settings);
 }
 

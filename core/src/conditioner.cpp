@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "rpem/core/clock.hpp"
+
 namespace rpem::core {
 namespace {
 
@@ -236,7 +238,7 @@ Vec2 SampleConditioner::observed_current_dq_A(const DriveSample& s, const Rotati
   const bool chained = has_previous_ && !s.gap_before;
   if (chained) {
     auto& iv = out.interval;
-    iv.dt_s = 1e-9 * static_cast<double>(s.t_ns - previous_t_ns_);
+    iv.dt_s = to_seconds(s.t_ns - previous_t_ns_);
     iv.n_start_pu = previous_n_pu_;
     iv.n_end_pu = m.n_pu;
     const Vec2 command = delay_ && iv.dt_s > 0.0 ? delayed_command_alphabeta_pu(iv.dt_s) : commands_[0];
@@ -251,7 +253,7 @@ Vec2 SampleConditioner::observed_current_dq_A(const DriveSample& s, const Rotati
   } else {
     out.resync = true;
     // The gap's length (0 for the first sample) lets the estimator keep ε across a short one.
-    out.interval.dt_s = has_previous_ ? 1e-9 * static_cast<double>(s.t_ns - previous_t_ns_) : 0.0;
+    out.interval.dt_s = has_previous_ ? to_seconds(s.t_ns - previous_t_ns_) : 0.0;
     out.interval.n_start_pu = m.n_pu;
     out.interval.n_end_pu = m.n_pu;
   }

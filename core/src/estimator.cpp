@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "rpem/core/assert.hpp"
+
 namespace rpem::core {
 namespace {
 
@@ -14,13 +16,6 @@ bool finite(const EstimatorSample& s) noexcept {
 /// γ_0 are per nominal sample; a longer or shorter interval scales them so that the adaptation time
 /// constant T_0 = T_samp/γ_0 stays fixed in seconds. Capped at 1 (a filter gain above 1 is unstable).
 Vec2 scaled(const Vec2& gamma, double factor) noexcept { return (gamma * factor).cwiseMin(1.0); }
-
-/// Rates [1/s] as the per-sample factors of an interval dt: γ = 1 − e^{−rate·dt}, the exact discrete
-/// counterpart of a first-order filter with that rate, so a time constant holds at any sample rate
-/// (≈ rate·dt for rate·dt ≪ 1, as scaled() gives; never above 1).
-Vec2 per_interval(const Vec2& rate_per_s, double dt_s) noexcept {
-  return {-std::expm1(-rate_per_s[0] * dt_s), -std::expm1(-rate_per_s[1] * dt_s)};
-}
 
 bool finite(const SteadyStateSample& s) noexcept {
   return std::isfinite(s.dt_s) && std::isfinite(s.n_pu) && s.u_pu.allFinite() && s.i_meas_pu.allFinite() &&
@@ -37,6 +32,34 @@ double gna_hessian_sequence(const Schedule& active, const Vec2& gamma_r) noexcep
 }
 
 }  // namespace
+
+// The exact discrete counterpart of a first-order filter with that rate, so a time constant holds at any
+// sample rate (≈ rate·dt for rate·dt ≪ 1, as scaled() gives; never above 1).
+Vec2 per_interval(const Vec2& rate_per_s, double dt_s) noexcept {
+  return {-std::expm1(-rate_per_s[0] * dt_s), -std::expm1(-rate_per_s[1] * dt_s)};
+}
+
+void PointGains::start(const GainSequences& rates_per_s, double nominal_period_s) noexcept {
+  weight.hessian = per_interval(rates_per_s.hessian, nominal_period_s).cwiseInverse();
+  weight.gain = per_interval(rates_per_s.gain, nominal_period_s).cwiseInverse();
+  counted = false;
+}
+
+GainSequences PointGains::at(const GainSequences& rates_per_s, std::int64_t t_ns) const noexcept {
+  const double dt_s = counted ? std::max(0.0, 1e-9 * static_cast<double>(t_ns - last_ns)) : 0.0;
+  const auto gains = [dt_s](const Vec2& s, const Vec2& rate) {
+    Vec2 g;
+    for (int j = 0; j < 2; ++j) g[j] = 1.0 / (1.0 + std::exp(-rate[j] * dt_s) * s[j]);  // a rate of 0: S = ∞, γ = 0
+    return g;
+  };
+  return {gains(weight.hessian, rates_per_s.hessian), gains(weight.gain, rates_per_s.gain)};
+}
+
+void PointGains::count(const GainSequences& gains, std::int64_t t_ns) noexcept {
+  weight = {gains.hessian.cwiseInverse(), gains.gain.cwiseInverse()};
+  last_ns = t_ns;
+  counted = true;
+}
 
 RpemEstimator::RpemEstimator(const EstimatorConfig& config) noexcept {
   reconfigure(config);
@@ -64,6 +87,7 @@ void RpemEstimator::reconfigure(const EstimatorConfig& config) noexcept {
   config_ = config;
   coefficients_ = PredictorCoefficients::of(config.model, config.omega_n_rad_s);
   inverse_nominal_period_ = 1.0 / config.nominal_sample_period_s;
+  inverse_r_min_ = 1.0 / config.bounds.min_pu[kRs];
   // With steady-state forms for both parameters the dynamic gradients would be computed for nothing.
   gradients_ = config.gradient_psi_m == GradientForm::kDynamic || config.gradient_r_s == GradientForm::kDynamic
                    ? Gradients::kAdvance
@@ -102,6 +126,36 @@ Mat2 RpemEstimator::select_gradient(const MachinePu& model, double n_pu) const n
   return g;
 }
 
+EstimatorOutput RpemEstimator::predicted_only(StepCode code, const Vec2& epsilon, const Vec2& i_hat) const noexcept {
+  EstimatorOutput out = held(code);
+  out.epsilon_pu = epsilon;
+  out.i_hat_pu = i_hat;
+  return out;
+}
+
+bool RpemEstimator::outlier(const Update& u, const Admission& admission) const noexcept {
+  // The largest error a θ in D_M explains, per row: |Ψᵀ|·Δθ with Δθ the distance from θ̂ to D_M's far
+  // bound. ε is linear in ψm; in r_s it is convex (î = u/r̂ at standstill), where the exact error exceeds
+  // the linear one by at most r̂/r_min: the r_s column takes that factor.
+  const Vec2& th = state_.theta_pu;
+  const ParameterBounds& b = config_.bounds;
+  const double d_psi = std::max(th[kPsiM] - b.min_pu[kPsiM], b.max_pu[kPsiM] - th[kPsiM]);
+  const double d_r = std::max(th[kRs] - b.min_pu[kRs], b.max_pu[kRs] - th[kRs]) * std::max(1.0, th[kRs] * inverse_r_min_);
+  const Vec2 beyond = u.epsilon_pu.cwiseAbs() - (u.gradient.col(kPsiM).cwiseAbs() * d_psi + u.gradient.col(kRs).cwiseAbs() * d_r);
+  if (!(beyond.maxCoeff() > 0.0)) return false;
+  // ε's noise: the current's, and the voltage's and the speed's (through n·ψ̂m) through the steady state,
+  // M̂⁻¹ = [r̂ n·x_q; −n·x_d r̂]/D.
+  const MachinePu& m = u.model;
+  const double n2 = u.n_pu * u.n_pu, r2 = m.r_s_pu * m.r_s_pu;
+  const double d = steady_state_denominator(m, u.n_pu), inv_d2 = 1.0 / (d * d);
+  const double emf = m.psi_m_pu * m.psi_m_pu * admission.var_n_pu;
+  const double xq2 = m.x_q_pu * m.x_q_pu, xd2 = m.x_d_pu * m.x_d_pu;
+  const double var_d = admission.var_i_pu + inv_d2 * ((r2 + n2 * xq2) * admission.var_u_pu + n2 * xq2 * emf);
+  const double var_q = admission.var_i_pu + inv_d2 * ((r2 + n2 * xd2) * admission.var_u_pu + r2 * emf);
+  const double nu2 = config_.outlier_bound_sigma * config_.outlier_bound_sigma;
+  return (beyond[0] > 0.0 && beyond[0] * beyond[0] > nu2 * var_d) || (beyond[1] > 0.0 && beyond[1] * beyond[1] > nu2 * var_q);
+}
+
 EstimatorOutput RpemEstimator::held(StepCode code) const noexcept {
   EstimatorOutput out;
   out.theta_pu = state_.theta_pu;
@@ -114,10 +168,12 @@ EstimatorOutput RpemEstimator::held(StepCode code) const noexcept {
 // The update both sample kinds share: eq:GainSchedule, the algorithm's gain, θ̂ += L·ε, eq:paramsubset.
 // Inlined into step(): the native per-sample path keeps `model` and the gradient in registers.
 [[gnu::always_inline]] inline EstimatorOutput RpemEstimator::update(const Update& u, const Vec2& gamma_r,
-                                                                    const Vec2& gamma_l) noexcept {
+                                                                    const Vec2& gamma_l, const Admission& admission) noexcept {
+  // eq:GainSchedule says where a parameter is identifiable at all; the sample's regime, whether its term
+  // stands out of the noise here (docs/derivations.md §13): a parameter adapts where both hold.
   Schedule active = schedule(config_.scheduler, u.n_pu);
-  active.psi_m = active.psi_m && config_.adapt_psi_m && !state_.frozen;
-  active.r_s = active.r_s && config_.adapt_r_s && !state_.frozen;
+  active.psi_m = active.psi_m && admission.psi_m && config_.adapt_psi_m && !state_.frozen;
+  active.r_s = active.r_s && admission.r_s && config_.adapt_r_s && !state_.frozen;
 
   GainOutput gain;
   Vec2 change = Vec2::Zero();  // L·ε, before eq:GainSchedule
@@ -151,6 +207,8 @@ EstimatorOutput RpemEstimator::held(StepCode code) const noexcept {
   unsigned clamped = 0;
   double psi_m = state_.theta_pu[kPsiM], r_s = state_.theta_pu[kRs];
   const auto adapt = [&](int j, bool adapts, double& value) {
+    RPEM_ASSERT(adapts || !(value < config_.bounds.min_pu[j] || value > config_.bounds.max_pu[j]),
+                "a held parameter is inside D_M: every path that sets theta projects it");
     if (!adapts) return;
     value += change[j];
     clamped |= static_cast<unsigned>(project(config_.bounds, j, value)) << j;
@@ -172,7 +230,7 @@ EstimatorOutput RpemEstimator::held(StepCode code) const noexcept {
   return {theta, u.epsilon_pu, u.i_hat_pu, u.gradient, gain.gain, StepCode::kAdapted, flags};  // every member: no zero fill
 }
 
-[[gnu::flatten]] EstimatorOutput RpemEstimator::step(const EstimatorSample& sample) noexcept {
+[[gnu::flatten]] EstimatorOutput RpemEstimator::step(const EstimatorSample& sample, const Admission& admission) noexcept {
   if (!finite(sample)) {
     state_.synchronized = false;
     state_.epsilon_valid = false;
@@ -204,6 +262,13 @@ EstimatorOutput RpemEstimator::held(StepCode code) const noexcept {
   }
 
   const Vec2 epsilon = sample.i_meas_pu - i_hat;
+  if (!admission.adapt) [[unlikely]] {
+    // The model does not describe this sample (bridge off, frame not locked): the open-loop prediction
+    // would carry its error on; start again from the measurement.
+    state_.epsilon_valid = false;
+    synchronize(sample, model);
+    return predicted_only(StepCode::kExcluded, epsilon, i_hat);
+  }
   state_.last_epsilon_pu = epsilon;
   state_.epsilon_valid = true;
 
@@ -214,11 +279,21 @@ EstimatorOutput RpemEstimator::held(StepCode code) const noexcept {
     gamma_l_ = scaled(seq.gain, factor);
     scaled_for_dt_s_ = iv.dt_s;
   }
-  return update({model, iv.n_end_pu, i_hat, epsilon, i_hat, select_gradient(model, iv.n_end_pu)}, gamma_r_, gamma_l_);
+  const Update u{model, iv.n_end_pu, i_hat, epsilon, i_hat, select_gradient(model, iv.n_end_pu)};
+  if (admission.judge && config_.outlier_bound_sigma > 0.0 && outlier(u, admission)) [[unlikely]] {
+    return predicted_only(StepCode::kOutlier, epsilon, i_hat);
+  }
+  return update(u, gamma_r_, gamma_l_, admission);
 }
 
 EstimatorOutput RpemEstimator::step_steady_state(const SteadyStateSample& sample,
                                                  const GainSequences& rates_per_s) noexcept {
+  return step_steady_state(sample, per_interval(rates_per_s.hessian, sample.dt_s), per_interval(rates_per_s.gain, sample.dt_s),
+                           Admission{});
+}
+
+EstimatorOutput RpemEstimator::step_steady_state(const SteadyStateSample& sample, const Vec2& gamma_r,
+                                                 const Vec2& gamma_l, const Admission& admission) noexcept {
   if (!finite(sample)) {
     state_.epsilon_valid = false;
     return held(StepCode::kRejectedNonFinite);
@@ -242,9 +317,13 @@ EstimatorOutput RpemEstimator::step_steady_state(const SteadyStateSample& sample
     out.epsilon_pu = epsilon;
     return out;
   }
+  if (!admission.adapt) return predicted_only(StepCode::kExcluded, epsilon, i_hat);
   const Mat2 gradient = steady_state_gradients(model, sample.n_gradient_pu, sample.i_gradient_pu);
-  return update({model, sample.n_pu, sample.i_gradient_pu, epsilon, i_hat, gradient},
-                per_interval(rates_per_s.hessian, sample.dt_s), per_interval(rates_per_s.gain, sample.dt_s));
+  const Update u{model, sample.n_pu, sample.i_gradient_pu, epsilon, i_hat, gradient};
+  if (admission.judge && config_.outlier_bound_sigma > 0.0 && outlier(u, admission)) {
+    return predicted_only(StepCode::kOutlier, epsilon, i_hat);
+  }
+  return update(u, gamma_r, gamma_l, admission);
 }
 
 }  // namespace rpem::core

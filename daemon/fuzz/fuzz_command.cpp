@@ -45,20 +45,24 @@ bool inside(double v, double lo, double hi) { return std::isfinite(v) && v >= lo
 constexpr std::string_view kChannel = "RPEM_COMMAND";
 
 rpem::auth::Key key(std::int32_t id) {
-  rpem::auth::Key k;
-  k.id = id;
-  k.bytes.fill(static_cast<std::uint8_t>(0x30 + id));
-  return k;
+  std::array<std::uint8_t, rpem::auth::kKeyBytes> bytes{};
+  bytes.fill(static_cast<std::uint8_t>(0x30 + id));
+  return {id, bytes};
+}
+
+/// The keys rpemd holds (1 and 2: a rotation).
+rpem::auth::Keyring held_keys() {
+  rpem::auth::Keyring held;
+  held.add(key(1));
+  held.add(key(2));
+  return held;
 }
 
 struct Harness {
-  rpem::auth::Keyring held;
+  rpem::auth::Keyring held = held_keys();
+  std::array<rpem::auth::Key, 3> signers{key(1), key(2), key(9)};  // the harness's own: two held, one not
   int sign_mode = 0;          // 0 none, 1 key 1, 2 key 2, 3 key 9
   bool other_channel = false;
-  Harness() {
-    held.add(key(1));
-    held.add(key(2));
-  }
   /// Whether the harness signed `bytes` correctly for RPEM_COMMAND under a held key.
   [[nodiscard]] bool authentic() const { return (sign_mode == 1 || sign_mode == 2) && !other_channel; }
 };
@@ -69,7 +73,7 @@ std::span<const std::uint8_t> prepare(std::span<std::uint8_t> m, const Harness& 
     const std::int32_t id = h.sign_mode == 3 ? 9 : h.sign_mode;
     std::uint8_t* p = m.data() + m.size() - rpem::auth::kTrailerBytes;
     p[0] = 0, p[1] = 0, p[2] = 0, p[3] = static_cast<std::uint8_t>(id);
-    require(rpem::auth::sign(key(id), h.other_channel ? "RPEM_ESTIMATE" : kChannel, m));
+    require(rpem::auth::sign(h.signers[static_cast<std::size_t>(h.sign_mode - 1)], h.other_channel ? "RPEM_ESTIMATE" : kChannel, m));
   }
   return m;
 }
@@ -146,15 +150,15 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   }
 
   // The loop's queue is built once (it allocates its Commands, 1 kB each) and is empty between inputs.
-  static rpem::daemon::SpscQueue<Command> to_loop(4);
+  static auto to_loop = rpem::daemon::SpscQueue<Command>::make(4);
   static Command c;
-  require(!to_loop.pop(c));
+  require(!to_loop.consumer.pop(c));
   rpem::daemon::CommandKeys keys;
-  keys.keys = h.held;
-  rpem::daemon::CommandGate gate(policy, to_loop, keys);
+  keys.keys = held_keys();
+  rpem::daemon::CommandGate gate(policy, to_loop.producer, std::move(keys));
   std::int64_t queued = 0, previous = INT64_MIN;
   auto pop = [&] {
-    while (to_loop.pop(c)) {
+    while (to_loop.consumer.pop(c)) {
       require(c.seq > previous);
       previous = c.seq;
     }

@@ -3,6 +3,7 @@
 #include <array>
 
 #include "rpem/command_t.hpp"
+#include "rpem/core/assert.hpp"
 
 namespace rpem::daemon {
 namespace {
@@ -101,7 +102,8 @@ bool CommandGate::handle(std::span<const std::uint8_t> message, bool commit_now)
     v.result = CommandResult::kRejectedBusy;
   }
   if (v.result == CommandResult::kApplied) {
-    if (n_pending_ == kMaxPending) (void)commit();
+    if (n_pending_ == kMaxPending) (void)queue_pending();
+    RPEM_ASSERT(n_pending_ < kMaxPending, "a full pending list was committed");
     pending_[n_pending_++] = v.command;
     last_accepted_seq_ = v.command.seq;
   } else {
@@ -114,23 +116,41 @@ bool CommandGate::handle(std::span<const std::uint8_t> message, bool commit_now)
   last_verdict_seq_ = v.command.seq;
   last_key_id_ = v.key_id;
   last_result_ = v.result;
+  check_counts();
   if (v.result != CommandResult::kApplied) return false;
   return !commit_now || commit();
 }
 
+void CommandGate::check_counts() const noexcept {
+  RPEM_ASSERT(counters_.received == counters_.malformed + counters_.rejected + queued_count_ +
+                                        static_cast<std::int64_t>(n_pending_),
+              "every message received is malformed, rejected, queued or pending");
+  RPEM_ASSERT(counters_.unauthenticated + counters_.unknown_key + counters_.bad_mac + counters_.replayed <= counters_.rejected,
+              "the rejections counted by reason are among the rejections");
+}
+
 bool CommandGate::commit() noexcept {
+  const bool durable = queue_pending();
+  check_counts();
+  return durable;
+}
+
+bool CommandGate::queue_pending() noexcept {
   if (n_pending_ == 0) return true;
   // The sequence number durable first, then the commands: a restart can never accept one again.
   const bool durable = store_ == nullptr || store_->store(last_accepted_seq_);
   if (durable) {
     for (std::size_t k = 0; k < n_pending_; ++k) {
       const AdmittedCommand& a = pending_[k];
+      RPEM_ASSERT(k == 0 || a.seq > pending_[k - 1].seq, "commands are admitted in increasing sequence order");
       queued_.kind = a.kind;
       queued_.seq = a.seq;
       queued_.psi_m_Wb = a.psi_m_Wb;
       queued_.r_s_Ohm = a.r_s_Ohm;
-      (void)to_loop_.push(queued_);  // room was checked
+      const bool pushed = to_loop_.push(queued_);
+      RPEM_ASSERT(pushed, "room was checked in handle(), and this thread is the queue's one producer, so it stayed");
     }
+    queued_count_ += static_cast<std::int64_t>(n_pending_);
     durable_seq_ = last_accepted_seq_;
   } else {
     counters_.rejected += static_cast<std::int64_t>(n_pending_);

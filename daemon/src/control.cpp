@@ -74,10 +74,10 @@ bool Control::FileSequenceStore::store(std::int64_t seq) noexcept {
 Control::Control(DaemonConfig running, Reload reload, Queues queues, const LoopTimer& loop, Commands commands)
     : running_(std::move(running)),
       reload_(std::move(reload)),
-      queues_(queues),
+      queues_(std::move(queues)),
       loop_(loop),
       sequence_store_(std::move(commands.sequence_file)),
-      gate_(CommandPolicy::of(running_.live), queues.to_loop, std::move(commands.keys), commands.last_accepted_seq,
+      gate_(CommandPolicy::of(running_.live), queues_.to_loop, std::move(commands.keys), commands.last_accepted_seq,
             &sequence_store_) {
   std::uint64_t usec = 0;
   watchdog_enabled_ = sd_watchdog_enabled(0, &usec) > 0;
@@ -193,7 +193,7 @@ void Control::watchdog(std::int64_t now_ns) {
   if (beat != last_heartbeat_) {
     if (watchdog_enabled_) sd_notify(0, "WATCHDOG=1");
   } else {
-    std::fprintf(stderr, "rpemd: the estimator loop has not run for %.1f s\n", 1e-9 * static_cast<double>(watchdog_interval_ns_));
+    std::fprintf(stderr, "rpemd: the estimator loop has not run for %.1f s\n", core::to_seconds(watchdog_interval_ns_));
   }
   last_heartbeat_ = beat;
 }

@@ -22,14 +22,15 @@ DaemonKeys load_credential_keys(const char* directory) {
     if (name.rfind("rpem_", 0) == 0) name.erase(0, 5);  // LoadCredential=rpem:DIR names DIR/x "rpem_x"
     const bool command = name.rfind("command", 0) == 0, publish = name.rfind("publish", 0) == 0;
     if (!command && !publish) continue;
-    const auth::Key key = auth::load_key_file(file.string());
+    auth::Key key = auth::load_key_file(file.string());
+    const std::int32_t id = key.id();
     if (publish) {
       if (keys.publish) throw auth::KeyError(file.string() + ": a second publish key; rpemd signs with one");
-      keys.publish = key;
-    } else if (!keys.command.add(key)) {
-      throw auth::KeyError(file.string() + ": key id " + std::to_string(key.id) +
-                           (keys.command.find(key.id) != nullptr ? " is already used by another command key"
-                                                                 : ": more than two command keys (the current and the next)"));
+      keys.publish = std::move(key);
+    } else if (!keys.command.add(std::move(key))) {
+      throw auth::KeyError(file.string() + ": key id " + std::to_string(id) +
+                           (keys.command.find(id) != nullptr ? " is already used by another command key"
+                                                             : ": more than two command keys (the current and the next)"));
     }
   }
   return keys;

@@ -94,11 +94,12 @@ int Daemon::run() {
   commands.keys.channel = fixed.lcm.channel_prefix + "RPEM_COMMAND";
   commands.sequence_file = command_sequence_file(resolve_state_file(fixed.state));
   try {
+    auth::initialise();  // libsodium, once, before any key exists
     keys = load_credential_keys(std::getenv("CREDENTIALS_DIRECTORY"));
     if (const std::string problem = command_key_problem(config_.live, keys.command); !problem.empty()) {
       throw std::runtime_error(problem);
     }
-    commands.keys.keys = keys.command;
+    commands.keys.keys = std::move(keys.command);  // the control thread's command gate holds them
     commands.last_accepted_seq = load_command_sequence(commands.sequence_file);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "rpemd: configuration error: %s\n", e.what());
@@ -121,11 +122,17 @@ int Daemon::run() {
     if (qos_fd < 0) std::fprintf(stderr, "rpemd: note: %s; deep CPU idle states may add wake-up latency\n", problem.c_str());
   }
 
-  loop_ = std::make_unique<EstimatorLoop>(config_, EstimatorLoop::Queues{samples_, commands_, reports_});
+  const std::string signing =
+      keys.publish ? "signed with key id " + std::to_string(keys.publish->id()) : std::string("unsigned (no publish key)");
+  loop_ = std::make_unique<LoopThread>(
+      config_, LoopThread::Queues{std::move(samples_.consumer), std::move(commands_.consumer), std::move(reports_.producer)});
   seed_from_state_file();
   const char* source_type = SourceCatalogue::type(fixed.source);
-  publisher_ = std::make_unique<Publisher>(fixed, Publisher::Identity{source_type, source_name_, state_file_status_},
-                                           Publisher::Queues{reports_, source_reports_, control_reports_}, keys.publish);
+  publisher_ = std::make_unique<PersistingPublisher>(
+      fixed, PersistingPublisher::Identity{source_type, source_name_, state_file_status_},
+      PersistingPublisher::Queues{std::move(reports_.consumer), std::move(source_reports_.consumer),
+                                  std::move(control_reports_.consumer)},
+      std::move(keys.publish));  // the publisher thread holds it
   start_threads();
   while (!loop_->started()) std::this_thread::sleep_for(std::chrono::milliseconds(1));
   if (!loop_->setup_problems().empty()) {
@@ -153,20 +160,20 @@ int Daemon::run() {
                fixed.lcm.url.empty() ? "default" : fixed.lcm.url.c_str(), fixed.lcm.channel_prefix.c_str(),
                config_.live.commands_enabled ? "enabled" : "disabled", resolve_state_file(fixed.state).c_str());
   std::string ids;
-  for (int k = 0; k < keys.command.size(); ++k) ids += (k > 0 ? ", " : "") + std::to_string(keys.command[k].id);
+  const auth::Keyring& command_keys = commands.keys.keys;
+  for (int k = 0; k < command_keys.size(); ++k) ids += (k > 0 ? ", " : "") + std::to_string(command_keys[k].id());
   std::fprintf(stderr, "rpemd: commands %s; last accepted sequence number %lld (%s); estimates and diagnostics %s\n",
                !config_.live.commands_enabled ? "disabled (commands.enabled: false)"
                : config_.live.command_authentication == CommandAuthentication::kNone
                    ? "unauthenticated (authentication: none, local only)"
                    : (ids.empty() ? std::string("need a key (none loaded)") : "authenticated with key id " + ids).c_str(),
-               static_cast<long long>(commands.last_accepted_seq), commands.sequence_file.c_str(),
-               keys.publish ? ("signed with key id " + std::to_string(keys.publish->id)).c_str()
-                            : "unsigned (no publish key)");
+               static_cast<long long>(commands.last_accepted_seq), commands.sequence_file.c_str(), signing.c_str());
   sd_notifyf(0, "READY=1\nSTATUS=estimating from %s", source_name_.c_str());
 
   {
     Control control(std::move(config_), [this] { return load_configuration(options_); },
-                    Control::Queues{commands_, control_reports_}, loop_->timer(), std::move(commands));
+                    Control::Queues{std::move(commands_.producer), std::move(control_reports_.producer)}, loop_->timer(),
+                    std::move(commands));
     (void)control.run(signal_fd);
     config_ = control.running();
   }

@@ -6,6 +6,7 @@
 #include <variant>
 
 #include "rpem/io/averaged_log.hpp"
+#include "rpem/io/thermal_config.hpp"
 
 namespace rpem::daemon {
 namespace {
@@ -143,6 +144,8 @@ DaemonConfig parse(io::YamlMap& root, const std::string& name, const std::string
   std::optional<io::YamlMap> d = root.optional_map("daemon");
   std::string machine_file;
   if (d && d->has("machine_config")) machine_file = d->text("machine_config");
+  std::string thermal_file;
+  if (d && d->has("thermal_config")) thermal_file = d->text("thermal_config");
   io::MachineConfig& machine = c.live.machine;
   if (!machine_file.empty()) {
     if (root.has("machine")) root.fail("machine", "give the machine inline or daemon.machine_config, not both");
@@ -155,6 +158,15 @@ DaemonConfig parse(io::YamlMap& root, const std::string& name, const std::string
     machine = io::builtin_paper_config();
   }
   temperature_from_drifts(name, machine, c.live.temperature);
+  if (!thermal_file.empty()) {
+    if (root.has("thermal")) root.fail("thermal", "give the thermal section inline or daemon.thermal_config, not both");
+    c.live.thermal = io::load_thermal_config((fs::path(base_dir) / thermal_file).lexically_normal().string(), machine).fusion;
+    c.live.thermal_active = true;
+  } else if (root.has("thermal")) {
+    io::YamlMap t = root.map("thermal");
+    c.live.thermal = io::parse_thermal_config(t, machine).fusion;
+    c.live.thermal_active = true;
+  }
   if (d) parse_daemon(*d, c, base_dir);
   root.finish();
   fill_defaults(machine, c.live.temperature);

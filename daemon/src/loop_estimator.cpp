@@ -2,6 +2,9 @@
 
 #include <algorithm>
 #include <limits>
+#include <optional>
+
+#include "rpem/core/clock.hpp"
 
 namespace rpem::daemon {
 
@@ -27,42 +30,43 @@ bool LoopEstimator::step(const SourceSample& sample, core::Estimate& estimate, d
     return true;
   }
   const core::AveragedSample& a = *std::get_if<core::AveragedSample>(&sample);
-  estimate = std::get_if<core::AveragedDriveEstimator>(&estimator_)->step(a);
-  // The time this sample stands for: from the previous window's end (a gap or a long silence counts up
-  // to the interval the estimator still adapts across).
-  const double interval_s = has_previous_ ? 1e-9 * static_cast<double>(a.t_ns - previous_t_ns_) : 0.0;
-  dt_s = std::clamp(interval_s, 0.0, max_interval_s_);
-  has_previous_ = true;
-  previous_t_ns_ = a.t_ns;
+  core::AveragedDriveEstimator& averaged = *std::get_if<core::AveragedDriveEstimator>(&estimator_);
+  // The time this sample stands for: from the previous window's end — all of it for a window (however
+  // long: a window after a gap adapts nothing and is credited nothing); an instantaneous sample stands for
+  // at most the interval across which it continues a chain.
+  const std::optional<std::int64_t> previous_t_ns = averaged.previous_t_ns();
+  estimate = averaged.step(a);
+  const double interval_s = previous_t_ns ? core::to_seconds(a.t_ns - *previous_t_ns) : 0.0;
+  dt_s = a.t_start_ns < a.t_ns ? std::max(interval_s, 0.0) : std::clamp(interval_s, 0.0, max_interval_s_);
   summary = {a.t_ns, a.t_ns, std::numeric_limits<double>::quiet_NaN(), a.omega_el_rad_s, a.u_dc_V, a.t_winding_C, a.t_drive_C};
   return true;
 }
 
 void LoopEstimator::reset() noexcept {
-  std::visit([](auto& e) { e.reset(); }, estimator_);
+  std::visit([](core::SampleEstimator auto& e) { e.reset(); }, estimator_);
 }
 void LoopEstimator::resynchronize() noexcept {
-  std::visit([](auto& e) { e.resynchronize(); }, estimator_);
+  std::visit([](core::SampleEstimator auto& e) { e.resynchronize(); }, estimator_);
 }
 void LoopEstimator::set_frozen(bool frozen) noexcept {
-  std::visit([frozen](auto& e) { e.set_frozen(frozen); }, estimator_);
+  std::visit([frozen](core::SampleEstimator auto& e) { e.set_frozen(frozen); }, estimator_);
 }
 void LoopEstimator::set_estimates(double psi_m_Wb, double r_s_Ohm) noexcept {
-  std::visit([=](auto& e) { e.set_estimates(psi_m_Wb, r_s_Ohm); }, estimator_);
+  std::visit([=](core::SampleEstimator auto& e) { e.set_estimates(psi_m_Wb, r_s_Ohm); }, estimator_);
 }
 void LoopEstimator::reconfigure(const core::MachineSi& machine, const core::EstimatorSettings& settings) noexcept {
-  std::visit([&](auto& e) { e.reconfigure(machine, settings); }, estimator_);
+  std::visit([&](core::SampleEstimator auto& e) { e.reconfigure(machine, settings); }, estimator_);
   nominal_period_s_ = settings.nominal_sample_period_s;
   max_interval_s_ = settings.averaged.max_interval_s;
 }
 double LoopEstimator::psi_m_Wb() const noexcept {
-  return std::visit([](const auto& e) { return e.psi_m_Wb(); }, estimator_);
+  return std::visit([](const core::SampleEstimator auto& e) { return e.psi_m_Wb(); }, estimator_);
 }
 double LoopEstimator::r_s_Ohm() const noexcept {
-  return std::visit([](const auto& e) { return e.r_s_Ohm(); }, estimator_);
+  return std::visit([](const core::SampleEstimator auto& e) { return e.r_s_Ohm(); }, estimator_);
 }
 const core::RpemEstimator& LoopEstimator::core() const noexcept {
-  return std::visit([](const auto& e) -> const core::RpemEstimator& { return e.core(); }, estimator_);
+  return std::visit([](const core::SampleEstimator auto& e) -> const core::RpemEstimator& { return e.core(); }, estimator_);
 }
 
 }  // namespace rpem::daemon

@@ -22,7 +22,7 @@
 
 namespace rpem::daemon {
 
-struct Publisher::Lcm {
+struct PersistingPublisher::Lcm {
   explicit Lcm(const std::string& url) : lcm(url) {}
   lcm::LCM lcm;
 };
@@ -59,23 +59,24 @@ std::int64_t publisher_idle_ns(const LcmConfig& lcm) noexcept {
   return std::clamp(static_cast<std::int64_t>(std::llround(0.5e9 / fastest_Hz)), kMinNs, kMaxNs);
 }
 
-Publisher::Publisher(const FixedConfig& config, Identity identity, Queues queues, std::optional<auth::Key> publish_key)
+PersistingPublisher::PersistingPublisher(const FixedConfig& config, Identity identity, Queues queues,
+                                         std::optional<auth::Key> publish_key)
     : config_(config),
       identity_(std::move(identity)),
-      publish_key_(publish_key),
-      queues_(queues),
+      publish_key_(std::move(publish_key)),
+      queues_(std::move(queues)),
       buffer_(8192),
       estimate_channel_(config.lcm.channel_prefix + "RPEM_ESTIMATE"),
       measurement_channel_(config.lcm.channel_prefix + "RPEM_MEASUREMENT"),
       diagnostics_channel_(config.lcm.channel_prefix + "RPEM_DIAGNOSTICS"),
       state_path_(resolve_state_file(config.state)) {}
 
-Publisher::~Publisher() = default;
+PersistingPublisher::~PersistingPublisher() = default;
 
 template <class Message>
-void Publisher::publish(const std::string& channel, Message& m) {
+void PersistingPublisher::publish(const std::string& channel, Message& m) {
   constexpr bool kAuthenticated = requires { m.key_id; };
-  if constexpr (kAuthenticated) m.key_id = publish_key_ ? publish_key_->id : 0;
+  if constexpr (kAuthenticated) m.key_id = publish_key_ ? publish_key_->id() : 0;
   const int size = m.encode(buffer_.data(), 0, static_cast<int>(buffer_.size()));
   // Signed in the buffer, on this thread: the tag over the encoding (rpem/auth/mac.hpp), no allocation.
   if constexpr (kAuthenticated) {
@@ -89,7 +90,7 @@ void Publisher::publish(const std::string& channel, Message& m) {
 
 // Every field of the mirror, generically (rpem/schema/field.hpp); the strings, which the mirror does not
 // carry, by hand: a new string field fails the static_assert until it is spelled here.
-void Publisher::publish_estimate(const EstimateReport& r) {
+void PersistingPublisher::publish_estimate(const EstimateReport& r) {
   rpem::estimate_t m{};
   schema::copy(r, m);
   static_assert(schema::spelled_count<rpem::estimate_t>() == 1, "estimate_t's strings: algorithm");
@@ -103,14 +104,14 @@ void Publisher::publish_estimate(const EstimateReport& r) {
   }
 }
 
-void Publisher::publish_measurement(const MeasurementReport& r) {
+void PersistingPublisher::publish_measurement(const MeasurementReport& r) {
   rpem::measurement_t m{};
   schema::copy(r, m);
   static_assert(schema::spelled_count<rpem::measurement_t>() == 0);
   publish(measurement_channel_, m);
 }
 
-void Publisher::publish_diagnostics(const LoopStatsReport& r) {
+void PersistingPublisher::publish_diagnostics(const LoopStatsReport& r) {
   rpem::diagnostics_t m{};
   m.utime = r.utime_us;
   m.state = static_cast<std::int8_t>(r.state);
@@ -137,7 +138,7 @@ void Publisher::publish_diagnostics(const LoopStatsReport& r) {
   publish(diagnostics_channel_, m);
 }
 
-void Publisher::maybe_write_state(bool force) {
+void PersistingPublisher::maybe_write_state(bool force) {
   if (!have_estimate_) return;
   const EstimateReport& r = last_estimate_;
   if (!r.has_good_psi_m && !r.has_good_r_s) return;
@@ -164,7 +165,7 @@ void Publisher::maybe_write_state(bool force) {
   }
 }
 
-void Publisher::print_status(const EstimateReport& r) {
+void PersistingPublisher::print_status(const EstimateReport& r) {
   if (config_.status_interval_s <= 0.0 || r.utime < next_status_us_) return;
   next_status_us_ = r.utime + static_cast<std::int64_t>(config_.status_interval_s * 1e6);
   static const char* kStates[] = {"starting", "running", "STALE", "stopping"};
@@ -190,7 +191,7 @@ void Publisher::print_status(const EstimateReport& r) {
   std::fflush(stdout);
 }
 
-void Publisher::connect() {
+void PersistingPublisher::connect() {
   if (lcm_ && lcm_->lcm.good()) return;
   const std::int64_t now = core::unix_us();
   if (now < next_connect_us_) return;
@@ -202,14 +203,14 @@ void Publisher::connect() {
   }
 }
 
-void Publisher::drain_reports() {
+void PersistingPublisher::drain_reports() {
   SourceReport s;
   while (queues_.source.pop(s)) source_ = s;
   ControlReport c;
   while (queues_.control.pop(c)) control_ = c;
 }
 
-void Publisher::run(const std::atomic<bool>& stop) {
+void PersistingPublisher::run(const std::atomic<bool>& stop) {
   name_thread("rpemd-publish");
   (void)apply_thread_policy(config_.loop.realtime == RealtimeMode::kOff ? ThreadPolicy{} : config_.publish_thread);
   connect();

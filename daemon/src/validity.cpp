@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "rpem/core/clock.hpp"
 #include "rpem/core/estimator.hpp"
 
 namespace rpem::daemon {
@@ -70,7 +71,7 @@ ValidityTracker::Status ValidityTracker::report(int parameter, double value, std
   Status s;
   s.adapting = p.adapting;
   s.converged = converged(p);
-  if (p.last_adapted_ns != kNever) s.age_s = 1e-9 * static_cast<double>(std::max<std::int64_t>(0, now_ns - p.last_adapted_ns));
+  if (p.last_adapted_ns != kNever) s.age_s = core::to_seconds(std::max<std::int64_t>(0, now_ns - p.last_adapted_ns));
   s.valid = p.identified && s.age_s >= 0.0 && s.age_s <= config_.max_hold_s;
   s.good = s.valid && s.converged && s.adapting;
   return s;

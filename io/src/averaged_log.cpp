@@ -3,6 +3,7 @@
 #include <cmath>
 #include <limits>
 
+#include "rpem/core/clock.hpp"
 #include "rpem/io/number_format.hpp"
 
 namespace rpem::io {
@@ -52,6 +53,7 @@ std::vector<core::AveragedSample> read_averaged_log(const std::string& path, con
   read.layout.t_winding = reader.has(Quantity::kTWinding);
   read.layout.t_magnet = reader.has(Quantity::kTMagnet);
   read.layout.t_drive = reader.has(Quantity::kTDrive);
+  read.layout.t_coolant = reader.has(Quantity::kTCoolant);
 
   std::vector<core::AveragedSample> out;
   MappedRow r;
@@ -81,6 +83,7 @@ std::vector<core::AveragedSample> read_averaged_log(const std::string& path, con
     s.t_winding_C = r[Quantity::kTWinding];
     s.t_magnet_C = r[Quantity::kTMagnet];
     s.t_drive_C = r[Quantity::kTDrive];
+    s.t_coolant_C = r[Quantity::kTCoolant];
     out.push_back(s);
   }
   if (out.empty()) {
@@ -101,18 +104,20 @@ AveragedLogWriter::AveragedLogWriter(const std::string& path, const AveragedLogL
   if (layout_.t_winding) h += ",T_winding";
   if (layout_.t_magnet) h += ",T_magnet";
   if (layout_.t_drive) h += ",T_drive";
+  if (layout_.t_coolant) h += ",T_coolant";
   out_ << h << '\n';
 }
 
 void AveragedLogWriter::write(const core::AveragedSample& s) {
   line_.clear();
-  append_number(line_, 1e-9 * static_cast<double>(s.t_ns));
-  append_number(line_ += ',', 1e-9 * static_cast<double>(s.t_start_ns));
+  append_number(line_, core::to_seconds(s.t_ns));
+  append_number(line_ += ',', core::to_seconds(s.t_start_ns));
   for (double v : {s.i_dq_A[0], s.i_dq_A[1], s.u_dq_V[0], s.u_dq_V[1], s.omega_el_rad_s}) append_number(line_ += ',', v);
   if (layout_.u_dc) append_number(line_ += ',', s.u_dc_V);
   if (layout_.t_winding) append_number(line_ += ',', s.t_winding_C);
   if (layout_.t_magnet) append_number(line_ += ',', s.t_magnet_C);
   if (layout_.t_drive) append_number(line_ += ',', s.t_drive_C);
+  if (layout_.t_coolant) append_number(line_ += ',', s.t_coolant_C);
   line_ += '\n';
   out_ << line_;
 }
@@ -132,6 +137,7 @@ DriveLogRow to_drive_log_row(const core::AveragedSample& s) {
   r.sample.gap_before = s.gap_before;
   if (!std::isnan(s.t_winding_C)) r.t_winding_C = s.t_winding_C;
   if (!std::isnan(s.t_magnet_C)) r.t_magnet_C = s.t_magnet_C;
+  if (!std::isnan(s.t_coolant_C)) r.t_coolant_C = s.t_coolant_C;
   return r;
 }
 
@@ -143,6 +149,7 @@ DriveLogLayout rotor_frame_layout(const AveragedLogLayout& a) {
   l.voltage_dq = l.current_dq = true;
   l.t_winding = a.t_winding;
   l.t_magnet = a.t_magnet;
+  l.t_coolant = a.t_coolant;
   return l;
 }
 

@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <filesystem>
 
+#include "rpem/core/clock.hpp"
 #include "rpem/core/frames.hpp"
 #include "rpem/io/number_format.hpp"
 
@@ -46,6 +47,7 @@ void DriveLogReader::check_layout() {
   layout_.current_dq = has(Quantity::kID);
   layout_.t_winding = has(Quantity::kTWinding);
   layout_.t_magnet = has(Quantity::kTMagnet);
+  layout_.t_coolant = has(Quantity::kTCoolant);
   layout_.torque_cmd = has(Quantity::kTorqueCmd);
 }
 
@@ -75,6 +77,7 @@ bool DriveLogReader::next(DriveLogRow& row) {
   auto optional = [&](bool present, Quantity q) { return present ? std::optional(r[q]) : std::nullopt; };
   row.t_winding_C = optional(layout_.t_winding, Quantity::kTWinding);
   row.t_magnet_C = optional(layout_.t_magnet, Quantity::kTMagnet);
+  row.t_coolant_C = optional(layout_.t_coolant, Quantity::kTCoolant);
   row.torque_cmd_Nm = optional(layout_.torque_cmd, Quantity::kTorqueCmd);
   return true;
 }
@@ -97,6 +100,7 @@ DriveLogWriter::DriveLogWriter(const std::string& path, const DriveLogLayout& la
   if (layout_.current_dq) h += ",i_d,i_q";
   if (layout_.t_winding) h += ",T_winding";
   if (layout_.t_magnet) h += ",T_magnet";
+  if (layout_.t_coolant) h += ",T_coolant";
   if (layout_.torque_cmd) h += ",torque_cmd";
   out_ << h << '\n';
 }
@@ -115,7 +119,7 @@ void DriveLogWriter::write(const DriveLogRow& row) {
     return core::park(ab, rot);
   };
   line_.clear();
-  append_number(line_, 1e-9 * static_cast<double>(s.t_ns));
+  append_number(line_, core::to_seconds(s.t_ns));
   for (double v : {s.theta_el_rad, s.omega_el_rad_s, s.u_dc_V}) append_number(line_ += ',', v);
   if (layout_.voltage_abc) {
     const core::Vec3 u = to_abc(s.voltage_frame, s.u_V);
@@ -135,6 +139,7 @@ void DriveLogWriter::write(const DriveLogRow& row) {
   }
   if (layout_.t_winding) append_number(line_ += ',', row.t_winding_C.value_or(std::nan("")));
   if (layout_.t_magnet) append_number(line_ += ',', row.t_magnet_C.value_or(std::nan("")));
+  if (layout_.t_coolant) append_number(line_ += ',', row.t_coolant_C.value_or(std::nan("")));
   if (layout_.torque_cmd) append_number(line_ += ',', row.torque_cmd_Nm.value_or(std::nan("")));
   line_ += '\n';
   out_ << line_;

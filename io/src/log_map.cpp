@@ -69,6 +69,7 @@ constexpr std::array<QuantityInfo, kQuantityCount> kQuantities{{
     {Quantity::kTDrive, "T_drive", QuantityKind::kTemperature, false},
     {Quantity::kTorqueCmd, "torque_cmd", QuantityKind::kTorque, false},
     {Quantity::kTStart, "t_start", QuantityKind::kTime, false},
+    {Quantity::kTCoolant, "T_coolant", QuantityKind::kTemperature, false},
 }};
 
 const char* si_unit(QuantityKind k) {
@@ -187,7 +188,7 @@ LogMap averaged_log_map(const std::string& name) {
   t.unit = "s";
   m.time = t;
   for (Quantity q : {Quantity::kTStart, Quantity::kID, Quantity::kIQ, Quantity::kUD, Quantity::kUQ, Quantity::kOmegaEl,
-                     Quantity::kUDc, Quantity::kTWinding, Quantity::kTMagnet, Quantity::kTDrive}) {
+                     Quantity::kUDc, Quantity::kTWinding, Quantity::kTMagnet, Quantity::kTDrive, Quantity::kTCoolant}) {
     m.columns.push_back(identity(q));
   }
   return m;

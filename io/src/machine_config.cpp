@@ -70,6 +70,7 @@ core::EstimatorSettings parse_estimator(YamlMap e, const core::MachineSi& machin
       e.number_or("max_sample_interval_s", core::EstimatorOptions::kMaxSampleIntervalPeriods * s.nominal_sample_period_s,
                   s.nominal_sample_period_s, 10.0);
   s.max_gap_carry_s = e.number_or("max_gap_carry_s", s.max_gap_carry_s, 0.0, 1.0);
+  s.outlier_bound_sigma = e.number_or("outlier_bound_sigma", s.outlier_bound_sigma, 0.0, 100.0);
   if (auto a = e.optional_map("adapt")) {
     s.adapt_psi_m = a->boolean_or("psi_m", s.adapt_psi_m);
     s.adapt_r_s = a->boolean_or("r_s", s.adapt_r_s);
@@ -138,7 +139,23 @@ core::EstimatorSettings parse_estimator(YamlMap e, const core::MachineSi& machin
         a->number_or("instrument_time_constant_s", s.averaged.instrument_time_constant_s, 0.0, 10.0);
     s.averaged.control_period_s = a->number_or("control_period_s", s.averaged.control_period_s, 0.0, 1e-2);
     s.averaged.current_sample_at = a->number_or("current_sample_at", s.averaged.current_sample_at, 0.0, 1.0);
+    s.averaged.voltage_is_command = a->choice_or("voltage_reported", "mean", {"mean", "command"}) == "command";
+    if (s.averaged.voltage_is_command && !(s.averaged.control_period_s > 0.0)) {
+      a->fail("voltage_reported", "command needs control_period_s (the period the command is held)");
+    }
     a->finish();
+  }
+  if (auto g = e.optional_map("regimes")) {
+    // The regime classification (core/regime.hpp, docs/derivations.md §13).
+    core::RegimeSettings& r = s.regimes;
+    r.enabled = g->boolean_or("enabled", r.enabled);
+    r.significance_sigma = g->number_or("significance_sigma", r.significance_sigma, 1.0, 10.0);
+    r.voltage_resolution_V = g->number_or("voltage_resolution_V", r.voltage_resolution_V, 0.0, 1e3);
+    r.current_resolution_A = g->number_or("current_resolution_A", r.current_resolution_A, 0.0, 1e3);
+    r.speed_resolution_rad_s = g->number_or("speed_resolution_rad_s", r.speed_resolution_rad_s, 0.0, 1e4);
+    r.inductance_tolerance = g->number_or("inductance_tolerance", r.inductance_tolerance, 0.0, 10.0);
+    r.angle_tolerance_rad = g->number_or("angle_tolerance_rad", r.angle_tolerance_rad, 0.0, 1.5);
+    g->finish();
   }
   e.finish();
   return s;
@@ -153,10 +170,10 @@ std::array<std::pair<const char*, double*>, 4> harmonic_fields(core::FluxHarmoni
 }
 
 core::InductanceCurve parse_inductance_curve(YamlMap m) {
-  core::InductanceCurve c;
-  c.level = m.number_or("level", 1.0, 0.05, 20.0);
-  c.curvature_per_A2 = m.number_or("curvature_per_A2", 0.0, -1e3, 1e3);
-  c.slope_per_A = m.number_or("slope_per_A", 0.0, -1e3, 1e3);
+  core::InductanceCurve c;  // a key left out keeps the nominal curve's value
+  c.level = m.number_or("level", c.level, 0.05, 20.0);
+  c.curvature_per_A2 = m.number_or("curvature_per_A2", c.curvature_per_A2, -1e3, 1e3);
+  c.slope_per_A = m.number_or("slope_per_A", c.slope_per_A, -1e3, 1e3);
   m.finish();
   return c;
 }
@@ -167,8 +184,8 @@ ParameterDrift parse_drift(YamlMap m, const char* ref_key, double ref_min, doubl
   if (m.has("coeff_per_K")) {
     core::DriftLaw law;
     law.coeff_per_K = m.number("coeff_per_K", -0.1, 0.1);
-    law.reference_C = m.number_or("reference_C", 20.0, -273.0, 500.0);
-    law.value_ref = m.number_or(ref_key, 0.0, ref_min, ref_max);
+    law.reference_C = m.number_or("reference_C", law.reference_C, -273.0, 500.0);
+    law.value_ref = m.number_or(ref_key, law.value_ref, ref_min, ref_max);
     d.law = law;
   } else {
     for (const char* key : {"reference_C", ref_key}) {
@@ -182,11 +199,12 @@ ParameterDrift parse_drift(YamlMap m, const char* ref_key, double ref_min, doubl
 
 void parse_extensions(YamlMap x, MachineConfig& config) {
   core::ModelExtensions& c = config.estimator.extensions;
+  const core::ModelExtensions nominal;  // a key left out: its value in the nominal model
   if (auto d = x.optional_map("deadtime")) {
-    c.deadtime_t_dead_s = d->number_or("t_dead_s", 0.0, 0.0, 1e-3);
-    c.switching_frequency_Hz = d->number_or("switching_frequency_Hz", 0.0, 0.0, 1e6);
-    c.deadtime_v_err_V = d->number_or("v_err_V", 0.0, -1e4, 1e4);
-    c.deadtime_current_band_A = d->number_or("current_band_A", 0.0, 0.0, 1e4);
+    c.deadtime_t_dead_s = d->number_or("t_dead_s", nominal.deadtime_t_dead_s, 0.0, 1e-3);
+    c.switching_frequency_Hz = d->number_or("switching_frequency_Hz", nominal.switching_frequency_Hz, 0.0, 1e6);
+    c.deadtime_v_err_V = d->number_or("v_err_V", nominal.deadtime_v_err_V, -1e4, 1e4);
+    c.deadtime_current_band_A = d->number_or("current_band_A", nominal.deadtime_current_band_A, 0.0, 1e4);
     if (c.deadtime_t_dead_s > 0.0 && c.switching_frequency_Hz <= 0.0) {
       d->fail("switching_frequency_Hz", "t_dead_s needs the switching frequency");
     }
@@ -219,14 +237,15 @@ void parse_extensions(YamlMap x, MachineConfig& config) {
     d->finish();
   }
   if (auto k = x.optional_map("cross_saturation")) {
-    c.cross_coupling_H_per_A = k->number_or("coupling_H_per_A", 0.0, -10.0, 10.0);
-    c.cross_coupling_H_per_A2 = k->number_or("coupling_H_per_A2", 0.0, -10.0, 10.0);
+    c.cross_coupling_H_per_A = k->number_or("coupling_H_per_A", nominal.cross_coupling_H_per_A, -10.0, 10.0);
+    c.cross_coupling_H_per_A2 = k->number_or("coupling_H_per_A2", nominal.cross_coupling_H_per_A2, -10.0, 10.0);
     k->finish();
   }
   for (std::size_t j = 0; j < core::kFluxHarmonicOrders.size(); ++j) {
     if (auto h = x.optional_map(harmonic_key(j))) {
       core::FluxHarmonic& f = c.flux_harmonics[j];
-      for (auto [key, value] : harmonic_fields(f)) *value = h->number_or(key, 0.0, -100.0, 100.0);
+      f = nominal.flux_harmonics[j];
+      for (auto [key, value] : harmonic_fields(f)) *value = h->number_or(key, *value, -100.0, 100.0);
       h->finish();
     }
   }

@@ -36,6 +36,7 @@ std::optional<ControlCycle> CycleExtractor::add(const io::DriveLogRow& row) noex
     c.i_dq_A = core::park(stator_frame(a.current_frame, a.i_A, at), at);
     c.u_dq_V = sinc * core::park(stator_frame(a.voltage_frame, a.u_V, at), core::Rotation::of(a.theta_el_rad + half));
     c.omega_el_rad_s = a.omega_el_rad_s;
+    c.theta_el_rad = a.theta_el_rad;
     c.u_dc_V = a.u_dc_V;
     c.t_winding_C = previous_->t_winding_C.value_or(std::nan(""));
     c.t_magnet_C = previous_->t_magnet_C.value_or(std::nan(""));

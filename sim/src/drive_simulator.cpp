@@ -1,8 +1,10 @@
 #include "rpem/sim/drive_simulator.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include "rpem/core/machine.hpp"
+#include "rpem/core/units.hpp"
 
 namespace rpem::sim {
 namespace {
@@ -12,7 +14,7 @@ Magnetics make_magnetics(const Scenario& s) {
   return Magnetics(std::make_shared<const FluxMap>(FluxMap::load_csv(s.flux_map_file)));
 }
 
-double rpm_to_el_rad_s(double rpm, int pole_pairs) { return rpm * (2.0 * core::kPi / 60.0) * pole_pairs; }
+double rpm_to_el_rad_s(double rpm, int pole_pairs) { return core::rpm_to_rad_s(rpm) * pole_pairs; }
 
 }  // namespace
 
@@ -29,7 +31,8 @@ DriveSimulator::DriveSimulator(Scenario scenario)
       period_ns_(std::llround(scenario_.sample_period_s * 1e9)),
       samples_total_(std::llround(scenario_.duration_s / scenario_.sample_period_s)),
       warmup_periods_(std::llround(scenario_.warmup_s / scenario_.sample_period_s)),
-      substeps_(static_cast<int>(std::lround(scenario_.sample_period_s / scenario_.plant_step_s))) {
+      substeps_(static_cast<int>(std::lround(scenario_.sample_period_s / scenario_.plant_step_s))),
+      regimes_(scenario_.regimes) {
   // Start at the operating point of t = 0 (then settle over the warm-up).
   const int p = scenario_.machine.machine.rated.pole_pairs;
   parameters_ = parameters_at(-scenario_.warmup_s);
@@ -63,10 +66,32 @@ PlantParameters DriveSimulator::parameters_at(double t_s) noexcept {
   p.l_q_H = s.signal(Quantity::kLq).at(t_s);
   p.r_fe_Ohm = s.r_fe_Ohm;
   torque_signal_Nm_ = s.signal(Quantity::kTorque).at(t_s);
+  load_signal_Nm_ = s.separate_load ? s.signal(Quantity::kLoadTorque).at(t_s) : torque_signal_Nm_;
   u_dc_V_ = s.signal(Quantity::kUdc).at(t_s);
   t_winding_C_ = tw;
   t_magnet_C_ = tm;
   return p;
+}
+
+void DriveSimulator::update_regime(double t_s) noexcept {
+  if (regimes_.empty()) return;
+  const int p = scenario_.machine.machine.rated.pole_pairs;
+  const RegimeNow now = regimes_.at(t_s);
+  if (now.regime == DriveRegime::kOpenLoop && (regime_.regime != DriveRegime::kOpenLoop || now.event != regime_.event)) {
+    // The commanded frame starts where the held current is in equilibrium with the load: its q axis (the
+    // current's direction, s = the sign of the target speed) ahead of the rotor's d axis by the load angle δ0,
+    // T = (3/2)·p·ψm·I·sin δ (surface magnets). The firmware starts at the observer's angle + 60° and lets
+    // the lock time settle the rotor, which friction and iron losses damp on a real machine but nothing
+    // damps in this plant.
+    const RegimeEvent& e = regimes_.events()[static_cast<std::size_t>(now.event)];
+    const double s = e.speed_rpm > 0.0 ? 1.0 : -1.0;
+    const double load = scenario_.mechanics.dynamometer ? 0.0 : load_signal_Nm_;
+    const double k = 1.5 * p * parameters_.psi_m_Wb * e.current_A;
+    const double delta0 = std::asin(std::clamp(s * load / k, -0.95, 0.95));
+    theta_frame_rad_ = plant_.state().theta_el_rad + s * (delta0 - 0.5 * core::kPi);
+  }
+  regime_ = now;
+  omega_frame_rad_s_ = rpm_to_el_rad_s(now.open_loop_speed_rpm, p);
 }
 
 void DriveSimulator::sample_and_control(double t_s) noexcept {
@@ -75,12 +100,19 @@ void DriveSimulator::sample_and_control(double t_s) noexcept {
   const double speed_el = rpm_to_el_rad_s(scenario_.signal(Quantity::kSpeed).at(t_s), p);
   plant_.set_speed(speed_el);
   plant_.begin_period(parameters_, edge_to_edge_ ? scenario_.sample_period_s : scenario_.plant_step_s,
-                      scenario_.mechanics.dynamometer ? 0.0 : torque_signal_Nm_);
+                      scenario_.mechanics.dynamometer ? 0.0 : load_signal_Nm_);
+  update_regime(t_s);
 
   i_meas_A_ = sensors_.currents(plant_.phase_currents());
   theta_meas_rad_ = sensors_.angle(plant_.state().theta_el_rad);
   omega_meas_rad_s_ = sensors_.speed();
   u_dc_meas_V_ = sensors_.dc_link(u_dc_V_);
+  if (regime_.regime == DriveRegime::kOpenLoop) {
+    // The controller's frame is the commanded angle; the firmware's PLL, on that angle, reports its speed.
+    theta_meas_rad_ = core::wrap_angle(theta_frame_rad_);
+    omega_meas_rad_s_ = omega_frame_rad_s_;
+    theta_frame_rad_ += omega_frame_rad_s_ * scenario_.sample_period_s;
+  }
 
   // The command computed last period acts now; compute the next one. With an inverter delay δ < T the
   // command acts δ late: over this period the previous command holds for δ and this one for T − δ, in
@@ -98,8 +130,24 @@ void DriveSimulator::sample_and_control(double t_s) noexcept {
   in.theta_el_rad = theta_meas_rad_;
   in.omega_el_rad_s = omega_meas_rad_s_;
   in.u_dc_V = u_dc_meas_V_;
-  in.torque_ref_Nm = scenario_.control.speed_control ? 0.0 : torque_signal_Nm_;
+  in.speed_control = regime_.control == ControlOverride::kScenario ? scenario_.control.speed_control
+                                                                   : regime_.control == ControlOverride::kSpeed;
+  in.torque_ref_Nm = in.speed_control ? 0.0 : torque_signal_Nm_;
   in.speed_ref_el_rad_s = speed_el;
+  if (regime_.regime == DriveRegime::kOpenLoop) {
+    const RegimeEvent& e = regimes_.events()[static_cast<std::size_t>(regime_.event)];
+    in.current_override = true;
+    in.current_ref_A = {0.0, e.speed_rpm > 0.0 ? e.current_A : -e.current_A};
+    in.decouple = false;
+  } else if (regime_.regime == DriveRegime::kBridgeOff) {
+    // No current wanted; the integrators follow the back EMF the drive measures (the rotor frame's
+    // (0, ω·ψm) at zero current, seen at the measured angle), so the command is ready for re-engaging.
+    in.current_override = true;
+    const PlantState& st = plant_.state();
+    const core::Vec2 e_rotor(0.0, st.omega_el_rad_s * parameters_.psi_m_Wb);
+    foc_.preset(core::park(e_rotor, core::Rotation::of(core::wrap_angle(theta_meas_rad_ - st.theta_el_rad))),
+                omega_meas_rad_s_);
+  }
   const FocOutput out = foc_.step(in);
   torque_cmd_Nm_ = out.torque_ref_Nm;
   command_next_V_ = out.u_ab_V;
@@ -108,6 +156,12 @@ void DriveSimulator::sample_and_control(double t_s) noexcept {
 }
 
 void DriveSimulator::integrate(std::int64_t k) noexcept {
+  if (regime_.regime == DriveRegime::kBridgeOff) {
+    const PlantState& st = plant_.state();
+    if (std::sqrt(3.0) * std::abs(st.omega_el_rad_s) * parameters_.psi_m_Wb >= u_dc_V_) ++rectifying_periods_;
+    plant_.freewheel(edge_to_edge_ ? 1 : substeps_);
+    return;
+  }
   // The carrier valley is at even k (rising half), the peak at odd k.
   const bool rising = (k % 2) == 0;
   if (edge_to_edge_) {
@@ -128,7 +182,7 @@ void DriveSimulator::fill_row(std::int64_t t_ns, io::DriveLogRow& row) const noe
   s.omega_el_rad_s = omega_meas_rad_s_;
   s.u_dc_V = u_dc_meas_V_;
   s.voltage_frame = core::Frame::kAbc;
-  s.u_V = core::inverse_clarke(command_now_V_);
+  s.u_V = regime_.regime == DriveRegime::kBridgeOff ? core::Vec3::Zero() : core::inverse_clarke(command_now_V_);
   s.current_frame = core::Frame::kAbc;
   s.i_A = i_meas_A_;
   s.gap_before = false;
@@ -147,6 +201,9 @@ void DriveSimulator::fill_truth(std::int64_t t_ns, TruthRow& truth) const noexce
   truth.i_dq_A = st.i_A;
   truth.t_winding_C = t_winding_C_;
   truth.t_magnet_C = t_magnet_C_;
+  truth.regime = regime_.regime;
+  truth.off_report = regime_.report;
+  truth.theta_frame_rad = theta_meas_rad_;
   if (const FluxMap* map = plant_.magnetics().map()) {
     const core::Mat2 j = map->jacobian(st.i_A);  // differential inductances at the operating point
     truth.l_d_H = j(0, 0);

@@ -72,6 +72,20 @@ void PmsmPlant::step(const core::Vec2& u_ab_V) noexcept {
   rotation_ = r1;
 }
 
+void PmsmPlant::freewheel(int steps) noexcept {
+  const double h = h_s_;
+  i_flux_A_.setZero();
+  state_.i_A.setZero();
+  state_.psi_Wb = magnetics_.flux(i_flux_A_);
+  state_.torque_Nm = 0.0;
+  for (int s = 0; s < steps; ++s) {
+    const double omega = state_.omega_el_rad_s;
+    if (!mechanics_.dynamometer) state_.omega_el_rad_s += h * acceleration(0.0, omega) * pole_pairs_;
+    state_.theta_el_rad += omega * h;
+    rotation_ = core::compose(rotation_, rotation_by(omega * h));
+  }
+}
+
 void PmsmPlant::update_torque() noexcept {
   state_.torque_Nm = 1.5 * pole_pairs_ * (state_.psi_Wb[0] * state_.i_A[1] - state_.psi_Wb[1] * state_.i_A[0]);
 }

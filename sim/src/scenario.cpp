@@ -88,7 +88,7 @@ void parse_sensors(io::YamlMap m, Scenario& s) {
 
 Quantity parse_quantity(io::YamlMap& m, const std::string& key) {
   const std::string name = m.choice(key, {"psi_m_Wb", "r_s_Ohm", "l_d_H", "l_q_H", "speed_rpm", "torque_Nm", "u_dc_V",
-                                          "t_winding_C", "t_magnet_C"});
+                                          "t_winding_C", "t_magnet_C", "load_torque_Nm"});
   for (std::size_t q = 0; q < kQuantityNames.size(); ++q) {
     if (name == kQuantityNames[q]) return static_cast<Quantity>(q);
   }
@@ -114,7 +114,65 @@ void parse_events(std::vector<io::YamlMap> events, Scenario& s) {
     if (ev.t_s < last) e.fail("t_s", "events of one quantity must be in time order");
     last = ev.t_s;
     s.signal(q).add(ev);
+    if (q == Quantity::kLoadTorque) {
+      if (s.mechanics.dynamometer) e.fail("quantity", "load_torque_Nm needs plant.mechanics.mode: inertia (a dynamometer imposes the speed)");
+      s.separate_load = true;
+    }
   }
+}
+
+ControlOverride parse_control_override(io::YamlMap& e, const Scenario& s) {
+  if (!e.has("control")) {
+    (void)e.text_or("control", "");
+    return ControlOverride::kScenario;
+  }
+  const bool speed = e.choice("control", {"torque", "speed"}) == "speed";
+  if (speed && s.mechanics.dynamometer) e.fail("control", "speed control needs plant.mechanics.mode: inertia");
+  return speed ? ControlOverride::kSpeed : ControlOverride::kTorque;
+}
+
+OffVoltageReport parse_report(io::YamlMap& e) {
+  return e.choice_or("report", "back_emf", {"back_emf", "zero"}) == "zero" ? OffVoltageReport::kZero
+                                                                          : OffVoltageReport::kBackEmf;
+}
+
+/// `regimes:` (docs/scenarios.md, "Regimes"): what the controller does with the bridge from each t_s on.
+void parse_regimes(std::vector<io::YamlMap> events, Scenario& s) {
+  double last_t = -kHuge;
+  for (io::YamlMap& e : events) {
+    RegimeEvent r;
+    r.t_s = e.number("t_s", -kHuge, kHuge);
+    if (!(r.t_s > last_t)) e.fail("t_s", "regime events must be in strictly increasing time");
+    last_t = r.t_s;
+    const std::string regime = e.choice("regime", {"closed_loop", "open_loop", "bridge_off"});
+    r.regime = regime == "closed_loop" ? DriveRegime::kClosedLoop
+                                       : (regime == "open_loop" ? DriveRegime::kOpenLoop : DriveRegime::kBridgeOff);
+    r.then = r.regime == DriveRegime::kOpenLoop
+                 ? (e.choice_or("then", "closed_loop", {"closed_loop", "bridge_off"}) == "bridge_off" ? DriveRegime::kBridgeOff
+                                                                                                   : DriveRegime::kClosedLoop)
+                 : r.regime;
+    if (r.regime == DriveRegime::kOpenLoop) {
+      r.current_A = e.number("current_A", 1e-3, 1e5);
+      r.speed_rpm = e.number("speed_rpm", -1e6, 1e6);
+      if (r.speed_rpm == 0.0) e.fail("speed_rpm", "must not be 0 (its sign is the direction)");
+      r.lock_s = e.number_or("lock_s", 0.0, 0.0, 1e4);
+      r.ramp_s = e.number("ramp_s", 1e-3, 1e4);
+      r.hold_s = e.number_or("hold_s", 0.05, 0.0, 1e4);
+    }
+    if (r.then == DriveRegime::kClosedLoop) r.control = parse_control_override(e, s);
+    if (r.then == DriveRegime::kBridgeOff) r.report = parse_report(e);
+    e.finish();
+    s.regimes.push_back(r);
+  }
+}
+
+void parse_vesc(io::YamlMap m, Scenario& s) {
+  VescConfig& v = s.vesc;
+  v.wheel_diameter_m = m.number_or("wheel_diameter_m", v.wheel_diameter_m, 1e-3, 100.0);
+  v.gear_ratio = m.number_or("gear_ratio", v.gear_ratio, 1e-3, 1e4);
+  v.battery_cells = static_cast<int>(m.integer_or("battery_cells", v.battery_cells, 1, 255));
+  v.battery_Ah = m.number_or("battery_Ah", v.battery_Ah, 1e-3, 1e6);
+  m.finish();
 }
 
 void set_initial_signals(Scenario& s, std::optional<io::YamlMap> init) {
@@ -131,6 +189,11 @@ void set_initial_signals(Scenario& s, std::optional<io::YamlMap> init) {
   s.signal(Quantity::kUdc) = Signal(value("u_dc_V", 220.0, 1.0, 1e5));
   s.signal(Quantity::kTWinding) = Signal(value("t_winding_C", s.thermal.r_s.reference_C, -273.0, 1000.0));
   s.signal(Quantity::kTMagnet) = Signal(value("t_magnet_C", s.thermal.psi_m.reference_C, -273.0, 1000.0));
+  s.signal(Quantity::kLoadTorque) = Signal(value("load_torque_Nm", 0.0, -1e6, 1e6));
+  s.separate_load = init && init->has("load_torque_Nm");
+  if (s.separate_load && s.mechanics.dynamometer) {
+    init->fail("load_torque_Nm", "needs plant.mechanics.mode: inertia (a dynamometer imposes the speed)");
+  }
   if (init) init->finish();
 }
 
@@ -189,6 +252,12 @@ Scenario parse_scenario(const std::string& text, const std::string& name, const 
   } else {
     (void)root.optional_map("events");
   }
+  if (root.has("regimes")) {
+    parse_regimes(root.maps("regimes"), s);
+  } else {
+    (void)root.optional_map("regimes");
+  }
+  if (auto m = root.optional_map("vesc")) parse_vesc(*m, s);
   if (auto m = root.optional_map("log")) {
     s.log.dq_columns = m->boolean_or("dq_columns", false);
     s.log.temperatures = m->boolean_or("temperatures", false);

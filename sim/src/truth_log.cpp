@@ -1,5 +1,6 @@
 #include "rpem/sim/truth_log.hpp"
 
+#include "rpem/core/clock.hpp"
 #include "rpem/io/errors.hpp"
 #include "rpem/io/number_format.hpp"
 
@@ -12,7 +13,7 @@ TruthLogWriter::TruthLogWriter(const std::string& path) : out_(path, std::ios::b
 
 void TruthLogWriter::write(const TruthRow& r) {
   line_.clear();
-  io::append_number(line_, 1e-9 * static_cast<double>(r.t_ns));
+  io::append_number(line_, core::to_seconds(r.t_ns));
   for (double v : {r.parameters.psi_m_Wb, r.parameters.r_s_Ohm, r.l_d_H, r.l_q_H, r.t_winding_C, r.t_magnet_C,
                    r.omega_el_rad_s, r.theta_el_rad, r.torque_Nm, r.i_dq_A[0], r.i_dq_A[1]}) {
     io::append_number(line_ += ',', v);

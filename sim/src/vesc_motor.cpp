@@ -1,12 +1,14 @@
 #include "rpem/sim/vesc_motor.hpp"
 
 #include <cmath>
-#include <numbers>
+
+#include "rpem/core/clock.hpp"
+#include "rpem/core/units.hpp"
+
+#include "rpem/core/frames.hpp"
 
 namespace rpem::sim {
 namespace {
-
-constexpr double kRadPerSToRpm = 60.0 / (2.0 * std::numbers::pi);
 
 /// Input current from the power balance of a cycle (amplitude-invariant frame: P = 3/2·u·i).
 double input_current_A(const ControlCycle& c) noexcept {
@@ -19,10 +21,30 @@ VescMotor::VescMotor(Scenario scenario, Settings settings)
     : simulator_(std::move(scenario)), settings_(settings) {}
 
 bool VescMotor::step() noexcept {
+  const TruthRow at_start = truth_;  // the start of the cycle the next row completes
   if (!simulator_.next(row_, truth_)) return false;
   started_ = true;
-  if (const auto c = cycles_.add(row_)) account(*c);
+  if (const auto c = cycles_.add(row_)) account(firmware_view(*c, at_start));
   return true;
+}
+
+ControlCycle VescMotor::firmware_view(ControlCycle c, const TruthRow& at_start) noexcept {
+  if (at_start.modulating()) {
+    v_dq_filter_V_ = c.u_dq_V;
+    return c;
+  }
+  c.i_dq_A.setZero();  // "The current is 0 when the motor is undriven"
+  if (at_start.off_report == OffVoltageReport::kZero) {
+    v_dq_filter_V_.setZero();
+  } else {
+    // No current: the terminal voltage is the back EMF, (0, ω·ψm) in the rotor frame; the firmware Parks it
+    // at its observer's angle (the measured one here) and low-passes it (UTILS_LP_FAST, 0.2).
+    const core::Vec2 e(0.0, at_start.omega_el_rad_s * at_start.parameters.psi_m_Wb);
+    const core::Vec2 sensed = core::park(e, core::Rotation::of(core::wrap_angle(c.theta_el_rad - at_start.theta_el_rad)));
+    v_dq_filter_V_ += 0.2 * (sensed - v_dq_filter_V_);
+  }
+  c.u_dq_V = v_dq_filter_V_;
+  return c;
 }
 
 bool VescMotor::advance_to(std::int64_t t_ns) noexcept {
@@ -35,11 +57,11 @@ bool VescMotor::advance_to(std::int64_t t_ns) noexcept {
 void VescMotor::account(const ControlCycle& c) noexcept {
   last_cycle_ = c;
   sums_.add(c);
-  const double dt_s = 1e-9 * static_cast<double>(c.end_ns - c.t_ns);
+  const double dt_s = core::to_seconds(c.end_ns - c.t_ns);
   const double i_in = input_current_A(c);
   last_input_current_A_ = i_in;
   input_current_sum_A_ += i_in;
-  const double steps = 6.0 * c.omega_el_rad_s * dt_s / (2.0 * std::numbers::pi);
+  const double steps = 6.0 * c.omega_el_rad_s * dt_s / (2.0 * core::kPi);
   tacho_steps_ += steps;
   tacho_abs_steps_ += std::abs(steps);
   const double ah = std::abs(i_in) * dt_s / 3600.0;
@@ -88,7 +110,7 @@ can::vesc::Status VescMotor::status(int number) const noexcept {
   s.number = number;
   const ControlCycle& c = last_cycle_;
   const double u_max = c.u_dc_V / std::sqrt(3.0);
-  s.erpm = row_.sample.omega_el_rad_s * kRadPerSToRpm;
+  s.erpm = core::rad_s_to_rpm(row_.sample.omega_el_rad_s);
   s.current_A = c.i_dq_A[1];
   s.duty = u_max > 0.0 ? std::copysign(c.u_dq_V.norm() / u_max, c.u_dq_V[1]) : 0.0;
   s.amp_hours_Ah = amp_hours_;
@@ -98,7 +120,7 @@ can::vesc::Status VescMotor::status(int number) const noexcept {
   s.temp_fet_C = settings_.temp_fet_C;
   s.temp_motor_C = row_.t_winding_C.value_or(settings_.temp_fet_C);
   s.current_in_A = last_input_current_A_;
-  s.pid_pos_deg = std::remainder(row_.sample.theta_el_rad, 2.0 * std::numbers::pi) * 180.0 / std::numbers::pi;
+  s.pid_pos_deg = std::remainder(row_.sample.theta_el_rad, 2.0 * core::kPi) * 180.0 / core::kPi;
   s.tachometer = static_cast<std::int32_t>(tacho_steps_);
   s.v_in_V = row_.sample.u_dc_V;
   s.adc_V = {0.0, 0.0, 0.0, 0.0};

@@ -3,9 +3,13 @@
 // parameter error exactly, and the log's preparation (mode, exclusions, blocks).
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <complex>
+#include <numbers>
 #include <random>
 
 #include "rpem/analysis/diagnose/effect_fit.hpp"
+#include "rpem/analysis/diagnose/log_data.hpp"
 #include "rpem/analysis/diagnose/selection.hpp"
 #include "rpem/analysis/diagnose/verdict.hpp"
 #include "support/model_data.hpp"
@@ -36,9 +40,9 @@ LogData model_log(double psi_scale, bool standstill_first = true) {
   std::vector<io::DriveLogRow> rows;
   std::int64_t t_ns = 0;
   gen.i_ref_pu = core::mtpa_reference(gen.plant, 0.4);
-  for (int k = 0; k < (standstill_first ? 8000 : 0); ++k) rows.push_back({gen.next_si(base, t_ns), {}, {}, {}});
+  for (int k = 0; k < (standstill_first ? 8000 : 0); ++k) rows.push_back({gen.next_si(base, t_ns), {}, {}, {}, {}});
   gen.n_pu = 0.4;
-  for (int k = 0; k < 16000; ++k) rows.push_back({gen.next_si(base, t_ns), {}, {}, {}});
+  for (int k = 0; k < 16000; ++k) rows.push_back({gen.next_si(base, t_ns), {}, {}, {}, {}});
   return prepare_log(std::move(rows), io::DriveLogLayout{}, test::paper_machine_si(), {});
 }
 
@@ -129,22 +133,25 @@ TEST(NoiseFloor, SecondDifferencesRecoverTheWhiteNoiseUnderASmoothError) {
     const double smooth = 0.1 * std::sin(2.0 * core::kPi * 270.0 * t) + 0.5 * t + (k > 20000 ? 0.3 : 0.0);
     r.residual_A[k] = core::Vec2(smooth + noise(rng), -smooth + noise(rng));
   }
-  EXPECT_NEAR(noise_floor_A(log, r), std::sqrt(2.0) * 0.02, 0.03 * std::sqrt(2.0) * 0.02);
+  EXPECT_NEAR(measure_noise_floor(log, r).value_A.value(), std::sqrt(2.0) * 0.02, 0.03 * std::sqrt(2.0) * 0.02);
 }
 
 TEST(Verdict, ExplainedUpToTheBoundAndOtherwiseWhereTheResidualLives) {
   ResidualStatistics st;
   st.standstill_rms_A = {1.0, 0.05};
   st.motion_rms_A = {1.0, 0.2};
+  st.standstill_samples = 100;
+  st.motion_samples = 1000;
   st.regions = {{"n ≥ 0.5 pu", "i_q > 0", 1000, {1.0, 0.3}, {0.0, 0.1}, {0.0, -0.2}}};
   st.harmonics = {{0, {0.1, 0.01}}, {6, {0.5, 0.15}}, {12, {0.1, 0.02}}};
   st.correlations = {{"|speed| [pu]", {0.1, 0.6}, {0.1, 0.2}}};
-  const Verdict explained = verdict(0.029, 0.02, st);
-  EXPECT_TRUE(explained.explained);  // 1.45 ≤ 1.5
+  const NoiseFloor floor{0.02, 1000, ""};
+  const Verdict explained = verdict(0.029, floor, st);
+  EXPECT_TRUE(explained.explained());  // 1.45 ≤ 1.5
   EXPECT_TRUE(explained.findings.empty());
-  const Verdict v = verdict(0.2, 0.02, st);
-  EXPECT_FALSE(v.explained);
-  EXPECT_DOUBLE_EQ(v.ratio, 10.0);
+  const Verdict v = verdict(0.2, floor, st);
+  EXPECT_EQ(v.kind, VerdictKind::kUnexplained);
+  EXPECT_DOUBLE_EQ(v.ratio.value(), 10.0);
   std::string all;
   for (const std::string& f : v.findings) all += f + "\n";
   EXPECT_NE(all.find("harmonic 6"), std::string::npos) << all;
@@ -192,6 +199,33 @@ TEST(LogData, SteadyStateLeavesOutIdleAndTransitionalRowsAndBlocksAlternate) {
   EXPECT_TRUE(log.training(10));    // block 2
   EXPECT_TRUE(log.heldout(15));     // block 3
   EXPECT_EQ(log.block(log.size() - 1), 39);
+}
+
+TEST(ReportedCommand, AppliedMeanIsTheHeldVectorAveragedInTheRotorFrame) {
+  // Independently: the stator-frame vector e^{jθ(t)}·v held over [d − ½, d + ½]·T after the sample, seen from
+  // the rotor (angle θ(t) + ω·s), averaged by the midpoint rule over 20 000 steps (error ~1e-9 relative).
+  const double t_c = 80e-6;
+  for (const double omega : {-2600.0, -300.0, 0.0, 900.0, 2566.0}) {
+    for (const double d : {0.0, 0.5, 1.0}) {
+      const std::complex<double> v(0.7, 11.4);
+      std::complex<double> mean = 0.0;
+      constexpr int kSteps = 20000;
+      for (int k = 0; k < kSteps; ++k) {
+        const double s = (d - 0.5 + (k + 0.5) / kSteps) * t_c;
+        mean += v * std::polar(1.0, -omega * s) / static_cast<double>(kSteps);
+      }
+      const core::Vec2 u = applied_mean_V({v.real(), v.imag()}, omega, t_c, d);
+      EXPECT_NEAR(u[0], mean.real(), 1e-8) << omega << " " << d;
+      EXPECT_NEAR(u[1], mean.imag(), 1e-8) << omega << " " << d;
+    }
+  }
+  // VESC's d = 1 at 3500 rpm of a 7-pole-pair rotor (ω·T = 0.205): a command on q arrives 2.3 % shorter on q
+  // (cos·sinc) and with sin(ω·T)·sinc of it on +d.
+  const double w = 3500.0 * 7.0 * 2.0 * std::numbers::pi / 60.0;
+  const core::Vec2 u = applied_mean_V({0.0, 10.0}, w, t_c, 1.0);
+  const double wt = w * t_c;
+  EXPECT_NEAR(u[1], 10.0 * std::cos(wt) * std::sin(wt / 2) / (wt / 2), 1e-12);
+  EXPECT_NEAR(u[0], 10.0 * std::sin(wt) * std::sin(wt / 2) / (wt / 2), 1e-12);
 }
 
 }  // namespace

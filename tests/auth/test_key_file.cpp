@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 #include <sys/stat.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 
@@ -15,8 +16,8 @@ const std::string kText = "rpem-key-1 7 000102030405060708090a0b0c0d0e0f10111213
 
 TEST(KeyFile, ParsesAndFormatsTheOneLine) {
   const Key k = parse_key(kText, "t");
-  EXPECT_EQ(k.id, 7);
-  for (std::size_t i = 0; i < k.bytes.size(); ++i) EXPECT_EQ(k.bytes[i], i);
+  EXPECT_EQ(k.id(), 7);
+  for (std::size_t i = 0; i < k.bytes().size(); ++i) EXPECT_EQ(k.bytes()[i], i);
   EXPECT_EQ(format_key(k), kText);
 }
 
@@ -47,7 +48,7 @@ TEST(KeyFile, OnlyTheOwnerMayReadIt) {
   }
   for (const mode_t mode : {0600, 0400}) {
     ASSERT_EQ(::chmod(f.path().c_str(), mode), 0);
-    EXPECT_EQ(load_key_file(f.path()).id, 7);
+    EXPECT_EQ(load_key_file(f.path()).id(), 7);
   }
   EXPECT_THROW((void)load_key_file(f.path() + ".missing"), KeyError);
 }
@@ -55,12 +56,12 @@ TEST(KeyFile, OnlyTheOwnerMayReadIt) {
 TEST(KeyFile, GeneratedKeysAreWrittenOwnerOnlyAndReadBack) {
   test::TempFile f("generated.key");
   const Key a = generate_key(12), b = generate_key(12);
-  EXPECT_NE(a.bytes, b.bytes);
+  EXPECT_FALSE(std::ranges::equal(a.bytes(), b.bytes()));
   write_key_file(f.path(), a);
   EXPECT_EQ(std::filesystem::status(f.path()).permissions() & std::filesystem::perms::all, std::filesystem::perms::owner_read | std::filesystem::perms::owner_write);
   const Key back = load_key_file(f.path());
-  EXPECT_EQ(back.id, 12);
-  EXPECT_EQ(back.bytes, a.bytes);
+  EXPECT_EQ(back.id(), 12);
+  EXPECT_TRUE(std::ranges::equal(back.bytes(), a.bytes()));
   EXPECT_THROW(write_key_file(f.path(), b), KeyError);  // never replaces a key
 }
 

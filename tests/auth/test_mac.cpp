@@ -1,6 +1,7 @@
 // rpem/auth/mac.hpp: the tag against an independent computation, and every verdict of verify().
 #include <gtest/gtest.h>
 
+#include <array>
 #include <string>
 #include <vector>
 
@@ -24,12 +25,13 @@ const std::string kEncodingHex =
     "000000000000000000000000000000000000000000000000";
 const std::string kTagHex = "2eacff3d58d9336c3e4e33577f74ce636dc162e8ea56731e4429f777d79bfa98";
 
-Key test_key(std::int32_t id = 7) {
-  Key k;
-  k.id = id;
-  for (std::size_t i = 0; i < k.bytes.size(); ++i) k.bytes[i] = static_cast<std::uint8_t>(i);
-  return k;
+std::array<std::uint8_t, kKeyBytes> test_bytes() {
+  std::array<std::uint8_t, kKeyBytes> b{};
+  for (std::size_t i = 0; i < b.size(); ++i) b[i] = static_cast<std::uint8_t>(i);
+  return b;
 }
+
+Key test_key(std::int32_t id = 7) { return {id, test_bytes()}; }
 
 std::vector<std::uint8_t> signed_vector() {
   std::vector<std::uint8_t> e = from_hex(kEncodingHex);
@@ -96,9 +98,10 @@ TEST(Keyring, HoldsTwoDistinctPositiveIdsForARotation) {
   EXPECT_FALSE(keys.add(test_key(-1)));
   EXPECT_TRUE(keys.add(test_key(7)));
   EXPECT_FALSE(keys.add(test_key(7)));
-  Key next = test_key(8);
-  next.bytes[0] ^= 0xFF;
-  EXPECT_TRUE(keys.add(next));
+  std::array<std::uint8_t, kKeyBytes> next_bytes = test_bytes();
+  next_bytes[0] ^= 0xFF;
+  const Key next(8, next_bytes);  // the signer's copy
+  EXPECT_TRUE(keys.add(Key(8, next_bytes)));
   EXPECT_FALSE(keys.add(test_key(9)));
   EXPECT_EQ(keys.size(), 2);
   // Both verify their own messages during the change.

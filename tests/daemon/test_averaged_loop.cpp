@@ -6,8 +6,10 @@
 
 #include <cmath>
 
-#include "rpem/daemon/estimator_loop.hpp"
+#include "rpem/core/clock.hpp"
+#include "rpem/daemon/loop_thread.hpp"
 #include "support/averaged_data.hpp"
+#include "support/loop_queues.hpp"
 #include "support/model_data.hpp"
 #include "support/paper_machine.hpp"
 
@@ -16,10 +18,10 @@ namespace {
 
 struct AveragedRig {
   DaemonConfig config = builtin_daemon_config();
-  SpscQueue<SourceSample> input{16384};
-  SpscQueue<Command> commands{16};
-  SpscQueue<Report> output{65536};
-  std::unique_ptr<EstimatorLoop> loop;
+  test::LoopQueues queues = test::loop_queues(16384, 16, 65536);
+  SpscQueue<SourceSample>::Producer& input = queues.input;
+  SpscQueue<Report>::Consumer& output = queues.output;
+  std::unique_ptr<LoopThread> loop;
   test::AveragedDataGenerator gen;
   std::int64_t now_ns = 1'000'000'000;
   std::int64_t pushed = 0;
@@ -28,7 +30,7 @@ struct AveragedRig {
 
   explicit AveragedRig(double rate_Hz, double psi_scale = 1.0) {
     config.fixed.source = VescSource::Options{};
-    loop = std::make_unique<EstimatorLoop>(config, EstimatorLoop::Queues{input, commands, output});
+    loop = std::make_unique<LoopThread>(config, std::move(queues.loop));
     gen.base = test::paper_base();
     gen.plant = test::paper_machine_pu();
     gen.plant.psi_m_pu *= psi_scale;
@@ -64,7 +66,7 @@ struct AveragedRig {
       now_ns += 1'000'000;
       loop->process(now_ns);
     }
-    while (gen.t_s + 1.0 < 1e-9 * static_cast<double>(now_ns)) (void)gen.next();
+    while (gen.t_s + 1.0 < core::to_seconds(now_ns)) (void)gen.next();
     have_next = false;
   }
   EstimateReport estimate;

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 #include <sys/stat.h>
 
+#include <array>
 #include <filesystem>
 #include <fstream>
 #include <vector>
@@ -23,10 +24,16 @@ namespace {
 const CommandPolicy kRequired{true, 0.5, 1.7, 1.0, 4.5, CommandAuthentication::kRequired};
 
 auth::Key key(std::int32_t id, std::uint8_t fill) {
-  auth::Key k;
-  k.id = id;
-  k.bytes.fill(fill);
-  return k;
+  std::array<std::uint8_t, auth::kKeyBytes> bytes{};
+  bytes.fill(fill);
+  return {id, bytes};
+}
+
+/// rpemd's copy of a key (the supervisor signs with its own, key(id, fill)).
+CommandKeys held(std::int32_t id, std::uint8_t fill) {
+  CommandKeys keys;
+  EXPECT_TRUE(keys.keys.add(key(id, fill)));
+  return keys;
 }
 
 std::vector<std::uint8_t> command(std::int64_t seq, const auth::Key* signer, std::int32_t key_id = -1,
@@ -37,7 +44,7 @@ std::vector<std::uint8_t> command(std::int64_t seq, const auth::Key* signer, std
   m.command = rpem::command_t::SET_VALUES;
   m.psi_m_Wb = 1.1;
   m.r_s_Ohm = 2.2;
-  m.key_id = key_id >= 0 ? key_id : signer != nullptr ? signer->id : 0;
+  m.key_id = key_id >= 0 ? key_id : signer != nullptr ? signer->id() : 0;
   std::vector<std::uint8_t> bytes(static_cast<std::size_t>(m.getEncodedSize()));
   EXPECT_EQ(m.encode(bytes.data(), 0, static_cast<int>(bytes.size())), static_cast<int>(bytes.size()));
   if (signer != nullptr) {
@@ -72,10 +79,8 @@ TEST(CommandAuth, CppEncodingIsTheVectorsAndEndsWithTheMac) {
 
 TEST(CommandAuth, TheGateRefusesEachAttackForItsReasonAndCountsIt) {
   const auth::Key k1 = key(1, 0x11), stranger = key(1, 0x99), k9 = key(9, 0x11);
-  CommandKeys keys;
-  ASSERT_TRUE(keys.keys.add(k1));
-  SpscQueue<Command> to_loop(16);
-  CommandGate gate(kRequired, to_loop, keys);
+  auto [to_loop, loop_side] = SpscQueue<Command>::make(16);
+  CommandGate gate(kRequired, to_loop, held(1, 0x11));
   const std::vector<std::uint8_t> valid = command(5, &k1);
   EXPECT_TRUE(gate.handle(valid));
   EXPECT_FALSE(gate.handle(command(6, nullptr)));  // well-formed, unsigned
@@ -111,7 +116,7 @@ TEST(CommandAuth, TheGateRefusesEachAttackForItsReasonAndCountsIt) {
 }
 
 TEST(CommandAuth, AuthenticationNoneAdmitsUnsignedCommands) {
-  SpscQueue<Command> to_loop(4);
+  auto [to_loop, loop_side] = SpscQueue<Command>::make(4);
   CommandPolicy none = kRequired;
   none.authentication = CommandAuthentication::kNone;
   CommandGate gate(none, to_loop);
@@ -129,17 +134,15 @@ TEST(CommandAuth, AReplayIsRejectedAfterARestart) {
   store.path = command_sequence_file(state.path());
   std::filesystem::remove(store.path);
   const auth::Key k1 = key(1, 0x11);
-  CommandKeys keys;
-  ASSERT_TRUE(keys.keys.add(k1));
   const std::vector<std::uint8_t> valid = command(41, &k1);
   {
-    SpscQueue<Command> to_loop(4);
-    CommandGate gate(kRequired, to_loop, keys, load_command_sequence(store.path), &store);
+    auto [to_loop, loop_side] = SpscQueue<Command>::make(4);
+    CommandGate gate(kRequired, to_loop, held(1, 0x11), load_command_sequence(store.path), &store);
     EXPECT_TRUE(gate.handle(valid));
   }
   EXPECT_EQ(load_command_sequence(store.path), 41);
-  SpscQueue<Command> to_loop(4);
-  CommandGate restarted(kRequired, to_loop, keys, load_command_sequence(store.path), &store);
+  auto [to_loop, loop_side] = SpscQueue<Command>::make(4);
+  CommandGate restarted(kRequired, to_loop, held(1, 0x11), load_command_sequence(store.path), &store);
   EXPECT_FALSE(restarted.handle(valid));
   EXPECT_EQ(restarted.last_result(), CommandResult::kRejectedOldSequence);
   EXPECT_TRUE(restarted.handle(command(42, &k1)));
@@ -151,10 +154,8 @@ TEST(CommandAuth, AnUnpersistableSequenceNumberIsNotAccepted) {
     bool store(std::int64_t) noexcept override { return false; }
   } failing;
   const auth::Key k1 = key(1, 0x11);
-  CommandKeys keys;
-  ASSERT_TRUE(keys.keys.add(k1));
-  SpscQueue<Command> to_loop(4);
-  CommandGate gate(kRequired, to_loop, keys, 0, &failing);
+  auto [to_loop, loop_side] = SpscQueue<Command>::make(4);
+  CommandGate gate(kRequired, to_loop, held(1, 0x11), 0, &failing);
   EXPECT_FALSE(gate.handle(command(1, &k1)));
   EXPECT_EQ(gate.last_result(), CommandResult::kRejectedNotPersisted);
   EXPECT_EQ(to_loop.size(), 0u);
@@ -182,7 +183,7 @@ TEST(CommandAuth, KeysComeFromTheCredentialsDirectory) {
   EXPECT_NE(keys.command.find(1), nullptr);
   EXPECT_NE(keys.command.find(2), nullptr);
   ASSERT_TRUE(keys.publish.has_value());
-  EXPECT_EQ(keys.publish->id, 5);
+  EXPECT_EQ(keys.publish->id(), 5);
   put("rpem_command-third.key", key(3, 3));
   EXPECT_THROW((void)load_credential_keys(dir.c_str()), auth::KeyError);
   std::filesystem::remove(dir / "rpem_command-third.key");

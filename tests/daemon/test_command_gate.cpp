@@ -81,7 +81,7 @@ TEST(AdmitCommand, AnythingButExactlyOneCommandIsMalformed) {
 }
 
 TEST(CommandGate, QueuesAcceptedCommandsInOrderAndCountsTheRest) {
-  SpscQueue<Command> to_loop(2);
+  auto [to_loop, loop_side] = SpscQueue<Command>::make(2);
   CommandGate gate(kOn, to_loop);
   EXPECT_TRUE(gate.handle(encode(1, rpem::command_t::FREEZE)));
   EXPECT_FALSE(gate.handle(encode(1, rpem::command_t::UNFREEZE)));  // old sequence number
@@ -92,7 +92,7 @@ TEST(CommandGate, QueuesAcceptedCommandsInOrderAndCountsTheRest) {
   EXPECT_EQ(gate.last_result(), CommandResult::kRejectedBusy);
   EXPECT_EQ(gate.last_seq(), 3);
   Command c;
-  ASSERT_TRUE(to_loop.pop(c));
+  ASSERT_TRUE(loop_side.pop(c));
   EXPECT_EQ(c.seq, 1);
   EXPECT_TRUE(gate.handle(encode(3, rpem::command_t::RESET)));
   EXPECT_EQ(gate.last_result(), CommandResult::kApplied);
@@ -101,9 +101,9 @@ TEST(CommandGate, QueuesAcceptedCommandsInOrderAndCountsTheRest) {
   EXPECT_EQ(gate.counters().malformed, 1);
   EXPECT_EQ(gate.counters().rejected, 2);
   EXPECT_EQ(gate.last_seq(), 3);  // a malformed message has no verdict
-  ASSERT_TRUE(to_loop.pop(c));
+  ASSERT_TRUE(loop_side.pop(c));
   EXPECT_EQ(c.seq, 2);
-  ASSERT_TRUE(to_loop.pop(c));
+  ASSERT_TRUE(loop_side.pop(c));
   EXPECT_EQ(c.seq, 3);
   DiagnosticsRows rows;
   gate.report(rows);
@@ -116,7 +116,7 @@ TEST(CommandGate, QueuesAcceptedCommandsInOrderAndCountsTheRest) {
 // a reload had changed them. The control thread gives the gate the reloaded policy before the next
 // message, and queues the reload before any command checked against it.
 TEST(CommandGate, AReloadedPolicyChecksTheVeryNextCommand) {
-  SpscQueue<Command> to_loop(8);
+  auto [to_loop, loop_side] = SpscQueue<Command>::make(8);
   CommandGate gate(kOn, to_loop);
   EXPECT_FALSE(gate.handle(encode(1, rpem::command_t::SET_VALUES, 1.0, 5.0)));
   EXPECT_EQ(gate.last_result(), CommandResult::kRejectedBadValues);

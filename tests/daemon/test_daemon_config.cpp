@@ -71,6 +71,36 @@ TEST(DaemonConfig, DriftsFoundByDiagnoseCalibrateTheTemperatureModel) {
   EXPECT_THROW((void)load_daemon_config(h.path()), io::ConfigError);
 }
 
+TEST(DaemonConfig, AThermalSectionInlineOrInItsOwnFileRunsTheFusion) {
+  EXPECT_FALSE(builtin_daemon_config().live.thermal_active);
+  const std::string section =
+      "thermal:\n"
+      "  nodes:\n"
+      "    - {name: winding, capacitance_J_per_K: 3000, to_coolant_W_per_K: 2}\n"
+      "    - {name: magnet, capacitance_J_per_K: 7000, to_coolant_W_per_K: 4}\n"
+      "  conductances: [{from: winding, to: magnet, W_per_K: 12}]\n"
+      "  coolant_C: 35\n";
+  const std::string machine = test::read_file(test::source_dir() + "/config/paper-ipmsm.yaml");
+  test::TempFile inline_file("thermal_inline.yaml", machine + section);
+  const DaemonConfig c = load_daemon_config(inline_file.path());
+  ASSERT_TRUE(c.live.thermal_active);
+  EXPECT_EQ(c.live.thermal.filter.network.nodes, 2);
+  EXPECT_DOUBLE_EQ(c.live.thermal.filter.network.between_W_per_K(0, 1), 12.0);
+  EXPECT_DOUBLE_EQ(c.live.thermal.coolant_C, 35.0);
+  // The file `rpem thermal fit` wrote, named relative to the configuration.
+  test::TempFile own("thermal_own.yaml", section);
+  test::TempFile named("thermal_named.yaml",
+                       machine + "daemon:\n  thermal_config: " + std::filesystem::path(own.path()).filename().string() + "\n");
+  const DaemonConfig d = load_daemon_config(named.path());
+  ASSERT_TRUE(d.live.thermal_active);
+  EXPECT_DOUBLE_EQ(d.live.thermal.filter.network.capacitance_J_per_K[1], 7000.0);
+  // Both: an error naming the key; a bad section: the thermal section's own error.
+  test::TempFile both("thermal_both.yaml", machine + section + "daemon:\n  thermal_config: x.yaml\n");
+  EXPECT_THROW((void)load_daemon_config(both.path()), io::ConfigError);
+  test::TempFile bad("thermal_bad.yaml", machine + "thermal:\n  nodes: [{name: winding, capacitance_J_per_K: -1}]\n");
+  EXPECT_THROW((void)load_daemon_config(bad.path()), io::ConfigError);
+}
+
 TEST(DaemonConfig, SourcesComeFromTheCatalogueAndOnlyTheChosenOneIsKept) {
   const test::TempFile f("both.yaml",
                          "daemon:\n  source: {type: can, can: {interface: vcan3}, sim: {scenario: builtin:rpemd-demo, loop: false}}\n");

@@ -4,7 +4,8 @@
 
 #include <cmath>
 
-#include "rpem/daemon/estimator_loop.hpp"
+#include "rpem/daemon/loop_thread.hpp"
+#include "support/loop_queues.hpp"
 #include "support/model_data.hpp"
 #include "support/paper_machine.hpp"
 
@@ -22,10 +23,10 @@ Command command(Command::Kind kind, std::int64_t seq, double psi_m_Wb = 0.0, dou
 
 struct Rig {
   DaemonConfig config = builtin_daemon_config();
-  SpscQueue<SourceSample> input{16384};
-  SpscQueue<Command> commands{16};
-  SpscQueue<Report> output{65536};
-  std::unique_ptr<EstimatorLoop> loop;
+  SpscQueue<SourceSample>::Producer input;
+  SpscQueue<Command>::Producer commands;
+  SpscQueue<Report>::Consumer output;
+  std::unique_ptr<LoopThread> loop;
   test::ModelDataGenerator gen;
   core::PerUnitBase base = test::paper_base();
   std::int64_t t_ns = 0;
@@ -36,8 +37,14 @@ struct Rig {
     gen.plant = test::paper_machine_pu();
     gen.omega_n_rad_s = base.omega_el_rad_s;
   }
-  /// A new loop with the (changed) configuration.
-  void rebuild() { loop = std::make_unique<EstimatorLoop>(config, EstimatorLoop::Queues{input, commands, output}); }
+  /// A new loop with the (changed) configuration, and new queues to it.
+  void rebuild() {
+    test::LoopQueues queues = test::loop_queues(16384, 16, 65536);
+    loop = std::make_unique<LoopThread>(config, std::move(queues.loop));
+    input = std::move(queues.input);
+    commands = std::move(queues.commands);
+    output = std::move(queues.output);
+  }
   /// Feeds `seconds` of samples, processing every millisecond as the loop would.
   void run(double seconds) {
     const int ms = static_cast<int>(seconds * 1000);

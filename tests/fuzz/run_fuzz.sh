@@ -26,7 +26,8 @@ for a in "$@"; do [[ $a != -* && -d $a ]] && a=$(cd "$a" && pwd); args+=("$a"); 
 set -- "${args[@]}"
 
 core=("$repo"/core/src/*.cpp)
-io=("$repo"/io/src/*.cpp "$build/io/builtin_config.cpp" "$repo/can/src/signal_map.cpp")  # io reads signal maps
+io=("$repo"/io/src/*.cpp "$build"/io/*.cpp "$repo/can/src/signal_map.cpp")  # io's generated sources (compiled-in
+# configuration and log map) are configure_file outputs in $build/io; io reads signal maps
 # The YAML readers' inputs cost yaml-cpp about one allocation per byte, and under ASan an allocation is most
 # of the cost (docs/benchmarks.md, "Fuzzing"). -max_len: every key of the reader in one file is 2.1 kB
 # (io/fuzz/corpus/machine_config/every-key.yaml, sim/fuzz/corpus/every-key.yaml) and the largest seed 2.9 kB,
@@ -48,9 +49,9 @@ case $target in
                        corpus=io/fuzz/corpus/drive_log ;;
   fuzz_machine_config) main=io/fuzz/fuzz_machine_config.cpp;  objs=("${io[@]}" "${core[@]}")
                        corpus=io/fuzz/corpus/machine_config; opts=("${yaml_opts[@]}") asan=$yaml_asan ;;
-  fuzz_scenario)       main=sim/fuzz/fuzz_scenario.cpp;       objs=("$repo"/sim/src/*.cpp "${io[@]}" "${core[@]}")
+  fuzz_scenario)       main=sim/fuzz/fuzz_scenario.cpp;       objs=("$repo"/sim/src/*.cpp "$repo"/can/src/{vesc_firmware,vesc,e2e}.cpp "${io[@]}" "${core[@]}")
                        corpus=sim/fuzz/corpus; opts=("${yaml_opts[@]}") asan=$yaml_asan ;;
-  fuzz_command)        main=daemon/fuzz/fuzz_command.cpp;     objs=("$repo/daemon/src/command_gate.cpp" "$repo/auth/src/mac.cpp")
+  fuzz_command)        main=daemon/fuzz/fuzz_command.cpp;     objs=("$repo/daemon/src/command_gate.cpp" "$repo/auth/src/mac.cpp" "$repo/auth/src/key.cpp")
                        corpus=daemon/fuzz/corpus
                        lcm=1 ;;  # rpemd's RPEM_COMMAND entry point: the LCM types are generated in the build
   *) echo "run_fuzz: unknown target $target" >&2; exit 2 ;;
@@ -74,7 +75,7 @@ fi
 {
   echo "cxx = clang++ -std=c++20 -O1 -g -fno-sanitize-recover=undefined $trap -I$repo/can/include -I$repo/core/include" \
        "-I$repo/io/include -I$repo/sim/include -I$repo/daemon/include -I$repo/auth/include -isystem /usr/include/eigen3" \
-       "-isystem $build/lcm_types/cpp"
+       "-isystem $build/lcm_types/cpp -I$build/lcm_types/mirror -I$repo/lcm_types/include"
   echo "rule cc"
   echo "  command = \$cxx -fsanitize=fuzzer-no-link,$sanitize -MD -MF \$out.d -c \$in -o \$out"
   echo "  depfile = \$out.d"

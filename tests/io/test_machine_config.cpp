@@ -150,6 +150,20 @@ TEST(MachineConfig, AveragedEstimatorOptionsAreReadAndChecked) {
   EXPECT_NE(error_after_edit("\n  floors:", "\n  averaged: {rate: 1}\n  floors:").find("rate"), std::string::npos);
 }
 
+TEST(MachineConfig, ReportedCommandIsReadAndNeedsTheControlPeriod) {
+  EXPECT_FALSE(load_machine_config(test::source_dir() + "/config/vesc-6374-outrunner.yaml").estimator.averaged.voltage_is_command);
+  const MachineConfig firmware = load_machine_config(test::source_dir() + "/config/vesc-6374-firmware.yaml");
+  EXPECT_TRUE(firmware.estimator.averaged.voltage_is_command);
+  EXPECT_DOUBLE_EQ(firmware.estimator.averaged.current_sample_at, 0.5);
+  EXPECT_DOUBLE_EQ(firmware.estimator.extensions.delay_s, 40e-6);
+  const std::string error = error_after_edit("\n  floors:", "\n  averaged: {voltage_reported: command}\n  floors:");
+  EXPECT_NE(error.find("voltage_reported"), std::string::npos) << error;
+  EXPECT_NE(error.find("control_period_s"), std::string::npos) << error;
+  EXPECT_NE(error_after_edit("\n  floors:", "\n  averaged: {control_period_s: 8.0e-5, voltage_reported: duty}\n  floors:")
+                .find("voltage_reported"),
+            std::string::npos);
+}
+
 TEST(MachineConfig, ModelExtensionsAreRead) {
   const std::string text = paper_text() +
                            "model_extensions:\n"

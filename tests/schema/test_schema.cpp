@@ -63,7 +63,7 @@ TEST(Schema, EachFieldListIsLcmGensReadingOfTheSameFile) {
   EXPECT_EQ(fingerprint_of_list<measurement_t>(), measurement_t::getHash());
   EXPECT_EQ(fingerprint_of_list<diagnostics_t>(), diagnostics_t::getHash());
   EXPECT_EQ(fingerprint_of_list<command_t>(), command_t::getHash());
-  EXPECT_EQ(schema::kFieldCount<estimate_t>, 21u);
+  EXPECT_EQ(schema::kFieldCount<estimate_t>, 30u);  // 21, and 9 of thermal fusion
   EXPECT_EQ(schema::kFieldCount<measurement_t>, 13u);
   EXPECT_EQ(schema::spelled_count<diagnostics_t>(), 2u);  // source, source_name
 }
@@ -151,19 +151,27 @@ TEST(Schema, ALineShowsEachFieldByNameOrLabelWithGroupsApart) {
   EXPECT_EQ(schema::format_fields(e),
             "utime 0 sample_time_us 0 samples 0 psi_m 1.0987 Wb r_s 0 Ohm psi_m_pu 0 r_s_pu 0 T_magnet 51.25 C "
             "T_winding 0 C speed_pu 0 | psi_m_valid 1 r_s_valid 0 psi_m_converged 0 r_s_converged 0 psi_m_adapting 0 "
-            "r_s_adapting 0 psi_m_age_s 0 r_s_age_s 0 frozen 0 state 2 algorithm \"gna\"");
+            "r_s_adapting 0 psi_m_age_s 0 r_s_age_s 0 frozen 0 state 2 algorithm \"gna\" | thermal_active 0 "
+            "t_magnet_fused_C 0 t_magnet_fused_sd_C 0 t_magnet_source 0 t_magnet_observed_age_s 0 t_winding_fused_C 0 "
+            "t_winding_fused_sd_C 0 t_winding_source 0 t_winding_observed_age_s 0");
   constexpr std::array<std::string_view, 3> kShownElsewhere{"utime", "samples", "algorithm"};
   static_assert(schema::has_fields<estimate_t>(kShownElsewhere));
   static_assert(!schema::has_fields<estimate_t>(std::array<std::string_view, 1>{"psi_m"}));  // a label is not a name
   const std::string rest = schema::format_fields(e, kShownElsewhere);
   EXPECT_TRUE(rest.starts_with("sample_time_us 0 psi_m 1.0987 Wb r_s 0 Ohm")) << rest;
-  EXPECT_TRUE(rest.ends_with("frozen 0 state 2")) << rest;
+  EXPECT_TRUE(rest.ends_with("frozen 0 state 2 | thermal_active 0 t_magnet_fused_C 0 t_magnet_fused_sd_C 0 "
+                             "t_magnet_source 0 t_magnet_observed_age_s 0 t_winding_fused_C 0 t_winding_fused_sd_C 0 "
+                             "t_winding_source 0 t_winding_observed_age_s 0")) << rest;
 }
 
 TEST(Schema, TheCsvHasAColumnPerNumberFormattedAsAStreamFormatsIt) {
+  // The thermal fusion's fields label the fused temperatures [T_magnet] and [T_winding], as the raw ones
+  // are: a label is a unique key, so the raw ones keep it and the fused ones their names (schema_gen.py).
   EXPECT_EQ(schema::csv_header<estimate_t>(),
             "utime,sample_time_us,samples,psi_m,r_s,psi_m_pu,r_s_pu,T_magnet,T_winding,speed_pu,psi_m_valid,r_s_valid,"
-            "psi_m_converged,r_s_converged,psi_m_adapting,r_s_adapting,psi_m_age_s,r_s_age_s,frozen,state");
+            "psi_m_converged,r_s_converged,psi_m_adapting,r_s_adapting,psi_m_age_s,r_s_age_s,frozen,state,"
+            "thermal_active,t_magnet_fused_C,t_magnet_fused_sd_C,t_magnet_source,t_magnet_observed_age_s,"
+            "t_winding_fused_C,t_winding_fused_sd_C,t_winding_source,t_winding_observed_age_s");
   estimate_t e{};
   e.utime = 1'700'000'000'123'456;
   e.psi_m_Wb = 1.09872345;
@@ -171,7 +179,7 @@ TEST(Schema, TheCsvHasAColumnPerNumberFormattedAsAStreamFormatsIt) {
   e.frozen = 1;
   e.state = 3;
   e.algorithm = "sga";  // not a column: every column is a number
-  EXPECT_EQ(schema::csv_row(e), "1700000000123456,0,0,1.09872,0,0,0,0,0,0,0,0,0,0,0,0,0,-1,1,3");
+  EXPECT_EQ(schema::csv_row(e), "1700000000123456,0,0,1.09872,0,0,0,0,0,0,0,0,0,0,0,0,0,-1,1,3,0,0,0,0,0,0,0,0,0");
 
   // Each number as `std::ostream << double` writes it (6 significant digits, %g), over seeded random values.
   std::mt19937_64 rng(20261124);

@@ -105,6 +105,13 @@ class Refuses(unittest.TestCase):
     def test_a_duplicate_field(self):
         self.refused("package rpem;\nstruct probe_t {\n  double x;\n  double x;\n}\n", "rpem_probe_t.lcm:4:10:", "declared twice")
 
+    def test_a_label_taken_by_an_earlier_field(self):
+        code, err, out = run("package rpem;\nstruct probe_t {\n  double t_C;  // [T] raw\n  double u_C;  // [T] fused\n}\n")
+        self.assertEqual(code, 0, err)
+        self.assertIn("rpem_probe_t.lcm:4:10: warning: label [T] is taken by an earlier field; 'u_C' keeps its name", err)
+        self.assertIn('FieldInfo{"t_C", "double", "T", "C", "", "raw"}', out)
+        self.assertIn('FieldInfo{"u_C", "double", "", "C", "", "fused"}', out)
+
     def test_two_structs_in_one_file(self):
         self.refused("package rpem;\nstruct probe_t { double x; }\nstruct other_t { double y; }\n", "rpem_probe_t.lcm",
                      "one per file")

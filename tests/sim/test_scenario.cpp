@@ -47,6 +47,36 @@ struct Bad {
 };
 class BadScenario : public ::testing::TestWithParam<Bad> {};
 
+TEST(Scenario, RegimesLoadAndSetTheirDefaults) {
+  const Scenario s = parse_scenario(
+      "duration_s: 3\nplant: {mechanics: {mode: inertia}}\ninitial: {load_torque_Nm: 0.2}\n"
+      "regimes:\n  - {t_s: 0.5, regime: open_loop, current_A: 20, speed_rpm: -300, ramp_s: 1, control: speed}\n"
+      "  - {t_s: 2, regime: bridge_off, report: zero}\n"
+      "  - {t_s: 2.5, regime: open_loop, current_A: 9, speed_rpm: 100, ramp_s: 0.2, lock_s: 0.1, hold_s: 0, then: bridge_off}\n",
+      "r.yaml", "");
+  EXPECT_TRUE(s.separate_load);
+  ASSERT_EQ(s.regimes.size(), 3U);
+  const RegimeEvent& a = s.regimes[0];
+  EXPECT_EQ(a.regime, DriveRegime::kOpenLoop);
+  EXPECT_EQ(a.then, DriveRegime::kClosedLoop);
+  EXPECT_EQ(a.control, ControlOverride::kSpeed);
+  EXPECT_DOUBLE_EQ(a.speed_rpm, -300.0);
+  EXPECT_DOUBLE_EQ(a.lock_s, 0.0);
+  EXPECT_DOUBLE_EQ(a.hold_s, 0.05);  // VESC's foc_sl_openloop_time default
+  EXPECT_EQ(s.regimes[1].report, OffVoltageReport::kZero);
+  EXPECT_EQ(s.regimes[2].then, DriveRegime::kBridgeOff);
+  EXPECT_EQ(s.regimes[2].report, OffVoltageReport::kBackEmf);
+  RegimeTimeline timeline(s.regimes);
+  EXPECT_EQ(timeline.at(0.4).regime, DriveRegime::kClosedLoop);
+  EXPECT_EQ(timeline.at(0.5).regime, DriveRegime::kOpenLoop);
+  EXPECT_DOUBLE_EQ(timeline.at(1.0).open_loop_speed_rpm, -150.0);  // half-way up the ramp
+  EXPECT_DOUBLE_EQ(timeline.at(1.52).open_loop_speed_rpm, -300.0);
+  EXPECT_EQ(timeline.at(1.56).regime, DriveRegime::kClosedLoop);  // after 0 + 1 + 0.05 s: the observer
+  EXPECT_EQ(timeline.at(2.0).regime, DriveRegime::kBridgeOff);
+  EXPECT_DOUBLE_EQ(timeline.at(2.55).open_loop_speed_rpm, 0.0);  // locked
+  EXPECT_EQ(timeline.at(2.81).regime, DriveRegime::kBridgeOff);  // released after 0.1 + 0.2 + 0 s
+}
+
 TEST_P(BadScenario, IsRejectedWithLine) {
   try {
     (void)parse_scenario(GetParam().text, "bad.yaml", "");
@@ -82,6 +112,27 @@ INSTANTIATE_TEST_SUITE_P(
         Bad{"edges_averaged", "duration_s: 1\ninverter: {model: averaged}\nplant: {integrator: edges}\n",
             "plant.integrator: edges needs inverter.model: switching"},
         Bad{"machine", "duration_s: 1\nmachine: nowhere.yaml\n", "nowhere.yaml: cannot open file"},
+        Bad{"regime_order", "duration_s: 1\nregimes:\n  - {t_s: 1, regime: bridge_off}\n  - {t_s: 1, regime: closed_loop}\n",
+            "bad.yaml:4:11: regimes[1].t_s: regime events must be in strictly increasing time"},
+        Bad{"regime_name", "duration_s: 1\nregimes:\n  - {t_s: 1, regime: coasting}\n",
+            "bad.yaml:3:22: regimes[0].regime: 'coasting' is not one of: closed_loop, open_loop, bridge_off"},
+        Bad{"open_loop_current", "duration_s: 1\nregimes:\n  - {t_s: 1, regime: open_loop, speed_rpm: 300, ramp_s: 1}\n",
+            "regimes[0].current_A: required key is missing"},
+        Bad{"open_loop_direction", "duration_s: 1\nregimes:\n  - {t_s: 1, regime: open_loop, current_A: 5, speed_rpm: 0, ramp_s: 1}\n",
+            "regimes[0].speed_rpm: must not be 0"},
+        Bad{"released_with_control",
+            "duration_s: 1\nregimes:\n  - {t_s: 1, regime: open_loop, current_A: 5, speed_rpm: 9, ramp_s: 1, then: bridge_off, "
+            "control: torque}\n",
+            "regimes[0].control: unknown key"},
+        Bad{"regime_speed_on_dyno", "duration_s: 1\nregimes:\n  - {t_s: 1, regime: closed_loop, control: speed}\n",
+            "regimes[0].control: speed control needs plant.mechanics.mode: inertia"},
+        Bad{"report", "duration_s: 1\nregimes:\n  - {t_s: 1, regime: bridge_off, report: none}\n",
+            "regimes[0].report: 'none' is not one of: back_emf, zero"},
+        Bad{"load_on_dyno", "duration_s: 1\ninitial: {load_torque_Nm: 1}\n",
+            "bad.yaml:2:27: initial.load_torque_Nm: needs plant.mechanics.mode: inertia"},
+        Bad{"load_event_on_dyno", "duration_s: 1\nevents:\n  - {t_s: 1, quantity: load_torque_Nm, kind: step, value: 1}\n",
+            "events[0].quantity: load_torque_Nm needs plant.mechanics.mode: inertia"},
+        Bad{"vesc_key", "duration_s: 1\nvesc: {wheel_mm: 3}\n", "bad.yaml:2:8: vesc.wheel_mm: unknown key"},
         // A directory opens and then fails to read: it escaped as std::ios_base::failure (fuzz_scenario).
         Bad{"machine_directory", "duration_s: 1\nmachine: /\n", "/: is a directory, not a file"}),
     [](const auto& p) { return std::string(p.param.name); });

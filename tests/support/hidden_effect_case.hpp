@@ -16,6 +16,7 @@
 #include "support/hidden_effects.hpp"
 #include "rpem/sim/flux_map.hpp"
 #include "support/data_file.hpp"
+#include "support/diagnosis_detail.hpp"
 #include "support/temp_file.hpp"
 
 namespace rpem::test {
@@ -151,6 +152,7 @@ inline CaseOutcome run_hidden_case(const HiddenCase& c) {
   for (const auto& h : hidden) out.detail += " " + h.name;
   out.detail += hidden.empty() ? " none" : "";
   out.detail += "; found:" + (found_names.empty() ? std::string(" none") : found_names) + ";";
+  out.detail += fitting_detail(d);
 
   if (beckhoff) {
     // The map's L_q, 15-20 % above the data sheet's, must be found: as lq_saturation, or as the calibrated

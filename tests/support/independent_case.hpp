@@ -18,6 +18,7 @@
 #include "indep_drive/profile.hpp"
 #include "rpem/analysis/diagnose/diagnose_output.hpp"
 #include "rpem/io/machine_config.hpp"
+#include "support/diagnosis_detail.hpp"
 #include "support/temp_file.hpp"
 
 namespace rpem::test {
@@ -295,8 +296,9 @@ inline IndependentOutcome run_independent_case(const IndependentCase& ic) {
       parameters_ok = parameters_ok && x.within();
     }
   }
-  std::snprintf(buf, sizeof buf, " verdict %s (%.2f× the floor)", d.verdict.explained ? "explained" : "unexplained", d.verdict.ratio);
+  std::snprintf(buf, sizeof buf, " verdict %s (%.2f× the floor)", analysis::to_string(d.verdict.kind), d.verdict.ratio.value_or(0.0));
   out.detail += buf;
+  out.detail += fitting_detail(d);
   out.correct = names_ok && parameters_ok && psi_ok && rs_ok;
   return out;
 }

@@ -8,6 +8,7 @@
 //   - the VESC's stolen reads are found where check_vesc_rpemd.py looks.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <fstream>
@@ -16,6 +17,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 #include <thread>
+#include <cstdint>
 #include <type_traits>
 #include <vector>
 
@@ -149,6 +151,38 @@ print(json.dumps(out))
   const auto signal_map_heard = j["signal_map"].get<std::map<std::string, std::int64_t>>();
   EXPECT_EQ(signal_map_heard, signal_map) << heard.output;
   EXPECT_EQ(j["stolen"].get<std::int64_t>(), d.vesc_stolen_reads);
+}
+
+// A message whose string length field is 0 (lcm-gen's decoder throws on it: schema/decode.hpp), sent by anyone
+// on the channel: counted and named on stderr, never the end of `rpem listen`; the next message is heard.
+TEST(CliListenFormat, AMessageThatDoesNotDecodeIsCountedNotACrash) {
+  estimate_t e{};
+  e.algorithm = "x";
+  std::vector<std::uint8_t> crafted(static_cast<std::size_t>(e.getEncodedSize()));
+  ASSERT_EQ(e.encode(crafted.data(), 0, static_cast<int>(crafted.size())), static_cast<int>(crafted.size()));
+  const std::vector<std::uint8_t> length_and_text{0, 0, 0, 2, 'x', 0};  // big-endian strlen + 1, then "x\0"
+  const auto at = std::search(crafted.begin(), crafted.end(), length_and_text.begin(), length_and_text.end());
+  ASSERT_NE(at, crafted.end());
+  at[3] = 0;
+
+  test::ProcessResult heard;
+  std::thread listener([&] {
+    heard = test::run_command(test::binary_dir() + "/tools/rpem listen --duration 2.0 --lcm-url '" + kUrl + "'");
+  });
+  {
+    lcm::LCM lcm(kUrl);
+    ASSERT_TRUE(lcm.good());
+    std::this_thread::sleep_for(std::chrono::milliseconds(800));  // the listener subscribes
+    lcm.publish("RPEM_ESTIMATE", crafted.data(), static_cast<unsigned>(crafted.size()));
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    lcm.publish("RPEM_ESTIMATE", &e);
+  }
+  listener.join();
+  EXPECT_EQ(heard.exit_code, 0) << heard.output;
+  EXPECT_NE(heard.output.find("RPEM_ESTIMATE: " + std::to_string(crafted.size()) + " bytes that are not one estimate_t: ignored"),
+            std::string::npos) << heard.output;
+  EXPECT_NE(heard.output.find("1 estimates"), std::string::npos) << heard.output;
+  EXPECT_NE(heard.output.find("; 1 malformed"), std::string::npos) << heard.output;
 }
 
 }  // namespace

@@ -1,6 +1,7 @@
 // The logs people have, as a user runs the tools on them (docs/drive-log.md): a VESC Tool realtime log
 // (detected by its header, no flag), the Paderborn bench data as published and SimpleFOC's monitor output
-// (through their maps in config/log-maps/), each read end to end by `rpem estimate` and `rpem diagnose`;
+// (through their maps in config/log-maps/), each read end to end by `rpem estimate`, `rpem diagnose` and
+// `rpem figures --log`;
 // and the exit codes and messages of a bad map (78) and of a log a map cannot read (65).
 #include <gtest/gtest.h>
 
@@ -69,10 +70,49 @@ TEST_F(CliLogFormats, AVescToolLogIsReadWithoutAFlag) {
   EXPECT_NE(d.output.find("119 samples, steady_state model"), std::string::npos) << d.output;
 }
 
+TEST_F(CliLogFormats, FiguresDrawAVescToolLogsRegimes) {
+  // Every row modulates at a locked angle and excites ψm (ω·ψm ≈ 3–7 V against VESC Tool's 10 mV): nothing is
+  // bridge off or not locked, and the timeline is drawn.
+  const std::string log = vesc_log(120);
+  const test::ProcessResult r = test::run_command(rpem() + " figures --log " + log + " --config " + vesc_config() +
+                                                  " --out " + path("fig"));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("rpem figures: read " + log + " as VESC Tool realtime log"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("not_locked 0, bridge_off 0,"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("rpem figures: wrote " + path("fig") + "/regimes.png"), std::string::npos) << r.output;
+  EXPECT_GT(fs::file_size(path("fig/regimes.png")), 10'000u);
+  EXPECT_TRUE(fs::exists(path("fig/Fig_EigenTraj.png")));
+}
+
+TEST_F(CliLogFormats, FiguresReadAMappedLogAndRefuseABadOneBeforeDrawing) {
+  // The first 101 rows of the carried profile (header + 100; a log needs at least 80).
+  const std::string log = path("profile.csv");
+  {
+    std::ifstream in(test::source_dir() + "/data/paderborn-motor-temperature/profile_A_every5th.csv");
+    std::ofstream out(log);
+    std::string line;
+    for (int k = 0; k < 101 && std::getline(in, line); ++k) out << line << "\n";
+  }
+  const std::string map = " --log-map " + maps() + "paderborn-motor-temperature.yaml";
+  const std::string config = " --config " + test::source_dir() + "/config/paderborn-pmsm.yaml";
+  const test::ProcessResult r = test::run_command(rpem() + " figures --log " + log + map + config + " --out " + path("fig"));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("read through the map"), std::string::npos) << r.output;
+  EXPECT_TRUE(fs::exists(path("fig/regimes.png")));
+  // A row the map cannot read: exit 65 with the file and line, and no figure drawn.
+  std::ofstream(log, std::ios::app) << "not,a,row\n";
+  const test::ProcessResult bad = test::run_command(rpem() + " figures --log " + log + map + config + " --out " + path("bad"));
+  EXPECT_EQ(bad.exit_code, 65) << bad.output;
+  EXPECT_NE(bad.output.find("profile.csv:102"), std::string::npos) << bad.output;
+  EXPECT_FALSE(fs::exists(path("bad")));
+  // --log-map without --log is a usage error.
+  EXPECT_EQ(test::run_command(rpem() + " figures" + map + " --out " + path("bad")).exit_code, 64);
+}
+
 TEST_F(CliLogFormats, AVescToolLogWithoutDqVoltagesIsRefusedWithTheVersion) {
   const std::string log = path("old.csv");
   std::ofstream(log) << test::vesc_tool::kHeader117 << test::vesc_tool::values22(1000, 40, 50, 0, 1, 100) << "\n";
-  for (const std::string sub : {"estimate", "diagnose"}) {
+  for (const std::string sub : {"estimate", "diagnose", "figures"}) {
     const test::ProcessResult r = test::run_command(rpem() + " " + sub + " --log " + log + " --out " + path("o"));
     EXPECT_EQ(r.exit_code, 65) << sub << r.output;
     EXPECT_NE(r.output.find("old.csv:1: column d_axis_voltage: not in this VESC Tool realtime log (the header of VESC "

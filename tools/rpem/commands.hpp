@@ -28,5 +28,6 @@ Runner add_command_command(CLI::App& app);
 Runner add_publish_estimate_command(CLI::App& app);
 Runner add_keygen_command(CLI::App& app);
 Runner add_diagnose_command(CLI::App& app);
+Runner add_thermal_command(CLI::App& app);
 
 }  // namespace rpem::tools

@@ -18,13 +18,15 @@
 #include "rpem/analysis/diagnose/diagnose_output.hpp"
 #include "rpem/analysis/work_pool.hpp"
 #include "rpem/io/errors.hpp"
+#include "rpem/io/number_format.hpp"
+#include "rpem/io/sample_counts.hpp"
 
 namespace rpem::tools {
 namespace {
 
 struct DiagnoseCliOptions {
   std::string log, log_map, config, out, truth, model = "auto";
-  double reference_C = 20.0;
+  double reference_C = analysis::DiagnoseOptions{}.reference_C;
   double switching_frequency_Hz = 0.0;
   analysis::SelectionOptions selection;
   int blocks = 40;
@@ -87,6 +89,9 @@ int run_diagnose(const DiagnoseCliOptions& o) {
   analysis::LogOptions log_options;
   log_options.blocks = o.blocks;
   log_options.log_map = o.log_map;
+  log_options.voltage_is_command = config.estimator.averaged.voltage_is_command;
+  log_options.control_period_s = config.estimator.averaged.control_period_s;
+  log_options.command_delay_s = config.estimator.extensions.delay_s;
   if (o.model != "auto") {
     log_options.mode = o.model == "transient" ? analysis::ModelMode::kTransient : analysis::ModelMode::kSteadyState;
   }
@@ -122,6 +127,8 @@ int diagnose_and_write(const DiagnoseCliOptions& o, const io::MachineConfig& con
                analysis::to_string(log.mode), o.jobs);
   const analysis::Diagnosis d = analysis::diagnose(std::move(log), config, options, truth);
   monitor.finish();
+  std::fprintf(stderr, "rpem diagnose: %s\n", io::regime_summary(d.regimes.counts).c_str());
+  for (const std::string& why : d.regimes.explanations) std::fprintf(stderr, "rpem diagnose: %s\n", why.c_str());
 
   StagedOutput staged(o.out);
   try {
@@ -146,7 +153,14 @@ int diagnose_and_write(const DiagnoseCliOptions& o, const io::MachineConfig& con
     }
   }
   std::printf("\n");
+  for (const std::string& f : analysis::calibrated_despite_mismatch(d)) std::printf("calibrated despite a large mismatch: %s\n", f.c_str());
   for (const std::string& f : analysis::calibration_findings(d)) std::printf("calibration: %s\n", f.c_str());
+  if (d.least_squares) {
+    std::printf("outliers: %zu of %zu training samples beyond %.3g A moved the least-squares fit (%s by %.2g times its 95 %% "
+                "half-width): diagnosed again under Huber's loss, b = %.3g A after %d run%s\n",
+                d.outliers.test.beyond, d.outliers.test.samples, d.outliers.test.threshold_A, d.outliers.parameter.c_str(),
+                d.outliers.largest_shift, d.outliers.loss.threshold_A, d.outliers.robust_runs, d.outliers.robust_runs == 1 ? "" : "s");
+  }
   if (s.found.empty()) std::printf("effects: none\n");
   for (std::size_t j = 0; j < s.found.size(); ++j) {
     std::printf("effect %s:", s.found[j].effect.label().c_str());
@@ -169,8 +183,12 @@ int diagnose_and_write(const DiagnoseCliOptions& o, const io::MachineConfig& con
     std::printf("not identifiable: %s\n", names.c_str());
   }
   std::printf("extended model: held-out residual %.4g A RMS\n", s.extended_heldout_rms_A);
-  std::printf("verdict: %s (%.3g times the noise floor of %.3g A)\n", d.verdict.explained ? "explained" : "unexplained",
-              d.verdict.ratio, d.verdict.noise_floor_A);
+  if (d.verdict.ratio) {
+    std::printf("verdict: %s (%.3g times the noise floor of %.3g A)\n", analysis::to_string(d.verdict.kind), *d.verdict.ratio,
+                d.verdict.noise_floor_A.value_or(0.0));
+  } else {
+    std::printf("verdict: %s (noise floor unknown)\n", analysis::to_string(d.verdict.kind));
+  }
   for (const std::string& f : d.verdict.findings) std::printf("  %s\n", f.c_str());
   std::printf("wrote %s/report.html, report.md, diagnosis.json, extended.yaml (%.2f s)\n", o.out.c_str(), d.elapsed_s);
   return kExitOk;
@@ -199,8 +217,9 @@ Runner add_diagnose_command(CLI::App& app) {
       ->check(CLI::ExistingFile);
   cmd->add_option("--model", o->model, "replay model: auto (from the sample interval), transient, steady_state")
       ->check(CLI::IsMember({"auto", "transient", "steady_state"}));
-  cmd->add_option("--reference-temperature-C", o->reference_C,
-                  "temperature to which found drift laws are referred (default 20)");
+  std::string reference_help = "temperature to which found drift laws are referred (default ";
+  io::append_number(reference_help, o->reference_C);
+  cmd->add_option("--reference-temperature-C", o->reference_C, reference_help + ")");
   cmd->add_option("--switching-frequency-Hz", o->switching_frequency_Hz,
                   "PWM frequency, to report dead time in seconds (default: model_extensions.deadtime's)")
       ->check(CLI::PositiveNumber);

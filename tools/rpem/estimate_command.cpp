@@ -1,11 +1,14 @@
 // rpem estimate --log LOG.csv [--log-map MAP.yaml] --config CFG.yaml --out EST.csv [--algorithm sga|gna|phyint]
-//              [--every N | --rate HZ]
+//              [--every N | --rate HZ] [--thermal THERMAL.yaml]
 // Runs the estimator offline over a drive log, exactly as rpemd would run it online: a log of instantaneous
 // samples through DriveEstimator, a log of averaged samples (our averaged log, VESC Tool's realtime log, a
-// map of averaged samples; docs/drive-log.md) through AveragedDriveEstimator.
+// map of averaged samples; docs/drive-log.md) through AveragedDriveEstimator. With --thermal, the thermal
+// network's filter runs beside it as in rpemd (core::ThermalFusion, docs/thermal.md) and the estimate CSV
+// gains the fused temperatures.
 
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <optional>
 #include <string>
 
@@ -18,6 +21,8 @@
 #include "rpem/io/estimate_log.hpp"
 #include "rpem/io/log_source.hpp"
 #include "rpem/io/machine_config.hpp"
+#include "rpem/io/sample_counts.hpp"
+#include "rpem/io/thermal_config.hpp"
 
 namespace rpem::tools {
 namespace {
@@ -28,6 +33,7 @@ struct EstimateOptions {
   std::string config;
   std::string out;
   std::string algorithm;
+  std::string thermal;
   long every = 1;
   double rate_Hz = 0.0;
 };
@@ -54,20 +60,53 @@ class Decimation {
   std::int64_t next_ns_ = 0;  ///< the grid's next point (--rate), once a sample was seen
 };
 
+/// The thermal filter beside the estimator, when --thermal is given.
+class ThermalRun {
+ public:
+  ThermalRun(const EstimateOptions& o, const io::MachineConfig& cfg, const core::PerUnitBase& base) {
+    if (o.thermal.empty()) return;
+    const io::ThermalConfig t = io::load_thermal_config(o.thermal, cfg);
+    for (int i = 0; i < t.fusion.filter.network.nodes; ++i) names_.push_back(t.node_names[static_cast<std::size_t>(i)]);
+    fusion_.emplace(t.fusion, base, cfg.machine);
+  }
+  [[nodiscard]] const std::vector<std::string>& node_names() const { return names_; }
+  /// The sample's temperatures; `t_ns` its time (the interval since the previous sample is the time it stands for).
+  void step(const core::Estimate& e, std::int64_t t_ns, double coolant_C, double winding_C) {
+    if (!fusion_) return;
+    core::ThermalSample s;
+    s.dt_s = previous_ns_ ? 1e-9 * static_cast<double>(t_ns - *previous_ns_) : 0.0;
+    s.coolant_C = coolant_C;
+    s.winding_sensor_C = winding_C;
+    previous_ns_ = t_ns;
+    fusion_->step(e, s);
+  }
+  [[nodiscard]] const core::ThermalEstimate* estimate() const { return fusion_ ? &fusion_->estimate() : nullptr; }
+
+ private:
+  std::vector<std::string> names_;
+  std::optional<core::ThermalFusion> fusion_;
+  std::optional<std::int64_t> previous_ns_;
+};
+
+/// What the run did, for its summary on stderr: the last estimate and the samples per regime.
 struct Tally {
-  std::uint64_t rows = 0, resyncs = 0;
+  io::SampleCounts counts;
   core::Estimate last;
   void count(const core::Estimate& e) {
     last = e;
-    ++rows;
-    if (e.detail.code == core::StepCode::kSynchronized || e.detail.code == core::StepCode::kPredictorDiverged) ++resyncs;
+    counts.add(e);
   }
   [[nodiscard]] std::string summary(core::Algorithm a, const char* kind) const {
     char text[256];
     std::snprintf(text, sizeof text, "%llu %s, psi_m = %.5f Wb, r_s = %.5f Ohm (%s), %llu resyncs",
-                  static_cast<unsigned long long>(rows), kind, last.psi_m_Wb, last.r_s_Ohm, io::to_string(a),
-                  static_cast<unsigned long long>(resyncs));
+                  static_cast<unsigned long long>(counts.samples), kind, last.psi_m_Wb, last.r_s_Ohm, io::to_string(a),
+                  static_cast<unsigned long long>(counts.resyncs));
     return text;
+  }
+  /// The regimes' counts, and why, where more than a tenth of the samples adapted nothing.
+  void explain() const {
+    std::fprintf(stderr, "rpem estimate: %s\n", io::regime_summary(counts).c_str());
+    for (const std::string& why : io::exclusion_explanations(counts)) std::fprintf(stderr, "rpem estimate: %s\n", why.c_str());
   }
 };
 
@@ -78,16 +117,20 @@ int run_averaged(const EstimateOptions& o, const io::LogSource& source, const io
       io::read_averaged_log(o.log, source.map, io::machine_limits(cfg.machine), &read);
   std::fprintf(stderr, "rpem estimate: %s\n", io::describe(source, read).c_str());
   io::check_averaged_supports(cfg, config_name, read.layout.u_dc, o.log);
-  io::EstimateLogWriter writer(o.out);
   core::AveragedDriveEstimator estimator(cfg.machine, cfg.estimator);
+  ThermalRun thermal(o, cfg, estimator.base());
+  io::EstimateLogWriter writer(o.out, thermal.node_names());
   Tally tally;
+  tally.counts.averaged = true;
   Decimation decimation(o);
   for (const core::AveragedSample& s : samples) {
     const core::Estimate e = estimator.step(s);
-    if (decimation.take(e.t_ns)) writer.write(e, estimator.core());
+    thermal.step(e, s.t_ns, s.t_coolant_C, s.t_winding_C);
+    if (decimation.take(e.t_ns)) writer.write(e, estimator.core(), thermal.estimate());
     tally.count(e);
   }
   std::fprintf(stderr, "rpem estimate: %s\n", tally.summary(cfg.estimator.algorithm, "averaged samples").c_str());
+  tally.explain();
   return kExitOk;
 }
 
@@ -101,20 +144,24 @@ int run_estimate(const EstimateOptions& o) {
   io::DriveLogReader reader(o.log, source.map, io::machine_limits(cfg.machine));
   if (!source.map.columns_optional) std::fprintf(stderr, "rpem estimate: reading %s as %s\n", o.log.c_str(), source.format.c_str());
   io::check_log_supports(cfg, config_name, reader.layout().u_dc, o.log);
-  io::EstimateLogWriter writer(o.out);
   core::DriveEstimator estimator(cfg.machine, cfg.estimator);
+  ThermalRun thermal(o, cfg, estimator.base());
+  io::EstimateLogWriter writer(o.out, thermal.node_names());
   Progress progress("rpem estimate");
 
   io::DriveLogRow row;
   Tally tally;
+  constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
   Decimation decimation(o);
   while (reader.next(row)) {
     const core::Estimate e = estimator.step(row.sample);
-    if (decimation.take(e.t_ns)) writer.write(e, estimator);
+    thermal.step(e, row.sample.t_ns, row.t_coolant_C.value_or(kNaN), row.t_winding_C.value_or(kNaN));
+    if (decimation.take(e.t_ns)) writer.write(e, estimator, thermal.estimate());
     tally.count(e);
-    if ((tally.rows & 0xFFF) == 0) progress.update(reader.bytes_read(), reader.bytes_total());
+    if ((tally.counts.samples & 0xFFF) == 0) progress.update(reader.bytes_read(), reader.bytes_total());
   }
   progress.finish(tally.summary(cfg.estimator.algorithm, "samples") + io::describe(reader.reader().repairs()));
+  tally.explain();
   return kExitOk;
 }
 
@@ -142,6 +189,8 @@ Runner add_estimate_command(CLI::App& app) {
                   "e.g. 100 for an 8 kHz log: 1/80 of the file (docs/drive-log.md, \"Estimate CSV\")")
       ->check(CLI::PositiveNumber)
       ->excludes(every);
+  cmd->add_option("--thermal", opts->thermal, "thermal.yaml: run the thermal network's filter beside the estimator (docs/thermal.md)")
+      ->check(CLI::ExistingFile);
   return [cmd, opts]() { return cmd->parsed() ? run_estimate(*opts) : -1; };
 }
 

@@ -1,12 +1,21 @@
-// rpem figures --out DIR [--config CFG.yaml]
+// rpem figures --out DIR [--config CFG.yaml] [--log LOG.csv [--log-map MAP.yaml]]
+// rpem figures --out DIR --thermal-estimate EST.csv [--measured CSV [--magnet-column C] [--winding-column C]]
+//              [--judged-after-s T]
 // The paper's analysis figures (Fig_EigenTraj, Fig_sensitivity, fig_PEG_analytical, fig_hesscompstatic)
-// for the configured machine.
+// for the configured machine; with --log also the log's timeline coloured by regime (regimes.png, as
+// `rpem diagnose` draws it), for any log `rpem estimate` and `rpem diagnose` read (io::log_source); or,
+// with --thermal-estimate, the fused temperatures of `rpem estimate --thermal` against measured ones with
+// the ±2σ band (thermal_fused.png; docs/thermal.md, "Figures").
 
 #include <cstdio>
 #include <filesystem>
+#include <optional>
 
 #include "commands.hpp"
 #include "rpem/analysis/analysis_figures.hpp"
+#include "rpem/analysis/diagnose/diagnose_output.hpp"
+#include "rpem/analysis/diagnose/regimes.hpp"
+#include "rpem/analysis/thermal/thermal_figure.hpp"
 #include "rpem/io/machine_config.hpp"
 
 namespace rpem::tools {
@@ -15,12 +24,42 @@ namespace {
 struct FiguresOptions {
   std::string out;
   std::string config;
+  std::string log;
+  std::string log_map;
+  analysis::ThermalFigureInput thermal;
 };
 
 int run_figures(const FiguresOptions& o) {
+  if (!o.thermal.estimate_csv.empty()) {
+    std::filesystem::create_directories(o.out);
+    const std::string png = o.out + "/thermal_fused.png";
+    const analysis::ThermalFigureCoverage c = analysis::write_thermal_figure(png, o.thermal);
+    std::fprintf(stderr, "rpem figures: wrote %s", png.c_str());
+    if (!o.thermal.measured_csv.empty()) {
+      std::fprintf(stderr, " (measured inside ±2σ: magnet %.1f %%, winding %.1f %%)", 100.0 * c.magnet, 100.0 * c.winding);
+    }
+    std::fprintf(stderr, "\n");
+    return kExitOk;
+  }
   const io::MachineConfig cfg = o.config.empty() ? io::builtin_paper_config() : io::load_machine_config(o.config);
+  // The log first: a log that cannot be read fails before any figure is drawn.
+  std::optional<analysis::LogData> log;
+  analysis::LogRegimes regimes;
+  if (!o.log.empty()) {
+    analysis::LogOptions options;
+    options.log_map = o.log_map;
+    options.voltage_is_command = cfg.estimator.averaged.voltage_is_command;
+    options.control_period_s = cfg.estimator.averaged.control_period_s;
+    options.command_delay_s = cfg.estimator.extensions.delay_s;
+    log = analysis::load_log(o.log, cfg.machine, options);
+    std::fprintf(stderr, "rpem figures: read %s\n", log->format.c_str());
+    regimes = analysis::classify_regimes(*log, cfg);
+    std::fprintf(stderr, "rpem figures: %s\n", io::regime_summary(regimes.counts).c_str());
+    for (const std::string& why : regimes.explanations) std::fprintf(stderr, "rpem figures: %s\n", why.c_str());
+  }
   std::filesystem::create_directories(o.out);
-  const auto files = analysis::write_analysis_figures(o.out, cfg.machine, cfg.estimator.nominal_sample_period_s);
+  auto files = analysis::write_analysis_figures(o.out, cfg.machine, cfg.estimator.nominal_sample_period_s);
+  if (log) files.push_back(o.out + "/" + analysis::write_regime_timeline(o.out, *log, regimes, cfg.machine.rated.pole_pairs));
   for (const auto& f : files) std::fprintf(stderr, "rpem figures: wrote %s\n", f.c_str());
   return kExitOk;
 }
@@ -29,9 +68,24 @@ int run_figures(const FiguresOptions& o) {
 
 Runner add_figures_command(CLI::App& app) {
   auto opts = std::make_shared<FiguresOptions>();
-  CLI::App* cmd = app.add_subcommand("figures", "Write the paper's analysis figures for a machine (PNG)");
+  CLI::App* cmd = app.add_subcommand("figures", "Write the paper's analysis figures for a machine (PNG), and a log's regimes");
   cmd->add_option("--out", opts->out, "output directory")->required();
   cmd->add_option("--config", opts->config, "machine YAML (default: built-in paper-ipmsm.yaml)")->check(CLI::ExistingFile);
+  cmd->add_option("--log", opts->log,
+                  "also draw this log's timeline coloured by regime (regimes.png): a drive log, averaged log or VESC Tool "
+                  "realtime log (detected by its header), or any CSV with --log-map")
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--log-map", opts->log_map, "column map (YAML) saying how to read --log (docs/drive-log.md, \"Column maps\")")
+      ->check(CLI::ExistingFile)
+      ->needs("--log");
+  cmd->add_option("--thermal-estimate", opts->thermal.estimate_csv,
+                  "instead: plot this `rpem estimate --thermal` CSV's fused temperatures with their ±2σ band")
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--measured", opts->thermal.measured_csv, "CSV with t [s] and measured temperatures [°C] to plot against")
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--magnet-column", opts->thermal.magnet_column, "the measured magnet temperature's column (default T_magnet)");
+  cmd->add_option("--winding-column", opts->thermal.winding_column, "the measured winding temperature's column (default T_winding)");
+  cmd->add_option("--judged-after-s", opts->thermal.judged_after_s, "mark where a held-out part begins; coverage counted after it");
   return [cmd, opts]() { return cmd->parsed() ? run_figures(*opts) : -1; };
 }
 

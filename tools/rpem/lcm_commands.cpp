@@ -31,6 +31,7 @@
 #include "rpem/daemon/signal_map_source.hpp"
 #include "rpem/mirror/diagnostics_t.hpp"
 #include "rpem/mirror/estimate_t.hpp"
+#include "rpem/schema/decode.hpp"
 #include "rpem/schema/text.hpp"
 
 namespace rpem::tools {
@@ -101,7 +102,7 @@ constexpr std::array<SourceCounter, 6> kSignalMapCounters{{
 struct Listener {
   std::ofstream csv;
   std::int64_t estimates = 0, diagnostics = 0;
-  std::int64_t verified = 0, forged = 0, unverified = 0;
+  std::int64_t verified = 0, forged = 0, unverified = 0, malformed = 0;
   bool print_diagnostics = false;
   auth::Keyring keys;
 
@@ -120,6 +121,25 @@ struct Listener {
     if (valid) s += " valid";
     if (converged) s += " converged";
     return s;
+  }
+
+  /// The raw bytes decoded here, not by LCM's typed subscription (whose decode can throw outside any
+  /// handler: schema/decode.hpp): a message that is not exactly one T is counted and named, never a crash.
+  template <class T>
+  bool decoded(const lcm::ReceiveBuffer* rbuf, const std::string& channel, T& m) {
+    if (schema::decode_exactly(std::span(static_cast<const std::uint8_t*>(rbuf->data), rbuf->data_size), m)) return true;
+    ++malformed;
+    std::fprintf(stderr, "rpem listen: %s: %u bytes that are not one %s: ignored\n", channel.c_str(),
+                 static_cast<unsigned>(rbuf->data_size), T::getTypeName());
+    return false;
+  }
+  void on_estimate_bytes(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
+    rpem::estimate_t m;
+    if (decoded(rbuf, channel, m)) on_estimate(rbuf, channel, &m);
+  }
+  void on_diagnostics_bytes(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
+    rpem::diagnostics_t m;
+    if (decoded(rbuf, channel, m)) on_diagnostics(rbuf, channel, &m);
   }
 
   void on_estimate(const lcm::ReceiveBuffer* rbuf, const std::string& channel, const rpem::estimate_t* m) {
@@ -169,16 +189,18 @@ int run_listen(const ListenOptions& o) {
     listener.csv.open(o.csv, std::ios::trunc);
     listener.csv << schema::csv_header<rpem::estimate_t>() << ",auth\n";
   }
-  lcm.subscribe(o.prefix + "RPEM_ESTIMATE", &Listener::on_estimate, &listener);
-  lcm.subscribe(o.prefix + "RPEM_DIAGNOSTICS", &Listener::on_diagnostics, &listener);
+  lcm.subscribe(o.prefix + "RPEM_ESTIMATE", &Listener::on_estimate_bytes, &listener);
+  lcm.subscribe(o.prefix + "RPEM_DIAGNOSTICS", &Listener::on_diagnostics_bytes, &listener);
   std::signal(SIGINT, on_signal);
   std::signal(SIGTERM, on_signal);
   const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(o.duration_s > 0 ? o.duration_s : 1e9);
   while (!g_stop && std::chrono::steady_clock::now() < end) lcm.handleTimeout(100);
-  std::fprintf(stderr, "rpem listen: %lld estimates, %lld diagnostics; %lld verified, %lld FORGED, %lld unverified\n",
+  std::fprintf(stderr, "rpem listen: %lld estimates, %lld diagnostics; %lld verified, %lld FORGED, %lld unverified",
                static_cast<long long>(listener.estimates), static_cast<long long>(listener.diagnostics),
                static_cast<long long>(listener.verified), static_cast<long long>(listener.forged),
                static_cast<long long>(listener.unverified));
+  if (listener.malformed > 0) std::fprintf(stderr, "; %lld malformed", static_cast<long long>(listener.malformed));
+  std::fputc('\n', stderr);
   return listener.estimates > 0 ? kExitOk : 1;
 }
 
@@ -201,7 +223,7 @@ struct CommandOptions {
 /// Encodes `m` (key id from `key`, or 0) and signs it for `channel`.
 template <class Message>
 std::vector<std::uint8_t> encode_signed(Message& m, const std::optional<auth::Key>& key, const std::string& channel) {
-  m.key_id = key ? key->id : 0;
+  m.key_id = key ? key->id() : 0;
   std::vector<std::uint8_t> bytes(static_cast<std::size_t>(m.getEncodedSize()));
   m.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
   if (key) auth::sign(*key, channel, bytes);

@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "commands.hpp"
+#include "rpem/auth/key.hpp"
 #include "rpem/io/errors.hpp"
 
 int main(int argc, char** argv) {
@@ -17,6 +18,7 @@ int main(int argc, char** argv) {
   runners.push_back(add_reproduce_command(app));
   runners.push_back(add_figures_command(app));
   runners.push_back(add_diagnose_command(app));
+  runners.push_back(add_thermal_command(app));
   runners.push_back(add_replay_command(app));
   runners.push_back(add_record_command(app));
   runners.push_back(add_listen_command(app));
@@ -30,6 +32,7 @@ int main(int argc, char** argv) {
     return code == 0 ? kExitOk : kExitUsage;
   }
   try {
+    rpem::auth::initialise();  // libsodium, once, before any key exists
     for (const Runner& run : runners) {
       const int code = run();
       if (code >= 0) return code;

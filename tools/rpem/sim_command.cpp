@@ -1,6 +1,7 @@
 // rpem sim --scenario FILE.yaml --out LOG.csv [--truth TRUTH.csv] [--estimate EST.csv]
 //          [--averaged-out AVG.csv --averaged-rate HZ --averaged-jitter X --averaged-seed N]
 // rpem sim --scenario FILE.yaml --vesc IFACE --controller-id N [--status-rate-1 HZ …]   (vesc_emulator.hpp)
+// rpem sim --scenario FILE.yaml --vesc-tool-out LOG.csv [--vesc-tool-truth T.csv …]       (vesc_tool_out.hpp)
 // Simulates the drive of a scenario and writes what the drive would log, the truth beside it and,
 // optionally, the estimator's output run in the loop, and the averaged rotor-frame samples a drive that
 // averages every control cycle would report (sim/cycle_average.hpp; docs/drive-log.md, "Averaged logs").
@@ -21,6 +22,7 @@
 #include "rpem/sim/drive_simulator.hpp"
 #include "rpem/sim/truth_log.hpp"
 #include "vesc_emulator.hpp"
+#include "vesc_tool_out.hpp"
 
 namespace rpem::tools {
 namespace {
@@ -36,9 +38,23 @@ struct SimOptions {
   std::uint64_t averaged_seed = 1;
   StreamOptions stream;
   VescEmulatorOptions vesc;
+  VescToolOptions vesc_tool;
 };
 
 int run_sim(const SimOptions& o) {
+  if (!o.vesc_tool.out.empty()) {
+    if (!o.out.empty() || !o.averaged_out.empty() || !o.truth.empty() || !o.estimate.empty() ||
+        !o.stream.interface.empty() || !o.stream.candump_out.empty() || !o.vesc.interface.empty()) {
+      std::fprintf(stderr, "rpem sim: --vesc-tool-out runs alone (its truth: --vesc-tool-truth); drop --out, "
+                           "--averaged-out, --truth, --estimate, --can, --candump and --vesc\n");
+      return kExitUsage;
+    }
+    return run_vesc_tool_log(sim::load_scenario(o.scenario), o.vesc_tool);
+  }
+  if (!o.vesc_tool.truth.empty()) {
+    std::fprintf(stderr, "rpem sim: --vesc-tool-truth needs --vesc-tool-out\n");
+    return kExitUsage;
+  }
   if (!o.vesc.interface.empty()) {
     VescEmulatorOptions vesc = o.vesc;
     vesc.truth = o.truth;
@@ -57,7 +73,7 @@ int run_sim(const SimOptions& o) {
     averaged_log.emplace(o.averaged_out, io::AveragedLogLayout{true, l.temperatures, l.temperatures, false});
   }
   if (!log && !streamer && !averaged_log) {
-    std::fprintf(stderr, "rpem sim: give --out LOG.csv, --averaged-out AVG.csv, --can IFACE or --candump FILE\n");
+    std::fprintf(stderr, "rpem sim: give --out LOG.csv, --averaged-out AVG.csv, --vesc-tool-out LOG.csv, --can IFACE or --candump FILE\n");
     return kExitUsage;
   }
   std::optional<sim::TruthLogWriter> truth;
@@ -118,6 +134,7 @@ Runner add_sim_command(CLI::App& app) {
   cmd->add_option("--averaged-seed", opts->averaged_seed, "seed of the window lengths");
   add_stream_options(cmd, opts->stream);
   add_vesc_emulator_options(cmd, opts->vesc);
+  add_vesc_tool_options(cmd, opts->vesc_tool);
   return [cmd, opts]() { return cmd->parsed() ? run_sim(*opts) : -1; };
 }
 

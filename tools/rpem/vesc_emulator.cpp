@@ -107,7 +107,7 @@ int run_vesc_emulator(sim::Scenario scenario, const VescEmulatorOptions& o) {
                o.interface.c_str(), name.c_str(), static_cast<int>(getpid()));
   // Drive time is the kernel's receive clock (CLOCK_REALTIME) minus this origin (sim/vesc_on_demand.hpp).
   const std::int64_t origin_ns = core::now_ns(CLOCK_REALTIME);
-  std::fprintf(stderr, "rpem sim: t = 0 at CLOCK_REALTIME %.6f s\n", 1e-9 * static_cast<double>(origin_ns));
+  std::fprintf(stderr, "rpem sim: t = 0 at CLOCK_REALTIME %.6f s\n", core::to_seconds(origin_ns));
   auto host_now = [&] { return core::now_ns(CLOCK_REALTIME) - origin_ns; };
   // Idle simulation between two looks at the socket (drive time), and the longest wait for a poll.
   const auto idle_step_ns = static_cast<std::int64_t>(std::llround(o.idle_step_s * 1e9));
@@ -115,7 +115,7 @@ int run_vesc_emulator(sim::Scenario scenario, const VescEmulatorOptions& o) {
     const std::int64_t now = host_now();
     if (o.duration_s > 0.0 && now > static_cast<std::int64_t>(o.duration_s * 1e9)) break;
     if (g_toggle_silence.exchange(false)) toggled_silent = !toggled_silent;
-    const double t_s = 1e-9 * static_cast<double>(now);
+    const double t_s = core::to_seconds(now);
     const bool quiet = toggled_silent || (o.silent_at_s >= 0.0 && t_s >= o.silent_at_s && t_s < o.silent_at_s + o.silent_for_s);
     if (quiet != was_quiet) std::fprintf(stderr, "rpem sim: VESC %d %s at %.3f s\n", o.controller_id, quiet ? "silent" : "back", t_s);
     was_quiet = quiet;
@@ -159,13 +159,13 @@ int run_vesc_emulator(sim::Scenario scenario, const VescEmulatorOptions& o) {
     }
   }
   const sim::OnDemandVesc::Counters& d = drive.counters();
-  const double lag_s = 1e-9 * static_cast<double>(host_now() - drive.time_ns());
+  const double lag_s = core::to_seconds(host_now() - drive.time_ns());
   std::fprintf(stderr,
                "rpem sim: VESC %d stopped at %.3f s drive time (%.3f s behind the host): %llu polls, %llu replies in "
                "%llu frames, %llu unheard while silent, %llu unsupported, %llu reads with no control cycle since the "
                "previous, %llu polls read after the drive had passed them, %llu statuses, %llu frames the interface "
                "dropped\n",
-               o.controller_id, 1e-9 * static_cast<double>(drive.time_ns()), lag_s,
+               o.controller_id, core::to_seconds(drive.time_ns()), lag_s,
                static_cast<unsigned long long>(n.requests), static_cast<unsigned long long>(n.replies),
                static_cast<unsigned long long>(n.reply_frames), static_cast<unsigned long long>(n.unheard),
                static_cast<unsigned long long>(n.unsupported), static_cast<unsigned long long>(d.empty_reads),
@@ -177,7 +177,7 @@ int run_vesc_emulator(sim::Scenario scenario, const VescEmulatorOptions& o) {
                  static_cast<unsigned long long>(n.reply_delay[k]));
   }
   std::fprintf(stderr, " later %llu; the latest %.3f s\n", static_cast<unsigned long long>(n.reply_delay.back()),
-               1e-9 * static_cast<double>(n.reply_delay_max_ns));
+               core::to_seconds(n.reply_delay_max_ns));
   return kExitOk;
 }
 

@@ -242,13 +242,16 @@ double material_alpha(const core::DriftLaw& law, double value) {
   return recorded_law(law, value, core::kMaterialReference_C).coeff_per_K;
 }
 
+/// The materials' ranges and the temperature they refer to.
 template <std::size_t N>
 std::string materials_text(const std::array<core::MaterialCoefficient, N>& materials) {
   std::string s;
   for (const core::MaterialCoefficient& m : materials) {
     s += (s.empty() ? "" : ", ") + std::string(m.material) + " " + pct(m.min_per_K) + "…" + pct(m.max_per_K) + " %/K";
   }
-  return s;
+  char at[32];
+  std::snprintf(at, sizeof at, " at %g °C", core::kMaterialReference_C);
+  return s + at;
 }
 
 /// rs_drift (kWinding) or psim_drift.
@@ -320,14 +323,14 @@ EffectRow drift() {
     if (kWinding) {
       if (overlaps(core::kWindingMaterials)) return std::nullopt;
       return Implausibility{"R_s would change by " + pct(alpha) + " %/K against T_winding (" +
-                                materials_text(core::kWindingMaterials) + " at 20 °C)",
+                                materials_text(core::kWindingMaterials) + ")",
                             "a temperature-dependent error that is not resistance — an inverter voltage error (dead time, "
                             "device drops) or an inductance that changes with the operating point the temperature follows; "
                             "standstill at two or more currents per temperature would separate them"};
     }
     if (overlaps(core::kMagnetMaterials)) return std::nullopt;
     return Implausibility{"ψm would change by " + pct(alpha) + " %/K against T_magnet (" +
-                              materials_text(core::kMagnetMaterials) + " at 20 °C)",
+                              materials_text(core::kMagnetMaterials) + ")",
                           "a flux error that follows the load the temperature follows — cross-saturation or an inductance "
                           "changing with the current — or a constant ψm error the calibration takes; operation at two or "
                           "more currents per temperature would separate them"};

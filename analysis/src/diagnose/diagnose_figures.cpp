@@ -9,7 +9,9 @@
 
 #include "rpem/analysis/diagnose/diagnose_output.hpp"
 #include "rpem/analysis/gnuplot.hpp"
+#include "rpem/core/clock.hpp"
 #include "rpem/core/conditioner.hpp"
+#include "rpem/core/units.hpp"
 
 namespace rpem::analysis {
 namespace {
@@ -170,6 +172,58 @@ std::string overlay(const std::string& dir, const Diagnosis& d) {
   return "overlay.png";
 }
 
+/// Each regime's colour in the timeline, in core::kRegimes' order: admitted ones green to grey, excluded ones
+/// warm to black.
+constexpr std::array<const char*, core::kRegimeCount> kRegimeColour{"#2ca02c", "#1f77b4", "#17becf", "#9a9a9a",
+                                                                    "#ff7f0e", "#9467bd", "#d62728", "#000000"};
+
+std::string regime_timeline(const std::string& dir, const LogData& log, const LogRegimes& regimes, int pole_pairs) {
+  // Per time bin and regime, the mean speed and current amplitude of that regime's samples in the bin: a short
+  // stretch in one regime shows however long the log.
+  const std::size_t n = log.size();
+  const std::size_t per_bin = std::max<std::size_t>(1, n / FigureData::kTimeBins);
+  DataBlock b{"reg", std::vector<std::vector<double>>(4)};  // t, speed, |i|, regime
+  for (std::size_t start = 0; start < n; start += per_bin) {
+    std::array<std::array<double, 4>, core::kRegimeCount> sums{};  // count, t, speed, |i|
+    for (std::size_t k = start; k < std::min(n, start + per_bin); ++k) {
+      auto& s = sums[static_cast<std::size_t>(regimes.regime[k])];
+      const core::Vec2 i = log.logged_i_dq_A(k);
+      s[0] += 1.0;
+      s[1] += log.t_s(k);
+      s[2] += core::rad_s_to_rpm(log.samples.omega_el_rad_s(k)) / pole_pairs;
+      s[3] += std::hypot(i[0], i[1]);
+    }
+    for (std::size_t r = 0; r < core::kRegimeCount; ++r) {
+      if (sums[r][0] == 0.0) continue;
+      for (int c = 0; c < 3; ++c) b.columns[static_cast<std::size_t>(c)].push_back(sums[r][static_cast<std::size_t>(c) + 1] / sums[r][0]);
+      b.columns[3].push_back(static_cast<double>(r));
+    }
+  }
+  std::string speed_plot, current_plot;
+  for (const core::RegimeInfo& info : core::kRegimes) {
+    const std::uint64_t count = regimes.counts.regimes[info.regime];
+    if (count == 0) continue;
+    const std::string r = std::to_string(static_cast<int>(info.regime));
+    const std::string style = std::string(" w p pt 7 ps 0.5 lc rgb '") + kRegimeColour[static_cast<std::size_t>(info.regime)] + "'";
+    const std::string title = std::string(" t '") + info.name + (info.excluded ? ", excluded" : "") + " (" + std::to_string(count) + ")'";
+    speed_plot += std::string(speed_plot.empty() ? "plot" : ",") + " $reg u 1:($4==" + r + "?$2:NaN)" + style + title;
+    current_plot += std::string(current_plot.empty() ? "plot" : ",") + " $reg u 1:($4==" + r + "?$3:NaN)" + style + " notitle";
+  }
+  GnuplotFigure fig(dir + "/regimes.png", 1400, 800);
+  fig.add_data(std::move(b));
+  fig.add_line("set multiplot layout 2,1 title 'The log by regime: what the estimator and the fits take, and what they leave out' noenhanced");
+  // Regime names hold underscores (not subscripts); both panels keep the key's margin so their time axes align.
+  fig.add_line("set termoption noenhanced; set grid; set xlabel 't [s]'; set key outside right; set datafile missing NaN");
+  fig.add_line("set lmargin at screen 0.07; set rmargin at screen 0.78");
+  fig.add_line("set title 'speed'; set ylabel 'speed [rpm]'");
+  fig.add_line(speed_plot);
+  fig.add_line("set title 'current amplitude'; set ylabel '|i| [A]'");
+  fig.add_line(current_plot);
+  fig.add_line("unset multiplot");
+  fig.render();
+  return "regimes.png";
+}
+
 DataBlock track_block(const char* name, const ParameterTrack& t) {
   return {name, {t.t_s, t.psi_m_Wb, t.r_s_Ohm}};
 }
@@ -205,12 +259,17 @@ std::string estimates(const std::string& dir, const Diagnosis& d) {
 }  // namespace
 
 std::vector<std::string> write_diagnose_figures(const std::string& dir, const Diagnosis& d) {
-  std::vector<std::string> out = {residual_time(dir, d), residual_map(dir, d), overlay(dir, d)};
+  std::vector<std::string> out = {residual_time(dir, d), regime_timeline(dir, *d.log, d.regimes, d.context.machine.rated.pole_pairs),
+                                  residual_map(dir, d), overlay(dir, d)};
   if (!d.statistics.harmonics.empty()) out.push_back(harmonics(dir, d));
   if (!d.statistics.phase_signs.empty()) out.push_back(phase_sign(dir, d));
   if (temperature_varies(d)) out.push_back(residual_vs_temperature(dir, d));  // a constant axis shows nothing
   if (!d.estimates.nominal.empty()) out.push_back(estimates(dir, d));
   return out;
+}
+
+std::string write_regime_timeline(const std::string& dir, const LogData& log, const LogRegimes& regimes, int pole_pairs) {
+  return regime_timeline(dir, log, regimes, pole_pairs);
 }
 
 }  // namespace rpem::analysis

@@ -45,12 +45,16 @@ nlohmann::json calibration_json(const Diagnosis& d) {
     j[key] = c.value[i];
     const double hw = c.intervals.half_width[i] * c.value[i];
     j[key + "_ci95"] = c.identifiable[i] && std::isfinite(hw) ? nlohmann::json({c.value[i] - hw, c.value[i] + hw}) : nlohmann::json(nullptr);
-    j[key + "_excitation_ci95_rel"] = finite_json(c.intervals.excitation_half_width[i]);
+    // Unknown without a noise floor (the excitation test then admits every excited constant).
+    j[key + "_excitation_ci95_rel"] = d.noise_floor.value_A ? finite_json(c.intervals.excitation_half_width[i]) : nlohmann::json(nullptr);
     j[key + "_mismatch_rel"] = c.identifiable[i] ? nlohmann::json(mismatch_half_width(d, i)) : nlohmann::json(nullptr);
     configured[key] = c.configured[i];
     if (c.identifiable[i]) identifiable.push_back(key);
   }
   j["identifiable"] = identifiable;
+  nlohmann::json despite = nlohmann::json::array();
+  for (const std::string& text : calibrated_despite_mismatch(d)) despite.push_back(text);
+  j["despite_mismatch"] = despite;
   j["configured"] = configured;
   j["at_mean_temperature_C"] = {{"psi_m_Wb", d.context.t_magnet.logged ? nlohmann::json(d.context.t_magnet.mean_C) : nlohmann::json(nullptr)},
                                 {"r_s_Ohm", d.context.t_winding.logged ? nlohmann::json(d.context.t_winding.mean_C) : nlohmann::json(nullptr)}};
@@ -58,6 +62,37 @@ nlohmann::json calibration_json(const Diagnosis& d) {
   j["rpem"] = {{"psi_m_Wb", d.estimates.nominal_summary.psi_m_Wb}, {"r_s_Ohm", d.estimates.nominal_summary.r_s_Ohm},
                {"method", d.estimates.method}};
   j["findings"] = calibration_findings(d);
+  return j;
+}
+
+/// Samples per regime (core::kRegimes' names).
+nlohmann::json regimes_json(const LogRegimes& r) {
+  nlohmann::json j = nlohmann::json::object();
+  for (const core::RegimeInfo& info : core::kRegimes) j[info.name] = r.counts.regimes[info.regime];
+  return j;
+}
+
+/// Which loss the fits minimised, and why (docs/diagnose.md, "Outliers and the robust loss").
+nlohmann::json loss_json(const Diagnosis& d) {
+  const OutlierCheck& o = d.outliers;
+  nlohmann::json j = {{"kind", d.least_squares ? "huber" : "least_squares"},
+                      {"outlier_test", {{"samples", o.test.samples},
+                                        {"scale_A", o.test.scale_A},
+                                        {"threshold_A", finite_json(o.test.threshold_A)},
+                                        {"beyond", o.test.beyond},
+                                        {"p_value", o.test.p_value},
+                                        {"outliers", o.test.outliers}}},
+                      {"largest_shift", o.largest_shift},
+                      {"largest_shift_parameter", o.parameter.empty() ? nlohmann::json(nullptr) : nlohmann::json(o.parameter)}};
+  if (d.least_squares) {
+    j["huber_threshold_A"] = o.loss.threshold_A;
+    j["robust_runs"] = o.robust_runs;
+    nlohmann::json ls = {{"effects", d.least_squares->found}, {"heldout_rms", d.least_squares->extended_heldout_rms_A}};
+    for (std::size_t i = 0; i < kCalibrated.size(); ++i) {
+      ls[kCalibrated[i]] = d.least_squares->identifiable[i] ? nlohmann::json(d.least_squares->value[i]) : nlohmann::json(nullptr);
+    }
+    j["least_squares"] = ls;
+  }
   return j;
 }
 
@@ -69,6 +104,12 @@ void write_text(const std::string& path, const std::string& text) {
 std::string pct(double v) {
   char b[32];
   std::snprintf(b, sizeof b, "%.1f", 100.0 * std::abs(v));
+  return b;
+}
+
+std::string num(double v) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%.4g", v);
   return b;
 }
 
@@ -87,18 +128,28 @@ const EstimatorCheck* estimator_check(const Diagnosis& d, std::size_t j) {
   return nullptr;
 }
 
-// The allowance (docs/diagnose.md, "The calibrated baseline"): the change of the constant, the others refitted, that moves the model's training currents
-// by as much as the misfit the final model still leaves above the noise floor — which is also the
-// largest bias a misfit of that size could put into the constant (Cauchy–Schwarz on (JᵀJ)⁻¹Jᵀe). With
-// σ² = floor²/2 per residual component the excitation's half-width is z·σ·√((JᵀJ)⁻¹ₖₖ); the misfit over
-// the N training samples is |e|² = N·floor²·(ρ² − 1), ρ the held-out ratio to the floor; so the
-// allowance √((JᵀJ)⁻¹ₖₖ)·|e| is the excitation's half-width times √(2N(ρ² − 1))/z.
+// The allowance (docs/diagnose.md, "The calibrated baseline"; misfit_norm_A) at the final model: 0 where the
+// constant is not excited (its column vanishes).
 double mismatch_half_width(const Diagnosis& d, std::size_t i) {
-  constexpr double kZ = 1.959964;
-  const double excitation = d.calibration.intervals.excitation_half_width[i];
-  if (!std::isfinite(excitation) || d.verdict.ratio <= 1.0) return 0.0;
-  const std::size_t n = d.log->training_count();
-  return excitation * std::sqrt(2.0 * static_cast<double>(n) * (d.verdict.ratio * d.verdict.ratio - 1.0)) / kZ;
+  const double per_A = d.calibration.intervals.change_per_A[i];
+  if (!std::isfinite(per_A)) return 0.0;
+  const double floor = d.noise_floor.value_A.value_or(0.0);
+  return per_A * misfit_norm_A(d.log->training_count(), d.selection.extended_heldout_rms_A, floor);
+}
+
+std::vector<std::string> calibrated_despite_mismatch(const Diagnosis& d) {
+  std::vector<std::string> out;
+  const Calibration& c = d.calibration;
+  for (std::size_t i = 0; i < kCalibrated.size(); ++i) {
+    if (!c.identifiable[i] || c.identification[i] != Identification::kRejectsConfiguration) continue;
+    const double rel = c.value[i] / c.configured[i] - 1.0;
+    out.push_back(std::string(kCalibratedText[i]) + " " + num(c.value[i]) + " (" + (rel > 0.0 ? "+" : "−") + pct(rel) +
+                  " % of the configuration's " + num(c.configured[i]) + "): its cluster-robust 95 % interval, ±" +
+                  pct(c.intervals.half_width[i]) + " %, is wider than ±" + pct(kIdentifiedHalfWidth) +
+                  " % — the model's misfit widens it — but even widened by the mismatch allowance, ±" +
+                  pct(mismatch_half_width(d, i)) + " %, it excludes the configured value: the log rejects it");
+  }
+  return out;
 }
 
 std::vector<std::string> calibration_findings(const Diagnosis& d) {
@@ -133,12 +184,20 @@ void write_diagnosis_json(const std::string& path, const Diagnosis& d, const std
                 {"i_d_range_A", {d.context.min_i_d_A, d.context.max_signed_i_d_A}},
                 {"max_i_q_A", d.context.max_i_q_A},
                 {"t_winding_span_K", d.context.t_winding.logged ? nlohmann::json(d.context.t_winding.span_K) : nlohmann::json(nullptr)},
-                {"t_magnet_span_K", d.context.t_magnet.logged ? nlohmann::json(d.context.t_magnet.span_K) : nlohmann::json(nullptr)}};
+                {"t_magnet_span_K", d.context.t_magnet.logged ? nlohmann::json(d.context.t_magnet.span_K) : nlohmann::json(nullptr)},
+                {"regimes", regimes_json(d.regimes)},
+                {"excluded_regime", d.regimes.excluded_used},
+                {"estimator_resyncs", d.regimes.counts.resyncs},
+                {"estimator_outliers", d.regimes.counts.outliers},
+                {"exclusion_explanations", d.regimes.explanations}};
   out["machine_config"] = config_path;
-  out["verdict"] = d.verdict.explained ? "explained" : "unexplained";
-  out["noise_floor_A"] = d.verdict.noise_floor_A;
-  out["ratio"] = finite_json(d.verdict.ratio);
+  out["verdict"] = to_string(d.verdict.kind);
+  out["noise_floor_A"] = optional_json(d.verdict.noise_floor_A);
+  out["noise_floor"] = {{"second_differences", d.noise_floor.differences},
+                        {"unknown_reason", d.noise_floor.value_A ? nlohmann::json(nullptr) : nlohmann::json(d.noise_floor.unknown_reason)}};
+  out["ratio"] = d.verdict.ratio ? finite_json(*d.verdict.ratio) : nlohmann::json(nullptr);
   out["findings"] = d.verdict.findings;
+  out["loss"] = loss_json(d);
 
   out["baseline"] = {{"heldout_rms", d.baseline_heldout_rms_A},
                      {"rms", d.statistics.rms_A.before},
@@ -208,6 +267,9 @@ void write_diagnosis_json(const std::string& path, const Diagnosis& d, const std
                     {"switching_frequency_Hz", d.context.switching_frequency_Hz},
                     {"blocks", log.blocks},
                     {"explained_ratio", kExplainedRatio},
+                    {"min_noise_differences", kMinNoiseDifferences},
+                    {"identified_half_width", kIdentifiedHalfWidth},
+                    {"outlier_p", kOutlierP},
                     {"identifiable_half_width", kIdentifiableHalfWidth},
                     {"min_drift_span_K", kMinDriftSpan_K}};
   out["elapsed_s"] = d.elapsed_s;

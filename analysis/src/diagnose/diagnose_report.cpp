@@ -43,10 +43,15 @@ constexpr std::array<const char*, kCalibrated.size()> kCalibratedText{"ψm [Wb]"
 void summary(ReportDocument& doc, const Diagnosis& d, const std::string& config_path) {
   const Selection& s = d.selection;
   const LogData& log = *d.log;
-  std::string text = "**Verdict: " + std::string(d.verdict.explained ? "explained" : "unexplained") + "** — the final held-out "
-                     "residual is " + num(s.extended_heldout_rms_A) + " A RMS, " + num(d.verdict.ratio, 3) +
-                     " times the noise floor of " + num(d.verdict.noise_floor_A, 3) + " A estimated from the data (explained "
-                     "up to " + num(kExplainedRatio, 2) + " times).";
+  std::string text = "**Verdict: " + std::string(to_string(d.verdict.kind)) + "** — the final held-out residual is " +
+                     num(s.extended_heldout_rms_A) + " A RMS, ";
+  if (d.verdict.ratio) {
+    text += num(*d.verdict.ratio, 3) + " times the noise floor of " + num(d.verdict.noise_floor_A.value_or(0.0), 3) +
+            " A estimated from the data (explained up to " + num(kExplainedRatio, 2) + " times).";
+  } else {
+    text += "and whether that is noise cannot be told: the noise floor cannot be measured on this log (" +
+            d.noise_floor.unknown_reason + ").";
+  }
   doc.paragraph(text);
   text = "The configuration (`" + config_path + "`, its whole model: model extensions and drift laws) replayed on the inputs of `" +
          log.path + "` (" + std::to_string(log.size()) + " samples over " + num(log.t_end_s - log.t_start_s, 3) + " s, " +
@@ -98,6 +103,32 @@ void summary(ReportDocument& doc, const Diagnosis& d, const std::string& config_
   }
 }
 
+void regimes(ReportDocument& doc, const Diagnosis& d) {
+  const LogRegimes& r = d.regimes;
+  doc.heading(1, "Regimes: what the fits take and what they leave out");
+  doc.paragraph("Each sample's regime as the estimator decides it (`rpem estimate` and rpemd run the same classifier; "
+                "docs/derivations.md §13): the samples with the bridge off, with the dq frame not the rotor's, in a "
+                "transient the model does not represent, or not finite enter no fit (" + std::to_string(r.excluded_used) +
+                " here, besides " + std::to_string(d.log->excluded_idle + d.log->excluded_transitional) +
+                " rows the steady-state replay leaves out as idle or in transition). The estimator over the log "
+                "resynchronised " + std::to_string(r.counts.resyncs) + " times and skipped " +
+                std::to_string(r.counts.outliers) + " samples as outliers.");
+  std::vector<std::vector<std::string>> rows;
+  const double total = static_cast<double>(std::max<std::uint64_t>(r.counts.samples, 1));
+  for (const core::RegimeInfo& info : core::kRegimes) {
+    const std::uint64_t n = r.counts.regimes[info.regime];
+    if (n == 0) continue;
+    rows.push_back({info.name, std::to_string(n), pct(100.0 * static_cast<double>(n) / total), info.excluded ? "no (excluded)" : "yes"});
+  }
+  doc.table({"regime", "samples", "share", "in the fits"}, rows);
+  if (!r.explanations.empty()) {
+    doc.paragraph("More than " + num(100.0 * io::kExplainedShare, 2) + " % of the samples were left out by a rule; which, and "
+                  "what changes it:");
+    doc.bullets(r.explanations);
+  }
+  doc.figure("regimes.png", "The log against time, coloured by regime: speed and current amplitude of each regime's samples.");
+}
+
 void calibration(ReportDocument& doc, const Diagnosis& d) {
   const Calibration& c = d.calibration;
   doc.heading(1, "The calibrated baseline");
@@ -121,12 +152,46 @@ void calibration(ReportDocument& doc, const Diagnosis& d) {
              "RPEM estimate"},
             rows);
   doc.paragraph("The mismatch allowance is the largest bias the misfit the final model still leaves above the noise floor "
-                "could put into a constant (0 when the model explains the log down to the floor); a configured value "
-                "within the interval widened by it is not stated as off.");
+                "could put into a constant (0 when the model explains the log down to the floor; the whole residual where "
+                "the floor is unknown); a configured value within the interval widened by it is not stated as off.");
+  const std::vector<std::string> despite = calibrated_despite_mismatch(d);
+  if (!despite.empty()) {
+    doc.paragraph("Calibrated despite a large mismatch (a constant is identified when its interval is within ±" +
+                  num(100.0 * kIdentifiedHalfWidth, 2) + " %, or — wider — when it excludes the configured value):");
+    doc.bullets(despite);
+  }
   std::string temps;
   if (d.context.t_magnet.logged) temps += " ψm at the log's mean magnet temperature, " + num(d.context.t_magnet.mean_C, 3) + " °C.";
   if (d.context.t_winding.logged) temps += " R_s at the mean winding temperature, " + num(d.context.t_winding.mean_C, 3) + " °C.";
   if (!temps.empty()) doc.paragraph("Under a drift law the constants are the law's values at the log's mean temperature:" + temps);
+}
+
+void loss(ReportDocument& doc, const Diagnosis& d) {
+  const OutlierCheck& o = d.outliers;
+  if (!o.test.outliers) return;  // nothing beyond the Gaussian level: least squares, nothing to say
+  doc.heading(1, "Outliers and the loss");
+  std::string text = std::to_string(o.test.beyond) + " of the " + std::to_string(o.test.samples) +
+                     " training samples lie beyond b = " + num(o.test.threshold_A, 3) + " A (the level a Gaussian residual of "
+                     "that scale, σ̂ = " + num(o.test.scale_A, 3) + " A per axis from the median, exceeds once in that many; "
+                     "p = " + num(o.test.p_value, 2) + "). Refitted under Huber's loss at b, the largest parameter change is " +
+                     num(o.largest_shift, 2) + " times its 95 % half-width" + (o.parameter.empty() ? "" : " (" + o.parameter + ")");
+  if (!d.least_squares) {
+    text += ": the tail does not decide the fit, which stays least squares.";
+    doc.paragraph(text);
+    return;
+  }
+  text += ": the tail decided the least-squares fit, so calibration and every effect fit were run again minimising "
+          "Huber's loss (squares within b, linear beyond), b re-estimated from each run's residuals: " +
+          num(o.loss.threshold_A, 3) + " A after " + std::to_string(o.robust_runs) + " run" + (o.robust_runs == 1 ? "" : "s") +
+          ". The held-out residuals in this report are √(mean ρ). ";
+  std::string ls;
+  for (const std::string& e : d.least_squares->found) ls += (ls.empty() ? "" : ", ") + e;
+  text += "Least squares had found " + (ls.empty() ? std::string("no effect") : ls) + " (held-out " +
+          num(d.least_squares->extended_heldout_rms_A) + " A RMS)";
+  for (std::size_t i = 0; i < kCalibrated.size(); ++i) {
+    if (d.least_squares->identifiable[i]) text += std::string(", ") + kCalibrated[i] + " " + num(d.least_squares->value[i]);
+  }
+  doc.paragraph(text + ".");
 }
 
 void effects_table(ReportDocument& doc, const Diagnosis& d) {
@@ -156,14 +221,20 @@ void effects_table(ReportDocument& doc, const Diagnosis& d) {
 }
 
 void verdict_section(ReportDocument& doc, const Diagnosis& d, const std::vector<std::string>& figures) {
-  doc.heading(1, d.verdict.explained ? "What is left: noise" : "What is left: unexplained");
-  if (d.verdict.explained) {
+  const VerdictKind kind = d.verdict.kind;
+  doc.heading(1, kind == VerdictKind::kExplained     ? "What is left: noise"
+                 : kind == VerdictKind::kUnexplained ? "What is left: unexplained"
+                                                     : "What is left: undetermined");
+  if (kind == VerdictKind::kExplained) {
     doc.paragraph("The final model's held-out residual is within " + num(kExplainedRatio, 2) + " times the noise floor: what "
                   "is left is the sensors' noise.");
     return;
   }
-  doc.paragraph("The final model's held-out residual stays " + num(d.verdict.ratio, 3) + " times above the noise floor. "
-                "Where it lives, and what would explain it:");
+  doc.paragraph(kind == VerdictKind::kUnexplained
+                    ? "The final model's held-out residual stays " + num(d.verdict.ratio.value_or(0.0), 3) +
+                          " times above the noise floor. Where it lives, and what would explain it:"
+                    : "The noise floor cannot be measured on this log, so the residual cannot be judged against it "
+                      "(`noise_floor_A: null`, `verdict: undetermined`). Why, where the residual lives, and what would tell:");
   doc.bullets(d.verdict.findings);
   auto has = [&](const char* f) { return std::find(figures.begin(), figures.end(), f) != figures.end(); };
   if (has("residual_map.png")) doc.paragraph("The operating-point map (`residual_map.png`) and the content against the electrical "
@@ -273,7 +344,9 @@ void write_diagnose_report(const std::string& dir, const Diagnosis& d, const std
   const std::vector<std::string> figures = write_diagnose_figures(dir, d);
   ReportDocument doc("Diagnosis of " + d.log->path);
   summary(doc, d, config_path);
+  regimes(doc, d);
   calibration(doc, d);
+  loss(doc, d);
   effects_table(doc, d);
   verdict_section(doc, d, figures);
   residuals(doc, d, figures);

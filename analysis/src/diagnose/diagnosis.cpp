@@ -95,6 +95,77 @@ void prune_negligible(const EffectFitter& fitter, Diagnosis& d) {
   s.extended_heldout_rms_A = rms(fitter.heldout(s.model));
 }
 
+/// The calibrated baseline and the effects found from it, all fitted with `fitter`'s loss (docs/diagnose.md,
+/// "The calibrated baseline", "How an effect is accepted"); fills d.calibration and d.selection.
+void calibrate_and_select(const EffectFitter& fitter, double floor, Diagnosis& d) {
+  Monitor* monitor = d.options.monitor;
+  // The calibrated baseline: the constants the log's excitation pins down, fitted on the training blocks.
+  if (monitor) monitor->stage(fitter.loss().robust() ? "calibrating the constants (robust loss)" : "calibrating the configuration's constants", 0);
+  EffectSet start;
+  const CalibrationIntervals excitation = fitter.intervals(start, floor);
+  std::array<bool, kCalibrated.size()> admissible{};
+  for (std::size_t i = 0; i < kCalibrated.size(); ++i) {
+    admissible[i] = excitation.excitation_half_width[i] <= kIdentifiableHalfWidth;
+    start.calibrated[i] = d.calibration.identifiable[i] = admissible[i];
+    d.calibration.configured[i] = d.context.base.machine.*kCalibratedFields[i];
+  }
+  if (start.free_calibration() > 0) start = fitter.fit(start);
+  // A constant the excitation would pin down but whose fit the model's own errors move far (its
+  // cluster-robust interval wide and holding the configured value, or at the ±50 % bound) is not identified:
+  // it stays configured.
+  if (start.free_calibration() > 0) {
+    const CalibrationIntervals fitted = fitter.intervals(start, floor);
+    const double misfit = misfit_norm_A(fitter.training_samples(), rms(fitter.heldout(start)), floor);
+    bool dropped = false;
+    for (std::size_t i = 0; i < kCalibrated.size(); ++i) {
+      if (!start.calibrated[i] || identification(start, fitted, i, misfit) != Identification::kNot) continue;
+      start.calibrated[i] = d.calibration.identifiable[i] = false;
+      start.calibration[i] = 0.0;
+      dropped = true;
+    }
+    if (dropped && start.free_calibration() > 0) start = fitter.fit(start);
+  }
+  d.calibration.heldout_rms_A = rms(fitter.heldout(start));
+
+  d.selection = select_effects(fitter, d.options.selection, start, floor, admissible);
+  if (monitor) monitor->stage("refitting the model found", 0);
+  prune_negligible(fitter, d);
+  // A drift law found brings the constant it is referred to (EffectRow::frees_constant).
+  d.calibration.intervals = fitter.intervals(d.selection.model, floor);
+  const double misfit = misfit_norm_A(fitter.training_samples(), d.selection.extended_heldout_rms_A, floor);
+  for (std::size_t i = 0; i < kCalibrated.size(); ++i) {
+    d.calibration.identifiable[i] = d.selection.model.calibrated[i];
+    d.calibration.identification[i] =
+        d.calibration.identifiable[i] ? identification(d.selection.model, d.calibration.intervals, i, misfit) : Identification::kNot;
+  }
+  d.extended_model = d.selection.model.model(d.context);
+  for (std::size_t i = 0; i < kCalibrated.size(); ++i) d.calibration.value[i] = d.extended_model.machine.*kCalibratedFields[i];
+}
+
+/// The diagnosis again under Huber's loss (docs/diagnose.md, "Outliers and the robust loss"), after the
+/// least-squares one (kept in d.least_squares for the report). b from the least-squares model's residuals is
+/// too wide where the outliers pulled its bulk too: it is re-estimated from each robust diagnosis' own final
+/// residuals until it settles within 10 % (at most kRobustRuns).
+void diagnose_robustly(const EffectFitter& least_squares, double floor, Diagnosis& d) {
+  LeastSquaresResult ls;
+  for (const FoundEffect& f : d.selection.found) ls.found.push_back(f.effect.label());
+  ls.value = d.calibration.value;
+  ls.identifiable = d.calibration.identifiable;
+  ls.extended_heldout_rms_A = d.selection.extended_heldout_rms_A;
+  d.least_squares = ls;
+  for (int run = 1; run <= kRobustRuns; ++run) {
+    const EffectFitter robust = least_squares.with_loss(d.outliers.loss);
+    d.baseline_heldout_rms_A = rms(robust.heldout(EffectSet{}));
+    calibrate_and_select(robust, floor, d);
+    d.outliers.robust_runs = run;
+    std::vector<double> r;
+    least_squares.training_residuals(d.selection.model, r);
+    const double settled = test_outliers(r).threshold_A;
+    if (std::abs(settled / d.outliers.loss.threshold_A - 1.0) < 0.1 || run == kRobustRuns) break;
+    d.outliers.loss.threshold_A = settled;
+  }
+}
+
 }  // namespace
 
 io::MachineConfig config_of(const io::MachineConfig& input, const ExtendedModel& model,
@@ -120,6 +191,12 @@ Diagnosis diagnose(LogData log, const io::MachineConfig& config, const DiagnoseO
   d.config = config;
   Monitor none;
   Monitor& monitor = options.monitor ? *options.monitor : none;
+  const std::uint64_t n = d.log->size();
+  // Each sample's regime, as the estimator decides it; the excluded ones enter no fit.
+  monitor.stage("classifying the samples' regimes", n);
+  d.regimes = classify_regimes(*d.log, config, options.monitor);
+  exclude_regimes(*d.log, d.regimes);
+  for (std::string& why : left_out_explanations(*d.log)) d.regimes.explanations.push_back(std::move(why));
   const double f_sw = options.switching_frequency_Hz > 0.0 ? options.switching_frequency_Hz
                                                           : config.estimator.extensions.switching_frequency_Hz;
   const ExtendedModel base = make_base_model(config.machine, config.estimator.extensions, config.rs_drift.law,
@@ -128,50 +205,20 @@ Diagnosis diagnose(LogData log, const io::MachineConfig& config, const DiagnoseO
 
   const WorkPool pool(std::max(1, options.jobs));
   const ModelReplay replay(*d.log, config.machine.rated, pool, options.monitor);
-  const std::uint64_t n = d.log->size();
   monitor.stage("replaying the configuration", 2 * n);
-  const EffectFitter fitter(replay, d.context);
+  const EffectFitter least_squares(replay, d.context);
 
   // The configuration as it is, and the noise floor of its residual (the same for every model).
   const BaselinePass baseline = baseline_pass(replay, d.context, base);
-  d.baseline_heldout_rms_A = rms(fitter.heldout(EffectSet{}));
-  const double floor = baseline.noise_floor_A;
+  d.baseline_heldout_rms_A = rms(least_squares.heldout(EffectSet{}));
+  d.noise_floor = baseline.noise_floor;
+  const double floor = d.noise_floor.for_fits_A();
 
-  // The calibrated baseline: the constants the log's excitation pins down, fitted on the training blocks.
-  monitor.stage("calibrating the configuration's constants", 0);
-  EffectSet start;
-  const CalibrationIntervals excitation = fitter.intervals(start, floor);
-  for (std::size_t i = 0; i < kCalibrated.size(); ++i) {
-    start.calibrated[i] = excitation.excitation_half_width[i] <= kIdentifiableHalfWidth;
-    d.calibration.identifiable[i] = start.calibrated[i];
-    d.calibration.configured[i] = base.machine.*kCalibratedFields[i];
-  }
-  if (start.free_calibration() > 0) start = fitter.fit(start);
-  // A constant the excitation would pin down but whose fit the model's own errors move far (its
-  // cluster-robust interval wide, or at the ±50 % bound) is not identified: it stays configured.
-  if (start.free_calibration() > 0) {
-    const CalibrationIntervals fitted = fitter.intervals(start, floor);
-    bool dropped = false;
-    for (std::size_t i = 0; i < kCalibrated.size(); ++i) {
-      if (!start.calibrated[i] || identified(start, fitted, i)) continue;
-      start.calibrated[i] = d.calibration.identifiable[i] = false;
-      start.calibration[i] = 0.0;
-      dropped = true;
-    }
-    if (dropped && start.free_calibration() > 0) start = fitter.fit(start);
-  }
-  d.calibration.heldout_rms_A = rms(fitter.heldout(start));
-
-  std::array<bool, kCalibrated.size()> admissible{};
-  for (std::size_t i = 0; i < kCalibrated.size(); ++i) admissible[i] = excitation.excitation_half_width[i] <= kIdentifiableHalfWidth;
-  d.selection = select_effects(fitter, options.selection, start, floor, admissible);
-  monitor.stage("refitting the model found", 0);
-  prune_negligible(fitter, d);
-  // A drift law found brings the constant it is referred to (EffectRow::frees_constant).
-  for (std::size_t i = 0; i < kCalibrated.size(); ++i) d.calibration.identifiable[i] = d.selection.model.calibrated[i];
-  d.calibration.intervals = fitter.intervals(d.selection.model, floor);
-  d.extended_model = d.selection.model.model(d.context);
-  for (std::size_t i = 0; i < kCalibrated.size(); ++i) d.calibration.value[i] = d.extended_model.machine.*kCalibratedFields[i];
+  calibrate_and_select(least_squares, floor, d);
+  // Outliers that move the least-squares fit: everything again under the robust loss.
+  monitor.stage("checking for outliers", 0);
+  d.outliers = check_outliers(least_squares, d.selection.model, d.calibration.intervals);
+  if (d.outliers.influential) diagnose_robustly(least_squares, floor, d);
 
   const bool transient = d.log->mode == ModelMode::kTransient;
   monitor.stage("checking the effects on the estimator", transient ? (d.selection.model.effects.size() + 1) * n : 0);
@@ -189,7 +236,7 @@ Diagnosis diagnose(LogData log, const io::MachineConfig& config, const DiagnoseO
       comparison_pass(replay, d.context, base, d.extended_model, baseline, d.statistics, d.figures);
     }
   });
-  d.verdict = verdict(d.selection.extended_heldout_rms_A, floor, d.statistics);
+  d.verdict = verdict(d.selection.extended_heldout_rms_A, d.noise_floor, d.statistics);
   d.elapsed_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_time).count();
   return d;
 }

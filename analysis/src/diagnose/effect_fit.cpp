@@ -128,6 +128,12 @@ EffectFitter::EffectFitter(const ModelReplay& replay, const EffectContext& conte
   }
 }
 
+EffectFitter EffectFitter::with_loss(const RobustLoss& loss) const {
+  EffectFitter f = *this;
+  f.loss_ = loss;
+  return f;
+}
+
 void EffectFitter::training_residuals(const EffectSet& set, std::vector<double>& out) const {
   const std::vector<std::vector<double>> blocks =
       over_training({set.model(context_)}, std::vector<double>{}, [](std::vector<double>& v, std::span<const core::Vec2> r) {
@@ -156,7 +162,7 @@ BlockScores EffectFitter::heldout(const EffectSet& set) const {
   replay_.for_blocks(heldout_blocks_, [&](std::size_t i, int b) {
     replay_.replay_block(b, model, [&](std::size_t, std::span<const ModelSample> m) {
       if (!m[0].valid) return;
-      ssr[i] += m[0].residual_A.squaredNorm();
+      ssr[i] += loss_.rho(m[0].residual_A.squaredNorm());
       ++samples[i];
     });
   });
@@ -314,6 +320,7 @@ CalibrationIntervals EffectFitter::intervals(const EffectSet& set, double noise_
     const double factor = 1.0 + kCalibrationScale * set.calibration[i];
     const bool excited = unexcited[k] < 0.5;
     out.half_width[i] = excited ? kZ * kCalibrationScale * std::sqrt(std::max(robust(k, k), 0.0)) / factor : kInf;
+    out.change_per_A[i] = excited ? kCalibrationScale * std::sqrt(std::max(h_inv(k, k), 0.0)) / factor : kInf;
     out.excitation_half_width[i] = excited ? kZ * kCalibrationScale * std::sqrt(sigma2 * h_inv(k, k)) / factor : kInf;
   }
   auto k = static_cast<Eigen::Index>(kCalibrated.size());

@@ -10,6 +10,20 @@ bool identified(const EffectSet& set, const CalibrationIntervals& ci, std::size_
   return ci.half_width[i] <= kIdentifiedHalfWidth && std::abs(set.calibration[i]) < 0.99 * kCalibrationBound;
 }
 
+double misfit_norm_A(std::size_t training_samples, double heldout_rms_A, double noise_floor_A) {
+  if (heldout_rms_A <= noise_floor_A) return 0.0;
+  return std::sqrt(static_cast<double>(training_samples) * (heldout_rms_A * heldout_rms_A - noise_floor_A * noise_floor_A));
+}
+
+Identification identification(const EffectSet& set, const CalibrationIntervals& ci, std::size_t i, double misfit_A) {
+  if (identified(set, ci, i)) return Identification::kNarrow;
+  if (!(std::abs(set.calibration[i]) < 0.99 * kCalibrationBound)) return Identification::kNot;
+  // The configured value θ_c outside θ̂·(1 ± (h + m)), with θ̂ = θ_c·(1 + s·δ): |s·δ| > (h + m)·(1 + s·δ).
+  const double moved = kCalibrationScale * set.calibration[i];
+  const double widened = ci.half_width[i] + ci.change_per_A[i] * misfit_A;
+  return std::abs(moved) > widened * (1.0 + moved) ? Identification::kRejectsConfiguration : Identification::kNot;
+}
+
 ExtendedModel EffectSet::model(const EffectContext& c) const {
   ExtendedModel m = c.base;
   for (std::size_t i = 0; i < kCalibrated.size(); ++i) {

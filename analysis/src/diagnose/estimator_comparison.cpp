@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "rpem/core/clock.hpp"
 #include "rpem/core/drive_estimator.hpp"
 #include "rpem/io/csv_table.hpp"
 
@@ -50,26 +51,16 @@ EstimateSummary summarise(const ParameterTrack& track, const ParameterTrack& tru
   return s;
 }
 
-/// Samples run between two looks at the monitor.
-constexpr std::size_t kReportEvery = 1 << 16;
-
-/// Tells the monitor of a stretch of samples run, and stops if asked.
-void report(Monitor* monitor, std::size_t samples) {
-  if (!monitor) return;
-  monitor->advance(samples);
-  if (monitor->stop_requested()) throw Interrupted();
-}
-
 ParameterTrack run_rpem(const LogData& log, const io::MachineConfig& config, Monitor* monitor) {
   core::DriveEstimator estimator(config.machine, config.estimator);
   ParameterTrack track;
   const std::size_t every = std::max<std::size_t>(1, log.size() / kTrackPoints);
   for (std::size_t k = 0; k < log.size(); ++k) {
     const core::Estimate e = estimator.step(log.sample(k));
-    if (k % every == 0) track.add(1e-9 * static_cast<double>(e.t_ns), e.psi_m_Wb, e.r_s_Ohm);
-    if ((k + 1) % kReportEvery == 0) report(monitor, kReportEvery);
+    if (k % every == 0) track.add(core::to_seconds(e.t_ns), e.psi_m_Wb, e.r_s_Ohm);
+    if ((k + 1) % kMonitorSamples == 0) report_work(monitor, kMonitorSamples);
   }
-  report(monitor, log.size() % kReportEvery);
+  report_work(monitor, log.size() % kMonitorSamples);
   return track;
 }
 
@@ -87,7 +78,7 @@ void steady_state_tracks(const LogData& log, const EffectContext& context, const
     const double r_model = r_s_at(model, log, k), psi_model = psi_m_at(model, log, k);
     const double r_implied = (in.u_pu[0] + in.n_pu * in.x_q_pu * in.i_pu[1]) / in.i_pu[0];
     const double psi_implied = (in.u_pu[1] - base.resistance_pu(r_model) * in.i_pu[1]) / in.n_pu - in.x_d_pu * in.i_pu[0];
-    const double t = 1e-9 * static_cast<double>(sample.t_ns);
+    const double t = core::to_seconds(sample.t_ns);
     c.truth.add(t, base.flux_Wb_of(psi_implied), base.resistance_Ohm_of(r_implied));
     c.nominal.add(t, psi_m_at(context.base, log, k), r_s_at(context.base, log, k));
     c.extended.add(t, psi_model, r_model);
@@ -103,13 +94,13 @@ double estimator_heldout_rms_A(const LogData& log, const io::MachineConfig& conf
   for (int b = 0; b < log.blocks; ++b) {
     for (std::size_t k = log.block_first[static_cast<std::size_t>(b)]; k < log.block_first[static_cast<std::size_t>(b) + 1]; ++k) {
       const core::Estimate e = estimator.step(log.sample(k));
-      if ((k + 1) % kReportEvery == 0) report(monitor, kReportEvery);
+      if ((k + 1) % kMonitorSamples == 0) report_work(monitor, kMonitorSamples);
       if (b % 2 != 1 || !log.used(k) || e.detail.code != core::StepCode::kAdapted) continue;
       sum += e.epsilon_A.squaredNorm();
       ++n;
     }
   }
-  report(monitor, log.size() % kReportEvery);
+  report_work(monitor, log.size() % kMonitorSamples);
   return n ? std::sqrt(sum / static_cast<double>(n)) : 0.0;
 }
 

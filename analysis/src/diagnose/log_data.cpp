@@ -2,12 +2,15 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 
+#include "rpem/core/clock.hpp"
 #include "rpem/core/conditioner.hpp"
 #include "rpem/core/frames.hpp"
 #include "rpem/io/averaged_log.hpp"
 #include "rpem/io/log_source.hpp"
 #include "rpem/io/machine_config.hpp"
+#include "rpem/io/sample_counts.hpp"
 
 namespace rpem::analysis {
 namespace {
@@ -38,7 +41,7 @@ core::DriveSample LogData::replay_sample(std::size_t k) const noexcept {
   for (std::size_t j = k - w + 1; j <= k + w; ++j) {
     if (samples.gap_before(j)) return s;
   }
-  const double dt = 1e-9 * static_cast<double>(samples.t_ns(k + w) - samples.t_ns(k - w));
+  const double dt = core::to_seconds(samples.t_ns(k + w) - samples.t_ns(k - w));
   if (dt > 0.0) s.omega_el_rad_s = core::wrap_angle(samples.theta_el_rad(k + w) - samples.theta_el_rad(k - w)) / dt;
   return s;
 }
@@ -73,7 +76,7 @@ void prepare_log(LogData& d, const core::MachineSi& machine, const LogOptions& o
   {
     std::vector<double> dts;
     dts.reserve(n - 1);
-    for (std::size_t k = 1; k < n; ++k) dts.push_back(1e-9 * static_cast<double>(d.samples.t_ns(k) - d.samples.t_ns(k - 1)));
+    for (std::size_t k = 1; k < n; ++k) dts.push_back(core::to_seconds(d.samples.t_ns(k) - d.samples.t_ns(k - 1)));
     d.median_dt_s = median(std::move(dts));
   }
 
@@ -148,6 +151,60 @@ LogData prepare_log(const std::vector<io::DriveLogRow>& rows, const io::DriveLog
   return d;
 }
 
+std::vector<std::string> left_out_explanations(const LogData& log) {
+  std::vector<std::string> out;
+  const double n = static_cast<double>(log.size());
+  auto explain = [&](std::size_t count, const std::string& what) {
+    if (static_cast<double>(count) <= io::kExplainedShare * n) return;
+    char head[96];
+    std::snprintf(head, sizeof head, "%zu of %zu rows (%.1f %%) ", count, log.size(), 100.0 * static_cast<double>(count) / n);
+    out.push_back(head + what);
+  };
+  char text[512];
+  std::snprintf(text, sizeof text,
+                "were left out of the steady-state replay as in transition: their current or speed differs from a "
+                "neighbour's by more than %.0f %% of the log's range, so they are not at a steady operating point. "
+                "Keys: none — a log of samples at the control rate replays the transient model (--model transient), "
+                "and a faster logger gives rows a neighbour at the same operating point",
+                100.0 * kTransitionShare);
+  explain(log.excluded_transitional, text);
+  std::snprintf(text, sizeof text,
+                "were left out as idle: current and speed both below %.0f %% of their largest, where the model "
+                "predicts nothing a constant could be fitted to. Keys: none (nothing to fit there)",
+                100.0 * kIdleShare);
+  explain(log.excluded_idle, text);
+  return out;
+}
+
+core::Vec2 applied_mean_V(const core::Vec2& command_V, double omega_el_rad_s, double control_period_s,
+                          double delay_periods) noexcept {
+  const double wt = omega_el_rad_s * control_period_s;
+  const double half = 0.5 * wt;
+  const double sinc = std::abs(half) < 1e-6 ? 1.0 - half * half / 6.0 : std::sin(half) / half;
+  // Turned by −d·ω·T_c: the Park transform by the angle the rotor advances before the hold's centre.
+  return sinc * core::park(command_V, core::Rotation::of(delay_periods * wt));
+}
+
+namespace {
+
+/// Turns a drive's reported commands into the applied means (LogOptions::voltage_is_command); returns what it
+/// did, for the log's description.
+std::string apply_reported_command(std::vector<core::AveragedSample>& samples, const LogOptions& options) {
+  // Held one period from the delay on: its centre d·T_c = delay + T_c/2 after the sample. Every sample, the
+  // bridge-off ones too: at VESC Tool's 0.01 A a modulating bridge at zero current reads i = 0 as well, and the
+  // undriven branch's measured back EMF is then turned too (docs/drive-log.md, "The voltage is the command").
+  const double d = (options.command_delay_s + 0.5 * options.control_period_s) / options.control_period_s;
+  for (core::AveragedSample& s : samples) s.u_dq_V = applied_mean_V(s.u_dq_V, s.omega_el_rad_s, options.control_period_s, d);
+  char text[200];
+  std::snprintf(text, sizeof text,
+                "; voltages reported as the drive's command, turned into the applied mean (by −%.3g·ω·T_c, times "
+                "sinc(ω·T_c/2), T_c = %.3g µs)",
+                d, 1e6 * options.control_period_s);
+  return text;
+}
+
+}  // namespace
+
 LogData load_log(const std::string& path, const core::MachineSi& machine, const LogOptions& options,
                  const std::function<void(std::uint64_t, std::uint64_t)>& progress) {
   const io::LogSource source = io::log_source(path, options.log_map);
@@ -161,16 +218,23 @@ LogData load_log(const std::string& path, const core::MachineSi& machine, const 
                               "an averaged log replays only the steady-state model (give --model auto or steady_state)");
     }
     io::AveragedLogRead read;
-    const std::vector<core::AveragedSample> samples = io::read_averaged_log(path, source.map, limits, &read);
+    std::vector<core::AveragedSample> samples = io::read_averaged_log(path, source.map, limits, &read);
+    const bool turn = options.voltage_is_command && options.control_period_s > 0.0;
+    const std::string voltage = turn ? apply_reported_command(samples, options) : "";
     d.layout = io::rotor_frame_layout(read.layout);
     d.samples = SampleStore(d.layout);
-    for (const core::AveragedSample& s : samples) d.samples.push_back(io::to_drive_log_row(s));
+    d.window_start_ns.reserve(samples.size());
+    for (const core::AveragedSample& s : samples) {
+      d.samples.push_back(io::to_drive_log_row(s));
+      d.window_start_ns.push_back(s.t_start_ns);
+    }
     d.samples.finish();
     LogOptions steady = options;
     steady.mode = ModelMode::kSteadyState;
     prepare_log(d, machine, steady);
     d.averaged = true;
-    d.format = io::describe(source, read);
+    d.format = io::describe(source, read) + voltage;
+    d.voltage_applied = turn;
     return d;
   }
   io::DriveLogReader reader(path, source.map, limits);

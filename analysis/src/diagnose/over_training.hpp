@@ -14,9 +14,13 @@ std::vector<Acc> EffectFitter::over_training(const std::vector<ExtendedModel>& m
   replay_.for_blocks(training_blocks_, [&](std::size_t i, int b) {
     Acc& acc = out[i];
     std::vector<core::Vec2> r(models.size());
+    const bool robust = loss_.robust();
     replay_.replay_block(b, models, [&](std::size_t k, std::span<const ModelSample> m) {
       if (!fitted_[k]) return;
-      for (std::size_t j = 0; j < m.size(); ++j) r[j] = m[j].valid ? m[j].residual_A : core::Vec2::Constant(kMiss_A);
+      for (std::size_t j = 0; j < m.size(); ++j) {
+        r[j] = m[j].valid ? m[j].residual_A : core::Vec2::Constant(kMiss_A);
+        if (robust) r[j] *= loss_.residual_scale(r[j].squaredNorm());  // |r|² becomes ρ(|r|²) (robust_loss.hpp)
+      }
       add(acc, std::span<const core::Vec2>(r));
     });
   });

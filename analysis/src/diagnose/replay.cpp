@@ -61,7 +61,12 @@ class ModelReplay::Chain {
       coefficients = core::PredictorCoefficients::of(m_, r_.base_.omega_el_rad_s);
     }
     core::predict(m_, coefficients, core::Discretization::kTrapezoidal, iv, state_, core::Gradients::kSkip);
-    if (logged_i_dq_A == nullptr) return;  // not used
+    if (logged_i_dq_A == nullptr) {
+      // Left out (its regime excluded it: bridge off, not locked): the model does not describe it, so the
+      // prediction starts again from the measurement after it.
+      synchronized_ = false;
+      return;
+    }
     out.model_A = conditioner_.observed_current_dq_A(x.s, x.logged, state_.i_hat_pu);
     out.residual_A = *logged_i_dq_A - out.model_A;
     out.valid = out.residual_A.allFinite();

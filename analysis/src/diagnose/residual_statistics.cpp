@@ -2,6 +2,7 @@
 
 #include <cmath>
 
+#include "rpem/core/clock.hpp"
 #include "rpem/core/conditioner.hpp"
 
 namespace rpem::analysis {
@@ -167,6 +168,8 @@ ResidualStatistics ResidualSums::statistics() const {
   out.rms_A = {all_before_.rms(), all_after_.rms()};
   out.standstill_rms_A = {still_before_.rms(), still_after_.rms()};
   out.motion_rms_A = {moving_before_.rms(), moving_after_.rms()};
+  out.standstill_samples = still_before_.n;
+  out.motion_samples = moving_before_.n;
   for (int sr = 0; sr < 5; ++sr) {
     for (int lr = 0; lr < 3; ++lr) {
       const Moments& b = region_before_[sr][lr];

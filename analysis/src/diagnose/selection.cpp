@@ -112,7 +112,7 @@ bool leaves_configured(const EffectSet& set, const std::array<bool, kCalibrated.
 }
 
 /// `set` with the admissible constants it leaves configured freed and refitted from its values (a warm
-/// start), keeping those the fit then identifies (refitted without the others); `set` itself when it keeps
+/// start), keeping those the calibration's rule then keeps (identification()) (refitted without the others); `set` itself when it keeps
 /// none (`kept` false).
 EffectSet with_admissible_constants(const EffectFitter& fitter, double noise_floor_A,
                                     const std::array<bool, kCalibrated.size()>& admissible, const EffectSet& set, bool& kept) {
@@ -127,9 +127,10 @@ EffectSet with_admissible_constants(const EffectFitter& fitter, double noise_flo
   if (freed.empty()) return set;
   trial = fitter.fit(trial);  // from `set`'s fitted values: a warm start
   const CalibrationIntervals ci = fitter.intervals(trial, noise_floor_A);
+  const double misfit = misfit_norm_A(fitter.training_samples(), rms(fitter.heldout(trial)), noise_floor_A);
   bool all = true;
   for (std::size_t i : freed) {
-    if (identified(trial, ci, i)) {
+    if (identification(trial, ci, i, misfit) != Identification::kNot) {
       kept = true;
       continue;
     }

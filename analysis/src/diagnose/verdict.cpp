@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <limits>
 
 namespace rpem::analysis {
 namespace {
@@ -47,7 +46,17 @@ std::string regressor_meaning(const std::string& r) {
 
 }  // namespace
 
+const char* to_string(VerdictKind k) noexcept {
+  switch (k) {
+    case VerdictKind::kExplained: return "explained";
+    case VerdictKind::kUnexplained: return "unexplained";
+    case VerdictKind::kUndetermined: return "undetermined";
+  }
+  return "undetermined";
+}
+
 void SecondDifferences::add(const LogData& log, std::size_t k, const ModelSample& m) {
+  valid_ += m.valid ? 1 : 0;
   // A difference needs three consecutive predicted samples of one block with no gap before the last two.
   if (previous_.valid && last_.valid && m.valid && previous_.k + 1 == last_.k && last_.k + 1 == k &&
       !log.samples.gap_before(last_.k) && !log.samples.gap_before(k)) {
@@ -62,15 +71,36 @@ void SecondDifferences::add(const LogData& log, std::size_t k, const ModelSample
 void SecondDifferences::append(const SecondDifferences& other) {
   d2_.insert(d2_.end(), other.d2_.begin(), other.d2_.end());
   q2_.insert(q2_.end(), other.q2_.begin(), other.q2_.end());
+  valid_ += other.valid_;
 }
 
-double SecondDifferences::noise_floor_A() && {
-  if (d2_.size() < 10) return 0.0;
+NoiseFloor SecondDifferences::noise_floor(const LogData& log) && {
+  NoiseFloor f;
+  f.differences = d2_.size();
+  if (d2_.size() < kMinNoiseDifferences) {
+    f.unknown_reason = "only " + std::to_string(d2_.size()) + " of the " + std::to_string(log.size()) +
+                       " samples have replayed neighbours on both sides within their block (" +
+                       std::to_string(kMinNoiseDifferences) + " are needed): ";
+    if (log.mode == ModelMode::kSteadyState) {
+      f.unknown_reason += std::to_string(log.excluded_transitional) + " rows are in transition between operating points and " +
+                          std::to_string(log.excluded_idle) + " idle, so no stretch of rows repeats an operating point " +
+                          "(standstill under current included) and " + std::to_string(valid_) + " rows are replayed";
+    } else {
+      f.unknown_reason += "gaps and left-out samples leave " + std::to_string(valid_) + " replayed samples without runs of three";
+    }
+    return f;
+  }
   const double scale = 1.0 / (kSecondDifferenceGain * kMedianChiSquare1);
-  return std::sqrt(scale * (median(std::move(d2_)) + median(std::move(q2_))));
+  const double value = std::sqrt(scale * (median(std::move(d2_)) + median(std::move(q2_))));
+  if (!(value > 0.0)) {
+    f.unknown_reason = "the residual does not change between neighbouring samples (below the log's resolution)";
+    return f;
+  }
+  f.value_A = value;
+  return f;
 }
 
-double noise_floor_A(const LogData& log, const ReplayOutput& replay) {
+NoiseFloor measure_noise_floor(const LogData& log, const ReplayOutput& replay) {
   SecondDifferences all;
   for (int b = 0; b < log.blocks; ++b) {
     all.start();
@@ -78,19 +108,33 @@ double noise_floor_A(const LogData& log, const ReplayOutput& replay) {
       all.add(log, k, ModelSample{replay.residual_A[k], replay.model_A.empty() ? core::Vec2::Zero() : replay.model_A[k], replay.valid[k]});
     }
   }
-  return std::move(all).noise_floor_A();
+  return std::move(all).noise_floor(log);
 }
 
-Verdict verdict(double final_heldout_rms_A, double floor_A, const ResidualStatistics& st) {
+Verdict verdict(double final_heldout_rms_A, const NoiseFloor& floor, const ResidualStatistics& st) {
   Verdict v;
-  v.noise_floor_A = floor_A;
-  v.ratio = floor_A > 0.0 ? final_heldout_rms_A / floor_A : std::numeric_limits<double>::infinity();
-  v.explained = v.ratio <= kExplainedRatio;
-  if (v.explained) return v;
+  v.noise_floor_A = floor.value_A;
+  if (floor.value_A) {
+    v.ratio = final_heldout_rms_A / *floor.value_A;
+    v.kind = *v.ratio <= kExplainedRatio ? VerdictKind::kExplained : VerdictKind::kUnexplained;
+    if (v.explained()) return v;
+  } else {
+    v.kind = VerdictKind::kUndetermined;
+    v.findings.push_back("the noise floor cannot be measured on this log: " + floor.unknown_reason);
+    v.findings.push_back("the final model's held-out residual is " + num(final_heldout_rms_A) +
+                         " A RMS; whether that is the sensors' noise or a model error cannot be told without it");
+  }
+  const std::string floor_text = floor.value_A ? "noise floor " + num(*floor.value_A) + " A" : "noise floor unknown";
 
   // Where it lives: standstill against motion, and the region that carries the most.
-  v.findings.push_back("at standstill " + num(st.standstill_rms_A.after) + " A RMS, in motion " + num(st.motion_rms_A.after) +
-                       " A RMS (noise floor " + num(floor_A) + " A)");
+  if (st.standstill_samples == 0) {
+    v.findings.push_back("no samples at standstill; in motion " + num(st.motion_rms_A.after) + " A RMS (" + floor_text + ")");
+  } else if (st.motion_samples == 0) {
+    v.findings.push_back("at standstill " + num(st.standstill_rms_A.after) + " A RMS, no samples in motion (" + floor_text + ")");
+  } else {
+    v.findings.push_back("at standstill " + num(st.standstill_rms_A.after) + " A RMS, in motion " + num(st.motion_rms_A.after) +
+                         " A RMS (" + floor_text + ")");
+  }
   const RegionStatistics* worst = nullptr;
   for (const RegionStatistics& r : st.regions) {
     if (!worst || r.rms_A.after > worst->rms_A.after) worst = &r;
@@ -99,12 +143,12 @@ Verdict verdict(double final_heldout_rms_A, double floor_A, const ResidualStatis
     v.findings.push_back("largest in the region " + worst->speed + ", " + worst->load + ": " + num(worst->rms_A.after) +
                          " A RMS, mean ε_d " + num(worst->mean_d_A.after) + " A, ε_q " + num(worst->mean_q_A.after) + " A");
   }
-  // Against the electrical angle: the strongest harmonic, if it stands out.
+  // Against the electrical angle: the strongest harmonic, if it stands out of the noise.
   const HarmonicContent* strongest = nullptr;
   for (const HarmonicContent& h : st.harmonics) {
     if (!strongest || h.amplitude_A.after > strongest->amplitude_A.after) strongest = &h;
   }
-  if (strongest && strongest->amplitude_A.after > floor_A) {
+  if (strongest && floor.value_A && strongest->amplitude_A.after > *floor.value_A) {
     v.findings.push_back("against the electrical angle the residual is strongest at harmonic " + std::to_string(strongest->order) +
                          " (" + num(strongest->amplitude_A.after) + " A): most often " + harmonic_meaning(strongest->order));
   }
@@ -120,6 +164,10 @@ Verdict verdict(double final_heldout_rms_A, double floor_A, const ResidualStatis
   }
   if (best && best_r >= 0.3) {
     v.findings.push_back("it correlates with " + best->regressor + " (" + num(best_r) + "): " + regressor_meaning(best->regressor));
+  }
+  if (!floor.value_A) {
+    v.findings.push_back("three or more consecutive samples at one operating point (a steady stretch, or standstill under "
+                         "current) in several blocks would measure the noise floor");
   }
   v.findings.push_back("a log with more operating points — standstill at several currents of both signs, several speeds at "
                        "several loads, temperatures that span tens of kelvin — would tell more effects apart");

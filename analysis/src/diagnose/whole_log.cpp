@@ -5,6 +5,7 @@
 
 #include "rpem/analysis/diagnose/verdict.hpp"
 #include "rpem/core/conditioner.hpp"
+#include "rpem/core/units.hpp"
 
 namespace rpem::analysis {
 namespace {
@@ -31,7 +32,7 @@ struct BlockFigures {
 }  // namespace
 
 double speed_rpm(const EffectContext& context, double omega_el_rad_s) {
-  return omega_el_rad_s * 60.0 / (2.0 * core::kPi * context.machine.rated.pole_pairs);
+  return core::rad_s_to_rpm(omega_el_rad_s) / context.machine.rated.pole_pairs;
 }
 
 BaselinePass baseline_pass(const ModelReplay& replay, const EffectContext& context, const ExtendedModel& baseline) {
@@ -81,7 +82,7 @@ BaselinePass baseline_pass(const ModelReplay& replay, const EffectContext& conte
     out.temperature_lo_C = std::min(out.temperature_lo_C, b.ranges.temperature_lo_C);
     out.temperature_hi_C = std::max(out.temperature_hi_C, b.ranges.temperature_hi_C);
   }
-  out.noise_floor_A = std::move(differences).noise_floor_A();
+  out.noise_floor = std::move(differences).noise_floor(log);
 
   // The overlay's window: transient logs the 0.1 s where the configuration errs most; steady state the whole log.
   const std::size_t n = log.size();

@@ -5,22 +5,18 @@
 // anything else in it. rpemd reads them from $CREDENTIALS_DIRECTORY (systemd's LoadCredential=), the
 // rpem tool from --key FILE; a key is never in the YAML or on a command line.
 
-#include <stdexcept>
 #include <string>
 
 #include "rpem/auth/mac.hpp"
 
 namespace rpem::auth {
 
-/// A key file that cannot be used: names the file and why.
-class KeyError : public std::runtime_error {
- public:
-  using std::runtime_error::runtime_error;
-};
+// KeyError (key.hpp): a key file that cannot be used, naming the file and why.
 
-/// Parses a key file's text; `where` names it in errors.
+/// Parses a key file's text, decoding the key straight into its locked memory (wiping `text` is the
+/// caller's); `where` names it in errors.
 [[nodiscard]] Key parse_key(const std::string& text, const std::string& where);
-/// The key file's text for `key`.
+/// The key file's text for `key`: it holds the key, so wipe it when done (as write_key_file does).
 [[nodiscard]] std::string format_key(const Key& key);
 /// Reads and checks a key file (owner-only permissions, format).
 [[nodiscard]] Key load_key_file(const std::string& path);

@@ -10,7 +10,7 @@
 // prefix), so a valid estimate can never pass as a command, nor a command for one rpemd as one for
 // another. HMAC-SHA256 from libsodium (crypto_auth_hmacsha256_*), compared in constant time
 // (crypto_verify_32). Nothing here allocates or throws: the publisher and control threads call it per
-// message.
+// message. Keys: key.hpp.
 
 #include <array>
 #include <cstddef>
@@ -18,9 +18,10 @@
 #include <span>
 #include <string_view>
 
+#include "rpem/auth/key.hpp"
+
 namespace rpem::auth {
 
-inline constexpr std::size_t kKeyBytes = 32;
 inline constexpr std::size_t kMacBytes = 32;
 inline constexpr std::size_t kTrailerBytes = 4 + kMacBytes;  ///< key_id and mac at the end of E
 inline constexpr std::string_view kDomain{"rpem-auth-1"};
@@ -28,16 +29,12 @@ inline constexpr int kMaxKeys = 2;  ///< accepted at once: the current key and, 
 
 using Tag = std::array<std::uint8_t, kMacBytes>;
 
-struct Key {
-  std::int32_t id = 0;  ///< > 0
-  std::array<std::uint8_t, kKeyBytes> bytes{};
-};
-
-/// The accepted keys (at most kMaxKeys, distinct ids).
+/// The accepted keys (at most kMaxKeys, distinct ids), held here and nowhere else.
 class Keyring {
  public:
-  /// False (and nothing added) if full, the id is not positive or already present.
-  bool add(const Key& key) noexcept;
+  /// Takes the key; false (and the key left with the caller) if full, the id is not positive or
+  /// already present.
+  bool add(Key&& key) noexcept;
   [[nodiscard]] const Key* find(std::int32_t id) const noexcept;
   [[nodiscard]] int size() const noexcept { return n_; }
   [[nodiscard]] bool empty() const noexcept { return n_ == 0; }

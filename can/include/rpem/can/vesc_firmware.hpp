@@ -38,6 +38,12 @@ struct Request {
 inline constexpr std::size_t kMaxValuesPayload = 64;
 [[nodiscard]] std::size_t encode_values(const Values& v, std::uint32_t mask, std::span<std::uint8_t> out) noexcept;
 
+/// A number as a host reads it after the firmware sent it: value·scale in float, cast as the Cortex-M4 casts
+/// (buffer_append_float32 / _float16), then the integer divided by the scale (the receiver's buffer_get_float32
+/// / 16, VESC Tool's VByteArray::vbPopFrontDouble32 / 16).
+[[nodiscard]] double wire_float32(double value, float scale) noexcept;
+[[nodiscard]] double wire_float16(double value, float scale) noexcept;
+
 /// comm_can_send_buffer(to_id, payload, send): the frames a VESC with id `from_id` sends. Returns how
 /// many it wrote to `out` (0 if `out` is too small).
 [[nodiscard]] std::size_t buffer_frames(std::uint8_t to_id, std::uint8_t from_id, std::uint8_t send,

@@ -15,18 +15,18 @@
 
 #include <array>
 #include <cstdint>
+#include <optional>
 
 #include "rpem/core/averaged_sample.hpp"
 #include "rpem/core/drive_estimator.hpp"
+#include "rpem/core/regime.hpp"
 
 namespace rpem::core {
 
-/// The gain rates [1/s] the averaged estimator uses for each algorithm: `averaged.rates_per_s` where given,
-/// else γ_0/sample_period_s of `gains`.
-[[nodiscard]] std::array<GainSequences, 3> averaged_rates_per_s(const EstimatorSettings& s) noexcept;
-
 class AveragedDriveEstimator {
  public:
+  using Sample = AveragedSample;
+
   AveragedDriveEstimator(const MachineSi& machine, const EstimatorSettings& settings) noexcept;
 
   /// One averaged sample. Real-time safe.
@@ -35,7 +35,10 @@ class AveragedDriveEstimator {
   /// θ̂ and the Hessians back to their initial values; the next sample starts a new chain.
   void reset() noexcept;
   /// The next sample starts a new chain (adapts nothing).
-  void resynchronize() noexcept { has_previous_ = false; }
+  void resynchronize() noexcept {
+    has_previous_ = false;
+    classifier_.break_chain();
+  }
   void set_frozen(bool frozen) noexcept { core_.set_frozen(frozen); }
   void set_estimates(double psi_m_Wb, double r_s_Ohm) noexcept;
   /// Reloads gains, limits and model extensions, keeping θ̂ and the Hessians. Not real-time.
@@ -43,25 +46,38 @@ class AveragedDriveEstimator {
 
   [[nodiscard]] const PerUnitBase& base() const noexcept { return base_; }
   [[nodiscard]] const RpemEstimator& core() const noexcept { return core_; }
+  [[nodiscard]] const RegimeClassifier& classifier() const noexcept { return classifier_; }
   [[nodiscard]] double psi_m_Wb() const noexcept;
   [[nodiscard]] double r_s_Ohm() const noexcept;
+  /// The time of the newest sample stepped, whatever became of it (rejected, or the first of a new
+  /// chain), kept across reset() and resynchronize(); none before the first. rpemd's loop measures the
+  /// time each sample stands for from it.
+  [[nodiscard]] std::optional<std::int64_t> previous_t_ns() const noexcept { return previous_t_ns_; }
 
  private:
-  /// The sample as the steady-state model takes it (pu, corrections applied), and whether it continues
-  /// the chain of the previous one.
+  /// The sample as the steady-state model takes it (pu, corrections applied, before the inductive
+  /// correction), and how it continues the chain of the previous one (timing_).
   [[nodiscard]] SteadyStateSample condition(const AveragedSample& a) noexcept;
   void configure(const EstimatorSettings& settings) noexcept;
+  /// The estimate of a stepped sample (and the count of its observation, where an instantaneous one adapted).
+  [[nodiscard]] Estimate finish(const AveragedSample& sample, const SteadyStateSample& s, const EstimatorOutput& detail,
+                                Classification regime, bool point, const GainSequences& gains) noexcept;
 
   PerUnitBase base_;
   SampleConditioner conditioner_;
   RpemEstimator core_;
+  RegimeClassifier classifier_;
+  PointGains point_gains_;  ///< the gains of instantaneous samples (one observation each)
   std::array<GainSequences, 3> rates_per_s_{};
   AveragedSettings options_;
-  double delay_s_ = 0.0;
-  bool has_previous_ = false;
-  std::int64_t previous_t_ns_ = 0;
+  bool options_classify_ = true;  ///< estimator.regimes.enabled
+  // Without classification the inductive correction's slope is taken here (the classifier takes it otherwise).
   std::int64_t previous_centre2_ns_ = 0;  ///< t_start + t of the previous window (twice its centre)
   Vec2 previous_i_pu_ = Vec2::Zero();
+  double delay_s_ = 0.0;
+  bool has_previous_ = false;  ///< the next sample continues the chain of the previous one
+  std::optional<std::int64_t> previous_t_ns_;
+  SampleTiming timing_ = SampleTiming::kFirst;  ///< of the sample being stepped
   Vec2 instrument_i_pu_ = Vec2::Zero();  ///< low-passed current of the samples before this one
   double instrument_n_pu_ = 0.0;
 };

@@ -22,6 +22,7 @@ struct AveragedSample {
   double t_winding_C = std::numeric_limits<double>::quiet_NaN();  ///< NaN: not reported
   double t_magnet_C = std::numeric_limits<double>::quiet_NaN();   ///< NaN: not reported
   double t_drive_C = std::numeric_limits<double>::quiet_NaN();    ///< power stage; NaN: not reported
+  double t_coolant_C = std::numeric_limits<double>::quiet_NaN();  ///< the machine's coolant; NaN: not reported
   bool gap_before = false;        ///< windows were lost immediately before this one
 };
 

@@ -28,6 +28,11 @@ struct AveragedSettings {
   /// Where in the interval over which the drive holds a voltage it samples the current, as a fraction of
   /// T_c: 0 at the instant the voltage takes effect (a PWM update at the sampling instant), 0.5 in its middle.
   double current_sample_at = 0.0;
+  /// The drive reports the voltage it commands (computed in the frame of the current samples, taking effect
+  /// `model_extensions.delay` later and held, fixed in the stator frame, for one period T_c), not the
+  /// period's mean: the mean it applies is that command turned by a further −ω·T_c/2 and shortened by
+  /// sinc(ω·T_c/2) (§11, "Reported command"). Needs control_period_s.
+  bool voltage_is_command = false;
 };
 
 }  // namespace rpem::core

@@ -19,6 +19,9 @@ inline constexpr std::int64_t kNsPerS = 1'000'000'000;
 [[nodiscard]] constexpr std::int64_t to_ns(const timeval& t) noexcept {
   return static_cast<std::int64_t>(t.tv_sec) * kNsPerS + static_cast<std::int64_t>(t.tv_usec) * 1000;
 }
+/// A time or an interval in integer nanoseconds, in seconds: 1e-9·t (the one spelling of it, so every
+/// layer rounds alike).
+[[nodiscard]] constexpr double to_seconds(std::int64_t t_ns) noexcept { return 1e-9 * static_cast<double>(t_ns); }
 /// For t_ns ≥ 0.
 [[nodiscard]] constexpr timespec to_timespec(std::int64_t t_ns) noexcept {
   return timespec{static_cast<time_t>(t_ns / kNsPerS), static_cast<long>(t_ns % kNsPerS)};

@@ -1,12 +1,16 @@
 #pragma once
 // The estimator as every caller uses it (daemon, simulator, offline tools): SI drive samples in,
-// SI and pu estimates out. Holds the conditioner (frames, pu, input extensions) and RpemEstimator.
+// SI and pu estimates out. Holds the conditioner (frames, pu, input extensions), the regime classifier
+// and RpemEstimator. Samples of a control-rate stream go through the predictor; a sample further than
+// max_gap_carry_s (and max_sample_interval_s) after the previous one — a test bench's rows seconds apart —
+// is a steady-state observation of its own (docs/derivations.md §13, "Sparse samples").
 
 #include <cstdint>
 
 #include "rpem/core/conditioner.hpp"
 #include "rpem/core/drive_sample.hpp"
 #include "rpem/core/estimator.hpp"
+#include "rpem/core/regime.hpp"
 #include "rpem/core/settings.hpp"
 
 namespace rpem::core {
@@ -20,10 +24,13 @@ struct Estimate {
   Vec2 i_meas_A = Vec2::Zero();   ///< measured current, rotor frame (after input corrections)
   double speed_pu = 0.0;
   EstimatorOutput detail;         ///< per-unit detail: θ̂, Ψᵀ, L, code, flags
+  Classification regime;          ///< the sample's regime (regime.hpp)
 };
 
 class DriveEstimator {
  public:
+  using Sample = DriveSample;
+
   DriveEstimator(const MachineSi& machine, const EstimatorSettings& settings) noexcept;
 
   /// One sample. Real-time safe.
@@ -38,6 +45,7 @@ class DriveEstimator {
 
   [[nodiscard]] const PerUnitBase& base() const noexcept { return base_; }
   [[nodiscard]] const RpemEstimator& core() const noexcept { return core_; }
+  [[nodiscard]] const RegimeClassifier& classifier() const noexcept { return regimes_.classifier(); }
   [[nodiscard]] double psi_m_Wb() const noexcept;
   [[nodiscard]] double r_s_Ohm() const noexcept;
   /// θ̂ = [ψ̂m, r̂s] in pu now (also after reset(), set_estimates() or reconfigure(), before a step).
@@ -48,9 +56,24 @@ class DriveEstimator {
   [[nodiscard]] const Mat2& gna_hessian_pu() const noexcept { return core_.state().gna_hessian_pu; }
 
  private:
+  void configure(const EstimatorSettings& settings) noexcept;
+  /// A sample far from the previous one: the steady state of §1 at its own operating point.
+  [[nodiscard]] Estimate step_sparse(const DriveSample& sample, const EstimatorSample& conditioned) noexcept;
+  /// The sample's voltage as the drive reports it, |u|² [pu].
+  [[nodiscard]] double reported_voltage_sq_pu(const DriveSample& sample) const noexcept;
+  [[nodiscard]] Estimate estimate(const DriveSample& sample, const EstimatorOutput& detail, const Vec2& i_meas_pu,
+                                  double n_pu, Classification regime) const noexcept;
+
   PerUnitBase base_;
   SampleConditioner conditioner_;
   RpemEstimator core_;
+  StreamClassifier regimes_;
+  PointGains point_gains_;               ///< the sparse samples' gains
+  GainSequences rates_per_s_;            ///< the configured algorithm's gain rates [1/s] (sparse samples)
+  Vec2 dense_rates_per_s_ = Vec2::Zero();  ///< γ_0/T_samp of the step (dense samples)
+  double sparse_after_s_ = 0.0;          ///< max(max_sample_interval_s, max_gap_carry_s)
+  bool classify_ = true;                 ///< estimator.regimes.enabled
+  double inv_voltage_sq_ = 0.0;          ///< 1/U_b²
 };
 
 }  // namespace rpem::core

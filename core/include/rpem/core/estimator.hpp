@@ -38,6 +38,9 @@ struct EstimatorOptions {
   double nominal_sample_period_s = 125e-6;     ///< the period the γ_0 refer to; γ scales with dt
   double max_sample_interval_s = kMaxSampleIntervalPeriods * 125e-6;  ///< longer: the predictor resynchronises
   double max_gap_carry_s = 20e-3;              ///< across a shorter gap the prediction error is kept
+  /// ν_max: a sample whose prediction error lies further than ν_max of its noise beyond what any θ in D_M
+  /// explains is skipped (StepCode::kOutlier; docs/derivations.md §14); 0: never.
+  double outlier_bound_sigma = 5.0;
   bool adapt_psi_m = true;
   bool adapt_r_s = true;
 };
@@ -85,6 +88,19 @@ enum class StepCode : std::uint8_t {
   kSynchronized = 1,        ///< predictor (re)initialised from this measurement; no update
   kRejectedNonFinite = 2,   ///< NaN or Inf in the sample; ignored, predictor will resynchronise
   kPredictorDiverged = 3,   ///< |î| exceeded its bound; predictor resynchronised
+  kExcluded = 4,            ///< its regime excludes it (regime.hpp): predicted, nothing adapted
+  kOutlier = 5,             ///< its prediction error is beyond the outlier bound: predicted, skipped
+};
+
+/// What a sample's regime (regime.hpp) lets it do, and the noise its prediction error is judged against.
+/// The default admits everything and judges nothing (the estimator as the paper states it).
+struct Admission {
+  bool adapt = true;  ///< false: excluded — predicted, nothing adapted
+  bool psi_m = true;  ///< ψm's term is excited (on top of eq:GainSchedule)
+  bool r_s = true;    ///< r_s' term is excited
+  /// Judge the prediction error against the outlier bound, with the sample's noise variances [pu²].
+  bool judge = false;
+  double var_u_pu = 0.0, var_i_pu = 0.0, var_n_pu = 0.0;
 };
 
 namespace step_flag {
@@ -118,12 +134,35 @@ struct EstimatorOutput {
   std::uint16_t flags = 0;
 };
 
+/// Rates [1/s] as the gains of a window dt long: γ = 1 − e^{−rate·dt} (docs/derivations.md §11).
+[[nodiscard]] Vec2 per_interval(const Vec2& rate_per_s, double dt_s) noexcept;
+
+/// Gains for point observations at uneven intervals (docs/derivations.md §13, "Sparse samples"):
+/// exponentially weighted least squares that weighs each observation 1 and the past by e^{−rate·dt},
+///   γ_k = 1/S_k,   S_k = 1 + e^{−rate·(t_k − t_{k−1})}·S_{k−1},   S_0 = 1/(1 − e^{−rate·T_nom})
+/// over the observations that adapted (the start weighs a full memory of nominal samples). Evenly spaced:
+/// γ → 1 − e^{−rate·dt}, per_interval()'s; spaced far beyond the time constant 1/rate: γ → 1. Per parameter,
+/// for the Hessian's and the step's rates.
+struct PointGains {
+  GainSequences weight;      ///< S per rate (the counted observations' decayed weight)
+  std::int64_t last_ns = 0;  ///< the last counted observation
+  bool counted = false;
+  void start(const GainSequences& rates_per_s, double nominal_period_s) noexcept;
+  /// The gains of an observation at t_ns; nothing changes until count(). Real-time safe.
+  [[nodiscard]] GainSequences at(const GainSequences& rates_per_s, std::int64_t t_ns) const noexcept;
+  /// Counts the observation at t_ns that took `gains` (from at()). Real-time safe.
+  void count(const GainSequences& gains, std::int64_t t_ns) noexcept;
+};
+
 class RpemEstimator {
  public:
   explicit RpemEstimator(const EstimatorConfig& config) noexcept;
 
   /// One sample. Real-time safe.
-  EstimatorOutput step(const EstimatorSample& sample) noexcept;
+  EstimatorOutput step(const EstimatorSample& sample) noexcept { return step(sample, Admission{}); }
+  /// One sample with its admission: an excluded one re-anchors the predictor on the measurement (its
+  /// model, not the machine, failed) and adapts nothing; a judged outlier adapts nothing. Real-time safe.
+  EstimatorOutput step(const EstimatorSample& sample, const Admission& admission) noexcept;
 
   /// One averaged sample with the steady-state model instead of the predictor (docs/derivations.md §11):
   ///   î = M̂⁻¹·(u − [0, n·ψ̂m]ᵀ)  (§1),  ε = i − î,  Ψᵀ = the steady-state forms (§3) at the
@@ -131,6 +170,10 @@ class RpemEstimator {
   /// sequences as rates [1/s]; a sample dt_s after the previous one uses γ = 1 − e^{−rate·dt}.
   /// Real-time safe.
   EstimatorOutput step_steady_state(const SteadyStateSample& sample, const GainSequences& rates_per_s) noexcept;
+  /// The same with the sample's gains given (per parameter: the Hessian's γ_r and the step γ_L) and its
+  /// admission. Real-time safe.
+  EstimatorOutput step_steady_state(const SteadyStateSample& sample, const Vec2& gamma_r, const Vec2& gamma_l,
+                                    const Admission& admission) noexcept;
 
   /// θ̂ and the Hessians back to their initial values; the predictor resynchronises. Real-time safe.
   void reset() noexcept;
@@ -164,7 +207,12 @@ class RpemEstimator {
   };
   /// The update both sample kinds share: gain (SGA, GNA, PhyInt), eq:GainSchedule, θ̂ += L·ε, projection
   /// onto D_M (eq:paramsubset); the sample's output.
-  EstimatorOutput update(const Update& u, const Vec2& gamma_r, const Vec2& gamma_l) noexcept;
+  EstimatorOutput update(const Update& u, const Vec2& gamma_r, const Vec2& gamma_l, const Admission& admission) noexcept;
+  /// Whether ε lies beyond the bound: in a row, further than ν_max·σ_ε beyond the largest error a θ in
+  /// D_M explains (docs/derivations.md §14).
+  [[nodiscard]] bool outlier(const Update& u, const Admission& admission) const noexcept;
+  /// The output of a sample predicted but not adapted (excluded, outlier): ε and î as predicted.
+  [[nodiscard]] EstimatorOutput predicted_only(StepCode code, const Vec2& epsilon, const Vec2& i_hat) const noexcept;
   [[nodiscard]] Mat2 select_gradient(const MachinePu& model, double n_pu) const noexcept;
   /// The output of a sample that made no update: θ̂ and î as they stand.
   [[nodiscard]] EstimatorOutput held(StepCode code) const noexcept;
@@ -174,6 +222,7 @@ class RpemEstimator {
   // Decided by reconfigure(), so the per-sample path does not re-derive them.
   PredictorCoefficients coefficients_;   ///< from config_.model
   double inverse_nominal_period_ = 0.0;  ///< 1/T_samp
+  double inverse_r_min_ = 0.0;           ///< 1/r_min of D_M (the outlier bound)
   Gradients gradients_ = Gradients::kSkip;  ///< whether predict() advances the dynamic gradients
   double scaled_for_dt_s_ = -1.0;        ///< the interval gamma_r_, gamma_l_ were scaled for
   Vec2 gamma_r_ = Vec2::Zero(), gamma_l_ = Vec2::Zero();

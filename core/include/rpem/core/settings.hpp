@@ -9,6 +9,7 @@
 #include "rpem/core/conditioner.hpp"
 #include "rpem/core/estimator.hpp"
 #include "rpem/core/per_unit.hpp"
+#include "rpem/core/regime.hpp"
 
 namespace rpem::core {
 
@@ -32,10 +33,17 @@ struct EstimatorSettings : EstimatorOptions {
   double initial_r_s_Ohm = 0.0;
   ModelExtensions extensions;  ///< model_extensions (docs/model-extensions.md)
   AveragedSettings averaged;   ///< the averaged-sample estimator (averaged_estimator.hpp)
+  RegimeSettings regimes;      ///< the regime classification (regime.hpp)
 };
 
 [[nodiscard]] MachinePu to_pu(const PerUnitBase& base, const MachineSi& m) noexcept;
 [[nodiscard]] EstimatorConfig make_estimator_config(const PerUnitBase& base, const MachineSi& m,
                                                     const EstimatorSettings& s) noexcept;
+/// The gain rates [1/s] for each algorithm where samples come at their own times (averaged windows, sparse
+/// rows): `averaged.rates_per_s` where given, else γ_0/sample_period_s of `gains`.
+[[nodiscard]] std::array<GainSequences, 3> averaged_rates_per_s(const EstimatorSettings& s) noexcept;
+/// The classifier's configuration: the nominal machine, D_M, the tolerances and resolutions, per unit.
+[[nodiscard]] RegimeConfig make_regime_config(const PerUnitBase& base, const MachineSi& m,
+                                              const EstimatorSettings& s) noexcept;
 
 }  // namespace rpem::core

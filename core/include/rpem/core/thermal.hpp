@@ -17,10 +17,14 @@
 
 namespace rpem::core {
 
+/// The temperature the materials' coefficients below refer to (α relative to the value there), and the
+/// reference of a drift law unless it names another.
+inline constexpr double kMaterialReference_C = 20.0;
+
 /// A parameter's linear drift with temperature.
 struct DriftLaw {
   double coeff_per_K = 0.0;  ///< α, relative to the value at reference_C [1/K]
-  double reference_C = 20.0;
+  double reference_C = kMaterialReference_C;
   double value_ref = 0.0;    ///< the value at reference_C in SI (Ω or Wb); 0: the machine's configured value
 
   /// value(T)/value_ref.
@@ -39,9 +43,6 @@ struct DriftLaw {
   }
 };
 
-/// The temperature the materials' coefficients below refer to (α relative to the value there).
-inline constexpr double kMaterialReference_C = 20.0;
-
 /// A material's range of temperature coefficients [1/K], relative to the value at kMaterialReference_C.
 struct MaterialCoefficient {
   std::string_view material;
@@ -49,6 +50,10 @@ struct MaterialCoefficient {
   double min_per_K;
   double max_per_K;
   [[nodiscard]] constexpr bool contains(double alpha) const noexcept { return alpha >= min_per_K && alpha <= max_per_K; }
+  /// The standard deviation of α over the range, uniform, relative to the typical value: (max − min)/(√12·|typical|).
+  [[nodiscard]] constexpr double rel_sigma() const noexcept {
+    return (max_per_K - min_per_K) / (3.4641016151377544 * (typical_per_K < 0.0 ? -typical_per_K : typical_per_K));
+  }
 };
 
 inline constexpr MaterialCoefficient kCopper{"copper", 0.00393, 0.00393 * 0.85, 0.00393 * 1.15};
@@ -62,8 +67,8 @@ inline constexpr std::array<MaterialCoefficient, 3> kMagnetMaterials{kNdFeB, kSm
 /// The machine's thermal model: stator resistance against the winding temperature, magnet flux linkage
 /// against the magnet temperature. The defaults are a copper winding and NdFeB magnets.
 struct ThermalModel {
-  DriftLaw r_s{kCopper.typical_per_K, 20.0, 0.0};
-  DriftLaw psi_m{kNdFeB.typical_per_K, 20.0, 0.0};
+  DriftLaw r_s{kCopper.typical_per_K, kMaterialReference_C, 0.0};
+  DriftLaw psi_m{kNdFeB.typical_per_K, kMaterialReference_C, 0.0};
 };
 
 /// The material whose range holds α, if any.

@@ -2,10 +2,11 @@
 // Fixed-size linear-algebra types used throughout the estimator core. Nothing here allocates.
 
 #include <Eigen/Core>
+#include <numbers>
 
 namespace rpem::core {
 
-inline constexpr double kPi = 3.14159265358979323846;
+inline constexpr double kPi = std::numbers::pi;
 inline constexpr double kSqrt3 = 1.7320508075688772;
 inline constexpr double kInvSqrt3 = 1.0 / kSqrt3;  ///< per-sample code multiplies (a division costs ~4× more)
 

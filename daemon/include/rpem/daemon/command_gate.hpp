@@ -87,7 +87,7 @@ class CommandGate {
   };
 
   /// `last_accepted_seq`: as persisted by `store` (nullptr: not persisted — tests).
-  CommandGate(const CommandPolicy& policy, SpscQueue<Command>& to_loop, CommandKeys keys = {},
+  CommandGate(const CommandPolicy& policy, SpscQueue<Command>::Producer& to_loop, CommandKeys keys = {},
               std::int64_t last_accepted_seq = 0, SequenceStore* store = nullptr) noexcept
       : policy_(policy),
         to_loop_(to_loop),
@@ -116,8 +116,12 @@ class CommandGate {
   void report(DiagnosticsRows& rows) const noexcept;
 
  private:
+  /// commit()'s work, also when the pending list is full in the middle of handle().
+  bool queue_pending() noexcept;
+  void check_counts() const noexcept;
+
   CommandPolicy policy_;
-  SpscQueue<Command>& to_loop_;
+  SpscQueue<Command>::Producer& to_loop_;  ///< the control thread's (Control holds it)
   const CommandKeys keys_;
   SequenceStore* store_;
   Counters counters_;
@@ -125,6 +129,7 @@ class CommandGate {
   std::array<AdmittedCommand, kMaxPending> pending_{};
   std::size_t n_pending_ = 0;
   Command queued_;  ///< what commit() pushes, one pending command at a time
+  std::int64_t queued_count_ = 0;  ///< commands queued for the loop
   std::int64_t last_accepted_seq_ = 0;
   std::int64_t durable_seq_ = 0;  ///< the last accepted sequence number that is persisted
   std::int64_t last_verdict_seq_ = 0;

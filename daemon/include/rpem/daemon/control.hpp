@@ -35,8 +35,8 @@ struct ReloadCounters {
 class Control {
  public:
   struct Queues {
-    SpscQueue<Command>& to_loop;
-    SpscQueue<ControlReport>& to_publisher;
+    SpscQueue<Command>::Producer to_loop;
+    SpscQueue<ControlReport>::Producer to_publisher;
   };
   /// Reads the configuration again (the file, with the command line's overrides); throws io::InputError.
   using Reload = std::function<DaemonConfig()>;

@@ -14,7 +14,7 @@
 #include <thread>
 
 #include "rpem/daemon/daemon_config.hpp"
-#include "rpem/daemon/estimator_loop.hpp"
+#include "rpem/daemon/loop_thread.hpp"
 #include "rpem/daemon/messages.hpp"
 #include "rpem/daemon/publisher.hpp"
 #include "rpem/daemon/source.hpp"
@@ -54,17 +54,18 @@ class Daemon {
 
   DaemonOptions options_;
   DaemonConfig config_;  ///< until run() hands it to the control thread
-  SpscQueue<SourceSample> samples_{8192};
-  SpscQueue<SourceReport> source_reports_{8};
-  SpscQueue<Command> commands_{16};
-  SpscQueue<ControlReport> control_reports_{8};
-  SpscQueue<Report> reports_{4096};
+  // Each queue's ends, until run() hands them to the threads' owners (the source's here, below).
+  SpscQueue<SourceSample>::Ends samples_ = SpscQueue<SourceSample>::make(8192);
+  SpscQueue<SourceReport>::Ends source_reports_ = SpscQueue<SourceReport>::make(8);
+  SpscQueue<Command>::Ends commands_ = SpscQueue<Command>::make(16);
+  SpscQueue<ControlReport>::Ends control_reports_ = SpscQueue<ControlReport>::make(8);
+  SpscQueue<Report>::Ends reports_ = SpscQueue<Report>::make(4096);
   std::unique_ptr<SampleSource> source_;
   std::string source_name_;
   StateFileStatus state_file_status_ = StateFileStatus::kNone;
-  std::unique_ptr<EstimatorLoop> loop_;
-  std::unique_ptr<Publisher> publisher_;
-  SourceOutput source_output_{samples_, source_reports_};
+  std::unique_ptr<LoopThread> loop_;
+  std::unique_ptr<PersistingPublisher> publisher_;
+  SourceOutput source_output_{std::move(samples_.producer), std::move(source_reports_.producer)};
   std::atomic<bool> stop_acquisition_{false}, stop_publisher_{false};
   std::thread source_thread_, loop_thread_, publisher_thread_;
 };

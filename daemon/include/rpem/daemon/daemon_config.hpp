@@ -13,6 +13,7 @@
 #include <string>
 
 #include "rpem/core/thermal.hpp"
+#include "rpem/core/thermal_fusion.hpp"
 #include "rpem/daemon/realtime.hpp"
 #include "rpem/daemon/source_catalogue.hpp"
 #include "rpem/io/machine_config.hpp"
@@ -45,6 +46,10 @@ struct LiveConfig {
   io::MachineConfig machine;
   TemperatureModel temperature;
   ValidityConfig validity;
+  /// The thermal network and its filter (docs/thermal.md, "In rpemd"): a top-level `thermal` section or the
+  /// file `daemon.thermal_config` names (what `rpem thermal fit` writes). Without either, no fusion runs.
+  bool thermal_active = false;
+  core::ThermalFusionConfig thermal;
   bool commands_enabled = false;
   CommandAuthentication command_authentication = CommandAuthentication::kRequired;
 };

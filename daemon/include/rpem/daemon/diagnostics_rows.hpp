@@ -11,6 +11,7 @@
 #include <cstddef>
 #include <cstdint>
 
+#include "rpem/core/assert.hpp"
 #include "rpem/diagnostics_t.hpp"
 
 namespace rpem::daemon {
@@ -30,8 +31,8 @@ class DiagnosticsRows {
   static constexpr std::size_t kMaxCounts = 32;
   static constexpr std::size_t kMaxFigures = 16;
 
-  /// Sets a field (replacing an earlier row for it). Rows beyond the capacity are dropped; the tables
-  /// are checked against it at compile time where they are defined.
+  /// Sets a field (replacing an earlier row for it). Rows beyond the capacity are dropped (an assertion
+  /// where assertions are on); the tables are checked against it at compile time where they are defined.
   void set(DiagnosticsCount field, std::int64_t value) noexcept { put(counts_, n_counts_, field, value); }
   void set(DiagnosticsFigure field, double value) noexcept { put(figures_, n_figures_, field, value); }
 
@@ -69,6 +70,7 @@ class DiagnosticsRows {
         return;
       }
     }
+    RPEM_ASSERT(n < N, "a thread's rows fit DiagnosticsRows (kMaxCounts, kMaxFigures)");
     if (n < N) rows[n++] = {field, value};
   }
   template <class Field, class T, std::size_t N>

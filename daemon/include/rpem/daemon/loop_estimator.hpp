@@ -2,13 +2,14 @@
 // The estimator the loop owns, for the kind of sample its source produces: DriveEstimator stepping phase
 // samples (the predictor runs at the drive's period), or AveragedDriveEstimator stepping averaged
 // rotor-frame samples at their own, uneven host timestamps (docs/derivations.md §11; docs/rpemd.md,
-// "Averaged sources"). One interface for the loop's commands and reports. Real-time safe.
+// "Averaged sources"). One interface for the loop's commands and reports; each estimator it may hold is a
+// core::SampleEstimator, and their samples are a SourceSample's alternatives, in the same order. Real-time safe.
 
+#include <concepts>
 #include <cstdint>
 #include <variant>
 
-#include "rpem/core/averaged_estimator.hpp"
-#include "rpem/core/drive_estimator.hpp"
+#include "rpem/core/sample_estimator.hpp"
 #include "rpem/daemon/source_sample.hpp"
 
 namespace rpem::daemon {
@@ -24,6 +25,12 @@ struct SampleSummary {
   double t_drive_sensor_C = 0.0;
 };
 
+/// One of the estimators `E`, each a core::SampleEstimator, the k-th stepping a SourceSample's k-th
+/// alternative.
+template <core::SampleEstimator... E>
+  requires std::same_as<SourceSample, std::variant<typename E::Sample...>>
+using OneOfEstimators = std::variant<E...>;
+
 class LoopEstimator {
  public:
   LoopEstimator(SampleKind kind, const core::MachineSi& machine, const core::EstimatorSettings& settings) noexcept;
@@ -32,8 +39,8 @@ class LoopEstimator {
 
   /// Steps one sample of this estimator's kind: true, with the estimate, the time it stands for (for the
   /// validity tracker: the nominal period of a phase sample, the interval since the previous averaged
-  /// sample up to estimator.averaged.max_interval_s) and its summary. A sample of the other kind is not
-  /// stepped (false).
+  /// window — for an instantaneous averaged sample up to estimator.averaged.max_interval_s) and its
+  /// summary. A sample of the other kind is not stepped (false).
   bool step(const SourceSample& sample, core::Estimate& estimate, double& dt_s, SampleSummary& summary) noexcept;
 
   void reset() noexcept;
@@ -48,14 +55,12 @@ class LoopEstimator {
   [[nodiscard]] const core::RpemEstimator& core() const noexcept;
 
  private:
-  using Estimators = std::variant<core::DriveEstimator, core::AveragedDriveEstimator>;
+  using Estimators = OneOfEstimators<core::DriveEstimator, core::AveragedDriveEstimator>;
   static Estimators make(SampleKind kind, const core::MachineSi& machine, const core::EstimatorSettings& settings) noexcept;
 
   Estimators estimator_;
   double nominal_period_s_;
   double max_interval_s_;
-  bool has_previous_ = false;
-  std::int64_t previous_t_ns_ = 0;
 };
 
 }  // namespace rpem::daemon

@@ -1,9 +1,10 @@
 #pragma once
-// rpemd's publisher thread: turns the loop's reports into LCM messages (encoded into buffers allocated
-// once; LCM's C++ publish(const T*) would allocate per call), assembles RPEM_DIAGNOSTICS from the rows
-// the loop, the source and the control thread send it, persists the last good estimates, and prints
-// the status line. It is the one consumer of three queues and owns the LCM publishing instance and the
-// state file. A slow or failing network costs only this thread: the loop drops reports it cannot queue.
+// rpemd's publisher thread, a PersistingPublisher: it publishes, and it persists. It turns the loop's
+// reports into LCM messages (encoded into buffers allocated once; LCM's C++ publish(const T*) would
+// allocate per call), assembles RPEM_DIAGNOSTICS from the rows the loop, the source and the control
+// thread send it, persists the last good estimates in the state file, and prints the status line. It is
+// the one consumer of three queues and owns the LCM publishing instance and the state file. A slow or
+// failing network costs only this thread: the loop drops reports it cannot queue.
 
 #include <atomic>
 #include <cstdint>
@@ -35,12 +36,12 @@ struct PublisherCounters {
 /// slowly publishing rpemd (several per host, docs/rpemd.md) wakes up less often.
 [[nodiscard]] std::int64_t publisher_idle_ns(const LcmConfig& lcm) noexcept;
 
-class Publisher {
+class PersistingPublisher {
  public:
   struct Queues {
-    SpscQueue<Report>& loop;
-    SpscQueue<SourceReport>& source;
-    SpscQueue<ControlReport>& control;
+    SpscQueue<Report>::Consumer loop;
+    SpscQueue<SourceReport>::Consumer source;
+    SpscQueue<ControlReport>::Consumer control;
   };
   struct Identity {
     std::string source_type;  ///< diagnostics_t.source
@@ -50,8 +51,9 @@ class Publisher {
 
   /// `config` is the fixed part: nothing the publisher uses changes on a reload.
   /// `publish_key`: signs RPEM_ESTIMATE and RPEM_DIAGNOSTICS (rpem/auth/mac.hpp); none: key id 0.
-  Publisher(const FixedConfig& config, Identity identity, Queues queues, std::optional<auth::Key> publish_key = std::nullopt);
-  ~Publisher();
+  PersistingPublisher(const FixedConfig& config, Identity identity, Queues queues,
+                      std::optional<auth::Key> publish_key = std::nullopt);
+  ~PersistingPublisher();
 
   /// The thread body; runs until `stop` is set and the loop's queue is drained, then writes the
   /// state file a last time.
@@ -74,7 +76,7 @@ class Publisher {
 
   const FixedConfig config_;
   const Identity identity_;
-  const std::optional<auth::Key> publish_key_;
+  const std::optional<auth::Key> publish_key_;  ///< the one copy, in locked memory (rpem/auth/key.hpp)
   Queues queues_;
   PublisherCounters counters_;
   std::unique_ptr<Lcm> lcm_;

@@ -6,6 +6,7 @@
 #include <atomic>
 #include <cstdint>
 #include <string>
+#include <utility>
 
 #include "rpem/daemon/diagnostics_rows.hpp"
 #include "rpem/daemon/source_sample.hpp"
@@ -26,8 +27,8 @@ class SourceOutput {
  public:
   static constexpr std::int64_t kReportIntervalNs = 100'000'000;
 
-  SourceOutput(SpscQueue<SourceSample>& samples, SpscQueue<SourceReport>& reports) noexcept
-      : samples_(samples), reports_(reports) {}
+  SourceOutput(SpscQueue<SourceSample>::Producer samples, SpscQueue<SourceReport>::Producer reports) noexcept
+      : samples_(std::move(samples)), reports_(std::move(reports)) {}
 
   /// Queues a sample for the loop; a full queue drops it (diagnostics_t.input_queue_drops).
   void push(const SourceSample& s) noexcept {
@@ -44,8 +45,8 @@ class SourceOutput {
   }
 
  private:
-  SpscQueue<SourceSample>& samples_;
-  SpscQueue<SourceReport>& reports_;
+  SpscQueue<SourceSample>::Producer samples_;
+  SpscQueue<SourceReport>::Producer reports_;
   std::int64_t queue_drops_ = 0;
   std::int64_t next_report_ns_ = 0;
 };

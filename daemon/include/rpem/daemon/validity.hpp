@@ -1,6 +1,7 @@
 #pragma once
 // Per estimated parameter (ψm, r_s): whether it adapts, whether it is identified, how old its value is,
-// whether it is valid and converged, and its last good value (docs/rpemd.md, "Validity and age").
+// whether it is valid and converged, and whether its value now is good — worth persisting; the loop keeps
+// the last good value (docs/rpemd.md, "Validity and age").
 //
 // A parameter *adapts* in a sample when the estimator made its update (StepCode::kAdapted) with the
 // parameter's gain row kept by the gain schedule (eq:GainSchedule: ψm where |n| > n_lim,1, r_s where

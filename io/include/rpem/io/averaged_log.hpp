@@ -4,7 +4,7 @@
 // as the independent generator writes them (`indep_drive_log --averaged`).
 //
 //   t, t_start, i_d, i_q, u_d, u_q, omega_el   required: window [t_start, t] [s], means [A, V, rad/s]
-//   u_dc, T_winding, T_magnet, T_drive          optional [V, °C]; a cell "nan" means not reported
+//   u_dc, T_winding, T_magnet, T_drive, T_coolant   optional [V, °C]; a cell "nan" means not reported
 //
 // A header with a t_start column marks the file as an averaged log. Any CSV of window means reads into the
 // same samples through a column map (log_map.hpp): VESC Tool's realtime log is one (vesc_tool_log.hpp).
@@ -28,6 +28,7 @@ struct AveragedLogLayout {
   bool t_winding = false;
   bool t_magnet = false;
   bool t_drive = false;
+  bool t_coolant = false;
 };
 
 /// True if the CSV's header has a t_start column (an averaged log); throws DriveLogError if unreadable.

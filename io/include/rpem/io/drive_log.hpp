@@ -3,7 +3,7 @@
 // samples through a column map reads into the same rows.
 // One header row; SI units; required columns t, theta_el, omega_el, u_dc, a voltage command
 // (u_a,u_b,u_c and/or u_d,u_q) and a measured current (i_a,i_b,i_c and/or i_d,i_q); optional
-// T_winding, T_magnet [°C], torque_cmd [Nm]. Extra columns are ignored. A log whose voltage and current
+// T_winding, T_magnet, T_coolant [°C], torque_cmd [Nm]. Extra columns are ignored. A log whose voltage and current
 // are both in the rotor frame only may omit theta_el and u_dc. A log must hold at least one row, and every
 // cell must lie within the plausibility limits below.
 
@@ -26,6 +26,7 @@ struct DriveLogRow {
   core::DriveSample sample;
   std::optional<double> t_winding_C;
   std::optional<double> t_magnet_C;
+  std::optional<double> t_coolant_C;
   std::optional<double> torque_cmd_Nm;
 };
 
@@ -39,6 +40,7 @@ struct DriveLogLayout {
   bool current_dq = false;
   bool t_winding = false;
   bool t_magnet = false;
+  bool t_coolant = false;
   bool torque_cmd = false;
 };
 

@@ -39,6 +39,7 @@ enum class Quantity : std::uint8_t {
   kTDrive,
   kTorqueCmd,
   kTStart,
+  kTCoolant,  ///< the machine's coolant (issue 24: the thermal network's boundary)
   kCount
 };
 inline constexpr std::size_t kQuantityCount = static_cast<std::size_t>(Quantity::kCount);

@@ -25,6 +25,7 @@ struct ControlCycle {
   core::Vec2 i_dq_A = core::Vec2::Zero();
   core::Vec2 u_dq_V = core::Vec2::Zero();
   double omega_el_rad_s = 0.0;
+  double theta_el_rad = 0.0;  ///< the measured angle at the cycle's start (the frame of i_dq_A)
   double u_dc_V = 0.0;
   double t_winding_C = 0.0, t_magnet_C = 0.0;
 };

@@ -8,6 +8,12 @@
 // (computed in period k − 1); run the FOC on the samples (its command acts in period k + 1);
 // integrate the plant over [t_k, t_k+1] — at switching fidelity from one switching instant to the next
 // (EdgeIntegrator) or in fixed steps with the inverter's mean voltage over each (Scenario::integrator).
+//
+// Regimes (sim/regime.hpp; docs/scenarios.md, "Regimes"), each for whole periods from the first t_k at or
+// after its event: in open loop the controller's frame is the commanded angle, which the row logs as its
+// angle and speed; with the bridge off the plant freewheels (PmsmPlant::freewheel), the row logs a zero
+// command, and the FOC keeps tracking the back EMF with a zero current reference, so that its first command
+// after the bridge is back on is the back EMF, as the firmware presets its integrators to it.
 
 #include <cstdint>
 #include <memory>
@@ -17,6 +23,7 @@
 #include "rpem/sim/foc.hpp"
 #include "rpem/sim/inverter.hpp"
 #include "rpem/sim/plant.hpp"
+#include "rpem/sim/regime.hpp"
 #include "rpem/sim/scenario.hpp"
 #include "rpem/sim/sensors.hpp"
 
@@ -32,6 +39,14 @@ struct TruthRow {
   double theta_el_rad = 0.0;
   double torque_Nm = 0.0;
   core::Vec2 i_dq_A = core::Vec2::Zero();
+  DriveRegime regime = DriveRegime::kClosedLoop;             ///< over the period from t
+  OffVoltageReport off_report = OffVoltageReport::kBackEmf;  ///< bridge off: what a VESC reports as v_d, v_q
+  double theta_frame_rad = 0.0;  ///< the angle of the controller's dq frame, which the row logs (wrapped)
+
+  /// The bridge applies the controller's command.
+  [[nodiscard]] bool modulating() const noexcept { return regime != DriveRegime::kBridgeOff; }
+  /// The controller's frame is the rotor's (a sensor or an observer tracks it), not a commanded angle.
+  [[nodiscard]] bool angle_locked() const noexcept { return regime != DriveRegime::kOpenLoop; }
 };
 
 class DriveSimulator {
@@ -47,11 +62,16 @@ class DriveSimulator {
   [[nodiscard]] const PmsmPlant& plant() const noexcept { return plant_; }
   [[nodiscard]] std::int64_t period_ns() const noexcept { return period_ns_; }
   [[nodiscard]] std::int64_t samples_total() const noexcept { return samples_total_; }
+  /// Bridge-off periods whose back EMF (line-to-line peak √3·|ω|·ψm) reached the DC link: the diodes would
+  /// have rectified, which the freewheeling plant does not model.
+  [[nodiscard]] std::uint64_t rectifying_periods() const noexcept { return rectifying_periods_; }
   /// The edge-to-edge integrator (its counters); null with fixed steps.
   [[nodiscard]] const EdgeIntegrator* edge_integrator() const noexcept { return edge_to_edge_ ? &edges_ : nullptr; }
 
  private:
   [[nodiscard]] PlantParameters parameters_at(double t_s) noexcept;
+  /// Takes the regime of the period at t (entering open loop places the commanded frame).
+  void update_regime(double t_s) noexcept;
   /// Samples the sensors at t_k and runs the controller.
   void sample_and_control(double t_s) noexcept;
   /// Integrates the plant over [t_k, t_k+1].
@@ -73,7 +93,13 @@ class DriveSimulator {
   int substeps_ = 1;
 
   PlantParameters parameters_;
+  RegimeTimeline regimes_;
+  RegimeNow regime_;
+  double theta_frame_rad_ = 0.0;   ///< open loop: the commanded angle (unwrapped)
+  double omega_frame_rad_s_ = 0.0; ///< open loop: the commanded speed (electrical)
+  std::uint64_t rectifying_periods_ = 0;
   double torque_signal_Nm_ = 0.0;
+  double load_signal_Nm_ = 0.0;    ///< inertia mechanics' load
   double u_dc_V_ = 0.0;
   core::Vec2 command_now_V_ = core::Vec2::Zero();   ///< acts over the current period
   core::Vec2 command_next_V_ = core::Vec2::Zero();  ///< computed this period, acts in the next

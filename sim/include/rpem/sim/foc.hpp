@@ -19,7 +19,7 @@ struct FocConfig {
   double max_current_A = 0.0;     ///< |i| limit; 0: √2 × rated rms current
   double voltage_margin = 0.95;   ///< field weakening keeps the steady-state |u| below this × u_dc/√3
   bool field_weakening = true;
-  bool speed_control = false;     ///< false: torque mode (the scenario commands torque)
+  bool speed_control = false;     ///< false: torque mode (the scenario commands torque); the initial mode
   double inertia_kgm2 = 0.01;     ///< for tuning the speed loop
 };
 
@@ -30,6 +30,14 @@ struct FocInput {
   double u_dc_V = 0.0;                      ///< measured DC link
   double torque_ref_Nm = 0.0;               ///< torque mode
   double speed_ref_el_rad_s = 0.0;          ///< speed mode
+  bool speed_control = false;               ///< speed mode now (a scenario's regimes switch it; bumpless)
+  /// Open loop and bridge off (sim/regime.hpp): the current reference in the controller's frame, the torque
+  /// and speed loops, MTPA and field weakening bypassed.
+  bool current_override = false;
+  core::Vec2 current_ref_A = core::Vec2::Zero();
+  /// The back-EMF feed-forward on q: off in open loop, where the back EMF's direction in the commanded frame
+  /// is unknown (VESC's flux-linkage measurement runs with decoupling disabled).
+  bool decouple = true;
 };
 
 struct FocOutput {
@@ -44,6 +52,10 @@ class FocController {
   FocController(const FocConfig& config, const core::MachineSi& nominal) noexcept;
   [[nodiscard]] FocOutput step(const FocInput& in) noexcept;
   void reset() noexcept;
+  /// Bridge off: presets the current PI's integrators so that, at zero current, the command is u_dq_V (the
+  /// back EMF the drive measures), as the firmware sets vd_int, vq_int to its tracked v_d, v_q while undriven
+  /// (mcpwm_foc.c): re-engaging the bridge then applies the back EMF, not a stale voltage.
+  void preset(const core::Vec2& u_dq_V, double omega_el_rad_s) noexcept;
 
  private:
   /// Field weakening on the nominal model's voltage ellipse, then the current limit.
@@ -57,6 +69,8 @@ class FocController {
   double i_max_A_;
   core::Vec2 integral_V_ = core::Vec2::Zero();
   double speed_integral_Nm_ = 0.0;
+  double last_torque_ref_Nm_ = 0.0;               ///< the torque reference of the last step (0 when overridden)
+  bool was_speed_control_ = false;                ///< speed mode in the last step
   double mtpa_torque_Nm_ = 0.0;                   ///< torque of the cached MTPA references
   core::Vec2 mtpa_i_A_ = core::Vec2::Zero();
   core::RotationTracker rotation_;                ///< at the measured angle

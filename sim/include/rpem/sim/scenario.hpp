@@ -5,11 +5,13 @@
 #include <array>
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include "rpem/io/machine_config.hpp"
 #include "rpem/sim/foc.hpp"
 #include "rpem/sim/inverter.hpp"
 #include "rpem/sim/plant.hpp"
+#include "rpem/sim/regime.hpp"
 #include "rpem/sim/sensors.hpp"
 #include "rpem/sim/signal.hpp"
 
@@ -26,10 +28,12 @@ enum class Quantity : int {
   kUdc,              ///< u_dc_V
   kTWinding,         ///< t_winding_C
   kTMagnet,          ///< t_magnet_C
+  kLoadTorque,       ///< load_torque_Nm — inertia mechanics' load, when the scenario gives it (else torque_Nm)
   kCount
 };
 inline constexpr std::array<const char*, static_cast<int>(Quantity::kCount)> kQuantityNames = {
-    "psi_m_Wb", "r_s_Ohm", "l_d_H", "l_q_H", "speed_rpm", "torque_Nm", "u_dc_V", "t_winding_C", "t_magnet_C"};
+    "psi_m_Wb", "r_s_Ohm", "l_d_H", "l_q_H", "speed_rpm", "torque_Nm", "u_dc_V", "t_winding_C", "t_magnet_C",
+    "load_torque_Nm"};
 
 
 /// How the plant is integrated at switching fidelity (docs/scenarios.md, `plant.integrator`): from one
@@ -41,6 +45,15 @@ struct LogOptions {
   bool dq_columns = false;
   bool temperatures = false;
   bool torque_cmd = false;
+};
+
+/// The emulated VESC's configuration where its replies show it (`vesc:`; defaults of vedderb/bldc
+/// motor/mcconf_default.h): COMM_GET_VALUES_SETUP's speed, distance and battery level (sim/vesc_tool_session.hpp).
+struct VescConfig {
+  double wheel_diameter_m = 0.083;  ///< si_wheel_diameter
+  double gear_ratio = 3.0;          ///< si_gear_ratio
+  int battery_cells = 3;            ///< si_battery_cells, Li-ion 3.0–4.2 V (si_battery_type's default)
+  double battery_Ah = 6.0;          ///< si_battery_ah
 };
 
 struct Scenario {
@@ -65,6 +78,11 @@ struct Scenario {
   core::ThermalModel thermal;
   double r_fe_Ohm = 0.0;              ///< iron-loss resistance; 0: none (hidden effect)
   std::array<Signal, static_cast<int>(Quantity::kCount)> signals;
+  /// Inertia mechanics: the load is load_torque_Nm (given in `initial` or by an event) rather than torque_Nm.
+  bool separate_load = false;
+  /// What the controller does with the bridge over time (empty: closed loop throughout).
+  std::vector<RegimeEvent> regimes;
+  VescConfig vesc;
   LogOptions log;
 
   [[nodiscard]] Signal& signal(Quantity q) { return signals[static_cast<std::size_t>(q)]; }

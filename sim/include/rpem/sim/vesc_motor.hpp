@@ -8,7 +8,13 @@
 // mc_interface_read_reset_avg_id/iq/vd/vq (and _motor_current, _input_current) divide and zero them. So
 // a read returns the means over every cycle since the previous read — whoever read it — and a read
 // with no cycle since the previous one is 0/0 (NaN; the reply carries 0, can/vesc_firmware.hpp).
-// The cycles are sim/cycle_average.hpp's (measured current at the cycle's start, mean rotor-frame voltage).
+// The cycles are sim/cycle_average.hpp's (measured current at the cycle's start, mean rotor-frame voltage)
+// in the controller's frame — the commanded angle in open loop (sim/regime.hpp), whose speed the firmware's
+// PLL then reports. With the bridge off the firmware sums what mcpwm_foc_adc_int_handler leaves when "Motor
+// is not running" (vedderb/bldc motor/mcpwm_foc.c, since b1945b7d of 2020 in this form): i_d = i_q = 0, and
+// v_d, v_q the Park transform at the observer's angle of the phase voltages it measures — the back EMF —
+// through UTILS_LP_FAST with 0.2 per cycle, starting from the last modulated v_d, v_q (docs/can-vesc.md,
+// "Regimes").
 
 #include <cstdint>
 
@@ -49,6 +55,8 @@ class VescMotor {
 
  private:
   void account(const ControlCycle& c) noexcept;
+  /// The cycle as the firmware sums it, given the true state at its start.
+  [[nodiscard]] ControlCycle firmware_view(ControlCycle c, const TruthRow& at_start) noexcept;
 
   DriveSimulator simulator_;
   Settings settings_;
@@ -57,6 +65,7 @@ class VescMotor {
   io::DriveLogRow row_;
   TruthRow truth_;
   ControlCycle last_cycle_;
+  core::Vec2 v_dq_filter_V_ = core::Vec2::Zero();  ///< state_now->vd, vq (low-passed while undriven)
   bool started_ = false;
   double input_current_sum_A_ = 0.0;  ///< m_input_current_sum: power-balance input current per cycle
   double tacho_steps_ = 0.0;  ///< 6 per electrical revolution (mc_interface_get_tachometer_value)

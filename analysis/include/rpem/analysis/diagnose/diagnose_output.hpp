@@ -18,6 +18,10 @@ void write_extended_yaml(const std::string& path, const Diagnosis& d, const std:
 /// The figures; returns their file names (relative to `dir`).
 [[nodiscard]] std::vector<std::string> write_diagnose_figures(const std::string& dir, const Diagnosis& d);
 
+/// The log's timeline coloured by regime (speed and current amplitude against time), `dir`/regimes.png, as
+/// the diagnosis draws it; `rpem figures --log` draws it without a diagnosis. Returns the file name.
+std::string write_regime_timeline(const std::string& dir, const LogData& log, const LogRegimes& regimes, int pole_pairs);
+
 void write_diagnose_report(const std::string& dir, const Diagnosis& d, const std::string& config_path);
 
 /// The found effect j's parameters in SI (its row's describe() of the final joint fit).
@@ -26,6 +30,10 @@ void write_diagnose_report(const std::string& dir, const Diagnosis& d, const std
 /// The model mismatch allowance of calibrated constant i, relative (e.g. 0.10 for ±10 %): the largest bias
 /// the misfit the final model leaves above the noise floor could put into it (`<key>_mismatch_rel`).
 [[nodiscard]] double mismatch_half_width(const Diagnosis& d, std::size_t i);
+
+/// One sentence per constant calibrated despite a large mismatch (Identification::kRejectsConfiguration): its
+/// interval wider than ±10 % but excluding the configured value ("calibrated despite a large mismatch: …").
+[[nodiscard]] std::vector<std::string> calibrated_despite_mismatch(const Diagnosis& d);
 
 /// What the calibration says about the configuration, one sentence per identifiable constant whose
 /// configured value lies outside the calibrated 95 % interval widened by its mismatch allowance (e.g. "the configuration's ψm is 5.1 % high").

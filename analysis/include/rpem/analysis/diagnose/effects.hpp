@@ -54,7 +54,7 @@ struct EffectContext {
   double speed_spread_rel = 0.0;            ///< LogData::speed_spread_rel
   double t_start_s = 0.0, t_span_s = 0.0;
   TemperatureColumn t_winding, t_magnet;
-  double reference_C = 20.0;          ///< temperature at which reported drift laws are referred
+  double reference_C = core::kMaterialReference_C;  ///< temperature at which reported drift laws are referred
   double sample_period_s = 0.0;       ///< median sample interval
   double mean_u_dc_V = 0.0;
   double switching_frequency_Hz = 0.0;  ///< 0: unknown (t_dead_s is then not reported)

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "rpem/analysis/diagnose/sample_store.hpp"
+#include "rpem/core/clock.hpp"
 #include "rpem/core/settings.hpp"
 #include "rpem/core/types.hpp"
 #include "rpem/io/drive_log.hpp"
@@ -27,10 +28,15 @@ enum class ModelMode { kTransient, kSteadyState };
 struct LogData {
   std::string path;
   std::string format;  ///< what the log was read as, and what reading it did (io::describe)
+  /// The drive's reported commands were turned into the applied means at reading (LogOptions::voltage_is_command):
+  /// whatever runs over the rows must not turn them again.
+  bool voltage_applied = false;
   SampleStore samples;
   io::DriveLogLayout layout;
   ModelMode mode = ModelMode::kTransient;
   bool averaged = false;  ///< an averaged rotor-frame log (docs/drive-log.md, "Averaged logs"): always steady state
+  /// Averaged logs: each row's window start (its t is the window's end); empty for phase-sample logs.
+  std::vector<std::int64_t> window_start_ns;
   double t_start_s = 0.0, t_end_s = 0.0;
   double median_dt_s = 0.0;
   double max_current_A = 0.0;   ///< largest measured current amplitude
@@ -56,9 +62,10 @@ struct LogData {
   [[nodiscard]] core::DriveSample replay_sample(std::size_t k) const noexcept;
   /// The logged current as dq at the logged angle [A]: what every model is compared with.
   [[nodiscard]] core::Vec2 logged_i_dq_A(std::size_t k) const noexcept;
-  [[nodiscard]] double t_s(std::size_t k) const noexcept { return 1e-9 * static_cast<double>(samples.t_ns(k)); }
+  [[nodiscard]] double t_s(std::size_t k) const noexcept { return core::to_seconds(samples.t_ns(k)); }
 
-  /// Whether sample k takes part (steady state leaves out idle and transitional rows).
+  /// Whether sample k takes part (steady state leaves out idle and transitional rows; every log the samples
+  /// its regime excludes, regimes.hpp).
   [[nodiscard]] bool used(std::size_t k) const noexcept { return (samples.mark(k) & sample_mark::kLeftOut) == 0; }
   /// Samples that take part.
   [[nodiscard]] std::size_t used_count() const noexcept;
@@ -75,15 +82,32 @@ struct LogData {
   /// Samples of training blocks that take part.
   [[nodiscard]] std::size_t training_count() const noexcept;
   /// Heap bytes the log holds.
-  [[nodiscard]] std::size_t bytes() const noexcept { return samples.bytes() + block_first.capacity() * sizeof(std::size_t); }
+  [[nodiscard]] std::size_t bytes() const noexcept {
+    return samples.bytes() + block_first.capacity() * sizeof(std::size_t) + window_start_ns.capacity() * sizeof(std::int64_t);
+  }
 };
+
+/// The mean a reported command applies in the rotor frame over the period it is held (docs/derivations.md
+/// §11, "Reported command"): the command v, computed at the current sample's angle and held fixed in the
+/// stator frame over [d − ½, d + ½]·T_c after it, arrives turned by −ω·d·T_c and shortened by sinc(ω·T_c/2).
+[[nodiscard]] core::Vec2 applied_mean_V(const core::Vec2& command_V, double omega_el_rad_s, double control_period_s,
+                                        double delay_periods) noexcept;
 
 struct LogOptions {
   std::optional<ModelMode> mode;  ///< empty: decided from the sample interval
+  /// An averaged log whose voltages are the drive's command (estimator.averaged.voltage_reported: command): its
+  /// T_c and the delay before the hold (model_extensions.delay), which reading turns into the applied mean.
+  bool voltage_is_command = false;
+  double control_period_s = 0.0;
+  double command_delay_s = 0.0;
   int blocks = 40;                ///< training and held-out blocks, alternating, equal in time
   int speed_half_window = 4;      ///< transient logs: replay speed from the angle over ±this many samples
   std::string log_map;            ///< a column map (YAML) to read the log with; empty: detected (io::log_source)
 };
+
+/// Where the steady-state replay left out more than io::kExplainedShare of the rows as idle or in transition:
+/// one sentence per rule, how many, why, and what changes it (docs/diagnose.md, "The replay").
+[[nodiscard]] std::vector<std::string> left_out_explanations(const LogData& log);
 
 /// Loads and characterises a log, a phase-sample or an averaged one, in any format io::log_source reads
 /// (throws io::DriveLogError on bad input, io::ConfigError on a bad map). `progress`, if given, is told the

@@ -5,6 +5,7 @@
 // the diagnosis throws Interrupted and leaves nothing behind. Stages begin on the diagnosing thread; work is
 // reported from any thread of the pool.
 
+#include <cstddef>
 #include <cstdint>
 #include <exception>
 #include <string_view>
@@ -29,5 +30,15 @@ class Monitor {
 struct Interrupted : std::exception {
   [[nodiscard]] const char* what() const noexcept override { return "interrupted"; }
 };
+
+/// Samples a sequential run over the log (an estimator's) goes between two looks at the monitor.
+inline constexpr std::size_t kMonitorSamples = std::size_t{1} << 16;
+
+/// Tells `monitor` (if any) of `units` more work done, and throws Interrupted if it asks to stop.
+inline void report_work(Monitor* monitor, std::uint64_t units) {
+  if (!monitor) return;
+  monitor->advance(units);
+  if (monitor->stop_requested()) throw Interrupted();
+}
 
 }  // namespace rpem::analysis

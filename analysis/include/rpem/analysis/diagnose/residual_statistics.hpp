@@ -49,6 +49,7 @@ struct RegressorCorrelation {
 struct ResidualStatistics {
   BeforeAfter rms_A;                          ///< all used samples
   BeforeAfter standstill_rms_A, motion_rms_A;
+  std::size_t standstill_samples = 0, motion_samples = 0;
   std::vector<RegionStatistics> regions;      ///< regions holding at least 0.5 % of the samples
   std::vector<HarmonicContent> harmonics;     ///< samples in motion; empty for steady-state logs
   std::vector<PhaseSignStatistics> phase_signs;

@@ -14,6 +14,7 @@
 #include "rpem/analysis/diagnose/effects.hpp"
 #include "rpem/analysis/diagnose/replay.hpp"
 #include "rpem/analysis/diagnose/residual_statistics.hpp"
+#include "rpem/analysis/diagnose/verdict.hpp"
 
 namespace rpem::analysis {
 
@@ -44,7 +45,7 @@ struct FigureData {
 
 /// What the baseline's pass found.
 struct BaselinePass {
-  double noise_floor_A = 0.0;
+  NoiseFloor noise_floor;  ///< of the baseline's residual (verdict.hpp)
   /// The overlay's window [first, last): transient logs the 0.1 s where the baseline errs most, steady
   /// state the whole log.
   std::size_t overlay_first = 0, overlay_last = 0;

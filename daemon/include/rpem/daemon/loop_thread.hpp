@@ -1,10 +1,11 @@
 #pragma once
-// The fixed-rate estimator loop — rpemd's real-time thread, the owner of the estimator. Each period
+// The loop thread — rpemd's fixed-rate, real-time estimator loop, the owner of the estimator. Each period
 // (LoopTimer) it applies the commands the control thread queued, steps the estimator over every sample
 // that arrived (in order), tracks validity and age (ValidityTracker), and queues reports for the
 // publisher. The estimator is the one for the kind of sample the configured source produces
 // (LoopEstimator): phase samples step DriveEstimator, averaged rotor-frame samples AveragedDriveEstimator
-// at their host timestamps. It never allocates, locks, logs or does I/O once running: everything it touches was
+// at their host timestamps. With a thermal network configured, its Kalman filter (core::ThermalFusion) steps
+// beside the estimator on every sample and RPEM_ESTIMATE carries the fused temperatures. It never allocates, locks, logs or does I/O once running: everything it touches was
 // allocated before; a full output queue drops the report and counts it.
 
 #include <atomic>
@@ -12,6 +13,8 @@
 #include <optional>
 #include <string>
 
+#include "rpem/core/regime.hpp"
+#include "rpem/core/thermal_fusion.hpp"
 #include "rpem/daemon/daemon_config.hpp"
 #include "rpem/daemon/loop_estimator.hpp"
 #include "rpem/daemon/loop_timer.hpp"
@@ -21,7 +24,7 @@
 
 namespace rpem::daemon {
 
-/// The loop's counters: it is their one writer (published through a table in estimator_loop.cpp).
+/// The loop's counters: it is their one writer (published through a table in loop_thread.cpp).
 struct LoopCounters {
   std::int64_t samples = 0;
   std::int64_t resyncs = 0;
@@ -33,6 +36,8 @@ struct LoopCounters {
   std::int64_t commands_applied = 0;         ///< supervisory commands (seq > 0)
   std::int64_t command_sequence_errors = 0;  ///< an applied command not after the previous one (never expected)
   std::int64_t config_reloads = 0;           ///< reloads applied
+  std::int64_t outliers = 0;                 ///< samples skipped by the outlier bound
+  core::RegimeCounts regimes;                ///< samples per regime (core/regime.hpp)
 };
 
 /// A value from the state file and how long ago it last adapted.
@@ -41,15 +46,15 @@ struct SeedValue {
   double age_s = 0.0;
 };
 
-class EstimatorLoop {
+class LoopThread {
  public:
   struct Queues {
-    SpscQueue<SourceSample>& samples;  ///< from the source thread
-    SpscQueue<Command>& commands;           ///< from the control thread
-    SpscQueue<Report>& reports;             ///< to the publisher
+    SpscQueue<SourceSample>::Consumer samples;  ///< from the source thread
+    SpscQueue<Command>::Consumer commands;      ///< from the control thread
+    SpscQueue<Report>::Producer reports;        ///< to the publisher
   };
 
-  EstimatorLoop(const DaemonConfig& config, Queues queues);
+  LoopThread(const DaemonConfig& config, Queues queues);
 
   /// Seeds the estimates (from the state file) before the loop runs; `now_ns` on the loop's clock.
   void seed(const std::optional<SeedValue>& psi_m_Wb, const std::optional<SeedValue>& r_s_Ohm, std::int64_t now_ns);
@@ -72,6 +77,7 @@ class EstimatorLoop {
   void step(const SourceSample& s, std::int64_t now_ns) noexcept;
   void report_measurement() noexcept;
   void report_estimate(std::int64_t now_ns) noexcept;
+  void report_thermal(EstimateReport& r) const noexcept;
   void report_stats() noexcept;
   void push(const Report& r) noexcept;
 
@@ -80,6 +86,7 @@ class EstimatorLoop {
   Queues queues_;
   LoopEstimator estimator_;
   ValidityTracker validity_;
+  core::ThermalFusion thermal_;  ///< stepped only while live_.thermal_active
   LoopTimer timer_;
   std::string setup_problems_;
   std::atomic<bool> started_{false};

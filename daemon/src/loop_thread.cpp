@@ -1,9 +1,10 @@
-#include "rpem/daemon/estimator_loop.hpp"
+#include "rpem/daemon/loop_thread.hpp"
 
 #include <algorithm>
 #include <array>
 #include <cmath>
 
+#include "rpem/core/assert.hpp"
 #include "rpem/core/clock.hpp"
 #include "rpem/daemon/realtime.hpp"
 
@@ -12,7 +13,7 @@ namespace {
 
 using Diag = rpem::diagnostics_t;
 
-constexpr std::array<CounterRow<LoopCounters>, 10> kLoopRows{{
+constexpr std::array<CounterRow<LoopCounters>, 11> kLoopRows{{
     {&LoopCounters::samples, &Diag::samples},
     {&LoopCounters::resyncs, &Diag::resyncs},
     {&LoopCounters::rejected_non_finite, &Diag::rejected_non_finite},
@@ -23,8 +24,13 @@ constexpr std::array<CounterRow<LoopCounters>, 10> kLoopRows{{
     {&LoopCounters::commands_applied, &Diag::commands_applied},
     {&LoopCounters::command_sequence_errors, &Diag::command_sequence_errors},
     {&LoopCounters::config_reloads, &Diag::config_reloads},
+    {&LoopCounters::outliers, &Diag::outliers},
 }};
-static_assert(kLoopRows.size() + 3 <= DiagnosticsRows::kMaxCounts);
+/// The field of each regime's count, in core::kRegimes' order.
+constexpr std::array<DiagnosticsCount, core::kRegimeCount> kRegimeFields{
+    &Diag::regime_excites_both, &Diag::regime_excites_psi_m, &Diag::regime_excites_r_s, &Diag::regime_unexcited,
+    &Diag::regime_transient,    &Diag::regime_not_locked,    &Diag::regime_bridge_off,  &Diag::regime_invalid};
+static_assert(kLoopRows.size() + kRegimeFields.size() + 3 <= DiagnosticsRows::kMaxCounts);
 
 std::int64_t interval_ns(double rate_Hz) noexcept {
   return rate_Hz > 0.0 ? static_cast<std::int64_t>(1e9 / rate_Hz) : INT64_MAX / 4;
@@ -32,18 +38,19 @@ std::int64_t interval_ns(double rate_Hz) noexcept {
 
 }  // namespace
 
-EstimatorLoop::EstimatorLoop(const DaemonConfig& config, Queues queues)
+LoopThread::LoopThread(const DaemonConfig& config, Queues queues)
     : live_(config.live),
       loop_config_(config.fixed.loop),
-      queues_(queues),
+      queues_(std::move(queues)),
       estimator_(SourceCatalogue::sample_kind(config.fixed.source), config.live.machine.machine, config.live.machine.estimator),
       validity_(config.live.validity, config.fixed.lcm.estimate_rate_Hz),
+      thermal_(config.live.thermal, core::PerUnitBase::from_rated(config.live.machine.machine.rated), config.live.machine.machine),
       timer_(config.fixed.loop),
       estimate_interval_ns_(interval_ns(config.fixed.lcm.estimate_rate_Hz)),
       measurement_interval_ns_(interval_ns(config.fixed.lcm.measurement_rate_Hz)),
       stats_interval_ns_(interval_ns(config.fixed.lcm.diagnostics_rate_Hz)) {}
 
-void EstimatorLoop::seed(const std::optional<SeedValue>& psi_m, const std::optional<SeedValue>& r_s, std::int64_t now_ns) {
+void LoopThread::seed(const std::optional<SeedValue>& psi_m, const std::optional<SeedValue>& r_s, std::int64_t now_ns) {
   estimator_.set_estimates(psi_m ? psi_m->value : estimator_.psi_m_Wb(), r_s ? r_s->value : estimator_.r_s_Ohm());
   auto keep = [&](int j, const SeedValue& s) {
     validity_.seed(j, s.age_s, now_ns);
@@ -55,15 +62,16 @@ void EstimatorLoop::seed(const std::optional<SeedValue>& psi_m, const std::optio
   if (r_s) keep(core::kRs, *r_s);
 }
 
-void EstimatorLoop::push(const Report& r) noexcept {
+void LoopThread::push(const Report& r) noexcept {
   if (!queues_.reports.push(r)) ++counters_.output_queue_drops;
 }
 
-void EstimatorLoop::apply(const Command& c) noexcept {
+void LoopThread::apply(const Command& c) noexcept {
   switch (c.kind) {
     case Command::Kind::kReset:
       estimator_.reset();
       validity_.restart();
+      thermal_.restart_observations();
       break;
     case Command::Kind::kFreeze:
       estimator_.set_frozen(true);
@@ -74,22 +82,27 @@ void EstimatorLoop::apply(const Command& c) noexcept {
     case Command::Kind::kSetValues:  // new initial values: identification starts over from them
       estimator_.set_estimates(c.psi_m_Wb, c.r_s_Ohm);
       validity_.restart();
+      thermal_.restart_observations();
       break;
     case Command::Kind::kReconfigure:
       live_ = c.live;
       estimator_.reconfigure(live_.machine.machine, live_.machine.estimator);
       validity_.reconfigure(live_.validity);
+      // The temperatures and their covariance are kept (a new network starts from the old one's state).
+      thermal_.reconfigure(live_.thermal, core::PerUnitBase::from_rated(live_.machine.machine.rated), live_.machine.machine);
       ++counters_.config_reloads;
       break;
   }
   if (c.seq > 0) {
+    // Counted where assertions are off: the control thread admits commands in increasing order only.
+    RPEM_ASSERT(c.seq > last_applied_seq_, "commands arrive in the order the control thread admitted them");
     if (c.seq <= last_applied_seq_) ++counters_.command_sequence_errors;
     last_applied_seq_ = c.seq;
     ++counters_.commands_applied;
   }
 }
 
-void EstimatorLoop::step(const SourceSample& s, std::int64_t now_ns) noexcept {
+void LoopThread::step(const SourceSample& s, std::int64_t now_ns) noexcept {
   double dt_s = 0.0;
   if (!estimator_.step(s, last_, dt_s, last_sample_)) {
     ++counters_.wrong_kind;
@@ -107,17 +120,29 @@ void EstimatorLoop::step(const SourceSample& s, std::int64_t now_ns) noexcept {
     case core::StepCode::kPredictorDiverged:
       ++counters_.predictor_resets;
       break;
+    case core::StepCode::kOutlier:
+      ++counters_.outliers;
+      break;
+    case core::StepCode::kExcluded:  // counted by its regime below
+      break;
     case core::StepCode::kAdapted:
       eps2_d_ += last_.epsilon_A[0] * last_.epsilon_A[0];
       eps2_q_ += last_.epsilon_A[1] * last_.epsilon_A[1];
       ++eps_n_;
       break;
   }
+  counters_.regimes.add(last_.regime);
   if (d.flags & (core::step_flag::kProjectedPsiM | core::step_flag::kProjectedRs)) ++counters_.projections;
   validity_.on_sample(d.flags, dt_s, now_ns);
+  if (live_.thermal_active) {
+    core::ThermalSample t;
+    t.dt_s = dt_s;
+    t.winding_sensor_C = last_sample_.t_winding_sensor_C;  // NaN: none (the filter uses it if configured)
+    thermal_.step(last_, t);
+  }
 }
 
-void EstimatorLoop::report_measurement() noexcept {
+void LoopThread::report_measurement() noexcept {
   const SampleSummary& s = last_sample_;
   MeasurementReport m;
   m.utime = core::unix_us();
@@ -136,7 +161,7 @@ void EstimatorLoop::report_measurement() noexcept {
   push(m);
 }
 
-void EstimatorLoop::report_estimate(std::int64_t now_ns) noexcept {
+void LoopThread::report_estimate(std::int64_t now_ns) noexcept {
   EstimateReport r;
   r.utime = core::unix_us();
   r.sample_time_us = last_sample_.t_ns / 1000;
@@ -174,19 +199,39 @@ void EstimatorLoop::report_estimate(std::int64_t now_ns) noexcept {
   }
   r.has_good_psi_m = has_good_[core::kPsiM];
   r.good_psi_m_Wb = good_[core::kPsiM];
-  r.good_psi_m_age_s = 1e-9 * static_cast<double>(now_ns - good_ns_[core::kPsiM]);
+  r.good_psi_m_age_s = core::to_seconds(now_ns - good_ns_[core::kPsiM]);
+  report_thermal(r);
   r.has_good_r_s = has_good_[core::kRs];
   r.good_r_s_Ohm = good_[core::kRs];
-  r.good_r_s_age_s = 1e-9 * static_cast<double>(now_ns - good_ns_[core::kRs]);
+  r.good_r_s_age_s = core::to_seconds(now_ns - good_ns_[core::kRs]);
   push(r);
 }
 
-void EstimatorLoop::report_stats() noexcept {
+void LoopThread::report_thermal(EstimateReport& r) const noexcept {
+  const core::ThermalEstimate& e = thermal_.estimate();
+  r.thermal_active = live_.thermal_active && e.started;
+  const std::int64_t t_ns = last_sample_.t_ns;
+  const core::ThermalNodeReport m = core::report_node(e, r.thermal_active ? e.magnet : -1, t_ns);
+  const core::ThermalNodeReport w = core::report_node(e, r.thermal_active ? e.winding : -1, t_ns);
+  r.t_magnet_fused_C = m.t_C;
+  r.t_magnet_fused_sd_C = m.sd_K;
+  r.t_magnet_source = m.source;
+  r.t_magnet_observed_age_s = m.observed_age_s;
+  r.t_winding_fused_C = w.t_C;
+  r.t_winding_fused_sd_C = w.sd_K;
+  r.t_winding_source = w.source;
+  r.t_winding_observed_age_s = w.observed_age_s;
+}
+
+void LoopThread::report_stats() noexcept {
   LoopStatsReport r;
   r.utime_us = core::unix_us();
   r.state = state_;
   r.input_queue_depth = static_cast<std::int32_t>(queues_.samples.size());
   r.rows.set_all(kLoopRows, counters_);
+  for (std::size_t k = 0; k < core::kRegimeCount; ++k) {
+    r.rows.set(kRegimeFields[k], static_cast<std::int64_t>(counters_.regimes.n[k]));
+  }
   timer_.report(r.rows);
   const double n = eps_n_ > 0 ? static_cast<double>(eps_n_) : 1.0;
   r.rows.set(&Diag::epsilon_rms_d_A, std::sqrt(eps2_d_ / n));
@@ -201,7 +246,7 @@ void EstimatorLoop::report_stats() noexcept {
   eps_n_ = 0;
 }
 
-void EstimatorLoop::process(std::int64_t now_ns) noexcept {
+void LoopThread::process(std::int64_t now_ns) noexcept {
   Command c;
   while (queues_.commands.pop(c)) apply(c);
 
@@ -235,7 +280,7 @@ void EstimatorLoop::process(std::int64_t now_ns) noexcept {
   }
 }
 
-void EstimatorLoop::run(const std::atomic<bool>& stop) {
+void LoopThread::run(const std::atomic<bool>& stop) {
   name_thread("rpemd-loop");
   if (loop_config_.realtime != RealtimeMode::kOff) setup_problems_ = apply_thread_policy(loop_config_.thread);
   prefault_stack(256 * 1024);

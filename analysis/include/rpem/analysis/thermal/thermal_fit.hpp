@@ -1,0 +1,70 @@
+#pragma once
+// `rpem thermal fit` (docs/thermal.md): the thermal network's capacitances, conductances and loss
+// coefficients fitted, with the magnet law's reference value anchored at the soaked start, to what a log shows of the temperatures — a
+// winding sensor, the magnet temperature from ψ̂m, the winding's from r̂s (thermal_record.hpp) — by
+// weighted nonlinear least squares of the open-loop network (Ceres), every positive quantity as its
+// logarithm (positive by construction). The part of the log after `fit_until_s` is held out and judged.
+// Intervals and identifiability as `rpem diagnose` reports them (effect_fit.hpp): cluster-robust 95 %
+// intervals over blocks of the training part, what the excitation alone allows, identified when the
+// robust half-width is at most kIdentifiedHalfWidth. The process noise of the filter is then the
+// maximum-likelihood one of the filter's innovations over the training part.
+
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "rpem/analysis/thermal/thermal_record.hpp"
+#include "rpem/io/thermal_config.hpp"
+
+namespace rpem::analysis {
+
+struct ThermalFitOptions {
+  /// Steps ending at or before this time train; the rest is held out. NaN: the first 75 % of the log's time.
+  double fit_until_s = std::numeric_limits<double>::quiet_NaN();
+  int blocks = 8;                     ///< clusters of the training part for the robust intervals
+  /// The magnet law's ψ_ref from the first magnet observations at the soaked start (else as configured).
+  bool anchor_magnet_reference = true;
+  int max_iterations = 200;
+};
+
+struct FittedParameter {
+  std::string name;  ///< e.g. "C winding", "G winding–magnet", "iron_eddy at magnet", "psi_m_ref"
+  std::string unit;
+  double value = 0.0;
+  double half_width_rel = 0.0;             ///< 95 %, cluster-robust, relative (∞: not excited)
+  double excitation_half_width_rel = 0.0;  ///< 95 %, what the excitation alone allows
+  bool identified = false;
+};
+
+/// How well the network follows one observed signal [K]: on the training and on the held-out part.
+struct SignalFit {
+  std::string name;
+  std::size_t fit_points = 0, heldout_points = 0;
+  double fit_rms_K = 0.0, heldout_rms_K = 0.0, heldout_worst_K = 0.0;
+};
+
+struct ThermalFitResult {
+  io::ThermalConfig config;  ///< the fitted section
+  double fit_until_s = 0.0;
+  std::size_t training_steps = 0;
+  std::vector<FittedParameter> parameters;
+  std::vector<SignalFit> signals;
+  /// Parameters that move together where the log cannot tell them apart (the weakest directions of the
+  /// information matrix), as text.
+  std::vector<std::string> not_identifiable;
+  std::vector<std::string> notes;
+  double process_noise_K2_per_s = 0.0;
+  double disturbance_W2_per_s = 0.0;
+  double training_cost = 0.0;  ///< Σ of the squared weighted residuals
+  std::vector<core::ThermalVec> open_loop_C;  ///< the model alone over the whole log, per step
+};
+
+/// Fits `start` (its nodes, conductances and losses give the topology; their values the start) to the record.
+[[nodiscard]] ThermalFitResult fit_thermal(const ThermalRecord& record, const io::ThermalConfig& start,
+                                           const ThermalFitOptions& options);
+
+/// The default topologies (docs/thermal.md, "The network"): 2 nodes (winding, magnet) or 3 (winding,
+/// stator_iron, magnet), with starting values scaled to the record's copper loss and temperature rise.
+[[nodiscard]] io::ThermalConfig default_topology(const io::ThermalConfig& laws, const ThermalRecord& record, int nodes);
+
+}  // namespace rpem::analysis

@@ -1,0 +1,29 @@
+#pragma once
+// A drive log as the thermal network sees it (docs/thermal.md): the estimator run over the log as rpemd
+// would run it, and per step of the thermal filter the load, the estimator's observations of ψm and R_s
+// (core::ThermalObserver) and the log's winding sensor and coolant — never a magnet sensor.
+
+#include <string>
+#include <vector>
+
+#include "rpem/core/thermal_observer.hpp"
+#include "rpem/io/machine_config.hpp"
+#include "rpem/io/thermal_config.hpp"
+
+namespace rpem::analysis {
+
+struct ThermalRecord {
+  std::string log;
+  std::vector<core::ThermalStepData> steps;
+  std::vector<double> t_s;     ///< each step's end [s]
+  bool winding_sensor = false;  ///< the log has T_winding
+  bool coolant = false;         ///< the log has T_coolant (else thermal.coolant_C is used)
+  bool averaged = false;
+};
+
+/// Runs the configured estimator over the log (averaged or phase samples) and its observer with the
+/// thermal configuration's observer settings. Throws io::DriveLogError / io::ConfigError on bad input.
+[[nodiscard]] ThermalRecord record_thermal(const std::string& log_path, const io::MachineConfig& machine,
+                                           const io::ThermalConfig& thermal);
+
+}  // namespace rpem::analysis

@@ -1,0 +1,69 @@
+#include "rpem/analysis/thermal/thermal_record.hpp"
+
+#include <limits>
+#include <optional>
+
+#include "rpem/core/averaged_estimator.hpp"
+#include "rpem/core/drive_estimator.hpp"
+#include "rpem/io/averaged_log.hpp"
+#include "rpem/io/drive_log.hpp"
+
+namespace rpem::analysis {
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+/// Feeds one sample to the observer and keeps a completed step.
+class Recorder {
+ public:
+  Recorder(ThermalRecord& r, const io::MachineConfig& m, const io::ThermalConfig& t, const core::PerUnitBase& base)
+      : record_(r),
+        observer_(t.fusion.observer, base, m.machine, t.fusion.filter.network.base, t.fusion.coolant_C) {}
+  void add(const core::Estimate& e, std::int64_t t_ns, double coolant_C, double winding_C) {
+    core::ThermalSample s;
+    s.dt_s = previous_ns_ ? 1e-9 * static_cast<double>(t_ns - *previous_ns_) : 0.0;
+    s.coolant_C = coolant_C;
+    s.winding_sensor_C = winding_C;
+    previous_ns_ = t_ns;
+    if (!observer_.add(e, s)) return;
+    record_.steps.push_back(observer_.step());
+    record_.t_s.push_back(1e-9 * static_cast<double>(observer_.step().t_ns));
+  }
+
+ private:
+  ThermalRecord& record_;
+  core::ThermalObserver observer_;
+  std::optional<std::int64_t> previous_ns_;
+};
+
+}  // namespace
+
+ThermalRecord record_thermal(const std::string& log_path, const io::MachineConfig& machine, const io::ThermalConfig& thermal) {
+  ThermalRecord r;
+  r.log = log_path;
+  if (io::is_averaged_log(log_path)) {
+    r.averaged = true;
+    io::AveragedLogLayout layout;
+    const std::vector<core::AveragedSample> samples = io::read_averaged_log(log_path, &layout);
+    io::check_averaged_supports(machine, "configuration", layout.u_dc, log_path);
+    r.winding_sensor = layout.t_winding;
+    r.coolant = layout.t_coolant;
+    core::AveragedDriveEstimator estimator(machine.machine, machine.estimator);
+    Recorder rec(r, machine, thermal, estimator.base());
+    for (const core::AveragedSample& s : samples) rec.add(estimator.step(s), s.t_ns, s.t_coolant_C, s.t_winding_C);
+    return r;
+  }
+  io::DriveLogReader reader(log_path, io::machine_limits(machine.machine));
+  io::check_log_supports(machine, "configuration", reader.layout().u_dc, log_path);
+  r.winding_sensor = reader.layout().t_winding;
+  r.coolant = reader.layout().t_coolant;
+  core::DriveEstimator estimator(machine.machine, machine.estimator);
+  Recorder rec(r, machine, thermal, estimator.base());
+  io::DriveLogRow row;
+  while (reader.next(row)) {
+    rec.add(estimator.step(row.sample), row.sample.t_ns, row.t_coolant_C.value_or(kNaN), row.t_winding_C.value_or(kNaN));
+  }
+  return r;
+}
+
+}  // namespace rpem::analysis

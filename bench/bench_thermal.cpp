@@ -1,0 +1,172 @@
+// The thermal fusion's cost in rpemd's loop (issue 24, item 6: the filter update ≤ 1 µs; the loop's latency
+// unchanged). Estimates are pre-computed by DriveEstimator over the model's phase samples at 8 kHz
+// (tests/support/model_data.hpp) and replayed from memory.
+//
+//   BM_FusionPerSample     ThermalFusion::step per estimator sample, the filter's step (1 s) included
+//                          amortised: what the loop pays per sample on average
+//   BM_FilterStep          one filter step: exact network step (matrix exponential), covariance prediction,
+//                          both parameter observations and a winding sensor (ThermalFusion::apply)
+//   BM_SampleWithFusion    the estimator's step alone and with the fusion after it, alternating blocks on the
+//                          same samples, each timed on this thread's CPU clock: both and their ratio, one run
+
+#include <benchmark/benchmark.h>
+
+#include <algorithm>
+#include <ctime>
+#include <vector>
+
+#include "rpem/core/clock.hpp"
+#include "rpem/core/drive_estimator.hpp"
+#include "rpem/core/thermal_fusion.hpp"
+#include "support/model_data.hpp"
+#include "support/paper_machine.hpp"
+#include "support/paper_thermal.hpp"
+
+namespace {
+
+using namespace rpem;
+
+constexpr int kSamples = 8 * 8000;  // 8 s at 8 kHz: eight filter steps per pass
+constexpr double kPeriod_s = 125e-6;
+
+const std::vector<core::DriveSample>& samples() {
+  static const std::vector<core::DriveSample> s = [] {
+    const core::PerUnitBase base = test::paper_base();
+    test::ModelDataGenerator gen;
+    gen.plant = test::paper_machine_pu();
+    gen.plant.psi_m_pu *= 0.95;
+    gen.omega_n_rad_s = base.omega_el_rad_s;
+    gen.n_pu = 0.4;
+    gen.i_ref_pu = core::mtpa_reference(gen.plant, 0.4);
+    gen.current_noise_pu = 0.002;
+    std::vector<core::DriveSample> v;
+    std::int64_t t_ns = 0;
+    for (int k = 0; k < kSamples; ++k) v.push_back(gen.next_si(base, t_ns));
+    return v;
+  }();
+  return s;
+}
+
+const std::vector<core::Estimate>& estimates() {
+  static const std::vector<core::Estimate> e = [] {
+    core::DriveEstimator est(test::paper_machine_si(), test::paper_settings());
+    std::vector<core::Estimate> v;
+    for (const core::DriveSample& s : samples()) v.push_back(est.step(s));
+    return v;
+  }();
+  return e;
+}
+
+/// The test network with the filter's default step (1 s) and settling: rpemd's configuration.
+core::ThermalFusionConfig loop_config() {
+  core::ThermalFusionConfig c = test::paper_thermal_fusion();
+  c.observer.period_s = 1.0;
+  c.observer.settle_time_constants = 5.0;
+  c.filter.gate_sigma = 5.0;
+  return c;
+}
+
+double thread_cpu_s() {
+  timespec ts{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return static_cast<double>(ts.tv_sec) + core::to_seconds(ts.tv_nsec);
+}
+
+double max_of(const std::vector<double>& v) { return *std::max_element(v.begin(), v.end()); }
+
+core::ThermalSample sample() {
+  core::ThermalSample s;
+  s.dt_s = kPeriod_s;
+  s.coolant_C = 40.0;
+  return s;
+}
+
+void BM_FusionPerSample(benchmark::State& state) {
+  const std::vector<core::Estimate>& e = estimates();
+  core::ThermalFusion fusion(loop_config(), test::paper_base(), test::paper_machine_si());
+  const core::ThermalSample s = sample();
+  std::size_t k = 0;
+  for (auto _ : state) {
+    fusion.step(e[k], s);
+    benchmark::DoNotOptimize(fusion.estimate());
+    if (++k == e.size()) k = 0;
+  }
+  state.counters["observations"] = static_cast<double>(fusion.estimate().observations_accepted);
+  state.SetItemsProcessed(state.iterations());
+}
+
+void BM_FilterStep(benchmark::State& state) {
+  core::ThermalFusion fusion(loop_config(), test::paper_base(), test::paper_machine_si());
+  core::ThermalStepData d;
+  d.load.dt_s = 1.0;
+  d.load.current_sq_A2 = 30.0;
+  d.load.basis = {0.4, 0.16, 0.1};
+  d.load.coolant_C = 40.0;
+  const core::ThermalEstimate& out = fusion.estimate();
+  std::int64_t t_ns = 0;
+  for (auto _ : state) {
+    state.PauseTiming();
+    t_ns += 1'000'000'000;
+    d.t_ns = t_ns;
+    // ψ̂m and r̂s each an observation at the filter's own prediction (accepted: inside the gate).
+    const double t_m = out.started ? out.magnet_node().t_C : 40.0, t_w = out.started ? out.winding_node().t_C : 40.0;
+    d.parameter[static_cast<std::size_t>(core::kPsiM)] = {true, 1.14 * (1.0 - 0.0012 * (t_m - 20.0)), 0.0, 2.25, 1e-6, 1e-6, 2.0};
+    d.parameter[static_cast<std::size_t>(core::kRs)] = {true, 2.25 * (1.0 + 0.00393 * (t_w - 20.0)), 0.0, 1.14, 1e-4, 1e-4, 2.0};
+    d.winding_sensor_C = t_w;
+    d.psi_m_Wb = d.parameter[static_cast<std::size_t>(core::kPsiM)].value;
+    d.r_s_Ohm = d.parameter[static_cast<std::size_t>(core::kRs)].value;
+    state.ResumeTiming();
+    fusion.apply(d);
+    benchmark::DoNotOptimize(fusion.estimate());
+  }
+  state.counters["accepted"] = static_cast<double>(out.observations_accepted);
+  state.counters["rejected"] = static_cast<double>(out.observations_rejected);
+}
+
+void BM_SampleWithFusion(benchmark::State& state) {
+  const std::vector<core::DriveSample>& x = samples();
+  core::DriveEstimator alone(test::paper_machine_si(), test::paper_settings());
+  core::DriveEstimator fused(test::paper_machine_si(), test::paper_settings());
+  core::ThermalFusion fusion(loop_config(), test::paper_base(), test::paper_machine_si());
+  const core::ThermalSample s = sample();
+  double alone_s = 0.0, fused_s = 0.0;
+  std::int64_t pass_ns = 0;
+  constexpr std::size_t kBlock = 8000;  // one second of samples per block
+  std::size_t k = 0;
+  for (auto _ : state) {
+    const std::size_t begin = k;
+    const double t0 = thread_cpu_s();
+    for (std::size_t j = 0; j < kBlock; ++j) {
+      core::DriveSample d = x[begin + j];
+      d.t_ns += pass_ns;
+      benchmark::DoNotOptimize(alone.step(d));
+    }
+    const double t1 = thread_cpu_s();
+    for (std::size_t j = 0; j < kBlock; ++j) {
+      core::DriveSample d = x[begin + j];
+      d.t_ns += pass_ns;
+      fusion.step(fused.step(d), s);
+      benchmark::DoNotOptimize(fusion.estimate());
+    }
+    fused_s += thread_cpu_s() - t1;
+    alone_s += t1 - t0;
+    k += kBlock;
+    if (k + kBlock > x.size()) {
+      k = 0;
+      pass_ns += x.back().t_ns - x.front().t_ns + 125'000;
+    }
+  }
+  const double n = static_cast<double>(state.iterations()) * kBlock;
+  state.counters["alone_ns"] = 1e9 * alone_s / n;
+  state.counters["fused_ns"] = 1e9 * fused_s / n;
+  state.counters["fusion_ns"] = 1e9 * (fused_s - alone_s) / n;
+  state.counters["ratio"] = fused_s / alone_s;
+}
+
+BENCHMARK(BM_FusionPerSample)->Repetitions(10)->ComputeStatistics("max", max_of)->ReportAggregatesOnly(true);
+BENCHMARK(BM_FilterStep)->Repetitions(10)->ComputeStatistics("max", max_of)->ReportAggregatesOnly(true);
+BENCHMARK(BM_SampleWithFusion)->MinTime(1.0)->Repetitions(10)->ComputeStatistics("max", max_of)->ReportAggregatesOnly(true);
+
+}  // namespace
+
+BENCHMARK_MAIN();

@@ -1,0 +1,96 @@
+#pragma once
+// The Kalman filter of the node temperatures (docs/derivations.md §14, "Fusion"): the thermal network as its
+// process model, augmented by each node's heat disturbance d [W] — what the loss model gets wrong — and by
+// the temperature laws' calibration errors c, which it carries but does not estimate (Schmidt's "consider"
+// states: nothing in the data tells a calibration error from a model error), corrected by scalar linear
+// observations (a parameter estimate through its temperature law, a sensor).
+//
+//   state x = [T; d; c],  T⁺ = Φ·T + γ + Γ_d·d,  d⁺ = d + v,  c⁺ = c                    (eq. 14.4, 14.9)
+//   c = [e_ref,magnet, e_α,magnet, e_ref,copper, e_α,copper]: a law's temperature reads T + e_ref + e_α·(T − T_ref)
+//   Var(v_i) = q_d,i·Δt + Σ_terms (σ_rel,term·ΔP_term,i)²: a loss model's error moves with the loss it
+//   models, so each change ΔP of a modelled loss term between steps adds its relative uncertainty squared
+//   P⁺ = F·P·Fᵀ + Q_d,  F = [Φ Γ_d 0; 0 I 0; 0 0 I],  Q_d = (Δt/2)·(Φ·Q_T·Φᵀ + Q_T) on T (trapezoidal rule)
+//   observe:  y = h·T + h_c·c + offset + v_y,  v_y ~ N(0, r);  ν = y − ŷ,  s = H·P·Hᵀ + r
+//             K = [P_xx·Hᵀ/s on T and d; 0 on c],  x += K·ν,  P −= rank-one terms of that gain (eq. 14.11)
+//
+// An observation whose innovation lies beyond `gate_sigma`·√s is rejected (counted by the caller), so one
+// wild estimate cannot pull the state. Real-time safe: fixed size, noexcept, no allocation.
+
+#include "rpem/core/thermal_network.hpp"
+
+namespace rpem::core {
+
+inline constexpr int kCalibrationStates = 4;
+inline constexpr int kThermalStates = 2 * kMaxThermalNodes + kCalibrationStates;
+using ThermalStateVec = Eigen::Matrix<double, kThermalStates, 1>;
+using ThermalStateMat = Eigen::Matrix<double, kThermalStates, kThermalStates>;
+using CalibrationVec = Eigen::Matrix<double, kCalibrationStates, 1>;
+
+/// The calibration states: which law, and offset or coefficient.
+enum class Calibration : int { kMagnetOffset = 0, kMagnetCoefficient = 1, kCopperOffset = 2, kCopperCoefficient = 3 };
+
+/// One scalar observation y = h·T + h_c·c + offset + v, v ~ N(0, variance).
+struct ThermalObservation {
+  ThermalVec h = ThermalVec::Zero();
+  CalibrationVec h_c = CalibrationVec::Zero();
+  double offset = 0.0;
+  double value = 0.0;
+  double variance = 0.0;
+};
+
+enum class ObservationResult : std::uint8_t { kAccepted = 0, kRejectedGate = 1, kRejectedInvalid = 2 };
+
+struct ThermalFilterConfig {
+  ThermalNetwork network;
+  ThermalVec process_noise_K2_per_s = ThermalVec::Zero();  ///< Q_T: white noise on each node's dT/dt
+  ThermalVec disturbance_W2_per_s = ThermalVec::Zero();    ///< q_d: the heat disturbances' drift
+  /// σ_rel of each fitted loss term (form row, node column): its relative uncertainty.
+  Eigen::Matrix<double, kLossForms, kMaxThermalNodes> loss_rel_sigma = Eigen::Matrix<double, kLossForms, kMaxThermalNodes>::Zero();
+  double copper_rel_sigma = 0.1;  ///< σ_rel of the copper loss (R_s's law and reference)
+  /// σ of the calibration states (Calibration order): [K, relative, K, relative].
+  CalibrationVec calibration_sigma = CalibrationVec(1.0, kNdFeB.rel_sigma(), 1.0, kCopper.rel_sigma());
+  double gate_sigma = 5.0;
+  /// After this many consecutive rejected observations of one kind the model, not the observation, is taken
+  /// to be wrong: the observed node's variance grows by ν²/h² and the observation is applied (0: never).
+  int gate_reset_after = 3;
+};
+
+class ThermalFilter {
+ public:
+  explicit ThermalFilter(const ThermalFilterConfig& config) noexcept : config_(config) {}
+
+  /// Every node at `t_C` with standard deviation `sigma_K` (a soaked machine), no disturbance.
+  void reset(double t_C, double sigma_K) noexcept;
+  /// Starts from given temperatures (disturbances zero) with this covariance of the temperatures.
+  void set_temperatures(const ThermalVec& t_C, const ThermalMat& p) noexcept;
+  /// Advances by load.dt_s under `load` (nothing when dt_s ≤ 0).
+  void predict(const ThermalLoad& load) noexcept;
+  /// Applies one observation unless it is not finite or its innovation lies beyond the gate.
+  [[nodiscard]] ObservationResult observe(const ThermalObservation& o) noexcept;
+  /// Adds `variance_K2` to one node's variance (the model has drifted: a gate reset).
+  void inflate(int node, double variance_K2) noexcept { p_(node, node) += variance_K2; }
+  /// Replaces the model (a reload), keeping the state.
+  void reconfigure(const ThermalFilterConfig& config) noexcept { config_ = config; }
+
+  [[nodiscard]] ThermalVec temperature_C() const noexcept { return x_.head<kMaxThermalNodes>(); }
+  [[nodiscard]] ThermalVec disturbance_W() const noexcept { return x_.segment<kMaxThermalNodes>(kMaxThermalNodes); }
+  [[nodiscard]] const ThermalStateMat& covariance() const noexcept { return p_; }
+  [[nodiscard]] double sigma_K(int node) const noexcept;
+  [[nodiscard]] const ThermalFilterConfig& config() const noexcept { return config_; }
+  /// The last observation's innovation ν and its variance s.
+  [[nodiscard]] double last_innovation() const noexcept { return innovation_; }
+  [[nodiscard]] double last_innovation_variance() const noexcept { return innovation_variance_; }
+
+ private:
+  using LossTerms = Eigen::Matrix<double, kLossForms + 1, kMaxThermalNodes>;
+  /// The modelled loss terms of each node under `l` at the state's winding temperature: copper, then the forms.
+  [[nodiscard]] LossTerms loss_terms(const ThermalLoad& l) const noexcept;
+
+  ThermalFilterConfig config_;
+  ThermalStateVec x_ = ThermalStateVec::Zero();
+  ThermalStateMat p_ = ThermalStateMat::Zero();
+  LossTerms previous_terms_ = LossTerms::Zero();
+  double innovation_ = 0.0, innovation_variance_ = 0.0;
+};
+
+}  // namespace rpem::core

@@ -1,0 +1,123 @@
+#pragma once
+// Both temperatures at every moment (docs/thermal.md): the thermal network's Kalman filter (thermal_filter.hpp)
+// driven by the losses of the estimator's samples and corrected by what the estimator observes
+// (thermal_observer.hpp) — the magnet temperature from ψ̂m, the winding's from r̂s, each only while it adapts
+// and has settled — and by a winding sensor where there is one. The same block runs in rpemd's loop and in
+// `rpem estimate --thermal`.
+//
+// The observations through the temperature laws (core/thermal.hpp; docs/derivations.md §14, eq. 14.5–14.8):
+//   ψ̂m = ψ_ref·(1 + α_m·(T_m' − T_ref)) + κ_ψ·(R_s(T_w) − r̂s)    while ψ̂m adapts (r̂s held)
+//   r̂s = R_ref·(1 + α_cu·(T_w' − T_ref)) + κ_r·(ψm(T_m) − ψ̂m)    while r̂s adapts (ψ̂m held)
+//   T_sensor = T_w
+// where T' = T + e_ref + e_α·(T − T_ref) is what a law with calibration errors e reads (the filter's consider
+// states), with the variance of the estimator's own state (σ²_noise + σ²_model) and of the tracking lag
+// σ_T,lag = |dT̂/dt|·τ through the law's slope. Real-time safe.
+
+#include <array>
+#include <cstdint>
+
+#include "rpem/core/thermal_filter.hpp"
+#include "rpem/core/thermal_observer.hpp"
+
+namespace rpem::core {
+
+struct ThermalFusionConfig {
+  ThermalFilterConfig filter;  ///< the network (its copper law is R_s's), the noises, the laws' calibration σ
+  DriftLaw magnet_law;         ///< ψm(T_magnet) [Wb]
+  ThermalObserverConfig observer;
+  double coolant_C = 25.0;             ///< where the samples carry no coolant temperature
+  double winding_sensor_sigma_K = 0.0;  ///< a winding sensor's σ; 0: sensor not used
+  double initial_sigma_K = 10.0;       ///< σ of every node at the start (the coolant's temperature)
+};
+
+/// A node's fused temperature.
+struct ThermalNodeEstimate {
+  double t_C = 0.0;
+  double sigma_K = 0.0;
+  bool observed = false;  ///< an observation of this node was applied in the newest step
+  double age_s = -1.0;    ///< since the last one; −1: never
+};
+
+struct ThermalEstimate {
+  std::int64_t t_ns = 0;  ///< the newest step's end
+  bool started = false;   ///< at least one step
+  int nodes = 0, winding = 0, magnet = 1;
+  std::array<ThermalNodeEstimate, kMaxThermalNodes> node{};
+  /// The inverse laws of the current estimates (what the estimator alone says, held where it does not adapt).
+  double t_magnet_rpem_C = 0.0, t_winding_rpem_C = 0.0;
+  double coolant_C = 0.0;  ///< the newest step's mean
+  std::int64_t observations_accepted = 0;
+  std::int64_t observations_rejected = 0;  ///< beyond the gate (gate_sigma) or not finite
+  std::int64_t gate_resets = 0;            ///< the model taken to be wrong (gate_reset_after rejections in a row)
+  [[nodiscard]] const ThermalNodeEstimate& magnet_node() const noexcept { return node[static_cast<std::size_t>(magnet)]; }
+  [[nodiscard]] const ThermalNodeEstimate& winding_node() const noexcept { return node[static_cast<std::size_t>(winding)]; }
+};
+
+/// What RPEM_ESTIMATE and `rpem estimate --thermal` report of a node at `t_ns` (the newest sample, at or after
+/// the filter's newest step): source 0 none (the filter has not stepped), 1 observed in the newest step,
+/// 2 predicted; the age of the last observation run on to t_ns, −1: never observed; NaN values before the
+/// first step.
+struct ThermalNodeReport {
+  double t_C = 0.0;
+  double sd_K = 0.0;
+  std::int8_t source = 0;
+  double observed_age_s = -1.0;
+};
+[[nodiscard]] ThermalNodeReport report_node(const ThermalEstimate& e, int node, std::int64_t t_ns) noexcept;
+
+/// The observations of one step as the filter takes them, from a step's data and the state they linearise at.
+struct StepObservations {
+  std::array<ThermalObservation, 3> item{};  ///< magnet (ψ̂m), winding (r̂s), winding sensor
+  std::array<bool, 3> present{};
+};
+[[nodiscard]] StepObservations step_observations(const ThermalFusionConfig& c, const ThermalStepData& s,
+                                                 const ThermalVec& t_C, const ThermalVec& dt_dt_K_per_s) noexcept;
+
+class ThermalFusion {
+ public:
+  ThermalFusion(const ThermalFusionConfig& config, const PerUnitBase& base, const MachineSi& machine) noexcept;
+
+  /// One estimator sample. Real-time safe.
+  void step(const Estimate& e, const ThermalSample& s) noexcept;
+  /// One completed step of the observer (what step() does when the observer completes one): the first
+  /// starts the filter, then predict and observe. Public for replays of recorded steps. Real-time safe.
+  void apply(const ThermalStepData& d) noexcept;
+  /// Advances the filter by `dt_s` under the last load without observations (no samples arrive).
+  void coast(double dt_s) noexcept;
+  /// The estimator was reset or given new values: observations wait until it settles again.
+  void restart_observations() noexcept { observer_.restart(); }
+  /// A reload: new model, laws and observer settings; the temperatures and their covariance are kept.
+  void reconfigure(const ThermalFusionConfig& config, const PerUnitBase& base, const MachineSi& machine) noexcept;
+
+  [[nodiscard]] const ThermalEstimate& estimate() const noexcept { return out_; }
+  /// The newest step's observations (magnet from ψ̂m, winding from r̂s, winding sensor).
+  struct ObservationReport {
+    bool present = false;
+    ObservationResult result = ObservationResult::kRejectedInvalid;
+    double innovation = 0.0;  ///< ν, in the observation's unit
+    double variance = 0.0;    ///< s = h·P·hᵀ + r
+  };
+  [[nodiscard]] const std::array<ObservationReport, 3>& last_observations() const noexcept { return reports_; }
+  [[nodiscard]] const ThermalFilter& filter() const noexcept { return filter_; }
+  [[nodiscard]] const ThermalFusionConfig& config() const noexcept { return config_; }
+
+ private:
+  void start(const ThermalStepData& s) noexcept;
+  void finish_step(const ThermalStepData& s, double dt_s) noexcept;
+
+  ThermalFusionConfig config_;
+  ThermalObserver observer_;
+  ThermalFilter filter_;
+  ThermalEstimate out_;
+  ThermalLoad last_load_;
+  std::array<double, kMaxThermalNodes> since_observed_s_{};
+  std::array<bool, kMaxThermalNodes> ever_observed_{};
+  std::array<ObservationReport, 3> reports_{};
+  std::array<int, 3> rejected_in_a_row_{};
+  double last_psi_m_Wb_ = 0.0, last_r_s_Ohm_ = 0.0;
+};
+
+/// The loss base of a machine: rated electrical speed, its ψm and rated peak current (per_unit.hpp's base).
+[[nodiscard]] LossBase loss_base_of(const PerUnitBase& base, const MachineSi& machine) noexcept;
+
+}  // namespace rpem::core

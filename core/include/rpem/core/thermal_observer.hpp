@@ -1,0 +1,107 @@
+#pragma once
+// What the estimator tells the thermal filter (docs/derivations.md §14, "Observations"): per step of the
+// filter, the load the network is driven by (thermal_network.hpp) and, for ψ̂m and r̂s each, whether it is an
+// observation — it adapted through at least half of the step and has settled — with its value, its
+// variance from the estimator's own state, its sensitivity to the other, held parameter and its lag.
+//
+// Per adapted sample, with l the parameter's gain row after scheduling (eq:GainSchedule), g = dî/dθ_j its
+// gradient column, g_o the other parameter's, ε the prediction error (all pu):
+//   a = l·g                          the fraction of its error the update removes (contraction)
+//   settled:   Σ a ≥ settle_time_constants over uninterrupted adaptation (the start's error below e^−Σa)
+//   κ = (l·g_o)/a                    θ̂_j − θ_j = κ·(θ_o − θ̂_o) at the update's equilibrium l·ε = 0 (eq. 14.6)
+//   σ²_noise = l·Σ_ε·lᵀ / (a·(2 − a))  the stationary variance of θ̂_j, Σ_ε the residuals' long-run covariance
+//                                      (their spectral density at zero: the update is a low-pass) (eq. 14.7)
+//   σ²_model = |ε̄_⊥|²·|l|²/a²        the bias a model error as large as the mean residual the update cannot
+//                                      remove (ε̄_⊥ ⊥ l), in the direction it would remove, causes (eq. 14.8)
+//   τ = Δt/a                          the tracking time constant
+// ε̄ and Σ_ε are exponentially weighted over residual_time_constant_s, Σ_ε by batch means: M times the
+// covariance of the means of M consecutive residuals, a batch closing after a quarter of the estimator's time
+// constant (Σa ≥ ¼) or kMaxBatch samples — long against the noise's correlation, short against what the
+// estimator itself moves (a differenced noise, which the averaged path's inductive correction puts into ε
+// and which the update does not see, keeps 2/M of its variance; rows seconds apart, a ≈ 1: M = 1). A step's observation is the mean of its
+// adapted samples' values, κ, variances and τ; nothing here depends on the thermal model. Real-time safe.
+
+#include <array>
+#include <cstdint>
+#include <limits>
+
+#include "rpem/core/drive_estimator.hpp"
+#include "rpem/core/thermal_network.hpp"
+
+namespace rpem::core {
+
+struct ThermalObserverConfig {
+  double period_s = 1.0;                   ///< one filter step at least this long
+  double residual_time_constant_s = 10.0;  ///< ε̄ and Σ_ε
+  double settle_time_constants = 5.0;      ///< Σa before a parameter is an observation
+};
+
+/// What the thermal block needs of a sample besides its Estimate.
+struct ThermalSample {
+  double dt_s = 0.0;  ///< the time the sample stands for (since the previous one)
+  double coolant_C = std::numeric_limits<double>::quiet_NaN();         ///< measured; NaN: the configured one
+  double winding_sensor_C = std::numeric_limits<double>::quiet_NaN();  ///< NaN: none
+};
+
+/// One parameter's observation over a step, SI (Wb for ψm, Ω for R_s).
+struct ParameterObservation {
+  bool valid = false;
+  double value = 0.0;         ///< mean estimate over the adapted samples
+  double cross = 0.0;         ///< κ in SI: the value's change per unit error of the other parameter
+  double other_held = 0.0;    ///< the other parameter's estimate (its held value)
+  double variance = 0.0;      ///< σ²_noise + σ²_model [SI²]
+  double variance_noise = 0.0;
+  double time_constant_s = 0.0;
+};
+
+/// One step of the thermal filter.
+struct ThermalStepData {
+  std::int64_t t_ns = 0;                       ///< the step's end (its last sample)
+  ThermalLoad load;
+  std::array<ParameterObservation, 2> parameter;  ///< indexed by kPsiM, kRs
+  double winding_sensor_C = std::numeric_limits<double>::quiet_NaN();  ///< the step's mean; NaN: none
+  double psi_m_Wb = 0.0, r_s_Ohm = 0.0;        ///< the estimates at the step's end
+};
+
+class ThermalObserver {
+ public:
+  /// `coolant_C`: the temperature used where a sample carries none.
+  ThermalObserver(const ThermalObserverConfig& config, const PerUnitBase& base, const MachineSi& machine,
+                  const LossBase& loss_base, double coolant_C) noexcept;
+
+  /// One estimator sample; true when it completed a step (then step() holds it).
+  bool add(const Estimate& e, const ThermalSample& s) noexcept;
+  [[nodiscard]] const ThermalStepData& step() const noexcept { return step_; }
+  /// Forgets the settling and the residual statistics (an estimator reset or new initial values).
+  void restart() noexcept;
+  void reconfigure(const ThermalObserverConfig& config, const PerUnitBase& base, const MachineSi& machine,
+                   const LossBase& loss_base, double coolant_C) noexcept;
+
+ private:
+  struct Accumulated {
+    double adapted_s = 0.0, value = 0.0, cross = 0.0, other = 0.0, variance = 0.0, variance_noise = 0.0, tau = 0.0;
+    int samples = 0;
+  };
+  void add_parameter(int j, const Estimate& e, double dt_s) noexcept;
+
+  ThermalObserverConfig config_;
+  PerUnitBase base_;
+  MachineSi machine_;
+  LossBase loss_base_;
+  double coolant_C_;
+  LossAccumulator losses_;
+  static constexpr int kMaxBatch = 32;
+  Vec2 eps_mean_ = Vec2::Zero();   ///< ε̄, per sample
+  Vec2 batch_sum_ = Vec2::Zero();  ///< the current batch's residuals
+  double batch_dt_s_ = 0.0, batch_a_ = 0.0;
+  int batch_count_ = 0;
+  Vec2 batch_mean_ = Vec2::Zero(); ///< the batch means' mean
+  Mat2 eps_cov_ = Mat2::Zero();    ///< Σ_ε = kBatch·Cov(batch means)
+  bool eps_started_ = false, batch_started_ = false;
+  std::array<double, 2> settled_{};  ///< Σa over the current uninterrupted adaptation
+  std::array<Accumulated, 2> acc_{};
+  double sensor_sum_ = 0.0, sensor_time_ = 0.0;
+  ThermalStepData step_;
+};
+
+}  // namespace rpem::core

@@ -1,0 +1,331 @@
+#include "rpem/core/regime.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "rpem/core/assert.hpp"
+#include "rpem/core/clock.hpp"
+
+namespace rpem::core {
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+/// σ of a zero-mean normal over the median of its absolute value, 1/Φ⁻¹(3/4).
+constexpr double kSigmaPerMedian = 1.4826022185056018;
+/// The median tracker's step in log scale, η = 1/16: it moves by e^{±η} a sample, so the median of a
+/// normal |r| settles within ≈ 13 % (σ of log m ≈ √(0.29·η), §13) and follows a change of 10× in 37 samples.
+constexpr double kTrackUp = 1.0644944589178593;    // e^{1/16}
+constexpr double kTrackDown = 0.93941306281347581;  // e^{−1/16}
+
+/// One step of the median tracker m of |r|: up by e^η when |r| > m, down by e^{−η} otherwise; it settles
+/// where |r| exceeds m half the time. The first nonzero |r| starts it.
+double track_median(double m, double a) noexcept {
+  const double stepped = m * (a > m ? kTrackUp : kTrackDown);
+  return m == 0.0 ? a : stepped;
+}
+
+/// The smallest nonzero |change|.
+void track_resolution(double& q, double change) noexcept {
+  const double a = std::abs(change);
+  q = std::min(q, a > 0.0 ? a : q);
+}
+
+}  // namespace
+
+std::uint64_t RegimeCounts::total() const noexcept {
+  std::uint64_t s = 0;
+  for (std::uint64_t c : n) s += c;
+  return s;
+}
+
+std::uint64_t RegimeCounts::excluded() const noexcept {
+  std::uint64_t s = 0;
+  for (const RegimeInfo& r : kRegimes) s += r.excluded ? (*this)[r.regime] : 0;
+  return s;
+}
+
+double chi2_bound(double z) noexcept { return -2.0 * std::log(std::erfc(z / std::sqrt(2.0))); }
+
+RegimeClassifier::RegimeClassifier(const RegimeConfig& config) noexcept {
+  reconfigure(config);
+  reset();
+}
+
+void RegimeClassifier::reconfigure(const RegimeConfig& config) noexcept {
+  config_ = config;
+  inv_omega_n_ = 1.0 / config.omega_n_rad_s;
+}
+
+void RegimeClassifier::reset() noexcept {
+  state_ = RegimeState{};
+  state_.measured_resolution_pu.fill(kInf);
+  noise_ = RegimeNoise{};
+}
+
+RegimeNoise RegimeClassifier::current_noise() const noexcept {
+  const auto variance = [this](std::size_t q) {
+    const double sigma = state_.noise_median_pu[q] * kSigmaPerMedian;
+    const double measured = state_.measured_resolution_pu[q] < kInf ? state_.measured_resolution_pu[q] : 0.0;
+    const double res = config_.resolution_pu[q] > 0.0 ? config_.resolution_pu[q] : measured;
+    return sigma * sigma + res * res * (1.0 / 12.0);  // a uniform quantisation error has variance q²/12
+  };
+  return {variance(0), variance(1), variance(2)};
+}
+
+void RegimeClassifier::learn(const RegimeInput& in, double t_s) noexcept {
+  RegimeState& s = state_;
+  if (s.points >= 1) {
+    const Vec2 du = (in.u_pu - s.u_pu[0]).cwiseAbs(), di = (in.i_pu - s.i_pu[0]).cwiseAbs();
+    track_resolution(s.measured_resolution_pu[0], du[0]);
+    track_resolution(s.measured_resolution_pu[0], du[1]);
+    track_resolution(s.measured_resolution_pu[1], di[0]);
+    track_resolution(s.measured_resolution_pu[1], di[1]);
+    track_resolution(s.measured_resolution_pu[2], in.n_pu - s.n_pu[0]);
+  }
+  // Only a chain's samples are close enough for their second difference to be noise: a standalone
+  // sample's neighbours are other operating points.
+  const bool chain = in.timing == SampleTiming::kDense || in.timing == SampleTiming::kContiguous;
+  const double span = t_s - s.t_s[1];
+  if (s.points == 2 && chain && s.chained >= 1 && span > 0.0) {
+    // The middle sample against the line through its neighbours, r = x₁ − (w·x₂ + (1 − w)·x₀) with
+    // w = (t₁ − t₀)/(t₂ − t₀): zero for a ramp at any spacing; for white noise of σ its variance is
+    // σ²·(1 + w² + (1 − w)²) = σ²·(3/2 + 2·d), d = (w − ½)² ∈ [0, ¼], whose root the factor removes:
+    // (3/2 + 2d)^{−½} ≈ 0.81650 − 0.53215·d + 0.37763·d², within 2e-4 (no square root per sample).
+    const double w = (s.t_s[0] - s.t_s[1]) / span;
+    const double d = (w - 0.5) * (w - 0.5);
+    const double norm = 0.81649658 + d * (-0.53215 + d * 0.37763);
+    const Vec2 ru = norm * (s.u_pu[0] - (w * in.u_pu + (1.0 - w) * s.u_pu[1])).cwiseAbs();
+    const Vec2 ri = norm * (s.i_pu[0] - (w * in.i_pu + (1.0 - w) * s.i_pu[1])).cwiseAbs();
+    const double rn = norm * std::abs(s.n_pu[0] - (w * in.n_pu + (1.0 - w) * s.n_pu[1]));
+    s.noise_median_pu[0] = track_median(track_median(s.noise_median_pu[0], ru[0]), ru[1]);
+    s.noise_median_pu[1] = track_median(track_median(s.noise_median_pu[1], ri[0]), ri[1]);
+    s.noise_median_pu[2] = track_median(s.noise_median_pu[2], rn);
+    s.noise_known = true;
+  }
+  s.u_pu[1] = s.u_pu[0];
+  s.i_pu[1] = s.i_pu[0];
+  s.n_pu[1] = s.n_pu[0];
+  s.t_s[1] = s.t_s[0];
+  s.u_pu[0] = in.u_pu;
+  s.i_pu[0] = in.i_pu;
+  s.n_pu[0] = in.n_pu;
+  s.t_s[0] = t_s;
+  if (s.points < 2) ++s.points;
+  s.chained = chain ? std::min(s.chained + 1, 2) : 0;
+}
+
+std::uint8_t RegimeClassifier::transient_bits(const RegimeInput& in, double dt_s, const RegimeNoise& v) noexcept {
+  const RegimeConfig& c = config_;
+  RegimeState& s = state_;
+  const double z2 = c.z * c.z;
+  if (in.timing == SampleTiming::kStandalone) {
+    // A sample far from the previous one: the change of operating point between them excited a transient
+    // that has decayed to e^{−Δt/τ_el} of |Δi| (τ_el the slowest the model admits). Steady if that
+    // remnant is within the current's noise (its own estimate's noise, 2·decay²·σ_i², included).
+    const double decay = std::exp(-dt_s / c.electrical_time_constant_s);
+    const Vec2 remnant = decay * (in.i_pu - s.i_pu[0]).cwiseAbs();
+    const double bound = z2 * v.i_sq * (1.0 + 2.0 * decay * decay);
+    return remnant.squaredNorm() > 0.0 && remnant.cwiseProduct(remnant).maxCoeff() > bound ? regime_bit::kTransient : 0;
+  }
+  // Consecutive windows: what the steady state and the inductive correction (the slope between window
+  // centres) leave out, per row (d, q) in voltage:
+  //   (x/ω_n)·|s_k − s_{k−1}|   the slope changed: the correction is exact only for a ramp
+  //   (Δx/ω_n)·|s_k|            the inductance's tolerance on the correction
+  //   x_o·|Δn|·|Δi_o|/4          mean(n·x·i) − n̄·x·ī, bounded by the ranges' product over 4
+  // against the row's noise and the slope change's own noise.
+  if (!s.slope_valid) return 0;
+  const double inv_w = inv_omega_n_;
+  const double dn = std::abs(in.n_pu - s.n_pu[0]);
+  const Vec2 di = (in.i_pu - s.i_pu[0]).cwiseAbs();
+  const Vec2 x(c.x_d_pu, c.x_q_pu), dx(c.dx_d_pu, c.dx_q_pu);
+  Vec2 e = inv_w * dx.cwiseProduct(s.slope_pu_s.cwiseAbs()) + 0.25 * dn * Vec2(c.x_q_pu * di[1], c.x_d_pu * di[0]);
+  double slope_noise_sq = 0.0;  // Var(s_k − s_{k−1}) per σ_i²
+  if (s.previous_slope_valid) {
+    e += inv_w * x.cwiseProduct((s.slope_pu_s - s.previous_slope_pu_s).cwiseAbs());
+    const double a = s.inv_dt, b = s.previous_inv_dt;
+    slope_noise_sq = a * a + (a + b) * (a + b) + b * b;
+  }
+  const double n2 = in.n_pu * in.n_pu, r2 = c.r_pu * c.r_pu;
+  const double slope_var = inv_w * inv_w * slope_noise_sq * v.i_sq;
+  const double row_d = v.u_sq + (r2 + n2 * c.x_q_pu * c.x_q_pu) * v.i_sq + c.x_d_pu * c.x_d_pu * slope_var;
+  const double row_q = v.u_sq + (r2 + n2 * c.x_d_pu * c.x_d_pu) * v.i_sq + c.x_q_pu * c.x_q_pu * slope_var;
+  const bool own = e[0] * e[0] > z2 * row_d || e[1] * e[1] > z2 * row_q;
+  // A slope change shows only once both windows around the junction are in: the window after one is
+  // corrected with a slope that straddles it.
+  const bool transient = own || s.previous_transient;
+  s.previous_transient = own;
+  return transient ? regime_bit::kTransient : 0;
+}
+
+Classification RegimeClassifier::step(const RegimeInput& in) noexcept {
+  const RegimeConfig& c = config_;
+  RegimeState& s = state_;
+  if (!all_finite(in.u_pu, in.i_pu, in.n_pu, in.u_reported_sq_pu, in.window_s, in.weight)) {
+    break_chain();
+    return Classification::of(regime_bit::kInvalid);
+  }
+  if (in.timing == SampleTiming::kFirst) break_chain();
+  if (!s.has_origin) {
+    s.t_origin_ns = in.t_ns;
+    s.has_origin = true;
+  }
+  // Times are window centres (a mean stands for its centre), relative to the first sample.
+  const double t_s = to_seconds(in.t_ns - s.t_origin_ns) - 0.5 * in.window_s;
+  const double dt_s = s.points >= 1 ? t_s - s.t_s[0] : 0.0;
+
+  // The current's slope: given (a block's end points), or between consecutive samples of a chain.
+  s.previous_slope_pu_s = s.slope_pu_s;
+  s.previous_slope_valid = s.slope_valid;
+  s.previous_inv_dt = s.inv_dt;
+  const bool linked = s.points >= 1 && dt_s > 0.0 &&
+                      (in.timing == SampleTiming::kDense || in.timing == SampleTiming::kContiguous);
+  s.inv_dt = linked ? 1.0 / dt_s : 0.0;
+  s.slope_valid = linked;
+  if (!linked) {
+    s.slope_pu_s.setZero();
+    s.previous_transient = false;
+  } else if (std::isnan(in.di_dt_pu_s[0])) {
+    s.slope_pu_s = (in.i_pu - s.i_pu[0]) * s.inv_dt;
+  } else {
+    s.slope_pu_s = in.di_dt_pu_s;
+  }
+
+  noise_ = current_noise();
+  const RegimeNoise& v = noise_;
+  const double z2 = c.z * c.z;
+  std::uint8_t bits = 0;
+
+  // Bridge off: the reported voltage and the current are zero within their noise where a modulating bridge
+  // could not hold a zero current: with |u| inside the voltage's zero band √c₂·σ_u the machine would carry
+  // |i| = |M⁻¹·(u − e)| ≥ (|n|·ψ_min − √c₂·σ_u)/‖M‖, ‖M‖ ≤ ‖M‖_F = √(2·r² + n²·(x_d² + x_q²)) at D_M's largest r,
+  // beyond the current's zero band √c₂·σ_i.
+  const double i_sq = in.i_pu.squaredNorm();
+  if (in.u_reported_sq_pu <= c.chi2 * v.u_sq && i_sq <= c.chi2 * v.i_sq) [[unlikely]] {
+    const double n2 = in.n_pu * in.n_pu, r = c.r_pu + c.dr_pu;
+    const double emf_margin = std::abs(in.n_pu) * c.psi_min_pu - std::sqrt(c.chi2 * v.u_sq);
+    const double m_sq = 2.0 * r * r + n2 * (c.x_d_pu * c.x_d_pu + c.x_q_pu * c.x_q_pu);
+    if (emf_margin > 0.0 && emf_margin * emf_margin > c.chi2 * v.i_sq * m_sq) bits |= regime_bit::kBridgeOff;
+  }
+
+  // Angle locked: e, what the model leaves to the magnet, lies in the cone of half-angle δ_tol about
+  // sgn(n)·q, widened by what the configuration's uncertainty (r within D_M, x within its tolerance) and
+  // the noise can put there. Independent of ψm's magnitude.
+  const double inv_w = inv_omega_n_;
+  const Vec2& i = in.i_pu;
+  const Vec2& sl = s.slope_pu_s;
+  const double n = in.n_pu, n2 = n * n, abs_n = std::abs(n);
+  const double e_d = in.u_pu[0] - c.r_pu * i[0] - inv_w * c.x_d_pu * sl[0] + n * c.x_q_pu * i[1];
+  const double e_q = in.u_pu[1] - c.r_pu * i[1] - inv_w * c.x_q_pu * sl[1] - n * c.x_d_pu * i[0];
+  const Vec2 abs_i = i.cwiseAbs(), abs_sl = sl.cwiseAbs();
+  const double b_d = c.dr_pu * abs_i[0] + abs_n * c.dx_q_pu * abs_i[1] + inv_w * c.dx_d_pu * abs_sl[0];
+  const double b_q = c.dr_pu * abs_i[1] + abs_n * c.dx_d_pu * abs_i[0] + inv_w * c.dx_q_pu * abs_sl[1];
+  // The speed's sign where it stands out of its noise; else either direction of q.
+  const double along = n2 > z2 * v.n_sq ? (n > 0.0 ? e_q : -e_q) : std::abs(e_q);
+  const double lock = std::abs(e_d) - c.tan_angle * (along + b_q) - b_d;
+  if (lock > 0.0) [[unlikely]] {
+    const double slope_sq = 2.0 * s.inv_dt * s.inv_dt;  // Var(s) per σ_i²
+    const double r2 = c.r_pu * c.r_pu;
+    const double var_d = v.u_sq + (r2 + n2 * c.x_q_pu * c.x_q_pu + inv_w * inv_w * c.x_d_pu * c.x_d_pu * slope_sq) * v.i_sq +
+                         c.x_q_pu * c.x_q_pu * i[1] * i[1] * v.n_sq;
+    const double flux_q = c.psi_max_pu + c.x_d_pu * abs_i[0];
+    const double var_q = v.u_sq + (r2 + n2 * c.x_d_pu * c.x_d_pu + inv_w * inv_w * c.x_q_pu * c.x_q_pu * slope_sq) * v.i_sq +
+                         flux_q * flux_q * v.n_sq;
+    if (lock * lock > z2 * (var_d + c.tan_angle * c.tan_angle * var_q)) bits |= regime_bit::kNotLocked;
+  }
+
+  if (in.timing == SampleTiming::kContiguous || (in.timing == SampleTiming::kStandalone && s.points >= 1)) {
+    bits |= transient_bits(in, dt_s, v);
+  }
+
+  // Excitation: the parameter's term, at its smallest inside D_M, less what the other terms' uncertainty
+  // can put in its place, against its noise as the estimator's averaging leaves it: h² = γ/(2 − γ) of
+  // one sample's variance (an exponential filter of gain γ).
+  const double r2 = c.r_pu * c.r_pu;
+  const double psi_term = abs_n * c.psi_min_pu - c.dr_pu * abs_i[1] - abs_n * c.dx_d_pu * abs_i[0];
+  if (psi_term > 0.0) {
+    const double h_sq = in.weight[0] / (2.0 - in.weight[0]);
+    const double noise = v.u_sq + (r2 + n2 * c.x_d_pu * c.x_d_pu) * v.i_sq + c.psi_max_pu * c.psi_max_pu * v.n_sq;
+    if (psi_term * psi_term > z2 * h_sq * noise) bits |= regime_bit::kExcitesPsiM;
+  }
+  // r_min·|i| must at least exceed |n|·Δψ: checked on the squares before |i| is taken.
+  if (c.r_min_pu * c.r_min_pu * i_sq > n2 * c.dpsi_pu * c.dpsi_pu) {
+    const double i_abs = std::sqrt(i_sq);
+    const double dx = std::max(c.dx_d_pu, c.dx_q_pu), x = std::max(c.x_d_pu, c.x_q_pu);
+    const double term = c.r_min_pu * i_abs - abs_n * (c.dpsi_pu + dx * i_abs);
+    if (term > 0.0) {
+      const double h_sq = in.weight[1] / (2.0 - in.weight[1]);
+      const double flux = c.psi_max_pu + x * i_abs;
+      const double noise = v.u_sq + (r2 + n2 * x * x) * v.i_sq + flux * flux * v.n_sq;
+      if (term * term > z2 * h_sq * noise) bits |= regime_bit::kExcitesRs;
+    }
+  }
+
+  // Before a chain has shown the data's noise, nothing in it is excluded on a threshold made of it.
+  if (!s.noise_known && in.timing != SampleTiming::kStandalone) bits &= static_cast<std::uint8_t>(~regime_bit::kExcluded);
+  learn(in, t_s);
+  return Classification::of(bits);
+}
+
+void StreamClassifier::clear_sums() noexcept {
+  count_ = 0;
+  u_sum_.setZero();
+  i_sum_.setZero();
+  n_sum_ = u_reported_sum_ = 0.0;
+}
+
+void StreamClassifier::reset() noexcept {
+  classifier_.reset();
+  held_ = kUnclassified;  // until a chain's first sample is in: admitted
+  has_start_ = false;
+  clear_sums();
+}
+
+void StreamClassifier::reconfigure(const RegimeConfig& config) noexcept {
+  classifier_.reconfigure(config);
+  clear_sums();
+}
+
+Classification StreamClassifier::start(const RegimeInput& in) noexcept {
+  held_ = classifier_.step(in);
+  clear_sums();
+  i_start_ = in.i_pu;
+  start_ns_ = in.t_ns;
+  has_start_ = held_.regime != Regime::kInvalid;
+  return held_;
+}
+
+Classification StreamClassifier::close_block(std::int64_t t_ns, const Vec2& i_pu) noexcept {
+  RPEM_ASSERT(count_ >= 1, "a block closes on the sample step_dense() has just added");
+  if (!has_start_) {  // dense samples before any chain start (a caller's misuse): classified alone
+    RegimeInput in;
+    in.timing = SampleTiming::kFirst;
+    in.t_ns = t_ns;
+    in.u_pu = u_sum_ / count_;
+    in.i_pu = i_pu;
+    in.n_pu = n_sum_ / count_;
+    in.u_reported_sq_pu = u_reported_sum_ / count_;
+    return start(in);
+  }
+  // The block as one sample: the means, over the window from the previous block's last sample to its own,
+  // whose current's slope its end points give exactly.
+  const double inv_count = 1.0 / count_;
+  RegimeInput b;
+  b.timing = SampleTiming::kDense;
+  b.t_ns = t_ns;
+  b.window_s = to_seconds(t_ns - start_ns_);
+  b.u_pu = u_sum_ * inv_count;
+  b.i_pu = i_sum_ * inv_count;
+  b.n_pu = n_sum_ * inv_count;
+  b.u_reported_sq_pu = u_reported_sum_ * inv_count;
+  RPEM_ASSERT(b.window_s >= 0.0, "dense samples come in time order (the conditioner resynchronises otherwise)");
+  b.di_dt_pu_s = (i_pu - i_start_) / b.window_s;
+  b.weight = (gain_rate_per_s_ * b.window_s).cwiseMin(1.0);  // the block's share of each estimate: its γ_L summed
+  held_ = classifier_.step(b);
+  clear_sums();
+  i_start_ = i_pu;
+  start_ns_ = t_ns;
+  return held_;
+}
+
+}  // namespace rpem::core

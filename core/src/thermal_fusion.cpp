@@ -1,0 +1,186 @@
+#include "rpem/core/thermal_fusion.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "rpem/core/clock.hpp"
+
+namespace rpem::core {
+namespace {
+
+/// Value and slope of a law, written as θ(T) = slope·T + at_0C.
+struct Line {
+  double slope;
+  double at_0C;
+};
+Line line_of(const DriftLaw& law) noexcept {
+  const double slope = law.value_ref * law.coeff_per_K;
+  return {slope, law.value_ref - slope * law.reference_C};
+}
+
+}  // namespace
+
+LossBase loss_base_of(const PerUnitBase& base, const MachineSi& machine) noexcept {
+  return {base.omega_el_rad_s, machine.psi_m_Wb, base.current_A};
+}
+
+ThermalNodeReport report_node(const ThermalEstimate& e, int node, std::int64_t t_ns) noexcept {
+  ThermalNodeReport r;
+  if (!e.started || node < 0 || node >= e.nodes) {
+    r.t_C = r.sd_K = std::numeric_limits<double>::quiet_NaN();
+    return r;
+  }
+  const ThermalNodeEstimate& n = e.node[static_cast<std::size_t>(node)];
+  r.t_C = n.t_C;
+  r.sd_K = n.sigma_K;
+  r.source = static_cast<std::int8_t>(n.observed ? 1 : 2);
+  if (n.age_s >= 0.0) r.observed_age_s = n.age_s + std::max(0.0, to_seconds(t_ns - e.t_ns));
+  return r;
+}
+
+StepObservations step_observations(const ThermalFusionConfig& c, const ThermalStepData& s, const ThermalVec& t_C,
+                                   const ThermalVec& dt_dt_K_per_s) noexcept {
+  const ThermalNetwork& n = c.filter.network;
+  const Line magnet = line_of(c.magnet_law), copper = line_of(n.copper);
+  const int m = n.magnet, w = n.winding;
+  StepObservations out;
+  // [node of the parameter's own temperature, the other node], the laws, the law's calibration states.
+  struct Row {
+    int own, other;
+    Line own_law, other_law;
+    double reference_C;
+    Calibration offset, coefficient;
+  };
+  const Row rows[2] = {{m, w, magnet, copper, c.magnet_law.reference_C, Calibration::kMagnetOffset, Calibration::kMagnetCoefficient},
+                       {w, m, copper, magnet, n.copper.reference_C, Calibration::kCopperOffset, Calibration::kCopperCoefficient}};
+  for (std::size_t j = 0; j < 2; ++j) {
+    const ParameterObservation& p = s.parameter[j];
+    if (!p.valid) continue;
+    const Row& r = rows[j];
+    ThermalObservation& o = out.item[j];
+    o.h[r.own] = r.own_law.slope;
+    o.h[r.other] = p.cross * r.other_law.slope;
+    o.offset = r.own_law.at_0C + p.cross * (r.other_law.at_0C - p.other_held);
+    o.value = p.value;
+    // T' = T + e_ref + e_α·(T − T_ref), linearised at T̂ (eq. 14.10).
+    o.h_c[static_cast<int>(r.offset)] = r.own_law.slope;
+    o.h_c[static_cast<int>(r.coefficient)] = r.own_law.slope * (t_C[r.own] - r.reference_C);
+    const double lag_K = dt_dt_K_per_s[r.own] * p.time_constant_s;
+    o.variance = p.variance + r.own_law.slope * r.own_law.slope * lag_K * lag_K;
+    out.present[j] = true;
+  }
+  if (c.winding_sensor_sigma_K > 0.0 && std::isfinite(s.winding_sensor_C)) {
+    ThermalObservation& o = out.item[2];
+    o.h[w] = 1.0;
+    o.value = s.winding_sensor_C;
+    o.variance = c.winding_sensor_sigma_K * c.winding_sensor_sigma_K;
+    out.present[2] = true;
+  }
+  return out;
+}
+
+ThermalFusion::ThermalFusion(const ThermalFusionConfig& config, const PerUnitBase& base, const MachineSi& machine) noexcept
+    : config_(config),
+      observer_(config.observer, base, machine, config.filter.network.base, config.coolant_C),
+      filter_(config.filter) {
+  out_.nodes = config.filter.network.nodes;
+  out_.winding = config.filter.network.winding;
+  out_.magnet = config.filter.network.magnet;
+}
+
+void ThermalFusion::reconfigure(const ThermalFusionConfig& config, const PerUnitBase& base, const MachineSi& machine) noexcept {
+  config_ = config;
+  observer_.reconfigure(config.observer, base, machine, config.filter.network.base, config.coolant_C);
+  filter_.reconfigure(config.filter);
+  out_.nodes = config.filter.network.nodes;
+  out_.winding = config.filter.network.winding;
+  out_.magnet = config.filter.network.magnet;
+}
+
+void ThermalFusion::start(const ThermalStepData& s) noexcept {
+  // A soaked machine at the coolant's temperature, the winding at its sensor if there is one.
+  filter_.reset(s.load.coolant_C, config_.initial_sigma_K);
+  if (config_.winding_sensor_sigma_K > 0.0 && std::isfinite(s.winding_sensor_C)) {
+    ThermalVec t = filter_.temperature_C();
+    t[config_.filter.network.winding] = s.winding_sensor_C;
+    filter_.set_temperatures(t, filter_.covariance().topLeftCorner<kMaxThermalNodes, kMaxThermalNodes>());
+  }
+  out_.started = true;
+}
+
+void ThermalFusion::step(const Estimate& e, const ThermalSample& s) noexcept {
+  if (observer_.add(e, s)) apply(observer_.step());
+}
+
+void ThermalFusion::apply(const ThermalStepData& d) noexcept {
+  if (!out_.started) start(d);
+  filter_.predict(d.load);
+  last_load_ = d.load;
+  finish_step(d, d.load.dt_s);
+}
+
+void ThermalFusion::coast(double dt_s) noexcept {
+  if (!out_.started || !(dt_s > 0.0)) return;
+  ThermalLoad l = last_load_;
+  l.dt_s = dt_s;
+  filter_.predict(l);
+  ThermalStepData none;
+  none.t_ns = out_.t_ns + static_cast<std::int64_t>(dt_s * 1e9);
+  none.load = l;
+  none.psi_m_Wb = last_psi_m_Wb_;
+  none.r_s_Ohm = last_r_s_Ohm_;
+  finish_step(none, dt_s);
+}
+
+void ThermalFusion::finish_step(const ThermalStepData& d, double dt_s) noexcept {
+  const ThermalNetwork& n = config_.filter.network;
+  const ThermalRates rates = thermal_rates(n, d.load);
+  const ThermalVec slope = rates.a * filter_.temperature_C() + rates.u;
+  const StepObservations obs = step_observations(config_, d, filter_.temperature_C(), slope);
+  const int node_of[3] = {n.magnet, n.winding, n.winding};
+  std::array<bool, kMaxThermalNodes> observed{};
+  for (std::size_t k = 0; k < obs.item.size(); ++k) {
+    reports_[k] = ObservationReport{};
+    if (!obs.present[k]) continue;
+    ObservationResult result = filter_.observe(obs.item[k]);
+    reports_[k] = {true, result, filter_.last_innovation(), filter_.last_innovation_variance()};
+    const int reset_after = config_.filter.gate_reset_after;
+    if (result == ObservationResult::kRejectedGate && reset_after > 0 && ++rejected_in_a_row_[k] >= reset_after) {
+      // The observations keep disagreeing: the model has drifted. Open the node's variance to the miss.
+      const double h = obs.item[k].h[node_of[k]];
+      filter_.inflate(node_of[k], filter_.last_innovation() * filter_.last_innovation() / (h * h));
+      result = filter_.observe(obs.item[k]);
+      ++out_.gate_resets;
+    }
+    if (result != ObservationResult::kRejectedGate) rejected_in_a_row_[k] = 0;
+    if (result == ObservationResult::kAccepted) {
+      ++out_.observations_accepted;
+      observed[static_cast<std::size_t>(node_of[k])] = true;
+    } else {
+      ++out_.observations_rejected;
+    }
+  }
+  last_psi_m_Wb_ = d.psi_m_Wb;
+  last_r_s_Ohm_ = d.r_s_Ohm;
+  out_.t_ns = d.t_ns;
+  out_.coolant_C = d.load.coolant_C;
+  for (int i = 0; i < kMaxThermalNodes; ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    ThermalNodeEstimate& node = out_.node[k];
+    node.t_C = filter_.temperature_C()[i];
+    node.sigma_K = filter_.sigma_K(i);
+    node.observed = observed[k];
+    if (observed[k]) {
+      ever_observed_[k] = true;
+      since_observed_s_[k] = 0.0;
+    } else {
+      since_observed_s_[k] += dt_s;
+    }
+    node.age_s = ever_observed_[k] ? since_observed_s_[k] : -1.0;
+  }
+  out_.t_magnet_rpem_C = config_.magnet_law.temperature_C(d.psi_m_Wb);
+  out_.t_winding_rpem_C = n.copper.temperature_C(d.r_s_Ohm);
+}
+
+}  // namespace rpem::core

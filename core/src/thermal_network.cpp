@@ -1,0 +1,115 @@
+#include "rpem/core/thermal_network.hpp"
+
+#include <Eigen/LU>
+#include <cmath>
+
+#include "rpem/core/matrix_exponential.hpp"
+
+namespace rpem::core {
+namespace {
+
+// The loss forms (docs/derivations.md §14, "Losses"): B ∝ |ψ_s| at a given geometry, f ∝ |ω|.
+double hysteresis(const LossPoint& p) noexcept { return p.f_rel * p.psi_rel * p.psi_rel; }
+double eddy(const LossPoint& p) noexcept { return p.f_rel * p.f_rel * p.psi_rel * p.psi_rel; }
+double magnet_eddy(const LossPoint& p) noexcept { return p.f_rel * p.f_rel * p.i_rel * p.i_rel; }
+
+constexpr std::array<LossFormRow, kLossForms> kLossForms_{{
+    {LossForm::kIronHysteresis, "iron_hysteresis", "k·(f/f_b)·(ψ_s/ψ_b)²", &hysteresis},
+    {LossForm::kIronEddy, "iron_eddy", "k·(f/f_b)²·(ψ_s/ψ_b)²", &eddy},
+    {LossForm::kMagnetEddy, "magnet_eddy", "k·(f/f_b)²·(|i|/i_b)²", &magnet_eddy},
+}};
+
+}  // namespace
+
+const std::array<LossFormRow, kLossForms>& loss_forms() noexcept { return kLossForms_; }
+
+std::array<double, kLossForms> loss_basis(const LossBase& base, const Vec2& i_dq_A, double omega_el_rad_s,
+                                          const Vec2& psi_dq_Wb) noexcept {
+  const LossPoint p{std::abs(omega_el_rad_s) / base.omega_el_rad_s, psi_dq_Wb.norm() / base.psi_Wb,
+                    i_dq_A.norm() / base.current_A};
+  std::array<double, kLossForms> b{};
+  for (std::size_t f = 0; f < b.size(); ++f) b[f] = kLossForms_[f].basis(p);
+  return b;
+}
+
+void LossAccumulator::add(const LossBase& base, double dt_s, const Vec2& i_dq_A, double omega_el_rad_s,
+                          const Vec2& psi_dq_Wb, double coolant_C) noexcept {
+  const std::array<double, kLossForms> b = loss_basis(base, i_dq_A, omega_el_rad_s, psi_dq_Wb);
+  for (std::size_t f = 0; f < b.size(); ++f) basis_[f] += dt_s * b[f];
+  current_sq_ += dt_s * i_dq_A.squaredNorm();
+  coolant_ += dt_s * coolant_C;
+  dt_s_ += dt_s;
+}
+
+ThermalLoad LossAccumulator::take() noexcept {
+  ThermalLoad l;
+  l.dt_s = dt_s_;
+  if (dt_s_ > 0.0) {
+    const double w = 1.0 / dt_s_;
+    l.current_sq_A2 = current_sq_ * w;
+    l.coolant_C = coolant_ * w;
+    for (std::size_t f = 0; f < basis_.size(); ++f) l.basis[f] = basis_[f] * w;
+  }
+  *this = LossAccumulator{};
+  return l;
+}
+
+ThermalRates thermal_rates(const ThermalNetwork& n, const ThermalLoad& l) noexcept {
+  // Copper (eq. 14.2): (3/2)·R_ref·(1 + α·(T_w − T_ref))·i² = a + b·T_w.
+  const DriftLaw& r = n.copper;
+  const double copper_per_K = n.copper_scale * 1.5 * l.current_sq_A2 * r.value_ref * r.coeff_per_K;
+  const double copper_at_0C = n.copper_scale * 1.5 * l.current_sq_A2 * r.value_ref * (1.0 - r.coeff_per_K * r.reference_C);
+  ThermalRates out;
+  for (int i = 0; i < n.nodes; ++i) {
+    double loss = 0.0;
+    for (int f = 0; f < kLossForms; ++f) loss += n.loss_at_base_W(f, i) * l.basis[static_cast<std::size_t>(f)];
+    double g_total = n.to_coolant_W_per_K[i];
+    for (int j = 0; j < n.nodes; ++j) {
+      if (j == i) continue;
+      out.a(i, j) = n.between_W_per_K(i, j);
+      g_total += n.between_W_per_K(i, j);
+    }
+    out.a(i, i) = -g_total;
+    out.u[i] = loss + n.to_coolant_W_per_K[i] * l.coolant_C;
+    if (i == n.winding) {
+      out.a(i, i) += copper_per_K;
+      out.u[i] += copper_at_0C;
+    }
+    const double inv_c = 1.0 / n.capacitance_J_per_K[i];
+    out.a.row(i) *= inv_c;
+    out.u[i] *= inv_c;
+  }
+  return out;
+}
+
+ThermalVec node_losses_W(const ThermalNetwork& n, const ThermalLoad& l, const ThermalVec& t_C) noexcept {
+  ThermalVec p = ThermalVec::Zero();
+  for (int i = 0; i < n.nodes; ++i) {
+    for (int f = 0; f < kLossForms; ++f) p[i] += n.loss_at_base_W(f, i) * l.basis[static_cast<std::size_t>(f)];
+  }
+  p[n.winding] += n.copper_scale * 1.5 * l.current_sq_A2 * n.copper.at(t_C[n.winding]);
+  return p;
+}
+
+ThermalTransition thermal_transition(const ThermalNetwork& n, const ThermalLoad& l) noexcept {
+  const ThermalRates r = thermal_rates(n, l);
+  const ExponentialPair<kMaxThermalNodes> e = exponential_and_phi1<kMaxThermalNodes>(r.a * l.dt_s);
+  ThermalTransition t;
+  t.phi = e.exp;
+  const ThermalMat integral = l.dt_s * e.phi1;  // ∫₀^Δt e^{A·s} ds
+  t.gamma = integral * r.u;
+  t.gamma_d = integral * n.capacitance_J_per_K.cwiseInverse().asDiagonal();
+  for (int i = n.nodes; i < kMaxThermalNodes; ++i) t.gamma_d.col(i).setZero();  // unused nodes take no heat
+  return t;
+}
+
+ThermalVec thermal_steady_state(const ThermalNetwork& n, const ThermalLoad& l) noexcept {
+  ThermalRates r = thermal_rates(n, l);
+  for (int i = n.nodes; i < kMaxThermalNodes; ++i) {  // unused nodes: T_i = T_coolant
+    r.a(i, i) = -1.0;
+    r.u[i] = l.coolant_C;
+  }
+  return r.a.partialPivLu().solve(-r.u);
+}
+
+}  // namespace rpem::core

@@ -1,0 +1,46 @@
+#pragma once
+// The `thermal` section (docs/thermal.md, "thermal.yaml"): the machine's thermal network, the temperature
+// laws the estimates are observed through, the coolant, a winding sensor and the filter's settings — what
+// `rpem thermal fit` writes and `rpem estimate --thermal` and rpemd read. Strict: unknown keys and values
+// out of range are ConfigErrors naming file:line:column and the key.
+
+#include <array>
+#include <string>
+
+#include "rpem/core/thermal_fusion.hpp"
+#include "rpem/io/machine_config.hpp"
+#include "rpem/io/yaml_map.hpp"
+
+namespace rpem::io {
+
+struct ThermalConfig {
+  core::ThermalFusionConfig fusion;
+  std::array<std::string, core::kMaxThermalNodes> node_names{};
+  bool has_network = true;  ///< `nodes` given (a fit's start may give the laws only)
+};
+
+/// Whether a section must give the network (rpemd, `rpem estimate`) or may give the laws only (a fit's start).
+enum class NetworkRequired : bool { kNo = false, kYes = true };
+
+/// The `thermal` section itself (`section` is the mapping under the key). Defaults that depend on the
+/// machine (loss base, the laws' reference values) come from `machine`.
+[[nodiscard]] ThermalConfig parse_thermal_config(YamlMap& section, const MachineConfig& machine,
+                                                 NetworkRequired network = NetworkRequired::kYes);
+
+/// A file whose `thermal` section is read (other top-level sections are allowed and ignored, so a
+/// whole rpemd configuration can be given).
+[[nodiscard]] ThermalConfig load_thermal_config(const std::string& path, const MachineConfig& machine,
+                                                NetworkRequired network = NetworkRequired::kYes);
+
+/// The defaults a fit starts from (docs/thermal.md; no network: has_network false): the laws of the machine's
+/// drifts or of copper and NdFeB (core/thermal.hpp) about the machine's values at 20 °C, the loss base
+/// of the machine (core::loss_base_of).
+[[nodiscard]] ThermalConfig default_thermal_config(const MachineConfig& machine);
+
+/// The section as YAML text ("thermal:\n  …"), which parse_thermal_config() reads back to the same values.
+[[nodiscard]] std::string thermal_config_yaml(const ThermalConfig& c);
+
+/// The index of a node name, −1 if none.
+[[nodiscard]] int node_index(const ThermalConfig& c, const std::string& name);
+
+}  // namespace rpem::io

@@ -1,0 +1,276 @@
+#include "rpem/io/thermal_config.hpp"
+
+#include <sstream>
+
+#include "rpem/core/per_unit.hpp"
+#include "rpem/io/number_format.hpp"
+
+namespace rpem::io {
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+std::string num(double v) {
+  std::string s;
+  append_number(s, v);
+  return s;
+}
+
+/// A temperature law (core/thermal.hpp) and its calibration's σ (`offset`, `coefficient`: the filter's
+/// calibration states); the copper law's also gives the copper loss's scale and relative uncertainty.
+core::DriftLaw parse_law(YamlMap m, const char* ref_key, core::DriftLaw law, double ref_max, bool rising,
+                         core::CalibrationVec& sigma, core::Calibration offset, core::Calibration coefficient,
+                         double* loss_rel_sigma, double* loss_scale) {
+  law.value_ref = m.number_or(ref_key, law.value_ref, 1e-9, ref_max);
+  // A reference temperature without a coefficient: the default coefficient referred to it (the same line).
+  const double reference_C = m.number_or("reference_C", law.reference_C, -273.0, 500.0);
+  law.coeff_per_K = law.referred_to(reference_C).coeff_per_K;
+  law.reference_C = reference_C;
+  law.coeff_per_K = rising ? m.number_or("coeff_per_K", law.coeff_per_K, 1e-6, 0.1)
+                           : m.number_or("coeff_per_K", law.coeff_per_K, -0.1, -1e-6);
+  double& s_offset = sigma[static_cast<int>(offset)];
+  double& s_coefficient = sigma[static_cast<int>(coefficient)];
+  s_offset = m.number_or("reference_sigma_K", s_offset, 0.0, 100.0);
+  s_coefficient = m.number_or("coeff_rel_sigma", s_coefficient, 0.0, 1.0);
+  if (loss_rel_sigma) *loss_rel_sigma = m.number_or("loss_rel_sigma", *loss_rel_sigma, 0.0, 10.0);
+  if (loss_scale) *loss_scale = m.number_or("loss_scale", *loss_scale, 1e-3, 1e3);
+  m.finish();
+  return law;
+}
+
+/// σ of a law's coefficient relative to it: the spread of the material whose range holds it (core/thermal.hpp).
+template <std::size_t N>
+double coefficient_rel_sigma(const std::array<core::MaterialCoefficient, N>& materials, double alpha) {
+  const auto m = core::material_of(materials, alpha);
+  return m ? m->rel_sigma() : 0.1;
+}
+
+}  // namespace
+
+int node_index(const ThermalConfig& c, const std::string& name) {
+  for (int i = 0; i < c.fusion.filter.network.nodes; ++i) {
+    if (c.node_names[static_cast<std::size_t>(i)] == name) return i;
+  }
+  return -1;
+}
+
+ThermalConfig default_thermal_config(const MachineConfig& machine) {
+  ThermalConfig c;
+  c.has_network = false;  // the laws only: a fit gives the network
+  core::ThermalNetwork& n = c.fusion.filter.network;
+  n.nodes = 2;
+  n.winding = 0;
+  n.magnet = 1;
+  c.node_names[0] = "winding";
+  c.node_names[1] = "magnet";
+  n.base = core::loss_base_of(core::PerUnitBase::from_rated(machine.machine.rated), machine.machine);
+  n.copper = machine.rs_drift.law.value_or(core::DriftLaw{core::kCopper.typical_per_K, core::kMaterialReference_C, 0.0});
+  if (n.copper.value_ref <= 0.0) n.copper.value_ref = machine.machine.r_s_Ohm;
+  core::DriftLaw& m = c.fusion.magnet_law;
+  m = machine.psim_drift.law.value_or(core::DriftLaw{core::kNdFeB.typical_per_K, core::kMaterialReference_C, 0.0});
+  if (m.value_ref <= 0.0) m.value_ref = machine.machine.psi_m_Wb;
+  core::CalibrationVec& sigma = c.fusion.filter.calibration_sigma;
+  sigma[static_cast<int>(core::Calibration::kMagnetCoefficient)] = coefficient_rel_sigma(core::kMagnetMaterials, m.coeff_per_K);
+  sigma[static_cast<int>(core::Calibration::kCopperCoefficient)] = coefficient_rel_sigma(core::kWindingMaterials, n.copper.coeff_per_K);
+  return c;
+}
+
+namespace {
+
+/// `nodes`, `conductances` and `losses`.
+void parse_network(YamlMap& t, ThermalConfig& c) {
+  core::ThermalFusionConfig& f = c.fusion;
+  core::ThermalNetwork& n = f.filter.network;
+  std::vector<YamlMap> nodes = t.maps("nodes");
+  if (nodes.size() < 2 || nodes.size() > static_cast<std::size_t>(core::kMaxThermalNodes)) {
+    t.fail("nodes", "a network has 2 to " + std::to_string(core::kMaxThermalNodes) + " nodes, here " +
+                        std::to_string(nodes.size()));
+  }
+  n.nodes = static_cast<int>(nodes.size());
+  n.winding = n.magnet = -1;
+  c.node_names = {};
+  for (std::size_t i = 0; i < nodes.size(); ++i) {
+    YamlMap& m = nodes[i];
+    const std::string name = m.text("name");
+    if (name.empty() || name == "coolant") m.fail("name", "'" + name + "' cannot name a node (coolant is the boundary)");
+    for (std::size_t k = 0; k < i; ++k) {
+      if (c.node_names[k] == name) m.fail("name", "node '" + name + "' appears twice");
+    }
+    c.node_names[i] = name;
+    const int idx = static_cast<int>(i);
+    if (name == "winding") n.winding = idx;
+    if (name == "magnet") n.magnet = idx;
+    n.capacitance_J_per_K[idx] = m.number("capacitance_J_per_K", 1e-6, 1e9);
+    n.to_coolant_W_per_K[idx] = m.number_or("to_coolant_W_per_K", 0.0, 0.0, 1e6);
+    f.filter.process_noise_K2_per_s[idx] = m.number_or("process_noise_K2_per_s", 0.0, 0.0, 1e3);
+    f.filter.disturbance_W2_per_s[idx] = m.number_or("disturbance_W2_per_s", 0.0, 0.0, 1e12);
+    m.finish();
+  }
+  for (int i = n.nodes; i < core::kMaxThermalNodes; ++i) {
+    n.capacitance_J_per_K[i] = 1.0;
+    n.to_coolant_W_per_K[i] = 0.0;
+  }
+  if (n.winding < 0) t.fail("nodes", "a node named 'winding' is required (the copper loss heats it, R_s follows it)");
+  if (n.magnet < 0) t.fail("nodes", "a node named 'magnet' is required (ψm follows it)");
+
+  n.between_W_per_K.setZero();
+  if (t.has("conductances")) {
+    for (YamlMap& m : t.maps("conductances")) {
+      const std::string from = m.text("from"), to = m.text("to");
+      const int a = node_index(c, from), b = node_index(c, to);
+      if (a < 0) m.fail("from", "no node named '" + from + "'");
+      if (b < 0) m.fail("to", "no node named '" + to + "'");
+      if (a == b) m.fail("to", "a conductance joins two different nodes");
+      if (n.between_W_per_K(a, b) != 0.0) m.fail("to", "the conductance " + from + "–" + to + " is given twice");
+      n.between_W_per_K(a, b) = n.between_W_per_K(b, a) = m.number("W_per_K", 1e-9, 1e6);
+      m.finish();
+    }
+  }
+  // Every node must reach the coolant: otherwise its temperature has no steady state.
+  {
+    std::array<bool, core::kMaxThermalNodes> reach{};
+    for (int i = 0; i < n.nodes; ++i) reach[static_cast<std::size_t>(i)] = n.to_coolant_W_per_K[i] > 0.0;
+    for (int pass = 0; pass < n.nodes; ++pass) {
+      for (int i = 0; i < n.nodes; ++i) {
+        for (int j = 0; j < n.nodes; ++j) {
+          if (n.between_W_per_K(i, j) > 0.0 && reach[static_cast<std::size_t>(j)]) reach[static_cast<std::size_t>(i)] = true;
+        }
+      }
+    }
+    for (int i = 0; i < n.nodes; ++i) {
+      if (!reach[static_cast<std::size_t>(i)]) {
+        t.fail("nodes", "node '" + c.node_names[static_cast<std::size_t>(i)] +
+                            "' has no path of conductances to the coolant (its temperature would have no steady state)");
+      }
+    }
+  }
+
+  n.loss_at_base_W.setZero();
+  if (t.has("losses")) {
+    for (YamlMap& m : t.maps("losses")) {
+      const std::string form = m.text("form");
+      int fi = -1;
+      for (const core::LossFormRow& row : core::loss_forms()) {
+        if (row.name == form) fi = static_cast<int>(row.form);
+      }
+      if (fi < 0) {
+        std::string names;
+        for (const core::LossFormRow& row : core::loss_forms()) names += (names.empty() ? "" : ", ") + std::string(row.name);
+        m.fail("form", "unknown loss form '" + form + "' (one of " + names + ")");
+      }
+      const std::string node = m.text("node");
+      const int i = node_index(c, node);
+      if (i < 0) m.fail("node", "no node named '" + node + "'");
+      if (n.loss_at_base_W(fi, i) != 0.0) m.fail("node", "loss " + form + " at " + node + " is given twice");
+      n.loss_at_base_W(fi, i) = m.number("at_base_W", 0.0, 1e9);
+      f.filter.loss_rel_sigma(fi, i) = m.number_or("rel_sigma", 0.5, 0.0, 10.0);
+      m.finish();
+    }
+  }
+}
+
+}  // namespace
+
+ThermalConfig parse_thermal_config(YamlMap& t, const MachineConfig& machine, NetworkRequired network) {
+  ThermalConfig c = default_thermal_config(machine);
+  core::ThermalFusionConfig& f = c.fusion;
+  core::ThermalNetwork& n = f.filter.network;
+  c.has_network = network == NetworkRequired::kYes || t.has("nodes");
+  if (c.has_network) {
+    parse_network(t, c);
+  } else {
+    for (const char* key : {"conductances", "losses"}) {
+      if (t.has(key)) t.fail(key, "belongs to a network: give `nodes` too");
+    }
+  }
+  if (auto b = t.optional_map("loss_base")) {
+    n.base.omega_el_rad_s = b->number_or("omega_el_rad_s", n.base.omega_el_rad_s, 1e-3, 1e7);
+    n.base.psi_Wb = b->number_or("psi_Wb", n.base.psi_Wb, 1e-9, 100.0);
+    n.base.current_A = b->number_or("current_A", n.base.current_A, 1e-6, 1e6);
+    b->finish();
+  }
+  if (auto m = t.optional_map("copper")) {
+    n.copper = parse_law(*m, "r_s_ref_Ohm", n.copper, 1e4, true, f.filter.calibration_sigma, core::Calibration::kCopperOffset,
+                         core::Calibration::kCopperCoefficient, &f.filter.copper_rel_sigma, &n.copper_scale);
+  }
+  if (auto m = t.optional_map("magnet_law")) {
+    f.magnet_law = parse_law(*m, "psi_m_ref_Wb", f.magnet_law, 100.0, false, f.filter.calibration_sigma,
+                             core::Calibration::kMagnetOffset, core::Calibration::kMagnetCoefficient, nullptr, nullptr);
+  }
+  f.coolant_C = t.number_or("coolant_C", f.coolant_C, -60.0, 300.0);
+  if (auto s = t.optional_map("winding_sensor")) {
+    f.winding_sensor_sigma_K = s->number("sigma_K", 1e-3, 100.0);
+    s->finish();
+  }
+  if (auto m = t.optional_map("filter")) {
+    f.observer.period_s = m->number_or("period_s", f.observer.period_s, 1e-3, 3600.0);
+    f.initial_sigma_K = m->number_or("initial_sigma_K", f.initial_sigma_K, 1e-3, 1000.0);
+    f.filter.gate_sigma = m->number_or("gate_sigma", f.filter.gate_sigma, 1.0, kInf);
+    f.filter.gate_reset_after = static_cast<int>(m->integer_or("gate_reset_after", f.filter.gate_reset_after, 0, 1000000));
+    f.observer.residual_time_constant_s =
+        m->number_or("residual_time_constant_s", f.observer.residual_time_constant_s, 1e-3, 3600.0);
+    f.observer.settle_time_constants = m->number_or("settle_time_constants", f.observer.settle_time_constants, 0.0, 100.0);
+    m->finish();
+  }
+  t.finish();
+  return c;
+}
+
+ThermalConfig load_thermal_config(const std::string& path, const MachineConfig& machine, NetworkRequired network) {
+  YamlMap root = YamlMap::load_file(path);
+  YamlMap section = root.map("thermal");
+  return parse_thermal_config(section, machine, network);
+}
+
+std::string thermal_config_yaml(const ThermalConfig& c) {
+  const core::ThermalFusionConfig& f = c.fusion;
+  const core::ThermalNetwork& n = f.filter.network;
+  std::ostringstream o;
+  o << "thermal:\n  nodes:\n";
+  for (int i = 0; i < n.nodes; ++i) {
+    o << "    - {name: " << c.node_names[static_cast<std::size_t>(i)] << ", capacitance_J_per_K: " << num(n.capacitance_J_per_K[i])
+      << ", to_coolant_W_per_K: " << num(n.to_coolant_W_per_K[i])
+      << ", process_noise_K2_per_s: " << num(f.filter.process_noise_K2_per_s[i])
+      << ", disturbance_W2_per_s: " << num(f.filter.disturbance_W2_per_s[i]) << "}\n";
+  }
+  std::string between;
+  for (int i = 0; i < n.nodes; ++i) {
+    for (int j = i + 1; j < n.nodes; ++j) {
+      if (n.between_W_per_K(i, j) <= 0.0) continue;
+      between += "    - {from: " + c.node_names[static_cast<std::size_t>(i)] + ", to: " + c.node_names[static_cast<std::size_t>(j)] +
+                 ", W_per_K: " + num(n.between_W_per_K(i, j)) + "}\n";
+    }
+  }
+  if (!between.empty()) o << "  conductances:\n" << between;
+  std::string losses;
+  for (const core::LossFormRow& row : core::loss_forms()) {
+    for (int i = 0; i < n.nodes; ++i) {
+      const double k = n.loss_at_base_W(static_cast<int>(row.form), i);
+      if (k <= 0.0) continue;
+      losses += "    - {form: " + std::string(row.name) + ", node: " + c.node_names[static_cast<std::size_t>(i)] +
+                ", at_base_W: " + num(k) + ", rel_sigma: " + num(f.filter.loss_rel_sigma(static_cast<int>(row.form), i)) + "}\n";
+    }
+  }
+  if (!losses.empty()) o << "  losses:\n" << losses;
+  o << "  loss_base: {omega_el_rad_s: " << num(n.base.omega_el_rad_s) << ", psi_Wb: " << num(n.base.psi_Wb)
+    << ", current_A: " << num(n.base.current_A) << "}\n";
+  const core::CalibrationVec& sigma = f.filter.calibration_sigma;
+  auto s = [&](core::Calibration k) { return num(sigma[static_cast<int>(k)]); };
+  o << "  copper: {r_s_ref_Ohm: " << num(n.copper.value_ref) << ", reference_C: " << num(n.copper.reference_C)
+    << ", coeff_per_K: " << num(n.copper.coeff_per_K) << ", reference_sigma_K: " << s(core::Calibration::kCopperOffset)
+    << ", coeff_rel_sigma: " << s(core::Calibration::kCopperCoefficient) << ", loss_scale: " << num(n.copper_scale)
+    << ", loss_rel_sigma: " << num(f.filter.copper_rel_sigma) << "}\n";
+  const core::DriftLaw& m = f.magnet_law;
+  o << "  magnet_law: {psi_m_ref_Wb: " << num(m.value_ref) << ", reference_C: " << num(m.reference_C)
+    << ", coeff_per_K: " << num(m.coeff_per_K) << ", reference_sigma_K: " << s(core::Calibration::kMagnetOffset)
+    << ", coeff_rel_sigma: " << s(core::Calibration::kMagnetCoefficient) << "}\n";
+  o << "  coolant_C: " << num(f.coolant_C) << "\n";
+  if (f.winding_sensor_sigma_K > 0.0) o << "  winding_sensor: {sigma_K: " << num(f.winding_sensor_sigma_K) << "}\n";
+  o << "  filter: {period_s: " << num(f.observer.period_s) << ", initial_sigma_K: " << num(f.initial_sigma_K)
+    << ", gate_sigma: " << num(f.filter.gate_sigma) << ", gate_reset_after: " << f.filter.gate_reset_after
+    << ", residual_time_constant_s: " << num(f.observer.residual_time_constant_s)
+    << ", settle_time_constants: " << num(f.observer.settle_time_constants) << "}\n";
+  return o.str();
+}
+
+}  // namespace rpem::io

@@ -1,0 +1,386 @@
+// The regime classifier (core/regime.hpp, docs/derivations.md §13): each rule's threshold recomputed here
+// from its derivation and checked from both sides (1 % inside: the first class; 1 % outside: the other),
+// on samples made from the steady-state dq equations of a VESC-class outrunner; the noise and resolution it
+// measures; and seeded runs of locked, steady, noisy data whose exclusions stay within the false rate.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "rpem/core/frames.hpp"
+#include "rpem/core/regime.hpp"
+#include "rpem/core/settings.hpp"
+#include "support/outrunner_machine.hpp"
+#include "support/paper_machine.hpp"
+#include "support/seed.hpp"
+
+namespace rpem::core {
+namespace {
+
+/// The outrunner's classifier configuration with the data's resolution given: noise-free probes then
+/// see σ² = q²/12 exactly (the measured noise of identical samples is zero).
+struct Outrunner {
+  MachineSi machine = test::outrunner_machine_si();
+  EstimatorSettings settings = test::outrunner_settings();
+  PerUnitBase base = test::outrunner_base();
+  MachinePu nominal = to_pu(base, machine);
+  RegimeConfig config() const { return make_regime_config(base, machine, settings); }
+  Outrunner() {
+    settings.regimes.voltage_resolution_V = 0.01;  // VESC Tool writes volts with two decimals
+  }
+};
+
+/// A sample at the machine's steady state for a rotor-frame current, in a frame `delta` ahead of the rotor.
+RegimeInput steady(const MachinePu& plant, double n, const Vec2& i_frame, double delta = 0.0) {
+  const Rotation to_rotor = Rotation::of(delta);
+  const Vec2 i_rotor = inverse_park(i_frame, to_rotor);  // the frame's axes turned back by δ onto the rotor's
+  const Vec2 u_rotor = steady_state_voltage(plant, n, i_rotor);
+  RegimeInput in;
+  in.u_pu = park(u_rotor, to_rotor);
+  in.i_pu = i_frame;
+  in.n_pu = n;
+  in.u_reported_sq_pu = in.u_pu.squaredNorm();
+  in.weight = Vec2::Ones();
+  return in;
+}
+
+/// The classification of `in` after three identical samples 10 ms apart (noise known and zero, slope zero).
+Classification probe(const RegimeConfig& c, RegimeInput in) {
+  RegimeClassifier k(c);
+  Classification out;
+  for (int j = 0; j < 4; ++j) {
+    in.timing = j == 0 ? SampleTiming::kFirst : SampleTiming::kContiguous;
+    in.t_ns = (j + 1) * 10'000'000LL;
+    out = k.step(in);
+  }
+  return out;
+}
+
+TEST(Regime, TheTwoDimensionalBoundHasTheOneDimensionalFalseRate) {
+  // |v|²/σ² of a two-dimensional standard normal is χ²₂, P(χ²₂ > c) = e^{−c/2}: c₂ = −2·ln(erfc(z/√2)).
+  for (double z : {2.0, 3.0, 4.0, 5.0}) {
+    EXPECT_NEAR(std::exp(-0.5 * chi2_bound(z)) / std::erfc(z / std::sqrt(2.0)), 1.0, 1e-12) << z;
+  }
+  EXPECT_NEAR(chi2_bound(4.0), 19.3339, 1e-4);  // −2·ln(6.33425e-5)
+}
+
+TEST(Regime, RegimeOfTheBitsFollowsThePrecedence) {
+  using namespace regime_bit;
+  EXPECT_EQ(regime_of(0), Regime::kUnexcited);
+  EXPECT_EQ(regime_of(kExcitesPsiM | kExcitesRs), Regime::kExcitesBoth);
+  EXPECT_EQ(regime_of(kExcitesRs), Regime::kExcitesRs);
+  EXPECT_EQ(regime_of(kTransient | kExcitesPsiM), Regime::kTransient);
+  EXPECT_EQ(regime_of(kTransient | kNotLocked), Regime::kNotLocked);
+  EXPECT_EQ(regime_of(kBridgeOff | kNotLocked | kTransient), Regime::kBridgeOff);
+  EXPECT_EQ(regime_of(kInvalid | kBridgeOff), Regime::kInvalid);
+  const Classification c = Classification::of(kTransient | kExcitesPsiM);
+  EXPECT_TRUE(c.excluded());
+  EXPECT_FALSE(c.excites_psi_m());  // an excluded sample excites nothing
+  for (std::size_t k = 0; k < kRegimeCount; ++k) EXPECT_EQ(static_cast<std::size_t>(kRegimes[k].regime), k);
+}
+
+TEST(Regime, BridgeOffIsZeroVoltageAndCurrentWhereAModulatingBridgeWouldShortCircuit) {
+  Outrunner s;
+  s.settings.regimes.current_resolution_A = 0.1;
+  const RegimeConfig c = s.config();
+  // Freewheeling at speed: u reported 0, i within the current's noise. The boundary: |i|² = c₂·q_i²/12.
+  const double sigma_i = c.resolution_pu[1] / std::sqrt(12.0);
+  const double edge = std::sqrt(c.chi2) * sigma_i;
+  auto freewheel = [&](double n, double i) {
+    RegimeInput in;
+    in.n_pu = n;
+    in.i_pu = Vec2(0.6, 0.8) * i;
+    in.weight = Vec2::Ones();
+    return probe(c, in).regime;
+  };
+  EXPECT_EQ(freewheel(0.5, 0.99 * edge), Regime::kBridgeOff);
+  EXPECT_NE(freewheel(0.5, 1.01 * edge), Regime::kBridgeOff);
+  EXPECT_NE(freewheel(-0.5, 1.01 * edge), Regime::kBridgeOff);
+  EXPECT_EQ(freewheel(-0.5, 0.0), Regime::kBridgeOff);
+  // At standstill a modulating bridge at zero volts drives no current either: nothing tells them apart.
+  EXPECT_NE(freewheel(0.0, 0.0), Regime::kBridgeOff);
+  // Active short circuit: zero volts, the short-circuit current flows — the bridge modulates.
+  RegimeInput asc = steady(s.nominal, 0.5, steady_state_current(s.nominal, 0.5, Vec2::Zero()));
+  asc.u_pu.setZero();
+  asc.u_reported_sq_pu = 0.0;
+  EXPECT_FALSE(probe(c, asc).bits & regime_bit::kBridgeOff);
+  EXPECT_FALSE(probe(c, asc).excluded());
+}
+
+TEST(Regime, LockIsTheBackEmfsDirectionWithinTheDerivedCone) {
+  Outrunner s;
+  const RegimeConfig c = s.config();
+  const double n = 0.5, current = 0.5;
+  // The outrunner has x_d = x_q: in a frame δ ahead of the rotor e = n·ψm·[sin δ, cos δ] exactly, so the
+  // test |e_d| − tan δ_tol·e_q − B > z·σ turns at sin(δ* − δ_tol) = cos δ_tol·(B + z·σ/cos δ_tol)/(n·ψm), with
+  // B = |n|·Δx·I + tan δ_tol·Δr·I (i = [0, I] in the frame) and σ² = q_u²/12·(1 + tan² δ_tol).
+  const double tan_tol = std::tan(s.settings.regimes.angle_tolerance_rad);
+  const double b = n * c.dx_q_pu * current + tan_tol * c.dr_pu * current;
+  const double sigma_over_cos = c.resolution_pu[0] / std::sqrt(12.0) / std::cos(s.settings.regimes.angle_tolerance_rad);
+  const double edge = s.settings.regimes.angle_tolerance_rad +
+                      std::asin(std::cos(s.settings.regimes.angle_tolerance_rad) * (b + c.z * sigma_over_cos) /
+                                (n * s.nominal.psi_m_pu));
+  const Vec2 i(0.0, current);
+  EXPECT_EQ(probe(c, steady(s.nominal, n, i, edge - 0.002)).regime, Regime::kExcitesPsiM);
+  EXPECT_EQ(probe(c, steady(s.nominal, n, i, edge + 0.002)).regime, Regime::kNotLocked);
+  EXPECT_EQ(probe(c, steady(s.nominal, n, i, -edge - 0.002)).regime, Regime::kNotLocked);
+  EXPECT_GT(edge, s.settings.regimes.angle_tolerance_rad);
+  EXPECT_LT(edge, 0.35);
+  // Reversed (δ = π: the frame turned half a revolution), and an open-loop start-up's 80° lag.
+  EXPECT_EQ(probe(c, steady(s.nominal, n, i, kPi)).regime, Regime::kNotLocked);
+  EXPECT_EQ(probe(c, steady(s.nominal, -n, i, 80.0 * kPi / 180.0)).regime, Regime::kNotLocked);
+  // The magnet's size does not matter: a machine with ψm 30 % off either way is locked.
+  for (double scale : {0.7, 1.3}) {
+    MachinePu plant = s.nominal;
+    plant.psi_m_pu *= scale;
+    EXPECT_FALSE(probe(c, steady(plant, n, i)).excluded()) << scale;
+    EXPECT_FALSE(probe(c, steady(plant, -n, i)).excluded()) << scale;
+  }
+  // r_s anywhere in D_M and inductances within their tolerance: still locked.
+  MachinePu plant = s.nominal;
+  plant.r_s_pu = c.r_min_pu;
+  plant.x_d_pu *= 1.25;
+  plant.x_q_pu *= 0.75;
+  EXPECT_FALSE(probe(c, steady(plant, n, Vec2(-0.3, 0.6))).excluded());
+}
+
+TEST(Regime, PsiMIsExcitedWhereItsTermStandsOutOfTheAveragedNoise) {
+  Outrunner s;
+  const RegimeConfig c = s.config();
+  // i = 0: the term is |n|·ψ_min against N = σ_u = q_u/√12 as a gain γ averages it, h² = γ/(2 − γ).
+  const double gamma = 1e-3;
+  const double h = std::sqrt(gamma / (2.0 - gamma));
+  const double edge = c.z * h * c.resolution_pu[0] / std::sqrt(12.0) / c.psi_min_pu;
+  auto at = [&](double n) {
+    RegimeInput in = steady(s.nominal, n, Vec2::Zero());
+    in.weight = Vec2::Constant(gamma);
+    return probe(c, in).regime;
+  };
+  EXPECT_EQ(at(1.01 * edge), Regime::kExcitesPsiM);
+  EXPECT_EQ(at(0.99 * edge), Regime::kUnexcited);
+  EXPECT_EQ(at(-1.01 * edge), Regime::kExcitesPsiM);
+  EXPECT_GT(edge, 1e-5);
+}
+
+TEST(Regime, RsIsExcitedWhereItsDropStandsOutOfNoiseAndTheFluxsUncertainty) {
+  Outrunner s;
+  const RegimeConfig c = s.config();
+  const double gamma = 1e-3;
+  const double noise = std::sqrt(gamma / (2.0 - gamma)) * c.resolution_pu[0] / std::sqrt(12.0);
+  auto at = [&](double n, double current) {
+    RegimeInput in = steady(s.nominal, n, Vec2(0.0, current));
+    in.weight = Vec2::Constant(gamma);
+    return probe(c, in);
+  };
+  // Standstill: r_min·|i| > z·N.
+  const double still = c.z * noise / c.r_min_pu;
+  EXPECT_TRUE(at(0.0, 1.01 * still).bits & regime_bit::kExcitesRs);
+  EXPECT_FALSE(at(0.0, 0.99 * still).bits & regime_bit::kExcitesRs);
+  // At speed ψm's uncertainty inside D_M and the inductance's tolerance compete:
+  // r_min·|i| − |n|·(Δψ + Δx·|i|) > z·N  ⇔  |i| > (z·N + |n|·Δψ)/(r_min − |n|·Δx).
+  const double n = 2e-3;
+  const double moving = (c.z * noise + n * c.dpsi_pu) / (c.r_min_pu - n * c.dx_q_pu);
+  EXPECT_TRUE(at(n, 1.01 * moving).bits & regime_bit::kExcitesRs);
+  EXPECT_FALSE(at(n, 0.99 * moving).bits & regime_bit::kExcitesRs);
+  EXPECT_FALSE(at(-n, 0.99 * moving).bits & regime_bit::kExcitesRs);
+  EXPECT_GT(moving, 10.0 * still);  // the flux's uncertainty, not the noise, sets it there
+}
+
+/// Contiguous windows of `h` seconds at speed n, the current's q component given at each window's centre by
+/// `iq(t)` and its mean over the window by `mean_iq(t0, t1)`, the voltage the exact window mean of the
+/// machine's equations (§11: ū = M·ī + x·(i(t₁) − i(t₀))/(ω_n·h) + n·J·[ψm, 0]).
+template <typename Current, typename Mean>
+std::vector<Classification> windows(const RegimeConfig& c, const MachinePu& m, double omega_n, double n, double h, int count,
+                                    Current iq, Mean mean_iq) {
+  RegimeClassifier k(c);
+  std::vector<Classification> out;
+  for (int j = 0; j < count; ++j) {
+    const double t0 = j * h, t1 = t0 + h;
+    RegimeInput in;
+    in.timing = j == 0 ? SampleTiming::kFirst : SampleTiming::kContiguous;
+    in.t_ns = std::llround(t1 * 1e9);
+    in.window_s = h;
+    in.i_pu = Vec2(0.0, mean_iq(t0, t1));
+    in.n_pu = n;
+    in.u_pu = steady_state_voltage(m, n, in.i_pu) + Vec2(0.0, m.x_q_pu * (iq(t1) - iq(t0)) / (omega_n * h));
+    in.u_reported_sq_pu = in.u_pu.squaredNorm();
+    out.push_back(k.step(in));
+  }
+  return out;
+}
+
+TEST(Regime, ARampIsTransientOnlyWhereTheInductancesToleranceOnItsCorrectionStandsOut) {
+  Outrunner s;
+  s.settings.regimes.current_resolution_A = 1e-6;  // the ramp's own steps are not a resolution
+  const RegimeConfig c = s.config();
+  // A ramp: the slope between centres is exact, so the rows' error is (Δx/ω_n)·|s| against z·σ_u.
+  const double edge = c.z * (c.resolution_pu[0] / std::sqrt(12.0)) * s.base.omega_el_rad_s / c.dx_q_pu;
+  auto last = [&](double slope) {
+    const auto v = windows(c, s.nominal, s.base.omega_el_rad_s, 0.4, 0.09, 6, [=](double t) { return 0.2 + slope * t; },
+                           [=](double t0, double t1) { return 0.2 + slope * 0.5 * (t0 + t1); });
+    return v.back();
+  };
+  EXPECT_FALSE(last(0.99 * edge).excluded());
+  EXPECT_EQ(last(1.01 * edge).regime, Regime::kTransient);
+  EXPECT_EQ(last(-1.01 * edge).regime, Regime::kTransient);
+}
+
+TEST(Regime, AStepInsideAWindowMakesItAndTheNextTransient) {
+  // The paper's machine (L 95/206 mH): the step's inductive voltage L·ΔI/h is far above the log's
+  // resolution. (The outrunner's 20 µH makes it 6 mV for 28 A in 90 ms, below VESC Tool's 10 mV: there
+  // the speed-current covariance of an acceleration is what shows, RegimeEstimators.*.)
+  Outrunner s;
+  s.machine = test::paper_machine_si();
+  s.settings = test::paper_settings();
+  s.base = test::paper_base();
+  s.nominal = test::paper_machine_pu();
+  s.settings.regimes.voltage_resolution_V = 0.1;
+  s.settings.regimes.current_resolution_A = 0.01;
+  const RegimeConfig c = s.config();
+  const double h = 0.09, step_at = 5 * h + 0.3 * h;  // in window 5, 30 % into it
+  const double i0 = 0.1, i1 = 0.6;
+  const auto iq = [=](double t) { return t < step_at ? i0 : i1; };
+  const auto mean = [=](double t0, double t1) {
+    const double a = std::clamp(step_at, t0, t1);
+    return (i0 * (a - t0) + i1 * (t1 - a)) / (t1 - t0);
+  };
+  const auto v = windows(c, s.nominal, s.base.omega_el_rad_s, 0.4, h, 12, iq, mean);
+  for (int j = 1; j < 5; ++j) EXPECT_FALSE(v[j].excluded()) << j;
+  // The windows whose correction the step falsifies (5: it holds the step; 6: its slope straddles it).
+  EXPECT_EQ(v[5].regime, Regime::kTransient);
+  EXPECT_EQ(v[6].regime, Regime::kTransient);
+  for (int j = 9; j < 12; ++j) EXPECT_FALSE(v[j].excluded()) << j;
+}
+
+TEST(Regime, AStandaloneSampleIsSteadyOnceTheTransientHasDecayedIntoTheNoise) {
+  Outrunner s;
+  s.settings.regimes.current_resolution_A = 0.05;
+  const RegimeConfig c = s.config();
+  // The remnant of the change from the previous sample, e^{−Δt/τ}·|Δi|, against z·σ_i·√(1 + 2·e^{−2Δt/τ}),
+  // τ = max(x)/(ω_n·r_min); the boundary by bisection.
+  const double tau = std::max(s.nominal.x_d_pu, s.nominal.x_q_pu) / (s.base.omega_el_rad_s * c.r_min_pu);
+  EXPECT_NEAR(tau, 20e-6 / 0.0125, 1e-12);
+  const double sigma = c.resolution_pu[1] / std::sqrt(12.0), change = 0.5;
+  auto excess = [&](double dt) {
+    const double d = std::exp(-dt / tau);
+    return d * change - c.z * sigma * std::sqrt(1.0 + 2.0 * d * d);
+  };
+  double lo = 0.0, hi = 100.0 * tau;
+  for (int k = 0; k < 200; ++k) (excess(0.5 * (lo + hi)) > 0.0 ? lo : hi) = 0.5 * (lo + hi);
+  const double edge = 0.5 * (lo + hi);
+  auto after = [&](double dt) {
+    RegimeClassifier k(c);
+    RegimeInput in = steady(s.nominal, 0.3, Vec2(0.0, 0.1));
+    for (int j = 0; j < 3; ++j) {
+      in.timing = j == 0 ? SampleTiming::kFirst : SampleTiming::kContiguous;
+      in.t_ns = (j + 1) * 1'000'000LL;
+      (void)k.step(in);
+    }
+    RegimeInput next = steady(s.nominal, 0.3, Vec2(0.0, 0.1 + change));
+    next.timing = SampleTiming::kStandalone;
+    next.t_ns = in.t_ns + std::llround(dt * 1e9);
+    return k.step(next);
+  };
+  EXPECT_EQ(after(0.99 * edge).regime, Regime::kTransient);
+  EXPECT_FALSE(after(1.01 * edge).excluded());
+  EXPECT_GT(edge, 3.0 * tau);
+}
+
+TEST(Regime, NoiseAndResolutionAreMeasuredFromTheData) {
+  Outrunner s;
+  s.settings.regimes.voltage_resolution_V = 0.0;  // measured
+  const RegimeConfig c = s.config();
+  const std::uint64_t seed = test::test_seed(23);
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> spacing(0.5, 1.5);
+  // Ramps at uneven spacing with white noise of known σ: the normalised second difference removes both.
+  const double su = 2e-3, si = 5e-3, sn = 1e-3;
+  std::normal_distribution<double> nu(0.0, su), ni(0.0, si), nn(0.0, sn);
+  RegimeClassifier k(c);
+  double t = 0.0, mean_u = 0.0, mean_i = 0.0, mean_n = 0.0;
+  int counted = 0;
+  for (int j = 0; j < 40000; ++j) {
+    t += 0.01 * spacing(rng);
+    RegimeInput in;
+    in.timing = j == 0 ? SampleTiming::kFirst : SampleTiming::kContiguous;
+    in.t_ns = std::llround(t * 1e9);
+    in.u_pu = Vec2(0.1 + 0.2 * t + nu(rng), 0.5 - 0.1 * t + nu(rng));
+    in.i_pu = Vec2(-0.1 + ni(rng), 0.3 + 0.05 * t + ni(rng));
+    in.n_pu = 0.5 + 0.01 * t + nn(rng);
+    in.u_reported_sq_pu = in.u_pu.squaredNorm();
+    (void)k.step(in);
+    if (j >= 2000) {
+      const RegimeNoise v = k.current_noise();
+      mean_u += std::sqrt(v.u_sq), mean_i += std::sqrt(v.i_sq), mean_n += std::sqrt(v.n_sq);
+      ++counted;
+    }
+  }
+  std::printf("noise ratios %.4f %.4f %.4f\n", mean_u / counted / su, mean_i / counted / si, mean_n / counted / sn);
+  EXPECT_NEAR(mean_u / counted / su, 1.0, 0.05) << "seed " << seed;
+  EXPECT_NEAR(mean_i / counted / si, 1.0, 0.05) << "seed " << seed;
+  EXPECT_NEAR(mean_n / counted / sn, 1.0, 0.05) << "seed " << seed;
+
+  // Quantised and quiet (noise far below the quantum): the resolution is the quantum, σ² = q²/12.
+  RegimeClassifier q(c);
+  const double quantum = 1e-3;
+  for (int j = 0; j < 500; ++j) {
+    RegimeInput in;
+    in.timing = j == 0 ? SampleTiming::kFirst : SampleTiming::kContiguous;
+    in.t_ns = (j + 1) * 10'000'000LL;
+    const double raw = 0.4 + 0.00037 * j + 1e-6 * nu(rng);
+    in.u_pu = Vec2(quantum * std::round(raw / quantum), quantum * std::round(0.5 * raw / quantum));
+    in.i_pu = Vec2(0.0, 0.2);
+    in.n_pu = 0.4;
+    in.u_reported_sq_pu = in.u_pu.squaredNorm();
+    (void)q.step(in);
+  }
+  EXPECT_NEAR(q.state().measured_resolution_pu[0] / quantum, 1.0, 1e-9);
+  EXPECT_GE(q.current_noise().u_sq, quantum * quantum / 12.0);
+  EXPECT_LT(q.current_noise().u_sq, 2.0 * quantum * quantum / 12.0 + 4.0 * quantum * quantum);
+}
+
+TEST(Regime, LockedSteadyNoisyDataIsExcludedNoMoreOftenThanTheFalseRate) {
+  // Seeded machines inside the configuration's uncertainty (r_s in D_M, ψm in D_M, x within its
+  // tolerance), locked, at random steady operating points, with white noise on u, i and n: every exclusion
+  // is a false one. Each of the rows' tests fires with two-sided rate α = erfc(z/√2) on a known σ; the
+  // median tracker's spread (§13) and the rows' several tests allow a few α — checked here at 4·α per sample.
+  Outrunner s;
+  s.settings.regimes.voltage_resolution_V = 0.0;
+  const RegimeConfig c = s.config();
+  const std::uint64_t seed = test::test_seed(2301);
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  long judged = 0, excluded = 0;
+  for (int run = 0; run < 200; ++run) {
+    MachinePu plant = s.nominal;
+    plant.r_s_pu = c.r_min_pu + (2.0 * c.dr_pu) * unit(rng) * 0.7;
+    plant.psi_m_pu = c.psi_min_pu + (c.psi_max_pu - c.psi_min_pu) * unit(rng);
+    plant.x_d_pu = s.nominal.x_d_pu * (1.0 + 0.3 * (2.0 * unit(rng) - 1.0));
+    plant.x_q_pu = s.nominal.x_q_pu * (1.0 + 0.3 * (2.0 * unit(rng) - 1.0));
+    const double n = 2.0 * unit(rng) - 1.0;
+    const Vec2 i(-0.3 * unit(rng), 2.0 * unit(rng) - 1.0);
+    const double sigma = std::pow(10.0, -4.0 + 2.0 * unit(rng));
+    std::normal_distribution<double> noise(0.0, sigma);
+    RegimeClassifier k(c);
+    const RegimeInput clean = steady(plant, n, i);
+    for (int j = 0; j < 400; ++j) {
+      RegimeInput in = clean;
+      in.timing = j == 0 ? SampleTiming::kFirst : SampleTiming::kContiguous;
+      in.t_ns = (j + 1) * 50'000'000LL;
+      in.window_s = 0.05;
+      in.u_pu += Vec2(noise(rng), noise(rng));
+      in.i_pu += Vec2(noise(rng), noise(rng)) * 0.3;
+      in.n_pu += noise(rng) * 0.1;
+      in.u_reported_sq_pu = in.u_pu.squaredNorm();
+      const Classification r = k.step(in);
+      if (j < 50) continue;  // the noise tracker settling
+      ++judged;
+      excluded += r.excluded() ? 1 : 0;
+    }
+  }
+  const double alpha = std::erfc(c.z / std::sqrt(2.0));
+  EXPECT_LE(static_cast<double>(excluded), 4.0 * alpha * static_cast<double>(judged) + 3.0) << "seed " << seed << ": " << excluded << " of " << judged;
+}
+
+}  // namespace
+}  // namespace rpem::core

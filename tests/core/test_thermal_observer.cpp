@@ -1,0 +1,113 @@
+// What the estimator tells the thermal filter (core/thermal_observer.hpp, docs/derivations.md §13) checked
+// against the real estimator: the averaged estimator run on exact steady-state windows of a machine whose
+// R_s is off the held value — its ψ̂m settles where eq. 13.6's κ says — and on windows with white current
+// noise — the spread of ψ̂m is eq. 13.7's σ²_noise. The samples come from the machine equations directly
+// (tests/support/averaged_data.hpp), not from the estimator's code.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "rpem/core/averaged_estimator.hpp"
+#include "rpem/core/thermal_fusion.hpp"
+#include "support/averaged_data.hpp"
+#include "support/paper_machine.hpp"
+
+namespace rpem::core {
+namespace {
+
+struct ObserverRun {
+  std::vector<ThermalStepData> steps;
+  std::vector<double> psi_m_Wb;  ///< ψ̂m after each sample
+};
+
+/// The paper machine's averaged estimator over `seconds` of 200 Hz windows at 0.8 pu speed and i = (−0.3, 0.9)
+/// pu, the plant at `plant`, the estimator holding r̂s at its initial value; `noise_pu` white on the currents.
+ObserverRun run(const MachinePu& plant, double seconds, double noise_pu, std::uint64_t seed) {
+  const MachineSi machine = test::paper_machine_si();
+  EstimatorSettings settings = test::paper_settings();
+  settings.adapt_r_s = false;
+  AveragedDriveEstimator estimator(machine, settings);
+  test::AveragedDataGenerator gen;
+  gen.base = test::paper_base();
+  gen.plant = plant;
+  gen.jitter = 0.0;
+  gen.n_pu = [](double) { return 0.8; };
+  gen.i_pu = [](double) { return Vec2(-0.3, 0.9); };
+  ThermalObserverConfig oc;
+  oc.period_s = 1.0;
+  oc.residual_time_constant_s = 2.0;
+  ThermalObserver observer(oc, gen.base, machine, loss_base_of(gen.base, machine), 25.0);
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> noise(0.0, noise_pu * gen.base.current_A);
+  ObserverRun out;
+  std::int64_t previous = 0;
+  while (gen.t_s < seconds) {
+    AveragedSample s = gen.next();
+    if (noise_pu > 0.0) s.i_dq_A += Vec2(noise(rng), noise(rng));
+    const Estimate e = estimator.step(s);
+    ThermalSample ts;
+    ts.dt_s = previous ? 1e-9 * static_cast<double>(s.t_ns - previous) : 0.0;
+    previous = s.t_ns;
+    if (observer.add(e, ts)) out.steps.push_back(observer.step());
+    out.psi_m_Wb.push_back(e.psi_m_Wb);
+  }
+  return out;
+}
+
+TEST(ThermalObserver, HeldResistanceBiasesPsiMByKappaTimesItsError) {
+  // The plant 20 % hotter in R_s (held at 2.25 Ω) and 4 % weaker in ψm: ψ̂m settles at ψm + κ·(R − r̂s).
+  const PerUnitBase base = test::paper_base();
+  MachinePu plant = test::paper_machine_pu();
+  plant.r_s_pu *= 1.2;
+  plant.psi_m_pu *= 0.96;
+  const ObserverRun r = run(plant, 30.0, 0.0, 1);
+  const ThermalStepData& last = r.steps.back();
+  const ParameterObservation& p = last.parameter[kPsiM];
+  ASSERT_TRUE(p.valid);
+  EXPECT_FALSE(last.parameter[kRs].valid);  // r̂s does not adapt
+  EXPECT_NEAR(p.other_held, 2.25, 1e-12);
+  const double psi_true = base.flux_Wb_of(plant.psi_m_pu), r_true = base.resistance_Ohm_of(plant.r_s_pu);
+  const double bias = r.psi_m_Wb.back() - psi_true;
+  // The linearised equilibrium of eq. 13.6 against the estimator's own: within 2 % of the bias.
+  EXPECT_GT(std::abs(bias), 1e-3);
+  EXPECT_NEAR(p.cross * (r_true - 2.25), bias, 0.02 * std::abs(bias));
+  // In steady state the q equation says it: κ ≈ i_q/ω (ψ̂ = (u_q − r̂s·i_q)/ω − L_d·i_d), within the d row's share.
+  EXPECT_NEAR(p.cross, 0.9 * base.current_A / (0.8 * base.omega_el_rad_s), 0.1 * std::abs(p.cross));
+}
+
+TEST(ThermalObserver, SpreadOfPsiMUnderWhiteCurrentNoiseIsTheNoiseVariance) {
+  const MachinePu plant = test::paper_machine_pu();  // R_s exact: no held-parameter bias, ε̄ ≈ 0
+  const ObserverRun r = run(plant, 240.0, 0.01, 7);
+  // The estimator's spread after settling (the first 20 s dropped) against the observer's σ²_noise.
+  double mean = 0.0, m2 = 0.0;
+  std::size_t n = 0;
+  for (std::size_t k = r.psi_m_Wb.size() / 12; k < r.psi_m_Wb.size(); ++k, ++n) {
+    const double d = r.psi_m_Wb[k] - mean;
+    mean += d / static_cast<double>(n + 1);
+    m2 += d * (r.psi_m_Wb[k] - mean);
+  }
+  const double empirical = m2 / static_cast<double>(n - 1);
+  double predicted = 0.0;
+  std::size_t used = 0;
+  for (std::size_t k = r.steps.size() / 12; k < r.steps.size(); ++k) {
+    if (!r.steps[k].parameter[kPsiM].valid) continue;
+    predicted += r.steps[k].parameter[kPsiM].variance_noise;
+    ++used;
+  }
+  ASSERT_GT(used, 100u);
+  predicted /= static_cast<double>(used);
+  // ~1500 of the estimator's time constants: the empirical variance is good to about ±10 %; the batch means
+  // keep 2/kBatch of the inductive correction's differenced noise, which adds a few per cent to the prediction.
+  EXPECT_NEAR(empirical / predicted, 1.0, 0.25) << "empirical " << empirical << " predicted " << predicted;
+}
+
+TEST(ThermalObserver, NothingIsAnObservationBeforeTheEstimatorSettles) {
+  const ObserverRun r = run(test::paper_machine_pu(), 3.0, 0.0, 1);
+  ASSERT_FALSE(r.steps.empty());
+  // Σa ≥ 5 over uninterrupted adaptation: with a ≈ γ_L per window the first steps cannot qualify.
+  EXPECT_FALSE(r.steps.front().parameter[kPsiM].valid);
+}
+
+}  // namespace
+}  // namespace rpem::core

@@ -1,0 +1,146 @@
+// The `thermal` section (io/thermal_config.hpp, docs/thermal.md): what the writer writes reads back to the
+// same values; every bad section is refused with file:line:column, the key and the reason; the defaults
+// come from the machine and the materials' table (core/thermal.hpp).
+#include <gtest/gtest.h>
+
+#include <regex>
+
+#include "rpem/io/thermal_config.hpp"
+#include "support/temp_file.hpp"
+
+namespace rpem::io {
+namespace {
+
+const char* kThreeNodes = R"(thermal:
+  nodes:
+    - {name: winding, capacitance_J_per_K: 4200, to_coolant_W_per_K: 3, process_noise_K2_per_s: 0.001, disturbance_W2_per_s: 2}
+    - {name: stator_iron, capacitance_J_per_K: 11000, to_coolant_W_per_K: 95}
+    - {name: magnet, capacitance_J_per_K: 6500, to_coolant_W_per_K: 2.5}
+  conductances:
+    - {from: winding, to: stator_iron, W_per_K: 44}
+    - {from: magnet, to: stator_iron, W_per_K: 13}
+  losses:
+    - {form: iron_hysteresis, node: stator_iron, at_base_W: 210, rel_sigma: 0.3}
+    - {form: magnet_eddy, node: magnet, at_base_W: 35}
+  loss_base: {omega_el_rad_s: 2000, psi_Wb: 0.1, current_A: 150}
+  copper: {r_s_ref_Ohm: 0.07, reference_C: 120, coeff_per_K: 0.0028, reference_sigma_K: 2, coeff_rel_sigma: 0.05, loss_rel_sigma: 0.08}
+  magnet_law: {psi_m_ref_Wb: 0.117, reference_C: 20, coeff_per_K: -0.00105}
+  coolant_C: 35
+  winding_sensor: {sigma_K: 1.5}
+  filter: {period_s: 0.5, initial_sigma_K: 5, gate_sigma: 4, gate_reset_after: 2, residual_time_constant_s: 8, settle_time_constants: 4}
+)";
+
+MachineConfig machine() { return builtin_paper_config(); }
+
+ThermalConfig load_text(const std::string& text) {
+  test::TempFile f("thermal.yaml", text);
+  return load_thermal_config(f.path(), machine());
+}
+
+std::string error_of(const std::string& pattern, const std::string& replacement) {
+  const std::string text = std::regex_replace(std::string(kThreeNodes), std::regex(pattern), replacement,
+                                              std::regex_constants::format_first_only);
+  EXPECT_NE(text, kThreeNodes) << "pattern did not match: " << pattern;
+  try {
+    (void)load_text(text);
+  } catch (const ConfigError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(ThermalConfig, ReadsEveryKeyAndTheWriterReadsBack) {
+  const ThermalConfig c = load_text(kThreeNodes);
+  const core::ThermalNetwork& n = c.fusion.filter.network;
+  ASSERT_EQ(n.nodes, 3);
+  EXPECT_EQ(n.winding, 0);
+  EXPECT_EQ(n.magnet, 2);
+  EXPECT_EQ(c.node_names[1], "stator_iron");
+  EXPECT_DOUBLE_EQ(n.capacitance_J_per_K[1], 11000.0);
+  EXPECT_DOUBLE_EQ(n.between_W_per_K(2, 1), 13.0);
+  EXPECT_DOUBLE_EQ(n.between_W_per_K(0, 2), 0.0);
+  EXPECT_DOUBLE_EQ(n.loss_at_base_W(static_cast<int>(core::LossForm::kIronHysteresis), 1), 210.0);
+  EXPECT_DOUBLE_EQ(c.fusion.filter.loss_rel_sigma(static_cast<int>(core::LossForm::kIronHysteresis), 1), 0.3);
+  EXPECT_DOUBLE_EQ(c.fusion.filter.loss_rel_sigma(static_cast<int>(core::LossForm::kMagnetEddy), 2), 0.5);  // default
+  EXPECT_DOUBLE_EQ(n.copper.reference_C, 120.0);
+  EXPECT_DOUBLE_EQ(c.fusion.filter.copper_rel_sigma, 0.08);
+  EXPECT_DOUBLE_EQ(c.fusion.filter.calibration_sigma[static_cast<int>(core::Calibration::kCopperOffset)], 2.0);
+  EXPECT_DOUBLE_EQ(c.fusion.magnet_law.coeff_per_K, -0.00105);
+  EXPECT_DOUBLE_EQ(c.fusion.winding_sensor_sigma_K, 1.5);
+  EXPECT_DOUBLE_EQ(c.fusion.observer.period_s, 0.5);
+  EXPECT_EQ(c.fusion.filter.gate_reset_after, 2);
+  EXPECT_DOUBLE_EQ(c.fusion.filter.disturbance_W2_per_s[0], 2.0);
+
+  const ThermalConfig back = load_text(thermal_config_yaml(c));
+  const core::ThermalNetwork& m = back.fusion.filter.network;
+  EXPECT_EQ(m.nodes, n.nodes);
+  EXPECT_EQ(back.node_names, c.node_names);
+  EXPECT_EQ(m.capacitance_J_per_K, n.capacitance_J_per_K);
+  EXPECT_EQ(m.to_coolant_W_per_K, n.to_coolant_W_per_K);
+  EXPECT_EQ(m.between_W_per_K, n.between_W_per_K);
+  EXPECT_EQ(m.loss_at_base_W, n.loss_at_base_W);
+  EXPECT_EQ(back.fusion.filter.loss_rel_sigma, c.fusion.filter.loss_rel_sigma);
+  EXPECT_EQ(back.fusion.filter.calibration_sigma, c.fusion.filter.calibration_sigma);
+  EXPECT_EQ(back.fusion.filter.process_noise_K2_per_s, c.fusion.filter.process_noise_K2_per_s);
+  EXPECT_DOUBLE_EQ(m.copper.value_ref, n.copper.value_ref);
+  EXPECT_DOUBLE_EQ(back.fusion.magnet_law.value_ref, c.fusion.magnet_law.value_ref);
+  EXPECT_DOUBLE_EQ(back.fusion.coolant_C, 35.0);
+  EXPECT_DOUBLE_EQ(m.base.current_A, 150.0);
+}
+
+TEST(ThermalConfig, DefaultsComeFromTheMachineAndTheMaterials) {
+  const MachineConfig mc = machine();
+  const ThermalConfig c = default_thermal_config(mc);
+  EXPECT_DOUBLE_EQ(c.fusion.magnet_law.value_ref, mc.machine.psi_m_Wb);
+  EXPECT_DOUBLE_EQ(c.fusion.magnet_law.coeff_per_K, core::kNdFeB.typical_per_K);
+  EXPECT_DOUBLE_EQ(c.fusion.filter.network.copper.value_ref, mc.machine.r_s_Ohm);
+  // σ of α: the material's range as a uniform spread, (max − min)/(√12·|typical|): 12.0 % for NdFeB.
+  EXPECT_NEAR(c.fusion.filter.calibration_sigma[static_cast<int>(core::Calibration::kMagnetCoefficient)],
+              0.0005 / (std::sqrt(12.0) * 0.0012), 1e-12);
+  const core::PerUnitBase base = core::PerUnitBase::from_rated(mc.machine.rated);
+  EXPECT_DOUBLE_EQ(c.fusion.filter.network.base.omega_el_rad_s, base.omega_el_rad_s);
+  EXPECT_DOUBLE_EQ(c.fusion.filter.network.base.current_A, base.current_A);
+}
+
+TEST(ThermalConfig, BadSectionsNameFileLineKeyAndReason) {
+  EXPECT_NE(error_of("name: magnet", "name: rotor").find("a node named 'magnet' is required"), std::string::npos);
+  EXPECT_NE(error_of("name: stator_iron", "name: winding").find(":4:14: thermal.nodes[1].name: node 'winding' appears twice"),
+            std::string::npos)
+      << error_of("name: stator_iron", "name: winding");
+  EXPECT_NE(error_of("form: magnet_eddy", "form: magnet_hysteresis")
+                .find("unknown loss form 'magnet_hysteresis' (one of iron_hysteresis, iron_eddy, magnet_eddy)"),
+            std::string::npos);
+  EXPECT_NE(error_of("to: stator_iron, W_per_K: 44", "to: rotor, W_per_K: 44").find("no node named 'rotor'"), std::string::npos);
+  EXPECT_NE(error_of("from: magnet, to: stator_iron", "from: winding, to: stator_iron").find("is given twice"), std::string::npos);
+  // The magnet without a conductance of its own to the coolant still reaches it through the stator iron.
+  EXPECT_EQ(error_of("capacitance_J_per_K: 6500, to_coolant_W_per_K: 2.5", "capacitance_J_per_K: 6500, to_coolant_W_per_K: 0"), "");
+  EXPECT_NE(error_of("capacitance_J_per_K: 6500, to_coolant_W_per_K: 2.5", "capacitance_J_per_K: -1")
+                .find("thermal.nodes[2].capacitance_J_per_K: -1 is outside"),
+            std::string::npos);
+  EXPECT_NE(error_of("coolant_C: 35", "coolant_C: 35\n  coolnat: 3").find("thermal.coolnat"), std::string::npos);
+  EXPECT_NE(error_of("coeff_per_K: -0.00105", "coeff_per_K: 0.00105").find("thermal.magnet_law.coeff_per_K"),
+            std::string::npos);
+  // A magnet cut off from everything: no steady state.
+  const std::string cut = std::regex_replace(
+      std::regex_replace(std::string(kThreeNodes), std::regex("    - \\{from: magnet, to: stator_iron, W_per_K: 13\\}\n"), ""),
+      std::regex("to_coolant_W_per_K: 2.5"), "to_coolant_W_per_K: 0");
+  try {
+    (void)load_text(cut);
+    ADD_FAILURE() << "accepted a node without a path to the coolant";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("node 'magnet' has no path of conductances to the coolant"), std::string::npos) << e.what();
+  }
+}
+
+TEST(ThermalConfig, AFitsStartMayGiveTheLawsOnly) {
+  test::TempFile f("laws.yaml", "thermal:\n  copper: {r_s_ref_Ohm: 0.0758, reference_C: 120}\n");
+  const ThermalConfig c = load_thermal_config(f.path(), machine(), NetworkRequired::kNo);
+  EXPECT_FALSE(c.has_network);
+  EXPECT_DOUBLE_EQ(c.fusion.filter.network.copper.reference_C, 120.0);
+  EXPECT_THROW((void)load_thermal_config(f.path(), machine()), ConfigError);  // rpemd needs the network
+  test::TempFile g("bad.yaml", "thermal:\n  losses: []\n");
+  EXPECT_THROW((void)load_thermal_config(g.path(), machine(), NetworkRequired::kNo), ConfigError);
+}
+
+}  // namespace
+}  // namespace rpem::io

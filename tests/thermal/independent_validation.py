@@ -1,0 +1,158 @@
+#!/usr/bin/env python3
+"""Issue 24's second validation (docs/thermal.md, "Validation on the independent plant"): the independent
+three-node thermal plant (tests/independent_thermal/, its forms not ours, written without reading ours) with
+rpem's two-node network fitted on the first part of each log and the rest judged against the plant's true
+winding and magnet (rotor) temperatures — the fused estimate without the winding sensor in the judged part and
+with it, beside the model alone and RPEM alone. The temperature laws the tools are given are the plant's own
+coefficients (its parameters JSON: copper.alpha20_per_K, magnet.alpha20_per_K, referred to the references the
+machine's values hold at), as a commissioning measurement would give them; nothing else of the truth.
+
+Cases (one per ctest, --case):
+  profile_a     Paderborn profile A's operating points, constant coolant at 19.5 °C, the configuration's R_s and
+                ψm referred to 119 °C and 112 °C as on the bench; fitted on t <= 4400 s (the heat-up).
+  drive_cycle   a seeded two-hour drive cycle, the coolant loop heating with the load; fitted on t <= 5400 s.
+  no_coolant    the drive cycle without its T_coolant column: the stated failure mode (a constant coolant is
+                assumed; the fit says so, and the model is worse for it).
+
+  independent_validation.py --case NAME --rpem BIN --plant BIN --source-dir DIR --work DIR [--json OUT.json]
+
+Prints the table and asserts the bounds below (two-sided where the acceptance is not met: the figures measured)."""
+import argparse
+import csv
+import json
+import os
+import sys
+
+from thermal_judge import Bounds, judge, print_table, read, run
+
+PROFILE = "tests/independent_thermal/profiles/paderborn_profile_a_like.csv"
+CASES = {
+    "profile_a": {"split_s": 4400.0,
+                  "plant": ["--profile", PROFILE, "--coolant", "constant", "--set", "coolant.start_C=19.5",
+                            "--set", "electrical.r_s_reference_C=119", "--set", "electrical.psi_m_reference_C=112",
+                            "--duration-s", "7505", "--rate-Hz", "2", "--seed", "1"]},
+    "drive_cycle": {"split_s": 5400.0, "plant": ["--duration-s", "7200", "--rate-Hz", "2", "--seed", "7"]},
+    "no_coolant": {"split_s": 5400.0, "plant": ["--duration-s", "7200", "--rate-Hz", "2", "--seed", "7", "--no-coolant"]},
+}
+
+
+def without_winding_after(src, dst, split_s):
+    """The log with T_winding 'nan' (not reported) after split_s: nothing of the judged winding reaches the filter."""
+    with open(src, newline="") as f:
+        rows = list(csv.reader(f))
+    header = rows[0]
+    t, w = header.index("t"), header.index("T_winding")
+    with open(dst, "w", newline="") as f:
+        out = csv.writer(f)
+        out.writerow(header)
+        for r in rows[1:]:
+            if float(r[t]) > split_s:
+                r[w] = "nan"
+            out.writerow(r)
+
+
+def referred(alpha20, reference_C):
+    """A linear law's coefficient per K referred from 20 °C to reference_C (the same line)."""
+    return alpha20 / (1.0 + alpha20 * (reference_C - 20.0))
+
+
+def start_yaml(parameters, path):
+    """The laws of the plant's materials about the references its R_s and ψm are given at (no network)."""
+    p = parameters
+    rc, mc = p["electrical.r_s_reference_C"], p["electrical.psi_m_reference_C"]
+    with open(path, "w") as f:
+        f.write("# the plant's material coefficients (its parameters JSON), referred to its references\nthermal:\n")
+        f.write(f"  copper: {{r_s_ref_Ohm: {p['electrical.r_s_ref_Ohm']!r}, reference_C: {rc!r}, "
+                f"coeff_per_K: {referred(p['copper.alpha20_per_K'], rc)!r}}}\n")
+        f.write(f"  magnet_law: {{psi_m_ref_Wb: {p['electrical.psi_m_ref_Wb']!r}, reference_C: {mc!r}, "
+                f"coeff_per_K: {referred(p['magnet.alpha20_per_K'], mc)!r}}}\n")
+
+
+def validate(a, case):
+    c = CASES[case]
+    split = c["split_s"]
+    w = lambda name: os.path.join(a.work, f"{case}_{name}")
+    cfg = os.path.join(a.source_dir, "config/paderborn-pmsm.yaml")
+    plant = [x if not x.startswith("tests/") else os.path.join(a.source_dir, x) for x in c["plant"]]
+    run([a.plant, "--config", cfg, "--averaged", "--out", w("log.csv"), "--truth", w("truth.csv"),
+         "--parameters", w("plant.json")] + plant)
+    parameters = json.load(open(w("plant.json")))["parameters"]
+    start_yaml(parameters, w("start.yaml"))
+    without_winding_after(w("log.csv"), w("honest.csv"), split)
+    fit_out = run([a.rpem, "thermal", "fit", "--log", w("log.csv"), "--config", cfg, "--start", w("start.yaml"),
+                   "--fit-until-s", str(split), "--out", w("thermal.yaml"), "--report", w("fit")])
+    run([a.rpem, "estimate", "--log", w("honest.csv"), "--config", cfg, "--thermal", w("thermal.yaml"), "--out", w("honest_est.csv")])
+    run([a.rpem, "estimate", "--log", w("log.csv"), "--config", cfg, "--thermal", w("thermal.yaml"), "--out", w("full_est.csv")])
+    truth = read(w("truth.csv"))
+    estimates = {"fused": read(w("honest_est.csv")), "fused_with_sensor": read(w("full_est.csv"))}
+    result = {node: judge(truth, f"T_{node}", estimates, read(w("fit/predictions.csv")), node, split)
+              for node in ("magnet", "winding")}
+    print_table(f"{case}: t > {split:g} s against the plant's true temperatures", result,
+                ("model", "rpem", "fused", "fused_with_sensor"))
+    result["plant"] = parameters
+    result["fit_said_coolant_constant"] = "has no T_coolant column" in fit_out
+    return result
+
+
+def check(case, r, b):
+    m, wd = r["magnet"], r["winding"]
+    if case == "no_coolant":
+        b.check("no coolant column: the fit states the constant coolant", 1.0 if r["fit_said_coolant_constant"] else 0.0, 1.0, 1.0)
+        b.check(f"no coolant column: winding model alone RMS [K] (measured {MEASURED[case]['wm']})", wd["model"]["rms_K"],
+                *around(MEASURED[case]["wm"]))
+        return
+    expect = MEASURED[case]
+    for node, s in (("magnet", m), ("winding", wd)):
+        for what, key, bound in (("RMS", "rms_K", 3.0), ("worst", "worst_K", 6.0)):
+            v = s["fused"][key]
+            measured = expect[f"{node[0]}_{key}"]
+            if measured <= bound:
+                b.check(f"{node} fused {what} (acceptance <= {bound} K; measured {measured})", v, 0.0, bound)
+            else:
+                b.check(f"{node} fused {what} [K] (acceptance {bound}, not met; measured {measured})", v, *around(measured))
+        cover = expect[f"{node[0]}_cover"]
+        if cover >= 0.9:
+            b.check(f"{node} fused 2σ coverage (acceptance >= 0.9; measured {cover})", s["fused"]["cover_2sigma"], 0.9, 1.0)
+        else:
+            b.check(f"{node} fused 2σ coverage (acceptance 0.9, not met; measured {cover})", s["fused"]["cover_2sigma"],
+                    cover - 0.1, min(1.0, cover + 0.1))
+
+
+def around(v):
+    """A two-sided band about a measured figure: ±30 % and at least ±0.5 K."""
+    d = max(0.5, 0.3 * abs(v))
+    return (max(0.0, v - d), v + d)
+
+
+# The figures measured (docs/thermal.md, "Validation on the independent plant"), asserted two-sided where the
+# acceptance is not met so that a change either way is seen.
+MEASURED = {
+    # profile_a's winding since the regimes merge: 9.10 K RMS, 10.6 K worst, cover 0.967 (on the thermal branch
+    # alone 4.73, 9.63, 0.984): 3 of 15 011 windows now excite R_s (docs/thermal.md, "Since the regimes merge").
+    "profile_a": {"m_rms_K": 0.94, "m_worst_K": 1.55, "w_rms_K": 9.10, "w_worst_K": 10.61, "m_cover": 1.0, "w_cover": 0.967},
+    "drive_cycle": {"m_rms_K": 5.39, "m_worst_K": 13.48, "w_rms_K": 7.17, "w_worst_K": 20.89, "m_cover": 1.0, "w_cover": 1.0},
+    "no_coolant": {"wm": 5.64},  # the drive cycle's with its coolant column: 3.59
+}
+
+
+def main() -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--case", required=True, choices=sorted(CASES))
+    ap.add_argument("--rpem", required=True)
+    ap.add_argument("--plant", required=True)
+    ap.add_argument("--source-dir", required=True)
+    ap.add_argument("--work", required=True)
+    ap.add_argument("--json")
+    a = ap.parse_args()
+    os.makedirs(a.work, exist_ok=True)
+    r = validate(a, a.case)
+    if a.json:
+        with open(a.json, "w") as f:
+            json.dump(r, f, indent=2)
+    b = Bounds()
+    check(a.case, r, b)
+    return b.exit_code()
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,108 @@
+// rpem thermal fit --log LOG.csv --config CFG.yaml --out thermal.yaml [--start THERMAL.yaml | --nodes 2|3]
+//                  [--fit-until-s S] [--winding-sensor-sigma-K K] [--period-s S] [--report DIR]
+// Fits the machine's thermal network to what a log shows of its temperatures — a winding sensor, the
+// coolant, the magnet temperature from ψ̂m and the winding's from r̂s (the estimator run over the log) —
+// and writes the `thermal` section rpemd and `rpem estimate --thermal` read (docs/thermal.md). A magnet
+// sensor in the log (T_magnet) is never used.
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <limits>
+
+#include "commands.hpp"
+#include "rpem/analysis/thermal/thermal_fit.hpp"
+#include "rpem/analysis/thermal/thermal_report.hpp"
+#include "rpem/io/errors.hpp"
+#include "rpem/io/thermal_config.hpp"
+
+namespace rpem::tools {
+namespace {
+
+struct ThermalFitCliOptions {
+  std::string log, config, out, start, report;
+  int nodes = 2;
+  double fit_until_s = std::numeric_limits<double>::quiet_NaN();
+  double winding_sensor_sigma_K = 1.0;
+  double period_s = 0.0;
+  bool keep_magnet_reference = false;
+};
+
+int run_thermal_fit(const ThermalFitCliOptions& o) {
+  const io::MachineConfig machine = o.config.empty() ? io::builtin_paper_config() : io::load_machine_config(o.config);
+  const std::string config_name = o.config.empty() ? "builtin:paper-ipmsm" : o.config;
+  io::ThermalConfig laws = o.start.empty() ? io::default_thermal_config(machine)
+                                           : io::load_thermal_config(o.start, machine, io::NetworkRequired::kNo);
+  if (o.period_s > 0.0) laws.fusion.observer.period_s = o.period_s;
+  std::fprintf(stderr, "rpem thermal fit: running the estimator over %s\n", o.log.c_str());
+  const analysis::ThermalRecord record = analysis::record_thermal(o.log, machine, laws);
+  if (record.winding_sensor && laws.fusion.winding_sensor_sigma_K <= 0.0) laws.fusion.winding_sensor_sigma_K = o.winding_sensor_sigma_K;
+  if (!record.coolant) {
+    std::fprintf(stderr,
+                 "rpem thermal fit: %s has no T_coolant column: the coolant is taken as %.4g °C throughout "
+                 "(thermal.coolant_C); a coolant that moves shows as a model error (docs/thermal.md)\n",
+                 o.log.c_str(), laws.fusion.coolant_C);
+  }
+  const io::ThermalConfig start = laws.has_network ? laws : analysis::default_topology(laws, record, o.nodes);
+  analysis::ThermalFitOptions options;
+  options.fit_until_s = o.fit_until_s;
+  options.anchor_magnet_reference = !o.keep_magnet_reference;
+  std::fprintf(stderr, "rpem thermal fit: %zu steps of %.3g s; fitting a %d-node network\n", record.steps.size(),
+               start.fusion.observer.period_s, start.fusion.filter.network.nodes);
+  const analysis::ThermalFitResult fit = analysis::fit_thermal(record, start, options);
+
+  analysis::write_thermal_yaml(o.out, fit, record, config_name);
+  if (!o.report.empty()) {
+    std::error_code ec;
+    std::filesystem::create_directories(o.report, ec);
+    if (ec) throw io::InputError(o.report, 0, 0, "", "cannot create directory: " + ec.message());
+    analysis::write_thermal_fit_json(o.report + "/fit.json", fit, record, config_name);
+    analysis::write_thermal_fit_report(o.report + "/report.md", fit, record, config_name);
+    analysis::write_thermal_predictions(o.report + "/predictions.csv", fit, record);
+  }
+  for (const analysis::SignalFit& s : fit.signals) {
+    std::printf("%s: fit %.3g K RMS, held out %.3g K RMS (worst %.3g K)\n", s.name.c_str(), s.fit_rms_K, s.heldout_rms_K,
+                s.heldout_worst_K);
+  }
+  for (const analysis::FittedParameter& p : fit.parameters) {
+    if (p.half_width_rel <= 10.0) {
+      std::printf("%s = %.5g %s (±%.3g %%%s)\n", p.name.c_str(), p.value, p.unit.c_str(), 100.0 * p.half_width_rel,
+                  p.identified ? "" : ", not identified");
+    } else {
+      std::printf("%s = %.5g %s (not identified: the log does not bound it)\n", p.name.c_str(), p.value, p.unit.c_str());
+    }
+  }
+  for (const std::string& s : fit.not_identifiable) std::printf("not identifiable together: %s\n", s.c_str());
+  for (const std::string& s : fit.notes) std::printf("note: %s\n", s.c_str());
+  std::printf("process noise %.3g K^2/s, disturbance drift %.3g W^2/s; wrote %s\n", fit.process_noise_K2_per_s,
+              fit.disturbance_W2_per_s, o.out.c_str());
+  return kExitOk;
+}
+
+}  // namespace
+
+Runner add_thermal_command(CLI::App& app) {
+  auto opts = std::make_shared<ThermalFitCliOptions>();
+  CLI::App* cmd = app.add_subcommand("thermal", "The machine's thermal network (docs/thermal.md)");
+  cmd->require_subcommand(1);
+  CLI::App* fit = cmd->add_subcommand("fit", "Fit the thermal network to a log and write thermal.yaml");
+  fit->add_option("--log", opts->log, "drive log, phase samples or averaged (docs/drive-log.md)")->required()->check(CLI::ExistingFile);
+  fit->add_option("--config", opts->config, "machine and estimator YAML (default: built-in paper-ipmsm.yaml)")
+      ->check(CLI::ExistingFile);
+  fit->add_option("--out", opts->out, "thermal.yaml to write")->required();
+  fit->add_option("--start", opts->start,
+                  "thermal section to start from: its laws, filter settings and, if it has `nodes`, its network (topology and values)")
+      ->check(CLI::ExistingFile);
+  fit->add_option("--nodes", opts->nodes, "without a network to start from: 2 (winding, magnet) or 3 (winding, stator_iron, magnet)")
+      ->check(CLI::IsMember({2, 3}));
+  fit->add_option("--fit-until-s", opts->fit_until_s, "train on the log up to this time, judge the rest (default: 75 %)");
+  fit->add_option("--winding-sensor-sigma-K", opts->winding_sensor_sigma_K, "σ of the log's winding sensor (default 1 K)")
+      ->check(CLI::Range(1e-3, 100.0));
+  fit->add_option("--period-s", opts->period_s, "the filter's step (default: thermal.yaml's, 1 s)")->check(CLI::Range(1e-3, 3600.0));
+  fit->add_flag("--keep-magnet-reference", opts->keep_magnet_reference,
+                "keep the magnet law's psi_m_ref as given (--start or the machine's) instead of anchoring it at the soaked start");
+  fit->add_option("--report", opts->report, "directory for report.md, fit.json and predictions.csv");
+  return [fit, opts]() { return fit->parsed() ? run_thermal_fit(*opts) : -1; };
+}
+
+}  // namespace rpem::tools
