@@ -83,7 +83,7 @@ TEST(CliEstimate, RateWritesOneEstimatePerPeriodOfTheLogsTime) {
     std::int64_t t_ns = 0;
     for (int k = 0; k < 16000; ++k) {
       if (k == 8000) t_ns += 250'000'000;
-      w.write({gen.next_si(base, t_ns), {}, {}, {}});
+      w.write({gen.next_si(base, t_ns), {}, {}, {}, {}});
     }
   }
   const std::string rpem = test::binary_dir() + "/tools/rpem estimate --log " + log.path() + " --out " + est.path();
