@@ -23,6 +23,7 @@
 #include "rpem/core/regime.hpp"
 #include "rpem/core/settings.hpp"
 #include "support/averaged_data.hpp"
+#include "bench_support.hpp"
 #include "support/model_data.hpp"
 #include "support/paper_machine.hpp"
 #include "support/sga_kernel.hpp"
@@ -34,20 +35,7 @@ using namespace rpem;
 constexpr int kSamples = 8192;
 
 const std::vector<core::DriveSample>& samples() {
-  static const std::vector<core::DriveSample> s = [] {
-    const core::PerUnitBase base = test::paper_base();
-    test::ModelDataGenerator gen;
-    gen.plant = test::paper_machine_pu();
-    gen.plant.psi_m_pu *= 0.95;
-    gen.omega_n_rad_s = base.omega_el_rad_s;
-    gen.n_pu = 0.4;
-    gen.i_ref_pu = core::mtpa_reference(gen.plant, 0.4);
-    gen.current_noise_pu = 0.002;
-    std::vector<core::DriveSample> v;
-    std::int64_t t_ns = 0;
-    for (int k = 0; k < kSamples; ++k) v.push_back(gen.next_si(base, t_ns));
-    return v;
-  }();
+  static const std::vector<core::DriveSample> s = bench::paper_drive_samples(kSamples);
   return s;
 }
 
@@ -100,13 +88,8 @@ class KernelReplay {
   std::size_t k_ = 1;
 };
 
-double thread_cpu_s() {
-  timespec ts{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-  return static_cast<double>(ts.tv_sec) + rpem::core::to_seconds(ts.tv_nsec);
-}
-
-double max_of(const std::vector<double>& v) { return *std::max_element(v.begin(), v.end()); }
+using bench::max_of;
+using bench::thread_cpu_s;
 
 void BM_EstimatorStep(benchmark::State& state) {
   const auto algorithm = static_cast<core::Algorithm>(state.range(0));

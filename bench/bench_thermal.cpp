@@ -5,19 +5,25 @@
 //   BM_FusionPerSample     ThermalFusion::step per estimator sample, the filter's step (1 s) included
 //                          amortised: what the loop pays per sample on average
 //   BM_FilterStep          one filter step: exact network step (matrix exponential), covariance prediction,
-//                          both parameter observations and a winding sensor (ThermalFusion::apply)
+//                          both parameter observations and a winding sensor (ThermalFusion::apply), timed as
+//                          a batch of kRecordedSteps prepared steps on this thread's CPU clock: what a step
+//                          costs, without the harness's per-step timer reads
+//   BM_FilterStepPaused    the same steps one at a time between PauseTiming/ResumeTiming (how this file first
+//                          measured it), and BM_PauseResumePair an empty pair: the harness's share of that
 //   BM_SampleWithFusion    the estimator's step alone and with the fusion after it, alternating blocks on the
 //                          same samples, each timed on this thread's CPU clock: both and their ratio, one run
 
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
+#include <cmath>
 #include <ctime>
 #include <vector>
 
 #include "rpem/core/clock.hpp"
 #include "rpem/core/drive_estimator.hpp"
 #include "rpem/core/thermal_fusion.hpp"
+#include "bench_support.hpp"
 #include "support/model_data.hpp"
 #include "support/paper_machine.hpp"
 #include "support/paper_thermal.hpp"
@@ -30,20 +36,7 @@ constexpr int kSamples = 8 * 8000;  // 8 s at 8 kHz: eight filter steps per pass
 constexpr double kPeriod_s = 125e-6;
 
 const std::vector<core::DriveSample>& samples() {
-  static const std::vector<core::DriveSample> s = [] {
-    const core::PerUnitBase base = test::paper_base();
-    test::ModelDataGenerator gen;
-    gen.plant = test::paper_machine_pu();
-    gen.plant.psi_m_pu *= 0.95;
-    gen.omega_n_rad_s = base.omega_el_rad_s;
-    gen.n_pu = 0.4;
-    gen.i_ref_pu = core::mtpa_reference(gen.plant, 0.4);
-    gen.current_noise_pu = 0.002;
-    std::vector<core::DriveSample> v;
-    std::int64_t t_ns = 0;
-    for (int k = 0; k < kSamples; ++k) v.push_back(gen.next_si(base, t_ns));
-    return v;
-  }();
+  static const std::vector<core::DriveSample> s = bench::paper_drive_samples(kSamples);
   return s;
 }
 
@@ -66,13 +59,8 @@ core::ThermalFusionConfig loop_config() {
   return c;
 }
 
-double thread_cpu_s() {
-  timespec ts{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-  return static_cast<double>(ts.tv_sec) + core::to_seconds(ts.tv_nsec);
-}
-
-double max_of(const std::vector<double>& v) { return *std::max_element(v.begin(), v.end()); }
+using bench::max_of;
+using bench::thread_cpu_s;
 
 core::ThermalSample sample() {
   core::ThermalSample s;
@@ -95,32 +83,82 @@ void BM_FusionPerSample(benchmark::State& state) {
   state.SetItemsProcessed(state.iterations());
 }
 
-void BM_FilterStep(benchmark::State& state) {
-  core::ThermalFusion fusion(loop_config(), test::paper_base(), test::paper_machine_si());
+/// One step's data as the loop gives it: the 1 s means of a load that moves a little (the current's mean never
+/// repeats, so the network's exponential is new at every step), ψ̂m and r̂s each an observation at the filter's
+/// own prediction (accepted: inside the gate) and a winding sensor.
+core::ThermalStepData step_data(const core::ThermalEstimate& out, std::int64_t k) {
   core::ThermalStepData d;
+  d.t_ns = (k + 1) * 1'000'000'000;
   d.load.dt_s = 1.0;
-  d.load.current_sq_A2 = 30.0;
+  d.load.current_sq_A2 = 30.0 * (1.0 + 0.05 * std::sin(0.37 * static_cast<double>(k)));
   d.load.basis = {0.4, 0.16, 0.1};
   d.load.coolant_C = 40.0;
-  const core::ThermalEstimate& out = fusion.estimate();
-  std::int64_t t_ns = 0;
+  const double t_m = out.started ? out.magnet_node().t_C : 40.0, t_w = out.started ? out.winding_node().t_C : 40.0;
+  d.parameter[static_cast<std::size_t>(core::kPsiM)] = {true, 1.14 * (1.0 - 0.0012 * (t_m - 20.0)), 0.0, 2.25, 1e-6, 1e-6, 2.0};
+  d.parameter[static_cast<std::size_t>(core::kRs)] = {true, 2.25 * (1.0 + 0.00393 * (t_w - 20.0)), 0.0, 1.14, 1e-4, 1e-4, 2.0};
+  d.winding_sensor_C = t_w;
+  d.psi_m_Wb = d.parameter[static_cast<std::size_t>(core::kPsiM)].value;
+  d.r_s_Ohm = d.parameter[static_cast<std::size_t>(core::kRs)].value;
+  return d;
+}
+
+constexpr int kRecordedSteps = 1000;  // 1000 s of filter steps: the network heats most of the way
+
+/// kRecordedSteps steps recorded from a filter run once, replayed identically by every batch.
+const std::vector<core::ThermalStepData>& recorded_steps() {
+  static const std::vector<core::ThermalStepData> v = [] {
+    core::ThermalFusion fusion(loop_config(), test::paper_base(), test::paper_machine_si());
+    std::vector<core::ThermalStepData> steps;
+    for (int k = 0; k < kRecordedSteps; ++k) {
+      steps.push_back(step_data(fusion.estimate(), k));
+      fusion.apply(steps.back());
+    }
+    return steps;
+  }();
+  return v;
+}
+
+void BM_FilterStep(benchmark::State& state) {
+  const std::vector<core::ThermalStepData>& steps = recorded_steps();
+  const core::ThermalFusion initial(loop_config(), test::paper_base(), test::paper_machine_si());
+  core::ThermalFusion fusion = initial;
+  double cpu_s = 0.0;
+  for (auto _ : state) {
+    fusion = initial;
+    const double t0 = thread_cpu_s();
+    for (const core::ThermalStepData& d : steps) {
+      fusion.apply(d);
+      benchmark::DoNotOptimize(fusion.estimate());
+    }
+    cpu_s += thread_cpu_s() - t0;
+  }
+  state.counters["step_ns"] = 1e9 * cpu_s / (static_cast<double>(state.iterations()) * kRecordedSteps);
+  state.counters["accepted"] = static_cast<double>(fusion.estimate().observations_accepted);
+  state.counters["rejected"] = static_cast<double>(fusion.estimate().observations_rejected);
+}
+
+void BM_FilterStepPaused(benchmark::State& state) {
+  const std::vector<core::ThermalStepData>& steps = recorded_steps();
+  const core::ThermalFusion initial(loop_config(), test::paper_base(), test::paper_machine_si());
+  core::ThermalFusion fusion = initial;
+  std::size_t k = 0;
   for (auto _ : state) {
     state.PauseTiming();
-    t_ns += 1'000'000'000;
-    d.t_ns = t_ns;
-    // ψ̂m and r̂s each an observation at the filter's own prediction (accepted: inside the gate).
-    const double t_m = out.started ? out.magnet_node().t_C : 40.0, t_w = out.started ? out.winding_node().t_C : 40.0;
-    d.parameter[static_cast<std::size_t>(core::kPsiM)] = {true, 1.14 * (1.0 - 0.0012 * (t_m - 20.0)), 0.0, 2.25, 1e-6, 1e-6, 2.0};
-    d.parameter[static_cast<std::size_t>(core::kRs)] = {true, 2.25 * (1.0 + 0.00393 * (t_w - 20.0)), 0.0, 1.14, 1e-4, 1e-4, 2.0};
-    d.winding_sensor_C = t_w;
-    d.psi_m_Wb = d.parameter[static_cast<std::size_t>(core::kPsiM)].value;
-    d.r_s_Ohm = d.parameter[static_cast<std::size_t>(core::kRs)].value;
+    if (k == steps.size()) {
+      fusion = initial;
+      k = 0;
+    }
     state.ResumeTiming();
-    fusion.apply(d);
+    fusion.apply(steps[k++]);
     benchmark::DoNotOptimize(fusion.estimate());
   }
-  state.counters["accepted"] = static_cast<double>(out.observations_accepted);
-  state.counters["rejected"] = static_cast<double>(out.observations_rejected);
+}
+
+void BM_PauseResumePair(benchmark::State& state) {
+  for (auto _ : state) {
+    state.PauseTiming();
+    state.ResumeTiming();
+  }
 }
 
 void BM_SampleWithFusion(benchmark::State& state) {
@@ -165,6 +203,8 @@ void BM_SampleWithFusion(benchmark::State& state) {
 
 BENCHMARK(BM_FusionPerSample)->Repetitions(10)->ComputeStatistics("max", max_of)->ReportAggregatesOnly(true);
 BENCHMARK(BM_FilterStep)->Repetitions(10)->ComputeStatistics("max", max_of)->ReportAggregatesOnly(true);
+BENCHMARK(BM_FilterStepPaused)->Repetitions(10)->ComputeStatistics("max", max_of)->ReportAggregatesOnly(true);
+BENCHMARK(BM_PauseResumePair)->Repetitions(10)->ComputeStatistics("max", max_of)->ReportAggregatesOnly(true);
 BENCHMARK(BM_SampleWithFusion)->MinTime(1.0)->Repetitions(10)->ComputeStatistics("max", max_of)->ReportAggregatesOnly(true);
 
 }  // namespace

@@ -138,6 +138,9 @@ Estimate AveragedDriveEstimator::step(const AveragedSample& sample) noexcept {
   in.u_reported_sq_pu = sample.u_dq_V.squaredNorm() / (base_.voltage_V * base_.voltage_V);
   in.weight = gains.gain;
   const Classification regime = classifier_.step(in);
+  // A release inside the previous window (§13, "Mixed windows"): what it adapted is undone.
+  if (regime.bits & regime_bit::kPreviousMixed) core_.retract(before_previous_);
+  before_previous_ = core_.adaptation();
   if (options_.inductive_correction && timing_ == SampleTiming::kContiguous) {
     // (x/ω_n)·di/dt with di/dt from the means of consecutive windows, between their centres (§11).
     const Vec2& di_dt = classifier_.slope_pu_s();
@@ -170,11 +173,13 @@ void AveragedDriveEstimator::reset() noexcept {
   has_previous_ = false;
   core_.reset();
   classifier_.reset();
+  before_previous_ = core_.adaptation();
   point_gains_.start(rates_per_s_[static_cast<std::size_t>(core_.config().algorithm)], core_.config().nominal_sample_period_s);
 }
 
 void AveragedDriveEstimator::set_estimates(double psi_m_Wb, double r_s_Ohm) noexcept {
   core_.set_theta({base_.flux_pu(psi_m_Wb), base_.resistance_pu(r_s_Ohm)});
+  before_previous_ = core_.adaptation();  // a retraction never undoes the seed
 }
 
 void AveragedDriveEstimator::reconfigure(const MachineSi& machine, const EstimatorSettings& settings) noexcept {

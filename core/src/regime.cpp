@@ -21,67 +21,31 @@ constexpr double kTrackDown = 0.93941306281347581;  // e^{−1/16}
 /// One step of the median tracker m of |r|: up by e^η when |r| > m, down by e^{−η} otherwise; it settles
 /// where |r| exceeds m half the time. The first nonzero |r| starts it.
 double track_median(double m, double a) noexcept {
-  const double stepped = m * (a > m ? kTrackUp : kTrackDown);
+  // The factor by table look-up, not a branch: |r| > m is a coin toss once m has settled, which a
+  // conditional jump would mispredict half the time.
+  static constexpr std::array<double, 2> kStep{kTrackDown, kTrackUp};
+  const double stepped = m * kStep[static_cast<std::size_t>(a > m)];
   return m == 0.0 ? a : stepped;
 }
 
-/// The smallest nonzero |change|.
-void track_resolution(double& q, double change) noexcept {
-  const double a = std::abs(change);
+/// The smallest nonzero |change|; whether it became smaller.
+bool track_resolution(double& q, double change) noexcept {
+  const double a = std::abs(change), before = q;
   q = std::min(q, a > 0.0 ? a : q);
+  return q < before;
 }
 
-}  // namespace
-
-std::uint64_t RegimeCounts::total() const noexcept {
-  std::uint64_t s = 0;
-  for (std::uint64_t c : n) s += c;
-  return s;
-}
-
-std::uint64_t RegimeCounts::excluded() const noexcept {
-  std::uint64_t s = 0;
-  for (const RegimeInfo& r : kRegimes) s += r.excluded ? (*this)[r.regime] : 0;
-  return s;
-}
-
-double chi2_bound(double z) noexcept { return -2.0 * std::log(std::erfc(z / std::sqrt(2.0))); }
-
-RegimeClassifier::RegimeClassifier(const RegimeConfig& config) noexcept {
-  reconfigure(config);
-  reset();
-}
-
-void RegimeClassifier::reconfigure(const RegimeConfig& config) noexcept {
-  config_ = config;
-  inv_omega_n_ = 1.0 / config.omega_n_rad_s;
-}
-
-void RegimeClassifier::reset() noexcept {
-  state_ = RegimeState{};
-  state_.measured_resolution_pu.fill(kInf);
-  noise_ = RegimeNoise{};
-}
-
-RegimeNoise RegimeClassifier::current_noise() const noexcept {
-  const auto variance = [this](std::size_t q) {
-    const double sigma = state_.noise_median_pu[q] * kSigmaPerMedian;
-    const double measured = state_.measured_resolution_pu[q] < kInf ? state_.measured_resolution_pu[q] : 0.0;
-    const double res = config_.resolution_pu[q] > 0.0 ? config_.resolution_pu[q] : measured;
-    return sigma * sigma + res * res * (1.0 / 12.0);  // a uniform quantisation error has variance q²/12
-  };
-  return {variance(0), variance(1), variance(2)};
-}
-
-void RegimeClassifier::learn(const RegimeInput& in, double t_s) noexcept {
-  RegimeState& s = state_;
+/// Learns a sample's noise and resolution from the chain and takes it in as the chain's last. Returns
+/// whether a measured resolution changed.
+bool learn(RegimeState& s, const RegimeInput& in, double t_s) noexcept {
+  bool resolution_changed = false;
   if (s.points >= 1) {
     const Vec2 du = (in.u_pu - s.u_pu[0]).cwiseAbs(), di = (in.i_pu - s.i_pu[0]).cwiseAbs();
-    track_resolution(s.measured_resolution_pu[0], du[0]);
-    track_resolution(s.measured_resolution_pu[0], du[1]);
-    track_resolution(s.measured_resolution_pu[1], di[0]);
-    track_resolution(s.measured_resolution_pu[1], di[1]);
-    track_resolution(s.measured_resolution_pu[2], in.n_pu - s.n_pu[0]);
+    resolution_changed = track_resolution(s.measured_resolution_pu[0], du[0]) |
+                         track_resolution(s.measured_resolution_pu[0], du[1]) |
+                         track_resolution(s.measured_resolution_pu[1], di[0]) |
+                         track_resolution(s.measured_resolution_pu[1], di[1]) |
+                         track_resolution(s.measured_resolution_pu[2], in.n_pu - s.n_pu[0]);
   }
   // Only a chain's samples are close enough for their second difference to be noise: a standalone
   // sample's neighbours are other operating points.
@@ -113,60 +77,87 @@ void RegimeClassifier::learn(const RegimeInput& in, double t_s) noexcept {
   s.t_s[0] = t_s;
   if (s.points < 2) ++s.points;
   s.chained = chain ? std::min(s.chained + 1, 2) : 0;
+  return resolution_changed;
 }
 
-std::uint8_t RegimeClassifier::transient_bits(const RegimeInput& in, double dt_s, const RegimeNoise& v) noexcept {
-  const RegimeConfig& c = config_;
-  RegimeState& s = state_;
-  const double z2 = c.z * c.z;
-  if (in.timing == SampleTiming::kStandalone) {
-    // A sample far from the previous one: the change of operating point between them excited a transient
-    // that has decayed to e^{−Δt/τ_el} of |Δi| (τ_el the slowest the model admits). Steady if that
-    // remnant is within the current's noise (its own estimate's noise, 2·decay²·σ_i², included).
-    const double decay = std::exp(-dt_s / c.electrical_time_constant_s);
-    const Vec2 remnant = decay * (in.i_pu - s.i_pu[0]).cwiseAbs();
-    const double bound = z2 * v.i_sq * (1.0 + 2.0 * decay * decay);
-    return remnant.squaredNorm() > 0.0 && remnant.cwiseProduct(remnant).maxCoeff() > bound ? regime_bit::kTransient : 0;
+}  // namespace
+
+std::uint64_t RegimeCounts::total() const noexcept {
+  std::uint64_t s = 0;
+  for (std::uint64_t c : n) s += c;
+  return s;
+}
+
+std::uint64_t RegimeCounts::excluded() const noexcept {
+  std::uint64_t s = 0;
+  for (const RegimeInfo& r : kRegimes) s += r.excluded ? (*this)[r.regime] : 0;
+  return s;
+}
+
+double chi2_bound(double z) noexcept { return -2.0 * std::log(std::erfc(z / std::sqrt(2.0))); }
+
+RegimeClassifier::RegimeClassifier(const RegimeConfig& config) noexcept {
+  reconfigure(config);
+  reset();
+}
+
+void RegimeClassifier::reconfigure(const RegimeConfig& config) noexcept {
+  config_ = config;
+  const RegimeConfig& c = config;
+  Constants& k = k_;
+  k.z_sq = c.z * c.z;
+  k.r_sq = c.r_pu * c.r_pu;
+  k.r_min_sq = c.r_min_pu * c.r_min_pu;
+  k.r_max = c.r_pu + c.dr_pu;
+  k.psi_max_sq = c.psi_max_pu * c.psi_max_pu;
+  k.inv_omega_n = 1.0 / c.omega_n_rad_s;
+  k.inv_omega_n_sq = k.inv_omega_n * k.inv_omega_n;
+  k.x = Vec2(c.x_d_pu, c.x_q_pu);
+  k.x_swapped = k.x.reverse();
+  k.dx = Vec2(c.dx_d_pu, c.dx_q_pu);
+  k.dx_swapped = k.dx.reverse();
+  k.x_over_omega_n = Vec2(k.inv_omega_n * c.x_d_pu, k.inv_omega_n * c.x_q_pu);
+  k.dx_over_omega_n = Vec2(k.inv_omega_n * c.dx_d_pu, k.inv_omega_n * c.dx_q_pu);
+  k.x_sq = Vec2(c.x_d_pu * c.x_d_pu, c.x_q_pu * c.x_q_pu);
+  k.slope_var_x_sq = Vec2(k.inv_omega_n_sq * c.x_d_pu * c.x_d_pu, k.inv_omega_n_sq * c.x_q_pu * c.x_q_pu);
+  k.x_max = std::max(c.x_d_pu, c.x_q_pu);
+  k.dx_max = std::max(c.dx_d_pu, c.dx_q_pu);
+  update_quantisation();
+}
+
+void RegimeClassifier::reset() noexcept {
+  state_ = RegimeState{};
+  state_.measured_resolution_pu.fill(kInf);
+  noise_ = RegimeNoise{};
+  update_quantisation();
+}
+
+void RegimeClassifier::update_quantisation() noexcept {
+  for (std::size_t q = 0; q < 3; ++q) {
+    const double measured = state_.measured_resolution_pu[q] < kInf ? state_.measured_resolution_pu[q] : 0.0;
+    const double res = config_.resolution_pu[q] > 0.0 ? config_.resolution_pu[q] : measured;
+    quantisation_var_[q] = res * res * (1.0 / 12.0);  // a uniform quantisation error has variance q²/12
   }
-  // Consecutive windows: what the steady state and the inductive correction (the slope between window
-  // centres) leave out, per row (d, q) in voltage:
-  //   (x/ω_n)·|s_k − s_{k−1}|   the slope changed: the correction is exact only for a ramp
-  //   (Δx/ω_n)·|s_k|            the inductance's tolerance on the correction
-  //   x_o·|Δn|·|Δi_o|/4          mean(n·x·i) − n̄·x·ī, bounded by the ranges' product over 4
-  // against the row's noise and the slope change's own noise.
-  if (!s.slope_valid) return 0;
-  const double inv_w = inv_omega_n_;
-  const double dn = std::abs(in.n_pu - s.n_pu[0]);
-  const Vec2 di = (in.i_pu - s.i_pu[0]).cwiseAbs();
-  const Vec2 x(c.x_d_pu, c.x_q_pu), dx(c.dx_d_pu, c.dx_q_pu);
-  Vec2 e = inv_w * dx.cwiseProduct(s.slope_pu_s.cwiseAbs()) + 0.25 * dn * Vec2(c.x_q_pu * di[1], c.x_d_pu * di[0]);
-  double slope_noise_sq = 0.0;  // Var(s_k − s_{k−1}) per σ_i²
-  if (s.previous_slope_valid) {
-    e += inv_w * x.cwiseProduct((s.slope_pu_s - s.previous_slope_pu_s).cwiseAbs());
-    const double a = s.inv_dt, b = s.previous_inv_dt;
-    slope_noise_sq = a * a + (a + b) * (a + b) + b * b;
-  }
-  const double n2 = in.n_pu * in.n_pu, r2 = c.r_pu * c.r_pu;
-  const double slope_var = inv_w * inv_w * slope_noise_sq * v.i_sq;
-  const double row_d = v.u_sq + (r2 + n2 * c.x_q_pu * c.x_q_pu) * v.i_sq + c.x_d_pu * c.x_d_pu * slope_var;
-  const double row_q = v.u_sq + (r2 + n2 * c.x_d_pu * c.x_d_pu) * v.i_sq + c.x_q_pu * c.x_q_pu * slope_var;
-  const bool own = e[0] * e[0] > z2 * row_d || e[1] * e[1] > z2 * row_q;
-  // A slope change shows only once both windows around the junction are in: the window after one is
-  // corrected with a slope that straddles it.
-  const bool transient = own || s.previous_transient;
-  s.previous_transient = own;
-  return transient ? regime_bit::kTransient : 0;
+}
+
+RegimeNoise RegimeClassifier::current_noise() const noexcept {
+  const auto variance = [this](std::size_t q) {
+    const double sigma = state_.noise_median_pu[q] * kSigmaPerMedian;
+    return sigma * sigma + quantisation_var_[q];
+  };
+  return {variance(0), variance(1), variance(2)};
 }
 
 Classification RegimeClassifier::step(const RegimeInput& in) noexcept {
   const RegimeConfig& c = config_;
+  const Constants& k = k_;
   RegimeState& s = state_;
-  if (!all_finite(in.u_pu, in.i_pu, in.n_pu, in.u_reported_sq_pu, in.window_s, in.weight)) {
+  if (!all_finite(in.u_pu, in.i_pu, in.n_pu, in.u_reported_sq_pu, in.window_s, in.weight)) [[unlikely]] {
     break_chain();
     return Classification::of(regime_bit::kInvalid);
   }
   if (in.timing == SampleTiming::kFirst) break_chain();
-  if (!s.has_origin) {
+  if (!s.has_origin) [[unlikely]] {
     s.t_origin_ns = in.t_ns;
     s.has_origin = true;
   }
@@ -193,77 +184,117 @@ Classification RegimeClassifier::step(const RegimeInput& in) noexcept {
 
   noise_ = current_noise();
   const RegimeNoise& v = noise_;
-  const double z2 = c.z * c.z;
+  const Vec2& i = in.i_pu;
+  const double n = in.n_pu, n2 = n * n, abs_n = std::abs(n);
+  const Vec2 abs_i = i.cwiseAbs();
+  // n²·x_q², n²·x_d² as every test forms them (n²·x·x).
+  const double n2_xq2 = n2 * c.x_q_pu * c.x_q_pu, n2_xd2 = n2 * c.x_d_pu * c.x_d_pu;
   std::uint8_t bits = 0;
 
   // Bridge off: the reported voltage and the current are zero within their noise where a modulating bridge
   // could not hold a zero current: with |u| inside the voltage's zero band √c₂·σ_u the machine would carry
   // |i| = |M⁻¹·(u − e)| ≥ (|n|·ψ_min − √c₂·σ_u)/‖M‖, ‖M‖ ≤ ‖M‖_F = √(2·r² + n²·(x_d² + x_q²)) at D_M's largest r,
   // beyond the current's zero band √c₂·σ_i.
-  const double i_sq = in.i_pu.squaredNorm();
+  const double i_sq = i.squaredNorm();
   if (in.u_reported_sq_pu <= c.chi2 * v.u_sq && i_sq <= c.chi2 * v.i_sq) [[unlikely]] {
-    const double n2 = in.n_pu * in.n_pu, r = c.r_pu + c.dr_pu;
-    const double emf_margin = std::abs(in.n_pu) * c.psi_min_pu - std::sqrt(c.chi2 * v.u_sq);
+    const double r = k.r_max;
+    const double emf_margin = abs_n * c.psi_min_pu - std::sqrt(c.chi2 * v.u_sq);
     const double m_sq = 2.0 * r * r + n2 * (c.x_d_pu * c.x_d_pu + c.x_q_pu * c.x_q_pu);
     if (emf_margin > 0.0 && emf_margin * emf_margin > c.chi2 * v.i_sq * m_sq) bits |= regime_bit::kBridgeOff;
   }
 
   // Angle locked: e, what the model leaves to the magnet, lies in the cone of half-angle δ_tol about
   // sgn(n)·q, widened by what the configuration's uncertainty (r within D_M, x within its tolerance) and
-  // the noise can put there. Independent of ψm's magnitude.
-  const double inv_w = inv_omega_n_;
-  const Vec2& i = in.i_pu;
+  // the noise can put there. Independent of ψm's magnitude. Both axes at once: (d, q) in one vector.
   const Vec2& sl = s.slope_pu_s;
-  const double n = in.n_pu, n2 = n * n, abs_n = std::abs(n);
-  const double e_d = in.u_pu[0] - c.r_pu * i[0] - inv_w * c.x_d_pu * sl[0] + n * c.x_q_pu * i[1];
-  const double e_q = in.u_pu[1] - c.r_pu * i[1] - inv_w * c.x_q_pu * sl[1] - n * c.x_d_pu * i[0];
-  const Vec2 abs_i = i.cwiseAbs(), abs_sl = sl.cwiseAbs();
-  const double b_d = c.dr_pu * abs_i[0] + abs_n * c.dx_q_pu * abs_i[1] + inv_w * c.dx_d_pu * abs_sl[0];
-  const double b_q = c.dr_pu * abs_i[1] + abs_n * c.dx_d_pu * abs_i[0] + inv_w * c.dx_q_pu * abs_sl[1];
+  const Vec2 abs_sl = sl.cwiseAbs();
+  const Vec2 rotation = (n * k.x_swapped).cwiseProduct(i.reverse()).cwiseProduct(Vec2(1.0, -1.0));  // −n·J·x·i
+  const Vec2 e = ((in.u_pu - c.r_pu * i) - k.x_over_omega_n.cwiseProduct(sl)) + rotation;
+  const Vec2 b = (c.dr_pu * abs_i + (abs_n * k.dx_swapped).cwiseProduct(abs_i.reverse())) +
+                 k.dx_over_omega_n.cwiseProduct(abs_sl);
   // The speed's sign where it stands out of its noise; else either direction of q.
-  const double along = n2 > z2 * v.n_sq ? (n > 0.0 ? e_q : -e_q) : std::abs(e_q);
-  const double lock = std::abs(e_d) - c.tan_angle * (along + b_q) - b_d;
+  const double along = n2 > k.z_sq * v.n_sq ? (n > 0.0 ? e[1] : -e[1]) : std::abs(e[1]);
+  const double lock = std::abs(e[0]) - c.tan_angle * (along + b[1]) - b[0];
   if (lock > 0.0) [[unlikely]] {
     const double slope_sq = 2.0 * s.inv_dt * s.inv_dt;  // Var(s) per σ_i²
-    const double r2 = c.r_pu * c.r_pu;
-    const double var_d = v.u_sq + (r2 + n2 * c.x_q_pu * c.x_q_pu + inv_w * inv_w * c.x_d_pu * c.x_d_pu * slope_sq) * v.i_sq +
+    const double var_d = v.u_sq + (k.r_sq + n2_xq2 + k.slope_var_x_sq[0] * slope_sq) * v.i_sq +
                          c.x_q_pu * c.x_q_pu * i[1] * i[1] * v.n_sq;
     const double flux_q = c.psi_max_pu + c.x_d_pu * abs_i[0];
-    const double var_q = v.u_sq + (r2 + n2 * c.x_d_pu * c.x_d_pu + inv_w * inv_w * c.x_q_pu * c.x_q_pu * slope_sq) * v.i_sq +
-                         flux_q * flux_q * v.n_sq;
-    if (lock * lock > z2 * (var_d + c.tan_angle * c.tan_angle * var_q)) bits |= regime_bit::kNotLocked;
+    const double var_q = v.u_sq + (k.r_sq + n2_xd2 + k.slope_var_x_sq[1] * slope_sq) * v.i_sq + flux_q * flux_q * v.n_sq;
+    if (lock * lock > k.z_sq * (var_d + c.tan_angle * c.tan_angle * var_q)) bits |= regime_bit::kNotLocked;
   }
 
-  if (in.timing == SampleTiming::kContiguous || (in.timing == SampleTiming::kStandalone && s.points >= 1)) {
-    bits |= transient_bits(in, dt_s, v);
+  if (in.timing == SampleTiming::kStandalone && s.points >= 1) [[unlikely]] {
+    // A sample far from the previous one: the change of operating point between them excited a transient
+    // that has decayed to e^{−Δt/τ_el} of |Δi| (τ_el the slowest the model admits). Steady if that
+    // remnant is within the current's noise (its own estimate's noise, 2·decay²·σ_i², included).
+    const double decay = std::exp(-dt_s / c.electrical_time_constant_s);
+    const Vec2 remnant = decay * (i - s.i_pu[0]).cwiseAbs();
+    const double bound = k.z_sq * v.i_sq * (1.0 + 2.0 * decay * decay);
+    if (remnant.squaredNorm() > 0.0 && remnant.cwiseProduct(remnant).maxCoeff() > bound) bits |= regime_bit::kTransient;
+  } else if (in.timing == SampleTiming::kContiguous && s.slope_valid) {
+    // Consecutive windows: what the steady state and the inductive correction (the slope between window
+    // centres) leave out, per row (d, q) in voltage:
+    //   (x/ω_n)·|s_k − s_{k−1}|   the slope changed: the correction is exact only for a ramp
+    //   (Δx/ω_n)·|s_k|            the inductance's tolerance on the correction
+    //   x_o·|Δn|·|Δi_o|/4          mean(n·x·i) − n̄·x·ī, bounded by the ranges' product over 4
+    // against the row's noise and the slope change's own noise.
+    const double dn = std::abs(n - s.n_pu[0]);
+    const Vec2 di = (i - s.i_pu[0]).cwiseAbs();
+    Vec2 t = k.inv_omega_n * k.dx.cwiseProduct(abs_sl) + (0.25 * dn) * k.x_swapped.cwiseProduct(di.reverse());
+    double slope_noise_sq = 0.0;  // Var(s_k − s_{k−1}) per σ_i²
+    if (s.previous_slope_valid) {
+      t += k.inv_omega_n * k.x.cwiseProduct((sl - s.previous_slope_pu_s).cwiseAbs());
+      const double a = s.inv_dt, p = s.previous_inv_dt;
+      slope_noise_sq = a * a + (a + p) * (a + p) + p * p;
+    }
+    const double slope_var = k.inv_omega_n_sq * slope_noise_sq * v.i_sq;
+    const double row_d = v.u_sq + (k.r_sq + n2_xq2) * v.i_sq + k.x_sq[0] * slope_var;
+    const double row_q = v.u_sq + (k.r_sq + n2_xd2) * v.i_sq + k.x_sq[1] * slope_var;
+    const bool own = t[0] * t[0] > k.z_sq * row_d || t[1] * t[1] > k.z_sq * row_q;
+    // A slope change shows only once both windows around the junction are in: the window after one is
+    // corrected with a slope that straddles it.
+    if (own || s.previous_transient) bits |= regime_bit::kTransient;
+    s.previous_transient = own;
   }
 
   // Excitation: the parameter's term, at its smallest inside D_M, less what the other terms' uncertainty
   // can put in its place, against its noise as the estimator's averaging leaves it: h² = γ/(2 − γ) of
   // one sample's variance (an exponential filter of gain γ).
-  const double r2 = c.r_pu * c.r_pu;
   const double psi_term = abs_n * c.psi_min_pu - c.dr_pu * abs_i[1] - abs_n * c.dx_d_pu * abs_i[0];
   if (psi_term > 0.0) {
     const double h_sq = in.weight[0] / (2.0 - in.weight[0]);
-    const double noise = v.u_sq + (r2 + n2 * c.x_d_pu * c.x_d_pu) * v.i_sq + c.psi_max_pu * c.psi_max_pu * v.n_sq;
-    if (psi_term * psi_term > z2 * h_sq * noise) bits |= regime_bit::kExcitesPsiM;
+    const double noise = v.u_sq + (k.r_sq + n2_xd2) * v.i_sq + k.psi_max_sq * v.n_sq;
+    if (psi_term * psi_term > k.z_sq * h_sq * noise) bits |= regime_bit::kExcitesPsiM;
   }
   // r_min·|i| must at least exceed |n|·Δψ: checked on the squares before |i| is taken.
-  if (c.r_min_pu * c.r_min_pu * i_sq > n2 * c.dpsi_pu * c.dpsi_pu) {
+  if (k.r_min_sq * i_sq > n2 * c.dpsi_pu * c.dpsi_pu) {
     const double i_abs = std::sqrt(i_sq);
-    const double dx = std::max(c.dx_d_pu, c.dx_q_pu), x = std::max(c.x_d_pu, c.x_q_pu);
-    const double term = c.r_min_pu * i_abs - abs_n * (c.dpsi_pu + dx * i_abs);
+    const double term = c.r_min_pu * i_abs - abs_n * (c.dpsi_pu + k.dx_max * i_abs);
     if (term > 0.0) {
       const double h_sq = in.weight[1] / (2.0 - in.weight[1]);
-      const double flux = c.psi_max_pu + x * i_abs;
-      const double noise = v.u_sq + (r2 + n2 * x * x) * v.i_sq + flux * flux * v.n_sq;
-      if (term * term > z2 * h_sq * noise) bits |= regime_bit::kExcitesRs;
+      const double flux = c.psi_max_pu + k.x_max * i_abs;
+      const double noise = v.u_sq + (k.r_sq + n2 * k.x_max * k.x_max) * v.i_sq + flux * flux * v.n_sq;
+      if (term * term > k.z_sq * h_sq * noise) bits |= regime_bit::kExcitesRs;
     }
   }
 
   // Before a chain has shown the data's noise, nothing in it is excluded on a threshold made of it.
   if (!s.noise_known && in.timing != SampleTiming::kStandalone) bits &= static_cast<std::uint8_t>(~regime_bit::kExcluded);
-  learn(in, t_s);
+
+  // Mixed windows (§13): a bridge state change falls inside the window between the last one of the old
+  // state and the first of the new (a read instant holds it with probability zero), whose means then mix
+  // both states. The take-over: this window follows a bridge-off one; the release: this one is bridge off
+  // and the one before was not — that one is mixed, which only this one shows.
+  const bool window = in.window_s > 0.0;
+  const bool off = (bits & regime_bit::kBridgeOff) != 0;
+  if (window && in.timing == SampleTiming::kContiguous && s.previous_window) {
+    if (s.previous_bridge_off && !off) bits |= regime_bit::kTransient;
+    if (!s.previous_bridge_off && off) bits |= regime_bit::kPreviousMixed;
+  }
+  s.previous_window = window;
+  s.previous_bridge_off = off;
+  if (learn(s, in, t_s)) [[unlikely]] update_quantisation();
   return Classification::of(bits);
 }
 

@@ -54,37 +54,39 @@ void ThermalFilter::predict(const ThermalLoad& load) noexcept {
   // x⁺ = F·x + [γ; 0; 0]: only the rows of T change, through G = [Φ Γ_d] acting on [T; d].
   Eigen::Matrix<double, kN, kDynamic> g;
   g << tr.phi, tr.gamma_d;
-  x_.head<kN>() = g * x_.head<kDynamic>() + tr.gamma;
-  // P⁺ = F·P·Fᵀ blockwise: the rows of T become G·P[T,d rows], then the columns of T likewise.
-  const Eigen::Matrix<double, kN, kThermalStates> rows = g * p_.topRows<kDynamic>();
+  x_.head<kN>() = g * x_.head<kDynamic>() + tr.gamma;  // a product that may alias: Eigen evaluates it first
+  // P⁺ = F·P·Fᵀ + Q_d blockwise (docs/derivations.md §14, eq. 14.12): d and c are random walks, so only the
+  // rows and columns of T change — the rows of T become G·P[T,d rows], the columns their transpose, P_TT
+  // those rows times Gᵀ. Small fixed sizes: coefficient-wise products, no blocking.
+  const Eigen::Matrix<double, kN, kThermalStates> rows = g.lazyProduct(p_.topRows<kDynamic>());
   p_.topRows<kN>() = rows;
   p_.leftCols<kN>() = rows.transpose();
-  p_.topLeftCorner<kN, kN>() = rows.leftCols<kDynamic>() * g.transpose();
-  ThermalMat q = ThermalMat::Zero();
-  for (int i = 0; i < n.nodes; ++i) q(i, i) = config_.process_noise_K2_per_s[i];
-  p_.topLeftCorner<kN, kN>() += 0.5 * load.dt_s * (tr.phi * q * tr.phi.transpose() + q);
+  ThermalVec q = ThermalVec::Zero();  // Q_T, on the nodes in use
+  for (int i = 0; i < n.nodes; ++i) q[i] = config_.process_noise_K2_per_s[i];
+  ThermalMat p_tt = rows.leftCols<kDynamic>().lazyProduct(g.transpose());
+  p_tt += 0.5 * load.dt_s * ((tr.phi * q.asDiagonal()).lazyProduct(tr.phi.transpose()) + ThermalMat(q.asDiagonal()));
+  // Rounding must not make P asymmetric: P_TT is the only block not symmetric by construction.
+  p_.topLeftCorner<kN, kN>() = 0.5 * (p_tt + p_tt.transpose());
   p_.block<kN, kN>(kN, kN).diagonal() += d_var;
-  p_ = (0.5 * (p_ + p_.transpose())).eval();  // rounding must not make P asymmetric
 }
 
 ObservationResult ThermalFilter::observe(const ThermalObservation& o) noexcept {
   if (!all_finite(o.h, o.h_c, o.offset, o.value, o.variance) || !(o.variance > 0.0)) return ObservationResult::kRejectedInvalid;
-  ThermalStateVec h = ThermalStateVec::Zero();
-  h.head<kN>() = o.h;
-  h.tail<kCalibrationStates>() = o.h_c;
-  const ThermalStateVec ph = p_ * h;
-  const double s = h.dot(ph) + o.variance;
-  const double nu = o.value - h.dot(x_) - o.offset;
+  // H = [h, 0, h_c]: no observation sees a disturbance, so a = P·Hᵀ takes the columns of T and c only.
+  const ThermalStateVec a = p_.leftCols<kN>().lazyProduct(o.h) + p_.rightCols<kCalibrationStates>().lazyProduct(o.h_c);
+  const double s = o.h.dot(a.head<kN>()) + o.h_c.dot(a.tail<kCalibrationStates>()) + o.variance;
+  const double nu = o.value - o.h.dot(x_.head<kN>()) - o.h_c.dot(x_.tail<kCalibrationStates>()) - o.offset;
   innovation_ = nu;
   innovation_variance_ = s;
   if (nu * nu > config_.gate_sigma * config_.gate_sigma * s) return ObservationResult::kRejectedGate;
-  // Schmidt's update: K = P·Hᵀ/s on T and d, zero on the calibration states (eq. 14.11). With a = P·Hᵀ:
+  // Schmidt's update: K = a_x/s on T and d, zero on the calibration states (eq. 14.11):
   //   P_xx −= a_x·a_xᵀ/s,  P_xc −= a_x·a_cᵀ/s,  P_cc unchanged.
-  const Eigen::Matrix<double, kDynamic, 1> a_x = ph.head<kDynamic>();
+  // Only the rows of x change; each column j loses (a_x·a_j)·(1/s), the same product for (i, j) and (j, i),
+  // so P_xx stays exactly symmetric, and P_cx is P_xc's transpose.
+  const Eigen::Matrix<double, kDynamic, 1> a_x = a.head<kDynamic>();
   x_.head<kDynamic>() += a_x * (nu / s);
-  const ThermalStateVec a_x_full = (ThermalStateVec() << a_x, CalibrationVec::Zero()).finished();
-  const ThermalStateMat update = a_x_full * ph.transpose() / s;
-  p_ -= update;
+  const double inv_s = 1.0 / s;
+  for (int j = 0; j < kThermalStates; ++j) p_.col(j).head<kDynamic>() -= (a_x * a[j]) * inv_s;
   p_.bottomLeftCorner<kCalibrationStates, kDynamic>() = p_.topRightCorner<kDynamic, kCalibrationStates>().transpose();
   return ObservationResult::kAccepted;
 }

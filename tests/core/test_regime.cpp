@@ -4,8 +4,10 @@
 // measures; and seeded runs of locked, steady, noisy data whose exclusions stay within the false rate.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
+#include <vector>
 
 #include "rpem/core/frames.hpp"
 #include "rpem/core/regime.hpp"
@@ -250,6 +252,90 @@ TEST(Regime, AStepInsideAWindowMakesItAndTheNextTransient) {
   EXPECT_EQ(v[5].regime, Regime::kTransient);
   EXPECT_EQ(v[6].regime, Regime::kTransient);
   for (int j = 9; j < 12; ++j) EXPECT_FALSE(v[j].excluded()) << j;
+}
+
+/// Windows of h at speed n over a timeline: the bridge modulates (current i_mod, the machine's steady-state
+/// voltage) until t_release, is off (a drive that reports zeros while off: u = i = 0) until t_take_over and
+/// modulates again afterwards. Each window's means are its parts' time-weighted means; `share` the part of
+/// each window in which the bridge modulated, as the timeline gives it.
+struct BridgeTimeline {
+  double h = 0.09, n = 0.4, t_release = 0.0, t_take_over = 0.0;
+  Vec2 i_mod = Vec2(0.0, 0.1);
+  [[nodiscard]] double share(int j) const {
+    const double t0 = j * h, t1 = t0 + h;
+    const double off = std::max(0.0, std::min(t1, t_take_over) - std::max(t0, t_release)) / h;
+    return off > 1.0 - 1e-9 ? 0.0 : 1.0 - off;  // a whole window off (its ends' rounding aside)
+  }
+  [[nodiscard]] std::vector<Classification> classify(const RegimeConfig& c, const MachinePu& m, int count,
+                                                     RegimeCounts* counts = nullptr) const {
+    RegimeClassifier k(c);
+    std::vector<Classification> out;
+    const Vec2 u_mod = steady_state_voltage(m, n, i_mod);
+    for (int j = 0; j < count; ++j) {
+      RegimeInput in;
+      in.timing = j == 0 ? SampleTiming::kFirst : SampleTiming::kContiguous;
+      in.t_ns = std::llround((j + 1) * h * 1e9);
+      in.window_s = h;
+      in.n_pu = n;
+      in.u_pu = share(j) * u_mod;
+      in.i_pu = share(j) * i_mod;
+      in.u_reported_sq_pu = in.u_pu.squaredNorm();
+      out.push_back(k.step(in));
+      if (counts) counts->add(out.back());
+    }
+    return out;
+  }
+};
+
+TEST(Regime, AWindowHoldingTheBridgesReleaseOrTakeOverIsMixed) {
+  // §13, "Mixed windows": the window between the last modulating and the first bridge-off window holds the
+  // release, the one after the last bridge-off window the take-over. With zeros reported while off its means
+  // are share·(modulating means): the model reads ψm·share — inside D_M (±50 %) for shares above ½, so
+  // nothing in the window itself tells it apart; the outrunner's 20 µH keep the current's change below
+  // the transient test's threshold (x·Δi/(ω_n·h) ≈ 1e-5 pu against z·σ_u ≈ 3e-4 pu).
+  Outrunner s;
+  s.settings.regimes.current_resolution_A = 0.01;
+  const RegimeConfig c = s.config();
+  for (const double f : {0.1, 0.5, 0.9}) {  // where in its window each change falls
+    BridgeTimeline b;
+    b.t_release = (6.0 + f) * b.h;
+    b.t_take_over = (11.0 + f) * b.h;
+    RegimeCounts counts;
+    const std::vector<Classification> v = b.classify(c, s.nominal, 16, &counts);
+    // Expected from the timeline alone: off where the bridge never modulated, mixed where it changed.
+    for (int j = 1; j < 16; ++j) {
+      const double m = b.share(j);
+      const bool mixed = m > 0.0 && m < 1.0, off = m == 0.0;
+      if (off) {
+        EXPECT_EQ(v[j].regime, Regime::kBridgeOff) << f << " " << j;
+      } else if (mixed && j == 6) {
+        // The release: its own evidence admits it, the next window (the first off one) marks it mixed.
+        EXPECT_FALSE(v[j].excluded()) << f;
+        EXPECT_TRUE(v[j + 1].bits & regime_bit::kPreviousMixed) << f;
+      } else if (mixed) {
+        EXPECT_EQ(v[j].regime, Regime::kTransient) << f << " " << j;  // the take-over, causally
+      } else {
+        EXPECT_FALSE(v[j].excluded()) << f << " " << j;
+        EXPECT_FALSE(v[j].bits & regime_bit::kPreviousMixed) << f << " " << j;
+      }
+    }
+    EXPECT_EQ(counts[Regime::kBridgeOff], 4U) << f;  // windows 7–10
+    EXPECT_EQ(counts[Regime::kTransient], 2U) << f;  // 6 (moved by 7's mark) and 11
+    EXPECT_EQ(counts.total(), 16U) << f;
+  }
+  // A change exactly at a read leaves no window mixed, but nothing in the data says so: the window beside
+  // the off ones is set aside all the same (one window's data per change, the rule's price).
+  BridgeTimeline b;
+  b.t_release = 6.0 * b.h;
+  b.t_take_over = 11.0 * b.h;
+  const std::vector<Classification> v = b.classify(c, s.nominal, 16);
+  EXPECT_EQ(v[5].regime, Regime::kExcitesPsiM);
+  EXPECT_TRUE(v[6].bits & regime_bit::kPreviousMixed);
+  EXPECT_EQ(v[10].regime, Regime::kBridgeOff);
+  EXPECT_EQ(v[11].regime, Regime::kTransient);
+  EXPECT_FALSE(v[12].excluded());
+  // A drive that reports the back EMF while off (VESC's firmware) shows no bridge-off window: its mixed
+  // windows are the model's own (u = n·ψm at i = 0 while off), and nothing is set aside.
 }
 
 TEST(Regime, AStandaloneSampleIsSteadyOnceTheTransientHasDecayedIntoTheNoise) {

@@ -64,12 +64,17 @@ TEST(RegimeEstimators, AveragedEstimatorThroughEveryRegimeEndsAtTheMachine) {
   RegimeCounts counts;
   int excluded_moved = 0, coast_rs_active = 0, open_loop_at_speed = 0, open_loop_not_locked = 0;
   int off = 0, off_counted = 0;
-  Vec2 before = est.core().state().theta_pu;
+  Vec2 before = est.core().state().theta_pu, before_previous = before;
+  int retracted = 0;
   for (const auto& w : windows) {
     const Estimate e = est.step(w.sample);
     counts.add(e.regime);
     const Vec2 after = est.core().state().theta_pu;
-    if (e.regime.excluded() && after != before) ++excluded_moved;
+    // An excluded sample moves θ̂ only to retract the window before it, found mixed (§13): back exactly.
+    const bool retraction = (e.regime.bits & regime_bit::kPreviousMixed) && after == before_previous;
+    retracted += retraction && after != before ? 1 : 0;
+    if (e.regime.excluded() && after != before && !retraction) ++excluded_moved;
+    before_previous = before;
     before = after;
     if (w.mixed) continue;
     if (w.mode == DriveMode::kCoast && std::abs(w.sample.omega_el_rad_s) < 50.0 && (e.detail.flags & step_flag::kRsActive)) {
@@ -85,6 +90,7 @@ TEST(RegimeEstimators, AveragedEstimatorThroughEveryRegimeEndsAtTheMachine) {
     }
   }
   EXPECT_EQ(excluded_moved, 0);
+  EXPECT_GT(retracted, 0);  // the freewheel's release fell inside a read
   EXPECT_EQ(coast_rs_active, 0) << "r_s adapted while creeping at zero current";
   EXPECT_GT(open_loop_at_speed, 5);
   EXPECT_EQ(open_loop_not_locked, open_loop_at_speed);
@@ -114,6 +120,50 @@ TEST(RegimeEstimators, WindowLengthAloneNeverResynchronises) {
   EXPECT_EQ(resyncs, 1);  // the first
   EXPECT_GT(windows.size(), 25U);
   EXPECT_NEAR(est.psi_m_Wb() / drive.psi_m_Wb, 1.0, 0.02);
+}
+
+TEST(RegimeEstimators, AReleaseInsideAWindowRetractsWhatThatWindowAdapted) {
+  // §13, "Mixed windows": 90 ms windows of the outrunner (ψm 15 % below the configuration) at 1500 rad/s and
+  // 5 A; the bridge is released half-way through window 20 and the drive reports zeros while off. Window 20
+  // reads ψm at half (inside D_M) and adapts; window 21, the first off one, marks it mixed and the estimator
+  // goes back to where it stood before window 20 — exactly.
+  MachineSi truth = test::outrunner_machine_si();
+  truth.psi_m_Wb *= 0.85;
+  const double h = 0.09, omega = 1500.0;
+  const Vec2 i(0.0, 5.0);
+  const Vec2 u(truth.r_s_Ohm * i[0] - omega * truth.l_q_H * i[1],
+               truth.r_s_Ohm * i[1] + omega * (truth.l_d_H * i[0] + truth.psi_m_Wb));
+  EstimatorSettings settings = test::outrunner_settings();
+  settings.regimes.voltage_resolution_V = 0.01;
+  settings.regimes.current_resolution_A = 0.01;
+  AveragedDriveEstimator est(test::outrunner_machine_si(), settings);
+  double psi_before_mixed = 0.0, psi_after_mixed = 0.0;
+  RegimeCounts counts;
+  for (int j = 0; j < 26; ++j) {
+    const double share = j < 20 ? 1.0 : (j == 20 ? 0.5 : 0.0);
+    AveragedSample w;
+    w.t_start_ns = std::llround(j * h * 1e9);
+    w.t_ns = std::llround((j + 1) * h * 1e9);
+    w.i_dq_A = share * i;
+    w.u_dq_V = share * u;
+    w.omega_el_rad_s = omega;
+    if (j == 20) psi_before_mixed = est.psi_m_Wb();
+    const Estimate e = est.step(w);
+    counts.add(e.regime);
+    if (j == 20) {
+      EXPECT_FALSE(e.regime.excluded());
+      psi_after_mixed = est.psi_m_Wb();
+    }
+    if (j == 21) {
+      EXPECT_EQ(e.regime.regime, Regime::kBridgeOff);
+      EXPECT_TRUE(e.regime.bits & regime_bit::kPreviousMixed);
+    }
+  }
+  EXPECT_LT(psi_after_mixed, 0.9 * psi_before_mixed);  // what the mixed window did (γ ≈ 0.3 per window)
+  EXPECT_EQ(est.psi_m_Wb(), psi_before_mixed);         // and undid
+  EXPECT_NEAR(psi_before_mixed / truth.psi_m_Wb, 1.0, 0.01);
+  EXPECT_EQ(counts[Regime::kTransient], 1U);
+  EXPECT_EQ(counts[Regime::kBridgeOff], 5U);
 }
 
 /// Rows a test bench writes seconds apart at steady operating points of the paper's machine (ψm 8 % low,

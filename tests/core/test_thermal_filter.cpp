@@ -1,7 +1,8 @@
-// The thermal Kalman filter (core/thermal_filter.hpp, docs/derivations.md §13) against hand-worked updates
+// The thermal Kalman filter (core/thermal_filter.hpp, docs/derivations.md §14) against hand-worked updates
 // and closed-form limits: the scalar update, a correlated update, Schmidt's consider states (the calibration
 // bounds what observations can teach), the gate, the prediction's covariance, and a heat disturbance the
-// filter learns from observations of one node.
+// filter learns from observations of one node; the blockwise prediction and sparse update against the dense
+// forms on all twelve states.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -139,6 +140,94 @@ TEST(ThermalFilter, LearnsAHeatDisturbanceFromOneNodesReadingsAndCorrectsTheOthe
   EXPECT_NEAR(thermal_steady_state(truth, l)[0] - thermal_steady_state(c.network, l)[0], model_miss, 1e-6);
   EXPECT_GT(model_miss, 7.0);
   EXPECT_NEAR(f.temperature_C()[0], t[0], 1.0);
+}
+
+TEST(ThermalFilter, BlockwiseStepsAreTheDenseFormulasAndKeepPExactlySymmetric) {
+  // The filter predicts blockwise and updates with a sparse H (docs/derivations.md §14, eq. 14.11, 14.12);
+  // here the dense forms on all 12 states: P⁺ = F·P·Fᵀ + Q_d with F = [Φ Γ_d 0; 0 I 0; 0 0 I], and the Joseph
+  // form (I − K·H)·P·(I − K·H)ᵀ + K·r·Kᵀ with K = [P·Hᵀ/s on T and d; 0 on c]. Four nodes in use, so every row
+  // of the network moves, with a disturbance and cross-covariances built by earlier steps.
+  ThermalFilterConfig c;
+  ThermalNetwork& n = c.network;
+  n.nodes = 4;
+  n.winding = 0, n.magnet = 3;
+  n.capacitance_J_per_K << 3000.0, 12000.0, 5000.0, 7000.0;
+  n.to_coolant_W_per_K << 2.0, 90.0, 10.0, 4.0;
+  n.between_W_per_K(0, 1) = n.between_W_per_K(1, 0) = 40.0;
+  n.between_W_per_K(1, 2) = n.between_W_per_K(2, 1) = 25.0;
+  n.between_W_per_K(2, 3) = n.between_W_per_K(3, 2) = 12.0;
+  n.between_W_per_K(0, 3) = n.between_W_per_K(3, 0) = 3.0;
+  n.copper = {0.00393, 20.0, 2.25};
+  n.base = {1000.0, 0.1, 100.0};
+  n.loss_at_base_W(static_cast<int>(LossForm::kIronEddy), 1) = 100.0;
+  c.process_noise_K2_per_s << 1e-3, 2e-3, 3e-3, 4e-3;
+  c.disturbance_W2_per_s << 1.0, 2.0, 3.0, 4.0;
+  c.copper_rel_sigma = 0.0;  // Var(v) = q_d·Δt: the loss terms' changes are not what this test is about
+  c.gate_sigma = 100.0;
+  ThermalFilter f(c);
+  f.reset(40.0, 5.0);
+  ThermalLoad l;
+  l.dt_s = 7.0;
+  l.current_sq_A2 = 900.0;
+  l.basis[static_cast<std::size_t>(LossForm::kIronEddy)] = 0.5;
+  l.coolant_C = 30.0;
+  ThermalObservation magnet;  // the magnet through a law with its calibration states, and the winding
+  magnet.h << 0.1, 0.0, 0.0, -1.4e-3;
+  magnet.h_c << -1.4e-3, -0.04, 0.0, 0.0;
+  magnet.offset = 1.2;
+  magnet.variance = 1e-6;
+  ThermalObservation winding;
+  winding.h[0] = 1.0;
+  winding.variance = 0.5;
+  for (int k = 0; k < 5; ++k) {  // cross-covariances everywhere, the state off its start
+    f.predict(l);
+    magnet.value = magnet.h.dot(f.temperature_C()) + magnet.offset + 2e-3;
+    winding.value = f.temperature_C()[0] + 1.5;
+    ASSERT_EQ(f.observe(magnet), ObservationResult::kAccepted);
+    ASSERT_EQ(f.observe(winding), ObservationResult::kAccepted);
+  }
+  const auto state = [&f] {
+    ThermalStateVec x = ThermalStateVec::Zero();
+    x << f.temperature_C(), f.disturbance_W(), CalibrationVec::Zero();
+    return x;
+  };
+  const ThermalStateVec x0 = state();
+  const ThermalStateMat p0 = f.covariance();
+  ASSERT_GT((p0.block<4, 4>(0, 4).cwiseAbs().minCoeff()), 0.0);  // T and d correlated: the blocks matter
+  ASSERT_GT((p0.block<4, 4>(0, 8).cwiseAbs().maxCoeff()), 0.0);
+  EXPECT_TRUE(p0 == p0.transpose());
+
+  f.predict(l);
+  const ThermalTransition tr = thermal_transition(n, l);
+  ThermalStateMat big_f = ThermalStateMat::Identity();
+  big_f.block<4, 4>(0, 0) = tr.phi;
+  big_f.block<4, 4>(0, 4) = tr.gamma_d;
+  ThermalStateMat q_d = ThermalStateMat::Zero();
+  const ThermalMat q_t = c.process_noise_K2_per_s.asDiagonal();
+  q_d.block<4, 4>(0, 0) = 0.5 * l.dt_s * (tr.phi * q_t * tr.phi.transpose() + q_t);
+  q_d.block<4, 4>(4, 4) = (c.disturbance_W2_per_s * l.dt_s).asDiagonal();
+  const ThermalStateMat p1 = big_f * p0 * big_f.transpose() + q_d;
+  ThermalStateVec x1 = big_f * x0;
+  x1.head<4>() += tr.gamma;
+  const double tol_p = 1e-13 * p1.cwiseAbs().maxCoeff();
+  EXPECT_LT((f.covariance() - p1).cwiseAbs().maxCoeff(), tol_p);
+  EXPECT_LT((state() - x1).cwiseAbs().maxCoeff(), 1e-12);
+  EXPECT_TRUE(f.covariance() == f.covariance().transpose());
+
+  magnet.value = magnet.h.dot(f.temperature_C()) + magnet.offset - 3e-3;
+  ThermalStateVec h = ThermalStateVec::Zero();
+  h << magnet.h, ThermalVec::Zero(), magnet.h_c;
+  const double s = h.dot(p1 * h) + magnet.variance;
+  ThermalStateVec k = p1 * h / s;
+  k.tail<4>().setZero();  // Schmidt: the calibration states are considered, not estimated
+  const ThermalStateMat i_kh = ThermalStateMat::Identity() - k * h.transpose();
+  const ThermalStateMat p2 = i_kh * p1 * i_kh.transpose() + k * magnet.variance * k.transpose();
+  const ThermalStateVec x2 = x1 + k * (magnet.value - h.dot(x1) - magnet.offset);
+  ASSERT_EQ(f.observe(magnet), ObservationResult::kAccepted);
+  EXPECT_NEAR(f.last_innovation_variance(), s, 1e-13 * s);
+  EXPECT_LT((f.covariance() - p2).cwiseAbs().maxCoeff(), tol_p);
+  EXPECT_LT((state() - x2).cwiseAbs().maxCoeff(), 1e-12);
+  EXPECT_TRUE(f.covariance() == f.covariance().transpose());
 }
 
 }  // namespace

@@ -10,6 +10,7 @@
 
 #include "least_squares.hpp"
 #include "over_training.hpp"
+#include "rpem/analysis/cluster_robust.hpp"
 
 namespace rpem::analysis {
 namespace {
@@ -290,27 +291,15 @@ CalibrationIntervals EffectFitter::intervals(const EffectSet& set, double noise_
   least_squares::Gram total(n);
   for (const Block& b : blocks) total.add(b.gram);
   const Eigen::MatrixXd h = total.symmetric();
-  // A constant the log does not excite has a vanishing column: a pseudo-inverse leaves it infinitely uncertain.
-  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(h);
-  const double floor = 1e-12 * std::max(eig.eigenvalues().maxCoeff(), 1e-300);
-  Eigen::MatrixXd h_inv = Eigen::MatrixXd::Zero(n, n);
-  Eigen::VectorXd unexcited = Eigen::VectorXd::Zero(n);
-  for (Eigen::Index k = 0; k < n; ++k) {
-    const Eigen::VectorXd v = eig.eigenvectors().col(k);
-    if (eig.eigenvalues()[k] > floor) {
-      h_inv += v * v.transpose() / eig.eigenvalues()[k];
-    } else {
-      unexcited += v.cwiseAbs2();
-    }
-  }
   // Cluster-robust "meat": the training blocks' score vectors.
   const LogData& log = replay_.log();
   Eigen::MatrixXd g = Eigen::MatrixXd::Zero(n, static_cast<Eigen::Index>(log.blocks / 2 + 1));
   for (std::size_t i = 0; i < training_blocks_.size(); ++i) g.col(training_blocks_[i] / 2) = blocks[i].score;
-  Eigen::Index used_clusters = 0;
-  for (Eigen::Index b = 0; b < g.cols(); ++b) used_clusters += g.col(b).squaredNorm() > 0.0 ? 1 : 0;
-  const double correction = used_clusters > 1 ? static_cast<double>(used_clusters) / static_cast<double>(used_clusters - 1) : 1.0;
-  const Eigen::MatrixXd robust = correction * h_inv * (g * g.transpose()) * h_inv;
+  // A constant the log does not excite has a vanishing column: the pseudo-inverse leaves it infinitely uncertain.
+  const ClusterRobustCovariance cov = cluster_robust_covariance(h, g);
+  const Eigen::MatrixXd& h_inv = cov.excitation;
+  const Eigen::MatrixXd& robust = cov.robust;
+  const Eigen::VectorXd& unexcited = cov.unexcited;
   const double sigma2 = 0.5 * noise_floor_A * noise_floor_A;  // per residual component
   CalibrationIntervals out;
   constexpr double kZ = 1.959964;

@@ -37,6 +37,8 @@ LogRegimes classify_regimes(const LogData& log, const io::MachineConfig& config,
   out.counts.averaged = log.averaged;
   auto record = [&](std::size_t k, const core::Estimate& e) {
     out.regime[k] = e.regime.regime;
+    // The window before held the bridge's release (docs/derivations.md §13, "Mixed windows").
+    if ((e.regime.bits & core::regime_bit::kPreviousMixed) && k > 0) out.regime[k - 1] = core::as_mixed(out.regime[k - 1]);
     out.counts.add(e);
     if ((k + 1) % kMonitorSamples == 0) report_work(monitor, kMonitorSamples);
   };

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "rpem/analysis/cluster_robust.hpp"
 #include "rpem/analysis/diagnose/effect_fit.hpp"
 #include "rpem/analysis/thermal/thermal_replay.hpp"
 
@@ -336,19 +337,6 @@ void intervals(const Layout& layout, const ThermalRecord& r, std::size_t steps, 
   std::vector<double> r0;
   const Eigen::MatrixXd j = jacobian(layout, r, steps, points, x, r0);
   const Eigen::Index n = j.cols();
-  const Eigen::MatrixXd h = j.transpose() * j;
-  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(h);
-  const double floor = 1e-12 * std::max(eig.eigenvalues().maxCoeff(), 1e-300);
-  Eigen::MatrixXd h_inv = Eigen::MatrixXd::Zero(n, n);
-  Eigen::VectorXd unexcited = Eigen::VectorXd::Zero(n);
-  for (Eigen::Index k = 0; k < n; ++k) {
-    const Eigen::VectorXd v = eig.eigenvectors().col(k);
-    if (eig.eigenvalues()[k] > floor) {
-      h_inv += v * v.transpose() / eig.eigenvalues()[k];
-    } else {
-      unexcited += v.cwiseAbs2();
-    }
-  }
   const double t0 = r.t_s.front(), t1 = r.t_s[steps - 1];
   Eigen::MatrixXd g = Eigen::MatrixXd::Zero(n, blocks);
   for (std::size_t p = 0; p < points.size(); ++p) {
@@ -356,10 +344,11 @@ void intervals(const Layout& layout, const ThermalRecord& r, std::size_t steps, 
     const auto b = static_cast<Eigen::Index>(std::min(blocks - 1, static_cast<int>(frac * blocks)));
     g.col(b) += j.row(static_cast<Eigen::Index>(p)).transpose() * r0[p];
   }
-  Eigen::Index used = 0;
-  for (Eigen::Index b = 0; b < g.cols(); ++b) used += g.col(b).squaredNorm() > 0.0 ? 1 : 0;
-  const double correction = used > 1 ? static_cast<double>(used) / static_cast<double>(used - 1) : 1.0;
-  const Eigen::MatrixXd robust = correction * h_inv * (g * g.transpose()) * h_inv;
+  const Eigen::MatrixXd h = j.transpose() * j;
+  const ClusterRobustCovariance cov = cluster_robust_covariance(h, g);
+  const Eigen::MatrixXd& h_inv = cov.excitation;
+  const Eigen::MatrixXd& robust = cov.robust;
+  const Eigen::VectorXd& unexcited = cov.unexcited;
   const io::ThermalConfig fitted = layout.apply(x.data());
   for (std::size_t k = 0; k < layout.size(); ++k) {
     const Slot& s = layout.slots()[k];

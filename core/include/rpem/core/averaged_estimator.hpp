@@ -78,6 +78,8 @@ class AveragedDriveEstimator {
   bool has_previous_ = false;  ///< the next sample continues the chain of the previous one
   std::optional<std::int64_t> previous_t_ns_;
   SampleTiming timing_ = SampleTiming::kFirst;  ///< of the sample being stepped
+  /// The core's adaptation before the previous sample: what a release found inside that window retracts (§13).
+  RpemEstimator::Adaptation before_previous_{};
   Vec2 instrument_i_pu_ = Vec2::Zero();  ///< low-passed current of the samples before this one
   double instrument_n_pu_ = 0.0;
 };

@@ -183,6 +183,27 @@ class RpemEstimator {
   void set_theta(const Vec2& theta_pu) noexcept;
   /// Freezes or releases adaptation; prediction continues. Real-time safe.
   void set_frozen(bool frozen) noexcept { state_.frozen = frozen; }
+
+  /// What adapting on a sample changes: θ̂, the Hessians and the last adapted ε.
+  struct Adaptation {
+    Vec2 theta_pu = Vec2::Zero();
+    Vec2 sga_hessian_pu = Vec2::Zero();
+    Mat2 gna_hessian_pu = Mat2::Zero();
+    Vec2 last_epsilon_pu = Vec2::Zero();
+    bool epsilon_valid = false;
+  };
+  [[nodiscard]] Adaptation adaptation() const noexcept {
+    return {state_.theta_pu, state_.sga_hessian_pu, state_.gna_hessian_pu, state_.last_epsilon_pu, state_.epsilon_valid};
+  }
+  /// Back to an adaptation saved before the samples it undoes (a window found mixed afterwards,
+  /// docs/derivations.md §13); the predictor is left as it is. Real-time safe.
+  void retract(const Adaptation& before) noexcept {
+    state_.theta_pu = before.theta_pu;
+    state_.sga_hessian_pu = before.sga_hessian_pu;
+    state_.gna_hessian_pu = before.gna_hessian_pu;
+    state_.last_epsilon_pu = before.last_epsilon_pu;
+    state_.epsilon_valid = before.epsilon_valid;
+  }
   /// Replaces gains, floors, scheduler, bounds and algorithm while keeping θ̂, Hessians and the
   /// predictor (SIGHUP reload). Not real-time: call between steps from the owning thread.
   void reconfigure(const EstimatorConfig& config) noexcept;

@@ -1,7 +1,7 @@
 #pragma once
 // The matrix exponential e^X of a small fixed-size matrix and φ₁(X) = Σ_k X^k/(k+1)! (so that
 // ∫₀^Δt e^{A·s} ds = Δt·φ₁(A·Δt)), by scaling and squaring with Taylor series (docs/derivations.md §14,
-// "Discretisation"): X is scaled by 2^−s until its 1-norm is at most ½, both series are summed until a term
+// "Exact step"): X is scaled by 2^−s until its 1-norm is at most ½, both series are summed until a term
 // no longer changes the sums in double precision (at most kMaxTerms terms: the remainder at ‖X‖ ≤ ½ after 18
 // terms is below 10⁻²²), then doubled s times with e^{2X} = (e^X)² and φ₁(2X) = ½·φ₁(X)·(e^X + I).
 // Real-time safe: fixed-size Eigen, no allocation; the cost grows with ‖X‖ (a thermal step of 0.1 s whose
@@ -32,7 +32,7 @@ template <int N>
   Mat phi = Mat::Identity();
   Mat term = Mat::Identity();
   for (int k = 1; k <= kMaxTerms; ++k) {
-    term = (term * x) / static_cast<double>(k + 1);
+    term = (term * x) * (1.0 / static_cast<double>(k + 1));  // one division, not one per coefficient
     phi += term;
     if (term.cwiseAbs().maxCoeff() <= 1e-17 * phi.cwiseAbs().maxCoeff()) break;
   }

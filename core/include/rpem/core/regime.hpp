@@ -12,7 +12,9 @@
 //   bridge off   |u_reported|² ≤ c₂·σ_u²  and  |i|² ≤ c₂·σ_i²        c₂ = −2·ln α, α = erfc(z/√2)
 //   not locked   |e_d| − tan δ_tol·sgn(n)·e_q − B_d > z·σ_L         (e outside a cone about ±q: §13)
 //   transient    a term the steady state leaves out (slope change, speed-current covariance; a
-//                standalone sample: the decayed remnant e^{−Δt/τ_el}·|Δi|) beyond z·σ of its row
+//                standalone sample: the decayed remnant e^{−Δt/τ_el}·|Δi|) beyond z·σ of its row;
+//                a mixed window: the bridge was released or took over inside it (the window next to a
+//                bridge-off one; the release shows one window late: kPreviousMixed)
 //   excites ψm   |n|·ψ_min − Δr·|i_q| − |n|·Δx_d·|i_d| > z·h_ψ·N_ψ   (h² = γ/(2 − γ): the estimator's averaging)
 //   excites r_s  r_min·|i| − |n|·(Δψ + Δx·|i|)       > z·h_r·N_r
 // Real-time safe: noexcept, no allocation, fixed size.
@@ -48,6 +50,10 @@ inline constexpr std::uint8_t kTransient = 1U << 2;
 inline constexpr std::uint8_t kExcitesPsiM = 1U << 3;
 inline constexpr std::uint8_t kExcitesRs = 1U << 4;
 inline constexpr std::uint8_t kInvalid = 1U << 5;
+/// Not this sample's: the window before it (its chain's, adjacent) held the bridge's release — this one is
+/// bridge off, that one was not — so that one is mixed, transient from now on (docs/derivations.md §13,
+/// "Mixed windows"). An online consumer retracts what it adapted there; counts move it (RegimeCounts).
+inline constexpr std::uint8_t kPreviousMixed = 1U << 6;
 inline constexpr std::uint8_t kExcluded = kBridgeOff | kNotLocked | kTransient | kInvalid;
 }  // namespace regime_bit
 
@@ -94,10 +100,25 @@ inline constexpr std::array<RegimeInfo, kRegimeCount> kRegimes{{
 }};
 [[nodiscard]] constexpr const RegimeInfo& info(Regime r) noexcept { return kRegimes[static_cast<std::size_t>(r)]; }
 
-/// Samples per regime. Real-time safe.
+/// The regime of a sample found mixed afterwards (kPreviousMixed on the next): transient, unless a test of
+/// higher precedence already excluded it.
+[[nodiscard]] constexpr Regime as_mixed(Regime r) noexcept { return info(r).excluded ? r : Regime::kTransient; }
+
+/// Samples per regime; a sample found mixed by the next one's kPreviousMixed moves to its regime as_mixed().
+/// Real-time safe.
 struct RegimeCounts {
   std::array<std::uint64_t, kRegimeCount> n{};
-  void add(Classification c) noexcept { ++n[static_cast<std::size_t>(c.regime)]; }
+  Regime last = Regime::kInvalid;  ///< the regime the last sample counted in
+  bool has_last = false;
+  void add(Classification c) noexcept {
+    if ((c.bits & regime_bit::kPreviousMixed) && has_last) {
+      --n[static_cast<std::size_t>(last)];
+      ++n[static_cast<std::size_t>(as_mixed(last))];
+    }
+    ++n[static_cast<std::size_t>(c.regime)];
+    last = c.regime;
+    has_last = true;
+  }
   [[nodiscard]] std::uint64_t operator[](Regime r) const noexcept { return n[static_cast<std::size_t>(r)]; }
   [[nodiscard]] std::uint64_t total() const noexcept;
   [[nodiscard]] std::uint64_t excluded() const noexcept;
@@ -187,6 +208,8 @@ struct RegimeState {
   double inv_dt = 0.0, previous_inv_dt = 0.0;  ///< 1/Δt between window centres, this sample's and the one before
   bool slope_valid = false, previous_slope_valid = false;
   bool previous_transient = false;     ///< the previous sample's own slope test failed (the junction straddles)
+  /// The chain's previous sample: a window (averaged), and whether it was bridge off (mixed windows).
+  bool previous_window = false, previous_bridge_off = false;
 };
 
 /// The noise of a quantity [pu]: σ² = (median/0.6745)² + q²/12 (the measured noise and the quantisation).
@@ -205,6 +228,7 @@ class RegimeClassifier {
   void break_chain() noexcept {
     state_.points = state_.chained = 0;
     state_.slope_valid = state_.previous_slope_valid = false;
+    state_.previous_window = state_.previous_bridge_off = false;
   }
   /// Everything learnt back to the start.
   void reset() noexcept;
@@ -221,13 +245,37 @@ class RegimeClassifier {
   [[nodiscard]] const Vec2& slope_pu_s() const noexcept { return state_.slope_pu_s; }
 
  private:
-  void learn(const RegimeInput& in, double t_s) noexcept;
-  [[nodiscard]] std::uint8_t transient_bits(const RegimeInput& in, double dt_s, const RegimeNoise& s) noexcept;
+  /// What the tests take from the configuration alone, computed once by reconfigure(): each the product a
+  /// test formed per sample, in the same order of operations, so that every decision is bit-identical.
+  /// The pairs are vectors here because a Vec2 built from two scalars per sample goes through memory (two
+  /// 8-byte stores, one 16-byte load: a failed store forward, the largest cost the profile showed).
+  struct Constants {
+    double z_sq = 0.0;                       ///< z²
+    double r_sq = 0.0;                       ///< r²
+    double r_min_sq = 0.0;                   ///< r_min²
+    double r_max = 0.0;                      ///< D_M's largest r
+    double psi_max_sq = 0.0;                 ///< ψ_max²
+    double inv_omega_n = 0.0;                ///< 1/ω_n
+    double inv_omega_n_sq = 0.0;             ///< 1/ω_n²
+    Vec2 x = Vec2::Zero(), x_swapped = Vec2::Zero();    ///< (x_d, x_q), (x_q, x_d)
+    Vec2 dx = Vec2::Zero(), dx_swapped = Vec2::Zero();  ///< (Δx_d, Δx_q), (Δx_q, Δx_d)
+    Vec2 x_over_omega_n = Vec2::Zero();      ///< (x_d, x_q)/ω_n
+    Vec2 dx_over_omega_n = Vec2::Zero();     ///< (Δx_d, Δx_q)/ω_n
+    Vec2 x_sq = Vec2::Zero();                ///< (x_d², x_q²)
+    Vec2 slope_var_x_sq = Vec2::Zero();      ///< (x_d², x_q²)/ω_n²
+    double x_max = 0.0, dx_max = 0.0;        ///< the larger inductance and tolerance
+  };
+
+  /// Recomputes quantisation_var_ (after a resolution changed or the configuration did).
+  void update_quantisation() noexcept;
 
   RegimeConfig config_;
+  Constants k_;
   RegimeState state_;
   RegimeNoise noise_;
-  double inv_omega_n_ = 0.0;  ///< 1/ω_n
+  /// q²/12 of u, i, n with q the configured resolution, else the measured one (0 while none is): the
+  /// quantisation's share of each σ², kept here since it changes only where a resolution does.
+  std::array<double, 3> quantisation_var_{};
 };
 
 /// The classification of a control-rate stream (DriveEstimator's dense samples): the samples' means over

@@ -9,7 +9,8 @@
 //   c = [e_ref,magnet, e_α,magnet, e_ref,copper, e_α,copper]: a law's temperature reads T + e_ref + e_α·(T − T_ref)
 //   Var(v_i) = q_d,i·Δt + Σ_terms (σ_rel,term·ΔP_term,i)²: a loss model's error moves with the loss it
 //   models, so each change ΔP of a modelled loss term between steps adds its relative uncertainty squared
-//   P⁺ = F·P·Fᵀ + Q_d,  F = [Φ Γ_d 0; 0 I 0; 0 0 I],  Q_d = (Δt/2)·(Φ·Q_T·Φᵀ + Q_T) on T (trapezoidal rule)
+//   P⁺ = F·P·Fᵀ + Q_d,  F = [Φ Γ_d 0; 0 I 0; 0 0 I],  Q_d = (Δt/2)·(Φ·Q_T·Φᵀ + Q_T) on T (trapezoidal rule),
+//        formed blockwise: only the rows and columns of T change (eq. 14.12)
 //   observe:  y = h·T + h_c·c + offset + v_y,  v_y ~ N(0, r);  ν = y − ŷ,  s = H·P·Hᵀ + r
 //             K = [P_xx·Hᵀ/s on T and d; 0 on c],  x += K·ν,  P −= rank-one terms of that gain (eq. 14.11)
 //
