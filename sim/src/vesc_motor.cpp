@@ -24,12 +24,14 @@ bool VescMotor::step() noexcept {
   const TruthRow at_start = truth_;  // the start of the cycle the next row completes
   const std::int64_t before_ns = row_.sample.t_ns;
   if (!simulator_.next(row_, truth_)) return false;
-  if (!started_) {  // the drive is running when the emulation begins: the PLL is locked on it
-    pll_angle_rad_ = row_.sample.theta_el_rad;
-    pll_speed_rad_s_ = row_.sample.omega_el_rad_s;
+  const double dt_s = started_ ? core::to_seconds(row_.sample.t_ns - before_ns) : 0.0;
+  if (pll_cycles_++ < 2) {
+    // The drive is running when the emulation begins: the PLL is locked on the rotor, its angle one cycle
+    // ahead (after each update θ̂ predicts the next cycle's angle; e = 0 at a constant speed).
+    pll_speed_rad_s_ = truth_.omega_el_rad_s;
+    pll_angle_rad_ = core::wrap_angle(row_.sample.theta_el_rad + pll_speed_rad_s_ * dt_s);
   } else {
     // foc_pll_run: e = wrap(θ − θ̂), θ̂ += (ω̂ + k_p·e)·dt, ω̂ += k_i·e·dt.
-    const double dt_s = core::to_seconds(row_.sample.t_ns - before_ns);
     const double e = core::wrap_angle(row_.sample.theta_el_rad - pll_angle_rad_);
     pll_angle_rad_ = core::wrap_angle(pll_angle_rad_ + (pll_speed_rad_s_ + can::vesc::kDefaultPllKp * e) * dt_s);
     pll_speed_rad_s_ += can::vesc::kDefaultPllKi * e * dt_s;

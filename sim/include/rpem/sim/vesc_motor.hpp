@@ -71,6 +71,7 @@ class VescMotor {
   /// can::vesc::kDefaultPllKp/Ki): its speed is the ERPM the firmware reports (mcpwm_foc_get_rpm).
   double pll_angle_rad_ = 0.0;
   double pll_speed_rad_s_ = 0.0;
+  int pll_cycles_ = 0;
   bool started_ = false;
   double input_current_sum_A_ = 0.0;  ///< m_input_current_sum: power-balance input current per cycle
   double tacho_steps_ = 0.0;  ///< 6 per electrical revolution (mc_interface_get_tachometer_value)
