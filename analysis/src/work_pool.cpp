@@ -10,14 +10,14 @@ namespace rpem::analysis {
 
 /// One parallel_for: its indices, handed out one at a time, and how many have returned.
 struct WorkPool::Loop {
-  Loop(std::size_t count, const std::function<void(std::size_t)>& f) : n(count), body(f) {}
+  Loop(const WorkPool& p, std::size_t count, const std::function<void(std::size_t)>& f) : pool(p), n(count), body(f) {}
+  const WorkPool& pool;
   const std::size_t n;
   const std::function<void(std::size_t)>& body;
   std::atomic<std::size_t> next{0};
   std::atomic<std::size_t> done{0};
   std::atomic<bool> failed{false};
-  std::mutex mutex;
-  std::condition_variable finished;
+  std::mutex mutex;  ///< guards error
   std::exception_ptr error;
 
   [[nodiscard]] bool open() const noexcept { return next.load() < n; }
@@ -34,8 +34,10 @@ struct WorkPool::Loop {
         }
       }
       if (++done == n) {
-        const std::lock_guard lock(mutex);
-        finished.notify_all();
+        // The caller waits on the pool's signal (helping other loops meanwhile): under the pool's mutex, so
+        // that it cannot miss it between its test and its wait.
+        { const std::lock_guard lock(pool.mutex_); }
+        pool.wake_.notify_all();
       }
     }
   }
@@ -64,22 +66,36 @@ void WorkPool::parallel_for(std::size_t n, const std::function<void(std::size_t)
     for (std::size_t i = 0; i < n; ++i) body(i);
     return;
   }
-  const auto loop = std::make_shared<Loop>(n, body);
+  const auto loop = std::make_shared<Loop>(*this, n, body);
   {
     const std::lock_guard lock(mutex_);
     loops_.push_back(loop);
   }
   wake_.notify_all();
   loop->run();
-  {
-    const std::lock_guard lock(mutex_);
-    loops_.erase(std::find(loops_.begin(), loops_.end(), loop));
+  // Its indices are all taken; until the last one returns, this thread helps whatever loop still has
+  // indices (the nested loops of the ones still running, newest first) instead of waiting idle: a round's
+  // fits, say, end at different times, and the last one's replays would otherwise run on one thread.
+  std::unique_lock lock(mutex_);
+  loops_.erase(std::find(loops_.begin(), loops_.end(), loop));
+  while (loop->done.load() != n) {
+    if (const std::shared_ptr<Loop> other = newest_open()) {
+      lock.unlock();
+      other->run();
+      lock.lock();
+      continue;
+    }
+    wake_.wait(lock);
   }
-  {
-    std::unique_lock lock(loop->mutex);
-    loop->finished.wait(lock, [&] { return loop->done.load() == n; });
-  }
+  lock.unlock();
   if (loop->error) std::rethrow_exception(loop->error);
+}
+
+std::shared_ptr<WorkPool::Loop> WorkPool::newest_open() const {
+  for (auto it = loops_.rbegin(); it != loops_.rend(); ++it) {
+    if ((*it)->open()) return *it;
+  }
+  return nullptr;
 }
 
 void WorkPool::work() {
@@ -88,12 +104,6 @@ void WorkPool::work() {
     {
       std::unique_lock lock(mutex_);
       // The newest loop first: a nested one, whose caller waits for it inside an older loop's index.
-      auto newest_open = [&] {
-        for (auto it = loops_.rbegin(); it != loops_.rend(); ++it) {
-          if ((*it)->open()) return *it;
-        }
-        return std::shared_ptr<Loop>();
-      };
       wake_.wait(lock, [&] { return stopping_ || newest_open() != nullptr; });
       if (stopping_) return;
       loop = newest_open();

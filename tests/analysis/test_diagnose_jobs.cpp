@@ -4,10 +4,12 @@
 #include <gtest/gtest.h>
 
 #include <atomic>
+#include <chrono>
 #include <filesystem>
 #include <fstream>
 #include <regex>
 #include <sstream>
+#include <thread>
 
 #include "rpem/analysis/diagnose/diagnose_output.hpp"
 #include "rpem/analysis/work_pool.hpp"
@@ -86,6 +88,29 @@ TEST(WorkPool, NestedLoopsRunEveryIndexOnceAndRethrowTheFirstError) {
   for (const auto& r : runs) EXPECT_EQ(r.load(), 1);
   EXPECT_THROW(pool.parallel_for(50, [](std::size_t i) { if (i == 7) throw std::runtime_error("seven"); }), std::runtime_error);
   EXPECT_GE(analysis::available_cpus(), 1);
+}
+
+TEST(WorkPool, ACallerWhoseIndicesAreDoneHelpsTheNestedLoopsStillRunning) {
+  // Two fits of a round, say: the caller's ends at once, the other thread's runs a nested loop of replays.
+  // The caller, its own loop's indices all taken, must work on that nested loop rather than wait idle.
+  const analysis::WorkPool pool(2);
+  const std::thread::id caller = std::this_thread::get_id();
+  std::atomic<bool> long_one_started{false};
+  std::atomic<int> nested_on_caller{0}, nested_total{0};
+  pool.parallel_for(2, [&](std::size_t) {
+    if (std::this_thread::get_id() == caller) {
+      while (!long_one_started.load()) std::this_thread::yield();  // the other index is taken by the worker
+      return;
+    }
+    long_one_started = true;
+    pool.parallel_for(40, [&](std::size_t) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(2));
+      ++nested_total;
+      if (std::this_thread::get_id() == caller) ++nested_on_caller;
+    });
+  });
+  EXPECT_EQ(nested_total.load(), 40);
+  EXPECT_GT(nested_on_caller.load(), 0);
 }
 
 }  // namespace

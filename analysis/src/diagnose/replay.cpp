@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 
 #include "rpem/core/conditioner.hpp"
 #include "rpem/core/predictor.hpp"
@@ -34,10 +35,23 @@ class ModelReplay::Chain {
         m_(machine_),
         drifting_(model.r_s_law || model.psi_m_law || model.r_s_trend != 0.0 || model.psi_m_trend != 0.0) {}
 
+  /// Whether `other`'s conditioner gives this one's conditioned samples, bit for bit: the same extensions
+  /// (compared as bytes: ModelExtensions holds doubles only) and, where they read it, the same machine
+  /// (the base is the replay's). A model moved along a calibrated constant or a drift shares its samples
+  /// with the model it was moved from.
+  [[nodiscard]] bool conditions_like(const Chain& other) const noexcept {
+    const core::ModelExtensions &a = model_.extensions, &b = other.model_.extensions;
+    if (std::memcmp(&a, &b, sizeof a) != 0) return false;
+    return !a.reads_machine() || std::memcmp(&machine_, &other.machine_, sizeof machine_) == 0;
+  }
+  /// The sample as this chain's conditioner turns it into the predictor's interval (a chain that conditions
+  /// like another takes that one's instead, replay_block).
+  core::EstimatorSample condition(const Shared& x) noexcept { return conditioner_.condition(x.s); }
+
   /// Transient: sample k of a block whose own samples start at `first` (earlier ones warm the conditioner
-  /// up); `out` is filled for the block's own samples that take part.
-  void step_transient(std::size_t k, std::size_t first, const Shared& x, const core::Vec2* logged_i_dq_A, ModelSample& out) {
-    const core::EstimatorSample e = conditioner_.condition(x.s);
+  /// up), `e` the sample conditioned (condition()); `out` is filled for the block's own samples that take part.
+  void step_transient(std::size_t k, std::size_t first, const Shared& x, const core::EstimatorSample& e,
+                      const core::Vec2* logged_i_dq_A, ModelSample& out) {
     if (k < first) return;  // warm-up
     out = ModelSample{};
     if (!e.i_meas_pu.allFinite()) {
@@ -131,12 +145,29 @@ void ModelReplay::replay_block(int b, std::span<const ExtendedModel> models, con
   std::vector<ModelSample> out(models.size());
   Shared x;
   if (log_.mode == ModelMode::kTransient) {
+    // The models that condition alike share one conditioner's samples: the first of each kind conditions.
+    std::vector<std::size_t> conditioned_by(chains.size());
+    for (std::size_t j = 0; j < chains.size(); ++j) {
+      conditioned_by[j] = j;
+      for (std::size_t i = 0; i < j; ++i) {
+        if (conditioned_by[i] == i && chains[i].conditions_like(chains[j])) {
+          conditioned_by[j] = i;
+          break;
+        }
+      }
+    }
+    std::vector<core::EstimatorSample> conditioned(chains.size());
     for (std::size_t k = first >= kWarmup ? first - kWarmup : 0; k < end; ++k) {
       x.s = log_.replay_sample(k);
       x.logged = core::Rotation::of(x.s.theta_el_rad);
       const bool own = k >= first, used = own && log_.used(k);
       const core::Vec2 logged = used ? core::SampleConditioner::logged_current_dq_A(x.s, x.logged) : core::Vec2::Zero();
-      for (std::size_t j = 0; j < chains.size(); ++j) chains[j].step_transient(k, first, x, used ? &logged : nullptr, out[j]);
+      for (std::size_t j = 0; j < chains.size(); ++j) {
+        if (conditioned_by[j] == j) conditioned[j] = chains[j].condition(x);
+      }
+      for (std::size_t j = 0; j < chains.size(); ++j) {
+        chains[j].step_transient(k, first, x, conditioned[conditioned_by[j]], used ? &logged : nullptr, out[j]);
+      }
       if (used) visit(k, out);
     }
   } else {

@@ -2,10 +2,11 @@
 // A fixed set of threads that run the indices of a loop (`rpem diagnose --jobs N`: the blocks of a replay,
 // the candidates of a round). The calling thread takes part, so a pool of one thread is the plain loop.
 // Loops nest: a body may run a loop of its own on the same pool — its caller works on its own indices and
-// idle threads help, so no thread ever waits for a task nobody runs. Which thread runs an index is not
-// fixed; what it computes must not depend on it: bodies write to their own index's slot, and callers
-// combine the slots in index order, so that the results are the same, to the last bit, for any number of
-// threads.
+// idle threads help, so no thread ever waits for a task nobody runs; a caller whose indices are all taken
+// helps the loops still open (the others' nested ones) until its own last index returns. Which thread runs
+// an index is not fixed; what it computes must not depend on it: bodies write to their own index's slot,
+// and callers combine the slots in index order, so that the results are the same, to the last bit, for
+// any number of threads.
 
 #include <condition_variable>
 #include <cstddef>
@@ -37,6 +38,8 @@ class WorkPool {
  private:
   struct Loop;
   void work();
+  /// The newest loop with indices not yet taken, if any (mutex_ held).
+  [[nodiscard]] std::shared_ptr<Loop> newest_open() const;
 
   std::vector<std::thread> workers_;
   mutable std::mutex mutex_;

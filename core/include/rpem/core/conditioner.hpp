@@ -83,6 +83,10 @@ struct ModelExtensions {
     }
     return false;
   }
+  /// Whether SampleConditioner's condition() and observed_current_dq_A() read the machine's constants
+  /// under these extensions: the inductance curves scale x_d and x_q, iron loss needs them and ψm, r_s.
+  /// Without either, conditioners of one base and these extensions give the same results for any machine.
+  [[nodiscard]] bool reads_machine() const noexcept { return saturation() || iron_loss_r_fe_Ohm > 0.0; }
 };
 
 /// One sample's inputs for the steady-state model (dq logs sampled far apart in time): the command
