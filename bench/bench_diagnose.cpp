@@ -56,7 +56,7 @@ void BM_DiagnoseTwentySecondLog(benchmark::State& state) {
     analysis::write_extended_yaml(f.dir + "/extended.yaml", d, io::builtin_paper_config_text());
     analysis::write_diagnose_report(f.dir, d, "builtin:paper-ipmsm");
     if (d.selection.found.size() != 1) state.SkipWithError("the dead time was not found");
-    state.counters["samples"] = static_cast<double>(d.log->rows.size());
+    state.counters["samples"] = static_cast<double>(d.log->size());
   }
 }
 BENCHMARK(BM_DiagnoseTwentySecondLog)
@@ -127,11 +127,11 @@ void BM_DiagnoseVescToolLog(benchmark::State& state) {
     analysis::write_extended_yaml(f.dir + "/extended.yaml", d, f.config_text);
     analysis::write_diagnose_report(f.dir, d, "config/vesc-6374-outrunner.yaml");
     // The first row only opens the first window (docs/drive-log.md, "Averaging"): 9 999 samples.
-    if (d.log->rows.size() != 9'999) state.SkipWithError("not every row was read");
+    if (d.log->size() != 9'999) state.SkipWithError("not every row was read");
     if (!d.calibration.identifiable[0] || std::abs(d.calibration.value[0] / (0.8 * f.config.machine.psi_m_Wb) - 1.0) > 0.02) {
       state.SkipWithError("ψm was not calibrated within 2 %");
     }
-    state.counters["rows"] = static_cast<double>(d.log->rows.size());
+    state.counters["rows"] = static_cast<double>(d.log->size());
     state.counters["bridge_off"] = static_cast<double>(d.regimes.counts.regimes[core::Regime::kBridgeOff]);
   }
 }

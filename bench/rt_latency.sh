@@ -64,12 +64,22 @@ YAML
   # The same loop with timer anticipation (loop.wake_ahead_s: auto): after its first second it sleeps
   # until its median wake-up latency before each deadline, then spins to it.
   sed -e 's/period_s: 125.0e-6,/period_s: 125.0e-6, wake_ahead_s: auto,/' "$out/rpemd-host.yaml" >"$out/rpemd-ahead.yaml"
+  # The same loop with the thermal network's Kalman filter on every sample (issue 24 item 6: the fusion must
+  # not move the latency figures): a two-node network for the built-in drive (docs/thermal.md, "In rpemd").
+  cat "$out/rpemd-host.yaml" - >"$out/rpemd-thermal.yaml" <<YAML
+thermal:
+  nodes:
+    - {name: winding, capacitance_J_per_K: 3000, to_coolant_W_per_K: 2}
+    - {name: magnet, capacitance_J_per_K: 7000, to_coolant_W_per_K: 4}
+  conductances: [{from: winding, to: magnet, W_per_K: 12}]
+  coolant_C: 35
+YAML
   # The same daemon kept entirely on CPU 0: the load rpemd's own other threads put beside its loop.
   sed -e 's/cpu: 1}/cpu: 0}/' "$out/rpemd-host.yaml" >"$out/rpemd-cpu0.yaml"
   echo "== host: $rounds × ${slice} s each of cyclictest -m -p 80 -i 125 -a 1 (alone; and beside an rpemd kept on CPU 0)"
   echo "   and of rpemd (loop 125 µs, FIFO 80, CPU 1, sim source; its other threads on CPU 0), plain and with"
-  echo "   loop.wake_ahead_s: auto"
-  local cyc=() cycl=() rpm=() rpa=()
+  echo "   loop.wake_ahead_s: auto, and plain with the thermal fusion on"
+  local cyc=() cycl=() rpm=() rpa=() rpt=()
   run_rpemd() {  # config, histogram, log; prints CPU use per thread when asked
     "$build/daemon/rpemd" --config "$1" --latency-histogram "$2" 2>"$3" &
     local pid=$!
@@ -96,12 +106,16 @@ YAML
     rpm+=("$out/r$r.hist")
     run_rpemd "$out/rpemd-ahead.yaml" "$out/a$r.hist" "$out/a$r.txt" "$([[ $r -eq 1 ]] && echo ahead)"
     rpa+=("$out/a$r.hist")
+    run_rpemd "$out/rpemd-thermal.yaml" "$out/t$r.hist" "$out/t$r.txt" "$([[ $r -eq 1 ]] && echo thermal)"
+    rpt+=("$out/t$r.hist")
   done
   grep -h "overruns" "$out"/r*.txt | awk '{o += $(NF-4); p += $(NF-1)} END {printf "host: rpemd overruns %d in %d periods\n", o, p}'
   report host 125 "${cyc[@]}" -- "${rpm[@]}"
   grep -h "overruns" "$out"/a*.txt | awk '{o += $(NF-4); p += $(NF-1)} END {printf "host, wake-ahead auto: rpemd overruns %d in %d periods\n", o, p}'
   grep -h "calibrated" "$out"/a*.txt | sed 's/^/host, wake-ahead auto: /'
   report "host, wake-ahead auto" 125 "${cyc[@]}" -- "${rpa[@]}"
+  grep -h "overruns" "$out"/t*.txt | awk '{o += $(NF-4); p += $(NF-1)} END {printf "host, thermal fusion on: rpemd overruns %d in %d periods\n", o, p}'
+  report "host, thermal fusion on" 125 "${cyc[@]}" -- "${rpt[@]}"
   report "host, cyclictest beside rpemd on CPU 0" 125 "${cycl[@]}" -- "${rpm[@]}"
 }
 

@@ -178,12 +178,12 @@ SteadyStateInputs SampleConditioner::steady_state(const DriveSample& s) const no
   return out;
 }
 
-Vec2 SampleConditioner::logged_current_dq_A(const DriveSample& s) const noexcept {
+Vec2 SampleConditioner::logged_current_dq_A(const DriveSample& s, const Rotation& logged) noexcept {
   switch (s.current_frame) {
     case Frame::kAbc:
-      return park(clarke(s.i_A), Rotation::of(s.theta_el_rad));
+      return park(clarke(s.i_A), logged);
     case Frame::kAlphaBeta:
-      return park(s.i_A.head<2>(), Rotation::of(s.theta_el_rad));
+      return park(s.i_A.head<2>(), logged);
     case Frame::kDq:
       break;
   }

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 
+#include "rpem/core/units.hpp"
+
 namespace rpem::daemon {
 
 namespace vesc = can::vesc;
@@ -115,6 +117,8 @@ bool VescPoller::on_frame(const can::CanFrame& f, std::int64_t rx_ns, core::Aver
   }
   timed_out_unanswered_ = false;
 
+  const core::SpeedRead previous_speed = previous_speed_;
+  previous_speed_ = {t, core::rpm_to_rad_s(decoder_.values().erpm)};
   if (!has_window_start_) {  // the first reply only opens the first window
     has_window_start_ = true;
     window_start_ns_ = t;
@@ -127,6 +131,8 @@ bool VescPoller::on_frame(const can::CanFrame& f, std::int64_t rx_ns, core::Aver
     return false;
   }
   sample = vesc::to_averaged_sample(decoder_.values(), window_start_ns_, t);
+  sample.omega_el_rad_s =
+      core::window_mean_speed_rad_s(previous_speed, previous_speed_, window_start_ns_, config_.speed_lag_s);
   sample.gap_before = gap_;
   gap_ = false;
   window_start_ns_ = t;

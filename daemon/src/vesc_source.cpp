@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 #include <ctime>
+#include <optional>
 
 #include "rpem/can/socketcan.hpp"
 #include "rpem/can/vesc.hpp"
@@ -49,6 +50,7 @@ VescPoller::Config poller_config(const VescSource::Options& o) noexcept {
   c.period_ns = std::llround(1e9 / o.poll_rate_Hz);
   c.phase_ns = std::llround(o.poll_phase * static_cast<double>(c.period_ns));
   c.timeout_ns = std::llround(o.reply_timeout_s * 1e9);
+  c.speed_lag_s = core::pll_ramp_lag_s(o.pll_kp, o.pll_ki);
   return c;
 }
 
@@ -125,6 +127,11 @@ VescSource::Options VescSource::parse(io::YamlMap& section, const std::string&) 
   o.poll_phase = section.number_or("poll_phase", o.poll_phase, 0.0, 0.999);
   const double period_s = 1.0 / o.poll_rate_Hz;
   o.reply_timeout_s = section.number_or("reply_timeout_s", std::min(0.9 * period_s, 20e-3), 1e-4, period_s);
+  if (std::optional<io::YamlMap> pll = section.optional_map("pll")) {
+    o.pll_kp = pll->number_or("kp", o.pll_kp, 1e-3, 1e7);
+    o.pll_ki = pll->number_or("ki", o.pll_ki, 1e-3, 1e10);
+    pll->finish();
+  }
   section.finish();
   return o;
 }

@@ -4,6 +4,7 @@
 #include <limits>
 
 #include "rpem/core/clock.hpp"
+#include "rpem/core/reported_speed.hpp"
 #include "rpem/io/number_format.hpp"
 
 namespace rpem::io {
@@ -58,6 +59,7 @@ std::vector<core::AveragedSample> read_averaged_log(const std::string& path, con
   std::vector<core::AveragedSample> out;
   MappedRow r;
   std::optional<std::int64_t> previous_t_ns;
+  double previous_omega_rad_s = 0.0;  // the previous row's speed as the column gives it
   std::size_t first_line = 0;
   while (reader.next(r)) {
     ++read.rows;
@@ -69,16 +71,23 @@ std::vector<core::AveragedSample> read_averaged_log(const std::string& path, con
     } else if (!previous_t_ns) {
       // The means of the first row ran since a read before the log began: an unknown window.
       previous_t_ns = r.t_ns;
+      previous_omega_rad_s = r[Quantity::kOmegaEl];
       first_line = r.line;
       ++read.opening_rows;
       continue;
     } else {
       s.t_start_ns = *previous_t_ns;
     }
-    previous_t_ns = r.t_ns;
     s.i_dq_A = {r[Quantity::kID], r[Quantity::kIQ]};
     s.u_dq_V = {r[Quantity::kUD], r[Quantity::kUQ]};
     s.omega_el_rad_s = r[Quantity::kOmegaEl];
+    if (map.speed_lag_s > 0.0) {
+      // A PLL's speed at each read: the window's mean from this read's and the previous one's (§13).
+      s.omega_el_rad_s = core::window_mean_speed_rad_s({*previous_t_ns, previous_omega_rad_s}, {r.t_ns, s.omega_el_rad_s},
+                                                       s.t_start_ns, map.speed_lag_s);
+    }
+    previous_t_ns = r.t_ns;
+    previous_omega_rad_s = r[Quantity::kOmegaEl];
     s.u_dc_V = r[Quantity::kUDc];
     s.t_winding_C = r[Quantity::kTWinding];
     s.t_magnet_C = r[Quantity::kTMagnet];

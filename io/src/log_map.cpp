@@ -4,6 +4,8 @@
 #include <cassert>
 #include <numbers>
 
+#include "rpem/core/reported_speed.hpp"
+
 namespace rpem::io {
 namespace {
 
@@ -299,6 +301,17 @@ LogMap parse(YamlMap root) {
   for (const QuantityInfo& q : kQuantities) {
     std::optional<YamlMap> c = columns.optional_map(q.name);
     if (!c) continue;
+    if (std::optional<YamlMap> pll = c->optional_map("pll")) {
+      // The speed a type-2 PLL reports at the read (VESC: foc_pll_kp, foc_pll_ki; docs/drive-log.md).
+      if (q.quantity != Quantity::kOmegaEl) pll->fail("", "only a speed (omega_el) comes from a PLL");
+      if (m.window != Window::kPreviousRow) {
+        pll->fail("", "a PLL's speed at the read is rebuilt into window means only with window: previous_row");
+      }
+      const double kp = pll->number("kp", 1e-3, 1e7);
+      const double ki = pll->number("ki", 1e-3, 1e10);
+      pll->finish();
+      m.speed_lag_s = core::pll_ramp_lag_s(kp, ki);
+    }
     m.columns.push_back(parse_column(*c, q.quantity, q.kind, m.header, pole_pairs, mechanical));
     present[static_cast<std::size_t>(q.quantity)] = true;
   }

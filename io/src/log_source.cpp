@@ -1,5 +1,6 @@
 #include "rpem/io/log_source.hpp"
 
+#include <cstdio>
 #include <fstream>
 #include <vector>
 
@@ -77,6 +78,12 @@ std::string describe(const LogSource& source, const AveragedLogRead& read) {
   std::string s = source.path + " as " + source.format + ": " + std::to_string(read.rows) + " rows, " +
                   std::to_string(read.rows - read.opening_rows) + " averaged samples";
   if (read.opening_rows > 0) s += " (the first row opens the first window: its own began before the log)";
+  if (source.map.speed_lag_s > 0.0) {
+    char lag[160];
+    std::snprintf(lag, sizeof lag, "; each window's mean speed rebuilt from the PLL speeds at its two reads (lag %.4g ms)",
+                  1e3 * source.map.speed_lag_s);
+    s += lag;
+  }
   return s + describe(read.repairs);
 }
 

@@ -22,7 +22,20 @@ VescMotor::VescMotor(Scenario scenario, Settings settings)
 
 bool VescMotor::step() noexcept {
   const TruthRow at_start = truth_;  // the start of the cycle the next row completes
+  const std::int64_t before_ns = row_.sample.t_ns;
   if (!simulator_.next(row_, truth_)) return false;
+  const double dt_s = started_ ? core::to_seconds(row_.sample.t_ns - before_ns) : 0.0;
+  if (pll_cycles_++ < 2) {
+    // The drive is running when the emulation begins: the PLL is locked on the rotor, its angle one cycle
+    // ahead (after each update θ̂ predicts the next cycle's angle; e = 0 at a constant speed).
+    pll_speed_rad_s_ = truth_.omega_el_rad_s;
+    pll_angle_rad_ = core::wrap_angle(row_.sample.theta_el_rad + pll_speed_rad_s_ * dt_s);
+  } else {
+    // foc_pll_run: e = wrap(θ − θ̂), θ̂ += (ω̂ + k_p·e)·dt, ω̂ += k_i·e·dt.
+    const double e = core::wrap_angle(row_.sample.theta_el_rad - pll_angle_rad_);
+    pll_angle_rad_ = core::wrap_angle(pll_angle_rad_ + (pll_speed_rad_s_ + can::vesc::kDefaultPllKp * e) * dt_s);
+    pll_speed_rad_s_ += can::vesc::kDefaultPllKi * e * dt_s;
+  }
   started_ = true;
   if (const auto c = cycles_.add(row_)) account(firmware_view(*c, at_start));
   return true;
@@ -110,7 +123,7 @@ can::vesc::Status VescMotor::status(int number) const noexcept {
   s.number = number;
   const ControlCycle& c = last_cycle_;
   const double u_max = c.u_dc_V / std::sqrt(3.0);
-  s.erpm = core::rad_s_to_rpm(row_.sample.omega_el_rad_s);
+  s.erpm = core::rad_s_to_rpm(pll_speed_rad_s_);  // mc_interface_get_rpm: the PLL's speed
   s.current_A = c.i_dq_A[1];
   s.duty = u_max > 0.0 ? std::copysign(c.u_dq_V.norm() / u_max, c.u_dq_V[1]) : 0.0;
   s.amp_hours_Ah = amp_hours_;

@@ -115,9 +115,14 @@ TEST(NoiseFloor, SecondDifferencesRecoverTheWhiteNoiseUnderASmoothError) {
   // sampling rate (a 270 Hz ripple of 0.1 A at 8 kHz, a slow drift, a step): the floor is the noise's.
   LogData log;
   constexpr std::size_t n = 40000;
-  log.rows.resize(n);
-  log.block.assign(n, 0);
-  for (std::size_t k = 0; k < n; ++k) log.block[k] = static_cast<int>(k / 1000);
+  for (std::size_t k = 0; k < n; ++k) {
+    io::DriveLogRow row;
+    row.sample.t_ns = static_cast<std::int64_t>(k) * 125'000;
+    log.samples.push_back(row);
+  }
+  log.samples.finish();
+  log.blocks = static_cast<int>(n / 1000);
+  for (std::size_t b = 0; b <= n / 1000; ++b) log.block_first.push_back(b * 1000);
   ReplayOutput r;
   r.valid.assign(n, true);
   r.residual_A.resize(n);
@@ -186,14 +191,14 @@ TEST(LogData, SteadyStateLeavesOutIdleAndTransitionalRowsAndBlocksAlternate) {
   EXPECT_EQ(log.excluded_idle, 2U);
   // Row 2 follows an idle row and rows 99, 100 sit at the load change: transitional.
   EXPECT_EQ(log.excluded_transitional, 3U);
-  EXPECT_FALSE(log.used[2]);
-  EXPECT_TRUE(log.used[3]);
-  EXPECT_FALSE(log.used[99]);
-  EXPECT_FALSE(log.used[100]);
+  EXPECT_FALSE(log.used(2));
+  EXPECT_TRUE(log.used(3));
+  EXPECT_FALSE(log.used(99));
+  EXPECT_FALSE(log.used(100));
   EXPECT_EQ(log.blocks, 40);
   EXPECT_TRUE(log.training(10));    // block 2
   EXPECT_TRUE(log.heldout(15));     // block 3
-  EXPECT_EQ(log.block.back(), 39);
+  EXPECT_EQ(log.block(log.size() - 1), 39);
 }
 
 TEST(ReportedCommand, AppliedMeanIsTheHeldVectorAveragedInTheRotorFrame) {

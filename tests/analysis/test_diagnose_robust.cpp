@@ -88,8 +88,15 @@ TEST(Calibration, AConstantIsKeptNarrowOrWhereTheLogRejectsTheConfiguration) {
 /// A log of `n` rows in one block whose replay is `n` valid white residuals.
 std::pair<LogData, ReplayOutput> white_run(std::size_t n, std::mt19937_64& rng) {
   LogData log;
-  log.rows.resize(n);
-  log.block.assign(n, 0);
+  log.samples = SampleStore(io::DriveLogLayout{});
+  for (std::size_t k = 0; k < n; ++k) {
+    io::DriveLogRow row;
+    row.sample.t_ns = static_cast<std::int64_t>(k) * 125'000;
+    log.samples.push_back(row);
+  }
+  log.samples.finish();
+  log.blocks = 1;
+  log.block_first = {0, n};
   ReplayOutput r;
   r.valid.assign(n, true);
   r.residual_A.resize(n);
@@ -144,8 +151,9 @@ TEST(NoiseFloor, UnknownWhereNoRowsRepeatAnOperatingPointAndTheVerdictIsUndeterm
   const LogData log = prepare_log(std::move(rows), io::DriveLogLayout{}, test::paper_machine_si(), {});
   ASSERT_EQ(log.mode, ModelMode::kSteadyState);
   ReplayOutput r;
-  r.valid = log.used;
-  r.residual_A.assign(log.rows.size(), core::Vec2(0.1, -0.1));
+  r.valid.resize(log.size());
+  for (std::size_t k = 0; k < log.size(); ++k) r.valid[k] = log.used(k);
+  r.residual_A.assign(log.size(), core::Vec2(0.1, -0.1));
   const NoiseFloor f = measure_noise_floor(log, r);
   ASSERT_FALSE(f.value_A);
   EXPECT_EQ(f.differences, 0U);

@@ -227,6 +227,52 @@ TEST(Conditioner, IncrementalRotationAgreesWithTheExactOne) {
   EXPECT_LT(worst, 1e-12);
 }
 
+TEST(Conditioner, ReadsTheMachineOnlyWhereTheExtensionsSaySo) {
+  // rpem diagnose's replay lets models that differ only in the machine's constants share one conditioner's
+  // samples where !reads_machine(): their conditioned samples and observed currents are then equal bit for
+  // bit; with an inductance curve or iron loss they are not.
+  const PerUnitBase b = test::paper_base();
+  const MachinePu m = test::paper_machine_pu();
+  MachinePu other = m;
+  other.r_s_pu *= 1.1;
+  other.psi_m_pu *= 0.9;
+  other.x_d_pu *= 1.2;
+  other.x_q_pu *= 0.8;
+  ModelExtensions x;
+  x.theta_offset_rad = 0.05;
+  x.current_offset_A = Vec3(0.1, -0.05, 0.0);
+  x.deadtime_v_err_V = 2.0;
+  x.deadtime_t_dead_s = 1e-6;
+  x.switching_frequency_Hz = 8000.0;
+  x.delay_s = 60e-6;
+  x.flux_harmonics[0].d_cos_Wb = 0.004;
+  auto differs = [&](const ModelExtensions& e) {
+    SampleConditioner c1(b, m, e), c2(b, other, e);
+    bool any = false;
+    for (int k = 0; k < 200; ++k) {
+      const double theta = wrap_angle(0.05 * k);
+      const DriveSample s = sample(k * 125'000LL, theta, Vec3(30.0 * std::cos(theta), 30.0 * std::cos(theta - 2.1), -10.0),
+                                   Vec3(2.0 * std::sin(theta), -1.0, 3.0 * std::cos(theta)));
+      const EstimatorSample a = c1.condition(s), d = c2.condition(s);
+      const Vec2 i_model(0.1, -0.2);
+      any = any || a.interval.u_start_pu != d.interval.u_start_pu || a.interval.u_end_pu != d.interval.u_end_pu ||
+            a.i_meas_pu != d.i_meas_pu || a.x_d_pu != d.x_d_pu || a.x_q_pu != d.x_q_pu || a.interval.dt_s != d.interval.dt_s ||
+            c1.observed_current_dq_A(s, i_model) != c2.observed_current_dq_A(s, i_model);
+    }
+    return any;
+  };
+  ASSERT_FALSE(x.reads_machine());
+  EXPECT_FALSE(differs(x));
+  ModelExtensions curve = x;
+  curve.inductance_q = {1.0, -0.004};
+  ASSERT_TRUE(curve.reads_machine());
+  EXPECT_TRUE(differs(curve));
+  ModelExtensions iron = x;
+  iron.iron_loss_r_fe_Ohm = 2000.0;
+  ASSERT_TRUE(iron.reads_machine());
+  EXPECT_TRUE(differs(iron));
+}
+
 TEST(DriveEstimator, SiPhaseSamplesConvergeLikeThePerUnitPath) {
   const PerUnitBase base = test::paper_base();
   test::ModelDataGenerator gen;

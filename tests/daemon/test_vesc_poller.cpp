@@ -49,6 +49,19 @@ std::optional<core::AveragedSample> reply(VescPoller& p, std::int64_t t_ns) {
   return got ? std::optional(s) : std::nullopt;
 }
 
+/// `frames` received 20 µs apart from `t_ns` after a poll sent 300 µs before: the sample they complete, if any.
+std::optional<core::AveragedSample> poll_and_receive(VescPoller& p, std::int64_t t_ns, const std::vector<can::CanFrame>& frames) {
+  p.on_time(t_ns - 300'000);
+  p.polled(t_ns - 300'000, true);
+  core::AveragedSample s;
+  bool got = false;
+  for (const can::CanFrame& f : frames) {
+    got = p.on_frame(f, t_ns, s) || got;
+    t_ns += 20'000;
+  }
+  return got ? std::optional(s) : std::nullopt;
+}
+
 /// A poll sent at t, answered 300 µs later.
 std::optional<core::AveragedSample> poll_and_reply(VescPoller& p, std::int64_t t_ns) {
   p.on_time(t_ns);
@@ -105,6 +118,30 @@ TEST(VescPoller, RepliesBecomeWindowsBetweenTheirReceiveTimes) {
   EXPECT_EQ(p.counters().polls, 2U);
   EXPECT_EQ(p.counters().samples, 1U);
   EXPECT_EQ(p.counters().timeouts + p.counters().unrequested + p.counters().stolen_reads, 0U);
+}
+
+// The reply's ERPM is the PLL's speed at the read: the window's mean speed is rebuilt from it and the
+// previous reply's, ω̂_k + (ω̂_k − ω̂_{k−1})·(τ/h − ½) with the configured PLL's τ = k_p/k_i
+// (docs/derivations.md §13, "Speed at the read"; the function itself: test_core's ReportedSpeed.*).
+TEST(VescPoller, TheWindowsSpeedIsRebuiltFromThePllSpeedsAtItsTwoReads) {
+  constexpr double kRadSPerErpm = 2.0 * std::numbers::pi / 60.0;
+  for (const double kp : {2000.0, 1000.0}) {
+    VescSource::Options o;
+    o.controller_id = kController;
+    o.host_id = kHost;
+    o.reply_timeout_s = 2.5e-3;
+    o.pll_kp = kp;  // k_i stays 30000 /s²: τ 66.7 ms, then 33.3 ms
+    VescPoller p(poller_config(o));
+    EXPECT_FALSE(poll_and_receive(p, kT0, test::vesc_frames::reply_frames()).has_value());  // 21000 ERPM
+    const auto s = poll_and_receive(p, kT0 + 5 * kMs, test::vesc_frames::reply_frames_22000_erpm());
+    ASSERT_TRUE(s.has_value());
+    const double tau = kp / 30000.0, h = 5e-3;
+    EXPECT_NEAR(s->omega_el_rad_s, kRadSPerErpm * (22000.0 + 1000.0 * (tau / h - 0.5)), 1e-9) << kp;
+    // The same speed again: a constant speed is its own mean.
+    const auto c = poll_and_receive(p, kT0 + 10 * kMs, test::vesc_frames::reply_frames_22000_erpm());
+    ASSERT_TRUE(c.has_value());
+    EXPECT_NEAR(c->omega_el_rad_s, kRadSPerErpm * 22000.0, 1e-9);
+  }
 }
 
 // A silent controller: every poll times out (counted, and the source is silent). When it answers again,

@@ -14,6 +14,7 @@
 #include "rpem/io/drive_log.hpp"
 #include "rpem/io/log_map.hpp"
 #include "rpem/io/log_source.hpp"
+#include "rpem/io/vesc_tool_log.hpp"
 #include "support/temp_file.hpp"
 
 namespace rpem::io {
@@ -44,6 +45,29 @@ TEST(LogMap, TheMinimalMapReads) {
   ASSERT_TRUE(m.time.has_value());
   EXPECT_DOUBLE_EQ(m.time->unit_factor, 1e-3);
   EXPECT_EQ(m.columns.size(), 5U);
+}
+
+// omega_el's `pll: {kp, ki}` says the column is a PLL's speed at each read (VESC's erpm): its ramp lag k_p/k_i
+// is what the reader rebuilds window means with (docs/derivations.md §13, "Speed at the read"); only a speed,
+// and only where each row's window ends at its read.
+TEST(LogMap, APllSpeedIsASpeedAtTheReadsOfPreviousRowWindows) {
+  const std::string head = "samples: averaged\nwindow: previous_row\ntime: {column: t, unit: ms}\ncolumns:\n"
+                           "  u_d: {column: ud}\n  u_q: {column: uq}\n  i_q: {column: iq}\n";
+  const LogMap m = parse_log_map(head + "  i_d: {column: id}\n  omega_el: {column: w, unit: erpm, pll: {kp: 2000, ki: 30000}}\n",
+                                 "map.yaml");
+  EXPECT_DOUBLE_EQ(m.speed_lag_s, 2000.0 / 30000.0);
+  EXPECT_EQ(parse_log_map(head + "  i_d: {column: id}\n  omega_el: {column: w}\n", "map.yaml").speed_lag_s, 0.0);
+  EXPECT_DOUBLE_EQ(vesc_tool_log_map().speed_lag_s, 2000.0 / 30000.0);  // the firmware's defaults
+  EXPECT_NE(map_error(head + "  omega_el: {column: w}\n  i_d: {column: id, pll: {kp: 1, ki: 1}}\n")
+                .find("columns.i_d.pll: only a speed (omega_el) comes from a PLL"),
+            std::string::npos);
+  EXPECT_NE(map_error(head + "  i_d: {column: id}\n  omega_el: {column: w, pll: {kp: 2000}}\n").find("ki"),
+            std::string::npos);
+  EXPECT_NE(map_error("samples: instantaneous\ntime: {column: time, unit: ms}\ncolumns:\n"
+                      "  omega_el: {column: w, pll: {kp: 2000, ki: 30000}}\n  u_d: {column: ud}\n  u_q: {column: uq}\n"
+                      "  i_d: {column: id}\n  i_q: {column: iq}\n")
+                .find("only with window: previous_row"),
+            std::string::npos);
 }
 
 struct BadMap {

@@ -49,7 +49,9 @@ TEST(VescToolLog, EveryHeaderVersionIsIdentified) {
 
 TEST(VescToolLog, ReadsTheCurrentHeaderAsAveragedSamplesSinceThePreviousRow) {
   // GIVEN three reads 90 and 110 ms apart WHEN read THEN the first row opens the window and each sample
-  // holds the means since the previous row, the speed electrical (erpm·2π/60).
+  // holds the means since the previous row, the speed electrical (erpm·2π/60) and the window's mean: erpm is
+  // the PLL's at each read, lagging a ramp by k_p/k_i = 2000/30000 s, so the mean is
+  // erpm_k + (erpm_k − erpm_{k−1})·(τ/h − ½) (docs/derivations.md §13, "Speed at the read").
   test::TempFile f("vesc.csv", kHeader120 + row120(45000000, -0.5, 3.2, 6000, -0.31, 8.7) +
                                    row120(45000090, -1.25, 10.5, 6100, -0.9, 9.25) +
                                    row120(45000200, -1.5, 11.0, 6200, -1.0, 9.5));
@@ -68,7 +70,12 @@ TEST(VescToolLog, ReadsTheCurrentHeaderAsAveragedSamplesSinceThePreviousRow) {
   EXPECT_DOUBLE_EQ(s[0].i_dq_A[1], 10.5);
   EXPECT_DOUBLE_EQ(s[0].u_dq_V[0], -0.9);
   EXPECT_DOUBLE_EQ(s[0].u_dq_V[1], 9.25);
-  EXPECT_NEAR(s[0].omega_el_rad_s, 6100.0 * 2.0 * std::numbers::pi / 60.0, 1e-9);
+  constexpr double kTau = 2000.0 / 30000.0;
+  EXPECT_NEAR(s[0].omega_el_rad_s, (6100.0 + 100.0 * (kTau / 0.090 - 0.5)) * 2.0 * std::numbers::pi / 60.0, 1e-9);
+  EXPECT_NEAR(s[1].omega_el_rad_s, (6200.0 + 100.0 * (kTau / 0.110 - 0.5)) * 2.0 * std::numbers::pi / 60.0, 1e-9);
+  EXPECT_NE(describe(source, read).find("mean speed rebuilt from the PLL speeds at its two reads (lag 66.67 ms)"),
+            std::string::npos)
+      << describe(source, read);
   EXPECT_DOUBLE_EQ(s[0].u_dc_V, 40.1);
   EXPECT_DOUBLE_EQ(s[0].t_winding_C, 55.0);
   EXPECT_DOUBLE_EQ(s[0].t_drive_C, 41.3);

@@ -102,7 +102,8 @@ TEST(VescEmulator, RepliesCarryTheAveragesOfEveryCycleSinceThePreviousRead) {
     EXPECT_NEAR(v.i_d_A, sum.i_d / n, 0.0101) << "read " << reads;
     EXPECT_NEAR(v.v_d_V, sum.u_d / n, 0.00101) << "read " << reads;
     EXPECT_NEAR(v.v_q_V, sum.u_q / n, 0.00101) << "read " << reads;
-    // Instantaneous values at the read: the last row's speed, DC link and winding temperature.
+    // Instantaneous values at the read: the PLL's speed (locked on this steady drive: the last row's speed),
+    // DC link and winding temperature.
     EXPECT_NEAR(v.erpm, row.sample.omega_el_rad_s * 60.0 / (2.0 * std::numbers::pi), 1.0);
     EXPECT_NEAR(v.v_in_V, row.sample.u_dc_V, 0.1);
     EXPECT_NEAR(v.temp_motor_C, row.t_winding_C.value(), 0.1);

@@ -68,6 +68,42 @@ TEST(CliEstimate, RecoversPsiMAndRsFromADriveLog) {
   EXPECT_NEAR(last.r_s / (0.94 * 2.25), 1.0, 2e-3);
 }
 
+TEST(CliEstimate, RateWritesOneEstimatePerPeriodOfTheLogsTime) {
+  // 2 s at 8 kHz with a 0.25 s gap at 1 s: --rate 100 writes the first sample at or after each 10 ms of a
+  // grid from t = 0, which restarts after the gap (docs/drive-log.md, "Estimate CSV").
+  const core::PerUnitBase base = test::paper_base();
+  test::ModelDataGenerator gen;
+  gen.plant = test::paper_machine_pu();
+  gen.omega_n_rad_s = base.omega_el_rad_s;
+  gen.n_pu = 0.4;
+  gen.i_ref_pu = core::mtpa_reference(gen.plant, 0.4);
+  test::TempFile log("drive.csv"), est("est.csv");
+  {
+    io::DriveLogWriter w(log.path(), io::DriveLogLayout{});
+    std::int64_t t_ns = 0;
+    for (int k = 0; k < 16000; ++k) {
+      if (k == 8000) t_ns += 250'000'000;
+      w.write({gen.next_si(base, t_ns), {}, {}, {}, {}});
+    }
+  }
+  const std::string rpem = test::binary_dir() + "/tools/rpem estimate --log " + log.path() + " --out " + est.path();
+  test::ProcessResult r = test::run_command(rpem + " --rate 100");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  std::ifstream in(est.path());
+  std::string line;
+  std::getline(in, line);
+  std::vector<double> t;
+  while (std::getline(in, line)) t.push_back(std::stod(line.substr(0, line.find(','))));
+  ASSERT_EQ(t.size(), 200U);  // 100 before the gap, 100 after it
+  for (std::size_t j = 1; j < t.size(); ++j) {
+    if (j == 100) continue;  // across the gap
+    EXPECT_NEAR(t[j] - t[j - 1], 0.01, 1e-9) << j;
+  }
+  EXPECT_NEAR(t[100] - t[99], 0.01 + 0.25, 1e-9);
+  r = test::run_command(rpem + " --rate 100 --every 80");
+  EXPECT_EQ(r.exit_code, 64) << r.output;  // one decimation or the other
+}
+
 /// An estimate CSV's columns by name.
 struct EstimateTable {
   std::vector<std::string> names;

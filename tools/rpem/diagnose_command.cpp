@@ -1,7 +1,11 @@
 // rpem diagnose --log LOG.csv --config MACHINE.yaml --out DIR [--truth TRUTH.csv] …
 // Shows what the nominal model gets wrong on measured data, names the cause from the catalogue of
 // effects, extends the model and measures the gain (docs/diagnose.md). Writes DIR/report.html,
-// DIR/report.md, the figures, DIR/diagnosis.json and DIR/extended.yaml.
+// DIR/report.md, the figures, DIR/diagnosis.json and DIR/extended.yaml — all at once at the end: they are
+// written into a directory beside DIR and moved into it when complete, so that a run stopped by Ctrl-C
+// (exit 130) or failing leaves DIR as it was.
+
+#include <unistd.h>
 
 #include <cstdio>
 #include <filesystem>
@@ -10,7 +14,9 @@
 #include <string>
 
 #include "commands.hpp"
+#include "diagnose_monitor.hpp"
 #include "rpem/analysis/diagnose/diagnose_output.hpp"
+#include "rpem/analysis/work_pool.hpp"
 #include "rpem/io/errors.hpp"
 #include "rpem/io/number_format.hpp"
 #include "rpem/io/sample_counts.hpp"
@@ -24,6 +30,44 @@ struct DiagnoseCliOptions {
   double switching_frequency_Hz = 0.0;
   analysis::SelectionOptions selection;
   int blocks = 40;
+  int jobs = analysis::available_cpus();
+};
+
+namespace fs = std::filesystem;
+
+/// The output files, written into a staging directory beside DIR and moved into DIR once all are there.
+class StagedOutput {
+ public:
+  explicit StagedOutput(const std::string& out) : out_(fs::path(out).lexically_normal()) {
+    if (out_.filename().empty()) out_ = out_.parent_path();
+    staging_ = out_;
+    staging_ += ".partial-" + std::to_string(getpid());
+    std::error_code ec;
+    fs::remove_all(staging_, ec);
+    fs::create_directories(staging_, ec);
+    if (ec) throw io::InputError(staging_.string(), 0, 0, "", "cannot create directory: " + ec.message());
+  }
+  ~StagedOutput() {
+    std::error_code ec;
+    fs::remove_all(staging_, ec);
+  }
+  StagedOutput(const StagedOutput&) = delete;
+  StagedOutput& operator=(const StagedOutput&) = delete;
+
+  [[nodiscard]] std::string dir() const { return staging_.string(); }
+  /// Moves every file written into DIR (each one's rename replaces what DIR held under its name).
+  void commit() {
+    std::error_code ec;
+    fs::create_directories(out_, ec);
+    if (ec) throw io::InputError(out_.string(), 0, 0, "", "cannot create directory: " + ec.message());
+    for (const fs::directory_entry& e : fs::directory_iterator(staging_)) {
+      fs::rename(e.path(), out_ / e.path().filename(), ec);
+      if (ec) throw io::InputError((out_ / e.path().filename()).string(), 0, 0, "", "cannot write: " + ec.message());
+    }
+  }
+
+ private:
+  fs::path out_, staging_;
 };
 
 std::string read_text(const std::string& path) {
@@ -33,6 +77,9 @@ std::string read_text(const std::string& path) {
   s << f.rdbuf();
   return s.str();
 }
+
+int diagnose_and_write(const DiagnoseCliOptions& o, const io::MachineConfig& config, const std::string& config_text,
+                       const std::string& config_name, const analysis::LogOptions& log_options, TerminalMonitor& monitor);
 
 int run_diagnose(const DiagnoseCliOptions& o) {
   const std::string config_text = o.config.empty() ? io::builtin_paper_config_text() : read_text(o.config);
@@ -48,8 +95,24 @@ int run_diagnose(const DiagnoseCliOptions& o) {
   if (o.model != "auto") {
     log_options.mode = o.model == "transient" ? analysis::ModelMode::kTransient : analysis::ModelMode::kSteadyState;
   }
+  TerminalMonitor monitor;
+  try {
+    return diagnose_and_write(o, config, config_text, config_name, log_options, monitor);
+  } catch (const analysis::Interrupted&) {
+    monitor.finish();
+    std::fprintf(stderr, "rpem diagnose: interrupted; %s left as it was\n", o.out.c_str());
+    return io::kExitInterrupted;
+  }
+}
+
+int diagnose_and_write(const DiagnoseCliOptions& o, const io::MachineConfig& config, const std::string& config_text,
+                       const std::string& config_name, const analysis::LogOptions& log_options, TerminalMonitor& monitor) {
   std::fprintf(stderr, "rpem diagnose: reading %s\n", o.log.c_str());
-  analysis::LogData log = analysis::load_log(o.log, config.machine, log_options);
+  analysis::LogData log = analysis::load_log(o.log, config.machine, log_options, [&](std::uint64_t done, std::uint64_t total) {
+    monitor.reading(done, total);
+    if (monitor.stop_requested()) throw analysis::Interrupted();
+  });
+  monitor.finish();
   std::fprintf(stderr, "rpem diagnose: read %s\n", log.format.c_str());
   io::check_log_supports(config, config_name, log.layout.u_dc, o.log);
   const analysis::ParameterTrack truth = o.truth.empty() ? analysis::ParameterTrack{} : analysis::load_truth(o.truth);
@@ -58,18 +121,27 @@ int run_diagnose(const DiagnoseCliOptions& o) {
   options.reference_C = o.reference_C;
   options.switching_frequency_Hz = o.switching_frequency_Hz;
   options.selection = o.selection;
-  std::fprintf(stderr, "rpem diagnose: %zu samples, %s model; fitting the catalogue's effects\n", log.rows.size(),
-               analysis::to_string(log.mode));
+  options.jobs = o.jobs;
+  options.monitor = &monitor;
+  std::fprintf(stderr, "rpem diagnose: %zu samples, %s model; fitting the catalogue's effects (%d jobs)\n", log.size(),
+               analysis::to_string(log.mode), o.jobs);
   const analysis::Diagnosis d = analysis::diagnose(std::move(log), config, options, truth);
+  monitor.finish();
   std::fprintf(stderr, "rpem diagnose: %s\n", io::regime_summary(d.regimes.counts).c_str());
   for (const std::string& why : d.regimes.explanations) std::fprintf(stderr, "rpem diagnose: %s\n", why.c_str());
 
-  std::error_code ec;
-  std::filesystem::create_directories(o.out, ec);
-  if (ec) throw io::InputError(o.out, 0, 0, "", "cannot create directory: " + ec.message());
-  analysis::write_diagnosis_json(o.out + "/diagnosis.json", d, config_name);
-  analysis::write_extended_yaml(o.out + "/extended.yaml", d, config_text);
-  analysis::write_diagnose_report(o.out, d, config_name);
+  StagedOutput staged(o.out);
+  try {
+    analysis::write_diagnosis_json(staged.dir() + "/diagnosis.json", d, config_name);
+    analysis::write_extended_yaml(staged.dir() + "/extended.yaml", d, config_text);
+    analysis::write_diagnose_report(staged.dir(), d, config_name);
+  } catch (const std::exception&) {
+    if (monitor.stop_requested()) throw analysis::Interrupted();  // gnuplot, stopped by the same Ctrl-C
+    throw;
+  }
+  // A Ctrl-C while the figures were drawn stopped gnuplot too: what was written may be incomplete.
+  if (monitor.stop_requested()) throw analysis::Interrupted();
+  staged.commit();
 
   const analysis::Selection& s = d.selection;
   std::printf("baseline (the configuration as it is): held-out residual %.4g A RMS\n", d.baseline_heldout_rms_A);
@@ -156,7 +228,10 @@ Runner add_diagnose_command(CLI::App& app) {
   cmd->add_option("--max-p", o->selection.max_p, "largest signed-rank p over the held-out blocks (default 0.01)")
       ->check(CLI::Range(0.0, 1.0));
   cmd->add_option("--blocks", o->blocks, "training + held-out blocks (default 40)")->check(CLI::Range(4, 1000));
-  cmd->add_option("--threads", o->selection.threads, "fitting threads (default 2)")->check(CLI::Range(1, 64));
+  cmd->add_option("--jobs,--threads", o->jobs,
+                  "threads that replay the log's blocks and fit the candidates (default: the CPUs this process may use, " +
+                      std::to_string(o->jobs) + " here); the results are the same for any number")
+      ->check(CLI::Range(1, 256));
   return [cmd, o]() { return cmd->parsed() ? run_diagnose(*o) : -1; };
 }
 

@@ -1,5 +1,5 @@
 // rpem estimate --log LOG.csv [--log-map MAP.yaml] --config CFG.yaml --out EST.csv [--algorithm sga|gna|phyint]
-//              [--every N] [--thermal THERMAL.yaml]
+//              [--every N | --rate HZ] [--thermal THERMAL.yaml]
 // Runs the estimator offline over a drive log, exactly as rpemd would run it online: a log of instantaneous
 // samples through DriveEstimator, a log of averaged samples (our averaged log, VESC Tool's realtime log, a
 // map of averaged samples; docs/drive-log.md) through AveragedDriveEstimator. With --thermal, the thermal
@@ -36,6 +36,29 @@ struct EstimateOptions {
   std::string algorithm;
   std::string thermal;
   long every = 1;
+  double rate_Hz = 0.0;
+};
+
+/// Which estimates --out gets (docs/drive-log.md, "Estimate CSV"): every N-th sample (--every), or the first
+/// sample at or after each point of a grid 1/rate apart in the log's time, from its first sample (--rate; a
+/// gap in the log skips the grid's points inside it).
+class Decimation {
+ public:
+  explicit Decimation(const EstimateOptions& o)
+      : every_(static_cast<std::uint64_t>(o.every)), period_ns_(o.rate_Hz > 0.0 ? std::llround(1e9 / o.rate_Hz) : 0) {}
+  /// Whether the estimate of the sample at t_ns is written.
+  bool take(std::int64_t t_ns) {
+    if (period_ns_ <= 0) return seen_++ % every_ == 0;
+    if (seen_++ > 0 && t_ns < next_ns_) return false;
+    next_ns_ = seen_ == 1 ? t_ns + period_ns_ : next_ns_ + period_ns_;
+    if (next_ns_ <= t_ns) next_ns_ = t_ns + period_ns_;  // across a gap: the grid starts again here
+    return true;
+  }
+
+ private:
+  std::uint64_t every_, seen_ = 0;
+  std::int64_t period_ns_;
+  std::int64_t next_ns_ = 0;  ///< the grid's next point (--rate), once a sample was seen
 };
 
 /// The thermal filter beside the estimator, when --thermal is given.
@@ -140,10 +163,11 @@ int run_averaged(const EstimateOptions& o, const io::LogSource& source, const io
   io::EstimateLogWriter writer(o.out, thermal.node_names());
   Tally tally;
   tally.counts.averaged = true;
+  Decimation decimation(o);
   for (const core::AveragedSample& s : samples) {
     const core::Estimate e = estimator.step(s);
     thermal.step(e, s.t_ns, s.t_coolant_C, s.t_winding_C);
-    if (tally.counts.samples % static_cast<std::uint64_t>(o.every) == 0) writer.write(e, estimator.core(), thermal.estimate());
+    if (decimation.take(e.t_ns)) writer.write(e, estimator.core(), thermal.estimate());
     tally.count(e);
   }
   std::fprintf(stderr, "rpem estimate: %s\n", tally.summary(cfg.estimator.algorithm, "averaged samples").c_str());
@@ -170,10 +194,11 @@ int run_estimate(const EstimateOptions& o) {
   io::DriveLogRow row;
   Tally tally;
   constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+  Decimation decimation(o);
   while (reader.next(row)) {
     const core::Estimate e = estimator.step(row.sample);
     thermal.step(e, row.sample.t_ns, row.t_coolant_C.value_or(kNaN), row.t_winding_C.value_or(kNaN));
-    if (tally.counts.samples % static_cast<std::uint64_t>(o.every) == 0) writer.write(e, estimator, thermal.estimate());
+    if (decimation.take(e.t_ns)) writer.write(e, estimator, thermal.estimate());
     tally.count(e);
     if ((tally.counts.samples & 0xFFF) == 0) progress.update(reader.bytes_read(), reader.bytes_total());
   }
@@ -199,7 +224,13 @@ Runner add_estimate_command(CLI::App& app) {
   cmd->add_option("--out", opts->out, "estimate CSV to write")->required();
   cmd->add_option("--algorithm", opts->algorithm, "override the configured gain algorithm")
       ->check(CLI::IsMember({"sga", "gna", "phyint"}));
-  cmd->add_option("--every", opts->every, "write every N-th sample")->check(CLI::PositiveNumber);
+  CLI::Option* every = cmd->add_option("--every", opts->every, "write every N-th sample's estimate (default 1: all)")
+                           ->check(CLI::PositiveNumber);
+  cmd->add_option("--rate", opts->rate_Hz,
+                  "write estimates at this rate [Hz] of the log's time (the first sample at or after each 1/rate), "
+                  "e.g. 100 for an 8 kHz log: 1/80 of the file (docs/drive-log.md, \"Estimate CSV\")")
+      ->check(CLI::PositiveNumber)
+      ->excludes(every);
   cmd->add_option("--thermal", opts->thermal, "thermal.yaml: run the thermal network's filter beside the estimator (docs/thermal.md)")
       ->check(CLI::ExistingFile);
   return [cmd, opts]() { return cmd->parsed() ? run_estimate(*opts) : -1; };

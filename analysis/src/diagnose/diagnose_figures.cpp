@@ -17,23 +17,6 @@ namespace rpem::analysis {
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-constexpr std::size_t kTimeBins = 1500;
-
-struct SampleView {
-  double t_s, speed_rpm, i_d_A, i_q_A;
-};
-
-/// Per-sample operating point of the log, SI.
-std::vector<SampleView> operating_points(const LogData& log, int pole_pairs) {
-  std::vector<SampleView> v;
-  v.reserve(log.rows.size());
-  for (std::size_t k = 0; k < log.rows.size(); ++k) {
-    const core::DriveSample& s = log.rows[k].sample;
-    const core::Vec2& i = log.logged_i_dq_A[k];
-    v.push_back({core::to_seconds(s.t_ns), core::rad_s_to_rpm(s.omega_el_rad_s) / pole_pairs, i[0], i[1]});
-  }
-  return v;
-}
 
 /// The temperature column a figure draws against (the winding's if logged), and whether it varies.
 const TemperatureColumn& drawn_temperature(const Diagnosis& d) {
@@ -45,38 +28,18 @@ bool temperature_varies(const Diagnosis& d) {
 }
 
 /// Time-binned profile and residual statistics (every sample for short logs).
-DataBlock time_bins(const Diagnosis& d, const std::vector<SampleView>& ops) {
-  const std::size_t n = d.log->rows.size();
-  const std::size_t per_bin = std::max<std::size_t>(1, n / kTimeBins);
+DataBlock time_bins(const Diagnosis& d) {
   DataBlock b{"time", std::vector<std::vector<double>>(8)};  // t, speed, i_q, rms before, rms after, mean d, mean q, T
-  for (std::size_t start = 0; start < n; start += per_bin) {
-    double t = 0, sp = 0, iq = 0, sb = 0, sa = 0, md = 0, mq = 0, temp = 0, cnt = 0, all = 0;
-    for (std::size_t k = start; k < std::min(n, start + per_bin); ++k) {
-      t += ops[k].t_s;
-      sp += ops[k].speed_rpm;
-      iq += ops[k].i_q_A;
-      all += 1;
-      const auto& row = d.log->rows[k];
-      temp += row.t_winding_C.value_or(row.t_magnet_C.value_or(kNaN));
-      if (!d.baseline_replay.valid[k] || !d.extended_replay.valid[k]) continue;
-      sb += d.baseline_replay.residual_A[k].squaredNorm();
-      sa += d.extended_replay.residual_A[k].squaredNorm();
-      md += d.baseline_replay.residual_A[k][0];
-      mq += d.baseline_replay.residual_A[k][1];
-      cnt += 1;
-    }
-    const bool any = cnt != 0.0;
-    const double values[8] = {t / all, sp / all, iq / all, any ? std::sqrt(sb / cnt) : kNaN, any ? std::sqrt(sa / cnt) : kNaN,
-                              any ? md / cnt : kNaN, any ? mq / cnt : kNaN, temp / all};
-    for (int c = 0; c < 8; ++c) b.columns[static_cast<std::size_t>(c)].push_back(values[c]);
+  for (const auto& bin : d.figures.time) {
+    for (std::size_t c = 0; c < 8; ++c) b.columns[c].push_back(bin[c]);
   }
   return b;
 }
 
-std::string residual_time(const std::string& dir, const Diagnosis& d, const std::vector<SampleView>& ops) {
+std::string residual_time(const std::string& dir, const Diagnosis& d) {
   const bool temps = temperature_varies(d);
   GnuplotFigure fig(dir + "/residual_time.png", 1400, 1000);
-  fig.add_data(time_bins(d, ops));
+  fig.add_data(time_bins(d));
   fig.add_line("set multiplot layout 3,1 title 'What the model gets wrong, against time' noenhanced");
   fig.add_line("set grid; set xlabel 't [s]'; set key outside right");
   fig.add_line("set title 'operating profile'; set ylabel 'speed [rpm]'; set y2label 'i_q [A]" +
@@ -93,45 +56,26 @@ std::string residual_time(const std::string& dir, const Diagnosis& d, const std:
   return "residual_time.png";
 }
 
-std::string residual_map(const std::string& dir, const Diagnosis& d, const std::vector<SampleView>& ops) {
-  constexpr int kX = 40, kY = 30;
-  double s_lo = 1e300, s_hi = -1e300, q_lo = 1e300, q_hi = -1e300;
-  for (std::size_t k = 0; k < ops.size(); ++k) {
-    if (!d.baseline_replay.valid[k]) continue;
-    s_lo = std::min(s_lo, ops[k].speed_rpm);
-    s_hi = std::max(s_hi, ops[k].speed_rpm);
-    q_lo = std::min(q_lo, ops[k].i_q_A);
-    q_hi = std::max(q_hi, ops[k].i_q_A);
-  }
-  if (s_hi <= s_lo) s_hi = s_lo + 1.0;
-  if (q_hi <= q_lo) q_hi = q_lo + 1.0;
-  const std::size_t cells = static_cast<std::size_t>(kX) * static_cast<std::size_t>(kY);
-  std::vector<double> sb(cells, 0.0), sa(cells, 0.0), cnt(cells, 0.0);
-  for (std::size_t k = 0; k < ops.size(); ++k) {
-    if (!d.baseline_replay.valid[k] || !d.extended_replay.valid[k]) continue;
-    const int x = std::min(kX - 1, static_cast<int>((ops[k].speed_rpm - s_lo) / (s_hi - s_lo) * kX));
-    const int y = std::min(kY - 1, static_cast<int>((ops[k].i_q_A - q_lo) / (q_hi - q_lo) * kY));
-    const int c = y * kX + x;
-    sb[c] += d.baseline_replay.residual_A[k].squaredNorm();
-    sa[c] += d.extended_replay.residual_A[k].squaredNorm();
-    cnt[c] += 1;
-  }
+std::string residual_map(const std::string& dir, const Diagnosis& d) {
+  constexpr int kX = FigureData::kMapX, kY = FigureData::kMapY;
+  const FigureData& f = d.figures;
+  const double s_lo = f.speed_lo_rpm, s_hi = f.speed_hi_rpm, q_lo = f.i_q_lo_A, q_hi = f.i_q_hi_A;
   DataBlock b{"map", std::vector<std::vector<double>>(4)};
   double lo = 1e300, hi = 0.0;  // one colour scale for both maps, so the improvement shows
-  for (int c = 0; c < kX * kY; ++c) {
-    if (cnt[c] == 0.0) continue;
-    for (double v : {std::sqrt(sb[c] / cnt[c]), std::sqrt(sa[c] / cnt[c])}) {
+  for (const auto& cell : f.map) {
+    if (!cell[2]) continue;
+    for (double v : {std::sqrt(cell[0] / cell[2]), std::sqrt(cell[1] / cell[2])}) {
       if (v > 0.0) lo = std::min(lo, v);
       hi = std::max(hi, v);
     }
   }
   for (int y = 0; y < kY; ++y) {
     for (int x = 0; x < kX; ++x) {
-      const int c = y * kX + x;
+      const auto& cell = f.map[static_cast<std::size_t>(y * kX + x)];
       b.columns[0].push_back(s_lo + (x + 0.5) * (s_hi - s_lo) / kX);
       b.columns[1].push_back(q_lo + (y + 0.5) * (q_hi - q_lo) / kY);
-      b.columns[2].push_back(cnt[c] != 0.0 ? std::sqrt(sb[c] / cnt[c]) : kNaN);
-      b.columns[3].push_back(cnt[c] != 0.0 ? std::sqrt(sa[c] / cnt[c]) : kNaN);
+      b.columns[2].push_back(cell[2] ? std::sqrt(cell[0] / cell[2]) : kNaN);
+      b.columns[3].push_back(cell[2] ? std::sqrt(cell[1] / cell[2]) : kNaN);
     }
   }
   GnuplotFigure fig(dir + "/residual_map.png", 1400, 600);
@@ -188,32 +132,12 @@ std::string phase_sign(const std::string& dir, const Diagnosis& d) {
 
 std::string residual_vs_temperature(const std::string& dir, const Diagnosis& d) {
   // Binned over the temperature's range: the mean residual per bin, so a trend shows however long the log.
-  constexpr int kBins = 60;
+  constexpr int kBins = FigureData::kTemperatureBins;
   const bool winding = d.context.t_winding.logged;
-  double lo = 1e300, hi = -1e300;
-  auto temperature = [&](std::size_t k) {
-    const auto& row = d.log->rows[k];
-    return winding ? row.t_winding_C.value_or(kNaN) : row.t_magnet_C.value_or(kNaN);
-  };
-  for (std::size_t k = 0; k < d.log->rows.size(); ++k) {
-    if (!d.baseline_replay.valid[k] || !std::isfinite(temperature(k))) continue;
-    lo = std::min(lo, temperature(k));
-    hi = std::max(hi, temperature(k));
-  }
-  std::vector<std::array<double, 5>> sums(kBins, std::array<double, 5>{});
-  for (std::size_t k = 0; k < d.log->rows.size(); ++k) {
-    if (!d.baseline_replay.valid[k] || !d.extended_replay.valid[k] || !std::isfinite(temperature(k))) continue;
-    const int b = std::min(kBins - 1, static_cast<int>((temperature(k) - lo) / std::max(hi - lo, 1e-9) * kBins));
-    auto& s = sums[static_cast<std::size_t>(b)];
-    s[0] += 1.0;
-    s[1] += d.baseline_replay.residual_A[k][0];
-    s[2] += d.baseline_replay.residual_A[k][1];
-    s[3] += d.extended_replay.residual_A[k][0];
-    s[4] += d.extended_replay.residual_A[k][1];
-  }
+  const double lo = d.figures.temperature_lo_C, hi = d.figures.temperature_hi_C;
   DataBlock b{"t", std::vector<std::vector<double>>(5)};  // T, eps_d before, eps_q before, eps_d after, eps_q after
   for (int i = 0; i < kBins; ++i) {
-    const auto& s = sums[static_cast<std::size_t>(i)];
+    const auto& s = d.figures.temperature[static_cast<std::size_t>(i)];
     if (s[0] == 0.0) continue;
     b.columns[0].push_back(lo + (i + 0.5) * (hi - lo) / kBins);
     for (int c = 1; c < 5; ++c) b.columns[static_cast<std::size_t>(c)].push_back(s[static_cast<std::size_t>(c)] / s[0]);
@@ -228,29 +152,11 @@ std::string residual_vs_temperature(const std::string& dir, const Diagnosis& d) 
   return "residual_temperature.png";
 }
 
-std::string overlay(const std::string& dir, const Diagnosis& d, const std::vector<SampleView>& ops) {
+std::string overlay(const std::string& dir, const Diagnosis& d) {
   // Transient logs: the 0.1 s window where the configuration errs most; steady state: the whole log.
-  const std::size_t n = d.log->rows.size();
-  std::size_t first = 0, last = n;
-  if (d.log->mode == ModelMode::kTransient) {
-    const std::size_t window = std::max<std::size_t>(2, static_cast<std::size_t>(0.1 / std::max(d.log->median_dt_s, 1e-9)));
-    double best = -1.0, sum = 0.0;
-    for (std::size_t k = 0; k < n; ++k) {
-      sum += d.baseline_replay.valid[k] ? d.baseline_replay.residual_A[k].squaredNorm() : 0.0;
-      if (k >= window) sum -= d.baseline_replay.valid[k - window] ? d.baseline_replay.residual_A[k - window].squaredNorm() : 0.0;
-      if (k + 1 >= window && sum > best) {
-        best = sum;
-        first = k + 1 - window;
-      }
-    }
-    last = std::min(n, first + window);
-  }
   DataBlock b{"o", std::vector<std::vector<double>>(7)};
-  for (std::size_t k = first; k < last; ++k) {
-    if (!d.baseline_replay.valid[k] || !d.extended_replay.valid[k]) continue;
-    const double v[7] = {ops[k].t_s, ops[k].i_d_A, ops[k].i_q_A, d.baseline_replay.model_A[k][0], d.baseline_replay.model_A[k][1],
-                         d.extended_replay.model_A[k][0], d.extended_replay.model_A[k][1]};
-    for (int c = 0; c < 7; ++c) b.columns[static_cast<std::size_t>(c)].push_back(v[c]);
+  for (const auto& row : d.figures.overlay) {
+    for (std::size_t c = 0; c < 7; ++c) b.columns[c].push_back(row[c]);
   }
   const std::string style = d.log->mode == ModelMode::kTransient ? "w l lw 2" : "w p pt 7 ps 0.5";
   GnuplotFigure fig(dir + "/overlay.png", 1400, 800);
@@ -271,20 +177,21 @@ std::string overlay(const std::string& dir, const Diagnosis& d, const std::vecto
 constexpr std::array<const char*, core::kRegimeCount> kRegimeColour{"#2ca02c", "#1f77b4", "#17becf", "#9a9a9a",
                                                                     "#ff7f0e", "#9467bd", "#d62728", "#000000"};
 
-std::string regime_timeline(const std::string& dir, const LogRegimes& regimes, const std::vector<SampleView>& ops) {
+std::string regime_timeline(const std::string& dir, const LogData& log, const LogRegimes& regimes, int pole_pairs) {
   // Per time bin and regime, the mean speed and current amplitude of that regime's samples in the bin: a short
   // stretch in one regime shows however long the log.
-  const std::size_t n = ops.size();
-  const std::size_t per_bin = std::max<std::size_t>(1, n / kTimeBins);
+  const std::size_t n = log.size();
+  const std::size_t per_bin = std::max<std::size_t>(1, n / FigureData::kTimeBins);
   DataBlock b{"reg", std::vector<std::vector<double>>(4)};  // t, speed, |i|, regime
   for (std::size_t start = 0; start < n; start += per_bin) {
     std::array<std::array<double, 4>, core::kRegimeCount> sums{};  // count, t, speed, |i|
     for (std::size_t k = start; k < std::min(n, start + per_bin); ++k) {
       auto& s = sums[static_cast<std::size_t>(regimes.regime[k])];
+      const core::Vec2 i = log.logged_i_dq_A(k);
       s[0] += 1.0;
-      s[1] += ops[k].t_s;
-      s[2] += ops[k].speed_rpm;
-      s[3] += std::hypot(ops[k].i_d_A, ops[k].i_q_A);
+      s[1] += log.t_s(k);
+      s[2] += core::rad_s_to_rpm(log.samples.omega_el_rad_s(k)) / pole_pairs;
+      s[3] += std::hypot(i[0], i[1]);
     }
     for (std::size_t r = 0; r < core::kRegimeCount; ++r) {
       if (sums[r][0] == 0.0) continue;
@@ -299,10 +206,8 @@ std::string regime_timeline(const std::string& dir, const LogRegimes& regimes, c
     const std::string r = std::to_string(static_cast<int>(info.regime));
     const std::string style = std::string(" w p pt 7 ps 0.5 lc rgb '") + kRegimeColour[static_cast<std::size_t>(info.regime)] + "'";
     const std::string title = std::string(" t '") + info.name + (info.excluded ? ", excluded" : "") + " (" + std::to_string(count) + ")'";
-    speed_plot.append(speed_plot.empty() ? "plot" : ",").append(" $reg u 1:($4==").append(r).append("?$2:NaN)");
-    speed_plot.append(style).append(title);
-    current_plot.append(current_plot.empty() ? "plot" : ",").append(" $reg u 1:($4==").append(r).append("?$3:NaN)");
-    current_plot.append(style).append(" notitle");
+    speed_plot += std::string(speed_plot.empty() ? "plot" : ",") + " $reg u 1:($4==" + r + "?$2:NaN)" + style + title;
+    current_plot += std::string(current_plot.empty() ? "plot" : ",") + " $reg u 1:($4==" + r + "?$3:NaN)" + style + " notitle";
   }
   GnuplotFigure fig(dir + "/regimes.png", 1400, 800);
   fig.add_data(std::move(b));
@@ -354,9 +259,8 @@ std::string estimates(const std::string& dir, const Diagnosis& d) {
 }  // namespace
 
 std::vector<std::string> write_diagnose_figures(const std::string& dir, const Diagnosis& d) {
-  const std::vector<SampleView> ops = operating_points(*d.log, d.context.machine.rated.pole_pairs);
-  std::vector<std::string> out = {residual_time(dir, d, ops), regime_timeline(dir, d.regimes, ops), residual_map(dir, d, ops),
-                                  overlay(dir, d, ops)};
+  std::vector<std::string> out = {residual_time(dir, d), regime_timeline(dir, *d.log, d.regimes, d.context.machine.rated.pole_pairs),
+                                  residual_map(dir, d), overlay(dir, d)};
   if (!d.statistics.harmonics.empty()) out.push_back(harmonics(dir, d));
   if (!d.statistics.phase_signs.empty()) out.push_back(phase_sign(dir, d));
   if (temperature_varies(d)) out.push_back(residual_vs_temperature(dir, d));  // a constant axis shows nothing
@@ -365,7 +269,7 @@ std::vector<std::string> write_diagnose_figures(const std::string& dir, const Di
 }
 
 std::string write_regime_timeline(const std::string& dir, const LogData& log, const LogRegimes& regimes, int pole_pairs) {
-  return regime_timeline(dir, regimes, operating_points(log, pole_pairs));
+  return regime_timeline(dir, log, regimes, pole_pairs);
 }
 
 }  // namespace rpem::analysis

@@ -134,9 +134,7 @@ double mismatch_half_width(const Diagnosis& d, std::size_t i) {
   const double per_A = d.calibration.intervals.change_per_A[i];
   if (!std::isfinite(per_A)) return 0.0;
   const double floor = d.noise_floor.value_A.value_or(0.0);
-  std::size_t n = 0;
-  for (std::size_t k = 0; k < d.log->rows.size(); ++k) n += d.log->training(k) ? 1 : 0;
-  return per_A * misfit_norm_A(n, d.selection.extended_heldout_rms_A, floor);
+  return per_A * misfit_norm_A(d.log->training_count(), d.selection.extended_heldout_rms_A, floor);
 }
 
 std::vector<std::string> calibrated_despite_mismatch(const Diagnosis& d) {
@@ -173,12 +171,11 @@ void write_diagnosis_json(const std::string& path, const Diagnosis& d, const std
   const LogData& log = *d.log;
   const Selection& s = d.selection;
   nlohmann::json out;
-  std::size_t used = 0;
-  for (bool u : log.used) used += u;
+  const std::size_t used = log.used_count();
   out["log"] = {{"path", log.path},
                 {"model", to_string(log.mode)},
                 {"kind", log.averaged ? "averaged" : "phase_samples"},
-                {"samples", log.rows.size()},
+                {"samples", log.size()},
                 {"samples_used", used},
                 {"excluded_idle", log.excluded_idle},
                 {"excluded_transitional", log.excluded_transitional},

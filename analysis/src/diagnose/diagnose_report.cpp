@@ -54,7 +54,7 @@ void summary(ReportDocument& doc, const Diagnosis& d, const std::string& config_
   }
   doc.paragraph(text);
   text = "The configuration (`" + config_path + "`, its whole model: model extensions and drift laws) replayed on the inputs of `" +
-         log.path + "` (" + std::to_string(log.rows.size()) + " samples over " + num(log.t_end_s - log.t_start_s, 3) + " s, " +
+         log.path + "` (" + std::to_string(log.size()) + " samples over " + num(log.t_end_s - log.t_start_s, 3) + " s, " +
          (log.mode == ModelMode::kTransient ? "transient: the open-loop discrete predictor"
                                             : "steady state: the closed-form steady-state model") +
          ") predicts the currents with a held-out residual of **" + num(d.baseline_heldout_rms_A) + " A RMS**; with the "

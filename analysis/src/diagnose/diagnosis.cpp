@@ -1,5 +1,6 @@
 #include "rpem/analysis/diagnose/diagnosis.hpp"
 
+#include <algorithm>
 #include <chrono>
 
 #include "rpem/analysis/diagnose/replay.hpp"
@@ -31,7 +32,7 @@ EffectSet subset(const EffectSet& set, const std::vector<bool>& keep) {
 
 /// Greedy, in the order found: an effect stays in extended.yaml only if the RPEM estimator with it (and
 /// the effects kept before it) predicts the held-out blocks at least as well as without it.
-std::vector<EstimatorCheck> check_estimator(const Diagnosis& d, std::vector<bool>& keep) {
+std::vector<EstimatorCheck> check_estimator(const Diagnosis& d, const WorkPool& pool, std::vector<bool>& keep) {
   constexpr double kTolerance = 1e-3;  // "at least as well": within rounding of the RMS
   std::vector<EstimatorCheck> checks;
   const EffectSet& model = d.selection.model;
@@ -43,12 +44,21 @@ std::vector<EstimatorCheck> check_estimator(const Diagnosis& d, std::vector<bool
   std::vector<bool> trial(model.effects.size(), false);
   auto rms_with = [&](const std::vector<bool>& k) {
     const ExtendedModel m = subset(model, k).model(d.context);
-    return estimator_heldout_rms_A(*d.log, config_of(d.config, m, d.calibration.identifiable, d.context.reference_C));
+    return estimator_heldout_rms_A(*d.log, config_of(d.config, m, d.calibration.identifiable, d.context.reference_C),
+                                   d.options.monitor);
   };
-  double current = rms_with(trial);
+  // The model without any and with the first: both needed whatever is kept, so at once.
+  double current = 0.0, first_with = 0.0;
+  if (!model.effects.empty()) {
+    pool.parallel_for(2, [&](std::size_t i) {
+      std::vector<bool> k(model.effects.size(), false);
+      k[0] = i == 1;
+      (i == 0 ? current : first_with) = rms_with(k);
+    });
+  }
   for (std::size_t j = 0; j < model.effects.size(); ++j) {
     trial[j] = true;
-    const double with = rms_with(trial);
+    const double with = j == 0 ? first_with : rms_with(trial);
     EstimatorCheck c{model.effects[j], true, with, current, with <= current * (1.0 + kTolerance)};
     if (c.kept) {
       current = with;
@@ -88,7 +98,9 @@ void prune_negligible(const EffectFitter& fitter, Diagnosis& d) {
 /// The calibrated baseline and the effects found from it, all fitted with `fitter`'s loss (docs/diagnose.md,
 /// "The calibrated baseline", "How an effect is accepted"); fills d.calibration and d.selection.
 void calibrate_and_select(const EffectFitter& fitter, double floor, Diagnosis& d) {
+  Monitor* monitor = d.options.monitor;
   // The calibrated baseline: the constants the log's excitation pins down, fitted on the training blocks.
+  if (monitor) monitor->stage(fitter.loss().robust() ? "calibrating the constants (robust loss)" : "calibrating the configuration's constants", 0);
   EffectSet start;
   const CalibrationIntervals excitation = fitter.intervals(start, floor);
   std::array<bool, kCalibrated.size()> admissible{};
@@ -116,6 +128,7 @@ void calibrate_and_select(const EffectFitter& fitter, double floor, Diagnosis& d
   d.calibration.heldout_rms_A = rms(fitter.heldout(start));
 
   d.selection = select_effects(fitter, d.options.selection, start, floor, admissible);
+  if (monitor) monitor->stage("refitting the model found", 0);
   prune_negligible(fitter, d);
   // A drift law found brings the constant it is referred to (EffectRow::frees_constant).
   d.calibration.intervals = fitter.intervals(d.selection.model, floor);
@@ -176,8 +189,12 @@ Diagnosis diagnose(LogData log, const io::MachineConfig& config, const DiagnoseO
   d.options = options;
   d.log = std::make_unique<LogData>(std::move(log));
   d.config = config;
+  Monitor none;
+  Monitor& monitor = options.monitor ? *options.monitor : none;
+  const std::uint64_t n = d.log->size();
   // Each sample's regime, as the estimator decides it; the excluded ones enter no fit.
-  d.regimes = classify_regimes(*d.log, config);
+  monitor.stage("classifying the samples' regimes", n);
+  d.regimes = classify_regimes(*d.log, config, options.monitor);
   exclude_regimes(*d.log, d.regimes);
   for (std::string& why : left_out_explanations(*d.log)) d.regimes.explanations.push_back(std::move(why));
   const double f_sw = options.switching_frequency_Hz > 0.0 ? options.switching_frequency_Hz
@@ -186,31 +203,41 @@ Diagnosis diagnose(LogData log, const io::MachineConfig& config, const DiagnoseO
                                              config.psim_drift.law, *d.log);
   d.context = EffectContext::of(*d.log, config.machine, base, options.reference_C, f_sw);
 
-  const ModelReplay replay(*d.log, config.machine.rated);
+  const WorkPool pool(std::max(1, options.jobs));
+  const ModelReplay replay(*d.log, config.machine.rated, pool, options.monitor);
+  monitor.stage("replaying the configuration", 2 * n);
   const EffectFitter least_squares(replay, d.context);
 
   // The configuration as it is, and the noise floor of its residual (the same for every model).
-  replay.run(base, d.baseline_replay);
+  const BaselinePass baseline = baseline_pass(replay, d.context, base);
   d.baseline_heldout_rms_A = rms(least_squares.heldout(EffectSet{}));
-  d.noise_floor = measure_noise_floor(*d.log, d.baseline_replay);
+  d.noise_floor = baseline.noise_floor;
   const double floor = d.noise_floor.for_fits_A();
 
   calibrate_and_select(least_squares, floor, d);
   // Outliers that move the least-squares fit: everything again under the robust loss.
+  monitor.stage("checking for outliers", 0);
   d.outliers = check_outliers(least_squares, d.selection.model, d.calibration.intervals);
   if (d.outliers.influential) diagnose_robustly(least_squares, floor, d);
 
+  const bool transient = d.log->mode == ModelMode::kTransient;
+  monitor.stage("checking the effects on the estimator", transient ? (d.selection.model.effects.size() + 1) * n : 0);
   std::vector<bool> keep;
-  d.estimator_checks = check_estimator(d, keep);
+  d.estimator_checks = check_estimator(d, pool, keep);
   d.extended_config = config_of(config, subset(d.selection.model, keep).model(d.context), d.calibration.identifiable,
                                 options.reference_C);
 
-  replay.run(d.extended_model, d.extended_replay);
-  d.statistics = residual_statistics(*d.log, d.context, d.baseline_replay, d.extended_replay);
+  // The estimator's two runs and the whole-log comparison, at once.
+  monitor.stage("comparing the models over the whole log", (transient ? 2 * n : 0) + 2 * n);
+  pool.parallel_for(2, [&](std::size_t i) {
+    if (i == 0) {
+      d.estimates = compare_estimates(*d.log, config, d.extended_config, d.extended_model, d.context, truth, pool, options.monitor);
+    } else {
+      comparison_pass(replay, d.context, base, d.extended_model, baseline, d.statistics, d.figures);
+    }
+  });
   d.verdict = verdict(d.selection.extended_heldout_rms_A, d.noise_floor, d.statistics);
-  d.estimates = compare_estimates(*d.log, config, d.extended_config, d.extended_model, d.context, truth);
   d.elapsed_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_time).count();
-
   return d;
 }
 

@@ -11,13 +11,14 @@ namespace {
 
 const char* const kPhase[3] = {"a", "b", "c"};
 
-TemperatureColumn column(const LogData& log, bool logged, std::optional<double> io::DriveLogRow::*field) {
+TemperatureColumn column(const LogData& log, bool logged, std::optional<double> (SampleStore::*field)(std::size_t) const noexcept) {
   TemperatureColumn c;
   c.logged = logged;
   if (!logged) return c;
   std::vector<double> t;
-  for (std::size_t k = 0; k < log.rows.size(); ++k) {
-    if (log.used[k] && (log.rows[k].*field)) t.push_back(*(log.rows[k].*field));
+  for (std::size_t k = 0; k < log.size(); ++k) {
+    if (!log.used(k)) continue;
+    if (const std::optional<double> v = (log.samples.*field)(k)) t.push_back(*v);
   }
   if (t.empty()) {
     c.logged = false;
@@ -53,8 +54,8 @@ double drifted(double value, const std::optional<core::DriftLaw>& law, double tr
 
 }  // namespace
 
-TemperatureColumn winding_column(const LogData& log) { return column(log, log.layout.t_winding, &io::DriveLogRow::t_winding_C); }
-TemperatureColumn magnet_column(const LogData& log) { return column(log, log.layout.t_magnet, &io::DriveLogRow::t_magnet_C); }
+TemperatureColumn winding_column(const LogData& log) { return column(log, log.layout.t_winding, &SampleStore::t_winding_C); }
+TemperatureColumn magnet_column(const LogData& log) { return column(log, log.layout.t_magnet, &SampleStore::t_magnet_C); }
 
 ExtendedModel make_base_model(const core::MachineSi& machine, const core::ModelExtensions& extensions,
                               const std::optional<core::DriftLaw>& r_s_law, const std::optional<core::DriftLaw>& psi_m_law,
@@ -75,15 +76,14 @@ EffectContext EffectContext::of(const LogData& log, const core::MachineSi& machi
   c.base = base;
   const core::PerUnitBase pu = core::PerUnitBase::from_rated(machine.rated);
   c.base_current_A = pu.current_A;
-  for (std::size_t k = 0; k < log.rows.size(); ++k) {
-    if (!log.used[k]) continue;
-    if (std::abs(log.logged_i_dq_A[k][0]) > c.max_i_d_A) c.extreme_i_d_A = log.logged_i_dq_A[k][0];
-    c.max_i_d_A = std::max(c.max_i_d_A, std::abs(log.logged_i_dq_A[k][0]));
-    c.max_i_q_A = std::max(c.max_i_q_A, std::abs(log.logged_i_dq_A[k][1]));
-  }
   std::vector<double> i_d;
-  for (std::size_t k = 0; k < log.rows.size(); ++k) {
-    if (log.used[k]) i_d.push_back(log.logged_i_dq_A[k][0]);
+  for (std::size_t k = 0; k < log.size(); ++k) {
+    if (!log.used(k)) continue;
+    const core::Vec2 i = log.logged_i_dq_A(k);
+    if (std::abs(i[0]) > c.max_i_d_A) c.extreme_i_d_A = i[0];
+    c.max_i_d_A = std::max(c.max_i_d_A, std::abs(i[0]));
+    c.max_i_q_A = std::max(c.max_i_q_A, std::abs(i[1]));
+    i_d.push_back(i[0]);
   }
   if (!i_d.empty()) {
     std::sort(i_d.begin(), i_d.end());
@@ -161,11 +161,13 @@ std::pair<double, double> parameter_bounds(const Effect& e, const EffectContext&
 }
 
 double r_s_at(const ExtendedModel& m, const LogData& log, std::size_t k) noexcept {
-  return drifted(m.machine.r_s_Ohm, m.r_s_law, m.r_s_trend, log.rows[k].t_winding_C, log.time_fraction(k));
+  if (!m.r_s_law && m.r_s_trend == 0.0) return m.machine.r_s_Ohm;
+  return drifted(m.machine.r_s_Ohm, m.r_s_law, m.r_s_trend, log.samples.t_winding_C(k), log.time_fraction(k));
 }
 
 double psi_m_at(const ExtendedModel& m, const LogData& log, std::size_t k) noexcept {
-  return drifted(m.machine.psi_m_Wb, m.psi_m_law, m.psi_m_trend, log.rows[k].t_magnet_C, log.time_fraction(k));
+  if (!m.psi_m_law && m.psi_m_trend == 0.0) return m.machine.psi_m_Wb;
+  return drifted(m.machine.psi_m_Wb, m.psi_m_law, m.psi_m_trend, log.samples.t_magnet_C(k), log.time_fraction(k));
 }
 
 core::DriftLaw recorded_law(const core::DriftLaw& law, double value_at_law_reference, double reference_C) {

@@ -51,14 +51,16 @@ EstimateSummary summarise(const ParameterTrack& track, const ParameterTrack& tru
   return s;
 }
 
-ParameterTrack run_rpem(const LogData& log, const io::MachineConfig& config) {
+ParameterTrack run_rpem(const LogData& log, const io::MachineConfig& config, Monitor* monitor) {
   core::DriveEstimator estimator(config.machine, config.estimator);
   ParameterTrack track;
-  const std::size_t every = std::max<std::size_t>(1, log.rows.size() / kTrackPoints);
-  for (std::size_t k = 0; k < log.rows.size(); ++k) {
-    const core::Estimate e = estimator.step(log.rows[k].sample);
+  const std::size_t every = std::max<std::size_t>(1, log.size() / kTrackPoints);
+  for (std::size_t k = 0; k < log.size(); ++k) {
+    const core::Estimate e = estimator.step(log.sample(k));
     if (k % every == 0) track.add(core::to_seconds(e.t_ns), e.psi_m_Wb, e.r_s_Ohm);
+    if ((k + 1) % kMonitorSamples == 0) report_work(monitor, kMonitorSamples);
   }
+  report_work(monitor, log.size() % kMonitorSamples);
   return track;
 }
 
@@ -68,15 +70,15 @@ void steady_state_tracks(const LogData& log, const EffectContext& context, const
   const core::PerUnitBase base = core::PerUnitBase::from_rated(machine.rated);
   const core::MachinePu pu = core::to_pu(base, model.machine);
   const core::SampleConditioner conditioner(base, pu, model.extensions);
-  for (std::size_t k = 0; k < log.rows.size(); ++k) {
-    if (!log.used[k]) continue;
-    const io::DriveLogRow& row = log.rows[k];
-    const core::SteadyStateInputs in = conditioner.steady_state(row.sample);
+  for (std::size_t k = 0; k < log.size(); ++k) {
+    if (!log.used(k)) continue;
+    const core::DriveSample sample = log.sample(k);
+    const core::SteadyStateInputs in = conditioner.steady_state(sample);
     if (std::abs(in.n_pu) < 1e-3 || std::abs(in.i_pu[0]) < 1e-6) continue;
     const double r_model = r_s_at(model, log, k), psi_model = psi_m_at(model, log, k);
     const double r_implied = (in.u_pu[0] + in.n_pu * in.x_q_pu * in.i_pu[1]) / in.i_pu[0];
     const double psi_implied = (in.u_pu[1] - base.resistance_pu(r_model) * in.i_pu[1]) / in.n_pu - in.x_d_pu * in.i_pu[0];
-    const double t = core::to_seconds(row.sample.t_ns);
+    const double t = core::to_seconds(sample.t_ns);
     c.truth.add(t, base.flux_Wb_of(psi_implied), base.resistance_Ohm_of(r_implied));
     c.nominal.add(t, psi_m_at(context.base, log, k), r_s_at(context.base, log, k));
     c.extended.add(t, psi_model, r_model);
@@ -85,16 +87,20 @@ void steady_state_tracks(const LogData& log, const EffectContext& context, const
 
 }  // namespace
 
-double estimator_heldout_rms_A(const LogData& log, const io::MachineConfig& config) {
+double estimator_heldout_rms_A(const LogData& log, const io::MachineConfig& config, Monitor* monitor) {
   core::DriveEstimator estimator(config.machine, config.estimator);
   double sum = 0.0;
   std::size_t n = 0;
-  for (std::size_t k = 0; k < log.rows.size(); ++k) {
-    const core::Estimate e = estimator.step(log.rows[k].sample);
-    if (!log.heldout(k) || e.detail.code != core::StepCode::kAdapted) continue;
-    sum += e.epsilon_A.squaredNorm();
-    ++n;
+  for (int b = 0; b < log.blocks; ++b) {
+    for (std::size_t k = log.block_first[static_cast<std::size_t>(b)]; k < log.block_first[static_cast<std::size_t>(b) + 1]; ++k) {
+      const core::Estimate e = estimator.step(log.sample(k));
+      if ((k + 1) % kMonitorSamples == 0) report_work(monitor, kMonitorSamples);
+      if (b % 2 != 1 || !log.used(k) || e.detail.code != core::StepCode::kAdapted) continue;
+      sum += e.epsilon_A.squaredNorm();
+      ++n;
+    }
   }
+  report_work(monitor, log.size() % kMonitorSamples);
   return n ? std::sqrt(sum / static_cast<double>(n)) : 0.0;
 }
 
@@ -109,13 +115,15 @@ ParameterTrack load_truth(const std::string& path) {
 
 EstimatorComparison compare_estimates(const LogData& log, const io::MachineConfig& nominal,
                                       const io::MachineConfig& extended_config, const ExtendedModel& extended,
-                                      const EffectContext& context, const ParameterTrack& truth) {
+                                      const EffectContext& context, const ParameterTrack& truth, const WorkPool& pool,
+                                      Monitor* monitor) {
   EstimatorComparison c;
   c.truth = truth;
   if (log.mode == ModelMode::kTransient) {
     c.method = "rpem";
-    c.nominal = run_rpem(log, nominal);
-    c.extended = run_rpem(log, extended_config);
+    pool.parallel_for(2, [&](std::size_t i) {
+      (i == 0 ? c.nominal : c.extended) = run_rpem(log, i == 0 ? nominal : extended_config, monitor);
+    });
   } else {
     c.method = "steady_state";
     steady_state_tracks(log, context, extended, c);

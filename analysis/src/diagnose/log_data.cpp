@@ -29,128 +29,135 @@ double median(std::vector<double> v) {
   return *mid;
 }
 
-/// The measured current's amplitude and the speed per row, their largest values, the mean DC voltage and
-/// the spread of the moving speeds.
-void measure_amplitudes(LogData& d, const core::MachineSi& machine, std::vector<double>& current,
-                        std::vector<double>& speed) {
-  const std::size_t n = d.rows.size();
-  // The measured current's amplitude, the same in every frame (amplitude-invariant).
-  const core::PerUnitBase base = core::PerUnitBase::from_rated(machine.rated);
-  const core::SampleConditioner raw(base, core::to_pu(base, machine), {});
-  d.logged_i_dq_A.resize(n);
-  double u_dc_sum = 0.0;
-  for (std::size_t k = 0; k < n; ++k) {
-    const core::DriveSample& s = d.rows[k].sample;
-    d.logged_i_dq_A[k] = raw.logged_current_dq_A(s);
-    current[k] = d.logged_i_dq_A[k].norm();
-    speed[k] = s.omega_el_rad_s;
-    d.max_current_A = std::max(d.max_current_A, current[k]);
-    d.max_speed_rad_s = std::max(d.max_speed_rad_s, std::abs(speed[k]));
-    u_dc_sum += s.u_dc_V;
-  }
-  d.mean_u_dc_V = u_dc_sum / static_cast<double>(n);
-  std::vector<double> moving;
-  for (double w : speed) {
-    if (std::abs(w) > 0.05 * d.max_speed_rad_s) moving.push_back(std::abs(w));
-  }
-  if (!moving.empty()) {
-    std::sort(moving.begin(), moving.end());
-    d.speed_spread_rel = (moving[moving.size() * 9 / 10] - moving[moving.size() / 10]) / std::max(d.max_speed_rad_s, 1e-12);
-  }
-}
-
-/// The samples the replay runs on: the logged ones; in the transient mode with the speed taken from the
-/// angle's change over ±half_window rows where that stretch has no gap.
-void replay_samples(LogData& d, int half_window) {
-  const std::size_t n = d.rows.size();
-  d.replay_samples.resize(n);
-  for (std::size_t k = 0; k < n; ++k) d.replay_samples[k] = d.rows[k].sample;
-  if (d.mode != ModelMode::kTransient || half_window <= 0) return;
-  const std::size_t w = static_cast<std::size_t>(half_window);
-  for (std::size_t k = w; k + w < n; ++k) {
-    const core::DriveSample &a = d.rows[k - w].sample, &b = d.rows[k + w].sample;
-    const double dt = core::to_seconds(b.t_ns - a.t_ns);
-    // Only across a gap-free stretch; else the logged speed stays.
-    bool gap = false;
-    for (std::size_t j = k - w + 1; j <= k + w && !gap; ++j) gap = d.rows[j].sample.gap_before;
-    if (!gap && dt > 0.0) d.replay_samples[k].omega_el_rad_s = core::wrap_angle(b.theta_el_rad - a.theta_el_rad) / dt;
-  }
-}
-
-/// The steady-state replay leaves out idle rows and rows whose neighbour's current or speed differs by
-/// more than kTransitionShare of the log's range.
-void exclude_idle_and_transitional(LogData& d, const std::vector<double>& current, const std::vector<double>& speed) {
-  const std::size_t n = d.rows.size();
-  const double i_span = std::max(d.max_current_A, 1e-9), n_span = std::max(d.max_speed_rad_s, 1e-9);
-  for (std::size_t k = 0; k < n; ++k) {
-    if (current[k] < kIdleShare * i_span && std::abs(speed[k]) < kIdleShare * n_span) {
-      d.used[k] = false;
-      ++d.excluded_idle;
-      continue;
-    }
-    for (std::size_t j : {k - 1, k + 1}) {
-      if (j >= n) continue;  // k − 1 wraps for k = 0
-      if (std::abs(current[j] - current[k]) > kTransitionShare * i_span ||
-          std::abs(speed[j] - speed[k]) > kTransitionShare * n_span) {
-        d.used[k] = false;
-        ++d.excluded_transitional;
-        break;
-      }
-    }
-  }
-}
-
 }  // namespace
 
 const char* to_string(ModelMode m) noexcept { return m == ModelMode::kTransient ? "transient" : "steady_state"; }
 
-LogData prepare_log(std::vector<io::DriveLogRow> rows, const io::DriveLogLayout& layout,
-                    const core::MachineSi& machine, const LogOptions& options, const std::string& path) {
-  LogData d;
-  d.path = path;
-  d.rows = std::move(rows);
-  d.layout = layout;
-  const std::size_t n = d.rows.size();
-  if (n < 2 * static_cast<std::size_t>(std::max(2, options.blocks))) {
-    throw io::DriveLogError(path, n + 1, 0, "", "a log to diagnose needs at least " +
-                                                    std::to_string(2 * std::max(2, options.blocks)) + " rows");
+core::DriveSample LogData::replay_sample(std::size_t k) const noexcept {
+  core::DriveSample s = samples.sample(k);
+  const std::size_t w = static_cast<std::size_t>(speed_half_window), n = samples.size();
+  if (w == 0 || k < w || k + w >= n) return s;
+  // Only across a gap-free stretch; else the logged speed stays.
+  for (std::size_t j = k - w + 1; j <= k + w; ++j) {
+    if (samples.gap_before(j)) return s;
   }
-  d.t_start_s = core::to_seconds(d.rows.front().sample.t_ns);
-  d.t_end_s = core::to_seconds(d.rows.back().sample.t_ns);
+  const double dt = core::to_seconds(samples.t_ns(k + w) - samples.t_ns(k - w));
+  if (dt > 0.0) s.omega_el_rad_s = core::wrap_angle(samples.theta_el_rad(k + w) - samples.theta_el_rad(k - w)) / dt;
+  return s;
+}
 
-  std::vector<double> dts;
-  dts.reserve(n - 1);
-  for (std::size_t k = 1; k < n; ++k) dts.push_back(core::to_seconds(d.rows[k].sample.t_ns - d.rows[k - 1].sample.t_ns));
-  d.median_dt_s = median(dts);
+core::Vec2 LogData::logged_i_dq_A(std::size_t k) const noexcept {
+  const core::DriveSample s = samples.sample(k);
+  return core::SampleConditioner::logged_current_dq_A(s, core::Rotation::of(s.theta_el_rad));
+}
 
-  std::vector<double> current(n), speed(n);
-  measure_amplitudes(d, machine, current, speed);
+std::size_t LogData::used_count() const noexcept {
+  std::size_t n = 0;
+  for (std::size_t k = 0; k < size(); ++k) n += used(k) ? 1 : 0;
+  return n;
+}
+
+std::size_t LogData::training_count() const noexcept {
+  std::size_t n = 0;
+  for (int b = 0; b < blocks; b += 2) {
+    for (std::size_t k = block_first[static_cast<std::size_t>(b)]; k < block_first[static_cast<std::size_t>(b) + 1]; ++k) n += used(k) ? 1 : 0;
+  }
+  return n;
+}
+
+void prepare_log(LogData& d, const core::MachineSi& machine, const LogOptions& options) {
+  const std::size_t n = d.samples.size();
+  if (n < 2 * static_cast<std::size_t>(std::max(2, options.blocks))) {
+    throw io::DriveLogError(d.path, n + 1, 0, "", "a log to diagnose needs at least " +
+                                                      std::to_string(2 * std::max(2, options.blocks)) + " rows");
+  }
+  d.t_start_s = d.t_s(0);
+  d.t_end_s = d.t_s(n - 1);
+  {
+    std::vector<double> dts;
+    dts.reserve(n - 1);
+    for (std::size_t k = 1; k < n; ++k) dts.push_back(core::to_seconds(d.samples.t_ns(k) - d.samples.t_ns(k - 1)));
+    d.median_dt_s = median(std::move(dts));
+  }
+
+  // The measured current's amplitude, the same in every frame (amplitude-invariant).
+  double u_dc_sum = 0.0;
+  for (std::size_t k = 0; k < n; ++k) {
+    d.max_current_A = std::max(d.max_current_A, d.logged_i_dq_A(k).norm());
+    d.max_speed_rad_s = std::max(d.max_speed_rad_s, std::abs(d.samples.omega_el_rad_s(k)));
+    u_dc_sum += d.samples.u_dc_V(k);
+  }
+  d.mean_u_dc_V = u_dc_sum / static_cast<double>(n);
+  {
+    std::vector<double> moving;
+    for (std::size_t k = 0; k < n; ++k) {
+      const double w = d.samples.omega_el_rad_s(k);
+      if (std::abs(w) > 0.05 * d.max_speed_rad_s) moving.push_back(std::abs(w));
+    }
+    if (!moving.empty()) {
+      std::sort(moving.begin(), moving.end());
+      d.speed_spread_rel = (moving[moving.size() * 9 / 10] - moving[moving.size() / 10]) / std::max(d.max_speed_rad_s, 1e-12);
+    }
+  }
 
   const double time_constant_s = std::max(machine.l_d_H, machine.l_q_H) / machine.r_s_Ohm;
   d.mode = options.mode.value_or(d.median_dt_s >= kSteadyStateTimeConstants * time_constant_s ? ModelMode::kSteadyState
                                                                                                : ModelMode::kTransient);
+  d.speed_half_window = d.mode == ModelMode::kTransient ? std::max(0, options.speed_half_window) : 0;
 
-  replay_samples(d, options.speed_half_window);
-  d.used.assign(n, true);
-  if (d.mode == ModelMode::kSteadyState) exclude_idle_and_transitional(d, current, speed);
-
-  d.blocks = std::max(2, options.blocks);
-  d.block.resize(n);
-  const double span = std::max(d.t_end_s - d.t_start_s, 1e-12);
-  for (std::size_t k = 0; k < n; ++k) {
-    const double t = core::to_seconds(d.rows[k].sample.t_ns) - d.t_start_s;
-    d.block[k] = std::min(d.blocks - 1, static_cast<int>(t / span * d.blocks));
+  if (d.mode == ModelMode::kSteadyState) {
+    const double i_span = std::max(d.max_current_A, 1e-9), n_span = std::max(d.max_speed_rad_s, 1e-9);
+    auto current = [&](std::size_t k) { return d.logged_i_dq_A(k).norm(); };
+    auto speed = [&](std::size_t k) { return d.samples.omega_el_rad_s(k); };
+    for (std::size_t k = 0; k < n; ++k) {
+      if (current(k) < kIdleShare * i_span && std::abs(speed(k)) < kIdleShare * n_span) {
+        d.samples.set_mark(k, sample_mark::kLeftOut, true);
+        ++d.excluded_idle;
+        continue;
+      }
+      for (std::size_t j : {k - 1, k + 1}) {
+        if (j >= n) continue;  // k − 1 wraps for k = 0
+        if (std::abs(current(j) - current(k)) > kTransitionShare * i_span ||
+            std::abs(speed(j) - speed(k)) > kTransitionShare * n_span) {
+          d.samples.set_mark(k, sample_mark::kLeftOut, true);
+          ++d.excluded_transitional;
+          break;
+        }
+      }
+    }
   }
+
+  // Block b holds the samples whose time lies in [b, b + 1)·span/blocks (the last one's end included).
+  d.blocks = std::max(2, options.blocks);
+  d.block_first.assign(static_cast<std::size_t>(d.blocks) + 1, n);
+  const double span = std::max(d.t_end_s - d.t_start_s, 1e-12);
+  int next = 0;
+  for (std::size_t k = 0; k < n; ++k) {
+    const double t = d.t_s(k) - d.t_start_s;
+    const int b = std::min(d.blocks - 1, static_cast<int>(t / span * d.blocks));
+    for (; next <= b; ++next) d.block_first[static_cast<std::size_t>(next)] = k;
+  }
+}
+
+LogData prepare_log(const std::vector<io::DriveLogRow>& rows, const io::DriveLogLayout& layout, const core::MachineSi& machine,
+                    const LogOptions& options, const std::string& path) {
+  LogData d;
+  d.path = path;
+  d.layout = layout;
+  d.samples = SampleStore(layout);
+  for (const io::DriveLogRow& r : rows) d.samples.push_back(r);
+  d.samples.finish();
+  prepare_log(d, machine, options);
   return d;
 }
 
 std::vector<std::string> left_out_explanations(const LogData& log) {
   std::vector<std::string> out;
-  const double n = static_cast<double>(log.rows.size());
+  const double n = static_cast<double>(log.size());
   auto explain = [&](std::size_t count, const std::string& what) {
     if (static_cast<double>(count) <= io::kExplainedShare * n) return;
     char head[96];
-    std::snprintf(head, sizeof head, "%zu of %zu rows (%.1f %%) ", count, log.rows.size(), 100.0 * static_cast<double>(count) / n);
+    std::snprintf(head, sizeof head, "%zu of %zu rows (%.1f %%) ", count, log.size(), 100.0 * static_cast<double>(count) / n);
     out.push_back(head + what);
   };
   char text[512];
@@ -198,9 +205,12 @@ std::string apply_reported_command(std::vector<core::AveragedSample>& samples, c
 
 }  // namespace
 
-LogData load_log(const std::string& path, const core::MachineSi& machine, const LogOptions& options) {
+LogData load_log(const std::string& path, const core::MachineSi& machine, const LogOptions& options,
+                 const std::function<void(std::uint64_t, std::uint64_t)>& progress) {
   const io::LogSource source = io::log_source(path, options.log_map);
   const io::DriveLogLimits limits = io::machine_limits(machine);
+  LogData d;
+  d.path = path;
   if (source.averaged()) {
     // Window means carry no transient to replay: the steady-state model, whatever the spacing.
     if (options.mode == ModelMode::kTransient) {
@@ -211,30 +221,33 @@ LogData load_log(const std::string& path, const core::MachineSi& machine, const 
     std::vector<core::AveragedSample> samples = io::read_averaged_log(path, source.map, limits, &read);
     const bool turn = options.voltage_is_command && options.control_period_s > 0.0;
     const std::string voltage = turn ? apply_reported_command(samples, options) : "";
-    std::vector<io::DriveLogRow> rows;
-    std::vector<std::int64_t> starts;
-    rows.reserve(samples.size());
-    starts.reserve(samples.size());
+    d.layout = io::rotor_frame_layout(read.layout);
+    d.samples = SampleStore(d.layout);
+    d.window_start_ns.reserve(samples.size());
     for (const core::AveragedSample& s : samples) {
-      rows.push_back(io::to_drive_log_row(s));
-      starts.push_back(s.t_start_ns);
+      d.samples.push_back(io::to_drive_log_row(s));
+      d.window_start_ns.push_back(s.t_start_ns);
     }
+    d.samples.finish();
     LogOptions steady = options;
     steady.mode = ModelMode::kSteadyState;
-    LogData d = prepare_log(std::move(rows), io::rotor_frame_layout(read.layout), machine, steady, path);
+    prepare_log(d, machine, steady);
     d.averaged = true;
-    d.window_start_ns = std::move(starts);
     d.format = io::describe(source, read) + voltage;
     d.voltage_applied = turn;
     return d;
   }
   io::DriveLogReader reader(path, source.map, limits);
-  std::vector<io::DriveLogRow> rows;
+  d.layout = reader.layout();
+  d.samples = SampleStore(d.layout);
   io::DriveLogRow row;
-  while (reader.next(row)) rows.push_back(row);
-  LogData d = prepare_log(std::move(rows), reader.layout(), machine, options, path);
-  d.format = path + " as " + source.format + ": " + std::to_string(d.rows.size()) + " rows" +
-             io::describe(reader.reader().repairs());
+  while (reader.next(row)) {
+    d.samples.push_back(row);
+    if (progress && (d.samples.size() & 0xFFFF) == 0) progress(reader.bytes_read(), reader.bytes_total());
+  }
+  d.samples.finish();
+  prepare_log(d, machine, options);
+  d.format = path + " as " + source.format + ": " + std::to_string(d.size()) + " rows" + io::describe(reader.reader().repairs());
   return d;
 }
 

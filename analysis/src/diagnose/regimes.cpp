@@ -14,25 +14,25 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 /// An averaged log's row as the window it was read from (io::to_drive_log_row inverted).
 core::AveragedSample window_of(const LogData& log, std::size_t k) {
-  const io::DriveLogRow& r = log.rows[k];
+  const core::DriveSample r = log.sample(k);
   core::AveragedSample s;
   s.t_start_ns = log.window_start_ns[k];
-  s.t_ns = r.sample.t_ns;
-  s.i_dq_A = r.sample.i_A.head<2>();
-  s.u_dq_V = r.sample.u_V.head<2>();
-  s.omega_el_rad_s = r.sample.omega_el_rad_s;
-  s.u_dc_V = log.layout.u_dc ? r.sample.u_dc_V : kNaN;
-  s.t_winding_C = r.t_winding_C.value_or(kNaN);
-  s.t_magnet_C = r.t_magnet_C.value_or(kNaN);
-  s.gap_before = r.sample.gap_before;
+  s.t_ns = r.t_ns;
+  s.i_dq_A = r.i_A.head<2>();
+  s.u_dq_V = r.u_V.head<2>();
+  s.omega_el_rad_s = r.omega_el_rad_s;
+  s.u_dc_V = log.layout.u_dc ? r.u_dc_V : kNaN;
+  s.t_winding_C = log.samples.t_winding_C(k).value_or(kNaN);
+  s.t_magnet_C = log.samples.t_magnet_C(k).value_or(kNaN);
+  s.gap_before = r.gap_before;
   return s;
 }
 
 }  // namespace
 
-LogRegimes classify_regimes(const LogData& log, const io::MachineConfig& config) {
+LogRegimes classify_regimes(const LogData& log, const io::MachineConfig& config, Monitor* monitor) {
   LogRegimes out;
-  const std::size_t n = log.rows.size();
+  const std::size_t n = log.size();
   out.regime.resize(n);
   out.counts.averaged = log.averaged;
   auto record = [&](std::size_t k, const core::Estimate& e) {
@@ -40,6 +40,7 @@ LogRegimes classify_regimes(const LogData& log, const io::MachineConfig& config)
     // The window before held the bridge's release (docs/derivations.md §13, "Mixed windows").
     if ((e.regime.bits & core::regime_bit::kPreviousMixed) && k > 0) out.regime[k - 1] = core::as_mixed(out.regime[k - 1]);
     out.counts.add(e);
+    if ((k + 1) % kMonitorSamples == 0) report_work(monitor, kMonitorSamples);
   };
   if (log.averaged) {
     assert(log.window_start_ns.size() == n);
@@ -53,17 +54,18 @@ LogRegimes classify_regimes(const LogData& log, const io::MachineConfig& config)
     for (std::size_t k = 0; k < n; ++k) record(k, estimator.step(window_of(log, k)));
   } else {
     core::DriveEstimator estimator(config.machine, config.estimator);
-    for (std::size_t k = 0; k < n; ++k) record(k, estimator.step(log.rows[k].sample));
+    for (std::size_t k = 0; k < n; ++k) record(k, estimator.step(log.sample(k)));
   }
+  report_work(monitor, n % kMonitorSamples);
   out.explanations = io::exclusion_explanations(out.counts);
   return out;
 }
 
 void exclude_regimes(LogData& log, LogRegimes& regimes) {
-  assert(regimes.regime.size() == log.rows.size());
-  for (std::size_t k = 0; k < log.rows.size(); ++k) {
-    if (!core::info(regimes.regime[k]).excluded || !log.used[k]) continue;
-    log.used[k] = false;
+  assert(regimes.regime.size() == log.size());
+  for (std::size_t k = 0; k < log.size(); ++k) {
+    if (!core::info(regimes.regime[k]).excluded || !log.used(k)) continue;
+    log.samples.set_mark(k, sample_mark::kLeftOut, true);
     ++regimes.excluded_used;
   }
 }

@@ -1,9 +1,6 @@
 #include "rpem/analysis/diagnose/residual_statistics.hpp"
 
-#include <array>
 #include <cmath>
-#include <complex>
-#include <functional>
 
 #include "rpem/core/clock.hpp"
 #include "rpem/core/conditioner.hpp"
@@ -11,42 +8,10 @@
 namespace rpem::analysis {
 namespace {
 
-constexpr int kMaxHarmonic = 12;
 /// |i_q| below this share of the base current counts as no load.
 constexpr double kNoLoadShare = 0.05;
 /// Regions with fewer than this share of the samples are left out of the table.
 constexpr double kMinRegionShare = 0.005;
-
-/// Sums for mean and RMS of a 2-vector.
-struct Moments {
-  std::size_t n = 0;
-  core::Vec2 sum = core::Vec2::Zero();
-  double sum_sq = 0.0;
-  void add(const core::Vec2& v) {
-    ++n;
-    sum += v;
-    sum_sq += v.squaredNorm();
-  }
-  [[nodiscard]] double rms() const { return n ? std::sqrt(sum_sq / static_cast<double>(n)) : 0.0; }
-  [[nodiscard]] core::Vec2 mean() const { return n ? core::Vec2(sum / static_cast<double>(n)) : core::Vec2::Zero(); }
-};
-
-/// Pearson correlation accumulated over pairs.
-struct Pearson {
-  double n = 0, sx = 0, sy = 0, sxx = 0, syy = 0, sxy = 0;
-  void add(double x, double y) {
-    n += 1;
-    sx += x;
-    sy += y;
-    sxx += x * x;
-    syy += y * y;
-    sxy += x * y;
-  }
-  [[nodiscard]] double value() const {
-    const double vx = n * sxx - sx * sx, vy = n * syy - sy * sy;
-    return vx > 0.0 && vy > 0.0 ? (n * sxy - sx * sy) / std::sqrt(vx * vy) : 0.0;
-  }
-};
 
 const char* const kSpeedRegions[] = {"n ≤ −0.5 pu", "−0.5 < n < 0 pu", "standstill", "0 < n < 0.5 pu", "n ≥ 0.5 pu"};
 const char* const kLoadRegions[] = {"i_q < 0", "no load", "i_q > 0"};
@@ -65,137 +30,183 @@ int load_region(double i_q_A, double base_current_A) {
   return i_q_A > 0.0 ? 2 : 0;
 }
 
-/// The residuals' harmonics of the electrical angle (in motion) and their means by the sign of each phase
-/// current: the transient mode's statistics.
-struct TransientSums {
-  std::array<std::array<std::complex<double>, 2>, kMaxHarmonic + 1> harm_before{}, harm_after{};
-  std::size_t harmonic_samples = 0;
-  std::array<Moments, 3> pos_before{}, pos_after{}, neg_before{}, neg_after{};
+}  // namespace
 
-  void add(double theta_el_rad, bool still, const core::Vec2& i, const core::Vec2& rb, const core::Vec2& ra) {
-    const core::Rotation rot = core::Rotation::of(theta_el_rad);
+void ResidualSums::Moments::add(const core::Vec2& v) {
+  ++n;
+  sum += v;
+  sum_sq += v.squaredNorm();
+}
+void ResidualSums::Moments::merge(const Moments& o) {
+  n += o.n;
+  sum += o.sum;
+  sum_sq += o.sum_sq;
+}
+double ResidualSums::Moments::rms() const { return n ? std::sqrt(sum_sq / static_cast<double>(n)) : 0.0; }
+core::Vec2 ResidualSums::Moments::mean() const { return n ? core::Vec2(sum / static_cast<double>(n)) : core::Vec2::Zero(); }
+
+void ResidualSums::Pearson::add(double x, double y) {
+  n += 1;
+  sx += x;
+  sy += y;
+  sxx += x * x;
+  syy += y * y;
+  sxy += x * y;
+}
+void ResidualSums::Pearson::merge(const Pearson& o) {
+  n += o.n;
+  sx += o.sx;
+  sy += o.sy;
+  sxx += o.sxx;
+  syy += o.syy;
+  sxy += o.sxy;
+}
+double ResidualSums::Pearson::value() const {
+  const double vx = n * sxx - sx * sx, vy = n * syy - sy * sy;
+  return vx > 0.0 && vy > 0.0 ? (n * sxy - sx * sy) / std::sqrt(vx * vy) : 0.0;
+}
+
+ResidualSums::ResidualSums(const LogData& log, const EffectContext& context)
+    : log_(&log),
+      base_(core::PerUnitBase::from_rated(context.machine.rated)),
+      regressors_{"|i| [A]", "i_d [A]", "i_q [A]", "speed [pu]", "|speed| [pu]", "time [s]"} {
+  if (log.layout.t_winding) regressors_.emplace_back("T_winding [°C]");
+  if (log.layout.t_magnet) regressors_.emplace_back("T_magnet [°C]");
+  corr_.resize(regressors_.size());
+}
+
+double ResidualSums::regressor(std::size_t j, std::size_t k, const core::Vec2& i, double n_pu) const {
+  switch (j) {
+    case 0: return i.norm();
+    case 1: return i[0];
+    case 2: return i[1];
+    case 3: return n_pu;
+    case 4: return std::abs(n_pu);
+    case 5: return log_->t_s(k);
+    default: break;
+  }
+  // The temperatures, in the order the constructor lists them.
+  const bool winding = j == 6 && log_->layout.t_winding;
+  return (winding ? log_->samples.t_winding_C(k) : log_->samples.t_magnet_C(k)).value_or(0.0);
+}
+
+void ResidualSums::add(std::size_t k, const core::Vec2& rb, const core::Vec2& ra) {
+  const core::DriveSample s = log_->sample(k);
+  const core::Rotation rot = core::Rotation::of(s.theta_el_rad);
+  const core::Vec2 i = core::SampleConditioner::logged_current_dq_A(s, rot);
+  const double n = s.omega_el_rad_s / base_.omega_el_rad_s;
+  all_before_.add(rb);
+  all_after_.add(ra);
+  const bool still = std::abs(n) < kStandstillSpeedPu;
+  (still ? still_before_ : moving_before_).add(rb);
+  (still ? still_after_ : moving_after_).add(ra);
+  const int sr = speed_region(n), lr = load_region(i[1], base_.current_A);
+  region_before_[sr][lr].add(rb);
+  region_after_[sr][lr].add(ra);
+
+  if (log_->mode == ModelMode::kTransient) {
     if (!still) {
-      ++harmonic_samples;
+      ++harmonic_samples_;
       for (int h = 0; h <= kMaxHarmonic; ++h) {
-        const std::complex<double> e = std::polar(1.0, -h * theta_el_rad);
-        harm_before[h][0] += rb[0] * e;
-        harm_before[h][1] += rb[1] * e;
-        harm_after[h][0] += ra[0] * e;
-        harm_after[h][1] += ra[1] * e;
+        const std::complex<double> e = std::polar(1.0, -h * s.theta_el_rad);
+        harm_before_[h][0] += rb[0] * e;
+        harm_before_[h][1] += rb[1] * e;
+        harm_after_[h][0] += ra[0] * e;
+        harm_after_[h][1] += ra[1] * e;
       }
     }
     const core::Vec3 i_abc = core::inverse_clarke(core::inverse_park(i, rot));
     const core::Vec3 r_abc_b = core::inverse_clarke(core::inverse_park(rb, rot));
     const core::Vec3 r_abc_a = core::inverse_clarke(core::inverse_park(ra, rot));
     for (int x = 0; x < 3; ++x) {
-      (i_abc[x] > 0.0 ? pos_before : neg_before)[x].add({r_abc_b[x], 0.0});
-      (i_abc[x] > 0.0 ? pos_after : neg_after)[x].add({r_abc_a[x], 0.0});
+      (i_abc[x] > 0.0 ? pos_before_ : neg_before_)[x].add({r_abc_b[x], 0.0});
+      (i_abc[x] > 0.0 ? pos_after_ : neg_after_)[x].add({r_abc_a[x], 0.0});
     }
   }
-
-  void write(ResidualStatistics& out) const {
-    if (harmonic_samples == 0) return;
-    const double scale = 2.0 / static_cast<double>(harmonic_samples);
-    for (int h = 0; h <= kMaxHarmonic; ++h) {
-      // Amplitude of the residual vector's component at h·ϑ (the mean for h = 0).
-      const double f = h == 0 ? 0.5 * scale : scale;
-      const double before = f * std::hypot(std::abs(harm_before[h][0]), std::abs(harm_before[h][1]));
-      const double after = f * std::hypot(std::abs(harm_after[h][0]), std::abs(harm_after[h][1]));
-      out.harmonics.push_back({h, {before, after}});
-    }
-    for (int x = 0; x < 3; ++x) {
-      out.phase_signs.push_back({static_cast<char>('a' + x), {pos_before[x].mean()[0], pos_after[x].mean()[0]},
-                                 {neg_before[x].mean()[0], neg_after[x].mean()[0]}});
-    }
+  for (std::size_t j = 0; j < regressors_.size(); ++j) {
+    const double v = regressor(j, k, i, n);
+    corr_[j][0].add(v, rb[0]);
+    corr_[j][1].add(v, rb[1]);
+    corr_[j][2].add(v, ra[0]);
+    corr_[j][3].add(v, ra[1]);
   }
-};
-
-/// A quantity the residuals are correlated with.
-struct Regressor {
-  std::string name;
-  std::function<double(std::size_t, const core::Vec2&, double)> value;  ///< sample, logged i_dq, n_pu
-};
-
-std::vector<Regressor> regressors_of(const LogData& log) {
-  std::vector<Regressor> regressors = {
-      {"|i| [A]", [](std::size_t, const core::Vec2& i, double) { return i.norm(); }},
-      {"i_d [A]", [](std::size_t, const core::Vec2& i, double) { return i[0]; }},
-      {"i_q [A]", [](std::size_t, const core::Vec2& i, double) { return i[1]; }},
-      {"speed [pu]", [](std::size_t, const core::Vec2&, double n) { return n; }},
-      {"|speed| [pu]", [](std::size_t, const core::Vec2&, double n) { return std::abs(n); }},
-      {"time [s]", [&log](std::size_t k, const core::Vec2&, double) { return core::to_seconds(log.rows[k].sample.t_ns); }},
-  };
-  if (log.layout.t_winding) {
-    regressors.push_back({"T_winding [°C]", [&log](std::size_t k, const core::Vec2&, double) { return log.rows[k].t_winding_C.value_or(0.0); }});
-  }
-  if (log.layout.t_magnet) {
-    regressors.push_back({"T_magnet [°C]", [&log](std::size_t k, const core::Vec2&, double) { return log.rows[k].t_magnet_C.value_or(0.0); }});
-  }
-  return regressors;
 }
 
-}  // namespace
-
-ResidualStatistics residual_statistics(const LogData& log, const EffectContext& context, const ReplayOutput& nominal,
-                                       const ReplayOutput& extended) {
-  const core::PerUnitBase base = core::PerUnitBase::from_rated(context.machine.rated);
-  const core::SampleConditioner raw(base, core::to_pu(base, context.machine), {});
-  const bool transient = log.mode == ModelMode::kTransient;
-
-  std::array<std::array<Moments, 3>, 5> region_before{}, region_after{};
-  Moments all_before, all_after, still_before, still_after, moving_before, moving_after;
-  TransientSums transient_sums;
-  const std::vector<Regressor> regressors = regressors_of(log);
-  std::vector<std::array<Pearson, 4>> corr(regressors.size());  // d before, q before, d after, q after
-
-  for (std::size_t k = 0; k < log.rows.size(); ++k) {
-    if (!nominal.valid[k] || !extended.valid[k]) continue;
-    const core::DriveSample& s = log.rows[k].sample;
-    const core::Vec2& rb = nominal.residual_A[k];
-    const core::Vec2& ra = extended.residual_A[k];
-    const core::Vec2 i = raw.logged_current_dq_A(s);
-    const double n = s.omega_el_rad_s / base.omega_el_rad_s;
-    all_before.add(rb);
-    all_after.add(ra);
-    const bool still = std::abs(n) < kStandstillSpeedPu;
-    (still ? still_before : moving_before).add(rb);
-    (still ? still_after : moving_after).add(ra);
-    const int sr = speed_region(n), lr = load_region(i[1], base.current_A);
-    region_before[sr][lr].add(rb);
-    region_after[sr][lr].add(ra);
-
-    if (transient) transient_sums.add(s.theta_el_rad, still, i, rb, ra);
-    for (std::size_t j = 0; j < regressors.size(); ++j) {
-      const double v = regressors[j].value(k, i, n);
-      corr[j][0].add(v, rb[0]);
-      corr[j][1].add(v, rb[1]);
-      corr[j][2].add(v, ra[0]);
-      corr[j][3].add(v, ra[1]);
-    }
-  }
-
-  ResidualStatistics out;
-  out.rms_A = {all_before.rms(), all_after.rms()};
-  out.standstill_rms_A = {still_before.rms(), still_after.rms()};
-  out.motion_rms_A = {moving_before.rms(), moving_after.rms()};
-  out.standstill_samples = still_before.n;
-  out.motion_samples = moving_before.n;
+void ResidualSums::merge(const ResidualSums& o) {
   for (int sr = 0; sr < 5; ++sr) {
     for (int lr = 0; lr < 3; ++lr) {
-      const Moments& b = region_before[sr][lr];
+      region_before_[sr][lr].merge(o.region_before_[sr][lr]);
+      region_after_[sr][lr].merge(o.region_after_[sr][lr]);
+    }
+  }
+  all_before_.merge(o.all_before_);
+  all_after_.merge(o.all_after_);
+  still_before_.merge(o.still_before_);
+  still_after_.merge(o.still_after_);
+  moving_before_.merge(o.moving_before_);
+  moving_after_.merge(o.moving_after_);
+  for (int h = 0; h <= kMaxHarmonic; ++h) {
+    for (int a = 0; a < 2; ++a) {
+      harm_before_[h][a] += o.harm_before_[h][a];
+      harm_after_[h][a] += o.harm_after_[h][a];
+    }
+  }
+  harmonic_samples_ += o.harmonic_samples_;
+  for (int x = 0; x < 3; ++x) {
+    pos_before_[x].merge(o.pos_before_[x]);
+    pos_after_[x].merge(o.pos_after_[x]);
+    neg_before_[x].merge(o.neg_before_[x]);
+    neg_after_[x].merge(o.neg_after_[x]);
+  }
+  for (std::size_t j = 0; j < corr_.size(); ++j) {
+    for (int c = 0; c < 4; ++c) corr_[j][c].merge(o.corr_[j][c]);
+  }
+}
+
+ResidualStatistics ResidualSums::statistics() const {
+  ResidualStatistics out;
+  out.rms_A = {all_before_.rms(), all_after_.rms()};
+  out.standstill_rms_A = {still_before_.rms(), still_after_.rms()};
+  out.motion_rms_A = {moving_before_.rms(), moving_after_.rms()};
+  out.standstill_samples = still_before_.n;
+  out.motion_samples = moving_before_.n;
+  for (int sr = 0; sr < 5; ++sr) {
+    for (int lr = 0; lr < 3; ++lr) {
+      const Moments& b = region_before_[sr][lr];
       // Regions a log only passes through (a few samples in a transient) say little.
-      if (static_cast<double>(b.n) < kMinRegionShare * static_cast<double>(all_before.n) || b.n == 0) continue;
-      const Moments& a = region_after[sr][lr];
+      if (static_cast<double>(b.n) < kMinRegionShare * static_cast<double>(all_before_.n) || b.n == 0) continue;
+      const Moments& a = region_after_[sr][lr];
       out.regions.push_back({kSpeedRegions[sr], kLoadRegions[lr], b.n, {b.rms(), a.rms()}, {b.mean()[0], a.mean()[0]},
                              {b.mean()[1], a.mean()[1]}});
     }
   }
-  transient_sums.write(out);
-  for (std::size_t j = 0; j < regressors.size(); ++j) {
-    out.correlations.push_back({regressors[j].name, {corr[j][0].value(), corr[j][2].value()},
-                                {corr[j][1].value(), corr[j][3].value()}});
+  if (harmonic_samples_ > 0) {
+    const double scale = 2.0 / static_cast<double>(harmonic_samples_);
+    for (int h = 0; h <= kMaxHarmonic; ++h) {
+      // Amplitude of the residual vector's component at h·ϑ (the mean for h = 0).
+      const double f = h == 0 ? 0.5 * scale : scale;
+      const double before = f * std::hypot(std::abs(harm_before_[h][0]), std::abs(harm_before_[h][1]));
+      const double after = f * std::hypot(std::abs(harm_after_[h][0]), std::abs(harm_after_[h][1]));
+      out.harmonics.push_back({h, {before, after}});
+    }
+    for (int x = 0; x < 3; ++x) {
+      out.phase_signs.push_back({static_cast<char>('a' + x), {pos_before_[x].mean()[0], pos_after_[x].mean()[0]},
+                                 {neg_before_[x].mean()[0], neg_after_[x].mean()[0]}});
+    }
+  }
+  for (std::size_t j = 0; j < regressors_.size(); ++j) {
+    out.correlations.push_back({regressors_[j], {corr_[j][0].value(), corr_[j][2].value()}, {corr_[j][1].value(), corr_[j][3].value()}});
   }
   return out;
+}
+
+ResidualStatistics residual_statistics(const LogData& log, const EffectContext& context, const ReplayOutput& nominal,
+                                       const ReplayOutput& extended) {
+  ResidualSums sums(log, context);
+  for (std::size_t k = 0; k < log.size(); ++k) {
+    if (nominal.valid[k] && extended.valid[k]) sums.add(k, nominal.residual_A[k], extended.residual_A[k]);
+  }
+  return sums.statistics();
 }
 
 }  // namespace rpem::analysis

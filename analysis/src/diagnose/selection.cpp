@@ -1,52 +1,18 @@
 #include "rpem/analysis/diagnose/selection.hpp"
 
 #include <algorithm>
-#include <atomic>
 #include <cmath>
 #include <cstdio>
 #include <functional>
 #include <numeric>
 #include <optional>
 #include <string>
-#include <thread>
-#include <tuple>
 
 namespace rpem::analysis {
 namespace {
 
-/// Runs body(i) for i in [0, n) on `threads` threads.
-void parallel_for(std::size_t n, int threads, const std::function<void(std::size_t)>& body) {
-  std::atomic<std::size_t> next{0};
-  auto worker = [&] {
-    for (std::size_t i = next++; i < n; i = next++) body(i);
-  };
-  std::vector<std::thread> pool;
-  for (int t = 1; t < std::min<int>(threads, static_cast<int>(n)); ++t) pool.emplace_back(worker);
-  worker();
-  for (auto& t : pool) t.join();
-}
-
 double gain_pct(const BlockScores& before, const BlockScores& after) {
   return 100.0 * (1.0 - std::sqrt(after.total() / std::max(before.total(), 1e-300)));
-}
-
-/// How alike two model changes are over the held-out samples.
-double change_correlation(const EffectFitter& f, const EffectSet& base, const EffectSet& a, const EffectSet& b) {
-  ReplayOutput r0, ra, rb;
-  const ModelReplay& replay = f.replay();
-  replay.run(base.model(f.context()), r0, Blocks::kHeldout);
-  replay.run(a.model(f.context()), ra, Blocks::kHeldout);
-  replay.run(b.model(f.context()), rb, Blocks::kHeldout);
-  double ab = 0.0, aa = 0.0, bb = 0.0;
-  const LogData& log = replay.log();
-  for (std::size_t k = 0; k < log.rows.size(); ++k) {
-    if (!log.heldout(k) || !r0.valid[k] || !ra.valid[k] || !rb.valid[k]) continue;
-    const core::Vec2 da = ra.model_A[k] - r0.model_A[k], db = rb.model_A[k] - r0.model_A[k];
-    ab += da.dot(db);
-    aa += da.squaredNorm();
-    bb += db.squaredNorm();
-  }
-  return aa > 0.0 && bb > 0.0 ? ab / std::sqrt(aa * bb) : 0.0;
 }
 
 /// An effect whose parameters trade against a calibrated constant the model had identified — with it, the
@@ -176,6 +142,216 @@ EffectSet with_admissible_constants(const EffectFitter& fitter, double noise_flo
   return all ? trial : fitter.fit(trial);
 }
 
+/// One round of the selection: its candidates (best screened first), their fits, and how they compare.
+struct Round {
+  std::vector<CandidateScore> candidates;
+  std::vector<std::vector<double>> starts;  ///< per candidate: the screening's best start
+  double ssr_now = 0.0;                     ///< training sum of squares of the model as it is [A²]
+  std::string name;                         ///< "round N: " (progress)
+  std::size_t shortlisted = 0, leaders = 0;
+  std::vector<EffectSet> fitted;
+  std::vector<BlockScores> scores;
+  std::vector<double> reduction;            ///< training sum of squares each fit removed [A²]
+  BlockScores reference;                    ///< what the candidates are judged against
+  std::vector<std::size_t> ranked;          ///< the fitted ones, best held-out score first
+  double before = 0.0;                      ///< held-out RMS of the reference [A]
+  double min_change2 = 0.0;
+  const EffectContext* context = nullptr;
+  const SelectionOptions* options = nullptr;
+
+  /// Ranks the fitted candidates against `reference`.
+  void rank() {
+    ranked.clear();
+    for (std::size_t i = 0; i < shortlisted; ++i) {
+      CandidateScore& c = candidates[i];
+      if (!c.fitted) continue;
+      c.gain_pct = gain_pct(reference, scores[i]);
+      c.block_log_ratio = block_log_ratios(reference, scores[i]);
+      c.p_value = signed_rank_p(c.block_log_ratio);
+      c.start = starts[i];
+      c.parameters = fitted[i].parameters.back();
+      ranked.push_back(i);
+    }
+    std::sort(ranked.begin(), ranked.end(), [&](std::size_t a, std::size_t b) { return scores[a].total() < scores[b].total(); });
+  }
+  /// Judged against the model as it is.
+  void judge_against(const BlockScores& current, const EffectContext& c, const SelectionOptions& o, double change2) {
+    reference = current;
+    context = &c;
+    options = &o;
+    min_change2 = change2;
+    rank();
+    before = rms(reference);
+  }
+  /// Candidate i passes the acceptance tests: large, consistent, out of the noise, not negligible.
+  [[nodiscard]] bool passes(std::size_t i) const {
+    const CandidateScore& c = candidates[i];
+    const double after = rms(scores[i]);
+    if (c.gain_pct < options->min_gain_pct || c.p_value > options->max_p || before * before - after * after < min_change2) return false;
+    return !(c.effect.row->negligible && c.effect.row->negligible(c.effect, fitted[i].model(*context), *context));
+  }
+  /// The second look's condition (second_look): none passes, but the best lowers the held-out residual by
+  /// min_gain_pct, and the model leaves an admissible constant configured.
+  [[nodiscard]] bool needs_second_look(const SelectionOptions& o, const EffectSet& model,
+                                       const std::array<bool, kCalibrated.size()>& admissible) const {
+    return std::none_of(ranked.begin(), ranked.end(), [&](std::size_t i) { return passes(i); }) && !ranked.empty() &&
+           candidates[ranked.front()].gain_pct >= o.min_gain_pct && leaves_configured(model, admissible);
+  }
+};
+
+/// The round's candidates — the catalogue's, less those in the model or excluded — screened against the model
+/// and ordered by the training gain the screening credits them with, best first (none: nothing to screen).
+std::optional<Round> screen_round(const EffectFitter& fitter, const Selection& sel, const std::vector<Effect>& excluded) {
+  Round round;
+  std::vector<Effect> effects;
+  for (const Effect& e : candidates(fitter.context())) {
+    if (sel.model.contains(e) || std::find(excluded.begin(), excluded.end(), e) != excluded.end()) continue;
+    effects.push_back(e);
+  }
+  if (effects.empty()) return std::nullopt;
+  round.name = "round " + std::to_string(sel.rounds.size() + 1) + ": ";
+  if (Monitor* m = fitter.replay().monitor()) m->stage(round.name + "screening " + std::to_string(effects.size()) + " candidates", 0);
+  Screening screening = fitter.screen(sel.model, effects);
+  round.ssr_now = screening.ssr;
+  std::vector<std::size_t> order(effects.size());
+  for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return screening.gain[a] > screening.gain[b]; });
+  for (std::size_t i : order) {
+    CandidateScore c;
+    c.effect = effects[i];
+    c.screen_ssr = screening.gain[i];
+    round.candidates.push_back(c);
+    round.starts.push_back(std::move(screening.starts[i]));
+  }
+  return round;
+}
+
+/// Fits the shortlist: the best few, without those the screening credits with less than a small share of
+/// the best (they cannot win unless the screening's first step misleads by that much); the leaders first, a
+/// later one only if its screening could rival what the leaders' fits achieved.
+void fit_shortlist(const EffectFitter& fitter, const SelectionOptions& options, const EffectSet& model, Round& round) {
+  std::vector<CandidateScore>& c = round.candidates;
+  std::size_t shortlisted = std::min<std::size_t>(c.size(), static_cast<std::size_t>(options.shortlist));
+  while (shortlisted > 2 && c[shortlisted - 1].screen_ssr < options.shortlist_share * c.front().screen_ssr) --shortlisted;
+  if (Monitor* m = fitter.replay().monitor()) m->stage(round.name + "fitting the " + std::to_string(shortlisted) + " best", 0);
+  round.shortlisted = shortlisted;
+  round.fitted.assign(shortlisted, EffectSet{});
+  round.scores.assign(shortlisted, BlockScores{});
+  round.reduction.assign(shortlisted, 0.0);
+  auto fit = [&](std::size_t i) {
+    double ssr = 0.0;
+    round.fitted[i] = fitter.fit(model.with(c[i].effect, fitter.context(), round.starts[i]), &ssr);
+    round.reduction[i] = round.ssr_now - ssr;
+    round.scores[i] = fitter.heldout(round.fitted[i]);
+    c[i].fitted = true;
+  };
+  const WorkPool& pool = fitter.replay().pool();
+  round.leaders = std::min<std::size_t>(shortlisted, static_cast<std::size_t>(std::max(options.leaders, 1)));
+  pool.parallel_for(round.leaders, fit);
+  const double achieved = *std::max_element(round.reduction.begin(), round.reduction.begin() + static_cast<std::ptrdiff_t>(round.leaders));
+  std::vector<std::size_t> rivals;
+  for (std::size_t i = round.leaders; i < shortlisted; ++i) {
+    if (c[i].screen_ssr >= options.rival_share * achieved) rivals.push_back(i);
+  }
+  pool.parallel_for(rivals.size(), [&](std::size_t j) { fit(rivals[j]); });
+}
+
+/// The second look (docs/diagnose.md, "Constants a missing effect hid"): a constant the excitation pins but
+/// the calibration left configured — its cluster-robust interval widened by the residual of an effect still
+/// missing — held at a wrong value while a candidate is fitted, biases the candidate and makes the blocks
+/// disagree. When no candidate passes but one lowers the held-out residual by min_gain_pct, the leaders are
+/// fitted again with those constants free (kept only if then identified), from their fits; the reference is
+/// the better of the model as it is and the model with the same constants free, so that what the
+/// constants' freedom alone brings is not credited to an effect.
+void second_look(const EffectFitter& fitter, double noise_floor_A, const std::array<bool, kCalibrated.size()>& admissible,
+                 const EffectSet& model, Round& round) {
+  std::vector<std::size_t> again;
+  for (std::size_t i : round.ranked) {
+    if (again.size() < round.leaders && round.candidates[i].gain_pct >= round.options->min_gain_pct) again.push_back(i);
+  }
+  EffectSet freed_model = model;
+  bool freed_kept = false;
+  fitter.replay().pool().parallel_for(again.size() + 1, [&](std::size_t j) {
+    bool kept = false;
+    if (j == again.size()) {
+      freed_model = with_admissible_constants(fitter, noise_floor_A, admissible, model, kept);
+      freed_kept = kept;
+      return;
+    }
+    const std::size_t i = again[j];
+    round.fitted[i] = with_admissible_constants(fitter, noise_floor_A, admissible, round.fitted[i], kept);
+    if (kept) round.scores[i] = fitter.heldout(round.fitted[i]);
+  });
+  if (freed_kept) {
+    const BlockScores freed_scores = fitter.heldout(freed_model);
+    if (freed_scores.total() < round.reference.total()) round.reference = freed_scores;
+  }
+  round.rank();
+  round.before = rms(round.reference);
+}
+
+/// The best candidate that passes and is plausible; those that pass but are implausible, or take a constant
+/// the model had identified, are reported, excluded and set aside (`set_aside`). None: no candidate passed.
+std::optional<std::size_t> best_plausible(const EffectFitter& fitter, double noise_floor_A,
+                                          const std::array<bool, kCalibrated.size()>& admissible, const Round& round,
+                                          Selection& sel, std::vector<Effect>& excluded, bool& set_aside) {
+  const EffectContext& context = fitter.context();
+  for (std::size_t i : round.ranked) {
+    const CandidateScore& c = round.candidates[i];
+    if (!round.passes(i)) continue;  // the best that passes: each is tested on its own
+    const ExtendedModel m = round.fitted[i].model(context);
+    std::optional<Implausibility> why;
+    if (c.effect.row->judge && c.effect.row->judge(c.effect, m, context, {})) {
+      // Judged again within the fitted parameter's own uncertainty.
+      const CalibrationIntervals ci = fitter.intervals(round.fitted[i], noise_floor_A);
+      why = c.effect.row->judge(c.effect, m, context, ci.effect_half_width.back());
+    }
+    if (!why) {
+      if (const std::optional<std::string> lost = takes_a_constant(fitter, sel.model, round.fitted[i], c, noise_floor_A, admissible)) {
+        sel.not_identifiable.push_back({{c.effect.label()}, *lost});
+        excluded.push_back(c.effect);
+        set_aside = true;
+        continue;
+      }
+      return i;
+    }
+    sel.implausible.push_back({c.effect, c.effect.row->describe(c.effect, m, context), c.gain_pct, *why});
+    excluded.push_back(c.effect);
+    set_aside = true;
+  }
+  return std::nullopt;
+}
+
+/// The winner and the rivals that pass too, that the held-out blocks do not tell from it, and that change the
+/// model in the same way (the rivals are excluded): a group of more than one makes the winner a guess, and
+/// nobody is named.
+Unidentifiable ambiguous_group(const EffectFitter& fitter, const SelectionOptions& options, const EffectSet& model,
+                               const Round& round, std::size_t best, std::vector<Effect>& excluded) {
+  const CandidateScore& winner = round.candidates[best];
+  Unidentifiable group{{winner.effect.label()}, ""};
+  for (std::size_t i : round.ranked) {
+    const CandidateScore& rival = round.candidates[i];
+    if (i == best || rival.effect.name() == winner.effect.name()) continue;
+    if (!round.passes(i)) continue;
+    if (std::find(excluded.begin(), excluded.end(), rival.effect) != excluded.end()) continue;
+    const double p_preferred = signed_rank_p(block_log_ratios(round.scores[i], round.scores[best]));
+    if (p_preferred <= options.ambiguity_p) continue;
+    const double corr = fitter.change_correlation(model, round.fitted[best], round.fitted[i]);
+    if (std::abs(corr) < options.ambiguity_correlation) continue;
+    char text[640];
+    std::snprintf(text, sizeof text,
+                  "%s%s and %s change the model's currents the same way in this log (correlation %.3f) and lower "
+                  "the held-out residual alike (%.1f %% and %.1f %%; the held-out blocks prefer neither, p = %.2f); a "
+                  "log with %s would separate them",
+                  group.reason.empty() ? "" : "; ", winner.effect.label().c_str(), rival.effect.label().c_str(), corr,
+                  winner.gain_pct, rival.gain_pct, p_preferred, separating_data(winner.effect, rival.effect).c_str());
+    group.reason += text;
+    group.effects.push_back(rival.effect.label());
+    excluded.push_back(rival.effect);
+  }
+  return group;
+}
+
 }  // namespace
 
 double rms(const BlockScores& b) { return b.samples ? std::sqrt(b.total() / static_cast<double>(b.samples)) : 0.0; }
@@ -227,259 +403,44 @@ bool readmit_constants(const EffectFitter& fitter, double noise_floor_A, const s
   return true;
 }
 
-namespace {
-
-/// One round of the forward selection: the candidates, screened and ordered best first, the shortlist's
-/// fits and held-out scores, and their ranking against `reference`.
-struct Round {
-  std::vector<CandidateScore> candidates;
-  std::vector<std::vector<double>> starts;  ///< each candidate's best start (EffectFitter::best_start)
-  std::size_t shortlisted = 0;
-  std::size_t leaders = 0;
-  std::vector<EffectSet> fitted;
-  std::vector<BlockScores> scores;
-  /// The candidates are judged against this: the model as it is, or after a second look (second_look).
-  BlockScores reference;
-  std::vector<std::size_t> ranked;  ///< the fitted ones, best held-out score first
-
-  void rank() {
-    ranked.clear();
-    for (std::size_t i = 0; i < shortlisted; ++i) {
-      if (!candidates[i].fitted) continue;
-      candidates[i].gain_pct = gain_pct(reference, scores[i]);
-      candidates[i].block_log_ratio = block_log_ratios(reference, scores[i]);
-      candidates[i].p_value = signed_rank_p(candidates[i].block_log_ratio);
-      candidates[i].start = starts[i];
-      candidates[i].parameters = fitted[i].parameters.back();
-      ranked.push_back(i);
-    }
-    std::sort(ranked.begin(), ranked.end(), [&](std::size_t a, std::size_t b) { return scores[a].total() < scores[b].total(); });
-  }
-};
-
-/// The effects not in the model and not excluded, unscored.
-std::vector<CandidateScore> open_candidates(const EffectContext& context, const EffectSet& model,
-                                            const std::vector<Effect>& excluded) {
-  std::vector<CandidateScore> round;
-  for (const Effect& e : candidates(context)) {
-    if (model.contains(e) || std::find(excluded.begin(), excluded.end(), e) != excluded.end()) continue;
-    CandidateScore candidate;
-    candidate.effect = e;
-    round.push_back(candidate);
-  }
-  return round;
-}
-
-/// Screens the round's candidates from their best starts and orders them by the screening, best first.
-void screen(const EffectFitter& fitter, const SelectionOptions& options, const ScreenBasis& basis, const EffectSet& model,
-            Round& r) {
-  std::vector<CandidateScore>& round = r.candidates;
-  std::vector<std::vector<double>> starts(round.size());
-  parallel_for(round.size(), options.threads, [&](std::size_t i) {
-    std::tie(starts[i], round[i].screen_ssr) = fitter.best_start(basis, model, round[i].effect);
-  });
-  std::vector<std::size_t> order(round.size());
-  for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
-  std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return round[a].screen_ssr > round[b].screen_ssr; });
-  std::vector<CandidateScore> sorted;
-  std::vector<std::vector<double>> sorted_starts;
-  for (std::size_t i : order) {
-    sorted.push_back(round[i]);
-    sorted_starts.push_back(starts[i]);
-  }
-  round = std::move(sorted);
-  r.starts = std::move(sorted_starts);
-}
-
-/// Fits the shortlist: the best few of the screening, without those it credits with less than a small
-/// share of the best (they cannot win unless the screening's first step misleads by that much); the
-/// leaders first, a later one only if its screening could rival what the leaders' fits achieved.
-void fit_shortlist(const EffectFitter& fitter, const SelectionOptions& options, const ScreenBasis& basis,
-                   const EffectSet& model, Round& r) {
-  std::vector<CandidateScore>& round = r.candidates;
-  std::size_t shortlisted = std::min<std::size_t>(round.size(), static_cast<std::size_t>(options.shortlist));
-  while (shortlisted > 2 && round[shortlisted - 1].screen_ssr < options.shortlist_share * round.front().screen_ssr) --shortlisted;
-  r.shortlisted = shortlisted;
-  r.fitted.assign(shortlisted, EffectSet{});
-  r.scores.assign(shortlisted, BlockScores{});
-  std::vector<double> reduction(shortlisted, 0.0);
-  const double ssr_now = std::inner_product(basis.r0.begin(), basis.r0.end(), basis.r0.begin(), 0.0);
-  const EffectContext& context = fitter.context();
-  auto fit = [&](std::size_t i) {
-    double ssr = 0.0;
-    r.fitted[i] = fitter.fit(model.with(round[i].effect, context, r.starts[i]), &ssr);
-    reduction[i] = ssr_now - ssr;
-    r.scores[i] = fitter.heldout(r.fitted[i]);
-    round[i].fitted = true;
-  };
-  r.leaders = std::min<std::size_t>(shortlisted, static_cast<std::size_t>(std::max(options.threads, 1)));
-  parallel_for(r.leaders, options.threads, fit);
-  const double achieved = *std::max_element(reduction.begin(), reduction.begin() + static_cast<std::ptrdiff_t>(r.leaders));
-  std::vector<std::size_t> rivals;
-  for (std::size_t i = r.leaders; i < shortlisted; ++i) {
-    if (round[i].screen_ssr >= options.rival_share * achieved) rivals.push_back(i);
-  }
-  parallel_for(rivals.size(), options.threads, [&](std::size_t j) { fit(rivals[j]); });
-}
-
-/// Accepted only if large, consistent, and standing out of the noise: the model change a candidate brings
-/// (the held-out RMS² it removes against the round's reference) must be at least
-/// (min_change_of_floor × the noise floor)²; and not negligible by its row's own measure.
-bool passes(const Round& r, std::size_t i, const SelectionOptions& options, double min_change2,
-            const EffectContext& context) {
-  const CandidateScore& c = r.candidates[i];
-  const double before = rms(r.reference);
-  const double after = rms(r.scores[i]);
-  if (c.gain_pct < options.min_gain_pct || c.p_value > options.max_p || before * before - after * after < min_change2) return false;
-  return !(c.effect.row->negligible && c.effect.row->negligible(c.effect, r.fitted[i].model(context), context));
-}
-
-/// The second look (docs/diagnose.md, "Constants a missing effect hid"): a constant the excitation pins but
-/// the calibration left configured — its cluster-robust interval widened by the residual of an effect still
-/// missing — held at a wrong value while a candidate is fitted, biases the candidate and makes the blocks
-/// disagree. When no candidate passes but one lowers the held-out residual by min_gain_pct, the leaders are
-/// fitted again with those constants free (kept only if then identified), from their fits; the reference
-/// is the better of the model as it is and the model with the same constants free, so that what the
-/// constants' freedom alone brings is not credited to an effect.
-void second_look(const EffectFitter& fitter, const SelectionOptions& options, double noise_floor_A,
-                 const std::array<bool, kCalibrated.size()>& admissible, const EffectSet& model, Round& r) {
-  std::vector<std::size_t> again;
-  for (std::size_t i : r.ranked) {
-    if (again.size() < r.leaders && r.candidates[i].gain_pct >= options.min_gain_pct) again.push_back(i);
-  }
-  EffectSet freed_model = model;
-  bool freed_kept = false;
-  parallel_for(again.size() + 1, options.threads, [&](std::size_t j) {
-    bool kept = false;
-    if (j == again.size()) {
-      freed_model = with_admissible_constants(fitter, noise_floor_A, admissible, model, kept);
-      freed_kept = kept;
-      return;
-    }
-    const std::size_t i = again[j];
-    r.fitted[i] = with_admissible_constants(fitter, noise_floor_A, admissible, r.fitted[i], kept);
-    if (kept) r.scores[i] = fitter.heldout(r.fitted[i]);
-  });
-  if (freed_kept) {
-    const BlockScores freed_scores = fitter.heldout(freed_model);
-    if (freed_scores.total() < r.reference.total()) r.reference = freed_scores;
-  }
-  r.rank();
-}
-
-/// The best ranked candidate that passes and is plausible and identifiable (each tested on its own);
-/// implausible ones and those that take a constant's place are reported, excluded, and `set_aside` set.
-/// r.shortlisted when none.
-std::size_t best_plausible(const EffectFitter& fitter, const SelectionOptions& options, double noise_floor_A,
-                           const std::array<bool, kCalibrated.size()>& admissible, double min_change2, const Round& r,
-                           Selection& sel, std::vector<Effect>& excluded, bool& set_aside) {
-  const EffectContext& context = fitter.context();
-  for (std::size_t i : r.ranked) {
-    const CandidateScore& c = r.candidates[i];
-    if (!passes(r, i, options, min_change2, context)) continue;
-    const ExtendedModel m = r.fitted[i].model(context);
-    std::optional<Implausibility> why;
-    if (c.effect.row->judge && c.effect.row->judge(c.effect, m, context, {})) {
-      // Judged again within the fitted parameter's own uncertainty.
-      const CalibrationIntervals ci = fitter.intervals(r.fitted[i], noise_floor_A);
-      why = c.effect.row->judge(c.effect, m, context, ci.effect_half_width.back());
-    }
-    if (!why) {
-      if (const std::optional<std::string> lost = takes_a_constant(fitter, sel.model, r.fitted[i], c, noise_floor_A, admissible)) {
-        sel.not_identifiable.push_back({{c.effect.label()}, *lost});
-        excluded.push_back(c.effect);
-        set_aside = true;
-        continue;
-      }
-      return i;
-    }
-    sel.implausible.push_back({c.effect, c.effect.row->describe(c.effect, m, context), c.gain_pct, *why});
-    excluded.push_back(c.effect);
-    set_aside = true;
-  }
-  return r.shortlisted;
-}
-
-/// Rivals that pass too, that the held-out blocks do not tell from the winner, and that change the model in
-/// the same way, make the winner a guess: the group (the winner first) and why; the rivals are excluded.
-std::vector<std::string> ambiguous_group(const EffectFitter& fitter, const SelectionOptions& options, double min_change2,
-                                         const Round& r, std::size_t best, const EffectSet& model,
-                                         std::vector<Effect>& excluded, std::string& reason) {
-  const CandidateScore& winner = r.candidates[best];
-  std::vector<std::string> group = {winner.effect.label()};
-  for (std::size_t i : r.ranked) {
-    const CandidateScore& rival = r.candidates[i];
-    if (i == best || rival.effect.name() == winner.effect.name()) continue;
-    if (!passes(r, i, options, min_change2, fitter.context())) continue;
-    if (std::find(excluded.begin(), excluded.end(), rival.effect) != excluded.end()) continue;
-    const double p_preferred = signed_rank_p(block_log_ratios(r.scores[i], r.scores[best]));
-    if (p_preferred <= options.ambiguity_p) continue;
-    const double corr = change_correlation(fitter, model, r.fitted[best], r.fitted[i]);
-    if (std::abs(corr) < options.ambiguity_correlation) continue;
-    char text[640];
-    std::snprintf(text, sizeof text,
-                  "%s%s and %s change the model's currents the same way in this log (correlation %.3f) and lower "
-                  "the held-out residual alike (%.1f %% and %.1f %%; the held-out blocks prefer neither, p = %.2f); a "
-                  "log with %s would separate them",
-                  reason.empty() ? "" : "; ", winner.effect.label().c_str(), rival.effect.label().c_str(), corr,
-                  winner.gain_pct, rival.gain_pct, p_preferred, separating_data(winner.effect, rival.effect).c_str());
-    reason += text;
-    group.push_back(rival.effect.label());
-    excluded.push_back(rival.effect);
-  }
-  return group;
-}
-
-}  // namespace
-
 Selection select_effects(const EffectFitter& fitter, const SelectionOptions& options, const EffectSet& start,
                          double noise_floor_A, const std::array<bool, kCalibrated.size()>& admissible) {
   Selection sel;
   sel.model = start;
-  const EffectContext& context = fitter.context();
   BlockScores current = fitter.heldout(sel.model);
   sel.start_heldout_rms_A = rms(current);
-  std::vector<Effect> excluded, stand_ins;
+  // Accepted only if large, consistent, and standing out of the noise: the model change it brings (the
+  // held-out RMS² it removes) must be at least (min_change_of_floor × the noise floor)².
   const double min_change2 = std::pow(options.min_change_of_floor * noise_floor_A, 2);
+  std::vector<Effect> excluded, stand_ins;
 
   while (static_cast<int>(sel.found.size() + stand_ins.size()) < options.max_effects) {
-    Round r;
-    r.candidates = open_candidates(context, sel.model, excluded);
-    if (r.candidates.empty()) break;
-    const ScreenBasis basis = fitter.screen_basis(sel.model);
-    screen(fitter, options, basis, sel.model, r);
-    fit_shortlist(fitter, options, basis, sel.model, r);
-    r.reference = current;
-    r.rank();
-    const auto pass = [&](std::size_t i) { return passes(r, i, options, min_change2, context); };
-    if (std::none_of(r.ranked.begin(), r.ranked.end(), pass) && !r.ranked.empty() &&
-        r.candidates[r.ranked.front()].gain_pct >= options.min_gain_pct && leaves_configured(sel.model, admissible)) {
-      second_look(fitter, options, noise_floor_A, admissible, sel.model, r);
-    }
-    sel.rounds.push_back(r.candidates);
+    std::optional<Round> screened = screen_round(fitter, sel, excluded);
+    if (!screened) break;
+    Round& round = *screened;
+    fit_shortlist(fitter, options, sel.model, round);
+    round.judge_against(current, fitter.context(), options, min_change2);
+    if (round.needs_second_look(options, sel.model, admissible)) second_look(fitter, noise_floor_A, admissible, sel.model, round);
+    sel.rounds.push_back(round.candidates);
     bool set_aside = false;
-    const std::size_t best =
-        best_plausible(fitter, options, noise_floor_A, admissible, min_change2, r, sel, excluded, set_aside);
-    if (best == r.shortlisted) {
+    const std::optional<std::size_t> best = best_plausible(fitter, noise_floor_A, admissible, round, sel, excluded, set_aside);
+    if (!best) {
       if (set_aside) continue;  // only implausible ones passed: the next round looks again without them
       break;
     }
-    const CandidateScore winner = r.candidates[best];
-    std::string reason;
-    std::vector<std::string> group = ambiguous_group(fitter, options, min_change2, r, best, sel.model, excluded, reason);
-    if (group.size() > 1) {
+    const CandidateScore winner = round.candidates[*best];
+    if (Unidentifiable group = ambiguous_group(fitter, options, sel.model, round, *best, excluded); group.effects.size() > 1) {
       // The winner stays in the model as an unnamed stand-in, so that no later candidate is named for the
       // residual the group explains; it is taken out again at the end.
-      sel.not_identifiable.push_back({group, reason});
+      sel.not_identifiable.push_back(std::move(group));
       stand_ins.push_back(winner.effect);
-      sel.model = r.fitted[best];
-      current = r.scores[best];
+      sel.model = round.fitted[*best];
+      current = round.scores[*best];
       continue;
     }
-
-    sel.found.push_back({winner.effect, rms(r.reference), rms(r.scores[best]), winner.gain_pct, winner.p_value});
-    sel.model = r.fitted[best];
-    current = r.scores[best];
+    sel.found.push_back({winner.effect, rms(round.reference), rms(round.scores[*best]), winner.gain_pct, winner.p_value});
+    sel.model = round.fitted[*best];
+    current = round.scores[*best];
     withdraw_explained(fitter, options, min_change2, sel, current, excluded);
     readmit_constants(fitter, noise_floor_A, admissible, sel.model, current);
   }
@@ -491,7 +452,7 @@ Selection select_effects(const EffectFitter& fitter, const SelectionOptions& opt
   }
   readmit_constants(fitter, noise_floor_A, admissible, sel.model, current);
   sel.extended_heldout_rms_A = rms(current);
-  for (const Unidentifiable& u : unobservable(context)) sel.not_identifiable.push_back(u);
+  for (const Unidentifiable& u : unobservable(fitter.context())) sel.not_identifiable.push_back(u);
   return sel;
 }
 

@@ -55,39 +55,60 @@ const char* to_string(VerdictKind k) noexcept {
   return "undetermined";
 }
 
-NoiseFloor measure_noise_floor(const LogData& log, const ReplayOutput& replay) {
-  std::vector<double> d2, q2;
-  const std::size_t n = log.rows.size();
-  for (std::size_t k = 1; k + 1 < n; ++k) {
-    if (!replay.valid[k - 1] || !replay.valid[k] || !replay.valid[k + 1]) continue;
-    if (log.block[k - 1] != log.block[k + 1] || log.rows[k].sample.gap_before || log.rows[k + 1].sample.gap_before) continue;
-    const core::Vec2 e = replay.residual_A[k + 1] - 2.0 * replay.residual_A[k] + replay.residual_A[k - 1];
-    d2.push_back(e[0] * e[0]);
-    q2.push_back(e[1] * e[1]);
+void SecondDifferences::add(const LogData& log, std::size_t k, const ModelSample& m) {
+  valid_ += m.valid ? 1 : 0;
+  // A difference needs three consecutive predicted samples of one block with no gap before the last two.
+  if (previous_.valid && last_.valid && m.valid && previous_.k + 1 == last_.k && last_.k + 1 == k &&
+      !log.samples.gap_before(last_.k) && !log.samples.gap_before(k)) {
+    const core::Vec2 e = m.residual_A - 2.0 * last_.r + previous_.r;
+    d2_.push_back(e[0] * e[0]);
+    q2_.push_back(e[1] * e[1]);
   }
+  previous_ = last_;
+  last_ = {k, m.residual_A, m.valid};
+}
+
+void SecondDifferences::append(const SecondDifferences& other) {
+  d2_.insert(d2_.end(), other.d2_.begin(), other.d2_.end());
+  q2_.insert(q2_.end(), other.q2_.begin(), other.q2_.end());
+  valid_ += other.valid_;
+}
+
+NoiseFloor SecondDifferences::noise_floor(const LogData& log) && {
   NoiseFloor f;
-  f.differences = d2.size();
-  if (d2.size() < kMinNoiseDifferences) {
-    const std::size_t valid = static_cast<std::size_t>(std::count(replay.valid.begin(), replay.valid.end(), true));
-    f.unknown_reason = "only " + std::to_string(d2.size()) + " of the " + std::to_string(n) + " samples have replayed neighbours "
-                       "on both sides within their block (" + std::to_string(kMinNoiseDifferences) + " are needed): ";
+  f.differences = d2_.size();
+  if (d2_.size() < kMinNoiseDifferences) {
+    f.unknown_reason = "only " + std::to_string(d2_.size()) + " of the " + std::to_string(log.size()) +
+                       " samples have replayed neighbours on both sides within their block (" +
+                       std::to_string(kMinNoiseDifferences) + " are needed): ";
     if (log.mode == ModelMode::kSteadyState) {
       f.unknown_reason += std::to_string(log.excluded_transitional) + " rows are in transition between operating points and " +
                           std::to_string(log.excluded_idle) + " idle, so no stretch of rows repeats an operating point " +
-                          "(standstill under current included) and " + std::to_string(valid) + " rows are replayed";
+                          "(standstill under current included) and " + std::to_string(valid_) + " rows are replayed";
     } else {
-      f.unknown_reason += "gaps and left-out samples leave " + std::to_string(valid) + " replayed samples without runs of three";
+      f.unknown_reason += "gaps and left-out samples leave " + std::to_string(valid_) + " replayed samples without runs of three";
     }
     return f;
   }
   const double scale = 1.0 / (kSecondDifferenceGain * kMedianChiSquare1);
-  const double value = std::sqrt(scale * (median(std::move(d2)) + median(std::move(q2))));
+  const double value = std::sqrt(scale * (median(std::move(d2_)) + median(std::move(q2_))));
   if (!(value > 0.0)) {
     f.unknown_reason = "the residual does not change between neighbouring samples (below the log's resolution)";
     return f;
   }
   f.value_A = value;
   return f;
+}
+
+NoiseFloor measure_noise_floor(const LogData& log, const ReplayOutput& replay) {
+  SecondDifferences all;
+  for (int b = 0; b < log.blocks; ++b) {
+    all.start();
+    for (std::size_t k = log.block_first[static_cast<std::size_t>(b)]; k < log.block_first[static_cast<std::size_t>(b) + 1]; ++k) {
+      all.add(log, k, ModelSample{replay.residual_A[k], replay.model_A.empty() ? core::Vec2::Zero() : replay.model_A[k], replay.valid[k]});
+    }
+  }
+  return std::move(all).noise_floor(log);
 }
 
 Verdict verdict(double final_heldout_rms_A, const NoiseFloor& floor, const ResidualStatistics& st) {

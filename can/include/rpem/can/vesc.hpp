@@ -94,6 +94,12 @@ inline constexpr std::uint32_t kEstimatorMask =
 
 inline constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
+/// The firmware's default PLL gains, whose speed the reply's ERPM is (foc_pll_kp [1/s], foc_pll_ki [1/s²]:
+/// MCCONF_FOC_PLL_KP, MCCONF_FOC_PLL_KI in vedderb/bldc motor/mcconf_default.h at b9d287b3; the PLL:
+/// motor/foc_math.c, foc_pll_run). Its speed lags a ramp by k_p/k_i = 66.7 ms (docs/derivations.md §13).
+inline constexpr double kDefaultPllKp = 2000.0;
+inline constexpr double kDefaultPllKi = 30000.0;
+
 /// A COMM_GET_VALUES_SELECTIVE reply in SI; fields the mask left out are NaN (or 0 for the integers).
 struct Values {
   std::uint32_t mask = 0;

@@ -83,6 +83,10 @@ struct ModelExtensions {
     }
     return false;
   }
+  /// Whether SampleConditioner's condition() and observed_current_dq_A() read the machine's constants
+  /// under these extensions: the inductance curves scale x_d and x_q, iron loss needs them and ψm, r_s.
+  /// Without either, conditioners of one base and these extensions give the same results for any machine.
+  [[nodiscard]] bool reads_machine() const noexcept { return saturation() || iron_loss_r_fe_Ohm > 0.0; }
 };
 
 /// One sample's inputs for the steady-state model (dq logs sampled far apart in time): the command
@@ -111,7 +115,11 @@ class SampleConditioner {
   [[nodiscard]] SteadyStateInputs steady_state(const DriveSample& s) const noexcept;
 
   /// The logged current as dq at the logged angle, uncorrected [A]: what the log itself says.
-  [[nodiscard]] Vec2 logged_current_dq_A(const DriveSample& s) const noexcept;
+  [[nodiscard]] Vec2 logged_current_dq_A(const DriveSample& s) const noexcept {
+    return logged_current_dq_A(s, Rotation::of(s.theta_el_rad));
+  }
+  /// The same with the logged angle's rotation computed by the caller (it depends on nothing configured).
+  [[nodiscard]] static Vec2 logged_current_dq_A(const DriveSample& s, const Rotation& logged) noexcept;
   /// What the log would show for a model current (magnetising, rotor frame, pu): the extensions'
   /// observation model — iron-loss current added, per-phase gain and offset applied — as dq at the
   /// logged angle [A]. The inverse of the corrections condition() applies; `rpem diagnose` compares

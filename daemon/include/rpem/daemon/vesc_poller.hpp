@@ -2,7 +2,8 @@
 // The VESC source's poll schedule and reply state machine, without the socket (docs/rpemd.md,
 // "source: vesc"; the protocol: docs/can-vesc.md). Pure and allocation-free: the source thread gives it
 // the time and every received frame with its kernel receive time; it says when to poll and turns each
-// reply into an averaged rotor-frame sample.
+// reply into an averaged rotor-frame sample, its speed the window's mean rebuilt from the PLL's speed at
+// this read and the previous one (the reply's ERPM is the PLL's at the read).
 //
 // Schedule: polls at t = k·T + φ·T on the host's clock (T = 1/poll_rate_Hz, φ = poll_phase), so
 // instances polling drives on one bus interleave instead of colliding. One poll is outstanding at a time;
@@ -47,6 +48,7 @@
 
 #include "rpem/can/vesc.hpp"
 #include "rpem/core/averaged_sample.hpp"
+#include "rpem/core/reported_speed.hpp"
 
 namespace rpem::daemon {
 
@@ -72,6 +74,10 @@ class VescPoller {
     std::int64_t phase_ns = 0;    ///< in [0, period_ns)
     std::int64_t timeout_ns = 4'500'000;
     std::uint32_t mask = can::vesc::kEstimatorMask;
+    /// The reply's ERPM is the firmware's PLL speed at the read, lagging a ramp by k_p/k_i: each window's mean
+    /// speed is rebuilt from it and the previous reply's (core::window_mean_speed_rad_s; docs/derivations.md
+    /// §13, "Speed at the read").
+    double speed_lag_s = core::pll_ramp_lag_s(can::vesc::kDefaultPllKp, can::vesc::kDefaultPllKi);
   };
   /// Shorter windows are not measurements (a few of VESC's control cycles at most).
   static constexpr std::int64_t kMinWindowNs = 200'000;
@@ -122,6 +128,7 @@ class VescPoller {
   std::int64_t reply_start_ns_ = 0;   ///< receive time of the reply's first frame
   bool has_window_start_ = false;
   std::int64_t window_start_ns_ = 0;  ///< the newest read of the controller seen
+  core::SpeedRead previous_speed_;    ///< the PLL's speed in our previous reply, and when it was read
   bool gap_ = true;                   ///< windows before the next may be lost
   bool gap_before_timeout_ = true;    ///< gap_ as it was before the newest timeout (a late reply restores it)
 };

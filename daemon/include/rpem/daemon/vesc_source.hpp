@@ -27,6 +27,10 @@ struct VescSource {
     /// A reply not complete this long after its poll is a timeout (default: 0.9 poll periods, at most 20 ms:
     /// the reply alone takes ~0.9 ms of a 1 Mbit/s bus).
     double reply_timeout_s = 0.0;
+    /// The firmware's PLL gains (its motor configuration's foc_pll_kp, foc_pll_ki): the ERPM it reports lags a
+    /// speed ramp by k_p/k_i, which each window's mean speed allows for (docs/rpemd.md, "source: vesc").
+    double pll_kp = can::vesc::kDefaultPllKp;
+    double pll_ki = can::vesc::kDefaultPllKi;
     bool operator==(const Options&) const = default;
   };
   [[nodiscard]] static Options parse(io::YamlMap& section, const std::string& base_dir);

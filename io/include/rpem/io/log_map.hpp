@@ -105,6 +105,12 @@ struct LogMap {
 
   std::vector<MappedColumn> columns;
 
+  /// The speed column is a tracking loop's speed at the read, lagging a ramp by this much (omega_el's
+  /// `pll: {kp, ki}`: k_p/k_i; VESC's erpm, 66.7 ms by default): the reader rebuilds each window's mean speed
+  /// from it and the previous row's (core::window_mean_speed_rad_s). 0: the column is the window's mean speed.
+  /// window: previous_row only.
+  double speed_lag_s = 0.0;
+
   [[nodiscard]] bool averaged() const noexcept { return window != Window::kInstantaneous; }
   [[nodiscard]] const MappedColumn* find(Quantity q) const noexcept;
 };

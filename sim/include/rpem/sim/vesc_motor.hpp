@@ -10,7 +10,8 @@
 // with no cycle since the previous one is 0/0 (NaN; the reply carries 0, can/vesc_firmware.hpp).
 // The cycles are sim/cycle_average.hpp's (measured current at the cycle's start, mean rotor-frame voltage)
 // in the controller's frame — the commanded angle in open loop (sim/regime.hpp), whose speed the firmware's
-// PLL then reports. With the bridge off the firmware sums what mcpwm_foc_adc_int_handler leaves when "Motor
+// PLL then reports (run here as the firmware runs it, once per cycle: its speed lags a ramp by k_p/k_i,
+// docs/derivations.md §13, "Speed at the read"). With the bridge off the firmware sums what mcpwm_foc_adc_int_handler leaves when "Motor
 // is not running" (vedderb/bldc motor/mcpwm_foc.c, since b1945b7d of 2020 in this form): i_d = i_q = 0, and
 // v_d, v_q the Park transform at the observer's angle of the phase voltages it measures — the back EMF —
 // through UTILS_LP_FAST with 0.2 per cycle, starting from the last modulated v_d, v_q (docs/can-vesc.md,
@@ -66,6 +67,11 @@ class VescMotor {
   TruthRow truth_;
   ControlCycle last_cycle_;
   core::Vec2 v_dq_filter_V_ = core::Vec2::Zero();  ///< state_now->vd, vq (low-passed while undriven)
+  /// The firmware's PLL on the angle in use, once per cycle (motor/foc_math.c, foc_pll_run, the default gains
+  /// can::vesc::kDefaultPllKp/Ki): its speed is the ERPM the firmware reports (mcpwm_foc_get_rpm).
+  double pll_angle_rad_ = 0.0;
+  double pll_speed_rad_s_ = 0.0;
+  int pll_cycles_ = 0;
   bool started_ = false;
   double input_current_sum_A_ = 0.0;  ///< m_input_current_sum: power-balance input current per cycle
   double tacho_steps_ = 0.0;  ///< 6 per electrical revolution (mc_interface_get_tachometer_value)

@@ -17,6 +17,7 @@
 #include "rpem/analysis/diagnose/residual_statistics.hpp"
 #include "rpem/analysis/diagnose/selection.hpp"
 #include "rpem/analysis/diagnose/verdict.hpp"
+#include "rpem/analysis/diagnose/whole_log.hpp"
 #include "rpem/core/thermal.hpp"
 #include "rpem/io/machine_config.hpp"
 
@@ -26,6 +27,10 @@ struct DiagnoseOptions {
   double reference_C = core::kMaterialReference_C;  ///< temperature to which found drift laws are referred
   double switching_frequency_Hz = 0.0;  ///< for t_dead_s (0: the configuration's, else unknown)
   SelectionOptions selection;
+  /// Threads that replay blocks and fit candidates (the results are the same for any number).
+  int jobs = 1;
+  /// Told the stages and the work done, asked whether to stop (nullptr: none).
+  Monitor* monitor = nullptr;
 };
 
 /// The calibrated baseline (docs/diagnose.md, "The calibrated baseline"), kCalibrated order.
@@ -73,14 +78,14 @@ struct Diagnosis {
   Selection selection;
   std::vector<EstimatorCheck> estimator_checks;  ///< one per found effect, in the order found
   ExtendedModel extended_model;         ///< the calibrated baseline with every found effect
-  ReplayOutput baseline_replay, extended_replay;
   ResidualStatistics statistics;        ///< before: the baseline; after: the extended model
+  FigureData figures;                   ///< what the figures draw (whole_log.hpp)
   Verdict verdict;
   EstimatorComparison estimates;        ///< nominal: the configuration; extended: extended_config
   double elapsed_s = 0.0;
 };
 
-/// `truth` may be empty (unknown).
+/// `truth` may be empty (unknown). Throws Interrupted where options.monitor asks it to stop.
 [[nodiscard]] Diagnosis diagnose(LogData log, const io::MachineConfig& config, const DiagnoseOptions& options,
                                  const ParameterTrack& truth = {});
 

@@ -6,6 +6,17 @@
 // the training sum of squares it predicts, with the columns of the calibrated constants and of the effects
 // already in the model in J, so that what they already explain is not credited to a candidate, and what
 // they took of the candidate's residual while it was missing is.
+//
+// Nothing here holds a residual per sample (docs/diagnose.md, "Long recordings"). Every quantity is a sum
+// over the samples — JᵀJ, Jᵀr, rᵀr, the blocks' scores — accumulated as the models stream through a block
+// together, block by block on the replay's pool, and added in block order. Ceres is handed the fit in the
+// same reduced form: the least-squares problem ‖J·δ + r‖² over the training samples equals ‖R_J·δ + R_r‖²
+// with [R_J R_r] the triangular factor of the QR decomposition of [J r] (Householder over a few rows at a
+// time, then over the blocks' factors), so its trust-region steps are those of the whole problem, from P + 1
+// residuals instead of two per sample. The Jacobian's columns are the forward differences Ceres' own
+// numeric differentiation takes (step max(√ε, 10⁻³·|θ|)), from the same replays. Under a robust loss
+// (robust_loss.hpp) each sample's residual vector is scaled by √(ρ(|r|²)/|r|²) before it enters any of these
+// sums, so every fit, screening and interval minimises or linearises Σ ρ.
 
 #include <array>
 #include <vector>
@@ -82,12 +93,12 @@ enum class Identification {
 /// `misfit_A`: misfit_norm_A of the set.
 [[nodiscard]] Identification identification(const EffectSet& set, const CalibrationIntervals& ci, std::size_t i, double misfit_A);
 
-/// What the screening of one round shares: the starting residuals and the calibration's columns.
-struct ScreenBasis {
-  std::vector<double> r0;
-  /// Jacobian columns of the free calibrated constants and of the parameters of the effects in the model
-  std::vector<std::vector<double>> columns;
-  double explained = 0.0;                    ///< what those columns alone would remove [A²]
+/// A round's screening: for each candidate, its best start and the training gain the screening credits it
+/// with from there.
+struct Screening {
+  double ssr = 0.0;                         ///< training sum of squares of the round's model [A²]
+  std::vector<std::vector<double>> starts;  ///< per candidate (scaled, clamped to its bounds)
+  std::vector<double> gain;                 ///< per candidate [A²]
 };
 
 class EffectFitter {
@@ -103,14 +114,11 @@ class EffectFitter {
   /// asked, its training sum of squares).
   [[nodiscard]] EffectSet fit(const EffectSet& start, double* training_ssr = nullptr) const;
 
-  [[nodiscard]] ScreenBasis screen_basis(const EffectSet& base) const;
-  /// Training sum of squares `base` would lose, to first order, by adding `candidate` at `start`.
-  [[nodiscard]] double screen(const ScreenBasis& basis, const EffectSet& base, const Effect& candidate,
-                              const std::vector<double>& start) const;
-  /// The candidate's best start (of its row's starts: the lowest training sum of squares there, the basis'
-  /// constants and effects moved to their best) and what the screening credits it with from there.
-  [[nodiscard]] std::pair<std::vector<double>, double> best_start(const ScreenBasis& basis, const EffectSet& base,
-                                                                  const Effect& candidate) const;
+  /// Screens `candidates` against `base`: each one's best start (of its row's starts: the lowest training
+  /// sum of squares there, the base's free constants and effects moved to their best by the linear step
+  /// of their columns) and the training sum of squares `base` would lose, to first order, by adding it
+  /// there — with those columns moving too.
+  [[nodiscard]] Screening screen(const EffectSet& base, const std::vector<Effect>& candidates) const;
 
   /// Training sum of ρ(|r|²) [A²] (the sum of squares under least squares).
   [[nodiscard]] double training_ssr(const EffectSet& set) const;
@@ -120,22 +128,33 @@ class EffectFitter {
   /// The calibrated constants' intervals for a fitted set; `noise_floor_A` scales the excitation's.
   [[nodiscard]] CalibrationIntervals intervals(const EffectSet& set, double noise_floor_A) const;
 
-  [[nodiscard]] const ModelReplay& replay() const noexcept { return replay_; }
-  /// Samples the fits see (training blocks, replayed).
-  [[nodiscard]] std::size_t training_samples() const noexcept { return training_.size(); }
-  [[nodiscard]] const EffectContext& context() const noexcept { return context_; }
+  /// How alike the changes `a` and `b` make to `base`'s currents are over the held-out samples (their
+  /// correlation).
+  [[nodiscard]] double change_correlation(const EffectSet& base, const EffectSet& a, const EffectSet& b) const;
 
-  /// The training residuals of a set, d and q interleaved (fixed length), each sample's scaled by the loss.
+  [[nodiscard]] const ModelReplay& replay() const noexcept { return replay_; }
+  [[nodiscard]] const EffectContext& context() const noexcept { return context_; }
+  /// Samples the fits see (training blocks, replayed under the baseline).
+  [[nodiscard]] std::size_t training_samples() const noexcept { return training_samples_; }
+
+  /// The training residuals of a set, d and q interleaved, in sample order, each sample's scaled by the loss
+  /// (tests and the outlier check; the fits stream).
   void training_residuals(const EffectSet& set, std::vector<double>& out) const;
 
  private:
-  /// Forward-difference Jacobian column of the training residuals for a change h of one parameter.
-  [[nodiscard]] std::vector<double> column(const EffectSet& moved, const std::vector<double>& r0, double h) const;
+  class FitCost;
+  /// Per training block, in order: acc = init, then add(acc, residuals) for each fitted sample, with
+  /// residuals[j] model j's (a miss of 1 kA per axis where a model predicts nothing finite), scaled by the loss.
+  template <class Acc, class Add>
+  std::vector<Acc> over_training(const std::vector<ExtendedModel>& models, const Acc& init, const Add& add) const;
 
   const ModelReplay& replay_;
   EffectContext context_;
-  std::vector<std::size_t> training_;  ///< samples with a prediction in training blocks (baseline replay)
-  RobustLoss loss_;                     ///< least squares unless outliers remain (diagnosis.cpp)
+  std::vector<int> training_blocks_, heldout_blocks_;
+  std::vector<bool> fitted_;  ///< per sample: in a training block and replayed under the baseline
+  std::size_t training_samples_ = 0;
+  std::uint64_t training_block_samples_ = 0;  ///< every sample of the training blocks (a pass's work per model)
+  RobustLoss loss_;  ///< least squares unless outliers remain (diagnosis.cpp)
 };
 
 }  // namespace rpem::analysis

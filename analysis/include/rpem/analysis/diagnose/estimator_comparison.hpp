@@ -14,6 +14,8 @@
 
 #include "rpem/analysis/diagnose/effects.hpp"
 #include "rpem/analysis/diagnose/log_data.hpp"
+#include "rpem/analysis/diagnose/monitor.hpp"
+#include "rpem/analysis/work_pool.hpp"
 #include "rpem/io/machine_config.hpp"
 
 namespace rpem::analysis {
@@ -51,13 +53,15 @@ struct EstimatorComparison {
 /// `extended` is the model with the found effects (drifts apply to the steady-state method only:
 /// the recursive estimator tracks ψm and R_s itself); the steady-state method's "nominal" is the
 /// context's baseline.
+/// The two estimator runs go on `pool` at once; `monitor` (if any) is told the samples run and may stop them.
 [[nodiscard]] EstimatorComparison compare_estimates(const LogData& log, const io::MachineConfig& nominal,
                                                     const io::MachineConfig& extended_config,
                                                     const ExtendedModel& extended, const EffectContext& context,
-                                                    const ParameterTrack& truth);
+                                                    const ParameterTrack& truth, const WorkPool& pool = WorkPool::serial(),
+                                                    Monitor* monitor = nullptr);
 
 /// RMS of the RPEM estimator's prediction error ε over the held-out blocks when it runs over the whole
 /// log with `config` (docs/diagnose.md, "An extension must help the estimator") [A].
-[[nodiscard]] double estimator_heldout_rms_A(const LogData& log, const io::MachineConfig& config);
+[[nodiscard]] double estimator_heldout_rms_A(const LogData& log, const io::MachineConfig& config, Monitor* monitor = nullptr);
 
 }  // namespace rpem::analysis

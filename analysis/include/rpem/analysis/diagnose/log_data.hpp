@@ -1,14 +1,17 @@
 #pragma once
 // A drive log held in memory for `rpem diagnose`, with what the diagnosis needs to know about it: which
 // model replays it (transient or steady state), which samples take part, and how they split into
-// training and held-out blocks.
+// training and held-out blocks. The samples are kept once (SampleStore, about 90 bytes each); what the
+// replay derives from them — the logged current in dq, the centred speed — is computed as it goes.
 
 #include <algorithm>
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
 
+#include "rpem/analysis/diagnose/sample_store.hpp"
 #include "rpem/core/clock.hpp"
 #include "rpem/core/settings.hpp"
 #include "rpem/core/types.hpp"
@@ -28,7 +31,7 @@ struct LogData {
   /// The drive's reported commands were turned into the applied means at reading (LogOptions::voltage_is_command):
   /// whatever runs over the rows must not turn them again.
   bool voltage_applied = false;
-  std::vector<io::DriveLogRow> rows;
+  SampleStore samples;
   io::DriveLogLayout layout;
   ModelMode mode = ModelMode::kTransient;
   bool averaged = false;  ///< an averaged rotor-frame log (docs/drive-log.md, "Averaged logs"): always steady state
@@ -42,28 +45,46 @@ struct LogData {
   /// of the largest, relative to the largest (0: one speed).
   double speed_spread_rel = 0.0;
   double mean_u_dc_V = 0.0;
-  /// The samples the replay runs on: as logged, but (transient logs) with the electrical speed as the
-  /// centred difference of the logged angle over ±speed_half_window samples — no lag, unlike a drive's
-  /// causal speed signal. The estimator runs see the logged speed, as the drive gave it.
-  std::vector<core::DriveSample> replay_samples;
-  /// The logged current as dq at the logged angle [A]: what every model is compared with.
-  std::vector<core::Vec2> logged_i_dq_A;
-  /// Samples that take part (steady state leaves out idle and transitional rows; every log the samples its
-  /// regime excludes, regimes.hpp).
-  std::vector<bool> used;
+  /// Transient logs: the replay takes the electrical speed as the centred difference of the logged angle
+  /// over ±this many samples (replay_sample) — no lag, unlike a drive's causal speed signal; 0: as logged.
+  /// The estimator runs see the logged speed, as the drive gave it.
+  int speed_half_window = 0;
   std::size_t excluded_idle = 0, excluded_transitional = 0;
-  /// Block index of each sample; even blocks train, odd blocks are held out.
-  std::vector<int> block;
+  /// Training and held-out blocks, alternating, equal in time: block b holds the samples
+  /// [block_first[b], block_first[b + 1]) (possibly none); even blocks train, odd blocks are held out.
   int blocks = 0;
+  std::vector<std::size_t> block_first;
 
+  [[nodiscard]] std::size_t size() const noexcept { return samples.size(); }
+  /// Sample k as logged.
+  [[nodiscard]] core::DriveSample sample(std::size_t k) const noexcept { return samples.sample(k); }
+  /// Sample k as the replay takes it: with the centred speed (see speed_half_window).
+  [[nodiscard]] core::DriveSample replay_sample(std::size_t k) const noexcept;
+  /// The logged current as dq at the logged angle [A]: what every model is compared with.
+  [[nodiscard]] core::Vec2 logged_i_dq_A(std::size_t k) const noexcept;
+  [[nodiscard]] double t_s(std::size_t k) const noexcept { return core::to_seconds(samples.t_ns(k)); }
+
+  /// Whether sample k takes part (steady state leaves out idle and transitional rows; every log the samples
+  /// its regime excludes, regimes.hpp).
+  [[nodiscard]] bool used(std::size_t k) const noexcept { return (samples.mark(k) & sample_mark::kLeftOut) == 0; }
+  /// Samples that take part.
+  [[nodiscard]] std::size_t used_count() const noexcept;
+  /// The block of sample k.
+  [[nodiscard]] int block(std::size_t k) const noexcept {
+    return static_cast<int>(std::upper_bound(block_first.begin(), block_first.end(), k) - block_first.begin()) - 1;
+  }
   /// Where sample k lies in the log's time span, 0 … 1.
   [[nodiscard]] double time_fraction(std::size_t k) const noexcept {
-    return (core::to_seconds(rows[k].sample.t_ns) - t_start_s) / std::max(t_end_s - t_start_s, 1e-12);
+    return (t_s(k) - t_start_s) / std::max(t_end_s - t_start_s, 1e-12);
   }
-  [[nodiscard]] bool training(std::size_t k) const noexcept { return used[k] && block[k] % 2 == 0; }
-  [[nodiscard]] bool heldout(std::size_t k) const noexcept { return used[k] && block[k] % 2 == 1; }
-  /// Whether sample k opens its block.
-  [[nodiscard]] bool block_start(std::size_t k) const noexcept { return k == 0 || block[k] != block[k - 1]; }
+  [[nodiscard]] bool training(std::size_t k) const noexcept { return used(k) && block(k) % 2 == 0; }
+  [[nodiscard]] bool heldout(std::size_t k) const noexcept { return used(k) && block(k) % 2 == 1; }
+  /// Samples of training blocks that take part.
+  [[nodiscard]] std::size_t training_count() const noexcept;
+  /// Heap bytes the log holds.
+  [[nodiscard]] std::size_t bytes() const noexcept {
+    return samples.bytes() + block_first.capacity() * sizeof(std::size_t) + window_start_ns.capacity() * sizeof(std::int64_t);
+  }
 };
 
 /// The mean a reported command applies in the rotor frame over the period it is held (docs/derivations.md
@@ -89,12 +110,18 @@ struct LogOptions {
 [[nodiscard]] std::vector<std::string> left_out_explanations(const LogData& log);
 
 /// Loads and characterises a log, a phase-sample or an averaged one, in any format io::log_source reads
-/// (throws io::DriveLogError on bad input, io::ConfigError on a bad map).
-[[nodiscard]] LogData load_log(const std::string& path, const core::MachineSi& machine, const LogOptions& options);
+/// (throws io::DriveLogError on bad input, io::ConfigError on a bad map). `progress`, if given, is told the
+/// bytes read of the file's total as it goes.
+[[nodiscard]] LogData load_log(const std::string& path, const core::MachineSi& machine, const LogOptions& options,
+                               const std::function<void(std::uint64_t, std::uint64_t)>& progress = {});
 
 /// The same from rows already in memory (tests, the simulator).
-[[nodiscard]] LogData prepare_log(std::vector<io::DriveLogRow> rows, const io::DriveLogLayout& layout,
+[[nodiscard]] LogData prepare_log(const std::vector<io::DriveLogRow>& rows, const io::DriveLogLayout& layout,
                                   const core::MachineSi& machine, const LogOptions& options,
                                   const std::string& path = "<memory>");
+
+/// Characterises a log whose samples are stored (`d.samples` finished, `d.path` set): what load_log and
+/// prepare_log share.
+void prepare_log(LogData& d, const core::MachineSi& machine, const LogOptions& options);
 
 }  // namespace rpem::analysis

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "rpem/analysis/diagnose/log_data.hpp"
+#include "rpem/analysis/diagnose/monitor.hpp"
 #include "rpem/core/regime.hpp"
 #include "rpem/io/machine_config.hpp"
 #include "rpem/io/sample_counts.hpp"
@@ -26,8 +27,9 @@ struct LogRegimes {
 };
 
 /// Runs the configured estimator over `log` (its rows; an averaged log's windows) and records each
-/// sample's regime.
-[[nodiscard]] LogRegimes classify_regimes(const LogData& log, const io::MachineConfig& config);
+/// sample's regime. `monitor` (if any) is told the samples run and asked, every kMonitorSamples, whether to
+/// stop (then Interrupted is thrown).
+[[nodiscard]] LogRegimes classify_regimes(const LogData& log, const io::MachineConfig& config, Monitor* monitor = nullptr);
 
 /// Takes the samples `regimes` excludes out of log.used (counting those newly taken out).
 void exclude_regimes(LogData& log, LogRegimes& regimes);

@@ -9,20 +9,39 @@
 //   steady-state logs — the closed-form steady state (core::steady_state_current) per sample.
 // The model extensions enter exactly as the estimator applies them (core::SampleConditioner), and
 // leave again through its observation model, so every model is judged against the same numbers.
+//
+// A replay streams: several models go through a block together, sample by sample (the sample, its logged
+// angle's rotation and its logged current are computed once for all of them), and each sample's residuals
+// are handed to a visitor, never stored whole. Blocks are independent, so a pass over many blocks runs
+// them on a WorkPool and its caller combines the blocks' results in block order (the same for any number
+// of threads).
 
+#include <cstdint>
+#include <functional>
+#include <span>
 #include <vector>
 
 #include "rpem/analysis/diagnose/effects.hpp"
 #include "rpem/analysis/diagnose/log_data.hpp"
+#include "rpem/analysis/diagnose/monitor.hpp"
+#include "rpem/analysis/work_pool.hpp"
 #include "rpem/core/frames.hpp"
 #include "rpem/core/types.hpp"
 
 namespace rpem::analysis {
 
+/// One model's prediction at one sample.
+struct ModelSample {
+  core::Vec2 residual_A = core::Vec2::Zero();  ///< logged − model; zero where not valid
+  core::Vec2 model_A = core::Vec2::Zero();     ///< the model's current as the log would show it
+  bool valid = false;                          ///< a prediction exists (replayed, not a sync sample, not excluded)
+};
+
+/// A whole replay, every sample (tests and small logs; a diagnosis streams instead).
 struct ReplayOutput {
   std::vector<core::Vec2> residual_A;  ///< logged − model; zero where not valid
   std::vector<core::Vec2> model_A;     ///< the model's current as the log would show it
-  std::vector<bool> valid;             ///< a prediction exists (replayed, not a sync sample, not excluded)
+  std::vector<bool> valid;
 };
 
 /// Which blocks a replay covers.
@@ -30,29 +49,38 @@ enum class Blocks { kAll, kTraining, kHeldout };
 
 class ModelReplay {
  public:
-  /// `rated`: the per-unit base's name plate.
-  ModelReplay(const LogData& log, const core::RatedData& rated);
+  /// What a visitor sees of one sample: its index and each model's prediction (in the order given).
+  using Visit = std::function<void(std::size_t k, std::span<const ModelSample> models)>;
 
-  /// Replays `blocks` of the log with `model`. Thread-safe (const); allocates only the output.
+  /// `rated`: the per-unit base's name plate. `pool` runs the blocks of a pass; `monitor` (if any) is told the
+  /// samples replayed (per model) and asked, before each block, whether to stop (then Interrupted is thrown).
+  ModelReplay(const LogData& log, const core::RatedData& rated, const WorkPool& pool = WorkPool::serial(),
+              Monitor* monitor = nullptr);
+
+  /// Replays `models` together over block b (index into the log's blocks; its warm-up samples first) and
+  /// calls `visit` for each of its samples that takes part (LogData::used). Thread-safe (const).
+  void replay_block(int b, std::span<const ExtendedModel> models, const Visit& visit) const;
+
+  /// The blocks `blocks` selects that hold samples, in order.
+  [[nodiscard]] std::vector<int> blocks(Blocks blocks) const;
+
+  /// Runs per_block(i, b) for the i-th of `blocks` on the pool (checking between blocks whether to stop).
+  void for_blocks(const std::vector<int>& blocks, const std::function<void(std::size_t i, int b)>& per_block) const;
+
+  /// Replays `blocks` of the log with `model`, every sample kept (tests and small logs). Thread-safe (const).
   void run(const ExtendedModel& model, ReplayOutput& out, Blocks blocks = Blocks::kAll) const;
 
   [[nodiscard]] const LogData& log() const noexcept { return log_; }
+  [[nodiscard]] const WorkPool& pool() const noexcept { return pool_; }
+  [[nodiscard]] Monitor* monitor() const noexcept { return monitor_; }
 
  private:
-  /// A stretch of samples replayed in one chain: warm-up samples (conditioner only) from `begin`, the
-  /// block's own from `first`.
-  struct Stretch {
-    std::size_t begin, first, end;
-  };
-  [[nodiscard]] bool selected(std::size_t k, Blocks blocks) const noexcept;
-  void run_transient(const ExtendedModel& model, ReplayOutput& out, Blocks blocks) const;
-  void run_steady_state(const ExtendedModel& model, ReplayOutput& out, Blocks blocks) const;
-
+  class Chain;
   const LogData& log_;
   core::PerUnitBase base_;
   double max_interval_s_;
-  std::vector<Stretch> blocks_;  ///< one per block, in order
-  std::vector<core::Rotation> logged_rotation_;  ///< transient logs: each sample's logged angle, once
+  const WorkPool& pool_;
+  Monitor* monitor_;
 };
 
 }  // namespace rpem::analysis

@@ -30,15 +30,16 @@ struct SelectionOptions {
   int max_effects = 4;
   int shortlist = 4;           ///< candidates fitted in full per round (at most) …
   double shortlist_share = 0.05;  ///< … of those screened at this share of the best or more (at least 2);
-  /// after the first `threads` fits, a shortlisted candidate is fitted only if its screening credits it
+  /// after the first `leaders` fits, a shortlisted candidate is fitted only if its screening credits it
   /// with this share of the training gain the best of them achieved (it could not rival it otherwise).
   double rival_share = 0.25;
+  /// Candidates fitted first in each round (whatever the threads: the results do not depend on them).
+  int leaders = 2;
   /// Ambiguity: a rival that passes the same acceptance tests, that the held-out blocks do not prefer
   /// the winner to (signed-rank p above this) …
   double ambiguity_p = 0.05;
   /// … and whose change to the model's currents correlates at least this well with the winner's.
   double ambiguity_correlation = 0.9;
-  int threads = 2;
 };
 
 /// One candidate's result in one round (the report's audit trail).

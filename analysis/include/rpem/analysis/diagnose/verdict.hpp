@@ -49,6 +49,31 @@ struct NoiseFloor {
   [[nodiscard]] double for_fits_A() const noexcept { return value_A.value_or(0.0); }
 };
 
+/// The squared second differences of a replay's residual, per axis, as a replay streams through the
+/// blocks (what the floor's medians are taken of: their order does not matter).
+class SecondDifferences {
+ public:
+  /// Sample k of a block, in order (the samples a replay visits); a new block starts with start().
+  void add(const LogData& log, std::size_t k, const ModelSample& m);
+  void start() noexcept { last_ = previous_ = Last{}; }
+  /// Another block's differences.
+  void append(const SecondDifferences& other);
+  [[nodiscard]] std::size_t size() const noexcept { return d2_.size(); }
+  /// The noise floor (see above); unknown, with the reason, if too few differences.
+  [[nodiscard]] NoiseFloor noise_floor(const LogData& log) &&;
+
+ private:
+  struct Last {
+    std::size_t k = static_cast<std::size_t>(-1);
+    core::Vec2 r = core::Vec2::Zero();
+    bool valid = false;
+  };
+  Last last_, previous_;
+  std::vector<double> d2_, q2_;
+  std::size_t valid_ = 0;  ///< samples with a prediction (the reason an unknown floor gives)
+};
+
+/// The noise floor of a whole replay's residual (tests and small logs; a diagnosis streams).
 [[nodiscard]] NoiseFloor measure_noise_floor(const LogData& log, const ReplayOutput& replay);
 
 enum class VerdictKind { kExplained, kUnexplained, kUndetermined };

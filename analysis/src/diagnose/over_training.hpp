@@ -1,0 +1,30 @@
+#pragma once
+// EffectFitter::over_training (effect_fit.hpp), shared by the fits (effect_fit.cpp) and the screening
+// (screening.cpp).
+#include "rpem/analysis/diagnose/effect_fit.hpp"
+
+namespace rpem::analysis {
+
+/// A sample a model predicts nothing finite at counts as this large a miss on each axis rather than vanishing.
+inline constexpr double kMiss_A = 1e3;
+
+template <class Acc, class Add>
+std::vector<Acc> EffectFitter::over_training(const std::vector<ExtendedModel>& models, const Acc& init, const Add& add) const {
+  std::vector<Acc> out(training_blocks_.size(), init);
+  replay_.for_blocks(training_blocks_, [&](std::size_t i, int b) {
+    Acc& acc = out[i];
+    std::vector<core::Vec2> r(models.size());
+    const bool robust = loss_.robust();
+    replay_.replay_block(b, models, [&](std::size_t k, std::span<const ModelSample> m) {
+      if (!fitted_[k]) return;
+      for (std::size_t j = 0; j < m.size(); ++j) {
+        r[j] = m[j].valid ? m[j].residual_A : core::Vec2::Constant(kMiss_A);
+        if (robust) r[j] *= loss_.residual_scale(r[j].squaredNorm());  // |r|² becomes ρ(|r|²) (robust_loss.hpp)
+      }
+      add(acc, std::span<const core::Vec2>(r));
+    });
+  });
+  return out;
+}
+
+}  // namespace rpem::analysis
