@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <atomic>
 #include <exception>
+#include <ranges>
 
 namespace rpem::analysis {
 
@@ -92,8 +93,8 @@ void WorkPool::parallel_for(std::size_t n, const std::function<void(std::size_t)
 }
 
 std::shared_ptr<WorkPool::Loop> WorkPool::newest_open() const {
-  for (auto it = loops_.rbegin(); it != loops_.rend(); ++it) {
-    if ((*it)->open()) return *it;
+  for (const std::shared_ptr<Loop>& loop : std::views::reverse(loops_)) {
+    if (loop->open()) return loop;
   }
   return nullptr;
 }

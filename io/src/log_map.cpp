@@ -252,19 +252,8 @@ std::optional<LayoutProblem> averaged_log_layout_problem(const QuantitySet& p) {
 
 namespace {
 
-LogMap parse(YamlMap root) {
-  LogMap m;
-  m.name = root.file();
-  m.separator = one_character(root, "separator", ',');
-  if (m.separator == '"' || m.separator == '\n' || m.separator == '\r') root.fail("separator", "cannot separate cells");
-  m.header = root.boolean_or("header", true);
-  m.skip_lines = static_cast<std::size_t>(root.integer_or("skip_lines", 0, 0, 1000000));
-  m.comment = one_character(root, "comment", '\0');
-  if (m.comment != '\0' && m.comment == m.separator) root.fail("comment", "is the separator");
-  const std::string samples = root.choice("samples", {"instantaneous", "averaged"});
-  const long pole_pairs = root.integer_or("pole_pairs", 0, 1, 1000);
-
-  YamlMap time = root.map("time");
+/// The time section: evenly spaced rows (period_s) or a time column (column, unit, scale, offset, wrap, resolution).
+void parse_time(YamlMap time, LogMap& m) {
   if (time.has("period_s")) {
     m.period_s = time.number("period_s", 1e-9, 1e6);
     for (const char* k : {"column", "unit", "wrap", "resolution"}) {
@@ -288,16 +277,12 @@ LogMap parse(YamlMap root) {
     m.time = t;
   }
   time.finish();
+}
 
-  if (samples == "averaged") {
-    m.window = root.choice("window", {"previous_row", "t_start"}) == "t_start" ? Window::kStartColumn : Window::kPreviousRow;
-  } else if (root.has("window")) {
-    root.fail("window", "only averaged samples have windows");
-  }
-
-  YamlMap columns = root.map("columns");
+/// The columns section: one entry per quantity the log holds (a speed may come from a PLL); `mechanical` tells
+/// whether any column is in a mechanical unit. Unknown names are left to the caller's finish().
+QuantitySet parse_columns(YamlMap& columns, LogMap& m, long pole_pairs, bool& mechanical) {
   QuantitySet present{};
-  bool mechanical = false;
   for (const QuantityInfo& q : kQuantities) {
     std::optional<YamlMap> c = columns.optional_map(q.name);
     if (!c) continue;
@@ -315,6 +300,32 @@ LogMap parse(YamlMap root) {
     m.columns.push_back(parse_column(*c, q.quantity, q.kind, m.header, pole_pairs, mechanical));
     present[static_cast<std::size_t>(q.quantity)] = true;
   }
+  return present;
+}
+
+LogMap parse(YamlMap root) {
+  LogMap m;
+  m.name = root.file();
+  m.separator = one_character(root, "separator", ',');
+  if (m.separator == '"' || m.separator == '\n' || m.separator == '\r') root.fail("separator", "cannot separate cells");
+  m.header = root.boolean_or("header", true);
+  m.skip_lines = static_cast<std::size_t>(root.integer_or("skip_lines", 0, 0, 1000000));
+  m.comment = one_character(root, "comment", '\0');
+  if (m.comment != '\0' && m.comment == m.separator) root.fail("comment", "is the separator");
+  const std::string samples = root.choice("samples", {"instantaneous", "averaged"});
+  const long pole_pairs = root.integer_or("pole_pairs", 0, 1, 1000);
+
+  parse_time(root.map("time"), m);
+
+  if (samples == "averaged") {
+    m.window = root.choice("window", {"previous_row", "t_start"}) == "t_start" ? Window::kStartColumn : Window::kPreviousRow;
+  } else if (root.has("window")) {
+    root.fail("window", "only averaged samples have windows");
+  }
+
+  YamlMap columns = root.map("columns");
+  bool mechanical = false;
+  const QuantitySet present = parse_columns(columns, m, pole_pairs, mechanical);
   columns.finish();  // names no quantity: rejected with its line
   const std::optional<LayoutProblem> problem =
       m.averaged() ? averaged_log_layout_problem(present) : drive_log_layout_problem(present);

@@ -63,7 +63,7 @@ std::string residual_map(const std::string& dir, const Diagnosis& d) {
   DataBlock b{"map", std::vector<std::vector<double>>(4)};
   double lo = 1e300, hi = 0.0;  // one colour scale for both maps, so the improvement shows
   for (const auto& cell : f.map) {
-    if (!cell[2]) continue;
+    if (cell[2] == 0.0) continue;
     for (double v : {std::sqrt(cell[0] / cell[2]), std::sqrt(cell[1] / cell[2])}) {
       if (v > 0.0) lo = std::min(lo, v);
       hi = std::max(hi, v);
@@ -71,11 +71,11 @@ std::string residual_map(const std::string& dir, const Diagnosis& d) {
   }
   for (int y = 0; y < kY; ++y) {
     for (int x = 0; x < kX; ++x) {
-      const auto& cell = f.map[static_cast<std::size_t>(y * kX + x)];
+      const auto& cell = f.map[static_cast<std::size_t>(y) * kX + static_cast<std::size_t>(x)];
       b.columns[0].push_back(s_lo + (x + 0.5) * (s_hi - s_lo) / kX);
       b.columns[1].push_back(q_lo + (y + 0.5) * (q_hi - q_lo) / kY);
-      b.columns[2].push_back(cell[2] ? std::sqrt(cell[0] / cell[2]) : kNaN);
-      b.columns[3].push_back(cell[2] ? std::sqrt(cell[1] / cell[2]) : kNaN);
+      b.columns[2].push_back(cell[2] != 0.0 ? std::sqrt(cell[0] / cell[2]) : kNaN);
+      b.columns[3].push_back(cell[2] != 0.0 ? std::sqrt(cell[1] / cell[2]) : kNaN);
     }
   }
   GnuplotFigure fig(dir + "/residual_map.png", 1400, 600);
@@ -206,8 +206,10 @@ std::string regime_timeline(const std::string& dir, const LogData& log, const Lo
     const std::string r = std::to_string(static_cast<int>(info.regime));
     const std::string style = std::string(" w p pt 7 ps 0.5 lc rgb '") + kRegimeColour[static_cast<std::size_t>(info.regime)] + "'";
     const std::string title = std::string(" t '") + info.name + (info.excluded ? ", excluded" : "") + " (" + std::to_string(count) + ")'";
-    speed_plot += std::string(speed_plot.empty() ? "plot" : ",") + " $reg u 1:($4==" + r + "?$2:NaN)" + style + title;
-    current_plot += std::string(current_plot.empty() ? "plot" : ",") + " $reg u 1:($4==" + r + "?$3:NaN)" + style + " notitle";
+    speed_plot.append(speed_plot.empty() ? "plot" : ",").append(" $reg u 1:($4==").append(r).append("?$2:NaN)");
+    speed_plot.append(style).append(title);
+    current_plot.append(current_plot.empty() ? "plot" : ",").append(" $reg u 1:($4==").append(r).append("?$3:NaN)");
+    current_plot.append(style).append(" notitle");
   }
   GnuplotFigure fig(dir + "/regimes.png", 1400, 800);
   fig.add_data(std::move(b));

@@ -41,7 +41,9 @@ class ModelReplay::Chain {
   /// with the model it was moved from.
   [[nodiscard]] bool conditions_like(const Chain& other) const noexcept {
     const core::ModelExtensions &a = model_.extensions, &b = other.model_.extensions;
+    // NOLINTNEXTLINE(bugprone-suspicious-memory-comparison): bit for bit is the intent (a -0.0 or a NaN payload may condition differently)
     if (std::memcmp(&a, &b, sizeof a) != 0) return false;
+    // NOLINTNEXTLINE(bugprone-suspicious-memory-comparison): as above; a padding byte that differs only costs the sharing
     return !a.reads_machine() || std::memcmp(&machine_, &other.machine_, sizeof machine_) == 0;
   }
   /// The sample as this chain's conditioner turns it into the predictor's interval (a chain that conditions

@@ -90,34 +90,34 @@ double ResidualSums::regressor(std::size_t j, std::size_t k, const core::Vec2& i
   return (winding ? log_->samples.t_winding_C(k) : log_->samples.t_magnet_C(k)).value_or(0.0);
 }
 
-void ResidualSums::add(std::size_t k, const core::Vec2& rb, const core::Vec2& ra) {
+void ResidualSums::add(std::size_t k, const core::Vec2& nominal_A, const core::Vec2& extended_A) {
   const core::DriveSample s = log_->sample(k);
   const core::Rotation rot = core::Rotation::of(s.theta_el_rad);
   const core::Vec2 i = core::SampleConditioner::logged_current_dq_A(s, rot);
   const double n = s.omega_el_rad_s / base_.omega_el_rad_s;
-  all_before_.add(rb);
-  all_after_.add(ra);
+  all_before_.add(nominal_A);
+  all_after_.add(extended_A);
   const bool still = std::abs(n) < kStandstillSpeedPu;
-  (still ? still_before_ : moving_before_).add(rb);
-  (still ? still_after_ : moving_after_).add(ra);
+  (still ? still_before_ : moving_before_).add(nominal_A);
+  (still ? still_after_ : moving_after_).add(extended_A);
   const int sr = speed_region(n), lr = load_region(i[1], base_.current_A);
-  region_before_[sr][lr].add(rb);
-  region_after_[sr][lr].add(ra);
+  region_before_[sr][lr].add(nominal_A);
+  region_after_[sr][lr].add(extended_A);
 
   if (log_->mode == ModelMode::kTransient) {
     if (!still) {
       ++harmonic_samples_;
       for (int h = 0; h <= kMaxHarmonic; ++h) {
         const std::complex<double> e = std::polar(1.0, -h * s.theta_el_rad);
-        harm_before_[h][0] += rb[0] * e;
-        harm_before_[h][1] += rb[1] * e;
-        harm_after_[h][0] += ra[0] * e;
-        harm_after_[h][1] += ra[1] * e;
+        harm_before_[h][0] += nominal_A[0] * e;
+        harm_before_[h][1] += nominal_A[1] * e;
+        harm_after_[h][0] += extended_A[0] * e;
+        harm_after_[h][1] += extended_A[1] * e;
       }
     }
     const core::Vec3 i_abc = core::inverse_clarke(core::inverse_park(i, rot));
-    const core::Vec3 r_abc_b = core::inverse_clarke(core::inverse_park(rb, rot));
-    const core::Vec3 r_abc_a = core::inverse_clarke(core::inverse_park(ra, rot));
+    const core::Vec3 r_abc_b = core::inverse_clarke(core::inverse_park(nominal_A, rot));
+    const core::Vec3 r_abc_a = core::inverse_clarke(core::inverse_park(extended_A, rot));
     for (int x = 0; x < 3; ++x) {
       (i_abc[x] > 0.0 ? pos_before_ : neg_before_)[x].add({r_abc_b[x], 0.0});
       (i_abc[x] > 0.0 ? pos_after_ : neg_after_)[x].add({r_abc_a[x], 0.0});
@@ -125,10 +125,10 @@ void ResidualSums::add(std::size_t k, const core::Vec2& rb, const core::Vec2& ra
   }
   for (std::size_t j = 0; j < regressors_.size(); ++j) {
     const double v = regressor(j, k, i, n);
-    corr_[j][0].add(v, rb[0]);
-    corr_[j][1].add(v, rb[1]);
-    corr_[j][2].add(v, ra[0]);
-    corr_[j][3].add(v, ra[1]);
+    corr_[j][0].add(v, nominal_A[0]);
+    corr_[j][1].add(v, nominal_A[1]);
+    corr_[j][2].add(v, extended_A[0]);
+    corr_[j][3].add(v, extended_A[1]);
   }
 }
 

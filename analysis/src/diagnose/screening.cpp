@@ -190,6 +190,7 @@ void credit_gains(const OverTraining& over_training, const EffectContext& contex
   }
   // Per candidate, the Gram of [basis columns, its columns] against its residual at the start.
   std::vector<least_squares::Gram> init2;
+  init2.reserve(layout.size());
   for (const Candidate& l : layout) init2.emplace_back(nb + static_cast<Eigen::Index>(l.steps.size()));
   const std::vector<std::vector<least_squares::Gram>> second =
       over_training(pass.models, init2, [&](std::vector<least_squares::Gram>& g, std::span<const core::Vec2> r) {

@@ -62,13 +62,13 @@ class ModelReplay {
   void replay_block(int b, std::span<const ExtendedModel> models, const Visit& visit) const;
 
   /// The blocks `blocks` selects that hold samples, in order.
-  [[nodiscard]] std::vector<int> blocks(Blocks blocks) const;
+  [[nodiscard]] std::vector<int> blocks(Blocks which) const;
 
   /// Runs per_block(i, b) for the i-th of `blocks` on the pool (checking between blocks whether to stop).
   void for_blocks(const std::vector<int>& blocks, const std::function<void(std::size_t i, int b)>& per_block) const;
 
   /// Replays `blocks` of the log with `model`, every sample kept (tests and small logs). Thread-safe (const).
-  void run(const ExtendedModel& model, ReplayOutput& out, Blocks blocks = Blocks::kAll) const;
+  void run(const ExtendedModel& model, ReplayOutput& out, Blocks which = Blocks::kAll) const;
 
   [[nodiscard]] const LogData& log() const noexcept { return log_; }
   [[nodiscard]] const WorkPool& pool() const noexcept { return pool_; }
