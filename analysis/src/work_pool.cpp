@@ -5,7 +5,6 @@
 #include <algorithm>
 #include <atomic>
 #include <exception>
-#include <ranges>
 
 namespace rpem::analysis {
 
@@ -93,10 +92,8 @@ void WorkPool::parallel_for(std::size_t n, const std::function<void(std::size_t)
 }
 
 std::shared_ptr<WorkPool::Loop> WorkPool::newest_open() const {
-  for (const std::shared_ptr<Loop>& loop : std::views::reverse(loops_)) {
-    if (loop->open()) return loop;
-  }
-  return nullptr;
+  const auto newest = std::find_if(loops_.rbegin(), loops_.rend(), [](const std::shared_ptr<Loop>& l) { return l->open(); });
+  return newest == loops_.rend() ? nullptr : *newest;
 }
 
 void WorkPool::work() {
