@@ -114,11 +114,9 @@ void parse_nodes(YamlMap& t, ThermalConfig& c) {
   if (n.magnet < 0) t.fail("nodes", "a node named 'magnet' is required (ψm follows it)");
 }
 
-/// `nodes`, `conductances` and `losses`.
-void parse_network(YamlMap& t, ThermalConfig& c) {
-  parse_nodes(t, c);
-  core::ThermalFusionConfig& f = c.fusion;
-  core::ThermalNetwork& n = f.filter.network;
+/// `conductances`: each joins two different nodes, once; every node must reach the coolant.
+void parse_conductances(YamlMap& t, ThermalConfig& c) {
+  core::ThermalNetwork& n = c.fusion.filter.network;
   n.between_W_per_K.setZero();
   if (t.has("conductances")) {
     for (YamlMap& m : t.maps("conductances")) {
@@ -150,7 +148,12 @@ void parse_network(YamlMap& t, ThermalConfig& c) {
       }
     }
   }
+}
 
+/// `losses`: each a loss form of the catalogue at a node, once.
+void parse_losses(YamlMap& t, ThermalConfig& c) {
+  core::ThermalFusionConfig& f = c.fusion;
+  core::ThermalNetwork& n = f.filter.network;
   n.loss_at_base_W.setZero();
   if (t.has("losses")) {
     for (YamlMap& m : t.maps("losses")) {
@@ -162,7 +165,7 @@ void parse_network(YamlMap& t, ThermalConfig& c) {
       if (fi < 0) {
         std::string names;
         for (const core::LossFormRow& row : core::loss_forms()) names.append(names.empty() ? "" : ", ").append(row.name);
-        m.fail("form", "unknown loss form '" + form + "' (one of " + names + ")");
+        m.fail("form", std::string("unknown loss form '").append(form).append("' (one of ").append(names).append(")"));
       }
       const std::string node = m.text("node");
       const int i = node_index(c, node);
@@ -173,6 +176,13 @@ void parse_network(YamlMap& t, ThermalConfig& c) {
       m.finish();
     }
   }
+}
+
+/// `nodes`, `conductances` and `losses`.
+void parse_network(YamlMap& t, ThermalConfig& c) {
+  parse_nodes(t, c);
+  parse_conductances(t, c);
+  parse_losses(t, c);
 }
 
 }  // namespace

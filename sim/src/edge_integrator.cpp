@@ -69,19 +69,7 @@ void EdgeIntegrator::run(Flow& flow, PmsmPlant& plant, bool rising, const Duties
       continue;
     }
 
-    // Each leg's command over the interval, and each current's sign where it is clearly off zero.
-    const core::Vec3 i = plant.phase_currents();
-    int clamped = -1;
-    std::array<bool, 3> watched{};
-    for (int x = 0; x < 3; ++x) {
-      const LegCommand c = command_at(schedule[x], t_mid);
-      legs.positive_V[x] = inverter_.leg_voltage(c, 1, u_dc_V);
-      legs.negative_V[x] = inverter_.leg_voltage(c, -1, u_dc_V);
-      if (std::abs(i[x]) > kZeroCurrent_A) sign_[x] = i[x] > 0.0 ? 1 : -1;
-      if (sign_[x] == 0 && clamped >= 0) sign_[x] = i[x] >= 0.0 ? 1 : -1;  // one clamp at a time
-      if (sign_[x] == 0) clamped = x;
-      legs.applied_V[x] = sign_[x] < 0 ? legs.negative_V[x] : legs.positive_V[x];
-    }
+    const int clamped = select_legs(schedule, plant.phase_currents(), t_mid, u_dc_V, legs);
     double h = t_end - t;
     if (clamped >= 0) {
       start_at_zero(flow, plant, clamped, legs, std::min(h, kClampStep_s));
@@ -90,6 +78,7 @@ void EdgeIntegrator::run(Flow& flow, PmsmPlant& plant, bool rising, const Duties
       flow.start(plant, core::clarke(legs.applied_V), h);
     }
     h = flow.reach_s();
+    std::array<bool, 3> watched{};
     bool watch = false;  // a current whose sign selects its leg's voltage
     for (int x = 0; x < 3; ++x) {
       watched[x] = sign_[x] != 0 && legs.negative_V[x] != legs.positive_V[x];
@@ -110,6 +99,21 @@ void EdgeIntegrator::run(Flow& flow, PmsmPlant& plant, bool rising, const Duties
     }
   }
   if (events >= kMaxEvents) ++counters_.event_limit_hits;
+}
+
+int EdgeIntegrator::select_legs(const std::array<LegSchedule, 3>& schedule, const core::Vec3& i, double t_mid,
+                                double u_dc_V, Legs& legs) noexcept {
+  int clamped = -1;
+  for (int x = 0; x < 3; ++x) {
+    const LegCommand c = command_at(schedule[x], t_mid);
+    legs.positive_V[x] = inverter_.leg_voltage(c, 1, u_dc_V);
+    legs.negative_V[x] = inverter_.leg_voltage(c, -1, u_dc_V);
+    if (std::abs(i[x]) > kZeroCurrent_A) sign_[x] = i[x] > 0.0 ? 1 : -1;
+    if (sign_[x] == 0 && clamped >= 0) sign_[x] = i[x] >= 0.0 ? 1 : -1;  // one clamp at a time
+    if (sign_[x] == 0) clamped = x;
+    legs.applied_V[x] = sign_[x] < 0 ? legs.negative_V[x] : legs.positive_V[x];
+  }
+  return clamped;
 }
 
 template <class Flow>

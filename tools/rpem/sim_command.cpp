@@ -41,6 +41,21 @@ struct SimOptions {
   VescToolOptions vesc_tool;
 };
 
+/// What the simulation did: its samples, where they were written (`out`, if a drive log was) and streamed.
+std::string drive_sim_summary(std::uint64_t n, const std::string& name, const std::string& out,
+                              const TelemetryStreamer* streamer) {
+  std::string summary = std::to_string(n) + " samples of '" + name + "'";
+  if (!out.empty()) summary += " written to " + out;
+  if (streamer != nullptr) {
+    summary += ", streamed as " + std::to_string(streamer->frames_sent()) + " frames";
+    if (streamer->frames_dropped() > 0) summary += " (" + std::to_string(streamer->frames_dropped()) + " dropped on purpose)";
+  }
+  return summary;
+}
+
+int run_drive_sim(const SimOptions& o);
+
+/// --vesc-tool-out and --vesc run alone; anything else is the drive simulated (run_drive_sim).
 int run_sim(const SimOptions& o) {
   if (!o.vesc_tool.out.empty()) {
     if (!o.out.empty() || !o.averaged_out.empty() || !o.truth.empty() || !o.estimate.empty() ||
@@ -60,6 +75,12 @@ int run_sim(const SimOptions& o) {
     vesc.truth = o.truth;
     return run_vesc_emulator(sim::load_scenario(o.scenario), vesc);
   }
+  return run_drive_sim(o);
+}
+
+/// The drive simulated sample by sample into a drive log, an averaged log, CAN telemetry, the truth and the
+/// estimator's log, as the options ask.
+int run_drive_sim(const SimOptions& o) {
   sim::DriveSimulator simulator(sim::load_scenario(o.scenario));
   std::optional<io::DriveLogWriter> log;
   if (!o.out.empty()) log.emplace(o.out, simulator.layout());
@@ -104,13 +125,7 @@ int run_sim(const SimOptions& o) {
     if ((++n & 0x3FF) == 0) progress.update(n, total);
   }
   if (streamer) streamer->finish();
-  std::string summary = std::to_string(n) + " samples of '" + simulator.scenario().name + "'";
-  if (log) summary += " written to " + o.out;
-  if (streamer) {
-    summary += ", streamed as " + std::to_string(streamer->frames_sent()) + " frames";
-    if (streamer->frames_dropped() > 0) summary += " (" + std::to_string(streamer->frames_dropped()) + " dropped on purpose)";
-  }
-  progress.finish(summary);
+  progress.finish(drive_sim_summary(n, simulator.scenario().name, log ? o.out : std::string(), streamer ? &*streamer : nullptr));
   if (streamer && !streamer->lateness_summary().empty()) std::fprintf(stderr, "rpem sim: %s\n", streamer->lateness_summary().c_str());
   return kExitOk;
 }

@@ -250,25 +250,36 @@ EffectSet EffectFitter::fit(const EffectSet& start, double* training_ssr) const 
   return set;
 }
 
-CalibrationIntervals EffectFitter::intervals(const EffectSet& set, double noise_floor_A) const {
-  // Columns: every calibrated constant (free or not: the excitation is judged for all), then the effects'.
-  std::vector<ExtendedModel> models = {set.model(context_)};
-  std::vector<double> steps;
+namespace {
+
+/// The models of the intervals' Jacobian: `set` itself, then one per column, each with its step in `steps`.
+/// Columns: every calibrated constant (free or not: the excitation is judged for all), then the effects'
+/// parameters (stepped back where a step forward would pass the upper bound).
+std::vector<ExtendedModel> stepped_models(const EffectSet& set, const EffectContext& context, std::vector<double>& steps) {
+  std::vector<ExtendedModel> models = {set.model(context)};
   for (std::size_t i = 0; i < kCalibrated.size(); ++i) {
     EffectSet moved = set;
     moved.calibration[i] += kStep;
-    models.push_back(moved.model(context_));
+    models.push_back(moved.model(context));
     steps.push_back(kStep);
   }
   for (std::size_t j = 0; j < set.effects.size(); ++j) {
     for (std::size_t i = 0; i < set.parameters[j].size(); ++i) {
       EffectSet moved = set;
-      const double h = parameter_bounds(set.effects[j], context_, static_cast<int>(i)).second >= set.parameters[j][i] + kStep ? kStep : -kStep;
+      const double h = parameter_bounds(set.effects[j], context, static_cast<int>(i)).second >= set.parameters[j][i] + kStep ? kStep : -kStep;
       moved.parameters[j][i] += h;
-      models.push_back(moved.model(context_));
+      models.push_back(moved.model(context));
       steps.push_back(h);
     }
   }
+  return models;
+}
+
+}  // namespace
+
+CalibrationIntervals EffectFitter::intervals(const EffectSet& set, double noise_floor_A) const {
+  std::vector<double> steps;
+  const std::vector<ExtendedModel> models = stepped_models(set, context_, steps);
   const auto n = static_cast<Eigen::Index>(steps.size());
   assert(n <= kMaxColumns);
   // Per training block: JᵀJ, and the block's score vector g_b = J_bᵀ·r_b (the cluster-robust "meat").
@@ -293,7 +304,7 @@ CalibrationIntervals EffectFitter::intervals(const EffectSet& set, double noise_
   const Eigen::MatrixXd h = total.symmetric();
   // Cluster-robust "meat": the training blocks' score vectors.
   const LogData& log = replay_.log();
-  Eigen::MatrixXd g = Eigen::MatrixXd::Zero(n, static_cast<Eigen::Index>(log.blocks / 2 + 1));
+  Eigen::MatrixXd g = Eigen::MatrixXd::Zero(n, static_cast<Eigen::Index>(log.blocks) / 2 + 1);
   for (std::size_t i = 0; i < training_blocks_.size(); ++i) g.col(training_blocks_[i] / 2) = blocks[i].score;
   // A constant the log does not excite has a vanishing column: the pseudo-inverse leaves it infinitely uncertain.
   const ClusterRobustCovariance cov = cluster_robust_covariance(h, g);
