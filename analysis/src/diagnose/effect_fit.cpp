@@ -46,7 +46,9 @@ double training_ssr_of(const std::vector<TrainingResiduals>& blocks) {
 
 /// The fit as a Ceres cost: the free calibrated constants (one block, if any) and one block per effect;
 /// as residuals the triangular factor of the training blocks' [J r] (effect_fit.hpp), P + 1 of them, and
-/// where Ceres asks for the cost alone, P zeros and the root of the sum of squares.
+/// where Ceres asks for the cost alone, P zeros and the root of the sum of squares. After an accepted step
+/// Ceres asks for the cost at the new point and then for the Jacobian there: the cost's replay keeps the
+/// training residuals, and the Jacobian's replays only the steps.
 class EffectFitter::FitCost final : public ceres::CostFunction {
  public:
   FitCost(const EffectFitter& fitter, const EffectSet& start, std::vector<std::size_t> free)
@@ -62,7 +64,9 @@ class EffectFitter::FitCost final : public ceres::CostFunction {
     const int p = parameters_;
     assert(p < kMaxColumns);  // the row below holds the P columns and the residual
     if (jacobians == nullptr) {
-      // Kept with its point: at an accepted step Ceres asks for the Jacobian there next.
+      // Kept with its point: at an accepted step Ceres asks for the Jacobian there next. (The last point's
+      // are released first: one set per fit at any time.)
+      last_residuals_.clear();
       std::vector<TrainingResiduals> blocks(fitter_.training_blocks_.size());
       const std::vector<std::size_t>& first = fitter_.replay_.log().block_first;
       for (std::size_t i = 0; i < blocks.size(); ++i) {
