@@ -3,7 +3,9 @@
 // parameter error exactly, and the log's preparation (mode, exclusions, blocks).
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
+#include <cstring>
 #include <complex>
 #include <numbers>
 #include <random>
@@ -71,6 +73,40 @@ TEST(Replay, DataFromTheModelItselfLeavesNoResidual) {
   double late = 0.0;  // 1.75 s (≈ 20 time constants) after the speed step: round-off only
   for (std::size_t k = 22000; k < r.valid.size(); ++k) late = std::max(late, r.residual_A[k].norm());
   EXPECT_LT(late, 1e-9);
+}
+
+TEST(ModelReplay, ModelsReplayedTogetherGiveEachItsOwnReplayBitForBit) {
+  // A model given twice steps one chain (replay.cpp): each copy still gets exactly what that model gets
+  // replayed alone, and so does a different model replayed beside them.
+  const LogData log = model_log(0.95, false);
+  const ModelReplay replay(log, test::paper_machine_si().rated);
+  const ExtendedModel a = make_base_model(test::paper_machine_si(), {}, std::nullopt, std::nullopt, log);
+  ExtendedModel b = a;
+  b.extensions.deadtime_v_err_V = 0.5;
+  b.extensions.deadtime_current_band_A = 0.2;
+  const std::vector<ExtendedModel> together = {a, b, a};
+  for (int block = 0; block < 2; ++block) {
+    std::vector<ModelSample> alone_a, alone_b;
+    std::vector<std::array<ModelSample, 3>> joint;
+    replay.replay_block(block, std::span(&a, 1), [&](std::size_t, std::span<const ModelSample> m) { alone_a.push_back(m[0]); });
+    replay.replay_block(block, std::span(&b, 1), [&](std::size_t, std::span<const ModelSample> m) { alone_b.push_back(m[0]); });
+    replay.replay_block(block, together, [&](std::size_t, std::span<const ModelSample> m) {
+      ASSERT_EQ(m.size(), 3u);
+      joint.push_back({m[0], m[1], m[2]});
+    });
+    ASSERT_EQ(joint.size(), alone_a.size());
+    ASSERT_GT(joint.size(), 100u);
+    std::size_t differ = 0;  // a and b must differ somewhere, or the test shows nothing
+    for (std::size_t k = 0; k < joint.size(); ++k) {
+      for (const auto& [m, alone] : {std::pair{joint[k][0], alone_a[k]}, std::pair{joint[k][1], alone_b[k]}, std::pair{joint[k][2], alone_a[k]}}) {
+        EXPECT_EQ(m.valid, alone.valid);
+        EXPECT_EQ(std::memcmp(m.residual_A.data(), alone.residual_A.data(), sizeof(double) * 2), 0) << "block " << block << " sample " << k;
+        EXPECT_EQ(std::memcmp(m.model_A.data(), alone.model_A.data(), sizeof(double) * 2), 0) << "block " << block << " sample " << k;
+      }
+      if (joint[k][0].model_A != joint[k][1].model_A) ++differ;
+    }
+    EXPECT_GT(differ, joint.size() / 2);
+  }
 }
 
 TEST(EffectFit, TheCalibrationRecoversAKnownFluxErrorExactly) {

@@ -4,6 +4,7 @@
 
 #include <Eigen/Dense>
 #include <algorithm>
+#include <bit>
 #include <cassert>
 #include <cmath>
 #include <limits>
@@ -22,11 +23,32 @@ constexpr double kStep = 1e-3;
 /// effect's parameters; four effects of at most a few parameters use a fraction of it).
 constexpr int kMaxColumns = 64;
 
+/// A training block's residuals (scaled by the loss, as over_training gives them) and their sum of squares.
+struct TrainingResiduals {
+  double ssr = 0.0;
+  std::vector<core::Vec2> r;
+};
+
+void add_training_residual(TrainingResiduals& b, std::span<const core::Vec2> r) {
+  b.ssr += r[0][0] * r[0][0];
+  b.ssr += r[0][1] * r[0][1];
+  b.r.push_back(r[0]);
+}
+
+/// The training sum of squares from the blocks' sums, added in block order (as EffectFitter::training_ssr).
+double training_ssr_of(const std::vector<TrainingResiduals>& blocks) {
+  double s = 0.0;
+  for (const TrainingResiduals& b : blocks) s += b.ssr;
+  return s;
+}
+
 }  // namespace
 
 /// The fit as a Ceres cost: the free calibrated constants (one block, if any) and one block per effect;
 /// as residuals the triangular factor of the training blocks' [J r] (effect_fit.hpp), P + 1 of them, and
-/// where Ceres asks for the cost alone, P zeros and the root of the sum of squares.
+/// where Ceres asks for the cost alone, P zeros and the root of the sum of squares. After an accepted step
+/// Ceres asks for the cost at the new point and then for the Jacobian there: the cost's replay keeps the
+/// training residuals, and the Jacobian's replays only the steps.
 class EffectFitter::FitCost final : public ceres::CostFunction {
  public:
   FitCost(const EffectFitter& fitter, const EffectSet& start, std::vector<std::size_t> free)
@@ -42,12 +64,32 @@ class EffectFitter::FitCost final : public ceres::CostFunction {
     const int p = parameters_;
     assert(p < kMaxColumns);  // the row below holds the P columns and the residual
     if (jacobians == nullptr) {
+      // Kept with its point: at an accepted step Ceres asks for the Jacobian there next. (The last point's
+      // are released first: one set per fit at any time.)
+      last_residuals_.clear();
+      std::vector<TrainingResiduals> blocks(fitter_.training_blocks_.size());
+      const std::vector<std::size_t>& first = fitter_.replay_.log().block_first;
+      for (std::size_t i = 0; i < blocks.size(); ++i) {
+        const auto b = static_cast<std::size_t>(fitter_.training_blocks_[i]);
+        blocks[i].r.reserve(first[b + 1] - first[b]);
+      }
+      blocks = fitter_.over_training_from({set.model(fitter_.context_)}, std::move(blocks), add_training_residual);
       std::fill(residuals, residuals + p, 0.0);
-      residuals[p] = std::sqrt(fitter_.training_ssr(set));
+      residuals[p] = std::sqrt(training_ssr_of(blocks));
+      last_point_ = point(parameters);
+      last_residuals_ = std::move(blocks);
       return true;
     }
-    // The point and each parameter stepped forward as Ceres' numeric differentiation steps it.
-    std::vector<ExtendedModel> models = {set.model(fitter_.context_)};
+    // The base point's residuals: those of the cost-only evaluation just before if it was at these parameters
+    // bit for bit (the replay is deterministic: the same rows), else model 0 of this replay.
+    const bool known = !last_residuals_.empty() && last_point_ == point(parameters);
+    std::vector<TrainingResiduals> base = std::move(last_residuals_);
+    last_residuals_.clear();
+    if (!known) base.assign(fitter_.training_blocks_.size(), TrainingResiduals{});
+    // The point (unless known) and each parameter stepped forward as Ceres' numeric differentiation steps it.
+    std::vector<ExtendedModel> models;
+    if (!known) models.push_back(set.model(fitter_.context_));
+    const std::size_t stepped = known ? 0 : 1;  // index of the first stepped model
     std::vector<double> inverse_step;
     const std::vector<std::int32_t>& sizes = parameter_block_sizes();
     for (std::size_t b = 0; b < sizes.size(); ++b) {
@@ -61,17 +103,27 @@ class EffectFitter::FitCost final : public ceres::CostFunction {
         inverse_step.push_back(1.0 / delta);
       }
     }
-    std::vector<least_squares::TriangularFactor> factors =
-        fitter_.over_training(models, least_squares::TriangularFactor(p + 1), [&](least_squares::TriangularFactor& f, std::span<const core::Vec2> r) {
-          double row[kMaxColumns];
-          for (int axis = 0; axis < 2; ++axis) {
-            for (int j = 0; j < p; ++j) row[j] = (r[static_cast<std::size_t>(j) + 1][axis] - r[0][axis]) * inverse_step[static_cast<std::size_t>(j)];
-            row[p] = r[0][axis];
-            f.add_row(row);
-          }
-        });
+    struct Block {
+      least_squares::TriangularFactor factor;
+      const std::vector<core::Vec2>* base = nullptr;  ///< the known residuals, if known
+      std::size_t next = 0;
+    };
+    std::vector<Block> inits;
+    for (const TrainingResiduals& b : base) inits.push_back(Block{least_squares::TriangularFactor(p + 1), known ? &b.r : nullptr, 0});
+    std::vector<Block> factors = fitter_.over_training_from(models, std::move(inits), [&](Block& f, std::span<const core::Vec2> r) {
+      const core::Vec2 r0 = f.base ? (*f.base)[f.next++] : r[0];
+      double row[kMaxColumns];
+      for (int axis = 0; axis < 2; ++axis) {
+        for (int j = 0; j < p; ++j) row[j] = (r[static_cast<std::size_t>(j) + stepped][axis] - r0[axis]) * inverse_step[static_cast<std::size_t>(j)];
+        row[p] = r0[axis];
+        f.factor.add_row(row);
+      }
+    });
     least_squares::TriangularFactor all(p + 1);
-    for (least_squares::TriangularFactor& f : factors) all.add(std::move(f));
+    for (Block& f : factors) {
+      assert(!f.base || f.next == f.base->size());  // the same samples as the cost-only evaluation's
+      all.add(std::move(f.factor));
+    }
     const Eigen::MatrixXd r = all.r();
     for (int i = 0; i <= p; ++i) residuals[i] = r(i, p);
     int column = 0;
@@ -100,10 +152,24 @@ class EffectFitter::FitCost final : public ceres::CostFunction {
     return set;
   }
 
+  /// Ceres' parameters, every block's in order (compared bit for bit: the replay at equal bits is the same).
+  std::vector<std::uint64_t> point(double const* const* parameters) const {
+    std::vector<std::uint64_t> out;
+    const std::vector<std::int32_t>& sizes = parameter_block_sizes();
+    for (std::size_t b = 0; b < sizes.size(); ++b) {
+      for (std::int32_t i = 0; i < sizes[b]; ++i) out.push_back(std::bit_cast<std::uint64_t>(parameters[b][i]));
+    }
+    return out;
+  }
+
   const EffectFitter& fitter_;
   EffectSet start_;
   std::vector<std::size_t> free_;
   int parameters_ = 0;
+  // The last cost-only evaluation's point and training residuals (Ceres evaluates one problem's cost from one
+  // thread at a time: num_threads 1). Released by the Jacobian evaluation that follows.
+  mutable std::vector<std::uint64_t> last_point_;
+  mutable std::vector<TrainingResiduals> last_residuals_;
 };
 
 EffectFitter::EffectFitter(const ModelReplay& replay, const EffectContext& context)

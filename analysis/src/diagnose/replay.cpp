@@ -21,6 +21,17 @@ struct Shared {
   core::Rotation logged;    ///< at the logged angle
 };
 
+/// Whether two models are the same bit for bit, field by field (ModelExtensions and the machine hold doubles
+/// only): their replays then are too.
+bool same_bits(const ExtendedModel& a, const ExtendedModel& b) noexcept {
+  const auto bytes = [](const auto& x, const auto& y) { return std::memcmp(&x, &y, sizeof x) == 0; };
+  const auto law = [&](const std::optional<core::DriftLaw>& x, const std::optional<core::DriftLaw>& y) {
+    return x.has_value() == y.has_value() && (!x || bytes(*x, *y));
+  };
+  return bytes(a.machine, b.machine) && bytes(a.extensions, b.extensions) && law(a.r_s_law, b.r_s_law) &&
+         law(a.psi_m_law, b.psi_m_law) && bytes(a.r_s_trend, b.r_s_trend) && bytes(a.psi_m_trend, b.psi_m_trend);
+}
+
 }  // namespace
 
 /// One model's replay through a block: its conditioner and predictor state, sample by sample.
@@ -141,10 +152,28 @@ void ModelReplay::for_blocks(const std::vector<int>& blocks, const std::function
 
 void ModelReplay::replay_block(int b, std::span<const ExtendedModel> models, const Visit& visit) const {
   const std::size_t first = log_.block_first[static_cast<std::size_t>(b)], end = log_.block_first[static_cast<std::size_t>(b) + 1];
+  // A model the same as an earlier one bit for bit (a screening's candidate at a start that leaves the model as
+  // it is: the round's model) steps no chain of its own: it is given that one's samples.
+  std::vector<std::size_t> chain_of(models.size());
   std::vector<Chain> chains;
   chains.reserve(models.size());
-  for (const ExtendedModel& m : models) chains.emplace_back(*this, m);
-  std::vector<ModelSample> out(models.size());
+  for (std::size_t j = 0; j < models.size(); ++j) {
+    chain_of[j] = chains.size();
+    for (std::size_t i = 0; i < j; ++i) {
+      if (same_bits(models[i], models[j])) {
+        chain_of[j] = chain_of[i];
+        break;
+      }
+    }
+    if (chain_of[j] == chains.size()) chains.emplace_back(*this, models[j]);
+  }
+  const bool repeated = chains.size() < models.size();
+  std::vector<ModelSample> out(chains.size()), all(repeated ? models.size() : 0);
+  const auto visit_all = [&](std::size_t k) {
+    if (!repeated) return visit(k, out);
+    for (std::size_t j = 0; j < all.size(); ++j) all[j] = out[chain_of[j]];
+    visit(k, all);
+  };
   Shared x;
   if (log_.mode == ModelMode::kTransient) {
     // The models that condition alike share one conditioner's samples: the first of each kind conditions.
@@ -170,7 +199,7 @@ void ModelReplay::replay_block(int b, std::span<const ExtendedModel> models, con
       for (std::size_t j = 0; j < chains.size(); ++j) {
         chains[j].step_transient(k, first, x, conditioned[conditioned_by[j]], used ? &logged : nullptr, out[j]);
       }
-      if (used) visit(k, out);
+      if (used) visit_all(k);
     }
   } else {
     for (std::size_t k = first; k < end; ++k) {
@@ -179,7 +208,7 @@ void ModelReplay::replay_block(int b, std::span<const ExtendedModel> models, con
       x.logged = core::Rotation::of(x.s.theta_el_rad);
       const core::Vec2 logged = core::SampleConditioner::logged_current_dq_A(x.s, x.logged);
       for (std::size_t j = 0; j < chains.size(); ++j) chains[j].step_steady(k, x, logged, out[j]);
-      visit(k, out);
+      visit_all(k);
     }
   }
   if (monitor_) monitor_->advance(static_cast<std::uint64_t>(end - first) * models.size());

@@ -7,7 +7,9 @@
 // already in the model in J, so that what they already explain is not credited to a candidate, and what
 // they took of the candidate's residual while it was missing is.
 //
-// Nothing here holds a residual per sample (docs/diagnose.md, "Long recordings"). Every quantity is a sum
+// Nothing here holds a residual per sample (docs/diagnose.md, "Long recordings") but a fit's last cost-only
+// evaluation's training residuals, which the Jacobian Ceres asks for at the same point next takes as its base
+// point's instead of replaying them again. Every quantity is a sum
 // over the samples — JᵀJ, Jᵀr, rᵀr, the blocks' scores — accumulated as the models stream through a block
 // together, block by block on the replay's pool, and added in block order. Ceres is handed the fit in the
 // same reduced form: the least-squares problem ‖J·δ + r‖² over the training samples equals ‖R_J·δ + R_r‖²
@@ -147,6 +149,9 @@ class EffectFitter {
   /// residuals[j] model j's (a miss of 1 kA per axis where a model predicts nothing finite), scaled by the loss.
   template <class Acc, class Add>
   std::vector<Acc> over_training(const std::vector<ExtendedModel>& models, const Acc& init, const Add& add) const;
+  /// The same with each block's own start (`inits`, one per training block, in order).
+  template <class Acc, class Add>
+  std::vector<Acc> over_training_from(const std::vector<ExtendedModel>& models, std::vector<Acc> inits, const Add& add) const;
 
   const ModelReplay& replay_;
   EffectContext context_;
