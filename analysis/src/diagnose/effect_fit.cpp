@@ -64,20 +64,7 @@ class EffectFitter::FitCost final : public ceres::CostFunction {
     const int p = parameters_;
     assert(p < kMaxColumns);  // the row below holds the P columns and the residual
     if (jacobians == nullptr) {
-      // Kept with its point: at an accepted step Ceres asks for the Jacobian there next. (The last point's
-      // are released first: one set per fit at any time.)
-      last_residuals_.clear();
-      std::vector<TrainingResiduals> blocks(fitter_.training_blocks_.size());
-      const std::vector<std::size_t>& first = fitter_.replay_.log().block_first;
-      for (std::size_t i = 0; i < blocks.size(); ++i) {
-        const auto b = static_cast<std::size_t>(fitter_.training_blocks_[i]);
-        blocks[i].r.reserve(first[b + 1] - first[b]);
-      }
-      blocks = fitter_.over_training_from({set.model(fitter_.context_)}, std::move(blocks), add_training_residual);
-      std::fill(residuals, residuals + p, 0.0);
-      residuals[p] = std::sqrt(training_ssr_of(blocks));
-      last_point_ = point(parameters);
-      last_residuals_ = std::move(blocks);
+      cost_only(set, parameters, residuals);
       return true;
     }
     // The base point's residuals: those of the cost-only evaluation just before if it was at these parameters
@@ -91,24 +78,15 @@ class EffectFitter::FitCost final : public ceres::CostFunction {
     if (!known) models.push_back(set.model(fitter_.context_));
     const std::size_t stepped = known ? 0 : 1;  // index of the first stepped model
     std::vector<double> inverse_step;
+    add_stepped_models(parameters, models, inverse_step);
     const std::vector<std::int32_t>& sizes = parameter_block_sizes();
-    for (std::size_t b = 0; b < sizes.size(); ++b) {
-      for (std::int32_t i = 0; i < sizes[b]; ++i) {
-        std::vector<double> block(parameters[b], parameters[b] + sizes[b]);
-        const double delta = std::max(std::sqrt(std::numeric_limits<double>::epsilon()), std::abs(block[static_cast<std::size_t>(i)]) * kStep);
-        block[static_cast<std::size_t>(i)] += delta;
-        std::vector<const double*> moved(parameters, parameters + sizes.size());
-        moved[b] = block.data();
-        models.push_back(at(moved.data()).model(fitter_.context_));
-        inverse_step.push_back(1.0 / delta);
-      }
-    }
     struct Block {
       least_squares::TriangularFactor factor;
       const std::vector<core::Vec2>* base = nullptr;  ///< the known residuals, if known
       std::size_t next = 0;
     };
     std::vector<Block> inits;
+    inits.reserve(base.size());
     for (const TrainingResiduals& b : base) inits.push_back(Block{least_squares::TriangularFactor(p + 1), known ? &b.r : nullptr, 0});
     std::vector<Block> factors = fitter_.over_training_from(models, std::move(inits), [&](Block& f, std::span<const core::Vec2> r) {
       const core::Vec2 r0 = f.base ? (*f.base)[f.next++] : r[0];
@@ -137,6 +115,43 @@ class EffectFitter::FitCost final : public ceres::CostFunction {
   }
 
  private:
+  /// The cost alone at `set` (Ceres' `parameters`): P zeros and the root of the training sum of squares. The
+  /// training residuals are kept with their point: at an accepted step Ceres asks for the Jacobian there next.
+  /// (The last point's are released first: one set per fit at any time.)
+  void cost_only(const EffectSet& set, double const* const* parameters, double* residuals) const {
+    const int p = parameters_;
+    last_residuals_.clear();
+    std::vector<TrainingResiduals> blocks(fitter_.training_blocks_.size());
+    const std::vector<std::size_t>& first = fitter_.replay_.log().block_first;
+    for (std::size_t i = 0; i < blocks.size(); ++i) {
+      const auto b = static_cast<std::size_t>(fitter_.training_blocks_[i]);
+      blocks[i].r.reserve(first[b + 1] - first[b]);
+    }
+    blocks = fitter_.over_training_from({set.model(fitter_.context_)}, std::move(blocks), add_training_residual);
+    std::fill(residuals, residuals + p, 0.0);
+    residuals[p] = std::sqrt(training_ssr_of(blocks));
+    last_point_ = point(parameters);
+    last_residuals_ = std::move(blocks);
+  }
+
+  /// Each parameter stepped forward as Ceres' numeric differentiation steps it: its model appended to
+  /// `models`, the step's inverse to `inverse_step`.
+  void add_stepped_models(double const* const* parameters, std::vector<ExtendedModel>& models,
+                          std::vector<double>& inverse_step) const {
+    const std::vector<std::int32_t>& sizes = parameter_block_sizes();
+    for (std::size_t b = 0; b < sizes.size(); ++b) {
+      for (std::int32_t i = 0; i < sizes[b]; ++i) {
+        std::vector<double> block(parameters[b], parameters[b] + sizes[b]);
+        const double delta = std::max(std::sqrt(std::numeric_limits<double>::epsilon()), std::abs(block[static_cast<std::size_t>(i)]) * kStep);
+        block[static_cast<std::size_t>(i)] += delta;
+        std::vector<const double*> moved(parameters, parameters + sizes.size());
+        moved[b] = block.data();
+        models.push_back(at(moved.data()).model(fitter_.context_));
+        inverse_step.push_back(1.0 / delta);
+      }
+    }
+  }
+
   /// The set at Ceres' parameters.
   EffectSet at(double const* const* parameters) const {
     EffectSet set = start_;

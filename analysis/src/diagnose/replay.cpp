@@ -24,6 +24,7 @@ struct Shared {
 /// Whether two models are the same bit for bit, field by field (ModelExtensions and the machine hold doubles
 /// only): their replays then are too.
 bool same_bits(const ExtendedModel& a, const ExtendedModel& b) noexcept {
+  // NOLINTNEXTLINE(bugprone-suspicious-memory-comparison): bit for bit is the intent (a -0.0 or a NaN payload may replay differently)
   const auto bytes = [](const auto& x, const auto& y) { return std::memcmp(&x, &y, sizeof x) == 0; };
   const auto law = [&](const std::optional<core::DriftLaw>& x, const std::optional<core::DriftLaw>& y) {
     return x.has_value() == y.has_value() && (!x || bytes(*x, *y));
@@ -150,12 +151,8 @@ void ModelReplay::for_blocks(const std::vector<int>& blocks, const std::function
   });
 }
 
-void ModelReplay::replay_block(int b, std::span<const ExtendedModel> models, const Visit& visit) const {
-  const std::size_t first = log_.block_first[static_cast<std::size_t>(b)], end = log_.block_first[static_cast<std::size_t>(b) + 1];
-  // A model the same as an earlier one bit for bit (a screening's candidate at a start that leaves the model as
-  // it is: the round's model) steps no chain of its own: it is given that one's samples.
+std::vector<std::size_t> ModelReplay::distinct_chains(std::span<const ExtendedModel> models, std::vector<Chain>& chains) const {
   std::vector<std::size_t> chain_of(models.size());
-  std::vector<Chain> chains;
   chains.reserve(models.size());
   for (std::size_t j = 0; j < models.size(); ++j) {
     chain_of[j] = chains.size();
@@ -167,6 +164,29 @@ void ModelReplay::replay_block(int b, std::span<const ExtendedModel> models, con
     }
     if (chain_of[j] == chains.size()) chains.emplace_back(*this, models[j]);
   }
+  return chain_of;
+}
+
+std::vector<std::size_t> ModelReplay::shared_conditioners(const std::vector<Chain>& chains) {
+  std::vector<std::size_t> conditioned_by(chains.size());
+  for (std::size_t j = 0; j < chains.size(); ++j) {
+    conditioned_by[j] = j;
+    for (std::size_t i = 0; i < j; ++i) {
+      if (conditioned_by[i] == i && chains[i].conditions_like(chains[j])) {
+        conditioned_by[j] = i;
+        break;
+      }
+    }
+  }
+  return conditioned_by;
+}
+
+void ModelReplay::replay_block(int b, std::span<const ExtendedModel> models, const Visit& visit) const {
+  const std::size_t first = log_.block_first[static_cast<std::size_t>(b)], end = log_.block_first[static_cast<std::size_t>(b) + 1];
+  // A model the same as an earlier one bit for bit (a screening's candidate at a start that leaves the model as
+  // it is: the round's model) steps no chain of its own: it is given that one's samples.
+  std::vector<Chain> chains;
+  const std::vector<std::size_t> chain_of = distinct_chains(models, chains);
   const bool repeated = chains.size() < models.size();
   std::vector<ModelSample> out(chains.size()), all(repeated ? models.size() : 0);
   const auto visit_all = [&](std::size_t k) {
@@ -177,16 +197,7 @@ void ModelReplay::replay_block(int b, std::span<const ExtendedModel> models, con
   Shared x;
   if (log_.mode == ModelMode::kTransient) {
     // The models that condition alike share one conditioner's samples: the first of each kind conditions.
-    std::vector<std::size_t> conditioned_by(chains.size());
-    for (std::size_t j = 0; j < chains.size(); ++j) {
-      conditioned_by[j] = j;
-      for (std::size_t i = 0; i < j; ++i) {
-        if (conditioned_by[i] == i && chains[i].conditions_like(chains[j])) {
-          conditioned_by[j] = i;
-          break;
-        }
-      }
-    }
+    const std::vector<std::size_t> conditioned_by = shared_conditioners(chains);
     std::vector<core::EstimatorSample> conditioned(chains.size());
     for (std::size_t k = first >= kWarmup ? first - kWarmup : 0; k < end; ++k) {
       x.s = log_.replay_sample(k);

@@ -149,9 +149,9 @@ class EffectFitter {
   /// residuals[j] model j's (a miss of 1 kA per axis where a model predicts nothing finite), scaled by the loss.
   template <class Acc, class Add>
   std::vector<Acc> over_training(const std::vector<ExtendedModel>& models, const Acc& init, const Add& add) const;
-  /// The same with each block's own start (`inits`, one per training block, in order).
+  /// The same with each block's own start (`out`, one per training block, in order, added to and returned).
   template <class Acc, class Add>
-  std::vector<Acc> over_training_from(const std::vector<ExtendedModel>& models, std::vector<Acc> inits, const Add& add) const;
+  std::vector<Acc> over_training_from(const std::vector<ExtendedModel>& models, std::vector<Acc> out, const Add& add) const;
 
   const ModelReplay& replay_;
   EffectContext context_;

@@ -76,6 +76,13 @@ class ModelReplay {
 
  private:
   class Chain;
+  /// One chain per distinct model (a model the same as an earlier one bit for bit steps none of its own):
+  /// appends them to `chains` and returns each model's chain.
+  std::vector<std::size_t> distinct_chains(std::span<const ExtendedModel> models, std::vector<Chain>& chains) const;
+  /// Per chain, the chain whose conditioner's samples it takes: the first that conditions alike (itself if
+  /// none before it does).
+  static std::vector<std::size_t> shared_conditioners(const std::vector<Chain>& chains);
+
   const LogData& log_;
   core::PerUnitBase base_;
   double max_interval_s_;
