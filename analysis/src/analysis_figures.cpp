@@ -72,13 +72,15 @@ std::string write_eigen_trajectories(const std::string& dir, const core::Machine
   fig.add_data(std::move(cont));
   fig.add_data(std::move(disc));
   fig.add_line("set multiplot layout 1,2 title 'Fig_EigenTraj: predictor eigenvalues, 0 ≤ n ≤ 2 pu' noenhanced");
-  fig.add_line("set grid; set title '(a) continuous: λ_{1,2} (colour: n [pu])'; set xlabel 'Re λ [1/s]'; set ylabel 'Im λ [rad/s]'");
+  fig.add_line(
+      "set grid; set title '(a) continuous: λ_{1,2} (colour: n [pu])'; set xlabel 'Re λ [1/s]'; set ylabel 'Im λ [rad/s]'");
   fig.add_line("set palette defined (0 '#313695', 1 '#f46d43'); set cblabel 'n [pu]'");
   fig.add_line("plot $cont u 2:3:1 w l lw 3 lc palette notitle, '' u 2:4:1 w l lw 3 lc palette notitle");
   fig.add_line("set title " + gp_quote("(b) discrete, T_{samp} = " + std::to_string(sample_period_s * 1e6).substr(0, 5) +
                                        " µs: spectral radius of the one-step map"));
   fig.add_line("set xlabel 'n [pu]'; set ylabel 'max |z|'; set key top left; unset colorbox");
-  fig.add_line("plot $disc u 1:2 w l lw 2 t 'trapezoidal', '' u 1:3 w l lw 2 t 'explicit Euler', 1 w l dt 2 lc 'black' t '|z| = 1'");
+  fig.add_line(
+      "plot $disc u 1:2 w l lw 2 t 'trapezoidal', '' u 1:3 w l lw 2 t 'explicit Euler', 1 w l dt 2 lc 'black' t '|z| = 1'");
   fig.add_line("unset multiplot");
   fig.render();
   return dir + "/Fig_EigenTraj.png";
@@ -114,7 +116,9 @@ std::string write_sensitivity(const std::string& dir, const core::MachinePu& m) 
 std::string write_prediction_gradients(const std::string& dir, const core::MachinePu& m) {
   GnuplotFigure fig(dir + "/fig_PEG_analytical.png", 1100, 1000);
   auto grad = [&](int row, int col) {
-    return [&, row, col](double n, double tau) { return core::steady_state_gradients(m, n, core::mtpa_reference(m, tau))(row, col); };
+    return [&, row, col](double n, double tau) {
+      return core::steady_state_gradients(m, n, core::mtpa_reference(m, tau))(row, col);
+    };
   };
   fig.add_data(map_block("gpd", grad(0, core::kPsiM)));
   fig.add_data(map_block("gpq", grad(1, core::kPsiM)));

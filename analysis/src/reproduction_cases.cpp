@@ -53,8 +53,8 @@ sim::Scenario bench(double n_pu, double load_pu, double duration_s) {
   return s;
 }
 
-ReproductionCase make(std::string id, std::string figure, std::string description, core::Param p, CaseKind kind,
-                      double n, double tau, double step_s, sim::Scenario s) {
+ReproductionCase make(std::string id, std::string figure, std::string description, core::Param p, CaseKind kind, double n,
+                      double tau, double step_s, sim::Scenario s) {
   ReproductionCase c;
   c.id = std::move(id);
   c.figure = std::move(figure);
@@ -66,7 +66,8 @@ ReproductionCase make(std::string id, std::string figure, std::string descriptio
   c.step_time_s = step_s;
   c.scenario = std::move(s);
   c.estimator = c.scenario.machine.estimator;
-  c.estimator.regimes.enabled = false;  // the paper's estimator as it states it: no sample classified or skipped (regime.hpp)
+  c.estimator.regimes.enabled =
+      false;  // the paper's estimator as it states it: no sample classified or skipped (regime.hpp)
   return c;
 }
 
@@ -106,11 +107,11 @@ struct ErtsPanel {
 /// Section V, fig_psim_adapt: −8 % step of ψm at t = 2 s (the Hessians have settled by then).
 void add_erts_psim_steps(std::vector<ReproductionCase>& cases) {
   const std::string words = "SGA and PhyInt stable and noise-free; GNA converges but over-excited at low load ((a), (b))";
-  for (const ErtsPanel op : {ErtsPanel{"a", -0.2, 0.0}, ErtsPanel{"b", -0.4, 0.2}, ErtsPanel{"c", 0.4, 0.2},
-                             ErtsPanel{"d", 0.8, 0.4}}) {
-    auto c = make(std::string("V_psim_") + op.panel, std::string("fig_psim_adapt (") + op.panel + ")",
-                  "ERTS, -8 % step of psi_m", core::Param::kPsiM, CaseKind::kParameterStep, op.n, op.tau, 2.0,
-                  erts(op.n, op.tau, 8.0));
+  for (const ErtsPanel op :
+       {ErtsPanel{"a", -0.2, 0.0}, ErtsPanel{"b", -0.4, 0.2}, ErtsPanel{"c", 0.4, 0.2}, ErtsPanel{"d", 0.8, 0.4}}) {
+    auto c =
+        make(std::string("V_psim_") + op.panel, std::string("fig_psim_adapt (") + op.panel + ")", "ERTS, -8 % step of psi_m",
+             core::Param::kPsiM, CaseKind::kParameterStep, op.n, op.tau, 2.0, erts(op.n, op.tau, 8.0));
     step_parameter(c, 2.0, 0.92);
     c.paper.qualitative = words;
     cases.push_back(std::move(c));
@@ -124,18 +125,18 @@ void add_erts_psim_steps(std::vector<ReproductionCase>& cases) {
 void add_erts_rs_steps(std::vector<ReproductionCase>& cases) {
   const auto rs = core::Param::kRs;
   const std::string words = "GNA needs ~10x smaller gain and is slower; PhyInt noise-free but significantly slower than SGA";
-  for (const ErtsPanel op : {ErtsPanel{"a", -0.05, 0.2}, ErtsPanel{"b", 0.0, 0.2}, ErtsPanel{"c", 0.0, 0.6},
-                             ErtsPanel{"d", 0.05, 0.6}}) {
-    auto c = make(std::string("V_rs_") + op.panel, std::string("fig_rs_adapt (") + op.panel + ")",
-                  "ERTS, -8 % step of R_s", rs, CaseKind::kParameterStep, op.n, op.tau, 4.0, erts(op.n, op.tau, 44.0));
+  for (const ErtsPanel op :
+       {ErtsPanel{"a", -0.05, 0.2}, ErtsPanel{"b", 0.0, 0.2}, ErtsPanel{"c", 0.0, 0.6}, ErtsPanel{"d", 0.05, 0.6}}) {
+    auto c = make(std::string("V_rs_") + op.panel, std::string("fig_rs_adapt (") + op.panel + ")", "ERTS, -8 % step of R_s",
+                  rs, CaseKind::kParameterStep, op.n, op.tau, 4.0, erts(op.n, op.tau, 44.0));
     step_parameter(c, 4.0, 0.92);
     c.estimator.r_s_max_speed_rpm = 60.0;
     c.paper.qualitative = words;
     cases.push_back(std::move(c));
   }
   auto c = make("V_rs_a_gna_on_sga_gains", "fig_rs_adapt (a), GNA with SGA's gains",
-                "ERTS, -8 % step of R_s; GNA given SGA's gain sequences", rs, CaseKind::kParameterStep, -0.05, 0.2,
-                4.0, erts(-0.05, 0.2, 20.0));
+                "ERTS, -8 % step of R_s; GNA given SGA's gain sequences", rs, CaseKind::kParameterStep, -0.05, 0.2, 4.0,
+                erts(-0.05, 0.2, 20.0));
   step_parameter(c, 4.0, 0.92);
   c.estimator.r_s_max_speed_rpm = 60.0;
   c.estimator.gains[static_cast<int>(core::Algorithm::kGna)] = c.estimator.gains[static_cast<int>(core::Algorithm::kSga)];
@@ -155,14 +156,13 @@ void add_bench_psim_starts(std::vector<ReproductionCase>& cases) {
     const char* description;
     const char* words;
   };
-  for (const PsimStart p : {PsimStart{"a", 0.0, 2.0, 0.5, -0.5, 0.5, "bench, no load, 0.3 pu",
-                                      "GNA slightly quicker with a 6 % overshoot"},
-                            PsimStart{"b", 0.4, 1.5, 1.5, 0.0, 0.0, "bench, 0.4 pu load, 0.3 pu", "nearly identical adaptation"}}) {
+  for (const PsimStart p :
+       {PsimStart{"a", 0.0, 2.0, 0.5, -0.5, 0.5, "bench, no load, 0.3 pu", "GNA slightly quicker with a 6 % overshoot"},
+        PsimStart{"b", 0.4, 1.5, 1.5, 0.0, 0.0, "bench, 0.4 pu load, 0.3 pu", "nearly identical adaptation"}}) {
     for (const bool small_r0 : {false, true}) {
       auto c = make(std::string("VI_psim_") + p.panel + (small_r0 ? "_sga_r0_1" : ""),
-                    std::string("Fig_lab_psim (") + p.panel + ")" + (small_r0 ? ", SGA from r[0] = 1" : ""),
-                    p.description, core::Param::kPsiM, CaseKind::kStartWithError, 0.3, p.load_pu, 1.0,
-                    bench(0.3, p.load_pu, 7.0));
+                    std::string("Fig_lab_psim (") + p.panel + ")" + (small_r0 ? ", SGA from r[0] = 1" : ""), p.description,
+                    core::Param::kPsiM, CaseKind::kStartWithError, 0.3, p.load_pu, 1.0, bench(0.3, p.load_pu, 7.0));
       c.scenario.signal(sim::Quantity::kPsiM) = sim::Signal(0.92 * 1.14);
       c.paper = figures(p.paper_sga_s, p.paper_gna_s, p.paper_sga_e, p.paper_gna_e, p.words);
       if (small_r0) {
@@ -187,8 +187,8 @@ void add_bench_psim_disturbances(std::vector<ReproductionCase>& cases) {
                       "psi_m remains stable (SGA); GNA oscillates while the speed is unsettled, then converges");
     cases.push_back(std::move(c));
   }
-  auto c = make("VI_psim_d", "Fig_lab_psim (d)", "bench, load step -0.4 -> +0.4 pu at 0.3 pu", psi,
-                CaseKind::kDisturbance, 0.3, -0.4, 2.0, bench(0.3, -0.4, 8.0));
+  auto c = make("VI_psim_d", "Fig_lab_psim (d)", "bench, load step -0.4 -> +0.4 pu at 0.3 pu", psi, CaseKind::kDisturbance,
+                0.3, -0.4, 2.0, bench(0.3, -0.4, 8.0));
   c.scenario.signal(sim::Quantity::kTorque).add({2.0, sim::EventKind::kStep, 0.4 * kRatedTorqueNm, 0.0});
   c.paper = figures(std::nullopt, std::nullopt, std::nullopt, std::nullopt,
                     "SGA stable through the sign change of i_q; GNA oscillates while the speed is unsettled");
@@ -235,8 +235,8 @@ void add_bench_rs_disturbances(std::vector<ReproductionCase>& cases) {
                       "steady states indistinguishable; SGA more stable through the transient");
     cases.push_back(std::move(c));
   }
-  auto c = make("VI_rs_d", "Fig_Labrs (d)", "bench, load step 0.4 -> 0.6 pu at standstill", rs,
-                CaseKind::kDisturbance, 0.0, 0.4, 3.0, bench(0.0, 0.4, 10.0));
+  auto c = make("VI_rs_d", "Fig_Labrs (d)", "bench, load step 0.4 -> 0.6 pu at standstill", rs, CaseKind::kDisturbance, 0.0,
+                0.4, 3.0, bench(0.0, 0.4, 10.0));
   c.scenario.signal(sim::Quantity::kTorque).add({3.0, sim::EventKind::kStep, 0.6 * kRatedTorqueNm, 0.0});
   c.paper = figures(std::nullopt, std::nullopt, std::nullopt, std::nullopt,
                     "SGA yields more stable tracking during the load (and speed) transient");
@@ -278,9 +278,12 @@ StandstillRs standstill_rs_model(const ReproductionCase& c, core::Algorithm a) {
 
 const char* to_string(CaseRole r) noexcept {
   switch (r) {
-    case CaseRole::kPaper: return "paper";
-    case CaseRole::kHypothesis: return "hypothesis";
-    case CaseRole::kStudy: return "study";
+    case CaseRole::kPaper:
+      return "paper";
+    case CaseRole::kHypothesis:
+      return "hypothesis";
+    case CaseRole::kStudy:
+      return "study";
   }
   return "?";
 }

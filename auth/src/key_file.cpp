@@ -60,7 +60,8 @@ Key parse_key(const std::string& text, const std::string& where) {
   try {
     std::size_t used = 0;
     const long long value = std::stoll(id_text, &used);
-    if (used != id_text.size() || value <= 0 || value > std::numeric_limits<std::int32_t>::max()) throw std::out_of_range("");
+    if (used != id_text.size() || value <= 0 || value > std::numeric_limits<std::int32_t>::max())
+      throw std::out_of_range("");
     id = static_cast<std::int32_t>(value);
   } catch (const std::exception&) {
     throw fail("key id `" + id_text + "` is not a whole number in 1..2147483647");
@@ -98,7 +99,8 @@ Key load_key_file(const std::string& path) {
   } else if ((st.st_mode & 077) != 0) {
     char mode[8];
     std::snprintf(mode, sizeof mode, "%04o", static_cast<unsigned>(st.st_mode & 07777));
-    problem = std::string("mode ") + mode + " lets its group or others at it; a key file must be the owner's alone (chmod 600)";
+    problem =
+        std::string("mode ") + mode + " lets its group or others at it; a key file must be the owner's alone (chmod 600)";
   } else if (st.st_size > static_cast<off_t>(kMaxFileBytes)) {
     problem = "larger than a key file can be";
   } else {

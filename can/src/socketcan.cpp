@@ -157,7 +157,8 @@ std::size_t SocketCanChannel::receive_for(std::span<ReceivedFrame> out, std::int
   timeout_ns = std::max<std::int64_t>(timeout_ns, 0);
   if (fd_ < 0) {
     if (core::now_ns(CLOCK_MONOTONIC) < next_open_attempt_ns_ || !open()) {
-      const std::int64_t pause_ns = std::min<std::int64_t>(timeout_ns, std::int64_t{options_.reopen_interval_ms} * 1'000'000);
+      const std::int64_t pause_ns =
+          std::min<std::int64_t>(timeout_ns, std::int64_t{options_.reopen_interval_ms} * 1'000'000);
       timespec pause{static_cast<time_t>(pause_ns / 1'000'000'000), static_cast<long>(pause_ns % 1'000'000'000)};
       nanosleep(&pause, nullptr);
       return 0;

@@ -15,7 +15,7 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr double kSigmaPerMedian = 1.4826022185056018;
 /// The median tracker's step in log scale, η = 1/16: it moves by e^{±η} a sample, so the median of a
 /// normal |r| settles within ≈ 13 % (σ of log m ≈ √(0.29·η), §13) and follows a change of 10× in 37 samples.
-constexpr double kTrackUp = 1.0644944589178593;    // e^{1/16}
+constexpr double kTrackUp = 1.0644944589178593;     // e^{1/16}
 constexpr double kTrackDown = 0.93941306281347581;  // e^{−1/16}
 
 /// One step of the median tracker m of |r|: up by e^η when |r| > m, down by e^{−η} otherwise; it settles
@@ -41,11 +41,10 @@ bool learn(RegimeState& s, const RegimeInput& in, double t_s) noexcept {
   bool resolution_changed = false;
   if (s.points >= 1) {
     const Vec2 du = (in.u_pu - s.u_pu[0]).cwiseAbs(), di = (in.i_pu - s.i_pu[0]).cwiseAbs();
-    resolution_changed = track_resolution(s.measured_resolution_pu[0], du[0]) |
-                         track_resolution(s.measured_resolution_pu[0], du[1]) |
-                         track_resolution(s.measured_resolution_pu[1], di[0]) |
-                         track_resolution(s.measured_resolution_pu[1], di[1]) |
-                         track_resolution(s.measured_resolution_pu[2], in.n_pu - s.n_pu[0]);
+    resolution_changed =
+        track_resolution(s.measured_resolution_pu[0], du[0]) | track_resolution(s.measured_resolution_pu[0], du[1]) |
+        track_resolution(s.measured_resolution_pu[1], di[0]) | track_resolution(s.measured_resolution_pu[1], di[1]) |
+        track_resolution(s.measured_resolution_pu[2], in.n_pu - s.n_pu[0]);
   }
   // Only a chain's samples are close enough for their second difference to be noise: a standalone
   // sample's neighbours are other operating points.
@@ -246,15 +245,15 @@ std::uint8_t RegimeClassifier::lock_bits(const RegimeInput& in) const noexcept {
   const Vec2 abs_sl = sl.cwiseAbs();
   const Vec2 rotation = (n * k.x_swapped).cwiseProduct(i.reverse()).cwiseProduct(Vec2(1.0, -1.0));  // −n·J·x·i
   const Vec2 e = ((in.u_pu - c.r_pu * i) - k.x_over_omega_n.cwiseProduct(sl)) + rotation;
-  const Vec2 b = (c.dr_pu * abs_i + (abs_n * k.dx_swapped).cwiseProduct(abs_i.reverse())) +
-                 k.dx_over_omega_n.cwiseProduct(abs_sl);
+  const Vec2 b =
+      (c.dr_pu * abs_i + (abs_n * k.dx_swapped).cwiseProduct(abs_i.reverse())) + k.dx_over_omega_n.cwiseProduct(abs_sl);
   // The speed's sign where it stands out of its noise; else either direction of q.
   const double along = n2 > k.z_sq * v.n_sq ? (n > 0.0 ? e[1] : -e[1]) : std::abs(e[1]);
   const double lock = std::abs(e[0]) - c.tan_angle * (along + b[1]) - b[0];
   if (lock > 0.0) [[unlikely]] {
     const double slope_sq = 2.0 * s.inv_dt * s.inv_dt;  // Var(s) per σ_i²
-    const double var_d = v.u_sq + (k.r_sq + n2_xq2 + k.slope_var_x_sq[0] * slope_sq) * v.i_sq +
-                         c.x_q_pu * c.x_q_pu * i[1] * i[1] * v.n_sq;
+    const double var_d =
+        v.u_sq + (k.r_sq + n2_xq2 + k.slope_var_x_sq[0] * slope_sq) * v.i_sq + c.x_q_pu * c.x_q_pu * i[1] * i[1] * v.n_sq;
     const double flux_q = c.psi_max_pu + c.x_d_pu * abs_i[0];
     const double var_q = v.u_sq + (k.r_sq + n2_xd2 + k.slope_var_x_sq[1] * slope_sq) * v.i_sq + flux_q * flux_q * v.n_sq;
     if (lock * lock > k.z_sq * (var_d + c.tan_angle * c.tan_angle * var_q)) return regime_bit::kNotLocked;
@@ -283,8 +282,8 @@ Classification RegimeClassifier::step(const RegimeInput& in) noexcept {
   s.previous_slope_pu_s = s.slope_pu_s;
   s.previous_slope_valid = s.slope_valid;
   s.previous_inv_dt = s.inv_dt;
-  const bool linked = s.points >= 1 && dt_s > 0.0 &&
-                      (in.timing == SampleTiming::kDense || in.timing == SampleTiming::kContiguous);
+  const bool linked =
+      s.points >= 1 && dt_s > 0.0 && (in.timing == SampleTiming::kDense || in.timing == SampleTiming::kContiguous);
   s.inv_dt = linked ? 1.0 / dt_s : 0.0;
   s.slope_valid = linked;
   if (!linked) {
@@ -334,7 +333,8 @@ Classification RegimeClassifier::step(const RegimeInput& in) noexcept {
   }
   s.previous_window = window;
   s.previous_bridge_off = off;
-  if (learn(s, in, t_s)) [[unlikely]] update_quantisation();
+  if (learn(s, in, t_s)) [[unlikely]]
+    update_quantisation();
   return Classification::of(bits);
 }
 

@@ -30,12 +30,14 @@ LoopEstimator::Estimators LoopEstimator::make(SampleKind kind, const core::Machi
   return Estimators(std::in_place_index<0>, machine, settings);
 }
 
-LoopEstimator::LoopEstimator(SampleKind kind, const core::MachineSi& machine, const core::EstimatorSettings& settings) noexcept
+LoopEstimator::LoopEstimator(SampleKind kind, const core::MachineSi& machine,
+                             const core::EstimatorSettings& settings) noexcept
     : estimator_(make(kind, machine, settings)),
       nominal_period_s_(settings.nominal_sample_period_s),
       max_interval_s_(settings.averaged.max_interval_s) {}
 
-bool LoopEstimator::step(const SourceSample& sample, core::Estimate& estimate, double& dt_s, SampleSummary& summary) noexcept {
+bool LoopEstimator::step(const SourceSample& sample, core::Estimate& estimate, double& dt_s,
+                         SampleSummary& summary) noexcept {
   if (sample.index() != estimator_.index()) return false;
   if (auto* phase = std::get_if<core::DriveEstimator>(&estimator_)) {
     const core::DriveSample& s = *std::get_if<core::DriveSample>(&sample);
@@ -54,7 +56,8 @@ bool LoopEstimator::step(const SourceSample& sample, core::Estimate& estimate, d
   estimate = averaged.step(a);
   const double interval_s = previous_t_ns ? core::to_seconds(a.t_ns - *previous_t_ns) : 0.0;
   dt_s = a.t_start_ns < a.t_ns ? std::max(interval_s, 0.0) : std::clamp(interval_s, 0.0, max_interval_s_);
-  summary = {a.t_ns, a.t_ns, std::numeric_limits<double>::quiet_NaN(), a.omega_el_rad_s, a.u_dc_V, a.t_winding_C, a.t_drive_C};
+  summary = {a.t_ns,        a.t_ns,     std::numeric_limits<double>::quiet_NaN(), a.omega_el_rad_s, a.u_dc_V,
+             a.t_winding_C, a.t_drive_C};
   return true;
 }
 
@@ -82,7 +85,8 @@ double LoopEstimator::r_s_Ohm() const noexcept {
   return visit_estimator(estimator_, [](const core::SampleEstimator auto& e) { return e.r_s_Ohm(); });
 }
 const core::RpemEstimator& LoopEstimator::core() const noexcept {
-  return visit_estimator(estimator_, [](const core::SampleEstimator auto& e) -> const core::RpemEstimator& { return e.core(); });
+  return visit_estimator(estimator_,
+                         [](const core::SampleEstimator auto& e) -> const core::RpemEstimator& { return e.core(); });
 }
 
 }  // namespace rpem::daemon

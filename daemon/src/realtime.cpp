@@ -1,8 +1,8 @@
 #include "rpem/daemon/realtime.hpp"
 
+#include <fcntl.h>
 #include <pthread.h>
 #include <sched.h>
-#include <fcntl.h>
 #include <sys/mman.h>
 #include <unistd.h>
 
@@ -36,7 +36,8 @@ std::string apply_thread_policy(const ThreadPolicy& p) {
 
 std::string lock_memory() {
   if (mlockall(MCL_CURRENT | MCL_FUTURE) != 0) {
-    return std::string("mlockall: ") + core::errno_text(errno) + (errno == ENOMEM || errno == EPERM ? " (needs LimitMEMLOCK)" : "");
+    return std::string("mlockall: ") + core::errno_text(errno) +
+           (errno == ENOMEM || errno == EPERM ? " (needs LimitMEMLOCK)" : "");
   }
   return "";
 }

@@ -70,8 +70,8 @@ std::string command_sequence_file(const std::string& state_file) {
 }
 
 std::string write_command_sequence(const std::string& path, std::int64_t last_accepted_seq) {
-  return write_atomically(path, "{\"format\": \"rpemd-commands-1\", \"last_accepted_seq\": " +
-                                    std::to_string(last_accepted_seq) + "}\n");
+  return write_atomically(
+      path, "{\"format\": \"rpemd-commands-1\", \"last_accepted_seq\": " + std::to_string(last_accepted_seq) + "}\n");
 }
 
 std::int64_t load_command_sequence(const std::string& path) {
@@ -84,10 +84,12 @@ std::int64_t load_command_sequence(const std::string& path) {
   text << in.rdbuf();
   try {
     const nlohmann::json j = nlohmann::json::parse(text.str());
-    if (!j.is_object() || j.value("format", "") != "rpemd-commands-1") throw std::runtime_error("not an rpemd commands file");
+    if (!j.is_object() || j.value("format", "") != "rpemd-commands-1")
+      throw std::runtime_error("not an rpemd commands file");
     return j.at("last_accepted_seq").get<std::int64_t>();
   } catch (const std::exception& e) {
-    throw std::runtime_error(path + ": corrupt (" + e.what() + "); it holds the last accepted command's sequence number, "
+    throw std::runtime_error(path + ": corrupt (" + e.what() +
+                             "); it holds the last accepted command's sequence number, "
                              "which replay protection needs: restore it, or remove it to start again from 0");
   }
 }

@@ -33,8 +33,8 @@ std::vector<core::AveragedSample> read_averaged_log(const std::string& path, Ave
   return samples;
 }
 
-std::vector<core::AveragedSample> read_averaged_log(const std::string& path, const LogMap& map,
-                                                    const DriveLogLimits& limits, AveragedLogRead* read_out) {
+std::vector<core::AveragedSample> read_averaged_log(const std::string& path, const LogMap& map, const DriveLogLimits& limits,
+                                                    AveragedLogRead* read_out) {
   if (!map.averaged()) {
     throw ConfigError(map.name, 0, 0, "samples", "a map of instantaneous samples does not give averaged samples");
   }

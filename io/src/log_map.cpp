@@ -101,9 +101,10 @@ MappedColumn identity(Quantity q) {
 /// the unit is mechanical.
 bool apply_unit(YamlMap& m, MappedColumn& c, QuantityKind kind, long pole_pairs) {
   c.unit = m.text_or("unit", si_unit(kind));
-  const auto it = std::find_if(kUnits.begin(), kUnits.end(),
-                               [&](const Unit& u) { return u.kind == kind && c.unit == u.name; });
-  if (it == kUnits.end()) m.fail("unit", "'" + c.unit + "' is not a unit of this quantity (one of " + unit_names(kind) + ")");
+  const auto it =
+      std::find_if(kUnits.begin(), kUnits.end(), [&](const Unit& u) { return u.kind == kind && c.unit == u.name; });
+  if (it == kUnits.end())
+    m.fail("unit", "'" + c.unit + "' is not a unit of this quantity (one of " + unit_names(kind) + ")");
   if (it->per_pole_pair && pole_pairs <= 0) {
     m.fail("unit", "'" + c.unit + "' is mechanical: the map needs pole_pairs to make it electrical");
   }
@@ -217,7 +218,8 @@ std::optional<LayoutProblem> drive_log_layout_problem(const QuantitySet& p) {
     if (n != 0 && n != groups[g].size) {
       for (std::size_t k = 0; k < groups[g].size; ++k) {
         if (!present(p, groups[g].members[k])) {
-          return LayoutProblem{info(groups[g].members[k]).name, std::string("incomplete ") + groups[g].what + " column group"};
+          return LayoutProblem{info(groups[g].members[k]).name,
+                               std::string("incomplete ") + groups[g].what + " column group"};
         }
       }
     }
@@ -229,8 +231,9 @@ std::optional<LayoutProblem> drive_log_layout_problem(const QuantitySet& p) {
   const bool rotor_frame_only = !has[0] && !has[2];
   for (Quantity q : {Quantity::kThetaEl, Quantity::kUDc}) {
     if (!present(p, q) && !rotor_frame_only) {
-      return LayoutProblem{info(q).name, "required (optional only when voltage and current are both given as u_d,u_q and "
-                                         "i_d,i_q only)"};
+      return LayoutProblem{info(q).name,
+                           "required (optional only when voltage and current are both given as u_d,u_q and "
+                           "i_d,i_q only)"};
     }
   }
   return std::nullopt;
@@ -243,8 +246,9 @@ std::optional<LayoutProblem> averaged_log_layout_problem(const QuantitySet& p) {
   for (Quantity q : {Quantity::kThetaEl, Quantity::kUA, Quantity::kUB, Quantity::kUC, Quantity::kIA, Quantity::kIB,
                      Quantity::kIC, Quantity::kTorqueCmd}) {
     if (present(p, q)) {
-      return LayoutProblem{info(q).name, "not a quantity of averaged samples (their means are rotor-frame: i_d, i_q, "
-                                         "u_d, u_q, omega_el, u_dc, T_winding, T_magnet, T_drive)"};
+      return LayoutProblem{info(q).name,
+                           "not a quantity of averaged samples (their means are rotor-frame: i_d, i_q, "
+                           "u_d, u_q, omega_el, u_dc, T_winding, T_magnet, T_drive)"};
     }
   }
   return std::nullopt;

@@ -237,8 +237,8 @@ void parse_phase_errors(YamlMap& x, core::ModelExtensions& c) {
 void parse_delay(YamlMap& d, double period_s, core::ModelExtensions& c) {
   c.delay_s = d.number("delay_s", 0.0, 1e-2);
   if (c.delay_s >= (core::kMaxDelayPeriods + 1) * period_s) {
-    d.fail("delay_s", "must be below " + std::to_string(core::kMaxDelayPeriods + 1) +
-                          " sample periods (estimator.sample_period_s)");
+    d.fail("delay_s",
+           "must be below " + std::to_string(core::kMaxDelayPeriods + 1) + " sample periods (estimator.sample_period_s)");
   }
   d.finish();
 }
@@ -336,8 +336,8 @@ DriveLogLimits machine_limits(const core::MachineSi& machine) {
     const double max_abs = kRatedMultipleLimit * base_value;
     if (!(max_abs < bound.max_abs)) return;
     char why[160];
-    std::snprintf(why, sizeof why, "%g x the configured machine's %s %.4g %s, machine.rated", kRatedMultipleLimit,
-                  what, base_value, unit);
+    std::snprintf(why, sizeof why, "%g x the configured machine's %s %.4g %s, machine.rated", kRatedMultipleLimit, what,
+                  base_value, unit);
     bound = {max_abs, why};
   };
   narrow(limits.current_A, base.current_A, "rated peak phase current", "A");

@@ -70,8 +70,10 @@ ThermalConfig default_thermal_config(const MachineConfig& machine) {
   m = machine.psim_drift.law.value_or(core::DriftLaw{core::kNdFeB.typical_per_K, core::kMaterialReference_C, 0.0});
   if (m.value_ref <= 0.0) m.value_ref = machine.machine.psi_m_Wb;
   core::CalibrationVec& sigma = c.fusion.filter.calibration_sigma;
-  sigma[static_cast<int>(core::Calibration::kMagnetCoefficient)] = coefficient_rel_sigma(core::kMagnetMaterials, m.coeff_per_K);
-  sigma[static_cast<int>(core::Calibration::kCopperCoefficient)] = coefficient_rel_sigma(core::kWindingMaterials, n.copper.coeff_per_K);
+  sigma[static_cast<int>(core::Calibration::kMagnetCoefficient)] =
+      coefficient_rel_sigma(core::kMagnetMaterials, m.coeff_per_K);
+  sigma[static_cast<int>(core::Calibration::kCopperCoefficient)] =
+      coefficient_rel_sigma(core::kWindingMaterials, n.copper.coeff_per_K);
   return c;
 }
 
@@ -83,8 +85,8 @@ void parse_nodes(YamlMap& t, ThermalConfig& c) {
   core::ThermalNetwork& n = f.filter.network;
   std::vector<YamlMap> nodes = t.maps("nodes");
   if (nodes.size() < 2 || nodes.size() > static_cast<std::size_t>(core::kMaxThermalNodes)) {
-    t.fail("nodes", "a network has 2 to " + std::to_string(core::kMaxThermalNodes) + " nodes, here " +
-                        std::to_string(nodes.size()));
+    t.fail("nodes",
+           "a network has 2 to " + std::to_string(core::kMaxThermalNodes) + " nodes, here " + std::to_string(nodes.size()));
   }
   n.nodes = static_cast<int>(nodes.size());
   n.winding = n.magnet = -1;
@@ -125,7 +127,8 @@ void parse_conductances(YamlMap& t, ThermalConfig& c) {
       if (a < 0) m.fail("from", "no node named '" + from + "'");
       if (b < 0) m.fail("to", "no node named '" + to + "'");
       if (a == b) m.fail("to", "a conductance joins two different nodes");
-      if (n.between_W_per_K(a, b) != 0.0) m.fail("to", std::string("the conductance ").append(from).append("–").append(to).append(" is given twice"));
+      if (n.between_W_per_K(a, b) != 0.0)
+        m.fail("to", std::string("the conductance ").append(from).append("–").append(to).append(" is given twice"));
       n.between_W_per_K(a, b) = n.between_W_per_K(b, a) = m.number("W_per_K", 1e-9, 1e6);
       m.finish();
     }
@@ -170,7 +173,8 @@ void parse_losses(YamlMap& t, ThermalConfig& c) {
       const std::string node = m.text("node");
       const int i = node_index(c, node);
       if (i < 0) m.fail("node", "no node named '" + node + "'");
-      if (n.loss_at_base_W(fi, i) != 0.0) m.fail("node", std::string("loss ").append(form).append(" at ").append(node).append(" is given twice"));
+      if (n.loss_at_base_W(fi, i) != 0.0)
+        m.fail("node", std::string("loss ").append(form).append(" at ").append(node).append(" is given twice"));
       n.loss_at_base_W(fi, i) = m.number("at_base_W", 0.0, 1e9);
       f.filter.loss_rel_sigma(fi, i) = m.number_or("rel_sigma", 0.5, 0.0, 10.0);
       m.finish();
@@ -206,8 +210,9 @@ ThermalConfig parse_thermal_config(YamlMap& section, const MachineConfig& machin
     b->finish();
   }
   if (auto m = section.optional_map("copper")) {
-    n.copper = parse_law(*m, "r_s_ref_Ohm", n.copper, 1e4, true, f.filter.calibration_sigma, core::Calibration::kCopperOffset,
-                         core::Calibration::kCopperCoefficient, &f.filter.copper_rel_sigma, &n.copper_scale);
+    n.copper =
+        parse_law(*m, "r_s_ref_Ohm", n.copper, 1e4, true, f.filter.calibration_sigma, core::Calibration::kCopperOffset,
+                  core::Calibration::kCopperCoefficient, &f.filter.copper_rel_sigma, &n.copper_scale);
   }
   if (auto m = section.optional_map("magnet_law")) {
     f.magnet_law = parse_law(*m, "psi_m_ref_Wb", f.magnet_law, 100.0, false, f.filter.calibration_sigma,
@@ -244,7 +249,8 @@ std::string thermal_config_yaml(const ThermalConfig& c) {
   std::ostringstream o;
   o << "thermal:\n  nodes:\n";
   for (int i = 0; i < n.nodes; ++i) {
-    o << "    - {name: " << c.node_names[static_cast<std::size_t>(i)] << ", capacitance_J_per_K: " << num(n.capacitance_J_per_K[i])
+    o << "    - {name: " << c.node_names[static_cast<std::size_t>(i)]
+      << ", capacitance_J_per_K: " << num(n.capacitance_J_per_K[i])
       << ", to_coolant_W_per_K: " << num(n.to_coolant_W_per_K[i])
       << ", process_noise_K2_per_s: " << num(f.filter.process_noise_K2_per_s[i])
       << ", disturbance_W2_per_s: " << num(f.filter.disturbance_W2_per_s[i]) << "}\n";
@@ -253,8 +259,8 @@ std::string thermal_config_yaml(const ThermalConfig& c) {
   for (int i = 0; i < n.nodes; ++i) {
     for (int j = i + 1; j < n.nodes; ++j) {
       if (n.between_W_per_K(i, j) <= 0.0) continue;
-      between += "    - {from: " + c.node_names[static_cast<std::size_t>(i)] + ", to: " + c.node_names[static_cast<std::size_t>(j)] +
-                 ", W_per_K: " + num(n.between_W_per_K(i, j)) + "}\n";
+      between += "    - {from: " + c.node_names[static_cast<std::size_t>(i)] +
+                 ", to: " + c.node_names[static_cast<std::size_t>(j)] + ", W_per_K: " + num(n.between_W_per_K(i, j)) + "}\n";
     }
   }
   if (!between.empty()) o << "  conductances:\n" << between;
@@ -264,7 +270,8 @@ std::string thermal_config_yaml(const ThermalConfig& c) {
       const double k = n.loss_at_base_W(static_cast<int>(row.form), i);
       if (k <= 0.0) continue;
       losses += "    - {form: " + std::string(row.name) + ", node: " + c.node_names[static_cast<std::size_t>(i)] +
-                ", at_base_W: " + num(k) + ", rel_sigma: " + num(f.filter.loss_rel_sigma(static_cast<int>(row.form), i)) + "}\n";
+                ", at_base_W: " + num(k) + ", rel_sigma: " + num(f.filter.loss_rel_sigma(static_cast<int>(row.form), i)) +
+                "}\n";
     }
   }
   if (!losses.empty()) o << "  losses:\n" << losses;

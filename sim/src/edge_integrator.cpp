@@ -101,8 +101,8 @@ void EdgeIntegrator::run(Flow& flow, PmsmPlant& plant, bool rising, const Duties
   if (events >= kMaxEvents) ++counters_.event_limit_hits;
 }
 
-int EdgeIntegrator::select_legs(const std::array<LegSchedule, 3>& schedule, const core::Vec3& i, double t_mid,
-                                double u_dc_V, Legs& legs) noexcept {
+int EdgeIntegrator::select_legs(const std::array<LegSchedule, 3>& schedule, const core::Vec3& i, double t_mid, double u_dc_V,
+                                Legs& legs) noexcept {
   int clamped = -1;
   for (int x = 0; x < 3; ++x) {
     const LegCommand c = command_at(schedule[x], t_mid);

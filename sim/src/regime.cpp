@@ -7,7 +7,8 @@ namespace rpem::sim {
 
 RegimeTimeline::RegimeTimeline(std::vector<RegimeEvent> events) : events_(std::move(events)) {
   for (std::size_t k = 1; k < events_.size(); ++k) {
-    if (!(events_[k].t_s > events_[k - 1].t_s)) throw std::invalid_argument("regime events must be in strictly increasing time");
+    if (!(events_[k].t_s > events_[k - 1].t_s))
+      throw std::invalid_argument("regime events must be in strictly increasing time");
   }
 }
 

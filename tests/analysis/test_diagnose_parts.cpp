@@ -5,8 +5,8 @@
 
 #include <array>
 #include <cmath>
-#include <cstring>
 #include <complex>
+#include <cstring>
 #include <numbers>
 #include <random>
 
@@ -88,8 +88,10 @@ TEST(ModelReplay, ModelsReplayedTogetherGiveEachItsOwnReplayBitForBit) {
   for (int block = 0; block < 2; ++block) {
     std::vector<ModelSample> alone_a, alone_b;
     std::vector<std::array<ModelSample, 3>> joint;
-    replay.replay_block(block, std::span(&a, 1), [&](std::size_t, std::span<const ModelSample> m) { alone_a.push_back(m[0]); });
-    replay.replay_block(block, std::span(&b, 1), [&](std::size_t, std::span<const ModelSample> m) { alone_b.push_back(m[0]); });
+    replay.replay_block(block, std::span(&a, 1),
+                        [&](std::size_t, std::span<const ModelSample> m) { alone_a.push_back(m[0]); });
+    replay.replay_block(block, std::span(&b, 1),
+                        [&](std::size_t, std::span<const ModelSample> m) { alone_b.push_back(m[0]); });
     replay.replay_block(block, together, [&](std::size_t, std::span<const ModelSample> m) {
       ASSERT_EQ(m.size(), 3u);
       joint.push_back({m[0], m[1], m[2]});
@@ -98,10 +100,13 @@ TEST(ModelReplay, ModelsReplayedTogetherGiveEachItsOwnReplayBitForBit) {
     ASSERT_GT(joint.size(), 100u);
     std::size_t differ = 0;  // a and b must differ somewhere, or the test shows nothing
     for (std::size_t k = 0; k < joint.size(); ++k) {
-      for (const auto& [m, alone] : {std::pair{joint[k][0], alone_a[k]}, std::pair{joint[k][1], alone_b[k]}, std::pair{joint[k][2], alone_a[k]}}) {
+      for (const auto& [m, alone] :
+           {std::pair{joint[k][0], alone_a[k]}, std::pair{joint[k][1], alone_b[k]}, std::pair{joint[k][2], alone_a[k]}}) {
         EXPECT_EQ(m.valid, alone.valid);
-        EXPECT_EQ(std::memcmp(m.residual_A.data(), alone.residual_A.data(), sizeof(double) * 2), 0) << "block " << block << " sample " << k;
-        EXPECT_EQ(std::memcmp(m.model_A.data(), alone.model_A.data(), sizeof(double) * 2), 0) << "block " << block << " sample " << k;
+        EXPECT_EQ(std::memcmp(m.residual_A.data(), alone.residual_A.data(), sizeof(double) * 2), 0)
+            << "block " << block << " sample " << k;
+        EXPECT_EQ(std::memcmp(m.model_A.data(), alone.model_A.data(), sizeof(double) * 2), 0)
+            << "block " << block << " sample " << k;
       }
       if (joint[k][0].model_A != joint[k][1].model_A) ++differ;
     }
@@ -207,7 +212,8 @@ TEST(Catalogue, EveryRowIsComplete) {
     for (const Confusion& c : r.confusions) EXPECT_NO_THROW((void)effect_row(c.other)) << r.name << " → " << c.other;
   }
   EXPECT_THROW((void)effect("cogging"), std::invalid_argument);
-  for (const char* name : {"flux_harmonic_6", "flux_harmonic_12", "cross_saturation", "delay"}) EXPECT_NO_THROW((void)effect(name));
+  for (const char* name : {"flux_harmonic_6", "flux_harmonic_12", "cross_saturation", "delay"})
+    EXPECT_NO_THROW((void)effect(name));
 }
 
 TEST(LogData, SteadyStateLeavesOutIdleAndTransitionalRowsAndBlocksAlternate) {
@@ -232,8 +238,8 @@ TEST(LogData, SteadyStateLeavesOutIdleAndTransitionalRowsAndBlocksAlternate) {
   EXPECT_FALSE(log.used(99));
   EXPECT_FALSE(log.used(100));
   EXPECT_EQ(log.blocks, 40);
-  EXPECT_TRUE(log.training(10));    // block 2
-  EXPECT_TRUE(log.heldout(15));     // block 3
+  EXPECT_TRUE(log.training(10));  // block 2
+  EXPECT_TRUE(log.heldout(15));   // block 3
   EXPECT_EQ(log.block(log.size() - 1), 39);
 }
 

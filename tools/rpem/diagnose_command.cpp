@@ -90,13 +90,16 @@ void print_summary(const analysis::Diagnosis& d) {
     }
   }
   std::printf("\n");
-  for (const std::string& f : analysis::calibrated_despite_mismatch(d)) std::printf("calibrated despite a large mismatch: %s\n", f.c_str());
+  for (const std::string& f : analysis::calibrated_despite_mismatch(d))
+    std::printf("calibrated despite a large mismatch: %s\n", f.c_str());
   for (const std::string& f : analysis::calibration_findings(d)) std::printf("calibration: %s\n", f.c_str());
   if (d.least_squares) {
-    std::printf("outliers: %zu of %zu training samples beyond %.3g A moved the least-squares fit (%s by %.2g times its 95 %% "
-                "half-width): diagnosed again under Huber's loss, b = %.3g A after %d run%s\n",
-                d.outliers.test.beyond, d.outliers.test.samples, d.outliers.test.threshold_A, d.outliers.parameter.c_str(),
-                d.outliers.largest_shift, d.outliers.loss.threshold_A, d.outliers.robust_runs, d.outliers.robust_runs == 1 ? "" : "s");
+    std::printf(
+        "outliers: %zu of %zu training samples beyond %.3g A moved the least-squares fit (%s by %.2g times its 95 %% "
+        "half-width): diagnosed again under Huber's loss, b = %.3g A after %d run%s\n",
+        d.outliers.test.beyond, d.outliers.test.samples, d.outliers.test.threshold_A, d.outliers.parameter.c_str(),
+        d.outliers.largest_shift, d.outliers.loss.threshold_A, d.outliers.robust_runs,
+        d.outliers.robust_runs == 1 ? "" : "s");
   }
   if (s.found.empty()) std::printf("effects: none\n");
   for (std::size_t j = 0; j < s.found.size(); ++j) {
@@ -109,7 +112,8 @@ void print_summary(const analysis::Diagnosis& d) {
       }
     }
     const analysis::EstimatorCheck* c = analysis::estimator_check(d, j);
-    std::printf(" (held-out gain %.1f %%%s)\n", s.found[j].gain_pct, c && !c->kept ? "; not in extended.yaml: the estimator predicts worse with it" : "");
+    std::printf(" (held-out gain %.1f %%%s)\n", s.found[j].gain_pct,
+                c && !c->kept ? "; not in extended.yaml: the estimator predicts worse with it" : "");
   }
   for (const analysis::ImplausibleEffect& i : s.implausible) {
     std::printf("implausible, not named: %s: %s\n", i.effect.label().c_str(), i.why.reason.c_str());
@@ -121,8 +125,8 @@ void print_summary(const analysis::Diagnosis& d) {
   }
   std::printf("extended model: held-out residual %.4g A RMS\n", s.extended_heldout_rms_A);
   if (d.verdict.ratio) {
-    std::printf("verdict: %s (%.3g times the noise floor of %.3g A)\n", analysis::to_string(d.verdict.kind), *d.verdict.ratio,
-                d.verdict.noise_floor_A.value_or(0.0));
+    std::printf("verdict: %s (%.3g times the noise floor of %.3g A)\n", analysis::to_string(d.verdict.kind),
+                *d.verdict.ratio, d.verdict.noise_floor_A.value_or(0.0));
   } else {
     std::printf("verdict: %s (noise floor unknown)\n", analysis::to_string(d.verdict.kind));
   }
@@ -159,10 +163,11 @@ int run_diagnose(const DiagnoseCliOptions& o) {
 int diagnose_and_write(const DiagnoseCliOptions& o, const io::MachineConfig& config, const std::string& config_text,
                        const std::string& config_name, const analysis::LogOptions& log_options, TerminalMonitor& monitor) {
   std::fprintf(stderr, "rpem diagnose: reading %s\n", o.log.c_str());
-  analysis::LogData log = analysis::load_log(o.log, config.machine, log_options, [&](std::uint64_t done, std::uint64_t total) {
-    monitor.reading(done, total);
-    if (monitor.stop_requested()) throw analysis::Interrupted();
-  });
+  analysis::LogData log =
+      analysis::load_log(o.log, config.machine, log_options, [&](std::uint64_t done, std::uint64_t total) {
+        monitor.reading(done, total);
+        if (monitor.stop_requested()) throw analysis::Interrupted();
+      });
   monitor.finish();
   std::fprintf(stderr, "rpem diagnose: read %s\n", log.format.c_str());
   io::check_log_supports(config, config_name, log.layout.u_dc, o.log);
@@ -218,7 +223,8 @@ Runner add_diagnose_command(CLI::App& app) {
       ->check(CLI::ExistingFile);
   cmd->add_option("--out", o->out, "directory for report.html, report.md, figures, diagnosis.json, extended.yaml")
       ->required();
-  cmd->add_option("--truth", o->truth, "true parameters (t, psi_m, r_s) to judge the estimates against, e.g. rpem sim --truth")
+  cmd->add_option("--truth", o->truth,
+                  "true parameters (t, psi_m, r_s) to judge the estimates against, e.g. rpem sim --truth")
       ->check(CLI::ExistingFile);
   cmd->add_option("--model", o->model, "replay model: auto (from the sample interval), transient, steady_state")
       ->check(CLI::IsMember({"auto", "transient", "steady_state"}));

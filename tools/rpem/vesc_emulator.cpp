@@ -1,14 +1,14 @@
 #include "vesc_emulator.hpp"
 
-#include <array>
+#include <unistd.h>
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <cmath>
 #include <csignal>
 #include <cstdio>
 #include <ctime>
 #include <optional>
-#include <unistd.h>
 
 #include <vector>
 
@@ -51,12 +51,16 @@ constexpr std::int64_t kSettleNs = 2'000'000;
 }  // namespace
 
 void add_vesc_emulator_options(CLI::App* cmd, VescEmulatorOptions& o) {
-  cmd->add_option("--vesc", o.interface, "answer as a VESC on this SocketCAN interface, the drive run on demand up to each poll (docs/can-vesc.md)");
+  cmd->add_option(
+      "--vesc", o.interface,
+      "answer as a VESC on this SocketCAN interface, the drive run on demand up to each poll (docs/can-vesc.md)");
   cmd->add_option("--controller-id", o.controller_id, "the emulated VESC's controller id")->check(CLI::Range(0, 254));
   cmd->add_option("--fet-temperature", o.temp_fet_C, "the emulated power stage's temperature [C]");
-  cmd->add_option("--status-rate-1", o.status_rate_1_Hz, "rate of status thread 1 [Hz], 0: off")->check(CLI::Range(0.0, 1000.0));
+  cmd->add_option("--status-rate-1", o.status_rate_1_Hz, "rate of status thread 1 [Hz], 0: off")
+      ->check(CLI::Range(0.0, 1000.0));
   cmd->add_option("--status-msgs-1", o.status_msgs_1, "statuses of thread 1, bit k = status k+1")->check(CLI::Range(0, 63));
-  cmd->add_option("--status-rate-2", o.status_rate_2_Hz, "rate of status thread 2 [Hz], 0: off")->check(CLI::Range(0.0, 1000.0));
+  cmd->add_option("--status-rate-2", o.status_rate_2_Hz, "rate of status thread 2 [Hz], 0: off")
+      ->check(CLI::Range(0.0, 1000.0));
   cmd->add_option("--status-msgs-2", o.status_msgs_2, "statuses of thread 2, bit k = status k+1")->check(CLI::Range(0, 63));
   cmd->add_option("--silent-at", o.silent_at_s, "test aid: go silent (no replies, no statuses) at this time [s]");
   cmd->add_option("--silent-for", o.silent_for_s, "test aid: …for this long [s] (SIGUSR1 toggles silence too)")
@@ -91,7 +95,9 @@ class VescEmulator {
  public:
   VescEmulator(sim::Scenario scenario, const VescEmulatorOptions& o, can::SocketCanChannel& channel,
                sim::TruthLogWriter* truth)
-      : o_(o), channel_(channel), id_(static_cast<std::uint8_t>(o.controller_id)),
+      : o_(o),
+        channel_(channel),
+        id_(static_cast<std::uint8_t>(o.controller_id)),
         drive_(std::move(scenario), drive_settings(o), truth),
         idle_step_ns_(static_cast<std::int64_t>(std::llround(o.idle_step_s * 1e9))) {}
 
@@ -207,12 +213,11 @@ void VescEmulator::report() const {
                "%llu frames, %llu unheard while silent, %llu unsupported, %llu reads with no control cycle since the "
                "previous, %llu polls read after the drive had passed them, %llu statuses, %llu frames the interface "
                "dropped\n",
-               o_.controller_id, core::to_seconds(drive_.time_ns()), lag_s,
-               static_cast<unsigned long long>(n_.requests), static_cast<unsigned long long>(n_.replies),
-               static_cast<unsigned long long>(n_.reply_frames), static_cast<unsigned long long>(n_.unheard),
-               static_cast<unsigned long long>(n_.unsupported), static_cast<unsigned long long>(d.empty_reads),
-               static_cast<unsigned long long>(d.behind), static_cast<unsigned long long>(d.statuses),
-               static_cast<unsigned long long>(n_.send_failures));
+               o_.controller_id, core::to_seconds(drive_.time_ns()), lag_s, static_cast<unsigned long long>(n_.requests),
+               static_cast<unsigned long long>(n_.replies), static_cast<unsigned long long>(n_.reply_frames),
+               static_cast<unsigned long long>(n_.unheard), static_cast<unsigned long long>(n_.unsupported),
+               static_cast<unsigned long long>(d.empty_reads), static_cast<unsigned long long>(d.behind),
+               static_cast<unsigned long long>(d.statuses), static_cast<unsigned long long>(n_.send_failures));
   std::fprintf(stderr, "rpem sim: VESC %d replies sent after their poll's arrival:", o_.controller_id);
   for (std::size_t k = 0; k < kDelayEdgesMs.size(); ++k) {
     std::fprintf(stderr, " <=%lld ms %llu,", static_cast<long long>(kDelayEdgesMs[k]),

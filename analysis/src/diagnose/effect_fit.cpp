@@ -87,16 +87,20 @@ class EffectFitter::FitCost final : public ceres::CostFunction {
     };
     std::vector<Block> inits;
     inits.reserve(base.size());
-    for (const TrainingResiduals& b : base) inits.push_back(Block{least_squares::TriangularFactor(p + 1), known ? &b.r : nullptr, 0});
-    std::vector<Block> factors = fitter_.over_training_from(models, std::move(inits), [&](Block& f, std::span<const core::Vec2> r) {
-      const core::Vec2 r0 = f.base ? (*f.base)[f.next++] : r[0];
-      double row[kMaxColumns];
-      for (int axis = 0; axis < 2; ++axis) {
-        for (int j = 0; j < p; ++j) row[j] = (r[static_cast<std::size_t>(j) + stepped][axis] - r0[axis]) * inverse_step[static_cast<std::size_t>(j)];
-        row[p] = r0[axis];
-        f.factor.add_row(row);
-      }
-    });
+    for (const TrainingResiduals& b : base)
+      inits.push_back(Block{least_squares::TriangularFactor(p + 1), known ? &b.r : nullptr, 0});
+    std::vector<Block> factors =
+        fitter_.over_training_from(models, std::move(inits), [&](Block& f, std::span<const core::Vec2> r) {
+          const core::Vec2 r0 = f.base ? (*f.base)[f.next++] : r[0];
+          double row[kMaxColumns];
+          for (int axis = 0; axis < 2; ++axis) {
+            for (int j = 0; j < p; ++j)
+              row[j] =
+                  (r[static_cast<std::size_t>(j) + stepped][axis] - r0[axis]) * inverse_step[static_cast<std::size_t>(j)];
+            row[p] = r0[axis];
+            f.factor.add_row(row);
+          }
+        });
     least_squares::TriangularFactor all(p + 1);
     for (Block& f : factors) {
       assert(!f.base || f.next == f.base->size());  // the same samples as the cost-only evaluation's
@@ -142,7 +146,8 @@ class EffectFitter::FitCost final : public ceres::CostFunction {
     for (std::size_t b = 0; b < sizes.size(); ++b) {
       for (std::int32_t i = 0; i < sizes[b]; ++i) {
         std::vector<double> block(parameters[b], parameters[b] + sizes[b]);
-        const double delta = std::max(std::sqrt(std::numeric_limits<double>::epsilon()), std::abs(block[static_cast<std::size_t>(i)]) * kStep);
+        const double delta = std::max(std::sqrt(std::numeric_limits<double>::epsilon()),
+                                      std::abs(block[static_cast<std::size_t>(i)]) * kStep);
         block[static_cast<std::size_t>(i)] += delta;
         std::vector<const double*> moved(parameters, parameters + sizes.size());
         moved[b] = block.data();
@@ -194,7 +199,8 @@ EffectFitter::EffectFitter(const ModelReplay& replay, const EffectContext& conte
       heldout_blocks_(replay.blocks(Blocks::kHeldout)),
       fitted_(replay.log().size(), false) {
   for (int b : training_blocks_) {
-    training_block_samples_ += replay.log().block_first[static_cast<std::size_t>(b) + 1] - replay.log().block_first[static_cast<std::size_t>(b)];
+    training_block_samples_ +=
+        replay.log().block_first[static_cast<std::size_t>(b) + 1] - replay.log().block_first[static_cast<std::size_t>(b)];
   }
   // The samples the baseline predicts: every fit is judged on the same ones.
   const std::vector<ExtendedModel> base = {context_.base};
@@ -347,7 +353,9 @@ std::vector<ExtendedModel> stepped_models(const EffectSet& set, const EffectCont
   for (std::size_t j = 0; j < set.effects.size(); ++j) {
     for (std::size_t i = 0; i < set.parameters[j].size(); ++i) {
       EffectSet moved = set;
-      const double h = parameter_bounds(set.effects[j], context, static_cast<int>(i)).second >= set.parameters[j][i] + kStep ? kStep : -kStep;
+      const double h = parameter_bounds(set.effects[j], context, static_cast<int>(i)).second >= set.parameters[j][i] + kStep
+                           ? kStep
+                           : -kStep;
       moved.parameters[j][i] += h;
       models.push_back(moved.model(context));
       steps.push_back(h);
@@ -368,18 +376,18 @@ CalibrationIntervals EffectFitter::intervals(const EffectSet& set, double noise_
     least_squares::Gram gram;
     Eigen::VectorXd score;
   };
-  const std::vector<Block> blocks =
-      over_training(models, Block{least_squares::Gram(n), Eigen::VectorXd::Zero(n)}, [&](Block& b, std::span<const core::Vec2> r) {
-        double c[2][kMaxColumns];
-        for (Eigen::Index i = 0; i < n; ++i) {
-          const std::size_t m = static_cast<std::size_t>(i) + 1;
-          c[0][i] = (r[m][0] - r[0][0]) / steps[static_cast<std::size_t>(i)];
-          c[1][i] = (r[m][1] - r[0][1]) / steps[static_cast<std::size_t>(i)];
-          b.score[i] += c[0][i] * r[0][0] + c[1][i] * r[0][1];
-        }
-        b.gram.add(c[0], r[0][0]);
-        b.gram.add(c[1], r[0][1]);
-      });
+  const std::vector<Block> blocks = over_training(models, Block{least_squares::Gram(n), Eigen::VectorXd::Zero(n)},
+                                                  [&](Block& b, std::span<const core::Vec2> r) {
+                                                    double c[2][kMaxColumns];
+                                                    for (Eigen::Index i = 0; i < n; ++i) {
+                                                      const std::size_t m = static_cast<std::size_t>(i) + 1;
+                                                      c[0][i] = (r[m][0] - r[0][0]) / steps[static_cast<std::size_t>(i)];
+                                                      c[1][i] = (r[m][1] - r[0][1]) / steps[static_cast<std::size_t>(i)];
+                                                      b.score[i] += c[0][i] * r[0][0] + c[1][i] * r[0][1];
+                                                    }
+                                                    b.gram.add(c[0], r[0][0]);
+                                                    b.gram.add(c[1], r[0][1]);
+                                                  });
   least_squares::Gram total(n);
   for (const Block& b : blocks) total.add(b.gram);
   const Eigen::MatrixXd h = total.symmetric();

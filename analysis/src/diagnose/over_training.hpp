@@ -11,12 +11,14 @@ namespace rpem::analysis {
 inline constexpr double kMiss_A = 1e3;
 
 template <class Acc, class Add>
-std::vector<Acc> EffectFitter::over_training(const std::vector<ExtendedModel>& models, const Acc& init, const Add& add) const {
+std::vector<Acc> EffectFitter::over_training(const std::vector<ExtendedModel>& models, const Acc& init,
+                                             const Add& add) const {
   return over_training_from(models, std::vector<Acc>(training_blocks_.size(), init), add);
 }
 
 template <class Acc, class Add>
-std::vector<Acc> EffectFitter::over_training_from(const std::vector<ExtendedModel>& models, std::vector<Acc> out, const Add& add) const {
+std::vector<Acc> EffectFitter::over_training_from(const std::vector<ExtendedModel>& models, std::vector<Acc> out,
+                                                  const Add& add) const {
   assert(out.size() == training_blocks_.size());
   replay_.for_blocks(training_blocks_, [&](std::size_t i, int b) {
     Acc& acc = out[i];

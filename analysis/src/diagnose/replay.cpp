@@ -17,8 +17,8 @@ constexpr std::size_t kWarmup = core::kMaxDelayPeriods + 3;
 
 /// What every model of a replay shares at one sample.
 struct Shared {
-  core::DriveSample s;      ///< as the replay takes it (LogData::replay_sample)
-  core::Rotation logged;    ///< at the logged angle
+  core::DriveSample s;    ///< as the replay takes it (LogData::replay_sample)
+  core::Rotation logged;  ///< at the logged angle
 };
 
 /// Whether two models are the same bit for bit, field by field (ModelExtensions and the machine hold doubles
@@ -151,7 +151,8 @@ void ModelReplay::for_blocks(const std::vector<int>& blocks, const std::function
   });
 }
 
-std::vector<std::size_t> ModelReplay::distinct_chains(std::span<const ExtendedModel> models, std::vector<Chain>& chains) const {
+std::vector<std::size_t> ModelReplay::distinct_chains(std::span<const ExtendedModel> models,
+                                                      std::vector<Chain>& chains) const {
   std::vector<std::size_t> chain_of(models.size());
   chains.reserve(models.size());
   for (std::size_t j = 0; j < models.size(); ++j) {
@@ -182,7 +183,8 @@ std::vector<std::size_t> ModelReplay::shared_conditioners(const std::vector<Chai
 }
 
 void ModelReplay::replay_block(int b, std::span<const ExtendedModel> models, const Visit& visit) const {
-  const std::size_t first = log_.block_first[static_cast<std::size_t>(b)], end = log_.block_first[static_cast<std::size_t>(b) + 1];
+  const std::size_t first = log_.block_first[static_cast<std::size_t>(b)],
+                    end = log_.block_first[static_cast<std::size_t>(b) + 1];
   // A model the same as an earlier one bit for bit (a screening's candidate at a start that leaves the model as
   // it is: the round's model) steps no chain of its own: it is given that one's samples.
   std::vector<Chain> chains;

@@ -67,9 +67,9 @@ double ResidualSums::Pearson::value() const {
 }
 
 ResidualSums::ResidualSums(const LogData& log, const EffectContext& context)
-    : log_(&log),
-      base_(core::PerUnitBase::from_rated(context.machine.rated)),
-      regressors_{"|i| [A]", "i_d [A]", "i_q [A]", "speed [pu]", "|speed| [pu]", "time [s]"} {
+    : log_(&log), base_(core::PerUnitBase::from_rated(context.machine.rated)), regressors_{"|i| [A]",      "i_d [A]",
+                                                                                           "i_q [A]",      "speed [pu]",
+                                                                                           "|speed| [pu]", "time [s]"} {
   if (log.layout.t_winding) regressors_.emplace_back("T_winding [°C]");
   if (log.layout.t_magnet) regressors_.emplace_back("T_magnet [°C]");
   corr_.resize(regressors_.size());
@@ -77,13 +77,20 @@ ResidualSums::ResidualSums(const LogData& log, const EffectContext& context)
 
 double ResidualSums::regressor(std::size_t j, std::size_t k, const core::Vec2& i, double n_pu) const {
   switch (j) {
-    case 0: return i.norm();
-    case 1: return i[0];
-    case 2: return i[1];
-    case 3: return n_pu;
-    case 4: return std::abs(n_pu);
-    case 5: return log_->t_s(k);
-    default: break;
+    case 0:
+      return i.norm();
+    case 1:
+      return i[0];
+    case 2:
+      return i[1];
+    case 3:
+      return n_pu;
+    case 4:
+      return std::abs(n_pu);
+    case 5:
+      return log_->t_s(k);
+    default:
+      break;
   }
   // The temperatures, in the order the constructor lists them.
   const bool winding = j == 6 && log_->layout.t_winding;
@@ -176,7 +183,11 @@ ResidualStatistics ResidualSums::statistics() const {
       // Regions a log only passes through (a few samples in a transient) say little.
       if (static_cast<double>(b.n) < kMinRegionShare * static_cast<double>(all_before_.n) || b.n == 0) continue;
       const Moments& a = region_after_[sr][lr];
-      out.regions.push_back({kSpeedRegions[sr], kLoadRegions[lr], b.n, {b.rms(), a.rms()}, {b.mean()[0], a.mean()[0]},
+      out.regions.push_back({kSpeedRegions[sr],
+                             kLoadRegions[lr],
+                             b.n,
+                             {b.rms(), a.rms()},
+                             {b.mean()[0], a.mean()[0]},
                              {b.mean()[1], a.mean()[1]}});
     }
   }
@@ -190,12 +201,14 @@ ResidualStatistics ResidualSums::statistics() const {
       out.harmonics.push_back({h, {before, after}});
     }
     for (int x = 0; x < 3; ++x) {
-      out.phase_signs.push_back({static_cast<char>('a' + x), {pos_before_[x].mean()[0], pos_after_[x].mean()[0]},
+      out.phase_signs.push_back({static_cast<char>('a' + x),
+                                 {pos_before_[x].mean()[0], pos_after_[x].mean()[0]},
                                  {neg_before_[x].mean()[0], neg_after_[x].mean()[0]}});
     }
   }
   for (std::size_t j = 0; j < regressors_.size(); ++j) {
-    out.correlations.push_back({regressors_[j], {corr_[j][0].value(), corr_[j][2].value()}, {corr_[j][1].value(), corr_[j][3].value()}});
+    out.correlations.push_back(
+        {regressors_[j], {corr_[j][0].value(), corr_[j][2].value()}, {corr_[j][1].value(), corr_[j][3].value()}});
   }
   return out;
 }

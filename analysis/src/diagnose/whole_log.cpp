@@ -125,13 +125,15 @@ void merge_figures(const LogData& log, const EffectContext& context, const std::
   figures.temperature.assign(FigureData::kTemperatureBins, {0.0, 0.0, 0.0, 0.0, 0.0});
   for (const BlockFigures& f : parts) {
     for (std::size_t j = 0; j < f.bins.size(); ++j) {
-      for (int c = 0; c < 5; ++c) bins[f.first_bin + j][static_cast<std::size_t>(c)] += f.bins[j][static_cast<std::size_t>(c)];
+      for (int c = 0; c < 5; ++c)
+        bins[f.first_bin + j][static_cast<std::size_t>(c)] += f.bins[j][static_cast<std::size_t>(c)];
     }
     for (std::size_t c = 0; c < f.map.size(); ++c) {
       for (int v = 0; v < 3; ++v) figures.map[c][static_cast<std::size_t>(v)] += f.map[c][static_cast<std::size_t>(v)];
     }
     for (std::size_t c = 0; c < f.temperature.size(); ++c) {
-      for (int v = 0; v < 5; ++v) figures.temperature[c][static_cast<std::size_t>(v)] += f.temperature[c][static_cast<std::size_t>(v)];
+      for (int v = 0; v < 5; ++v)
+        figures.temperature[c][static_cast<std::size_t>(v)] += f.temperature[c][static_cast<std::size_t>(v)];
     }
     figures.overlay.insert(figures.overlay.end(), f.overlay.begin(), f.overlay.end());
   }
@@ -147,14 +149,16 @@ void merge_figures(const LogData& log, const EffectContext& context, const std::
     const auto& r = bins[j];
     const double cnt = r[4];
     figures.time.push_back({t / all_samples, sp / all_samples, iq / all_samples, cnt != 0.0 ? std::sqrt(r[0] / cnt) : kNaN,
-                            cnt != 0.0 ? std::sqrt(r[1] / cnt) : kNaN, cnt != 0.0 ? r[2] / cnt : kNaN, cnt != 0.0 ? r[3] / cnt : kNaN, temp / all_samples});
+                            cnt != 0.0 ? std::sqrt(r[1] / cnt) : kNaN, cnt != 0.0 ? r[2] / cnt : kNaN,
+                            cnt != 0.0 ? r[3] / cnt : kNaN, temp / all_samples});
   }
 }
 
 }  // namespace
 
 void comparison_pass(const ModelReplay& replay, const EffectContext& context, const ExtendedModel& baseline,
-                     const ExtendedModel& extended, const BaselinePass& pass, ResidualStatistics& statistics, FigureData& figures) {
+                     const ExtendedModel& extended, const BaselinePass& pass, ResidualStatistics& statistics,
+                     FigureData& figures) {
   const LogData& log = replay.log();
   const std::size_t n = log.size();
   const std::size_t per_bin = std::max<std::size_t>(1, n / FigureData::kTimeBins);
@@ -170,7 +174,8 @@ void comparison_pass(const ModelReplay& replay, const EffectContext& context, co
   std::vector<BlockFigures> parts(blocks.size());
   replay.for_blocks(blocks, [&](std::size_t i, int b) {
     BlockFigures& f = parts[i];
-    const std::size_t first = log.block_first[static_cast<std::size_t>(b)], end = log.block_first[static_cast<std::size_t>(b) + 1];
+    const std::size_t first = log.block_first[static_cast<std::size_t>(b)],
+                      end = log.block_first[static_cast<std::size_t>(b) + 1];
     f.first_bin = first / per_bin;
     f.bins.assign((end - 1) / per_bin - f.first_bin + 1, {0.0, 0.0, 0.0, 0.0, 0.0});
     f.map.assign(kCells, {0.0, 0.0, 0.0});
@@ -204,7 +209,8 @@ void comparison_pass(const ModelReplay& replay, const EffectContext& context, co
         s[4] += ra[1];
       }
       if (k >= pass.overlay_first && k < pass.overlay_last) {
-        f.overlay.push_back({log.t_s(k), i_dq[0], i_dq[1], m[0].model_A[0], m[0].model_A[1], m[1].model_A[0], m[1].model_A[1]});
+        f.overlay.push_back(
+            {log.t_s(k), i_dq[0], i_dq[1], m[0].model_A[0], m[0].model_A[1], m[1].model_A[0], m[1].model_A[1]});
       }
     });
   });

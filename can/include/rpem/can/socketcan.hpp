@@ -25,17 +25,17 @@ struct ReceivedFrame {
 struct ChannelCounters {
   std::uint64_t rx_frames = 0;
   std::uint64_t tx_frames = 0;
-  std::uint64_t tx_dropped = 0;        ///< send queue full or interface down
-  std::uint64_t kernel_drops = 0;      ///< SO_RXQ_OVFL: frames the kernel dropped for this socket
-  std::uint64_t reopens = 0;           ///< successful reopen after a failure
+  std::uint64_t tx_dropped = 0;    ///< send queue full or interface down
+  std::uint64_t kernel_drops = 0;  ///< SO_RXQ_OVFL: frames the kernel dropped for this socket
+  std::uint64_t reopens = 0;       ///< successful reopen after a failure
   std::uint64_t open_failures = 0;
   std::uint64_t error_frames = 0;
   std::uint64_t bus_off = 0;
-  std::uint64_t error_passive = 0;     ///< controller reported rx or tx error-passive
+  std::uint64_t error_passive = 0;  ///< controller reported rx or tx error-passive
   std::uint64_t error_warning = 0;
   std::uint64_t controller_overflow = 0;
   std::uint64_t protocol_violations = 0;
-  std::uint64_t restarted = 0;         ///< controller restarted after bus-off
+  std::uint64_t restarted = 0;  ///< controller restarted after bus-off
   std::uint64_t no_ack = 0;
 };
 

@@ -88,7 +88,7 @@ class EdgeIntegrator {
   Inverter inverter_;
   LinearFlow linear_;
   MapFlow map_;
-  bool signs_matter_;  ///< dead time or device drops: the currents' signs select leg voltages
+  bool signs_matter_;                 ///< dead time or device drops: the currents' signs select leg voltages
   std::array<int, 3> sign_{1, 1, 1};  ///< each phase current's sign: +1, −1, or 0 (clamped at zero)
   EdgeCounters counters_;
 };

@@ -93,7 +93,8 @@ enum class Identification {
 /// cluster-robust interval widened by the mismatch allowance, exactly where the report states the
 /// configuration off (calibration_findings). Away from the ±50 % bound in both cases.
 /// `misfit_A`: misfit_norm_A of the set.
-[[nodiscard]] Identification identification(const EffectSet& set, const CalibrationIntervals& ci, std::size_t i, double misfit_A);
+[[nodiscard]] Identification identification(const EffectSet& set, const CalibrationIntervals& ci, std::size_t i,
+                                            double misfit_A);
 
 /// A round's screening: for each candidate, its best start and the training gain the screening credits it
 /// with from there.
@@ -159,7 +160,7 @@ class EffectFitter {
   std::vector<bool> fitted_;  ///< per sample: in a training block and replayed under the baseline
   std::size_t training_samples_ = 0;
   std::uint64_t training_block_samples_ = 0;  ///< every sample of the training blocks (a pass's work per model)
-  RobustLoss loss_;  ///< least squares unless outliers remain (diagnosis.cpp)
+  RobustLoss loss_;                           ///< least squares unless outliers remain (diagnosis.cpp)
 };
 
 }  // namespace rpem::analysis
