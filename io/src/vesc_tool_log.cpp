@@ -4,51 +4,25 @@
 #include <charconv>
 
 #include "rpem/io/errors.hpp"
+#include "rpem/io/vesc_tool_columns.hpp"
 
 namespace rpem::io {
 namespace {
 
-// The column groups VESC Tool's openRtLogFile() writes, in its order (vedderb/vesc_tool, vescinterface.cpp).
-using Columns = std::vector<std::string_view>;
-const Columns kValues{
-    "ms_today",       "input_voltage",    "temp_mos_max",      "temp_mos_1",      "temp_mos_2",         "temp_mos_3",
-    "temp_motor",     "current_motor",    "current_in",        "d_axis_current",  "q_axis_current",     "erpm",
-    "duty_cycle",     "amp_hours_used",   "amp_hours_charged", "watt_hours_used", "watt_hours_charged", "tachometer",
-    "tachometer_abs", "encoder_position", "fault_code",        "vesc_id"};
-const Columns kDqVoltages{"d_axis_voltage", "q_axis_voltage"};
-const Columns kSetup{"ms_today_setup",
-                     "amp_hours_setup",
-                     "amp_hours_charged_setup",
-                     "watt_hours_setup",
-                     "watt_hours_charged_setup",
-                     "battery_level",
-                     "battery_wh_tot",
-                     "current_in_setup",
-                     "current_motor_setup",
-                     "speed_meters_per_sec",
-                     "tacho_meters",
-                     "tacho_abs_meters",
-                     "num_vescs"};
-const Columns kImu{"ms_today_imu", "roll", "pitch", "yaw", "accX", "accY", "accZ", "gyroX", "gyroY", "gyroZ"};
-const Columns kGnss{"gnss_posTime", "gnss_lat", "gnss_lon", "gnss_alt", "gnss_gVel", "gnss_vVel", "gnss_hAcc", "gnss_vAcc"};
-
-Columns join(std::initializer_list<const Columns*> parts) {
-  Columns c;
-  for (const Columns* p : parts) c.insert(c.end(), p->begin(), p->end());
-  return c;
+/// A column list of vesc_tool_columns.hpp as a header version's.
+template <std::size_t N>
+std::vector<std::string_view> list(const std::array<std::string_view, N>& columns) {
+  return {columns.begin(), columns.end()};
 }
-
-/// The number of values in a row of VESC Tool 1.11–1.16, which wrote no header (the 22 of kValues).
-constexpr std::size_t kHeaderlessValues = 22;
 
 }  // namespace
 
 const std::vector<VescToolHeader>& vesc_tool_headers() {
   static const std::vector<VescToolHeader> headers{
-      {"1.17 to 1.19", "vedderb/vesc_tool 95f18604 (2019-09-03, \"Added header to RT CSV log\")", join({&kValues})},
-      {"1.20 test builds", "vedderb/vesc_tool 5986063b (2019-09-17)", join({&kValues, &kDqVoltages, &kGnss})},
-      {"1.20 and later", "vedderb/vesc_tool 408f78fc (2019-09-27, v1.20)",
-       join({&kValues, &kDqVoltages, &kSetup, &kImu, &kGnss})},
+      {"1.17 to 1.19", "vedderb/vesc_tool 95f18604 (2019-09-03, \"Added header to RT CSV log\")", list(vesc_tool::kValues)},
+      {"1.20 test builds", "vedderb/vesc_tool 5986063b (2019-09-17)",
+       list(vesc_tool::join(vesc_tool::kValues, vesc_tool::kDqVoltages, vesc_tool::kGnss))},
+      {"1.20 and later", "vedderb/vesc_tool 408f78fc (2019-09-27, v1.20)", list(vesc_tool::kColumns120)},
   };
   return headers;
 }
@@ -101,7 +75,7 @@ bool is_headerless_vesc_tool_row(std::string_view line) {
     if (sep == std::string_view::npos) break;
     line.remove_prefix(sep + 1);
   }
-  return n == kHeaderlessValues;
+  return n == vesc_tool::kValues.size();  // 1.11–1.16: the values every later version writes first
 }
 
 }  // namespace rpem::io

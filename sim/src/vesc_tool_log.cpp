@@ -4,6 +4,7 @@
 #include <cstdio>
 
 #include "rpem/io/errors.hpp"
+#include "rpem/io/vesc_tool_columns.hpp"
 
 namespace rpem::sim {
 namespace {
@@ -32,12 +33,16 @@ void append_qt_fixed8(std::string& out, double v) { append_printf(out, true, v);
 
 std::string vesc_tool_header() {
   std::string h;
-  for (const char* name : kVescToolColumns) (h += name) += ';';
+  for (const std::string_view name : io::vesc_tool::kColumns120) (h += name) += ';';
   h += '\n';
   return h;
 }
 
 void append_vesc_tool_row(std::string& out, const VescToolRow& r) {
+  // One cell per name of the header (io::vesc_tool::kColumns120), group by group.
+  static_assert(
+      io::vesc_tool::kValues.size() == 22 && io::vesc_tool::kDqVoltages.size() == 2 && io::vesc_tool::kSetup.size() == 13,
+      "the values, voltages and setup cells written below, one per name");
   const can::vesc::Values& v = r.values;
   auto number = [&out](double x) {
     append_qt_double(out, x);
@@ -90,10 +95,10 @@ void append_vesc_tool_row(std::string& out, const VescToolRow& r) {
   number(s.distance_abs_m);
   integer(s.num_vescs);
 
-  integer(-1);                              // ms_today_imu: no IMU reply
-  for (int k = 0; k < 9; ++k) number(0.0);  // roll … gyroZ of IMU_VALUES()
-  integer(-1);                              // gnss_posTime: no position
-  for (int k = 0; k < 7; ++k) fixed(0.0);   // lat, lon, alt, gVel, vVel, hAcc, vAcc
+  integer(-1);                                                               // ms_today_imu: no IMU reply
+  for (std::size_t k = 1; k < io::vesc_tool::kImu.size(); ++k) number(0.0);  // roll … gyroZ of IMU_VALUES()
+  integer(-1);                                                               // gnss_posTime: no position
+  for (std::size_t k = 1; k < io::vesc_tool::kGnss.size(); ++k) fixed(0.0);  // lat, lon, alt, gVel, vVel, hAcc, vAcc
   out += '\n';
 }
 

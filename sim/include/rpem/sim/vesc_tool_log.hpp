@@ -2,7 +2,8 @@
 // The realtime-data log VESC Tool writes while "log to file" is on (`rpem sim --vesc-tool-out`;
 // docs/scenarios.md, "VESC Tool logs"). Everything here follows VESC Tool's source, vedderb/vesc_tool
 // vescinterface.cpp at 426a4f8e (2026-07-29), unchanged since 408f78fc (2019-09-27, VESC Tool 1.20):
-//   - VescInterface::openRtLogFile writes the header: 55 names, each followed by ';', then '\n' (kColumns);
+//   - VescInterface::openRtLogFile writes the header: 55 names, each followed by ';', then '\n' (the names
+//     and their citation are io's, io/include/rpem/io/vesc_tool_columns.hpp: kColumns120);
 //   - the Commands::valuesReceived handler writes one row per COMM_GET_VALUES reply, on a fresh QTextStream:
 //     ms_today is QDateTime::currentDateTimeUtc().time().msecsSinceStartOfDay() (UTC milliseconds since
 //     midnight, wrapping there), then the reply's fields as Commands decodes them (commands.cpp: the integer
@@ -12,9 +13,10 @@
 //     precision 6, C locale: printf's %g, a negative zero written 0), integers in decimal; the stream is set
 //     to Qt::fixed with precision 8 at the latitude, so the latitude and everything after it in the row —
 //     longitude, altitude, the two speeds and the two accuracies — come out fixed with 8 decimals.
-// Not a reader: the reader of these files is io/'s, written from VESC Tool's source separately.
+// Not a reader: the reader of these files is io/'s, which shares only the column names. Both are checked
+// against vectors typed from VESC Tool's source (tests/sim/test_vesc_tool_log.cpp,
+// tests/support/vesc_tool_vectors.hpp), never against each other.
 
-#include <array>
 #include <cstdint>
 #include <fstream>
 #include <string>
@@ -42,63 +44,6 @@ struct VescToolRow {
   std::int32_t ms_today_setup = -1;  ///< -1: no setup reply yet (then `setup` is all zeros)
   VescSetupValues setup;
 };
-
-/// The header's names, in order (openRtLogFile).
-inline constexpr std::array<const char*, 55> kVescToolColumns = {"ms_today",
-                                                                 "input_voltage",
-                                                                 "temp_mos_max",
-                                                                 "temp_mos_1",
-                                                                 "temp_mos_2",
-                                                                 "temp_mos_3",
-                                                                 "temp_motor",
-                                                                 "current_motor",
-                                                                 "current_in",
-                                                                 "d_axis_current",
-                                                                 "q_axis_current",
-                                                                 "erpm",
-                                                                 "duty_cycle",
-                                                                 "amp_hours_used",
-                                                                 "amp_hours_charged",
-                                                                 "watt_hours_used",
-                                                                 "watt_hours_charged",
-                                                                 "tachometer",
-                                                                 "tachometer_abs",
-                                                                 "encoder_position",
-                                                                 "fault_code",
-                                                                 "vesc_id",
-                                                                 "d_axis_voltage",
-                                                                 "q_axis_voltage",
-                                                                 "ms_today_setup",
-                                                                 "amp_hours_setup",
-                                                                 "amp_hours_charged_setup",
-                                                                 "watt_hours_setup",
-                                                                 "watt_hours_charged_setup",
-                                                                 "battery_level",
-                                                                 "battery_wh_tot",
-                                                                 "current_in_setup",
-                                                                 "current_motor_setup",
-                                                                 "speed_meters_per_sec",
-                                                                 "tacho_meters",
-                                                                 "tacho_abs_meters",
-                                                                 "num_vescs",
-                                                                 "ms_today_imu",
-                                                                 "roll",
-                                                                 "pitch",
-                                                                 "yaw",
-                                                                 "accX",
-                                                                 "accY",
-                                                                 "accZ",
-                                                                 "gyroX",
-                                                                 "gyroY",
-                                                                 "gyroZ",
-                                                                 "gnss_posTime",
-                                                                 "gnss_lat",
-                                                                 "gnss_lon",
-                                                                 "gnss_alt",
-                                                                 "gnss_gVel",
-                                                                 "gnss_vVel",
-                                                                 "gnss_hAcc",
-                                                                 "gnss_vAcc"};
 
 /// Milliseconds in a day: ms_today wraps here.
 inline constexpr std::int64_t kMsPerDay = 86'400'000;
