@@ -3,6 +3,9 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 #include "rpem/core/assert.hpp"
 #include "rpem/core/clock.hpp"
@@ -28,6 +31,43 @@ double track_median(double m, double a) noexcept {
   return m == 0.0 ? a : stepped;
 }
 
+/// Per lane, a > b ? x : y — as the scalar comparison (false where either is NaN), without a branch:
+/// Eigen's select() is evaluated element by element, with a conditional jump each.
+[[gnu::always_inline]] inline Vec2 select_greater(const Vec2& a, const Vec2& b, const Vec2& x, const Vec2& y) noexcept {
+#if defined(__SSE2__)
+  const __m128d mask = _mm_cmpgt_pd(_mm_loadu_pd(a.data()), _mm_loadu_pd(b.data()));
+  Vec2 r;
+  _mm_storeu_pd(r.data(), _mm_or_pd(_mm_and_pd(mask, _mm_loadu_pd(x.data())), _mm_andnot_pd(mask, _mm_loadu_pd(y.data()))));
+  return r;
+#else
+  return Vec2(a[0] > b[0] ? x[0] : y[0], a[1] > b[1] ? x[1] : y[1]);
+#endif
+}
+
+/// Per lane, m == 0 ? x : y (±0 alike, as the scalar comparison).
+[[gnu::always_inline]] inline Vec2 select_zero(const Vec2& m, const Vec2& x, const Vec2& y) noexcept {
+#if defined(__SSE2__)
+  const __m128d mask = _mm_cmpeq_pd(_mm_loadu_pd(m.data()), _mm_setzero_pd());
+  Vec2 r;
+  _mm_storeu_pd(r.data(), _mm_or_pd(_mm_and_pd(mask, _mm_loadu_pd(x.data())), _mm_andnot_pd(mask, _mm_loadu_pd(y.data()))));
+  return r;
+#else
+  return Vec2(m[0] == 0.0 ? x[0] : y[0], m[1] == 0.0 ? x[1] : y[1]);
+#endif
+}
+
+/// track_median on two quantities at once (u and i), each lane as the scalar form steps it: the same
+/// factor, the same product, the same start (the pair is one SSE2 operation where a scalar step was one each).
+[[gnu::always_inline]] inline Vec2 track_medians(const Vec2& m, const Vec2& a) noexcept {
+  const Vec2 stepped = m.cwiseProduct(select_greater(a, m, Vec2::Constant(kTrackUp), Vec2::Constant(kTrackDown)));
+  return select_zero(m, a, stepped);
+}
+
+/// The smallest nonzero |change| of two quantities at once (u and i): q = min(q, a > 0 ? a : q) per lane.
+[[gnu::always_inline]] inline Vec2 track_resolutions(const Vec2& q, const Vec2& a) noexcept {
+  return q.cwiseMin(select_greater(a, Vec2::Zero(), a, q));
+}
+
 /// The smallest nonzero |change|; whether it became smaller.
 bool track_resolution(double& q, double change) noexcept {
   const double a = std::abs(change), before = q;
@@ -36,15 +76,17 @@ bool track_resolution(double& q, double change) noexcept {
 }
 
 /// Learns a sample's noise and resolution from the chain and takes it in as the chain's last. Returns
-/// whether a measured resolution changed.
-bool learn(RegimeState& s, const RegimeInput& in, double t_s) noexcept {
+/// whether a measured resolution changed. u's and i's trackers run as one pair (d's change first, then
+/// q's: a minimum does not depend on the order, a median tracker's two steps keep theirs).
+bool learn(RegimeState& s, const RegimeInput& in, double t_s, double w) noexcept {
   bool resolution_changed = false;
   if (s.points >= 1) {
     const Vec2 du = (in.u_pu - s.u_pu[0]).cwiseAbs(), di = (in.i_pu - s.i_pu[0]).cwiseAbs();
-    resolution_changed = track_resolution(s.measured_resolution_pu[0], du[0]) |
-                         track_resolution(s.measured_resolution_pu[0], du[1]) |
-                         track_resolution(s.measured_resolution_pu[1], di[0]) |
-                         track_resolution(s.measured_resolution_pu[1], di[1]) |
+    const Vec2 before(s.measured_resolution_pu[0], s.measured_resolution_pu[1]);
+    const Vec2 q = track_resolutions(track_resolutions(before, Vec2(du[0], di[0])), Vec2(du[1], di[1]));
+    s.measured_resolution_pu[0] = q[0];
+    s.measured_resolution_pu[1] = q[1];
+    resolution_changed = (q[0] < before[0]) | (q[1] < before[1]) |
                          track_resolution(s.measured_resolution_pu[2], in.n_pu - s.n_pu[0]);
   }
   // Only a chain's samples are close enough for their second difference to be noise: a standalone
@@ -53,17 +95,19 @@ bool learn(RegimeState& s, const RegimeInput& in, double t_s) noexcept {
   const double span = t_s - s.t_s[1];
   if (s.points == 2 && chain && s.chained >= 1 && span > 0.0) {
     // The middle sample against the line through its neighbours, r = x₁ − (w·x₂ + (1 − w)·x₀) with
-    // w = (t₁ − t₀)/(t₂ − t₀): zero for a ramp at any spacing; for white noise of σ its variance is
-    // σ²·(1 + w² + (1 − w)²) = σ²·(3/2 + 2·d), d = (w − ½)² ∈ [0, ¼], whose root the factor removes:
+    // w = (t₁ − t₀)/(t₂ − t₀) (the caller's, divided with the slope's 1/Δt): zero for a ramp at any
+    // spacing; for white noise of σ its variance is σ²·(1 + w² + (1 − w)²) = σ²·(3/2 + 2·d),
+    // d = (w − ½)² ∈ [0, ¼], whose root the factor removes:
     // (3/2 + 2d)^{−½} ≈ 0.81650 − 0.53215·d + 0.37763·d², within 2e-4 (no square root per sample).
-    const double w = (s.t_s[0] - s.t_s[1]) / span;
     const double d = (w - 0.5) * (w - 0.5);
     const double norm = 0.81649658 + d * (-0.53215 + d * 0.37763);
     const Vec2 ru = norm * (s.u_pu[0] - (w * in.u_pu + (1.0 - w) * s.u_pu[1])).cwiseAbs();
     const Vec2 ri = norm * (s.i_pu[0] - (w * in.i_pu + (1.0 - w) * s.i_pu[1])).cwiseAbs();
     const double rn = norm * std::abs(s.n_pu[0] - (w * in.n_pu + (1.0 - w) * s.n_pu[1]));
-    s.noise_median_pu[0] = track_median(track_median(s.noise_median_pu[0], ru[0]), ru[1]);
-    s.noise_median_pu[1] = track_median(track_median(s.noise_median_pu[1], ri[0]), ri[1]);
+    const Vec2 m = track_medians(track_medians(Vec2(s.noise_median_pu[0], s.noise_median_pu[1]), Vec2(ru[0], ri[0])),
+                                 Vec2(ru[1], ri[1]));
+    s.noise_median_pu[0] = m[0];
+    s.noise_median_pu[1] = m[1];
     s.noise_median_pu[2] = track_median(s.noise_median_pu[2], rn);
     s.noise_known = true;
   }
@@ -171,7 +215,9 @@ Classification RegimeClassifier::step(const RegimeInput& in) noexcept {
   s.previous_inv_dt = s.inv_dt;
   const bool linked = s.points >= 1 && dt_s > 0.0 &&
                       (in.timing == SampleTiming::kDense || in.timing == SampleTiming::kContiguous);
-  s.inv_dt = linked ? 1.0 / dt_s : 0.0;
+  // 1/Δt and the second difference's w = (t₁ − t₀)/(t₂ − t₀) (learn()) in one division of a pair.
+  const Vec2 quotients(1.0 / dt_s, (s.t_s[0] - s.t_s[1]) / (t_s - s.t_s[1]));
+  s.inv_dt = linked ? quotients[0] : 0.0;
   s.slope_valid = linked;
   if (!linked) {
     s.slope_pu_s.setZero();
@@ -294,7 +340,7 @@ Classification RegimeClassifier::step(const RegimeInput& in) noexcept {
   }
   s.previous_window = window;
   s.previous_bridge_off = off;
-  if (learn(s, in, t_s)) [[unlikely]] update_quantisation();
+  if (learn(s, in, t_s, quotients[1])) [[unlikely]] update_quantisation();
   return Classification::of(bits);
 }
 
