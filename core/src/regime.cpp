@@ -234,7 +234,11 @@ Classification RegimeClassifier::step(const RegimeInput& in) noexcept {
   const double n = in.n_pu, n2 = n * n, abs_n = std::abs(n);
   const Vec2 abs_i = i.cwiseAbs();
   // n²·x_q², n²·x_d² as every test forms them (n²·x·x).
-  const double n2_xq2 = n2 * c.x_q_pu * c.x_q_pu, n2_xd2 = n2 * c.x_d_pu * c.x_d_pu;
+  // n²·x_q², n²·x_d² as every test forms them (n²·x·x), as one pair; and the voltage noise of a row, d and q
+  // (the transient test's rows and ψm's noise begin with it): σ_u² + (r² + n²·x_o²)·σ_i².
+  const Vec2 n2_x2 = (n2 * k.x_swapped).cwiseProduct(k.x_swapped);
+  const double n2_xq2 = n2_x2[0], n2_xd2 = n2_x2[1];
+  const Vec2 row_noise = Vec2::Constant(v.u_sq) + (Vec2::Constant(k.r_sq) + n2_x2) * v.i_sq;
   std::uint8_t bits = 0;
 
   // Bridge off: the reported voltage and the current are zero within their noise where a modulating bridge
@@ -295,9 +299,9 @@ Classification RegimeClassifier::step(const RegimeInput& in) noexcept {
       slope_noise_sq = a * a + (a + p) * (a + p) + p * p;
     }
     const double slope_var = k.inv_omega_n_sq * slope_noise_sq * v.i_sq;
-    const double row_d = v.u_sq + (k.r_sq + n2_xq2) * v.i_sq + k.x_sq[0] * slope_var;
-    const double row_q = v.u_sq + (k.r_sq + n2_xd2) * v.i_sq + k.x_sq[1] * slope_var;
-    const bool own = t[0] * t[0] > k.z_sq * row_d || t[1] * t[1] > k.z_sq * row_q;
+    const Vec2 row = row_noise + k.x_sq * slope_var;  // σ² of the rows d and q
+    const Vec2 t_sq = t.cwiseProduct(t), bound = k.z_sq * row;
+    const bool own = (t_sq[0] > bound[0]) | (t_sq[1] > bound[1]);
     // A slope change shows only once both windows around the junction are in: the window after one is
     // corrected with a slope that straddles it.
     if (own || s.previous_transient) bits |= regime_bit::kTransient;
@@ -310,7 +314,7 @@ Classification RegimeClassifier::step(const RegimeInput& in) noexcept {
   const double psi_term = abs_n * c.psi_min_pu - c.dr_pu * abs_i[1] - abs_n * c.dx_d_pu * abs_i[0];
   if (psi_term > 0.0) {
     const double h_sq = in.weight[0] / (2.0 - in.weight[0]);
-    const double noise = v.u_sq + (k.r_sq + n2_xd2) * v.i_sq + k.psi_max_sq * v.n_sq;
+    const double noise = row_noise[1] + k.psi_max_sq * v.n_sq;
     if (psi_term * psi_term > k.z_sq * h_sq * noise) bits |= regime_bit::kExcitesPsiM;
   }
   // r_min·|i| must at least exceed |n|·Δψ: checked on the squares before |i| is taken.
