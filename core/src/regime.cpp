@@ -233,7 +233,6 @@ Classification RegimeClassifier::step(const RegimeInput& in) noexcept {
   const Vec2& i = in.i_pu;
   const double n = in.n_pu, n2 = n * n, abs_n = std::abs(n);
   const Vec2 abs_i = i.cwiseAbs();
-  // n²·x_q², n²·x_d² as every test forms them (n²·x·x).
   // n²·x_q², n²·x_d² as every test forms them (n²·x·x), as one pair; and the voltage noise of a row, d and q
   // (the transient test's rows and ψm's noise begin with it): σ_u² + (r² + n²·x_o²)·σ_i².
   const Vec2 n2_x2 = (n2 * k.x_swapped).cwiseProduct(k.x_swapped);
@@ -311,21 +310,20 @@ Classification RegimeClassifier::step(const RegimeInput& in) noexcept {
   // Excitation: the parameter's term, at its smallest inside D_M, less what the other terms' uncertainty
   // can put in its place, against its noise as the estimator's averaging leaves it: h² = γ/(2 − γ) of
   // one sample's variance (an exponential filter of gain γ).
+  const Vec2 h_sq = in.weight.array() / (2.0 - in.weight.array());  // ψm's and r_s' in one division of a pair
   const double psi_term = abs_n * c.psi_min_pu - c.dr_pu * abs_i[1] - abs_n * c.dx_d_pu * abs_i[0];
   if (psi_term > 0.0) {
-    const double h_sq = in.weight[0] / (2.0 - in.weight[0]);
     const double noise = row_noise[1] + k.psi_max_sq * v.n_sq;
-    if (psi_term * psi_term > k.z_sq * h_sq * noise) bits |= regime_bit::kExcitesPsiM;
+    if (psi_term * psi_term > k.z_sq * h_sq[0] * noise) bits |= regime_bit::kExcitesPsiM;
   }
   // r_min·|i| must at least exceed |n|·Δψ: checked on the squares before |i| is taken.
   if (k.r_min_sq * i_sq > n2 * c.dpsi_pu * c.dpsi_pu) {
     const double i_abs = std::sqrt(i_sq);
     const double term = c.r_min_pu * i_abs - abs_n * (c.dpsi_pu + k.dx_max * i_abs);
     if (term > 0.0) {
-      const double h_sq = in.weight[1] / (2.0 - in.weight[1]);
       const double flux = c.psi_max_pu + k.x_max * i_abs;
       const double noise = v.u_sq + (k.r_sq + n2 * k.x_max * k.x_max) * v.i_sq + flux * flux * v.n_sq;
-      if (term * term > k.z_sq * h_sq * noise) bits |= regime_bit::kExcitesRs;
+      if (term * term > k.z_sq * h_sq[1] * noise) bits |= regime_bit::kExcitesRs;
     }
   }
 
