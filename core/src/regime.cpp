@@ -21,6 +21,16 @@ constexpr double kSigmaPerMedian = 1.4826022185056018;
 constexpr double kTrackUp = 1.0644944589178593;    // e^{1/16}
 constexpr double kTrackDown = 0.93941306281347581;  // e^{−1/16}
 
+/// regime_of() for every combination of the bits, by look-up: the precedence as a chain of conditional
+/// jumps on bits that vary from sample to sample costs a misprediction now and then.
+static_assert((regime_bit::kExcluded | regime_bit::kExcitesPsiM | regime_bit::kExcitesRs | regime_bit::kPreviousMixed) < 128,
+              "every classification's bits index the table");
+constexpr std::array<Regime, 128> kRegimeOfBits = [] {
+  std::array<Regime, 128> table{};
+  for (std::size_t b = 0; b < table.size(); ++b) table[b] = regime_of(static_cast<std::uint8_t>(b));
+  return table;
+}();
+
 /// One step of the median tracker m of |r|: up by e^η when |r| > m, down by e^{−η} otherwise; it settles
 /// where |r| exceeds m half the time. The first nonzero |r| starts it.
 double track_median(double m, double a) noexcept {
@@ -73,6 +83,17 @@ bool track_resolution(double& q, double change) noexcept {
   const double a = std::abs(change), before = q;
   q = std::min(q, a > 0.0 ? a : q);
   return q < before;
+}
+
+/// A sample far from the previous one: the change of operating point between them excited a transient
+/// that has decayed to e^{−Δt/τ_el} of |Δi| (τ_el the slowest the model admits). Steady if that remnant is
+/// within the current's noise (its own estimate's noise, 2·decay²·σ_i², included). `dt_over_tau` = Δt/τ_el,
+/// `z_sq_var_i` = z²·σ_i². Out of line: the exp() call would otherwise make the common path spill.
+[[gnu::noinline]] std::uint8_t standalone_transient(double dt_over_tau, const Vec2& di, double z_sq_var_i) noexcept {
+  const double decay = std::exp(-dt_over_tau);
+  const Vec2 remnant = decay * di.cwiseAbs();
+  const double bound = z_sq_var_i * (1.0 + 2.0 * decay * decay);
+  return remnant.squaredNorm() > 0.0 && remnant.cwiseProduct(remnant).maxCoeff() > bound ? regime_bit::kTransient : 0;
 }
 
 /// Learns a sample's noise and resolution from the chain and takes it in as the chain's last. Returns
@@ -273,15 +294,11 @@ Classification RegimeClassifier::step(const RegimeInput& in) noexcept {
     if (lock * lock > k.z_sq * (var_d + c.tan_angle * c.tan_angle * var_q)) bits |= regime_bit::kNotLocked;
   }
 
-  if (in.timing == SampleTiming::kStandalone && s.points >= 1) [[unlikely]] {
-    // A sample far from the previous one: the change of operating point between them excited a transient
-    // that has decayed to e^{−Δt/τ_el} of |Δi| (τ_el the slowest the model admits). Steady if that
-    // remnant is within the current's noise (its own estimate's noise, 2·decay²·σ_i², included).
-    const double decay = std::exp(-dt_s / c.electrical_time_constant_s);
-    const Vec2 remnant = decay * (i - s.i_pu[0]).cwiseAbs();
-    const double bound = k.z_sq * v.i_sq * (1.0 + 2.0 * decay * decay);
-    if (remnant.squaredNorm() > 0.0 && remnant.cwiseProduct(remnant).maxCoeff() > bound) bits |= regime_bit::kTransient;
-  } else if (in.timing == SampleTiming::kContiguous && s.slope_valid) {
+  // A standalone sample's transient test calls exp(): judged last (below), so that across the call few values
+  // are live and the common path keeps its values in registers.
+  const bool standalone = in.timing == SampleTiming::kStandalone && s.points >= 1;
+  const Vec2 i_before = s.i_pu[0];
+  if (in.timing == SampleTiming::kContiguous && s.slope_valid) {
     // Consecutive windows: what the steady state and the inductive correction (the slope between window
     // centres) leave out, per row (d, q) in voltage:
     //   (x/ω_n)·|s_k − s_{k−1}|   the slope changed: the correction is exact only for a ramp
@@ -289,7 +306,7 @@ Classification RegimeClassifier::step(const RegimeInput& in) noexcept {
     //   x_o·|Δn|·|Δi_o|/4          mean(n·x·i) − n̄·x·ī, bounded by the ranges' product over 4
     // against the row's noise and the slope change's own noise.
     const double dn = std::abs(n - s.n_pu[0]);
-    const Vec2 di = (i - s.i_pu[0]).cwiseAbs();
+    const Vec2 di = (i - i_before).cwiseAbs();
     Vec2 t = k.inv_omega_n * k.dx.cwiseProduct(abs_sl) + (0.25 * dn) * k.x_swapped.cwiseProduct(di.reverse());
     double slope_noise_sq = 0.0;  // Var(s_k − s_{k−1}) per σ_i²
     if (s.previous_slope_valid) {
@@ -343,7 +360,8 @@ Classification RegimeClassifier::step(const RegimeInput& in) noexcept {
   s.previous_window = window;
   s.previous_bridge_off = off;
   if (learn(s, in, t_s, quotients[1])) [[unlikely]] update_quantisation();
-  return Classification::of(bits);
+  if (standalone) [[unlikely]] bits |= standalone_transient(dt_s / c.electrical_time_constant_s, in.i_pu - i_before, k.z_sq * v.i_sq);
+  return {kRegimeOfBits[bits], bits};
 }
 
 void StreamClassifier::clear_sums() noexcept {
