@@ -231,23 +231,28 @@ Classification RegimeClassifier::step(const RegimeInput& in) noexcept {
   const double dt_s = s.points >= 1 ? t_s - s.t_s[0] : 0.0;
 
   // The current's slope: given (a block's end points), or between consecutive samples of a chain.
-  s.previous_slope_pu_s = s.slope_pu_s;
+  // The tests read the slope and 1/Δt from locals, not back from the state they are stored in (each such
+  // load would wait on its store, on the path from 1/Δt's division to every test).
+  const Vec2 previous_slope = s.slope_pu_s;
+  const double previous_inv_dt = s.inv_dt;
+  s.previous_slope_pu_s = previous_slope;
   s.previous_slope_valid = s.slope_valid;
-  s.previous_inv_dt = s.inv_dt;
+  s.previous_inv_dt = previous_inv_dt;
   const bool linked = s.points >= 1 && dt_s > 0.0 &&
                       (in.timing == SampleTiming::kDense || in.timing == SampleTiming::kContiguous);
-  // 1/Δt and the second difference's w = (t₁ − t₀)/(t₂ − t₀) (learn()) in one division of a pair.
-  const Vec2 quotients(1.0 / dt_s, (s.t_s[0] - s.t_s[1]) / (t_s - s.t_s[1]));
-  s.inv_dt = linked ? quotients[0] : 0.0;
-  s.slope_valid = linked;
+  const double inv_dt = linked ? 1.0 / dt_s : 0.0;
+  const double w = (s.t_s[0] - s.t_s[1]) / (t_s - s.t_s[1]);  // learn()'s w = (t₁ − t₀)/(t₂ − t₀)
+  Vec2 slope = Vec2::Zero();
   if (!linked) {
-    s.slope_pu_s.setZero();
     s.previous_transient = false;
   } else if (std::isnan(in.di_dt_pu_s[0])) {
-    s.slope_pu_s = (in.i_pu - s.i_pu[0]) * s.inv_dt;
+    slope = (in.i_pu - s.i_pu[0]) * inv_dt;
   } else {
-    s.slope_pu_s = in.di_dt_pu_s;
+    slope = in.di_dt_pu_s;
   }
+  s.inv_dt = inv_dt;
+  s.slope_valid = linked;
+  s.slope_pu_s = slope;
 
   noise_ = current_noise();
   const RegimeNoise& v = noise_;
@@ -276,7 +281,7 @@ Classification RegimeClassifier::step(const RegimeInput& in) noexcept {
   // Angle locked: e, what the model leaves to the magnet, lies in the cone of half-angle δ_tol about
   // sgn(n)·q, widened by what the configuration's uncertainty (r within D_M, x within its tolerance) and
   // the noise can put there. Independent of ψm's magnitude. Both axes at once: (d, q) in one vector.
-  const Vec2& sl = s.slope_pu_s;
+  const Vec2& sl = slope;
   const Vec2 abs_sl = sl.cwiseAbs();
   const Vec2 rotation = (n * k.x_swapped).cwiseProduct(i.reverse()).cwiseProduct(Vec2(1.0, -1.0));  // −n·J·x·i
   const Vec2 e = ((in.u_pu - c.r_pu * i) - k.x_over_omega_n.cwiseProduct(sl)) + rotation;
@@ -286,7 +291,7 @@ Classification RegimeClassifier::step(const RegimeInput& in) noexcept {
   const double along = n2 > k.z_sq * v.n_sq ? (n > 0.0 ? e[1] : -e[1]) : std::abs(e[1]);
   const double lock = std::abs(e[0]) - c.tan_angle * (along + b[1]) - b[0];
   if (lock > 0.0) [[unlikely]] {
-    const double slope_sq = 2.0 * s.inv_dt * s.inv_dt;  // Var(s) per σ_i²
+    const double slope_sq = 2.0 * inv_dt * inv_dt;  // Var(s) per σ_i²
     const double var_d = v.u_sq + (k.r_sq + n2_xq2 + k.slope_var_x_sq[0] * slope_sq) * v.i_sq +
                          c.x_q_pu * c.x_q_pu * i[1] * i[1] * v.n_sq;
     const double flux_q = c.psi_max_pu + c.x_d_pu * abs_i[0];
@@ -310,8 +315,8 @@ Classification RegimeClassifier::step(const RegimeInput& in) noexcept {
     Vec2 t = k.inv_omega_n * k.dx.cwiseProduct(abs_sl) + (0.25 * dn) * k.x_swapped.cwiseProduct(di.reverse());
     double slope_noise_sq = 0.0;  // Var(s_k − s_{k−1}) per σ_i²
     if (s.previous_slope_valid) {
-      t += k.inv_omega_n * k.x.cwiseProduct((sl - s.previous_slope_pu_s).cwiseAbs());
-      const double a = s.inv_dt, p = s.previous_inv_dt;
+      t += k.inv_omega_n * k.x.cwiseProduct((sl - previous_slope).cwiseAbs());
+      const double a = inv_dt, p = previous_inv_dt;
       slope_noise_sq = a * a + (a + p) * (a + p) + p * p;
     }
     const double slope_var = k.inv_omega_n_sq * slope_noise_sq * v.i_sq;
@@ -359,7 +364,7 @@ Classification RegimeClassifier::step(const RegimeInput& in) noexcept {
   }
   s.previous_window = window;
   s.previous_bridge_off = off;
-  if (learn(s, in, t_s, quotients[1])) [[unlikely]] update_quantisation();
+  if (learn(s, in, t_s, w)) [[unlikely]] update_quantisation();
   if (standalone) [[unlikely]] bits |= standalone_transient(dt_s / c.electrical_time_constant_s, in.i_pu - i_before, k.z_sq * v.i_sq);
   return {kRegimeOfBits[bits], bits};
 }
