@@ -116,7 +116,7 @@ bool learn(RegimeState& s, const RegimeInput& in, double t_s, double w) noexcept
   const double span = t_s - s.t_s[1];
   if (s.points == 2 && chain && s.chained >= 1 && span > 0.0) {
     // The middle sample against the line through its neighbours, r = x₁ − (w·x₂ + (1 − w)·x₀) with
-    // w = (t₁ − t₀)/(t₂ − t₀) (the caller's, divided with the slope's 1/Δt): zero for a ramp at any
+    // w = (t₁ − t₀)/(t₂ − t₀) (step() divides it beside the slope's 1/Δt): zero for a ramp at any
     // spacing; for white noise of σ its variance is σ²·(1 + w² + (1 − w)²) = σ²·(3/2 + 2·d),
     // d = (w − ½)² ∈ [0, ¼], whose root the factor removes:
     // (3/2 + 2d)^{−½} ≈ 0.81650 − 0.53215·d + 0.37763·d², within 2e-4 (no square root per sample).
