@@ -18,8 +18,8 @@
 #include <vector>
 
 #include "rpem/analysis/diagnose/diagnose_output.hpp"
-#include "support/hidden_effects.hpp"
 #include "rpem/io/drive_log.hpp"
+#include "support/hidden_effects.hpp"
 #include "support/vesc_tool_vectors.hpp"
 
 namespace {
@@ -128,7 +128,8 @@ void BM_DiagnoseVescToolLog(benchmark::State& state) {
     analysis::write_diagnose_report(f.dir, d, "config/vesc-6374-outrunner.yaml");
     // The first row only opens the first window (docs/drive-log.md, "Averaging"): 9 999 samples.
     if (d.log->size() != 9'999) state.SkipWithError("not every row was read");
-    if (!d.calibration.identifiable[0] || std::abs(d.calibration.value[0] / (0.8 * f.config.machine.psi_m_Wb) - 1.0) > 0.02) {
+    if (!d.calibration.identifiable[0] ||
+        std::abs(d.calibration.value[0] / (0.8 * f.config.machine.psi_m_Wb) - 1.0) > 0.02) {
       state.SkipWithError("ψm was not calibrated within 2 %");
     }
     state.counters["rows"] = static_cast<double>(d.log->size());

@@ -16,6 +16,7 @@
 #include <ctime>
 #include <vector>
 
+#include "bench_support.hpp"
 #include "rpem/core/averaged_estimator.hpp"
 #include "rpem/core/clock.hpp"
 #include "rpem/core/drive_estimator.hpp"
@@ -23,7 +24,6 @@
 #include "rpem/core/regime.hpp"
 #include "rpem/core/settings.hpp"
 #include "support/averaged_data.hpp"
-#include "bench_support.hpp"
 #include "support/model_data.hpp"
 #include "support/paper_machine.hpp"
 #include "support/sga_kernel.hpp"
@@ -305,7 +305,6 @@ void BM_AveragedClassificationOverStep(benchmark::State& state) {
   state.counters["ratio"] = classify_s / step_s;
 }
 
-
 /// The classification's cost inside the averaged step, as BM_ClassificationInStep: AveragedDriveEstimator::step
 /// with `estimator.regimes.enabled` and without (which takes the slope between window centres itself), in
 /// alternating blocks. ratio = (with − without)/with.
@@ -338,10 +337,26 @@ void BM_AveragedClassificationInStep(benchmark::State& state) {
   state.counters["ratio"] = (with_s - without_s) / with_s;
 }
 
-BENCHMARK(BM_ClassificationInStep)->MinTime(1.0)->Repetitions(10)->ComputeStatistics("max", max_of)->ReportAggregatesOnly(true);
-BENCHMARK(BM_ClassificationOverStep)->MinTime(1.0)->Repetitions(10)->ComputeStatistics("max", max_of)->ReportAggregatesOnly(true);
-BENCHMARK(BM_AveragedClassificationOverStep)->MinTime(1.0)->Repetitions(10)->ComputeStatistics("max", max_of)->ReportAggregatesOnly(true);
-BENCHMARK(BM_AveragedClassificationInStep)->MinTime(1.0)->Repetitions(10)->ComputeStatistics("max", max_of)->ReportAggregatesOnly(true);
+BENCHMARK(BM_ClassificationInStep)
+    ->MinTime(1.0)
+    ->Repetitions(10)
+    ->ComputeStatistics("max", max_of)
+    ->ReportAggregatesOnly(true);
+BENCHMARK(BM_ClassificationOverStep)
+    ->MinTime(1.0)
+    ->Repetitions(10)
+    ->ComputeStatistics("max", max_of)
+    ->ReportAggregatesOnly(true);
+BENCHMARK(BM_AveragedClassificationOverStep)
+    ->MinTime(1.0)
+    ->Repetitions(10)
+    ->ComputeStatistics("max", max_of)
+    ->ReportAggregatesOnly(true);
+BENCHMARK(BM_AveragedClassificationInStep)
+    ->MinTime(1.0)
+    ->Repetitions(10)
+    ->ComputeStatistics("max", max_of)
+    ->ReportAggregatesOnly(true);
 
 BENCHMARK(BM_StepOverKernel)->MinTime(1.0)->Repetitions(10)->ComputeStatistics("max", max_of)->ReportAggregatesOnly(true);
 

@@ -135,7 +135,11 @@ void BM_EmulatedVescOneSecond(benchmark::State& state) {
   state.counters["switching_real_time_factor"] = switching_cpu_s / seconds;
 }
 
-BENCHMARK(BM_EmulatedVescOneSecond)->Unit(benchmark::kMillisecond)->Iterations(3)->Repetitions(3)->ReportAggregatesOnly(true);
+BENCHMARK(BM_EmulatedVescOneSecond)
+    ->Unit(benchmark::kMillisecond)
+    ->Iterations(3)
+    ->Repetitions(3)
+    ->ReportAggregatesOnly(true);
 
 BENCHMARK(BM_SwitchingOverAveraged)
     ->Unit(benchmark::kMillisecond)

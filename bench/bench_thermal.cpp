@@ -20,10 +20,10 @@
 #include <ctime>
 #include <vector>
 
+#include "bench_support.hpp"
 #include "rpem/core/clock.hpp"
 #include "rpem/core/drive_estimator.hpp"
 #include "rpem/core/thermal_fusion.hpp"
-#include "bench_support.hpp"
 #include "support/model_data.hpp"
 #include "support/paper_machine.hpp"
 #include "support/paper_thermal.hpp"
@@ -94,8 +94,10 @@ core::ThermalStepData step_data(const core::ThermalEstimate& out, std::int64_t k
   d.load.basis = {0.4, 0.16, 0.1};
   d.load.coolant_C = 40.0;
   const double t_m = out.started ? out.magnet_node().t_C : 40.0, t_w = out.started ? out.winding_node().t_C : 40.0;
-  d.parameter[static_cast<std::size_t>(core::kPsiM)] = {true, 1.14 * (1.0 - 0.0012 * (t_m - 20.0)), 0.0, 2.25, 1e-6, 1e-6, 2.0};
-  d.parameter[static_cast<std::size_t>(core::kRs)] = {true, 2.25 * (1.0 + 0.00393 * (t_w - 20.0)), 0.0, 1.14, 1e-4, 1e-4, 2.0};
+  d.parameter[static_cast<std::size_t>(core::kPsiM)] = {true, 1.14 * (1.0 - 0.0012 * (t_m - 20.0)), 0.0, 2.25, 1e-6, 1e-6,
+                                                        2.0};
+  d.parameter[static_cast<std::size_t>(core::kRs)] = {true, 2.25 * (1.0 + 0.00393 * (t_w - 20.0)), 0.0, 1.14, 1e-4, 1e-4,
+                                                      2.0};
   d.winding_sensor_C = t_w;
   d.psi_m_Wb = d.parameter[static_cast<std::size_t>(core::kPsiM)].value;
   d.r_s_Ohm = d.parameter[static_cast<std::size_t>(core::kRs)].value;

@@ -1,10 +1,10 @@
 // A supervisory controller that acts only on estimates it can verify (docs/rpemd.md, "Authentication";
 // the lines between the markers are quoted there, and test_docs_snippet checks the quote).
 //   example_supervisor_verify PUBLISH_KEY_FILE [SECONDS]
-#include <lcm/lcm-cpp.hpp>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
+#include <lcm/lcm-cpp.hpp>
 #include <span>
 #include <string>
 

@@ -14,6 +14,8 @@ packages=(
   liblcm-dev liblcm-bin liblcm-java libjchart2d-java default-jdk-headless
   # tests and benchmarks
   libgtest-dev libgmock-dev libbenchmark-dev clang libclang-rt-14-dev rt-tests
+  # the format and lint gates (scripts/lint.py)
+  clang-format clang-tidy
   # plots
   gnuplot-nox
   # CAN tooling and the PREEMPT_RT VM test rig (qemu, busybox initramfs)

@@ -8,41 +8,57 @@
 #   4. builds rpemd and the daemon's tests with ThreadSanitizer and runs them — the storm test drives
 #      the instrumented rpemd with reloads and commands at once — expecting no report (suppressed: only
 #      the uninstrumented LCM/GLib internals, tests/daemon/tsan.supp)
+#   5. the format and lint gates (scripts/lint.py; docs/architecture.md, "Format and lint"): clang-format
+#      first (seconds), clang-tidy over the production translation units of build/ci last
 # The sanitizer trees of 3 and 4 compile at nice 19 while step 2's tests run: they take only the CPU the
 # tests leave idle (the VM suites' real-time pacing, the serial package test, the last test's tail) and
 # yield it otherwise (CFS weight 15 against 1024), so a test's share of the CPU is what it was without them.
+# clang-tidy on the production units (the chosen checks: ≈ 970 s of CPU, ≈ 8 min at -j2 on two quiet cores;
+# docs/benchmarks.md, "Format and lint gates") follows them at nice 19 too: it yields to the sanitizer tests
+# and delays nothing a test waits for. Its CPU is paid for by what the trees no longer compile (same
+# benchmarks section): build/ci is Release, the -O3 -DNDEBUG of RelWithDebInfo without -g (g++ emits the
+# same code with or without debug information, -fcompare-debug's guarantee: what runs is what ran), a third
+# less compiler time; the sanitizer trees keep line tables only (-g1: every report still names file:line).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 jobs=$(nproc)
 
 scripts/setup.sh
+if ! scripts/lint.py --format; then
+  echo "test.sh: the format gate failed: scripts/lint.py --fix-format rewrites the files listed above" >&2
+  exit 1
+fi
 
-cmake -S . -B build/ci -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DRPEM_WERROR=ON
+cmake -S . -B build/ci -G Ninja -DCMAKE_BUILD_TYPE=Release -DRPEM_WERROR=ON
 cmake --build build/ci -j "$jobs"
 
 sanitizer_builds() {
-  cmake -S . -B build/sanitize -G Ninja -DCMAKE_BUILD_TYPE=Debug -DRPEM_WERROR=ON \
+  cmake -S . -B build/sanitize -G Ninja -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS_DEBUG="-g1" -DRPEM_WERROR=ON \
     -DRPEM_SANITIZE=address,undefined -DRPEM_BUILD_BENCHMARKS=OFF -DRPEM_BUILD_DAEMON=OFF -DRPEM_BUILD_TOOLS=OFF
   cmake --build build/sanitize -j "$jobs" --target test_core test_io test_can test_sim test_sim_vesc test_analysis \
     test_auth test_indep_drive indep_drive_log test_indep_thermal indep_thermal_plant
-  cmake -S . -B build/tsan -G Ninja -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS_DEBUG="-O1 -g" -DRPEM_WERROR=ON \
+  cmake -S . -B build/tsan -G Ninja -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS_DEBUG="-O1 -g1" -DRPEM_WERROR=ON \
     -DRPEM_SANITIZE=thread -DRPEM_BUILD_BENCHMARKS=OFF -DRPEM_BUILD_TOOLS=OFF
   cmake --build build/tsan -j "$jobs" --target rpemd test_daemon test_daemon_allocations test_daemon_storm
 }
 sanitizer_log=build/sanitizer-builds.log
+tidy_log=build/lint-tidy.log
 set -m  # the builds in a process group of their own, so that a failing ctest stops all of them
 (renice -n 19 -p "$BASHPID" >/dev/null && sanitizer_builds) </dev/null >"$sanitizer_log" 2>&1 &
 sanitizer_pid=$!
+# clang-tidy once the sanitizer builds are done (they gate the sanitizer tests; it gates nothing)
+(renice -n 19 -p "$BASHPID" >/dev/null && while kill -0 "$sanitizer_pid" 2>/dev/null; do sleep 5; done &&
+  scripts/lint.py --tidy -p build/ci -j "$jobs") </dev/null >"$tidy_log" 2>&1 &
+tidy_pid=$!
 set +m
-trap 'kill -- "-$sanitizer_pid" 2>/dev/null || true' EXIT
-ctest --test-dir build/ci --output-on-failure -j "$jobs" --timeout 1800
+trap 'kill -- "-$sanitizer_pid" "-$tidy_pid" 2>/dev/null || true' EXIT
+ctest --test-dir build/ci --output-on-failure -j "$jobs" --timeout 1800 -LE lint
 echo "test.sh: waiting for the sanitizer builds (log: $sanitizer_log)"
 if ! wait "$sanitizer_pid"; then
   cat "$sanitizer_log"
   echo "test.sh: the sanitizer builds failed" >&2
   exit 1
 fi
-trap - EXIT
 
 UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1 ASAN_OPTIONS=detect_leaks=1 \
   ctest --test-dir build/sanitize --output-on-failure -j "$jobs" -L unit
@@ -50,4 +66,12 @@ for t in test_daemon test_daemon_allocations test_daemon_storm; do
   TSAN_OPTIONS="suppressions=$PWD/tests/daemon/tsan.supp halt_on_error=1 second_deadlock_stack=1" \
     "build/tsan/tests/daemon/$t" --gtest_brief=1
 done
+echo "test.sh: waiting for clang-tidy (log: $tidy_log)"
+if ! wait "$tidy_pid"; then
+  cat "$tidy_log"
+  echo "test.sh: clang-tidy found something (scripts/lint.py --tidy -p build/ci lists it)" >&2
+  exit 1
+fi
+trap - EXIT
+tail -n 1 "$tidy_log"
 echo "test.sh: all tests passed"

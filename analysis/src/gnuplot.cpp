@@ -1,11 +1,11 @@
 #include "rpem/analysis/gnuplot.hpp"
 
+#include <sys/wait.h>
 #include <array>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <stdexcept>
-#include <sys/wait.h>
 
 #include "rpem/io/number_format.hpp"
 
@@ -53,8 +53,8 @@ void GnuplotFigure::render() const {
     for (const std::string& l : lines_) gp << l << '\n';
     gp << "unset output\n";
   }
-  const std::string cmd = "cd " + gp_quote(png.parent_path().empty() ? "." : png.parent_path().string()) +
-                          " && gnuplot " + gp_quote(script.filename().string()) + " 2>&1";
+  const std::string cmd = "cd " + gp_quote(png.parent_path().empty() ? "." : png.parent_path().string()) + " && gnuplot " +
+                          gp_quote(script.filename().string()) + " 2>&1";
   FILE* pipe = popen(cmd.c_str(), "r");
   if (!pipe) throw std::runtime_error("cannot run gnuplot");
   std::string output;

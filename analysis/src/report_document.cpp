@@ -9,11 +9,20 @@ std::string escape_html(const std::string& s) {
   std::string out;
   for (char c : s) {
     switch (c) {
-      case '&': out += "&amp;"; break;
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '"': out += "&quot;"; break;
-      default: out += c;
+      case '&':
+        out += "&amp;";
+        break;
+      case '<':
+        out += "&lt;";
+        break;
+      case '>':
+        out += "&gt;";
+        break;
+      case '"':
+        out += "&quot;";
+        break;
+      default:
+        out += c;
     }
   }
   return out;
@@ -126,14 +135,15 @@ std::string ReportDocument::html() const {
         h << "<table>";
         for (std::size_t r = 0; r < b.rows.size(); ++r) {
           h << "<tr>";
-          for (const std::string& cell : b.rows[r]) h << (r ? "<td>" : "<th>") << inline_html(cell) << (r ? "</td>" : "</th>");
+          for (const std::string& cell : b.rows[r])
+            h << (r ? "<td>" : "<th>") << inline_html(cell) << (r ? "</td>" : "</th>");
           h << "</tr>";
         }
         h << "</table>\n";
         break;
       case Kind::kFigure:
-        h << "<figure><img src=\"" << escape_html(b.text[0]) << "\" alt=\"" << escape_html(b.text[1])
-          << "\"><figcaption>" << inline_html(b.text[1]) << "</figcaption></figure>\n";
+        h << "<figure><img src=\"" << escape_html(b.text[0]) << "\" alt=\"" << escape_html(b.text[1]) << "\"><figcaption>"
+          << inline_html(b.text[1]) << "</figcaption></figure>\n";
         break;
     }
   }

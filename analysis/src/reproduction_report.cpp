@@ -49,8 +49,8 @@ void write_reproduce_json(const std::string& path, const std::vector<Reproductio
       j["parameter"] = parameter_name(c.parameter);
       j["n_pu"] = c.n_pu;
       j["tau_pu"] = c.tau_pu;
-      j["convergence_time_s"] = run.metrics.convergence_time_s ? nlohmann::json(*run.metrics.convergence_time_s)
-                                                                : nlohmann::json(nullptr);
+      j["convergence_time_s"] =
+          run.metrics.convergence_time_s ? nlohmann::json(*run.metrics.convergence_time_s) : nlohmann::json(nullptr);
       j["steady_state_error_pct"] = run.metrics.steady_state_error_pct;
       j["overshoot_pct"] = run.metrics.overshoot_pct;
       j["wrong_way_pct"] = run.metrics.wrong_way_pct;
@@ -76,9 +76,12 @@ std::string ratio(std::optional<double> ours, std::optional<double> paper) {
 
 const char* role_prefix(CaseRole r) {
   switch (r) {
-    case CaseRole::kPaper: return "";
-    case CaseRole::kHypothesis: return "*hypothesis:* ";
-    case CaseRole::kStudy: return "*study:* ";
+    case CaseRole::kPaper:
+      return "";
+    case CaseRole::kHypothesis:
+      return "*hypothesis:* ";
+    case CaseRole::kStudy:
+      return "*study:* ";
   }
   return "";
 }
@@ -101,7 +104,8 @@ void write_tab_comparison(std::ostringstream& md, const std::vector<Reproduction
     using Figures = std::array<std::optional<double>, 3>;
     auto row = [&](const char* what, const Figures& paper, const Figures& ours) {
       md << "| " << name << ", " << what;
-      for (std::size_t a = 0; a < 2; ++a) md << " | " << fmt(paper[a], 1) << " | " << fmt(ours[a]) << " | " << ratio(ours[a], paper[a]);
+      for (std::size_t a = 0; a < 2; ++a)
+        md << " | " << fmt(paper[a], 1) << " | " << fmt(ours[a]) << " | " << ratio(ours[a], paper[a]);
       md << " | " << fmt(ours[2]) << " |\n";
     };
     Figures times, errors;
@@ -159,8 +163,8 @@ void write_standstill_rs(std::ostringstream& md, const std::vector<ReproductionC
         "|---|---|---|---|---|\n";
   const double ours = initial_error(*paper_case);
   for (const double e0 : {0.02, 0.04, 0.08, ours}) {
-    md << "| " << fmt(100.0 * e0) << " %" << (e0 == ours ? " (ours: the machine 8 % below the offline value)" : "")
-       << " | " << fmt(standstill_rs_time_s(gna, e0)) << " | "
+    md << "| " << fmt(100.0 * e0) << " %" << (e0 == ours ? " (ours: the machine 8 % below the offline value)" : "") << " | "
+       << fmt(standstill_rs_time_s(gna, e0)) << " | "
        << fmt(linearised_rs_bound_s(gna.gamma_r, gna.gamma_L, gna.sample_period_s, e0)) << " | "
        << fmt(standstill_rs_time_s(sga, e0)) << " | "
        << fmt(linearised_rs_bound_s(sga.gamma_r, sga.gamma_L, sga.sample_period_s, e0)) << " |\n";
@@ -174,8 +178,8 @@ void write_standstill_rs(std::ostringstream& md, const std::vector<ReproductionC
   md << "SGA's settled time constant is T_samp/γ_0,Lk = " << fmt(sga.sample_period_s / sga.gamma_L)
      << " s. With its configured start (R[0]/(i/r_s)² = " << fmt(sga_ours.hessian0_rel) << ") it takes tab_comparison's "
      << "8 s and 6 s into ±1 % from an initial error of " << pct(standstill_rs_initial_error_for(sga_ours, 8.0)) << " and "
-     << pct(standstill_rs_initial_error_for(sga_ours, 6.0)) << "; from ours (" << fmt(100.0 * ours)
-     << " %) it is within ±" << fmt(100.0 * std::abs(standstill_rs_error_after(sga_ours, ours, 8.0)), 3) << " % after 8 s and ±"
+     << pct(standstill_rs_initial_error_for(sga_ours, 6.0)) << "; from ours (" << fmt(100.0 * ours) << " %) it is within ±"
+     << fmt(100.0 * std::abs(standstill_rs_error_after(sga_ours, ours, 8.0)), 3) << " % after 8 s and ±"
      << fmt(100.0 * std::abs(standstill_rs_error_after(sga_ours, ours, 6.0)), 3) << " % after 6 s.\n\n";
   md << "Our standstill runs beside the recursion with their own initial Hessians:\n\n";
   md << "| case | algorithm | R[0] / (i/r_s)² | recursion [s] | measured [s] |\n|---|---|---|---|---|\n";
@@ -211,8 +215,8 @@ void write_comparison_markdown(const std::string& path, const std::vector<Reprod
   md << "|---|---|---|---|---|---|---|---|---|---|\n";
   for (const ReproductionCase& c : cases) {
     const CaseResult& r = result_of(results, c.id);
-    md << "| " << c.id << " | " << to_string(c.role) << " | " << c.figure << " | " << c.n_pu << " | " << c.tau_pu
-       << " | " << parameter_name(c.parameter);
+    md << "| " << c.id << " | " << to_string(c.role) << " | " << c.figure << " | " << c.n_pu << " | " << c.tau_pu << " | "
+       << parameter_name(c.parameter);
     for (const AlgorithmRun& run : r.runs) {
       md << " | " << fmt(run.metrics.convergence_time_s) << " / " << fmt(run.metrics.steady_state_error_pct) << " / "
          << fmt(run.metrics.overshoot_pct) << " / " << fmt(run.metrics.wrong_way_pct);
@@ -236,10 +240,11 @@ std::vector<std::string> plot_reproduction(const std::string& dir, const std::ve
   for (const auto& [name, members] : figures) {
     const int panels = static_cast<int>(members.size());
     const int cols = panels > 1 ? 2 : 1, rows = (panels + cols - 1) / cols;
-    GnuplotFigure fig(dir + "/" + name + ".png", 560 * cols, 380 * rows);
+    std::string png = dir;
+    png.append("/").append(name).append(".png");
+    GnuplotFigure fig(png, 560 * cols, 380 * rows);
     fig.add_line("set multiplot layout " + std::to_string(rows) + "," + std::to_string(cols) + " title " +
-                 gp_quote(name + ": estimates of SGA, GNA, PhyInt on the simulated drive (rpem reproduce)") +
-                 " noenhanced");
+                 gp_quote(name + ": estimates of SGA, GNA, PhyInt on the simulated drive (rpem reproduce)") + " noenhanced");
     fig.add_line("set grid; set key bottom right; set xlabel 't [s]'");
     for (const ReproductionCase* c : members) {
       const CaseResult& r = result_of(results, c->id);
@@ -261,12 +266,13 @@ std::vector<std::string> plot_reproduction(const std::string& dir, const std::ve
                    gp_quote(c->description + " (n = " + fmt(c->n_pu, 3) + ", τ = " + fmt(c->tau_pu) + " pu)") +
                    " noenhanced font ',9'");
       fig.add_line(std::string("set ylabel ") + (psi ? "'ψ_m [pu]'" : "'r_s [pu]'"));
-      fig.add_line("plot $" + c->id + " u 1:2 w l lw 2 dt 2 lc 'black' t 'true', '' u 1:3 w l lw 1.5 lc rgb '#1f77b4' t 'SGA', "
+      fig.add_line("plot $" + c->id +
+                   " u 1:2 w l lw 2 dt 2 lc 'black' t 'true', '' u 1:3 w l lw 1.5 lc rgb '#1f77b4' t 'SGA', "
                    "'' u 1:4 w l lw 1.5 lc rgb '#d62728' t 'GNA', '' u 1:5 w l lw 1.5 lc rgb '#2ca02c' t 'PhyInt'");
     }
     fig.add_line("unset multiplot");
     fig.render();
-    written.push_back(dir + "/" + name + ".png");
+    written.push_back(png);
   }
   return written;
 }

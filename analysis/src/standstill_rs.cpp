@@ -10,7 +10,7 @@ namespace {
 /// One sample of the recursion: updates R (relative to (i/r_s)²) and x.
 void step(const StandstillRs& m, double& x, double& r) {
   const double psi = -1.0 / ((1.0 + x) * (1.0 + x));  // Ψ / (i/r_s)
-  const double eps = x / (1.0 + x);                    // ε / i
+  const double eps = x / (1.0 + x);                   // ε / i
   r = (1.0 - m.gamma_r) * r + m.gamma_r * psi * psi;
   x += m.gamma_L * psi * eps / r;
 }
@@ -37,8 +37,8 @@ double standstill_rs_error_after(const StandstillRs& m, double initial_error, do
   return x;
 }
 
-std::optional<double> linearised_rs_bound_s(double gamma_r, double gamma_L, double sample_period_s,
-                                            double initial_error, double band, double horizon_s) {
+std::optional<double> linearised_rs_bound_s(double gamma_r, double gamma_L, double sample_period_s, double initial_error,
+                                            double band, double horizon_s) {
   const auto horizon = static_cast<std::int64_t>(horizon_s / sample_period_s);
   double e = std::abs(initial_error);
   double forget = 1.0;  // (1 − γ_r)^k

@@ -92,10 +92,8 @@ void WorkPool::parallel_for(std::size_t n, const std::function<void(std::size_t)
 }
 
 std::shared_ptr<WorkPool::Loop> WorkPool::newest_open() const {
-  for (auto it = loops_.rbegin(); it != loops_.rend(); ++it) {
-    if ((*it)->open()) return *it;
-  }
-  return nullptr;
+  const auto newest = std::find_if(loops_.rbegin(), loops_.rend(), [](const std::shared_ptr<Loop>& l) { return l->open(); });
+  return newest == loops_.rend() ? nullptr : *newest;
 }
 
 void WorkPool::work() {

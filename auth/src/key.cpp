@@ -37,8 +37,7 @@ void Key::release() noexcept {
   id_ = 0;
 }
 
-Key::Key(Key&& other) noexcept
-    : id_(std::exchange(other.id_, 0)), bytes_(std::exchange(other.bytes_, nullptr)) {}
+Key::Key(Key&& other) noexcept : id_(std::exchange(other.id_, 0)), bytes_(std::exchange(other.bytes_, nullptr)) {}
 
 Key& Key::operator=(Key&& other) noexcept {
   if (this != &other) {

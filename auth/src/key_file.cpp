@@ -11,6 +11,8 @@
 #include <limits>
 #include <string_view>
 
+#include "rpem/core/errno_text.hpp"
+
 namespace rpem::auth {
 namespace {
 
@@ -58,7 +60,8 @@ Key parse_key(const std::string& text, const std::string& where) {
   try {
     std::size_t used = 0;
     const long long value = std::stoll(id_text, &used);
-    if (used != id_text.size() || value <= 0 || value > std::numeric_limits<std::int32_t>::max()) throw std::out_of_range("");
+    if (used != id_text.size() || value <= 0 || value > std::numeric_limits<std::int32_t>::max())
+      throw std::out_of_range("");
     id = static_cast<std::int32_t>(value);
   } catch (const std::exception&) {
     throw fail("key id `" + id_text + "` is not a whole number in 1..2147483647");
@@ -85,18 +88,19 @@ std::string format_key(const Key& key) {
 
 Key load_key_file(const std::string& path) {
   const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NOFOLLOW);
-  if (fd < 0) throw KeyError(path + ": cannot open the key file: " + std::strerror(errno));
+  if (fd < 0) throw KeyError(path + ": cannot open the key file: " + core::errno_text(errno));
   struct stat st {};
   std::string text;
   std::string problem;
   if (::fstat(fd, &st) != 0) {
-    problem = std::string("stat: ") + std::strerror(errno);
+    problem = std::string("stat: ") + core::errno_text(errno);
   } else if (!S_ISREG(st.st_mode)) {
     problem = "not a regular file";
   } else if ((st.st_mode & 077) != 0) {
     char mode[8];
     std::snprintf(mode, sizeof mode, "%04o", static_cast<unsigned>(st.st_mode & 07777));
-    problem = std::string("mode ") + mode + " lets its group or others at it; a key file must be the owner's alone (chmod 600)";
+    problem =
+        std::string("mode ") + mode + " lets its group or others at it; a key file must be the owner's alone (chmod 600)";
   } else if (st.st_size > static_cast<off_t>(kMaxFileBytes)) {
     problem = "larger than a key file can be";
   } else {
@@ -123,7 +127,7 @@ Key generate_key(std::int32_t id) {
 
 void write_key_file(const std::string& path, const Key& key) {
   const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0600);
-  if (fd < 0) throw KeyError(path + ": cannot create the key file: " + std::strerror(errno));
+  if (fd < 0) throw KeyError(path + ": cannot create the key file: " + core::errno_text(errno));
   std::string text = format_key(key);
   const WipeOnExit wipe{text};
   const bool ok = ::write(fd, text.data(), text.size()) == static_cast<ssize_t>(text.size()) && ::fsync(fd) == 0;

@@ -54,11 +54,16 @@ bool sign(const Key& key, std::string_view channel, std::span<std::uint8_t> enco
 
 const char* to_string(Verdict v) noexcept {
   switch (v) {
-    case Verdict::kVerified: return "verified";
-    case Verdict::kUnsigned: return "unsigned";
-    case Verdict::kUnknownKey: return "unknown key";
-    case Verdict::kBadMac: return "bad MAC";
-    case Verdict::kMalformed: return "malformed";
+    case Verdict::kVerified:
+      return "verified";
+    case Verdict::kUnsigned:
+      return "unsigned";
+    case Verdict::kUnknownKey:
+      return "unknown key";
+    case Verdict::kBadMac:
+      return "bad MAC";
+    case Verdict::kMalformed:
+      return "malformed";
   }
   return "?";
 }

@@ -36,8 +36,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     if (got > 3) std::abort();
     for (std::size_t k = 0; k < got; ++k) {
       const auto& s = out[k];
-      if (!s.i_A.allFinite() || !s.u_V.allFinite() || !std::isfinite(s.theta_el_rad) ||
-          !std::isfinite(s.omega_el_rad_s) || !std::isfinite(s.u_dc_V)) {
+      if (!s.i_A.allFinite() || !s.u_V.allFinite() || !std::isfinite(s.theta_el_rad) || !std::isfinite(s.omega_el_rad_s) ||
+          !std::isfinite(s.u_dc_V)) {
         std::abort();
       }
       if (s.t_ns <= last_t) std::abort();

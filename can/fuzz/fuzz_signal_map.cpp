@@ -23,12 +23,18 @@ using rpem::can::SignalSpec;
 rpem::can::SignalMap rotor_frame_map() {
   rpem::can::SignalMap m;
   m.trigger_id = 0x20;
-  m.frames.push_back({0x10, false, 8, {{SampleField::kIdA, 0, 16, false, true, 0.01, 0.0},
-                                       {SampleField::kIqA, 16, 16, false, true, 0.01, 0.0},
-                                       {SampleField::kUdV, 32, 16, false, true, 0.1, 0.0},
-                                       {SampleField::kUqV, 48, 16, false, true, 0.1, 0.0}}});
-  m.frames.push_back({0x20, false, 6, {{SampleField::kSpeedMechRpm, 0, 32, false, true, 1.0, 0.0},
-                                       {SampleField::kUdcV, 32, 16, false, false, 0.1, -5.0}}});
+  m.frames.push_back({0x10,
+                      false,
+                      8,
+                      {{SampleField::kIdA, 0, 16, false, true, 0.01, 0.0},
+                       {SampleField::kIqA, 16, 16, false, true, 0.01, 0.0},
+                       {SampleField::kUdV, 32, 16, false, true, 0.1, 0.0},
+                       {SampleField::kUqV, 48, 16, false, true, 0.1, 0.0}}});
+  m.frames.push_back(
+      {0x20,
+       false,
+       6,
+       {{SampleField::kSpeedMechRpm, 0, 32, false, true, 1.0, 0.0}, {SampleField::kUdcV, 32, 16, false, false, 0.1, -5.0}}});
   m.pole_pairs = 7;
   return m;
 }
@@ -38,19 +44,26 @@ rpem::can::SignalMap phase_map() {
   m.trigger_id = 0x18FF0002;
   m.trigger_extended = true;
   m.averaged = true;
-  m.frames.push_back({0x18FF0001, true, 8, {{SampleField::kIaA, 7, 16, true, true, 0.001, 0.0},
-                                            {SampleField::kIbA, 23, 16, true, true, 0.001, 0.0},
-                                            {SampleField::kThetaElRad, 39, 16, true, false, 9.5873799e-5, 0.0},
-                                            {SampleField::kErpm, 55, 16, true, true, 1.0, 0.0}}});
-  m.frames.push_back({0x18FF0002, true, 8, {{SampleField::kUaV, 7, 20, true, true, 0.001, 0.0},
-                                            {SampleField::kUbV, 19, 20, true, true, 0.001, 0.0},
-                                            {SampleField::kUcV, 48, 16, false, true, 0.01, 0.0}}});
+  m.frames.push_back({0x18FF0001,
+                      true,
+                      8,
+                      {{SampleField::kIaA, 7, 16, true, true, 0.001, 0.0},
+                       {SampleField::kIbA, 23, 16, true, true, 0.001, 0.0},
+                       {SampleField::kThetaElRad, 39, 16, true, false, 9.5873799e-5, 0.0},
+                       {SampleField::kErpm, 55, 16, true, true, 1.0, 0.0}}});
+  m.frames.push_back({0x18FF0002,
+                      true,
+                      8,
+                      {{SampleField::kUaV, 7, 20, true, true, 0.001, 0.0},
+                       {SampleField::kUbV, 19, 20, true, true, 0.001, 0.0},
+                       {SampleField::kUcV, 48, 16, false, true, 0.01, 0.0}}});
   return m;
 }
 
 rpem::can::SignalMap float_map() {
   using rpem::can::ValueType;
-  const auto f = [](SampleField field, int start, int length, bool big, ValueType t, double scale = 1.0, double offset = 0.0) {
+  const auto f = [](SampleField field, int start, int length, bool big, ValueType t, double scale = 1.0,
+                    double offset = 0.0) {
     SignalSpec s{field, start, length, big, false, scale, offset};
     s.value_type = t;
     return s;
@@ -60,7 +73,8 @@ rpem::can::SignalMap float_map() {
   m.trigger_id = 0x32;
   m.averaged = true;
   m.frames.push_back({0x30, false, 8, {f(SampleField::kIdA, 0, 32, false, k32), f(SampleField::kIqA, 39, 32, true, k32)}});
-  m.frames.push_back({0x31, false, 8, {f(SampleField::kUdV, 0, 32, false, k32, 1e3), f(SampleField::kUqV, 32, 32, false, k32, 1e3)}});
+  m.frames.push_back(
+      {0x31, false, 8, {f(SampleField::kUdV, 0, 32, false, k32, 1e3), f(SampleField::kUqV, 32, 32, false, k32, 1e3)}});
   m.frames.push_back({0x32, false, 8, {f(SampleField::kOmegaElRadS, 7, 64, true, k64)}});
   m.frames.push_back({0x33, false, 8, {f(SampleField::kUdcV, 0, 64, false, k64, 1e12)}});
   m.frames.push_back({0x34, false, 4, {f(SampleField::kTWindingC, 7, 32, true, k32, 0.1, -40.0)}});
@@ -92,7 +106,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     if (decoder.decode(f, t, s)) {
       ++samples;
       if (!s.i_dq_A.allFinite() || !s.u_dq_V.allFinite() || !std::isfinite(s.omega_el_rad_s)) std::abort();
-      if (!optional_ok(s.u_dc_V) || !optional_ok(s.t_winding_C) || !optional_ok(s.t_magnet_C) || !optional_ok(s.t_drive_C)) std::abort();
+      if (!optional_ok(s.u_dc_V) || !optional_ok(s.t_winding_C) || !optional_ok(s.t_magnet_C) || !optional_ok(s.t_drive_C))
+        std::abort();
       if (s.t_start_ns > s.t_ns || s.t_ns <= last_t) std::abort();
       last_t = s.t_ns;
     }

@@ -31,8 +31,8 @@ struct Harness {
         const v::Values& x = decoder.values();
         if ((x.mask & v::kEstimatorMask) != v::kEstimatorMask) std::abort();
         const auto s = v::to_averaged_sample(x, 0, 1);
-        if (!s.i_dq_A.allFinite() || !s.u_dq_V.allFinite() || !std::isfinite(s.omega_el_rad_s) ||
-            !std::isfinite(s.u_dc_V) || !std::isfinite(s.t_winding_C) || !std::isfinite(s.t_drive_C)) {
+        if (!s.i_dq_A.allFinite() || !s.u_dq_V.allFinite() || !std::isfinite(s.omega_el_rad_s) || !std::isfinite(s.u_dc_V) ||
+            !std::isfinite(s.t_winding_C) || !std::isfinite(s.t_drive_C)) {
           std::abort();
         }
         break;
@@ -80,8 +80,12 @@ struct Harness {
       offer(frame(v::Packet::kFillRxBufferLong, b, k + 2));
     }
     const std::uint16_t crc = rpem::can::crc16_ccitt_false(p, n, 0);
-    const std::uint8_t end[6] = {kController, 1, static_cast<std::uint8_t>(n >> 8), static_cast<std::uint8_t>(n),
-                                 static_cast<std::uint8_t>(crc >> 8), static_cast<std::uint8_t>(crc)};
+    const std::uint8_t end[6] = {kController,
+                                 1,
+                                 static_cast<std::uint8_t>(n >> 8),
+                                 static_cast<std::uint8_t>(n),
+                                 static_cast<std::uint8_t>(crc >> 8),
+                                 static_cast<std::uint8_t>(crc)};
     offer(frame(v::Packet::kProcessRxBuffer, end, 6));
   }
 };

@@ -43,7 +43,9 @@ double frame_time_s(const WireFrame& f, const BusTiming& t) noexcept {
   return b.nominal / t.nominal_bit_rate + b.data / t.data_bit_rate;
 }
 
-double frame_time_s(bool fd, int n, const BusTiming& t) noexcept { return frame_time_s(WireFrame{fd, false, n, 1.0}, t); }
+double frame_time_s(bool fd, int payload_bytes, const BusTiming& timing) noexcept {
+  return frame_time_s(WireFrame{fd, false, payload_bytes, 1.0}, timing);
+}
 
 double time_per_sample_s(const Traffic& traffic, int drives, const BusTiming& t) noexcept {
   double drive_s = 0.0, bus_s = 0.0;
@@ -80,11 +82,11 @@ Traffic signal_map_traffic(const SignalMap& map, bool fd, bool sync) {
   return t;
 }
 
-BusBudget telemetry_budget(bool fd, double rate, int per_frame, const BusTiming& t) {
+BusBudget telemetry_budget(bool fd, double sample_rate_Hz, int samples_per_fd_frame, const BusTiming& timing) {
   BusBudget b;
-  const Traffic traffic = native_traffic(fd, per_frame);
-  b.frames_per_s = rate * traffic.per_drive.front().per_sample;
-  b.load = rate * time_per_sample_s(traffic, 1, t);
+  const Traffic traffic = native_traffic(fd, samples_per_fd_frame);
+  b.frames_per_s = sample_rate_Hz * traffic.per_drive.front().per_sample;
+  b.load = sample_rate_Hz * time_per_sample_s(traffic, 1, timing);
   return b;
 }
 

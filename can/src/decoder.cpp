@@ -24,8 +24,7 @@ Value check_u16(std::uint16_t raw) noexcept {
 
 /// Builds a sample from raw fields; false (and the kind counted) if any field is unusable.
 bool build(const std::array<std::int16_t, 3>& i, const std::array<std::int16_t, 3>& u, std::uint16_t theta,
-           std::int16_t omega, std::uint16_t u_dc, std::uint8_t status, DecoderCounters& c,
-           core::DriveSample& s) noexcept {
+           std::int16_t omega, std::uint16_t u_dc, std::uint8_t status, DecoderCounters& c, core::DriveSample& s) noexcept {
   Value worst = check_u16(u_dc);
   auto fold = [&](Value v) {
     if (v == Value::kInvalid || (v == Value::kSaturated && worst == Value::kOk)) worst = v;
@@ -116,7 +115,7 @@ bool TelemetryDecoder::accept(core::DriveSample& s) noexcept {
 std::size_t TelemetryDecoder::decode(const CanFrame& f, std::span<core::DriveSample> out) noexcept {
   ++counters_.frames;
   if (f.error) return 0;  // error frames are counted by the transport
-  if (f.extended) {      // telemetry uses standard IDs only; an extended one (e.g. a VESC's) is not ours
+  if (f.extended) {       // telemetry uses standard IDs only; an extended one (e.g. a VESC's) is not ours
     ++counters_.unknown_id;
     return 0;
   }

@@ -15,11 +15,24 @@ struct FieldInfo {
   std::string_view name, unit;
 };
 constexpr std::array<FieldInfo, kSampleFieldCount> kFields = {{
-    {"i_d", "A"}, {"i_q", "A"}, {"u_d", "V"}, {"u_q", "V"},
-    {"i_a", "A"}, {"i_b", "A"}, {"i_c", "A"}, {"u_a", "V"}, {"u_b", "V"}, {"u_c", "V"},
+    {"i_d", "A"},
+    {"i_q", "A"},
+    {"u_d", "V"},
+    {"u_q", "V"},
+    {"i_a", "A"},
+    {"i_b", "A"},
+    {"i_c", "A"},
+    {"u_a", "V"},
+    {"u_b", "V"},
+    {"u_c", "V"},
     {"theta_el", "rad"},
-    {"omega_el", "rad/s"}, {"erpm", "rpm"}, {"speed_mech", "rpm"},
-    {"u_dc", "V"}, {"T_winding", "degC"}, {"T_magnet", "degC"}, {"T_drive", "degC"},
+    {"omega_el", "rad/s"},
+    {"erpm", "rpm"},
+    {"speed_mech", "rpm"},
+    {"u_dc", "V"},
+    {"T_winding", "degC"},
+    {"T_magnet", "degC"},
+    {"T_drive", "degC"},
 }};
 
 /// DBC bit positions of a signal, MSB first for big endian (the "sawtooth" numbering: bit 7 of byte 0 is
@@ -50,8 +63,8 @@ std::string float_problem(const SignalSpec& s) {
   if (s.length != bits) return std::string(name) + " is " + std::to_string(bits) + " bits, not " + std::to_string(s.length);
   // Byte-aligned: the LSB at bit 0 of a byte (little endian) or the MSB at bit 7 of a byte (big endian).
   if (s.start_bit % 8 != (s.big_endian ? 7 : 0)) {
-    return std::string(name) + " must start on a byte boundary (start_bit " + (s.big_endian ? "8k+7 for big_endian" : "8k for little_endian") +
-           ", not " + std::to_string(s.start_bit) + ")";
+    return std::string(name) + " must start on a byte boundary (start_bit " +
+           (s.big_endian ? "8k+7 for big_endian" : "8k for little_endian") + ", not " + std::to_string(s.start_bit) + ")";
   }
   if (s.is_signed) return std::string(name) + " carries its own sign: leave out `signed`";
   return {};
@@ -84,9 +97,11 @@ std::string check_layout(const SignalMap& map) {
     for (const SignalSpec& s : f.signals) {
       const std::string where = "frame " + std::to_string(f.id) + ", signal " + std::string(field_name(s.field));
       if (s.length < 1 || s.length > 64) return where + ": length must be 1-64 bits";
-      if (!walk_bits(s, 8 * f.length, [](int) {})) return where + ": bits lie outside the frame's " + std::to_string(f.length) + " bytes";
-      if (!std::isfinite(s.scale) || s.scale == 0.0 || !std::isfinite(s.offset)) return where + ": scale must be finite and non-zero, offset finite";
-      if (const std::string e = float_problem(s); !e.empty()) return where + ": " + e;
+      if (!walk_bits(s, 8 * f.length, [](int) {}))
+        return where + ": bits lie outside the frame's " + std::to_string(f.length) + " bytes";
+      if (!std::isfinite(s.scale) || s.scale == 0.0 || !std::isfinite(s.offset))
+        return where + ": scale must be finite and non-zero, offset finite";
+      if (const std::string e = float_problem(s); !e.empty()) return std::string(where).append(": ").append(e);
     }
   }
   bool trigger = false;
@@ -136,9 +151,15 @@ double physical_value(const CanFrame& f, const SignalSpec& s) noexcept {
   const auto bits = static_cast<std::uint64_t>(raw);
   double v = 0.0;
   switch (s.value_type) {
-    case ValueType::kFloat32: v = static_cast<double>(std::bit_cast<float>(static_cast<std::uint32_t>(bits))); break;
-    case ValueType::kFloat64: v = std::bit_cast<double>(bits); break;
-    case ValueType::kInteger: v = s.is_signed ? static_cast<double>(raw) : static_cast<double>(bits); break;
+    case ValueType::kFloat32:
+      v = static_cast<double>(std::bit_cast<float>(static_cast<std::uint32_t>(bits)));
+      break;
+    case ValueType::kFloat64:
+      v = std::bit_cast<double>(bits);
+      break;
+    case ValueType::kInteger:
+      v = s.is_signed ? static_cast<double>(raw) : static_cast<double>(bits);
+      break;
   }
   return v * s.scale + s.offset;
 }
@@ -200,8 +221,8 @@ bool SignalMapDecoder::complete(std::int64_t t_ns, core::AveragedSample& out) no
   auto value = [&](F f) { return values_[static_cast<std::size_t>(f)]; };
   const bool dq_i = has(F::kIdA) && has(F::kIqA);
   const bool dq_u = has(F::kUdV) && has(F::kUqV);
-  const bool abc_i = has(F::kIaA) && has(F::kIbA) && (has(F::kIcA) || !mapped_[static_cast<std::size_t>(F::kIcA)]) &&
-                     has(F::kThetaElRad);
+  const bool abc_i =
+      has(F::kIaA) && has(F::kIbA) && (has(F::kIcA) || !mapped_[static_cast<std::size_t>(F::kIcA)]) && has(F::kThetaElRad);
   const bool abc_u = has(F::kUaV) && has(F::kUbV) && has(F::kUcV) && has(F::kThetaElRad);
   const bool speed = has(F::kOmegaElRadS) || has(F::kErpm) || (has(F::kSpeedMechRpm) && map_.pole_pairs > 0);
   if (!((dq_i || abc_i) && (dq_u || abc_u) && speed)) {

@@ -17,6 +17,7 @@
 #include <stdexcept>
 
 #include "rpem/core/clock.hpp"
+#include "rpem/core/errno_text.hpp"
 
 static_assert(rpem::can::kEffFlag == CAN_EFF_FLAG && rpem::can::kRtrFlag == CAN_RTR_FLAG &&
               rpem::can::kEffMask == CAN_EFF_MASK);
@@ -24,7 +25,25 @@ static_assert(rpem::can::kEffFlag == CAN_EFF_FLAG && rpem::can::kRtrFlag == CAN_
 namespace rpem::can {
 namespace {
 
-std::string errno_text(const char* what) { return std::string(what) + ": " + std::strerror(errno); }
+std::string errno_text(const char* what) { return std::string(what) + ": " + core::errno_text(errno); }
+
+/// The frame a raw socket read: classic or FD (by the read's size), error, extended or standard.
+CanFrame to_can_frame(const canfd_frame& raw, bool fd) {
+  CanFrame frame{};
+  frame.fd = fd;
+  frame.len = std::min<std::uint8_t>(raw.len, frame.fd ? 64 : 8);
+  std::memcpy(frame.data.data(), raw.data, frame.len);
+  if (raw.can_id & CAN_ERR_FLAG) {
+    frame.error = true;
+    frame.id = raw.can_id & CAN_ERR_MASK;
+  } else if (raw.can_id & CAN_EFF_FLAG) {
+    frame.extended = true;
+    frame.id = raw.can_id & CAN_EFF_MASK;
+  } else {
+    frame.id = raw.can_id & CAN_SFF_MASK;
+  }
+  return frame;
+}
 
 }  // namespace
 
@@ -112,11 +131,34 @@ void SocketCanChannel::count_error_frame(const CanFrame& f) {
   }
 }
 
+std::int64_t SocketCanChannel::read_ancillary(msghdr& msg) {
+  std::int64_t kernel_rx_ns = 0;
+  for (cmsghdr* c = CMSG_FIRSTHDR(&msg); c != nullptr; c = CMSG_NXTHDR(&msg, c)) {
+    if (c->cmsg_level != SOL_SOCKET) continue;
+    if (c->cmsg_type == SO_TIMESTAMPING) {
+      timespec ts[3];
+      std::memcpy(ts, CMSG_DATA(c), sizeof ts);
+      kernel_rx_ns = core::to_ns(ts[0]);
+    } else if (c->cmsg_type == SO_TIMESTAMP) {
+      timeval tv{};
+      std::memcpy(&tv, CMSG_DATA(c), sizeof tv);
+      kernel_rx_ns = core::to_ns(tv);
+    } else if (c->cmsg_type == SO_RXQ_OVFL) {
+      std::uint32_t overflow = 0;
+      std::memcpy(&overflow, CMSG_DATA(c), sizeof overflow);
+      counters_.kernel_drops += static_cast<std::uint32_t>(overflow - last_overflow_);  // wraps with it
+      last_overflow_ = overflow;
+    }
+  }
+  return kernel_rx_ns;
+}
+
 std::size_t SocketCanChannel::receive_for(std::span<ReceivedFrame> out, std::int64_t timeout_ns) {
   timeout_ns = std::max<std::int64_t>(timeout_ns, 0);
   if (fd_ < 0) {
     if (core::now_ns(CLOCK_MONOTONIC) < next_open_attempt_ns_ || !open()) {
-      const std::int64_t pause_ns = std::min<std::int64_t>(timeout_ns, std::int64_t{options_.reopen_interval_ms} * 1'000'000);
+      const std::int64_t pause_ns =
+          std::min<std::int64_t>(timeout_ns, std::int64_t{options_.reopen_interval_ms} * 1'000'000);
       timespec pause{static_cast<time_t>(pause_ns / 1'000'000'000), static_cast<long>(pause_ns % 1'000'000'000)};
       nanosleep(&pause, nullptr);
       return 0;
@@ -130,7 +172,7 @@ std::size_t SocketCanChannel::receive_for(std::span<ReceivedFrame> out, std::int
     int err = 0;
     socklen_t len = sizeof err;
     (void)getsockopt(fd_, SOL_SOCKET, SO_ERROR, &err, &len);
-    close_socket(std::string("socket error: ") + std::strerror(err));
+    close_socket(std::string("socket error: ") + core::errno_text(err));
     return 0;
   }
   std::size_t n = 0;
@@ -151,38 +193,9 @@ std::size_t SocketCanChannel::receive_for(std::span<ReceivedFrame> out, std::int
       break;
     }
     ReceivedFrame& r = out[n];
-    r.frame = CanFrame{};
-    r.kernel_rx_ns = 0;
-    for (cmsghdr* c = CMSG_FIRSTHDR(&msg); c != nullptr; c = CMSG_NXTHDR(&msg, c)) {
-      if (c->cmsg_level != SOL_SOCKET) continue;
-      if (c->cmsg_type == SO_TIMESTAMPING) {
-        timespec ts[3];
-        std::memcpy(ts, CMSG_DATA(c), sizeof ts);
-        r.kernel_rx_ns = core::to_ns(ts[0]);
-      } else if (c->cmsg_type == SO_TIMESTAMP) {
-        timeval tv{};
-        std::memcpy(&tv, CMSG_DATA(c), sizeof tv);
-        r.kernel_rx_ns = core::to_ns(tv);
-      } else if (c->cmsg_type == SO_RXQ_OVFL) {
-        std::uint32_t overflow = 0;
-        std::memcpy(&overflow, CMSG_DATA(c), sizeof overflow);
-        counters_.kernel_drops += static_cast<std::uint32_t>(overflow - last_overflow_);  // wraps with it
-        last_overflow_ = overflow;
-      }
-    }
-    r.frame.fd = got == static_cast<ssize_t>(CANFD_MTU);
-    r.frame.len = std::min<std::uint8_t>(raw.len, r.frame.fd ? 64 : 8);
-    std::memcpy(r.frame.data.data(), raw.data, r.frame.len);
-    if (raw.can_id & CAN_ERR_FLAG) {
-      r.frame.error = true;
-      r.frame.id = raw.can_id & CAN_ERR_MASK;
-      count_error_frame(r.frame);
-    } else if (raw.can_id & CAN_EFF_FLAG) {
-      r.frame.extended = true;
-      r.frame.id = raw.can_id & CAN_EFF_MASK;
-    } else {
-      r.frame.id = raw.can_id & CAN_SFF_MASK;
-    }
+    r.kernel_rx_ns = read_ancillary(msg);
+    r.frame = to_can_frame(raw, got == static_cast<ssize_t>(CANFD_MTU));
+    if (r.frame.error) count_error_frame(r.frame);
     ++counters_.rx_frames;
     ++n;
   }

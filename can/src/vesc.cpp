@@ -47,31 +47,74 @@ class Reader {
 
 void read_field(Reader& r, Field f, Values& v) noexcept {
   switch (f) {
-    case kTempFet: v.temp_fet_C = r.f16(1e1); break;
-    case kTempMotor: v.temp_motor_C = r.f16(1e1); break;
-    case kCurrentMotor: v.current_motor_A = r.f32(1e2); break;
-    case kCurrentIn: v.current_in_A = r.f32(1e2); break;
-    case kId: v.i_d_A = r.f32(1e2); break;
-    case kIq: v.i_q_A = r.f32(1e2); break;
-    case kDuty: v.duty = r.f16(1e3); break;
-    case kRpm: v.erpm = r.f32(1e0); break;
-    case kVin: v.v_in_V = r.f16(1e1); break;
-    case kAmpHours: v.amp_hours_Ah = r.f32(1e4); break;
-    case kAmpHoursCharged: v.amp_hours_charged_Ah = r.f32(1e4); break;
-    case kWattHours: v.watt_hours_Wh = r.f32(1e4); break;
-    case kWattHoursCharged: v.watt_hours_charged_Wh = r.f32(1e4); break;
-    case kTachometer: v.tachometer = r.i32(); break;
-    case kTachometerAbs: v.tachometer_abs = r.i32(); break;
-    case kFault: v.fault = r.u8(); break;
-    case kPidPos: v.pid_pos_deg = r.f32(1e6); break;
-    case kControllerId: v.controller_id = r.u8(); break;
+    case kTempFet:
+      v.temp_fet_C = r.f16(1e1);
+      break;
+    case kTempMotor:
+      v.temp_motor_C = r.f16(1e1);
+      break;
+    case kCurrentMotor:
+      v.current_motor_A = r.f32(1e2);
+      break;
+    case kCurrentIn:
+      v.current_in_A = r.f32(1e2);
+      break;
+    case kId:
+      v.i_d_A = r.f32(1e2);
+      break;
+    case kIq:
+      v.i_q_A = r.f32(1e2);
+      break;
+    case kDuty:
+      v.duty = r.f16(1e3);
+      break;
+    case kRpm:
+      v.erpm = r.f32(1e0);
+      break;
+    case kVin:
+      v.v_in_V = r.f16(1e1);
+      break;
+    case kAmpHours:
+      v.amp_hours_Ah = r.f32(1e4);
+      break;
+    case kAmpHoursCharged:
+      v.amp_hours_charged_Ah = r.f32(1e4);
+      break;
+    case kWattHours:
+      v.watt_hours_Wh = r.f32(1e4);
+      break;
+    case kWattHoursCharged:
+      v.watt_hours_charged_Wh = r.f32(1e4);
+      break;
+    case kTachometer:
+      v.tachometer = r.i32();
+      break;
+    case kTachometerAbs:
+      v.tachometer_abs = r.i32();
+      break;
+    case kFault:
+      v.fault = r.u8();
+      break;
+    case kPidPos:
+      v.pid_pos_deg = r.f32(1e6);
+      break;
+    case kControllerId:
+      v.controller_id = r.u8();
+      break;
     case kTempMos123:
       for (double& t : v.temp_mos_C) t = r.f16(1e1);
       break;
-    case kVd: v.v_d_V = r.f32(1e3); break;
-    case kVq: v.v_q_V = r.f32(1e3); break;
-    case kStatusBits: v.status_bits = r.u8(); break;
-    case kFieldCount: break;
+    case kVd:
+      v.v_d_V = r.f32(1e3);
+      break;
+    case kVq:
+      v.v_q_V = r.f32(1e3);
+      break;
+    case kStatusBits:
+      v.status_bits = r.u8();
+      break;
+    case kFieldCount:
+      break;
   }
 }
 
@@ -116,8 +159,8 @@ std::array<KernelFilter, 3> kernel_filters(std::uint8_t controller_id, std::uint
 }
 
 std::array<KernelFilter, 2> controller_kernel_filters(std::uint8_t controller_id) noexcept {
-  return {{addressed_to(controller_id, Packet::kProcessShortBuffer),
-           addressed_to(kBroadcastId, Packet::kProcessShortBuffer)}};
+  return {
+      {addressed_to(controller_id, Packet::kProcessShortBuffer), addressed_to(kBroadcastId, Packet::kProcessShortBuffer)}};
 }
 
 VescDecoder::VescDecoder(std::uint8_t controller_id, std::uint8_t own_id, std::uint32_t required_mask) noexcept
@@ -232,7 +275,8 @@ VescDecoder::Event VescDecoder::fill(const CanFrame& f, std::size_t header) noex
     fill_ = 0;
     return Event::kNone;
   }
-  std::copy_n(f.data.begin() + static_cast<std::ptrdiff_t>(header), n, buffer_.begin() + static_cast<std::ptrdiff_t>(offset));
+  std::copy_n(f.data.begin() + static_cast<std::ptrdiff_t>(header), n,
+              buffer_.begin() + static_cast<std::ptrdiff_t>(offset));
   fill_ = offset + n;
   return Event::kNone;
 }

@@ -28,8 +28,7 @@ class Writer {
   explicit Writer(std::span<std::uint8_t> out) noexcept : out_(out) {}
   void u8(std::uint8_t v) noexcept { put(&v, 1); }
   void i16(std::int16_t v) noexcept {
-    const std::uint8_t b[2] = {static_cast<std::uint8_t>(static_cast<std::uint16_t>(v) >> 8),
-                               static_cast<std::uint8_t>(v)};
+    const std::uint8_t b[2] = {static_cast<std::uint8_t>(static_cast<std::uint16_t>(v) >> 8), static_cast<std::uint8_t>(v)};
     put(b, 2);
   }
   void i32(std::int32_t v) noexcept {
@@ -58,31 +57,74 @@ class Writer {
 
 void write_field(Writer& w, Field f, const Values& v) noexcept {
   switch (f) {
-    case kTempFet: w.f16(v.temp_fet_C, 1e1f); break;
-    case kTempMotor: w.f16(v.temp_motor_C, 1e1f); break;
-    case kCurrentMotor: w.f32(v.current_motor_A, 1e2f); break;
-    case kCurrentIn: w.f32(v.current_in_A, 1e2f); break;
-    case kId: w.f32(v.i_d_A, 1e2f); break;
-    case kIq: w.f32(v.i_q_A, 1e2f); break;
-    case kDuty: w.f16(v.duty, 1e3f); break;
-    case kRpm: w.f32(v.erpm, 1e0f); break;
-    case kVin: w.f16(v.v_in_V, 1e1f); break;
-    case kAmpHours: w.f32(v.amp_hours_Ah, 1e4f); break;
-    case kAmpHoursCharged: w.f32(v.amp_hours_charged_Ah, 1e4f); break;
-    case kWattHours: w.f32(v.watt_hours_Wh, 1e4f); break;
-    case kWattHoursCharged: w.f32(v.watt_hours_charged_Wh, 1e4f); break;
-    case kTachometer: w.i32(v.tachometer); break;
-    case kTachometerAbs: w.i32(v.tachometer_abs); break;
-    case kFault: w.u8(v.fault); break;
-    case kPidPos: w.f32(v.pid_pos_deg, 1e6f); break;
-    case kControllerId: w.u8(v.controller_id); break;
+    case kTempFet:
+      w.f16(v.temp_fet_C, 1e1f);
+      break;
+    case kTempMotor:
+      w.f16(v.temp_motor_C, 1e1f);
+      break;
+    case kCurrentMotor:
+      w.f32(v.current_motor_A, 1e2f);
+      break;
+    case kCurrentIn:
+      w.f32(v.current_in_A, 1e2f);
+      break;
+    case kId:
+      w.f32(v.i_d_A, 1e2f);
+      break;
+    case kIq:
+      w.f32(v.i_q_A, 1e2f);
+      break;
+    case kDuty:
+      w.f16(v.duty, 1e3f);
+      break;
+    case kRpm:
+      w.f32(v.erpm, 1e0f);
+      break;
+    case kVin:
+      w.f16(v.v_in_V, 1e1f);
+      break;
+    case kAmpHours:
+      w.f32(v.amp_hours_Ah, 1e4f);
+      break;
+    case kAmpHoursCharged:
+      w.f32(v.amp_hours_charged_Ah, 1e4f);
+      break;
+    case kWattHours:
+      w.f32(v.watt_hours_Wh, 1e4f);
+      break;
+    case kWattHoursCharged:
+      w.f32(v.watt_hours_charged_Wh, 1e4f);
+      break;
+    case kTachometer:
+      w.i32(v.tachometer);
+      break;
+    case kTachometerAbs:
+      w.i32(v.tachometer_abs);
+      break;
+    case kFault:
+      w.u8(v.fault);
+      break;
+    case kPidPos:
+      w.f32(v.pid_pos_deg, 1e6f);
+      break;
+    case kControllerId:
+      w.u8(v.controller_id);
+      break;
     case kTempMos123:
       for (double t : v.temp_mos_C) w.f16(t, 1e1f);
       break;
-    case kVd: w.f32(v.v_d_V, 1e3f); break;
-    case kVq: w.f32(v.v_q_V, 1e3f); break;
-    case kStatusBits: w.u8(v.status_bits); break;
-    case kFieldCount: break;
+    case kVd:
+      w.f32(v.v_d_V, 1e3f);
+      break;
+    case kVq:
+      w.f32(v.v_q_V, 1e3f);
+      break;
+    case kStatusBits:
+      w.u8(v.status_bits);
+      break;
+    case kFieldCount:
+      break;
   }
 }
 
@@ -107,8 +149,8 @@ std::optional<Request> parse_request(const CanFrame& f, std::uint8_t controller_
   r.commands_send = f.data[1];
   r.command = f.data[2];
   if (r.command == kCommGetValuesSelective && f.len >= 7) {
-    r.mask = (std::uint32_t{f.data[3]} << 24) | (std::uint32_t{f.data[4]} << 16) | (std::uint32_t{f.data[5]} << 8) |
-             f.data[6];
+    r.mask =
+        (std::uint32_t{f.data[3]} << 24) | (std::uint32_t{f.data[4]} << 16) | (std::uint32_t{f.data[5]} << 8) | f.data[6];
     r.has_mask = true;
   }
   return r;
@@ -132,8 +174,8 @@ std::size_t encode_values(const Values& v, std::uint32_t mask, std::span<std::ui
   return w.size();
 }
 
-std::size_t buffer_frames(std::uint8_t to_id, std::uint8_t from_id, std::uint8_t send,
-                          std::span<const std::uint8_t> payload, std::span<CanFrame> out) noexcept {
+std::size_t buffer_frames(std::uint8_t to_id, std::uint8_t from_id, std::uint8_t send, std::span<const std::uint8_t> payload,
+                          std::span<CanFrame> out) noexcept {
   const std::size_t len = payload.size();
   if (len > 0xFFFF || out.size() < buffer_frame_count(len)) return 0;
   std::uint8_t b[8];

@@ -126,7 +126,8 @@ Estimate AveragedDriveEstimator::step(const AveragedSample& sample) noexcept {
     }
     previous_centre2_ns_ = sample.t_start_ns + sample.t_ns;
     previous_i_pu_ = s.i_meas_pu;
-    return finish(sample, s, core_.step_steady_state(s, gains.hessian, gains.gain, Admission{}), kUnclassified, point, gains);
+    return finish(sample, s, core_.step_steady_state(s, gains.hessian, gains.gain, Admission{}), kUnclassified, point,
+                  gains);
   }
   RegimeInput in;
   in.timing = timing_;
@@ -148,13 +149,14 @@ Estimate AveragedDriveEstimator::step(const AveragedSample& sample) noexcept {
   }
 
   const RegimeNoise noise = classifier_.noise();
-  const Admission admission{!regime.excluded(), regime.excites_psi_m(), regime.excites_r_s(), true,
-                            noise.u_sq,          noise.i_sq,             noise.n_sq};
+  const Admission admission{!regime.excluded(), regime.excites_psi_m(), regime.excites_r_s(), true, noise.u_sq, noise.i_sq,
+                            noise.n_sq};
   return finish(sample, s, core_.step_steady_state(s, gains.hessian, gains.gain, admission), regime, point, gains);
 }
 
-Estimate AveragedDriveEstimator::finish(const AveragedSample& sample, const SteadyStateSample& s, const EstimatorOutput& detail,
-                                        Classification regime, bool point, const GainSequences& gains) noexcept {
+Estimate AveragedDriveEstimator::finish(const AveragedSample& sample, const SteadyStateSample& s,
+                                        const EstimatorOutput& detail, Classification regime, bool point,
+                                        const GainSequences& gains) noexcept {
   Estimate e;
   e.t_ns = sample.t_ns;
   e.detail = detail;
@@ -174,7 +176,8 @@ void AveragedDriveEstimator::reset() noexcept {
   core_.reset();
   classifier_.reset();
   before_previous_ = core_.adaptation();
-  point_gains_.start(rates_per_s_[static_cast<std::size_t>(core_.config().algorithm)], core_.config().nominal_sample_period_s);
+  point_gains_.start(rates_per_s_[static_cast<std::size_t>(core_.config().algorithm)],
+                     core_.config().nominal_sample_period_s);
 }
 
 void AveragedDriveEstimator::set_estimates(double psi_m_Wb, double r_s_Ohm) noexcept {

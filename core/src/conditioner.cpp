@@ -13,9 +13,7 @@ double soft_sign(double x, double band) noexcept {
   return std::clamp(x / band, -1.0, 1.0);
 }
 
-bool finite(const DriveSample& s) noexcept {
-  return all_finite(s.theta_el_rad, s.omega_el_rad_s, s.u_dc_V, s.u_V, s.i_A);
-}
+bool finite(const DriveSample& s) noexcept { return all_finite(s.theta_el_rad, s.omega_el_rad_s, s.u_dc_V, s.u_V, s.i_A); }
 
 }  // namespace
 
@@ -32,8 +30,7 @@ SampleConditioner::SampleConditioner(const PerUnitBase& base, const MachinePu& m
   reconfigure(base, machine, extensions);
 }
 
-void SampleConditioner::reconfigure(const PerUnitBase& base, const MachinePu& machine,
-                                    const ModelExtensions& x) noexcept {
+void SampleConditioner::reconfigure(const PerUnitBase& base, const MachinePu& machine, const ModelExtensions& x) noexcept {
   base_ = base;
   machine_ = machine;
   inv_current_A_ = 1.0 / base.current_A;
@@ -52,7 +49,8 @@ void SampleConditioner::reconfigure(const PerUnitBase& base, const MachinePu& ma
   harmonics_ = x.harmonics();
   for (std::size_t j = 0; j < harmonics_pu_.size(); ++j) {
     const FluxHarmonic& h = x.flux_harmonics[j];
-    harmonics_pu_[j] = {base.flux_pu(h.d_cos_Wb), base.flux_pu(h.d_sin_Wb), base.flux_pu(h.q_cos_Wb), base.flux_pu(h.q_sin_Wb)};
+    harmonics_pu_[j] = {base.flux_pu(h.d_cos_Wb), base.flux_pu(h.d_sin_Wb), base.flux_pu(h.q_cos_Wb),
+                        base.flux_pu(h.q_sin_Wb)};
   }
   cross_ = x.cross_coupling_H_per_A != 0.0 || x.cross_coupling_H_per_A2 != 0.0;
   half_cross_pu_ = 0.5 * x.cross_coupling_H_per_A * base.current_A * base.current_A / base.flux_Wb;
@@ -190,7 +188,8 @@ Vec2 SampleConditioner::logged_current_dq_A(const DriveSample& s, const Rotation
   return s.i_A.head<2>();
 }
 
-Vec2 SampleConditioner::observed_current_dq_A(const DriveSample& s, const Rotation& logged, const Vec2& i_model_pu) const noexcept {
+Vec2 SampleConditioner::observed_current_dq_A(const DriveSample& s, const Rotation& logged,
+                                              const Vec2& i_model_pu) const noexcept {
   // Without observation-side extensions the log's dq frame is the model's.
   if (!angle_offset_ && !phase_corrections_ && inv_r_fe_pu_ == 0.0) return i_model_pu * base_.current_A;
   const Rotation rot = angle_offset_ ? compose(logged, offset_rotation_) : logged;

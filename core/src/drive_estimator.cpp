@@ -27,7 +27,8 @@ void DriveEstimator::configure(const EstimatorSettings& settings) noexcept {
 
 double DriveEstimator::reported_voltage_sq_pu(const DriveSample& sample) const noexcept {
   // |u| is the same in every amplitude-invariant frame.
-  const double u_sq = sample.voltage_frame == Frame::kAbc ? clarke(sample.u_V).squaredNorm() : sample.u_V.head<2>().squaredNorm();
+  const double u_sq =
+      sample.voltage_frame == Frame::kAbc ? clarke(sample.u_V).squaredNorm() : sample.u_V.head<2>().squaredNorm();
   return u_sq * inv_voltage_sq_;
 }
 
@@ -49,15 +50,16 @@ Estimate DriveEstimator::estimate(const DriveSample& sample, const EstimatorOutp
 [[gnu::flatten]] Estimate DriveEstimator::step(const DriveSample& sample) noexcept {
   const EstimatorSample conditioned = conditioner_.condition(sample);
   const PredictorInterval& iv = conditioned.interval;
-  if (iv.dt_s > sparse_after_s_ && !conditioned.resync) [[unlikely]] return step_sparse(sample, conditioned);
+  if (iv.dt_s > sparse_after_s_ && !conditioned.resync) [[unlikely]]
+    return step_sparse(sample, conditioned);
 
   if (!classify_) [[unlikely]] {
     const EstimatorOutput detail = core_.step(conditioned);
     return estimate(sample, detail, conditioned.i_meas_pu, iv.n_end_pu, kUnclassified);
   }
   Classification regime;
-  const bool short_loss = conditioned.resync && regimes_.started() && iv.dt_s > 0.0 &&
-                          iv.dt_s <= core_.config().max_sample_interval_s;
+  const bool short_loss =
+      conditioned.resync && regimes_.started() && iv.dt_s > 0.0 && iv.dt_s <= core_.config().max_sample_interval_s;
   if (short_loss) [[unlikely]] {
     // Samples lost on the way (the source saw a gap) but the stream goes on within the predictor's interval:
     // the open block spans the loss and its classification holds (the estimator resynchronises on this one).
@@ -79,8 +81,8 @@ Estimate DriveEstimator::estimate(const DriveSample& sample, const EstimatorOutp
                                  reported_voltage_sq_pu(sample));
   }
   const RegimeNoise& noise = regimes_.noise();
-  const Admission admission{!regime.excluded(), regime.excites_psi_m(), regime.excites_r_s(), true,
-                            noise.u_sq,          noise.i_sq,             noise.n_sq};
+  const Admission admission{!regime.excluded(), regime.excites_psi_m(), regime.excites_r_s(), true, noise.u_sq, noise.i_sq,
+                            noise.n_sq};
   const EstimatorOutput detail = core_.step(conditioned, admission);
   return estimate(sample, detail, conditioned.i_meas_pu, iv.n_end_pu, regime);
 }
@@ -114,8 +116,8 @@ Estimate DriveEstimator::step_sparse(const DriveSample& sample, const EstimatorS
   in.weight = gains.gain;
   const Classification regime = regimes_.step(in);
   const RegimeNoise& noise = regimes_.noise();
-  const Admission admission{!regime.excluded(), regime.excites_psi_m(), regime.excites_r_s(), true,
-                            noise.u_sq,          noise.i_sq,             noise.n_sq};
+  const Admission admission{!regime.excluded(), regime.excites_psi_m(), regime.excites_r_s(), true, noise.u_sq, noise.i_sq,
+                            noise.n_sq};
   const EstimatorOutput detail = core_.step_steady_state(s, gains.hessian, gains.gain, admission);
   if (detail.code == StepCode::kAdapted) point_gains_.count(gains, sample.t_ns);
   return estimate(sample, detail, own.i_pu, own.n_pu, regime);

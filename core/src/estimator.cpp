@@ -19,8 +19,7 @@ Vec2 scaled(const Vec2& gamma, double factor) noexcept { return (gamma * factor)
 
 bool finite(const SteadyStateSample& s) noexcept {
   return std::isfinite(s.dt_s) && std::isfinite(s.n_pu) && s.u_pu.allFinite() && s.i_meas_pu.allFinite() &&
-         std::isfinite(s.x_d_pu) && std::isfinite(s.x_q_pu) && s.i_gradient_pu.allFinite() &&
-         std::isfinite(s.n_gradient_pu);
+         std::isfinite(s.x_d_pu) && std::isfinite(s.x_q_pu) && s.i_gradient_pu.allFinite() && std::isfinite(s.n_gradient_pu);
 }
 
 /// The GNA matrix Hessian has one forgetting factor: that of the parameter being estimated
@@ -118,7 +117,7 @@ void RpemEstimator::synchronize(const EstimatorSample& sample, const MachinePu& 
 }
 
 Mat2 RpemEstimator::select_gradient(const MachinePu& model, double n_pu) const noexcept {
-  const Mat2 steady = steady_state_gradients(model, n_pu, state_.predictor.i_hat_pu);
+  Mat2 steady = steady_state_gradients(model, n_pu, state_.predictor.i_hat_pu);  // not const: returned by move
   if (gradients_ == Gradients::kSkip) return steady;  // both forms steady-state (decided in reconfigure)
   Mat2 g = state_.predictor.gradient;
   if (config_.gradient_psi_m == GradientForm::kSteadyState) g.col(kPsiM) = steady.col(kPsiM);
@@ -141,7 +140,8 @@ bool RpemEstimator::outlier(const Update& u, const Admission& admission) const n
   const ParameterBounds& b = config_.bounds;
   const double d_psi = std::max(th[kPsiM] - b.min_pu[kPsiM], b.max_pu[kPsiM] - th[kPsiM]);
   const double d_r = std::max(th[kRs] - b.min_pu[kRs], b.max_pu[kRs] - th[kRs]) * std::max(1.0, th[kRs] * inverse_r_min_);
-  const Vec2 beyond = u.epsilon_pu.cwiseAbs() - (u.gradient.col(kPsiM).cwiseAbs() * d_psi + u.gradient.col(kRs).cwiseAbs() * d_r);
+  const Vec2 beyond =
+      u.epsilon_pu.cwiseAbs() - (u.gradient.col(kPsiM).cwiseAbs() * d_psi + u.gradient.col(kRs).cwiseAbs() * d_r);
   if (!(beyond.maxCoeff() > 0.0)) return false;
   // ε's noise: the current's, and the voltage's and the speed's (through n·ψ̂m) through the steady state,
   // M̂⁻¹ = [r̂ n·x_q; −n·x_d r̂]/D.
@@ -153,7 +153,8 @@ bool RpemEstimator::outlier(const Update& u, const Admission& admission) const n
   const double var_d = admission.var_i_pu + inv_d2 * ((r2 + n2 * xq2) * admission.var_u_pu + n2 * xq2 * emf);
   const double var_q = admission.var_i_pu + inv_d2 * ((r2 + n2 * xd2) * admission.var_u_pu + r2 * emf);
   const double nu2 = config_.outlier_bound_sigma * config_.outlier_bound_sigma;
-  return (beyond[0] > 0.0 && beyond[0] * beyond[0] > nu2 * var_d) || (beyond[1] > 0.0 && beyond[1] * beyond[1] > nu2 * var_q);
+  return (beyond[0] > 0.0 && beyond[0] * beyond[0] > nu2 * var_d) ||
+         (beyond[1] > 0.0 && beyond[1] * beyond[1] > nu2 * var_q);
 }
 
 EstimatorOutput RpemEstimator::held(StepCode code) const noexcept {
@@ -168,7 +169,8 @@ EstimatorOutput RpemEstimator::held(StepCode code) const noexcept {
 // The update both sample kinds share: eq:GainSchedule, the algorithm's gain, θ̂ += L·ε, eq:paramsubset.
 // Inlined into step(): the native per-sample path keeps `model` and the gradient in registers.
 [[gnu::always_inline]] inline EstimatorOutput RpemEstimator::update(const Update& u, const Vec2& gamma_r,
-                                                                    const Vec2& gamma_l, const Admission& admission) noexcept {
+                                                                    const Vec2& gamma_l,
+                                                                    const Admission& admission) noexcept {
   // eq:GainSchedule says where a parameter is identifiable at all; the sample's regime, whether its term
   // stands out of the noise here (docs/derivations.md §13): a parameter adapts where both hold.
   Schedule active = schedule(config_.scheduler, u.n_pu);
@@ -188,12 +190,12 @@ EstimatorOutput RpemEstimator::held(StepCode code) const noexcept {
       break;
     }
     case Algorithm::kGna:
-      gain = gna_gain(u.gradient, gna_hessian_sequence(active, gamma_r), gamma_l, config_.floors,
-                      state_.gna_hessian_pu);
+      gain = gna_gain(u.gradient, gna_hessian_sequence(active, gamma_r), gamma_l, config_.floors, state_.gna_hessian_pu);
       change = gain.gain * u.epsilon_pu;
       break;
     case Algorithm::kPhyInt:
-      gain = phyint_gain(MachinePu(u.model), u.n_pu, u.i_gain_pu, gamma_l, config_.floors);  // a copy: `model` stays in registers
+      gain = phyint_gain(MachinePu(u.model), u.n_pu, u.i_gain_pu, gamma_l,
+                         config_.floors);  // a copy: `model` stays in registers
       change = gain.gain * u.epsilon_pu;
       break;
   }
@@ -246,7 +248,8 @@ EstimatorOutput RpemEstimator::held(StepCode code) const noexcept {
   // Saturation extensions give each sample its own inductances (two divisions); else the cached ones.
   // A branch, not a select: the divisions would otherwise compete with the predictor's for the divider.
   PredictorCoefficients coefficients = coefficients_;
-  if (sample.x_d_pu > 0.0) [[unlikely]] coefficients = PredictorCoefficients::of(model, config_.omega_n_rad_s);
+  if (sample.x_d_pu > 0.0) [[unlikely]]
+    coefficients = PredictorCoefficients::of(model, config_.omega_n_rad_s);
   // Predicted on a local copy, stored once: î, on the dependency chain, stays in registers.
   PredictorState predictor = state_.predictor;
   predict(model, coefficients, config_.discretization, iv, predictor, gradients_);
@@ -288,12 +291,12 @@ EstimatorOutput RpemEstimator::held(StepCode code) const noexcept {
 
 EstimatorOutput RpemEstimator::step_steady_state(const SteadyStateSample& sample,
                                                  const GainSequences& rates_per_s) noexcept {
-  return step_steady_state(sample, per_interval(rates_per_s.hessian, sample.dt_s), per_interval(rates_per_s.gain, sample.dt_s),
-                           Admission{});
+  return step_steady_state(sample, per_interval(rates_per_s.hessian, sample.dt_s),
+                           per_interval(rates_per_s.gain, sample.dt_s), Admission{});
 }
 
-EstimatorOutput RpemEstimator::step_steady_state(const SteadyStateSample& sample, const Vec2& gamma_r,
-                                                 const Vec2& gamma_l, const Admission& admission) noexcept {
+EstimatorOutput RpemEstimator::step_steady_state(const SteadyStateSample& sample, const Vec2& gamma_r, const Vec2& gamma_l,
+                                                 const Admission& admission) noexcept {
   if (!finite(sample)) {
     state_.epsilon_valid = false;
     return held(StepCode::kRejectedNonFinite);

@@ -4,8 +4,7 @@
 
 namespace rpem::core {
 
-Vec2 current_derivative(const MachinePu& m, double omega_n_rad_s, double n_pu, const Vec2& i_pu,
-                        const Vec2& u_pu) noexcept {
+Vec2 current_derivative(const MachinePu& m, double omega_n_rad_s, double n_pu, const Vec2& i_pu, const Vec2& u_pu) noexcept {
   const double did = omega_n_rad_s / m.x_d_pu * (u_pu[0] - m.r_s_pu * i_pu[0] + n_pu * m.x_q_pu * i_pu[1]);
   const double diq =
       omega_n_rad_s / m.x_q_pu * (u_pu[1] - m.r_s_pu * i_pu[1] - n_pu * m.x_d_pu * i_pu[0] - n_pu * m.psi_m_pu);
@@ -23,8 +22,7 @@ Vec2 steady_state_voltage(const MachinePu& m, double n_pu, const Vec2& i_pu) noe
           m.r_s_pu * i_pu[1] + n_pu * m.x_d_pu * i_pu[0] + n_pu * m.psi_m_pu};
 }
 
-Vec2 steady_state_prediction_error(const MachinePu& plant, const MachinePu& model, double n_pu,
-                                   const Vec2& u_pu) noexcept {
+Vec2 steady_state_prediction_error(const MachinePu& plant, const MachinePu& model, double n_pu, const Vec2& u_pu) noexcept {
   return steady_state_current(plant, n_pu, u_pu) - steady_state_current(model, n_pu, u_pu);
 }
 
@@ -35,8 +33,7 @@ Mat2 system_matrix(const MachinePu& m, double omega_n_rad_s, double n_pu) noexce
   return omega_n_rad_s * a;
 }
 
-std::pair<std::complex<double>, std::complex<double>> continuous_eigenvalues(const MachinePu& m,
-                                                                             double omega_n_rad_s,
+std::pair<std::complex<double>, std::complex<double>> continuous_eigenvalues(const MachinePu& m, double omega_n_rad_s,
                                                                              double n_pu) noexcept {
   // Eq:lambda with 1/T_d = r_s·ω_n/x_d, 1/T_q = r_s·ω_n/x_q (Eq:TdTq).
   const double inv_td = m.r_s_pu * omega_n_rad_s / m.x_d_pu;

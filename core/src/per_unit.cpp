@@ -20,12 +20,8 @@ PerUnitBase PerUnitBase::from_rated(const RatedData& rated) noexcept {
   return b;
 }
 
-double PerUnitBase::mech_speed_rpm_to_pu(double n_rpm) const noexcept {
-  return rpm_to_rad_s(n_rpm) / omega_mech_rad_s;
-}
+double PerUnitBase::mech_speed_rpm_to_pu(double n_rpm) const noexcept { return rpm_to_rad_s(n_rpm) / omega_mech_rad_s; }
 
-double PerUnitBase::mech_speed_rpm_of(double n_pu) const noexcept {
-  return rad_s_to_rpm(n_pu * omega_mech_rad_s);
-}
+double PerUnitBase::mech_speed_rpm_of(double n_pu) const noexcept { return rad_s_to_rpm(n_pu * omega_mech_rad_s); }
 
 }  // namespace rpem::core

@@ -2,8 +2,7 @@
 
 namespace rpem::core {
 
-Mat2 transition_matrix(const MachinePu& model, double omega_n, Discretization method, double dt_s,
-                       double n_pu) noexcept {
+Mat2 transition_matrix(const MachinePu& model, double omega_n, Discretization method, double dt_s, double n_pu) noexcept {
   const Mat2 a = system_matrix(model, omega_n, n_pu);
   if (method == Discretization::kExplicitEuler) {
     return Mat2::Identity() + dt_s * a;

@@ -6,12 +6,10 @@
 namespace rpem::core {
 
 MachinePu to_pu(const PerUnitBase& base, const MachineSi& m) noexcept {
-  return {base.resistance_pu(m.r_s_Ohm), base.inductance_pu(m.l_d_H), base.inductance_pu(m.l_q_H),
-          base.flux_pu(m.psi_m_Wb)};
+  return {base.resistance_pu(m.r_s_Ohm), base.inductance_pu(m.l_d_H), base.inductance_pu(m.l_q_H), base.flux_pu(m.psi_m_Wb)};
 }
 
-EstimatorConfig make_estimator_config(const PerUnitBase& base, const MachineSi& m,
-                                      const EstimatorSettings& s) noexcept {
+EstimatorConfig make_estimator_config(const PerUnitBase& base, const MachineSi& m, const EstimatorSettings& s) noexcept {
   EstimatorConfig c;
   static_cast<EstimatorOptions&>(c) = s;
   c.model = to_pu(base, m);

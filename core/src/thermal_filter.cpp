@@ -71,7 +71,8 @@ void ThermalFilter::predict(const ThermalLoad& load) noexcept {
 }
 
 ObservationResult ThermalFilter::observe(const ThermalObservation& o) noexcept {
-  if (!all_finite(o.h, o.h_c, o.offset, o.value, o.variance) || !(o.variance > 0.0)) return ObservationResult::kRejectedInvalid;
+  if (!all_finite(o.h, o.h_c, o.offset, o.value, o.variance) || !(o.variance > 0.0))
+    return ObservationResult::kRejectedInvalid;
   // H = [h, 0, h_c]: no observation sees a disturbance, so a = P·Hᵀ takes the columns of T and c only.
   const ThermalStateVec a = p_.leftCols<kN>().lazyProduct(o.h) + p_.rightCols<kCalibrationStates>().lazyProduct(o.h_c);
   const double s = o.h.dot(a.head<kN>()) + o.h_c.dot(a.tail<kCalibrationStates>()) + o.variance;

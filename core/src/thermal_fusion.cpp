@@ -52,8 +52,9 @@ StepObservations step_observations(const ThermalFusionConfig& c, const ThermalSt
     double reference_C;
     Calibration offset, coefficient;
   };
-  const Row rows[2] = {{m, w, magnet, copper, c.magnet_law.reference_C, Calibration::kMagnetOffset, Calibration::kMagnetCoefficient},
-                       {w, m, copper, magnet, n.copper.reference_C, Calibration::kCopperOffset, Calibration::kCopperCoefficient}};
+  const Row rows[2] = {
+      {m, w, magnet, copper, c.magnet_law.reference_C, Calibration::kMagnetOffset, Calibration::kMagnetCoefficient},
+      {w, m, copper, magnet, n.copper.reference_C, Calibration::kCopperOffset, Calibration::kCopperCoefficient}};
   for (std::size_t j = 0; j < 2; ++j) {
     const ParameterObservation& p = s.parameter[j];
     if (!p.valid) continue;
@@ -89,7 +90,8 @@ ThermalFusion::ThermalFusion(const ThermalFusionConfig& config, const PerUnitBas
   out_.magnet = config.filter.network.magnet;
 }
 
-void ThermalFusion::reconfigure(const ThermalFusionConfig& config, const PerUnitBase& base, const MachineSi& machine) noexcept {
+void ThermalFusion::reconfigure(const ThermalFusionConfig& config, const PerUnitBase& base,
+                                const MachineSi& machine) noexcept {
   config_ = config;
   observer_.reconfigure(config.observer, base, machine, config.filter.network.base, config.coolant_C);
   filter_.reconfigure(config.filter);

@@ -61,7 +61,7 @@ rpem::auth::Keyring held_keys() {
 struct Harness {
   rpem::auth::Keyring held = held_keys();
   std::array<rpem::auth::Key, 3> signers{key(1), key(2), key(9)};  // the harness's own: two held, one not
-  int sign_mode = 0;          // 0 none, 1 key 1, 2 key 2, 3 key 9
+  int sign_mode = 0;                                               // 0 none, 1 key 1, 2 key 2, 3 key 9
   bool other_channel = false;
   /// Whether the harness signed `bytes` correctly for RPEM_COMMAND under a held key.
   [[nodiscard]] bool authentic() const { return (sign_mode == 1 || sign_mode == 2) && !other_channel; }
@@ -73,7 +73,8 @@ std::span<const std::uint8_t> prepare(std::span<std::uint8_t> m, const Harness& 
     const std::int32_t id = h.sign_mode == 3 ? 9 : h.sign_mode;
     std::uint8_t* p = m.data() + m.size() - rpem::auth::kTrailerBytes;
     p[0] = 0, p[1] = 0, p[2] = 0, p[3] = static_cast<std::uint8_t>(id);
-    require(rpem::auth::sign(h.signers[static_cast<std::size_t>(h.sign_mode - 1)], h.other_channel ? "RPEM_ESTIMATE" : kChannel, m));
+    require(rpem::auth::sign(h.signers[static_cast<std::size_t>(h.sign_mode - 1)],
+                             h.other_channel ? "RPEM_ESTIMATE" : kChannel, m));
   }
   return m;
 }

@@ -24,11 +24,15 @@ bool inside(double v, double lo, double hi) noexcept { return v >= lo && v <= hi
 
 CommandResult result_of(auth::Verdict v) noexcept {
   switch (v) {
-    case auth::Verdict::kVerified: return CommandResult::kApplied;
-    case auth::Verdict::kUnsigned: return CommandResult::kRejectedUnauthenticated;
-    case auth::Verdict::kUnknownKey: return CommandResult::kRejectedUnknownKey;
+    case auth::Verdict::kVerified:
+      return CommandResult::kApplied;
+    case auth::Verdict::kUnsigned:
+      return CommandResult::kRejectedUnauthenticated;
+    case auth::Verdict::kUnknownKey:
+      return CommandResult::kRejectedUnknownKey;
     case auth::Verdict::kBadMac:
-    case auth::Verdict::kMalformed: break;  // a decoded command_t always holds the trailer
+    case auth::Verdict::kMalformed:
+      break;  // a decoded command_t always holds the trailer
   }
   return CommandResult::kRejectedBadMac;
 }
@@ -122,11 +126,12 @@ bool CommandGate::handle(std::span<const std::uint8_t> message, bool commit_now)
 }
 
 void CommandGate::check_counts() const noexcept {
-  RPEM_ASSERT(counters_.received == counters_.malformed + counters_.rejected + queued_count_ +
-                                        static_cast<std::int64_t>(n_pending_),
-              "every message received is malformed, rejected, queued or pending");
-  RPEM_ASSERT(counters_.unauthenticated + counters_.unknown_key + counters_.bad_mac + counters_.replayed <= counters_.rejected,
-              "the rejections counted by reason are among the rejections");
+  RPEM_ASSERT(
+      counters_.received == counters_.malformed + counters_.rejected + queued_count_ + static_cast<std::int64_t>(n_pending_),
+      "every message received is malformed, rejected, queued or pending");
+  RPEM_ASSERT(
+      counters_.unauthenticated + counters_.unknown_key + counters_.bad_mac + counters_.replayed <= counters_.rejected,
+      "the rejections counted by reason are among the rejections");
 }
 
 bool CommandGate::commit() noexcept {

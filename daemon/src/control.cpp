@@ -1,13 +1,13 @@
 #include "rpem/daemon/control.hpp"
 
 #include <poll.h>
-#include <signal.h>
 #include <sys/signalfd.h>
 #include <systemd/sd-daemon.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <array>
+#include <csignal>
 #include <cstdio>
 #include <lcm/lcm-cpp.hpp>
 #include <span>
@@ -43,17 +43,28 @@ namespace {
 
 const char* describe(CommandResult r) {
   switch (r) {
-    case CommandResult::kNone: return "malformed (not one rpem.command_t)";
-    case CommandResult::kApplied: return "applied";
-    case CommandResult::kRejectedDisabled: return "commands are disabled";
-    case CommandResult::kRejectedOldSequence: return "replayed or stale: sequence number not above the last accepted one";
-    case CommandResult::kRejectedBadValues: return "values outside D_M";
-    case CommandResult::kRejectedUnknown: return "unknown command";
-    case CommandResult::kRejectedBusy: return "busy (the loop's queue is full)";
-    case CommandResult::kRejectedUnauthenticated: return "unauthenticated (no key id, no MAC)";
-    case CommandResult::kRejectedUnknownKey: return "unknown key id";
-    case CommandResult::kRejectedBadMac: return "bad MAC (forged or altered)";
-    case CommandResult::kRejectedNotPersisted: return "its sequence number could not be persisted";
+    case CommandResult::kNone:
+      return "malformed (not one rpem.command_t)";
+    case CommandResult::kApplied:
+      return "applied";
+    case CommandResult::kRejectedDisabled:
+      return "commands are disabled";
+    case CommandResult::kRejectedOldSequence:
+      return "replayed or stale: sequence number not above the last accepted one";
+    case CommandResult::kRejectedBadValues:
+      return "values outside D_M";
+    case CommandResult::kRejectedUnknown:
+      return "unknown command";
+    case CommandResult::kRejectedBusy:
+      return "busy (the loop's queue is full)";
+    case CommandResult::kRejectedUnauthenticated:
+      return "unauthenticated (no key id, no MAC)";
+    case CommandResult::kRejectedUnknownKey:
+      return "unknown key id";
+    case CommandResult::kRejectedBadMac:
+      return "bad MAC (forged or altered)";
+    case CommandResult::kRejectedNotPersisted:
+      return "its sequence number could not be persisted";
   }
   return "?";
 }
@@ -93,7 +104,8 @@ void Control::connect_lcm(std::int64_t now_ns) {
   const LcmConfig& c = running_.fixed.lcm;
   lcm_ = std::make_unique<Lcm>(c.url);
   if (!lcm_->lcm.good()) {
-    std::fprintf(stderr, "rpemd: LCM not available for commands (%s); retrying\n", c.url.empty() ? "default URL" : c.url.c_str());
+    std::fprintf(stderr, "rpemd: LCM not available for commands (%s); retrying\n",
+                 c.url.empty() ? "default URL" : c.url.c_str());
     return;
   }
   lcm::Subscription* subscription = lcm_->lcm.subscribe(c.channel_prefix + "RPEM_COMMAND", &Control::on_command, this);
@@ -122,7 +134,8 @@ void Control::log_rejection(CommandResult result, std::int64_t seq, std::int32_t
   }
   char more[96] = "";
   if (rejections_unlogged_[k] > 0) {
-    std::snprintf(more, sizeof more, " (and %lld more such since the last line)", static_cast<long long>(rejections_unlogged_[k]));
+    std::snprintf(more, sizeof more, " (and %lld more such since the last line)",
+                  static_cast<long long>(rejections_unlogged_[k]));
   }
   if (result == CommandResult::kNone) {
     std::fprintf(stderr, "rpemd: RPEM_COMMAND message rejected: %s%s\n", describe(result), more);
@@ -147,7 +160,8 @@ void Control::reload() {
                    key_problem.c_str());
     } else if (const char* part = fixed_difference(running_.fixed, fresh.fixed); *part != '\0') {
       ++reloads_.restart_required;
-      std::fprintf(stderr, "rpemd: SIGHUP: %s changes `%s`, which only a restart applies; keeping the running configuration\n",
+      std::fprintf(stderr,
+                   "rpemd: SIGHUP: %s changes `%s`, which only a restart applies; keeping the running configuration\n",
                    fresh.source_file.c_str(), part);
     } else {
       Command c;
@@ -159,7 +173,8 @@ void Control::reload() {
       } else {
         running_.live = fresh.live;
         gate_.set_policy(CommandPolicy::of(running_.live));
-        std::fprintf(stderr, "rpemd: SIGHUP: reloaded gains, limits, model extensions, temperature, validity and commands from %s\n",
+        std::fprintf(stderr,
+                     "rpemd: SIGHUP: reloaded gains, limits, model extensions, temperature, validity and commands from %s\n",
                      fresh.source_file.c_str());
       }
     }

@@ -37,7 +37,8 @@ DaemonKeys load_credential_keys(const char* directory) {
 }
 
 std::string command_key_problem(const LiveConfig& live, const auth::Keyring& command_keys) {
-  if (!live.commands_enabled || live.command_authentication == CommandAuthentication::kNone || !command_keys.empty()) return "";
+  if (!live.commands_enabled || live.command_authentication == CommandAuthentication::kNone || !command_keys.empty())
+    return "";
   return "commands are enabled but no command key is configured: give rpemd a key file as the credential rpem_command "
          "(LoadCredential=, docs/rpemd.md \"Authentication\"), or — where LCM cannot leave this host — set "
          "daemon.commands.authentication: none";

@@ -1,11 +1,11 @@
 #include "rpem/daemon/daemon.hpp"
 
-#include <signal.h>
 #include <sys/signalfd.h>
 #include <systemd/sd-daemon.h>
 #include <unistd.h>
 
 #include <chrono>
+#include <csignal>
 #include <cstdio>
 #include <cstdlib>
 #include <ctime>
@@ -34,6 +34,51 @@ int block_signals_into_fd() {
   return signalfd(-1, &signals, SFD_NONBLOCK | SFD_CLOEXEC);
 }
 
+/// Locks rpemd's memory where the configuration asks for it with a real-time loop; false when that fails
+/// and real time is required (a warning otherwise).
+bool lock_memory_if_asked(const LoopConfig& loop, bool realtime, bool required) {
+  if (!loop.lock_memory || !realtime) return true;
+  const std::string problem = lock_memory();
+  if (problem.empty()) return true;
+  std::fprintf(stderr, required ? "rpemd: %s\n" : "rpemd: warning: %s; continuing without locked memory\n", problem.c_str());
+  return !required;
+}
+
+/// The /dev/cpu_dma_latency request where the configuration asks for it with a real-time loop: the file
+/// descriptor that holds it, or -1 (with a note when the request failed).
+int request_cpu_dma_latency_if_asked(const LoopConfig& loop, bool realtime) {
+  if (loop.cpu_dma_latency_us < 0 || !realtime) return -1;
+  std::string problem;
+  const int fd = request_cpu_dma_latency(loop.cpu_dma_latency_us, problem);
+  if (fd < 0) std::fprintf(stderr, "rpemd: note: %s; deep CPU idle states may add wake-up latency\n", problem.c_str());
+  return fd;
+}
+
+/// The two lines rpemd prints when it starts: what it runs, and how it authenticates.
+void print_start(const DaemonConfig& config, const std::string& source_name, const char* source_type,
+                 const Control::Commands& commands, const std::string& signing) {
+  char wake_ahead[32];
+  std::snprintf(wake_ahead, sizeof wake_ahead, config.fixed.loop.wake_ahead_auto ? "auto" : "%.0f µs",
+                config.fixed.loop.wake_ahead_s * 1e6);
+  std::fprintf(stderr,
+               "rpemd: source %s '%s', loop %.0f µs (realtime %s, wake-ahead %s), machine %s, algorithm %s, LCM %s, "
+               "channels %sRPEM_*, commands %s, state file %s\n",
+               source_type, source_name.c_str(), config.fixed.loop.period_s * 1e6, realtime_name(config.fixed.loop.realtime),
+               wake_ahead, config.source_file.c_str(), io::to_string(config.live.machine.estimator.algorithm),
+               config.fixed.lcm.url.empty() ? "default" : config.fixed.lcm.url.c_str(),
+               config.fixed.lcm.channel_prefix.c_str(), config.live.commands_enabled ? "enabled" : "disabled",
+               resolve_state_file(config.fixed.state).c_str());
+  std::string ids;
+  const auth::Keyring& command_keys = commands.keys.keys;
+  for (int k = 0; k < command_keys.size(); ++k) ids += (k > 0 ? ", " : "") + std::to_string(command_keys[k].id());
+  std::fprintf(stderr, "rpemd: commands %s; last accepted sequence number %lld (%s); estimates and diagnostics %s\n",
+               !config.live.commands_enabled ? "disabled (commands.enabled: false)"
+               : config.live.command_authentication == CommandAuthentication::kNone
+                   ? "unauthenticated (authentication: none, local only)"
+                   : (ids.empty() ? std::string("need a key (none loaded)") : "authenticated with key id " + ids).c_str(),
+               static_cast<long long>(commands.last_accepted_seq), commands.sequence_file.c_str(), signing.c_str());
+}
+
 }  // namespace
 
 DaemonConfig load_configuration(const DaemonOptions& o) {
@@ -54,8 +99,8 @@ Daemon::~Daemon() {
 void Daemon::seed_from_state_file() {
   const core::EstimatorSettings& est = config_.live.machine.estimator;
   const std::string path = resolve_state_file(config_.fixed.state);
-  const LoadedState loaded =
-      load_state_file(path, config_.fixed.state.max_age_s, est.psi_m_min_Wb, est.psi_m_max_Wb, est.r_s_min_Ohm, est.r_s_max_Ohm);
+  const LoadedState loaded = load_state_file(path, config_.fixed.state.max_age_s, est.psi_m_min_Wb, est.psi_m_max_Wb,
+                                             est.r_s_min_Ohm, est.r_s_max_Ohm);
   state_file_status_ = loaded.status;
   if (loaded.status != StateFileStatus::kNone) std::fprintf(stderr, "rpemd: %s\n", loaded.message.c_str());
   if (loaded.status != StateFileStatus::kLoaded) return;
@@ -108,24 +153,14 @@ int Daemon::run() {
   }
   const bool realtime = fixed.loop.realtime != RealtimeMode::kOff;
   const bool required = fixed.loop.realtime == RealtimeMode::kRequired;
-  if (fixed.loop.lock_memory && realtime) {
-    const std::string problem = lock_memory();
-    if (!problem.empty()) {
-      std::fprintf(stderr, required ? "rpemd: %s\n" : "rpemd: warning: %s; continuing without locked memory\n", problem.c_str());
-      if (required) return io::kExitSoftware;
-    }
-  }
-  int qos_fd = -1;  // held open while rpemd runs
-  if (fixed.loop.cpu_dma_latency_us >= 0 && realtime) {
-    std::string problem;
-    qos_fd = request_cpu_dma_latency(fixed.loop.cpu_dma_latency_us, problem);
-    if (qos_fd < 0) std::fprintf(stderr, "rpemd: note: %s; deep CPU idle states may add wake-up latency\n", problem.c_str());
-  }
+  if (!lock_memory_if_asked(fixed.loop, realtime, required)) return io::kExitSoftware;
+  const int qos_fd = request_cpu_dma_latency_if_asked(fixed.loop, realtime);  // held open while rpemd runs
 
   const std::string signing =
       keys.publish ? "signed with key id " + std::to_string(keys.publish->id()) : std::string("unsigned (no publish key)");
   loop_ = std::make_unique<LoopThread>(
-      config_, LoopThread::Queues{std::move(samples_.consumer), std::move(commands_.consumer), std::move(reports_.producer)});
+      config_,
+      LoopThread::Queues{std::move(samples_.consumer), std::move(commands_.consumer), std::move(reports_.producer)});
   seed_from_state_file();
   const char* source_type = SourceCatalogue::type(fixed.source);
   publisher_ = std::make_unique<PersistingPublisher>(
@@ -150,30 +185,14 @@ int Daemon::run() {
     source_->run(stop_acquisition_, source_output_);
   });
 
-  char wake_ahead[32];
-  std::snprintf(wake_ahead, sizeof wake_ahead, fixed.loop.wake_ahead_auto ? "auto" : "%.0f µs", fixed.loop.wake_ahead_s * 1e6);
-  std::fprintf(stderr,
-               "rpemd: source %s '%s', loop %.0f µs (realtime %s, wake-ahead %s), machine %s, algorithm %s, LCM %s, "
-               "channels %sRPEM_*, commands %s, state file %s\n",
-               source_type, source_name_.c_str(), fixed.loop.period_s * 1e6, realtime_name(fixed.loop.realtime), wake_ahead,
-               config_.source_file.c_str(), io::to_string(config_.live.machine.estimator.algorithm),
-               fixed.lcm.url.empty() ? "default" : fixed.lcm.url.c_str(), fixed.lcm.channel_prefix.c_str(),
-               config_.live.commands_enabled ? "enabled" : "disabled", resolve_state_file(fixed.state).c_str());
-  std::string ids;
-  const auth::Keyring& command_keys = commands.keys.keys;
-  for (int k = 0; k < command_keys.size(); ++k) ids += (k > 0 ? ", " : "") + std::to_string(command_keys[k].id());
-  std::fprintf(stderr, "rpemd: commands %s; last accepted sequence number %lld (%s); estimates and diagnostics %s\n",
-               !config_.live.commands_enabled ? "disabled (commands.enabled: false)"
-               : config_.live.command_authentication == CommandAuthentication::kNone
-                   ? "unauthenticated (authentication: none, local only)"
-                   : (ids.empty() ? std::string("need a key (none loaded)") : "authenticated with key id " + ids).c_str(),
-               static_cast<long long>(commands.last_accepted_seq), commands.sequence_file.c_str(), signing.c_str());
+  print_start(config_, source_name_, source_type, commands, signing);
   sd_notifyf(0, "READY=1\nSTATUS=estimating from %s", source_name_.c_str());
 
   {
-    Control control(std::move(config_), [this] { return load_configuration(options_); },
-                    Control::Queues{std::move(commands_.producer), std::move(control_reports_.producer)}, loop_->timer(),
-                    std::move(commands));
+    Control control(
+        std::move(config_), [this] { return load_configuration(options_); },
+        Control::Queues{std::move(commands_.producer), std::move(control_reports_.producer)}, loop_->timer(),
+        std::move(commands));
     (void)control.run(signal_fd);
     config_ = control.running();
   }

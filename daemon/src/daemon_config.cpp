@@ -160,7 +160,8 @@ DaemonConfig parse(io::YamlMap& root, const std::string& name, const std::string
   temperature_from_drifts(name, machine, c.live.temperature);
   if (!thermal_file.empty()) {
     if (root.has("thermal")) root.fail("thermal", "give the thermal section inline or daemon.thermal_config, not both");
-    c.live.thermal = io::load_thermal_config((fs::path(base_dir) / thermal_file).lexically_normal().string(), machine).fusion;
+    c.live.thermal =
+        io::load_thermal_config((fs::path(base_dir) / thermal_file).lexically_normal().string(), machine).fusion;
     c.live.thermal_active = true;
   } else if (root.has("thermal")) {
     io::YamlMap t = root.map("thermal");

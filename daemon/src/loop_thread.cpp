@@ -42,9 +42,11 @@ LoopThread::LoopThread(const DaemonConfig& config, Queues queues)
     : live_(config.live),
       loop_config_(config.fixed.loop),
       queues_(std::move(queues)),
-      estimator_(SourceCatalogue::sample_kind(config.fixed.source), config.live.machine.machine, config.live.machine.estimator),
+      estimator_(SourceCatalogue::sample_kind(config.fixed.source), config.live.machine.machine,
+                 config.live.machine.estimator),
       validity_(config.live.validity, config.fixed.lcm.estimate_rate_Hz),
-      thermal_(config.live.thermal, core::PerUnitBase::from_rated(config.live.machine.machine.rated), config.live.machine.machine),
+      thermal_(config.live.thermal, core::PerUnitBase::from_rated(config.live.machine.machine.rated),
+               config.live.machine.machine),
       timer_(config.fixed.loop),
       estimate_interval_ns_(interval_ns(config.fixed.lcm.estimate_rate_Hz)),
       measurement_interval_ns_(interval_ns(config.fixed.lcm.measurement_rate_Hz)),
@@ -283,7 +285,7 @@ void LoopThread::process(std::int64_t now_ns) noexcept {
 void LoopThread::run(const std::atomic<bool>& stop) {
   name_thread("rpemd-loop");
   if (loop_config_.realtime != RealtimeMode::kOff) setup_problems_ = apply_thread_policy(loop_config_.thread);
-  prefault_stack(256 * 1024);
+  prefault_stack(std::size_t{256} * 1024);
   const std::int64_t start = timer_.start();
   next_estimate_ns_ = next_measurement_ns_ = next_stats_ns_ = start;
   started_.store(true, std::memory_order_release);

@@ -80,7 +80,8 @@ void PersistingPublisher::publish(const std::string& channel, Message& m) {
   const int size = m.encode(buffer_.data(), 0, static_cast<int>(buffer_.size()));
   // Signed in the buffer, on this thread: the tag over the encoding (rpem/auth/mac.hpp), no allocation.
   if constexpr (kAuthenticated) {
-    if (size > 0 && publish_key_) (void)auth::sign(*publish_key_, channel, std::span(buffer_.data(), static_cast<std::size_t>(size)));
+    if (size > 0 && publish_key_)
+      (void)auth::sign(*publish_key_, channel, std::span(buffer_.data(), static_cast<std::size_t>(size)));
   }
   if (size < 0 || !lcm_ || !lcm_->lcm.good() ||
       lcm_->lcm.publish(channel, buffer_.data(), static_cast<unsigned>(size)) != 0) {
@@ -131,7 +132,7 @@ void PersistingPublisher::publish_diagnostics(const LoopStatsReport& r) {
   rx_to_publish_.reset();
   m.input_queue_depth = r.input_queue_depth;
   m.output_queue_depth = static_cast<std::int32_t>(queues_.loop.size());
-  m.commands_enabled = control_.commands_enabled;
+  m.commands_enabled = static_cast<std::int8_t>(control_.commands_enabled ? 1 : 0);
   m.last_command_seq = control_.last_command_seq;
   m.last_command_result = static_cast<std::int8_t>(control_.last_command_result);
   m.state_file_status = static_cast<std::int8_t>(identity_.state_file_status);
@@ -176,15 +177,15 @@ void PersistingPublisher::print_status(const EstimateReport& r) {
   char vesc[192] = "";  // a VESC source's poll counters (docs/rpemd.md, "source: vesc")
   if (const DiagnosticsRows& s = source_.rows; s.get(&rpem::diagnostics_t::vesc_polls) >= 0) {
     using D = rpem::diagnostics_t;
-    std::snprintf(vesc, sizeof vesc, "  [vesc polls %lld replies %lld timeouts %lld late %lld unrequested %lld stolen_reads %lld]",
-                  static_cast<long long>(s.get(&D::vesc_polls)), static_cast<long long>(s.get(&D::vesc_replies)),
-                  static_cast<long long>(s.get(&D::vesc_timeouts)), static_cast<long long>(s.get(&D::vesc_late_replies)),
-                  static_cast<long long>(s.get(&D::vesc_unrequested_replies)),
-                  static_cast<long long>(s.get(&D::vesc_stolen_reads)));
+    std::snprintf(
+        vesc, sizeof vesc, "  [vesc polls %lld replies %lld timeouts %lld late %lld unrequested %lld stolen_reads %lld]",
+        static_cast<long long>(s.get(&D::vesc_polls)), static_cast<long long>(s.get(&D::vesc_replies)),
+        static_cast<long long>(s.get(&D::vesc_timeouts)), static_cast<long long>(s.get(&D::vesc_late_replies)),
+        static_cast<long long>(s.get(&D::vesc_unrequested_replies)), static_cast<long long>(s.get(&D::vesc_stolen_reads)));
   }
   char psi[32], rs[32];
   std::printf("rpemd %-8s n=%+.3f pu  psi_m=%.4f Wb%s (T_magnet %5.1f C)  r_s=%.4f Ohm%s (T_winding %5.1f C)%s%s%s\n",
-              kStates[static_cast<int>(r.state)], r.speed_pu, r.psi_m_Wb,
+              kStates[static_cast<std::uint8_t>(r.state)], r.speed_pu, r.psi_m_Wb,
               mark(psi, sizeof psi, r.psi_m_adapting, r.psi_m_age_s, r.psi_m_valid), r.t_magnet_C, r.r_s_Ohm,
               mark(rs, sizeof rs, r.r_s_adapting, r.r_s_age_s, r.r_s_valid), r.t_winding_C, truth, vesc,
               r.frozen ? "  FROZEN" : "");

@@ -1,8 +1,8 @@
 #include "rpem/daemon/realtime.hpp"
 
+#include <fcntl.h>
 #include <pthread.h>
 #include <sched.h>
-#include <fcntl.h>
 #include <sys/mman.h>
 #include <unistd.h>
 
@@ -10,6 +10,8 @@
 
 #include <cerrno>
 #include <cstring>
+
+#include "rpem/core/errno_text.hpp"
 
 namespace rpem::daemon {
 
@@ -20,13 +22,13 @@ std::string apply_thread_policy(const ThreadPolicy& p) {
     CPU_ZERO(&set);
     CPU_SET(p.cpu, &set);
     if (const int rc = pthread_setaffinity_np(pthread_self(), sizeof set, &set); rc != 0) {
-      problems += std::string("cpu ") + std::to_string(p.cpu) + ": " + std::strerror(rc) + "; ";
+      problems += std::string("cpu ") + std::to_string(p.cpu) + ": " + core::errno_text(rc) + "; ";
     }
   }
   sched_param param{};
   param.sched_priority = p.fifo ? p.priority : 0;
   if (const int rc = pthread_setschedparam(pthread_self(), p.fifo ? SCHED_FIFO : SCHED_OTHER, &param); rc != 0) {
-    problems += std::string("SCHED_FIFO ") + std::to_string(p.priority) + ": " + std::strerror(rc) +
+    problems += std::string("SCHED_FIFO ") + std::to_string(p.priority) + ": " + core::errno_text(rc) +
                 (rc == EPERM ? " (needs LimitRTPRIO or CAP_SYS_NICE)" : "") + "; ";
   }
   return problems;
@@ -34,7 +36,8 @@ std::string apply_thread_policy(const ThreadPolicy& p) {
 
 std::string lock_memory() {
   if (mlockall(MCL_CURRENT | MCL_FUTURE) != 0) {
-    return std::string("mlockall: ") + std::strerror(errno) + (errno == ENOMEM || errno == EPERM ? " (needs LimitMEMLOCK)" : "");
+    return std::string("mlockall: ") + core::errno_text(errno) +
+           (errno == ENOMEM || errno == EPERM ? " (needs LimitMEMLOCK)" : "");
   }
   return "";
 }
@@ -42,12 +45,12 @@ std::string lock_memory() {
 int request_cpu_dma_latency(int us, std::string& problem) {
   const int fd = ::open("/dev/cpu_dma_latency", O_WRONLY | O_CLOEXEC);
   if (fd < 0) {
-    problem = std::string("/dev/cpu_dma_latency: ") + std::strerror(errno);
+    problem = std::string("/dev/cpu_dma_latency: ") + core::errno_text(errno);
     return -1;
   }
   const std::int32_t value = us;
   if (::write(fd, &value, sizeof value) != static_cast<ssize_t>(sizeof value)) {
-    problem = std::string("/dev/cpu_dma_latency: ") + std::strerror(errno);
+    problem = std::string("/dev/cpu_dma_latency: ") + core::errno_text(errno);
     ::close(fd);
     return -1;
   }

@@ -11,7 +11,7 @@
 #include "rpem/daemon/daemon.hpp"
 #include "rpem/io/exit_codes.hpp"
 
-int main(int argc, char** argv) {
+int main(int argc, char** argv) {  // NOLINT(bugprone-exception-escape): only a defect escapes; terminate() shows it
   using namespace rpem;
   CLI::App app{"rpemd: online identification of PMSM magnet flux linkage and stator resistance (docs/rpemd.md)"};
   daemon::DaemonOptions options;

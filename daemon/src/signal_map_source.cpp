@@ -98,7 +98,8 @@ SignalMapSource::Options SignalMapSource::parse(io::YamlMap& section, const std:
   Options o;
   o.interface = parse_interface(section);
   o.map = section.text("map");
-  if (std::filesystem::path(o.map).is_relative()) o.map = (std::filesystem::path(base_dir) / o.map).lexically_normal().string();
+  if (std::filesystem::path(o.map).is_relative())
+    o.map = (std::filesystem::path(base_dir) / o.map).lexically_normal().string();
   section.finish();
   // Refused here, at start (and on a reload), naming the map file and what it lacks.
   const can::SignalMap map = io::load_signal_map(o.map);

@@ -12,6 +12,8 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "rpem/core/errno_text.hpp"
+
 namespace rpem::daemon {
 namespace fs = std::filesystem;
 
@@ -25,22 +27,22 @@ std::string write_atomically(const std::string& path, const std::string& text) {
   if (target.has_parent_path()) fs::create_directories(target.parent_path(), ec);
   const std::string tmp = path + ".tmp";
   const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0600);
-  if (fd < 0) return "open " + tmp + ": " + std::strerror(errno);
+  if (fd < 0) return "open " + tmp + ": " + core::errno_text(errno);
   const char* p = text.data();
   std::size_t left = text.size();
   while (left > 0) {
     const ssize_t n = ::write(fd, p, left);
     if (n < 0) {
       if (errno == EINTR) continue;
-      const std::string why = std::strerror(errno);
+      const std::string why = core::errno_text(errno);
       ::close(fd);
-      return "write " + tmp + ": " + why;
+      return std::string("write ").append(tmp).append(": ").append(why);
     }
     p += n;
     left -= static_cast<std::size_t>(n);
   }
-  if (::fsync(fd) != 0 || ::close(fd) != 0) return "fsync " + tmp + ": " + std::strerror(errno);
-  if (::rename(tmp.c_str(), path.c_str()) != 0) return "rename to " + path + ": " + std::strerror(errno);
+  if (::fsync(fd) != 0 || ::close(fd) != 0) return "fsync " + tmp + ": " + core::errno_text(errno);
+  if (::rename(tmp.c_str(), path.c_str()) != 0) return "rename to " + path + ": " + core::errno_text(errno);
   const std::string dir = target.has_parent_path() ? target.parent_path().string() : ".";
   if (const int dfd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC); dfd >= 0) {
     (void)::fsync(dfd);
@@ -68,8 +70,8 @@ std::string command_sequence_file(const std::string& state_file) {
 }
 
 std::string write_command_sequence(const std::string& path, std::int64_t last_accepted_seq) {
-  return write_atomically(path, "{\"format\": \"rpemd-commands-1\", \"last_accepted_seq\": " +
-                                    std::to_string(last_accepted_seq) + "}\n");
+  return write_atomically(
+      path, "{\"format\": \"rpemd-commands-1\", \"last_accepted_seq\": " + std::to_string(last_accepted_seq) + "}\n");
 }
 
 std::int64_t load_command_sequence(const std::string& path) {
@@ -82,10 +84,12 @@ std::int64_t load_command_sequence(const std::string& path) {
   text << in.rdbuf();
   try {
     const nlohmann::json j = nlohmann::json::parse(text.str());
-    if (!j.is_object() || j.value("format", "") != "rpemd-commands-1") throw std::runtime_error("not an rpemd commands file");
+    if (!j.is_object() || j.value("format", "") != "rpemd-commands-1")
+      throw std::runtime_error("not an rpemd commands file");
     return j.at("last_accepted_seq").get<std::int64_t>();
   } catch (const std::exception& e) {
-    throw std::runtime_error(path + ": corrupt (" + e.what() + "); it holds the last accepted command's sequence number, "
+    throw std::runtime_error(path + ": corrupt (" + e.what() +
+                             "); it holds the last accepted command's sequence number, "
                              "which replay protection needs: restore it, or remove it to start again from 0");
   }
 }

@@ -79,7 +79,7 @@ class VescSampleSource final : public SampleSource {
     // The kernel passes what the poller reads: replies to us, the controller's statuses, and other nodes'
     // commands to it or to all (stolen averages); the rest of the bus stays in the kernel.
     const auto filters = can::vesc::kernel_filters(static_cast<std::uint8_t>(options_.controller_id),
-                                                    static_cast<std::uint8_t>(options_.host_id));
+                                                   static_cast<std::uint8_t>(options_.host_id));
     o.filters.assign(filters.begin(), filters.end());
     can::SocketCanChannel channel(o);
     VescPoller poller(poller_config(options_));
@@ -136,6 +136,8 @@ VescSource::Options VescSource::parse(io::YamlMap& section, const std::string&) 
   return o;
 }
 
-std::unique_ptr<SampleSource> VescSource::make(const Options& options) { return std::make_unique<VescSampleSource>(options); }
+std::unique_ptr<SampleSource> VescSource::make(const Options& options) {
+  return std::make_unique<VescSampleSource>(options);
+}
 
 }  // namespace rpem::daemon

@@ -33,8 +33,8 @@ std::vector<core::AveragedSample> read_averaged_log(const std::string& path, Ave
   return samples;
 }
 
-std::vector<core::AveragedSample> read_averaged_log(const std::string& path, const LogMap& map,
-                                                    const DriveLogLimits& limits, AveragedLogRead* read_out) {
+std::vector<core::AveragedSample> read_averaged_log(const std::string& path, const LogMap& map, const DriveLogLimits& limits,
+                                                    AveragedLogRead* read_out) {
   if (!map.averaged()) {
     throw ConfigError(map.name, 0, 0, "samples", "a map of instantaneous samples does not give averaged samples");
   }
@@ -150,15 +150,15 @@ DriveLogRow to_drive_log_row(const core::AveragedSample& s) {
   return r;
 }
 
-DriveLogLayout rotor_frame_layout(const AveragedLogLayout& a) {
+DriveLogLayout rotor_frame_layout(const AveragedLogLayout& layout) {
   DriveLogLayout l;
   l.angle = false;
-  l.u_dc = a.u_dc;
+  l.u_dc = layout.u_dc;
   l.voltage_abc = l.current_abc = false;
   l.voltage_dq = l.current_dq = true;
-  l.t_winding = a.t_winding;
-  l.t_magnet = a.t_magnet;
-  l.t_coolant = a.t_coolant;
+  l.t_winding = layout.t_winding;
+  l.t_magnet = layout.t_magnet;
+  l.t_coolant = layout.t_coolant;
   return l;
 }
 

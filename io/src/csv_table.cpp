@@ -44,8 +44,8 @@ CsvTable CsvTable::read(const std::string& path, bool allow_nan, const std::vect
     if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
     const auto cells = split(line);
     if (cells.size() != t.header_.size()) {
-      throw InputError(path, line_no, 0, "", "row has " + std::to_string(cells.size()) + " cells, header has " +
-                                                 std::to_string(t.header_.size()));
+      throw InputError(path, line_no, 0, "",
+                       "row has " + std::to_string(cells.size()) + " cells, header has " + std::to_string(t.header_.size()));
     }
     for (std::size_t c = 0; c < cells.size(); ++c) {
       double v = std::nan("");

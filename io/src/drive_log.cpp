@@ -33,9 +33,8 @@ void DriveLogReader::check_layout() {
   // Our own format names its quantities in the header, so what a drive log needs is checked here; a map
   // was checked when it was loaded.
   if (const std::optional<LayoutProblem> p = drive_log_layout_problem(reader_.present())) {
-    const std::string reason = p->reason.rfind("required", 0) == 0
-                                   ? "required column is missing from the header" + p->reason.substr(8)
-                                   : p->reason;
+    const std::string reason =
+        p->reason.rfind("required", 0) == 0 ? "required column is missing from the header" + p->reason.substr(8) : p->reason;
     reader_.fail_at(reader_.line(), p->column, reason);
   }
   auto has = [&](Quantity q) { return reader_.has(q); };

@@ -23,13 +23,14 @@ EstimateLogWriter::EstimateLogWriter(const std::string& path, const std::vector<
   out_ << '\n';
 }
 
-void EstimateLogWriter::write(const core::Estimate& e, const core::RpemEstimator& core, const core::ThermalEstimate* thermal) {
+void EstimateLogWriter::write(const core::Estimate& e, const core::RpemEstimator& core,
+                              const core::ThermalEstimate* thermal) {
   const auto& d = e.detail;
   const auto& st = core.state();
   line_.clear();
   append_number(line_, core::to_seconds(e.t_ns));
-  for (double v : {e.psi_m_Wb, e.r_s_Ohm, d.theta_pu[core::kPsiM], d.theta_pu[core::kRs], e.epsilon_A[0],
-                   e.epsilon_A[1], e.i_hat_A[0], e.i_hat_A[1], e.i_meas_A[0], e.i_meas_A[1], e.speed_pu}) {
+  for (double v : {e.psi_m_Wb, e.r_s_Ohm, d.theta_pu[core::kPsiM], d.theta_pu[core::kRs], e.epsilon_A[0], e.epsilon_A[1],
+                   e.i_hat_A[0], e.i_hat_A[1], e.i_meas_A[0], e.i_meas_A[1], e.speed_pu}) {
     append_number(line_ += ',', v);
   }
   line_ += (d.flags & core::step_flag::kPsiMActive) ? ",1" : ",0";
@@ -46,7 +47,8 @@ void EstimateLogWriter::write(const core::Estimate& e, const core::RpemEstimator
     constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
     const bool on = thermal != nullptr && thermal->started;
     static const core::ThermalEstimate kNotStarted{};
-    for (double v : {on ? thermal->t_magnet_rpem_C : kNaN, on ? thermal->t_winding_rpem_C : kNaN, on ? thermal->coolant_C : kNaN}) {
+    for (double v :
+         {on ? thermal->t_magnet_rpem_C : kNaN, on ? thermal->t_winding_rpem_C : kNaN, on ? thermal->coolant_C : kNaN}) {
       append_number(line_ += ',', v);
     }
     for (std::size_t i = 0; i < thermal_nodes_; ++i) {

@@ -101,9 +101,10 @@ MappedColumn identity(Quantity q) {
 /// the unit is mechanical.
 bool apply_unit(YamlMap& m, MappedColumn& c, QuantityKind kind, long pole_pairs) {
   c.unit = m.text_or("unit", si_unit(kind));
-  const auto it = std::find_if(kUnits.begin(), kUnits.end(),
-                               [&](const Unit& u) { return u.kind == kind && c.unit == u.name; });
-  if (it == kUnits.end()) m.fail("unit", "'" + c.unit + "' is not a unit of this quantity (one of " + unit_names(kind) + ")");
+  const auto it =
+      std::find_if(kUnits.begin(), kUnits.end(), [&](const Unit& u) { return u.kind == kind && c.unit == u.name; });
+  if (it == kUnits.end())
+    m.fail("unit", "'" + c.unit + "' is not a unit of this quantity (one of " + unit_names(kind) + ")");
   if (it->per_pole_pair && pole_pairs <= 0) {
     m.fail("unit", "'" + c.unit + "' is mechanical: the map needs pole_pairs to make it electrical");
   }
@@ -217,7 +218,8 @@ std::optional<LayoutProblem> drive_log_layout_problem(const QuantitySet& p) {
     if (n != 0 && n != groups[g].size) {
       for (std::size_t k = 0; k < groups[g].size; ++k) {
         if (!present(p, groups[g].members[k])) {
-          return LayoutProblem{info(groups[g].members[k]).name, std::string("incomplete ") + groups[g].what + " column group"};
+          return LayoutProblem{info(groups[g].members[k]).name,
+                               std::string("incomplete ") + groups[g].what + " column group"};
         }
       }
     }
@@ -229,8 +231,9 @@ std::optional<LayoutProblem> drive_log_layout_problem(const QuantitySet& p) {
   const bool rotor_frame_only = !has[0] && !has[2];
   for (Quantity q : {Quantity::kThetaEl, Quantity::kUDc}) {
     if (!present(p, q) && !rotor_frame_only) {
-      return LayoutProblem{info(q).name, "required (optional only when voltage and current are both given as u_d,u_q and "
-                                         "i_d,i_q only)"};
+      return LayoutProblem{info(q).name,
+                           "required (optional only when voltage and current are both given as u_d,u_q and "
+                           "i_d,i_q only)"};
     }
   }
   return std::nullopt;
@@ -243,8 +246,9 @@ std::optional<LayoutProblem> averaged_log_layout_problem(const QuantitySet& p) {
   for (Quantity q : {Quantity::kThetaEl, Quantity::kUA, Quantity::kUB, Quantity::kUC, Quantity::kIA, Quantity::kIB,
                      Quantity::kIC, Quantity::kTorqueCmd}) {
     if (present(p, q)) {
-      return LayoutProblem{info(q).name, "not a quantity of averaged samples (their means are rotor-frame: i_d, i_q, "
-                                         "u_d, u_q, omega_el, u_dc, T_winding, T_magnet, T_drive)"};
+      return LayoutProblem{info(q).name,
+                           "not a quantity of averaged samples (their means are rotor-frame: i_d, i_q, "
+                           "u_d, u_q, omega_el, u_dc, T_winding, T_magnet, T_drive)"};
     }
   }
   return std::nullopt;
@@ -252,19 +256,8 @@ std::optional<LayoutProblem> averaged_log_layout_problem(const QuantitySet& p) {
 
 namespace {
 
-LogMap parse(YamlMap root) {
-  LogMap m;
-  m.name = root.file();
-  m.separator = one_character(root, "separator", ',');
-  if (m.separator == '"' || m.separator == '\n' || m.separator == '\r') root.fail("separator", "cannot separate cells");
-  m.header = root.boolean_or("header", true);
-  m.skip_lines = static_cast<std::size_t>(root.integer_or("skip_lines", 0, 0, 1000000));
-  m.comment = one_character(root, "comment", '\0');
-  if (m.comment != '\0' && m.comment == m.separator) root.fail("comment", "is the separator");
-  const std::string samples = root.choice("samples", {"instantaneous", "averaged"});
-  const long pole_pairs = root.integer_or("pole_pairs", 0, 1, 1000);
-
-  YamlMap time = root.map("time");
+/// The time section: evenly spaced rows (period_s) or a time column (column, unit, scale, offset, wrap, resolution).
+void parse_time(YamlMap time, LogMap& m) {
   if (time.has("period_s")) {
     m.period_s = time.number("period_s", 1e-9, 1e6);
     for (const char* k : {"column", "unit", "wrap", "resolution"}) {
@@ -288,16 +281,12 @@ LogMap parse(YamlMap root) {
     m.time = t;
   }
   time.finish();
+}
 
-  if (samples == "averaged") {
-    m.window = root.choice("window", {"previous_row", "t_start"}) == "t_start" ? Window::kStartColumn : Window::kPreviousRow;
-  } else if (root.has("window")) {
-    root.fail("window", "only averaged samples have windows");
-  }
-
-  YamlMap columns = root.map("columns");
+/// The columns section: one entry per quantity the log holds (a speed may come from a PLL); `mechanical` tells
+/// whether any column is in a mechanical unit. Unknown names are left to the caller's finish().
+QuantitySet parse_columns(YamlMap& columns, LogMap& m, long pole_pairs, bool& mechanical) {
   QuantitySet present{};
-  bool mechanical = false;
   for (const QuantityInfo& q : kQuantities) {
     std::optional<YamlMap> c = columns.optional_map(q.name);
     if (!c) continue;
@@ -315,6 +304,32 @@ LogMap parse(YamlMap root) {
     m.columns.push_back(parse_column(*c, q.quantity, q.kind, m.header, pole_pairs, mechanical));
     present[static_cast<std::size_t>(q.quantity)] = true;
   }
+  return present;
+}
+
+LogMap parse(YamlMap root) {
+  LogMap m;
+  m.name = root.file();
+  m.separator = one_character(root, "separator", ',');
+  if (m.separator == '"' || m.separator == '\n' || m.separator == '\r') root.fail("separator", "cannot separate cells");
+  m.header = root.boolean_or("header", true);
+  m.skip_lines = static_cast<std::size_t>(root.integer_or("skip_lines", 0, 0, 1000000));
+  m.comment = one_character(root, "comment", '\0');
+  if (m.comment != '\0' && m.comment == m.separator) root.fail("comment", "is the separator");
+  const std::string samples = root.choice("samples", {"instantaneous", "averaged"});
+  const long pole_pairs = root.integer_or("pole_pairs", 0, 1, 1000);
+
+  parse_time(root.map("time"), m);
+
+  if (samples == "averaged") {
+    m.window = root.choice("window", {"previous_row", "t_start"}) == "t_start" ? Window::kStartColumn : Window::kPreviousRow;
+  } else if (root.has("window")) {
+    root.fail("window", "only averaged samples have windows");
+  }
+
+  YamlMap columns = root.map("columns");
+  bool mechanical = false;
+  const QuantitySet present = parse_columns(columns, m, pole_pairs, mechanical);
   columns.finish();  // names no quantity: rejected with its line
   const std::optional<LayoutProblem> problem =
       m.averaged() ? averaged_log_layout_problem(present) : drive_log_layout_problem(present);

@@ -67,9 +67,11 @@ LogSource log_source(const std::string& log_path, const std::string& map_path) {
 
 std::string describe(const TimeRepairs& r) {
   std::string s;
-  if (r.wraps > 0) s += "; " + std::to_string(r.wraps) + (r.wraps == 1 ? " wrap" : " wraps") + " of the time column (midnight)";
+  if (r.wraps > 0)
+    s += "; " + std::to_string(r.wraps) + (r.wraps == 1 ? " wrap" : " wraps") + " of the time column (midnight)";
   if (r.tied_rows > 0) {
-    s += "; " + std::to_string(r.tied_rows) + " rows shared their time stamp with the row before (spread over its resolution)";
+    s += "; " + std::to_string(r.tied_rows) +
+         " rows shared their time stamp with the row before (spread over its resolution)";
   }
   return s;
 }

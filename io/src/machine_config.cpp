@@ -52,6 +52,53 @@ core::GradientForm parse_form(YamlMap& m, const char* key, core::GradientForm fa
                                                                                    : core::GradientForm::kSteadyState;
 }
 
+void parse_initial_hessians(YamlMap hess, core::EstimatorSettings& s) {
+  const auto r0 = hess.numbers("sga_pu", 2, 0.0, 1e6);
+  s.initial_sga_hessian_pu = {r0[0], r0[1]};
+  const auto big_r0 = hess.numbers("gna_pu", 3, -1e6, 1e6);  // [R11, R12, R22]
+  s.initial_gna_hessian_pu << big_r0[0], big_r0[1], big_r0[1], big_r0[2];
+  if (big_r0[0] < 0.0 || big_r0[2] < 0.0 || big_r0[0] * big_r0[2] < big_r0[1] * big_r0[1]) {
+    hess.fail("gna_pu", "R[0] = [[R11, R12], [R12, R22]] must be positive semi-definite");
+  }
+  hess.finish();
+}
+
+void parse_floors(YamlMap floors, core::EstimatorSettings& s) {
+  s.floors.sga_hessian_min_pu = floors.number("sga_hessian_min_pu", 0.0, kInf);
+  s.floors.gna_determinant_min_pu = floors.number("gna_determinant_min_pu", 0.0, kInf);
+  s.floors.gna_eigenvalue_min_pu = floors.number("gna_eigenvalue_min_pu", 0.0, kInf);
+  s.floors.phyint_denominator_min_pu = floors.number("phyint_denominator_min_pu", 0.0, kInf);
+  floors.finish();
+}
+
+/// The averaged-sample estimator (docs/derivations.md §11); its gains are those of estimator.gains, as rates
+/// per second.
+void parse_averaged(YamlMap& a, core::EstimatorSettings& s) {
+  s.averaged.max_interval_s = a.number_or("max_interval_s", s.averaged.max_interval_s, 1e-4, 10.0);
+  s.averaged.inductive_correction = a.boolean_or("inductive_correction", s.averaged.inductive_correction);
+  s.averaged.instrument_time_constant_s =
+      a.number_or("instrument_time_constant_s", s.averaged.instrument_time_constant_s, 0.0, 10.0);
+  s.averaged.control_period_s = a.number_or("control_period_s", s.averaged.control_period_s, 0.0, 1e-2);
+  s.averaged.current_sample_at = a.number_or("current_sample_at", s.averaged.current_sample_at, 0.0, 1.0);
+  s.averaged.voltage_is_command = a.choice_or("voltage_reported", "mean", {"mean", "command"}) == "command";
+  if (s.averaged.voltage_is_command && !(s.averaged.control_period_s > 0.0)) {
+    a.fail("voltage_reported", "command needs control_period_s (the period the command is held)");
+  }
+  a.finish();
+}
+
+/// The regime classification (core/regime.hpp, docs/derivations.md §13).
+void parse_regimes(YamlMap& g, core::RegimeSettings& r) {
+  r.enabled = g.boolean_or("enabled", r.enabled);
+  r.significance_sigma = g.number_or("significance_sigma", r.significance_sigma, 1.0, 10.0);
+  r.voltage_resolution_V = g.number_or("voltage_resolution_V", r.voltage_resolution_V, 0.0, 1e3);
+  r.current_resolution_A = g.number_or("current_resolution_A", r.current_resolution_A, 0.0, 1e3);
+  r.speed_resolution_rad_s = g.number_or("speed_resolution_rad_s", r.speed_resolution_rad_s, 0.0, 1e4);
+  r.inductance_tolerance = g.number_or("inductance_tolerance", r.inductance_tolerance, 0.0, 10.0);
+  r.angle_tolerance_rad = g.number_or("angle_tolerance_rad", r.angle_tolerance_rad, 0.0, 1.5);
+  g.finish();
+}
+
 core::EstimatorSettings parse_estimator(YamlMap e, const core::MachineSi& machine) {
   core::EstimatorSettings s;  // the defaults of every optional key (core/estimator.hpp, EstimatorOptions)
   s.algorithm = parse_algorithm(e.choice_or("algorithm", to_string(s.algorithm), {"sga", "gna", "phyint"}));
@@ -115,48 +162,10 @@ core::EstimatorSettings parse_estimator(YamlMap e, const core::MachineSi& machin
   s.gains[static_cast<int>(core::Algorithm::kPhyInt)] = parse_sequences(gains.map("phyint"), false);
   gains.finish();
 
-  YamlMap hess = e.map("initial_hessian");
-  const auto r0 = hess.numbers("sga_pu", 2, 0.0, 1e6);
-  s.initial_sga_hessian_pu = {r0[0], r0[1]};
-  const auto big_r0 = hess.numbers("gna_pu", 3, -1e6, 1e6);  // [R11, R12, R22]
-  s.initial_gna_hessian_pu << big_r0[0], big_r0[1], big_r0[1], big_r0[2];
-  if (big_r0[0] < 0.0 || big_r0[2] < 0.0 || big_r0[0] * big_r0[2] < big_r0[1] * big_r0[1]) {
-    hess.fail("gna_pu", "R[0] = [[R11, R12], [R12, R22]] must be positive semi-definite");
-  }
-  hess.finish();
-
-  YamlMap floors = e.map("floors");
-  s.floors.sga_hessian_min_pu = floors.number("sga_hessian_min_pu", 0.0, kInf);
-  s.floors.gna_determinant_min_pu = floors.number("gna_determinant_min_pu", 0.0, kInf);
-  s.floors.gna_eigenvalue_min_pu = floors.number("gna_eigenvalue_min_pu", 0.0, kInf);
-  s.floors.phyint_denominator_min_pu = floors.number("phyint_denominator_min_pu", 0.0, kInf);
-  floors.finish();
-  if (auto a = e.optional_map("averaged")) {
-    // The averaged-sample estimator (docs/derivations.md §11); its gains are those above, as rates per second.
-    s.averaged.max_interval_s = a->number_or("max_interval_s", s.averaged.max_interval_s, 1e-4, 10.0);
-    s.averaged.inductive_correction = a->boolean_or("inductive_correction", s.averaged.inductive_correction);
-    s.averaged.instrument_time_constant_s =
-        a->number_or("instrument_time_constant_s", s.averaged.instrument_time_constant_s, 0.0, 10.0);
-    s.averaged.control_period_s = a->number_or("control_period_s", s.averaged.control_period_s, 0.0, 1e-2);
-    s.averaged.current_sample_at = a->number_or("current_sample_at", s.averaged.current_sample_at, 0.0, 1.0);
-    s.averaged.voltage_is_command = a->choice_or("voltage_reported", "mean", {"mean", "command"}) == "command";
-    if (s.averaged.voltage_is_command && !(s.averaged.control_period_s > 0.0)) {
-      a->fail("voltage_reported", "command needs control_period_s (the period the command is held)");
-    }
-    a->finish();
-  }
-  if (auto g = e.optional_map("regimes")) {
-    // The regime classification (core/regime.hpp, docs/derivations.md §13).
-    core::RegimeSettings& r = s.regimes;
-    r.enabled = g->boolean_or("enabled", r.enabled);
-    r.significance_sigma = g->number_or("significance_sigma", r.significance_sigma, 1.0, 10.0);
-    r.voltage_resolution_V = g->number_or("voltage_resolution_V", r.voltage_resolution_V, 0.0, 1e3);
-    r.current_resolution_A = g->number_or("current_resolution_A", r.current_resolution_A, 0.0, 1e3);
-    r.speed_resolution_rad_s = g->number_or("speed_resolution_rad_s", r.speed_resolution_rad_s, 0.0, 1e4);
-    r.inductance_tolerance = g->number_or("inductance_tolerance", r.inductance_tolerance, 0.0, 10.0);
-    r.angle_tolerance_rad = g->number_or("angle_tolerance_rad", r.angle_tolerance_rad, 0.0, 1.5);
-    g->finish();
-  }
+  parse_initial_hessians(e.map("initial_hessian"), s);
+  parse_floors(e.map("floors"), s);
+  if (auto a = e.optional_map("averaged")) parse_averaged(*a, s);
+  if (auto g = e.optional_map("regimes")) parse_regimes(*g, s.regimes);
   e.finish();
   return s;
 }
@@ -197,23 +206,19 @@ ParameterDrift parse_drift(YamlMap m, const char* ref_key, double ref_min, doubl
   return d;
 }
 
-void parse_extensions(YamlMap x, MachineConfig& config) {
-  core::ModelExtensions& c = config.estimator.extensions;
-  const core::ModelExtensions nominal;  // a key left out: its value in the nominal model
-  if (auto d = x.optional_map("deadtime")) {
-    c.deadtime_t_dead_s = d->number_or("t_dead_s", nominal.deadtime_t_dead_s, 0.0, 1e-3);
-    c.switching_frequency_Hz = d->number_or("switching_frequency_Hz", nominal.switching_frequency_Hz, 0.0, 1e6);
-    c.deadtime_v_err_V = d->number_or("v_err_V", nominal.deadtime_v_err_V, -1e4, 1e4);
-    c.deadtime_current_band_A = d->number_or("current_band_A", nominal.deadtime_current_band_A, 0.0, 1e4);
-    if (c.deadtime_t_dead_s > 0.0 && c.switching_frequency_Hz <= 0.0) {
-      d->fail("switching_frequency_Hz", "t_dead_s needs the switching frequency");
-    }
-    d->finish();
+void parse_deadtime(YamlMap& d, const core::ModelExtensions& nominal, core::ModelExtensions& c) {
+  c.deadtime_t_dead_s = d.number_or("t_dead_s", nominal.deadtime_t_dead_s, 0.0, 1e-3);
+  c.switching_frequency_Hz = d.number_or("switching_frequency_Hz", nominal.switching_frequency_Hz, 0.0, 1e6);
+  c.deadtime_v_err_V = d.number_or("v_err_V", nominal.deadtime_v_err_V, -1e4, 1e4);
+  c.deadtime_current_band_A = d.number_or("current_band_A", nominal.deadtime_current_band_A, 0.0, 1e4);
+  if (c.deadtime_t_dead_s > 0.0 && c.switching_frequency_Hz <= 0.0) {
+    d.fail("switching_frequency_Hz", "t_dead_s needs the switching frequency");
   }
-  if (auto t = x.optional_map("theta_offset")) {
-    c.theta_offset_rad = t->number("offset_rad", -3.2, 3.2);
-    t->finish();
-  }
+  d.finish();
+}
+
+/// current_offset and current_gain: lists of one phase's error each.
+void parse_phase_errors(YamlMap& x, core::ModelExtensions& c) {
   for (const char* kind : {"current_offset", "current_gain"}) {
     if (!x.has(kind)) continue;
     for (YamlMap& p : x.maps(kind)) {
@@ -227,15 +232,27 @@ void parse_extensions(YamlMap x, MachineConfig& config) {
       p.finish();
     }
   }
-  if (auto d = x.optional_map("delay")) {
-    const double period_s = config.estimator.nominal_sample_period_s;
-    c.delay_s = d->number("delay_s", 0.0, 1e-2);
-    if (c.delay_s >= (core::kMaxDelayPeriods + 1) * period_s) {
-      d->fail("delay_s", "must be below " + std::to_string(core::kMaxDelayPeriods + 1) +
-                             " sample periods (estimator.sample_period_s)");
-    }
-    d->finish();
+}
+
+void parse_delay(YamlMap& d, double period_s, core::ModelExtensions& c) {
+  c.delay_s = d.number("delay_s", 0.0, 1e-2);
+  if (c.delay_s >= (core::kMaxDelayPeriods + 1) * period_s) {
+    d.fail("delay_s",
+           "must be below " + std::to_string(core::kMaxDelayPeriods + 1) + " sample periods (estimator.sample_period_s)");
   }
+  d.finish();
+}
+
+void parse_extensions(YamlMap x, MachineConfig& config) {
+  core::ModelExtensions& c = config.estimator.extensions;
+  const core::ModelExtensions nominal;  // a key left out: its value in the nominal model
+  if (auto d = x.optional_map("deadtime")) parse_deadtime(*d, nominal, c);
+  if (auto t = x.optional_map("theta_offset")) {
+    c.theta_offset_rad = t->number("offset_rad", -3.2, 3.2);
+    t->finish();
+  }
+  parse_phase_errors(x, c);
+  if (auto d = x.optional_map("delay")) parse_delay(*d, config.estimator.nominal_sample_period_s, c);
   if (auto k = x.optional_map("cross_saturation")) {
     c.cross_coupling_H_per_A = k->number_or("coupling_H_per_A", nominal.cross_coupling_H_per_A, -10.0, 10.0);
     c.cross_coupling_H_per_A2 = k->number_or("coupling_H_per_A2", nominal.cross_coupling_H_per_A2, -10.0, 10.0);
@@ -319,8 +336,8 @@ DriveLogLimits machine_limits(const core::MachineSi& machine) {
     const double max_abs = kRatedMultipleLimit * base_value;
     if (!(max_abs < bound.max_abs)) return;
     char why[160];
-    std::snprintf(why, sizeof why, "%g x the configured machine's %s %.4g %s, machine.rated", kRatedMultipleLimit,
-                  what, base_value, unit);
+    std::snprintf(why, sizeof why, "%g x the configured machine's %s %.4g %s, machine.rated", kRatedMultipleLimit, what,
+                  base_value, unit);
     bound = {max_abs, why};
   };
   narrow(limits.current_A, base.current_A, "rated peak phase current", "A");
@@ -395,9 +412,9 @@ std::string replace_machine_values(const std::string& yaml_text, const std::vect
         old = old.substr(0, old.find('#'));
         old.erase(0, old.find_first_not_of(' '));
         old.erase(old.find_last_not_of(' ') + 1);
-        line = line.substr(0, indent) + key + " ";
+        line = line.substr(0, indent).append(key).append(" ");
         append_number(line, values[j].second);
-        line += "  # " + comment + " (was " + old + ")";
+        line.append("  # ").append(comment).append(" (was ").append(old).append(")");
         done[j] = true;
       }
     }

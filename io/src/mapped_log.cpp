@@ -50,7 +50,7 @@ void MappedLogReader::fail_cell(int index, const std::string& label, const std::
 
 std::string MappedLogReader::label(Quantity q) const {
   const MappedColumn* c = column_[static_cast<std::size_t>(q)];
-  const std::string name = info(q).name;
+  std::string name = info(q).name;  // not const: returned by move
   if (c == nullptr || c->column.name == name) return name;
   return c->column.label() + " (" + name + ")";
 }
@@ -66,7 +66,7 @@ bool MappedLogReader::next_line(std::string& text) {
     ++line_;
     bytes_read_ += text.size() + 1;
     const auto first = std::find_if_not(text.begin(), text.end(), blank);
-    if (first == text.end()) continue;                              // blank line
+    if (first == text.end()) continue;                             // blank line
     if (map_.comment != '\0' && *first == map_.comment) continue;  // comment line
     return true;
   }
@@ -113,10 +113,11 @@ void MappedLogReader::read_header() {
     return;
   }
   std::string header_line;
-  if (!next_line(header_line)) throw DriveLogError(path_, line_ == 0 ? 1 : line_, 0, "", "empty file: expected a header row");
+  if (!next_line(header_line))
+    throw DriveLogError(path_, line_ == 0 ? 1 : line_, 0, "", "empty file: expected a header row");
   if (header_line.rfind("\xEF\xBB\xBF", 0) == 0) header_line.erase(0, 3);  // a UTF-8 byte-order mark
-  const auto last = std::find_if_not(header_line.rbegin(), header_line.rend(),
-                                     [&](char c) { return blank(c) && c != map_.separator; });
+  const auto last =
+      std::find_if_not(header_line.rbegin(), header_line.rend(), [&](char c) { return blank(c) && c != map_.separator; });
   trailing_separator_ = last != header_line.rend() && *last == map_.separator;
   width_ = std::numeric_limits<std::size_t>::max();  // no trailing cell dropped from the header itself
   split(header_line);
@@ -134,8 +135,9 @@ void MappedLogReader::read_header() {
     return index;
   };
   auto missing = [&](const std::string& label) {
-    fail_at(line_, label, map_.columns_optional ? "required column is missing from the header"
-                                                : "is missing from the header (the map " + map_.name + " reads it)");
+    fail_at(line_, label,
+            map_.columns_optional ? "required column is missing from the header"
+                                  : "is missing from the header (the map " + map_.name + " reads it)");
   };
   if (map_.time) {
     time_label_ = map_.time->column.name == "t" ? "t" : map_.time->column.name + " (t)";
@@ -177,27 +179,41 @@ void MappedLogReader::check(const MappedRow& row, int index, const std::string& 
   const char* unit = "";
   const Bound* bound = nullptr;
   switch (i.kind) {
-    case QuantityKind::kTime: bound = &limits_.time_s, unit = "s"; break;
-    case QuantityKind::kAngle: bound = &limits_.angle_rad, unit = "rad"; break;
-    case QuantityKind::kSpeed: bound = &limits_.speed_rad_s, unit = "rad/s"; break;
-    case QuantityKind::kVoltage: bound = &limits_.voltage_V, unit = "V"; break;
-    case QuantityKind::kCurrent: bound = &limits_.current_A, unit = "A"; break;
-    case QuantityKind::kTorque: bound = &limits_.torque_Nm, unit = "Nm"; break;
+    case QuantityKind::kTime:
+      bound = &limits_.time_s, unit = "s";
+      break;
+    case QuantityKind::kAngle:
+      bound = &limits_.angle_rad, unit = "rad";
+      break;
+    case QuantityKind::kSpeed:
+      bound = &limits_.speed_rad_s, unit = "rad/s";
+      break;
+    case QuantityKind::kVoltage:
+      bound = &limits_.voltage_V, unit = "V";
+      break;
+    case QuantityKind::kCurrent:
+      bound = &limits_.current_A, unit = "A";
+      break;
+    case QuantityKind::kTorque:
+      bound = &limits_.torque_Nm, unit = "Nm";
+      break;
     case QuantityKind::kTemperature:
       if (v < limits_.temperature_min_C || v > limits_.temperature_max_C) {
-        fail_cell(index, label, g6(v) + " °C is outside the plausible [" + g6(limits_.temperature_min_C) + ", " +
-                                    g6(limits_.temperature_max_C) + "] °C");
+        fail_cell(index, label,
+                  g6(v) + " °C is outside the plausible [" + g6(limits_.temperature_min_C) + ", " +
+                      g6(limits_.temperature_max_C) + "] °C");
       }
       return;
   }
   if (std::abs(v) > bound->max_abs) {
-    fail_cell(index, label, g6(v) + " " + unit + " is beyond the plausible ±" + g6(bound->max_abs) + " " + unit + " (" +
-                                bound->why + ")");
+    fail_cell(index, label,
+              g6(v) + " " + unit + " is beyond the plausible ±" + g6(bound->max_abs) + " " + unit + " (" + bound->why + ")");
   }
   const double u_dc = row[Quantity::kUDc];
   if (i.voltage_command && u_dc >= 1.0 && std::abs(v) > limits_.command_per_dc_link * u_dc) {
-    fail_cell(index, label, g6(v) + " V is more than " + g6(limits_.command_per_dc_link) + " x this row's u_dc = " +
-                                g6(u_dc) + " V (a two-level inverter applies at most u_dc/2 from the link's midpoint)");
+    fail_cell(index, label,
+              g6(v) + " V is more than " + g6(limits_.command_per_dc_link) + " x this row's u_dc = " + g6(u_dc) +
+                  " V (a two-level inverter applies at most u_dc/2 from the link's midpoint)");
   }
 }
 
@@ -209,18 +225,21 @@ bool MappedLogReader::read_raw(MappedRow& row) {
     width_ = cells_.size();
     for (std::size_t q = 0; q < kQuantityCount; ++q) {
       if (index_[q] >= static_cast<int>(width_)) {
-        fail_at(line_, static_cast<Quantity>(q), "the map reads cell " + std::to_string(index_[q] + 1) + ", the row has " +
-                                                    std::to_string(width_) + " cells");
+        fail_at(
+            line_, static_cast<Quantity>(q),
+            "the map reads cell " + std::to_string(index_[q] + 1) + ", the row has " + std::to_string(width_) + " cells");
       }
     }
     if (time_index_ >= static_cast<int>(width_)) {
-      fail_at(line_, time_label_, "the map reads cell " + std::to_string(time_index_ + 1) + ", the row has " +
-                                      std::to_string(width_) + " cells");
+      fail_at(
+          line_, time_label_,
+          "the map reads cell " + std::to_string(time_index_ + 1) + ", the row has " + std::to_string(width_) + " cells");
     }
   }
   if (cells_.size() != width_) {
-    fail_at(line_, "*", "row has " + std::to_string(cells_.size()) + " cells, " +
-                            (map_.header ? "header has " : "the first row has ") + std::to_string(width_));
+    fail_at(line_, "*",
+            "row has " + std::to_string(cells_.size()) + " cells, " + (map_.header ? "header has " : "the first row has ") +
+                std::to_string(width_));
   }
   row.line = line_;
   row.value.fill(kNaN);
@@ -230,8 +249,8 @@ bool MappedLogReader::read_raw(MappedRow& row) {
   if (map_.time) {
     double t_s = cell(time_index_, time_label_, *map_.time, false);
     if (std::abs(t_s) > limits_.time_s.max_abs) {
-      fail_cell(time_index_, time_label_, g6(t_s) + " s is beyond the plausible ±" + g6(limits_.time_s.max_abs) + " s (" +
-                                              limits_.time_s.why + ")");
+      fail_cell(time_index_, time_label_,
+                g6(t_s) + " s is beyond the plausible ±" + g6(limits_.time_s.max_abs) + " s (" + limits_.time_s.why + ")");
     }
     if (previous_cell_s_ && map_.wrap_s > 0.0 && t_s < *previous_cell_s_ - 0.5 * map_.wrap_s) {
       // A step back by more than half the period is the column wrapping (ms_today at midnight): the
@@ -261,12 +280,14 @@ bool MappedLogReader::read_raw(MappedRow& row) {
   for (std::size_t q = 0; q < kQuantityCount; ++q) {
     if (index_[q] < 0) continue;
     const MappedColumn& c = *column_[q];
-    const bool allow_nan = map_.nan_is_missing && (c.quantity == Quantity::kUDc || info(c.quantity).kind == QuantityKind::kTemperature);
+    const bool allow_nan =
+        map_.nan_is_missing && (c.quantity == Quantity::kUDc || info(c.quantity).kind == QuantityKind::kTemperature);
     row.value[q] = cell(index_[q], label(c.quantity), c, allow_nan);
   }
   // Checked after every cell is read: a command is held to its row's u_dc.
   for (std::size_t q = 0; q < kQuantityCount; ++q) {
-    if (index_[q] >= 0 && !std::isnan(row.value[q])) check(row, index_[q], label(static_cast<Quantity>(q)), static_cast<Quantity>(q), row.value[q]);
+    if (index_[q] >= 0 && !std::isnan(row.value[q]))
+      check(row, index_[q], label(static_cast<Quantity>(q)), static_cast<Quantity>(q), row.value[q]);
   }
   return true;
 }
@@ -299,9 +320,10 @@ bool MappedLogReader::next(MappedRow& row) {
         ++repairs_.tied_rows;
       }
       if (lookahead_ && ready_.back().t_ns >= lookahead_->t_ns) {
-        fail_at(lookahead_->line, time_label_, "stamped within the resolution (" + g6(map_.resolution_s) +
-                                                   " s) of a run of equal stamps before it: the column is finer than the "
-                                                   "map's time.resolution");
+        fail_at(lookahead_->line, time_label_,
+                "stamped within the resolution (" + g6(map_.resolution_s) +
+                    " s) of a run of equal stamps before it: the column is finer than the "
+                    "map's time.resolution");
       }
     }
   }

@@ -14,23 +14,25 @@ struct Rule {
   const char* keys;
 };
 
-constexpr Rule kUnexcited{"adapted nothing (neither parameter excited)",
-                          "neither term stood out: ψm's back-EMF |ω|·ψ_min and R_s' drop R_min·|i| must exceed their noise as "
-                          "the gains average it and what the other parameters' uncertainty (D_M, the inductance tolerance) "
-                          "can put in their place; zero-current coasting and standstill without current excite neither",
-                          "estimator.bounds (narrower ψm bounds let R_s adapt at speed), estimator.regimes.significance_sigma, "
-                          "estimator.regimes.inductance_tolerance"};
+constexpr Rule kUnexcited{
+    "adapted nothing (neither parameter excited)",
+    "neither term stood out: ψm's back-EMF |ω|·ψ_min and R_s' drop R_min·|i| must exceed their noise as "
+    "the gains average it and what the other parameters' uncertainty (D_M, the inductance tolerance) "
+    "can put in their place; zero-current coasting and standstill without current excite neither",
+    "estimator.bounds (narrower ψm bounds let R_s adapt at speed), estimator.regimes.significance_sigma, "
+    "estimator.regimes.inductance_tolerance"};
 constexpr Rule kTransient{"were transient",
                           "the window's current or speed changed more than the steady state with the inductive correction "
                           "represents (a slope change, the inductance's tolerance on the correction, speed and current "
                           "changing together inside the window)",
                           "estimator.regimes.inductance_tolerance, estimator.regimes.significance_sigma; shorter windows "
                           "(a faster logger) help"};
-constexpr Rule kNotLocked{"were not locked",
-                          "the back-EMF e = u − R·i − ω·J·L·i pointed off ±q by more than the angle tolerance and the "
-                          "configured uncertainty allow: the dq frame was not the rotor's (an open-loop start-up, a "
-                          "sensor offset — model_extensions.theta_offset, which rpem diagnose finds)",
-                          "estimator.regimes.angle_tolerance_rad, estimator.regimes.inductance_tolerance, estimator.bounds.r_s_Ohm"};
+constexpr Rule kNotLocked{
+    "were not locked",
+    "the back-EMF e = u − R·i − ω·J·L·i pointed off ±q by more than the angle tolerance and the "
+    "configured uncertainty allow: the dq frame was not the rotor's (an open-loop start-up, a "
+    "sensor offset — model_extensions.theta_offset, which rpem diagnose finds)",
+    "estimator.regimes.angle_tolerance_rad, estimator.regimes.inductance_tolerance, estimator.bounds.r_s_Ohm"};
 constexpr Rule kBridgeOff{"had the bridge off",
                           "the reported voltage and the current were zero within their noise and resolution while the "
                           "machine turned fast enough that a modulating bridge would have driven its short-circuit "
@@ -46,11 +48,12 @@ constexpr Rule kResyncPhase{"resynchronised",
                             "estimator.max_gap_carry_s, or followed lost samples: the predictor started over and adapted "
                             "nothing (samples further apart than both are steady-state observations that adapt)",
                             "estimator.max_sample_interval_s, estimator.max_gap_carry_s"};
-constexpr Rule kResyncAveraged{"resynchronised",
-                               "each followed lost windows (a gap, or a window starting later than the previous one ended "
-                               "by more than half its length), or was an instantaneous sample after a silence: adapted nothing",
-                               "none for windows (their length never resyncs); estimator.averaged.max_interval_s for "
-                               "instantaneous samples"};
+constexpr Rule kResyncAveraged{
+    "resynchronised",
+    "each followed lost windows (a gap, or a window starting later than the previous one ended "
+    "by more than half its length), or was an instantaneous sample after a silence: adapted nothing",
+    "none for windows (their length never resyncs); estimator.averaged.max_interval_s for "
+    "instantaneous samples"};
 
 /// Each regime's rule, in core::kRegimes' order (the admitted regimes that adapt have none).
 constexpr std::array<const Rule*, core::kRegimeCount> kRules{nullptr,     nullptr,     nullptr,     &kUnexcited,

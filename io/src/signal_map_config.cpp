@@ -14,7 +14,9 @@ can::SignalSpec read_signal(YamlMap m) {
   s.big_endian = m.choice_or("byte_order", "little_endian", {"little_endian", "big_endian"}) == "big_endian";
   // DBC's SIG_VALTYPE_: 0 integer (the default), 1 IEEE float (binary32), 2 IEEE double (binary64).
   const std::string type = m.choice_or("value_type", "integer", {"integer", "float", "double"});
-  s.value_type = type == "float" ? can::ValueType::kFloat32 : type == "double" ? can::ValueType::kFloat64 : can::ValueType::kInteger;
+  s.value_type = type == "float"    ? can::ValueType::kFloat32
+                 : type == "double" ? can::ValueType::kFloat64
+                                    : can::ValueType::kInteger;
   if (s.value_type != can::ValueType::kInteger && m.has("signed")) {
     m.fail("signed", "a " + type + " signal is an IEEE 754 value, which carries its own sign: leave out `signed`");
   }

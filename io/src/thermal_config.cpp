@@ -70,21 +70,23 @@ ThermalConfig default_thermal_config(const MachineConfig& machine) {
   m = machine.psim_drift.law.value_or(core::DriftLaw{core::kNdFeB.typical_per_K, core::kMaterialReference_C, 0.0});
   if (m.value_ref <= 0.0) m.value_ref = machine.machine.psi_m_Wb;
   core::CalibrationVec& sigma = c.fusion.filter.calibration_sigma;
-  sigma[static_cast<int>(core::Calibration::kMagnetCoefficient)] = coefficient_rel_sigma(core::kMagnetMaterials, m.coeff_per_K);
-  sigma[static_cast<int>(core::Calibration::kCopperCoefficient)] = coefficient_rel_sigma(core::kWindingMaterials, n.copper.coeff_per_K);
+  sigma[static_cast<int>(core::Calibration::kMagnetCoefficient)] =
+      coefficient_rel_sigma(core::kMagnetMaterials, m.coeff_per_K);
+  sigma[static_cast<int>(core::Calibration::kCopperCoefficient)] =
+      coefficient_rel_sigma(core::kWindingMaterials, n.copper.coeff_per_K);
   return c;
 }
 
 namespace {
 
-/// `nodes`, `conductances` and `losses`.
-void parse_network(YamlMap& t, ThermalConfig& c) {
+/// `nodes`: their names, capacities, coolant conductances and noises; winding and magnet among them.
+void parse_nodes(YamlMap& t, ThermalConfig& c) {
   core::ThermalFusionConfig& f = c.fusion;
   core::ThermalNetwork& n = f.filter.network;
   std::vector<YamlMap> nodes = t.maps("nodes");
   if (nodes.size() < 2 || nodes.size() > static_cast<std::size_t>(core::kMaxThermalNodes)) {
-    t.fail("nodes", "a network has 2 to " + std::to_string(core::kMaxThermalNodes) + " nodes, here " +
-                        std::to_string(nodes.size()));
+    t.fail("nodes",
+           "a network has 2 to " + std::to_string(core::kMaxThermalNodes) + " nodes, here " + std::to_string(nodes.size()));
   }
   n.nodes = static_cast<int>(nodes.size());
   n.winding = n.magnet = -1;
@@ -112,7 +114,11 @@ void parse_network(YamlMap& t, ThermalConfig& c) {
   }
   if (n.winding < 0) t.fail("nodes", "a node named 'winding' is required (the copper loss heats it, R_s follows it)");
   if (n.magnet < 0) t.fail("nodes", "a node named 'magnet' is required (ψm follows it)");
+}
 
+/// `conductances`: each joins two different nodes, once; every node must reach the coolant.
+void parse_conductances(YamlMap& t, ThermalConfig& c) {
+  core::ThermalNetwork& n = c.fusion.filter.network;
   n.between_W_per_K.setZero();
   if (t.has("conductances")) {
     for (YamlMap& m : t.maps("conductances")) {
@@ -121,7 +127,8 @@ void parse_network(YamlMap& t, ThermalConfig& c) {
       if (a < 0) m.fail("from", "no node named '" + from + "'");
       if (b < 0) m.fail("to", "no node named '" + to + "'");
       if (a == b) m.fail("to", "a conductance joins two different nodes");
-      if (n.between_W_per_K(a, b) != 0.0) m.fail("to", "the conductance " + from + "–" + to + " is given twice");
+      if (n.between_W_per_K(a, b) != 0.0)
+        m.fail("to", std::string("the conductance ").append(from).append("–").append(to).append(" is given twice"));
       n.between_W_per_K(a, b) = n.between_W_per_K(b, a) = m.number("W_per_K", 1e-9, 1e6);
       m.finish();
     }
@@ -144,7 +151,12 @@ void parse_network(YamlMap& t, ThermalConfig& c) {
       }
     }
   }
+}
 
+/// `losses`: each a loss form of the catalogue at a node, once.
+void parse_losses(YamlMap& t, ThermalConfig& c) {
+  core::ThermalFusionConfig& f = c.fusion;
+  core::ThermalNetwork& n = f.filter.network;
   n.loss_at_base_W.setZero();
   if (t.has("losses")) {
     for (YamlMap& m : t.maps("losses")) {
@@ -155,13 +167,14 @@ void parse_network(YamlMap& t, ThermalConfig& c) {
       }
       if (fi < 0) {
         std::string names;
-        for (const core::LossFormRow& row : core::loss_forms()) names += (names.empty() ? "" : ", ") + std::string(row.name);
-        m.fail("form", "unknown loss form '" + form + "' (one of " + names + ")");
+        for (const core::LossFormRow& row : core::loss_forms()) names.append(names.empty() ? "" : ", ").append(row.name);
+        m.fail("form", std::string("unknown loss form '").append(form).append("' (one of ").append(names).append(")"));
       }
       const std::string node = m.text("node");
       const int i = node_index(c, node);
       if (i < 0) m.fail("node", "no node named '" + node + "'");
-      if (n.loss_at_base_W(fi, i) != 0.0) m.fail("node", "loss " + form + " at " + node + " is given twice");
+      if (n.loss_at_base_W(fi, i) != 0.0)
+        m.fail("node", std::string("loss ").append(form).append(" at ").append(node).append(" is given twice"));
       n.loss_at_base_W(fi, i) = m.number("at_base_W", 0.0, 1e9);
       f.filter.loss_rel_sigma(fi, i) = m.number_or("rel_sigma", 0.5, 0.0, 10.0);
       m.finish();
@@ -169,40 +182,48 @@ void parse_network(YamlMap& t, ThermalConfig& c) {
   }
 }
 
+/// `nodes`, `conductances` and `losses`.
+void parse_network(YamlMap& t, ThermalConfig& c) {
+  parse_nodes(t, c);
+  parse_conductances(t, c);
+  parse_losses(t, c);
+}
+
 }  // namespace
 
-ThermalConfig parse_thermal_config(YamlMap& t, const MachineConfig& machine, NetworkRequired network) {
+ThermalConfig parse_thermal_config(YamlMap& section, const MachineConfig& machine, NetworkRequired network) {
   ThermalConfig c = default_thermal_config(machine);
   core::ThermalFusionConfig& f = c.fusion;
   core::ThermalNetwork& n = f.filter.network;
-  c.has_network = network == NetworkRequired::kYes || t.has("nodes");
+  c.has_network = network == NetworkRequired::kYes || section.has("nodes");
   if (c.has_network) {
-    parse_network(t, c);
+    parse_network(section, c);
   } else {
     for (const char* key : {"conductances", "losses"}) {
-      if (t.has(key)) t.fail(key, "belongs to a network: give `nodes` too");
+      if (section.has(key)) section.fail(key, "belongs to a network: give `nodes` too");
     }
   }
-  if (auto b = t.optional_map("loss_base")) {
+  if (auto b = section.optional_map("loss_base")) {
     n.base.omega_el_rad_s = b->number_or("omega_el_rad_s", n.base.omega_el_rad_s, 1e-3, 1e7);
     n.base.psi_Wb = b->number_or("psi_Wb", n.base.psi_Wb, 1e-9, 100.0);
     n.base.current_A = b->number_or("current_A", n.base.current_A, 1e-6, 1e6);
     b->finish();
   }
-  if (auto m = t.optional_map("copper")) {
-    n.copper = parse_law(*m, "r_s_ref_Ohm", n.copper, 1e4, true, f.filter.calibration_sigma, core::Calibration::kCopperOffset,
-                         core::Calibration::kCopperCoefficient, &f.filter.copper_rel_sigma, &n.copper_scale);
+  if (auto m = section.optional_map("copper")) {
+    n.copper =
+        parse_law(*m, "r_s_ref_Ohm", n.copper, 1e4, true, f.filter.calibration_sigma, core::Calibration::kCopperOffset,
+                  core::Calibration::kCopperCoefficient, &f.filter.copper_rel_sigma, &n.copper_scale);
   }
-  if (auto m = t.optional_map("magnet_law")) {
+  if (auto m = section.optional_map("magnet_law")) {
     f.magnet_law = parse_law(*m, "psi_m_ref_Wb", f.magnet_law, 100.0, false, f.filter.calibration_sigma,
                              core::Calibration::kMagnetOffset, core::Calibration::kMagnetCoefficient, nullptr, nullptr);
   }
-  f.coolant_C = t.number_or("coolant_C", f.coolant_C, -60.0, 300.0);
-  if (auto s = t.optional_map("winding_sensor")) {
+  f.coolant_C = section.number_or("coolant_C", f.coolant_C, -60.0, 300.0);
+  if (auto s = section.optional_map("winding_sensor")) {
     f.winding_sensor_sigma_K = s->number("sigma_K", 1e-3, 100.0);
     s->finish();
   }
-  if (auto m = t.optional_map("filter")) {
+  if (auto m = section.optional_map("filter")) {
     f.observer.period_s = m->number_or("period_s", f.observer.period_s, 1e-3, 3600.0);
     f.initial_sigma_K = m->number_or("initial_sigma_K", f.initial_sigma_K, 1e-3, 1000.0);
     f.filter.gate_sigma = m->number_or("gate_sigma", f.filter.gate_sigma, 1.0, kInf);
@@ -212,7 +233,7 @@ ThermalConfig parse_thermal_config(YamlMap& t, const MachineConfig& machine, Net
     f.observer.settle_time_constants = m->number_or("settle_time_constants", f.observer.settle_time_constants, 0.0, 100.0);
     m->finish();
   }
-  t.finish();
+  section.finish();
   return c;
 }
 
@@ -228,7 +249,8 @@ std::string thermal_config_yaml(const ThermalConfig& c) {
   std::ostringstream o;
   o << "thermal:\n  nodes:\n";
   for (int i = 0; i < n.nodes; ++i) {
-    o << "    - {name: " << c.node_names[static_cast<std::size_t>(i)] << ", capacitance_J_per_K: " << num(n.capacitance_J_per_K[i])
+    o << "    - {name: " << c.node_names[static_cast<std::size_t>(i)]
+      << ", capacitance_J_per_K: " << num(n.capacitance_J_per_K[i])
       << ", to_coolant_W_per_K: " << num(n.to_coolant_W_per_K[i])
       << ", process_noise_K2_per_s: " << num(f.filter.process_noise_K2_per_s[i])
       << ", disturbance_W2_per_s: " << num(f.filter.disturbance_W2_per_s[i]) << "}\n";
@@ -237,8 +259,8 @@ std::string thermal_config_yaml(const ThermalConfig& c) {
   for (int i = 0; i < n.nodes; ++i) {
     for (int j = i + 1; j < n.nodes; ++j) {
       if (n.between_W_per_K(i, j) <= 0.0) continue;
-      between += "    - {from: " + c.node_names[static_cast<std::size_t>(i)] + ", to: " + c.node_names[static_cast<std::size_t>(j)] +
-                 ", W_per_K: " + num(n.between_W_per_K(i, j)) + "}\n";
+      between += "    - {from: " + c.node_names[static_cast<std::size_t>(i)] +
+                 ", to: " + c.node_names[static_cast<std::size_t>(j)] + ", W_per_K: " + num(n.between_W_per_K(i, j)) + "}\n";
     }
   }
   if (!between.empty()) o << "  conductances:\n" << between;
@@ -248,7 +270,8 @@ std::string thermal_config_yaml(const ThermalConfig& c) {
       const double k = n.loss_at_base_W(static_cast<int>(row.form), i);
       if (k <= 0.0) continue;
       losses += "    - {form: " + std::string(row.name) + ", node: " + c.node_names[static_cast<std::size_t>(i)] +
-                ", at_base_W: " + num(k) + ", rel_sigma: " + num(f.filter.loss_rel_sigma(static_cast<int>(row.form), i)) + "}\n";
+                ", at_base_W: " + num(k) + ", rel_sigma: " + num(f.filter.loss_rel_sigma(static_cast<int>(row.form), i)) +
+                "}\n";
     }
   }
   if (!losses.empty()) o << "  losses:\n" << losses;

@@ -10,15 +10,24 @@ namespace {
 
 // The column groups VESC Tool's openRtLogFile() writes, in its order (vedderb/vesc_tool, vescinterface.cpp).
 using Columns = std::vector<std::string_view>;
-const Columns kValues{"ms_today",          "input_voltage",      "temp_mos_max",     "temp_mos_1",     "temp_mos_2",
-                      "temp_mos_3",        "temp_motor",         "current_motor",    "current_in",     "d_axis_current",
-                      "q_axis_current",    "erpm",               "duty_cycle",       "amp_hours_used", "amp_hours_charged",
-                      "watt_hours_used",   "watt_hours_charged", "tachometer",       "tachometer_abs", "encoder_position",
-                      "fault_code",        "vesc_id"};
+const Columns kValues{
+    "ms_today",       "input_voltage",    "temp_mos_max",      "temp_mos_1",      "temp_mos_2",         "temp_mos_3",
+    "temp_motor",     "current_motor",    "current_in",        "d_axis_current",  "q_axis_current",     "erpm",
+    "duty_cycle",     "amp_hours_used",   "amp_hours_charged", "watt_hours_used", "watt_hours_charged", "tachometer",
+    "tachometer_abs", "encoder_position", "fault_code",        "vesc_id"};
 const Columns kDqVoltages{"d_axis_voltage", "q_axis_voltage"};
-const Columns kSetup{"ms_today_setup",      "amp_hours_setup",     "amp_hours_charged_setup", "watt_hours_setup",
-                     "watt_hours_charged_setup", "battery_level",  "battery_wh_tot",          "current_in_setup",
-                     "current_motor_setup", "speed_meters_per_sec", "tacho_meters",           "tacho_abs_meters",
+const Columns kSetup{"ms_today_setup",
+                     "amp_hours_setup",
+                     "amp_hours_charged_setup",
+                     "watt_hours_setup",
+                     "watt_hours_charged_setup",
+                     "battery_level",
+                     "battery_wh_tot",
+                     "current_in_setup",
+                     "current_motor_setup",
+                     "speed_meters_per_sec",
+                     "tacho_meters",
+                     "tacho_abs_meters",
                      "num_vescs"};
 const Columns kImu{"ms_today_imu", "roll", "pitch", "yaw", "accX", "accY", "accZ", "gyroX", "gyroY", "gyroZ"};
 const Columns kGnss{"gnss_posTime", "gnss_lat", "gnss_lon", "gnss_alt", "gnss_gVel", "gnss_vVel", "gnss_hAcc", "gnss_vAcc"};

@@ -36,15 +36,15 @@ YamlMap YamlMap::load_string(const std::string& text, const std::string& name) {
   try {
     root = YAML::Load(text);
   } catch (const YAML::ParserException& e) {
-    throw ConfigError(name, static_cast<std::size_t>(e.mark.line + 1), static_cast<std::size_t>(e.mark.column + 1),
-                      "", "YAML syntax: " + e.msg);
+    throw ConfigError(name, static_cast<std::size_t>(e.mark.line + 1), static_cast<std::size_t>(e.mark.column + 1), "",
+                      "YAML syntax: " + e.msg);
   }
   if (!root.IsMap()) throw ConfigError(name, 1, 1, "", "the document must be a mapping");
   return YamlMap(root, name, "");
 }
 
-YamlMap::YamlMap(YAML::Node node, std::string file, std::string path)
-    : node_(std::move(node)), file_(std::move(file)), path_(std::move(path)) {}
+YamlMap::YamlMap(const YAML::Node& node, std::string file, std::string path)
+    : node_(node), file_(std::move(file)), path_(std::move(path)) {}
 
 std::string YamlMap::field(const std::string& key) const {
   if (key.empty()) return path_;
@@ -102,7 +102,8 @@ long YamlMap::integer(const std::string& key, long lo, long hi) {
   const char* first = s.data() + (hex ? 2 : 0);
   const auto [end, ec] = std::from_chars(first, s.data() + s.size(), v, hex ? 16 : 10);
   if (ec != std::errc() || end != s.data() + s.size()) fail_at(n, key, "'" + s + "' is not an integer");
-  if (v < lo || v > hi) fail_at(n, key, s + " is outside " + describe_range(static_cast<double>(lo), static_cast<double>(hi)));
+  if (v < lo || v > hi)
+    fail_at(n, key, s + " is outside " + describe_range(static_cast<double>(lo), static_cast<double>(hi)));
   return v;
 }
 
@@ -143,7 +144,7 @@ std::string YamlMap::text_or(const std::string& key, const std::string& fallback
 }
 
 std::string YamlMap::choice(const std::string& key, std::initializer_list<const char*> choices) {
-  const std::string v = text(key);
+  std::string v = text(key);  // not const: returned by move
   std::string list;
   for (const char* c : choices) {
     if (v == c) return v;
@@ -164,7 +165,8 @@ std::string YamlMap::choice_or(const std::string& key, const std::string& fallba
 std::vector<double> YamlMap::numbers(const std::string& key, std::size_t n, double lo, double hi) {
   const YAML::Node seq = get(key);
   if (!seq.IsSequence() || seq.size() == 0) fail_at(seq, key, "expected a list of numbers");
-  if (n > 0 && seq.size() != n) fail_at(seq, key, "expected " + std::to_string(n) + " numbers, got " + std::to_string(seq.size()));
+  if (n > 0 && seq.size() != n)
+    fail_at(seq, key, "expected " + std::to_string(n) + " numbers, got " + std::to_string(seq.size()));
   std::vector<double> out;
   for (std::size_t i = 0; i < seq.size(); ++i) out.push_back(as_number(seq[i], key + "[" + std::to_string(i) + "]", lo, hi));
   return out;

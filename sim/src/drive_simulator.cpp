@@ -26,8 +26,7 @@ DriveSimulator::DriveSimulator(Scenario scenario)
       edge_to_edge_(scenario_.inverter.model == InverterModel::kSwitching &&
                     scenario_.integrator == PlantIntegrator::kEdges),
       foc_(scenario_.control, scenario_.machine.machine),
-      sensors_(scenario_.sensors, scenario_.machine.machine.rated.pole_pairs, scenario_.sample_period_s,
-               scenario_.seed),
+      sensors_(scenario_.sensors, scenario_.machine.machine.rated.pole_pairs, scenario_.sample_period_s, scenario_.seed),
       period_ns_(std::llround(scenario_.sample_period_s * 1e9)),
       samples_total_(std::llround(scenario_.duration_s / scenario_.sample_period_s)),
       warmup_periods_(std::llround(scenario_.warmup_s / scenario_.sample_period_s)),

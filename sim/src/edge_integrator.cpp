@@ -12,6 +12,20 @@ LegCommand command_at(const LegSchedule& s, double t_s) noexcept {
   return t_s < s.switch_s ? s.first : (t_s < s.on_s ? LegCommand::kBlank : s.last);
 }
 
+/// The legs' switching instants inside the half period, in order (insertion: at most six); their number.
+int order_edges(const std::array<LegSchedule, 3>& schedule, double half_s, std::array<double, 6>& edges) noexcept {
+  int n_edges = 0;
+  for (int x = 0; x < 3; ++x) {
+    for (const double e : {schedule[x].switch_s, schedule[x].on_s}) {
+      if (e >= half_s) continue;
+      int k = n_edges++;
+      for (; k > 0 && edges[k - 1] > e; --k) edges[k] = edges[k - 1];
+      edges[k] = e;
+    }
+  }
+  return n_edges;
+}
+
 }  // namespace
 
 EdgeIntegrator::EdgeIntegrator(const InverterConfig& inverter, double tolerance) noexcept
@@ -33,17 +47,9 @@ template <class Flow>
 void EdgeIntegrator::run(Flow& flow, PmsmPlant& plant, bool rising, const Duties& duties, double u_dc_V) noexcept {
   const double half = inverter_.half_period_s();
   std::array<LegSchedule, 3> schedule;
+  for (int x = 0; x < 3; ++x) schedule[x] = inverter_.schedule(rising, duties.d[x]);
   std::array<double, 6> edges{};  // the legs' switching instants in order
-  int n_edges = 0;
-  for (int x = 0; x < 3; ++x) {
-    schedule[x] = inverter_.schedule(rising, duties.d[x]);
-    for (const double e : {schedule[x].switch_s, schedule[x].on_s}) {
-      if (e >= half) continue;
-      int k = n_edges++;
-      for (; k > 0 && edges[k - 1] > e; --k) edges[k] = edges[k - 1];
-      edges[k] = e;
-    }
-  }
+  const int n_edges = order_edges(schedule, half, edges);
 
   flow.prepare(plant);
   double t = 0.0;
@@ -63,19 +69,7 @@ void EdgeIntegrator::run(Flow& flow, PmsmPlant& plant, bool rising, const Duties
       continue;
     }
 
-    // Each leg's command over the interval, and each current's sign where it is clearly off zero.
-    const core::Vec3 i = plant.phase_currents();
-    int clamped = -1;
-    std::array<bool, 3> watched{};
-    for (int x = 0; x < 3; ++x) {
-      const LegCommand c = command_at(schedule[x], t_mid);
-      legs.positive_V[x] = inverter_.leg_voltage(c, 1, u_dc_V);
-      legs.negative_V[x] = inverter_.leg_voltage(c, -1, u_dc_V);
-      if (std::abs(i[x]) > kZeroCurrent_A) sign_[x] = i[x] > 0.0 ? 1 : -1;
-      if (sign_[x] == 0 && clamped >= 0) sign_[x] = i[x] >= 0.0 ? 1 : -1;  // one clamp at a time
-      if (sign_[x] == 0) clamped = x;
-      legs.applied_V[x] = sign_[x] < 0 ? legs.negative_V[x] : legs.positive_V[x];
-    }
+    const int clamped = select_legs(schedule, plant.phase_currents(), t_mid, u_dc_V, legs);
     double h = t_end - t;
     if (clamped >= 0) {
       start_at_zero(flow, plant, clamped, legs, std::min(h, kClampStep_s));
@@ -84,6 +78,7 @@ void EdgeIntegrator::run(Flow& flow, PmsmPlant& plant, bool rising, const Duties
       flow.start(plant, core::clarke(legs.applied_V), h);
     }
     h = flow.reach_s();
+    std::array<bool, 3> watched{};
     bool watch = false;  // a current whose sign selects its leg's voltage
     for (int x = 0; x < 3; ++x) {
       watched[x] = sign_[x] != 0 && legs.negative_V[x] != legs.positive_V[x];
@@ -92,15 +87,7 @@ void EdgeIntegrator::run(Flow& flow, PmsmPlant& plant, bool rising, const Duties
 
     // The first zero crossing among them.
     double t_cross = h;
-    int crossing = -1;
-    if (watch && events < kMaxEvents) {
-      const PhaseCurrents begin = flow.phases(0.0), end = flow.phases(h);
-      for (int x = 0; x < 3; ++x) {
-        if (!watched[x]) continue;
-        const double tc = first_crossing(flow, x, begin, end, h);
-        if (tc >= 0.0 && tc < t_cross) t_cross = tc, crossing = x;
-      }
-    }
+    const int crossing = watch && events < kMaxEvents ? first_watched_crossing(flow, watched, h, t_cross) : -1;
     flow.commit(plant, t_cross);
     t += t_cross;
     if (crossing >= 0) {
@@ -112,6 +99,34 @@ void EdgeIntegrator::run(Flow& flow, PmsmPlant& plant, bool rising, const Duties
     }
   }
   if (events >= kMaxEvents) ++counters_.event_limit_hits;
+}
+
+int EdgeIntegrator::select_legs(const std::array<LegSchedule, 3>& schedule, const core::Vec3& i, double t_mid, double u_dc_V,
+                                Legs& legs) noexcept {
+  int clamped = -1;
+  for (int x = 0; x < 3; ++x) {
+    const LegCommand c = command_at(schedule[x], t_mid);
+    legs.positive_V[x] = inverter_.leg_voltage(c, 1, u_dc_V);
+    legs.negative_V[x] = inverter_.leg_voltage(c, -1, u_dc_V);
+    if (std::abs(i[x]) > kZeroCurrent_A) sign_[x] = i[x] > 0.0 ? 1 : -1;
+    if (sign_[x] == 0 && clamped >= 0) sign_[x] = i[x] >= 0.0 ? 1 : -1;  // one clamp at a time
+    if (sign_[x] == 0) clamped = x;
+    legs.applied_V[x] = sign_[x] < 0 ? legs.negative_V[x] : legs.positive_V[x];
+  }
+  return clamped;
+}
+
+template <class Flow>
+int EdgeIntegrator::first_watched_crossing(const Flow& flow, const std::array<bool, 3>& watched, double h_s,
+                                           double& t_cross_s) const noexcept {
+  int crossing = -1;
+  const PhaseCurrents begin = flow.phases(0.0), end = flow.phases(h_s);
+  for (int x = 0; x < 3; ++x) {
+    if (!watched[x]) continue;
+    const double tc = first_crossing(flow, x, begin, end, h_s);
+    if (tc >= 0.0 && tc < t_cross_s) t_cross_s = tc, crossing = x;
+  }
+  return crossing;
 }
 
 template <class Flow>

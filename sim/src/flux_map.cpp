@@ -12,8 +12,7 @@ namespace rpem::sim {
 FluxMap::FluxMap(std::vector<double> i_d_A, std::vector<double> i_q_A, std::vector<double> psi_d_Wb,
                  std::vector<double> psi_q_Wb)
     : i_d_(std::move(i_d_A)), i_q_(std::move(i_q_A)), psi_d_(std::move(psi_d_Wb)), psi_q_(std::move(psi_q_Wb)) {
-  if (i_d_.size() < 2 || i_q_.size() < 2 || psi_d_.size() != i_d_.size() * i_q_.size() ||
-      psi_q_.size() != psi_d_.size()) {
+  if (i_d_.size() < 2 || i_q_.size() < 2 || psi_d_.size() != i_d_.size() * i_q_.size() || psi_q_.size() != psi_d_.size()) {
     throw std::invalid_argument("flux map: grid needs at least 2×2 points and one value per point");
   }
   if (!std::is_sorted(i_d_.begin(), i_d_.end()) || !std::is_sorted(i_q_.begin(), i_q_.end())) {
@@ -34,8 +33,9 @@ FluxMap FluxMap::load_csv(const std::string& path) {
   q_axis.erase(std::unique(q_axis.begin(), q_axis.end()), q_axis.end());
   const std::size_t n = d_axis.size() * q_axis.size();
   if (t.rows() != n) {
-    throw io::InputError(path, 0, 0, "", "expected a full grid of " + std::to_string(n) + " points, found " +
-                                             std::to_string(t.rows()) + " rows");
+    throw io::InputError(
+        path, 0, 0, "",
+        "expected a full grid of " + std::to_string(n) + " points, found " + std::to_string(t.rows()) + " rows");
   }
   std::vector<double> psi_d(n, std::nan("")), psi_q(n, std::nan(""));
   for (std::size_t r = 0; r < t.rows(); ++r) {

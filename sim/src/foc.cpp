@@ -29,8 +29,7 @@ void FocController::preset(const core::Vec2& u_dq_V, double omega_el_rad_s) noex
   integral_V_ = u_dq_V - core::Vec2(0.0, omega_el_rad_s * nominal_.psi_m_Wb);  // less the feed-forward at i = 0
 }
 
-core::Vec2 FocController::field_weaken(core::Vec2 i_ref, double torque_Nm, double omega,
-                                       double u_limit) const noexcept {
+core::Vec2 FocController::field_weaken(core::Vec2 i_ref, double torque_Nm, double omega, double u_limit) const noexcept {
   // Voltage ellipse of the nominal model (R neglected; the margin covers it):
   //   (ω·L_q·i_q)² + (ω·(L_d·i_d + ψ_m))² ≤ u_limit²
   const double l_d = nominal_.l_d_H, l_q = nominal_.l_q_H, psi = nominal_.psi_m_Wb;
@@ -103,9 +102,9 @@ FocOutput FocController::step(const FocInput& in) noexcept {
   const double ki = wc * nominal_.r_s_Ohm;
   const core::Vec2 error = i_ref - i_dq;
   // Decoupling from the references: no extra feedback path through the measured currents.
-  const core::Vec2 feedforward = in.decouple ? core::Vec2(-omega * nominal_.l_q_H * i_ref[1],
-                                                         omega * (nominal_.l_d_H * i_ref[0] + nominal_.psi_m_Wb))
-                                             : core::Vec2::Zero();
+  const core::Vec2 feedforward =
+      in.decouple ? core::Vec2(-omega * nominal_.l_q_H * i_ref[1], omega * (nominal_.l_d_H * i_ref[0] + nominal_.psi_m_Wb))
+                  : core::Vec2::Zero();
   const core::Vec2 candidate_integral = integral_V_ + ki * t * error;
   core::Vec2 u_dq = kp.cwiseProduct(error) + candidate_integral + feedforward;
 

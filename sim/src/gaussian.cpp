@@ -6,8 +6,8 @@ namespace rpem::sim {
 namespace {
 
 constexpr int kLayers = 128;
-constexpr double kR = 3.442619855899;            // start of the tail
-constexpr double kArea = 9.91256303526217e-3;    // area of each layer
+constexpr double kR = 3.442619855899;          // start of the tail
+constexpr double kArea = 9.91256303526217e-3;  // area of each layer
 
 struct Tables {
   std::array<double, kLayers + 1> x{};  // layer edges, x[0] = v/f(r), x[1] = r, …, x[128] = 0

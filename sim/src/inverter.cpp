@@ -61,12 +61,12 @@ double Inverter::high_fraction(bool rising, double tau, double h, double d, doub
   const double lo = rising ? 0.0 : (i > 0.0 ? s.on_s : s.switch_s);
   const double hi = rising ? (i < 0.0 ? s.on_s : s.switch_s) : half_period_s_;
   if (lo <= tau && tau + h <= hi) return 1.0;  // the common cases first: wholly high…
-  if (hi <= tau || tau + h <= lo) return 0.0;   // …or wholly low
+  if (hi <= tau || tau + h <= lo) return 0.0;  // …or wholly low
   return (std::min(hi, tau + h) - std::max(lo, tau)) / h;
 }
 
-core::Vec2 Inverter::mean_voltage(bool rising, double tau_s, double h_s, const Duties& duties,
-                                  const core::Vec3& i_abc_A, double u_dc_V) const noexcept {
+core::Vec2 Inverter::mean_voltage(bool rising, double tau_s, double h_s, const Duties& duties, const core::Vec3& i_abc_A,
+                                  double u_dc_V) const noexcept {
   core::Vec3 leg;
   for (int x = 0; x < 3; ++x) {
     const double i = i_abc_A[x];

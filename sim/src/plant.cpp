@@ -4,8 +4,7 @@ namespace rpem::sim {
 PmsmPlant::PmsmPlant(int pole_pairs, Magnetics magnetics, MechanicsConfig mechanics) noexcept
     : pole_pairs_(pole_pairs), magnetics_(std::move(magnetics)), mechanics_(mechanics) {}
 
-void PmsmPlant::reset(const core::Vec2& i_A, double theta_el_rad, double omega_el_rad_s,
-                      const PlantParameters& p) noexcept {
+void PmsmPlant::reset(const core::Vec2& i_A, double theta_el_rad, double omega_el_rad_s, const PlantParameters& p) noexcept {
   state_.theta_el_rad = theta_el_rad;
   state_.omega_el_rad_s = omega_el_rad_s;
   i_flux_A_ = i_A;

@@ -7,7 +7,8 @@ namespace rpem::sim {
 
 RegimeTimeline::RegimeTimeline(std::vector<RegimeEvent> events) : events_(std::move(events)) {
   for (std::size_t k = 1; k < events_.size(); ++k) {
-    if (!(events_[k].t_s > events_[k - 1].t_s)) throw std::invalid_argument("regime events must be in strictly increasing time");
+    if (!(events_[k].t_s > events_[k - 1].t_s))
+      throw std::invalid_argument("regime events must be in strictly increasing time");
   }
 }
 
@@ -18,7 +19,8 @@ double open_loop_speed_rpm(const RegimeEvent& e, double dt_s) noexcept {
 }
 
 RegimeNow RegimeTimeline::at(double t_s) noexcept {
-  while (active_ + 1 < static_cast<int>(events_.size()) && events_[static_cast<std::size_t>(active_ + 1)].t_s <= t_s) {
+  // The next event's index in size_t: active_ ≥ −1, and −1 widened wraps to 0 once 1 is added.
+  while (active_ + 1 < static_cast<int>(events_.size()) && events_[static_cast<std::size_t>(active_) + 1].t_s <= t_s) {
     ++active_;
   }
   RegimeNow now;

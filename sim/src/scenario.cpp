@@ -20,7 +20,7 @@ std::string resolve(const std::string& base_dir, const std::string& path) {
 
 void parse_inverter(io::YamlMap m, Scenario& s) {
   s.inverter.model = m.choice_or("model", "switching", {"switching", "averaged"}) == "averaged" ? InverterModel::kAveraged
-                                                                                               : InverterModel::kSwitching;
+                                                                                                : InverterModel::kSwitching;
   s.inverter.switching_frequency_Hz = m.number_or("switching_frequency_Hz", 4000.0, 100.0, 1e6);
   s.inverter.dead_time_s = m.number_or("dead_time_s", 0.0, 0.0, 1e-4);
   s.inverter.v_igbt_V = m.number_or("v_igbt_V", 0.0, 0.0, 100.0);
@@ -115,7 +115,8 @@ void parse_events(std::vector<io::YamlMap> events, Scenario& s) {
     last = ev.t_s;
     s.signal(q).add(ev);
     if (q == Quantity::kLoadTorque) {
-      if (s.mechanics.dynamometer) e.fail("quantity", "load_torque_Nm needs plant.mechanics.mode: inertia (a dynamometer imposes the speed)");
+      if (s.mechanics.dynamometer)
+        e.fail("quantity", "load_torque_Nm needs plant.mechanics.mode: inertia (a dynamometer imposes the speed)");
       s.separate_load = true;
     }
   }
@@ -133,7 +134,7 @@ ControlOverride parse_control_override(io::YamlMap& e, const Scenario& s) {
 
 OffVoltageReport parse_report(io::YamlMap& e) {
   return e.choice_or("report", "back_emf", {"back_emf", "zero"}) == "zero" ? OffVoltageReport::kZero
-                                                                          : OffVoltageReport::kBackEmf;
+                                                                           : OffVoltageReport::kBackEmf;
 }
 
 /// `regimes:` (docs/scenarios.md, "Regimes"): what the controller does with the bridge from each t_s on.
@@ -147,10 +148,11 @@ void parse_regimes(std::vector<io::YamlMap> events, Scenario& s) {
     const std::string regime = e.choice("regime", {"closed_loop", "open_loop", "bridge_off"});
     r.regime = regime == "closed_loop" ? DriveRegime::kClosedLoop
                                        : (regime == "open_loop" ? DriveRegime::kOpenLoop : DriveRegime::kBridgeOff);
-    r.then = r.regime == DriveRegime::kOpenLoop
-                 ? (e.choice_or("then", "closed_loop", {"closed_loop", "bridge_off"}) == "bridge_off" ? DriveRegime::kBridgeOff
-                                                                                                   : DriveRegime::kClosedLoop)
-                 : r.regime;
+    r.then =
+        r.regime == DriveRegime::kOpenLoop
+            ? (e.choice_or("then", "closed_loop", {"closed_loop", "bridge_off"}) == "bridge_off" ? DriveRegime::kBridgeOff
+                                                                                                 : DriveRegime::kClosedLoop)
+            : r.regime;
     if (r.regime == DriveRegime::kOpenLoop) {
       r.current_A = e.number("current_A", 1e-3, 1e5);
       r.speed_rpm = e.number("speed_rpm", -1e6, 1e6);

@@ -22,8 +22,8 @@ double Signal::segment_value(double t) const noexcept {
 }
 
 double Signal::advance(double t) noexcept {
-  while (active_ + 1 < static_cast<int>(events_.size()) && events_[static_cast<std::size_t>(active_ + 1)].t_s <= t) {
-    start_value_ = segment_value(events_[static_cast<std::size_t>(active_ + 1)].t_s);
+  while (active_ + 1 < static_cast<int>(events_.size()) && events_[static_cast<std::size_t>(active_) + 1].t_s <= t) {
+    start_value_ = segment_value(events_[static_cast<std::size_t>(active_) + 1].t_s);
     ++active_;
   }
   const double v = segment_value(t);

@@ -17,8 +17,7 @@ double input_current_A(const ControlCycle& c) noexcept {
 
 }  // namespace
 
-VescMotor::VescMotor(Scenario scenario, Settings settings)
-    : simulator_(std::move(scenario)), settings_(settings) {}
+VescMotor::VescMotor(Scenario scenario, Settings settings) : simulator_(std::move(scenario)), settings_(settings) {}
 
 bool VescMotor::step() noexcept {
   const TruthRow at_start = truth_;  // the start of the cycle the next row completes

@@ -39,9 +39,18 @@ std::string vesc_tool_header() {
 
 void append_vesc_tool_row(std::string& out, const VescToolRow& r) {
   const can::vesc::Values& v = r.values;
-  auto number = [&out](double x) { append_qt_double(out, x); out += ';'; };
-  auto integer = [&out](long long x) { append_int(out, x); out += ';'; };
-  auto fixed = [&out](double x) { append_qt_fixed8(out, x); out += ';'; };
+  auto number = [&out](double x) {
+    append_qt_double(out, x);
+    out += ';';
+  };
+  auto integer = [&out](long long x) {
+    append_int(out, x);
+    out += ';';
+  };
+  auto fixed = [&out](double x) {
+    append_qt_fixed8(out, x);
+    out += ';';
+  };
 
   integer(r.ms_today);
   number(v.v_in_V);
@@ -81,10 +90,10 @@ void append_vesc_tool_row(std::string& out, const VescToolRow& r) {
   number(s.distance_abs_m);
   integer(s.num_vescs);
 
-  integer(-1);                                // ms_today_imu: no IMU reply
-  for (int k = 0; k < 9; ++k) number(0.0);    // roll … gyroZ of IMU_VALUES()
-  integer(-1);                                // gnss_posTime: no position
-  for (int k = 0; k < 7; ++k) fixed(0.0);     // lat, lon, alt, gVel, vVel, hAcc, vAcc
+  integer(-1);                              // ms_today_imu: no IMU reply
+  for (int k = 0; k < 9; ++k) number(0.0);  // roll … gyroZ of IMU_VALUES()
+  integer(-1);                              // gnss_posTime: no position
+  for (int k = 0; k < 7; ++k) fixed(0.0);   // lat, lon, alt, gVel, vVel, hAcc, vAcc
   out += '\n';
 }
 

@@ -23,7 +23,8 @@ vesc::Values through_the_wire(const vesc::Values& v) noexcept {
   std::array<std::uint8_t, 128> payload{};  // every field: 78 bytes
   const std::size_t n = vesc::encode_values(v, kAllFields, payload);
   vesc::Values out;
-  [[maybe_unused]] const vesc::ParseResult parsed = vesc::parse_values(std::span<const std::uint8_t>(payload.data(), n), out);
+  [[maybe_unused]] const vesc::ParseResult parsed =
+      vesc::parse_values(std::span<const std::uint8_t>(payload.data(), n), out);
   assert(n > 0 && parsed == vesc::ParseResult::kOk);
   return out;
 }
@@ -198,8 +199,8 @@ void VescToolTruthWriter::write(const VescToolTruth& t) {
   number(1e-9 * static_cast<double>(t.window_start_ns));
   (line_ += ',') += std::to_string(t.cycles);
   (line_ += ',') += std::to_string(t.lost_before);
-  for (double v : {t.psi_m_Wb, t.r_s_Ohm, t.l_d_H, t.l_q_H, t.t_winding_C, t.t_magnet_C, t.modulating, t.angle_locked,
-                   t.off_zero}) {
+  for (double v :
+       {t.psi_m_Wb, t.r_s_Ohm, t.l_d_H, t.l_q_H, t.t_winding_C, t.t_magnet_C, t.modulating, t.angle_locked, t.off_zero}) {
     number(v);
   }
   line_ += ',';

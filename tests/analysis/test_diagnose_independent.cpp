@@ -14,7 +14,8 @@ namespace {
 TEST(IndependentData, OneCasePerKind) {
   // A null, a single, a pair and a triple (seeds chosen to cover dead time, delay and a flux harmonic).
   for (std::uint64_t seed : {1U, 2U, 6U, 10U}) {
-    const test::IndependentOutcome out = test::run_independent_case(test::independent_case_of(seed, test::kIndependentDuration_s));
+    const test::IndependentOutcome out =
+        test::run_independent_case(test::independent_case_of(seed, test::kIndependentDuration_s));
     std::printf("%s %s\n", out.correct ? "right" : "WRONG", out.detail.c_str());
     EXPECT_TRUE(out.correct) << out.detail;
   }
@@ -24,7 +25,9 @@ TEST(IndependentData, ACommandDelayOfWholePeriodsIsToldFromAnAngleOffset) {
   // The most common drive delay, two whole control periods, together with a 3° encoder offset: at one
   // speed they would both turn the voltage; the profile's speeds tell them apart (issue 10 item 3).
   for (double periods : {1.0, 2.0, 2.5}) {
-    test::IndependentCase c{{"delay", "theta_offset"}, 31, test::kIndependentDuration_s,
+    test::IndependentCase c{{"delay", "theta_offset"},
+                            31,
+                            test::kIndependentDuration_s,
                             {{"delay.periods", periods}, {"theta_offset.offset_rad", 0.05236}}};
     const test::IndependentOutcome out = test::run_independent_case(c);
     std::printf("%s %s\n", out.correct ? "right" : "WRONG", out.detail.c_str());
@@ -43,8 +46,14 @@ TEST(IndependentData, ACommandDelayIsFoundBesideOtherEffectsOnAMachineOffItsConf
        42,
        test::kIndependentDuration_s,
        {{"delay.periods", 2.0}, {"deadtime.t_dead_s", 2e-6}, {"draw.psi_m_rel", -0.05}, {"draw.r_s_rel", 0.18}}},
-      {{"deadtime", "delay", "theta_offset"}, 43, test::kIndependentDuration_s, {{"delay.periods", 2.0}, {"theta_offset.offset_rad", 0.05236}}},
-      {{"delay"}, 44, test::kIndependentDuration_s, {{"delay.periods", 1.0}, {"draw.psi_m_rel", 0.06}, {"draw.r_s_rel", -0.2}}},
+      {{"deadtime", "delay", "theta_offset"},
+       43,
+       test::kIndependentDuration_s,
+       {{"delay.periods", 2.0}, {"theta_offset.offset_rad", 0.05236}}},
+      {{"delay"},
+       44,
+       test::kIndependentDuration_s,
+       {{"delay.periods", 1.0}, {"draw.psi_m_rel", 0.06}, {"draw.r_s_rel", -0.2}}},
   };
   const char* only = std::getenv("RPEM_INDEPENDENT_ONLY_SEED");  // to replay one case
   for (const test::IndependentCase& c : cases) {

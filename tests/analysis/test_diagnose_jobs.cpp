@@ -86,7 +86,11 @@ TEST(WorkPool, NestedLoopsRunEveryIndexOnceAndRethrowTheFirstError) {
   std::vector<std::atomic<int>> runs(100);
   pool.parallel_for(10, [&](std::size_t i) { pool.parallel_for(10, [&](std::size_t j) { ++runs[10 * i + j]; }); });
   for (const auto& r : runs) EXPECT_EQ(r.load(), 1);
-  EXPECT_THROW(pool.parallel_for(50, [](std::size_t i) { if (i == 7) throw std::runtime_error("seven"); }), std::runtime_error);
+  EXPECT_THROW(pool.parallel_for(50,
+                                 [](std::size_t i) {
+                                   if (i == 7) throw std::runtime_error("seven");
+                                 }),
+               std::runtime_error);
   EXPECT_GE(analysis::available_cpus(), 1);
 }
 

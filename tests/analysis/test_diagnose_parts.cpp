@@ -3,8 +3,10 @@
 // parameter error exactly, and the log's preparation (mode, exclusions, blocks).
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <complex>
+#include <cstring>
 #include <numbers>
 #include <random>
 
@@ -71,6 +73,45 @@ TEST(Replay, DataFromTheModelItselfLeavesNoResidual) {
   double late = 0.0;  // 1.75 s (≈ 20 time constants) after the speed step: round-off only
   for (std::size_t k = 22000; k < r.valid.size(); ++k) late = std::max(late, r.residual_A[k].norm());
   EXPECT_LT(late, 1e-9);
+}
+
+TEST(ModelReplay, ModelsReplayedTogetherGiveEachItsOwnReplayBitForBit) {
+  // A model given twice steps one chain (replay.cpp): each copy still gets exactly what that model gets
+  // replayed alone, and so does a different model replayed beside them.
+  const LogData log = model_log(0.95, false);
+  const ModelReplay replay(log, test::paper_machine_si().rated);
+  const ExtendedModel a = make_base_model(test::paper_machine_si(), {}, std::nullopt, std::nullopt, log);
+  ExtendedModel b = a;
+  b.extensions.deadtime_v_err_V = 0.5;
+  b.extensions.deadtime_current_band_A = 0.2;
+  const std::vector<ExtendedModel> together = {a, b, a};
+  for (int block = 0; block < 2; ++block) {
+    std::vector<ModelSample> alone_a, alone_b;
+    std::vector<std::array<ModelSample, 3>> joint;
+    replay.replay_block(block, std::span(&a, 1),
+                        [&](std::size_t, std::span<const ModelSample> m) { alone_a.push_back(m[0]); });
+    replay.replay_block(block, std::span(&b, 1),
+                        [&](std::size_t, std::span<const ModelSample> m) { alone_b.push_back(m[0]); });
+    replay.replay_block(block, together, [&](std::size_t, std::span<const ModelSample> m) {
+      ASSERT_EQ(m.size(), 3u);
+      joint.push_back({m[0], m[1], m[2]});
+    });
+    ASSERT_EQ(joint.size(), alone_a.size());
+    ASSERT_GT(joint.size(), 100u);
+    std::size_t differ = 0;  // a and b must differ somewhere, or the test shows nothing
+    for (std::size_t k = 0; k < joint.size(); ++k) {
+      for (const auto& [m, alone] :
+           {std::pair{joint[k][0], alone_a[k]}, std::pair{joint[k][1], alone_b[k]}, std::pair{joint[k][2], alone_a[k]}}) {
+        EXPECT_EQ(m.valid, alone.valid);
+        EXPECT_EQ(std::memcmp(m.residual_A.data(), alone.residual_A.data(), sizeof(double) * 2), 0)
+            << "block " << block << " sample " << k;
+        EXPECT_EQ(std::memcmp(m.model_A.data(), alone.model_A.data(), sizeof(double) * 2), 0)
+            << "block " << block << " sample " << k;
+      }
+      if (joint[k][0].model_A != joint[k][1].model_A) ++differ;
+    }
+    EXPECT_GT(differ, joint.size() / 2);
+  }
 }
 
 TEST(EffectFit, TheCalibrationRecoversAKnownFluxErrorExactly) {
@@ -171,7 +212,8 @@ TEST(Catalogue, EveryRowIsComplete) {
     for (const Confusion& c : r.confusions) EXPECT_NO_THROW((void)effect_row(c.other)) << r.name << " → " << c.other;
   }
   EXPECT_THROW((void)effect("cogging"), std::invalid_argument);
-  for (const char* name : {"flux_harmonic_6", "flux_harmonic_12", "cross_saturation", "delay"}) EXPECT_NO_THROW((void)effect(name));
+  for (const char* name : {"flux_harmonic_6", "flux_harmonic_12", "cross_saturation", "delay"})
+    EXPECT_NO_THROW((void)effect(name));
 }
 
 TEST(LogData, SteadyStateLeavesOutIdleAndTransitionalRowsAndBlocksAlternate) {
@@ -196,8 +238,8 @@ TEST(LogData, SteadyStateLeavesOutIdleAndTransitionalRowsAndBlocksAlternate) {
   EXPECT_FALSE(log.used(99));
   EXPECT_FALSE(log.used(100));
   EXPECT_EQ(log.blocks, 40);
-  EXPECT_TRUE(log.training(10));    // block 2
-  EXPECT_TRUE(log.heldout(15));     // block 3
+  EXPECT_TRUE(log.training(10));  // block 2
+  EXPECT_TRUE(log.heldout(15));   // block 3
   EXPECT_EQ(log.block(log.size() - 1), 39);
 }
 

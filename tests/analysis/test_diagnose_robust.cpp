@@ -54,7 +54,7 @@ TEST(RobustLoss, HuberSquaresWithinTheThresholdAndIsLinearBeyond) {
   EXPECT_DOUBLE_EQ(huber.rho(1.0), 1.0);
   EXPECT_DOUBLE_EQ(huber.rho(4.0), 4.0);
   EXPECT_DOUBLE_EQ(huber.rho(16.0), 2.0 * 2.0 * 4.0 - 4.0);  // 2·b·|r| − b² at |r| = 4
-  EXPECT_EQ(huber.residual_scale(3.9), 1.0);                   // within b exactly as least squares
+  EXPECT_EQ(huber.residual_scale(3.9), 1.0);                 // within b exactly as least squares
   const double s = huber.residual_scale(16.0);
   EXPECT_DOUBLE_EQ(s * s * 16.0, huber.rho(16.0));  // the scaled residual's square is ρ
 }

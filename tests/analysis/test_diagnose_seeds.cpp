@@ -12,10 +12,19 @@ namespace rpem {
 namespace {
 
 TEST(HiddenEffectSeeds, AtLeast95PercentRightAndNoFalsePositive) {
-  const std::vector<std::vector<std::string>> cycle = {
-      {},           {"deadtime"},   {"theta_offset"}, {"current_offset"}, {"current_gain"}, {"rs_drift"},
-      {"psim_drift"}, {"delay"},    {"iron_loss"},    {},                 {"deadtime", "theta_offset"},
-      {"rs_drift", "current_offset"}, {"iron_loss", "current_gain"}};
+  const std::vector<std::vector<std::string>> cycle = {{},
+                                                       {"deadtime"},
+                                                       {"theta_offset"},
+                                                       {"current_offset"},
+                                                       {"current_gain"},
+                                                       {"rs_drift"},
+                                                       {"psim_drift"},
+                                                       {"delay"},
+                                                       {"iron_loss"},
+                                                       {},
+                                                       {"deadtime", "theta_offset"},
+                                                       {"rs_drift", "current_offset"},
+                                                       {"iron_loss", "current_gain"}};
   const char* env = std::getenv("RPEM_DIAGNOSE_SEEDS");
   const int seeds = env ? std::atoi(env) : 60;
   int right = 0, nulls = 0, false_positives = 0;

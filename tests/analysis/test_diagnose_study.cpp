@@ -48,7 +48,8 @@ TEST(IndependentData, Study) {
     return std::string(b);
   };
   std::printf("%d of %llu right (%.1f %%); %d null cases, %d false effects in them\n", right,
-              static_cast<unsigned long long>(seeds), 100.0 * right / static_cast<double>(seeds), nulls, false_effects_in_nulls);
+              static_cast<unsigned long long>(seeds), 100.0 * right / static_cast<double>(seeds), nulls,
+              false_effects_in_nulls);
   std::printf("calibrated ψm error: %s; R_s: %s\n", summary(psi_errors).c_str(), summary(rs_errors).c_str());
   for (const auto& [name, e] : errors) std::printf("  %-18s parameter error %s\n", name.c_str(), summary(e).c_str());
   for (const std::string& w : wrong) std::printf("WRONG %s\n", w.c_str());

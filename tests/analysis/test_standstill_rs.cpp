@@ -35,8 +35,7 @@ TEST(StandstillRs, SettledRecursionIsTheLogisticApproach) {
   EXPECT_NEAR(*standstill_rs_time_s(m, x0), expected, 2e-3 * expected);
   // From below the same rate law with x < 0.
   const double xm = -0.08;
-  EXPECT_NEAR(*standstill_rs_time_s(m, xm),
-              kTs / m.gamma_L * std::log((xm / (1.0 + xm)) / (-0.01 / 0.99)), 2e-3 * expected);
+  EXPECT_NEAR(*standstill_rs_time_s(m, xm), kTs / m.gamma_L * std::log((xm / (1.0 + xm)) / (-0.01 / 0.99)), 2e-3 * expected);
 }
 
 TEST(StandstillRs, FallingEstimateConvergesFasterThanTheLinearisation) {

@@ -22,10 +22,10 @@ TEST(KeyFile, ParsesAndFormatsTheOneLine) {
 }
 
 TEST(KeyFile, RefusesAnythingElseNamingTheFile) {
-  for (const std::string& bad : {std::string(""), std::string("rpem-key-1 7"), "rpem-key-2 7 " + kText.substr(13),
-                                "rpem-key-1 0 " + kText.substr(13), "rpem-key-1 x " + kText.substr(13),
-                                "rpem-key-1 2147483648 " + kText.substr(13), kText.substr(0, kText.size() - 3) + "\n",
-                                kText.substr(0, kText.size() - 2) + "g\n", kText + "more\n"}) {
+  for (const std::string& bad :
+       {std::string(""), std::string("rpem-key-1 7"), "rpem-key-2 7 " + kText.substr(13), "rpem-key-1 0 " + kText.substr(13),
+        "rpem-key-1 x " + kText.substr(13), "rpem-key-1 2147483648 " + kText.substr(13),
+        kText.substr(0, kText.size() - 3) + "\n", kText.substr(0, kText.size() - 2) + "g\n", kText + "more\n"}) {
     try {
       (void)parse_key(bad, "keys/command.key");
       ADD_FAILURE() << "accepted: " << bad;
@@ -58,7 +58,8 @@ TEST(KeyFile, GeneratedKeysAreWrittenOwnerOnlyAndReadBack) {
   const Key a = generate_key(12), b = generate_key(12);
   EXPECT_FALSE(std::ranges::equal(a.bytes(), b.bytes()));
   write_key_file(f.path(), a);
-  EXPECT_EQ(std::filesystem::status(f.path()).permissions() & std::filesystem::perms::all, std::filesystem::perms::owner_read | std::filesystem::perms::owner_write);
+  EXPECT_EQ(std::filesystem::status(f.path()).permissions() & std::filesystem::perms::all,
+            std::filesystem::perms::owner_read | std::filesystem::perms::owner_write);
   const Key back = load_key_file(f.path());
   EXPECT_EQ(back.id(), 12);
   EXPECT_TRUE(std::ranges::equal(back.bytes(), a.bytes()));

@@ -21,8 +21,8 @@
 namespace rpem {
 namespace {
 
-constexpr double kPsiRel = -0.06;   // true ψm = configured · (1 + this)
-constexpr double kRsRel = 0.18;     // true R_s = configured · (1 + this)
+constexpr double kPsiRel = -0.06;  // true ψm = configured · (1 + this)
+constexpr double kRsRel = 0.18;    // true R_s = configured · (1 + this)
 constexpr double kStandstillEnd_s = 14.0;
 constexpr double kDuration_s = 20.0;
 constexpr double kTorque_Nm = 16.3;  // 0.5 of rated
@@ -35,10 +35,10 @@ struct Point {
 };
 const std::vector<Point>& profile() {
   static const std::vector<Point> p = {
-      {0.0, 0, kTorque_Nm},    {4.0, 0, kTorque_Nm},    {4.0, 0, 24.0},          {8.0, 0, 24.0},
-      {8.0, 0, 10.0},          {11.0, 0, 10.0},         {11.0, 0, kTorque_Nm},   {kStandstillEnd_s, 0, kTorque_Nm},
-      {14.5, 500, kTorque_Nm}, {16.0, 500, kTorque_Nm}, {16.0, 500, 24.0},       {17.0, 500, 24.0},
-      {17.5, 700, 24.0},       {18.5, 700, 24.0},       {18.5, 700, 10.0},       {kDuration_s, 700, 10.0}};
+      {0.0, 0, kTorque_Nm},    {4.0, 0, kTorque_Nm},    {4.0, 0, 24.0},        {8.0, 0, 24.0},
+      {8.0, 0, 10.0},          {11.0, 0, 10.0},         {11.0, 0, kTorque_Nm}, {kStandstillEnd_s, 0, kTorque_Nm},
+      {14.5, 500, kTorque_Nm}, {16.0, 500, kTorque_Nm}, {16.0, 500, 24.0},     {17.0, 500, 24.0},
+      {17.5, 700, 24.0},       {18.5, 700, 24.0},       {18.5, 700, 10.0},     {kDuration_s, 700, 10.0}};
   return p;
 }
 
@@ -49,7 +49,8 @@ std::string scenario_events() {
   const auto& p = profile();
   for (std::size_t k = 1; k < p.size(); ++k) {
     if (p[k].t_s == p[k - 1].t_s && p[k].torque_Nm != p[k - 1].torque_Nm) {
-      std::snprintf(line, sizeof line, "  - {t_s: %g, quantity: torque_Nm, kind: step, value: %g}\n", p[k].t_s, p[k].torque_Nm);
+      std::snprintf(line, sizeof line, "  - {t_s: %g, quantity: torque_Nm, kind: step, value: %g}\n", p[k].t_s,
+                    p[k].torque_Nm);
       e += line;
     }
     if (p[k].speed_rpm != p[k - 1].speed_rpm) {
@@ -95,8 +96,9 @@ std::vector<core::AveragedSample> our_simulator(double rate_Hz) {
                 "inverter: {model: switching, switching_frequency_Hz: 4000}\n"
                 "sensors: {current_noise_A: 0.02, current_lsb_A: 0.005, encoder_counts: 16384}\n"
                 "initial: {psi_m_Wb: %.6f, r_s_Ohm: %.6f, speed_rpm: 0, torque_Nm: %g, u_dc_V: 565}\n"
-                "events:\n%s", paper_config().c_str(), kDuration_s, 1.14 * (1 + kPsiRel), 2.25 * (1 + kRsRel),
-                kTorque_Nm, scenario_events().c_str());
+                "events:\n%s",
+                paper_config().c_str(), kDuration_s, 1.14 * (1 + kPsiRel), 2.25 * (1 + kRsRel), kTorque_Nm,
+                scenario_events().c_str());
   sim::DriveSimulator simulator(sim::parse_scenario(text, "averaged-accuracy", test::source_dir()));
   sim::CycleExtractor cycles;
   sim::WindowAverager windows(rate_Hz, 0.3, 11);

@@ -73,8 +73,8 @@ TEST(BadInput, LostDuplicatedAndReorderedFrames) {
   TelemetryDecoder dec;
   const auto out = test::decode_all(dec, received);
   const auto& c = dec.counters();
-  EXPECT_EQ(c.duplicated, 1U);   // f[1] twice
-  EXPECT_EQ(c.reordered, 1U);    // f[2] after f[3]
+  EXPECT_EQ(c.duplicated, 1U);        // f[1] twice
+  EXPECT_EQ(c.reordered, 1U);         // f[2] after f[3]
   EXPECT_EQ(c.frames_lost, 1U + 2U);  // f[2] (jump 1→3) and f[5], f[6]
   EXPECT_EQ(out.size(), 3U * 7U);
   // Gaps where frames went missing, nowhere else.

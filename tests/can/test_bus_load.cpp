@@ -84,23 +84,26 @@ TEST(BusLoad, NativeAndCia402ByHand) {
   //   4 bytes: 47 + 32 = 79 bits + (34 + 32 − 1)/4 = 16 stuff bits = 95; 8 bytes: 111 + 97/4 = 24 → 135;
   //   SYNC (no data): 47 + (34 − 1)/4 = 8 → 55. 12 drives: 12·500 + 55 = 6055 µs per sample period, at 70 %
   //   0.7/6055 µs = 115.6 Hz.
-  const Traffic t = signal_map_traffic(io::load_signal_map(std::string(RPEM_TEST_SOURCE_DIR) +
-                                                           "/config/signal-maps/beckhoff-ax8000-cia402.yaml"),
-                                       false, true);
+  const Traffic t = signal_map_traffic(
+      io::load_signal_map(std::string(RPEM_TEST_SOURCE_DIR) + "/config/signal-maps/beckhoff-ax8000-cia402.yaml"), false,
+      true);
   EXPECT_NEAR(time_per_sample_s(t, 12, {1e6, 1e6}), (12 * 500 + 55) * 1e-6, 1e-12);
   EXPECT_NEAR(max_sample_rate_Hz(t, 12, 0.7, {1e6, 1e6}), 0.7e6 / 6055.0, 1e-9);
 }
 
 /// The table of docs/benchmarks.md ("Several drives per bus"), printed.
 TEST(BusLoad, TwelveDrivesUnderSeventyPercent) {
-  const auto map = io::load_signal_map(std::string(RPEM_TEST_SOURCE_DIR) + "/config/signal-maps/beckhoff-ax8000-cia402.yaml");
+  const auto map =
+      io::load_signal_map(std::string(RPEM_TEST_SOURCE_DIR) + "/config/signal-maps/beckhoff-ax8000-cia402.yaml");
   struct Bus {
     const char* name;
     bool fd;
     BusTiming timing;
   };
-  const Bus buses[] = {{"classic 1 Mbit/s", false, {1e6, 1e6}}, {"FD 1M/1M", true, {1e6, 1e6}}, {"FD 1M/5M", true, {1e6, 5e6}}};
-  std::printf("| source (12 drives, 70 %% load, worst-case stuffing) | classic 1 Mbit/s | CAN FD 1 Mbit/s data | CAN FD 5 Mbit/s data |\n|---|---|---|---|\n");
+  const Bus buses[] = {
+      {"classic 1 Mbit/s", false, {1e6, 1e6}}, {"FD 1M/1M", true, {1e6, 1e6}}, {"FD 1M/5M", true, {1e6, 5e6}}};
+  std::printf(
+      "| source (12 drives, 70 %% load, worst-case stuffing) | classic 1 Mbit/s | CAN FD 1 Mbit/s data | CAN FD 5 Mbit/s data |\n|---|---|---|---|\n");
   int map_bytes = 0;  // every PDO of the map in one FD frame
   for (const FrameSpec& f : map.frames) map_bytes += f.length;
   EXPECT_EQ(map_bytes, 4 + 8 + 8 + 8);

@@ -32,17 +32,15 @@ TEST_P(RoundTrip, ValuesWithinHalfAnLsbAndNoGaps) {
   TelemetryEncoder enc(GetParam().first, GetParam().second);
   TelemetryDecoder dec;
   const auto frames = test::encode_all(enc, in);
-  const std::size_t expected_frames = GetParam().first == BusMode::kClassic
-                                          ? in.size() * 5
-                                          : (in.size() + GetParam().second - 1) / GetParam().second;
+  const std::size_t expected_frames =
+      GetParam().first == BusMode::kClassic ? in.size() * 5 : (in.size() + GetParam().second - 1) / GetParam().second;
   EXPECT_EQ(frames.size(), expected_frames);
   const auto out = test::decode_all(dec, frames);
   ASSERT_EQ(out.size(), in.size());
   for (std::size_t k = 0; k < in.size(); ++k) {
     expect_within_resolution(in[k], out[k]);
     EXPECT_EQ(out[k].gap_before, k == 0);
-    EXPECT_NEAR(out[k].u_dc_V, GetParam().first == BusMode::kClassic ? in[k].u_dc_V
-                                                                      : in[k - k % GetParam().second].u_dc_V,
+    EXPECT_NEAR(out[k].u_dc_V, GetParam().first == BusMode::kClassic ? in[k].u_dc_V : in[k - k % GetParam().second].u_dc_V,
                 p::kDcLinkLsb_V / 2 + 1e-12);
   }
   const DecoderCounters& c = dec.counters();

@@ -132,7 +132,8 @@ TEST(SignalMapFloats, Binary32AndBinary64InBothByteOrdersWithScaleAndOffset) {
   EXPECT_EQ(physical_value(frame(1, {0, 0, 0, 0, 0, 0xC8, 0x6C, 0x40}), spec(0, 64, false, V::kFloat64)), 230.25);
   EXPECT_EQ(physical_value(frame(1, {0x40, 0x6C, 0xC8, 0, 0, 0, 0, 0}), spec(7, 64, true, V::kFloat64)), 230.25);
   // −0.1 (not exact in binary: the nearest double, 0xBFB999999999999A).
-  EXPECT_EQ(physical_value(frame(1, {0x9A, 0x99, 0x99, 0x99, 0x99, 0x99, 0xB9, 0xBF}), spec(0, 64, false, V::kFloat64)), -0.1);
+  EXPECT_EQ(physical_value(frame(1, {0x9A, 0x99, 0x99, 0x99, 0x99, 0x99, 0xB9, 0xBF}), spec(0, 64, false, V::kFloat64)),
+            -0.1);
   // In a CAN FD frame: binary32 big endian at byte 12 (MSB at DBC bit 12·8+7 = 103), 12.5 = 0x41480000.
   CanFrame fd;
   fd.len = 16;
@@ -149,8 +150,8 @@ TEST(SignalMapFloats, Binary32AndBinary64InBothByteOrdersWithScaleAndOffset) {
   EXPECT_EQ(physical_value(frame(1, {0, 0, 0x80, 0x7F}), spec(0, 32, false, V::kFloat32)), HUGE_VAL);
   EXPECT_EQ(physical_value(frame(1, {0, 0, 0x80, 0xFF}), spec(0, 32, false, V::kFloat32)), -HUGE_VAL);
   // 1e300 = 0x7E37E43C8800759C; ·1e12 is beyond the largest double.
-  EXPECT_TRUE(std::isinf(physical_value(frame(1, {0x9C, 0x75, 0x00, 0x88, 0x3C, 0xE4, 0x37, 0x7E}),
-                                        spec(0, 64, false, V::kFloat64, 1e12))));
+  EXPECT_TRUE(std::isinf(
+      physical_value(frame(1, {0x9C, 0x75, 0x00, 0x88, 0x3C, 0xE4, 0x37, 0x7E}), spec(0, 64, false, V::kFloat64, 1e12))));
 }
 
 TEST(SignalMapFloats, NanAndInfinityAreCountedAndNeverDelivered) {
@@ -287,10 +288,12 @@ void expect_refused(const std::string& text, const std::string& what) {
 
 TEST(SignalMapConfig, UnusableMapsAreRefusedNamingWhy) {
   const std::string head = "name: m\nsample: {trigger: 0x10}\nframes:\n  - id: 0x10\n    signals:\n";
-  const std::string i = "      - {field: i_d, start_bit: 0, length: 16, unit: A}\n"
-                        "      - {field: i_q, start_bit: 16, length: 16, unit: A}\n";
-  const std::string u = "      - {field: u_d, start_bit: 32, length: 8, unit: V}\n"
-                        "      - {field: u_q, start_bit: 40, length: 8, unit: V}\n";
+  const std::string i =
+      "      - {field: i_d, start_bit: 0, length: 16, unit: A}\n"
+      "      - {field: i_q, start_bit: 16, length: 16, unit: A}\n";
+  const std::string u =
+      "      - {field: u_d, start_bit: 32, length: 8, unit: V}\n"
+      "      - {field: u_q, start_bit: 40, length: 8, unit: V}\n";
   const std::string w = "      - {field: omega_el, start_bit: 48, length: 16, signed: true, unit: rad/s}\n";
   EXPECT_NO_THROW((void)io::parse_signal_map(head + i + u + w, "map.yaml"));
   expect_refused(head + i + w, "does not give what the estimator needs: voltage");
@@ -305,31 +308,35 @@ TEST(SignalMapConfig, UnusableMapsAreRefusedNamingWhy) {
 
 TEST(SignalMapConfig, FloatSignalsMustBeWholeByteAlignedIeeeValues) {
   const std::string head = "name: m\nsample: {trigger: 0x10}\nframes:\n  - id: 0x10\n    signals:\n";
-  const std::string u = "      - {field: u_d, start_bit: 32, length: 8, unit: V}\n"
-                        "      - {field: u_q, start_bit: 40, length: 8, unit: V}\n"
-                        "      - {field: omega_el, start_bit: 48, length: 16, signed: true, unit: rad/s}\n";
+  const std::string u =
+      "      - {field: u_d, start_bit: 32, length: 8, unit: V}\n"
+      "      - {field: u_q, start_bit: 40, length: 8, unit: V}\n"
+      "      - {field: omega_el, start_bit: 48, length: 16, signed: true, unit: rad/s}\n";
   const auto i = [](const std::string& i_d) { return i_d + "      - {field: i_q, start_bit: 16, length: 16, unit: A}\n"; };
   // Accepted: binary32 from bit 0 (LE), and big endian with its MSB at bit 7 of a byte.
   EXPECT_NO_THROW((void)io::parse_signal_map(
-      head + "      - {field: i_d, start_bit: 0, length: 32, value_type: float, unit: A}\n"
-             "      - {field: i_q, start_bit: 39, length: 32, byte_order: big_endian, value_type: float, unit: A}\n"
-             "  - id: 0x11\n    signals:\n"
-             "      - {field: u_d, start_bit: 0, length: 64, value_type: double, unit: V}\n"
-             "  - id: 0x12\n    signals:\n"
-             "      - {field: u_q, start_bit: 7, length: 64, byte_order: big_endian, value_type: double, unit: V}\n"
-             "  - id: 0x13\n    signals:\n"
-             "      - {field: omega_el, start_bit: 0, length: 32, value_type: float, scale: 6.283185307179586, unit: rad/s}\n",
+      head +
+          "      - {field: i_d, start_bit: 0, length: 32, value_type: float, unit: A}\n"
+          "      - {field: i_q, start_bit: 39, length: 32, byte_order: big_endian, value_type: float, unit: A}\n"
+          "  - id: 0x11\n    signals:\n"
+          "      - {field: u_d, start_bit: 0, length: 64, value_type: double, unit: V}\n"
+          "  - id: 0x12\n    signals:\n"
+          "      - {field: u_q, start_bit: 7, length: 64, byte_order: big_endian, value_type: double, unit: V}\n"
+          "  - id: 0x13\n    signals:\n"
+          "      - {field: omega_el, start_bit: 0, length: 32, value_type: float, scale: 6.283185307179586, unit: rad/s}\n",
       "map.yaml"));
   expect_refused(head + i("      - {field: i_d, start_bit: 0, length: 16, value_type: float, unit: A}\n") + u,
                  "binary32 (float) is 32 bits, not 16");
-  expect_refused(head + "      - {field: i_d, start_bit: 0, length: 32, value_type: double, unit: A}\n"
-                        "      - {field: i_q, start_bit: 32, length: 32, value_type: double, unit: A}\n" +
+  expect_refused(head +
+                     "      - {field: i_d, start_bit: 0, length: 32, value_type: double, unit: A}\n"
+                     "      - {field: i_q, start_bit: 32, length: 32, value_type: double, unit: A}\n" +
                      "  - id: 0x11\n    signals:\n" + u,
                  "binary64 (double) is 64 bits, not 32");
   expect_refused(head + "      - {field: i_d, start_bit: 4, length: 32, value_type: float, unit: A}\n" + u,
                  "must start on a byte boundary");
-  expect_refused(head + "      - {field: i_d, start_bit: 0, length: 32, byte_order: big_endian, value_type: float, unit: A}\n" + u,
-                 "must start on a byte boundary");
+  expect_refused(
+      head + "      - {field: i_d, start_bit: 0, length: 32, byte_order: big_endian, value_type: float, unit: A}\n" + u,
+      "must start on a byte boundary");
   expect_refused(head + i("      - {field: i_d, start_bit: 0, length: 32, value_type: float, signed: true, unit: A}\n") + u,
                  "carries its own sign");
   expect_refused(head + i("      - {field: i_d, start_bit: 0, length: 16, value_type: half, unit: A}\n") + u, "value_type");

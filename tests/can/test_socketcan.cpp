@@ -119,7 +119,8 @@ TEST(SocketCan, ErrorFramesAreDecodedIntoCounters) {
   passive.can_id = CAN_ERR_FLAG | CAN_ERR_CRTL;
   passive.len = CAN_ERR_DLC;
   passive.data[1] = CAN_ERR_CRTL_RX_PASSIVE;
-  const bool sent = ::write(fd, &busoff, sizeof busoff) == sizeof busoff && ::write(fd, &passive, sizeof passive) == sizeof passive;
+  const bool sent =
+      ::write(fd, &busoff, sizeof busoff) == sizeof busoff && ::write(fd, &passive, sizeof passive) == sizeof passive;
   ::close(fd);
   if (!sent) GTEST_SKIP() << "this kernel does not pass error frames from a raw socket";
   std::vector<ReceivedFrame> got;
@@ -152,14 +153,16 @@ TEST(SocketCan, SurvivesTheInterfaceGoingDownAndUp) {
 }
 
 TEST(SocketCan, ReopensWhenTheInterfaceIsRecreated) {
-  ASSERT_EQ(std::system("ip link add dev rpemtest0 type vcan && ip link set rpemtest0 mtu 72 && ip link set rpemtest0 up"), 0);
+  ASSERT_EQ(std::system("ip link add dev rpemtest0 type vcan && ip link set rpemtest0 mtu 72 && ip link set rpemtest0 up"),
+            0);
   SocketCanChannel rx(SocketCanChannel::Options::receiver("rpemtest0", {protocol::kFdId}));
   ASSERT_TRUE(rx.is_open());
   ASSERT_EQ(std::system("ip link del rpemtest0"), 0);
   std::vector<ReceivedFrame> got;
   receive_for(rx, got, 300);
   EXPECT_FALSE(rx.is_open());
-  ASSERT_EQ(std::system("ip link add dev rpemtest0 type vcan && ip link set rpemtest0 mtu 72 && ip link set rpemtest0 up"), 0);
+  ASSERT_EQ(std::system("ip link add dev rpemtest0 type vcan && ip link set rpemtest0 mtu 72 && ip link set rpemtest0 up"),
+            0);
   receive_for(rx, got, 400);
   EXPECT_TRUE(rx.is_open());
   SocketCanChannel tx(SocketCanChannel::Options::sender("rpemtest0"));

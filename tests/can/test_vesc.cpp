@@ -134,7 +134,7 @@ TEST(Vesc, KernelFiltersPassWhatThePollerReadsAndNothingElse) {
     EXPECT_TRUE(kernel_passes(filters, ext((status << 8) | kController, {0, 0, 0, 0, 0, 0, 0, 0}))) << status;
   }
   EXPECT_TRUE(kernel_passes(filters, test::vesc_frames::status4()));
-  EXPECT_TRUE(kernel_passes(filters, values_request(kController, 0x42, kEstimatorMask)));  // another host's poll
+  EXPECT_TRUE(kernel_passes(filters, values_request(kController, 0x42, kEstimatorMask)));       // another host's poll
   EXPECT_TRUE(kernel_passes(filters, ext(0x8FF, {0x42, 0x00, 0x32, 0x00, 0x18, 0x01, 0xB3})));  // to every VESC
 
   // Kept in the kernel: replies to another host (0x42), another controller's statuses and replies, our
@@ -262,8 +262,9 @@ std::vector<CanFrame> frames_of(const std::vector<std::uint8_t>& p) {
 
 TEST(VescBadInput, ShortTrailingWrongMaskAndOtherCommandRepliesAreCounted) {
   VescDecoder dec(kController, kOwn);
-  std::vector<std::uint8_t> good = {0x32, 0x00, 0x18, 0x01, 0xB3, 0x01, 0x9D, 0x02, 0xA6, 0xFF, 0xFF, 0xFE, 0xBF, 0x00, 0x00,
-                                    0x0A, 0xB9, 0x00, 0x00, 0x52, 0x08, 0x01, 0xE2, 0xFF, 0xFF, 0xFB, 0x2E, 0x00, 0x00, 0x2E, 0x61};
+  std::vector<std::uint8_t> good = {0x32, 0x00, 0x18, 0x01, 0xB3, 0x01, 0x9D, 0x02, 0xA6, 0xFF, 0xFF,
+                                    0xFE, 0xBF, 0x00, 0x00, 0x0A, 0xB9, 0x00, 0x00, 0x52, 0x08, 0x01,
+                                    0xE2, 0xFF, 0xFF, 0xFB, 0x2E, 0x00, 0x00, 0x2E, 0x61};
   EXPECT_EQ(feed(dec, frames_of(good)).back(), VescDecoder::Event::kValues);
   auto shorter = good;
   shorter.pop_back();
@@ -304,7 +305,8 @@ TEST(VescBadInput, TooShortFramesAndOverflow) {
   EXPECT_EQ(dec.counters().out_of_order, 1U);
   // 6 bytes at offsets 0, 6, …: the one at 510 would end past the 512-byte buffer.
   for (std::size_t offset = 0; offset <= 510; offset += 6) {
-    EXPECT_EQ(dec.decode(ext(0x67D, {static_cast<std::uint8_t>(offset >> 8), static_cast<std::uint8_t>(offset), 1, 2, 3, 4, 5, 6})),
+    EXPECT_EQ(dec.decode(
+                  ext(0x67D, {static_cast<std::uint8_t>(offset >> 8), static_cast<std::uint8_t>(offset), 1, 2, 3, 4, 5, 6})),
               VescDecoder::Event::kNone);
   }
   EXPECT_EQ(dec.counters().overflow, 1U);

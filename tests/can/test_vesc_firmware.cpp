@@ -39,7 +39,8 @@ std::uint16_t crc_xmodem(const std::vector<std::uint8_t>& d) {
   std::uint16_t crc = 0;
   for (std::uint8_t byte : d) {
     crc ^= static_cast<std::uint16_t>(byte << 8);
-    for (int k = 0; k < 8; ++k) crc = (crc & 0x8000) ? static_cast<std::uint16_t>((crc << 1) ^ 0x1021) : static_cast<std::uint16_t>(crc << 1);
+    for (int k = 0; k < 8; ++k)
+      crc = (crc & 0x8000) ? static_cast<std::uint16_t>((crc << 1) ^ 0x1021) : static_cast<std::uint16_t>(crc << 1);
   }
   return crc;
 }
@@ -85,8 +86,9 @@ TEST(VescFirmware, LongBuffersSwitchToTwoByteOffsetsPastByte255) {
   EXPECT_EQ(frames[37].data[2], p[259]);
   EXPECT_EQ(frames[43].len, 2 + 5);  // 295..299
   const std::uint16_t crc = crc_xmodem(p);
-  expect_same({frames.back()},
-              {ext(0x77D, {kController, 0x01, 0x01, 0x2C, static_cast<std::uint8_t>(crc >> 8), static_cast<std::uint8_t>(crc)})});
+  expect_same(
+      {frames.back()},
+      {ext(0x77D, {kController, 0x01, 0x01, 0x2C, static_cast<std::uint8_t>(crc >> 8), static_cast<std::uint8_t>(crc)})});
   EXPECT_EQ(crc_xmodem({'1', '2', '3', '4', '5', '6', '7', '8', '9'}), 0x31C3);  // the check value, for the helper
 }
 
@@ -135,9 +137,9 @@ TEST(VescFirmware, AcceptsShortBufferRequestsToItselfOrEveryone) {
   EXPECT_EQ(r->command, kCommGetValuesSelective);
   ASSERT_TRUE(r->has_mask);
   EXPECT_EQ(r->mask, 0x001801B3U);
-  EXPECT_TRUE(parse_request(ext(0x8FF, {0x7D, 0x00, 0x32, 0, 0, 0, 1}), kController).has_value());  // 255
+  EXPECT_TRUE(parse_request(ext(0x8FF, {0x7D, 0x00, 0x32, 0, 0, 0, 1}), kController).has_value());   // 255
   EXPECT_FALSE(parse_request(ext(0x812, {0x7D, 0x00, 0x32, 0, 0, 0, 1}), kController).has_value());  // VESC 18
-  EXPECT_FALSE(parse_request(ext(0x511, {0x00, 0x32}), kController).has_value());  // a fill, not a request
+  EXPECT_FALSE(parse_request(ext(0x511, {0x00, 0x32}), kController).has_value());                    // a fill, not a request
   CanFrame standard = ext(0x011, {0x7D, 0x00, 0x32});
   standard.extended = false;
   EXPECT_FALSE(parse_request(standard, kController).has_value());

@@ -14,13 +14,13 @@
 
 namespace rpem::test::reference {
 
+using core::all_finite;
 using core::RegimeConfig;
 using core::RegimeInput;
 using core::RegimeNoise;
 using core::SampleTiming;
-using core::Vec2;
 using core::to_seconds;
-using core::all_finite;
+using core::Vec2;
 namespace regime_bit = core::regime_bit;
 
 struct State {
@@ -34,26 +34,25 @@ struct State {
   /// The chain's last two samples: u, i, n and the time of each [s, relative to t_origin_ns].
   std::array<Vec2, 2> u_pu{}, i_pu{};
   std::array<double, 2> n_pu{}, t_s{};
-  std::int64_t t_origin_ns = 0;       ///< the first sample's time (times are kept relative to it)
+  std::int64_t t_origin_ns = 0;  ///< the first sample's time (times are kept relative to it)
   bool has_origin = false;
-  int points = 0;                      ///< samples held (0–2)
-  int chained = 0;                     ///< of those, how many a chain joins to this one (dense, contiguous)
-  Vec2 slope_pu_s = Vec2::Zero();      ///< di/dt the sample's inductive correction takes (0: none)
+  int points = 0;                  ///< samples held (0–2)
+  int chained = 0;                 ///< of those, how many a chain joins to this one (dense, contiguous)
+  Vec2 slope_pu_s = Vec2::Zero();  ///< di/dt the sample's inductive correction takes (0: none)
   Vec2 previous_slope_pu_s = Vec2::Zero();
   double inv_dt = 0.0, previous_inv_dt = 0.0;  ///< 1/Δt between window centres, this sample's and the one before
   bool slope_valid = false, previous_slope_valid = false;
-  bool previous_transient = false;     ///< the previous sample's own slope test failed (the junction straddles)
+  bool previous_transient = false;  ///< the previous sample's own slope test failed (the junction straddles)
   /// The chain's previous sample: a window (averaged), and whether it was bridge off (mixed windows).
   bool previous_window = false, previous_bridge_off = false;
 };
-
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 /// σ of a zero-mean normal over the median of its absolute value, 1/Φ⁻¹(3/4).
 constexpr double kSigmaPerMedian = 1.4826022185056018;
 /// The median tracker's step in log scale, η = 1/16: it moves by e^{±η} a sample, so the median of a
 /// normal |r| settles within ≈ 13 % (σ of log m ≈ √(0.29·η), §13) and follows a change of 10× in 37 samples.
-constexpr double kTrackUp = 1.0644944589178593;    // e^{1/16}
+constexpr double kTrackUp = 1.0644944589178593;     // e^{1/16}
 constexpr double kTrackDown = 0.93941306281347581;  // e^{−1/16}
 
 /// One step of the median tracker m of |r|: up by e^η when |r| > m, down by e^{−η} otherwise; it settles
@@ -80,11 +79,10 @@ inline bool learn(State& s, const RegimeInput& in, double t_s) noexcept {
   bool resolution_changed = false;
   if (s.points >= 1) {
     const Vec2 du = (in.u_pu - s.u_pu[0]).cwiseAbs(), di = (in.i_pu - s.i_pu[0]).cwiseAbs();
-    resolution_changed = track_resolution(s.measured_resolution_pu[0], du[0]) |
-                         track_resolution(s.measured_resolution_pu[0], du[1]) |
-                         track_resolution(s.measured_resolution_pu[1], di[0]) |
-                         track_resolution(s.measured_resolution_pu[1], di[1]) |
-                         track_resolution(s.measured_resolution_pu[2], in.n_pu - s.n_pu[0]);
+    resolution_changed =
+        track_resolution(s.measured_resolution_pu[0], du[0]) | track_resolution(s.measured_resolution_pu[0], du[1]) |
+        track_resolution(s.measured_resolution_pu[1], di[0]) | track_resolution(s.measured_resolution_pu[1], di[1]) |
+        track_resolution(s.measured_resolution_pu[2], in.n_pu - s.n_pu[0]);
   }
   // Only a chain's samples are close enough for their second difference to be noise: a standalone
   // sample's neighbours are other operating points.
@@ -118,7 +116,6 @@ inline bool learn(State& s, const RegimeInput& in, double t_s) noexcept {
   s.chained = chain ? std::min(s.chained + 1, 2) : 0;
   return resolution_changed;
 }
-
 
 /// core::RegimeClassifier's step, break_chain, current_noise and slope, in their original formulation.
 class Classifier {
@@ -194,13 +191,13 @@ class Classifier {
     // Times are window centres (a mean stands for its centre), relative to the first sample.
     const double t_s = to_seconds(in.t_ns - s.t_origin_ns) - 0.5 * in.window_s;
     const double dt_s = s.points >= 1 ? t_s - s.t_s[0] : 0.0;
-  
+
     // The current's slope: given (a block's end points), or between consecutive samples of a chain.
     s.previous_slope_pu_s = s.slope_pu_s;
     s.previous_slope_valid = s.slope_valid;
     s.previous_inv_dt = s.inv_dt;
-    const bool linked = s.points >= 1 && dt_s > 0.0 &&
-                        (in.timing == SampleTiming::kDense || in.timing == SampleTiming::kContiguous);
+    const bool linked =
+        s.points >= 1 && dt_s > 0.0 && (in.timing == SampleTiming::kDense || in.timing == SampleTiming::kContiguous);
     s.inv_dt = linked ? 1.0 / dt_s : 0.0;
     s.slope_valid = linked;
     if (!linked) {
@@ -211,7 +208,7 @@ class Classifier {
     } else {
       s.slope_pu_s = in.di_dt_pu_s;
     }
-  
+
     noise_ = current_noise();
     const RegimeNoise& v = noise_;
     const Vec2& i = in.i_pu;
@@ -220,7 +217,7 @@ class Classifier {
     // n²·x_q², n²·x_d² as every test forms them (n²·x·x).
     const double n2_xq2 = n2 * c.x_q_pu * c.x_q_pu, n2_xd2 = n2 * c.x_d_pu * c.x_d_pu;
     std::uint8_t bits = 0;
-  
+
     // Bridge off: the reported voltage and the current are zero within their noise where a modulating bridge
     // could not hold a zero current: with |u| inside the voltage's zero band √c₂·σ_u the machine would carry
     // |i| = |M⁻¹·(u − e)| ≥ (|n|·ψ_min − √c₂·σ_u)/‖M‖, ‖M‖ ≤ ‖M‖_F = √(2·r² + n²·(x_d² + x_q²)) at D_M's largest r,
@@ -232,7 +229,7 @@ class Classifier {
       const double m_sq = 2.0 * r * r + n2 * (c.x_d_pu * c.x_d_pu + c.x_q_pu * c.x_q_pu);
       if (emf_margin > 0.0 && emf_margin * emf_margin > c.chi2 * v.i_sq * m_sq) bits |= regime_bit::kBridgeOff;
     }
-  
+
     // Angle locked: e, what the model leaves to the magnet, lies in the cone of half-angle δ_tol about
     // sgn(n)·q, widened by what the configuration's uncertainty (r within D_M, x within its tolerance) and
     // the noise can put there. Independent of ψm's magnitude. Both axes at once: (d, q) in one vector.
@@ -240,20 +237,20 @@ class Classifier {
     const Vec2 abs_sl = sl.cwiseAbs();
     const Vec2 rotation = (n * k.x_swapped).cwiseProduct(i.reverse()).cwiseProduct(Vec2(1.0, -1.0));  // −n·J·x·i
     const Vec2 e = ((in.u_pu - c.r_pu * i) - k.x_over_omega_n.cwiseProduct(sl)) + rotation;
-    const Vec2 b = (c.dr_pu * abs_i + (abs_n * k.dx_swapped).cwiseProduct(abs_i.reverse())) +
-                   k.dx_over_omega_n.cwiseProduct(abs_sl);
+    const Vec2 b =
+        (c.dr_pu * abs_i + (abs_n * k.dx_swapped).cwiseProduct(abs_i.reverse())) + k.dx_over_omega_n.cwiseProduct(abs_sl);
     // The speed's sign where it stands out of its noise; else either direction of q.
     const double along = n2 > k.z_sq * v.n_sq ? (n > 0.0 ? e[1] : -e[1]) : std::abs(e[1]);
     const double lock = std::abs(e[0]) - c.tan_angle * (along + b[1]) - b[0];
     if (lock > 0.0) [[unlikely]] {
       const double slope_sq = 2.0 * s.inv_dt * s.inv_dt;  // Var(s) per σ_i²
-      const double var_d = v.u_sq + (k.r_sq + n2_xq2 + k.slope_var_x_sq[0] * slope_sq) * v.i_sq +
-                           c.x_q_pu * c.x_q_pu * i[1] * i[1] * v.n_sq;
+      const double var_d =
+          v.u_sq + (k.r_sq + n2_xq2 + k.slope_var_x_sq[0] * slope_sq) * v.i_sq + c.x_q_pu * c.x_q_pu * i[1] * i[1] * v.n_sq;
       const double flux_q = c.psi_max_pu + c.x_d_pu * abs_i[0];
       const double var_q = v.u_sq + (k.r_sq + n2_xd2 + k.slope_var_x_sq[1] * slope_sq) * v.i_sq + flux_q * flux_q * v.n_sq;
       if (lock * lock > k.z_sq * (var_d + c.tan_angle * c.tan_angle * var_q)) bits |= regime_bit::kNotLocked;
     }
-  
+
     if (in.timing == SampleTiming::kStandalone && s.points >= 1) [[unlikely]] {
       // A sample far from the previous one: the change of operating point between them excited a transient
       // that has decayed to e^{−Δt/τ_el} of |Δi| (τ_el the slowest the model admits). Steady if that
@@ -287,7 +284,7 @@ class Classifier {
       if (own || s.previous_transient) bits |= regime_bit::kTransient;
       s.previous_transient = own;
     }
-  
+
     // Excitation: the parameter's term, at its smallest inside D_M, less what the other terms' uncertainty
     // can put in its place, against its noise as the estimator's averaging leaves it: h² = γ/(2 − γ) of
     // one sample's variance (an exponential filter of gain γ).
@@ -308,10 +305,10 @@ class Classifier {
         if (term * term > k.z_sq * h_sq * noise) bits |= regime_bit::kExcitesRs;
       }
     }
-  
+
     // Before a chain has shown the data's noise, nothing in it is excluded on a threshold made of it.
     if (!s.noise_known && in.timing != SampleTiming::kStandalone) bits &= static_cast<std::uint8_t>(~regime_bit::kExcluded);
-  
+
     // Mixed windows (§13): a bridge state change falls inside the window between the last one of the old
     // state and the first of the new (a read instant holds it with probability zero), whose means then mix
     // both states. The take-over: this window follows a bridge-off one; the release: this one is bridge off
@@ -324,28 +321,28 @@ class Classifier {
     }
     s.previous_window = window;
     s.previous_bridge_off = off;
-    if (learn(s, in, t_s)) [[unlikely]] update_quantisation();
+    if (learn(s, in, t_s)) [[unlikely]]
+      update_quantisation();
     return core::Classification::of(bits);
   }
 
  private:
   struct Constants {
-    double z_sq = 0.0;                       ///< z²
-    double r_sq = 0.0;                       ///< r²
-    double r_min_sq = 0.0;                   ///< r_min²
-    double r_max = 0.0;                      ///< D_M's largest r
-    double psi_max_sq = 0.0;                 ///< ψ_max²
-    double inv_omega_n = 0.0;                ///< 1/ω_n
-    double inv_omega_n_sq = 0.0;             ///< 1/ω_n²
+    double z_sq = 0.0;                                  ///< z²
+    double r_sq = 0.0;                                  ///< r²
+    double r_min_sq = 0.0;                              ///< r_min²
+    double r_max = 0.0;                                 ///< D_M's largest r
+    double psi_max_sq = 0.0;                            ///< ψ_max²
+    double inv_omega_n = 0.0;                           ///< 1/ω_n
+    double inv_omega_n_sq = 0.0;                        ///< 1/ω_n²
     Vec2 x = Vec2::Zero(), x_swapped = Vec2::Zero();    ///< (x_d, x_q), (x_q, x_d)
     Vec2 dx = Vec2::Zero(), dx_swapped = Vec2::Zero();  ///< (Δx_d, Δx_q), (Δx_q, Δx_d)
-    Vec2 x_over_omega_n = Vec2::Zero();      ///< (x_d, x_q)/ω_n
-    Vec2 dx_over_omega_n = Vec2::Zero();     ///< (Δx_d, Δx_q)/ω_n
-    Vec2 x_sq = Vec2::Zero();                ///< (x_d², x_q²)
-    Vec2 slope_var_x_sq = Vec2::Zero();      ///< (x_d², x_q²)/ω_n²
-    double x_max = 0.0, dx_max = 0.0;        ///< the larger inductance and tolerance
+    Vec2 x_over_omega_n = Vec2::Zero();                 ///< (x_d, x_q)/ω_n
+    Vec2 dx_over_omega_n = Vec2::Zero();                ///< (Δx_d, Δx_q)/ω_n
+    Vec2 x_sq = Vec2::Zero();                           ///< (x_d², x_q²)
+    Vec2 slope_var_x_sq = Vec2::Zero();                 ///< (x_d², x_q²)/ω_n²
+    double x_max = 0.0, dx_max = 0.0;                   ///< the larger inductance and tolerance
   };
-
 
   RegimeConfig config_;
   Constants k_;

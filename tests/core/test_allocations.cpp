@@ -14,9 +14,9 @@
 #include "support/averaged_data.hpp"
 #include "support/model_data.hpp"
 #include "support/outrunner_machine.hpp"
-#include "support/regime_drive.hpp"
 #include "support/paper_machine.hpp"
 #include "support/paper_thermal.hpp"
+#include "support/regime_drive.hpp"
 
 namespace {
 std::atomic<long> g_allocations{0};
@@ -106,13 +106,13 @@ TEST_P(Allocations, NoneAcrossOneHundredThousandSteps) {
   expect_no_allocations(est, samples);
 }
 
-INSTANTIATE_TEST_SUITE_P(
-    EveryPath, Allocations,
-    ::testing::Values(Case{Algorithm::kSga, GradientForm::kSteadyState, Discretization::kTrapezoidal},
-                      Case{Algorithm::kSga, GradientForm::kDynamic, Discretization::kTrapezoidal},
-                      Case{Algorithm::kGna, GradientForm::kSteadyState, Discretization::kTrapezoidal},
-                      Case{Algorithm::kGna, GradientForm::kDynamic, Discretization::kExplicitEuler},
-                      Case{Algorithm::kPhyInt, GradientForm::kSteadyState, Discretization::kTrapezoidal}));
+INSTANTIATE_TEST_SUITE_P(EveryPath, Allocations,
+                         ::testing::Values(Case{Algorithm::kSga, GradientForm::kSteadyState, Discretization::kTrapezoidal},
+                                           Case{Algorithm::kSga, GradientForm::kDynamic, Discretization::kTrapezoidal},
+                                           Case{Algorithm::kGna, GradientForm::kSteadyState, Discretization::kTrapezoidal},
+                                           Case{Algorithm::kGna, GradientForm::kDynamic, Discretization::kExplicitEuler},
+                                           Case{Algorithm::kPhyInt, GradientForm::kSteadyState,
+                                                Discretization::kTrapezoidal}));
 
 class AveragedAllocations : public ::testing::TestWithParam<Algorithm> {};
 
@@ -174,7 +174,8 @@ TEST(RegimeAllocations, NoneThroughEveryRegimeAndTheSparsePath) {
   AveragedDriveEstimator averaged(test::outrunner_machine_si(), test::outrunner_settings());
   expect_no_allocations(averaged, windows);
 
-  RegimeClassifier classifier(make_regime_config(test::outrunner_base(), test::outrunner_machine_si(), test::outrunner_settings()));
+  RegimeClassifier classifier(
+      make_regime_config(test::outrunner_base(), test::outrunner_machine_si(), test::outrunner_settings()));
   std::vector<RegimeInput> inputs;
   for (const AveragedSample& w : windows) {
     RegimeInput in;

@@ -192,8 +192,8 @@ TEST(Conditioner, ObservationModelInvertsTheCorrections) {
   x.current_gain_error = Vec3(0.0, 0.03, -0.01);
   SampleConditioner c(b, test::paper_machine_pu(), x);
   const Vec3 i_true(2.0, -0.7, -1.3);  // a three-wire machine: no zero sequence
-  const DriveSample s = sample(0, 2.1, Vec3::Zero(),
-                               i_true.cwiseProduct(Vec3::Ones() + x.current_gain_error) + x.current_offset_A);
+  const DriveSample s =
+      sample(0, 2.1, Vec3::Zero(), i_true.cwiseProduct(Vec3::Ones() + x.current_gain_error) + x.current_offset_A);
   const EstimatorSample out = c.condition(s);
   EXPECT_LT((c.observed_current_dq_A(s, out.i_meas_pu) - c.logged_current_dq_A(s)).norm(), 1e-13);
   EXPECT_LT((c.logged_current_dq_A(s) - park(clarke(s.i_A), Rotation::of(2.1))).norm(), 1e-15);
@@ -256,7 +256,8 @@ TEST(Conditioner, ReadsTheMachineOnlyWhereTheExtensionsSaySo) {
       const EstimatorSample a = c1.condition(s), d = c2.condition(s);
       const Vec2 i_model(0.1, -0.2);
       any = any || a.interval.u_start_pu != d.interval.u_start_pu || a.interval.u_end_pu != d.interval.u_end_pu ||
-            a.i_meas_pu != d.i_meas_pu || a.x_d_pu != d.x_d_pu || a.x_q_pu != d.x_q_pu || a.interval.dt_s != d.interval.dt_s ||
+            a.i_meas_pu != d.i_meas_pu || a.x_d_pu != d.x_d_pu || a.x_q_pu != d.x_q_pu ||
+            a.interval.dt_s != d.interval.dt_s ||
             c1.observed_current_dq_A(s, i_model) != c2.observed_current_dq_A(s, i_model);
     }
     return any;

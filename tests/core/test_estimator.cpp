@@ -89,13 +89,10 @@ TEST_P(EachAlgorithm, ConvergesOnRandomOperatingPointsInFourQuadrants) {
   }
 }
 
-INSTANTIATE_TEST_SUITE_P(Algorithms, EachAlgorithm,
-                         ::testing::Values(Algorithm::kSga, Algorithm::kGna, Algorithm::kPhyInt),
-                         [](const auto& p) {
-                           return std::string(p.param == Algorithm::kSga   ? "sga"
-                                              : p.param == Algorithm::kGna ? "gna"
-                                                                              : "phyint");
-                         });
+INSTANTIATE_TEST_SUITE_P(
+    Algorithms, EachAlgorithm, ::testing::Values(Algorithm::kSga, Algorithm::kGna, Algorithm::kPhyInt), [](const auto& p) {
+      return std::string(p.param == Algorithm::kSga ? "sga" : p.param == Algorithm::kGna ? "gna" : "phyint");
+    });
 
 TEST(Estimator, DynamicGradientsConvergeToo) {
   auto gen = generator(0.6, 0.5, 0.92);

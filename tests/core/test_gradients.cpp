@@ -86,8 +86,7 @@ TEST_P(GradientPlane, SteadyStateEqualsDynamicEquilibriumAndFiniteDifference) {
 }
 
 INSTANTIATE_TEST_SUITE_P(FourQuadrants, GradientPlane,
-                         ::testing::Combine(::testing::Values(-2.0, -1.0, -0.4, -0.1, -0.01, 0.0, 0.005, 0.1, 0.4,
-                                                              1.0, 2.0),
+                         ::testing::Combine(::testing::Values(-2.0, -1.0, -0.4, -0.1, -0.01, 0.0, 0.005, 0.1, 0.4, 1.0, 2.0),
                                             ::testing::Values(-1.0, -0.4, -0.1, 0.0, 0.1, 0.4, 1.0)));
 
 TEST(Gradients, PrintedSteadyStateFormIsWrongWithoutTheSquare) {

@@ -15,12 +15,11 @@ namespace {
 const double kOmegaN = 100.0 * kPi;
 
 /// eq_epsilon_steadystate as printed, with i the plant's (measured) current.
-Vec2 printed_epsilon(const MachinePu& hat, double n, const Vec2& i, double d_psi, double d_rs, double d_xd,
-                     double d_xq) {
+Vec2 printed_epsilon(const MachinePu& hat, double n, const Vec2& i, double d_psi, double d_rs, double d_xd, double d_xq) {
   const double D = hat.r_s_pu * hat.r_s_pu + n * n * hat.x_d_pu * hat.x_q_pu;
   const double r = hat.r_s_pu, xd = hat.x_d_pu, xq = hat.x_q_pu;
-  const double ed = -(n * n * xq / D) * d_psi - (r / D * i[0] + n * xq / D * i[1]) * d_rs -
-                    (n * n * xq / D * i[0]) * d_xd + (n * r / D * i[1]) * d_xq;
+  const double ed = -(n * n * xq / D) * d_psi - (r / D * i[0] + n * xq / D * i[1]) * d_rs - (n * n * xq / D * i[0]) * d_xd +
+                    (n * r / D * i[1]) * d_xq;
   const double eq = -(n * r / D) * d_psi - (r / D * i[1] - n * xd / D * i[0]) * d_rs - (n * r / D * i[0]) * d_xd -
                     (n * n * xd / D * i[1]) * d_xq;
   return {ed, eq};

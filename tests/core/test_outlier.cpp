@@ -70,7 +70,8 @@ TEST(Outlier, AGlitchIsSkippedAndCountedAndAdaptsNothing) {
   const MachinePu plant = test::paper_machine_pu();
   const double sigma = 1e-3;
   for (int k = 0; k < 10; ++k) {
-    (void)est.step_steady_state(window(plant, 0.5, 0.5, Vec2::Zero()), Vec2::Constant(1e-3), Vec2::Constant(1e-3), judged(sigma * sigma));
+    (void)est.step_steady_state(window(plant, 0.5, 0.5, Vec2::Zero()), Vec2::Constant(1e-3), Vec2::Constant(1e-3),
+                                judged(sigma * sigma));
   }
   const Vec2 theta = est.state().theta_pu;
   // A current reading 2 pu off: more than any ψm or r_s inside D_M (paper: ψm 0.5-1.5×, r_s 0.44-2×) explains.
@@ -80,10 +81,10 @@ TEST(Outlier, AGlitchIsSkippedAndCountedAndAdaptsNothing) {
   EXPECT_EQ(est.state().theta_pu, theta);
   EXPECT_GT(out.epsilon_pu.norm(), 1.9);
   // Unjudged (the plain estimator), the same reading adapts.
-  EXPECT_EQ(est.step_steady_state(window(plant, 0.5, 0.5, Vec2(0.0, 2.0)), Vec2::Constant(1e-3), Vec2::Constant(1e-3),
-                                  Admission{})
-                .code,
-            StepCode::kAdapted);
+  EXPECT_EQ(
+      est.step_steady_state(window(plant, 0.5, 0.5, Vec2(0.0, 2.0)), Vec2::Constant(1e-3), Vec2::Constant(1e-3), Admission{})
+          .code,
+      StepCode::kAdapted);
 }
 
 TEST(Outlier, APredictionErrorAWrongPsiMExplainsIsNotSkippedHoweverSuddenly) {
@@ -94,7 +95,8 @@ TEST(Outlier, APredictionErrorAWrongPsiMExplainsIsNotSkippedHoweverSuddenly) {
   const MachinePu plant = test::paper_machine_pu();
   const double sigma = 1e-4;
   for (int k = 0; k < 20; ++k) {
-    (void)est.step_steady_state(window(plant, 0.0, 0.3, Vec2::Zero()), Vec2::Constant(1e-3), Vec2::Constant(1e-3), judged(sigma * sigma));
+    (void)est.step_steady_state(window(plant, 0.0, 0.3, Vec2::Zero()), Vec2::Constant(1e-3), Vec2::Constant(1e-3),
+                                judged(sigma * sigma));
   }
   const EstimatorOutput out = est.step_steady_state(window(plant, 0.8, 0.3, Vec2::Zero()), Vec2::Constant(1e-3),
                                                     Vec2::Constant(1e-3), judged(sigma * sigma));

@@ -13,8 +13,8 @@ namespace {
 TEST(PerUnit, PaperBaseMatchesHandComputation) {
   const PerUnitBase b = test::paper_base();
   EXPECT_NEAR(b.voltage_V, std::sqrt(2.0) * 400.0 / std::sqrt(3.0), 1e-12);  // 326.60 V
-  EXPECT_NEAR(b.current_A, std::sqrt(2.0) * 4.93, 1e-12);                   // 6.972 A
-  EXPECT_NEAR(b.omega_el_rad_s, 100.0 * kPi, 1e-12);                        // 3 pole pairs at 1000 rpm: 50 Hz
+  EXPECT_NEAR(b.current_A, std::sqrt(2.0) * 4.93, 1e-12);                    // 6.972 A
+  EXPECT_NEAR(b.omega_el_rad_s, 100.0 * kPi, 1e-12);                         // 3 pole pairs at 1000 rpm: 50 Hz
   EXPECT_NEAR(b.flux_Wb, b.voltage_V / (100.0 * kPi), 1e-12);
   // tab_machineData's rated torque, 32.6 Nm, is this base's torque T_b = 1.5·p·ψ_b·I_b (to print precision).
   EXPECT_NEAR(b.torque_Nm, 32.6, 0.05);

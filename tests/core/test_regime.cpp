@@ -119,9 +119,9 @@ TEST(Regime, LockIsTheBackEmfsDirectionWithinTheDerivedCone) {
   const double tan_tol = std::tan(s.settings.regimes.angle_tolerance_rad);
   const double b = n * c.dx_q_pu * current + tan_tol * c.dr_pu * current;
   const double sigma_over_cos = c.resolution_pu[0] / std::sqrt(12.0) / std::cos(s.settings.regimes.angle_tolerance_rad);
-  const double edge = s.settings.regimes.angle_tolerance_rad +
-                      std::asin(std::cos(s.settings.regimes.angle_tolerance_rad) * (b + c.z * sigma_over_cos) /
-                                (n * s.nominal.psi_m_pu));
+  const double edge =
+      s.settings.regimes.angle_tolerance_rad +
+      std::asin(std::cos(s.settings.regimes.angle_tolerance_rad) * (b + c.z * sigma_over_cos) / (n * s.nominal.psi_m_pu));
   const Vec2 i(0.0, current);
   EXPECT_EQ(probe(c, steady(s.nominal, n, i, edge - 0.002)).regime, Regime::kExcitesPsiM);
   EXPECT_EQ(probe(c, steady(s.nominal, n, i, edge + 0.002)).regime, Regime::kNotLocked);
@@ -218,8 +218,9 @@ TEST(Regime, ARampIsTransientOnlyWhereTheInductancesToleranceOnItsCorrectionStan
   // A ramp: the slope between centres is exact, so the rows' error is (Δx/ω_n)·|s| against z·σ_u.
   const double edge = c.z * (c.resolution_pu[0] / std::sqrt(12.0)) * s.base.omega_el_rad_s / c.dx_q_pu;
   auto last = [&](double slope) {
-    const auto v = windows(c, s.nominal, s.base.omega_el_rad_s, 0.4, 0.09, 6, [=](double t) { return 0.2 + slope * t; },
-                           [=](double t0, double t1) { return 0.2 + slope * 0.5 * (t0 + t1); });
+    const auto v = windows(
+        c, s.nominal, s.base.omega_el_rad_s, 0.4, 0.09, 6, [=](double t) { return 0.2 + slope * t; },
+        [=](double t0, double t1) { return 0.2 + slope * 0.5 * (t0 + t1); });
     return v.back();
   };
   EXPECT_FALSE(last(0.99 * edge).excluded());
@@ -465,7 +466,8 @@ TEST(Regime, LockedSteadyNoisyDataIsExcludedNoMoreOftenThanTheFalseRate) {
     }
   }
   const double alpha = std::erfc(c.z / std::sqrt(2.0));
-  EXPECT_LE(static_cast<double>(excluded), 4.0 * alpha * static_cast<double>(judged) + 3.0) << "seed " << seed << ": " << excluded << " of " << judged;
+  EXPECT_LE(static_cast<double>(excluded), 4.0 * alpha * static_cast<double>(judged) + 3.0)
+      << "seed " << seed << ": " << excluded << " of " << judged;
 }
 
 }  // namespace

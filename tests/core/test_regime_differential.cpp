@@ -80,8 +80,8 @@ class Stream {
                 : tr < 0.85 ? SampleTiming::kDense
                 : tr < 0.92 ? SampleTiming::kStandalone
                             : SampleTiming::kFirst;
-    const double step_s = uniform(0.0, 1.0) < 0.02 ? uniform(-0.01, 0.0)  // back in time, or repeated
-                          : uniform(0.0, 1.0) < 0.05 ? uniform(0.05, 5.0)  // a far row
+    const double step_s = uniform(0.0, 1.0) < 0.02   ? uniform(-0.01, 0.0)  // back in time, or repeated
+                          : uniform(0.0, 1.0) < 0.05 ? uniform(0.05, 5.0)   // a far row
                                                      : uniform(0.5e-3, 20e-3);
     t_ns_ += std::llround(step_s * 1e9);
     in.t_ns = t_ns_;
@@ -98,12 +98,24 @@ class Stream {
       const std::array<double, 3> v{kNaN, kInf, -kInf};
       const double x = v[static_cast<std::size_t>(uniform(0.0, 2.999))];
       switch (static_cast<int>(uniform(0.0, 5.999))) {
-        case 0: in.u_pu[1] = x; break;
-        case 1: in.i_pu[0] = x; break;
-        case 2: in.n_pu = x; break;
-        case 3: in.u_reported_sq_pu = x; break;
-        case 4: in.window_s = x; break;
-        default: in.weight[1] = x; break;
+        case 0:
+          in.u_pu[1] = x;
+          break;
+        case 1:
+          in.i_pu[0] = x;
+          break;
+        case 2:
+          in.n_pu = x;
+          break;
+        case 3:
+          in.u_reported_sq_pu = x;
+          break;
+        case 4:
+          in.window_s = x;
+          break;
+        default:
+          in.weight[1] = x;
+          break;
       }
     } else if (bad < 0.005) {
       in.u_pu[0] = std::copysign(1.7e308, gauss(1.0));

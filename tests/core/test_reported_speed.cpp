@@ -7,8 +7,8 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <cstdint>
+#include <cstdio>
 #include <functional>
 #include <vector>
 
@@ -63,7 +63,7 @@ std::vector<Window> run(const std::function<double(double)>& omega, double durat
 // a·(h/2 − k_p/k_i); rebuilt, the mean is exact to the loop's discretisation (measured: the discrete PLL lags
 // by 1.5 cycles more, as it turns its angle with the speed before this cycle's update: 1.5·a·dt).
 TEST(ReportedSpeed, ARampsWindowMeanIsRebuiltExactlyWhereTheReadIsOffByTheLag) {
-  constexpr double a = 500.0;  // rad/s² electrical
+  constexpr double a = 500.0;                 // rad/s² electrical
   for (const int read_cycles : {1125, 62}) {  // 90 ms (VESC Tool at 11 Hz) and ~5 ms (rpemd at 200 Hz)
     const std::vector<Window> w = run([](double t) { return 100.0 + a * t; }, 3.0, read_cycles);
     const double h = read_cycles * kDt;
@@ -82,8 +82,8 @@ TEST(ReportedSpeed, ARampsWindowMeanIsRebuiltExactlyWhereTheReadIsOffByTheLag) {
 TEST(ReportedSpeed, WhereTheAccelerationChangesTheErrorIsWithinTheTrapezoidsBound) {
   constexpr double a = 2000.0;  // a hard acceleration: 0 to 2000 rad/s in 1 s, then steady
   for (const int read_cycles : {1125, 62}) {
-    const std::vector<Window> w = run([](double t) { return t < 0.5 ? 50.0 : 50.0 + a * std::min(t - 0.5, 1.0); }, 3.0,
-                                      read_cycles);
+    const std::vector<Window> w =
+        run([](double t) { return t < 0.5 ? 50.0 : 50.0 + a * std::min(t - 0.5, 1.0); }, 3.0, read_cycles);
     const double h = read_cycles * kDt;
     const double root = std::sqrt(kKp * kKp - 4.0 * kKi);
     const double bound = h * h / 12.0 * a * kKi / root + std::min(a / (kKi * h), a / root) + 2.0 * a * kDt;

@@ -19,10 +19,10 @@ namespace {
 /// What a run leaves: the final estimates and sums over every sample's outputs.
 struct Fingerprint {
   double psi_m_Wb, r_s_Ohm;
-  double epsilon_sum_A;   ///< Σ (ε_d + 2·ε_q)
-  double i_hat_sum_A;     ///< Σ (î_d + 2·î_q)
-  double gain_sum;        ///< Σ of every element of L
-  std::uint64_t flag_sum; ///< Σ (code·256 + flags)
+  double epsilon_sum_A;    ///< Σ (ε_d + 2·ε_q)
+  double i_hat_sum_A;      ///< Σ (î_d + 2·î_q)
+  double gain_sum;         ///< Σ of every element of L
+  std::uint64_t flag_sum;  ///< Σ (code·256 + flags)
 };
 
 Fingerprint run(const EstimatorSettings& settings, double n_pu, double torque_pu) {
@@ -63,8 +63,8 @@ void expect_same(const Fingerprint& got, const Fingerprint& want) {
   EXPECT_EQ(got.flag_sum, want.flag_sum);
   // On failure, the run's figures in full (to record them after an intended change of behaviour).
   if (testing::Test::HasFailure()) {
-    std::printf("{%.17g, %.17g, %.17g, %.17g, %.17g, %llu}\n", got.psi_m_Wb, got.r_s_Ohm, got.epsilon_sum_A,
-                got.i_hat_sum_A, got.gain_sum, static_cast<unsigned long long>(got.flag_sum));
+    std::printf("{%.17g, %.17g, %.17g, %.17g, %.17g, %llu}\n", got.psi_m_Wb, got.r_s_Ohm, got.epsilon_sum_A, got.i_hat_sum_A,
+                got.gain_sum, static_cast<unsigned long long>(got.flag_sum));
   }
 }
 
@@ -75,25 +75,33 @@ EstimatorSettings settings(Algorithm algorithm, GradientForm form) {
 }
 
 TEST(StepRegression, SgaSteadyState) {
-  expect_same(run(settings(Algorithm::kSga, GradientForm::kSteadyState), 0.4, 0.4), {1.1043698056020574, 2.25, 1332.3749023572254, 16297.304846265364, -0.79736476438691184, 128416});
+  expect_same(run(settings(Algorithm::kSga, GradientForm::kSteadyState), 0.4, 0.4),
+              {1.1043698056020574, 2.25, 1332.3749023572254, 16297.304846265364, -0.79736476438691184, 128416});
 }
 TEST(StepRegression, SgaDynamic) {
-  expect_same(run(settings(Algorithm::kSga, GradientForm::kDynamic), 0.4, 0.4), {1.1045625396287464, 2.25, 1338.2310364339387, 16291.446552833246, -0.78869820326017792, 128416});
+  expect_same(run(settings(Algorithm::kSga, GradientForm::kDynamic), 0.4, 0.4),
+              {1.1045625396287464, 2.25, 1338.2310364339387, 16291.446552833246, -0.78869820326017792, 128416});
 }
 TEST(StepRegression, SgaSteadyStateAtStandstill) {
-  expect_same(run(settings(Algorithm::kSga, GradientForm::kSteadyState), 0.005, 0.4), {1.1399999999999999, 2.3051392918094313, -1078.1321631702299, 18789.607862807734, -0.074797924288415946, 256320});
+  expect_same(
+      run(settings(Algorithm::kSga, GradientForm::kSteadyState), 0.005, 0.4),
+      {1.1399999999999999, 2.3051392918094313, -1078.1321631702299, 18789.607862807734, -0.074797924288415946, 256320});
 }
 TEST(StepRegression, GnaSteadyState) {
-  expect_same(run(settings(Algorithm::kGna, GradientForm::kSteadyState), 0.4, 0.4), {1.1033170059731243, 2.25, 1310.0256726050668, 16319.659646944383, -0.40425615293053407, 128416});
+  expect_same(run(settings(Algorithm::kGna, GradientForm::kSteadyState), 0.4, 0.4),
+              {1.1033170059731243, 2.25, 1310.0256726050668, 16319.659646944383, -0.40425615293053407, 128416});
 }
 TEST(StepRegression, GnaDynamic) {
-  expect_same(run(settings(Algorithm::kGna, GradientForm::kDynamic), 0.4, 0.4), {1.10200931919443, 2.25, 1254.974206992493, 16374.738200704003, -0.48349886152241012, 128416});
+  expect_same(run(settings(Algorithm::kGna, GradientForm::kDynamic), 0.4, 0.4),
+              {1.10200931919443, 2.25, 1254.974206992493, 16374.738200704003, -0.48349886152241012, 128416});
 }
 TEST(StepRegression, PhyIntSteadyState) {
-  expect_same(run(settings(Algorithm::kPhyInt, GradientForm::kSteadyState), 0.4, 0.4), {1.1020131579382708, 2.25, 1408.5068195697129, 16221.150090914041, -0.83024799959667805, 128416});
+  expect_same(run(settings(Algorithm::kPhyInt, GradientForm::kSteadyState), 0.4, 0.4),
+              {1.1020131579382708, 2.25, 1408.5068195697129, 16221.150090914041, -0.83024799959667805, 128416});
 }
 TEST(StepRegression, PhyIntDynamic) {
-  expect_same(run(settings(Algorithm::kPhyInt, GradientForm::kDynamic), 0.4, 0.4), {1.1020131579382708, 2.25, 1408.5068195697129, 16221.150090914041, -0.83024799959667805, 128416});
+  expect_same(run(settings(Algorithm::kPhyInt, GradientForm::kDynamic), 0.4, 0.4),
+              {1.1020131579382708, 2.25, 1408.5068195697129, 16221.150090914041, -0.83024799959667805, 128416});
 }
 
 TEST(StepRegression, SgaWithEveryExtension) {
@@ -114,7 +122,8 @@ TEST(StepRegression, SgaWithEveryExtension) {
   x.iron_loss_r_fe_Ohm = 300.0;
   x.flux_harmonics[0] = {1e-3, -5e-4, 2e-4, 3e-4};
   x.flux_harmonics[1] = {0.0, 2e-4, -1e-4, 0.0};
-  expect_same(run(s, 0.4, 0.4), {1.0808634875239533, 2.25, 172.14222246577435, 14897.360554112431, -0.84528736795419468, 128416});
+  expect_same(run(s, 0.4, 0.4),
+              {1.0808634875239533, 2.25, 172.14222246577435, 14897.360554112431, -0.84528736795419468, 128416});
 }
 
 }  // namespace

@@ -171,9 +171,7 @@ TEST(CommandAuth, KeysComeFromTheCredentialsDirectory) {
   const std::filesystem::path dir = std::filesystem::path(test::TempFile("creds").path());
   std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);
-  auto put = [&](const std::string& name, const auth::Key& k) {
-    auth::write_key_file((dir / name).string(), k);
-  };
+  auto put = [&](const std::string& name, const auth::Key& k) { auth::write_key_file((dir / name).string(), k); };
   put("rpem_command.key", key(1, 1));
   put("rpem_command-next.key", key(2, 2));
   put("rpem_publish.key", key(5, 5));
@@ -224,7 +222,9 @@ TEST(CommandAuth, AuthenticationNoneIsRefusedWhereLcmReachesTheNetwork) {
       EXPECT_NE(std::string(e.what()).find("authentication"), std::string::npos) << e.what();
     }
   }
-  test::TempFile local("rpemd.yaml", "daemon:\n  lcm: {url: \"udpm://239.255.76.67:7667?ttl=0\"}\n  commands: {enabled: true, authentication: none}\n");
+  test::TempFile local(
+      "rpemd.yaml",
+      "daemon:\n  lcm: {url: \"udpm://239.255.76.67:7667?ttl=0\"}\n  commands: {enabled: true, authentication: none}\n");
   EXPECT_EQ(load_daemon_config(local.path()).live.command_authentication, CommandAuthentication::kNone);
 }
 

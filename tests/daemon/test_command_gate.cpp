@@ -32,15 +32,17 @@ TEST(AdmitCommand, EachCommandKindIsAdmitted) {
     std::int8_t command;
     Command::Kind kind;
   };
-  for (const Case& c : {Case{rpem::command_t::RESET, Command::Kind::kReset}, Case{rpem::command_t::FREEZE, Command::Kind::kFreeze},
-                        Case{rpem::command_t::UNFREEZE, Command::Kind::kUnfreeze}}) {
+  for (const Case& c :
+       {Case{rpem::command_t::RESET, Command::Kind::kReset}, Case{rpem::command_t::FREEZE, Command::Kind::kFreeze},
+        Case{rpem::command_t::UNFREEZE, Command::Kind::kUnfreeze}}) {
     const CommandVerdict v = admit_command(encode(3, c.command), kOn, kNoKeys, "RPEM_COMMAND", 2);
     EXPECT_TRUE(v.decoded);
     EXPECT_EQ(v.result, CommandResult::kApplied);
     EXPECT_EQ(v.command.kind, c.kind);
     EXPECT_EQ(v.command.seq, 3);
   }
-  const CommandVerdict set = admit_command(encode(1, rpem::command_t::SET_VALUES, 1.2, 2.5), kOn, kNoKeys, "RPEM_COMMAND", 0);
+  const CommandVerdict set =
+      admit_command(encode(1, rpem::command_t::SET_VALUES, 1.2, 2.5), kOn, kNoKeys, "RPEM_COMMAND", 0);
   EXPECT_EQ(set.result, CommandResult::kApplied);
   EXPECT_EQ(set.command.kind, Command::Kind::kSetValues);
   EXPECT_DOUBLE_EQ(set.command.psi_m_Wb, 1.2);
@@ -48,20 +50,25 @@ TEST(AdmitCommand, EachCommandKindIsAdmitted) {
 }
 
 TEST(AdmitCommand, RefusalsSayWhy) {
-  EXPECT_EQ(admit_command(encode(1, rpem::command_t::RESET), CommandPolicy{}, kNoKeys, "RPEM_COMMAND", 0).result, CommandResult::kRejectedDisabled);
-  EXPECT_EQ(admit_command(encode(5, rpem::command_t::RESET), kOn, kNoKeys, "RPEM_COMMAND", 5).result, CommandResult::kRejectedOldSequence);
-  EXPECT_EQ(admit_command(encode(0, rpem::command_t::RESET), kOn, kNoKeys, "RPEM_COMMAND", 0).result, CommandResult::kRejectedOldSequence);
-  EXPECT_EQ(admit_command(encode(-3, rpem::command_t::RESET), kOn, kNoKeys, "RPEM_COMMAND", 0).result, CommandResult::kRejectedOldSequence);
+  EXPECT_EQ(admit_command(encode(1, rpem::command_t::RESET), CommandPolicy{}, kNoKeys, "RPEM_COMMAND", 0).result,
+            CommandResult::kRejectedDisabled);
+  EXPECT_EQ(admit_command(encode(5, rpem::command_t::RESET), kOn, kNoKeys, "RPEM_COMMAND", 5).result,
+            CommandResult::kRejectedOldSequence);
+  EXPECT_EQ(admit_command(encode(0, rpem::command_t::RESET), kOn, kNoKeys, "RPEM_COMMAND", 0).result,
+            CommandResult::kRejectedOldSequence);
+  EXPECT_EQ(admit_command(encode(-3, rpem::command_t::RESET), kOn, kNoKeys, "RPEM_COMMAND", 0).result,
+            CommandResult::kRejectedOldSequence);
   EXPECT_EQ(admit_command(encode(1, 9), kOn, kNoKeys, "RPEM_COMMAND", 0).result, CommandResult::kRejectedUnknown);
   EXPECT_EQ(admit_command(encode(1, 0), kOn, kNoKeys, "RPEM_COMMAND", 0).result, CommandResult::kRejectedUnknown);
-  for (const auto& [psi, rs] : {std::pair{0.4, 2.0}, {1.8, 2.0}, {1.0, 0.9}, {1.0, 4.6}, {std::nan(""), 2.0},
-                               {1.0, INFINITY}, {-1.0, 2.0}}) {
+  for (const auto& [psi, rs] :
+       {std::pair{0.4, 2.0}, {1.8, 2.0}, {1.0, 0.9}, {1.0, 4.6}, {std::nan(""), 2.0}, {1.0, INFINITY}, {-1.0, 2.0}}) {
     const CommandVerdict v = admit_command(encode(1, rpem::command_t::SET_VALUES, psi, rs), kOn, kNoKeys, "RPEM_COMMAND", 0);
     EXPECT_TRUE(v.decoded);
     EXPECT_EQ(v.result, CommandResult::kRejectedBadValues) << psi << " " << rs;
   }
   // D_M's edges are inside.
-  EXPECT_EQ(admit_command(encode(1, rpem::command_t::SET_VALUES, 0.5, 4.5), kOn, kNoKeys, "RPEM_COMMAND", 0).result, CommandResult::kApplied);
+  EXPECT_EQ(admit_command(encode(1, rpem::command_t::SET_VALUES, 0.5, 4.5), kOn, kNoKeys, "RPEM_COMMAND", 0).result,
+            CommandResult::kApplied);
 }
 
 TEST(AdmitCommand, AnythingButExactlyOneCommandIsMalformed) {
@@ -72,8 +79,8 @@ TEST(AdmitCommand, AnythingButExactlyOneCommandIsMalformed) {
   std::vector<std::uint8_t> other_type(good);
   other_type[0] ^= 1;  // the fingerprint
   const std::uint8_t text[] = "this is not an rpem command_t";
-  for (const auto& bytes : {truncated, trailing, other_type, std::vector<std::uint8_t>(text, text + sizeof text),
-                            std::vector<std::uint8_t>{}}) {
+  for (const auto& bytes :
+       {truncated, trailing, other_type, std::vector<std::uint8_t>(text, text + sizeof text), std::vector<std::uint8_t>{}}) {
     const CommandVerdict v = admit_command(bytes, kOn, kNoKeys, "RPEM_COMMAND", 0);
     EXPECT_FALSE(v.decoded);
     EXPECT_EQ(v.result, CommandResult::kNone);

@@ -89,8 +89,8 @@ TEST(DaemonConfig, AThermalSectionInlineOrInItsOwnFileRunsTheFusion) {
   EXPECT_DOUBLE_EQ(c.live.thermal.coolant_C, 35.0);
   // The file `rpem thermal fit` wrote, named relative to the configuration.
   test::TempFile own("thermal_own.yaml", section);
-  test::TempFile named("thermal_named.yaml",
-                       machine + "daemon:\n  thermal_config: " + std::filesystem::path(own.path()).filename().string() + "\n");
+  test::TempFile named("thermal_named.yaml", machine + "daemon:\n  thermal_config: " +
+                                                 std::filesystem::path(own.path()).filename().string() + "\n");
   const DaemonConfig d = load_daemon_config(named.path());
   ASSERT_TRUE(d.live.thermal_active);
   EXPECT_DOUBLE_EQ(d.live.thermal.filter.network.capacitance_J_per_K[1], 7000.0);
@@ -102,8 +102,9 @@ TEST(DaemonConfig, AThermalSectionInlineOrInItsOwnFileRunsTheFusion) {
 }
 
 TEST(DaemonConfig, SourcesComeFromTheCatalogueAndOnlyTheChosenOneIsKept) {
-  const test::TempFile f("both.yaml",
-                         "daemon:\n  source: {type: can, can: {interface: vcan3}, sim: {scenario: builtin:rpemd-demo, loop: false}}\n");
+  const test::TempFile f(
+      "both.yaml",
+      "daemon:\n  source: {type: can, can: {interface: vcan3}, sim: {scenario: builtin:rpemd-demo, loop: false}}\n");
   const DaemonConfig c = load_daemon_config(f.path());
   ASSERT_TRUE(std::holds_alternative<CanSource::Options>(c.fixed.source));
   EXPECT_EQ(std::get<CanSource::Options>(c.fixed.source).interface, "vcan3");
@@ -150,16 +151,19 @@ TEST_P(BadDaemonConfig, IsRejectedWithFileLineAndField) {
 
 INSTANTIATE_TEST_SUITE_P(
     Cases, BadDaemonConfig,
-    ::testing::Values(
-        Bad{"unknown", "daemon: {sauce: {type: can}}\n", ":1:10: daemon.sauce: unknown key"},
-        Bad{"source_type", "daemon:\n  source: {type: serial}\n", "daemon.source.type: 'serial' is not one of: sim, can"},
-        Bad{"priority", "daemon:\n  loop: {thread: {policy: fifo, priority: 120}}\n", "daemon.loop.thread.priority: 120 is outside [1, 99]"},
-        Bad{"period", "daemon:\n  loop: {period_s: 5}\n", "daemon.loop.period_s: 5 is outside"},
-        Bad{"wake_ahead", "daemon:\n  loop: {period_s: 1.0e-3, wake_ahead_s: 6.0e-4}\n",
-            "daemon.loop.wake_ahead_s: 6.0e-4 is outside [0, 0.0005]"},
-        Bad{"both_machines", "daemon: {machine_config: a.yaml}\nmachine: {}\n", "give the machine inline or daemon.machine_config"},
-        Bad{"iface", "daemon:\n  source: {type: can, can: {interface: ''}}\n", "not an interface name"},
-        Bad{"coefficient_sign", "daemon:\n  temperature: {psi_m_coeff_per_K: 0.001}\n", "psi_m_coeff_per_K: 0.001 is outside"}),
+    ::testing::Values(Bad{"unknown", "daemon: {sauce: {type: can}}\n", ":1:10: daemon.sauce: unknown key"},
+                      Bad{"source_type", "daemon:\n  source: {type: serial}\n",
+                          "daemon.source.type: 'serial' is not one of: sim, can"},
+                      Bad{"priority", "daemon:\n  loop: {thread: {policy: fifo, priority: 120}}\n",
+                          "daemon.loop.thread.priority: 120 is outside [1, 99]"},
+                      Bad{"period", "daemon:\n  loop: {period_s: 5}\n", "daemon.loop.period_s: 5 is outside"},
+                      Bad{"wake_ahead", "daemon:\n  loop: {period_s: 1.0e-3, wake_ahead_s: 6.0e-4}\n",
+                          "daemon.loop.wake_ahead_s: 6.0e-4 is outside [0, 0.0005]"},
+                      Bad{"both_machines", "daemon: {machine_config: a.yaml}\nmachine: {}\n",
+                          "give the machine inline or daemon.machine_config"},
+                      Bad{"iface", "daemon:\n  source: {type: can, can: {interface: ''}}\n", "not an interface name"},
+                      Bad{"coefficient_sign", "daemon:\n  temperature: {psi_m_coeff_per_K: 0.001}\n",
+                          "psi_m_coeff_per_K: 0.001 is outside"}),
     [](const auto& p) { return std::string(p.param.name); });
 
 }  // namespace

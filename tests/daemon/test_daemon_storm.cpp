@@ -40,8 +40,8 @@ namespace {
 namespace fs = std::filesystem;
 using namespace std::chrono_literals;
 
-constexpr int kRounds = 300;            // × 10 ms
-constexpr int kCommandsPerRound = 10;   // 1 kHz
+constexpr int kRounds = 300;           // × 10 ms
+constexpr int kCommandsPerRound = 10;  // 1 kHz
 const std::string kUrl = "udpm://239.255.76.67:7817?ttl=0";
 
 /// rpemd as a child process, its output in a file.
@@ -109,8 +109,8 @@ void write_atomically(const std::string& path, const std::string& text) {
 }
 
 std::string daemon_section(const std::string& dir, const std::string& machine, const char* extra) {
-  return "daemon:\n  machine_config: " + machine + "\n  commands: {enabled: true, authentication: none}\n  lcm: {url: \"" + kUrl +
-         "\"}\n  state: {file: " + dir + "/state.json, write_interval_s: 0.1}\n  status_interval_s: 0\n" + extra;
+  return "daemon:\n  machine_config: " + machine + "\n  commands: {enabled: true, authentication: none}\n  lcm: {url: \"" +
+         kUrl + "\"}\n  state: {file: " + dir + "/state.json, write_interval_s: 0.1}\n  status_interval_s: 0\n" + extra;
 }
 
 /// "N overruns in M periods" from rpemd's summary at exit.
@@ -133,9 +133,12 @@ TEST(DaemonStorm, CommandsAndReloadsUnderContentionKeepOneOrder) {
   const std::string d = dir.string();
   // Two machine files: the paper's, and one whose D_M admits r_s up to 6 Ω.
   const std::string paper = test::read_file(test::source_dir() + "/config/paper-ipmsm.yaml");
-  std::ofstream(d + "/wide.yaml") << std::regex_replace(paper, std::regex(R"(r_s_Ohm: \[1\.0, 4\.5\])"), "r_s_Ohm: [1.0, 6.0]");
-  const std::string a = daemon_section(d, test::source_dir() + "/config/paper-ipmsm.yaml", "  temperature: {reference_C: 20}\n");
-  const std::string b = daemon_section(d, d + "/wide.yaml", "  temperature: {reference_C: 25}\n  validity: {max_hold_s: 10}\n");
+  std::ofstream(d + "/wide.yaml") << std::regex_replace(paper, std::regex(R"(r_s_Ohm: \[1\.0, 4\.5\])"),
+                                                        "r_s_Ohm: [1.0, 6.0]");
+  const std::string a =
+      daemon_section(d, test::source_dir() + "/config/paper-ipmsm.yaml", "  temperature: {reference_C: 20}\n");
+  const std::string b =
+      daemon_section(d, d + "/wide.yaml", "  temperature: {reference_C: 25}\n  validity: {max_hold_s: 10}\n");
   const std::string invalid = a + "  sauce: 1\n";
   const std::string restart = a + "  stale_timeout_s: 0.2\n";
   const std::string config = d + "/rpemd.yaml";
@@ -167,7 +170,8 @@ TEST(DaemonStorm, CommandsAndReloadsUnderContentionKeepOneOrder) {
     ++sent;
   };
   Rpemd rpemd(config, d + "/storm.log");
-  ASSERT_TRUE(listener.wait_for([](const diagnostics_t& m) { return m.state == 1; }, 20s)) << test::read_file(d + "/storm.log");
+  ASSERT_TRUE(listener.wait_for([](const diagnostics_t& m) { return m.state == 1; }, 20s))
+      << test::read_file(d + "/storm.log");
   const std::string variants[] = {a, b, a, b, invalid, b, a, restart};
   for (int round = 0; round < kRounds; ++round) {
     write_atomically(config, variants[round % 8]);
@@ -175,13 +179,28 @@ TEST(DaemonStorm, CommandsAndReloadsUnderContentionKeepOneOrder) {
     ++hups;
     for (int k = 0; k < kCommandsPerRound; ++k) {
       switch ((round * kCommandsPerRound + k) % 10) {
-        case 0: send(command_t::FREEZE); break;
-        case 1: send(command_t::UNFREEZE); break;
-        case 2: send(command_t::SET_VALUES, 1.10, 2.40); break;
-        case 3: send(command_t::SET_VALUES, 1.10, 5.00); break;  // inside D_M only while b runs
-        case 4: send(command_t::RESET); break;
-        case 5: send(command_t::SET_VALUES, 1.12, 2.30); break;
-        case 6: send(command_t::UNFREEZE, 0.0, 0.0, seq); ++stale; break;  // its number again: stale
+        case 0:
+          send(command_t::FREEZE);
+          break;
+        case 1:
+          send(command_t::UNFREEZE);
+          break;
+        case 2:
+          send(command_t::SET_VALUES, 1.10, 2.40);
+          break;
+        case 3:
+          send(command_t::SET_VALUES, 1.10, 5.00);
+          break;  // inside D_M only while b runs
+        case 4:
+          send(command_t::RESET);
+          break;
+        case 5:
+          send(command_t::SET_VALUES, 1.12, 2.30);
+          break;
+        case 6:
+          send(command_t::UNFREEZE, 0.0, 0.0, seq);
+          ++stale;
+          break;  // its number again: stale
         case 7: {
           const char text[] = "not a command";
           ASSERT_EQ(sender.publish("RPEM_COMMAND", text, sizeof text), 0);
@@ -189,7 +208,9 @@ TEST(DaemonStorm, CommandsAndReloadsUnderContentionKeepOneOrder) {
           ++junk;
           break;
         }
-        default: send(command_t::UNFREEZE); break;
+        default:
+          send(command_t::UNFREEZE);
+          break;
       }
       std::this_thread::sleep_for(1ms);
     }
@@ -207,8 +228,8 @@ TEST(DaemonStorm, CommandsAndReloadsUnderContentionKeepOneOrder) {
       [&](const diagnostics_t& m) {
         return m.last_command_seq == last &&
                m.commands_applied == m.commands_received - m.commands_malformed - m.commands_rejected &&
-               m.config_reload_requests == m.config_reloads + m.config_reloads_invalid +
-                                               m.config_reloads_restart_required + m.config_reloads_busy;
+               m.config_reload_requests ==
+                   m.config_reloads + m.config_reloads_invalid + m.config_reloads_restart_required + m.config_reloads_busy;
       },
       30s);
   std::this_thread::sleep_for(300ms);

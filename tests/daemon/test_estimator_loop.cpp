@@ -129,7 +129,7 @@ TEST(EstimatorLoop, HeldValuesSayHowOldTheyAreAndLapseAfterMaxHold) {
   EstimateReport e = rig.last_estimate();
   EXPECT_TRUE(e.r_s_adapting);
   EXPECT_TRUE(e.r_s_valid);
-  EXPECT_NEAR(e.r_s_age_s, 0.0, 1e-3);  // adapted in this period
+  EXPECT_NEAR(e.r_s_age_s, 0.0, 1e-3);    // adapted in this period
   EXPECT_DOUBLE_EQ(e.psi_m_age_s, -1.0);  // ψm has never adapted: the configured initial value
   EXPECT_FALSE(e.psi_m_valid);
 
@@ -184,7 +184,7 @@ TEST(EstimatorLoop, SeededValuesCarryTheirAgeFromTheStateFile) {
   EXPECT_NEAR(e.r_s_age_s, 5.001, 1e-9);
   EXPECT_TRUE(e.r_s_valid);  // identified before the restart, 5 s old
   EXPECT_NEAR(e.psi_m_age_s, 30.001, 1e-9);
-  EXPECT_FALSE(e.psi_m_valid);  // older than max_hold_s (20 s)
+  EXPECT_FALSE(e.psi_m_valid);    // older than max_hold_s (20 s)
   EXPECT_TRUE(e.has_good_psi_m);  // still what the state file keeps until a better value comes
   EXPECT_NEAR(e.good_r_s_age_s, 5.001, 1e-9);
 }

@@ -66,7 +66,8 @@ long phase_path_allocations(const DaemonConfig& config, ThermalSeen& seen) {
   cmds[3].live = config.live;
   cmds[3].live.validity.max_hold_s = 1.0;
   cmds[4].kind = Command::Kind::kReset;
-  for (std::size_t k = 0; k < cmds.size(); ++k) cmds[k].seq = cmds[k].kind == Command::Kind::kReconfigure ? 0 : static_cast<std::int64_t>(k + 1);
+  for (std::size_t k = 0; k < cmds.size(); ++k)
+    cmds[k].seq = cmds[k].kind == Command::Kind::kReconfigure ? 0 : static_cast<std::int64_t>(k + 1);
 
   const long before = g_allocations.load();
   std::int64_t now = 1'000'000'000;
@@ -106,8 +107,8 @@ TEST(LoopAllocations, NoneWithTheThermalFilter) {
   config.live.thermal_active = true;
   ThermalSeen seen;
   EXPECT_EQ(phase_path_allocations(config, seen), 0);
-  EXPECT_GT(seen.active, 100);   // 10 Hz estimates over 20 s, the first after the filter's first step
-  EXPECT_GT(seen.observed, 0);   // corrected by ψ̂m or r̂s at least once at a report
+  EXPECT_GT(seen.active, 100);  // 10 Hz estimates over 20 s, the first after the filter's first step
+  EXPECT_GT(seen.observed, 0);  // corrected by ψ̂m or r̂s at least once at a report
 }
 
 // The averaged path (source: vesc, rotor-frame signal maps): 20 s of windows at 1 kHz with jitter, a

@@ -89,7 +89,8 @@ TEST(LoopThermal, TheEstimateCsvNamesTheColumnsAsRpemListensCsv) {
   const std::vector<std::string> l = columns(listen), est = columns(estimate);
   for (const char* node : {"magnet", "winding"}) {
     const std::string n(node);
-    for (const std::string& c : {"t_" + n + "_fused_C", "t_" + n + "_fused_sd_C", "t_" + n + "_source", "t_" + n + "_observed_age_s"}) {
+    for (const std::string& c :
+         {"t_" + n + "_fused_C", "t_" + n + "_fused_sd_C", "t_" + n + "_source", "t_" + n + "_observed_age_s"}) {
       SCOPED_TRACE(c);
       EXPECT_NE(std::find(l.begin(), l.end(), c), l.end());
       EXPECT_NE(std::find(est.begin(), est.end(), c), est.end());

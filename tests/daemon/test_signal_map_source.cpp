@@ -27,9 +27,7 @@ can::CanFrame frame(std::uint32_t id, std::vector<std::uint8_t> bytes) {
   return f;
 }
 
-can::SignalMap shipped(const char* name) {
-  return io::load_signal_map(test::source_dir() + "/config/signal-maps/" + name);
-}
+can::SignalMap shipped(const char* name) { return io::load_signal_map(test::source_dir() + "/config/signal-maps/" + name); }
 
 // Beckhoff AX8000 TxPDOs (little endian): 1500 rpm (15 000 000 in 0.0001 rpm); i_d −2 A (REAL32 0xC0000000),
 // i_q 5 A (0x40A00000); u_d −3.5 V (0xC0600000), u_q 24 V (0x41C00000); u_dc 48000 mV (UINT32 0x0000BB80),
@@ -105,14 +103,16 @@ TEST(SignalMapSource, TheShippedConfigurationsLoadWithTheirSourcesKind) {
 
 // A map without voltages: refused when the configuration loads, naming the map and what it lacks.
 TEST(SignalMapSource, AMapWithoutANeededQuantityIsRefusedNamingFileAndQuantity) {
-  const test::TempFile map("no-voltage-map.yaml",
-                           "name: no-voltage\nsample: {trigger: 0x201, averaged: true}\nframes:\n"
-                           "  - id: 0x201\n    signals:\n"
-                           "      - {field: i_d, start_bit: 0, length: 16, byte_order: little_endian, signed: true, scale: 0.01, unit: A}\n"
-                           "      - {field: i_q, start_bit: 16, length: 16, byte_order: little_endian, signed: true, scale: 0.01, unit: A}\n"
-                           "      - {field: erpm, start_bit: 32, length: 32, byte_order: little_endian, signed: true, scale: 1, unit: rpm}\n");
-  const test::TempFile config("rpemd-no-voltage.yaml",
-                              "daemon:\n  source:\n    type: signal_map\n    signal_map: {interface: can0, map: " + map.path() + "}\n");
+  const test::TempFile map(
+      "no-voltage-map.yaml",
+      "name: no-voltage\nsample: {trigger: 0x201, averaged: true}\nframes:\n"
+      "  - id: 0x201\n    signals:\n"
+      "      - {field: i_d, start_bit: 0, length: 16, byte_order: little_endian, signed: true, scale: 0.01, unit: A}\n"
+      "      - {field: i_q, start_bit: 16, length: 16, byte_order: little_endian, signed: true, scale: 0.01, unit: A}\n"
+      "      - {field: erpm, start_bit: 32, length: 32, byte_order: little_endian, signed: true, scale: 1, unit: rpm}\n");
+  const test::TempFile config(
+      "rpemd-no-voltage.yaml",
+      "daemon:\n  source:\n    type: signal_map\n    signal_map: {interface: can0, map: " + map.path() + "}\n");
   try {
     (void)load_daemon_config(config.path());
     FAIL() << "loaded";
@@ -128,8 +128,9 @@ TEST(SignalMapSource, PerPhaseCurrentCorrectionsAreRefusedOnAnAveragedSource) {
   std::ifstream paper(test::source_dir() + "/config/paper-ipmsm.yaml");
   const std::string machine((std::istreambuf_iterator<char>(paper)), std::istreambuf_iterator<char>());
   const test::TempFile config("rpemd-vesc-offsets.yaml",
-                              machine + "model_extensions:\n  current_offset: [{phase: a, offset_A: 0.1}]\n"
-                                        "daemon:\n  source:\n    type: vesc\n    vesc: {interface: can0, controller_id: 3}\n");
+                              machine +
+                                  "model_extensions:\n  current_offset: [{phase: a, offset_A: 0.1}]\n"
+                                  "daemon:\n  source:\n    type: vesc\n    vesc: {interface: can0, controller_id: 3}\n");
   try {
     (void)load_daemon_config(config.path());
     FAIL() << "loaded";

@@ -50,9 +50,10 @@ TEST(StateFile, MissingTooOldImplausibleCorrupt) {
   e.written_unix_s = std::time(nullptr);
   ASSERT_EQ(write_state_file(odd.path(), e), "");
   EXPECT_EQ(load(odd.path()).status, StateFileStatus::kImplausible);
-  for (const char* text : {"{ not json", "[]", "{\"format\": \"rpemd-estimates-1\"}",
-                           "{\"format\": \"other\", \"psi_m_Wb\": 1.1, \"r_s_Ohm\": null, \"written_unix_s\": 0}",
-                           "{\"format\": \"rpemd-estimates-1\", \"psi_m_Wb\": \"x\", \"r_s_Ohm\": null, \"written_unix_s\": 1}"}) {
+  for (const char* text :
+       {"{ not json", "[]", "{\"format\": \"rpemd-estimates-1\"}",
+        "{\"format\": \"other\", \"psi_m_Wb\": 1.1, \"r_s_Ohm\": null, \"written_unix_s\": 0}",
+        "{\"format\": \"rpemd-estimates-1\", \"psi_m_Wb\": \"x\", \"r_s_Ohm\": null, \"written_unix_s\": 1}"}) {
     test::TempFile bad("bad.json", std::string(text));
     const LoadedState s = load(bad.path());
     EXPECT_EQ(s.status, StateFileStatus::kCorrupt) << text;

@@ -50,7 +50,8 @@ std::optional<core::AveragedSample> reply(VescPoller& p, std::int64_t t_ns) {
 }
 
 /// `frames` received 20 µs apart from `t_ns` after a poll sent 300 µs before: the sample they complete, if any.
-std::optional<core::AveragedSample> poll_and_receive(VescPoller& p, std::int64_t t_ns, const std::vector<can::CanFrame>& frames) {
+std::optional<core::AveragedSample> poll_and_receive(VescPoller& p, std::int64_t t_ns,
+                                                     const std::vector<can::CanFrame>& frames) {
   p.on_time(t_ns - 300'000);
   p.polled(t_ns - 300'000, true);
   core::AveragedSample s;
@@ -104,8 +105,8 @@ TEST(VescPoller, RepliesBecomeWindowsBetweenTheirReceiveTimes) {
   EXPECT_FALSE(poll_and_reply(p, kT0).has_value());  // the first reply only opens a window
   const auto s = poll_and_reply(p, kT0 + 5 * kMs);
   ASSERT_TRUE(s.has_value());
-  EXPECT_EQ(s->t_start_ns, kT0 + 300'000);           // the previous reply's first frame
-  EXPECT_EQ(s->t_ns, kT0 + 5 * kMs + 300'000);       // this reply's first frame
+  EXPECT_EQ(s->t_start_ns, kT0 + 300'000);      // the previous reply's first frame
+  EXPECT_EQ(s->t_ns, kT0 + 5 * kMs + 300'000);  // this reply's first frame
   EXPECT_FALSE(s->gap_before);
   EXPECT_DOUBLE_EQ(s->i_dq_A[0], -3.21);
   EXPECT_DOUBLE_EQ(s->i_dq_A[1], 27.45);
@@ -350,8 +351,10 @@ TEST(VescPoller, ABrokenReplyIsCountedAndItsPollTimesOut) {
 
 TEST(VescPoller, TheDefaultTimeoutLeavesTheReplyMostOfThePeriod) {
   for (double rate : {50.0, 200.0, 1000.0}) {
-    const test::TempFile config("rpemd-vesc-timeout.yaml", "daemon:\n  source:\n    type: vesc\n    vesc: {interface: can0, "
-                                                           "controller_id: 17, poll_rate_Hz: " + std::to_string(rate) + "}\n");
+    const test::TempFile config("rpemd-vesc-timeout.yaml",
+                                "daemon:\n  source:\n    type: vesc\n    vesc: {interface: can0, "
+                                "controller_id: 17, poll_rate_Hz: " +
+                                    std::to_string(rate) + "}\n");
     const DaemonConfig c = load_daemon_config(config.path());
     EXPECT_NEAR(std::get<VescSource::Options>(c.fixed.source).reply_timeout_s, std::min(0.9 / rate, 0.02), 1e-12) << rate;
   }

@@ -18,18 +18,18 @@ const PartLimits kMagnet{100.0, 140.0, 30.0, 4.0, 0.05};
 constexpr double kRated = 120.0;
 
 TEST(Derating, HandWorkedPointsOfTheLaw) {
-  EXPECT_DOUBLE_EQ(part_current_A(kMagnet, kRated, 20.0), 120.0);    // cold
-  EXPECT_DOUBLE_EQ(part_current_A(kMagnet, kRated, 100.0), 120.0);   // at W: still full
-  EXPECT_DOUBLE_EQ(part_current_A(kMagnet, kRated, 110.0), 97.5);    // 120 − 2.25·10
-  EXPECT_DOUBLE_EQ(part_current_A(kMagnet, kRated, 120.0), 75.0);    // half way: (120 + 30)/2
-  EXPECT_DOUBLE_EQ(part_current_A(kMagnet, kRated, 140.0), 30.0);    // at L: the floor
-  EXPECT_DOUBLE_EQ(part_current_A(kMagnet, kRated, 140.01), 0.0);    // above L: nothing
+  EXPECT_DOUBLE_EQ(part_current_A(kMagnet, kRated, 20.0), 120.0);         // cold
+  EXPECT_DOUBLE_EQ(part_current_A(kMagnet, kRated, 100.0), 120.0);        // at W: still full
+  EXPECT_DOUBLE_EQ(part_current_A(kMagnet, kRated, 110.0), 97.5);         // 120 − 2.25·10
+  EXPECT_DOUBLE_EQ(part_current_A(kMagnet, kRated, 120.0), 75.0);         // half way: (120 + 30)/2
+  EXPECT_DOUBLE_EQ(part_current_A(kMagnet, kRated, 140.0), 30.0);         // at L: the floor
+  EXPECT_DOUBLE_EQ(part_current_A(kMagnet, kRated, 140.01), 0.0);         // above L: nothing
   EXPECT_DOUBLE_EQ(part_current_A(kMagnet, kRated, std::nullopt), 30.0);  // unknown: taken to be at L
   EXPECT_DOUBLE_EQ(part_current_A(kMagnet, kRated, std::numeric_limits<double>::quiet_NaN()), 30.0);
   // A floor of zero: linear to nothing at L.
   PartLimits to_zero = kMagnet;
   to_zero.floor_A = 0.0;
-  EXPECT_DOUBLE_EQ(part_current_A(to_zero, kRated, 130.0), 30.0);    // 120·(1 − 30/40)
+  EXPECT_DOUBLE_EQ(part_current_A(to_zero, kRated, 130.0), 30.0);  // 120·(1 − 30/40)
   EXPECT_DOUBLE_EQ(part_current_A(to_zero, kRated, std::nullopt), 0.0);
 }
 

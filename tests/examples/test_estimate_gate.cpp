@@ -14,7 +14,7 @@ namespace rpem::supervisor {
 namespace {
 
 constexpr std::int64_t kT0 = 1'790'000'000'000'000;  // a utime in 2026 [µs]
-constexpr Freshness kFreshness{500'000, 50'000};      // 0.5 s, 0.05 s
+constexpr Freshness kFreshness{500'000, 50'000};     // 0.5 s, 0.05 s
 
 struct Gate : ::testing::Test {
   auth::Keyring keys;
@@ -51,9 +51,9 @@ TEST_F(Gate, RefusesWhatDoesNotVerify) {
     const Admission a = send(b, kT0);
     const bool in_key_id = bit / 8 >= genuine.size() - auth::kTrailerBytes && bit / 8 < genuine.size() - auth::kMacBytes;
     // In the key id (2): 0 is unsigned, any other id unknown.
-    const Admission expected = !in_key_id ? Admission::kBadMac : bit == 8 * (genuine.size() - auth::kMacBytes) - 7
-                                                                    ? Admission::kUnsigned
-                                                                    : Admission::kUnknownKey;
+    const Admission expected = !in_key_id                                          ? Admission::kBadMac
+                               : bit == 8 * (genuine.size() - auth::kMacBytes) - 7 ? Admission::kUnsigned
+                                                                                   : Admission::kUnknownKey;
     ASSERT_EQ(a, expected) << "bit " << bit;
   }
   EXPECT_EQ(gate.count(Admission::kAccepted), 0);

@@ -110,15 +110,18 @@ TEST_F(SupervisorTest, ForgedOrReplayedColdMagnetsNeverLiftTheLimit) {
   ASSERT_EQ(send(cold, kT0 + 1'000), Admission::kAccepted);
   EXPECT_EQ(supervisor.current_limit(kT0 + 2'000).current_A, 120.0);
   // Hot, then above the magnet's limit: nothing.
-  ASSERT_EQ(send(test::encode_signed(test::raw_estimate(kT0 + 100'000, 135.0, 90.0), &key), kT0 + 101'000), Admission::kAccepted);
+  ASSERT_EQ(send(test::encode_signed(test::raw_estimate(kT0 + 100'000, 135.0, 90.0), &key), kT0 + 101'000),
+            Admission::kAccepted);
   const double hot_A = supervisor.current_limit(kT0 + 102'000).current_A;
   EXPECT_EQ(hot_A, 0.0);  // T+ = 143 > L = 140
   const auth::Key guessed = test::test_key(2, 1);
-  EXPECT_EQ(send(test::encode_signed(test::raw_estimate(kT0 + 150'000, 25.0, 25.0), &guessed), kT0 + 151'000), Admission::kBadMac);
-  EXPECT_EQ(send(test::encode_signed(test::raw_estimate(kT0 + 150'000, 25.0, 25.0), nullptr), kT0 + 151'000), Admission::kUnsigned);
+  EXPECT_EQ(send(test::encode_signed(test::raw_estimate(kT0 + 150'000, 25.0, 25.0), &guessed), kT0 + 151'000),
+            Admission::kBadMac);
+  EXPECT_EQ(send(test::encode_signed(test::raw_estimate(kT0 + 150'000, 25.0, 25.0), nullptr), kT0 + 151'000),
+            Admission::kUnsigned);
   EXPECT_EQ(send(cold, kT0 + 152'000), Admission::kNotNewer);
   EXPECT_EQ(supervisor.current_limit(kT0 + 153'000).current_A, hot_A);
-  EXPECT_EQ(send(cold, kT0 + 3'600'000'000), Admission::kStale);  // an hour later
+  EXPECT_EQ(send(cold, kT0 + 3'600'000'000), Admission::kStale);             // an hour later
   EXPECT_EQ(supervisor.current_limit(kT0 + 3'600'000'000).current_A, 30.0);  // the floor, not 120 A
 }
 
@@ -149,11 +152,20 @@ TEST(SupervisorConfig, BadFilesAreRefusedNamingLineAndKey) {
     return "accepted";
   };
   const std::string good_tail = "  winding: " + part + "\n  freshness: {max_age_s: 0.5, max_skew_s: 0.05}\n";
-  EXPECT_NE(refused("supervisor:\n  rated_current_A: 120\n  magnet: {warning_C: 100, limit_C: 90, floor_A: 30, raw_sd_K: 4, max_rate_K_s: 0.05}\n" + good_tail)
-                .find(":3:"), std::string::npos);
-  EXPECT_NE(refused("supervisor:\n  rated_current_A: 120\n  magnet: {warning_C: 100, limit_C: 140, floor_A: 130, raw_sd_K: 4, max_rate_K_s: 0.05}\n" + good_tail)
-                .find("floor_A"), std::string::npos);
-  EXPECT_NE(refused("supervisor:\n  rated_current_A: 120\n  magnet: " + part + "\n  manget: " + part + "\n" + good_tail).find("manget"),
+  EXPECT_NE(
+      refused(
+          "supervisor:\n  rated_current_A: 120\n  magnet: {warning_C: 100, limit_C: 90, floor_A: 30, raw_sd_K: 4, max_rate_K_s: 0.05}\n" +
+          good_tail)
+          .find(":3:"),
+      std::string::npos);
+  EXPECT_NE(
+      refused(
+          "supervisor:\n  rated_current_A: 120\n  magnet: {warning_C: 100, limit_C: 140, floor_A: 130, raw_sd_K: 4, max_rate_K_s: 0.05}\n" +
+          good_tail)
+          .find("floor_A"),
+      std::string::npos);
+  EXPECT_NE(refused("supervisor:\n  rated_current_A: 120\n  magnet: " + part + "\n  manget: " + part + "\n" + good_tail)
+                .find("manget"),
             std::string::npos);
   EXPECT_NE(refused("supervisor:\n  rated_current_A: 120\n" + good_tail).find("magnet"), std::string::npos);
 }

@@ -117,7 +117,7 @@ TEST(SupervisorLcm, DeratesOnVerifiedEstimatesFromRpemdAndTheAuthLibraryAndIgnor
   resend(eve.captured[10]);  // the second of the 150 °C ones, within the freshness window
   resend(eve.captured[0]);   // the cold magnet, 1.2 s ago
   std::this_thread::sleep_for(std::chrono::milliseconds(1000));
-  resend(eve.captured[0]);   // and again, later still
+  resend(eve.captured[0]);  // and again, later still
   std::this_thread::sleep_for(std::chrono::milliseconds(300));
   EXPECT_EQ(supervisor.stop(), -1);  // killed by SIGTERM: it runs until told
 
@@ -159,7 +159,8 @@ TEST(SupervisorLcm, DeratesOnVerifiedEstimatesFromRpemdAndTheAuthLibraryAndIgnor
   // the supervisor said when it fell to the floor.
   bool fell_to_floor = false;
   std::size_t first_hot = from_rpemd;
-  while (first_hot < lines.size() && !(lines[first_hot].what == "accepted" && lines[first_hot].utime == sent_utimes[9])) ++first_hot;
+  while (first_hot < lines.size() && !(lines[first_hot].what == "accepted" && lines[first_hot].utime == sent_utimes[9]))
+    ++first_hot;
   ASSERT_LT(first_hot, lines.size()) << out;
   for (std::size_t k = first_hot; k < lines.size(); ++k) {
     EXPECT_TRUE(lines[k].current_A == 0.0 || lines[k].current_A == 30.0) << k << "\n" << out;

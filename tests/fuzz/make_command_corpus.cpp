@@ -25,8 +25,8 @@ std::vector<std::uint8_t> encode(std::int64_t seq, std::int8_t command, double p
   return bytes;
 }
 
-void write(const std::string& path, std::uint8_t flags, std::int64_t last, const std::vector<std::vector<std::uint8_t>>& messages,
-           std::uint8_t auth = 0) {
+void write(const std::string& path, std::uint8_t flags, std::int64_t last,
+           const std::vector<std::vector<std::uint8_t>>& messages, std::uint8_t auth = 0) {
   std::ofstream out(path, std::ios::binary);
   out.put(static_cast<char>(flags));
   out.put(static_cast<char>(auth));

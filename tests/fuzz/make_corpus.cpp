@@ -13,8 +13,8 @@ using namespace rpem;
 void write(const std::string& path, const std::vector<can::CanFrame>& frames) {
   std::ofstream out(path, std::ios::binary);
   for (const auto& f : frames) {
-    const char head[4] = {static_cast<char>(f.id & 0xFF), static_cast<char>(f.id >> 8), static_cast<char>((f.fd ? 1 : 0) | 4),
-                          static_cast<char>(f.len)};
+    const char head[4] = {static_cast<char>(f.id & 0xFF), static_cast<char>(f.id >> 8),
+                          static_cast<char>((f.fd ? 1 : 0) | 4), static_cast<char>(f.len)};
     out.write(head, 4);
     out.write(reinterpret_cast<const char*>(f.data.data()), f.len);
   }

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Builds one libFuzzer target with clang and runs it from its committed seed corpus for a time budget (and
 # any further libFuzzer options, e.g. -runs=10000000, or more corpus directories). ctest runs each target
-# for 60 s (label fuzz); docs/benchmarks.md ("Fuzzing") records the long runs.
+# for 30 s (label fuzz); docs/benchmarks.md ("Fuzzing") records the long runs.
 #   [RPEM_FUZZ_SANITIZERS=asan+ub|ub+leak] run_fuzz.sh BUILD_DIR TARGET [SECONDS] [libFuzzer options...]
 # RPEM_FUZZ_SANITIZERS:
 #   asan+ub  (default) AddressSanitizer + UndefinedBehaviorSanitizer (UB aborts), LeakSanitizer on;

@@ -45,7 +45,8 @@ TEST(DriveLog, ReadsAbcLogWithExtraAndOptionalColumns) {
 }
 
 TEST(DriveLog, ReadsDqOnlyLog) {
-  test::TempFile f("log.csv", "t,theta_el,omega_el,u_dc,u_d,u_q,i_d,i_q\n1,0,100,300,-20,80,-1,3\n2,0,100,300,-20,80,-1,3\n");
+  test::TempFile f("log.csv",
+                   "t,theta_el,omega_el,u_dc,u_d,u_q,i_d,i_q\n1,0,100,300,-20,80,-1,3\n2,0,100,300,-20,80,-1,3\n");
   DriveLogReader r(f.path());
   EXPECT_FALSE(r.layout().voltage_abc);
   EXPECT_TRUE(r.layout().current_dq);
@@ -57,7 +58,8 @@ TEST(DriveLog, ReadsDqOnlyLog) {
 }
 
 TEST(DriveLog, RotorFrameOnlyLogMayOmitAngleAndDcLink) {
-  test::TempFile f("log.csv", "t,omega_el,u_d,u_q,i_d,i_q,T_magnet\n0,2300,-125,37,-194,66,52\n2.5,2300,-126,35,-195,66,53\n");
+  test::TempFile f("log.csv",
+                   "t,omega_el,u_d,u_q,i_d,i_q,T_magnet\n0,2300,-125,37,-194,66,52\n2.5,2300,-126,35,-195,66,53\n");
   DriveLogReader r(f.path());
   EXPECT_FALSE(r.layout().angle);
   EXPECT_FALSE(r.layout().u_dc);
@@ -119,7 +121,8 @@ INSTANTIATE_TEST_SUITE_P(
         BadCase{"angle", kHeader + "0,1e12,0,220,1,2,3,0,0,0\n", ":2:2: column theta_el: 1e+12 rad is beyond"},
         BadCase{"time_beyond_int64_ns", kHeader + "1e10,0,0,220,1,2,3,0,0,0\n", ":2:1: column t: 1e+10 s is beyond"},
         BadCase{"dq_voltage", "t,omega_el,u_d,u_q,i_d,i_q\n0,0,1,-1e20,0,0\n", ":2:4: column u_q: -1e+20 V is beyond"},
-        BadCase{"dq_current_also_given", "t,theta_el,omega_el,u_dc,u_a,u_b,u_c,i_a,i_b,i_c,i_d,i_q\n0,0,0,220,1,2,3,0,0,0,0,1e6\n",
+        BadCase{"dq_current_also_given",
+                "t,theta_el,omega_el,u_dc,u_a,u_b,u_c,i_a,i_b,i_c,i_d,i_q\n0,0,0,220,1,2,3,0,0,0,0,1e6\n",
                 ":2:12: column i_q: 1e+06 A is beyond"},
         BadCase{"temperature_below_absolute_zero", "t,omega_el,u_d,u_q,i_d,i_q,T_magnet\n0,0,1,1,0,0,-300\n",
                 ":2:7: column T_magnet: -300 °C is outside the plausible [-273.15, 1000] °C"},
@@ -131,10 +134,11 @@ INSTANTIATE_TEST_SUITE_P(
 
 TEST(DriveLog, ValuesAtTheLimitsAreAccepted) {
   // Just inside every bound; a command of 2·u_dc where u_dc < 1 V is not held to the DC link.
-  test::TempFile f("log.csv", "t,theta_el,omega_el,u_dc,u_a,u_b,u_c,i_a,i_b,i_c,T_winding,torque_cmd\n"
-                              "-9e9,-1e9,1e6,100000,1e5,-1e5,0,1e5,-1e5,0,-273.15,-1e7\n"
-                              "0,0,0,0.5,200,0,0,0,0,0,1000,0\n"
-                              "1,0,0,220,440,-440,0,0,0,0,25,0\n");
+  test::TempFile f("log.csv",
+                   "t,theta_el,omega_el,u_dc,u_a,u_b,u_c,i_a,i_b,i_c,T_winding,torque_cmd\n"
+                   "-9e9,-1e9,1e6,100000,1e5,-1e5,0,1e5,-1e5,0,-273.15,-1e7\n"
+                   "0,0,0,0.5,200,0,0,0,0,0,1000,0\n"
+                   "1,0,0,220,440,-440,0,0,0,0,25,0\n");
   EXPECT_EQ(read_drive_log(f.path()).size(), 3U);
 }
 
@@ -178,9 +182,7 @@ TEST(DriveLog, ReadsFromAStreamUnderAGivenName) {
   }
 }
 
-TEST(DriveLog, MissingFileIsReported) {
-  EXPECT_THROW((void)read_drive_log("/nonexistent/rpem.csv"), DriveLogError);
-}
+TEST(DriveLog, MissingFileIsReported) { EXPECT_THROW((void)read_drive_log("/nonexistent/rpem.csv"), DriveLogError); }
 
 TEST(DriveLog, WriteThenReadIsBitExact) {
   std::mt19937_64 rng(test::test_seed(31));

@@ -51,10 +51,11 @@ TEST(LogMap, TheMinimalMapReads) {
 // is what the reader rebuilds window means with (docs/derivations.md §13, "Speed at the read"); only a speed,
 // and only where each row's window ends at its read.
 TEST(LogMap, APllSpeedIsASpeedAtTheReadsOfPreviousRowWindows) {
-  const std::string head = "samples: averaged\nwindow: previous_row\ntime: {column: t, unit: ms}\ncolumns:\n"
-                           "  u_d: {column: ud}\n  u_q: {column: uq}\n  i_q: {column: iq}\n";
-  const LogMap m = parse_log_map(head + "  i_d: {column: id}\n  omega_el: {column: w, unit: erpm, pll: {kp: 2000, ki: 30000}}\n",
-                                 "map.yaml");
+  const std::string head =
+      "samples: averaged\nwindow: previous_row\ntime: {column: t, unit: ms}\ncolumns:\n"
+      "  u_d: {column: ud}\n  u_q: {column: uq}\n  i_q: {column: iq}\n";
+  const LogMap m = parse_log_map(
+      head + "  i_d: {column: id}\n  omega_el: {column: w, unit: erpm, pll: {kp: 2000, ki: 30000}}\n", "map.yaml");
   EXPECT_DOUBLE_EQ(m.speed_lag_s, 2000.0 / 30000.0);
   EXPECT_EQ(parse_log_map(head + "  i_d: {column: id}\n  omega_el: {column: w}\n", "map.yaml").speed_lag_s, 0.0);
   EXPECT_DOUBLE_EQ(vesc_tool_log_map().speed_lag_s, 2000.0 / 30000.0);  // the firmware's defaults
@@ -111,8 +112,7 @@ INSTANTIATE_TEST_SUITE_P(
                "  u_d: {column: ud}\n  u_q: {column: uq}\n  i_d: {column: id}\n  i_q: {column: iq}\n  i_a: {column: ia}\n",
                "5:3: columns: i_a: not a quantity of averaged samples (their means are rotor-frame: i_d, i_q, u_d, u_q, "
                "omega_el, u_dc, T_winding, T_magnet, T_drive) in an averaged log, which this map gives"},
-        BadMap{"averaged_without_window",
-               "samples: averaged\ntime: {period_s: 1}\ncolumns: {omega_el: {column: w}}\n",
+        BadMap{"averaged_without_window", "samples: averaged\ntime: {period_s: 1}\ncolumns: {omega_el: {column: w}}\n",
                "1:1: window: required key is missing"},
         BadMap{"window_t_start_without_column",
                "samples: averaged\nwindow: t_start\ntime: {column: t}\ncolumns:\n  omega_el: {column: w}\n"
@@ -180,8 +180,9 @@ std::string data_error(const std::string& map_yaml, const std::string& csv) {
 }
 
 TEST(LogMap, DataErrorsNameTheFilesColumnAndTheQuantity) {
-  EXPECT_NE(data_error(kMinimal, "time,w,ud,uq,id\n").find("log.csv:1: column iq (i_q): is missing from the header (the "
-                                                           "map "),
+  EXPECT_NE(data_error(kMinimal, "time,w,ud,uq,id\n")
+                .find("log.csv:1: column iq (i_q): is missing from the header (the "
+                      "map "),
             std::string::npos);
   EXPECT_NE(data_error(kMinimal, "time,w,ud,uq,id,iq\n0,1,2,3,4,5\n1,1,2,3,4,5e6\n")
                 .find("log.csv:3:6: column iq (i_q): 5e+06 A is beyond the plausible ±100000 A"),
@@ -189,14 +190,17 @@ TEST(LogMap, DataErrorsNameTheFilesColumnAndTheQuantity) {
   const std::string headerless =
       "header: false\nseparator: \"\\t\"\nsamples: instantaneous\ntime: {period_s: 0.1}\ncolumns:\n"
       "  omega_el: {column: 1}\n  u_d: {column: 2}\n  u_q: {column: 3}\n  i_d: {column: 4}\n  i_q: {column: 9}\n";
-  EXPECT_NE(data_error(headerless, "1\t2\t3\t4\t5\n").find("log.csv:1:9: column 9 (i_q): the map reads cell 9, the row has 5 cells"),
+  EXPECT_NE(data_error(headerless, "1\t2\t3\t4\t5\n")
+                .find("log.csv:1:9: column 9 (i_q): the map reads cell 9, the row has 5 cells"),
             std::string::npos)
       << data_error(headerless, "1\t2\t3\t4\t5\n");
-  const std::string wide = "header: false\nseparator: \"\\t\"\nsamples: instantaneous\ntime: {period_s: 0.1}\ncolumns:\n"
-                           "  omega_el: {column: 1}\n  u_d: {column: 2}\n  u_q: {column: 3}\n  i_d: {column: 4}\n"
-                           "  i_q: {column: 5}\n";
-  EXPECT_NE(data_error(wide, "1\t2\t3\t4\t5\n1\t2\t3\t4\n").find("log.csv:2: column *: row has 4 cells, the first row has 5"),
-            std::string::npos);
+  const std::string wide =
+      "header: false\nseparator: \"\\t\"\nsamples: instantaneous\ntime: {period_s: 0.1}\ncolumns:\n"
+      "  omega_el: {column: 1}\n  u_d: {column: 2}\n  u_q: {column: 3}\n  i_d: {column: 4}\n"
+      "  i_q: {column: 5}\n";
+  EXPECT_NE(
+      data_error(wide, "1\t2\t3\t4\t5\n1\t2\t3\t4\n").find("log.csv:2: column *: row has 4 cells, the first row has 5"),
+      std::string::npos);
 }
 
 TEST(LogMap, EqualStampsAreAnErrorWithoutAResolution) {
@@ -216,8 +220,8 @@ TEST(LogMapExamples, PaderbornAsPublishedEqualsTheConversionScript) {
   // module, its own arithmetic): the same rows.
   const std::string data = source_dir() + "/data/paderborn-motor-temperature/profile_A_every5th.csv";
   test::TempFile converted("converted.csv");
-  ASSERT_EQ(std::system(("python3 " + source_dir() + "/scripts/paderborn_to_drive_log.py " + data + " " +
-                         converted.path() + " --pole-pairs 4 --sample-period-s 2.5")
+  ASSERT_EQ(std::system(("python3 " + source_dir() + "/scripts/paderborn_to_drive_log.py " + data + " " + converted.path() +
+                         " --pole-pairs 4 --sample-period-s 2.5")
                             .c_str()),
             0);
   const auto expected = read_drive_log(converted.path());

@@ -21,8 +21,8 @@ std::string paper_text() {
 
 /// Replaces the first match of `pattern` in the paper config and returns the loader's message.
 std::string error_after_edit(const std::string& pattern, const std::string& replacement) {
-  const std::string text = std::regex_replace(paper_text(), std::regex(pattern), replacement,
-                                              std::regex_constants::format_first_only);
+  const std::string text =
+      std::regex_replace(paper_text(), std::regex(pattern), replacement, std::regex_constants::format_first_only);
   EXPECT_NE(text, paper_text()) << "pattern did not match: " << pattern;
   test::TempFile f("cfg.yaml", text);
   try {
@@ -99,30 +99,36 @@ INSTANTIATE_TEST_SUITE_P(
     ::testing::Values(
         BadEdit{"unknown_top", "\nmachine:", "\nmachnie_typo: 1\nmachine:", ":3:1: machnie_typo: unknown key"},
         BadEdit{"unknown_nested", "r_s_Ohm: 2.25", "r_s_Ohm: 2.25\n  r_s_ohm: 2.25", "machine.r_s_ohm: unknown key"},
-        BadEdit{"out_of_range_gain", "gain: 3.25e-4", "gain: 3.25", "estimator.gains.sga.psi_m.gain: 3.25 is outside [0, 1]"},
+        BadEdit{"out_of_range_gain", "gain: 3.25e-4", "gain: 3.25",
+                "estimator.gains.sga.psi_m.gain: 3.25 is outside [0, 1]"},
         BadEdit{"negative_resistance", "r_s_Ohm: 2.25", "r_s_Ohm: -2.25", "machine.r_s_Ohm: -2.25 is outside"},
         BadEdit{"not_a_number", "l_d_H: 0.0953", "l_d_H: small", "machine.l_d_H: 'small' is not a number"},
-        BadEdit{"bad_choice", "algorithm: sga", "algorithm: kalman", "estimator.algorithm: 'kalman' is not one of: sga, gna, phyint"},
+        BadEdit{"bad_choice", "algorithm: sga", "algorithm: kalman",
+                "estimator.algorithm: 'kalman' is not one of: sga, gna, phyint"},
         BadEdit{"missing", "    pole_pairs: 3 .*\n", "", "machine.rated.pole_pairs: required key is missing"},
         BadEdit{"fractional_pole_pairs", "pole_pairs: 3", "pole_pairs: 3.5", "'3.5' is not an integer"},
         BadEdit{"reversed_bounds", "psi_m_Wb: \\[0.57, 1.71\\]", "psi_m_Wb: [1.71, 0.57]", "min < max"},
-        BadEdit{"initial_outside_bounds", "initial: \\{psi_m_Wb: 1.14", "initial: {psi_m_Wb: 2.0", "estimator.initial.psi_m_Wb: 2.0 is outside [0.57, 1.71]"},
+        BadEdit{"initial_outside_bounds", "initial: \\{psi_m_Wb: 1.14", "initial: {psi_m_Wb: 2.0",
+                "estimator.initial.psi_m_Wb: 2.0 is outside [0.57, 1.71]"},
         // Found by fuzz_machine_config: without estimator.initial the start is the machine's value, which D_M must hold.
         BadEdit{"default_start_outside_bounds",
                 "  initial: \\{psi_m_Wb: 1.14, r_s_Ohm: 2.25\\}\n(.*\n    psi_m_Wb: )\\[0.57", "$1[1.57",
                 "estimator.bounds.psi_m_Wb: excludes the estimator's start, machine.psi_m_Wb = 1.14"},
         BadEdit{"partial_initial_default_outside_bounds",
-                "initial: \\{psi_m_Wb: 1.14, r_s_Ohm: 2.25\\}(\n.*\n.*\n    r_s_Ohm: )\\[1.0", "initial: {psi_m_Wb: 1.14}$1[2.5",
+                "initial: \\{psi_m_Wb: 1.14, r_s_Ohm: 2.25\\}(\n.*\n.*\n    r_s_Ohm: )\\[1.0",
+                "initial: {psi_m_Wb: 1.14}$1[2.5",
                 "estimator.bounds.r_s_Ohm: excludes the estimator's start, machine.r_s_Ohm = 2.25"},
         // Found by fuzz_machine_config: a complex key escaped the reader as a yaml-cpp exception.
         BadEdit{"complex_key", "\n  sample_period_s:", "\n  ? [a, b]\n  : 1\n  sample_period_s:",
                 "estimator: a key must be a name, not a list or mapping"},
-        BadEdit{"scheduler_order", "r_s_max_speed_rpm: 10 ", "r_s_max_speed_rpm: 200 ", "must not exceed psi_m_min_speed_rpm"},
+        BadEdit{"scheduler_order", "r_s_max_speed_rpm: 10 ", "r_s_max_speed_rpm: 200 ",
+                "must not exceed psi_m_min_speed_rpm"},
         BadEdit{"indefinite_hessian", "gna_pu: \\[1.0, 0.0, 1.0\\]", "gna_pu: [1.0, 2.0, 1.0]", "positive semi-definite"},
         BadEdit{"wrong_length", "sga_pu: \\[100.0, 100.0\\]", "sga_pu: [1.0]", "expected 2 numbers, got 1"},
         BadEdit{"bool", "psi_m: true", "psi_m: yes please", "expected true or false"},
         BadEdit{"syntax", "machine:", "machine: [", "YAML syntax"},
-        BadEdit{"ext_unknown", "\nestimator:", "\nmodel_extensions:\n  deadtime: {t_dead_s: 1.0e-6, switching_frequency_Hz: 4000, colour: red}\nestimator:",
+        BadEdit{"ext_unknown", "\nestimator:",
+                "\nmodel_extensions:\n  deadtime: {t_dead_s: 1.0e-6, switching_frequency_Hz: 4000, colour: red}\nestimator:",
                 "model_extensions.deadtime.colour: unknown key"},
         BadEdit{"drift_without_law", "\nestimator:", "\nmodel_extensions:\n  rs_drift: {reference_C: 20}\nestimator:",
                 "a drift needs coeff_per_K or rel_change"},
@@ -130,12 +136,13 @@ INSTANTIATE_TEST_SUITE_P(
                 "model_extensions.delay.delay_s: must be below 4 sample periods"},
         BadEdit{"harmonic_unknown_key", "\nestimator:", "\nmodel_extensions:\n  flux_harmonic_6: {d_Wb: 0.01}\nestimator:",
                 "model_extensions.flux_harmonic_6.d_Wb: unknown key"},
-        BadEdit{"negative_r_fe", "\nestimator:", "\nmodel_extensions:\n  iron_loss: {r_fe_Ohm: -5}\nestimator:",
-                "iron_loss.r_fe_Ohm"}),
+        BadEdit{"negative_r_fe",
+                "\nestimator:", "\nmodel_extensions:\n  iron_loss: {r_fe_Ohm: -5}\nestimator:", "iron_loss.r_fe_Ohm"}),
     [](const auto& p) { return std::string(p.param.name); });
 
 TEST(MachineConfig, AveragedEstimatorOptionsAreReadAndChecked) {
-  EXPECT_DOUBLE_EQ(load_machine_config(test::source_dir() + "/config/paper-ipmsm.yaml").estimator.averaged.max_interval_s, 0.05);
+  EXPECT_DOUBLE_EQ(load_machine_config(test::source_dir() + "/config/paper-ipmsm.yaml").estimator.averaged.max_interval_s,
+                   0.05);
   const std::string edited = std::regex_replace(
       paper_text(), std::regex("\n  floors:"),
       "\n  averaged: {max_interval_s: 0.1, inductive_correction: false, instrument_time_constant_s: 0.02}\n  floors:",
@@ -151,7 +158,8 @@ TEST(MachineConfig, AveragedEstimatorOptionsAreReadAndChecked) {
 }
 
 TEST(MachineConfig, ReportedCommandIsReadAndNeedsTheControlPeriod) {
-  EXPECT_FALSE(load_machine_config(test::source_dir() + "/config/vesc-6374-outrunner.yaml").estimator.averaged.voltage_is_command);
+  EXPECT_FALSE(
+      load_machine_config(test::source_dir() + "/config/vesc-6374-outrunner.yaml").estimator.averaged.voltage_is_command);
   const MachineConfig firmware = load_machine_config(test::source_dir() + "/config/vesc-6374-firmware.yaml");
   EXPECT_TRUE(firmware.estimator.averaged.voltage_is_command);
   EXPECT_DOUBLE_EQ(firmware.estimator.averaged.current_sample_at, 0.5);
@@ -221,8 +229,8 @@ TEST(MachineConfig, ExtensionsWrittenAsYamlReadBackToTheSameValues) {
   x.flux_harmonics[1] = {0.0031, -0.0007, 0.0, 0.0125};
   c.rs_drift.law = core::DriftLaw{0.00391698, 25.0, 2.31};
   c.psim_drift.rel_change = -0.067;
-  const std::string text = replace_model_extensions(paper_text() + "model_extensions:\n  delay: {delay_s: 7.77e-7}\n",
-                                                    model_extensions_yaml(c));
+  const std::string text =
+      replace_model_extensions(paper_text() + "model_extensions:\n  delay: {delay_s: 7.77e-7}\n", model_extensions_yaml(c));
   EXPECT_EQ(text.find("7.77e-7"), std::string::npos);  // the old section is gone
   const MachineConfig back = load_machine_config(test::TempFile("x.yaml", text).path());
   const core::ModelExtensions& y = back.estimator.extensions;

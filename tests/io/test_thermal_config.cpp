@@ -104,16 +104,21 @@ TEST(ThermalConfig, DefaultsComeFromTheMachineAndTheMaterials) {
 
 TEST(ThermalConfig, BadSectionsNameFileLineKeyAndReason) {
   EXPECT_NE(error_of("name: magnet", "name: rotor").find("a node named 'magnet' is required"), std::string::npos);
-  EXPECT_NE(error_of("name: stator_iron", "name: winding").find(":4:14: thermal.nodes[1].name: node 'winding' appears twice"),
-            std::string::npos)
+  EXPECT_NE(
+      error_of("name: stator_iron", "name: winding").find(":4:14: thermal.nodes[1].name: node 'winding' appears twice"),
+      std::string::npos)
       << error_of("name: stator_iron", "name: winding");
   EXPECT_NE(error_of("form: magnet_eddy", "form: magnet_hysteresis")
                 .find("unknown loss form 'magnet_hysteresis' (one of iron_hysteresis, iron_eddy, magnet_eddy)"),
             std::string::npos);
-  EXPECT_NE(error_of("to: stator_iron, W_per_K: 44", "to: rotor, W_per_K: 44").find("no node named 'rotor'"), std::string::npos);
-  EXPECT_NE(error_of("from: magnet, to: stator_iron", "from: winding, to: stator_iron").find("is given twice"), std::string::npos);
+  EXPECT_NE(error_of("to: stator_iron, W_per_K: 44", "to: rotor, W_per_K: 44").find("no node named 'rotor'"),
+            std::string::npos);
+  EXPECT_NE(error_of("from: magnet, to: stator_iron", "from: winding, to: stator_iron").find("is given twice"),
+            std::string::npos);
   // The magnet without a conductance of its own to the coolant still reaches it through the stator iron.
-  EXPECT_EQ(error_of("capacitance_J_per_K: 6500, to_coolant_W_per_K: 2.5", "capacitance_J_per_K: 6500, to_coolant_W_per_K: 0"), "");
+  EXPECT_EQ(
+      error_of("capacitance_J_per_K: 6500, to_coolant_W_per_K: 2.5", "capacitance_J_per_K: 6500, to_coolant_W_per_K: 0"),
+      "");
   EXPECT_NE(error_of("capacitance_J_per_K: 6500, to_coolant_W_per_K: 2.5", "capacitance_J_per_K: -1")
                 .find("thermal.nodes[2].capacitance_J_per_K: -1 is outside"),
             std::string::npos);
@@ -121,14 +126,16 @@ TEST(ThermalConfig, BadSectionsNameFileLineKeyAndReason) {
   EXPECT_NE(error_of("coeff_per_K: -0.00105", "coeff_per_K: 0.00105").find("thermal.magnet_law.coeff_per_K"),
             std::string::npos);
   // A magnet cut off from everything: no steady state.
-  const std::string cut = std::regex_replace(
-      std::regex_replace(std::string(kThreeNodes), std::regex("    - \\{from: magnet, to: stator_iron, W_per_K: 13\\}\n"), ""),
-      std::regex("to_coolant_W_per_K: 2.5"), "to_coolant_W_per_K: 0");
+  const std::string cut =
+      std::regex_replace(std::regex_replace(std::string(kThreeNodes),
+                                            std::regex("    - \\{from: magnet, to: stator_iron, W_per_K: 13\\}\n"), ""),
+                         std::regex("to_coolant_W_per_K: 2.5"), "to_coolant_W_per_K: 0");
   try {
     (void)load_text(cut);
     ADD_FAILURE() << "accepted a node without a path to the coolant";
   } catch (const ConfigError& e) {
-    EXPECT_NE(std::string(e.what()).find("node 'magnet' has no path of conductances to the coolant"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("node 'magnet' has no path of conductances to the coolant"), std::string::npos)
+        << e.what();
   }
 }
 

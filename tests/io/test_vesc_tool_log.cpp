@@ -104,7 +104,8 @@ TEST(VescToolLog, AHeaderWithoutDqVoltagesNamesTheVersionThatAddedThem) {
 TEST(VescToolLog, TheHeaderlessLogOfVersions111To116IsRefusedWithWhy) {
   // 2323a806 (VESC Tool 1.11, 2019-05-06) wrote the 22 values with no header.
   const std::string msg = error_of(values22(1000, 40, 50, 0, 1, 100) + "\n" + values22(1100, 40, 50, 0, 1, 100) + "\n");
-  EXPECT_NE(msg.find("vesc.csv:1: a VESC Tool realtime log without header (VESC Tool 1.11 to 1.16"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("vesc.csv:1: a VESC Tool realtime log without header (VESC Tool 1.11 to 1.16"), std::string::npos)
+      << msg;
   EXPECT_NE(msg.find("d_axis_voltage, q_axis_voltage"), std::string::npos) << msg;
 }
 

@@ -56,8 +56,8 @@ int main() {
 
   const std::vector<std::string> header = split(rpem::schema::csv_header<rpem::estimate_t>());
   const std::vector<std::string> row = split(rpem::schema::csv_row(heard));
-  expect(header.size() == row.size(), "the CSV: " + std::to_string(header.size()) + " columns, " +
-                                          std::to_string(row.size()) + " values");
+  expect(header.size() == row.size(),
+         "the CSV: " + std::to_string(header.size()) + " columns, " + std::to_string(row.size()) + " values");
   std::string found;
   for (std::size_t k = 0; k < header.size() && k < row.size(); ++k) {
     if (header[k] == "T_probe" || header[k].rfind("probe_counts[", 0) == 0) found += header[k] + "=" + row[k] + " ";

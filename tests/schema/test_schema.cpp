@@ -104,7 +104,8 @@ void expect_copied_every_field() {
       EXPECT_TRUE((to.*f.member).empty()) << f.info.name << ": a string is the caller's";
     }
   });
-  EXPECT_EQ(static_cast<std::size_t>(checked), schema::kFieldCount<typename Mirror::Message> - schema::spelled_count<typename Mirror::Message>());
+  EXPECT_EQ(static_cast<std::size_t>(checked),
+            schema::kFieldCount<typename Mirror::Message> - schema::spelled_count<typename Mirror::Message>());
 }
 
 TEST(Schema, CopyWritesEveryFieldOfTheMirrorAndLeavesStringsAndKeysToTheCaller) {
@@ -159,9 +160,11 @@ TEST(Schema, ALineShowsEachFieldByNameOrLabelWithGroupsApart) {
   static_assert(!schema::has_fields<estimate_t>(std::array<std::string_view, 1>{"psi_m"}));  // a label is not a name
   const std::string rest = schema::format_fields(e, kShownElsewhere);
   EXPECT_TRUE(rest.starts_with("sample_time_us 0 psi_m 1.0987 Wb r_s 0 Ohm")) << rest;
-  EXPECT_TRUE(rest.ends_with("frozen 0 state 2 | thermal_active 0 t_magnet_fused_C 0 t_magnet_fused_sd_C 0 "
-                             "t_magnet_source 0 t_magnet_observed_age_s 0 t_winding_fused_C 0 t_winding_fused_sd_C 0 "
-                             "t_winding_source 0 t_winding_observed_age_s 0")) << rest;
+  EXPECT_TRUE(
+      rest.ends_with("frozen 0 state 2 | thermal_active 0 t_magnet_fused_C 0 t_magnet_fused_sd_C 0 "
+                     "t_magnet_source 0 t_magnet_observed_age_s 0 t_winding_fused_C 0 t_winding_fused_sd_C 0 "
+                     "t_winding_source 0 t_winding_observed_age_s 0"))
+      << rest;
 }
 
 TEST(Schema, TheCsvHasAColumnPerNumberFormattedAsAStreamFormatsIt) {

@@ -15,7 +15,6 @@ namespace {
 using Mat5 = Eigen::Matrix<double, 5, 5>;
 using Vec5 = Eigen::Matrix<double, 5, 1>;
 
-
 /// ψ(t) from the augmented system d/dt [ψ; u; 1] = [A I c; 0 Ω 0; 0 0 0]·[ψ; u; 1] (docs/derivations.md
 /// §10), its matrix set up here from the plant's equations and exponentiated by Eigen.
 core::Vec2 augmented_exponential(const PlantParameters& p, double omega, const core::Vec2& psi0, const core::Vec2& u0,
@@ -110,8 +109,8 @@ TEST(MapFlow, OnAMapOfConstantInductancesAgreesWithTheExactSolutionWithinItsTole
     linear.prepare(exact);
     map.prepare(mapped);
     // Five intervals of one period, the voltages of a PWM pattern.
-    for (const core::Vec2& u : {core::Vec2(0, 0), core::Vec2(377, 0), core::Vec2(188, 326), core::Vec2(0, 0),
-                               core::Vec2(-188, 326)}) {
+    for (const core::Vec2& u :
+         {core::Vec2(0, 0), core::Vec2(377, 0), core::Vec2(188, 326), core::Vec2(0, 0), core::Vec2(-188, 326)}) {
       linear.start(exact, u, 25e-6);
       map.start(mapped, u, 25e-6);
       ASSERT_DOUBLE_EQ(map.reach_s(), 25e-6);

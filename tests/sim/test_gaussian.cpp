@@ -26,10 +26,10 @@ TEST(GaussianNoise, MomentsAndTailsMatchTheStandardNormal) {
     beyond_r += std::abs(x) > 3.5;
   }
   m1 /= kN, m2 /= kN, m3 /= kN, m4 /= kN;
-  EXPECT_NEAR(m1, 0.0, 5 * 1e-3);        // standard error 1e-3
-  EXPECT_NEAR(m2, 1.0, 5 * 1.4e-3);      // √2/√N
-  EXPECT_NEAR(m3, 0.0, 5 * 3.9e-3);      // √15/√N
-  EXPECT_NEAR(m4, 3.0, 5 * 9.8e-3);      // √96/√N
+  EXPECT_NEAR(m1, 0.0, 5 * 1e-3);    // standard error 1e-3
+  EXPECT_NEAR(m2, 1.0, 5 * 1.4e-3);  // √2/√N
+  EXPECT_NEAR(m3, 0.0, 5 * 3.9e-3);  // √15/√N
+  EXPECT_NEAR(m4, 3.0, 5 * 9.8e-3);  // √96/√N
   EXPECT_NEAR(beyond1 / double(kN), 0.317311, 5 * 4.7e-4);
   EXPECT_NEAR(beyond3 / double(kN), 0.0026998, 5 * 5.2e-5);
   EXPECT_NEAR(beyond_r / double(kN), 4.6525e-4, 5 * 2.2e-5);  // the tail beyond the Ziggurat's r

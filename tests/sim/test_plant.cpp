@@ -11,7 +11,6 @@
 namespace rpem::sim {
 namespace {
 
-
 core::Vec2 settle(PmsmPlant& plant, const PlantParameters& p, double omega, const core::Vec2& u_dq, double seconds,
                   double h) {
   MechanicsConfig mech;

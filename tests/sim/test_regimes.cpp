@@ -23,21 +23,29 @@ namespace rpem::sim {
 namespace {
 
 constexpr double kPsiM = 0.0037, kRs = 0.031, kL = 20e-6;  // the plant (the configuration says 4.633 mWb, 25 mΩ)
-constexpr double kJ = 0.004, kB = 1e-3, kLoad = 0.05;        // kg m², N m s, N m
+constexpr double kJ = 0.004, kB = 1e-3, kLoad = 0.05;      // kg m², N m s, N m
 constexpr int kP = 7;
 constexpr double kPi = std::numbers::pi;
 
 Scenario scenario(const std::string& initial, const std::string& regimes, double duration_s,
                   const std::string& control = "torque") {
-  const std::string text = "name: regimes\nmachine: " + std::string(RPEM_TEST_SOURCE_DIR) +
-                           "/config/vesc-6374-outrunner.yaml\n"
-                           "duration_s: " + std::to_string(duration_s) + "\nwarmup_s: 0.02\nseed: 5\n"
-                           "sample_period_s: 80.0e-6\ninverter: {model: averaged, switching_frequency_Hz: 6250}\n"
-                           "plant: {step_s: 20.0e-6, mechanics: {mode: inertia, inertia_kgm2: 0.004, friction_Nms: 1.0e-3}}\n"
-                           "control: {current_bandwidth_Hz: 1000, mode: " + control + "}\n"
-                           "sensors: {current_noise_A: 0.15, current_lsb_A: 0.05}\n"
-                           "initial: {psi_m_Wb: 0.0037, r_s_Ohm: 0.031, u_dc_V: 48, load_torque_Nm: 0.05, " + initial + "}\n"
-                           "regimes:\n" + regimes;
+  const std::string text =
+      "name: regimes\nmachine: " + std::string(RPEM_TEST_SOURCE_DIR) +
+      "/config/vesc-6374-outrunner.yaml\n"
+      "duration_s: " +
+      std::to_string(duration_s) +
+      "\nwarmup_s: 0.02\nseed: 5\n"
+      "sample_period_s: 80.0e-6\ninverter: {model: averaged, switching_frequency_Hz: 6250}\n"
+      "plant: {step_s: 20.0e-6, mechanics: {mode: inertia, inertia_kgm2: 0.004, friction_Nms: 1.0e-3}}\n"
+      "control: {current_bandwidth_Hz: 1000, mode: " +
+      control +
+      "}\n"
+      "sensors: {current_noise_A: 0.15, current_lsb_A: 0.05}\n"
+      "initial: {psi_m_Wb: 0.0037, r_s_Ohm: 0.031, u_dc_V: 48, load_torque_Nm: 0.05, " +
+      initial +
+      "}\n"
+      "regimes:\n" +
+      regimes;
   return parse_scenario(text, "regimes.yaml", "");
 }
 
@@ -49,13 +57,13 @@ double load_angle(const TruthRow& t) { return 0.5 * kPi + core::wrap_angle(t.the
 
 TEST(Regimes, OpenLoopRotorFollowsAtTheLoadAngleOfTheTorqueBalance) {
   // Lock 0.2 s, ramp to 400 rpm over 4 s, hold 3 s; 21 A.
-  DriveSimulator sim(scenario("speed_rpm: 0, torque_Nm: 0",
-                              "  - {t_s: 0.1, regime: open_loop, current_A: 21, speed_rpm: 400, lock_s: 0.2, ramp_s: 4, hold_s: 3}\n",
-                              7.2));
-  const double k = 1.5 * kP * kPsiM * 21.0;                 // torque per sin δ [N m]
-  const double w_target = 400.0 * 2.0 * kPi / 60.0;         // mechanical [rad/s]
-  const double alpha = w_target / 4.0;                      // during the ramp
-  const double w_n = std::sqrt(kP * k / kJ);                // the rotor's natural frequency on the current [rad/s]
+  DriveSimulator sim(scenario(
+      "speed_rpm: 0, torque_Nm: 0",
+      "  - {t_s: 0.1, regime: open_loop, current_A: 21, speed_rpm: 400, lock_s: 0.2, ramp_s: 4, hold_s: 3}\n", 7.2));
+  const double k = 1.5 * kP * kPsiM * 21.0;          // torque per sin δ [N m]
+  const double w_target = 400.0 * 2.0 * kPi / 60.0;  // mechanical [rad/s]
+  const double alpha = w_target / 4.0;               // during the ramp
+  const double w_n = std::sqrt(kP * k / kJ);         // the rotor's natural frequency on the current [rad/s]
   io::DriveLogRow row;
   TruthRow t;
   double hold_sum = 0, hold_min = 1e9, hold_max = -1e9, hold_speed = 0, ramp_sum = 0, ramp_predicted = 0;
@@ -91,10 +99,10 @@ TEST(Regimes, OpenLoopRotorFollowsAtTheLoadAngleOfTheTorqueBalance) {
 }
 
 TEST(Regimes, OpenLoopReportsTheCommandedFrameWithTheBackEmfOnTheDAxis) {
-  VescMotor motor(scenario("speed_rpm: 0, torque_Nm: 0",
-                           "  - {t_s: 0.1, regime: open_loop, current_A: 21, speed_rpm: 400, lock_s: 0.2, ramp_s: 2, hold_s: 3}\n",
-                           5.3),
-                  {});
+  VescMotor motor(
+      scenario("speed_rpm: 0, torque_Nm: 0",
+               "  - {t_s: 0.1, regime: open_loop, current_A: 21, speed_rpm: 400, lock_s: 0.2, ramp_s: 2, hold_s: 3}\n", 5.3),
+      {});
   const double w_c = 400.0 * 2.0 * kPi / 60.0 * kP;  // the commanded speed in the hold [rad/s, electrical]
   ASSERT_TRUE(motor.advance_to(2'500'000'000));
   (void)motor.read_values();
@@ -183,7 +191,8 @@ int check_bridge_off(VescMotor& motor, bool zero) {
 TEST(Regimes, BridgeOffFreewheelsAndReportsWhatTheFirmwareReports) {
   for (const bool zero : {false, true}) {
     SCOPED_TRACE(zero ? "report: zero" : "report: back_emf");
-    const std::string off = zero ? "  - {t_s: 0.3, regime: bridge_off, report: zero}\n" : "  - {t_s: 0.3, regime: bridge_off}\n";
+    const std::string off =
+        zero ? "  - {t_s: 0.3, regime: bridge_off, report: zero}\n" : "  - {t_s: 0.3, regime: bridge_off}\n";
     VescMotor motor(scenario("speed_rpm: 2000, torque_Nm: 0", off + "  - {t_s: 2.3, regime: closed_loop}\n", 2.6), {});
     // A read wholly inside the interval: no current at all, and the back EMF (or nothing).
     ASSERT_TRUE(motor.advance_to(1'000'000'000));
@@ -248,8 +257,8 @@ TEST(Regimes, ASpeedStepUnderTheCurrentLimitAcceleratesHardWithinOneRead) {
   Scenario s = scenario("speed_rpm: 0, torque_Nm: 0", "  - {t_s: 0, regime: closed_loop}\n", 0.6, "speed");
   s.signal(Quantity::kSpeed).add({0.1, EventKind::kStep, 3000.0, 0.0});
   VescMotor motor(std::move(s), {});
-  const double i_max = std::sqrt(2.0) * 40.0;             // control.max_current_A's default: √2·I_n
-  const double torque = 1.5 * kP * kPsiM * i_max;         // the true torque at the limit (ψm below nominal)
+  const double i_max = std::sqrt(2.0) * 40.0;      // control.max_current_A's default: √2·I_n
+  const double torque = 1.5 * kP * kPsiM * i_max;  // the true torque at the limit (ψm below nominal)
   const double w_inf = (torque - kLoad) / kB;
   ASSERT_TRUE(motor.advance_to(200'000'000));
   const double t0 = 1e-9 * static_cast<double>(motor.truth().t_ns), w0 = motor.truth().omega_el_rad_s / kP;
@@ -259,8 +268,8 @@ TEST(Regimes, ASpeedStepUnderTheCurrentLimitAcceleratesHardWithinOneRead) {
   const double t1 = 1e-9 * static_cast<double>(motor.truth().t_ns), w1 = motor.truth().omega_el_rad_s / kP;
   const double expected = (w0 - w_inf) * std::exp(-kB * (t1 - t0) / kJ) + w_inf;
   EXPECT_NEAR(w1, expected, 2e-3 * (expected - w0));
-  EXPECT_GT(w1 - w0, 50.0);                     // rad/s mechanical within one read: 40 % of the speed
-  EXPECT_NEAR(v.i_q_A, i_max, 0.05);            // the window's mean current: at the limit throughout
+  EXPECT_GT(w1 - w0, 50.0);           // rad/s mechanical within one read: 40 % of the speed
+  EXPECT_NEAR(v.i_q_A, i_max, 0.05);  // the window's mean current: at the limit throughout
   // The end's speed as the firmware's PLL reports it: behind the rotor by its ramp response since the step at
   // 0.1 s, a·(τ − p₂/(p₁(p₂ − p₁))·e^{−p₁·t'}), τ = k_p/k_i (docs/derivations.md §13, "Speed at the read"), with
   // a the read's mean acceleration (the rotor accelerates nearly evenly here: J/B ≫ the read).

@@ -103,8 +103,9 @@ INSTANTIATE_TEST_SUITE_P(
             "bad.yaml:3:24: events[0].quantity: 'flux' is not one of"},
         Bad{"both", "duration_s: 1\nevents:\n  - {t_s: 1, quantity: r_s_Ohm, kind: step, value: 1, scale: 2}\n",
             "give exactly one of value and scale"},
-        Bad{"order", "duration_s: 1\nevents:\n  - {t_s: 2, quantity: r_s_Ohm, kind: step, value: 1}\n"
-                     "  - {t_s: 1, quantity: r_s_Ohm, kind: step, value: 2}\n",
+        Bad{"order",
+            "duration_s: 1\nevents:\n  - {t_s: 2, quantity: r_s_Ohm, kind: step, value: 1}\n"
+            "  - {t_s: 1, quantity: r_s_Ohm, kind: step, value: 2}\n",
             "events[1].t_s: events of one quantity must be in time order"},
         Bad{"speed_on_dyno", "duration_s: 1\ncontrol: {mode: speed}\n", "speed control needs plant.mechanics.mode: inertia"},
         Bad{"step", "duration_s: 1\nplant: {integrator: fixed, step_s: 3.0e-6}\n", "step_s must divide sample_period_s"},
@@ -118,7 +119,8 @@ INSTANTIATE_TEST_SUITE_P(
             "bad.yaml:3:22: regimes[0].regime: 'coasting' is not one of: closed_loop, open_loop, bridge_off"},
         Bad{"open_loop_current", "duration_s: 1\nregimes:\n  - {t_s: 1, regime: open_loop, speed_rpm: 300, ramp_s: 1}\n",
             "regimes[0].current_A: required key is missing"},
-        Bad{"open_loop_direction", "duration_s: 1\nregimes:\n  - {t_s: 1, regime: open_loop, current_A: 5, speed_rpm: 0, ramp_s: 1}\n",
+        Bad{"open_loop_direction",
+            "duration_s: 1\nregimes:\n  - {t_s: 1, regime: open_loop, current_A: 5, speed_rpm: 0, ramp_s: 1}\n",
             "regimes[0].speed_rpm: must not be 0"},
         Bad{"released_with_control",
             "duration_s: 1\nregimes:\n  - {t_s: 1, regime: open_loop, current_A: 5, speed_rpm: 9, ramp_s: 1, then: bridge_off, "

@@ -48,8 +48,8 @@ Deviations against_reference(const Scenario& s) {
   const auto reference = sampled_currents(s, PlantIntegrator::kFixedStep, 10e-9);
   const Deviations d{largest_deviation(sampled_currents(s, PlantIntegrator::kEdges, 0.0), reference),
                      largest_deviation(sampled_currents(s, PlantIntegrator::kFixedStep, 1e-6), reference)};
-  std::printf("%s: largest deviation from the 10 ns reference: edge to edge %.2e A, fixed 1 us %.2e A\n",
-              s.name.c_str(), d.edges_A, d.fixed_A);
+  std::printf("%s: largest deviation from the 10 ns reference: edge to edge %.2e A, fixed 1 us %.2e A\n", s.name.c_str(),
+              d.edges_A, d.fixed_A);
   return d;
 }
 

@@ -11,11 +11,11 @@
 #include <random>
 #include <vector>
 
-#include "support/vesc_frames.hpp"
 #include "rpem/can/vesc.hpp"
 #include "rpem/can/vesc_firmware.hpp"
 #include "rpem/sim/vesc_motor.hpp"
 #include "rpem/sim/vesc_on_demand.hpp"
+#include "support/vesc_frames.hpp"
 
 namespace rpem::sim {
 namespace {
@@ -90,7 +90,8 @@ TEST(VescEmulator, RepliesCarryTheAveragesOfEveryCycleSinceThePreviousRead) {
     ASSERT_EQ(motor.cycles_since_read(), n);
     const std::size_t len = vesc::encode_values(motor.read_values(), vesc::kEstimatorMask, payload);
     frames.resize(vesc::buffer_frame_count(len));
-    frames.resize(vesc::buffer_frames(test::vesc_frames::kHost, test::vesc_frames::kController, 1, {payload.data(), len}, frames));
+    frames.resize(
+        vesc::buffer_frames(test::vesc_frames::kHost, test::vesc_frames::kController, 1, {payload.data(), len}, frames));
     vesc::VescDecoder::Event last = vesc::VescDecoder::Event::kNone;
     for (const auto& f : frames) last = decoder.decode(f);
     ASSERT_EQ(last, vesc::VescDecoder::Event::kValues);
@@ -149,7 +150,6 @@ TEST(VescEmulator, StatusBroadcastsCarryTheInstantaneousState) {
   EXPECT_NEAR(decoder.status().tachometer, 6 * 35, 6);
   EXPECT_EQ(motor.cycles_since_read(), 1250);  // statuses read no average
 }
-
 
 // ---- Drive time on demand (sim/vesc_on_demand.hpp): the reads of OnDemandVesc against the same drive
 // stepped here one cycle at a time, read at the same instants (independent means, as above).
@@ -256,7 +256,7 @@ TEST(VescOnDemand, APollTheDriveHadPassedIsReadLateButNeverEmpty) {
   const auto first = drive.poll(6'000'000, ignore);
   ASSERT_TRUE(first);
   EXPECT_TRUE(first->behind);
-  EXPECT_EQ(first->cycles, 100);  // 2 … 10 ms: every cycle run, none lost
+  EXPECT_EQ(first->cycles, 100);                      // 2 … 10 ms: every cycle run, none lost
   const auto second = drive.poll(7'000'000, ignore);  // also behind, and no cycle since the first
   ASSERT_TRUE(second);
   EXPECT_TRUE(second->behind);

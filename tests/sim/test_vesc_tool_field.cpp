@@ -66,8 +66,8 @@ TEST(VescToolField, HoldsEveryRegimeOfARealDrive) {
   EXPECT_GT(open_forward, 50);
   EXPECT_GT(open_backward, 5);
   EXPECT_GE(released, 1);
-  EXPECT_GT(coasting_s, 150.0);   // minutes of zero-current coasting
-  EXPECT_GT(hard, 60);            // reads with a hard acceleration or braking inside
+  EXPECT_GT(coasting_s, 150.0);  // minutes of zero-current coasting
+  EXPECT_GT(hard, 60);           // reads with a hard acceleration or braking inside
 }
 
 }  // namespace

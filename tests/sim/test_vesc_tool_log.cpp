@@ -33,27 +33,27 @@ TEST(VescToolLog, RowIsWrittenAsVescToolWritesIt) {
   VescToolRow r;
   can::vesc::Values& v = r.values;
   // Values as Commands decodes them: the firmware's integers over their scales.
-  r.ms_today = 45296789;                  // 12:34:56.789 UTC
-  v.v_in_V = 482 / 1e1;                   // float16 ×10
+  r.ms_today = 45296789;  // 12:34:56.789 UTC
+  v.v_in_V = 482 / 1e1;   // float16 ×10
   v.temp_fet_C = 413 / 1e1;
   v.temp_mos_C = {413 / 1e1, 409 / 1e1, 398 / 1e1};
   v.temp_motor_C = 678 / 1e1;
-  v.current_motor_A = 2745 / 1e2;         // float32 ×100
+  v.current_motor_A = 2745 / 1e2;  // float32 ×100
   v.current_in_A = 1234 / 1e2;
   v.i_d_A = -321 / 1e2;
   v.i_q_A = 2745 / 1e2;
-  v.erpm = 1234567 / 1e0;                 // 7 digits: exponent form at precision 6
+  v.erpm = 1234567 / 1e0;  // 7 digits: exponent form at precision 6
   v.duty = 354 / 1e3;
   v.amp_hours_Ah = 12345 / 1e4;
-  v.amp_hours_charged_Ah = 1 / 1e4;       // 0.0001: fixed (exponent −4)
-  v.watt_hours_Wh = 1234567 / 1e4;        // 123.4567: six significant digits
+  v.amp_hours_charged_Ah = 1 / 1e4;  // 0.0001: fixed (exponent −4)
+  v.watt_hours_Wh = 1234567 / 1e4;   // 123.4567: six significant digits
   v.watt_hours_charged_Wh = 0 / 1e4;
   v.tachometer = -123456;
   v.tachometer_abs = 234567;
-  v.pid_pos_deg = 12 / 1e6;               // 1.2e-05: exponent form (exponent −5), two-digit exponent
+  v.pid_pos_deg = 12 / 1e6;  // 1.2e-05: exponent form (exponent −5), two-digit exponent
   v.fault = 0;
   v.controller_id = 17;
-  v.v_d_V = -0.0;                         // a negative zero prints as 0
+  v.v_d_V = -0.0;  // a negative zero prints as 0
   v.v_q_V = 11873 / 1e3;
   r.ms_today_setup = 45296701;
   VescSetupValues& s = r.setup;
@@ -62,12 +62,12 @@ TEST(VescToolLog, RowIsWrittenAsVescToolWritesIt) {
   s.watt_hours_Wh = 1234567 / 1e4;
   s.watt_hours_charged_Wh = 0.0;
   s.battery_level = 873 / 1e3;
-  s.battery_wh = 123456789 / 1e3;         // 123456.789 → 123457
+  s.battery_wh = 123456789 / 1e3;  // 123456.789 → 123457
   s.current_in_A = 1234 / 1e2;
   s.current_motor_A = 2745 / 1e2;
   s.speed_m_s = 9876 / 1e3;
-  s.distance_m = 1000000000 / 1e3;        // 1e+06
-  s.distance_abs_m = 98765432 / 1e3;      // 98765.4
+  s.distance_m = 1000000000 / 1e3;    // 1e+06
+  s.distance_abs_m = 98765432 / 1e3;  // 98765.4
   s.num_vescs = 1;
   const std::string expected =
       "45296789;48.2;41.3;41.3;40.9;39.8;67.8;27.45;12.34;-3.21;27.45;1.23457e+06;0.354;1.2345;0.0001;123.457;0;"

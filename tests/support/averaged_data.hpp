@@ -19,11 +19,11 @@ namespace rpem::test {
 
 struct AveragedDataGenerator {
   core::PerUnitBase base;
-  core::MachinePu plant;                                    ///< the true machine, pu
+  core::MachinePu plant;  ///< the true machine, pu
   double rate_Hz = 200.0;
   double jitter = 0.3;
-  std::function<double(double)> n_pu = [](double) { return 0.0; };                       ///< speed at t [s]
-  std::function<core::Vec2(double)> i_pu = [](double) { return core::Vec2::Zero(); };     ///< current at t
+  std::function<double(double)> n_pu = [](double) { return 0.0; };                            ///< speed at t [s]
+  std::function<core::Vec2(double)> i_pu = [](double) { return core::Vec2::Zero(); };         ///< current at t
   std::function<core::Vec2(double)> di_pu_per_s = [](double) { return core::Vec2::Zero(); };  ///< its slope
   std::mt19937_64 rng{1};
   double t_s = 0.0;

@@ -13,10 +13,10 @@
 #include <vector>
 
 #include "rpem/analysis/diagnose/diagnose_output.hpp"
-#include "support/hidden_effects.hpp"
 #include "rpem/sim/flux_map.hpp"
 #include "support/data_file.hpp"
 #include "support/diagnosis_detail.hpp"
+#include "support/hidden_effects.hpp"
 #include "support/temp_file.hpp"
 
 namespace rpem::test {
@@ -24,8 +24,8 @@ namespace rpem::test {
 inline constexpr double kParameterTolerance = 0.15;
 
 struct HiddenCase {
-  std::string profile = "bench";           ///< "bench", "beckhoff400" or "beckhoff800"
-  std::vector<std::string> effects;        ///< catalogue names; empty: a null case
+  std::string profile = "bench";     ///< "bench", "beckhoff400" or "beckhoff800"
+  std::vector<std::string> effects;  ///< catalogue names; empty: a null case
   std::uint64_t seed = 1;
 };
 
@@ -43,7 +43,8 @@ struct CaseOutcome {
   std::string detail;           ///< what was hidden, what was found, and why it is judged so
 };
 
-inline double parameter(const std::vector<analysis::NamedValue>& values, const std::string& name, std::string* text = nullptr) {
+inline double parameter(const std::vector<analysis::NamedValue>& values, const std::string& name,
+                        std::string* text = nullptr) {
   for (const auto& v : values) {
     if (v.name == name) {
       if (text) *text = v.text;
@@ -74,7 +75,8 @@ inline bool matches(const HiddenEffect& h, const std::vector<analysis::NamedValu
   if (h.name == "delay") got = parameter(p, "delay_s"), truth = h.value;
   if (h.name == "iron_loss") got = parameter(p, "r_fe_Ohm"), truth = h.value;
   char buf[160];
-  std::snprintf(buf, sizeof buf, " %s: %.5g vs true %.5g (%+.1f %%)", h.name.c_str(), got, truth, 100.0 * (got / truth - 1.0));
+  std::snprintf(buf, sizeof buf, " %s: %.5g vs true %.5g (%+.1f %%)", h.name.c_str(), got, truth,
+                100.0 * (got / truth - 1.0));
   why += buf;
   if (h.phase >= 0 && phase != std::string(1, static_cast<char>('a' + h.phase))) {
     why += " [wrong phase " + phase + "]";
@@ -109,7 +111,8 @@ inline bool explained_by_map(const std::string& name, const std::vector<analysis
     const double i = parameter(p, "max_i_q_A");
     const double truth = map.flux(core::Vec2(0.0, i))[0] / map.flux(core::Vec2::Zero())[0] - 1.0;
     const double got = parameter(p, "psi_d_rel_change_at_max_i_q");
-    std::snprintf(buf, sizeof buf, " cross_saturation: ψ_d %+.3g %% at %.2f A vs the map's %+.3g %%", 100.0 * got, i, 100.0 * truth);
+    std::snprintf(buf, sizeof buf, " cross_saturation: ψ_d %+.3g %% at %.2f A vs the map's %+.3g %%", 100.0 * got, i,
+                  100.0 * truth);
     why += buf;
     return std::abs(got - truth) <= std::max(kParameterTolerance * std::abs(truth), 0.003);
   }
@@ -126,7 +129,8 @@ inline bool explained_by_map(const std::string& name, const std::vector<analysis
 inline CaseOutcome run_hidden_case(const HiddenCase& c) {
   const std::string src = source_dir();
   const bool beckhoff = c.profile != "bench";
-  sim::Scenario s = sim::load_scenario(src + (beckhoff ? "/scenarios/diagnose-beckhoff.yaml" : "/scenarios/diagnose-bench.yaml"));
+  sim::Scenario s =
+      sim::load_scenario(src + (beckhoff ? "/scenarios/diagnose-beckhoff.yaml" : "/scenarios/diagnose-bench.yaml"));
   if (c.profile == "beckhoff800") {
     s.flux_map_file = data_file("beckhoff-am8141-flux-maps/beckhoff_AM8141_measured_800rpm.csv");
   }
@@ -185,7 +189,8 @@ inline CaseOutcome run_hidden_case(const HiddenCase& c) {
   bool all = true;
   for (const auto& h : hidden) {
     for (std::size_t j = 0; j < d.selection.found.size(); ++j) {
-      if (d.selection.found[j].effect.name() == h.name) all = matches(h, analysis::found_parameters(d, j), s.thermal, out.detail) && all;
+      if (d.selection.found[j].effect.name() == h.name)
+        all = matches(h, analysis::found_parameters(d, j), s.thermal, out.detail) && all;
     }
   }
   out.correct = all;

@@ -16,9 +16,9 @@ namespace rpem::test {
 
 /// One hidden effect with its true value, in the catalogue's terms (effects.hpp).
 struct HiddenEffect {
-  std::string name;   ///< catalogue name, or "none"
-  double value = 0.0; ///< t_dead_s, offset_rad, offset_A, gain_error, ΔT [K], delay_s, r_fe_Ohm
-  int phase = -1;     ///< for current_offset and current_gain
+  std::string name;                  ///< catalogue name, or "none"
+  double value = 0.0;                ///< t_dead_s, offset_rad, offset_A, gain_error, ΔT [K], delay_s, r_fe_Ohm
+  int phase = -1;                    ///< for current_offset and current_gain
   bool temperatures_logged = false;  ///< rs_drift, psim_drift: T columns in the log
 };
 

@@ -7,8 +7,8 @@
 // 5 % of the true machine's.
 
 #include <cmath>
-#include <cstdlib>
 #include <cstdio>
+#include <cstdlib>
 #include <set>
 #include <string>
 #include <vector>
@@ -37,8 +37,8 @@ struct IndependentCase {
 struct IndependentOutcome {
   bool correct = false;
   bool null_case = false;
-  int false_effects = 0;   ///< effects named that were not hidden
-  std::string detail;      ///< case, seed, what was hidden and found, every comparison
+  int false_effects = 0;  ///< effects named that were not hidden
+  std::string detail;     ///< case, seed, what was hidden and found, every comparison
   /// Parameter errors, relative, per effect name (for the study's summary).
   std::vector<std::pair<std::string, double>> errors;
   double psi_m_error = 0.0, r_s_error = 0.0;  ///< calibrated against true, relative
@@ -125,7 +125,8 @@ inline std::vector<Comparison> compare(const std::string& name, const std::vecto
     const double slope = d ? value(p, "slope_per_A") : 0.0;
     auto factor = [&](double i) { return value(p, "level") + slope * i + value(p, "curvature_per_A2") * i * i; };
     const double got = value(p, "l_at_max_current_H") / factor(value(p, "i_max_A")) * factor(at);
-    const double true_l = (d ? truth.true_machine.l_d_H : truth.true_machine.l_q_H) * t.value(d ? "l_d_apparent_ratio" : "l_q_apparent_ratio");
+    const double true_l =
+        (d ? truth.true_machine.l_d_H : truth.true_machine.l_q_H) * t.value(d ? "l_d_apparent_ratio" : "l_q_apparent_ratio");
     c.push_back({got, true_l, true_l});
   } else if (name == "cross_saturation") {
     // The d-axis flux's change under load, relative to ψm, at the generator's point.
@@ -172,8 +173,10 @@ inline constexpr double kIndependentSpeed_pu = 0.8;
 inline std::vector<indep::ProfilePoint> independent_profile(const indep::MachineConfig& m, double duration_s) {
   const indep::OperatingProfile base = indep::default_profile(m, duration_s, kIndependentSpeed_pu, kIndependentTorque_pu);
   const double i_peak = m.rated_peak_current_A();
-  const std::vector<std::pair<double, double>> steps = {  // (time fraction, injection from then on [A])
-      {0.04, 0.3 * i_peak}, {0.08, 0.0}, {0.60, -0.5 * i_peak}};
+  const std::vector<std::pair<double, double>> steps = {// (time fraction, injection from then on [A])
+                                                        {0.04, 0.3 * i_peak},
+                                                        {0.08, 0.0},
+                                                        {0.60, -0.5 * i_peak}};
   auto injection = [&](double t) {
     double v = 0.0;
     for (const auto& [f, a] : steps) {
@@ -201,10 +204,10 @@ inline std::vector<indep::ProfilePoint> independent_profile(const indep::Machine
 }
 
 /// The independent generator's effect names.
-inline const std::vector<std::string> kIndependentEffects = {"deadtime",         "delay",           "theta_offset",    "current_offset",
-                                           "current_gain",     "ld_saturation",   "lq_saturation",   "cross_saturation",
-                                           "flux_harmonic_6",  "flux_harmonic_12", "iron_loss",      "rs_drift",
-                                           "psim_drift"};
+inline const std::vector<std::string> kIndependentEffects = {
+    "deadtime",      "delay",         "theta_offset",     "current_offset",  "current_gain",
+    "ld_saturation", "lq_saturation", "cross_saturation", "flux_harmonic_6", "flux_harmonic_12",
+    "iron_loss",     "rs_drift",      "psim_drift"};
 
 /// The case of seed k: odd seeds are nulls; even ones cycle through singles, pairs and triples.
 inline IndependentCase independent_case_of(std::uint64_t k, double duration_s) {
@@ -296,7 +299,8 @@ inline IndependentOutcome run_independent_case(const IndependentCase& ic) {
       parameters_ok = parameters_ok && x.within();
     }
   }
-  std::snprintf(buf, sizeof buf, " verdict %s (%.2f× the floor)", analysis::to_string(d.verdict.kind), d.verdict.ratio.value_or(0.0));
+  std::snprintf(buf, sizeof buf, " verdict %s (%.2f× the floor)", analysis::to_string(d.verdict.kind),
+                d.verdict.ratio.value_or(0.0));
   out.detail += buf;
   out.detail += fitting_detail(d);
   out.correct = names_ok && parameters_ok && psi_ok && rs_ok;

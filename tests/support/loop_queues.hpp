@@ -20,7 +20,9 @@ inline LoopQueues loop_queues(std::size_t samples, std::size_t commands, std::si
   auto in = daemon::SpscQueue<daemon::SourceSample>::make(samples);
   auto to_loop = daemon::SpscQueue<daemon::Command>::make(commands);
   auto out = daemon::SpscQueue<daemon::Report>::make(reports);
-  return {std::move(in.producer), std::move(to_loop.producer), std::move(out.consumer),
+  return {std::move(in.producer),
+          std::move(to_loop.producer),
+          std::move(out.consumer),
           {std::move(in.consumer), std::move(to_loop.consumer), std::move(out.producer)}};
 }
 

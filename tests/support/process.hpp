@@ -1,11 +1,11 @@
 #pragma once
 // Runs a project binary from a test and captures its exit code and output.
 
+#include <sys/wait.h>
 #include <array>
 #include <cstdio>
 #include <cstdlib>
 #include <string>
-#include <sys/wait.h>
 
 namespace rpem::test {
 

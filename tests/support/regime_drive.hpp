@@ -39,15 +39,15 @@ struct DriveSegment {
 struct RegimeDrive {
   double r_s_Ohm = 0.025, l_d_H = 20e-6, l_q_H = 20e-6, psi_m_Wb = 0.004633;  ///< the true machine
   double fine_step_s = 50e-6;
-  double jitter = 0.3;          ///< window lengths uniform in (1 ± jitter)·window_s
+  double jitter = 0.3;  ///< window lengths uniform in (1 ± jitter)·window_s
   double current_noise_A = 0.05, voltage_noise_V = 0.002, speed_noise_rad_s = 0.5;
   double current_quantum_A = 0.01, voltage_quantum_V = 0.001, erpm_quantum = 1.0;
   std::uint64_t seed = 1;
 
   struct Window {
     core::AveragedSample sample;
-    DriveMode mode;            ///< the mode at the window's end
-    bool mixed = false;        ///< the window holds more than one segment
+    DriveMode mode;      ///< the mode at the window's end
+    bool mixed = false;  ///< the window holds more than one segment
   };
 
   /// The windows of the cycle, each with its means, in the order a logger writes them.
@@ -103,7 +103,8 @@ struct RegimeDrive {
       t += h;
       a.t_ns = std::llround(t * 1e9);
       const double noise_scale = std::sqrt(0.09 / h);  // means over longer windows are quieter
-      a.i_dq_A = quantise(i_sum / steps + current_noise_A * noise_scale * core::Vec2(unit(rng), unit(rng)), current_quantum_A);
+      a.i_dq_A =
+          quantise(i_sum / steps + current_noise_A * noise_scale * core::Vec2(unit(rng), unit(rng)), current_quantum_A);
       if (off_all) a.i_dq_A = quantise(current_noise_A * noise_scale * core::Vec2(unit(rng), unit(rng)), current_quantum_A);
       a.u_dq_V = off_all ? core::Vec2::Zero()
                          : quantise(u_sum / steps + voltage_noise_V * noise_scale * core::Vec2(unit(rng), unit(rng)),

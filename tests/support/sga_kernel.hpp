@@ -18,19 +18,19 @@ namespace rpem::test {
 
 struct SgaKernel {
   // Configuration (per unit; rates in 1/s).
-  double wd = 0.0, wq = 0.0;        ///< ω_n/x_d, ω_n/x_q
+  double wd = 0.0, wq = 0.0;  ///< ω_n/x_d, ω_n/x_q
   double x_d = 0.0, x_q = 0.0;
-  double half_h = 0.0;              ///< half the sample interval [s]
+  double half_h = 0.0;  ///< half the sample interval [s]
   double gamma_r_psi = 0.0, gamma_r_rs = 0.0, gamma_l_psi = 0.0, gamma_l_rs = 0.0;
   double r_min = 0.0;
   double n_lim_psi = 0.0, n_lim_rs = 0.0;  ///< ψ̂m adapts where |n| > n_lim_psi, r̂s where |n| < n_lim_rs
   double psi_lo = 0.0, psi_hi = 0.0, rs_lo = 0.0, rs_hi = 0.0;
   // State.
-  double psi = 0.0, rs = 0.0;        ///< θ̂
-  double id = 0.0, iq = 0.0;         ///< î
-  double gpd = 0.0, gpq = 0.0;       ///< dî/dψ̂m
-  double grd = 0.0, grq = 0.0;       ///< dî/dr̂s
-  double r_psi = 0.0, r_rs = 0.0;    ///< SGA Hessians
+  double psi = 0.0, rs = 0.0;      ///< θ̂
+  double id = 0.0, iq = 0.0;       ///< î
+  double gpd = 0.0, gpq = 0.0;     ///< dî/dψ̂m
+  double grd = 0.0, grq = 0.0;     ///< dî/dr̂s
+  double r_psi = 0.0, r_rs = 0.0;  ///< SGA Hessians
 
   /// SGA's settings of an estimator configuration, at its initial θ̂ and Hessians, for samples dt_s apart.
   static SgaKernel from(const core::EstimatorConfig& c, double dt_s) noexcept {

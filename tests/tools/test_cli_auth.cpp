@@ -14,8 +14,8 @@
 
 #include <chrono>
 #include <csignal>
-#include <fstream>
 #include <filesystem>
+#include <fstream>
 #include <lcm/lcm-cpp.hpp>
 #include <optional>
 #include <string>
@@ -47,7 +47,8 @@ Heard listen(double seconds, const auth::Keyring& publish) {
     Heard& h;
     const auth::Keyring& keys;
     void count(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
-      const auth::Verdict v = auth::verify(keys, channel, std::span(static_cast<const std::uint8_t*>(rbuf->data), rbuf->data_size));
+      const auth::Verdict v =
+          auth::verify(keys, channel, std::span(static_cast<const std::uint8_t*>(rbuf->data), rbuf->data_size));
       (v == auth::Verdict::kVerified ? h.verified : h.other) += 1;
     }
     void estimate(const lcm::ReceiveBuffer* rbuf, const std::string& channel, const rpem::estimate_t*) {
@@ -68,7 +69,9 @@ Heard listen(double seconds, const auth::Keyring& publish) {
 
 std::string rpem_tool() { return test::binary_dir() + "/tools/rpem"; }
 
-test::ProcessResult rpem(const std::string& args) { return test::run_command(rpem_tool() + " " + args + " --lcm-url '" + kUrl + "'"); }
+test::ProcessResult rpem(const std::string& args) {
+  return test::run_command(rpem_tool() + " " + args + " --lcm-url '" + kUrl + "'");
+}
 
 TEST(CliAuth, AttacksAreRejectedAndCountedForgedEstimatesFlaggedAndReplayProtectionSurvivesARestart) {
   const fs::path dir = fs::path(test::TempFile("keys").path());
@@ -79,14 +82,15 @@ TEST(CliAuth, AttacksAreRejectedAndCountedForgedEstimatesFlaggedAndReplayProtect
   const std::string creds = (dir / "credentials").string();
   auth::write_key_file(creds + "/command.key", auth::generate_key(1));
   auth::write_key_file(creds + "/publish.key", auth::generate_key(2));
-  auth::write_key_file((dir / "attacker/guess.key").string(), auth::generate_key(1));     // the right id, not the key
-  auth::write_key_file((dir / "attacker/other.key").string(), auth::generate_key(9));     // an id rpemd does not hold
-  auth::write_key_file((dir / "attacker/publish.key").string(), auth::generate_key(2));   // forges estimates
+  auth::write_key_file((dir / "attacker/guess.key").string(), auth::generate_key(1));    // the right id, not the key
+  auth::write_key_file((dir / "attacker/other.key").string(), auth::generate_key(9));    // an id rpemd does not hold
+  auth::write_key_file((dir / "attacker/publish.key").string(), auth::generate_key(2));  // forges estimates
   auth::Keyring publish;
   ASSERT_TRUE(publish.add(auth::load_key_file(creds + "/publish.key")));
   const std::string captured = (dir / "attacker/captured.bin").string();
 
-  test::TempFile config("rpemd.yaml", "daemon:\n  lcm: {url: \"" + kUrl + "\"}\n  commands: {enabled: true}\n  state: {file: " +
+  test::TempFile config("rpemd.yaml", "daemon:\n  lcm: {url: \"" + kUrl +
+                                          "\"}\n  commands: {enabled: true}\n  state: {file: " +
                                           (dir / "state/estimates.json").string() + "}\n  status_interval_s: 0\n");
   test::TempFile log("rpemd.log"), log2("rpemd2.log");
   ASSERT_EQ(::setenv("CREDENTIALS_DIRECTORY", creds.c_str(), 1), 0);
@@ -145,7 +149,8 @@ TEST(CliAuth, AttacksAreRejectedAndCountedForgedEstimatesFlaggedAndReplayProtect
     ASSERT_TRUE(h.diagnostics) << test::read_file(log2.path());
     EXPECT_EQ(h.diagnostics->commands_replayed, 1) << test::read_file(log2.path());
     EXPECT_EQ(h.diagnostics->commands_applied, 1);
-    EXPECT_NE(test::read_file(log2.path()).find("last accepted sequence number 5"), std::string::npos) << test::read_file(log2.path());
+    EXPECT_NE(test::read_file(log2.path()).find("last accepted sequence number 5"), std::string::npos)
+        << test::read_file(log2.path());
   }
   // Commands enabled and no key: refused at start (78); so is `authentication: none` beyond this host.
   fs::create_directories(dir / "empty");
@@ -154,17 +159,21 @@ TEST(CliAuth, AttacksAreRejectedAndCountedForgedEstimatesFlaggedAndReplayProtect
   test::ChildProcess keyless({test::binary_dir() + "/daemon/rpemd", "--config", config.path()}, log3.path());
   EXPECT_EQ(keyless.wait(), 78);
   EXPECT_NE(test::read_file(log3.path()).find("no command key is configured"), std::string::npos);
-  test::TempFile wide("wide.yaml", "daemon:\n  lcm: {url: \"udpm://239.255.76.67:7823?ttl=1\"}\n  commands: {enabled: true, authentication: none}\n");
+  test::TempFile wide(
+      "wide.yaml",
+      "daemon:\n  lcm: {url: \"udpm://239.255.76.67:7823?ttl=1\"}\n  commands: {enabled: true, authentication: none}\n");
   test::ChildProcess widened({test::binary_dir() + "/daemon/rpemd", "--config", wide.path()}, log3.path());
   EXPECT_EQ(widened.wait(), 78);
   {
     // A reload that enables commands without a key is refused like an invalid file; rpemd keeps running.
-    test::TempFile reloadable("reloadable.yaml", "daemon:\n  lcm: {url: \"" + kUrl + "\"}\n  commands: {enabled: false}\n  state: {file: " +
-                                                     (dir / "state/estimates.json").string() + "}\n  status_interval_s: 0\n");
+    test::TempFile reloadable("reloadable.yaml",
+                              "daemon:\n  lcm: {url: \"" + kUrl + "\"}\n  commands: {enabled: false}\n  state: {file: " +
+                                  (dir / "state/estimates.json").string() + "}\n  status_interval_s: 0\n");
     test::TempFile log4("rpemd4.log");
     test::ChildProcess rpemd({test::binary_dir() + "/daemon/rpemd", "--config", reloadable.path()}, log4.path());
     std::this_thread::sleep_for(std::chrono::seconds(1));
-    std::ofstream(reloadable.path()) << "daemon:\n  lcm: {url: \"" << kUrl << "\"}\n  commands: {enabled: true}\n  state: {file: "
+    std::ofstream(reloadable.path()) << "daemon:\n  lcm: {url: \"" << kUrl
+                                     << "\"}\n  commands: {enabled: true}\n  state: {file: "
                                      << (dir / "state/estimates.json").string() << "}\n  status_interval_s: 0\n";
     rpemd.signal(SIGHUP);
     const Heard h = listen(2.5, publish);

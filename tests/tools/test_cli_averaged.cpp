@@ -64,8 +64,8 @@ TEST_P(CliAveraged, EstimateRecoversTheIndependentGeneratorsMachine) {
   const std::string gen = test::binary_dir() + "/tests/independent_drive/indep_drive_log --config " + config() +
                           " --duration-s 18 --seed 9 --averaged --rate-Hz " + std::to_string(GetParam()) +
                           " --averaged-source drive --profile " + profile.path() +
-                          " --set draw.psi_m_rel=-0.05 --set draw.r_s_rel=0.15 --out " + avg.path() +
-                          " --truth " + truth.path();
+                          " --set draw.psi_m_rel=-0.05 --set draw.r_s_rel=0.15 --out " + avg.path() + " --truth " +
+                          truth.path();
   const test::ProcessResult g = test::run_command(gen);
   ASSERT_EQ(g.exit_code, 0) << gen << "\n" << g.output;
   const test::ProcessResult r =
@@ -106,7 +106,8 @@ TEST(CliAveragedDiagnose, FindsAMagnetDriftHiddenInAnAveragedLog) {
   const std::string dir = avg.path() + ".diag";
   const std::string gen = test::binary_dir() + "/tests/independent_drive/indep_drive_log --config " + config() +
                           " --effects psim_drift --nominal --seed 4 --duration-s 30 --averaged --rate-Hz 200"
-                          " --averaged-source drive --out " + avg.path() + " --truth " + truth.path();
+                          " --averaged-source drive --out " +
+                          avg.path() + " --truth " + truth.path();
   const test::ProcessResult g = test::run_command(gen);
   ASSERT_EQ(g.exit_code, 0) << gen << "\n" << g.output;
   const test::ProcessResult r = test::run_command(rpem() + " diagnose --log " + avg.path() + " --config " + config() +
@@ -154,7 +155,8 @@ TEST(CliAveragedDiagnose, NamesNothingInAnAveragedLogOfAMachineOffItsConfigurati
                             " --truth " + truth.path();
     const test::ProcessResult g = test::run_command(gen);
     ASSERT_EQ(g.exit_code, 0) << gen << "\n" << g.output;
-    const test::ProcessResult r = test::run_command(rpem() + " diagnose --log " + avg.path() + " --config " + config() + " --out " + dir);
+    const test::ProcessResult r =
+        test::run_command(rpem() + " diagnose --log " + avg.path() + " --config " + config() + " --out " + dir);
     ASSERT_EQ(r.exit_code, 0) << r.output;
     const auto d = nlohmann::json::parse(std::ifstream(dir + "/diagnosis.json"));
     const auto t = nlohmann::json::parse(std::ifstream(truth.path()));

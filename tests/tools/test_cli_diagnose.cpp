@@ -10,8 +10,8 @@
 #include <string>
 #include <vector>
 
-#include "support/process.hpp"
 #include "support/data_file.hpp"
+#include "support/process.hpp"
 #include "support/temp_file.hpp"
 
 namespace rpem {
@@ -113,14 +113,16 @@ TEST(CliDiagnose, FindsAHiddenDeadTimeAndTheExtendedModelCarriesIntoTheTools) {
 
 TEST(CliDiagnose, BadInputGetsAClearErrorAndItsExitCode) {
   const std::string dir = out_dir("bad");
-  std::ofstream(dir + "/bad.csv") << "t,theta_el,omega_el,u_dc,u_a,u_b,u_c,i_a,i_b,i_c\n0,0,0,220,1,2,3,0,0,0\n0.1,0,0,x,1,2,3,0,0,0\n";
+  std::ofstream(dir + "/bad.csv")
+      << "t,theta_el,omega_el,u_dc,u_a,u_b,u_c,i_a,i_b,i_c\n0,0,0,220,1,2,3,0,0,0\n0.1,0,0,x,1,2,3,0,0,0\n";
   auto r = test::run_command(rpem_tool() + " diagnose --log " + dir + "/bad.csv --out " + dir + "/o");
   EXPECT_EQ(r.exit_code, 65) << r.output;
   EXPECT_NE(r.output.find("bad.csv:3:4: column u_dc: 'x' is not a number"), std::string::npos) << r.output;
 
   std::ofstream(dir + "/cfg.yaml") << read(test::source_dir() + "/config/paper-ipmsm.yaml") << "colour: blue\n";
   std::ofstream(dir + "/short.csv") << "t,omega_el,u_d,u_q,i_d,i_q\n0,100,1,2,3,4\n";
-  r = test::run_command(rpem_tool() + " diagnose --log " + dir + "/short.csv --config " + dir + "/cfg.yaml --out " + dir + "/o");
+  r = test::run_command(rpem_tool() + " diagnose --log " + dir + "/short.csv --config " + dir + "/cfg.yaml --out " + dir +
+                        "/o");
   EXPECT_EQ(r.exit_code, 78) << r.output;
   EXPECT_NE(r.output.find("colour: unknown key"), std::string::npos) << r.output;
 
@@ -227,16 +229,18 @@ TEST(CliDiagnose, AModelExtendedOnOneRecordingIsTheBaselineOfTheNext) {
   heat.close();
   cool.close();
   const std::string config = test::source_dir() + "/config/paderborn-pmsm.yaml";
-  r = test::run_command(rpem_tool() + " diagnose --log " + dir + "/heatup.csv --config " + config + " --out " + dir + "/heatup");
+  r = test::run_command(rpem_tool() + " diagnose --log " + dir + "/heatup.csv --config " + config + " --out " + dir +
+                        "/heatup");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const nlohmann::json a = nlohmann::json::parse(read(dir + "/heatup/diagnosis.json"));
   ASSERT_FALSE(a["effects"].empty()) << a.dump(2);
   EXPECT_EQ(a["effects"][0]["name"], "psim_drift");
   EXPECT_NE(read(dir + "/heatup/extended.yaml").find("psim_drift"), std::string::npos);
-  r = test::run_command(rpem_tool() + " diagnose --log " + dir + "/cooldown.csv --config " + config + " --out " + dir + "/plain");
+  r = test::run_command(rpem_tool() + " diagnose --log " + dir + "/cooldown.csv --config " + config + " --out " + dir +
+                        "/plain");
   ASSERT_EQ(r.exit_code, 0) << r.output;
-  r = test::run_command(rpem_tool() + " diagnose --log " + dir + "/cooldown.csv --config " + dir + "/heatup/extended.yaml --out " +
-                        dir + "/carried");
+  r = test::run_command(rpem_tool() + " diagnose --log " + dir + "/cooldown.csv --config " + dir +
+                        "/heatup/extended.yaml --out " + dir + "/carried");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const nlohmann::json plain = nlohmann::json::parse(read(dir + "/plain/diagnosis.json"));
   const nlohmann::json carried = nlohmann::json::parse(read(dir + "/carried/diagnosis.json"));

@@ -79,7 +79,8 @@ class FieldLog : public ::testing::Test {
                             " --effects none --seed 3 --duration-s 300 --control-rate-Hz 12500 --averaged --rate-Hz 11"
                             " --jitter 0.5 --set averaged.min_interval_s=0.06 --set averaged.max_interval_s=0.2"
                             " --averaged-source drive --set draw.psi_m_rel=-0.2 --set draw.r_s_rel=0.2"
-                            " --set draw.l_d_rel=0 --set draw.l_q_rel=0 --out " + dir_ + "/clean.csv --truth " + dir_ + "/truth.json";
+                            " --set draw.l_d_rel=0 --set draw.l_q_rel=0 --out " +
+                            dir_ + "/clean.csv --truth " + dir_ + "/truth.json";
     const test::ProcessResult g = test::run_command(gen);
     ASSERT_EQ(g.exit_code, 0) << gen << "\n" << g.output;
     true_psi_m_ = nlohmann::json::parse(std::ifstream(dir_ + "/truth.json"))["true_machine"]["psi_m_Wb"];
@@ -87,7 +88,8 @@ class FieldLog : public ::testing::Test {
   static void TearDownTestSuite() { fs::remove_all(dir_); }
 
   static nlohmann::json diagnose(const std::string& log, const std::string& out, std::string* output = nullptr) {
-    const test::ProcessResult r = test::run_command(rpem_tool() + " diagnose --log " + log + " --config " + config() + " --out " + out);
+    const test::ProcessResult r =
+        test::run_command(rpem_tool() + " diagnose --log " + log + " --config " + config() + " --out " + out);
     EXPECT_EQ(r.exit_code, 0) << r.output;
     if (output) *output = r.output;
     return nlohmann::json::parse(std::ifstream(out + "/diagnosis.json"));
@@ -126,10 +128,11 @@ TEST_F(FieldLog, RowsAModelTheFitDoesNotShareAreOutweighedNotFitted) {
   ASSERT_EQ(d["loss"]["kind"], "huber") << d["loss"].dump(2);
   EXPECT_GT(d["loss"]["largest_shift"].get<double>(), 1.0);
   const double ls = d["loss"]["least_squares"]["psi_m_Wb"].get<double>();
-  std::printf("saturated rows %d: psi_m least squares %+.2f %%, robust %+.2f %% (clean %+.2f %%); largest shift %.2f; b %.3g A after %d runs\n",
-              saturated, 100.0 * (ls / true_psi_m_ - 1.0), 100.0 * (d["calibration"]["psi_m_Wb"].get<double>() / true_psi_m_ - 1.0),
-              100.0 * (clean["calibration"]["psi_m_Wb"].get<double>() / true_psi_m_ - 1.0), d["loss"]["largest_shift"].get<double>(),
-              d["loss"]["huber_threshold_A"].get<double>(), d["loss"]["robust_runs"].get<int>());
+  std::printf(
+      "saturated rows %d: psi_m least squares %+.2f %%, robust %+.2f %% (clean %+.2f %%); largest shift %.2f; b %.3g A after %d runs\n",
+      saturated, 100.0 * (ls / true_psi_m_ - 1.0), 100.0 * (d["calibration"]["psi_m_Wb"].get<double>() / true_psi_m_ - 1.0),
+      100.0 * (clean["calibration"]["psi_m_Wb"].get<double>() / true_psi_m_ - 1.0), d["loss"]["largest_shift"].get<double>(),
+      d["loss"]["huber_threshold_A"].get<double>(), d["loss"]["robust_runs"].get<int>());
   EXPECT_GT(std::abs(ls / true_psi_m_ - 1.0), 0.01) << ls;
   EXPECT_NEAR(d["calibration"]["psi_m_Wb"].get<double>() / true_psi_m_, 1.0, 0.005);
   EXPECT_EQ(d["effects"].size(), 0U) << d["effects"].dump(2);
@@ -166,8 +169,9 @@ TEST_F(FieldLog, AVescToolLogSaysWhatItLeftOutAndWhy) {
   EXPECT_EQ(d["log"]["kind"], "averaged");
   const nlohmann::json& regimes = d["log"]["regimes"];
   const int bridge_off = regimes["bridge_off"];
-  std::printf("VESC Tool log: %zu rows, %d with the bridge off put in, classified %s; psi_m %+.2f %%; loss %s\n", t.rows.size(), off,
-              regimes.dump().c_str(), 100.0 * (d["calibration"]["psi_m_Wb"].get<double>() / true_psi_m_ - 1.0),
+  std::printf("VESC Tool log: %zu rows, %d with the bridge off put in, classified %s; psi_m %+.2f %%; loss %s\n",
+              t.rows.size(), off, regimes.dump().c_str(),
+              100.0 * (d["calibration"]["psi_m_Wb"].get<double>() / true_psi_m_ - 1.0),
               d["loss"]["kind"].get<std::string>().c_str());
   EXPECT_GT(bridge_off, off * 9 / 10) << regimes.dump(2);
   EXPECT_LE(bridge_off, off + 20) << regimes.dump(2);

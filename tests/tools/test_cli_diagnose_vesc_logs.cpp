@@ -28,7 +28,8 @@ std::string firmware_config() { return test::source_dir() + "/config/vesc-6374-f
 class VescToolLogs : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ = test::temp_path(std::string("cli_diagnose_vesc_") + ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    dir_ =
+        test::temp_path(std::string("cli_diagnose_vesc_") + ::testing::UnitTest::GetInstance()->current_test_info()->name());
     fs::remove_all(dir_);
     fs::create_directories(dir_);
   }
@@ -87,9 +88,8 @@ TEST_F(VescToolLogs, IndependentGeneratorSeed1) {
 
 TEST_F(VescToolLogs, IndependentGeneratorSeed2ZerosWhileOffAcrossMidnight) {
   // ψm −15 %, R_s +20 %, zeros while the bridge is off (the field log's kind), across midnight: 3.938 mWb.
-  const nlohmann::json d =
-      diagnose(independent_log(dir_, "--seed 2 --psi-m-rel -0.15 --r-s-rel 0.2 --off-voltage zero --midnight"),
-               firmware_config());
+  const nlohmann::json d = diagnose(
+      independent_log(dir_, "--seed 2 --psi-m-rel -0.15 --r-s-rel 0.2 --off-voltage zero --midnight"), firmware_config());
   EXPECT_NEAR(d["calibration"]["psi_m_Wb"].get<double>() / 3.93805e-3, 1.0, 0.02);
 }
 

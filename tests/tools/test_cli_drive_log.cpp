@@ -75,16 +75,17 @@ TEST(CliDriveLog, ToolsThatKnowTheMachineHoldCurrentsToTenTimesItsRating) {
   const std::string log = (dir / "amps.csv").string();
   std::ofstream(log) << kHeader << "0,0,0,220,1,2,3,0,100,-100\n";
   for (const std::string& sub : {"estimate --log " + log + " --out " + (dir / "est.csv").string(),
-                                "diagnose --log " + log + " --out " + (dir / "d").string()}) {
+                                 "diagnose --log " + log + " --out " + (dir / "d").string()}) {
     const test::ProcessResult r = test::run_command(test::binary_dir() + "/tools/rpem " + sub);
     EXPECT_EQ(r.exit_code, 65) << sub << "\n" << r.output;
     EXPECT_NE(r.output.find("amps.csv:2:9: column i_b: 100 A is beyond the plausible ±69.7207 A (10 x the configured "
                             "machine's rated peak phase current 6.972 A"),
               std::string::npos)
-        << sub << "\n" << r.output;
+        << sub << "\n"
+        << r.output;
   }
-  const test::ProcessResult r = test::run_command(test::binary_dir() + "/tools/rpem replay " + log + " --candump " +
-                                                  (dir / "frames.log").string());
+  const test::ProcessResult r =
+      test::run_command(test::binary_dir() + "/tools/rpem replay " + log + " --candump " + (dir / "frames.log").string());
   EXPECT_EQ(r.exit_code, 0) << r.output;
   fs::remove_all(dir);
 }

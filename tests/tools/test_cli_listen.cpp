@@ -60,8 +60,8 @@ std::vector<Row> read_rows(const std::string& csv) {
     ADD_FAILURE() << "no column " << name;
     return std::size_t{0};
   };
-  const std::size_t utime = column("utime"), r_s = column("r_s"), age = column("r_s_age_s"),
-                    valid = column("r_s_valid"), adapting = column("r_s_adapting");
+  const std::size_t utime = column("utime"), r_s = column("r_s"), age = column("r_s_age_s"), valid = column("r_s_valid"),
+                    adapting = column("r_s_adapting");
   std::vector<Row> rows;
   while (std::getline(in, line)) {
     std::vector<std::string> f;
@@ -75,13 +75,14 @@ std::vector<Row> read_rows(const std::string& csv) {
 TEST(CliListen, AHeldEstimateShowsItsAgeAndLapsesAfterMaxHold) {
   test::TempFile scenario("scenario.yaml", std::string(kScenario));
   test::TempFile state("state.json");
-  test::TempFile config("rpemd.yaml", "daemon:\n  source: {type: sim, sim: {scenario: " + scenario.path() +
-                                          ", loop: false}}\n  lcm: {url: \"" + kUrl + "\"}\n  state: {file: " +
-                                          state.path() + "}\n  status_interval_s: 0.5\n  validity: {max_hold_s: " +
-                                          std::to_string(kMaxHold_s) + "}\n");
+  test::TempFile config("rpemd.yaml",
+                        "daemon:\n  source: {type: sim, sim: {scenario: " + scenario.path() +
+                            ", loop: false}}\n  lcm: {url: \"" + kUrl + "\"}\n  state: {file: " + state.path() +
+                            "}\n  status_interval_s: 0.5\n  validity: {max_hold_s: " + std::to_string(kMaxHold_s) + "}\n");
   test::TempFile rpemd_log("rpemd.log"), csv("listen.csv");
   const auto listen = [&] {
-    return test::run_command(test::binary_dir() + "/tools/rpem listen --lcm-url '" + kUrl + "' --duration 10 --csv " + csv.path());
+    return test::run_command(test::binary_dir() + "/tools/rpem listen --lcm-url '" + kUrl + "' --duration 10 --csv " +
+                             csv.path());
   };
   test::ProcessResult heard;
   {

@@ -11,13 +11,13 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <fstream>
 #include <lcm/lcm-cpp.hpp>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <thread>
-#include <cstdint>
 #include <type_traits>
 #include <vector>
 
@@ -134,9 +134,15 @@ print(json.dumps(out))
   }
   // The estimate columns the checkers read (values as %.6g: these have fewer digits).
   const std::map<std::string, double> est{
-      {"utime", static_cast<double>(e.utime)}, {"sample_time_us", static_cast<double>(e.sample_time_us)},
-      {"samples", static_cast<double>(e.samples)}, {"psi_m", e.psi_m_Wb}, {"r_s", e.r_s_Ohm},
-      {"T_magnet", e.t_magnet_C}, {"T_winding", e.t_winding_C}, {"frozen", e.frozen}, {"state", e.state},
+      {"utime", static_cast<double>(e.utime)},
+      {"sample_time_us", static_cast<double>(e.sample_time_us)},
+      {"samples", static_cast<double>(e.samples)},
+      {"psi_m", e.psi_m_Wb},
+      {"r_s", e.r_s_Ohm},
+      {"T_magnet", e.t_magnet_C},
+      {"T_winding", e.t_winding_C},
+      {"frozen", e.frozen},
+      {"state", e.state},
   };
   for (const auto& [column, value] : est) {
     ASSERT_TRUE(j["est"].contains(column)) << column;
@@ -145,7 +151,7 @@ print(json.dumps(out))
   EXPECT_EQ(j["est"]["auth"], "unverified");
   // check_ax8000_rpemd.py's signal_map counters, in the source's terms.
   const std::map<std::string, std::int64_t> signal_map{
-      {"frames", d.can_frames},         {"unknown_id", d.can_unknown_id},   {"wrong_length", d.can_wrong_dlc},
+      {"frames", d.can_frames},         {"unknown_id", d.can_unknown_id},    {"wrong_length", d.can_wrong_dlc},
       {"incomplete", d.can_incomplete}, {"non_finite", d.can_invalid_value}, {"kernel_drops", d.can_kernel_drops},
   };
   const auto signal_map_heard = j["signal_map"].get<std::map<std::string, std::int64_t>>();
@@ -166,9 +172,8 @@ TEST(CliListenFormat, AMessageThatDoesNotDecodeIsCountedNotACrash) {
   at[3] = 0;
 
   test::ProcessResult heard;
-  std::thread listener([&] {
-    heard = test::run_command(test::binary_dir() + "/tools/rpem listen --duration 2.0 --lcm-url '" + kUrl + "'");
-  });
+  std::thread listener(
+      [&] { heard = test::run_command(test::binary_dir() + "/tools/rpem listen --duration 2.0 --lcm-url '" + kUrl + "'"); });
   {
     lcm::LCM lcm(kUrl);
     ASSERT_TRUE(lcm.good());
@@ -179,8 +184,10 @@ TEST(CliListenFormat, AMessageThatDoesNotDecodeIsCountedNotACrash) {
   }
   listener.join();
   EXPECT_EQ(heard.exit_code, 0) << heard.output;
-  EXPECT_NE(heard.output.find("RPEM_ESTIMATE: " + std::to_string(crafted.size()) + " bytes that are not one estimate_t: ignored"),
-            std::string::npos) << heard.output;
+  EXPECT_NE(
+      heard.output.find("RPEM_ESTIMATE: " + std::to_string(crafted.size()) + " bytes that are not one estimate_t: ignored"),
+      std::string::npos)
+      << heard.output;
   EXPECT_NE(heard.output.find("1 estimates"), std::string::npos) << heard.output;
   EXPECT_NE(heard.output.find("; 1 malformed"), std::string::npos) << heard.output;
 }

@@ -27,7 +27,8 @@ std::string maps() { return test::source_dir() + "/config/log-maps/"; }
 class CliLogFormats : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ = test::temp_path(std::string("cli_log_formats_") + ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    dir_ =
+        test::temp_path(std::string("cli_log_formats_") + ::testing::UnitTest::GetInstance()->current_test_info()->name());
     fs::remove_all(dir_);
     fs::create_directories(dir_);
   }
@@ -55,8 +56,8 @@ std::string vesc_config() { return test::source_dir() + "/config/vesc-6374-outru
 
 TEST_F(CliLogFormats, AVescToolLogIsReadWithoutAFlag) {
   const std::string log = vesc_log(120);
-  const test::ProcessResult e = test::run_command(rpem() + " estimate --log " + log + " --config " + vesc_config() +
-                                                  " --out " + path("est.csv"));
+  const test::ProcessResult e =
+      test::run_command(rpem() + " estimate --log " + log + " --config " + vesc_config() + " --out " + path("est.csv"));
   EXPECT_EQ(e.exit_code, 0) << e.output;
   EXPECT_NE(e.output.find("as VESC Tool realtime log (the header of VESC Tool 1.20 and later): 120 rows, 119 averaged "
                           "samples (the first row opens the first window"),
@@ -74,8 +75,8 @@ TEST_F(CliLogFormats, FiguresDrawAVescToolLogsRegimes) {
   // Every row modulates at a locked angle and excites ψm (ω·ψm ≈ 3–7 V against VESC Tool's 10 mV): nothing is
   // bridge off or not locked, and the timeline is drawn.
   const std::string log = vesc_log(120);
-  const test::ProcessResult r = test::run_command(rpem() + " figures --log " + log + " --config " + vesc_config() +
-                                                  " --out " + path("fig"));
+  const test::ProcessResult r =
+      test::run_command(rpem() + " figures --log " + log + " --config " + vesc_config() + " --out " + path("fig"));
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("rpem figures: read " + log + " as VESC Tool realtime log"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("not_locked 0, bridge_off 0,"), std::string::npos) << r.output;
@@ -101,7 +102,8 @@ TEST_F(CliLogFormats, FiguresReadAMappedLogAndRefuseABadOneBeforeDrawing) {
   EXPECT_TRUE(fs::exists(path("fig/regimes.png")));
   // A row the map cannot read: exit 65 with the file and line, and no figure drawn.
   std::ofstream(log, std::ios::app) << "not,a,row\n";
-  const test::ProcessResult bad = test::run_command(rpem() + " figures --log " + log + map + config + " --out " + path("bad"));
+  const test::ProcessResult bad =
+      test::run_command(rpem() + " figures --log " + log + map + config + " --out " + path("bad"));
   EXPECT_EQ(bad.exit_code, 65) << bad.output;
   EXPECT_NE(bad.output.find("profile.csv:102"), std::string::npos) << bad.output;
   EXPECT_FALSE(fs::exists(path("bad")));

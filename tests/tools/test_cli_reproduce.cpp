@@ -27,7 +27,7 @@ TEST(CliReproduce, WritesThePlotsTheTableAndReproduceJson) {
     SCOPED_TRACE(png);
     ASSERT_TRUE(fs::exists(dir / png));
     const std::string bytes = test::read_file((dir / png).string());
-    ASSERT_GT(bytes.size(), 10'000U);                 // a rendered chart, not an empty canvas
+    ASSERT_GT(bytes.size(), 10'000U);  // a rendered chart, not an empty canvas
     EXPECT_EQ(bytes.substr(1, 3), "PNG");
   }
   const std::string table = test::read_file((dir / "comparison.md").string());

@@ -58,16 +58,17 @@ TEST(CliRpemdSources, EachSourceSectionOfTheDocsGivesAConfigurationThatChecksOut
 }
 
 TEST(CliRpemdSources, AMapWithoutSpeedStopsRpemdWithExit78NamingMapAndQuantity) {
-  const rpem::test::TempFile map("rpemd-map-no-speed.yaml",
-                                 "name: no-speed\nsample: {trigger: 0x301, averaged: true}\nframes:\n"
-                                 "  - id: 0x301\n    signals:\n"
-                                 "      - {field: i_d, start_bit: 0, length: 16, byte_order: little_endian, signed: true, scale: 0.01, unit: A}\n"
-                                 "      - {field: i_q, start_bit: 16, length: 16, byte_order: little_endian, signed: true, scale: 0.01, unit: A}\n"
-                                 "      - {field: u_d, start_bit: 32, length: 16, byte_order: little_endian, signed: true, scale: 0.01, unit: V}\n"
-                                 "      - {field: u_q, start_bit: 48, length: 16, byte_order: little_endian, signed: true, scale: 0.01, unit: V}\n");
-  const rpem::test::TempFile config("rpemd-map-no-speed-config.yaml",
-                                    "daemon:\n  source:\n    type: signal_map\n    signal_map: {interface: vcan0, map: " +
-                                        map.path() + "}\n");
+  const rpem::test::TempFile map(
+      "rpemd-map-no-speed.yaml",
+      "name: no-speed\nsample: {trigger: 0x301, averaged: true}\nframes:\n"
+      "  - id: 0x301\n    signals:\n"
+      "      - {field: i_d, start_bit: 0, length: 16, byte_order: little_endian, signed: true, scale: 0.01, unit: A}\n"
+      "      - {field: i_q, start_bit: 16, length: 16, byte_order: little_endian, signed: true, scale: 0.01, unit: A}\n"
+      "      - {field: u_d, start_bit: 32, length: 16, byte_order: little_endian, signed: true, scale: 0.01, unit: V}\n"
+      "      - {field: u_q, start_bit: 48, length: 16, byte_order: little_endian, signed: true, scale: 0.01, unit: V}\n");
+  const rpem::test::TempFile config(
+      "rpemd-map-no-speed-config.yaml",
+      "daemon:\n  source:\n    type: signal_map\n    signal_map: {interface: vcan0, map: " + map.path() + "}\n");
   for (const char* mode : {" --check-config", ""}) {  // refused before any socket or thread exists
     const auto r = rpem::test::run_command(rpemd() + mode + " --config " + config.path());
     EXPECT_EQ(r.exit_code, 78) << r.output;
@@ -87,14 +88,16 @@ TEST(CliRpemdSources, AFloatSignalOfTheWrongLengthOrAlignmentStopsRpemdWithExit7
       {"      - {field: i_d, start_bit: 4, length: 64, value_type: double, unit: A}\n", "must start on a byte boundary"},
   };
   for (const auto& [signal, why] : cases) {
-    const rpem::test::TempFile map("rpemd-map-float.yaml", "name: float\nsample: {trigger: 0x302, averaged: true}\nframes:\n"
-                                                         "  - id: 0x300\n    length: 16\n    signals:\n" +
-                                                             std::string(signal) +
-                                                             "      - {field: i_q, start_bit: 96, length: 32, value_type: float, unit: A}\n"
-                                                             "  - id: 0x301\n    signals:\n" + rest);
-    const rpem::test::TempFile config("rpemd-map-float-config.yaml",
-                                      "daemon:\n  source:\n    type: signal_map\n    signal_map: {interface: vcan0, map: " +
-                                          map.path() + "}\n");
+    const rpem::test::TempFile map("rpemd-map-float.yaml",
+                                   "name: float\nsample: {trigger: 0x302, averaged: true}\nframes:\n"
+                                   "  - id: 0x300\n    length: 16\n    signals:\n" +
+                                       std::string(signal) +
+                                       "      - {field: i_q, start_bit: 96, length: 32, value_type: float, unit: A}\n"
+                                       "  - id: 0x301\n    signals:\n" +
+                                       rest);
+    const rpem::test::TempFile config(
+        "rpemd-map-float-config.yaml",
+        "daemon:\n  source:\n    type: signal_map\n    signal_map: {interface: vcan0, map: " + map.path() + "}\n");
     const auto r = rpem::test::run_command(rpemd() + " --check-config --config " + config.path());
     EXPECT_EQ(r.exit_code, 78) << r.output;
     EXPECT_NE(r.output.find("rpemd-map-float.yaml"), std::string::npos) << r.output;

@@ -17,7 +17,8 @@ std::string rpem() { return test::binary_dir() + "/tools/rpem"; }
 
 /// A 3 s stretch of scenarios/vesc-6374.yaml with a bridge-off second in it.
 std::string scenario_text() {
-  return "name: cli-vesc-tool\nmachine: " + test::source_dir() + "/config/vesc-6374-outrunner.yaml\n"
+  return "name: cli-vesc-tool\nmachine: " + test::source_dir() +
+         "/config/vesc-6374-outrunner.yaml\n"
          "duration_s: 3\nwarmup_s: 0.05\nseed: 4\nsample_period_s: 80.0e-6\n"
          "inverter: {model: averaged, switching_frequency_Hz: 6250}\nplant: {step_s: 20.0e-6}\n"
          "control: {current_bandwidth_Hz: 1000}\nsensors: {current_noise_A: 0.15, current_lsb_A: 0.05}\n"
@@ -47,7 +48,7 @@ TEST(CliVescTool, WritesTheLogAndItsTruthRowForRow) {
     EXPECT_EQ(std::count(rows[k].begin(), rows[k].end(), ';'), 55) << rows[k];
     const long ms = std::stol(rows[k]);
     EXPECT_EQ(ms, std::stol(truth_rows[k])) << k;  // the same row
-    EXPECT_GE(ms, 8L * 3'600'000);                  // 08:00:00 UTC at t = 0
+    EXPECT_GE(ms, 8L * 3'600'000);                 // 08:00:00 UTC at t = 0
     EXPECT_LT(ms, 8L * 3'600'000 + 3'100);
   }
   EXPECT_NE(test::read_file(truth.path()).find(",bridge_off,"), std::string::npos);
@@ -59,12 +60,12 @@ TEST(CliVescTool, WritesTheLogAndItsTruthRowForRow) {
 TEST(CliVescTool, WhatCannotBeCombinedOrParsedIsAUsageError) {
   test::TempFile scenario("s.yaml", scenario_text()), log("log.csv");
   const std::string base = rpem() + " sim --scenario " + scenario.path();
-  for (const std::string& args : {" --vesc-tool-out " + log.path() + " --out " + log.path() + ".x",
-                                 " --vesc-tool-out " + log.path() + " --truth " + log.path() + ".t",
-                                 " --vesc-tool-truth " + log.path(),
-                                 " --vesc-tool-out " + log.path() + " --vesc-tool-start 24:00:00",
-                                 " --vesc-tool-out " + log.path() + " --vesc-tool-start 12:00",
-                                 " --vesc-tool-out " + log.path() + " --vesc-tool-rate 500"}) {
+  for (const std::string& args :
+       {" --vesc-tool-out " + log.path() + " --out " + log.path() + ".x",
+        " --vesc-tool-out " + log.path() + " --truth " + log.path() + ".t", " --vesc-tool-truth " + log.path(),
+        " --vesc-tool-out " + log.path() + " --vesc-tool-start 24:00:00",
+        " --vesc-tool-out " + log.path() + " --vesc-tool-start 12:00",
+        " --vesc-tool-out " + log.path() + " --vesc-tool-rate 500"}) {
     const auto r = test::run_command(base + args);
     EXPECT_EQ(r.exit_code, 64) << args << "\n" << r.output;
   }

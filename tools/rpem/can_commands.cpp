@@ -116,9 +116,13 @@ int run_record(const RecordOptions& o) {
                static_cast<unsigned long long>(c.bus_off), static_cast<unsigned long long>(c.error_passive));
   if (o.latency && !latencies_us.empty()) {
     std::sort(latencies_us.begin(), latencies_us.end());
-    auto pct = [&](double q) { return latencies_us[static_cast<std::size_t>(q * static_cast<double>(latencies_us.size() - 1))]; };
-    std::fprintf(stderr, "  latency, scheduled time of a frame's last sample -> kernel receive [us]: p50 %.1f, p99 %.1f, max %.1f (%zu frames)\n",
-                 pct(0.5), pct(0.99), latencies_us.back(), latencies_us.size());
+    auto pct = [&](double q) {
+      return latencies_us[static_cast<std::size_t>(q * static_cast<double>(latencies_us.size() - 1))];
+    };
+    std::fprintf(
+        stderr,
+        "  latency, scheduled time of a frame's last sample -> kernel receive [us]: p50 %.1f, p99 %.1f, max %.1f (%zu frames)\n",
+        pct(0.5), pct(0.99), latencies_us.back(), latencies_us.size());
   }
   return kExitOk;
 }

@@ -15,7 +15,8 @@ void add_stream_options(CLI::App* cmd, StreamOptions& o) {
   cmd->add_option("--rate", o.rate, "playback speed: 1 real time, 0 as fast as possible")->check(CLI::NonNegativeNumber);
   cmd->add_flag("--classic", o.classic, "classic CAN mapping (five 8-byte frames per sample)");
   cmd->add_option("--samples-per-frame", o.samples_per_frame, "samples per CAN FD frame")->check(CLI::Range(1, 3));
-  cmd->add_flag("--wall-timestamps", o.wall_timestamps, "stamp samples with their scheduled wall-clock time (latency tests)");
+  cmd->add_flag("--wall-timestamps", o.wall_timestamps,
+                "stamp samples with their scheduled wall-clock time (latency tests)");
   cmd->add_option("--candump", o.candump_out, "also write the frames as a candump -L log");
   cmd->add_option("--drop-probability", o.drop_probability, "test aid: drop this fraction of losses at random")
       ->check(CLI::Range(0.0, 1.0));

@@ -15,12 +15,12 @@
 namespace rpem::tools {
 
 struct StreamOptions {
-  std::string interface;       ///< SocketCAN interface; empty: none
-  std::string candump_out;     ///< candump -L file; empty: none
-  double rate = 1.0;           ///< 1: real time, 2: twice as fast, 0: as fast as possible
-  bool classic = false;        ///< classic CAN mapping (five frames per sample)
-  int samples_per_frame = 3;   ///< CAN FD
-  bool wall_timestamps = false;  ///< stamp samples with their scheduled CLOCK_REALTIME time (latency tests)
+  std::string interface;          ///< SocketCAN interface; empty: none
+  std::string candump_out;        ///< candump -L file; empty: none
+  double rate = 1.0;              ///< 1: real time, 2: twice as fast, 0: as fast as possible
+  bool classic = false;           ///< classic CAN mapping (five frames per sample)
+  int samples_per_frame = 3;      ///< CAN FD
+  bool wall_timestamps = false;   ///< stamp samples with their scheduled CLOCK_REALTIME time (latency tests)
   double drop_probability = 0.0;  ///< test aid: drop frames at random with this probability…
   int drop_burst = 1;             ///< …each loss taking this many consecutive frames
   std::uint64_t drop_seed = 1;

@@ -78,6 +78,61 @@ std::string read_text(const std::string& path) {
   return s.str();
 }
 
+/// The diagnosis in brief on stdout: the baseline, the calibration, the effects found and left out, the verdict.
+void print_summary(const analysis::Diagnosis& d) {
+  const analysis::Selection& s = d.selection;
+  std::printf("baseline (the configuration as it is): held-out residual %.4g A RMS\n", d.baseline_heldout_rms_A);
+  std::printf("calibrated baseline: held-out residual %.4g A RMS", d.calibration.heldout_rms_A);
+  for (std::size_t i = 0; i < analysis::kCalibrated.size(); ++i) {
+    if (d.calibration.identifiable[i]) {
+      std::printf(" %s=%.6g (mismatch ±%.2g %%)", analysis::kCalibrated[i], d.calibration.value[i],
+                  100.0 * analysis::mismatch_half_width(d, i));
+    }
+  }
+  std::printf("\n");
+  for (const std::string& f : analysis::calibrated_despite_mismatch(d))
+    std::printf("calibrated despite a large mismatch: %s\n", f.c_str());
+  for (const std::string& f : analysis::calibration_findings(d)) std::printf("calibration: %s\n", f.c_str());
+  if (d.least_squares) {
+    std::printf(
+        "outliers: %zu of %zu training samples beyond %.3g A moved the least-squares fit (%s by %.2g times its 95 %% "
+        "half-width): diagnosed again under Huber's loss, b = %.3g A after %d run%s\n",
+        d.outliers.test.beyond, d.outliers.test.samples, d.outliers.test.threshold_A, d.outliers.parameter.c_str(),
+        d.outliers.largest_shift, d.outliers.loss.threshold_A, d.outliers.robust_runs,
+        d.outliers.robust_runs == 1 ? "" : "s");
+  }
+  if (s.found.empty()) std::printf("effects: none\n");
+  for (std::size_t j = 0; j < s.found.size(); ++j) {
+    std::printf("effect %s:", s.found[j].effect.label().c_str());
+    for (const analysis::NamedValue& v : analysis::found_parameters(d, j)) {
+      if (v.text.empty()) {
+        std::printf(" %s=%.6g", v.name.c_str(), v.value);
+      } else {
+        std::printf(" %s=%s", v.name.c_str(), v.text.c_str());
+      }
+    }
+    const analysis::EstimatorCheck* c = analysis::estimator_check(d, j);
+    std::printf(" (held-out gain %.1f %%%s)\n", s.found[j].gain_pct,
+                c && !c->kept ? "; not in extended.yaml: the estimator predicts worse with it" : "");
+  }
+  for (const analysis::ImplausibleEffect& i : s.implausible) {
+    std::printf("implausible, not named: %s: %s\n", i.effect.label().c_str(), i.why.reason.c_str());
+  }
+  for (const analysis::Unidentifiable& u : s.not_identifiable) {
+    std::string names;
+    for (const std::string& e : u.effects) names += (names.empty() ? "" : " / ") + e;
+    std::printf("not identifiable: %s\n", names.c_str());
+  }
+  std::printf("extended model: held-out residual %.4g A RMS\n", s.extended_heldout_rms_A);
+  if (d.verdict.ratio) {
+    std::printf("verdict: %s (%.3g times the noise floor of %.3g A)\n", analysis::to_string(d.verdict.kind),
+                *d.verdict.ratio, d.verdict.noise_floor_A.value_or(0.0));
+  } else {
+    std::printf("verdict: %s (noise floor unknown)\n", analysis::to_string(d.verdict.kind));
+  }
+  for (const std::string& f : d.verdict.findings) std::printf("  %s\n", f.c_str());
+}
+
 int diagnose_and_write(const DiagnoseCliOptions& o, const io::MachineConfig& config, const std::string& config_text,
                        const std::string& config_name, const analysis::LogOptions& log_options, TerminalMonitor& monitor);
 
@@ -108,10 +163,11 @@ int run_diagnose(const DiagnoseCliOptions& o) {
 int diagnose_and_write(const DiagnoseCliOptions& o, const io::MachineConfig& config, const std::string& config_text,
                        const std::string& config_name, const analysis::LogOptions& log_options, TerminalMonitor& monitor) {
   std::fprintf(stderr, "rpem diagnose: reading %s\n", o.log.c_str());
-  analysis::LogData log = analysis::load_log(o.log, config.machine, log_options, [&](std::uint64_t done, std::uint64_t total) {
-    monitor.reading(done, total);
-    if (monitor.stop_requested()) throw analysis::Interrupted();
-  });
+  analysis::LogData log =
+      analysis::load_log(o.log, config.machine, log_options, [&](std::uint64_t done, std::uint64_t total) {
+        monitor.reading(done, total);
+        if (monitor.stop_requested()) throw analysis::Interrupted();
+      });
   monitor.finish();
   std::fprintf(stderr, "rpem diagnose: read %s\n", log.format.c_str());
   io::check_log_supports(config, config_name, log.layout.u_dc, o.log);
@@ -143,53 +199,7 @@ int diagnose_and_write(const DiagnoseCliOptions& o, const io::MachineConfig& con
   if (monitor.stop_requested()) throw analysis::Interrupted();
   staged.commit();
 
-  const analysis::Selection& s = d.selection;
-  std::printf("baseline (the configuration as it is): held-out residual %.4g A RMS\n", d.baseline_heldout_rms_A);
-  std::printf("calibrated baseline: held-out residual %.4g A RMS", d.calibration.heldout_rms_A);
-  for (std::size_t i = 0; i < analysis::kCalibrated.size(); ++i) {
-    if (d.calibration.identifiable[i]) {
-      std::printf(" %s=%.6g (mismatch ±%.2g %%)", analysis::kCalibrated[i], d.calibration.value[i],
-                  100.0 * analysis::mismatch_half_width(d, i));
-    }
-  }
-  std::printf("\n");
-  for (const std::string& f : analysis::calibrated_despite_mismatch(d)) std::printf("calibrated despite a large mismatch: %s\n", f.c_str());
-  for (const std::string& f : analysis::calibration_findings(d)) std::printf("calibration: %s\n", f.c_str());
-  if (d.least_squares) {
-    std::printf("outliers: %zu of %zu training samples beyond %.3g A moved the least-squares fit (%s by %.2g times its 95 %% "
-                "half-width): diagnosed again under Huber's loss, b = %.3g A after %d run%s\n",
-                d.outliers.test.beyond, d.outliers.test.samples, d.outliers.test.threshold_A, d.outliers.parameter.c_str(),
-                d.outliers.largest_shift, d.outliers.loss.threshold_A, d.outliers.robust_runs, d.outliers.robust_runs == 1 ? "" : "s");
-  }
-  if (s.found.empty()) std::printf("effects: none\n");
-  for (std::size_t j = 0; j < s.found.size(); ++j) {
-    std::printf("effect %s:", s.found[j].effect.label().c_str());
-    for (const analysis::NamedValue& v : analysis::found_parameters(d, j)) {
-      if (v.text.empty()) {
-        std::printf(" %s=%.6g", v.name.c_str(), v.value);
-      } else {
-        std::printf(" %s=%s", v.name.c_str(), v.text.c_str());
-      }
-    }
-    const analysis::EstimatorCheck* c = analysis::estimator_check(d, j);
-    std::printf(" (held-out gain %.1f %%%s)\n", s.found[j].gain_pct, c && !c->kept ? "; not in extended.yaml: the estimator predicts worse with it" : "");
-  }
-  for (const analysis::ImplausibleEffect& i : s.implausible) {
-    std::printf("implausible, not named: %s: %s\n", i.effect.label().c_str(), i.why.reason.c_str());
-  }
-  for (const analysis::Unidentifiable& u : s.not_identifiable) {
-    std::string names;
-    for (const std::string& e : u.effects) names += (names.empty() ? "" : " / ") + e;
-    std::printf("not identifiable: %s\n", names.c_str());
-  }
-  std::printf("extended model: held-out residual %.4g A RMS\n", s.extended_heldout_rms_A);
-  if (d.verdict.ratio) {
-    std::printf("verdict: %s (%.3g times the noise floor of %.3g A)\n", analysis::to_string(d.verdict.kind), *d.verdict.ratio,
-                d.verdict.noise_floor_A.value_or(0.0));
-  } else {
-    std::printf("verdict: %s (noise floor unknown)\n", analysis::to_string(d.verdict.kind));
-  }
-  for (const std::string& f : d.verdict.findings) std::printf("  %s\n", f.c_str());
+  print_summary(d);
   std::printf("wrote %s/report.html, report.md, diagnosis.json, extended.yaml (%.2f s)\n", o.out.c_str(), d.elapsed_s);
   return kExitOk;
 }
@@ -213,7 +223,8 @@ Runner add_diagnose_command(CLI::App& app) {
       ->check(CLI::ExistingFile);
   cmd->add_option("--out", o->out, "directory for report.html, report.md, figures, diagnosis.json, extended.yaml")
       ->required();
-  cmd->add_option("--truth", o->truth, "true parameters (t, psi_m, r_s) to judge the estimates against, e.g. rpem sim --truth")
+  cmd->add_option("--truth", o->truth,
+                  "true parameters (t, psi_m, r_s) to judge the estimates against, e.g. rpem sim --truth")
       ->check(CLI::ExistingFile);
   cmd->add_option("--model", o->model, "replay model: auto (from the sample interval), transient, steady_state")
       ->check(CLI::IsMember({"auto", "transient", "steady_state"}));

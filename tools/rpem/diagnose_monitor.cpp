@@ -97,7 +97,8 @@ void TerminalMonitor::draw(bool force) noexcept {
   if (work > 0) {
     const double fraction = static_cast<double>(done) / static_cast<double>(work);
     const int filled = static_cast<int>(fraction * kBarWidth);
-    line += " [" + std::string(static_cast<std::size_t>(filled), '#') + std::string(static_cast<std::size_t>(kBarWidth - filled), '.') + "] ";
+    line += " [" + std::string(static_cast<std::size_t>(filled), '#') +
+            std::string(static_cast<std::size_t>(kBarWidth - filled), '.') + "] ";
     char percent[16];
     std::snprintf(percent, sizeof percent, "%3.0f %%", 100.0 * fraction);
     line += percent;

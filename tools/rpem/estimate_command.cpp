@@ -110,7 +110,8 @@ struct Tally {
   /// The regimes' counts, and why, where more than a tenth of the samples adapted nothing.
   void explain() const {
     std::fprintf(stderr, "rpem estimate: %s\n", io::regime_summary(counts).c_str());
-    for (const std::string& why : io::exclusion_explanations(counts)) std::fprintf(stderr, "rpem estimate: %s\n", why.c_str());
+    for (const std::string& why : io::exclusion_explanations(counts))
+      std::fprintf(stderr, "rpem estimate: %s\n", why.c_str());
   }
 };
 
@@ -129,8 +130,8 @@ struct Identifiability {
 void check_identifiable(const std::vector<core::AveragedSample>& samples, const io::MachineConfig& cfg,
                         const core::Estimate& last, const std::array<std::uint64_t, 2>& adapted) {
   const core::EstimatorSettings& e = cfg.estimator;
-  std::array<Identifiability, 2> p{{{"psi_m", "Wb", 0.02, e.psi_m_min_Wb, e.psi_m_max_Wb},
-                                    {"r_s", "Ohm", 0.05, e.r_s_min_Ohm, e.r_s_max_Ohm}}};
+  std::array<Identifiability, 2> p{
+      {{"psi_m", "Wb", 0.02, e.psi_m_min_Wb, e.psi_m_max_Wb}, {"r_s", "Ohm", 0.05, e.r_s_min_Ohm, e.r_s_max_Ohm}}};
   const std::array<double, 2> estimate{last.psi_m_Wb, last.r_s_Ohm};
   for (std::size_t k = 0; k < p.size(); ++k) {
     for (const bool high : {false, true}) {
@@ -142,12 +143,13 @@ void check_identifiable(const std::vector<core::AveragedSample>& samples, const 
     }
     const double half = 0.5 * std::abs(p[k].from_hi - p[k].from_lo) / std::abs(estimate[k]);
     if (half <= p[k].tolerance) continue;
-    std::fprintf(stderr,
-                 "rpem estimate: %s not identifiable from this log: started at the ends of its bounds (%.5g, %.5g %s) "
-                 "the estimator ends at %.5g and %.5g %s: its start still decides +-%.0f %% of %.5g %s, more than the %.0f %% "
-                 "asked of it (it adapted on %llu samples; the regimes above say why not more)\n",
-                 p[k].name, p[k].lo, p[k].hi, p[k].unit, p[k].from_lo, p[k].from_hi, p[k].unit, 100.0 * half, estimate[k],
-                 p[k].unit, 100.0 * p[k].tolerance, static_cast<unsigned long long>(adapted[k]));
+    std::fprintf(
+        stderr,
+        "rpem estimate: %s not identifiable from this log: started at the ends of its bounds (%.5g, %.5g %s) "
+        "the estimator ends at %.5g and %.5g %s: its start still decides +-%.0f %% of %.5g %s, more than the %.0f %% "
+        "asked of it (it adapted on %llu samples; the regimes above say why not more)\n",
+        p[k].name, p[k].lo, p[k].hi, p[k].unit, p[k].from_lo, p[k].from_hi, p[k].unit, 100.0 * half, estimate[k], p[k].unit,
+        100.0 * p[k].tolerance, static_cast<unsigned long long>(adapted[k]));
   }
 }
 
@@ -184,7 +186,8 @@ int run_estimate(const EstimateOptions& o) {
   if (source.averaged()) return run_averaged(o, source, cfg, config_name);
 
   io::DriveLogReader reader(o.log, source.map, io::machine_limits(cfg.machine));
-  if (!source.map.columns_optional) std::fprintf(stderr, "rpem estimate: reading %s as %s\n", o.log.c_str(), source.format.c_str());
+  if (!source.map.columns_optional)
+    std::fprintf(stderr, "rpem estimate: reading %s as %s\n", o.log.c_str(), source.format.c_str());
   io::check_log_supports(cfg, config_name, reader.layout().u_dc, o.log);
   core::DriveEstimator estimator(cfg.machine, cfg.estimator);
   ThermalRun thermal(o, cfg, estimator.base());
@@ -217,7 +220,8 @@ Runner add_estimate_command(CLI::App& app) {
                   "(docs/drive-log.md)")
       ->required()
       ->check(CLI::ExistingFile);
-  cmd->add_option("--log-map", opts->log_map, "column map (YAML) saying how to read --log (docs/drive-log.md, \"Column maps\")")
+  cmd->add_option("--log-map", opts->log_map,
+                  "column map (YAML) saying how to read --log (docs/drive-log.md, \"Column maps\")")
       ->check(CLI::ExistingFile);
   cmd->add_option("--config", opts->config, "machine and estimator YAML (default: built-in paper-ipmsm.yaml)")
       ->check(CLI::ExistingFile);
@@ -231,7 +235,8 @@ Runner add_estimate_command(CLI::App& app) {
                   "e.g. 100 for an 8 kHz log: 1/80 of the file (docs/drive-log.md, \"Estimate CSV\")")
       ->check(CLI::PositiveNumber)
       ->excludes(every);
-  cmd->add_option("--thermal", opts->thermal, "thermal.yaml: run the thermal network's filter beside the estimator (docs/thermal.md)")
+  cmd->add_option("--thermal", opts->thermal,
+                  "thermal.yaml: run the thermal network's filter beside the estimator (docs/thermal.md)")
       ->check(CLI::ExistingFile);
   return [cmd, opts]() { return cmd->parsed() ? run_estimate(*opts) : -1; };
 }

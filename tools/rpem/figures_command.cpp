@@ -59,7 +59,8 @@ int run_figures(const FiguresOptions& o) {
   }
   std::filesystem::create_directories(o.out);
   auto files = analysis::write_analysis_figures(o.out, cfg.machine, cfg.estimator.nominal_sample_period_s);
-  if (log) files.push_back(o.out + "/" + analysis::write_regime_timeline(o.out, *log, regimes, cfg.machine.rated.pole_pairs));
+  if (log)
+    files.push_back(o.out + "/" + analysis::write_regime_timeline(o.out, *log, regimes, cfg.machine.rated.pole_pairs));
   for (const auto& f : files) std::fprintf(stderr, "rpem figures: wrote %s\n", f.c_str());
   return kExitOk;
 }
@@ -68,14 +69,16 @@ int run_figures(const FiguresOptions& o) {
 
 Runner add_figures_command(CLI::App& app) {
   auto opts = std::make_shared<FiguresOptions>();
-  CLI::App* cmd = app.add_subcommand("figures", "Write the paper's analysis figures for a machine (PNG), and a log's regimes");
+  CLI::App* cmd =
+      app.add_subcommand("figures", "Write the paper's analysis figures for a machine (PNG), and a log's regimes");
   cmd->add_option("--out", opts->out, "output directory")->required();
   cmd->add_option("--config", opts->config, "machine YAML (default: built-in paper-ipmsm.yaml)")->check(CLI::ExistingFile);
   cmd->add_option("--log", opts->log,
                   "also draw this log's timeline coloured by regime (regimes.png): a drive log, averaged log or VESC Tool "
                   "realtime log (detected by its header), or any CSV with --log-map")
       ->check(CLI::ExistingFile);
-  cmd->add_option("--log-map", opts->log_map, "column map (YAML) saying how to read --log (docs/drive-log.md, \"Column maps\")")
+  cmd->add_option("--log-map", opts->log_map,
+                  "column map (YAML) saying how to read --log (docs/drive-log.md, \"Column maps\")")
       ->check(CLI::ExistingFile)
       ->needs("--log");
   cmd->add_option("--thermal-estimate", opts->thermal.estimate_csv,
@@ -83,9 +86,12 @@ Runner add_figures_command(CLI::App& app) {
       ->check(CLI::ExistingFile);
   cmd->add_option("--measured", opts->thermal.measured_csv, "CSV with t [s] and measured temperatures [°C] to plot against")
       ->check(CLI::ExistingFile);
-  cmd->add_option("--magnet-column", opts->thermal.magnet_column, "the measured magnet temperature's column (default T_magnet)");
-  cmd->add_option("--winding-column", opts->thermal.winding_column, "the measured winding temperature's column (default T_winding)");
-  cmd->add_option("--judged-after-s", opts->thermal.judged_after_s, "mark where a held-out part begins; coverage counted after it");
+  cmd->add_option("--magnet-column", opts->thermal.magnet_column,
+                  "the measured magnet temperature's column (default T_magnet)");
+  cmd->add_option("--winding-column", opts->thermal.winding_column,
+                  "the measured winding temperature's column (default T_winding)");
+  cmd->add_option("--judged-after-s", opts->thermal.judged_after_s,
+                  "mark where a held-out part begins; coverage counted after it");
   return [cmd, opts]() { return cmd->parsed() ? run_figures(*opts) : -1; };
 }
 

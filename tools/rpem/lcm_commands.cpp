@@ -17,12 +17,12 @@
 #include <ctime>
 #include <fstream>
 #include <iterator>
+#include <lcm/lcm-cpp.hpp>
 #include <optional>
 #include <span>
 #include <string_view>
-#include <vector>
-#include <lcm/lcm-cpp.hpp>
 #include <thread>
+#include <vector>
 
 #include "commands.hpp"
 #include "rpem/auth/key_file.hpp"
@@ -61,12 +61,16 @@ std::string authenticity(const auth::Keyring& keys, const lcm::ReceiveBuffer* rb
   const std::span bytes(static_cast<const std::uint8_t*>(rbuf->data), rbuf->data_size);
   const std::int32_t id = auth::key_id_of(bytes);
   switch (auth::verify(keys, channel, bytes)) {
-    case auth::Verdict::kVerified: return "verified";
-    case auth::Verdict::kBadMac: return "FORGED";
-    case auth::Verdict::kUnsigned: return "unverified (unsigned)";
+    case auth::Verdict::kVerified:
+      return "verified";
+    case auth::Verdict::kBadMac:
+      return "FORGED";
+    case auth::Verdict::kUnsigned:
+      return "unverified (unsigned)";
     case auth::Verdict::kUnknownKey:
       return keys.empty() ? "unverified (no --key)" : "unverified (key id " + std::to_string(id) + " not held)";
-    case auth::Verdict::kMalformed: break;
+    case auth::Verdict::kMalformed:
+      break;
   }
   return "unverified (malformed)";
 }
@@ -76,9 +80,10 @@ std::string authenticity(const auth::Keyring& keys, const lcm::ReceiveBuffer* rb
 // without code here.
 
 /// The fields the head of an estimate's line shows: each parameter with its status, then the temperatures.
-constexpr std::array<std::string_view, 16> kEstimateHead{
-    "sample_time_us", "state", "speed_pu", "psi_m_Wb", "psi_m_adapting", "psi_m_age_s", "psi_m_valid", "psi_m_converged",
-    "r_s_Ohm", "r_s_adapting", "r_s_age_s", "r_s_valid", "r_s_converged", "t_magnet_C", "t_winding_C", "algorithm"};
+constexpr std::array<std::string_view, 16> kEstimateHead{"sample_time_us", "state",        "speed_pu",    "psi_m_Wb",
+                                                         "psi_m_adapting", "psi_m_age_s",  "psi_m_valid", "psi_m_converged",
+                                                         "r_s_Ohm",        "r_s_adapting", "r_s_age_s",   "r_s_valid",
+                                                         "r_s_converged",  "t_magnet_C",   "t_winding_C", "algorithm"};
 static_assert(schema::has_fields<rpem::estimate_t>(kEstimateHead));
 /// A diagnostics line starts "diag UTIME:".
 constexpr std::array<std::string_view, 1> kDiagnosticsHead{"utime"};
@@ -145,11 +150,12 @@ struct Listener {
   void on_estimate(const lcm::ReceiveBuffer* rbuf, const std::string& channel, const rpem::estimate_t* m) {
     ++estimates;
     const std::string verdict = check(rbuf, channel);
-    std::printf("%.3f s  state %d  n %+.3f pu  psi_m %.5f Wb %s  r_s %.5f Ohm %s  T_magnet %.1f C  T_winding %.1f C  %s  %s | %s\n",
-                1e-6 * static_cast<double>(m->sample_time_us), m->state, m->speed_pu, m->psi_m_Wb,
-                describe(m->psi_m_adapting, m->psi_m_age_s, m->psi_m_valid, m->psi_m_converged).c_str(), m->r_s_Ohm,
-                describe(m->r_s_adapting, m->r_s_age_s, m->r_s_valid, m->r_s_converged).c_str(), m->t_magnet_C,
-                m->t_winding_C, m->algorithm.c_str(), verdict.c_str(), schema::format_fields(*m, kEstimateHead).c_str());
+    std::printf(
+        "%.3f s  state %d  n %+.3f pu  psi_m %.5f Wb %s  r_s %.5f Ohm %s  T_magnet %.1f C  T_winding %.1f C  %s  %s | %s\n",
+        1e-6 * static_cast<double>(m->sample_time_us), m->state, m->speed_pu, m->psi_m_Wb,
+        describe(m->psi_m_adapting, m->psi_m_age_s, m->psi_m_valid, m->psi_m_converged).c_str(), m->r_s_Ohm,
+        describe(m->r_s_adapting, m->r_s_age_s, m->r_s_valid, m->r_s_converged).c_str(), m->t_magnet_C, m->t_winding_C,
+        m->algorithm.c_str(), verdict.c_str(), schema::format_fields(*m, kEstimateHead).c_str());
     std::fflush(stdout);
     if (csv.is_open()) {
       csv << schema::csv_row(*m) << ',' << verdict.substr(0, verdict.find(' ')) << '\n';
@@ -164,7 +170,8 @@ struct Listener {
     std::printf("diag %lld: %s | %s\n", utime, schema::format_fields(*m, kDiagnosticsHead).c_str(), verdict.c_str());
     if (m->source == daemon::SignalMapSource::kType) {
       std::string counters;
-      for (const SourceCounter& c : kSignalMapCounters) counters += " " + std::string(c.label) + " " + std::to_string(m->*c.field);
+      for (const SourceCounter& c : kSignalMapCounters)
+        counters += " " + std::string(c.label) + " " + std::to_string(m->*c.field);
       std::printf("diag %lld %s:%s\n", utime, daemon::SignalMapSource::kType, counters.c_str());
     }
     std::fflush(stdout);
@@ -247,10 +254,12 @@ int run_command(const CommandOptions& o) {
     if (!in.good() && !in.eof()) return kExitIoError;
     if (o.flip_bit >= 0) {
       if (static_cast<std::size_t>(o.flip_bit / 8) >= bytes.size()) {
-        std::fprintf(stderr, "rpem command: --flip-bit %d is beyond the %zu bytes of %s\n", o.flip_bit, bytes.size(), o.resend.c_str());
+        std::fprintf(stderr, "rpem command: --flip-bit %d is beyond the %zu bytes of %s\n", o.flip_bit, bytes.size(),
+                     o.resend.c_str());
         return kExitUsage;
       }
-      bytes[static_cast<std::size_t>(o.flip_bit / 8)] ^= static_cast<char>(1 << (o.flip_bit % 8));
+      char& byte = bytes[static_cast<std::size_t>(o.flip_bit / 8)];
+      byte = static_cast<char>(byte ^ (1 << (o.flip_bit % 8)));
     }
     lcm.publish(channel, bytes.data(), static_cast<unsigned>(bytes.size()));
     std::fprintf(stderr, "rpem command: resent %zu bytes of %s%s on %s\n", bytes.size(), o.resend.c_str(),
@@ -288,9 +297,14 @@ int run_command(const CommandOptions& o) {
       std::fprintf(stderr, "rpem command: publish failed\n");
       return kExitIoError;
     }
-    if (!o.save.empty()) std::ofstream(o.save, std::ios::binary | std::ios::trunc).write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+    if (!o.save.empty())
+      std::ofstream(o.save, std::ios::binary | std::ios::trunc)
+          .write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
   }
-  if (!key) std::fprintf(stderr, "rpem command: warning: no --key: the command is unsigned, and rpemd applies it only with authentication: none\n");
+  if (!key)
+    std::fprintf(
+        stderr,
+        "rpem command: warning: no --key: the command is unsigned, and rpemd applies it only with authentication: none\n");
   std::fprintf(stderr, "rpem command: %s (seq %lld%s) sent on %s; see RPEM_DIAGNOSTICS for the acknowledgement\n",
                o.action.c_str(), static_cast<long long>(o.seq),
                o.repeat > 1 ? (" to " + std::to_string(o.seq + o.repeat - 1)).c_str() : "", channel.c_str());

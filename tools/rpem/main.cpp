@@ -8,7 +8,7 @@
 #include "rpem/auth/key.hpp"
 #include "rpem/io/errors.hpp"
 
-int main(int argc, char** argv) {
+int main(int argc, char** argv) {  // NOLINT(bugprone-exception-escape): only a defect escapes; terminate() shows it
   using namespace rpem::tools;
   CLI::App app{"rpem: offline tools of rpem-drive (online identification of PMSM psi_m and R_s)"};
   app.require_subcommand(1);

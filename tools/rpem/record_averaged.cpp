@@ -13,8 +13,8 @@
 #include "rpem/can/decoder.hpp"
 #include "rpem/can/signal_map.hpp"
 #include "rpem/can/socketcan.hpp"
-#include "rpem/daemon/vesc_poller.hpp"
 #include "rpem/core/clock.hpp"
+#include "rpem/daemon/vesc_poller.hpp"
 #include "rpem/io/averaged_log.hpp"
 #include "rpem/io/signal_map_config.hpp"
 #include "rpem/sim/cycle_average.hpp"
@@ -110,8 +110,8 @@ class VescFeed final : public Feed {
     return "VESC: polls " + std::to_string(c.polls) + ", windows " + std::to_string(c.samples) + ", timeouts " +
            std::to_string(c.timeouts) + ", late " + std::to_string(c.late) + ", unrequested " +
            std::to_string(c.unrequested) + ", stolen reads " + std::to_string(c.stolen_reads) + ", short windows " +
-           std::to_string(c.short_windows) + ", empty reads " + std::to_string(c.empty_reads) +
-           ", long windows " + std::to_string(c.long_windows) + ", send failures " + std::to_string(c.send_failures);
+           std::to_string(c.short_windows) + ", empty reads " + std::to_string(c.empty_reads) + ", long windows " +
+           std::to_string(c.long_windows) + ", send failures " + std::to_string(c.send_failures);
   }
   [[nodiscard]] io::AveragedLogLayout layout() const override { return {true, true, false, true}; }
 
@@ -172,10 +172,12 @@ int run_record_averaged(const RecordOptions& o) {
   }
   writer.flush();
   const auto& c = channel.counters();
-  std::fprintf(stderr, "rpem record: %llu averaged samples written to %s\n  %s\n  kernel drops %llu, reopens %llu, error frames %llu\n",
-               static_cast<unsigned long long>(written), o.averaged_out.c_str(), feed->summary().c_str(),
-               static_cast<unsigned long long>(c.kernel_drops), static_cast<unsigned long long>(c.reopens),
-               static_cast<unsigned long long>(c.error_frames));
+  std::fprintf(
+      stderr,
+      "rpem record: %llu averaged samples written to %s\n  %s\n  kernel drops %llu, reopens %llu, error frames %llu\n",
+      static_cast<unsigned long long>(written), o.averaged_out.c_str(), feed->summary().c_str(),
+      static_cast<unsigned long long>(c.kernel_drops), static_cast<unsigned long long>(c.reopens),
+      static_cast<unsigned long long>(c.error_frames));
   return kExitOk;
 }
 

@@ -19,9 +19,9 @@ struct RecordOptions {
   std::uint64_t samples = 0;
   double idle_timeout_s = 0.0;
   bool latency = false;
-  std::string signal_map;    ///< --signal-map
-  int vesc_id = -1;          ///< --vesc-id; −1: not a VESC
-  int host_id = 254;         ///< the poller's node id
+  std::string signal_map;  ///< --signal-map
+  int vesc_id = -1;        ///< --vesc-id; −1: not a VESC
+  int host_id = 254;       ///< the poller's node id
   double poll_rate_Hz = 200.0;
   double window_rate_Hz = 200.0;  ///< native telemetry's averaging windows
 };

@@ -13,12 +13,12 @@
 
 #include "can_stream.hpp"
 #include "commands.hpp"
-#include "rpem/can/protocol.hpp"
 #include "progress.hpp"
+#include "rpem/can/protocol.hpp"
 #include "rpem/core/drive_estimator.hpp"
 #include "rpem/io/averaged_log.hpp"
-#include "rpem/sim/cycle_average.hpp"
 #include "rpem/io/estimate_log.hpp"
+#include "rpem/sim/cycle_average.hpp"
 #include "rpem/sim/drive_simulator.hpp"
 #include "rpem/sim/truth_log.hpp"
 #include "vesc_emulator.hpp"
@@ -41,12 +41,29 @@ struct SimOptions {
   VescToolOptions vesc_tool;
 };
 
+/// What the simulation did: its samples, where they were written (`out`, if a drive log was) and streamed.
+std::string drive_sim_summary(std::uint64_t n, const std::string& name, const std::string& out,
+                              const TelemetryStreamer* streamer) {
+  std::string summary = std::to_string(n) + " samples of '" + name + "'";
+  if (!out.empty()) summary += " written to " + out;
+  if (streamer != nullptr) {
+    summary += ", streamed as " + std::to_string(streamer->frames_sent()) + " frames";
+    if (streamer->frames_dropped() > 0)
+      summary += " (" + std::to_string(streamer->frames_dropped()) + " dropped on purpose)";
+  }
+  return summary;
+}
+
+int run_drive_sim(const SimOptions& o);
+
+/// --vesc-tool-out and --vesc run alone; anything else is the drive simulated (run_drive_sim).
 int run_sim(const SimOptions& o) {
   if (!o.vesc_tool.out.empty()) {
     if (!o.out.empty() || !o.averaged_out.empty() || !o.truth.empty() || !o.estimate.empty() ||
         !o.stream.interface.empty() || !o.stream.candump_out.empty() || !o.vesc.interface.empty()) {
-      std::fprintf(stderr, "rpem sim: --vesc-tool-out runs alone (its truth: --vesc-tool-truth); drop --out, "
-                           "--averaged-out, --truth, --estimate, --can, --candump and --vesc\n");
+      std::fprintf(stderr,
+                   "rpem sim: --vesc-tool-out runs alone (its truth: --vesc-tool-truth); drop --out, "
+                   "--averaged-out, --truth, --estimate, --can, --candump and --vesc\n");
       return kExitUsage;
     }
     return run_vesc_tool_log(sim::load_scenario(o.scenario), o.vesc_tool);
@@ -60,6 +77,12 @@ int run_sim(const SimOptions& o) {
     vesc.truth = o.truth;
     return run_vesc_emulator(sim::load_scenario(o.scenario), vesc);
   }
+  return run_drive_sim(o);
+}
+
+/// The drive simulated sample by sample into a drive log, an averaged log, CAN telemetry, the truth and the
+/// estimator's log, as the options ask.
+int run_drive_sim(const SimOptions& o) {
   sim::DriveSimulator simulator(sim::load_scenario(o.scenario));
   std::optional<io::DriveLogWriter> log;
   if (!o.out.empty()) log.emplace(o.out, simulator.layout());
@@ -73,7 +96,9 @@ int run_sim(const SimOptions& o) {
     averaged_log.emplace(o.averaged_out, io::AveragedLogLayout{true, l.temperatures, l.temperatures, false});
   }
   if (!log && !streamer && !averaged_log) {
-    std::fprintf(stderr, "rpem sim: give --out LOG.csv, --averaged-out AVG.csv, --vesc-tool-out LOG.csv, --can IFACE or --candump FILE\n");
+    std::fprintf(
+        stderr,
+        "rpem sim: give --out LOG.csv, --averaged-out AVG.csv, --vesc-tool-out LOG.csv, --can IFACE or --candump FILE\n");
     return kExitUsage;
   }
   std::optional<sim::TruthLogWriter> truth;
@@ -85,7 +110,9 @@ int run_sim(const SimOptions& o) {
     const auto& cfg = simulator.scenario().machine;
     estimator = std::make_unique<core::DriveEstimator>(cfg.machine, cfg.estimator);
   }
-  if (streamer && o.stream.rate > 0) std::fprintf(stderr, "rpem sim: streaming '%s' on %s at %.3g× real time\n", simulator.scenario().name.c_str(), o.stream.interface.empty() ? o.stream.candump_out.c_str() : o.stream.interface.c_str(), o.stream.rate);
+  if (streamer && o.stream.rate > 0)
+    std::fprintf(stderr, "rpem sim: streaming '%s' on %s at %.3g× real time\n", simulator.scenario().name.c_str(),
+                 o.stream.interface.empty() ? o.stream.candump_out.c_str() : o.stream.interface.c_str(), o.stream.rate);
   Progress progress("rpem sim");
   io::DriveLogRow row;
   sim::TruthRow truth_row;
@@ -104,14 +131,10 @@ int run_sim(const SimOptions& o) {
     if ((++n & 0x3FF) == 0) progress.update(n, total);
   }
   if (streamer) streamer->finish();
-  std::string summary = std::to_string(n) + " samples of '" + simulator.scenario().name + "'";
-  if (log) summary += " written to " + o.out;
-  if (streamer) {
-    summary += ", streamed as " + std::to_string(streamer->frames_sent()) + " frames";
-    if (streamer->frames_dropped() > 0) summary += " (" + std::to_string(streamer->frames_dropped()) + " dropped on purpose)";
-  }
-  progress.finish(summary);
-  if (streamer && !streamer->lateness_summary().empty()) std::fprintf(stderr, "rpem sim: %s\n", streamer->lateness_summary().c_str());
+  progress.finish(
+      drive_sim_summary(n, simulator.scenario().name, log ? o.out : std::string(), streamer ? &*streamer : nullptr));
+  if (streamer && !streamer->lateness_summary().empty())
+    std::fprintf(stderr, "rpem sim: %s\n", streamer->lateness_summary().c_str());
   return kExitOk;
 }
 

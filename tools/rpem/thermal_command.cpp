@@ -36,7 +36,8 @@ int run_thermal_fit(const ThermalFitCliOptions& o) {
   if (o.period_s > 0.0) laws.fusion.observer.period_s = o.period_s;
   std::fprintf(stderr, "rpem thermal fit: running the estimator over %s\n", o.log.c_str());
   const analysis::ThermalRecord record = analysis::record_thermal(o.log, machine, laws);
-  if (record.winding_sensor && laws.fusion.winding_sensor_sigma_K <= 0.0) laws.fusion.winding_sensor_sigma_K = o.winding_sensor_sigma_K;
+  if (record.winding_sensor && laws.fusion.winding_sensor_sigma_K <= 0.0)
+    laws.fusion.winding_sensor_sigma_K = o.winding_sensor_sigma_K;
   if (!record.coolant) {
     std::fprintf(stderr,
                  "rpem thermal fit: %s has no T_coolant column: the coolant is taken as %.4g °C throughout "
@@ -86,21 +87,27 @@ Runner add_thermal_command(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand("thermal", "The machine's thermal network (docs/thermal.md)");
   cmd->require_subcommand(1);
   CLI::App* fit = cmd->add_subcommand("fit", "Fit the thermal network to a log and write thermal.yaml");
-  fit->add_option("--log", opts->log, "drive log, phase samples or averaged (docs/drive-log.md)")->required()->check(CLI::ExistingFile);
+  fit->add_option("--log", opts->log, "drive log, phase samples or averaged (docs/drive-log.md)")
+      ->required()
+      ->check(CLI::ExistingFile);
   fit->add_option("--config", opts->config, "machine and estimator YAML (default: built-in paper-ipmsm.yaml)")
       ->check(CLI::ExistingFile);
   fit->add_option("--out", opts->out, "thermal.yaml to write")->required();
-  fit->add_option("--start", opts->start,
-                  "thermal section to start from: its laws, filter settings and, if it has `nodes`, its network (topology and values)")
+  fit->add_option(
+         "--start", opts->start,
+         "thermal section to start from: its laws, filter settings and, if it has `nodes`, its network (topology and values)")
       ->check(CLI::ExistingFile);
-  fit->add_option("--nodes", opts->nodes, "without a network to start from: 2 (winding, magnet) or 3 (winding, stator_iron, magnet)")
+  fit->add_option("--nodes", opts->nodes,
+                  "without a network to start from: 2 (winding, magnet) or 3 (winding, stator_iron, magnet)")
       ->check(CLI::IsMember({2, 3}));
   fit->add_option("--fit-until-s", opts->fit_until_s, "train on the log up to this time, judge the rest (default: 75 %)");
   fit->add_option("--winding-sensor-sigma-K", opts->winding_sensor_sigma_K, "σ of the log's winding sensor (default 1 K)")
       ->check(CLI::Range(1e-3, 100.0));
-  fit->add_option("--period-s", opts->period_s, "the filter's step (default: thermal.yaml's, 1 s)")->check(CLI::Range(1e-3, 3600.0));
-  fit->add_flag("--keep-magnet-reference", opts->keep_magnet_reference,
-                "keep the magnet law's psi_m_ref as given (--start or the machine's) instead of anchoring it at the soaked start");
+  fit->add_option("--period-s", opts->period_s, "the filter's step (default: thermal.yaml's, 1 s)")
+      ->check(CLI::Range(1e-3, 3600.0));
+  fit->add_flag(
+      "--keep-magnet-reference", opts->keep_magnet_reference,
+      "keep the magnet law's psi_m_ref as given (--start or the machine's) instead of anchoring it at the soaked start");
   fit->add_option("--report", opts->report, "directory for report.md, fit.json and predictions.csv");
   return [fit, opts]() { return fit->parsed() ? run_thermal_fit(*opts) : -1; };
 }

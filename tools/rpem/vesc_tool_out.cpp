@@ -20,8 +20,7 @@ void add_vesc_tool_options(CLI::App* cmd, VescToolOptions& o) {
   cmd->add_option("--vesc-tool-jitter", o.link.jitter, "intervals between rows uniform in (1 +- jitter)/rate")
       ->check(CLI::Range(0.0, 0.95))
       ->capture_default_str();
-  cmd->add_option("--vesc-tool-loss", o.link.loss,
-                  "probability that a poll is lost (VESC Tool then waits its 1 s timeout)")
+  cmd->add_option("--vesc-tool-loss", o.link.loss, "probability that a poll is lost (VESC Tool then waits its 1 s timeout)")
       ->check(CLI::Range(0.0, 0.5))
       ->capture_default_str();
   cmd->add_option("--vesc-tool-seed", o.link.seed, "seed of the intervals and losses")->capture_default_str();

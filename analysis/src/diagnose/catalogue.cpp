@@ -13,15 +13,15 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr double kDeg = core::kPi / 180.0;
 
 // Scales: a scaled parameter of 1 is this much of the physical one.
-constexpr double kVoltScale = 1.0;         ///< dead time: 1 V of leg error
-constexpr double kBandScale = 0.01;        ///< dead time's linear band: 1 % of I_b
-constexpr double kRelativeScale = 0.1;     ///< saturation: 10 % change of the inductance at the largest current
-constexpr double kSensorScale = 0.01;      ///< offsets: 1 % of I_b; gains: 1 %
-constexpr double kPerKelvinScale = 1e-3;   ///< drift against temperature: 0.1 %/K
-constexpr double kTrendScale = 0.01;       ///< drift against time: 1 % over the log
-constexpr double kIronLossScale = 0.01;    ///< i_fe of 1 % of I_b at the largest speed
-constexpr double kCrossScale = 0.01;       ///< cross-saturation: ψ_d lowered by 1 % of ψm at the largest i_q
-constexpr double kHarmonicScale = 0.005;   ///< flux harmonics: 0.5 % of ψm per coefficient
+constexpr double kVoltScale = 1.0;        ///< dead time: 1 V of leg error
+constexpr double kBandScale = 0.01;       ///< dead time's linear band: 1 % of I_b
+constexpr double kRelativeScale = 0.1;    ///< saturation: 10 % change of the inductance at the largest current
+constexpr double kSensorScale = 0.01;     ///< offsets: 1 % of I_b; gains: 1 %
+constexpr double kPerKelvinScale = 1e-3;  ///< drift against temperature: 0.1 %/K
+constexpr double kTrendScale = 0.01;      ///< drift against time: 1 % over the log
+constexpr double kIronLossScale = 0.01;   ///< i_fe of 1 % of I_b at the largest speed
+constexpr double kCrossScale = 0.01;      ///< cross-saturation: ψ_d lowered by 1 % of ψm at the largest i_q
+constexpr double kHarmonicScale = 0.005;  ///< flux harmonics: 0.5 % of ψm per coefficient
 /// Delays: up to this many periods (the conditioner's history holds kMaxDelayPeriods + 1).
 constexpr double kMaxDelayPeriodsFitted = core::kMaxDelayPeriods + 0.9;
 
@@ -44,9 +44,13 @@ EffectRow deadtime() {
   r.name = "deadtime";
   r.parameters = 2;
   r.shows_as = "residual against each phase current's sign; the 6th harmonic in motion; large at standstill";
-  r.enters = "each leg's voltage short by v_err·sign(i), sign linear within ±current_band_A; v_err = v_err_V + t_dead·f_sw·u_dc";
-  r.confusions = {{"rs_drift", "standstill at two or more current levels (the resistive drop grows with |i|, the dead-time error does not)"},
-                  {"current_offset", "current of both signs in that phase, or motion (an offset then shows at the fundamental, dead time at the 6th)"}};
+  r.enters =
+      "each leg's voltage short by v_err·sign(i), sign linear within ±current_band_A; v_err = v_err_V + t_dead·f_sw·u_dc";
+  r.confusions = {
+      {"rs_drift",
+       "standstill at two or more current levels (the resistive drop grows with |i|, the dead-time error does not)"},
+      {"current_offset",
+       "current of both signs in that phase, or motion (an offset then shows at the fundamental, dead time at the 6th)"}};
   r.starts = {{0.0, 1.0}};  // the band's derivative vanishes with the error: start it at 1 % of I_b
   r.bounds = [](const EffectContext& c, int i) {
     const core::ModelExtensions& x = c.base.extensions;
@@ -88,12 +92,13 @@ template <bool kD>
 EffectRow saturation() {
   EffectRow r;
   r.name = kD ? "ld_saturation" : "lq_saturation";
-  r.parameters = kD ? 2 : 1;  // the d axis also has the magnet's asymmetry (a slope in i_d)
+  r.parameters = kD ? 2 : 1;       // the d axis also has the magnet's asymmetry (a slope in i_d)
   r.shapes_constant = kD ? 2 : 3;  // kCalibrated: l_d_H, l_q_H — the curve's level
   r.shows_as = kD ? "errors growing with |i_d|; transients" : "errors growing with |i_q|; transients";
-  r.enters = kD ? "L_d(i_d) = L_d·(level + slope·i_d + curvature·i_d²) at the measured current each sample (the calibrated "
-                  "L_d is the level)"
-                : "L_q(i_q) = L_q·(level + curvature·i_q²) at the measured current each sample (the calibrated L_q is the level)";
+  r.enters =
+      kD ? "L_d(i_d) = L_d·(level + slope·i_d + curvature·i_d²) at the measured current each sample (the calibrated "
+           "L_d is the level)"
+         : "L_q(i_q) = L_q·(level + curvature·i_q²) at the measured current each sample (the calibrated L_q is the level)";
   if (kD) {
     r.confusions = {{"psim_drift", "operation at two or more d-axis currents"},
                     {"cross_saturation", "the same d-axis current at two or more q-axis currents"}};
@@ -130,10 +135,12 @@ EffectRow cross_saturation() {
   EffectRow r;
   r.name = "cross_saturation";
   r.parameters = 2;
-  r.shows_as = "the d-axis flux falling with the load, L_q changing with i_d: q-axis errors growing with i_q², d-axis ones "
-               "with i_d·i_q";
-  r.enters = "ψ_d = L_d·i_d + ψm + (c/2 + c₂·i_d)·i_q², ψ_q = (L_q + c·i_d + c₂·i_d²)·i_q (the two lowest-order reciprocal "
-             "co-energy terms even in i_q)";
+  r.shows_as =
+      "the d-axis flux falling with the load, L_q changing with i_d: q-axis errors growing with i_q², d-axis ones "
+      "with i_d·i_q";
+  r.enters =
+      "ψ_d = L_d·i_d + ψm + (c/2 + c₂·i_d)·i_q², ψ_q = (L_q + c·i_d + c₂·i_d²)·i_q (the two lowest-order reciprocal "
+      "co-energy terms even in i_q)";
   r.confusions = {{"lq_saturation", "the same q-axis current at two or more d-axis currents"},
                   {"ld_saturation", "the same d-axis current at two or more q-axis currents"},
                   {"psim_drift", "a load change at constant temperature"}};
@@ -182,9 +189,13 @@ EffectRow theta_offset() {
   r.name = "theta_offset";
   r.shows_as = "errors growing with speed, in the direction of the EMF";
   r.enters = "true angle = logged angle + offset (every Park transform)";
-  r.confusions = {{"delay", "operation at two or more speeds (a delay turns the voltage by ω·delay, an encoder offset by a fixed angle)"},
-                  {"iron_loss", "the same torque at two or more speeds"}};
-  r.apply = [](const Effect&, const double* p, const EffectContext&, ExtendedModel& m) { m.extensions.theta_offset_rad += kDeg * p[0]; };
+  r.confusions = {
+      {"delay",
+       "operation at two or more speeds (a delay turns the voltage by ω·delay, an encoder offset by a fixed angle)"},
+      {"iron_loss", "the same torque at two or more speeds"}};
+  r.apply = [](const Effect&, const double* p, const EffectContext&, ExtendedModel& m) {
+    m.extensions.theta_offset_rad += kDeg * p[0];
+  };
   r.describe = [](const Effect&, const ExtendedModel& m, const EffectContext&) {
     return std::vector<NamedValue>{{"offset_rad", m.extensions.theta_offset_rad, ""},
                                    {"offset_deg", m.extensions.theta_offset_rad / kDeg, ""}};
@@ -230,7 +241,8 @@ EffectRow current_gain() {
     m.extensions.current_gain_error[e.phase] += kSensorScale * p[0];
   };
   r.describe = [](const Effect& e, const ExtendedModel& m, const EffectContext&) {
-    return std::vector<NamedValue>{{"phase", 0.0, kPhaseNames[e.phase]}, {"gain_error", m.extensions.current_gain_error[e.phase], ""}};
+    return std::vector<NamedValue>{{"phase", 0.0, kPhaseNames[e.phase]},
+                                   {"gain_error", m.extensions.current_gain_error[e.phase], ""}};
   };
   return r;
 }
@@ -262,9 +274,10 @@ EffectRow drift() {
   r.frees_constant = kWinding ? 1 : 0;  // kCalibrated: r_s_Ohm, psi_m_Wb
   r.shows_as = kWinding ? "a trend with the winding temperature (or time), growing with |i|"
                         : "a trend with the magnet temperature (or time), growing with speed";
-  r.enters = kWinding ? "R_s(T) = R_s,ref·(1 + coeff·(T − reference)) against T_winding (without temperatures: a change over "
-                        "the log)"
-                      : "ψm(T) = ψm,ref·(1 + coeff·(T − reference)) against T_magnet (without temperatures: a change over the log)";
+  r.enters =
+      kWinding ? "R_s(T) = R_s,ref·(1 + coeff·(T − reference)) against T_winding (without temperatures: a change over "
+                 "the log)"
+               : "ψm(T) = ψm,ref·(1 + coeff·(T − reference)) against T_magnet (without temperatures: a change over the log)";
   if (kWinding) {
     r.confusions = {{"iron_loss", "standstill with current (no iron loss there)"}};
   } else {
@@ -303,7 +316,7 @@ EffectRow drift() {
     return out;
   };
   r.judge = [](const Effect&, const ExtendedModel& m, const EffectContext&,
-                const std::vector<double>& half_width) -> std::optional<Implausibility> {
+               const std::vector<double>& half_width) -> std::optional<Implausibility> {
     const std::optional<core::DriftLaw>& law = kWinding ? m.r_s_law : m.psi_m_law;
     if (!law) return std::nullopt;  // against time: no temperature to judge it by
     const double alpha = material_alpha(*law, kWinding ? m.machine.r_s_Ohm : m.machine.psi_m_Wb);
@@ -322,18 +335,18 @@ EffectRow drift() {
     };
     if (kWinding) {
       if (overlaps(core::kWindingMaterials)) return std::nullopt;
-      return Implausibility{"R_s would change by " + pct(alpha) + " %/K against T_winding (" +
-                                materials_text(core::kWindingMaterials) + ")",
-                            "a temperature-dependent error that is not resistance — an inverter voltage error (dead time, "
-                            "device drops) or an inductance that changes with the operating point the temperature follows; "
-                            "standstill at two or more currents per temperature would separate them"};
+      return Implausibility{
+          "R_s would change by " + pct(alpha) + " %/K against T_winding (" + materials_text(core::kWindingMaterials) + ")",
+          "a temperature-dependent error that is not resistance — an inverter voltage error (dead time, "
+          "device drops) or an inductance that changes with the operating point the temperature follows; "
+          "standstill at two or more currents per temperature would separate them"};
     }
     if (overlaps(core::kMagnetMaterials)) return std::nullopt;
-    return Implausibility{"ψm would change by " + pct(alpha) + " %/K against T_magnet (" +
-                              materials_text(core::kMagnetMaterials) + ")",
-                          "a flux error that follows the load the temperature follows — cross-saturation or an inductance "
-                          "changing with the current — or a constant ψm error the calibration takes; operation at two or "
-                          "more currents per temperature would separate them"};
+    return Implausibility{
+        "ψm would change by " + pct(alpha) + " %/K against T_magnet (" + materials_text(core::kMagnetMaterials) + ")",
+        "a flux error that follows the load the temperature follows — cross-saturation or an inductance "
+        "changing with the current — or a constant ψm error the calibration takes; operation at two or "
+        "more currents per temperature would separate them"};
   };
   return r;
 }
@@ -344,13 +357,16 @@ EffectRow delay() {
   EffectRow r;
   r.name = "delay";
   r.steady_state = false;
-  r.not_in_steady_state = "in steady state a command delay only rotates the voltage by ω·delay, which a steady-state log "
-                          "cannot tell from theta_offset";
+  r.not_in_steady_state =
+      "in steady state a command delay only rotates the voltage by ω·delay, which a steady-state log "
+      "cannot tell from theta_offset";
   r.shows_as = "errors growing with speed and with the command's change";
-  r.enters = "the command acts delay = (m + f)·T late: (1 − f)·u_{k−m} + f·u_{k−m−1} over each interval (whole and "
-             "fractional periods, up to 3.9)";
-  r.confusions = {{"theta_offset", "operation at two or more speeds (a delay turns the voltage by ω·delay, an encoder offset "
-                                   "by a fixed angle)"}};
+  r.enters =
+      "the command acts delay = (m + f)·T late: (1 − f)·u_{k−m} + f·u_{k−m−1} over each interval (whole and "
+      "fractional periods, up to 3.9)";
+  r.confusions = {{"theta_offset",
+                   "operation at two or more speeds (a delay turns the voltage by ω·delay, an encoder offset "
+                   "by a fixed angle)"}};
   // The residual is piecewise in the delay (between whole periods): several starts, in periods.
   r.starts = {{0.0}, {0.5}, {1.0}, {1.5}, {2.0}, {2.5}, {3.0}};
   r.bounds = [](const EffectContext& c, int) {
@@ -383,7 +399,8 @@ EffectRow iron_loss() {
   r.enters = "a resistance parallel to the induced voltage: i_s = i_m + n·J·ψ(i_m)/r_fe";
   // Its signature is the growth with speed: at one speed it is one more operating-point-dependent current
   // error, like a resistance or flux error at that speed.
-  r.confusions = {{"psim_drift", "the same torque at two or more speeds"}, {"rs_drift", "the same current at two or more speeds"}};
+  r.confusions = {{"psim_drift", "the same torque at two or more speeds"},
+                  {"rs_drift", "the same current at two or more speeds"}};
   r.applies = [](const EffectContext& c) { return c.speed_spread_rel >= kMinSpeedSpread; };
   r.bounds = [](const EffectContext& c, int) { return range(-base_conductance(c) / iron_loss_conductance_scale(c), kInf); };
   r.apply = [](const Effect&, const double* p, const EffectContext& c, ExtendedModel& m) {
@@ -405,14 +422,16 @@ EffectRow flux_harmonic() {
   r.name = name;
   r.parameters = 4;
   r.steady_state = false;
-  r.not_in_steady_state = "a steady-state log's rows average over revolutions: harmonics of the electrical angle do not "
-                          "survive them";
+  r.not_in_steady_state =
+      "a steady-state log's rows average over revolutions: harmonics of the electrical angle do not "
+      "survive them";
   r.shows_as = kJ == 0 ? "the 6th harmonic of the angle in dq, growing with speed (not with current)"
                        : "the 12th harmonic of the angle in dq, growing with speed (not with current)";
   r.enters = "ψ_dq += [d_cos·cos hϑ + d_sin·sin hϑ, q_cos·cos hϑ + q_sin·sin hϑ]; the voltage takes ω·(∂ψ_h/∂ϑ + J·ψ_h)";
   if (kJ == 0) {
-    r.confusions = {{"deadtime", "standstill with current (dead time acts there, a flux harmonic does not) or motion at "
-                                 "small current (the harmonic's EMF grows with speed, the dead-time error does not)"}};
+    r.confusions = {{"deadtime",
+                     "standstill with current (dead time acts there, a flux harmonic does not) or motion at "
+                     "small current (the harmonic's EMF grows with speed, the dead-time error does not)"}};
   }
   r.apply = [](const Effect&, const double* p, const EffectContext& c, ExtendedModel& m) {
     core::FluxHarmonic& h = m.extensions.flux_harmonics[kJ];
@@ -441,9 +460,9 @@ EffectRow flux_harmonic() {
 }
 
 std::vector<EffectRow> make_catalogue() {
-  return {deadtime(),       saturation<true>(),  saturation<false>(), cross_saturation(), theta_offset(),
-          current_offset(), current_gain(),      drift<true>(),       drift<false>(),     delay(),
-          iron_loss(),      flux_harmonic<0>(),  flux_harmonic<1>()};
+  return {deadtime(),       saturation<true>(), saturation<false>(), cross_saturation(), theta_offset(),
+          current_offset(), current_gain(),     drift<true>(),       drift<false>(),     delay(),
+          iron_loss(),      flux_harmonic<0>(), flux_harmonic<1>()};
 }
 
 }  // namespace

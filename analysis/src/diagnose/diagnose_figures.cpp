@@ -3,8 +3,8 @@
 // signature or the residual against temperature, measured against modelled currents, and the estimates
 // with the configuration and the extended model. Before (the configuration) and after (extended) side by side throughout.
 #include <algorithm>
-#include <cmath>
 #include <array>
+#include <cmath>
 #include <limits>
 
 #include "rpem/analysis/diagnose/diagnose_output.hpp"
@@ -48,7 +48,8 @@ std::string residual_time(const std::string& dir, const Diagnosis& d) {
                (temps ? ", '' u 1:8 axes x1y2 w l lw 2 t 'T'" : ""));
   fig.add_line("unset y2tics; unset y2label; set ytics mirror");
   fig.add_line("set title 'residual RMS (logged − model)'; set ylabel '|ε| [A]'; set logscale y");
-  fig.add_line("plot $time u 1:4 w l lw 2 lc rgb '#d62728' t 'configuration', '' u 1:5 w l lw 2 lc rgb '#2ca02c' t 'extended model'");
+  fig.add_line(
+      "plot $time u 1:4 w l lw 2 lc rgb '#d62728' t 'configuration', '' u 1:5 w l lw 2 lc rgb '#2ca02c' t 'extended model'");
   fig.add_line("unset logscale y; set title 'mean residual of the configuration'; set ylabel 'ε [A]'");
   fig.add_line("plot $time u 1:6 w l lw 2 t 'ε_d', '' u 1:7 w l lw 2 t 'ε_q'");
   fig.add_line("unset multiplot");
@@ -63,7 +64,7 @@ std::string residual_map(const std::string& dir, const Diagnosis& d) {
   DataBlock b{"map", std::vector<std::vector<double>>(4)};
   double lo = 1e300, hi = 0.0;  // one colour scale for both maps, so the improvement shows
   for (const auto& cell : f.map) {
-    if (!cell[2]) continue;
+    if (cell[2] == 0.0) continue;
     for (double v : {std::sqrt(cell[0] / cell[2]), std::sqrt(cell[1] / cell[2])}) {
       if (v > 0.0) lo = std::min(lo, v);
       hi = std::max(hi, v);
@@ -71,11 +72,11 @@ std::string residual_map(const std::string& dir, const Diagnosis& d) {
   }
   for (int y = 0; y < kY; ++y) {
     for (int x = 0; x < kX; ++x) {
-      const auto& cell = f.map[static_cast<std::size_t>(y * kX + x)];
+      const auto& cell = f.map[static_cast<std::size_t>(y) * kX + static_cast<std::size_t>(x)];
       b.columns[0].push_back(s_lo + (x + 0.5) * (s_hi - s_lo) / kX);
       b.columns[1].push_back(q_lo + (y + 0.5) * (q_hi - q_lo) / kY);
-      b.columns[2].push_back(cell[2] ? std::sqrt(cell[0] / cell[2]) : kNaN);
-      b.columns[3].push_back(cell[2] ? std::sqrt(cell[1] / cell[2]) : kNaN);
+      b.columns[2].push_back(cell[2] != 0.0 ? std::sqrt(cell[0] / cell[2]) : kNaN);
+      b.columns[3].push_back(cell[2] != 0.0 ? std::sqrt(cell[1] / cell[2]) : kNaN);
     }
   }
   GnuplotFigure fig(dir + "/residual_map.png", 1400, 600);
@@ -104,7 +105,8 @@ std::string harmonics(const std::string& dir, const Diagnosis& d) {
   fig.add_line("set title 'Residual content at harmonics of the electrical angle (samples in motion)' noenhanced");
   fig.add_line("set xlabel 'harmonic order (dq frame; 0 = mean)'; set ylabel 'amplitude [A]'; set logscale y; set grid");
   fig.add_line("set style fill solid 0.8; set boxwidth 0.35; set xtics 1");
-  fig.add_line("plot $h u ($1-0.18):2 w boxes lc rgb '#d62728' t 'configuration', '' u ($1+0.18):3 w boxes lc rgb '#2ca02c' t 'extended model'");
+  fig.add_line(
+      "plot $h u ($1-0.18):2 w boxes lc rgb '#d62728' t 'configuration', '' u ($1+0.18):3 w boxes lc rgb '#2ca02c' t 'extended model'");
   fig.render();
   return "harmonics.png";
 }
@@ -121,11 +123,13 @@ std::string phase_sign(const std::string& dir, const Diagnosis& d) {
   }
   GnuplotFigure fig(dir + "/phase_sign.png", 1000, 500);
   fig.add_data(std::move(b));
-  fig.add_line("set title 'Mean phase residual by the sign of the phase current (dead time pulls it against the current)' noenhanced");
+  fig.add_line(
+      "set title 'Mean phase residual by the sign of the phase current (dead time pulls it against the current)' noenhanced");
   fig.add_line("set ylabel 'mean residual [A]'; set xtics (\"a\" 0, \"b\" 1, \"c\" 2); set grid; set xrange [-0.6:2.6]");
   fig.add_line("set style fill solid 0.8; set boxwidth 0.18");
-  fig.add_line("plot $p u ($1-0.3):2 w boxes lc rgb '#d62728' t 'configuration, i > 0', '' u ($1-0.1):3 w boxes lc rgb '#ff9896' t 'configuration, i < 0', "
-               "'' u ($1+0.1):4 w boxes lc rgb '#2ca02c' t 'extended, i > 0', '' u ($1+0.3):5 w boxes lc rgb '#98df8a' t 'extended, i < 0'");
+  fig.add_line(
+      "plot $p u ($1-0.3):2 w boxes lc rgb '#d62728' t 'configuration, i > 0', '' u ($1-0.1):3 w boxes lc rgb '#ff9896' t 'configuration, i < 0', "
+      "'' u ($1+0.1):4 w boxes lc rgb '#2ca02c' t 'extended, i > 0', '' u ($1+0.3):5 w boxes lc rgb '#98df8a' t 'extended, i < 0'");
   fig.render();
   return "phase_sign.png";
 }
@@ -144,10 +148,13 @@ std::string residual_vs_temperature(const std::string& dir, const Diagnosis& d) 
   }
   GnuplotFigure fig(dir + "/residual_temperature.png", 1000, 550);
   fig.add_data(std::move(b));
-  fig.add_line(std::string("set title 'Mean residual against the ") + (winding ? "winding" : "magnet") + " temperature' noenhanced");
-  fig.add_line(std::string("set xlabel '") + (winding ? "T_winding" : "T_magnet") + " [°C]'; set ylabel 'mean ε [A]'; set grid; set key outside right");
-  fig.add_line("plot $t u 1:2 w lp pt 7 ps 0.6 lc rgb '#d62728' t 'ε_d configuration', '' u 1:3 w lp pt 7 ps 0.6 lc rgb '#ff7f0e' t 'ε_q configuration', "
-               "'' u 1:4 w lp pt 7 ps 0.6 lc rgb '#2ca02c' t 'ε_d extended', '' u 1:5 w lp pt 7 ps 0.6 lc rgb '#17becf' t 'ε_q extended'");
+  fig.add_line(std::string("set title 'Mean residual against the ") + (winding ? "winding" : "magnet") +
+               " temperature' noenhanced");
+  fig.add_line(std::string("set xlabel '") + (winding ? "T_winding" : "T_magnet") +
+               " [°C]'; set ylabel 'mean ε [A]'; set grid; set key outside right");
+  fig.add_line(
+      "plot $t u 1:2 w lp pt 7 ps 0.6 lc rgb '#d62728' t 'ε_d configuration', '' u 1:3 w lp pt 7 ps 0.6 lc rgb '#ff7f0e' t 'ε_q configuration', "
+      "'' u 1:4 w lp pt 7 ps 0.6 lc rgb '#2ca02c' t 'ε_d extended', '' u 1:5 w lp pt 7 ps 0.6 lc rgb '#17becf' t 'ε_q extended'");
   fig.render();
   return "residual_temperature.png";
 }
@@ -161,12 +168,13 @@ std::string overlay(const std::string& dir, const Diagnosis& d) {
   const std::string style = d.log->mode == ModelMode::kTransient ? "w l lw 2" : "w p pt 7 ps 0.5";
   GnuplotFigure fig(dir + "/overlay.png", 1400, 800);
   fig.add_data(std::move(b));
-  fig.add_line("set multiplot layout 2,1 title 'Logged current against the configuration and the extended model' noenhanced");
+  fig.add_line(
+      "set multiplot layout 2,1 title 'Logged current against the configuration and the extended model' noenhanced");
   fig.add_line("set grid; set xlabel 't [s]'; set key outside right");
-  fig.add_line("set title 'd axis'; set ylabel 'i_d [A]'; plot $o u 1:2 " + style + " lc rgb 'black' t 'logged', '' u 1:4 " + style +
-               " lc rgb '#d62728' t 'configuration', '' u 1:6 " + style + " lc rgb '#2ca02c' t 'extended'");
-  fig.add_line("set title 'q axis'; set ylabel 'i_q [A]'; plot $o u 1:3 " + style + " lc rgb 'black' t 'logged', '' u 1:5 " + style +
-               " lc rgb '#d62728' t 'configuration', '' u 1:7 " + style + " lc rgb '#2ca02c' t 'extended'");
+  fig.add_line("set title 'd axis'; set ylabel 'i_d [A]'; plot $o u 1:2 " + style + " lc rgb 'black' t 'logged', '' u 1:4 " +
+               style + " lc rgb '#d62728' t 'configuration', '' u 1:6 " + style + " lc rgb '#2ca02c' t 'extended'");
+  fig.add_line("set title 'q axis'; set ylabel 'i_q [A]'; plot $o u 1:3 " + style + " lc rgb 'black' t 'logged', '' u 1:5 " +
+               style + " lc rgb '#d62728' t 'configuration', '' u 1:7 " + style + " lc rgb '#2ca02c' t 'extended'");
   fig.add_line("unset multiplot");
   fig.render();
   return "overlay.png";
@@ -195,7 +203,8 @@ std::string regime_timeline(const std::string& dir, const LogData& log, const Lo
     }
     for (std::size_t r = 0; r < core::kRegimeCount; ++r) {
       if (sums[r][0] == 0.0) continue;
-      for (int c = 0; c < 3; ++c) b.columns[static_cast<std::size_t>(c)].push_back(sums[r][static_cast<std::size_t>(c) + 1] / sums[r][0]);
+      for (int c = 0; c < 3; ++c)
+        b.columns[static_cast<std::size_t>(c)].push_back(sums[r][static_cast<std::size_t>(c) + 1] / sums[r][0]);
       b.columns[3].push_back(static_cast<double>(r));
     }
   }
@@ -204,14 +213,19 @@ std::string regime_timeline(const std::string& dir, const LogData& log, const Lo
     const std::uint64_t count = regimes.counts.regimes[info.regime];
     if (count == 0) continue;
     const std::string r = std::to_string(static_cast<int>(info.regime));
-    const std::string style = std::string(" w p pt 7 ps 0.5 lc rgb '") + kRegimeColour[static_cast<std::size_t>(info.regime)] + "'";
-    const std::string title = std::string(" t '") + info.name + (info.excluded ? ", excluded" : "") + " (" + std::to_string(count) + ")'";
-    speed_plot += std::string(speed_plot.empty() ? "plot" : ",") + " $reg u 1:($4==" + r + "?$2:NaN)" + style + title;
-    current_plot += std::string(current_plot.empty() ? "plot" : ",") + " $reg u 1:($4==" + r + "?$3:NaN)" + style + " notitle";
+    const std::string style =
+        std::string(" w p pt 7 ps 0.5 lc rgb '") + kRegimeColour[static_cast<std::size_t>(info.regime)] + "'";
+    const std::string title =
+        std::string(" t '") + info.name + (info.excluded ? ", excluded" : "") + " (" + std::to_string(count) + ")'";
+    speed_plot.append(speed_plot.empty() ? "plot" : ",").append(" $reg u 1:($4==").append(r).append("?$2:NaN)");
+    speed_plot.append(style).append(title);
+    current_plot.append(current_plot.empty() ? "plot" : ",").append(" $reg u 1:($4==").append(r).append("?$3:NaN)");
+    current_plot.append(style).append(" notitle");
   }
   GnuplotFigure fig(dir + "/regimes.png", 1400, 800);
   fig.add_data(std::move(b));
-  fig.add_line("set multiplot layout 2,1 title 'The log by regime: what the estimator and the fits take, and what they leave out' noenhanced");
+  fig.add_line(
+      "set multiplot layout 2,1 title 'The log by regime: what the estimator and the fits take, and what they leave out' noenhanced");
   // Regime names hold underscores (not subscripts); both panels keep the key's margin so their time axes align.
   fig.add_line("set termoption noenhanced; set grid; set xlabel 't [s]'; set key outside right; set datafile missing NaN");
   fig.add_line("set lmargin at screen 0.07; set rmargin at screen 0.78");
@@ -224,9 +238,7 @@ std::string regime_timeline(const std::string& dir, const LogData& log, const Lo
   return "regimes.png";
 }
 
-DataBlock track_block(const char* name, const ParameterTrack& t) {
-  return {name, {t.t_s, t.psi_m_Wb, t.r_s_Ohm}};
-}
+DataBlock track_block(const char* name, const ParameterTrack& t) { return {name, {t.t_s, t.psi_m_Wb, t.r_s_Ohm}}; }
 
 std::string estimates(const std::string& dir, const Diagnosis& d) {
   const EstimatorComparison& c = d.estimates;
@@ -248,9 +260,11 @@ std::string estimates(const std::string& dir, const Diagnosis& d) {
                "' noenhanced");
   fig.add_line("set grid; set xlabel 't [s]'; set key outside right");
   fig.add_line("set title 'magnet flux linkage'; set ylabel 'ψm [Wb]'; plot $nom u 1:2 " + style +
-               " lc rgb '#d62728' t 'configuration', $ext u 1:2 " + style + " lc rgb '#2ca02c' t 'extended'" + with_truth(2));
+               " lc rgb '#d62728' t 'configuration', $ext u 1:2 " + style + " lc rgb '#2ca02c' t 'extended'" +
+               with_truth(2));
   fig.add_line("set title 'stator resistance'; set ylabel 'R_s [Ω]'; plot $nom u 1:3 " + style +
-               " lc rgb '#d62728' t 'configuration', $ext u 1:3 " + style + " lc rgb '#2ca02c' t 'extended'" + with_truth(3));
+               " lc rgb '#d62728' t 'configuration', $ext u 1:3 " + style + " lc rgb '#2ca02c' t 'extended'" +
+               with_truth(3));
   fig.add_line("unset multiplot");
   fig.render();
   return "estimates.png";
@@ -259,7 +273,8 @@ std::string estimates(const std::string& dir, const Diagnosis& d) {
 }  // namespace
 
 std::vector<std::string> write_diagnose_figures(const std::string& dir, const Diagnosis& d) {
-  std::vector<std::string> out = {residual_time(dir, d), regime_timeline(dir, *d.log, d.regimes, d.context.machine.rated.pole_pairs),
+  std::vector<std::string> out = {residual_time(dir, d),
+                                  regime_timeline(dir, *d.log, d.regimes, d.context.machine.rated.pole_pairs),
                                   residual_map(dir, d), overlay(dir, d)};
   if (!d.statistics.harmonics.empty()) out.push_back(harmonics(dir, d));
   if (!d.statistics.phase_signs.empty()) out.push_back(phase_sign(dir, d));

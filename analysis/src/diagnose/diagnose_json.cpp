@@ -31,7 +31,8 @@ nlohmann::json summary_json(const EstimateSummary& s) {
 }
 
 nlohmann::json drift_json(const io::ParameterDrift& d) {
-  if (d.law) return {{"coeff_per_K", d.law->coeff_per_K}, {"reference_C", d.law->reference_C}, {"value_ref", d.law->value_ref}};
+  if (d.law)
+    return {{"coeff_per_K", d.law->coeff_per_K}, {"reference_C", d.law->reference_C}, {"value_ref", d.law->value_ref}};
   if (d.rel_change) return {{"rel_change", *d.rel_change}};
   return nullptr;
 }
@@ -44,9 +45,11 @@ nlohmann::json calibration_json(const Diagnosis& d) {
     const std::string key = kCalibrated[i];
     j[key] = c.value[i];
     const double hw = c.intervals.half_width[i] * c.value[i];
-    j[key + "_ci95"] = c.identifiable[i] && std::isfinite(hw) ? nlohmann::json({c.value[i] - hw, c.value[i] + hw}) : nlohmann::json(nullptr);
+    j[key + "_ci95"] = c.identifiable[i] && std::isfinite(hw) ? nlohmann::json({c.value[i] - hw, c.value[i] + hw})
+                                                              : nlohmann::json(nullptr);
     // Unknown without a noise floor (the excitation test then admits every excited constant).
-    j[key + "_excitation_ci95_rel"] = d.noise_floor.value_A ? finite_json(c.intervals.excitation_half_width[i]) : nlohmann::json(nullptr);
+    j[key + "_excitation_ci95_rel"] =
+        d.noise_floor.value_A ? finite_json(c.intervals.excitation_half_width[i]) : nlohmann::json(nullptr);
     j[key + "_mismatch_rel"] = c.identifiable[i] ? nlohmann::json(mismatch_half_width(d, i)) : nlohmann::json(nullptr);
     configured[key] = c.configured[i];
     if (c.identifiable[i]) identifiable.push_back(key);
@@ -56,10 +59,12 @@ nlohmann::json calibration_json(const Diagnosis& d) {
   for (const std::string& text : calibrated_despite_mismatch(d)) despite.push_back(text);
   j["despite_mismatch"] = despite;
   j["configured"] = configured;
-  j["at_mean_temperature_C"] = {{"psi_m_Wb", d.context.t_magnet.logged ? nlohmann::json(d.context.t_magnet.mean_C) : nlohmann::json(nullptr)},
-                                {"r_s_Ohm", d.context.t_winding.logged ? nlohmann::json(d.context.t_winding.mean_C) : nlohmann::json(nullptr)}};
+  j["at_mean_temperature_C"] = {
+      {"psi_m_Wb", d.context.t_magnet.logged ? nlohmann::json(d.context.t_magnet.mean_C) : nlohmann::json(nullptr)},
+      {"r_s_Ohm", d.context.t_winding.logged ? nlohmann::json(d.context.t_winding.mean_C) : nlohmann::json(nullptr)}};
   j["heldout_rms"] = c.heldout_rms_A;
-  j["rpem"] = {{"psi_m_Wb", d.estimates.nominal_summary.psi_m_Wb}, {"r_s_Ohm", d.estimates.nominal_summary.r_s_Ohm},
+  j["rpem"] = {{"psi_m_Wb", d.estimates.nominal_summary.psi_m_Wb},
+               {"r_s_Ohm", d.estimates.nominal_summary.r_s_Ohm},
                {"method", d.estimates.method}};
   j["findings"] = calibration_findings(d);
   return j;
@@ -75,21 +80,24 @@ nlohmann::json regimes_json(const LogRegimes& r) {
 /// Which loss the fits minimised, and why (docs/diagnose.md, "Outliers and the robust loss").
 nlohmann::json loss_json(const Diagnosis& d) {
   const OutlierCheck& o = d.outliers;
-  nlohmann::json j = {{"kind", d.least_squares ? "huber" : "least_squares"},
-                      {"outlier_test", {{"samples", o.test.samples},
-                                        {"scale_A", o.test.scale_A},
-                                        {"threshold_A", finite_json(o.test.threshold_A)},
-                                        {"beyond", o.test.beyond},
-                                        {"p_value", o.test.p_value},
-                                        {"outliers", o.test.outliers}}},
-                      {"largest_shift", o.largest_shift},
-                      {"largest_shift_parameter", o.parameter.empty() ? nlohmann::json(nullptr) : nlohmann::json(o.parameter)}};
+  nlohmann::json j = {
+      {"kind", d.least_squares ? "huber" : "least_squares"},
+      {"outlier_test",
+       {{"samples", o.test.samples},
+        {"scale_A", o.test.scale_A},
+        {"threshold_A", finite_json(o.test.threshold_A)},
+        {"beyond", o.test.beyond},
+        {"p_value", o.test.p_value},
+        {"outliers", o.test.outliers}}},
+      {"largest_shift", o.largest_shift},
+      {"largest_shift_parameter", o.parameter.empty() ? nlohmann::json(nullptr) : nlohmann::json(o.parameter)}};
   if (d.least_squares) {
     j["huber_threshold_A"] = o.loss.threshold_A;
     j["robust_runs"] = o.robust_runs;
     nlohmann::json ls = {{"effects", d.least_squares->found}, {"heldout_rms", d.least_squares->extended_heldout_rms_A}};
     for (std::size_t i = 0; i < kCalibrated.size(); ++i) {
-      ls[kCalibrated[i]] = d.least_squares->identifiable[i] ? nlohmann::json(d.least_squares->value[i]) : nlohmann::json(nullptr);
+      ls[kCalibrated[i]] =
+          d.least_squares->identifiable[i] ? nlohmann::json(d.least_squares->value[i]) : nlohmann::json(nullptr);
     }
     j["least_squares"] = ls;
   }
@@ -162,7 +170,8 @@ std::vector<std::string> calibration_findings(const Diagnosis& d) {
     const double hw = std::isfinite(c.intervals.half_width[i]) ? c.intervals.half_width[i] : 0.0;
     const double mismatch = mismatch_half_width(d, i);
     if (std::abs(c.value[i] / c.configured[i] - 1.0) <= std::max(hw + mismatch, 0.005)) continue;
-    out.push_back(std::string("the configuration's ") + kCalibratedText[i] + " is " + pct(rel) + " % " + (rel > 0.0 ? "high" : "low"));
+    out.push_back(std::string("the configuration's ") + kCalibratedText[i] + " is " + pct(rel) + " % " +
+                  (rel > 0.0 ? "high" : "low"));
   }
   return out;
 }
@@ -172,40 +181,45 @@ void write_diagnosis_json(const std::string& path, const Diagnosis& d, const std
   const Selection& s = d.selection;
   nlohmann::json out;
   const std::size_t used = log.used_count();
-  out["log"] = {{"path", log.path},
-                {"model", to_string(log.mode)},
-                {"kind", log.averaged ? "averaged" : "phase_samples"},
-                {"samples", log.size()},
-                {"samples_used", used},
-                {"excluded_idle", log.excluded_idle},
-                {"excluded_transitional", log.excluded_transitional},
-                {"duration_s", log.t_end_s - log.t_start_s},
-                {"median_sample_interval_s", log.median_dt_s},
-                {"i_d_range_A", {d.context.min_i_d_A, d.context.max_signed_i_d_A}},
-                {"max_i_q_A", d.context.max_i_q_A},
-                {"t_winding_span_K", d.context.t_winding.logged ? nlohmann::json(d.context.t_winding.span_K) : nlohmann::json(nullptr)},
-                {"t_magnet_span_K", d.context.t_magnet.logged ? nlohmann::json(d.context.t_magnet.span_K) : nlohmann::json(nullptr)},
-                {"regimes", regimes_json(d.regimes)},
-                {"excluded_regime", d.regimes.excluded_used},
-                {"estimator_resyncs", d.regimes.counts.resyncs},
-                {"estimator_outliers", d.regimes.counts.outliers},
-                {"exclusion_explanations", d.regimes.explanations}};
+  out["log"] = {
+      {"path", log.path},
+      {"model", to_string(log.mode)},
+      {"kind", log.averaged ? "averaged" : "phase_samples"},
+      {"samples", log.size()},
+      {"samples_used", used},
+      {"excluded_idle", log.excluded_idle},
+      {"excluded_transitional", log.excluded_transitional},
+      {"duration_s", log.t_end_s - log.t_start_s},
+      {"median_sample_interval_s", log.median_dt_s},
+      {"i_d_range_A", {d.context.min_i_d_A, d.context.max_signed_i_d_A}},
+      {"max_i_q_A", d.context.max_i_q_A},
+      {"t_winding_span_K",
+       d.context.t_winding.logged ? nlohmann::json(d.context.t_winding.span_K) : nlohmann::json(nullptr)},
+      {"t_magnet_span_K", d.context.t_magnet.logged ? nlohmann::json(d.context.t_magnet.span_K) : nlohmann::json(nullptr)},
+      {"regimes", regimes_json(d.regimes)},
+      {"excluded_regime", d.regimes.excluded_used},
+      {"estimator_resyncs", d.regimes.counts.resyncs},
+      {"estimator_outliers", d.regimes.counts.outliers},
+      {"exclusion_explanations", d.regimes.explanations}};
   out["machine_config"] = config_path;
   out["verdict"] = to_string(d.verdict.kind);
   out["noise_floor_A"] = optional_json(d.verdict.noise_floor_A);
-  out["noise_floor"] = {{"second_differences", d.noise_floor.differences},
-                        {"unknown_reason", d.noise_floor.value_A ? nlohmann::json(nullptr) : nlohmann::json(d.noise_floor.unknown_reason)}};
+  out["noise_floor"] = {
+      {"second_differences", d.noise_floor.differences},
+      {"unknown_reason", d.noise_floor.value_A ? nlohmann::json(nullptr) : nlohmann::json(d.noise_floor.unknown_reason)}};
   out["ratio"] = d.verdict.ratio ? finite_json(*d.verdict.ratio) : nlohmann::json(nullptr);
   out["findings"] = d.verdict.findings;
   out["loss"] = loss_json(d);
 
-  out["baseline"] = {{"heldout_rms", d.baseline_heldout_rms_A},
-                     {"rms", d.statistics.rms_A.before},
-                     {"model_extensions", io::model_extensions_yaml(d.config)},
-                     {"rs_drift", drift_json(d.config.rs_drift)},
-                     {"psim_drift", drift_json(d.config.psim_drift)},
-                     {"drift_laws_replayed", {{"rs_drift", d.context.base.r_s_law.has_value()}, {"psim_drift", d.context.base.psi_m_law.has_value()}}},
-                     {"estimates", summary_json(d.estimates.nominal_summary)}};
+  out["baseline"] = {
+      {"heldout_rms", d.baseline_heldout_rms_A},
+      {"rms", d.statistics.rms_A.before},
+      {"model_extensions", io::model_extensions_yaml(d.config)},
+      {"rs_drift", drift_json(d.config.rs_drift)},
+      {"psim_drift", drift_json(d.config.psim_drift)},
+      {"drift_laws_replayed",
+       {{"rs_drift", d.context.base.r_s_law.has_value()}, {"psim_drift", d.context.base.psi_m_law.has_value()}}},
+      {"estimates", summary_json(d.estimates.nominal_summary)}};
   out["calibration"] = calibration_json(d);
 
   out["effects"] = nlohmann::json::array();
@@ -220,8 +234,9 @@ void write_diagnosis_json(const std::string& path, const Diagnosis& d, const std
                         {"p_value", f.p_value}};
     if (const EstimatorCheck* c = estimator_check(d, j)) {
       e["kept"] = c->kept;
-      e["estimator"] = c->applicable ? nlohmann::json({{"heldout_eps_rms_with", c->with_A}, {"heldout_eps_rms_without", c->without_A}})
-                                     : nlohmann::json(nullptr);
+      e["estimator"] = c->applicable
+                           ? nlohmann::json({{"heldout_eps_rms_with", c->with_A}, {"heldout_eps_rms_without", c->without_A}})
+                           : nlohmann::json(nullptr);
     }
     out["effects"].push_back(e);
   }
@@ -232,9 +247,10 @@ void write_diagnosis_json(const std::string& path, const Diagnosis& d, const std
                      {"estimates", summary_json(d.estimates.extended_summary)}};
   out["estimates_method"] = d.estimates.method;
   out["not_identifiable"] = nlohmann::json::array();
-  for (const Unidentifiable& u : s.not_identifiable) out["not_identifiable"].push_back({{"effects", u.effects}, {"reason", u.reason}});
+  for (const Unidentifiable& u : s.not_identifiable)
+    out["not_identifiable"].push_back({{"effects", u.effects}, {"reason", u.reason}});
   for (const auto& [key, list] : {std::pair{"implausible", &s.implausible}, std::pair{"negligible", &s.negligible},
-                                 std::pair{"withdrawn", &s.withdrawn}}) {
+                                  std::pair{"withdrawn", &s.withdrawn}}) {
     out[key] = nlohmann::json::array();
     for (const ImplausibleEffect& i : *list) {
       out[key].push_back({{"effect", i.effect.label()},
@@ -277,7 +293,8 @@ void write_diagnosis_json(const std::string& path, const Diagnosis& d, const std
 }
 
 void write_extended_yaml(const std::string& path, const Diagnosis& d, const std::string& config_text) {
-  std::string header = "# Written by rpem diagnose: " + d.log->path + " diagnosed with this configuration as the baseline;\n"
+  std::string header = "# Written by rpem diagnose: " + d.log->path +
+                       " diagnosed with this configuration as the baseline;\n"
                        "# the machine's calibrated constants and the model_extensions section hold what it found\n"
                        "# (docs/diagnose.md, docs/model-extensions.md).\n";
   bool kept = false;
@@ -286,9 +303,11 @@ void write_extended_yaml(const std::string& path, const Diagnosis& d, const std:
   std::vector<std::pair<std::string, double>> constants;
   for (std::size_t i = 0; i < kCalibrated.size(); ++i) {
     const double v = d.extended_config.machine.*kCalibratedFields[i];
-    if (d.calibration.identifiable[i] && v != d.config.machine.*kCalibratedFields[i]) constants.emplace_back(kCalibrated[i], v);
+    if (d.calibration.identifiable[i] && v != d.config.machine.*kCalibratedFields[i])
+      constants.emplace_back(kCalibrated[i], v);
   }
-  const std::string text = constants.empty() ? config_text : io::replace_machine_values(config_text, constants, "calibrated by rpem diagnose");
+  const std::string text =
+      constants.empty() ? config_text : io::replace_machine_values(config_text, constants, "calibrated by rpem diagnose");
   write_text(path, header + io::replace_model_extensions(text, io::model_extensions_yaml(d.extended_config)));
 }
 

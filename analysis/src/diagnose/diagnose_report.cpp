@@ -53,20 +53,25 @@ void summary(ReportDocument& doc, const Diagnosis& d, const std::string& config_
             d.noise_floor.unknown_reason + ").";
   }
   doc.paragraph(text);
-  text = "The configuration (`" + config_path + "`, its whole model: model extensions and drift laws) replayed on the inputs of `" +
-         log.path + "` (" + std::to_string(log.size()) + " samples over " + num(log.t_end_s - log.t_start_s, 3) + " s, " +
+  text = "The configuration (`" + config_path +
+         "`, its whole model: model extensions and drift laws) replayed on the inputs of `" + log.path + "` (" +
+         std::to_string(log.size()) + " samples over " + num(log.t_end_s - log.t_start_s, 3) + " s, " +
          (log.mode == ModelMode::kTransient ? "transient: the open-loop discrete predictor"
                                             : "steady state: the closed-form steady-state model") +
-         ") predicts the currents with a held-out residual of **" + num(d.baseline_heldout_rms_A) + " A RMS**; with the "
-         "machine's constants calibrated on the log, **" + num(d.calibration.heldout_rms_A) + " A**. ";
+         ") predicts the currents with a held-out residual of **" + num(d.baseline_heldout_rms_A) +
+         " A RMS**; with the "
+         "machine's constants calibrated on the log, **" +
+         num(d.calibration.heldout_rms_A) + " A**. ";
   const std::vector<std::string> findings = calibration_findings(d);
-  for (std::size_t i = 0; i < findings.size(); ++i) text += (i ? "; " : "Calibration: ") + findings[i] + (i + 1 == findings.size() ? ". " : "");
+  for (std::size_t i = 0; i < findings.size(); ++i)
+    text += (i ? "; " : "Calibration: ") + findings[i] + (i + 1 == findings.size() ? ". " : "");
   if (s.found.empty()) {
     text += "No effect of the catalogue lowers the calibrated baseline's residual significantly.";
   } else {
     text += "Found: ";
     for (std::size_t j = 0; j < s.found.size(); ++j) {
-      text += (j ? "; " : "") + std::string("**") + s.found[j].effect.label() + "** (" + parameters_text(found_parameters(d, j)) + ")";
+      text += (j ? "; " : "") + std::string("**") + s.found[j].effect.label() + "** (" +
+              parameters_text(found_parameters(d, j)) + ")";
     }
     text += ". The extended model lowers the held-out residual to **" + num(s.extended_heldout_rms_A) + " A** (" +
             pct(100.0 * (1.0 - s.extended_heldout_rms_A / std::max(s.start_heldout_rms_A, 1e-300))) +
@@ -106,54 +111,65 @@ void summary(ReportDocument& doc, const Diagnosis& d, const std::string& config_
 void regimes(ReportDocument& doc, const Diagnosis& d) {
   const LogRegimes& r = d.regimes;
   doc.heading(1, "Regimes: what the fits take and what they leave out");
-  doc.paragraph("Each sample's regime as the estimator decides it (`rpem estimate` and rpemd run the same classifier; "
-                "docs/derivations.md §13): the samples with the bridge off, with the dq frame not the rotor's, in a "
-                "transient the model does not represent, or not finite enter no fit (" + std::to_string(r.excluded_used) +
-                " here, besides " + std::to_string(d.log->excluded_idle + d.log->excluded_transitional) +
-                " rows the steady-state replay leaves out as idle or in transition). The estimator over the log "
-                "resynchronised " + std::to_string(r.counts.resyncs) + " times and skipped " +
-                std::to_string(r.counts.outliers) + " samples as outliers.");
+  doc.paragraph(
+      "Each sample's regime as the estimator decides it (`rpem estimate` and rpemd run the same classifier; "
+      "docs/derivations.md §13): the samples with the bridge off, with the dq frame not the rotor's, in a "
+      "transient the model does not represent, or not finite enter no fit (" +
+      std::to_string(r.excluded_used) + " here, besides " +
+      std::to_string(d.log->excluded_idle + d.log->excluded_transitional) +
+      " rows the steady-state replay leaves out as idle or in transition). The estimator over the log "
+      "resynchronised " +
+      std::to_string(r.counts.resyncs) + " times and skipped " + std::to_string(r.counts.outliers) +
+      " samples as outliers.");
   std::vector<std::vector<std::string>> rows;
   const double total = static_cast<double>(std::max<std::uint64_t>(r.counts.samples, 1));
   for (const core::RegimeInfo& info : core::kRegimes) {
     const std::uint64_t n = r.counts.regimes[info.regime];
     if (n == 0) continue;
-    rows.push_back({info.name, std::to_string(n), pct(100.0 * static_cast<double>(n) / total), info.excluded ? "no (excluded)" : "yes"});
+    rows.push_back({info.name, std::to_string(n), pct(100.0 * static_cast<double>(n) / total),
+                    info.excluded ? "no (excluded)" : "yes"});
   }
   doc.table({"regime", "samples", "share", "in the fits"}, rows);
   if (!r.explanations.empty()) {
-    doc.paragraph("More than " + num(100.0 * io::kExplainedShare, 2) + " % of the samples were left out by a rule; which, and "
+    doc.paragraph("More than " + num(100.0 * io::kExplainedShare, 2) +
+                  " % of the samples were left out by a rule; which, and "
                   "what changes it:");
     doc.bullets(r.explanations);
   }
-  doc.figure("regimes.png", "The log against time, coloured by regime: speed and current amplitude of each regime's samples.");
+  doc.figure("regimes.png",
+             "The log against time, coloured by regime: speed and current amplitude of each regime's samples.");
 }
 
 void calibration(ReportDocument& doc, const Diagnosis& d) {
   const Calibration& c = d.calibration;
   doc.heading(1, "The calibrated baseline");
-  doc.paragraph("Before any effect, the machine's constants that this log identifies are fitted on the training blocks, "
-                "jointly with every effect found later; a constant is identifiable when the log's excitation and noise "
-                "floor alone pin it within ±" + num(100.0 * kIdentifiableHalfWidth, 2) + " % (95 %). Intervals: cluster-"
-                "robust over the training blocks, at the final model. The RPEM estimator's own estimates with the "
-                "configuration (mean over the last quarter of the log) are the cross-check.");
+  doc.paragraph(
+      "Before any effect, the machine's constants that this log identifies are fitted on the training blocks, "
+      "jointly with every effect found later; a constant is identifiable when the log's excitation and noise "
+      "floor alone pin it within ±" +
+      num(100.0 * kIdentifiableHalfWidth, 2) +
+      " % (95 %). Intervals: cluster-"
+      "robust over the training blocks, at the final model. The RPEM estimator's own estimates with the "
+      "configuration (mean over the last quarter of the log) are the cross-check.");
   std::vector<std::vector<std::string>> rows;
   for (std::size_t i = 0; i < kCalibrated.size(); ++i) {
     const double hw = c.intervals.half_width[i] * c.value[i];
     std::string rpem = "—";
     if (i == 0 && d.estimates.method == "rpem") rpem = num(d.estimates.nominal_summary.psi_m_Wb);
     if (i == 1 && d.estimates.method == "rpem") rpem = num(d.estimates.nominal_summary.r_s_Ohm);
-    rows.push_back({kCalibratedText[i], num(c.configured[i]), c.identifiable[i] ? num(c.value[i]) : "not identifiable",
-                    c.identifiable[i] && std::isfinite(hw) ? "[" + num(c.value[i] - hw) + ", " + num(c.value[i] + hw) + "]" : "—",
-                    c.identifiable[i] ? "±" + pct(100.0 * mismatch_half_width(d, i)) : "—",
-                    c.identifiable[i] ? pct(100.0 * (c.configured[i] / c.value[i] - 1.0)) : "—", rpem});
+    rows.push_back(
+        {kCalibratedText[i], num(c.configured[i]), c.identifiable[i] ? num(c.value[i]) : "not identifiable",
+         c.identifiable[i] && std::isfinite(hw) ? "[" + num(c.value[i] - hw) + ", " + num(c.value[i] + hw) + "]" : "—",
+         c.identifiable[i] ? "±" + pct(100.0 * mismatch_half_width(d, i)) : "—",
+         c.identifiable[i] ? pct(100.0 * (c.configured[i] / c.value[i] - 1.0)) : "—", rpem});
   }
   doc.table({"constant", "configured", "calibrated", "95 % interval", "mismatch allowance", "configuration off by",
              "RPEM estimate"},
             rows);
-  doc.paragraph("The mismatch allowance is the largest bias the misfit the final model still leaves above the noise floor "
-                "could put into a constant (0 when the model explains the log down to the floor; the whole residual where "
-                "the floor is unknown); a configured value within the interval widened by it is not stated as off.");
+  doc.paragraph(
+      "The mismatch allowance is the largest bias the misfit the final model still leaves above the noise floor "
+      "could put into a constant (0 when the model explains the log down to the floor; the whole residual where "
+      "the floor is unknown); a configured value within the interval widened by it is not stated as off.");
   const std::vector<std::string> despite = calibrated_despite_mismatch(d);
   if (!despite.empty()) {
     doc.paragraph("Calibrated despite a large mismatch (a constant is identified when its interval is within ±" +
@@ -161,9 +177,12 @@ void calibration(ReportDocument& doc, const Diagnosis& d) {
     doc.bullets(despite);
   }
   std::string temps;
-  if (d.context.t_magnet.logged) temps += " ψm at the log's mean magnet temperature, " + num(d.context.t_magnet.mean_C, 3) + " °C.";
-  if (d.context.t_winding.logged) temps += " R_s at the mean winding temperature, " + num(d.context.t_winding.mean_C, 3) + " °C.";
-  if (!temps.empty()) doc.paragraph("Under a drift law the constants are the law's values at the log's mean temperature:" + temps);
+  if (d.context.t_magnet.logged)
+    temps += " ψm at the log's mean magnet temperature, " + num(d.context.t_magnet.mean_C, 3) + " °C.";
+  if (d.context.t_winding.logged)
+    temps += " R_s at the mean winding temperature, " + num(d.context.t_winding.mean_C, 3) + " °C.";
+  if (!temps.empty())
+    doc.paragraph("Under a drift law the constants are the law's values at the log's mean temperature:" + temps);
 }
 
 void loss(ReportDocument& doc, const Diagnosis& d) {
@@ -171,19 +190,25 @@ void loss(ReportDocument& doc, const Diagnosis& d) {
   if (!o.test.outliers) return;  // nothing beyond the Gaussian level: least squares, nothing to say
   doc.heading(1, "Outliers and the loss");
   std::string text = std::to_string(o.test.beyond) + " of the " + std::to_string(o.test.samples) +
-                     " training samples lie beyond b = " + num(o.test.threshold_A, 3) + " A (the level a Gaussian residual of "
-                     "that scale, σ̂ = " + num(o.test.scale_A, 3) + " A per axis from the median, exceeds once in that many; "
-                     "p = " + num(o.test.p_value, 2) + "). Refitted under Huber's loss at b, the largest parameter change is " +
-                     num(o.largest_shift, 2) + " times its 95 % half-width" + (o.parameter.empty() ? "" : " (" + o.parameter + ")");
+                     " training samples lie beyond b = " + num(o.test.threshold_A, 3) +
+                     " A (the level a Gaussian residual of "
+                     "that scale, σ̂ = " +
+                     num(o.test.scale_A, 3) +
+                     " A per axis from the median, exceeds once in that many; "
+                     "p = " +
+                     num(o.test.p_value, 2) + "). Refitted under Huber's loss at b, the largest parameter change is " +
+                     num(o.largest_shift, 2) + " times its 95 % half-width" +
+                     (o.parameter.empty() ? "" : " (" + o.parameter + ")");
   if (!d.least_squares) {
     text += ": the tail does not decide the fit, which stays least squares.";
     doc.paragraph(text);
     return;
   }
-  text += ": the tail decided the least-squares fit, so calibration and every effect fit were run again minimising "
-          "Huber's loss (squares within b, linear beyond), b re-estimated from each run's residuals: " +
-          num(o.loss.threshold_A, 3) + " A after " + std::to_string(o.robust_runs) + " run" + (o.robust_runs == 1 ? "" : "s") +
-          ". The held-out residuals in this report are √(mean ρ). ";
+  text +=
+      ": the tail decided the least-squares fit, so calibration and every effect fit were run again minimising "
+      "Huber's loss (squares within b, linear beyond), b re-estimated from each run's residuals: " +
+      num(o.loss.threshold_A, 3) + " A after " + std::to_string(o.robust_runs) + " run" + (o.robust_runs == 1 ? "" : "s") +
+      ". The held-out residuals in this report are √(mean ρ). ";
   std::string ls;
   for (const std::string& e : d.least_squares->found) ls += (ls.empty() ? "" : ", ") + e;
   text += "Least squares had found " + (ls.empty() ? std::string("no effect") : ls) + " (held-out " +
@@ -211,13 +236,15 @@ void effects_table(ReportDocument& doc, const Diagnosis& d) {
     rows.push_back({f.effect.label(), parameters_text(found_parameters(d, j)), num(f.heldout_rms_before_A),
                     num(f.heldout_rms_after_A), pct(f.gain_pct), num(f.p_value, 2), kept});
   }
-  doc.table({"effect", "parameters (SI; final joint fit)", "held-out RMS before [A]", "after [A]", "gain", "p", "in extended.yaml"},
+  doc.table({"effect", "parameters (SI; final joint fit)", "held-out RMS before [A]", "after [A]", "gain", "p",
+             "in extended.yaml"},
             rows);
-  doc.paragraph("Before and after are the held-out residual RMS of the model without and with the effect, each with the "
-                "effects found before it. An effect goes into `extended.yaml` only if the RPEM estimator with it (and the "
-                "effects kept before it) predicts the held-out blocks at least as well as without it; `rpem estimate "
-                "--config extended.yaml` and rpemd use that file as it is, and `rpem diagnose --config extended.yaml` "
-                "replays it as the baseline of the next recording.");
+  doc.paragraph(
+      "Before and after are the held-out residual RMS of the model without and with the effect, each with the "
+      "effects found before it. An effect goes into `extended.yaml` only if the RPEM estimator with it (and the "
+      "effects kept before it) predicts the held-out blocks at least as well as without it; `rpem estimate "
+      "--config extended.yaml` and rpemd use that file as it is, and `rpem diagnose --config extended.yaml` "
+      "replays it as the baseline of the next recording.");
 }
 
 void verdict_section(ReportDocument& doc, const Diagnosis& d, const std::vector<std::string>& figures) {
@@ -226,30 +253,36 @@ void verdict_section(ReportDocument& doc, const Diagnosis& d, const std::vector<
                  : kind == VerdictKind::kUnexplained ? "What is left: unexplained"
                                                      : "What is left: undetermined");
   if (kind == VerdictKind::kExplained) {
-    doc.paragraph("The final model's held-out residual is within " + num(kExplainedRatio, 2) + " times the noise floor: what "
+    doc.paragraph("The final model's held-out residual is within " + num(kExplainedRatio, 2) +
+                  " times the noise floor: what "
                   "is left is the sensors' noise.");
     return;
   }
-  doc.paragraph(kind == VerdictKind::kUnexplained
-                    ? "The final model's held-out residual stays " + num(d.verdict.ratio.value_or(0.0), 3) +
-                          " times above the noise floor. Where it lives, and what would explain it:"
-                    : "The noise floor cannot be measured on this log, so the residual cannot be judged against it "
-                      "(`noise_floor_A: null`, `verdict: undetermined`). Why, where the residual lives, and what would tell:");
+  doc.paragraph(
+      kind == VerdictKind::kUnexplained
+          ? "The final model's held-out residual stays " + num(d.verdict.ratio.value_or(0.0), 3) +
+                " times above the noise floor. Where it lives, and what would explain it:"
+          : "The noise floor cannot be measured on this log, so the residual cannot be judged against it "
+            "(`noise_floor_A: null`, `verdict: undetermined`). Why, where the residual lives, and what would tell:");
   doc.bullets(d.verdict.findings);
   auto has = [&](const char* f) { return std::find(figures.begin(), figures.end(), f) != figures.end(); };
-  if (has("residual_map.png")) doc.paragraph("The operating-point map (`residual_map.png`) and the content against the electrical "
-                                             "angle (`harmonics.png`) below show it in full.");
+  if (has("residual_map.png"))
+    doc.paragraph(
+        "The operating-point map (`residual_map.png`) and the content against the electrical "
+        "angle (`harmonics.png`) below show it in full.");
 }
 
 void residuals(ReportDocument& doc, const Diagnosis& d, const std::vector<std::string>& figures) {
   const ResidualStatistics& st = d.statistics;
   auto has = [&](const char* f) { return std::find(figures.begin(), figures.end(), f) != figures.end(); };
   doc.heading(1, "What the configuration gets wrong");
-  doc.paragraph("Residual RMS over all used samples: " + num(st.rms_A.before) + " A with the configuration, " + num(st.rms_A.after) +
-                " A extended; at standstill " + num(st.standstill_rms_A.before) + " → " + num(st.standstill_rms_A.after) +
-                " A, in motion " + num(st.motion_rms_A.before) + " → " + num(st.motion_rms_A.after) + " A.");
-  doc.figure("residual_time.png", "Operating profile, residual RMS of the configuration (red) and the extended model "
-                                  "(green), and the configuration's mean residual, against time.");
+  doc.paragraph("Residual RMS over all used samples: " + num(st.rms_A.before) + " A with the configuration, " +
+                num(st.rms_A.after) + " A extended; at standstill " + num(st.standstill_rms_A.before) + " → " +
+                num(st.standstill_rms_A.after) + " A, in motion " + num(st.motion_rms_A.before) + " → " +
+                num(st.motion_rms_A.after) + " A.");
+  doc.figure("residual_time.png",
+             "Operating profile, residual RMS of the configuration (red) and the extended model "
+             "(green), and the configuration's mean residual, against time.");
   doc.figure("residual_map.png", "Residual RMS over the speed × i_q plane: where the configuration errs, and what is left.");
   std::vector<std::vector<std::string>> rows;
   for (const RegionStatistics& r : st.regions) {
@@ -260,8 +293,9 @@ void residuals(ReportDocument& doc, const Diagnosis& d, const std::vector<std::s
              "mean ε_q configuration", "mean ε_d extended", "mean ε_q extended"},
             rows);
   if (has("harmonics.png")) {
-    doc.figure("harmonics.png", "Residual amplitude at harmonics of the electrical angle, in the dq frame: a current "
-                                "sensor offset shows at the 1st, a gain error at the 2nd, dead time at the 6th.");
+    doc.figure("harmonics.png",
+               "Residual amplitude at harmonics of the electrical angle, in the dq frame: a current "
+               "sensor offset shows at the 1st, a gain error at the 2nd, dead time at the 6th.");
     std::vector<std::vector<std::string>> h;
     for (const HarmonicContent& c : st.harmonics) {
       h.push_back({std::to_string(c.order), num(c.amplitude_A.before), num(c.amplitude_A.after)});
@@ -269,8 +303,9 @@ void residuals(ReportDocument& doc, const Diagnosis& d, const std::vector<std::s
     doc.table({"harmonic", "configuration [A]", "extended [A]"}, h);
   }
   if (has("phase_sign.png")) {
-    doc.figure("phase_sign.png", "Mean residual of each phase while its current is positive and negative: dead time pulls "
-                                 "the logged current below the model's in the current's direction.");
+    doc.figure("phase_sign.png",
+               "Mean residual of each phase while its current is positive and negative: dead time pulls "
+               "the logged current below the model's in the current's direction.");
   }
   if (has("residual_temperature.png")) {
     doc.figure("residual_temperature.png", "The residual against the logged temperature: a thermal drift shows as a trend.");
@@ -290,18 +325,20 @@ void estimator(ReportDocument& doc, const Diagnosis& d) {
   const EstimatorComparison& c = d.estimates;
   if (c.nominal.empty()) return;
   doc.heading(1, "The estimator with the extended model");
-  doc.paragraph(c.method == "rpem"
-                    ? "The RPEM estimator (as `rpem estimate` and rpemd run it) over this log with the input configuration "
-                      "and with `extended.yaml`. Values: mean over the last quarter of the log; errors: RMS against the "
-                      "truth over the second half, where a truth was given."
-                    : "A steady-state log cannot drive the recursive estimator (its samples lie seconds apart). Instead, "
-                      "each row's steady-state equations give the ψm and R_s the data implies — R_s = (u_d + ω·L_q·i_q)/i_d, "
-                      "ψm = (u_q − R_s·i_q)/ω − L_d·i_d, with the extended model's corrections — set against what the "
-                      "configuration assumes and what the extended model assumes (its drifts). Values: "
-                      "mean over the last quarter; errors: RMS against the implied values over the second half.");
-  doc.figure("estimates.png", c.method == "rpem" ? "ψm and R_s estimated with the configuration (red) and the extended model (green)."
-                                                : "ψm and R_s as the configuration (red) and the extended model (green) assume them, "
-                                                  "and as the data implies them (black).");
+  doc.paragraph(
+      c.method == "rpem"
+          ? "The RPEM estimator (as `rpem estimate` and rpemd run it) over this log with the input configuration "
+            "and with `extended.yaml`. Values: mean over the last quarter of the log; errors: RMS against the "
+            "truth over the second half, where a truth was given."
+          : "A steady-state log cannot drive the recursive estimator (its samples lie seconds apart). Instead, "
+            "each row's steady-state equations give the ψm and R_s the data implies — R_s = (u_d + ω·L_q·i_q)/i_d, "
+            "ψm = (u_q − R_s·i_q)/ω − L_d·i_d, with the extended model's corrections — set against what the "
+            "configuration assumes and what the extended model assumes (its drifts). Values: "
+            "mean over the last quarter; errors: RMS against the implied values over the second half.");
+  doc.figure("estimates.png", c.method == "rpem"
+                                  ? "ψm and R_s estimated with the configuration (red) and the extended model (green)."
+                                  : "ψm and R_s as the configuration (red) and the extended model (green) assume them, "
+                                    "and as the data implies them (black).");
   doc.table({"model", "ψm [Wb]", "R_s [Ω]", "ψm error", "R_s error"},
             {{"configuration", num(c.nominal_summary.psi_m_Wb), num(c.nominal_summary.r_s_Ohm),
               optional_pct(c.nominal_summary.psi_m_error_pct), optional_pct(c.nominal_summary.r_s_error_pct)},
@@ -316,7 +353,8 @@ void selection(ReportDocument& doc, const Diagnosis& d) {
                 "candidate by the training gain its first Gauss–Newton step predicts, fits the best " +
                 std::to_string(d.options.selection.shortlist) +
                 " jointly with the effects already found (Ceres), and accepts the one that lowers the held-out residual "
-                "most — if it lowers its RMS by at least " + num(d.options.selection.min_gain_pct, 3) +
+                "most — if it lowers its RMS by at least " +
+                num(d.options.selection.min_gain_pct, 3) +
                 " % and the held-out blocks agree (one-sided Wilcoxon signed-rank test on the per-block log ratios, p ≤ " +
                 num(d.options.selection.max_p, 3) +
                 "). Candidates the held-out blocks cannot tell from the winner, and that change the model alike, make "

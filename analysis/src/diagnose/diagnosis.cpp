@@ -82,7 +82,9 @@ void prune_negligible(const EffectFitter& fitter, Diagnosis& d) {
     const EffectRow& row = *f.effect.row;
     if (row.negligible && row.negligible(f.effect, m, d.context)) {
       kept = kept.without(f.effect);
-      s.negligible.push_back({f.effect, row.describe(f.effect, m, d.context), f.gain_pct,
+      s.negligible.push_back({f.effect,
+                              row.describe(f.effect, m, d.context),
+                              f.gain_pct,
                               {"negligible once the calibrated constants were refitted with the effects found",
                                "part of the calibrated constants it stood in for"}});
       continue;
@@ -100,7 +102,9 @@ void prune_negligible(const EffectFitter& fitter, Diagnosis& d) {
 void calibrate_and_select(const EffectFitter& fitter, double floor, Diagnosis& d) {
   Monitor* monitor = d.options.monitor;
   // The calibrated baseline: the constants the log's excitation pins down, fitted on the training blocks.
-  if (monitor) monitor->stage(fitter.loss().robust() ? "calibrating the constants (robust loss)" : "calibrating the configuration's constants", 0);
+  if (monitor)
+    monitor->stage(
+        fitter.loss().robust() ? "calibrating the constants (robust loss)" : "calibrating the configuration's constants", 0);
   EffectSet start;
   const CalibrationIntervals excitation = fitter.intervals(start, floor);
   std::array<bool, kCalibrated.size()> admissible{};
@@ -135,11 +139,13 @@ void calibrate_and_select(const EffectFitter& fitter, double floor, Diagnosis& d
   const double misfit = misfit_norm_A(fitter.training_samples(), d.selection.extended_heldout_rms_A, floor);
   for (std::size_t i = 0; i < kCalibrated.size(); ++i) {
     d.calibration.identifiable[i] = d.selection.model.calibrated[i];
-    d.calibration.identification[i] =
-        d.calibration.identifiable[i] ? identification(d.selection.model, d.calibration.intervals, i, misfit) : Identification::kNot;
+    d.calibration.identification[i] = d.calibration.identifiable[i]
+                                          ? identification(d.selection.model, d.calibration.intervals, i, misfit)
+                                          : Identification::kNot;
   }
   d.extended_model = d.selection.model.model(d.context);
-  for (std::size_t i = 0; i < kCalibrated.size(); ++i) d.calibration.value[i] = d.extended_model.machine.*kCalibratedFields[i];
+  for (std::size_t i = 0; i < kCalibrated.size(); ++i)
+    d.calibration.value[i] = d.extended_model.machine.*kCalibratedFields[i];
 }
 
 /// The diagnosis again under Huber's loss (docs/diagnose.md, "Outliers and the robust loss"), after the
@@ -183,7 +189,8 @@ io::MachineConfig config_of(const io::MachineConfig& input, const ExtendedModel&
   return c;
 }
 
-Diagnosis diagnose(LogData log, const io::MachineConfig& config, const DiagnoseOptions& options, const ParameterTrack& truth) {
+Diagnosis diagnose(LogData log, const io::MachineConfig& config, const DiagnoseOptions& options,
+                   const ParameterTrack& truth) {
   const auto start_time = std::chrono::steady_clock::now();
   Diagnosis d;
   d.options = options;
@@ -198,9 +205,9 @@ Diagnosis diagnose(LogData log, const io::MachineConfig& config, const DiagnoseO
   exclude_regimes(*d.log, d.regimes);
   for (std::string& why : left_out_explanations(*d.log)) d.regimes.explanations.push_back(std::move(why));
   const double f_sw = options.switching_frequency_Hz > 0.0 ? options.switching_frequency_Hz
-                                                          : config.estimator.extensions.switching_frequency_Hz;
-  const ExtendedModel base = make_base_model(config.machine, config.estimator.extensions, config.rs_drift.law,
-                                             config.psim_drift.law, *d.log);
+                                                           : config.estimator.extensions.switching_frequency_Hz;
+  const ExtendedModel base =
+      make_base_model(config.machine, config.estimator.extensions, config.rs_drift.law, config.psim_drift.law, *d.log);
   d.context = EffectContext::of(*d.log, config.machine, base, options.reference_C, f_sw);
 
   const WorkPool pool(std::max(1, options.jobs));
@@ -224,14 +231,15 @@ Diagnosis diagnose(LogData log, const io::MachineConfig& config, const DiagnoseO
   monitor.stage("checking the effects on the estimator", transient ? (d.selection.model.effects.size() + 1) * n : 0);
   std::vector<bool> keep;
   d.estimator_checks = check_estimator(d, pool, keep);
-  d.extended_config = config_of(config, subset(d.selection.model, keep).model(d.context), d.calibration.identifiable,
-                                options.reference_C);
+  d.extended_config =
+      config_of(config, subset(d.selection.model, keep).model(d.context), d.calibration.identifiable, options.reference_C);
 
   // The estimator's two runs and the whole-log comparison, at once.
   monitor.stage("comparing the models over the whole log", (transient ? 2 * n : 0) + 2 * n);
   pool.parallel_for(2, [&](std::size_t i) {
     if (i == 0) {
-      d.estimates = compare_estimates(*d.log, config, d.extended_config, d.extended_model, d.context, truth, pool, options.monitor);
+      d.estimates =
+          compare_estimates(*d.log, config, d.extended_config, d.extended_model, d.context, truth, pool, options.monitor);
     } else {
       comparison_pass(replay, d.context, base, d.extended_model, baseline, d.statistics, d.figures);
     }

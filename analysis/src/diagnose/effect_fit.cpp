@@ -4,6 +4,7 @@
 
 #include <Eigen/Dense>
 #include <algorithm>
+#include <bit>
 #include <cassert>
 #include <cmath>
 #include <limits>
@@ -22,11 +23,32 @@ constexpr double kStep = 1e-3;
 /// effect's parameters; four effects of at most a few parameters use a fraction of it).
 constexpr int kMaxColumns = 64;
 
+/// A training block's residuals (scaled by the loss, as over_training gives them) and their sum of squares.
+struct TrainingResiduals {
+  double ssr = 0.0;
+  std::vector<core::Vec2> r;
+};
+
+void add_training_residual(TrainingResiduals& b, std::span<const core::Vec2> r) {
+  b.ssr += r[0][0] * r[0][0];
+  b.ssr += r[0][1] * r[0][1];
+  b.r.push_back(r[0]);
+}
+
+/// The training sum of squares from the blocks' sums, added in block order (as EffectFitter::training_ssr).
+double training_ssr_of(const std::vector<TrainingResiduals>& blocks) {
+  double s = 0.0;
+  for (const TrainingResiduals& b : blocks) s += b.ssr;
+  return s;
+}
+
 }  // namespace
 
 /// The fit as a Ceres cost: the free calibrated constants (one block, if any) and one block per effect;
 /// as residuals the triangular factor of the training blocks' [J r] (effect_fit.hpp), P + 1 of them, and
-/// where Ceres asks for the cost alone, P zeros and the root of the sum of squares.
+/// where Ceres asks for the cost alone, P zeros and the root of the sum of squares. After an accepted step
+/// Ceres asks for the cost at the new point and then for the Jacobian there: the cost's replay keeps the
+/// training residuals, and the Jacobian's replays only the steps.
 class EffectFitter::FitCost final : public ceres::CostFunction {
  public:
   FitCost(const EffectFitter& fitter, const EffectSet& start, std::vector<std::size_t> free)
@@ -42,36 +64,48 @@ class EffectFitter::FitCost final : public ceres::CostFunction {
     const int p = parameters_;
     assert(p < kMaxColumns);  // the row below holds the P columns and the residual
     if (jacobians == nullptr) {
-      std::fill(residuals, residuals + p, 0.0);
-      residuals[p] = std::sqrt(fitter_.training_ssr(set));
+      cost_only(set, parameters, residuals);
       return true;
     }
-    // The point and each parameter stepped forward as Ceres' numeric differentiation steps it.
-    std::vector<ExtendedModel> models = {set.model(fitter_.context_)};
+    // The base point's residuals: those of the cost-only evaluation just before if it was at these parameters
+    // bit for bit (the replay is deterministic: the same rows), else model 0 of this replay.
+    const bool known = !last_residuals_.empty() && last_point_ == point(parameters);
+    std::vector<TrainingResiduals> base = std::move(last_residuals_);
+    last_residuals_.clear();
+    if (!known) base.assign(fitter_.training_blocks_.size(), TrainingResiduals{});
+    // The point (unless known) and each parameter stepped forward as Ceres' numeric differentiation steps it.
+    std::vector<ExtendedModel> models;
+    if (!known) models.push_back(set.model(fitter_.context_));
+    const std::size_t stepped = known ? 0 : 1;  // index of the first stepped model
     std::vector<double> inverse_step;
+    add_stepped_models(parameters, models, inverse_step);
     const std::vector<std::int32_t>& sizes = parameter_block_sizes();
-    for (std::size_t b = 0; b < sizes.size(); ++b) {
-      for (std::int32_t i = 0; i < sizes[b]; ++i) {
-        std::vector<double> block(parameters[b], parameters[b] + sizes[b]);
-        const double delta = std::max(std::sqrt(std::numeric_limits<double>::epsilon()), std::abs(block[static_cast<std::size_t>(i)]) * kStep);
-        block[static_cast<std::size_t>(i)] += delta;
-        std::vector<const double*> moved(parameters, parameters + sizes.size());
-        moved[b] = block.data();
-        models.push_back(at(moved.data()).model(fitter_.context_));
-        inverse_step.push_back(1.0 / delta);
-      }
-    }
-    std::vector<least_squares::TriangularFactor> factors =
-        fitter_.over_training(models, least_squares::TriangularFactor(p + 1), [&](least_squares::TriangularFactor& f, std::span<const core::Vec2> r) {
+    struct Block {
+      least_squares::TriangularFactor factor;
+      const std::vector<core::Vec2>* base = nullptr;  ///< the known residuals, if known
+      std::size_t next = 0;
+    };
+    std::vector<Block> inits;
+    inits.reserve(base.size());
+    for (const TrainingResiduals& b : base)
+      inits.push_back(Block{least_squares::TriangularFactor(p + 1), known ? &b.r : nullptr, 0});
+    std::vector<Block> factors =
+        fitter_.over_training_from(models, std::move(inits), [&](Block& f, std::span<const core::Vec2> r) {
+          const core::Vec2 r0 = f.base ? (*f.base)[f.next++] : r[0];
           double row[kMaxColumns];
           for (int axis = 0; axis < 2; ++axis) {
-            for (int j = 0; j < p; ++j) row[j] = (r[static_cast<std::size_t>(j) + 1][axis] - r[0][axis]) * inverse_step[static_cast<std::size_t>(j)];
-            row[p] = r[0][axis];
-            f.add_row(row);
+            for (int j = 0; j < p; ++j)
+              row[j] =
+                  (r[static_cast<std::size_t>(j) + stepped][axis] - r0[axis]) * inverse_step[static_cast<std::size_t>(j)];
+            row[p] = r0[axis];
+            f.factor.add_row(row);
           }
         });
     least_squares::TriangularFactor all(p + 1);
-    for (least_squares::TriangularFactor& f : factors) all.add(std::move(f));
+    for (Block& f : factors) {
+      assert(!f.base || f.next == f.base->size());  // the same samples as the cost-only evaluation's
+      all.add(std::move(f.factor));
+    }
     const Eigen::MatrixXd r = all.r();
     for (int i = 0; i <= p; ++i) residuals[i] = r(i, p);
     int column = 0;
@@ -85,6 +119,44 @@ class EffectFitter::FitCost final : public ceres::CostFunction {
   }
 
  private:
+  /// The cost alone at `set` (Ceres' `parameters`): P zeros and the root of the training sum of squares. The
+  /// training residuals are kept with their point: at an accepted step Ceres asks for the Jacobian there next.
+  /// (The last point's are released first: one set per fit at any time.)
+  void cost_only(const EffectSet& set, double const* const* parameters, double* residuals) const {
+    const int p = parameters_;
+    last_residuals_.clear();
+    std::vector<TrainingResiduals> blocks(fitter_.training_blocks_.size());
+    const std::vector<std::size_t>& first = fitter_.replay_.log().block_first;
+    for (std::size_t i = 0; i < blocks.size(); ++i) {
+      const auto b = static_cast<std::size_t>(fitter_.training_blocks_[i]);
+      blocks[i].r.reserve(first[b + 1] - first[b]);
+    }
+    blocks = fitter_.over_training_from({set.model(fitter_.context_)}, std::move(blocks), add_training_residual);
+    std::fill(residuals, residuals + p, 0.0);
+    residuals[p] = std::sqrt(training_ssr_of(blocks));
+    last_point_ = point(parameters);
+    last_residuals_ = std::move(blocks);
+  }
+
+  /// Each parameter stepped forward as Ceres' numeric differentiation steps it: its model appended to
+  /// `models`, the step's inverse to `inverse_step`.
+  void add_stepped_models(double const* const* parameters, std::vector<ExtendedModel>& models,
+                          std::vector<double>& inverse_step) const {
+    const std::vector<std::int32_t>& sizes = parameter_block_sizes();
+    for (std::size_t b = 0; b < sizes.size(); ++b) {
+      for (std::int32_t i = 0; i < sizes[b]; ++i) {
+        std::vector<double> block(parameters[b], parameters[b] + sizes[b]);
+        const double delta = std::max(std::sqrt(std::numeric_limits<double>::epsilon()),
+                                      std::abs(block[static_cast<std::size_t>(i)]) * kStep);
+        block[static_cast<std::size_t>(i)] += delta;
+        std::vector<const double*> moved(parameters, parameters + sizes.size());
+        moved[b] = block.data();
+        models.push_back(at(moved.data()).model(fitter_.context_));
+        inverse_step.push_back(1.0 / delta);
+      }
+    }
+  }
+
   /// The set at Ceres' parameters.
   EffectSet at(double const* const* parameters) const {
     EffectSet set = start_;
@@ -100,10 +172,24 @@ class EffectFitter::FitCost final : public ceres::CostFunction {
     return set;
   }
 
+  /// Ceres' parameters, every block's in order (compared bit for bit: the replay at equal bits is the same).
+  std::vector<std::uint64_t> point(double const* const* parameters) const {
+    std::vector<std::uint64_t> out;
+    const std::vector<std::int32_t>& sizes = parameter_block_sizes();
+    for (std::size_t b = 0; b < sizes.size(); ++b) {
+      for (std::int32_t i = 0; i < sizes[b]; ++i) out.push_back(std::bit_cast<std::uint64_t>(parameters[b][i]));
+    }
+    return out;
+  }
+
   const EffectFitter& fitter_;
   EffectSet start_;
   std::vector<std::size_t> free_;
   int parameters_ = 0;
+  // The last cost-only evaluation's point and training residuals (Ceres evaluates one problem's cost from one
+  // thread at a time: num_threads 1). Released by the Jacobian evaluation that follows.
+  mutable std::vector<std::uint64_t> last_point_;
+  mutable std::vector<TrainingResiduals> last_residuals_;
 };
 
 EffectFitter::EffectFitter(const ModelReplay& replay, const EffectContext& context)
@@ -113,7 +199,8 @@ EffectFitter::EffectFitter(const ModelReplay& replay, const EffectContext& conte
       heldout_blocks_(replay.blocks(Blocks::kHeldout)),
       fitted_(replay.log().size(), false) {
   for (int b : training_blocks_) {
-    training_block_samples_ += replay.log().block_first[static_cast<std::size_t>(b) + 1] - replay.log().block_first[static_cast<std::size_t>(b)];
+    training_block_samples_ +=
+        replay.log().block_first[static_cast<std::size_t>(b) + 1] - replay.log().block_first[static_cast<std::size_t>(b)];
   }
   // The samples the baseline predicts: every fit is judged on the same ones.
   const std::vector<ExtendedModel> base = {context_.base};
@@ -250,25 +337,38 @@ EffectSet EffectFitter::fit(const EffectSet& start, double* training_ssr) const 
   return set;
 }
 
-CalibrationIntervals EffectFitter::intervals(const EffectSet& set, double noise_floor_A) const {
-  // Columns: every calibrated constant (free or not: the excitation is judged for all), then the effects'.
-  std::vector<ExtendedModel> models = {set.model(context_)};
-  std::vector<double> steps;
+namespace {
+
+/// The models of the intervals' Jacobian: `set` itself, then one per column, each with its step in `steps`.
+/// Columns: every calibrated constant (free or not: the excitation is judged for all), then the effects'
+/// parameters (stepped back where a step forward would pass the upper bound).
+std::vector<ExtendedModel> stepped_models(const EffectSet& set, const EffectContext& context, std::vector<double>& steps) {
+  std::vector<ExtendedModel> models = {set.model(context)};
   for (std::size_t i = 0; i < kCalibrated.size(); ++i) {
     EffectSet moved = set;
     moved.calibration[i] += kStep;
-    models.push_back(moved.model(context_));
+    models.push_back(moved.model(context));
     steps.push_back(kStep);
   }
   for (std::size_t j = 0; j < set.effects.size(); ++j) {
     for (std::size_t i = 0; i < set.parameters[j].size(); ++i) {
       EffectSet moved = set;
-      const double h = parameter_bounds(set.effects[j], context_, static_cast<int>(i)).second >= set.parameters[j][i] + kStep ? kStep : -kStep;
+      const double h = parameter_bounds(set.effects[j], context, static_cast<int>(i)).second >= set.parameters[j][i] + kStep
+                           ? kStep
+                           : -kStep;
       moved.parameters[j][i] += h;
-      models.push_back(moved.model(context_));
+      models.push_back(moved.model(context));
       steps.push_back(h);
     }
   }
+  return models;
+}
+
+}  // namespace
+
+CalibrationIntervals EffectFitter::intervals(const EffectSet& set, double noise_floor_A) const {
+  std::vector<double> steps;
+  const std::vector<ExtendedModel> models = stepped_models(set, context_, steps);
   const auto n = static_cast<Eigen::Index>(steps.size());
   assert(n <= kMaxColumns);
   // Per training block: JᵀJ, and the block's score vector g_b = J_bᵀ·r_b (the cluster-robust "meat").
@@ -276,24 +376,24 @@ CalibrationIntervals EffectFitter::intervals(const EffectSet& set, double noise_
     least_squares::Gram gram;
     Eigen::VectorXd score;
   };
-  const std::vector<Block> blocks =
-      over_training(models, Block{least_squares::Gram(n), Eigen::VectorXd::Zero(n)}, [&](Block& b, std::span<const core::Vec2> r) {
-        double c[2][kMaxColumns];
-        for (Eigen::Index i = 0; i < n; ++i) {
-          const std::size_t m = static_cast<std::size_t>(i) + 1;
-          c[0][i] = (r[m][0] - r[0][0]) / steps[static_cast<std::size_t>(i)];
-          c[1][i] = (r[m][1] - r[0][1]) / steps[static_cast<std::size_t>(i)];
-          b.score[i] += c[0][i] * r[0][0] + c[1][i] * r[0][1];
-        }
-        b.gram.add(c[0], r[0][0]);
-        b.gram.add(c[1], r[0][1]);
-      });
+  const std::vector<Block> blocks = over_training(models, Block{least_squares::Gram(n), Eigen::VectorXd::Zero(n)},
+                                                  [&](Block& b, std::span<const core::Vec2> r) {
+                                                    double c[2][kMaxColumns];
+                                                    for (Eigen::Index i = 0; i < n; ++i) {
+                                                      const std::size_t m = static_cast<std::size_t>(i) + 1;
+                                                      c[0][i] = (r[m][0] - r[0][0]) / steps[static_cast<std::size_t>(i)];
+                                                      c[1][i] = (r[m][1] - r[0][1]) / steps[static_cast<std::size_t>(i)];
+                                                      b.score[i] += c[0][i] * r[0][0] + c[1][i] * r[0][1];
+                                                    }
+                                                    b.gram.add(c[0], r[0][0]);
+                                                    b.gram.add(c[1], r[0][1]);
+                                                  });
   least_squares::Gram total(n);
   for (const Block& b : blocks) total.add(b.gram);
   const Eigen::MatrixXd h = total.symmetric();
   // Cluster-robust "meat": the training blocks' score vectors.
   const LogData& log = replay_.log();
-  Eigen::MatrixXd g = Eigen::MatrixXd::Zero(n, static_cast<Eigen::Index>(log.blocks / 2 + 1));
+  Eigen::MatrixXd g = Eigen::MatrixXd::Zero(n, static_cast<Eigen::Index>(log.blocks) / 2 + 1);
   for (std::size_t i = 0; i < training_blocks_.size(); ++i) g.col(training_blocks_[i] / 2) = blocks[i].score;
   // A constant the log does not excite has a vanishing column: the pseudo-inverse leaves it infinitely uncertain.
   const ClusterRobustCovariance cov = cluster_robust_covariance(h, g);

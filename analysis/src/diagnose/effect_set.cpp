@@ -55,9 +55,7 @@ EffectSet EffectSet::without(const Effect& e) const {
 
 bool EffectSet::contains(const Effect& e) const { return std::find(effects.begin(), effects.end(), e) != effects.end(); }
 
-int EffectSet::free_calibration() const {
-  return static_cast<int>(std::count(calibrated.begin(), calibrated.end(), true));
-}
+int EffectSet::free_calibration() const { return static_cast<int>(std::count(calibrated.begin(), calibrated.end(), true)); }
 
 double BlockScores::total() const {
   double t = 0.0;

@@ -11,7 +11,8 @@ namespace {
 
 const char* const kPhase[3] = {"a", "b", "c"};
 
-TemperatureColumn column(const LogData& log, bool logged, std::optional<double> (SampleStore::*field)(std::size_t) const noexcept) {
+TemperatureColumn column(const LogData& log, bool logged,
+                         std::optional<double> (SampleStore::*field)(std::size_t) const noexcept) {
   TemperatureColumn c;
   c.logged = logged;
   if (!logged) return c;
@@ -136,7 +137,8 @@ std::vector<Unidentifiable> unobservable(const EffectContext& c) {
   for (const EffectRow& r : catalogue()) {
     if (r.steady_state) continue;
     // Rows that share a reason are reported together.
-    auto same = std::find_if(out.begin(), out.end(), [&](const Unidentifiable& u) { return u.reason == r.not_in_steady_state; });
+    auto same =
+        std::find_if(out.begin(), out.end(), [&](const Unidentifiable& u) { return u.reason == r.not_in_steady_state; });
     if (same != out.end()) {
       same->effects.emplace_back(r.name);
     } else {

@@ -65,7 +65,8 @@ ParameterTrack run_rpem(const LogData& log, const io::MachineConfig& config, Mon
 }
 
 /// Per used steady-state row: what the data implies (→ implied) and what each model assumes.
-void steady_state_tracks(const LogData& log, const EffectContext& context, const ExtendedModel& model, EstimatorComparison& c) {
+void steady_state_tracks(const LogData& log, const EffectContext& context, const ExtendedModel& model,
+                         EstimatorComparison& c) {
   const core::MachineSi& machine = context.base.machine;
   const core::PerUnitBase base = core::PerUnitBase::from_rated(machine.rated);
   const core::MachinePu pu = core::to_pu(base, model.machine);
@@ -92,7 +93,8 @@ double estimator_heldout_rms_A(const LogData& log, const io::MachineConfig& conf
   double sum = 0.0;
   std::size_t n = 0;
   for (int b = 0; b < log.blocks; ++b) {
-    for (std::size_t k = log.block_first[static_cast<std::size_t>(b)]; k < log.block_first[static_cast<std::size_t>(b) + 1]; ++k) {
+    for (std::size_t k = log.block_first[static_cast<std::size_t>(b)]; k < log.block_first[static_cast<std::size_t>(b) + 1];
+         ++k) {
       const core::Estimate e = estimator.step(log.sample(k));
       if ((k + 1) % kMonitorSamples == 0) report_work(monitor, kMonitorSamples);
       if (b % 2 != 1 || !log.used(k) || e.detail.code != core::StepCode::kAdapted) continue;

@@ -16,7 +16,8 @@ struct Gram {
   Eigen::VectorXd jr;
   double rr = 0.0;
 
-  explicit Gram(Eigen::Index columns = 0) : jj(Eigen::MatrixXd::Zero(columns, columns)), jr(Eigen::VectorXd::Zero(columns)) {}
+  explicit Gram(Eigen::Index columns = 0)
+      : jj(Eigen::MatrixXd::Zero(columns, columns)), jr(Eigen::VectorXd::Zero(columns)) {}
   /// One row: the columns' values c and the residual r.
   void add(const double* c, double r) noexcept {
     for (Eigen::Index i = 0; i < jr.size(); ++i) {
@@ -49,8 +50,8 @@ class TriangularFactor {
  private:
   static constexpr Eigen::Index kBatch = 256;
   void fold();
-  Eigen::MatrixXd r_;       ///< up to columns rows
-  Eigen::MatrixXd batch_;   ///< rows not yet folded
+  Eigen::MatrixXd r_;      ///< up to columns rows
+  Eigen::MatrixXd batch_;  ///< rows not yet folded
   Eigen::Index filled_ = 0;
 };
 
@@ -65,7 +66,8 @@ class TriangularFactor {
 /// (bounds(i) for the i-th of them, i = 0 …): a parameter whose step would leave them is held at the bound
 /// and the rest re-solved (an active set; a candidate has at most a few parameters).
 template <class Bounds>
-Eigen::VectorXd bounded_step(const Eigen::MatrixXd& jj, const Eigen::VectorXd& jr, Eigen::Index first, const Bounds& bounds) {
+Eigen::VectorXd bounded_step(const Eigen::MatrixXd& jj, const Eigen::VectorXd& jr, Eigen::Index first,
+                             const Bounds& bounds) {
   const Eigen::Index n = jr.size();
   std::vector<bool> held(static_cast<std::size_t>(n), false);
   Eigen::VectorXd delta = Eigen::VectorXd::Zero(n);
@@ -83,7 +85,8 @@ Eigen::VectorXd bounded_step(const Eigen::MatrixXd& jj, const Eigen::VectorXd& j
         if (held[static_cast<std::size_t>(c)]) g += jj(free[a], c) * delta[c];
       }
       jr_free[static_cast<Eigen::Index>(a)] = g;
-      for (std::size_t b = 0; b < free.size(); ++b) jj_free(static_cast<Eigen::Index>(a), static_cast<Eigen::Index>(b)) = jj(free[a], free[b]);
+      for (std::size_t b = 0; b < free.size(); ++b)
+        jj_free(static_cast<Eigen::Index>(a), static_cast<Eigen::Index>(b)) = jj(free[a], free[b]);
     }
     const Eigen::VectorXd step = free.empty() ? Eigen::VectorXd() : gauss_newton_step(jj_free, jr_free);
     bool violated = false;

@@ -60,7 +60,8 @@ std::size_t LogData::used_count() const noexcept {
 std::size_t LogData::training_count() const noexcept {
   std::size_t n = 0;
   for (int b = 0; b < blocks; b += 2) {
-    for (std::size_t k = block_first[static_cast<std::size_t>(b)]; k < block_first[static_cast<std::size_t>(b) + 1]; ++k) n += used(k) ? 1 : 0;
+    for (std::size_t k = block_first[static_cast<std::size_t>(b)]; k < block_first[static_cast<std::size_t>(b) + 1]; ++k)
+      n += used(k) ? 1 : 0;
   }
   return n;
 }
@@ -68,8 +69,8 @@ std::size_t LogData::training_count() const noexcept {
 void prepare_log(LogData& d, const core::MachineSi& machine, const LogOptions& options) {
   const std::size_t n = d.samples.size();
   if (n < 2 * static_cast<std::size_t>(std::max(2, options.blocks))) {
-    throw io::DriveLogError(d.path, n + 1, 0, "", "a log to diagnose needs at least " +
-                                                      std::to_string(2 * std::max(2, options.blocks)) + " rows");
+    throw io::DriveLogError(d.path, n + 1, 0, "",
+                            "a log to diagnose needs at least " + std::to_string(2 * std::max(2, options.blocks)) + " rows");
   }
   d.t_start_s = d.t_s(0);
   d.t_end_s = d.t_s(n - 1);
@@ -96,13 +97,14 @@ void prepare_log(LogData& d, const core::MachineSi& machine, const LogOptions& o
     }
     if (!moving.empty()) {
       std::sort(moving.begin(), moving.end());
-      d.speed_spread_rel = (moving[moving.size() * 9 / 10] - moving[moving.size() / 10]) / std::max(d.max_speed_rad_s, 1e-12);
+      d.speed_spread_rel =
+          (moving[moving.size() * 9 / 10] - moving[moving.size() / 10]) / std::max(d.max_speed_rad_s, 1e-12);
     }
   }
 
   const double time_constant_s = std::max(machine.l_d_H, machine.l_q_H) / machine.r_s_Ohm;
   d.mode = options.mode.value_or(d.median_dt_s >= kSteadyStateTimeConstants * time_constant_s ? ModelMode::kSteadyState
-                                                                                               : ModelMode::kTransient);
+                                                                                              : ModelMode::kTransient);
   d.speed_half_window = d.mode == ModelMode::kTransient ? std::max(0, options.speed_half_window) : 0;
 
   if (d.mode == ModelMode::kSteadyState) {
@@ -139,8 +141,8 @@ void prepare_log(LogData& d, const core::MachineSi& machine, const LogOptions& o
   }
 }
 
-LogData prepare_log(const std::vector<io::DriveLogRow>& rows, const io::DriveLogLayout& layout, const core::MachineSi& machine,
-                    const LogOptions& options, const std::string& path) {
+LogData prepare_log(const std::vector<io::DriveLogRow>& rows, const io::DriveLogLayout& layout,
+                    const core::MachineSi& machine, const LogOptions& options, const std::string& path) {
   LogData d;
   d.path = path;
   d.layout = layout;
@@ -157,7 +159,8 @@ std::vector<std::string> left_out_explanations(const LogData& log) {
   auto explain = [&](std::size_t count, const std::string& what) {
     if (static_cast<double>(count) <= io::kExplainedShare * n) return;
     char head[96];
-    std::snprintf(head, sizeof head, "%zu of %zu rows (%.1f %%) ", count, log.size(), 100.0 * static_cast<double>(count) / n);
+    std::snprintf(head, sizeof head, "%zu of %zu rows (%.1f %%) ", count, log.size(),
+                  100.0 * static_cast<double>(count) / n);
     out.push_back(head + what);
   };
   char text[512];
@@ -247,7 +250,8 @@ LogData load_log(const std::string& path, const core::MachineSi& machine, const 
   }
   d.samples.finish();
   prepare_log(d, machine, options);
-  d.format = path + " as " + source.format + ": " + std::to_string(d.size()) + " rows" + io::describe(reader.reader().repairs());
+  d.format =
+      path + " as " + source.format + ": " + std::to_string(d.size()) + " rows" + io::describe(reader.reader().repairs());
   return d;
 }
 

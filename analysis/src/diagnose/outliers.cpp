@@ -36,7 +36,8 @@ OutlierCheck check_outliers(const EffectFitter& least_squares, const EffectSet& 
   };
   for (std::size_t i = 0; i < kCalibrated.size(); ++i) {
     if (!fitted.calibrated[i] || !(ci.half_width[i] > 0.0)) continue;
-    const double moved = kCalibrationScale * (robust.calibration[i] - fitted.calibration[i]) / (1.0 + kCalibrationScale * fitted.calibration[i]);
+    const double moved = kCalibrationScale * (robust.calibration[i] - fitted.calibration[i]) /
+                         (1.0 + kCalibrationScale * fitted.calibration[i]);
     consider(std::abs(moved) / ci.half_width[i], kCalibrated[i]);
   }
   for (std::size_t j = 0; j < fitted.effects.size(); ++j) {

@@ -1,6 +1,8 @@
 #pragma once
 // EffectFitter::over_training (effect_fit.hpp), shared by the fits (effect_fit.cpp) and the screening
 // (screening.cpp).
+#include <cassert>
+
 #include "rpem/analysis/diagnose/effect_fit.hpp"
 
 namespace rpem::analysis {
@@ -9,8 +11,15 @@ namespace rpem::analysis {
 inline constexpr double kMiss_A = 1e3;
 
 template <class Acc, class Add>
-std::vector<Acc> EffectFitter::over_training(const std::vector<ExtendedModel>& models, const Acc& init, const Add& add) const {
-  std::vector<Acc> out(training_blocks_.size(), init);
+std::vector<Acc> EffectFitter::over_training(const std::vector<ExtendedModel>& models, const Acc& init,
+                                             const Add& add) const {
+  return over_training_from(models, std::vector<Acc>(training_blocks_.size(), init), add);
+}
+
+template <class Acc, class Add>
+std::vector<Acc> EffectFitter::over_training_from(const std::vector<ExtendedModel>& models, std::vector<Acc> out,
+                                                  const Add& add) const {
+  assert(out.size() == training_blocks_.size());
   replay_.for_blocks(training_blocks_, [&](std::size_t i, int b) {
     Acc& acc = out[i];
     std::vector<core::Vec2> r(models.size());

@@ -17,9 +17,21 @@ constexpr std::size_t kWarmup = core::kMaxDelayPeriods + 3;
 
 /// What every model of a replay shares at one sample.
 struct Shared {
-  core::DriveSample s;      ///< as the replay takes it (LogData::replay_sample)
-  core::Rotation logged;    ///< at the logged angle
+  core::DriveSample s;    ///< as the replay takes it (LogData::replay_sample)
+  core::Rotation logged;  ///< at the logged angle
 };
+
+/// Whether two models are the same bit for bit, field by field (ModelExtensions and the machine hold doubles
+/// only): their replays then are too.
+bool same_bits(const ExtendedModel& a, const ExtendedModel& b) noexcept {
+  // NOLINTNEXTLINE(bugprone-suspicious-memory-comparison): bit for bit is the intent (a -0.0 or a NaN payload may replay differently)
+  const auto bytes = [](const auto& x, const auto& y) { return std::memcmp(&x, &y, sizeof x) == 0; };
+  const auto law = [&](const std::optional<core::DriftLaw>& x, const std::optional<core::DriftLaw>& y) {
+    return x.has_value() == y.has_value() && (!x || bytes(*x, *y));
+  };
+  return bytes(a.machine, b.machine) && bytes(a.extensions, b.extensions) && law(a.r_s_law, b.r_s_law) &&
+         law(a.psi_m_law, b.psi_m_law) && bytes(a.r_s_trend, b.r_s_trend) && bytes(a.psi_m_trend, b.psi_m_trend);
+}
 
 }  // namespace
 
@@ -41,7 +53,9 @@ class ModelReplay::Chain {
   /// with the model it was moved from.
   [[nodiscard]] bool conditions_like(const Chain& other) const noexcept {
     const core::ModelExtensions &a = model_.extensions, &b = other.model_.extensions;
+    // NOLINTNEXTLINE(bugprone-suspicious-memory-comparison): bit for bit is the intent (a -0.0 or a NaN payload may condition differently)
     if (std::memcmp(&a, &b, sizeof a) != 0) return false;
+    // NOLINTNEXTLINE(bugprone-suspicious-memory-comparison): as above; a padding byte that differs only costs the sharing
     return !a.reads_machine() || std::memcmp(&machine_, &other.machine_, sizeof machine_) == 0;
   }
   /// The sample as this chain's conditioner turns it into the predictor's interval (a chain that conditions
@@ -137,25 +151,55 @@ void ModelReplay::for_blocks(const std::vector<int>& blocks, const std::function
   });
 }
 
-void ModelReplay::replay_block(int b, std::span<const ExtendedModel> models, const Visit& visit) const {
-  const std::size_t first = log_.block_first[static_cast<std::size_t>(b)], end = log_.block_first[static_cast<std::size_t>(b) + 1];
-  std::vector<Chain> chains;
+std::vector<std::size_t> ModelReplay::distinct_chains(std::span<const ExtendedModel> models,
+                                                      std::vector<Chain>& chains) const {
+  std::vector<std::size_t> chain_of(models.size());
   chains.reserve(models.size());
-  for (const ExtendedModel& m : models) chains.emplace_back(*this, m);
-  std::vector<ModelSample> out(models.size());
+  for (std::size_t j = 0; j < models.size(); ++j) {
+    chain_of[j] = chains.size();
+    for (std::size_t i = 0; i < j; ++i) {
+      if (same_bits(models[i], models[j])) {
+        chain_of[j] = chain_of[i];
+        break;
+      }
+    }
+    if (chain_of[j] == chains.size()) chains.emplace_back(*this, models[j]);
+  }
+  return chain_of;
+}
+
+std::vector<std::size_t> ModelReplay::shared_conditioners(const std::vector<Chain>& chains) {
+  std::vector<std::size_t> conditioned_by(chains.size());
+  for (std::size_t j = 0; j < chains.size(); ++j) {
+    conditioned_by[j] = j;
+    for (std::size_t i = 0; i < j; ++i) {
+      if (conditioned_by[i] == i && chains[i].conditions_like(chains[j])) {
+        conditioned_by[j] = i;
+        break;
+      }
+    }
+  }
+  return conditioned_by;
+}
+
+void ModelReplay::replay_block(int b, std::span<const ExtendedModel> models, const Visit& visit) const {
+  const std::size_t first = log_.block_first[static_cast<std::size_t>(b)],
+                    end = log_.block_first[static_cast<std::size_t>(b) + 1];
+  // A model the same as an earlier one bit for bit (a screening's candidate at a start that leaves the model as
+  // it is: the round's model) steps no chain of its own: it is given that one's samples.
+  std::vector<Chain> chains;
+  const std::vector<std::size_t> chain_of = distinct_chains(models, chains);
+  const bool repeated = chains.size() < models.size();
+  std::vector<ModelSample> out(chains.size()), all(repeated ? models.size() : 0);
+  const auto visit_all = [&](std::size_t k) {
+    if (!repeated) return visit(k, out);
+    for (std::size_t j = 0; j < all.size(); ++j) all[j] = out[chain_of[j]];
+    visit(k, all);
+  };
   Shared x;
   if (log_.mode == ModelMode::kTransient) {
     // The models that condition alike share one conditioner's samples: the first of each kind conditions.
-    std::vector<std::size_t> conditioned_by(chains.size());
-    for (std::size_t j = 0; j < chains.size(); ++j) {
-      conditioned_by[j] = j;
-      for (std::size_t i = 0; i < j; ++i) {
-        if (conditioned_by[i] == i && chains[i].conditions_like(chains[j])) {
-          conditioned_by[j] = i;
-          break;
-        }
-      }
-    }
+    const std::vector<std::size_t> conditioned_by = shared_conditioners(chains);
     std::vector<core::EstimatorSample> conditioned(chains.size());
     for (std::size_t k = first >= kWarmup ? first - kWarmup : 0; k < end; ++k) {
       x.s = log_.replay_sample(k);
@@ -168,7 +212,7 @@ void ModelReplay::replay_block(int b, std::span<const ExtendedModel> models, con
       for (std::size_t j = 0; j < chains.size(); ++j) {
         chains[j].step_transient(k, first, x, conditioned[conditioned_by[j]], used ? &logged : nullptr, out[j]);
       }
-      if (used) visit(k, out);
+      if (used) visit_all(k);
     }
   } else {
     for (std::size_t k = first; k < end; ++k) {
@@ -177,7 +221,7 @@ void ModelReplay::replay_block(int b, std::span<const ExtendedModel> models, con
       x.logged = core::Rotation::of(x.s.theta_el_rad);
       const core::Vec2 logged = core::SampleConditioner::logged_current_dq_A(x.s, x.logged);
       for (std::size_t j = 0; j < chains.size(); ++j) chains[j].step_steady(k, x, logged, out[j]);
-      visit(k, out);
+      visit_all(k);
     }
   }
   if (monitor_) monitor_->advance(static_cast<std::uint64_t>(end - first) * models.size());

@@ -67,9 +67,9 @@ double ResidualSums::Pearson::value() const {
 }
 
 ResidualSums::ResidualSums(const LogData& log, const EffectContext& context)
-    : log_(&log),
-      base_(core::PerUnitBase::from_rated(context.machine.rated)),
-      regressors_{"|i| [A]", "i_d [A]", "i_q [A]", "speed [pu]", "|speed| [pu]", "time [s]"} {
+    : log_(&log), base_(core::PerUnitBase::from_rated(context.machine.rated)), regressors_{"|i| [A]",      "i_d [A]",
+                                                                                           "i_q [A]",      "speed [pu]",
+                                                                                           "|speed| [pu]", "time [s]"} {
   if (log.layout.t_winding) regressors_.emplace_back("T_winding [°C]");
   if (log.layout.t_magnet) regressors_.emplace_back("T_magnet [°C]");
   corr_.resize(regressors_.size());
@@ -77,47 +77,54 @@ ResidualSums::ResidualSums(const LogData& log, const EffectContext& context)
 
 double ResidualSums::regressor(std::size_t j, std::size_t k, const core::Vec2& i, double n_pu) const {
   switch (j) {
-    case 0: return i.norm();
-    case 1: return i[0];
-    case 2: return i[1];
-    case 3: return n_pu;
-    case 4: return std::abs(n_pu);
-    case 5: return log_->t_s(k);
-    default: break;
+    case 0:
+      return i.norm();
+    case 1:
+      return i[0];
+    case 2:
+      return i[1];
+    case 3:
+      return n_pu;
+    case 4:
+      return std::abs(n_pu);
+    case 5:
+      return log_->t_s(k);
+    default:
+      break;
   }
   // The temperatures, in the order the constructor lists them.
   const bool winding = j == 6 && log_->layout.t_winding;
   return (winding ? log_->samples.t_winding_C(k) : log_->samples.t_magnet_C(k)).value_or(0.0);
 }
 
-void ResidualSums::add(std::size_t k, const core::Vec2& rb, const core::Vec2& ra) {
+void ResidualSums::add(std::size_t k, const core::Vec2& nominal_A, const core::Vec2& extended_A) {
   const core::DriveSample s = log_->sample(k);
   const core::Rotation rot = core::Rotation::of(s.theta_el_rad);
   const core::Vec2 i = core::SampleConditioner::logged_current_dq_A(s, rot);
   const double n = s.omega_el_rad_s / base_.omega_el_rad_s;
-  all_before_.add(rb);
-  all_after_.add(ra);
+  all_before_.add(nominal_A);
+  all_after_.add(extended_A);
   const bool still = std::abs(n) < kStandstillSpeedPu;
-  (still ? still_before_ : moving_before_).add(rb);
-  (still ? still_after_ : moving_after_).add(ra);
+  (still ? still_before_ : moving_before_).add(nominal_A);
+  (still ? still_after_ : moving_after_).add(extended_A);
   const int sr = speed_region(n), lr = load_region(i[1], base_.current_A);
-  region_before_[sr][lr].add(rb);
-  region_after_[sr][lr].add(ra);
+  region_before_[sr][lr].add(nominal_A);
+  region_after_[sr][lr].add(extended_A);
 
   if (log_->mode == ModelMode::kTransient) {
     if (!still) {
       ++harmonic_samples_;
       for (int h = 0; h <= kMaxHarmonic; ++h) {
         const std::complex<double> e = std::polar(1.0, -h * s.theta_el_rad);
-        harm_before_[h][0] += rb[0] * e;
-        harm_before_[h][1] += rb[1] * e;
-        harm_after_[h][0] += ra[0] * e;
-        harm_after_[h][1] += ra[1] * e;
+        harm_before_[h][0] += nominal_A[0] * e;
+        harm_before_[h][1] += nominal_A[1] * e;
+        harm_after_[h][0] += extended_A[0] * e;
+        harm_after_[h][1] += extended_A[1] * e;
       }
     }
     const core::Vec3 i_abc = core::inverse_clarke(core::inverse_park(i, rot));
-    const core::Vec3 r_abc_b = core::inverse_clarke(core::inverse_park(rb, rot));
-    const core::Vec3 r_abc_a = core::inverse_clarke(core::inverse_park(ra, rot));
+    const core::Vec3 r_abc_b = core::inverse_clarke(core::inverse_park(nominal_A, rot));
+    const core::Vec3 r_abc_a = core::inverse_clarke(core::inverse_park(extended_A, rot));
     for (int x = 0; x < 3; ++x) {
       (i_abc[x] > 0.0 ? pos_before_ : neg_before_)[x].add({r_abc_b[x], 0.0});
       (i_abc[x] > 0.0 ? pos_after_ : neg_after_)[x].add({r_abc_a[x], 0.0});
@@ -125,10 +132,10 @@ void ResidualSums::add(std::size_t k, const core::Vec2& rb, const core::Vec2& ra
   }
   for (std::size_t j = 0; j < regressors_.size(); ++j) {
     const double v = regressor(j, k, i, n);
-    corr_[j][0].add(v, rb[0]);
-    corr_[j][1].add(v, rb[1]);
-    corr_[j][2].add(v, ra[0]);
-    corr_[j][3].add(v, ra[1]);
+    corr_[j][0].add(v, nominal_A[0]);
+    corr_[j][1].add(v, nominal_A[1]);
+    corr_[j][2].add(v, extended_A[0]);
+    corr_[j][3].add(v, extended_A[1]);
   }
 }
 
@@ -176,7 +183,11 @@ ResidualStatistics ResidualSums::statistics() const {
       // Regions a log only passes through (a few samples in a transient) say little.
       if (static_cast<double>(b.n) < kMinRegionShare * static_cast<double>(all_before_.n) || b.n == 0) continue;
       const Moments& a = region_after_[sr][lr];
-      out.regions.push_back({kSpeedRegions[sr], kLoadRegions[lr], b.n, {b.rms(), a.rms()}, {b.mean()[0], a.mean()[0]},
+      out.regions.push_back({kSpeedRegions[sr],
+                             kLoadRegions[lr],
+                             b.n,
+                             {b.rms(), a.rms()},
+                             {b.mean()[0], a.mean()[0]},
                              {b.mean()[1], a.mean()[1]}});
     }
   }
@@ -190,12 +201,14 @@ ResidualStatistics ResidualSums::statistics() const {
       out.harmonics.push_back({h, {before, after}});
     }
     for (int x = 0; x < 3; ++x) {
-      out.phase_signs.push_back({static_cast<char>('a' + x), {pos_before_[x].mean()[0], pos_after_[x].mean()[0]},
+      out.phase_signs.push_back({static_cast<char>('a' + x),
+                                 {pos_before_[x].mean()[0], pos_after_[x].mean()[0]},
                                  {neg_before_[x].mean()[0], neg_after_[x].mean()[0]}});
     }
   }
   for (std::size_t j = 0; j < regressors_.size(); ++j) {
-    out.correlations.push_back({regressors_[j], {corr_[j][0].value(), corr_[j][2].value()}, {corr_[j][1].value(), corr_[j][3].value()}});
+    out.correlations.push_back(
+        {regressors_[j], {corr_[j][0].value(), corr_[j][2].value()}, {corr_[j][1].value(), corr_[j][3].value()}});
   }
   return out;
 }

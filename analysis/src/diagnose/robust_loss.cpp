@@ -30,7 +30,8 @@ OutlierTest test_outliers(const std::vector<double>& residuals) {
   t.samples = residuals.size() / 2;
   if (t.samples < 3) return t;
   std::vector<double> s(t.samples);
-  for (std::size_t k = 0; k < t.samples; ++k) s[k] = residuals[2 * k] * residuals[2 * k] + residuals[2 * k + 1] * residuals[2 * k + 1];
+  for (std::size_t k = 0; k < t.samples; ++k)
+    s[k] = residuals[2 * k] * residuals[2 * k] + residuals[2 * k + 1] * residuals[2 * k + 1];
   std::vector<double> sorted = s;
   const auto mid = sorted.begin() + static_cast<std::ptrdiff_t>(t.samples / 2);
   std::nth_element(sorted.begin(), mid, sorted.end());

@@ -35,8 +35,16 @@ void SampleStore::push_back(const io::DriveLogRow& row) {
   }
   staged_t_.push_back(s.t_ns);
   staged_marks_.push_back(s.gap_before ? sample_mark::kGapBefore : 0);
-  const double values[kColumns] = {s.theta_el_rad, s.omega_el_rad_s, s.u_dc_V, s.u_V[0], s.u_V[1], s.u_V[2], s.i_A[0], s.i_A[1],
-                                   s.i_A[2],       has_winding_ ? row.t_winding_C.value_or(kNaN) : 0.0,
+  const double values[kColumns] = {s.theta_el_rad,
+                                   s.omega_el_rad_s,
+                                   s.u_dc_V,
+                                   s.u_V[0],
+                                   s.u_V[1],
+                                   s.u_V[2],
+                                   s.i_A[0],
+                                   s.i_A[1],
+                                   s.i_A[2],
+                                   has_winding_ ? row.t_winding_C.value_or(kNaN) : 0.0,
                                    has_magnet_ ? row.t_magnet_C.value_or(kNaN) : 0.0};
   for (std::size_t c = 0; c < kColumns; ++c) staged_[c].push_back(values[c]);
   ++size_;

@@ -50,8 +50,9 @@ std::vector<Column> basis_columns(const EffectSet& base, const EffectContext& co
 /// The starts a candidate's row offers (zero if none), clamped to its bounds.
 std::vector<std::vector<double>> starts_of(const Effect& candidate, const EffectContext& context) {
   std::vector<std::vector<double>> starts =
-      candidate.row->starts.empty() ? std::vector<std::vector<double>>{std::vector<double>(static_cast<std::size_t>(candidate.row->parameters), 0.0)}
-                                    : candidate.row->starts;
+      candidate.row->starts.empty()
+          ? std::vector<std::vector<double>>{std::vector<double>(static_cast<std::size_t>(candidate.row->parameters), 0.0)}
+          : candidate.row->starts;
   for (std::vector<double>& s : starts) {
     for (std::size_t i = 0; i < s.size(); ++i) {
       const auto [lo, hi] = parameter_bounds(candidate, context, static_cast<int>(i));
@@ -96,12 +97,13 @@ void judge_starts(const OverTraining& over_training, const EffectContext& contex
     starts[c] = starts_of(candidates[c], context);
     first_start[c] = pass.models.size();
     if (starts[c].size() < 2) continue;
-    for (const std::vector<double>& s : starts[c]) pass.models.push_back(base.with(candidates[c], context, s).model(context));
+    for (const std::vector<double>& s : starts[c])
+      pass.models.push_back(base.with(candidates[c], context, s).model(context));
   }
   struct First {
     least_squares::Gram basis;
-    std::vector<double> ss;             ///< per start model: rᵀr
-    std::vector<Eigen::VectorXd> br;    ///< per start model: basis columnsᵀ·r
+    std::vector<double> ss;           ///< per start model: rᵀr
+    std::vector<Eigen::VectorXd> br;  ///< per start model: basis columnsᵀ·r
   };
   const std::size_t start_models = pass.models.size() - pass.basis_end();
   const First init{least_squares::Gram(nb), std::vector<double>(start_models, 0.0),
@@ -128,7 +130,8 @@ void judge_starts(const OverTraining& over_training, const EffectContext& contex
   }
   const Eigen::MatrixXd basis_jj = sum.basis.symmetric();
   const double explained =
-      nb > 0 ? -least_squares::step_change(basis_jj, sum.basis.jr, least_squares::gauss_newton_step(basis_jj, sum.basis.jr)) : 0.0;
+      nb > 0 ? -least_squares::step_change(basis_jj, sum.basis.jr, least_squares::gauss_newton_step(basis_jj, sum.basis.jr))
+             : 0.0;
   pass.baseline_after = sum.basis.rr - explained;
   out.ssr = sum.basis.rr;
   out.starts.resize(candidates.size());
@@ -141,7 +144,8 @@ void judge_starts(const OverTraining& over_training, const EffectContext& contex
     for (std::size_t s = 0; s < starts[c].size(); ++s) {
       const std::size_t m = first_start[c] - pass.basis_end() + s;
       double ssr = sum.ss[m];
-      if (nb > 0) ssr += least_squares::step_change(basis_jj, sum.br[m], least_squares::gauss_newton_step(basis_jj, sum.br[m]));
+      if (nb > 0)
+        ssr += least_squares::step_change(basis_jj, sum.br[m], least_squares::gauss_newton_step(basis_jj, sum.br[m]));
       if (ssr < best) {
         best = ssr;
         out.starts[c] = starts[c][s];
@@ -161,9 +165,9 @@ void credit_gains(const OverTraining& over_training, const EffectContext& contex
   // the basis' columns.
   pass.models.resize(pass.basis_end());
   struct Candidate {
-    std::size_t model = 0;        ///< its model at the start; its columns' models follow
-    std::vector<double> steps;    ///< its columns' steps
-    Eigen::Index constant = 0;    ///< 1 if its first column is a constant's
+    std::size_t model = 0;      ///< its model at the start; its columns' models follow
+    std::vector<double> steps;  ///< its columns' steps
+    Eigen::Index constant = 0;  ///< 1 if its first column is a constant's
   };
   std::vector<Candidate> layout(candidates.size());
   for (std::size_t c = 0; c < candidates.size(); ++c) {
@@ -190,6 +194,7 @@ void credit_gains(const OverTraining& over_training, const EffectContext& contex
   }
   // Per candidate, the Gram of [basis columns, its columns] against its residual at the start.
   std::vector<least_squares::Gram> init2;
+  init2.reserve(layout.size());
   for (const Candidate& l : layout) init2.emplace_back(nb + static_cast<Eigen::Index>(l.steps.size()));
   const std::vector<std::vector<least_squares::Gram>> second =
       over_training(pass.models, init2, [&](std::vector<least_squares::Gram>& g, std::span<const core::Vec2> r) {
@@ -239,8 +244,9 @@ Screening EffectFitter::screen(const EffectSet& base, const std::vector<Effect>&
     std::uint64_t models = 2 * (1 + static_cast<std::uint64_t>(pass.basis_size()));
     for (const Effect& e : candidates) {
       const std::size_t starts = e.row->starts.size();
-      models += (starts > 1 ? starts : 0) + 1 + static_cast<std::uint64_t>(e.row->parameters) +
-                (e.row->fitted_constant() >= 0 && !base.calibrated[static_cast<std::size_t>(e.row->fitted_constant())] ? 1 : 0);
+      models +=
+          (starts > 1 ? starts : 0) + 1 + static_cast<std::uint64_t>(e.row->parameters) +
+          (e.row->fitted_constant() >= 0 && !base.calibrated[static_cast<std::size_t>(e.row->fitted_constant())] ? 1 : 0);
     }
     monitor->add_work(models * training_block_samples_);
   }

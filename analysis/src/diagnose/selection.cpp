@@ -88,13 +88,16 @@ void withdraw_explained(const EffectFitter& fitter, const SelectionOptions& opti
     const FoundEffect& f = sel.found[weakest];
     const ExtendedModel m = sel.model.model(context);
     std::string later;
-    for (std::size_t j = weakest + 1; j < sel.found.size(); ++j) later += (later.empty() ? "" : ", ") + sel.found[j].effect.label();
+    for (std::size_t j = weakest + 1; j < sel.found.size(); ++j)
+      later += (later.empty() ? "" : ", ") + sel.found[j].effect.label();
     char reason[320];
     std::snprintf(reason, sizeof reason,
                   "found first (held-out gain %.1f %%), but with %s found later it no longer lowers the held-out "
                   "residual significantly (%.1f %% against the model refitted without it)",
                   f.gain_pct, later.c_str(), weakest_gain);
-    sel.withdrawn.push_back({f.effect, f.effect.row->describe(f.effect, m, context), f.gain_pct,
+    sel.withdrawn.push_back({f.effect,
+                             f.effect.row->describe(f.effect, m, context),
+                             f.gain_pct,
                              {reason, "what " + later + " explain; it had stood in for it"}});
     excluded.push_back(f.effect);
     sel.found.erase(sel.found.begin() + static_cast<std::ptrdiff_t>(weakest));
@@ -115,7 +118,8 @@ bool leaves_configured(const EffectSet& set, const std::array<bool, kCalibrated.
 /// start), keeping those the calibration's rule then keeps (identification()) (refitted without the others); `set` itself when it keeps
 /// none (`kept` false).
 EffectSet with_admissible_constants(const EffectFitter& fitter, double noise_floor_A,
-                                    const std::array<bool, kCalibrated.size()>& admissible, const EffectSet& set, bool& kept) {
+                                    const std::array<bool, kCalibrated.size()>& admissible, const EffectSet& set,
+                                    bool& kept) {
   kept = false;
   EffectSet trial = set;
   std::vector<std::size_t> freed;
@@ -151,10 +155,10 @@ struct Round {
   std::size_t shortlisted = 0, leaders = 0;
   std::vector<EffectSet> fitted;
   std::vector<BlockScores> scores;
-  std::vector<double> reduction;            ///< training sum of squares each fit removed [A²]
-  BlockScores reference;                    ///< what the candidates are judged against
-  std::vector<std::size_t> ranked;          ///< the fitted ones, best held-out score first
-  double before = 0.0;                      ///< held-out RMS of the reference [A]
+  std::vector<double> reduction;    ///< training sum of squares each fit removed [A²]
+  BlockScores reference;            ///< what the candidates are judged against
+  std::vector<std::size_t> ranked;  ///< the fitted ones, best held-out score first
+  double before = 0.0;              ///< held-out RMS of the reference [A]
   double min_change2 = 0.0;
   const EffectContext* context = nullptr;
   const SelectionOptions* options = nullptr;
@@ -172,7 +176,8 @@ struct Round {
       c.parameters = fitted[i].parameters.back();
       ranked.push_back(i);
     }
-    std::sort(ranked.begin(), ranked.end(), [&](std::size_t a, std::size_t b) { return scores[a].total() < scores[b].total(); });
+    std::sort(ranked.begin(), ranked.end(),
+              [&](std::size_t a, std::size_t b) { return scores[a].total() < scores[b].total(); });
   }
   /// Judged against the model as it is.
   void judge_against(const BlockScores& current, const EffectContext& c, const SelectionOptions& o, double change2) {
@@ -187,7 +192,8 @@ struct Round {
   [[nodiscard]] bool passes(std::size_t i) const {
     const CandidateScore& c = candidates[i];
     const double after = rms(scores[i]);
-    if (c.gain_pct < options->min_gain_pct || c.p_value > options->max_p || before * before - after * after < min_change2) return false;
+    if (c.gain_pct < options->min_gain_pct || c.p_value > options->max_p || before * before - after * after < min_change2)
+      return false;
     return !(c.effect.row->negligible && c.effect.row->negligible(c.effect, fitted[i].model(*context), *context));
   }
   /// The second look's condition (second_look): none passes, but the best lowers the held-out residual by
@@ -210,7 +216,8 @@ std::optional<Round> screen_round(const EffectFitter& fitter, const Selection& s
   }
   if (effects.empty()) return std::nullopt;
   round.name = "round " + std::to_string(sel.rounds.size() + 1) + ": ";
-  if (Monitor* m = fitter.replay().monitor()) m->stage(round.name + "screening " + std::to_string(effects.size()) + " candidates", 0);
+  if (Monitor* m = fitter.replay().monitor())
+    m->stage(round.name + "screening " + std::to_string(effects.size()) + " candidates", 0);
   Screening screening = fitter.screen(sel.model, effects);
   round.ssr_now = screening.ssr;
   std::vector<std::size_t> order(effects.size());
@@ -233,7 +240,8 @@ void fit_shortlist(const EffectFitter& fitter, const SelectionOptions& options, 
   std::vector<CandidateScore>& c = round.candidates;
   std::size_t shortlisted = std::min<std::size_t>(c.size(), static_cast<std::size_t>(options.shortlist));
   while (shortlisted > 2 && c[shortlisted - 1].screen_ssr < options.shortlist_share * c.front().screen_ssr) --shortlisted;
-  if (Monitor* m = fitter.replay().monitor()) m->stage(round.name + "fitting the " + std::to_string(shortlisted) + " best", 0);
+  if (Monitor* m = fitter.replay().monitor())
+    m->stage(round.name + "fitting the " + std::to_string(shortlisted) + " best", 0);
   round.shortlisted = shortlisted;
   round.fitted.assign(shortlisted, EffectSet{});
   round.scores.assign(shortlisted, BlockScores{});
@@ -248,7 +256,8 @@ void fit_shortlist(const EffectFitter& fitter, const SelectionOptions& options, 
   const WorkPool& pool = fitter.replay().pool();
   round.leaders = std::min<std::size_t>(shortlisted, static_cast<std::size_t>(std::max(options.leaders, 1)));
   pool.parallel_for(round.leaders, fit);
-  const double achieved = *std::max_element(round.reduction.begin(), round.reduction.begin() + static_cast<std::ptrdiff_t>(round.leaders));
+  const double achieved =
+      *std::max_element(round.reduction.begin(), round.reduction.begin() + static_cast<std::ptrdiff_t>(round.leaders));
   std::vector<std::size_t> rivals;
   for (std::size_t i = round.leaders; i < shortlisted; ++i) {
     if (c[i].screen_ssr >= options.rival_share * achieved) rivals.push_back(i);
@@ -307,7 +316,8 @@ std::optional<std::size_t> best_plausible(const EffectFitter& fitter, double noi
       why = c.effect.row->judge(c.effect, m, context, ci.effect_half_width.back());
     }
     if (!why) {
-      if (const std::optional<std::string> lost = takes_a_constant(fitter, sel.model, round.fitted[i], c, noise_floor_A, admissible)) {
+      if (const std::optional<std::string> lost =
+              takes_a_constant(fitter, sel.model, round.fitted[i], c, noise_floor_A, admissible)) {
         sel.not_identifiable.push_back({{c.effect.label()}, *lost});
         excluded.push_back(c.effect);
         set_aside = true;
@@ -391,8 +401,8 @@ double signed_rank_p(const std::vector<double>& values) {
   return tail / std::pow(2.0, static_cast<double>(n));
 }
 
-bool readmit_constants(const EffectFitter& fitter, double noise_floor_A, const std::array<bool, kCalibrated.size()>& admissible,
-                       EffectSet& model, BlockScores& scores) {
+bool readmit_constants(const EffectFitter& fitter, double noise_floor_A,
+                       const std::array<bool, kCalibrated.size()>& admissible, EffectSet& model, BlockScores& scores) {
   bool kept = false;
   const EffectSet trial = with_admissible_constants(fitter, noise_floor_A, admissible, model, kept);
   if (!kept) return false;
@@ -420,16 +430,19 @@ Selection select_effects(const EffectFitter& fitter, const SelectionOptions& opt
     Round& round = *screened;
     fit_shortlist(fitter, options, sel.model, round);
     round.judge_against(current, fitter.context(), options, min_change2);
-    if (round.needs_second_look(options, sel.model, admissible)) second_look(fitter, noise_floor_A, admissible, sel.model, round);
+    if (round.needs_second_look(options, sel.model, admissible))
+      second_look(fitter, noise_floor_A, admissible, sel.model, round);
     sel.rounds.push_back(round.candidates);
     bool set_aside = false;
-    const std::optional<std::size_t> best = best_plausible(fitter, noise_floor_A, admissible, round, sel, excluded, set_aside);
+    const std::optional<std::size_t> best =
+        best_plausible(fitter, noise_floor_A, admissible, round, sel, excluded, set_aside);
     if (!best) {
       if (set_aside) continue;  // only implausible ones passed: the next round looks again without them
       break;
     }
     const CandidateScore winner = round.candidates[*best];
-    if (Unidentifiable group = ambiguous_group(fitter, options, sel.model, round, *best, excluded); group.effects.size() > 1) {
+    if (Unidentifiable group = ambiguous_group(fitter, options, sel.model, round, *best, excluded);
+        group.effects.size() > 1) {
       // The winner stays in the model as an unnamed stand-in, so that no later candidate is named for the
       // residual the group explains; it is taken out again at the end.
       sel.not_identifiable.push_back(std::move(group));

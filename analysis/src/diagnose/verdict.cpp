@@ -27,12 +27,14 @@ std::string num(double v) {
 
 /// What a residual at harmonic h of the electrical angle (dq frame) is most often.
 std::string harmonic_meaning(int h) {
-  if (h == 0) return "an error that depends on the operating point (saturation of another shape, cross-saturation, a "
-                     "resistance or flux error varying with the load)";
+  if (h == 0)
+    return "an error that depends on the operating point (saturation of another shape, cross-saturation, a "
+           "resistance or flux error varying with the load)";
   if (h == 1) return "a current-sensor offset or an unbalanced winding";
   if (h == 2) return "a current-sensor gain error or an unbalanced impedance";
-  if (h % 6 == 0) return "rotor-frame flux harmonics of another form, or an inverter voltage error of another shape than "
-                         "the catalogue's dead time";
+  if (h % 6 == 0)
+    return "rotor-frame flux harmonics of another form, or an inverter voltage error of another shape than "
+           "the catalogue's dead time";
   return "an angle-periodic error outside the catalogue (encoder eccentricity, slotting)";
 }
 
@@ -48,9 +50,12 @@ std::string regressor_meaning(const std::string& r) {
 
 const char* to_string(VerdictKind k) noexcept {
   switch (k) {
-    case VerdictKind::kExplained: return "explained";
-    case VerdictKind::kUnexplained: return "unexplained";
-    case VerdictKind::kUndetermined: return "undetermined";
+    case VerdictKind::kExplained:
+      return "explained";
+    case VerdictKind::kUnexplained:
+      return "unexplained";
+    case VerdictKind::kUndetermined:
+      return "undetermined";
   }
   return "undetermined";
 }
@@ -82,11 +87,13 @@ NoiseFloor SecondDifferences::noise_floor(const LogData& log) && {
                        " samples have replayed neighbours on both sides within their block (" +
                        std::to_string(kMinNoiseDifferences) + " are needed): ";
     if (log.mode == ModelMode::kSteadyState) {
-      f.unknown_reason += std::to_string(log.excluded_transitional) + " rows are in transition between operating points and " +
-                          std::to_string(log.excluded_idle) + " idle, so no stretch of rows repeats an operating point " +
+      f.unknown_reason += std::to_string(log.excluded_transitional) +
+                          " rows are in transition between operating points and " + std::to_string(log.excluded_idle) +
+                          " idle, so no stretch of rows repeats an operating point " +
                           "(standstill under current included) and " + std::to_string(valid_) + " rows are replayed";
     } else {
-      f.unknown_reason += "gaps and left-out samples leave " + std::to_string(valid_) + " replayed samples without runs of three";
+      f.unknown_reason +=
+          "gaps and left-out samples leave " + std::to_string(valid_) + " replayed samples without runs of three";
     }
     return f;
   }
@@ -104,8 +111,11 @@ NoiseFloor measure_noise_floor(const LogData& log, const ReplayOutput& replay) {
   SecondDifferences all;
   for (int b = 0; b < log.blocks; ++b) {
     all.start();
-    for (std::size_t k = log.block_first[static_cast<std::size_t>(b)]; k < log.block_first[static_cast<std::size_t>(b) + 1]; ++k) {
-      all.add(log, k, ModelSample{replay.residual_A[k], replay.model_A.empty() ? core::Vec2::Zero() : replay.model_A[k], replay.valid[k]});
+    for (std::size_t k = log.block_first[static_cast<std::size_t>(b)]; k < log.block_first[static_cast<std::size_t>(b) + 1];
+         ++k) {
+      all.add(log, k,
+              ModelSample{replay.residual_A[k], replay.model_A.empty() ? core::Vec2::Zero() : replay.model_A[k],
+                          replay.valid[k]});
     }
   }
   return std::move(all).noise_floor(log);
@@ -128,12 +138,14 @@ Verdict verdict(double final_heldout_rms_A, const NoiseFloor& floor, const Resid
 
   // Where it lives: standstill against motion, and the region that carries the most.
   if (st.standstill_samples == 0) {
-    v.findings.push_back("no samples at standstill; in motion " + num(st.motion_rms_A.after) + " A RMS (" + floor_text + ")");
+    v.findings.push_back("no samples at standstill; in motion " + num(st.motion_rms_A.after) + " A RMS (" + floor_text +
+                         ")");
   } else if (st.motion_samples == 0) {
-    v.findings.push_back("at standstill " + num(st.standstill_rms_A.after) + " A RMS, no samples in motion (" + floor_text + ")");
+    v.findings.push_back("at standstill " + num(st.standstill_rms_A.after) + " A RMS, no samples in motion (" + floor_text +
+                         ")");
   } else {
-    v.findings.push_back("at standstill " + num(st.standstill_rms_A.after) + " A RMS, in motion " + num(st.motion_rms_A.after) +
-                         " A RMS (" + floor_text + ")");
+    v.findings.push_back("at standstill " + num(st.standstill_rms_A.after) + " A RMS, in motion " +
+                         num(st.motion_rms_A.after) + " A RMS (" + floor_text + ")");
   }
   const RegionStatistics* worst = nullptr;
   for (const RegionStatistics& r : st.regions) {
@@ -149,8 +161,9 @@ Verdict verdict(double final_heldout_rms_A, const NoiseFloor& floor, const Resid
     if (!strongest || h.amplitude_A.after > strongest->amplitude_A.after) strongest = &h;
   }
   if (strongest && floor.value_A && strongest->amplitude_A.after > *floor.value_A) {
-    v.findings.push_back("against the electrical angle the residual is strongest at harmonic " + std::to_string(strongest->order) +
-                         " (" + num(strongest->amplitude_A.after) + " A): most often " + harmonic_meaning(strongest->order));
+    v.findings.push_back("against the electrical angle the residual is strongest at harmonic " +
+                         std::to_string(strongest->order) + " (" + num(strongest->amplitude_A.after) + " A): most often " +
+                         harmonic_meaning(strongest->order));
   }
   // With what it moves.
   const RegressorCorrelation* best = nullptr;
@@ -163,14 +176,17 @@ Verdict verdict(double final_heldout_rms_A, const NoiseFloor& floor, const Resid
     }
   }
   if (best && best_r >= 0.3) {
-    v.findings.push_back("it correlates with " + best->regressor + " (" + num(best_r) + "): " + regressor_meaning(best->regressor));
+    v.findings.push_back("it correlates with " + best->regressor + " (" + num(best_r) +
+                         "): " + regressor_meaning(best->regressor));
   }
   if (!floor.value_A) {
-    v.findings.push_back("three or more consecutive samples at one operating point (a steady stretch, or standstill under "
-                         "current) in several blocks would measure the noise floor");
+    v.findings.emplace_back(
+        "three or more consecutive samples at one operating point (a steady stretch, or standstill under "
+        "current) in several blocks would measure the noise floor");
   }
-  v.findings.push_back("a log with more operating points — standstill at several currents of both signs, several speeds at "
-                       "several loads, temperatures that span tens of kelvin — would tell more effects apart");
+  v.findings.emplace_back(
+      "a log with more operating points — standstill at several currents of both signs, several speeds at "
+      "several loads, temperatures that span tens of kelvin — would tell more effects apart");
   return v;
 }
 

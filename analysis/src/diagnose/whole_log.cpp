@@ -110,8 +110,55 @@ BaselinePass baseline_pass(const ModelReplay& replay, const EffectContext& conte
   return out;
 }
 
+namespace {
+
+/// The blocks' figure sums merged in block order into the figures' time bins, operating-plane map, temperature
+/// bins and overlay. Time bins: the log's own columns over every sample of the bin, the residuals over those
+/// both models predict.
+void merge_figures(const LogData& log, const EffectContext& context, const std::vector<BlockFigures>& parts,
+                   std::size_t per_bin, FigureData& figures) {
+  const std::size_t n = log.size();
+  constexpr int kCells = FigureData::kMapX * FigureData::kMapY;
+  figures = FigureData();
+  std::vector<std::array<double, 5>> bins((n + per_bin - 1) / per_bin, {0.0, 0.0, 0.0, 0.0, 0.0});
+  figures.map.assign(kCells, {0.0, 0.0, 0.0});
+  figures.temperature.assign(FigureData::kTemperatureBins, {0.0, 0.0, 0.0, 0.0, 0.0});
+  for (const BlockFigures& f : parts) {
+    for (std::size_t j = 0; j < f.bins.size(); ++j) {
+      for (int c = 0; c < 5; ++c)
+        bins[f.first_bin + j][static_cast<std::size_t>(c)] += f.bins[j][static_cast<std::size_t>(c)];
+    }
+    for (std::size_t c = 0; c < f.map.size(); ++c) {
+      for (int v = 0; v < 3; ++v) figures.map[c][static_cast<std::size_t>(v)] += f.map[c][static_cast<std::size_t>(v)];
+    }
+    for (std::size_t c = 0; c < f.temperature.size(); ++c) {
+      for (int v = 0; v < 5; ++v)
+        figures.temperature[c][static_cast<std::size_t>(v)] += f.temperature[c][static_cast<std::size_t>(v)];
+    }
+    figures.overlay.insert(figures.overlay.end(), f.overlay.begin(), f.overlay.end());
+  }
+  for (std::size_t start = 0, j = 0; start < n; start += per_bin, ++j) {
+    double t = 0, sp = 0, iq = 0, temp = 0, all_samples = 0;
+    for (std::size_t k = start; k < std::min(n, start + per_bin); ++k) {
+      t += log.t_s(k);
+      sp += speed_rpm(context, log.samples.omega_el_rad_s(k));
+      iq += log.logged_i_dq_A(k)[1];
+      all_samples += 1;
+      temp += log.samples.t_winding_C(k).value_or(log.samples.t_magnet_C(k).value_or(kNaN));
+    }
+    const auto& r = bins[j];
+    const double cnt = r[4];
+    figures.time.push_back({t / all_samples, sp / all_samples, iq / all_samples, cnt != 0.0 ? std::sqrt(r[0] / cnt) : kNaN,
+                            cnt != 0.0 ? std::sqrt(r[1] / cnt) : kNaN, cnt != 0.0 ? r[2] / cnt : kNaN,
+                            cnt != 0.0 ? r[3] / cnt : kNaN, temp / all_samples});
+  }
+}
+
+}  // namespace
+
 void comparison_pass(const ModelReplay& replay, const EffectContext& context, const ExtendedModel& baseline,
-                     const ExtendedModel& extended, const BaselinePass& pass, ResidualStatistics& statistics, FigureData& figures) {
+                     const ExtendedModel& extended, const BaselinePass& pass, ResidualStatistics& statistics,
+                     FigureData& figures) {
   const LogData& log = replay.log();
   const std::size_t n = log.size();
   const std::size_t per_bin = std::max<std::size_t>(1, n / FigureData::kTimeBins);
@@ -127,7 +174,8 @@ void comparison_pass(const ModelReplay& replay, const EffectContext& context, co
   std::vector<BlockFigures> parts(blocks.size());
   replay.for_blocks(blocks, [&](std::size_t i, int b) {
     BlockFigures& f = parts[i];
-    const std::size_t first = log.block_first[static_cast<std::size_t>(b)], end = log.block_first[static_cast<std::size_t>(b) + 1];
+    const std::size_t first = log.block_first[static_cast<std::size_t>(b)],
+                      end = log.block_first[static_cast<std::size_t>(b) + 1];
     f.first_bin = first / per_bin;
     f.bins.assign((end - 1) / per_bin - f.first_bin + 1, {0.0, 0.0, 0.0, 0.0, 0.0});
     f.map.assign(kCells, {0.0, 0.0, 0.0});
@@ -146,7 +194,7 @@ void comparison_pass(const ModelReplay& replay, const EffectContext& context, co
       const core::Vec2 i_dq = log.logged_i_dq_A(k);
       const int x = std::min(FigureData::kMapX - 1, static_cast<int>((speed - s_lo) / (s_hi - s_lo) * FigureData::kMapX));
       const int y = std::min(FigureData::kMapY - 1, static_cast<int>((i_dq[1] - q_lo) / (q_hi - q_lo) * FigureData::kMapY));
-      auto& cell = f.map[static_cast<std::size_t>(y * FigureData::kMapX + x)];
+      auto& cell = f.map[static_cast<std::size_t>(y) * FigureData::kMapX + static_cast<std::size_t>(x)];
       cell[0] += rb.squaredNorm();
       cell[1] += ra.squaredNorm();
       cell[2] += 1.0;
@@ -161,7 +209,8 @@ void comparison_pass(const ModelReplay& replay, const EffectContext& context, co
         s[4] += ra[1];
       }
       if (k >= pass.overlay_first && k < pass.overlay_last) {
-        f.overlay.push_back({log.t_s(k), i_dq[0], i_dq[1], m[0].model_A[0], m[0].model_A[1], m[1].model_A[0], m[1].model_A[1]});
+        f.overlay.push_back(
+            {log.t_s(k), i_dq[0], i_dq[1], m[0].model_A[0], m[0].model_A[1], m[1].model_A[0], m[1].model_A[1]});
       }
     });
   });
@@ -170,37 +219,7 @@ void comparison_pass(const ModelReplay& replay, const EffectContext& context, co
   for (const ResidualSums& s : sums) all.merge(s);
   statistics = all.statistics();
 
-  // Time bins: the log's own columns over every sample of the bin, the residuals over those both models predict.
-  figures = FigureData();
-  std::vector<std::array<double, 5>> bins((n + per_bin - 1) / per_bin, {0.0, 0.0, 0.0, 0.0, 0.0});
-  figures.map.assign(kCells, {0.0, 0.0, 0.0});
-  figures.temperature.assign(FigureData::kTemperatureBins, {0.0, 0.0, 0.0, 0.0, 0.0});
-  for (const BlockFigures& f : parts) {
-    for (std::size_t j = 0; j < f.bins.size(); ++j) {
-      for (int c = 0; c < 5; ++c) bins[f.first_bin + j][static_cast<std::size_t>(c)] += f.bins[j][static_cast<std::size_t>(c)];
-    }
-    for (std::size_t c = 0; c < f.map.size(); ++c) {
-      for (int v = 0; v < 3; ++v) figures.map[c][static_cast<std::size_t>(v)] += f.map[c][static_cast<std::size_t>(v)];
-    }
-    for (std::size_t c = 0; c < f.temperature.size(); ++c) {
-      for (int v = 0; v < 5; ++v) figures.temperature[c][static_cast<std::size_t>(v)] += f.temperature[c][static_cast<std::size_t>(v)];
-    }
-    figures.overlay.insert(figures.overlay.end(), f.overlay.begin(), f.overlay.end());
-  }
-  for (std::size_t start = 0, j = 0; start < n; start += per_bin, ++j) {
-    double t = 0, sp = 0, iq = 0, temp = 0, all_samples = 0;
-    for (std::size_t k = start; k < std::min(n, start + per_bin); ++k) {
-      t += log.t_s(k);
-      sp += speed_rpm(context, log.samples.omega_el_rad_s(k));
-      iq += log.logged_i_dq_A(k)[1];
-      all_samples += 1;
-      temp += log.samples.t_winding_C(k).value_or(log.samples.t_magnet_C(k).value_or(kNaN));
-    }
-    const auto& r = bins[j];
-    const double cnt = r[4];
-    figures.time.push_back({t / all_samples, sp / all_samples, iq / all_samples, cnt ? std::sqrt(r[0] / cnt) : kNaN,
-                            cnt ? std::sqrt(r[1] / cnt) : kNaN, cnt ? r[2] / cnt : kNaN, cnt ? r[3] / cnt : kNaN, temp / all_samples});
-  }
+  merge_figures(log, context, parts, per_bin, figures);
   figures.speed_lo_rpm = s_lo;
   figures.speed_hi_rpm = s_hi;
   figures.i_q_lo_A = q_lo;

@@ -38,16 +38,20 @@ double panel(GnuplotFigure& fig, const io::CsvTable& est, const io::CsvTable* me
   const std::size_t stride = std::max<std::size_t>(1, t.size() / 4000);
   DataBlock e{node + "_est", std::vector<std::vector<double>>(5)};
   for (std::size_t k = 0; k < t.size(); k += stride) {
-    for (auto [c, v] : {std::pair{0, t[k]}, {1, fused[k]}, {2, fused[k] - 2.0 * sd[k]}, {3, fused[k] + 2.0 * sd[k]},
-                        {4, alone[k]}}) {
+    for (auto [c, v] :
+         {std::pair{0, t[k]}, {1, fused[k]}, {2, fused[k] - 2.0 * sd[k]}, {3, fused[k] + 2.0 * sd[k]}, {4, alone[k]}}) {
       e.columns[static_cast<std::size_t>(c)].push_back(std::isfinite(v) ? v : kNaN);
     }
   }
   fig.add_data(e);
   double covered = 0.0, counted = 0.0;
-  std::string plot = "plot $" + node + "_est u 1:3:4 w filledcurves fc rgb '#c6dbef' title 'fused ±2σ', "
-                     "$" + node + "_est u 1:2 w l lw 2 lc rgb '#08519c' title 'fused', "
-                     "$" + node + "_est u 1:5 w l dt 2 lc rgb '#636363' title 'RPEM alone (held where not adapting)'";
+  std::string plot = "plot $" + node +
+                     "_est u 1:3:4 w filledcurves fc rgb '#c6dbef' title 'fused ±2σ', "
+                     "$" +
+                     node +
+                     "_est u 1:2 w l lw 2 lc rgb '#08519c' title 'fused', "
+                     "$" +
+                     node + "_est u 1:5 w l dt 2 lc rgb '#636363' title 'RPEM alone (held where not adapting)'";
   if (measured != nullptr && measured->has(measured_column)) {
     const std::vector<double>& tm = measured->column("t");
     const std::vector<double>& vm = measured->column(measured_column);

@@ -55,7 +55,8 @@ class Layout {
     }
     for (int i = 0; i < n.nodes; ++i) {
       for (int j = i + 1; j < n.nodes; ++j) {
-        if (n.between_W_per_K(i, j) > 0.0) slots_.push_back({SlotKind::kBetween, i, j, "G " + name(i) + "–" + name(j), "W/K"});
+        if (n.between_W_per_K(i, j) > 0.0)
+          slots_.push_back({SlotKind::kBetween, i, j, "G " + name(i) + "–" + name(j), "W/K"});
       }
     }
     const auto& forms = core::loss_forms();
@@ -98,13 +99,22 @@ class Layout {
       const Slot& s = slots_[k];
       const double v = std::exp(x[k]);
       switch (s.kind) {
-        case SlotKind::kCapacitance: n.capacitance_J_per_K[s.i] = v; break;
-        case SlotKind::kCopperScale: n.copper_scale = v; break;
-        case SlotKind::kToCoolant: n.to_coolant_W_per_K[s.i] = v; break;
-        case SlotKind::kBetween: n.between_W_per_K(s.i, s.j) = n.between_W_per_K(s.j, s.i) = v; break;
+        case SlotKind::kCapacitance:
+          n.capacitance_J_per_K[s.i] = v;
+          break;
+        case SlotKind::kCopperScale:
+          n.copper_scale = v;
+          break;
+        case SlotKind::kToCoolant:
+          n.to_coolant_W_per_K[s.i] = v;
+          break;
+        case SlotKind::kBetween:
+          n.between_W_per_K(s.i, s.j) = n.between_W_per_K(s.j, s.i) = v;
+          break;
         case SlotKind::kLoss:
           for (int f = 0; f < core::kLossForms; ++f) {
-            if (s.share[static_cast<std::size_t>(f)] > 0.0) n.loss_at_base_W(f, s.i) = v * s.share[static_cast<std::size_t>(f)];
+            if (s.share[static_cast<std::size_t>(f)] > 0.0)
+              n.loss_at_base_W(f, s.i) = v * s.share[static_cast<std::size_t>(f)];
           }
           break;
       }
@@ -116,11 +126,16 @@ class Layout {
   [[nodiscard]] static double quantity(const io::ThermalConfig& c, const Slot& s) {
     const core::ThermalNetwork& n = c.fusion.filter.network;
     switch (s.kind) {
-      case SlotKind::kCapacitance: return n.capacitance_J_per_K[s.i];
-      case SlotKind::kCopperScale: return n.copper_scale;
-      case SlotKind::kToCoolant: return n.to_coolant_W_per_K[s.i];
-      case SlotKind::kBetween: return n.between_W_per_K(s.i, s.j);
-      case SlotKind::kLoss: return n.loss_at_base_W(s.j, s.i);  // the first form's
+      case SlotKind::kCapacitance:
+        return n.capacitance_J_per_K[s.i];
+      case SlotKind::kCopperScale:
+        return n.copper_scale;
+      case SlotKind::kToCoolant:
+        return n.to_coolant_W_per_K[s.i];
+      case SlotKind::kBetween:
+        return n.between_W_per_K(s.i, s.j);
+      case SlotKind::kLoss:
+        return n.loss_at_base_W(s.j, s.i);  // the first form's
     }
     return 0.0;
   }
@@ -200,7 +215,8 @@ std::vector<Point> training_points(const io::ThermalConfig& c, const ThermalReco
   std::vector<Point> points;
   const core::ThermalFusionConfig& f = c.fusion;
   for (std::size_t k = 0; k < steps; ++k) {
-    const core::StepObservations o = core::step_observations(f, r.steps[k], core::ThermalVec::Zero(), core::ThermalVec::Zero());
+    const core::StepObservations o =
+        core::step_observations(f, r.steps[k], core::ThermalVec::Zero(), core::ThermalVec::Zero());
     for (int kind = 0; kind < 3; ++kind) {
       if (!o.present[static_cast<std::size_t>(kind)]) continue;
       double sigma = 0.0;
@@ -243,7 +259,8 @@ std::vector<LossTie> tie_collinear_losses(io::ThermalConfig& c, const ThermalRec
     for (std::size_t k = 0; k < steps; ++k) largest = std::max(largest, r.steps[k].load.basis[static_cast<std::size_t>(f)]);
     for (std::size_t k = 0; k < steps; ++k) {
       const auto& b = r.steps[k].load.basis;
-      if (b[static_cast<std::size_t>(f)] > 1e-3 * largest) ratio.push_back(b[static_cast<std::size_t>(g)] / b[static_cast<std::size_t>(f)]);
+      if (b[static_cast<std::size_t>(f)] > 1e-3 * largest)
+        ratio.push_back(b[static_cast<std::size_t>(g)] / b[static_cast<std::size_t>(f)]);
     }
     if (ratio.size() < 3) return false;
     std::sort(ratio.begin(), ratio.end());
@@ -325,7 +342,8 @@ Eigen::MatrixXd jacobian(const Layout& layout, const ThermalRecord& r, std::size
     const double h = 1e-5;
     xk[k] += h;
     residuals(layout.apply(xk.data()), r, steps, points, moved.data());
-    for (std::size_t p = 0; p < points.size(); ++p) j(static_cast<Eigen::Index>(p), static_cast<Eigen::Index>(k)) = (moved[p] - r0[p]) / h;
+    for (std::size_t p = 0; p < points.size(); ++p)
+      j(static_cast<Eigen::Index>(p), static_cast<Eigen::Index>(k)) = (moved[p] - r0[p]) / h;
   }
   return j;
 }
@@ -409,7 +427,8 @@ void judge(const io::ThermalConfig& c, const ThermalRecord& r, std::size_t train
     s.name = names[kind];
     double fit2 = 0.0, held2 = 0.0;
     for (std::size_t k = 0; k < r.steps.size(); ++k) {
-      const core::StepObservations o = core::step_observations(judged, r.steps[k], out.open_loop_C[k], core::ThermalVec::Zero());
+      const core::StepObservations o =
+          core::step_observations(judged, r.steps[k], out.open_loop_C[k], core::ThermalVec::Zero());
       if (!o.present[static_cast<std::size_t>(kind)]) continue;
       const double m = miss_K(o, kind, out.open_loop_C[k], own_node(f.filter.network, kind));
       if (k < training) {
@@ -504,7 +523,7 @@ io::ThermalConfig default_topology(const io::ThermalConfig& laws, const ThermalR
   const double copper_W = std::max(1.5 * n.copper.value_ref * i2 / count, 1.0);
   const double iron_basis = std::max(iron / count, 1e-3);
   const double magnet_basis = std::max(magnet_eddy / count, 1e-3);
-  const double rise_K = 60.0;                   // a machine near its rating
+  const double rise_K = 60.0;  // a machine near its rating
   // The winding's conductance: the mean copper loss over a typical rise, at least three times the copper loss's
   // own growth with temperature at the largest current ((3/2)·R_ref·α·i²_max: below it the network runs away).
   const double feedback_W_per_K = 1.5 * n.copper.value_ref * n.copper.coeff_per_K * i2_max;
@@ -543,10 +562,12 @@ io::ThermalConfig default_topology(const io::ThermalConfig& laws, const ThermalR
   return c;
 }
 
-ThermalFitResult fit_thermal(const ThermalRecord& record, const io::ThermalConfig& start_config, const ThermalFitOptions& options) {
+ThermalFitResult fit_thermal(const ThermalRecord& record, const io::ThermalConfig& start_config,
+                             const ThermalFitOptions& options) {
   if (record.steps.size() < 10) {
-    throw std::invalid_argument("the log gives " + std::to_string(record.steps.size()) +
-                                " steps of the thermal filter; a fit needs at least 10 (a longer log, or a shorter filter.period_s)");
+    throw std::invalid_argument(
+        "the log gives " + std::to_string(record.steps.size()) +
+        " steps of the thermal filter; a fit needs at least 10 (a longer log, or a shorter filter.period_s)");
   }
   ThermalFitResult out;
   const double t0 = record.t_s.front(), t_end = record.t_s.back();
@@ -571,8 +592,9 @@ ThermalFitResult fit_thermal(const ThermalRecord& record, const io::ThermalConfi
     if (options.anchor_magnet_reference) anchor_magnet_reference(start, record, t_magnet, t_winding, out.notes);
     points = training_points(start, record, training);
     if (points.empty()) {
-      throw std::invalid_argument("the training part holds no temperature the network can be fitted to (no winding sensor, "
-                                  "and ψm and R_s never adapt and settle)");
+      throw std::invalid_argument(
+          "the training part holds no temperature the network can be fitted to (no winding sensor, "
+          "and ψm and R_s never adapt and settle)");
     }
     const Layout pass_layout(start, ties);
     // Three starts: the topology's time constants as they are, three times shorter and three times longer.
@@ -593,8 +615,9 @@ ThermalFitResult fit_thermal(const ThermalRecord& record, const io::ThermalConfi
   }
   const Layout fitted_layout(start, ties);
   if (!std::isfinite(best.cost) || best.cost >= kRunaway * kRunaway) {
-    throw std::invalid_argument("the fit did not converge to a network that follows the log (it runs away or is not "
-                                "finite); start it from another network (--start) or another topology (--nodes)");
+    throw std::invalid_argument(
+        "the fit did not converge to a network that follows the log (it runs away or is not "
+        "finite); start it from another network (--start) or another topology (--nodes)");
   }
   out.training_cost = best.cost;
   out.config = fitted_layout.apply(best.x.data());

@@ -17,8 +17,7 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 class Recorder {
  public:
   Recorder(ThermalRecord& r, const io::MachineConfig& m, const io::ThermalConfig& t, const core::PerUnitBase& base)
-      : record_(r),
-        observer_(t.fusion.observer, base, m.machine, t.fusion.filter.network.base, t.fusion.coolant_C) {}
+      : record_(r), observer_(t.fusion.observer, base, m.machine, t.fusion.filter.network.base, t.fusion.coolant_C) {}
   void add(const core::Estimate& e, std::int64_t t_ns, double coolant_C, double winding_C) {
     core::ThermalSample s;
     s.dt_s = previous_ns_ ? 1e-9 * static_cast<double>(t_ns - *previous_ns_) : 0.0;
@@ -38,7 +37,8 @@ class Recorder {
 
 }  // namespace
 
-ThermalRecord record_thermal(const std::string& log_path, const io::MachineConfig& machine, const io::ThermalConfig& thermal) {
+ThermalRecord record_thermal(const std::string& log_path, const io::MachineConfig& machine,
+                             const io::ThermalConfig& thermal) {
   ThermalRecord r;
   r.log = log_path;
   if (io::is_averaged_log(log_path)) {

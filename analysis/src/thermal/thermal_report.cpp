@@ -95,10 +95,11 @@ void write_thermal_fit_report(const std::string& path, const ThermalFitResult& f
     << "); the rest is held out. The network runs open loop from a soaked start (every node at the coolant).\n\n";
   o << "| signal | fit RMS [K] | points | held-out RMS [K] | held-out worst [K] | points |\n|---|---|---|---|---|---|\n";
   for (const SignalFit& s : fit.signals) {
-    o << "| " << s.name << " | " << fmt(s.fit_rms_K) << " | " << s.fit_points << " | " << fmt(s.heldout_rms_K)
-      << " | " << fmt(s.heldout_worst_K) << " | " << s.heldout_points << " |\n";
+    o << "| " << s.name << " | " << fmt(s.fit_rms_K) << " | " << s.fit_points << " | " << fmt(s.heldout_rms_K) << " | "
+      << fmt(s.heldout_worst_K) << " | " << s.heldout_points << " |\n";
   }
-  o << "\n## Parameters (95 % intervals: cluster-robust over " << "blocks of the training part; excitation alone)\n\n";
+  o << "\n## Parameters (95 % intervals: cluster-robust over "
+    << "blocks of the training part; excitation alone)\n\n";
   o << "| parameter | value | unit | robust | excitation | identified |\n|---|---|---|---|---|---|\n";
   for (const FittedParameter& p : fit.parameters) {
     o << "| " << p.name << " | " << fmt(p.value, 5) << " | " << p.unit << " | ±" << percent(p.half_width_rel) << " | ±"

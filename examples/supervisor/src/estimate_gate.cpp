@@ -7,14 +7,22 @@ namespace rpem::supervisor {
 
 const char* to_string(Admission a) noexcept {
   switch (a) {
-    case Admission::kAccepted: return "accepted";
-    case Admission::kUnsigned: return "unsigned";
-    case Admission::kUnknownKey: return "unknown key";
-    case Admission::kBadMac: return "bad MAC";
-    case Admission::kMalformed: return "malformed";
-    case Admission::kStale: return "stale";
-    case Admission::kFromFuture: return "from the future";
-    case Admission::kNotNewer: return "not newer (replayed or reordered)";
+    case Admission::kAccepted:
+      return "accepted";
+    case Admission::kUnsigned:
+      return "unsigned";
+    case Admission::kUnknownKey:
+      return "unknown key";
+    case Admission::kBadMac:
+      return "bad MAC";
+    case Admission::kMalformed:
+      return "malformed";
+    case Admission::kStale:
+      return "stale";
+    case Admission::kFromFuture:
+      return "from the future";
+    case Admission::kNotNewer:
+      return "not newer (replayed or reordered)";
   }
   return "?";
 }
@@ -30,11 +38,16 @@ Admission EstimateGate::admit(std::string_view channel, std::span<const std::uin
                               rpem::estimate_t& out) noexcept {
   const Admission a = [&] {
     switch (auth::verify(keys_, channel, encoded)) {
-      case auth::Verdict::kVerified: break;
-      case auth::Verdict::kUnsigned: return Admission::kUnsigned;
-      case auth::Verdict::kUnknownKey: return Admission::kUnknownKey;
-      case auth::Verdict::kBadMac: return Admission::kBadMac;
-      case auth::Verdict::kMalformed: return Admission::kMalformed;
+      case auth::Verdict::kVerified:
+        break;
+      case auth::Verdict::kUnsigned:
+        return Admission::kUnsigned;
+      case auth::Verdict::kUnknownKey:
+        return Admission::kUnknownKey;
+      case auth::Verdict::kBadMac:
+        return Admission::kBadMac;
+      case auth::Verdict::kMalformed:
+        return Admission::kMalformed;
     }
     if (!schema::decode_exactly(encoded, out)) return Admission::kMalformed;
     const Stamp stamp{out.utime, out.sample_time_us};

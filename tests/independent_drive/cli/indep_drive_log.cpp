@@ -21,8 +21,8 @@ constexpr int kExitConfig = 78;
 
 /// The Beckhoff map beside the configuration's data folder (config/../data/...), if it is there.
 std::string map_beside(const std::string& config) {
-  const std::filesystem::path p = std::filesystem::path(config).parent_path() / ".." / "data" /
-                                  "beckhoff-am8141-flux-maps" / "beckhoff_AM8141_measured_400rpm.csv";
+  const std::filesystem::path p = std::filesystem::path(config).parent_path() / ".." / "data" / "beckhoff-am8141-flux-maps" /
+                                  "beckhoff_AM8141_measured_400rpm.csv";
   return std::filesystem::exists(p) ? p.lexically_normal().string() : std::string();
 }
 
@@ -44,8 +44,9 @@ void apply_set(indep::Case& c, const std::string& assignment) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"Independent drive-log generator: a closed-loop PMSM drive with hidden effects, written apart from "
-               "rpem's simulator (tests/independent_drive/README.md)"};
+  CLI::App app{
+      "Independent drive-log generator: a closed-loop PMSM drive with hidden effects, written apart from "
+      "rpem's simulator (tests/independent_drive/README.md)"};
   std::string config, effects = "none", out, truth_path, plant_out, profile, flux_map, modulation = "space_vector";
   std::string averaged_source = "plant";
   std::uint64_t seed = 1;

@@ -19,7 +19,8 @@ void IntervalAverager::close_window() {
     AveragedRow r;
     r.t_s = end_;
     r.t_start_s = start_;
-    double* fields[8] = {&r.i_d_A, &r.i_q_A, &r.u_d_V, &r.u_q_V, &r.omega_el_rad_s, &r.u_dc_V, &r.T_winding_C, &r.T_magnet_C};
+    double* fields[8] = {&r.i_d_A,          &r.i_q_A,  &r.u_d_V,       &r.u_q_V,
+                         &r.omega_el_rad_s, &r.u_dc_V, &r.T_winding_C, &r.T_magnet_C};
     for (std::size_t k = 0; k < 8; ++k) *fields[k] = sum_[k] / weight_;
     rows_.push_back(r);
   }

@@ -24,9 +24,12 @@ const std::vector<EffectEntry>& effect_catalogue() {
       {"current_gain", [](Effects& e) -> bool& { return e.current_gain.on; }, "current sensor gains per phase"},
       {"ld_saturation", [](Effects& e) -> bool& { return e.saturation.ld; }, "L_d against i_d (measured map)"},
       {"lq_saturation", [](Effects& e) -> bool& { return e.saturation.lq; }, "L_q against i_q (measured map)"},
-      {"cross_saturation", [](Effects& e) -> bool& { return e.saturation.cross; }, "psi_d against i_q, L_q against i_d (map)"},
-      {"flux_harmonic_6", [](Effects& e) -> bool& { return e.flux_harmonic_6.on; }, "6th rotor-frame flux harmonic (5th/7th EMF)"},
-      {"flux_harmonic_12", [](Effects& e) -> bool& { return e.flux_harmonic_12.on; }, "12th rotor-frame flux harmonic (11th/13th)"},
+      {"cross_saturation", [](Effects& e) -> bool& { return e.saturation.cross; },
+       "psi_d against i_q, L_q against i_d (map)"},
+      {"flux_harmonic_6", [](Effects& e) -> bool& { return e.flux_harmonic_6.on; },
+       "6th rotor-frame flux harmonic (5th/7th EMF)"},
+      {"flux_harmonic_12", [](Effects& e) -> bool& { return e.flux_harmonic_12.on; },
+       "12th rotor-frame flux harmonic (11th/13th)"},
       {"iron_loss", [](Effects& e) -> bool& { return e.iron_loss.on; }, "resistance across the induced voltage"},
       {"rs_drift", [](Effects& e) -> bool& { return e.rs_drift.on; }, "R_s against winding temperature"},
       {"psim_drift", [](Effects& e) -> bool& { return e.psim_drift.on; }, "psi_m against magnet temperature"},
@@ -88,7 +91,8 @@ Case resolve_defaults(Case c) {
   const double t_c = 1.0 / c.control.rate_Hz;
   fill(c.inverter.u_dc_V, std::sqrt(2.0) * c.machine.rated.voltage_ll_rms_V);
   fill(c.inverter.switching_frequency_Hz, c.control.rate_Hz);
-  require(c.inverter.u_dc_V > 0.0 && c.inverter.switching_frequency_Hz > 0.0, "inverter: u_dc_V and switching_frequency_Hz must be > 0");
+  require(c.inverter.u_dc_V > 0.0 && c.inverter.switching_frequency_Hz > 0.0,
+          "inverter: u_dc_V and switching_frequency_Hz must be > 0");
 
   Effects& e = c.effects;
   fill(e.deadtime.v_device_V, 0.002 * c.inverter.u_dc_V);
@@ -98,12 +102,14 @@ Case resolve_defaults(Case c) {
   if (!std::isnan(e.delay.periods)) e.delay.delay_s = e.delay.periods * t_c;
   fill(e.delay.delay_s, t_c);
   e.delay.periods = e.delay.delay_s / t_c;
-  require(e.delay.delay_s >= 0.0 && e.delay.periods < DelayLine::kMaxPeriods, "delay: delay_s must be in [0, 4 control periods)");
+  require(e.delay.delay_s >= 0.0 && e.delay.periods < DelayLine::kMaxPeriods,
+          "delay: delay_s must be in [0, 4 control periods)");
   for (double& v : e.current_offset.value) fill(v, 0.015 * i_peak);
   for (double g : e.current_gain.value) require(g > 0.0, "current_gain: every phase's gain must be > 0");
   if (e.saturation.map_path.empty()) e.saturation.map_path = INDEP_DRIVE_DEFAULT_MAP;
   fill(e.saturation.full_scale_current_A, i_peak);
-  require(e.saturation.full_scale_current_A > 0.0 && e.saturation.depth >= 0.0, "saturation: full_scale_current_A > 0, depth >= 0");
+  require(e.saturation.full_scale_current_A > 0.0 && e.saturation.depth >= 0.0,
+          "saturation: full_scale_current_A > 0, depth >= 0");
   const double e_rated = c.machine.rated_omega_el_rad_s() * c.machine.params.psi_m_Wb;
   fill(e.iron_loss.r_fe_Ohm, 1.5 * e_rated * e_rated / (0.01 * c.machine.reference_power_W()));
   require(e.iron_loss.r_fe_Ohm > 0.0, "iron_loss.r_fe_Ohm must be > 0");
@@ -129,7 +135,8 @@ Case resolve_defaults(Case c) {
 
   fill(c.control.bandwidth_Hz, c.control.rate_Hz / 40.0);
   fill(c.control.current_limit_A, 1.5 * i_peak);
-  require(c.control.bandwidth_Hz >= 0.0 && c.control.current_limit_A > 0.0, "control: bandwidth_Hz >= 0, current_limit_A > 0");
+  require(c.control.bandwidth_Hz >= 0.0 && c.control.current_limit_A > 0.0,
+          "control: bandwidth_Hz >= 0, current_limit_A > 0");
 
   AveragedSettings& a = c.averaged;
   require(a.rate_Hz > 0.0 && a.jitter_rel >= 0.0 && a.jitter_rel < 1.0 && a.min_interval_s > 0.0 &&
@@ -155,7 +162,11 @@ const std::vector<Entry>& table() {
       {"deadtime.t_dead_s", "s", [](Case& c, double v) { c.effects.deadtime.t_dead_s = v; }},
       {"deadtime.v_device_V", "V", [](Case& c, double v) { c.effects.deadtime.v_device_V = v; }},
       {"deadtime.i_band_A", "A", [](Case& c, double v) { c.effects.deadtime.i_band_A = v; }},
-      {"delay.delay_s", "s", [](Case& c, double v) { c.effects.delay.delay_s = v; c.effects.delay.periods = kAuto; }},
+      {"delay.delay_s", "s",
+       [](Case& c, double v) {
+         c.effects.delay.delay_s = v;
+         c.effects.delay.periods = kAuto;
+       }},
       {"delay.periods", "1", [](Case& c, double v) { c.effects.delay.periods = v; }},
       {"theta_offset.offset_rad", "rad", [](Case& c, double v) { c.effects.theta_offset.offset_rad = v; }},
       {"theta_offset.offset_deg", "deg", [](Case& c, double v) { c.effects.theta_offset.offset_rad = v * kPi / 180.0; }},
@@ -184,7 +195,8 @@ const std::vector<Entry>& table() {
       {"sensors.current_noise_A", "A", [](Case& c, double v) { c.sensors.current_noise_A = v; }},
       {"sensors.adc_bits", "0-24", [](Case& c, double v) { c.sensors.adc_bits = as_int(v, 0, 24); }},
       {"sensors.adc_full_scale_A", "A", [](Case& c, double v) { c.sensors.adc_full_scale_A = v; }},
-      {"sensors.encoder_counts_per_rev", "1", [](Case& c, double v) { c.sensors.encoder_counts_per_rev = as_int(v, 0, 1 << 30); }},
+      {"sensors.encoder_counts_per_rev", "1",
+       [](Case& c, double v) { c.sensors.encoder_counts_per_rev = as_int(v, 0, 1 << 30); }},
       {"sensors.u_dc_noise_V", "V", [](Case& c, double v) { c.sensors.u_dc_noise_V = v; }},
       {"sensors.u_dc_adc_bits", "0-24", [](Case& c, double v) { c.sensors.u_dc_adc_bits = as_int(v, 0, 24); }},
       {"sensors.u_dc_full_scale_V", "V", [](Case& c, double v) { c.sensors.u_dc_full_scale_V = v; }},
@@ -220,7 +232,8 @@ const std::vector<ParameterEntry>& parameter_catalogue() { return table(); }
 void set_parameter(Case& c, std::string_view key, double value) {
   const auto& t = table();
   const auto it = std::find_if(t.begin(), t.end(), [&](const Entry& e) { return key == e.key; });
-  if (it == t.end()) throw std::invalid_argument("unknown parameter '" + std::string(key) + "' (--list-parameters shows them)");
+  if (it == t.end())
+    throw std::invalid_argument("unknown parameter '" + std::string(key) + "' (--list-parameters shows them)");
   if (!std::isfinite(value)) throw std::invalid_argument(std::string(key) + ": not a finite number");
   try {
     it->set(c, value);

@@ -46,8 +46,9 @@ std::string plant_csv(const std::vector<PlantRow>& rows) {
   std::string out = std::string(kPlantHeader) + "\n";
   out.reserve(rows.size() * 200);
   for (const PlantRow& r : rows) {
-    append_row(out, {r.t_s, r.theta_el_rad, r.omega_el_rad_s, r.i_A.x, r.i_A.y, r.u_applied_V.x, r.u_applied_V.y,
-                     r.u_applied_ab_V.x, r.u_applied_ab_V.y, r.psi_m_Wb, r.r_s_Ohm, r.torque_Nm, r.T_winding_C, r.T_magnet_C});
+    append_row(out,
+               {r.t_s, r.theta_el_rad, r.omega_el_rad_s, r.i_A.x, r.i_A.y, r.u_applied_V.x, r.u_applied_V.y,
+                r.u_applied_ab_V.x, r.u_applied_ab_V.y, r.psi_m_Wb, r.r_s_Ohm, r.torque_Nm, r.T_winding_C, r.T_magnet_C});
   }
   return out;
 }

@@ -70,8 +70,8 @@ FluxMapData read_flux_map(const std::string& path) {
         *dest[k] = std::stod(s, &used);
         if (used != s.size()) throw std::invalid_argument(s);
       } catch (const std::exception&) {
-        throw std::runtime_error(path + ":" + std::to_string(line_no) + ": column " + header[static_cast<std::size_t>(cols[k])] +
-                                 ": '" + s + "' is not a number");
+        throw std::runtime_error(path + ":" + std::to_string(line_no) + ": column " +
+                                 header[static_cast<std::size_t>(cols[k])] + ": '" + s + "' is not a number");
       }
       finite = finite && std::isfinite(*dest[k]);
     }
@@ -82,12 +82,14 @@ FluxMapData read_flux_map(const std::string& path) {
 }
 
 double FluxMapFit::l_d0_H() const {
-  for (const PolyTerm& t : terms) if (t.m == 2 && t.n == 0) return 2.0 * t.b_Wb / current_scale_A;
+  for (const PolyTerm& t : terms)
+    if (t.m == 2 && t.n == 0) return 2.0 * t.b_Wb / current_scale_A;
   return 0.0;
 }
 
 double FluxMapFit::l_q0_H() const {
-  for (const PolyTerm& t : terms) if (t.m == 0 && t.n == 2) return 2.0 * t.b_Wb / current_scale_A;
+  for (const PolyTerm& t : terms)
+    if (t.m == 0 && t.n == 2) return 2.0 * t.b_Wb / current_scale_A;
   return 0.0;
 }
 

@@ -67,8 +67,8 @@ SensorErrors sensor_errors_of(const Effects& e) {
 }
 
 SensorSpec sensor_spec_of(const SensorSettings& s) {
-  return {s.current_noise_A, s.adc_bits, s.adc_full_scale_A, s.encoder_counts_per_rev, s.u_dc_noise_V,
-          s.u_dc_adc_bits, s.u_dc_full_scale_V, s.omega_noise_rad_s, s.temperature_noise_K};
+  return {s.current_noise_A, s.adc_bits,          s.adc_full_scale_A,  s.encoder_counts_per_rev, s.u_dc_noise_V,
+          s.u_dc_adc_bits,   s.u_dc_full_scale_V, s.omega_noise_rad_s, s.temperature_noise_K};
 }
 
 /// Checks that the flux map stays invertible (positive-definite inductance) over every current the drive may ask for.
@@ -117,7 +117,8 @@ Result generate(const Case& input) {
   const OperatingProfile profile =
       c.profile.points.empty() ? default_profile(c.machine, c.duration_s, c.profile.max_speed_pu, c.profile.max_torque_pu)
                                : OperatingProfile(c.profile.points);
-  const Drivers drivers{&profile, 2.0 * kPi / 60.0 * p, c.thermal.winding, c.thermal.magnet, truth, e.rs_drift, e.psim_drift};
+  const Drivers drivers{&profile, 2.0 * kPi / 60.0 * p, c.thermal.winding, c.thermal.magnet,
+                        truth,    e.rs_drift,           e.psim_drift};
 
   Sensors sensors(sensor_spec_of(c.sensors), sensor_errors_of(e), p, stream_rng(c.seed, Stream::sensors)());
   ControllerConfig cc;
@@ -154,8 +155,14 @@ Result generate(const Case& input) {
   if (c.keep_log_rows) r.log.reserve(rows);
   if (c.keep_plant_rows) r.plant.reserve(rows);
   auto outputs = [&](const PlantEval& ev, double t) {
-    return AveragedSample{ev.i_A.x, ev.i_A.y, ev.u_V.x, ev.u_V.y, drivers(t).omega_el_rad_s, u_dc,
-                          c.thermal.winding.at(t), c.thermal.magnet.at(t)};
+    return AveragedSample{ev.i_A.x,
+                          ev.i_A.y,
+                          ev.u_V.x,
+                          ev.u_V.y,
+                          drivers(t).omega_el_rad_s,
+                          u_dc,
+                          c.thermal.winding.at(t),
+                          c.thermal.magnet.at(t)};
   };
 
   for (std::size_t k = 0; k < rows; ++k) {
@@ -171,7 +178,8 @@ Result generate(const Case& input) {
     const double u_dc_meas = sensors.u_dc(u_dc);
     const double t_w = sensors.temperature(c.thermal.winding.at(t));
     const double t_m = sensors.temperature(c.thermal.magnet.at(t));
-    const ControllerOutput cmd = controller.step(i_meas, theta_meas, omega_meas, u_dc_meas, point.torque_Nm, point.i_d_inject_A);
+    const ControllerOutput cmd =
+        controller.step(i_meas, theta_meas, omega_meas, u_dc_meas, point.torque_Nm, point.i_d_inject_A);
     if (c.keep_log_rows) {
       r.log.push_back({t, theta_meas, omega_meas, u_dc_meas, cmd.u_abc_V, i_meas, t_w, t_m, point.torque_Nm});
     }
@@ -193,7 +201,10 @@ Result generate(const Case& input) {
 
     // The plant over [t, t + T_c): the delayed issues, each held, in RK4 sub-steps.
     const double f = delay.fraction();
-    struct Segment { double t0, t1; const std::array<double, 3>* duty; };
+    struct Segment {
+      double t0, t1;
+      const std::array<double, 3>* duty;
+    };
     Segment segments[2] = {{t, t + f * t_c, &delay.first()}, {t + f * t_c, t + t_c, &delay.second()}};
     Vec2 u_integral, u_integral_ab;
     for (const Segment& s : segments) {
@@ -208,7 +219,8 @@ Result generate(const Case& input) {
         const double theta_before = x.theta_rad;
         const PlantEval next = rk4_step(plant, x, now, t0, h, legs, drivers);
         u_integral = u_integral + (0.5 * h) * (now.u_V + next.u_V);
-        u_integral_ab = u_integral_ab + (0.5 * h) * (inverse_park(now.u_V, theta_before) + inverse_park(next.u_V, x.theta_rad));
+        u_integral_ab =
+            u_integral_ab + (0.5 * h) * (inverse_park(now.u_V, theta_before) + inverse_park(next.u_V, x.theta_rad));
         if (plant_average) averager->add_segment(t0, outputs(now, t0), t0 + h, outputs(next, t0 + h));
         now = next;
       }

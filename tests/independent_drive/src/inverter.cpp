@@ -18,9 +18,12 @@ Modulation modulation_from_name(std::string_view name) {
 
 const char* modulation_name(Modulation m) {
   switch (m) {
-    case Modulation::sine: return "sine";
-    case Modulation::third_harmonic: return "third_harmonic";
-    case Modulation::space_vector: return "space_vector";
+    case Modulation::sine:
+      return "sine";
+    case Modulation::third_harmonic:
+      return "third_harmonic";
+    case Modulation::space_vector:
+      return "space_vector";
   }
   return "?";
 }

@@ -10,13 +10,9 @@ namespace indep {
 
 double MachineConfig::rated_peak_current_A() const { return std::sqrt(2.0) * rated.current_rms_A; }
 
-double MachineConfig::rated_omega_el_rad_s() const {
-  return 2.0 * kPi * rated.speed_rpm / 60.0 * params.pole_pairs;
-}
+double MachineConfig::rated_omega_el_rad_s() const { return 2.0 * kPi * rated.speed_rpm / 60.0 * params.pole_pairs; }
 
-double MachineConfig::torque_base_Nm() const {
-  return 1.5 * params.pole_pairs * params.psi_m_Wb * rated_peak_current_A();
-}
+double MachineConfig::torque_base_Nm() const { return 1.5 * params.pole_pairs * params.psi_m_Wb * rated_peak_current_A(); }
 
 double MachineConfig::reference_power_W() const {
   return rated.power_W > 0.0 ? rated.power_W : kSqrt3 * rated.voltage_ll_rms_V * rated.current_rms_A;
@@ -24,14 +20,13 @@ double MachineConfig::reference_power_W() const {
 
 namespace {
 
-[[noreturn]] void fail(const std::string& path, const YAML::Node& node, const std::string& key,
-                       const std::string& why) {
+[[noreturn]] void fail(const std::string& path, const YAML::Node& node, const std::string& key, const std::string& why) {
   const int line = node.IsDefined() ? node.Mark().line + 1 : 0;
   throw ConfigError(path + ":" + std::to_string(line) + ": " + key + ": " + why);
 }
 
-double positive(const std::string& path, const YAML::Node& parent, const char* name, const std::string& key,
-                double lo, double hi) {
+double positive(const std::string& path, const YAML::Node& parent, const char* name, const std::string& key, double lo,
+                double hi) {
   const YAML::Node node = parent[name];
   if (!node) fail(path, parent, key, "missing");
   double value = 0.0;

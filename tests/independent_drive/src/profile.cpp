@@ -21,8 +21,8 @@ OperatingProfile::OperatingProfile(std::vector<ProfilePoint> points) : points_(s
 
 ProfilePoint OperatingProfile::at(double t) const {
   // The last point at or before t, so that at a step time the later point holds.
-  const auto after = std::upper_bound(points_.begin(), points_.end(), t,
-                                      [](double v, const ProfilePoint& p) { return v < p.t_s; });
+  const auto after =
+      std::upper_bound(points_.begin(), points_.end(), t, [](double v, const ProfilePoint& p) { return v < p.t_s; });
   if (after == points_.begin()) return points_.front();
   if (after == points_.end()) return points_.back();
   const ProfilePoint& a = *(after - 1);
@@ -35,12 +35,11 @@ ProfilePoint OperatingProfile::at(double t) const {
 OperatingProfile default_profile(const MachineConfig& m, double duration, double max_speed_pu, double max_torque_pu) {
   // t / duration, speed / max_speed, torque / max_torque
   static constexpr double kTable[][3] = {
-      {0.00, 0.0, 0.0},   {0.02, 0.0, 0.0},   {0.02, 0.0, 0.6},    {0.10, 0.0, 0.6},    // standstill under load
-      {0.20, 0.6, 0.6},   {0.27, 0.6, 0.6},   {0.27, 0.6, -0.4},   {0.33, 0.6, -0.4},   // ramp, torque steps
-      {0.33, 0.6, 1.0},   {0.40, 0.6, 1.0},   {0.48, 1.0, 0.5},    {0.56, 1.0, 0.5},    // ramp with torque ramp
-      {0.64, -0.6, 0.5},  {0.70, -0.6, 0.5},  {0.70, -0.6, -0.7},  {0.77, -0.6, -0.7},  // reversal, motoring back
-      {0.85, 0.3, 0.2},   {0.90, 0.9, 0.8},   {0.95, 0.9, 0.8},    {0.95, 0.9, 0.3},
-      {1.00, 0.9, 0.3}};
+      {0.00, 0.0, 0.0},  {0.02, 0.0, 0.0},  {0.02, 0.0, 0.6},   {0.10, 0.0, 0.6},    // standstill under load
+      {0.20, 0.6, 0.6},  {0.27, 0.6, 0.6},  {0.27, 0.6, -0.4},  {0.33, 0.6, -0.4},   // ramp, torque steps
+      {0.33, 0.6, 1.0},  {0.40, 0.6, 1.0},  {0.48, 1.0, 0.5},   {0.56, 1.0, 0.5},    // ramp with torque ramp
+      {0.64, -0.6, 0.5}, {0.70, -0.6, 0.5}, {0.70, -0.6, -0.7}, {0.77, -0.6, -0.7},  // reversal, motoring back
+      {0.85, 0.3, 0.2},  {0.90, 0.9, 0.8},  {0.95, 0.9, 0.8},   {0.95, 0.9, 0.3},   {1.00, 0.9, 0.3}};
   const double speed = max_speed_pu * m.rated.speed_rpm;
   const double torque = max_torque_pu * m.torque_base_Nm();
   std::vector<ProfilePoint> points;

@@ -25,7 +25,11 @@ const EffectTruth* Truth::effect(const std::string& n) const {
 namespace {
 
 nlohmann::json machine_json(const MachineParams& m) {
-  return {{"psi_m_Wb", m.psi_m_Wb}, {"r_s_Ohm", m.r_s_Ohm}, {"l_d_H", m.l_d_H}, {"l_q_H", m.l_q_H}, {"pole_pairs", m.pole_pairs}};
+  return {{"psi_m_Wb", m.psi_m_Wb},
+          {"r_s_Ohm", m.r_s_Ohm},
+          {"l_d_H", m.l_d_H},
+          {"l_q_H", m.l_q_H},
+          {"pole_pairs", m.pole_pairs}};
 }
 
 nlohmann::json track_json(const TemperatureTrack& t) {

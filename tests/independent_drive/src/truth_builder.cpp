@@ -92,19 +92,22 @@ std::vector<EffectTruth> saturation(const Case& c, const RunFacts& f) {
     return scale_flux_map(*f.fit, m, s.full_scale_current_A, parts);
   };
   auto common = [&](EffectTruth& t) {
-    t.values.insert(t.values.end(), {{"full_scale_current_A", s.full_scale_current_A},
-                                     {"depth", s.depth},
-                                     {"map_fit_rms_Wb", f.fit->rms_residual_Wb},
-                                     {"map_axis_rotation_rad", f.fit->axis_rotation_rad},
-                                     {"largest_current_over_full_scale", f.extremes.at_max_norm.norm() / s.full_scale_current_A}});
+    t.values.insert(t.values.end(),
+                    {{"full_scale_current_A", s.full_scale_current_A},
+                     {"depth", s.depth},
+                     {"map_fit_rms_Wb", f.fit->rms_residual_Wb},
+                     {"map_axis_rotation_rad", f.fit->axis_rotation_rad},
+                     {"largest_current_over_full_scale", f.extremes.at_max_norm.norm() / s.full_scale_current_A}});
     t.labels.push_back({"map", s.map_path});
   };
   if (s.ld) {
     const FluxModel fm = model({true, false, false});
     const double i = f.extremes.at_max_abs_d.x;
     const double apparent = std::abs(i) > 0 ? (fm.flux({i, 0}, m.psi_m_Wb).x - m.psi_m_Wb) / (i * m.l_d_H) : 1.0;
-    EffectTruth t{"ld_saturation", "psi_d gains the map's pure-d terms (scaled co-energy polynomial); L_d depends on i_d",
-                  {{"at_i_d_A", i}, {"l_dd_ratio", fm.inductance({i, 0}).dd_H / m.l_d_H}, {"l_d_apparent_ratio", apparent}}, {}};
+    EffectTruth t{"ld_saturation",
+                  "psi_d gains the map's pure-d terms (scaled co-energy polynomial); L_d depends on i_d",
+                  {{"at_i_d_A", i}, {"l_dd_ratio", fm.inductance({i, 0}).dd_H / m.l_d_H}, {"l_d_apparent_ratio", apparent}},
+                  {}};
     common(t);
     out.push_back(t);
   }
@@ -112,8 +115,10 @@ std::vector<EffectTruth> saturation(const Case& c, const RunFacts& f) {
     const FluxModel fm = model({false, true, false});
     const double i = f.extremes.at_max_abs_q.y;
     const double apparent = std::abs(i) > 0 ? fm.flux({0, i}, m.psi_m_Wb).y / (i * m.l_q_H) : 1.0;
-    EffectTruth t{"lq_saturation", "psi_q gains the map's pure-q terms (scaled co-energy polynomial); L_q depends on i_q",
-                  {{"at_i_q_A", i}, {"l_qq_ratio", fm.inductance({0, i}).qq_H / m.l_q_H}, {"l_q_apparent_ratio", apparent}}, {}};
+    EffectTruth t{"lq_saturation",
+                  "psi_q gains the map's pure-q terms (scaled co-energy polynomial); L_q depends on i_q",
+                  {{"at_i_q_A", i}, {"l_qq_ratio", fm.inductance({0, i}).qq_H / m.l_q_H}, {"l_q_apparent_ratio", apparent}},
+                  {}};
     common(t);
     out.push_back(t);
   }
@@ -165,14 +170,17 @@ EffectTruth harmonic(const char* name, const HarmonicPair& h) {
 EffectTruth iron_loss(const Case& c, const RunFacts& f) {
   const double r = c.effects.iron_loss.r_fe_Ohm;
   const double e = c.machine.rated_omega_el_rad_s() * f.true_machine.psi_m_Wb;
-  return {"iron_loss", "a resistance r_fe_Ohm across the induced voltage dpsi/dt + omega*J*psi (rotor frame)",
-          {{"r_fe_Ohm", r}, {"loss_W_at_rated_speed_no_load", 1.5 * e * e / r}}, {}};
+  return {"iron_loss",
+          "a resistance r_fe_Ohm across the induced voltage dpsi/dt + omega*J*psi (rotor frame)",
+          {{"r_fe_Ohm", r}, {"loss_W_at_rated_speed_no_load", 1.5 * e * e / r}},
+          {}};
 }
 
 EffectTruth drift(const char* name, const char* form, const DriftParams& d, const TemperatureTrack& track, double value0,
                   double duration) {
   const double start = track.at(0.0), end = track.at(duration);
-  return {name, form,
+  return {name,
+          form,
           {{"coeff_per_K", d.coeff_per_K},
            {"reference_C", d.reference_C},
            {"temperature_start_C", start},

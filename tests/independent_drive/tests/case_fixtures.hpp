@@ -28,8 +28,6 @@ inline Case ideal_case(const std::string& config = "config/paper-ipmsm.yaml") {
 }
 
 /// Constant speed [rpm] and torque [Nm] from t = 0.
-inline void hold(Case& c, double speed_rpm, double torque_Nm) {
-  c.profile.points = {{0.0, speed_rpm, torque_Nm, 0.0}};
-}
+inline void hold(Case& c, double speed_rpm, double torque_Nm) { c.profile.points = {{0.0, speed_rpm, torque_Nm, 0.0}}; }
 
 }  // namespace indep::testing

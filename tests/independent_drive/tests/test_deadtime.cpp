@@ -15,7 +15,8 @@ namespace {
 Vec2 mean_command(const Result& r, double omega, double advance) {
   const double t_c = r.truth.control_period_s;
   const auto per_period = 2 * kPi / (omega * t_c);
-  const auto n = static_cast<std::size_t>(std::llround(std::floor(static_cast<double>(r.log.size()) / 2.0 / per_period) * per_period));
+  const auto n =
+      static_cast<std::size_t>(std::llround(std::floor(static_cast<double>(r.log.size()) / 2.0 / per_period) * per_period));
   Vec2 sum;
   for (std::size_t k = r.log.size() - n; k < r.log.size(); ++k) {
     const LogRow& row = r.log[k];

@@ -51,8 +51,8 @@ Case delay_case(double periods) {
   c.seed = 3;
   c.duration_s = 1.0;
   // Speed ramps and torque steps: a command with broad spectrum.
-  c.profile.points = {{0.0, 0, 10, 0}, {0.2, 300, 10, 0}, {0.2, 300, -15, 0}, {0.5, 100, -15, 0},
-                      {0.5, 100, 25, 0}, {0.8, 400, 25, 0}, {0.8, 400, 5, 0}, {1.0, 200, 5, 0}};
+  c.profile.points = {{0.0, 0, 10, 0},   {0.2, 300, 10, 0}, {0.2, 300, -15, 0}, {0.5, 100, -15, 0},
+                      {0.5, 100, 25, 0}, {0.8, 400, 25, 0}, {0.8, 400, 5, 0},   {1.0, 200, 5, 0}};
   if (periods > 0.0) {
     c.effects.delay.on = true;
     c.effects.delay.periods = periods;

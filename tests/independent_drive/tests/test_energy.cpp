@@ -15,8 +15,8 @@ namespace {
 
 TEST(IndepEnergy, TerminalEnergyIsLossesWorkAndStoredField) {
   const MachineParams m{1.2, 2.3, 0.09, 0.2, 3};
-  const FluxMapFit fit =
-      fit_flux_map(read_flux_map(testing::source_path("data/beckhoff-am8141-flux-maps/beckhoff_AM8141_measured_400rpm.csv")));
+  const FluxMapFit fit = fit_flux_map(
+      read_flux_map(testing::source_path("data/beckhoff-am8141-flux-maps/beckhoff_AM8141_measured_400rpm.csv")));
   HarmonicFlux h;
   h.add({6, 0.03, 0.4, 0.02, -0.9});
   h.add({12, 0.008, 1.1, 0.005, 0.2});
@@ -65,7 +65,8 @@ TEST(IndepEnergy, TerminalEnergyIsLossesWorkAndStoredField) {
 
 TEST(IndepEnergy, LinearTorqueIsTheTextbookForm) {
   const MachineParams m{1.1, 2.0, 0.1, 0.2, 3};
-  const Plant plant(FluxModel(m.l_d_H, m.l_q_H, 7.0, {}), HarmonicFlux{}, std::numeric_limits<double>::infinity(), {}, false);
+  const Plant plant(FluxModel(m.l_d_H, m.l_q_H, 7.0, {}), HarmonicFlux{}, std::numeric_limits<double>::infinity(), {},
+                    false);
   PlantState x;
   const Vec2 i{-2.0, 4.0};
   x.psi_Wb = plant.flux().flux(i, m.psi_m_Wb);

@@ -43,9 +43,10 @@ void check_pair(const char* effect, int n) {
   const C hi = current(n + 1, h.h_hi_rel, h.phi_hi_rad);
   const C lo = current(-(n - 1), h.h_lo_rel, h.phi_lo_rad);
   const C got_hi = dft(r, n + 1, samples), got_lo = dft(r, n - 1, samples);
-  EXPECT_NEAR(std::abs(got_hi - hi), 0.0, 0.01 * std::abs(hi)) << effect << " order " << n + 1 << ": " << got_hi << " vs " << hi;
-  EXPECT_NEAR(std::abs(got_lo - std::conj(lo)), 0.0, 0.01 * std::abs(lo)) << effect << " order " << n - 1 << ": " << got_lo
-                                                                            << " vs " << std::conj(lo);
+  EXPECT_NEAR(std::abs(got_hi - hi), 0.0, 0.01 * std::abs(hi))
+      << effect << " order " << n + 1 << ": " << got_hi << " vs " << hi;
+  EXPECT_NEAR(std::abs(got_lo - std::conj(lo)), 0.0, 0.01 * std::abs(lo))
+      << effect << " order " << n - 1 << ": " << got_lo << " vs " << std::conj(lo);
   // No fundamental current: the feed-forward matches the (nominal) machine.
   EXPECT_LT(std::abs(dft(r, 1, samples)), 0.01 * std::abs(hi));
 }

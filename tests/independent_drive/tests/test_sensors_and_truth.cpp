@@ -129,7 +129,8 @@ TEST(IndepCatalogue, NamesAndKeysAreCheckedWithClearErrors) {
     enable_effects(e, "deadtime,dead_time");
     FAIL();
   } catch (const std::invalid_argument& x) {
-    EXPECT_NE(std::string(x.what()).find("unknown effect 'dead_time' (known: deadtime, delay"), std::string::npos) << x.what();
+    EXPECT_NE(std::string(x.what()).find("unknown effect 'dead_time' (known: deadtime, delay"), std::string::npos)
+        << x.what();
   }
   EXPECT_TRUE(e.deadtime.on);
   Case c = testing::machine_case();

@@ -63,8 +63,9 @@ TEST(IndepSteadyState, LinearMachineOffItsConfigurationMeetsTheDqEquations) {
 TEST(IndepSteadyState, SaturatedMachineMeetsTheDqEquationsOnItsMap) {
   Case c = testing::ideal_case();
   c.duration_s = 0.8;
-  c.effects.saturation = {true, true, true, testing::source_path("data/beckhoff-am8141-flux-maps/beckhoff_AM8141_measured_400rpm.csv"),
-                          kAuto, 2.5, 4};
+  c.effects.saturation = {
+      true,  true, true, testing::source_path("data/beckhoff-am8141-flux-maps/beckhoff_AM8141_measured_400rpm.csv"),
+      kAuto, 2.5,  4};
   testing::hold(c, -300.0, -25.0);
   const Result r = generate(c);
   const MachineParams& t = r.truth.true_machine;

@@ -54,10 +54,10 @@ void close_output(std::ofstream& out, const std::string& path) {
 void list_parameters() {
   std::cout << "key,unit,draw,lo,hi,meaning\n";
   for (const auto& e : indep_thermal::catalogue()) {
-    const char* draw = e.draw == indep_thermal::Draw::fixed               ? "fixed"
-                       : e.draw == indep_thermal::Draw::factor            ? "factor"
-                       : e.draw == indep_thermal::Draw::uniform           ? "uniform"
-                                                                          : "electrical_factor";
+    const char* draw = e.draw == indep_thermal::Draw::fixed     ? "fixed"
+                       : e.draw == indep_thermal::Draw::factor  ? "factor"
+                       : e.draw == indep_thermal::Draw::uniform ? "uniform"
+                                                                : "electrical_factor";
     std::cout << e.key << ',' << e.unit << ',' << draw << ',' << indep_thermal::shortest(e.lo) << ','
               << indep_thermal::shortest(e.hi) << ",\"" << e.meaning << "\"\n";
   }
@@ -71,8 +71,8 @@ int main(int argc, char** argv) {
   std::uint64_t seed = 1;
   double duration_s = 7200.0, rate_Hz = 2.0, rtol = 1e-8, max_step_s = 0.25, load_scale = 1.0;
   std::size_t truth_every = 1;
-  bool no_coolant = false, no_winding = false, nominal = false, draw_electrical = false, exact = false,
-       averaged = false, list = false;
+  bool no_coolant = false, no_winding = false, nominal = false, draw_electrical = false, exact = false, averaged = false,
+       list = false;
   std::vector<std::string> sets;
   app.add_option("--config", config, "configuration YAML (only machine: is read)");
   app.add_option("--seed", seed, "seed of the parameter draw, the drive cycle and the noise (default 1)");

@@ -28,8 +28,7 @@ Quadratic voltage_excess(const Machine& m, double omega, double i_q, double u_ma
 
 }  // namespace
 
-DqVoltage steady_state_voltage(const Parameters& p, const OperatingPoint& op, double t_winding_C,
-                               double t_rotor_C) {
+DqVoltage steady_state_voltage(const Parameters& p, const OperatingPoint& op, double t_winding_C, double t_rotor_C) {
   const double f = std::abs(op.omega_el_rad_s) / (2.0 * kPi);
   const double r = copper_resistance_Ohm(p, t_winding_C) * ac_resistance_factor(p, f);
   const double w = op.omega_el_rad_s;
@@ -42,12 +41,10 @@ double mtpa_i_d_A(double psi_m_Wb, double l_d_H, double l_q_H, double i_q_A) {
   return (psi_m_Wb - std::sqrt(psi_m_Wb * psi_m_Wb + 4.0 * dl * dl * i_q_A * i_q_A)) / (2.0 * dl);
 }
 
-OperatingPoint drive_currents(const Machine& m, const Parameters& p, const Demand& demand,
-                              double t_winding_sensor_C) {
+OperatingPoint drive_currents(const Machine& m, const Parameters& p, const Demand& demand, double t_winding_sensor_C) {
   OperatingPoint op;
   op.omega_el_rad_s = demand.speed_rpm * 2.0 * kPi / 60.0 * m.pole_pairs;
-  const double derate =
-      std::clamp((p.derate_end_C - t_winding_sensor_C) / (p.derate_end_C - p.derate_start_C), 0.0, 1.0);
+  const double derate = std::clamp((p.derate_end_C - t_winding_sensor_C) / (p.derate_end_C - p.derate_start_C), 0.0, 1.0);
   double i_q = demand.i_q_A * derate;
   const double i_max = p.current_limit_rel * m.peak_current_A();
   double i_d = 0.0;

@@ -12,14 +12,13 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
-[[noreturn]] void fail(const std::string& path, const YAML::Node& node, const std::string& key,
-                       const std::string& why) {
+[[noreturn]] void fail(const std::string& path, const YAML::Node& node, const std::string& key, const std::string& why) {
   const int line = node.IsDefined() ? node.Mark().line + 1 : 0;
   throw ConfigError(path + ":" + std::to_string(line) + ": " + key + ": " + why);
 }
 
-double number(const std::string& path, const YAML::Node& parent, const char* name, const std::string& key,
-              double lo, double hi, bool required = true) {
+double number(const std::string& path, const YAML::Node& parent, const char* name, const std::string& key, double lo,
+              double hi, bool required = true) {
   const YAML::Node node = parent[name];
   if (!node) {
     if (required) fail(path, parent, key, "missing");

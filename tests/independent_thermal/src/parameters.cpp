@@ -24,10 +24,10 @@ constexpr double kTorquePerRotorVolume_Nm_m3 = 20.0e3;  // liquid-cooled PMSM
 constexpr double kStatorToRotorDiameter = 1.6;
 constexpr double kCopperShareOfStatorAnnulus = 0.12;
 constexpr double kIronShareOfStatorAnnulus = 0.55;
-constexpr double kInsulationCapacityShare = 0.15;       // impregnation and liners, on top of the copper
-constexpr double kWindingOverIronRise_K = 40.0;         // at the rated copper loss
-constexpr double kIronOverCoolantRise_K = 45.0;         // at the rated copper and stator iron loss
-constexpr double kLoopRise_K = 15.0;                    // coolant over ambient at the rated losses
+constexpr double kInsulationCapacityShare = 0.15;  // impregnation and liners, on top of the copper
+constexpr double kWindingOverIronRise_K = 40.0;    // at the rated copper loss
+constexpr double kIronOverCoolantRise_K = 45.0;    // at the rated copper and stator iron loss
+constexpr double kLoopRise_K = 15.0;               // coolant over ambient at the rated losses
 constexpr double kLoopTimeConstant_s = 600.0;
 
 using E = CatalogueEntry;
@@ -60,31 +60,26 @@ const std::vector<CatalogueEntry>& catalogue() {
       {"rated.current_A", &Parameters::rated_current_A, "A", Draw::fixed, 0, 0, "rated peak phase current"},
       {"geometry.rotor_diameter_m", &Parameters::rotor_diameter_m, "m", Draw::factor, 0.87, 1.15,
        "rotor outer diameter D_r"},
-      {"geometry.active_length_m", &Parameters::active_length_m, "m", Draw::factor, 0.8, 1.25,
-       "stack length L"},
+      {"geometry.active_length_m", &Parameters::active_length_m, "m", Draw::factor, 0.8, 1.25, "stack length L"},
       {"geometry.airgap_m", &Parameters::airgap_m, "m", Draw::factor, 0.7, 1.4, "radial air gap g"},
       {"geometry.stator_outer_diameter_m", &Parameters::stator_outer_diameter_m, "m", Draw::factor, 0.92, 1.08,
        "stator outer diameter D_s"},
       {"geometry.endwinding_overhang_m", &Parameters::endwinding_overhang_m, "m", Draw::factor, 0.7, 1.4,
        "axial overhang of each end winding"},
-      {"capacity.winding_J_K", &Parameters::c_winding_J_K, "J/K", Draw::factor, 0.8, 1.25,
-       "winding (copper, insulation)"},
+      {"capacity.winding_J_K", &Parameters::c_winding_J_K, "J/K", Draw::factor, 0.8, 1.25, "winding (copper, insulation)"},
       {"capacity.iron_J_K", &Parameters::c_iron_J_K, "J/K", Draw::factor, 0.8, 1.25,
        "stator iron and the inner half of the housing"},
-      {"capacity.rotor_J_K", &Parameters::c_rotor_J_K, "J/K", Draw::factor, 0.8, 1.25,
-       "rotor iron, magnets, shaft"},
+      {"capacity.rotor_J_K", &Parameters::c_rotor_J_K, "J/K", Draw::factor, 0.8, 1.25, "rotor iron, magnets, shaft"},
       {"conductance.winding_iron_W_K", &Parameters::g_winding_iron_W_K, "W/K", Draw::factor, 0.7, 1.4,
        "winding to stator iron through the slot liner"},
       {"conductance.iron_coolant_W_K", &Parameters::g_iron_coolant_W_K, "W/K", Draw::factor, 0.7, 1.4,
        "stator iron to coolant (housing contact, water jacket)"},
       {"conductance.shaft_W_K", &Parameters::g_shaft_W_K, "W/K", Draw::factor, 0.5, 2.0,
        "rotor to coolant through shaft and bearings"},
-      {"endspace.k1_W_m2K", &Parameters::endspace_k1_W_m2K, "W/(m²·K)", Draw::factor, 0.7, 1.4,
-       "end-space h at standstill"},
+      {"endspace.k1_W_m2K", &Parameters::endspace_k1_W_m2K, "W/(m²·K)", Draw::factor, 0.7, 1.4, "end-space h at standstill"},
       {"endspace.k2", &Parameters::endspace_k2, "(s/m)^k3", Draw::factor, 0.5, 2.0, "end-space speed gain"},
       {"endspace.k3", &Parameters::endspace_k3, "1", Draw::uniform, 0.7, 1.0, "end-space speed exponent"},
-      {"air.conductivity_W_mK", &Parameters::air_conductivity_W_mK, "W/(m·K)", Draw::fixed, 0, 0,
-       "air at about 60 °C"},
+      {"air.conductivity_W_mK", &Parameters::air_conductivity_W_mK, "W/(m·K)", Draw::fixed, 0, 0, "air at about 60 °C"},
       {"air.viscosity_m2_s", &Parameters::air_viscosity_m2_s, "m²/s", Draw::fixed, 0, 0,
        "kinematic viscosity of air at about 60 °C"},
       {"air.prandtl", &Parameters::air_prandtl, "1", Draw::fixed, 0, 0, "Prandtl number of air"},
@@ -94,8 +89,7 @@ const std::vector<CatalogueEntry>& catalogue() {
        "hysteresis share of it (∝ f·B^β)"},
       {"loss.stator_excess_share", &Parameters::stator_excess_share, "1", Draw::uniform, 0.0, 0.15,
        "excess share of it (∝ f^1.5·B^1.5); eddy (∝ f²·B²) the rest"},
-      {"loss.steinmetz_exponent", &Parameters::steinmetz_exponent, "1", Draw::uniform, 1.6, 2.2,
-       "β of the hysteresis term"},
+      {"loss.steinmetz_exponent", &Parameters::steinmetz_exponent, "1", Draw::uniform, 1.6, 2.2, "β of the hysteresis term"},
       {"loss.rotor_iron_rated_W", &Parameters::rotor_iron_rated_W, "W", Draw::factor, 0.5, 2.0,
        "rotor iron loss at rated frequency and flux ψm_ref"},
       {"loss.rotor_hysteresis_share", &Parameters::rotor_hysteresis_share, "1", Draw::uniform, 0.1, 0.5,
@@ -116,14 +110,12 @@ const std::vector<CatalogueEntry>& catalogue() {
        "other heat on the loop as a share of the machine's losses (loop mode)"},
       {"sensor.winding_tau_s", &Parameters::sensor_winding_tau_s, "s", Draw::uniform, 3.0, 20.0,
        "time constant of the winding sensor"},
-      {"sensor.winding_noise_K", &Parameters::sensor_winding_noise_K, "K", Draw::fixed, 0, 0,
-       "σ of the winding sensor"},
+      {"sensor.winding_noise_K", &Parameters::sensor_winding_noise_K, "K", Draw::fixed, 0, 0, "σ of the winding sensor"},
       {"sensor.winding_resolution_K", &Parameters::sensor_winding_resolution_K, "K", Draw::fixed, 0, 0,
        "quantum of the winding sensor (0: none)"},
       {"sensor.placement_gain", &Parameters::sensor_placement_gain, "1", Draw::fixed, 0, 0,
        "the sensor reads T_c + gain·(T_lag − T_c)"},
-      {"sensor.coolant_noise_K", &Parameters::sensor_coolant_noise_K, "K", Draw::fixed, 0, 0,
-       "σ of the coolant sensor"},
+      {"sensor.coolant_noise_K", &Parameters::sensor_coolant_noise_K, "K", Draw::fixed, 0, 0, "σ of the coolant sensor"},
       {"sensor.coolant_resolution_K", &Parameters::sensor_coolant_resolution_K, "K", Draw::fixed, 0, 0,
        "quantum of the coolant sensor (0: none)"},
       {"noise.current_rel", &Parameters::noise_current_rel, "1", Draw::fixed, 0, 0,
@@ -144,9 +136,7 @@ const std::vector<CatalogueEntry>& catalogue() {
   return table;
 }
 
-double rated_copper_loss_W(const Parameters& p) {
-  return 1.5 * p.r_s_ref_Ohm * p.rated_current_A * p.rated_current_A;
-}
+double rated_copper_loss_W(const Parameters& p) { return 1.5 * p.r_s_ref_Ohm * p.rated_current_A * p.rated_current_A; }
 
 Parameters nominal_parameters(const Machine& m) {
   Parameters p;
@@ -196,8 +186,7 @@ Parameters nominal_parameters(const Machine& m) {
   p.g_shaft_W_K = kSteelConductivity_W_mK * kPi / 4.0 * d_shaft * d_shaft / (0.5 * len);
 
   // Coolant loop: the rated losses plus the other heat raise it kLoopRise_K over ambient.
-  const double p_loss_n =
-      p_cu_n + p.stator_iron_rated_W + p.rotor_iron_rated_W + p.magnet_rated_W + p.mechanical_rated_W;
+  const double p_loss_n = p_cu_n + p.stator_iron_rated_W + p.rotor_iron_rated_W + p.magnet_rated_W + p.mechanical_rated_W;
   p.coolant_radiator_W_K = (1.0 + p.coolant_other_heat_share) * p_loss_n / kLoopRise_K;
   p.coolant_loop_capacity_J_K = p.coolant_radiator_W_K * kLoopTimeConstant_s;
   return p;
@@ -283,8 +272,7 @@ void validate(const Parameters& p) {
   require(p.rated_current_A > 0, "rated.current_A", "must be > 0");
   require(p.rotor_diameter_m > 0, "geometry.rotor_diameter_m", "must be > 0");
   require(p.active_length_m > 0, "geometry.active_length_m", "must be > 0");
-  require(p.airgap_m > 0 && p.airgap_m < 0.1 * p.rotor_diameter_m, "geometry.airgap_m",
-          "must be in (0, D_r/10)");
+  require(p.airgap_m > 0 && p.airgap_m < 0.1 * p.rotor_diameter_m, "geometry.airgap_m", "must be in (0, D_r/10)");
   require(p.stator_outer_diameter_m > p.rotor_diameter_m + 2.0 * p.airgap_m, "geometry.stator_outer_diameter_m",
           "must exceed D_r + 2·g");
   require(p.endwinding_overhang_m > 0, "geometry.endwinding_overhang_m", "must be > 0");
@@ -301,9 +289,9 @@ void validate(const Parameters& p) {
   require(p.air_viscosity_m2_s > 0, "air.viscosity_m2_s", "must be > 0");
   require(p.air_prandtl > 0, "air.prandtl", "must be > 0");
   require(p.stator_iron_rated_W >= 0, "loss.stator_iron_rated_W", "must be >= 0");
-  require(p.stator_hysteresis_share >= 0 && p.stator_excess_share >= 0 &&
-              p.stator_hysteresis_share + p.stator_excess_share <= 1,
-          "loss.stator_hysteresis_share", "with loss.stator_excess_share: shares >= 0 summing to <= 1");
+  require(
+      p.stator_hysteresis_share >= 0 && p.stator_excess_share >= 0 && p.stator_hysteresis_share + p.stator_excess_share <= 1,
+      "loss.stator_hysteresis_share", "with loss.stator_excess_share: shares >= 0 summing to <= 1");
   require(p.steinmetz_exponent > 0, "loss.steinmetz_exponent", "must be > 0");
   require(p.rotor_iron_rated_W >= 0, "loss.rotor_iron_rated_W", "must be >= 0");
   require(p.rotor_hysteresis_share >= 0 && p.rotor_hysteresis_share <= 1, "loss.rotor_hysteresis_share",

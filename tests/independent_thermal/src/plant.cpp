@@ -24,9 +24,7 @@ Plant::Plant(const Machine& configured, const Parameters& p, const Profile& prof
 
 State Plant::initial_state() const { return y0_; }
 
-double Plant::stored_heat_J(const State& y) const {
-  return c_.dot(y.head<3>() - y0_.head<3>());
-}
+double Plant::stored_heat_J(const State& y) const { return c_.dot(y.head<3>() - y0_.head<3>()); }
 
 Snapshot Plant::evaluate(double t, const State& y, bool left_limit) const {
   Snapshot s;

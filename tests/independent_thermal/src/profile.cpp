@@ -41,10 +41,8 @@ std::vector<double> Profile::knots() const {
 
 namespace {
 
-[[noreturn]] void data_error(const std::string& path, std::size_t line, std::size_t column,
-                             const std::string& why) {
-  throw DataError(path + ":" + std::to_string(line) + (column > 0 ? ":" + std::to_string(column) : "") + ": " +
-                  why);
+[[noreturn]] void data_error(const std::string& path, std::size_t line, std::size_t column, const std::string& why) {
+  throw DataError(path + ":" + std::to_string(line) + (column > 0 ? ":" + std::to_string(column) : "") + ": " + why);
 }
 
 std::vector<std::string> split(const std::string& line) {
@@ -103,8 +101,7 @@ Profile read_profile_csv(const std::string& path) {
       continue;
     }
     if (cells.size() != header.size()) {
-      data_error(path, line_no, 0,
-                 std::to_string(cells.size()) + " cells, the header has " + std::to_string(header.size()));
+      data_error(path, line_no, 0, std::to_string(cells.size()) + " cells, the header has " + std::to_string(header.size()));
     }
     auto number = [&](int col, double limit) {
       const std::string& s = cells[static_cast<std::size_t>(col)];
@@ -116,8 +113,7 @@ Profile read_profile_csv(const std::string& path) {
       }
       if (!std::isfinite(v) || std::abs(v) > limit) {
         data_error(path, line_no, static_cast<std::size_t>(col) + 1,
-                   "column " + header[static_cast<std::size_t>(col)] + ": " + s + " is beyond ±" +
-                       std::to_string(limit));
+                   "column " + header[static_cast<std::size_t>(col)] + ": " + s + " is beyond ±" + std::to_string(limit));
       }
       return v;
     };
@@ -232,11 +228,9 @@ Profile drive_cycle_profile(const Machine& m, double duration_s, std::uint64_t s
   add({0.0, 0.0, std::min(30.0, duration_s)}, 1.0);
   add({0.0, 0.4, 30.0}, 2.0);
   add({0.0, 0.0, 20.0}, 2.0);
-  const std::vector<std::pair<Kind, double>> load = {{Kind::cruise, 0.35},     {Kind::high_speed, 0.2},
-                                                     {Kind::hard, 0.15},       {Kind::regen, 0.1},
-                                                     {Kind::standstill_hold, 0.2}};
-  const std::vector<std::pair<Kind, double>> rest = {{Kind::idle, 0.5}, {Kind::standstill_hold, 0.2},
-                                                     {Kind::light, 0.3}};
+  const std::vector<std::pair<Kind, double>> load = {
+      {Kind::cruise, 0.35}, {Kind::high_speed, 0.2}, {Kind::hard, 0.15}, {Kind::regen, 0.1}, {Kind::standstill_hold, 0.2}};
+  const std::vector<std::pair<Kind, double>> rest = {{Kind::idle, 0.5}, {Kind::standstill_hold, 0.2}, {Kind::light, 0.3}};
   while (t < duration_s) {
     const double load_end = t + rng.uniform(900.0, 2400.0);
     while (t < std::min(load_end, duration_s)) add(draw_segment(pick(rng, load), rng), rng.uniform(5.0, 20.0));

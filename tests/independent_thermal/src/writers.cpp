@@ -43,9 +43,8 @@ std::vector<double> time_constants_s(const Parameters& p, double omega_mech) {
 }
 
 nlohmann::json conductances_json(const Conductances& g) {
-  return {{"winding_iron", g.winding_iron},     {"iron_coolant", g.iron_coolant},
-          {"airgap", g.airgap},                 {"winding_rotor", g.winding_rotor},
-          {"winding_coolant", g.winding_coolant}, {"rotor_coolant", g.rotor_coolant}};
+  return {{"winding_iron", g.winding_iron},   {"iron_coolant", g.iron_coolant},       {"airgap", g.airgap},
+          {"winding_rotor", g.winding_rotor}, {"winding_coolant", g.winding_coolant}, {"rotor_coolant", g.rotor_coolant}};
 }
 
 nlohmann::json parameter_values(const Parameters& p) {
@@ -66,15 +65,50 @@ std::vector<std::string> log_header(LogColumns columns) {
 }
 
 const std::vector<std::string>& truth_header() {
-  static const std::vector<std::string> h = {
-      "t",           "T_winding",   "T_iron",      "T_magnet",     "T_coolant",     "T_winding_sensor",
-      "r_s",         "r_s_ac",      "psi_m",       "omega_el",     "speed_rpm",     "i_d",
-      "i_q",         "u_d",         "u_q",         "flux_rel",     "P_copper",      "P_stator_hysteresis",
-      "P_stator_eddy", "P_stator_excess", "P_rotor_iron", "P_magnet", "P_mechanical", "P_winding",
-      "P_iron",      "P_rotor",     "P_total",     "Q_coolant",    "G_winding_iron", "G_iron_coolant",
-      "G_airgap",    "G_winding_rotor", "G_winding_coolant", "G_rotor_coolant", "E_losses", "E_coolant",
-      "E_stored",    "E_residual",  "t_start",     "i_d_mean",     "i_q_mean",      "u_d_mean",
-      "u_q_mean",    "omega_el_mean"};
+  static const std::vector<std::string> h = {"t",
+                                             "T_winding",
+                                             "T_iron",
+                                             "T_magnet",
+                                             "T_coolant",
+                                             "T_winding_sensor",
+                                             "r_s",
+                                             "r_s_ac",
+                                             "psi_m",
+                                             "omega_el",
+                                             "speed_rpm",
+                                             "i_d",
+                                             "i_q",
+                                             "u_d",
+                                             "u_q",
+                                             "flux_rel",
+                                             "P_copper",
+                                             "P_stator_hysteresis",
+                                             "P_stator_eddy",
+                                             "P_stator_excess",
+                                             "P_rotor_iron",
+                                             "P_magnet",
+                                             "P_mechanical",
+                                             "P_winding",
+                                             "P_iron",
+                                             "P_rotor",
+                                             "P_total",
+                                             "Q_coolant",
+                                             "G_winding_iron",
+                                             "G_iron_coolant",
+                                             "G_airgap",
+                                             "G_winding_rotor",
+                                             "G_winding_coolant",
+                                             "G_rotor_coolant",
+                                             "E_losses",
+                                             "E_coolant",
+                                             "E_stored",
+                                             "E_residual",
+                                             "t_start",
+                                             "i_d_mean",
+                                             "i_q_mean",
+                                             "u_d_mean",
+                                             "u_q_mean",
+                                             "omega_el_mean"};
   return h;
 }
 
@@ -95,15 +129,50 @@ void write_truth_row(std::ostream& out, const Row& r) {
   const Snapshot& s = r.truth;
   const Losses& l = s.losses;
   const double e_losses = s.y(kEWinding) + s.y(kEIron) + s.y(kERotor);
-  write_row(out, {s.t_s,          s.y(kTWinding),  s.y(kTIron),         s.y(kTRotor),     s.y(kTCoolant),
-                  s.sensor_reading_C, s.r_s_dc_Ohm, s.r_s_ac_Ohm,       s.psi_m_Wb,       s.op.omega_el_rad_s,
-                  s.speed_rpm,    s.op.i_d_A,      s.op.i_q_A,          s.u.u_d_V,        s.u.u_q_V,
-                  l.flux_rel,     l.copper,        l.stator_hysteresis, l.stator_eddy,    l.stator_excess,
-                  l.rotor_iron,   l.magnet,        l.mechanical,        l.winding(),      l.iron(),
-                  l.rotor(),      l.total(),       s.heat_to_coolant_W, s.g.winding_iron, s.g.iron_coolant,
-                  s.g.airgap,     s.g.winding_rotor, s.g.winding_coolant, s.g.rotor_coolant, e_losses,
-                  s.y(kECoolant), r.stored_J,      r.residual_J,        r.t_start_s,      r.i_d_mean_A,
-                  r.i_q_mean_A,   r.u_d_mean_V,    r.u_q_mean_V,        r.omega_el_mean_rad_s});
+  write_row(out, {s.t_s,
+                  s.y(kTWinding),
+                  s.y(kTIron),
+                  s.y(kTRotor),
+                  s.y(kTCoolant),
+                  s.sensor_reading_C,
+                  s.r_s_dc_Ohm,
+                  s.r_s_ac_Ohm,
+                  s.psi_m_Wb,
+                  s.op.omega_el_rad_s,
+                  s.speed_rpm,
+                  s.op.i_d_A,
+                  s.op.i_q_A,
+                  s.u.u_d_V,
+                  s.u.u_q_V,
+                  l.flux_rel,
+                  l.copper,
+                  l.stator_hysteresis,
+                  l.stator_eddy,
+                  l.stator_excess,
+                  l.rotor_iron,
+                  l.magnet,
+                  l.mechanical,
+                  l.winding(),
+                  l.iron(),
+                  l.rotor(),
+                  l.total(),
+                  s.heat_to_coolant_W,
+                  s.g.winding_iron,
+                  s.g.iron_coolant,
+                  s.g.airgap,
+                  s.g.winding_rotor,
+                  s.g.winding_coolant,
+                  s.g.rotor_coolant,
+                  e_losses,
+                  s.y(kECoolant),
+                  r.stored_J,
+                  r.residual_J,
+                  r.t_start_s,
+                  r.i_d_mean_A,
+                  r.i_q_mean_A,
+                  r.u_d_mean_V,
+                  r.u_q_mean_V,
+                  r.omega_el_mean_rad_s});
 }
 
 void write_log_csv(std::ostream& out, const Result& result, LogColumns columns) {
@@ -149,18 +218,18 @@ nlohmann::json parameters_json(const Case& c, const Result& result, LogColumns c
 
   const double w_n = p.rated_speed_rad_s;
   const EndSpaceAreas a = endspace_areas(p);
-  j["derived"] = {
-      {"copper_inferred_zero_C", -(1.0 / p.copper_alpha20_per_K - 20.0)},
-      {"rated_copper_loss_W", rated_copper_loss_W(p)},
-      {"taylor_number_at_rated_speed", taylor_number(p, w_n)},
-      {"endspace_areas_m2", {{"winding", a.winding_m2}, {"rotor", a.rotor_m2}, {"caps", a.caps_m2}}},
-      {"conductances_W_K_at_standstill", conductances_json(conductances(p, 0.0))},
-      {"conductances_W_K_at_rated_speed", conductances_json(conductances(p, w_n))},
-      {"time_constants_s_at_standstill", time_constants_s(p, 0.0)},
-      {"time_constants_s_at_rated_speed", time_constants_s(p, w_n)}};
+  j["derived"] = {{"copper_inferred_zero_C", -(1.0 / p.copper_alpha20_per_K - 20.0)},
+                  {"rated_copper_loss_W", rated_copper_loss_W(p)},
+                  {"taylor_number_at_rated_speed", taylor_number(p, w_n)},
+                  {"endspace_areas_m2", {{"winding", a.winding_m2}, {"rotor", a.rotor_m2}, {"caps", a.caps_m2}}},
+                  {"conductances_W_K_at_standstill", conductances_json(conductances(p, 0.0))},
+                  {"conductances_W_K_at_rated_speed", conductances_json(conductances(p, w_n))},
+                  {"time_constants_s_at_standstill", time_constants_s(p, 0.0)},
+                  {"time_constants_s_at_rated_speed", time_constants_s(p, w_n)}};
   j["laws"] = {
-      {"r_s", "R_s(T_w) = r_s_ref*(K + T_w)/(K + r_s_reference_C), K = 1/alpha20_copper - 20 degC (DC; the "
-              "log's voltages use R_s*(1 + k_ac*(f/f_n)^2))"},
+      {"r_s",
+       "R_s(T_w) = r_s_ref*(K + T_w)/(K + r_s_reference_C), K = 1/alpha20_copper - 20 degC (DC; the "
+       "log's voltages use R_s*(1 + k_ac*(f/f_n)^2))"},
       {"psi_m", "psi_m(T_m) = psi_m_ref*(1 + alpha20_magnet*(T_m - 20))/(1 + alpha20_magnet*(psi_m_reference_C - 20))"},
       {"voltages", "steady state: u_d = R*i_d - w*L_q*i_q, u_q = R*i_q + w*(L_d*i_d + psi_m)"},
       {"magnet_temperature", "T_magnet is the rotor node (rotor iron, magnets, shaft)"}};

@@ -25,8 +25,7 @@ inline Profile constant_profile(double speed_rpm, double i_d_A, double i_q_A, do
 }
 
 /// A case with exact logging (no noise) and constant coolant.
-inline Case exact_case(const Machine& m, const Parameters& p, const Profile& profile, double duration_s,
-                       double rate_Hz) {
+inline Case exact_case(const Machine& m, const Parameters& p, const Profile& profile, double duration_s, double rate_Hz) {
   Case c;
   c.machine = m;
   c.params = p;

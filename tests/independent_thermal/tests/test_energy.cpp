@@ -65,9 +65,9 @@ TEST(IndepThermalEnergy, AccumulatorsBalanceToRounding) {
 Case smooth_case(std::uint64_t seed) {
   Case c = drive_cycle_case(seed, 3600, 20);
   c.profile.gives_i_d = true;
-  c.profile.points = {{0, 0, 0, 0},          {20, 0, 100, -20},     {200, 0, 100, -20}, {220, 4000, 60, -120},
-                      {900, 4000, 60, -120}, {910, 4000, 20, -80},  {1500, 5500, 20, -80}, {1800, 0, 150, 0},
-                      {2400, 0, 150, 0},     {2410, 0, 0, 0},       {3600, 0, 0, 0}};
+  c.profile.points = {{0, 0, 0, 0},          {20, 0, 100, -20},    {200, 0, 100, -20},    {220, 4000, 60, -120},
+                      {900, 4000, 60, -120}, {910, 4000, 20, -80}, {1500, 5500, 20, -80}, {1800, 0, 150, 0},
+                      {2400, 0, 150, 0},     {2410, 0, 0, 0},      {3600, 0, 0, 0}};
   return c;
 }
 
@@ -85,7 +85,8 @@ TEST(IndepThermalEnergy, StoredPlusCoolantHeatEqualsLossesByIndependentQuadratur
   ASSERT_GT(losses.fine, 1e6);
   EXPECT_NEAR(losses.fine - to_coolant.fine, stored, tol_losses + tol_coolant + 1e-9 * losses.fine);
   // The accumulators agree with the quadrature within the same bounds.
-  EXPECT_NEAR(last.truth.y(kEWinding) + last.truth.y(kEIron) + last.truth.y(kERotor), losses.fine, tol_losses + 1e-9 * losses.fine);
+  EXPECT_NEAR(last.truth.y(kEWinding) + last.truth.y(kEIron) + last.truth.y(kERotor), losses.fine,
+              tol_losses + 1e-9 * losses.fine);
   EXPECT_NEAR(last.truth.y(kECoolant), to_coolant.fine, tol_coolant + 1e-9 * to_coolant.fine);
   // The bounds are tight enough to mean something: under 1e-5 of the energy moved.
   EXPECT_LT(tol_losses + tol_coolant, 1e-5 * losses.fine);

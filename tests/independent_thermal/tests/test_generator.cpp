@@ -165,8 +165,10 @@ TEST(IndepThermalGenerator, AveragedRowsAreWindowMeans) {
     EXPECT_EQ(a.t_start_s, avg.rows[k - 1].truth.t_s);
     double q100 = 0.0, q50 = 0.0;
     const std::size_t j0 = 50 * (k - 1);
-    for (std::size_t j = j0; j < j0 + 50; ++j) q100 += 0.5 * (inst.rows[j].truth.u.u_q_V + inst.rows[j + 1].truth.u.u_q_V) / 50.0;
-    for (std::size_t j = j0; j < j0 + 50; j += 2) q50 += (inst.rows[j].truth.u.u_q_V + inst.rows[j + 2].truth.u.u_q_V) / 50.0;
+    for (std::size_t j = j0; j < j0 + 50; ++j)
+      q100 += 0.5 * (inst.rows[j].truth.u.u_q_V + inst.rows[j + 1].truth.u.u_q_V) / 50.0;
+    for (std::size_t j = j0; j < j0 + 50; j += 2)
+      q50 += (inst.rows[j].truth.u.u_q_V + inst.rows[j + 2].truth.u.u_q_V) / 50.0;
     EXPECT_NEAR(a.u_q_V, q100, std::abs(q50 - q100) + 1e-6 * (1.0 + std::abs(q100))) << a.truth.t_s;
     EXPECT_EQ(a.u_q_V, a.u_q_mean_V);
     checked += std::abs(a.truth.u.u_q_V - avg.rows[k - 1].truth.u.u_q_V) > 0.1;  // windows where u_q moved

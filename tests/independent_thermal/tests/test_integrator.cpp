@@ -33,8 +33,9 @@ TEST(IndepThermalIntegrator, ScalarOdeWithinItsTolerance) {
     double t = 0.0;
     double worst = 0.0;
     for (int k = 1; k <= 30; ++k) {
-      dp.advance([](double tt, const Eigen::Matrix<double, 1, 1>& yy) { return Eigen::Matrix<double, 1, 1>(-2.0 * tt * yy(0)); },
-                 t, 0.1 * k, y);
+      dp.advance(
+          [](double tt, const Eigen::Matrix<double, 1, 1>& yy) { return Eigen::Matrix<double, 1, 1>(-2.0 * tt * yy(0)); }, t,
+          0.1 * k, y);
       worst = std::max(worst, std::abs(y(0) - std::exp(-t * t)));
     }
     EXPECT_EQ(t, 3.0);
@@ -60,7 +61,8 @@ TEST(IndepThermalIntegrator, LinearPlantAgainstExactSolution) {
   const Eigen::Vector3d t_ss = mat.partialPivLu().solve(b);
   const Eigen::Vector3d cap = capacities(p);
   const Eigen::Vector3d s = cap.cwiseSqrt();
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(s.cwiseInverse().asDiagonal() * mat * s.cwiseInverse().asDiagonal());
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(s.cwiseInverse().asDiagonal() * mat *
+                                                           s.cwiseInverse().asDiagonal());
   const Eigen::Vector3d z0 = eig.eigenvectors().transpose() * (s.asDiagonal() * (Eigen::Vector3d::Constant(t_c) - t_ss));
   double worst = 0.0;
   for (const Row& row : r.rows) {
@@ -110,9 +112,8 @@ double worst_difference(const Case& c, double rk4_step_s) {
   EXPECT_EQ(ref.size(), r.rows.size());
   double worst = 0.0;
   for (std::size_t k = 0; k < std::min(ref.size(), r.rows.size()); ++k) {
-    worst = std::max(worst, (r.rows[k].truth.y.head<kTemperatureStates>() - ref[k].head<kTemperatureStates>())
-                                .cwiseAbs()
-                                .maxCoeff());
+    worst = std::max(
+        worst, (r.rows[k].truth.y.head<kTemperatureStates>() - ref[k].head<kTemperatureStates>()).cwiseAbs().maxCoeff());
   }
   return worst;
 }

@@ -77,8 +77,7 @@ TEST(IndepThermalConvection, AirGapAtStandstillIsConductionAcrossTheGap) {
   EXPECT_NEAR(airgap_conductance_W_K(p, 0.0), p.air_conductivity_W_mK / p.airgap_m * area, 1e-12);
   // Ta = Re·√(g/R), Re = Ω·R·g/ν.
   const double r = 0.5 * p.rotor_diameter_m;
-  EXPECT_NEAR(taylor_number(p, 600.0), 600.0 * r * p.airgap_m / p.air_viscosity_m2_s * std::sqrt(p.airgap_m / r),
-              1e-9);
+  EXPECT_NEAR(taylor_number(p, 600.0), 600.0 * r * p.airgap_m / p.air_viscosity_m2_s * std::sqrt(p.airgap_m / r), 1e-9);
 }
 
 TEST(IndepThermalConvection, EndSpaceDeltaCarriesTheStarsHeat) {
@@ -148,7 +147,8 @@ TEST(IndepThermalLosses, FrequencyAndFluxLaws) {
   EXPECT_NEAR(a.flux_rel, bb, 1e-14);
   const double x = 0.4;
   const double eddy_share = 1.0 - p.stator_hysteresis_share - p.stator_excess_share;
-  EXPECT_NEAR(a.stator_hysteresis, p.stator_iron_rated_W * p.stator_hysteresis_share * x * std::pow(bb, p.steinmetz_exponent), 1e-9);
+  EXPECT_NEAR(a.stator_hysteresis,
+              p.stator_iron_rated_W * p.stator_hysteresis_share * x * std::pow(bb, p.steinmetz_exponent), 1e-9);
   EXPECT_NEAR(a.stator_eddy, p.stator_iron_rated_W * eddy_share * x * x * bb * bb, 1e-9);
   // A hotter magnet carries less flux: less iron loss.
   EXPECT_LT(compute_losses(p, op1, 60.0, 120.0).iron(), a.iron());
@@ -260,10 +260,12 @@ TEST(IndepThermalProfile, FileErrorsNameLineColumnAndWhy) {
   ASSERT_EQ(p.points.size(), 2u);
   EXPECT_EQ(p.points[1].i_q_A, 2.0);
   EXPECT_NE(message(write_temp("a.csv", "t_s,speed_rpm,iq\n")).find("a.csv:1:3: unknown column 'iq'"), std::string::npos);
-  EXPECT_NE(message(write_temp("b.csv", "t_s,speed_rpm,i_q_A\n0,x,1\n")).find("b.csv:2:2: column speed_rpm: 'x' is not a number"),
-            std::string::npos);
-  EXPECT_NE(message(write_temp("c.csv", "t_s,speed_rpm,i_q_A\n5,0,1\n4,0,1\n")).find("c.csv:3:1: column t_s: time goes back"),
-            std::string::npos);
+  EXPECT_NE(
+      message(write_temp("b.csv", "t_s,speed_rpm,i_q_A\n0,x,1\n")).find("b.csv:2:2: column speed_rpm: 'x' is not a number"),
+      std::string::npos);
+  EXPECT_NE(
+      message(write_temp("c.csv", "t_s,speed_rpm,i_q_A\n5,0,1\n4,0,1\n")).find("c.csv:3:1: column t_s: time goes back"),
+      std::string::npos);
   EXPECT_NE(message(write_temp("d.csv", "t_s,i_q_A\n")).find("d.csv:1: the header needs"), std::string::npos);
   EXPECT_NE(message(write_temp("e.csv", "t_s,speed_rpm,i_q_A\n0,0\n")).find("e.csv:2: 2 cells"), std::string::npos);
   EXPECT_NE(message(write_temp("f.csv", "t_s,speed_rpm,i_q_A\n")).find("no points"), std::string::npos);
@@ -272,8 +274,8 @@ TEST(IndepThermalProfile, FileErrorsNameLineColumnAndWhy) {
 }
 
 TEST(IndepThermalProfile, ShippedPaderbornLikeProfileReads) {
-  const Profile p =
-      read_profile_csv(std::string(RPEM_TEST_SOURCE_DIR) + "/tests/independent_thermal/profiles/paderborn_profile_a_like.csv");
+  const Profile p = read_profile_csv(std::string(RPEM_TEST_SOURCE_DIR) +
+                                     "/tests/independent_thermal/profiles/paderborn_profile_a_like.csv");
   EXPECT_TRUE(p.gives_i_d);
   EXPECT_EQ(p.points.back().t_s, 7505.0);
   EXPECT_EQ(p.at(3000).speed_rpm, 5500.0);
@@ -366,10 +368,11 @@ TEST(IndepThermalMachine, ConfigurationErrorsNameFileLineAndKey) {
   const Machine m = test::paper_machine();
   EXPECT_EQ(m.pole_pairs, 3);
   EXPECT_NEAR(m.rated_torque_Nm(), 32.6, 1e-12);
-  EXPECT_NEAR(test::paderborn_machine().rated_torque_Nm(),
-              0.85 * std::sqrt(3.0) * 170 * 160 / (2 * kPi * 6000 / 60.0), 1e-9);
-  const std::string bad = write_temp("bad.yaml", "machine:\n  rated:\n    voltage_ll_rms_V: 400\n    current_rms_A: 5\n"
-                                                 "    speed_rpm: 1000\n    pole_pairs: 2.5\n");
+  EXPECT_NEAR(test::paderborn_machine().rated_torque_Nm(), 0.85 * std::sqrt(3.0) * 170 * 160 / (2 * kPi * 6000 / 60.0),
+              1e-9);
+  const std::string bad = write_temp("bad.yaml",
+                                     "machine:\n  rated:\n    voltage_ll_rms_V: 400\n    current_rms_A: 5\n"
+                                     "    speed_rpm: 1000\n    pole_pairs: 2.5\n");
   try {
     read_machine(bad);
     FAIL();

@@ -42,8 +42,8 @@ double parse_time_of_day(const std::string& s) {
   int h = 0, m = 0;
   double sec = 0.0;
   char c1 = 0, c2 = 0;
-  if (std::sscanf(s.c_str(), "%d%c%d%c%lf", &h, &c1, &m, &c2, &sec) != 5 || c1 != ':' || c2 != ':' || h < 0 ||
-      h > 23 || m < 0 || m > 59 || sec < 0.0 || sec >= 60.0) {
+  if (std::sscanf(s.c_str(), "%d%c%d%c%lf", &h, &c1, &m, &c2, &sec) != 5 || c1 != ':' || c2 != ':' || h < 0 || h > 23 ||
+      m < 0 || m > 59 || sec < 0.0 || sec >= 60.0) {
     throw std::invalid_argument("--start-time '" + s + "': expected HH:MM:SS[.mmm]");
   }
   return (h * 3600.0 + m * 60.0 + sec) * 1000.0;
@@ -58,8 +58,9 @@ void write(const std::string& path, const std::string& text) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"Independent VESC Tool log generator: a sensorless VESC driving an outrunner, read by VESC Tool "
-               "(tests/independent_vesc/README.md)"};
+  CLI::App app{
+      "Independent VESC Tool log generator: a sensorless VESC driving an outrunner, read by VESC Tool "
+      "(tests/independent_vesc/README.md)"};
   std::string config, out, truth_path, scenario, start_time, off_voltage = "measured", trace;
   int trace_every = 125;
   std::uint64_t seed = 1;
@@ -130,8 +131,7 @@ int main(int argc, char** argv) {
     c.firmware.invert_direction = invert;
     c.keep_cycle_trace = !trace.empty();
     c.trace_every = trace_every;
-    c.firmware.off_voltage =
-        off_voltage == "zero" ? indep::vesc::OffVoltage::zero : indep::vesc::OffVoltage::measured;
+    c.firmware.off_voltage = off_voltage == "zero" ? indep::vesc::OffVoltage::zero : indep::vesc::OffVoltage::measured;
     for (const std::string& s : sets) apply_set(c, s);
     c = indep::vesc::resolve_defaults(c);
   } catch (const std::invalid_argument& e) {
@@ -157,8 +157,8 @@ int main(int argc, char** argv) {
                  "R_s %.6g Ohm (%+.1f %%) at %.0f C; at the end %.6g Wb, %.6g Ohm\n",
                  r.rows.size(), r.reads, r.lost_replies, c.duration_s, r.true_at_reference.psi_m_Wb,
                  100.0 * (r.true_at_reference.psi_m_Wb / r.configured.psi_m_Wb - 1.0), r.true_at_reference.r_s_Ohm,
-                 100.0 * (r.true_at_reference.r_s_Ohm / r.configured.r_s_Ohm - 1.0), c.thermal.reference_C,
-                 r.end_psi_m_Wb, r.end_r_s_Ohm);
+                 100.0 * (r.true_at_reference.r_s_Ohm / r.configured.r_s_Ohm - 1.0), c.thermal.reference_C, r.end_psi_m_Wb,
+                 r.end_r_s_Ohm);
   } catch (const std::invalid_argument& e) {
     std::cerr << "indep_vesc_log: " << e.what() << "\n";
     return kExitUsage;

@@ -9,25 +9,17 @@ namespace indep::vesc {
 namespace {
 
 /// mc_interface_set_current: the app's current in the motor's configured direction.
-void mc_set_current(VescFirmware& fw, double i_A) {
-  fw.set_current(fw.params().conf.invert_direction ? -i_A : i_A);
-}
+void mc_set_current(VescFirmware& fw, double i_A) { fw.set_current(fw.params().conf.invert_direction ? -i_A : i_A); }
 
 }  // namespace
 
 App::App(std::vector<Segment> segments) : segments_(std::move(segments)) {}
 
-SegmentKind App::kind_now() const {
-  return done_ || !started_ ? SegmentKind::off : segments_[index_].kind;
-}
+SegmentKind App::kind_now() const { return done_ || !started_ ? SegmentKind::off : segments_[index_].kind; }
 
-double App::external_torque_Nm() const {
-  return done_ || !started_ ? 0.0 : segments_[index_].external_Nm;
-}
+double App::external_torque_Nm() const { return done_ || !started_ ? 0.0 : segments_[index_].external_Nm; }
 
-double App::added_friction_Nm() const {
-  return done_ || !started_ ? 0.0 : segments_[index_].friction_Nm;
-}
+double App::added_friction_Nm() const { return done_ || !started_ ? 0.0 : segments_[index_].friction_Nm; }
 
 void App::begin(std::size_t index, double t_s, VescFirmware& fw) {
   index_ = index;
@@ -103,7 +95,8 @@ bool App::run_segment(double t_s, VescFirmware& fw) {
       const double erpm = fw.erpm();
       return !((s.until_erpm > 0.0 && std::fabs(erpm) < s.until_erpm) || erpm * brake_sign_ > 0.0);
     }
-    case SegmentKind::flux_measurement: break;
+    case SegmentKind::flux_measurement:
+      break;
   }
   return false;
 }
@@ -188,7 +181,8 @@ bool App::run_flux_measurement(double t_s, VescFirmware& fw) {
       ++flux_ms_;
       return true;
     }
-    case Flux::stopped: return false;
+    case Flux::stopped:
+      return false;
   }
   return false;
 }

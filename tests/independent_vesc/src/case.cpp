@@ -22,9 +22,8 @@ void require(bool ok, const std::string& what) {
 }
 
 void in_range(double v, double lo, double hi, const char* key) {
-  require(std::isfinite(v) && v >= lo && v <= hi,
-          std::string(key) + " = " + std::to_string(v) + " is outside [" + std::to_string(lo) + ", " +
-              std::to_string(hi) + "]");
+  require(std::isfinite(v) && v >= lo && v <= hi, std::string(key) + " = " + std::to_string(v) + " is outside [" +
+                                                      std::to_string(lo) + ", " + std::to_string(hi) + "]");
 }
 
 // The VESC 6's measurement chain (vedderb/bldc hwconf/trampa/vesc6/hw_60_core.h): 12-bit ADC at V_REG 3.3 V,
@@ -133,8 +132,10 @@ Case resolve_defaults(Case c) {
   return c;
 }
 
-#define INDEP_VESC_PARAM(key, unit, member) \
-  { key, unit, [](Case& c) -> double& { return c.member; } }
+#define INDEP_VESC_PARAM(key, unit, member)                \
+  {                                                        \
+    key, unit, [](Case& c) -> double& { return c.member; } \
+  }
 
 const std::vector<ParameterEntry>& parameter_catalogue() {
   static const std::vector<ParameterEntry> table = {

@@ -21,10 +21,14 @@ double clamp_abs(double x, double limit) { return std::clamp(x, -limit, limit); 
 
 const char* to_string(AngleSource s) {
   switch (s) {
-    case AngleSource::off: return "off";
-    case AngleSource::observer: return "observer";
-    case AngleSource::startup: return "startup";
-    case AngleSource::openloop: return "openloop";
+    case AngleSource::off:
+      return "off";
+    case AngleSource::observer:
+      return "observer";
+    case AngleSource::startup:
+      return "startup";
+    case AngleSource::openloop:
+      return "openloop";
   }
   return "?";
 }
@@ -216,8 +220,10 @@ void VescFirmware::speed_and_tachometer(double phase) {
   step = std::clamp(step, 0, 5);
   int d = step - tacho_step_last_;
   tacho_step_last_ = step;
-  if (d > 3) d -= 6;
-  else if (d < -2) d += 6;
+  if (d > 3)
+    d -= 6;
+  else if (d < -2)
+    d += 6;
   tacho_ += d;
   tacho_abs_ += std::abs(d);
 }

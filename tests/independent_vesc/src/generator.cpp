@@ -79,9 +79,9 @@ struct Window {
     t.excites_psi_m = t.psi_m_term_V >= rules.excites_psi_m_min_V;
     t.excites_r_s = t.r_s_term_V >= rules.excites_r_s_min_V;
     const double dw = std::fabs(w_last - w_first);
-    t.transient = dw > rules.transient_speed_rel * std::max(std::fabs(t.omega_el_mean_rad_s),
-                                                            rules.transient_speed_floor_rad_s) ||
-                  t.i_dev_rms_A > rules.transient_current_rms_A;
+    t.transient =
+        dw > rules.transient_speed_rel * std::max(std::fabs(t.omega_el_mean_rad_s), rules.transient_speed_floor_rad_s) ||
+        t.i_dev_rms_A > rules.transient_current_rms_A;
     return t;
   }
 };
@@ -219,12 +219,11 @@ Result generate(const Case& input) {
     if (!bridge_on) {
       // Undriven phases float at the back EMF around the link's middle; each is measured against ground.
       const double e = c.sensors.phase_voltage_gain * omega_el * plant.params().psi_m_Wb;
-      const std::array<double, 3> e_abc =
-          inverse_clarke({-e * std::sin(x.theta_el_rad), e * std::cos(x.theta_el_rad)});
+      const std::array<double, 3> e_abc = inverse_clarke({-e * std::sin(x.theta_el_rad), e * std::cos(x.theta_el_rad)});
       std::array<double, 3> v_meas{};
       for (int p = 0; p < 3; ++p) {
-        v_meas[p] = adc(e_abc[p] + 0.5 * v_dc, c.sensors.voltage_lsb_V, 0.0, c.sensors.voltage_noise_lsb, 0.0,
-                        adc_rng, normal);
+        v_meas[p] =
+            adc(e_abc[p] + 0.5 * v_dc, c.sensors.voltage_lsb_V, 0.0, c.sensors.voltage_noise_lsb, 0.0, adc_rng, normal);
       }
       in.v_terminal_ab_V = clarke(v_meas);
     }
@@ -324,8 +323,8 @@ Result generate(const Case& input) {
                    [](const LogRow& a, const LogRow& b) { return a.t_reply_s < b.t_reply_s; });
   std::sort(setups.begin(), setups.end(), [](const SetupAt& a, const SetupAt& b) { return a.t_s < b.t_s; });
   for (LogRow& row : res.rows) {
-    const auto it = std::lower_bound(setups.begin(), setups.end(), row.t_reply_s,
-                                     [](const SetupAt& s, double t) { return s.t_s < t; });
+    const auto it =
+        std::lower_bound(setups.begin(), setups.end(), row.t_reply_s, [](const SetupAt& s, double t) { return s.t_s < t; });
     if (it != setups.begin()) {
       row.context.ms_setup = ms_today(c.format.start_ms_today, std::prev(it)->t_s);
       row.context.setup = std::prev(it)->values;

@@ -119,8 +119,6 @@ IntervalResult Plant::step_off(PlantState& x, double h) const {
   return r;
 }
 
-void Plant::open_phases(PlantState& x) const {
-  x.psi_ab_Wb = inverse_park({p_.psi_m_Wb, 0.0}, x.theta_el_rad);
-}
+void Plant::open_phases(PlantState& x) const { x.psi_ab_Wb = inverse_park({p_.psi_m_Wb, 0.0}, x.theta_el_rad); }
 
 }  // namespace indep::vesc

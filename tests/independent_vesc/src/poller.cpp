@@ -26,8 +26,7 @@ double rtt_median_s(const Poller& p) {
     const double z = std::log(p.rtt_min_s > 0.0 ? p.rtt_min_s / m : 1e-300) / s;
     const double rtt = p.rtt_min_s * phi(z) + m * std::exp(0.5 * s * s) * phi(s - z);
     const double cycle = (1.0 - p.loss_probability) * (rtt + 0.5 * period + 5e-4) +
-                         p.loss_probability * (1.0 + 0.5 * period) +
-                         p.stall_probability * 0.5 * (0.3 + p.stall_max_s);
+                         p.loss_probability * (1.0 + 0.5 * period) + p.stall_probability * 0.5 * (0.3 + p.stall_max_s);
     return cycle / (1.0 - p.loss_probability);
   };
   double lo = 1e-4, hi = 10.0;
@@ -47,9 +46,9 @@ std::vector<ReadEvent> poll_schedule(const Poller& p, double duration_s, std::ui
   const double timeout_s = 100 * 10e-3;  // mTimeoutCount ticks of the 10 ms timer
 
   std::vector<ReadEvent> reads;
-  double can_send_at = 0.0;      // the time-out runs out (when a request is outstanding)
+  double can_send_at = 0.0;  // the time-out runs out (when a request is outstanding)
   bool outstanding = false;
-  std::vector<double> replies;   // arrival times of replies still under way
+  std::vector<double> replies;  // arrival times of replies still under way
   for (double tick = period * unit(rng); tick <= duration_s; tick += period) {
     const double t = tick + 1e-3 * unit(rng);  // the event loop's latency
     // Replies that arrived by now cleared the outstanding request.
@@ -68,7 +67,7 @@ std::vector<ReadEvent> poll_schedule(const Poller& p, double duration_s, std::ui
     double rtt = std::max(p.rtt_min_s, median * std::exp(p.rtt_sigma_log * normal(rng)));
     if (unit(rng) < p.stall_probability) rtt += 0.3 + (p.stall_max_s - 0.3) * unit(rng);
     const double u_loss = unit(rng);
-    const double split = 0.3 + 0.4 * unit(rng);  // the request's share of the round trip
+    const double split = 0.3 + 0.4 * unit(rng);       // the request's share of the round trip
     if (u_loss < 0.5 * p.loss_probability) continue;  // the request was lost: no read, no reply
     ReadEvent e;
     e.t_request_s = t;

@@ -11,17 +11,22 @@ namespace indep::vesc {
 
 const char* to_string(SegmentKind k) {
   switch (k) {
-    case SegmentKind::off: return "off";
-    case SegmentKind::current: return "current";
-    case SegmentKind::coast: return "coast";
-    case SegmentKind::brake: return "brake";
-    case SegmentKind::flux_measurement: return "flux_measurement";
+    case SegmentKind::off:
+      return "off";
+    case SegmentKind::current:
+      return "current";
+    case SegmentKind::coast:
+      return "coast";
+    case SegmentKind::brake:
+      return "brake";
+    case SegmentKind::flux_measurement:
+      return "flux_measurement";
   }
   return "?";
 }
 
-std::vector<Segment> builtin_scenario(double duration_s, double l_current_max_A, double rated_erpm,
-                                      double creep_torque_Nm, double torque_per_A_Nm, std::uint64_t seed) {
+std::vector<Segment> builtin_scenario(double duration_s, double l_current_max_A, double rated_erpm, double creep_torque_Nm,
+                                      double torque_per_A_Nm, std::uint64_t seed) {
   std::mt19937_64 rng = stream_rng(seed, Stream::scenario);
   auto u = [&](double lo, double hi) { return std::uniform_real_distribution<double>(lo, hi)(rng); };
   const double i_max = l_current_max_A;
@@ -48,16 +53,19 @@ std::vector<Segment> builtin_scenario(double duration_s, double l_current_max_A,
     }
     // From standstill or a slow roll: the sensorless open-loop start-up, then closed loop (an app's ramp or a
     // step).
-    Segment start{SegmentKind::current, u(1.0, 2.0), sign * u(0.2, 0.35) * i_max, u(0.0, 0.3),
-                  u(0.15, 0.25) * rated_erpm};
+    Segment start{SegmentKind::current, u(1.0, 2.0), sign * u(0.2, 0.35) * i_max, u(0.0, 0.3), u(0.15, 0.25) * rated_erpm};
     start.friction_Nm = u(0.3, 0.7) * torque_per_A_Nm * std::fabs(start.current_A);  // a load to start against
     add(start);
     // A hard acceleration: a current step, over within a read or two.
     add({SegmentKind::current, u(0.15, 0.4), sign * u(0.6, 0.9) * i_max, 0.0, u(0.35, 0.45) * rated_erpm});
     add({SegmentKind::current, u(15.0, 40.0), sign * u(0.03, 0.07) * i_max});
     switch (episode % 3) {
-      case 0: add({SegmentKind::off, u(10.0, 25.0)}); break;                 // freewheel at speed
-      case 1: add({SegmentKind::coast, u(45.0, 100.0)}); break;              // a minute or more at zero current
+      case 0:
+        add({SegmentKind::off, u(10.0, 25.0)});
+        break;  // freewheel at speed
+      case 1:
+        add({SegmentKind::coast, u(45.0, 100.0)});
+        break;  // a minute or more at zero current
       default:
         add({SegmentKind::brake, 4.0, u(0.15, 0.3) * i_max, 0.0, 0.03 * rated_erpm});
         add({SegmentKind::off, u(3.0, 8.0)});
@@ -107,8 +115,9 @@ std::vector<Segment> read_scenario_csv(const std::string& path) {
       }
       for (std::size_t c = 0; c < header.size(); ++c) {
         if (c >= known.size() || header[c] != known[c]) {
-          fail(path, n, "column " + std::to_string(c + 1) + " '" + header[c] + "': expected '" +
-                            (c < known.size() ? known[c] : std::string("nothing")) + "'");
+          fail(path, n,
+               "column " + std::to_string(c + 1) + " '" + header[c] + "': expected '" +
+                   (c < known.size() ? known[c] : std::string("nothing")) + "'");
         }
       }
       continue;
@@ -118,13 +127,19 @@ std::vector<Segment> read_scenario_csv(const std::string& path) {
     }
     Segment seg;
     const std::string& kind = cells[0];
-    if (kind == "off") seg.kind = SegmentKind::off;
-    else if (kind == "current") seg.kind = SegmentKind::current;
-    else if (kind == "coast") seg.kind = SegmentKind::coast;
-    else if (kind == "brake") seg.kind = SegmentKind::brake;
-    else if (kind == "flux_measurement") seg.kind = SegmentKind::flux_measurement;
-    else fail(path, n, "kind '" + kind + "' (known: off, current, coast, brake, flux_measurement)");
-    double* fields[] = {&seg.duration_s, &seg.current_A, &seg.ramp_s,     &seg.until_erpm,
+    if (kind == "off")
+      seg.kind = SegmentKind::off;
+    else if (kind == "current")
+      seg.kind = SegmentKind::current;
+    else if (kind == "coast")
+      seg.kind = SegmentKind::coast;
+    else if (kind == "brake")
+      seg.kind = SegmentKind::brake;
+    else if (kind == "flux_measurement")
+      seg.kind = SegmentKind::flux_measurement;
+    else
+      fail(path, n, "kind '" + kind + "' (known: off, current, coast, brake, flux_measurement)");
+    double* fields[] = {&seg.duration_s, &seg.current_A,   &seg.ramp_s,     &seg.until_erpm,
                         &seg.erpm_per_s, &seg.external_Nm, &seg.friction_Nm};
     for (std::size_t c = 1; c < cells.size(); ++c) {
       double v = 0.0;

@@ -34,10 +34,9 @@ std::string cycle_trace_csv(const Result& r) {
   for (const CycleRecord& c : r.cycles) {
     const double eps = std::remainder(c.phase_rad - c.theta_el_rad, 2.0 * kPi);
     std::snprintf(buf, sizeof buf, "%.6f,%.6f,%.4f,%.6f,%.6f,%s,%d,%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,%.5g,%.7g,%.7g\n",
-                  c.t_s, std::remainder(c.theta_el_rad, 2.0 * kPi), c.omega_el_rad_s, c.phase_rad, eps,
-                  to_string(c.source), c.modulating ? 1 : 0, c.i_dq_true_A.x, c.i_dq_true_A.y, c.i_dq_reported_A.x,
-                  c.i_dq_reported_A.y, c.v_dq_reported_V.x, c.v_dq_reported_V.y, c.v_dq_applied_V.x,
-                  c.v_dq_applied_V.y, c.psi_m_Wb, c.r_s_Ohm);
+                  c.t_s, std::remainder(c.theta_el_rad, 2.0 * kPi), c.omega_el_rad_s, c.phase_rad, eps, to_string(c.source),
+                  c.modulating ? 1 : 0, c.i_dq_true_A.x, c.i_dq_true_A.y, c.i_dq_reported_A.x, c.i_dq_reported_A.y,
+                  c.v_dq_reported_V.x, c.v_dq_reported_V.y, c.v_dq_applied_V.x, c.v_dq_applied_V.y, c.psi_m_Wb, c.r_s_Ohm);
     out += buf;
   }
   return out;
@@ -46,7 +45,10 @@ std::string cycle_trace_csv(const Result& r) {
 namespace {
 
 nlohmann::json machine_json(const MachineValues& m) {
-  return {{"psi_m_Wb", m.psi_m_Wb}, {"r_s_Ohm", m.r_s_Ohm}, {"l_d_H", m.l_d_H}, {"l_q_H", m.l_q_H},
+  return {{"psi_m_Wb", m.psi_m_Wb},
+          {"r_s_Ohm", m.r_s_Ohm},
+          {"l_d_H", m.l_d_H},
+          {"l_q_H", m.l_q_H},
           {"pole_pairs", m.pole_pairs}};
 }
 
@@ -105,17 +107,20 @@ std::string truth_json(const Result& r) {
   j["true_machine"]["reference_temperature_C"] = c.thermal.reference_C;
   j["true_over_configured"] = {{"psi_m", r.true_at_reference.psi_m_Wb / r.configured.psi_m_Wb},
                                {"r_s", r.true_at_reference.r_s_Ohm / r.configured.r_s_Ohm}};
-  j["true_at_end"] = {{"psi_m_Wb", r.end_psi_m_Wb}, {"r_s_Ohm", r.end_r_s_Ohm}, {"T_winding_C", r.end_T_winding_C},
+  j["true_at_end"] = {{"psi_m_Wb", r.end_psi_m_Wb},
+                      {"r_s_Ohm", r.end_r_s_Ohm},
+                      {"T_winding_C", r.end_T_winding_C},
                       {"T_magnet_C", r.end_T_magnet_C}};
-  j["thermal"] = {{"on", c.thermal.on},
-                  {"ambient_C", c.thermal.ambient_C},
-                  {"winding_start_C", c.thermal.winding_start_C},
-                  {"magnet_start_C", c.thermal.magnet_start_C},
-                  {"r_s_coeff_per_K", c.thermal.r_s_coeff_per_K},
-                  {"psi_m_coeff_per_K", c.thermal.psi_m_coeff_per_K},
-                  {"winding_tau_s", c.thermal.winding_tau_s},
-                  {"magnet_tau_s", c.thermal.magnet_tau_s},
-                  {"law", "r_s = r_s_ref*(1 + r_s_coeff*(T_winding - ref)); psi_m = psi_m_ref*(1 + psi_m_coeff*(T_magnet - ref))"}};
+  j["thermal"] = {
+      {"on", c.thermal.on},
+      {"ambient_C", c.thermal.ambient_C},
+      {"winding_start_C", c.thermal.winding_start_C},
+      {"magnet_start_C", c.thermal.magnet_start_C},
+      {"r_s_coeff_per_K", c.thermal.r_s_coeff_per_K},
+      {"psi_m_coeff_per_K", c.thermal.psi_m_coeff_per_K},
+      {"winding_tau_s", c.thermal.winding_tau_s},
+      {"magnet_tau_s", c.thermal.magnet_tau_s},
+      {"law", "r_s = r_s_ref*(1 + r_s_coeff*(T_winding - ref)); psi_m = psi_m_ref*(1 + psi_m_coeff*(T_magnet - ref))"}};
   j["vesc"] = {{"configuration_at_start", machine_json(r.vesc_configuration)},
                {"measured_flux_linkage_Wb",
                 r.vesc_measured_flux_Wb ? nlohmann::json(*r.vesc_measured_flux_Wb) : nlohmann::json(nullptr)},

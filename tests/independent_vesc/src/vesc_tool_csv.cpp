@@ -9,19 +9,27 @@ namespace indep::vesc {
 namespace {
 
 constexpr const char* kBase[] = {
-    "ms_today", "input_voltage", "temp_mos_max", "temp_mos_1", "temp_mos_2", "temp_mos_3", "temp_motor",
-    "current_motor", "current_in", "d_axis_current", "q_axis_current", "erpm", "duty_cycle", "amp_hours_used",
-    "amp_hours_charged", "watt_hours_used", "watt_hours_charged", "tachometer", "tachometer_abs",
-    "encoder_position", "fault_code", "vesc_id"};
+    "ms_today",       "input_voltage",    "temp_mos_max",      "temp_mos_1",      "temp_mos_2",         "temp_mos_3",
+    "temp_motor",     "current_motor",    "current_in",        "d_axis_current",  "q_axis_current",     "erpm",
+    "duty_cycle",     "amp_hours_used",   "amp_hours_charged", "watt_hours_used", "watt_hours_charged", "tachometer",
+    "tachometer_abs", "encoder_position", "fault_code",        "vesc_id"};
 constexpr const char* kDq[] = {"d_axis_voltage", "q_axis_voltage"};
-constexpr const char* kSetup[] = {"ms_today_setup", "amp_hours_setup", "amp_hours_charged_setup", "watt_hours_setup",
-                                  "watt_hours_charged_setup", "battery_level", "battery_wh_tot", "current_in_setup",
-                                  "current_motor_setup", "speed_meters_per_sec", "tacho_meters", "tacho_abs_meters",
+constexpr const char* kSetup[] = {"ms_today_setup",
+                                  "amp_hours_setup",
+                                  "amp_hours_charged_setup",
+                                  "watt_hours_setup",
+                                  "watt_hours_charged_setup",
+                                  "battery_level",
+                                  "battery_wh_tot",
+                                  "current_in_setup",
+                                  "current_motor_setup",
+                                  "speed_meters_per_sec",
+                                  "tacho_meters",
+                                  "tacho_abs_meters",
                                   "num_vescs"};
-constexpr const char* kImu[] = {"ms_today_imu", "roll", "pitch", "yaw", "accX", "accY", "accZ", "gyroX", "gyroY",
-                                "gyroZ"};
-constexpr const char* kGnss[] = {"gnss_posTime", "gnss_lat", "gnss_lon", "gnss_alt", "gnss_gVel", "gnss_vVel",
-                                 "gnss_hAcc", "gnss_vAcc"};
+constexpr const char* kImu[] = {"ms_today_imu", "roll", "pitch", "yaw", "accX", "accY", "accZ", "gyroX", "gyroY", "gyroZ"};
+constexpr const char* kGnss[] = {"gnss_posTime", "gnss_lat",  "gnss_lon",  "gnss_alt",
+                                 "gnss_gVel",    "gnss_vVel", "gnss_hAcc", "gnss_vAcc"};
 
 void check(int version) {
   if (version < 0 || version > kNewestHeaderVersion) {
@@ -132,10 +140,10 @@ std::string row_line(int version, const RowContext& r) {
     put(s, u.tachometer);
     put(s, u.tachometer_abs);
     put_int(s, u.num_vescs);
-    put_int(s, -1);                             // ms_today_imu: no IMU polled
-    for (int k = 0; k < 9; ++k) put(s, 0.0);    // roll … gyroZ of a default IMU_VALUES
+    put_int(s, -1);                           // ms_today_imu: no IMU polled
+    for (int k = 0; k < 9; ++k) put(s, 0.0);  // roll … gyroZ of a default IMU_VALUES
   }
-  put_int(s, -1);                               // gnss_posTime: no position source
+  put_int(s, -1);                                      // gnss_posTime: no position source
   for (int k = 0; k < 7; ++k) put(s, qt_fixed8(0.0));  // lat, lon (fixed, 8) and the rest, still fixed
   return s;
 }

@@ -126,7 +126,7 @@ TEST(IndepVescGenerator, OpenLoopRotorLagsByItsLoadAngle) {
 TEST(IndepVescGenerator, RowsHoldTheMeansSinceThePreviousRead) {
   Case cs = outrunner_case(4.0);
   cs.keep_cycle_trace = true;
-  cs.poller.loss_probability = 0.2;  // lost replies: windows that start at a read no row shows
+  cs.poller.loss_probability = 0.2;   // lost replies: windows that start at a read no row shows
   cs.poller.stall_probability = 0.0;  // rows in the order of their reads
   cs.scenario = {segment(SegmentKind::off, 0.2), segment(SegmentKind::current, 0.6, 20.0),
                  segment(SegmentKind::current, 0.1, 60.0), segment(SegmentKind::current, 2.0, 5.0),

@@ -65,10 +65,12 @@ TEST(IndepVescCsv, HeadersAreVescToolsOfEachVersion) {
   EXPECT_EQ(header_line(1), base);
   EXPECT_EQ(header_line(2), base + "d_axis_voltage;q_axis_voltage;" + gnss);
   EXPECT_EQ(header_line(3),
-            base + "d_axis_voltage;q_axis_voltage;ms_today_setup;amp_hours_setup;amp_hours_charged_setup;"
-                   "watt_hours_setup;watt_hours_charged_setup;battery_level;battery_wh_tot;current_in_setup;"
-                   "current_motor_setup;speed_meters_per_sec;tacho_meters;tacho_abs_meters;num_vescs;ms_today_imu;"
-                   "roll;pitch;yaw;accX;accY;accZ;gyroX;gyroY;gyroZ;" + gnss);
+            base +
+                "d_axis_voltage;q_axis_voltage;ms_today_setup;amp_hours_setup;amp_hours_charged_setup;"
+                "watt_hours_setup;watt_hours_charged_setup;battery_level;battery_wh_tot;current_in_setup;"
+                "current_motor_setup;speed_meters_per_sec;tacho_meters;tacho_abs_meters;num_vescs;ms_today_imu;"
+                "roll;pitch;yaw;accX;accY;accZ;gyroX;gyroY;gyroZ;" +
+                gnss);
   for (int v = 1; v <= 3; ++v) EXPECT_EQ(static_cast<int>(split(header_line(v)).size()), column_count(v));
   EXPECT_THROW(header_line(4), std::invalid_argument);
 }

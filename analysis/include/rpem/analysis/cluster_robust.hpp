@@ -20,6 +20,7 @@ struct ClusterRobustCovariance {
 
 /// `normal` = JᵀJ (n×n, symmetric); `scores` = one column g_b per cluster (n×B; a zero column is a cluster
 /// without residuals and does not count in c).
-[[nodiscard]] ClusterRobustCovariance cluster_robust_covariance(const Eigen::MatrixXd& normal, const Eigen::MatrixXd& scores);
+[[nodiscard]] ClusterRobustCovariance cluster_robust_covariance(const Eigen::MatrixXd& normal,
+                                                                const Eigen::MatrixXd& scores);
 
 }  // namespace rpem::analysis

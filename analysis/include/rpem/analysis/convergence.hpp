@@ -26,9 +26,9 @@ struct ConvergenceMetrics {
 };
 
 struct ConvergenceOptions {
-  double step_time_s = 0.0;       ///< the step (or start of adaptation)
-  double band = 0.01;             ///< ±1 %
-  double final_window_s = 1.0;    ///< steady-state error: mean over the last window
+  double step_time_s = 0.0;     ///< the step (or start of adaptation)
+  double band = 0.01;           ///< ±1 %
+  double final_window_s = 1.0;  ///< steady-state error: mean over the last window
 };
 
 /// "1.23" or "—" when the estimate never settled.

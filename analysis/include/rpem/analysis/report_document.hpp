@@ -26,7 +26,7 @@ class ReportDocument {
   struct Block {
     Kind kind;
     int level = 0;
-    std::vector<std::string> text;              ///< paragraph / bullets / figure path + caption
+    std::vector<std::string> text;               ///< paragraph / bullets / figure path + caption
     std::vector<std::vector<std::string>> rows;  ///< table, first row the header
   };
   std::string title_;

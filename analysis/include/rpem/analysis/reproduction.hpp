@@ -20,12 +20,12 @@
 namespace rpem::analysis {
 
 inline constexpr std::array<core::Algorithm, 3> kAlgorithms = {core::Algorithm::kSga, core::Algorithm::kGna,
-                                                                core::Algorithm::kPhyInt};
+                                                               core::Algorithm::kPhyInt};
 
 enum class CaseKind {
-  kParameterStep,    ///< Section V: the machine's parameter steps at step_time_s
-  kStartWithError,   ///< Section VI: the estimators start at step_time_s from the offline value
-  kDisturbance,      ///< Section VI: a speed or load transient at step_time_s; the parameter is constant
+  kParameterStep,   ///< Section V: the machine's parameter steps at step_time_s
+  kStartWithError,  ///< Section VI: the estimators start at step_time_s from the offline value
+  kDisturbance,     ///< Section VI: a speed or load transient at step_time_s; the parameter is constant
 };
 
 /// What a case stands for in the comparison with the paper.
@@ -45,15 +45,15 @@ struct PaperFigures {
 };
 
 struct ReproductionCase {
-  std::string id;           ///< e.g. "V_psim_a"
-  std::string figure;       ///< the paper's \label and panel, e.g. "fig_psim_adapt (a)"
+  std::string id;      ///< e.g. "V_psim_a"
+  std::string figure;  ///< the paper's \label and panel, e.g. "fig_psim_adapt (a)"
   std::string description;
   CaseRole role = CaseRole::kPaper;
   std::string study_figure;  ///< hypothesis and study cases: the PNG they are drawn in (without .png)
   core::Param parameter = core::Param::kPsiM;
   CaseKind kind = CaseKind::kParameterStep;
-  double n_pu = 0.0;        ///< operating speed (before a disturbance)
-  double tau_pu = 0.0;      ///< electromagnetic torque (Section V) or load torque (Section VI)
+  double n_pu = 0.0;    ///< operating speed (before a disturbance)
+  double tau_pu = 0.0;  ///< electromagnetic torque (Section V) or load torque (Section VI)
   double step_time_s = 0.0;
   sim::Scenario scenario;
   core::EstimatorSettings estimator;  ///< the algorithm is set per run

@@ -13,16 +13,16 @@
 namespace rpem::analysis {
 
 struct StandstillRs {
-  double gamma_r = 0.0;          ///< γ_0,rk of the R_s sequence (per sample)
-  double gamma_L = 0.0;          ///< γ_0,Lk of the R_s sequence (per sample)
+  double gamma_r = 0.0;  ///< γ_0,rk of the R_s sequence (per sample)
+  double gamma_L = 0.0;  ///< γ_0,Lk of the R_s sequence (per sample)
   double sample_period_s = 125e-6;
-  double hessian0_rel = 0.0;     ///< R[0] / (i/r_s)²; 0: the fastest start (the bound)
+  double hessian0_rel = 0.0;  ///< R[0] / (i/r_s)²; 0: the fastest start (the bound)
 };
 
 /// Time from the start until |r̂s/r_s − 1| ≤ band, from r̂s/r_s − 1 = initial_error; empty if that takes
 /// longer than `horizon_s` or the recursion leaves (−1, ∞).
-[[nodiscard]] std::optional<double> standstill_rs_time_s(const StandstillRs& m, double initial_error,
-                                                         double band = 0.01, double horizon_s = 1000.0);
+[[nodiscard]] std::optional<double> standstill_rs_time_s(const StandstillRs& m, double initial_error, double band = 0.01,
+                                                         double horizon_s = 1000.0);
 
 /// The same linearised about the true value (x ≪ 1, Ψ constant): e[k+1] = (1 − g_k)·e[k] with
 /// g_k = γ_L / (1 − (1 − γ_r)^k), the largest rate any R[0] ⪰ 0 allows. This is the bound as first derived

@@ -56,11 +56,11 @@ class Keyring {
 bool sign(const Key& key, std::string_view channel, std::span<std::uint8_t> encoded) noexcept;
 
 enum class Verdict : std::int8_t {
-  kVerified,      ///< the tag is right under the key its key id names
-  kUnsigned,      ///< key id 0
-  kUnknownKey,    ///< a key id the keyring does not hold
-  kBadMac,        ///< the key is known, the tag wrong: altered or forged
-  kMalformed,     ///< shorter than the trailer
+  kVerified,    ///< the tag is right under the key its key id names
+  kUnsigned,    ///< key id 0
+  kUnknownKey,  ///< a key id the keyring does not hold
+  kBadMac,      ///< the key is known, the tag wrong: altered or forged
+  kMalformed,   ///< shorter than the trailer
 };
 [[nodiscard]] const char* to_string(Verdict v) noexcept;
 

@@ -28,7 +28,7 @@ struct BusTiming {
 /// A frame on the wire and how many of it a sample takes.
 struct WireFrame {
   bool fd = false;
-  bool extended = false;   ///< 29-bit identifier
+  bool extended = false;  ///< 29-bit identifier
   int payload_bytes = 8;
   double per_sample = 1.0;  ///< frames per sample (1/3: three samples share one frame)
 };
@@ -71,7 +71,6 @@ struct BusBudget {
   double frames_per_s = 0.0;
   double load = 0.0;  ///< fraction of the bus time, worst-case stuffing
 };
-[[nodiscard]] BusBudget telemetry_budget(bool fd, double sample_rate_Hz, int samples_per_fd_frame,
-                                         const BusTiming& timing);
+[[nodiscard]] BusBudget telemetry_budget(bool fd, double sample_rate_Hz, int samples_per_fd_frame, const BusTiming& timing);
 
 }  // namespace rpem::can

@@ -13,20 +13,20 @@ namespace rpem::can {
 
 /// Counters by kind of bad input (published in diagnostics; numbers only ever grow).
 struct DecoderCounters {
-  std::uint64_t frames = 0;           ///< frames offered to the decoder
-  std::uint64_t samples = 0;          ///< samples delivered
-  std::uint64_t unknown_id = 0;       ///< not a telemetry ID
-  std::uint64_t wrong_dlc = 0;        ///< wrong length or FD/classic type for the ID, or bad n_samples
-  std::uint64_t bad_version = 0;      ///< protocol version other than 1
-  std::uint64_t crc_error = 0;        ///< E2E CRC mismatch
-  std::uint64_t frames_lost = 0;      ///< alive-counter jumps: frames (FD) or samples (classic) missing
-  std::uint64_t duplicated = 0;       ///< same counter as the previous frame
-  std::uint64_t reordered = 0;        ///< counter behind the previous one
-  std::uint64_t stale = 0;            ///< drive time not after the last delivered sample
-  std::uint64_t out_of_range = 0;     ///< a saturated value
-  std::uint64_t invalid_value = 0;    ///< a "no valid value" code, or an invalid angle
-  std::uint64_t incomplete = 0;       ///< classic: a sample missing some of its five frames
-  std::uint64_t gaps = 0;             ///< samples delivered with gap_before
+  std::uint64_t frames = 0;         ///< frames offered to the decoder
+  std::uint64_t samples = 0;        ///< samples delivered
+  std::uint64_t unknown_id = 0;     ///< not a telemetry ID
+  std::uint64_t wrong_dlc = 0;      ///< wrong length or FD/classic type for the ID, or bad n_samples
+  std::uint64_t bad_version = 0;    ///< protocol version other than 1
+  std::uint64_t crc_error = 0;      ///< E2E CRC mismatch
+  std::uint64_t frames_lost = 0;    ///< alive-counter jumps: frames (FD) or samples (classic) missing
+  std::uint64_t duplicated = 0;     ///< same counter as the previous frame
+  std::uint64_t reordered = 0;      ///< counter behind the previous one
+  std::uint64_t stale = 0;          ///< drive time not after the last delivered sample
+  std::uint64_t out_of_range = 0;   ///< a saturated value
+  std::uint64_t invalid_value = 0;  ///< a "no valid value" code, or an invalid angle
+  std::uint64_t incomplete = 0;     ///< classic: a sample missing some of its five frames
+  std::uint64_t gaps = 0;           ///< samples delivered with gap_before
 };
 
 class TelemetryDecoder {
@@ -55,9 +55,9 @@ class TelemetryDecoder {
   bool has_last_classic_counter_ = false;
   std::uint8_t last_classic_counter_ = 0;
   bool has_time_ = false;
-  std::int64_t last_time_us_ = 0;   ///< unwrapped drive time of the last delivered sample
+  std::int64_t last_time_us_ = 0;  ///< unwrapped drive time of the last delivered sample
   bool has_epoch_ = false;
-  std::int64_t epoch_us_ = 0;       ///< unwrapping state
+  std::int64_t epoch_us_ = 0;  ///< unwrapping state
   std::uint32_t last_raw_us_ = 0;
 
   // Classic assembly of one sample from five frames.

@@ -20,8 +20,7 @@ class TelemetryEncoder {
 
   /// Adds one sample (any frame: abc, αβ or dq are converted to phases). Returns the frames that
   /// became complete (0–5) in `out`, which must hold at least 5.
-  [[nodiscard]] std::size_t add(const core::DriveSample& sample, std::uint8_t status,
-                                std::span<CanFrame> out) noexcept;
+  [[nodiscard]] std::size_t add(const core::DriveSample& sample, std::uint8_t status, std::span<CanFrame> out) noexcept;
   /// Emits a partially filled FD frame, if any.
   [[nodiscard]] std::size_t flush(std::span<CanFrame> out) noexcept;
 

@@ -18,11 +18,24 @@ namespace rpem::can {
 
 /// The sample quantities a signal can carry, each in one unit (the map's `unit` must name it).
 enum class SampleField : std::uint8_t {
-  kIdA, kIqA, kUdV, kUqV,              // rotor frame
-  kIaA, kIbA, kIcA, kUaV, kUbV, kUcV,  // phases (turned into the rotor frame at theta_el)
+  kIdA,
+  kIqA,
+  kUdV,
+  kUqV,  // rotor frame
+  kIaA,
+  kIbA,
+  kIcA,
+  kUaV,
+  kUbV,
+  kUcV,  // phases (turned into the rotor frame at theta_el)
   kThetaElRad,
-  kOmegaElRadS, kErpm, kSpeedMechRpm,  // speed: one of these
-  kUdcV, kTWindingC, kTMagnetC, kTDriveC,
+  kOmegaElRadS,
+  kErpm,
+  kSpeedMechRpm,  // speed: one of these
+  kUdcV,
+  kTWindingC,
+  kTMagnetC,
+  kTDriveC,
   kCount
 };
 inline constexpr std::size_t kSampleFieldCount = static_cast<std::size_t>(SampleField::kCount);

@@ -13,6 +13,8 @@
 #include "rpem/can/frame.hpp"
 #include "rpem/can/kernel_filter.hpp"
 
+struct msghdr;  // <sys/socket.h>, kept out of this header
+
 namespace rpem::can {
 
 struct ReceivedFrame {
@@ -23,17 +25,17 @@ struct ReceivedFrame {
 struct ChannelCounters {
   std::uint64_t rx_frames = 0;
   std::uint64_t tx_frames = 0;
-  std::uint64_t tx_dropped = 0;        ///< send queue full or interface down
-  std::uint64_t kernel_drops = 0;      ///< SO_RXQ_OVFL: frames the kernel dropped for this socket
-  std::uint64_t reopens = 0;           ///< successful reopen after a failure
+  std::uint64_t tx_dropped = 0;    ///< send queue full or interface down
+  std::uint64_t kernel_drops = 0;  ///< SO_RXQ_OVFL: frames the kernel dropped for this socket
+  std::uint64_t reopens = 0;       ///< successful reopen after a failure
   std::uint64_t open_failures = 0;
   std::uint64_t error_frames = 0;
   std::uint64_t bus_off = 0;
-  std::uint64_t error_passive = 0;     ///< controller reported rx or tx error-passive
+  std::uint64_t error_passive = 0;  ///< controller reported rx or tx error-passive
   std::uint64_t error_warning = 0;
   std::uint64_t controller_overflow = 0;
   std::uint64_t protocol_violations = 0;
-  std::uint64_t restarted = 0;         ///< controller restarted after bus-off
+  std::uint64_t restarted = 0;  ///< controller restarted after bus-off
   std::uint64_t no_ack = 0;
 };
 
@@ -93,6 +95,9 @@ class SocketCanChannel {
   bool open();
   void close_socket(const std::string& why);
   void count_error_frame(const CanFrame& f);
+  /// The kernel's receive time from a received message's ancillary data (0 without one); counts the
+  /// socket's overflow drops (SO_RXQ_OVFL) on the way.
+  std::int64_t read_ancillary(::msghdr& msg);
 
   Options options_;
   int fd_ = -1;

@@ -107,7 +107,7 @@ struct Values {
   double current_motor_A = kNaN, current_in_A = kNaN;  ///< averages since the previous read
   double i_d_A = kNaN, i_q_A = kNaN;                   ///< averages since the previous read
   double duty = kNaN;
-  double erpm = kNaN;                                  ///< electrical revolutions per minute
+  double erpm = kNaN;  ///< electrical revolutions per minute
   double v_in_V = kNaN;
   double amp_hours_Ah = kNaN, amp_hours_charged_Ah = kNaN, watt_hours_Wh = kNaN, watt_hours_charged_Wh = kNaN;
   std::int32_t tachometer = 0, tachometer_abs = 0;
@@ -115,7 +115,7 @@ struct Values {
   double pid_pos_deg = kNaN;
   std::uint8_t controller_id = 0;
   std::array<double, 3> temp_mos_C{kNaN, kNaN, kNaN};
-  double v_d_V = kNaN, v_q_V = kNaN;                   ///< averages since the previous read
+  double v_d_V = kNaN, v_q_V = kNaN;  ///< averages since the previous read
   std::uint8_t status_bits = 0;
 };
 
@@ -129,31 +129,31 @@ enum class ParseResult { kOk, kNotValues, kShort, kTrailing };
 struct Status {
   std::uint8_t controller_id = 0;
   int number = 0;
-  double erpm = kNaN, current_A = kNaN, duty = kNaN;                                    // 1
-  double amp_hours_Ah = kNaN, amp_hours_charged_Ah = kNaN;                              // 2
-  double watt_hours_Wh = kNaN, watt_hours_charged_Wh = kNaN;                            // 3
+  double erpm = kNaN, current_A = kNaN, duty = kNaN;                                       // 1
+  double amp_hours_Ah = kNaN, amp_hours_charged_Ah = kNaN;                                 // 2
+  double watt_hours_Wh = kNaN, watt_hours_charged_Wh = kNaN;                               // 3
   double temp_fet_C = kNaN, temp_motor_C = kNaN, current_in_A = kNaN, pid_pos_deg = kNaN;  // 4
-  std::int32_t tachometer = 0;                                                          // 5
-  double v_in_V = kNaN;                                                                 // 5
+  std::int32_t tachometer = 0;                                                             // 5
+  double v_in_V = kNaN;                                                                    // 5
   std::array<double, 4> adc_V{kNaN, kNaN, kNaN, kNaN};  ///< 6: ADC1–3 and the PPM input (ppm as given)
 };
 
 /// Counters by kind of input (published in diagnostics; numbers only ever grow).
 struct VescCounters {
   std::uint64_t frames = 0;
-  std::uint64_t replies = 0;         ///< COMM_GET_VALUES_SELECTIVE replies delivered
-  std::uint64_t statuses = 0;        ///< status broadcasts delivered
-  std::uint64_t foreign = 0;         ///< standard IDs, or addressed to / sent by another node
-  std::uint64_t unknown_packet = 0;  ///< a CAN_PACKET_ID this decoder does not read
-  std::uint64_t wrong_length = 0;    ///< a frame too short for its packet
-  std::uint64_t out_of_order = 0;    ///< a buffer fill at an offset other than the fill level
-  std::uint64_t overflow = 0;        ///< a buffer longer than the decoder's
-  std::uint64_t length_mismatch = 0; ///< PROCESS_RX_BUFFER's length is not the fill level
+  std::uint64_t replies = 0;          ///< COMM_GET_VALUES_SELECTIVE replies delivered
+  std::uint64_t statuses = 0;         ///< status broadcasts delivered
+  std::uint64_t foreign = 0;          ///< standard IDs, or addressed to / sent by another node
+  std::uint64_t unknown_packet = 0;   ///< a CAN_PACKET_ID this decoder does not read
+  std::uint64_t wrong_length = 0;     ///< a frame too short for its packet
+  std::uint64_t out_of_order = 0;     ///< a buffer fill at an offset other than the fill level
+  std::uint64_t overflow = 0;         ///< a buffer longer than the decoder's
+  std::uint64_t length_mismatch = 0;  ///< PROCESS_RX_BUFFER's length is not the fill level
   std::uint64_t crc_error = 0;
-  std::uint64_t not_values = 0;      ///< a reply to another command
-  std::uint64_t short_reply = 0;     ///< fewer bytes than its mask names
-  std::uint64_t trailing = 0;        ///< more bytes than its mask names
-  std::uint64_t wrong_mask = 0;      ///< a reply whose mask lacks what was asked for
+  std::uint64_t not_values = 0;   ///< a reply to another command
+  std::uint64_t short_reply = 0;  ///< fewer bytes than its mask names
+  std::uint64_t trailing = 0;     ///< more bytes than its mask names
+  std::uint64_t wrong_mask = 0;   ///< a reply whose mask lacks what was asked for
   std::uint64_t error_frames = 0;
 };
 
@@ -192,7 +192,6 @@ class VescDecoder {
 /// A reply as an averaged rotor-frame sample over the window [t_start_ns, t_ns] (the previous reply's
 /// and this one's receive times: VESC's averages run from read to read). ω_el = ERPM·2π/60; T_winding is
 /// the motor sensor, T_drive the FET's. The sample carries no magnet temperature.
-[[nodiscard]] core::AveragedSample to_averaged_sample(const Values& v, std::int64_t t_start_ns,
-                                                      std::int64_t t_ns) noexcept;
+[[nodiscard]] core::AveragedSample to_averaged_sample(const Values& v, std::int64_t t_start_ns, std::int64_t t_ns) noexcept;
 
 }  // namespace rpem::can::vesc

@@ -13,17 +13,17 @@
 namespace rpem::core {
 
 struct AveragedSample {
-  std::int64_t t_start_ns = 0;    ///< window start (== t_ns: an instantaneous sample)
-  std::int64_t t_ns = 0;          ///< window end: the host time that closed the window
-  Vec2 i_dq_A = Vec2::Zero();     ///< mean measured current, rotor frame
-  Vec2 u_dq_V = Vec2::Zero();     ///< mean voltage the drive reports (its command, or its estimate of the applied voltage)
-  double omega_el_rad_s = 0.0;    ///< mean electrical speed
+  std::int64_t t_start_ns = 0;  ///< window start (== t_ns: an instantaneous sample)
+  std::int64_t t_ns = 0;        ///< window end: the host time that closed the window
+  Vec2 i_dq_A = Vec2::Zero();   ///< mean measured current, rotor frame
+  Vec2 u_dq_V = Vec2::Zero();   ///< mean voltage the drive reports (its command, or its estimate of the applied voltage)
+  double omega_el_rad_s = 0.0;  ///< mean electrical speed
   double u_dc_V = std::numeric_limits<double>::quiet_NaN();       ///< mean DC link; NaN: not reported
   double t_winding_C = std::numeric_limits<double>::quiet_NaN();  ///< NaN: not reported
   double t_magnet_C = std::numeric_limits<double>::quiet_NaN();   ///< NaN: not reported
   double t_drive_C = std::numeric_limits<double>::quiet_NaN();    ///< power stage; NaN: not reported
   double t_coolant_C = std::numeric_limits<double>::quiet_NaN();  ///< the machine's coolant; NaN: not reported
-  bool gap_before = false;        ///< windows were lost immediately before this one
+  bool gap_before = false;                                        ///< windows were lost immediately before this one
 };
 
 }  // namespace rpem::core

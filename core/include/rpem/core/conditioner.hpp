@@ -38,7 +38,9 @@ struct InductanceCurve {
 /// which the conditioner takes from the applied voltage.
 struct FluxHarmonic {
   double d_cos_Wb = 0.0, d_sin_Wb = 0.0, q_cos_Wb = 0.0, q_sin_Wb = 0.0;
-  [[nodiscard]] bool nominal() const noexcept { return d_cos_Wb == 0.0 && d_sin_Wb == 0.0 && q_cos_Wb == 0.0 && q_sin_Wb == 0.0; }
+  [[nodiscard]] bool nominal() const noexcept {
+    return d_cos_Wb == 0.0 && d_sin_Wb == 0.0 && q_cos_Wb == 0.0 && q_sin_Wb == 0.0;
+  }
   /// The largest |ψ_h| over a revolution [Wb].
   [[nodiscard]] double amplitude_Wb() const noexcept;
 };
@@ -52,25 +54,25 @@ inline constexpr int kMaxDelayPeriods = 3;
 /// Model extensions (all defaults: the nominal model). Input side: what the sensors and the inverter do
 /// to the logged quantities; machine side: what the constant-parameter model leaves out.
 struct ModelExtensions {
-  double theta_offset_rad = 0.0;             ///< true angle = logged angle + offset
-  Vec3 current_offset_A = Vec3::Zero();      ///< per phase: measured = true·(1 + gain) + offset
-  Vec3 current_gain_error = Vec3::Zero();    ///< per phase, relative
-  double deadtime_v_err_V = 0.0;             ///< constant part of the per-leg voltage error
-  double deadtime_t_dead_s = 0.0;            ///< dead time; adds t_dead·f_sw·u_dc to the voltage error
-  double switching_frequency_Hz = 0.0;       ///< f_sw for the dead-time term
-  double deadtime_current_band_A = 0.0;      ///< sign(i) is linear within ±band (0: hard sign)
+  double theta_offset_rad = 0.0;           ///< true angle = logged angle + offset
+  Vec3 current_offset_A = Vec3::Zero();    ///< per phase: measured = true·(1 + gain) + offset
+  Vec3 current_gain_error = Vec3::Zero();  ///< per phase, relative
+  double deadtime_v_err_V = 0.0;           ///< constant part of the per-leg voltage error
+  double deadtime_t_dead_s = 0.0;          ///< dead time; adds t_dead·f_sw·u_dc to the voltage error
+  double switching_frequency_Hz = 0.0;     ///< f_sw for the dead-time term
+  double deadtime_current_band_A = 0.0;    ///< sign(i) is linear within ±band (0: hard sign)
   /// Extra delay of the applied voltage, 0 ≤ delay < (kMaxDelayPeriods + 1)·T_samp: whole control periods
   /// (a drive's computation delay) and fractions of one.
   double delay_s = 0.0;
-  InductanceCurve inductance_d;              ///< ld_saturation
-  InductanceCurve inductance_q;              ///< lq_saturation
+  InductanceCurve inductance_d;  ///< ld_saturation
+  InductanceCurve inductance_q;  ///< lq_saturation
   /// cross_saturation: the two lowest-order reciprocal co-energy terms even in i_q, (c/2)·i_d·i_q² and
   /// (c₂/2)·i_d²·i_q², so that
   ///   ψ_d = L_d·i_d + ψm + (c/2 + c₂·i_d)·i_q²,   ψ_q = (L_q + c·i_d + c₂·i_d²)·i_q
   /// (L_q against i_d, and the d-axis flux against the load); quasi-static (docs/model-extensions.md).
-  double cross_coupling_H_per_A = 0.0;    ///< c [H/A = Wb/A²]
-  double cross_coupling_H_per_A2 = 0.0;   ///< c₂ [H/A² = Wb/A³]
-  double iron_loss_r_fe_Ohm = 0.0;           ///< resistance parallel to the induced voltage; 0: none
+  double cross_coupling_H_per_A = 0.0;   ///< c [H/A = Wb/A²]
+  double cross_coupling_H_per_A2 = 0.0;  ///< c₂ [H/A² = Wb/A³]
+  double iron_loss_r_fe_Ohm = 0.0;       ///< resistance parallel to the induced voltage; 0: none
   std::array<FluxHarmonic, kFluxHarmonicOrders.size()> flux_harmonics{};  ///< orders kFluxHarmonicOrders
 
   [[nodiscard]] bool saturation() const noexcept {
@@ -129,7 +131,8 @@ class SampleConditioner {
   }
   /// The same with the logged angle's rotation, Rotation::of(s.theta_el_rad), computed by the caller
   /// (a replay of many models over one log computes it once per sample).
-  [[nodiscard]] Vec2 observed_current_dq_A(const DriveSample& s, const Rotation& logged, const Vec2& i_model_pu) const noexcept;
+  [[nodiscard]] Vec2 observed_current_dq_A(const DriveSample& s, const Rotation& logged,
+                                           const Vec2& i_model_pu) const noexcept;
 
   /// Forgets the previous sample: the next one starts a new interval chain (resynchronises).
   void reset() noexcept { has_previous_ = false; }
@@ -142,11 +145,11 @@ class SampleConditioner {
  private:
   /// The parts every sample needs: angles, corrected current, speed, inductances.
   struct Measured {
-    Rotation logged;       ///< at the logged angle
-    Rotation rot;          ///< at the corrected angle
-    Vec2 i_ab_pu;          ///< corrected phase currents, stator frame (before iron loss)
-    Vec2 i_dq_pu;          ///< magnetising current, rotor frame (iron-loss current removed)
-    Vec2 i_fe_dq_pu;       ///< iron-loss current
+    Rotation logged;  ///< at the logged angle
+    Rotation rot;     ///< at the corrected angle
+    Vec2 i_ab_pu;     ///< corrected phase currents, stator frame (before iron loss)
+    Vec2 i_dq_pu;     ///< magnetising current, rotor frame (iron-loss current removed)
+    Vec2 i_fe_dq_pu;  ///< iron-loss current
     double n_pu;
     double x_d_pu, x_q_pu;  ///< inductances at the measured current (the nominal ones without curves)
   };
@@ -174,15 +177,15 @@ class SampleConditioner {
   ModelExtensions extensions_;
   // Reciprocals, so the per-sample path multiplies instead of dividing.
   double inv_current_A_ = 0.0, inv_voltage_V_ = 0.0, inv_omega_rad_s_ = 0.0;
-  ScaledClarke current_pu_, voltage_pu_;     ///< phase samples [A], [V] → stator frame [pu], one step
-  double inv_r_fe_pu_ = 0.0;                 ///< 1/r_fe in pu; 0 without iron loss
-  Vec3 inv_current_gain_ = Vec3::Ones();     ///< 1/(1 + gain error) per phase
-  Rotation offset_rotation_;                 ///< by theta_offset_rad
+  ScaledClarke current_pu_, voltage_pu_;  ///< phase samples [A], [V] → stator frame [pu], one step
+  double inv_r_fe_pu_ = 0.0;              ///< 1/r_fe in pu; 0 without iron loss
+  Vec3 inv_current_gain_ = Vec3::Ones();  ///< 1/(1 + gain error) per phase
+  Rotation offset_rotation_;              ///< by theta_offset_rad
   std::array<FluxHarmonic, kFluxHarmonicOrders.size()> harmonics_pu_{};  ///< flux harmonics in pu
-  double half_cross_pu_ = 0.0;               ///< c/2 in pu (ψ_b/I_b²)
-  double cross2_pu_ = 0.0;                   ///< c₂ in pu (ψ_b/I_b³)
-  double cross_x_q_pu_per_A_ = 0.0;          ///< c/L_b: x_q's change per ampere of i_d [pu/A]
-  double cross_x_q_pu_per_A2_ = 0.0;         ///< c₂/L_b [pu/A²]
+  double half_cross_pu_ = 0.0;                                           ///< c/2 in pu (ψ_b/I_b²)
+  double cross2_pu_ = 0.0;                                               ///< c₂ in pu (ψ_b/I_b³)
+  double cross_x_q_pu_per_A_ = 0.0;                                      ///< c/L_b: x_q's change per ampere of i_d [pu/A]
+  double cross_x_q_pu_per_A2_ = 0.0;                                     ///< c₂/L_b [pu/A²]
   // Which extensions are active, decided when configured (the per-sample path tests one flag each).
   bool angle_offset_ = false, phase_corrections_ = false, saturation_ = false, deadtime_ = false;
   bool harmonics_ = false, cross_ = false, delay_ = false;
@@ -193,8 +196,8 @@ class SampleConditioner {
   Rotation previous_rotation_;
   double previous_n_pu_ = 0.0;
   Vec2 previous_correction_ab_pu_ = Vec2::Zero();  ///< inverter and iron-loss corrections at the previous sample
-  Vec2 previous_emf_pu_ = Vec2::Zero();           ///< extra_emf_pu() at the previous sample
-  RotationTracker logged_rotation_;      ///< at the logged angle, incremental between consecutive samples
+  Vec2 previous_emf_pu_ = Vec2::Zero();            ///< extra_emf_pu() at the previous sample
+  RotationTracker logged_rotation_;                ///< at the logged angle, incremental between consecutive samples
   /// The last commands issued, stator frame [pu], newest first (commands_[0] is the previous sample's).
   std::array<Vec2, kMaxDelayPeriods + 2> commands_{};
 };

@@ -23,8 +23,8 @@ struct Estimate {
   Vec2 i_hat_A = Vec2::Zero();    ///< predicted current, rotor frame
   Vec2 i_meas_A = Vec2::Zero();   ///< measured current, rotor frame (after input corrections)
   double speed_pu = 0.0;
-  EstimatorOutput detail;         ///< per-unit detail: θ̂, Ψᵀ, L, code, flags
-  Classification regime;          ///< the sample's regime (regime.hpp)
+  EstimatorOutput detail;  ///< per-unit detail: θ̂, Ψᵀ, L, code, flags
+  Classification regime;   ///< the sample's regime (regime.hpp)
 };
 
 class DriveEstimator {
@@ -68,12 +68,12 @@ class DriveEstimator {
   SampleConditioner conditioner_;
   RpemEstimator core_;
   StreamClassifier regimes_;
-  PointGains point_gains_;               ///< the sparse samples' gains
-  GainSequences rates_per_s_;            ///< the configured algorithm's gain rates [1/s] (sparse samples)
+  PointGains point_gains_;                 ///< the sparse samples' gains
+  GainSequences rates_per_s_;              ///< the configured algorithm's gain rates [1/s] (sparse samples)
   Vec2 dense_rates_per_s_ = Vec2::Zero();  ///< γ_0/T_samp of the step (dense samples)
-  double sparse_after_s_ = 0.0;          ///< max(max_sample_interval_s, max_gap_carry_s)
-  bool classify_ = true;                 ///< estimator.regimes.enabled
-  double inv_voltage_sq_ = 0.0;          ///< 1/U_b²
+  double sparse_after_s_ = 0.0;            ///< max(max_sample_interval_s, max_gap_carry_s)
+  bool classify_ = true;                   ///< estimator.regimes.enabled
+  double inv_voltage_sq_ = 0.0;            ///< 1/U_b²
 };
 
 }  // namespace rpem::core

@@ -33,11 +33,11 @@ struct EstimatorOptions {
   GradientForm gradient_r_s = GradientForm::kSteadyState;
   std::array<GainSequences, 3> gains{};  ///< indexed by Algorithm
   GainFloors floors;
-  Vec2 initial_sga_hessian_pu = Vec2::Zero();  ///< r[0] per parameter
-  Mat2 initial_gna_hessian_pu = Mat2::Zero();  ///< R[0]
-  double nominal_sample_period_s = 125e-6;     ///< the period the γ_0 refer to; γ scales with dt
+  Vec2 initial_sga_hessian_pu = Vec2::Zero();                         ///< r[0] per parameter
+  Mat2 initial_gna_hessian_pu = Mat2::Zero();                         ///< R[0]
+  double nominal_sample_period_s = 125e-6;                            ///< the period the γ_0 refer to; γ scales with dt
   double max_sample_interval_s = kMaxSampleIntervalPeriods * 125e-6;  ///< longer: the predictor resynchronises
-  double max_gap_carry_s = 20e-3;              ///< across a shorter gap the prediction error is kept
+  double max_gap_carry_s = 20e-3;                                     ///< across a shorter gap the prediction error is kept
   /// ν_max: a sample whose prediction error lies further than ν_max of its noise beyond what any θ in D_M
   /// explains is skipped (StepCode::kOutlier; docs/derivations.md §14); 0: never.
   double outlier_bound_sigma = 5.0;
@@ -46,8 +46,8 @@ struct EstimatorOptions {
 };
 
 struct EstimatorConfig : EstimatorOptions {
-  MachinePu model;              ///< nominal model; x_d, x_q are used as they are
-  double omega_n_rad_s = 0.0;   ///< ω_n, the electrical base speed
+  MachinePu model;             ///< nominal model; x_d, x_q are used as they are
+  double omega_n_rad_s = 0.0;  ///< ω_n, the electrical base speed
   SchedulerConfig scheduler;
   ParameterBounds bounds;
   Vec2 initial_theta_pu = Vec2::Zero();
@@ -68,15 +68,15 @@ struct EstimatorSample {
 /// One averaged (or slowly sampled) rotor-frame sample for the steady-state model (docs/derivations.md
 /// §11): the voltage as the machine sees it, the measured current, the mean speed, pu.
 struct SteadyStateSample {
-  double dt_s = 0.0;            ///< time since the previous sample (scales the gains)
-  Vec2 u_pu = Vec2::Zero();     ///< rotor-frame voltage, input corrections applied
+  double dt_s = 0.0;         ///< time since the previous sample (scales the gains)
+  Vec2 u_pu = Vec2::Zero();  ///< rotor-frame voltage, input corrections applied
   Vec2 i_meas_pu = Vec2::Zero();
-  double n_pu = 0.0;            ///< mean speed over the sample's window
+  double n_pu = 0.0;  ///< mean speed over the sample's window
   /// Where Ψᵀ (and PhyInt's denominators) are evaluated: an instrument — the operating point of the
   /// preceding samples, whose noise is independent of this sample's (docs/derivations.md §11).
   Vec2 i_gradient_pu = Vec2::Zero();
   double n_gradient_pu = 0.0;
-  bool resync = false;          ///< no update: first sample, or samples were lost before this one
+  bool resync = false;  ///< no update: first sample, or samples were lost before this one
   /// Model inductances at this sample's current (the saturation extensions); 0: the configured ones.
   double x_d_pu = 0.0;
   double x_q_pu = 0.0;
@@ -84,12 +84,12 @@ struct SteadyStateSample {
 
 /// Stable result codes; they are published in diagnostics (numbers never change).
 enum class StepCode : std::uint8_t {
-  kAdapted = 0,             ///< prediction, gradient and update done (the update may be scheduled out)
-  kSynchronized = 1,        ///< predictor (re)initialised from this measurement; no update
-  kRejectedNonFinite = 2,   ///< NaN or Inf in the sample; ignored, predictor will resynchronise
-  kPredictorDiverged = 3,   ///< |î| exceeded its bound; predictor resynchronised
-  kExcluded = 4,            ///< its regime excludes it (regime.hpp): predicted, nothing adapted
-  kOutlier = 5,             ///< its prediction error is beyond the outlier bound: predicted, skipped
+  kAdapted = 0,            ///< prediction, gradient and update done (the update may be scheduled out)
+  kSynchronized = 1,       ///< predictor (re)initialised from this measurement; no update
+  kRejectedNonFinite = 2,  ///< NaN or Inf in the sample; ignored, predictor will resynchronise
+  kPredictorDiverged = 3,  ///< |î| exceeded its bound; predictor resynchronised
+  kExcluded = 4,           ///< its regime excludes it (regime.hpp): predicted, nothing adapted
+  kOutlier = 5,            ///< its prediction error is beyond the outlier bound: predicted, skipped
 };
 
 /// What a sample's regime (regime.hpp) lets it do, and the noise its prediction error is judged against.
@@ -104,13 +104,13 @@ struct Admission {
 };
 
 namespace step_flag {
-inline constexpr std::uint16_t kGainFloored = 1U << 0;     ///< gain_flag::kFloored
-inline constexpr std::uint16_t kPseudoInverse = 1U << 1;   ///< gain_flag::kPseudoInverse
-inline constexpr std::uint16_t kProjectedPsiM = 1U << 2;   ///< ψ̂m clamped to D_M
-inline constexpr std::uint16_t kProjectedRs = 1U << 3;     ///< r̂s clamped to D_M
-inline constexpr std::uint16_t kFrozen = 1U << 4;          ///< adaptation frozen by command
-inline constexpr std::uint16_t kPsiMActive = 1U << 5;      ///< ψ̂m adapted in this sample
-inline constexpr std::uint16_t kRsActive = 1U << 6;        ///< r̂s adapted in this sample
+inline constexpr std::uint16_t kGainFloored = 1U << 0;    ///< gain_flag::kFloored
+inline constexpr std::uint16_t kPseudoInverse = 1U << 1;  ///< gain_flag::kPseudoInverse
+inline constexpr std::uint16_t kProjectedPsiM = 1U << 2;  ///< ψ̂m clamped to D_M
+inline constexpr std::uint16_t kProjectedRs = 1U << 3;    ///< r̂s clamped to D_M
+inline constexpr std::uint16_t kFrozen = 1U << 4;         ///< adaptation frozen by command
+inline constexpr std::uint16_t kPsiMActive = 1U << 5;     ///< ψ̂m adapted in this sample
+inline constexpr std::uint16_t kRsActive = 1U << 6;       ///< r̂s adapted in this sample
 }  // namespace step_flag
 
 struct EstimatorState {
@@ -241,11 +241,11 @@ class RpemEstimator {
   EstimatorConfig config_;
   EstimatorState state_;
   // Decided by reconfigure(), so the per-sample path does not re-derive them.
-  PredictorCoefficients coefficients_;   ///< from config_.model
-  double inverse_nominal_period_ = 0.0;  ///< 1/T_samp
-  double inverse_r_min_ = 0.0;           ///< 1/r_min of D_M (the outlier bound)
+  PredictorCoefficients coefficients_;      ///< from config_.model
+  double inverse_nominal_period_ = 0.0;     ///< 1/T_samp
+  double inverse_r_min_ = 0.0;              ///< 1/r_min of D_M (the outlier bound)
   Gradients gradients_ = Gradients::kSkip;  ///< whether predict() advances the dynamic gradients
-  double scaled_for_dt_s_ = -1.0;        ///< the interval gamma_r_, gamma_l_ were scaled for
+  double scaled_for_dt_s_ = -1.0;           ///< the interval gamma_r_, gamma_l_ were scaled for
   Vec2 gamma_r_ = Vec2::Zero(), gamma_l_ = Vec2::Zero();
 };
 

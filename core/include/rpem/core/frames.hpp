@@ -59,7 +59,7 @@ struct ScaledClarke {
 /// row instead of five (the rotor angle's rotation is on the estimator's per-sample path).
 [[nodiscard]] inline Rotation small_rotation(double x) noexcept {
   constexpr double c2 = 1.0 / 2.0, c4 = 1.0 / 24.0, c6 = 1.0 / 720.0, c8 = 1.0 / 40320.0;  // 1/n!, folded
-  constexpr double s3 = 1.0 / 6.0, s5 = 1.0 / 120.0, s7 = 1.0 / 5040.0;                  // at compile time
+  constexpr double s3 = 1.0 / 6.0, s5 = 1.0 / 120.0, s7 = 1.0 / 5040.0;                    // at compile time
   const double x2 = x * x, x4 = x2 * x2;
   const double cos_low = 1.0 - c2 * x2, cos_high = (c4 - c6 * x2) + c8 * x4;  // 1 − x²/2!, x⁴/4! − x⁶/6! + x⁸/8!
   const double sin_low = 1.0 - s3 * x2, sin_high = s5 - s7 * x2;              // (sin x)/x, the same way
@@ -95,7 +95,8 @@ class RotationTracker {
       // An increment in range needs no wrapping (wrap_angle leaves it as it is). A branch, tested first:
       // the usual sample's rotation then does not wait for the wrap's conversions.
       double step = theta_rad - theta_rad_;
-      if (!in_range(step)) [[unlikely]] step = wrap_angle(step);
+      if (!in_range(step)) [[unlikely]]
+        step = wrap_angle(step);
       if (in_range(step)) {
         rotation_ = compose(rotation_, small_rotation(step));
         theta_rad_ = theta_rad;

@@ -87,8 +87,8 @@ struct SgaScale {
 ///   den_d = −r̂s·î_d − n·x̂_q·î_q,  den_q = −r̂s·î_q + n·x̂_d·î_d,  D = r̂s² + n²·x̂_d·x̂_q.
 /// The 1/m weight makes L·ε = γ·δr̂s in steady state; the printed form (m = 1) gives 2γ·δr̂s when
 /// both components are used (erratum E3, docs/derivations.md).
-[[nodiscard]] GainOutput phyint_gain(const MachinePu& model, double n_pu, const Vec2& i_hat_pu,
-                                     const Vec2& gamma_gain, const GainFloors& floors) noexcept;
+[[nodiscard]] GainOutput phyint_gain(const MachinePu& model, double n_pu, const Vec2& i_hat_pu, const Vec2& gamma_gain,
+                                     const GainFloors& floors) noexcept;
 
 /// Moore–Penrose pseudo-inverse of a symmetric 2×2 matrix, closed form; eigenvalues ≤ `eigenvalue_min`
 /// are treated as zero.

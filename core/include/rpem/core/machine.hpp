@@ -71,8 +71,9 @@ struct MachinePu {
 [[nodiscard]] Mat2 system_matrix(const MachinePu& m, double omega_n_rad_s, double n_pu) noexcept;
 
 /// Eigenvalues of A (Eq:lambda), returned as a conjugate pair or two real values.
-[[nodiscard]] std::pair<std::complex<double>, std::complex<double>> continuous_eigenvalues(
-    const MachinePu& m, double omega_n_rad_s, double n_pu) noexcept;
+[[nodiscard]] std::pair<std::complex<double>, std::complex<double>> continuous_eigenvalues(const MachinePu& m,
+                                                                                           double omega_n_rad_s,
+                                                                                           double n_pu) noexcept;
 
 /// MTPA current references of eq_refcurrents (the printed closed form; see docs/derivations.md for its
 /// accuracy against the exact MTPA solution). Valid for x_q > x_d; falls back to i_d = 0 otherwise.

@@ -22,7 +22,7 @@ template <int N>
 [[nodiscard]] ExponentialPair<N> exponential_and_phi1(const Eigen::Matrix<double, N, N>& m) noexcept {
   using Mat = Eigen::Matrix<double, N, N>;
   constexpr int kMaxTerms = 18;
-  constexpr int kMaxSquarings = 60;  // 2^60: beyond any finite norm a thermal network produces
+  constexpr int kMaxSquarings = 60;                             // 2^60: beyond any finite norm a thermal network produces
   const double norm = m.cwiseAbs().colwise().sum().maxCoeff();  // the 1-norm
   int squarings = 0;
   if (norm > 0.5) squarings = static_cast<int>(std::ceil(std::log2(norm / 0.5)));

@@ -37,7 +37,9 @@ struct PerUnitBase {
   // SI → pu
   [[nodiscard]] constexpr double voltage_pu(double v_V) const noexcept { return v_V / voltage_V; }
   [[nodiscard]] constexpr double current_pu(double i_A) const noexcept { return i_A / current_A; }
-  [[nodiscard]] constexpr double speed_pu(double omega_el_rad_s_in) const noexcept { return omega_el_rad_s_in / omega_el_rad_s; }
+  [[nodiscard]] constexpr double speed_pu(double omega_el_rad_s_in) const noexcept {
+    return omega_el_rad_s_in / omega_el_rad_s;
+  }
   [[nodiscard]] constexpr double flux_pu(double psi_Wb) const noexcept { return psi_Wb / flux_Wb; }
   [[nodiscard]] constexpr double resistance_pu(double r_Ohm) const noexcept { return r_Ohm / impedance_Ohm; }
   [[nodiscard]] constexpr double inductance_pu(double l_H) const noexcept { return l_H / inductance_H; }

@@ -27,8 +27,8 @@ enum class Discretization : std::uint8_t { kTrapezoidal = 0, kExplicitEuler = 1 
 /// One prediction interval [t_{k−1}, t_k] in the rotor frame, pu.
 struct PredictorInterval {
   double dt_s = 0.0;
-  double n_start_pu = 0.0;  ///< speed at t_{k−1}
-  double n_end_pu = 0.0;    ///< speed at t_k
+  double n_start_pu = 0.0;         ///< speed at t_{k−1}
+  double n_end_pu = 0.0;           ///< speed at t_k
   Vec2 u_start_pu = Vec2::Zero();  ///< the held voltage command, rotor frame at t_{k−1}
   Vec2 u_end_pu = Vec2::Zero();    ///< the same stator-frame command, rotor frame at t_k
 };
@@ -71,7 +71,9 @@ struct Coefficients {
     return a;
   }
   /// Forcing of the current equation: B·u + f(n, ψ̂m).
-  [[nodiscard]] Vec2 current_forcing(double n, const Vec2& u) const noexcept { return input(u) + m.psi_m_pu * psi_forcing(n); }
+  [[nodiscard]] Vec2 current_forcing(double n, const Vec2& u) const noexcept {
+    return input(u) + m.psi_m_pu * psi_forcing(n);
+  }
   /// The voltage's part of the current's forcing: B·u.
   [[nodiscard]] Vec2 input(const Vec2& u) const noexcept { return {wd * u[0], wq * u[1]}; }
   /// Forcing of the ψ̂m-sensitivity: ∂f/∂ψ̂m (f is linear in ψ̂m: current_forcing = input + ψ̂m·this).
@@ -106,7 +108,7 @@ struct Trapezoid {
 }  // namespace detail
 
 inline void predict(const MachinePu& model, const PredictorCoefficients& pc, Discretization method,
-             const PredictorInterval& iv, PredictorState& s, Gradients gradients = Gradients::kAdvance) noexcept {
+                    const PredictorInterval& iv, PredictorState& s, Gradients gradients = Gradients::kAdvance) noexcept {
   const detail::Coefficients c{pc.wd, pc.wq, model};
   const double h = iv.dt_s;
   const Vec2 i_prev = s.i_hat_pu;
@@ -135,10 +137,9 @@ inline void predict(const MachinePu& model, const PredictorCoefficients& pc, Dis
   s.gradient.col(kRs) = t.step(s.gradient.col(kRs), w_rs[0], w_rs[1]);
 }
 
-
 /// The same, computing the coefficients on the way.
-inline void predict(const MachinePu& model, double omega_n_rad_s, Discretization method,
-                    const PredictorInterval& interval, PredictorState& state) noexcept {
+inline void predict(const MachinePu& model, double omega_n_rad_s, Discretization method, const PredictorInterval& interval,
+                    PredictorState& state) noexcept {
   predict(model, PredictorCoefficients::of(model, omega_n_rad_s), method, interval, state);
 }
 

@@ -147,14 +147,14 @@ struct RegimeSettings {
 
 /// The classifier's configuration, per unit (make_regime_config() in settings.hpp builds it).
 struct RegimeConfig {
-  double z = 4.0;                ///< significance of the one-dimensional tests
-  double chi2 = 19.334;           ///< c₂ = −2·ln α: the same significance for a two-dimensional zero test
+  double z = 4.0;        ///< significance of the one-dimensional tests
+  double chi2 = 19.334;  ///< c₂ = −2·ln α: the same significance for a two-dimensional zero test
   double omega_n_rad_s = 1.0;
-  double r_pu = 0.0, r_min_pu = 0.0, dr_pu = 0.0;          ///< nominal r_s, D_M's smallest, largest deviation
+  double r_pu = 0.0, r_min_pu = 0.0, dr_pu = 0.0;            ///< nominal r_s, D_M's smallest, largest deviation
   double psi_min_pu = 0.0, psi_max_pu = 0.0, dpsi_pu = 0.0;  ///< D_M's ψm range, largest deviation from nominal
   double x_d_pu = 0.0, x_q_pu = 0.0;                         ///< nominal inductances
   double dx_d_pu = 0.0, dx_q_pu = 0.0;                       ///< their tolerance
-  double tan_angle = 0.0;        ///< tan δ_tol
+  double tan_angle = 0.0;                                    ///< tan δ_tol
   /// Configured resolution of u, i, n [pu]; 0: measured.
   std::array<double, 3> resolution_pu{};
   /// τ_el = max(x)/(ω_n·r_min) [s]: the slowest decay of the electrical transient the model admits.
@@ -199,15 +199,15 @@ struct RegimeState {
   /// The chain's last two samples: u, i, n and the time of each [s, relative to t_origin_ns].
   std::array<Vec2, 2> u_pu{}, i_pu{};
   std::array<double, 2> n_pu{}, t_s{};
-  std::int64_t t_origin_ns = 0;       ///< the first sample's time (times are kept relative to it)
+  std::int64_t t_origin_ns = 0;  ///< the first sample's time (times are kept relative to it)
   bool has_origin = false;
-  int points = 0;                      ///< samples held (0–2)
-  int chained = 0;                     ///< of those, how many a chain joins to this one (dense, contiguous)
-  Vec2 slope_pu_s = Vec2::Zero();      ///< di/dt the sample's inductive correction takes (0: none)
+  int points = 0;                  ///< samples held (0–2)
+  int chained = 0;                 ///< of those, how many a chain joins to this one (dense, contiguous)
+  Vec2 slope_pu_s = Vec2::Zero();  ///< di/dt the sample's inductive correction takes (0: none)
   Vec2 previous_slope_pu_s = Vec2::Zero();
   double inv_dt = 0.0, previous_inv_dt = 0.0;  ///< 1/Δt between window centres, this sample's and the one before
   bool slope_valid = false, previous_slope_valid = false;
-  bool previous_transient = false;     ///< the previous sample's own slope test failed (the junction straddles)
+  bool previous_transient = false;  ///< the previous sample's own slope test failed (the junction straddles)
   /// The chain's previous sample: a window (averaged), and whether it was bridge off (mixed windows).
   bool previous_window = false, previous_bridge_off = false;
 };
@@ -250,24 +250,32 @@ class RegimeClassifier {
   /// The pairs are vectors here because a Vec2 built from two scalars per sample goes through memory (two
   /// 8-byte stores, one 16-byte load: a failed store forward, the largest cost the profile showed).
   struct Constants {
-    double z_sq = 0.0;                       ///< z²
-    double r_sq = 0.0;                       ///< r²
-    double r_min_sq = 0.0;                   ///< r_min²
-    double r_max = 0.0;                      ///< D_M's largest r
-    double psi_max_sq = 0.0;                 ///< ψ_max²
-    double inv_omega_n = 0.0;                ///< 1/ω_n
-    double inv_omega_n_sq = 0.0;             ///< 1/ω_n²
+    double z_sq = 0.0;                                  ///< z²
+    double r_sq = 0.0;                                  ///< r²
+    double r_min_sq = 0.0;                              ///< r_min²
+    double r_max = 0.0;                                 ///< D_M's largest r
+    double psi_max_sq = 0.0;                            ///< ψ_max²
+    double inv_omega_n = 0.0;                           ///< 1/ω_n
+    double inv_omega_n_sq = 0.0;                        ///< 1/ω_n²
     Vec2 x = Vec2::Zero(), x_swapped = Vec2::Zero();    ///< (x_d, x_q), (x_q, x_d)
     Vec2 dx = Vec2::Zero(), dx_swapped = Vec2::Zero();  ///< (Δx_d, Δx_q), (Δx_q, Δx_d)
-    Vec2 x_over_omega_n = Vec2::Zero();      ///< (x_d, x_q)/ω_n
-    Vec2 dx_over_omega_n = Vec2::Zero();     ///< (Δx_d, Δx_q)/ω_n
-    Vec2 x_sq = Vec2::Zero();                ///< (x_d², x_q²)
-    Vec2 slope_var_x_sq = Vec2::Zero();      ///< (x_d², x_q²)/ω_n²
-    double x_max = 0.0, dx_max = 0.0;        ///< the larger inductance and tolerance
+    Vec2 x_over_omega_n = Vec2::Zero();                 ///< (x_d, x_q)/ω_n
+    Vec2 dx_over_omega_n = Vec2::Zero();                ///< (Δx_d, Δx_q)/ω_n
+    Vec2 x_sq = Vec2::Zero();                           ///< (x_d², x_q²)
+    Vec2 slope_var_x_sq = Vec2::Zero();                 ///< (x_d², x_q²)/ω_n²
+    double x_max = 0.0, dx_max = 0.0;                   ///< the larger inductance and tolerance
   };
 
   /// Recomputes quantisation_var_ (after a resolution changed or the configuration did).
   void update_quantisation() noexcept;
+  /// step()'s parts, each against noise_ and the terms step() has just taken (regime.cpp): the slope and
+  /// its state; the bridge-off, angle-lock, contiguous windows' transient and excitation bits.
+  struct Terms;
+  [[nodiscard]] Terms take_slope(const RegimeInput& in, double dt_s) noexcept;
+  [[nodiscard]] std::uint8_t bridge_bits(const RegimeInput& in) const noexcept;                ///< kBridgeOff or 0
+  [[nodiscard]] std::uint8_t lock_bits(const RegimeInput& in, const Terms& t) const noexcept;  ///< kNotLocked or 0
+  [[nodiscard]] std::uint8_t contiguous_transient_bits(const RegimeInput& in, const Terms& t) noexcept;
+  [[nodiscard]] std::uint8_t excitation_bits(const RegimeInput& in, const Terms& t) const noexcept;
 
   RegimeConfig config_;
   Constants k_;
@@ -300,7 +308,8 @@ class StreamClassifier {
     i_sum_ += i_pu;
     n_sum_ += n_pu;
     u_reported_sum_ += u_reported_sq_pu;
-    if (++count_ < classifier_.config().stream_block && has_start_) [[likely]] return held_;
+    if (++count_ < classifier_.config().stream_block && has_start_) [[likely]]
+      return held_;
     return close_block(t_ns, i_pu);
   }
   /// The dense samples' gain rates [1/s] (γ_L = rate·Δt per sample): a block's weight is rate·span.
@@ -334,7 +343,7 @@ class StreamClassifier {
   Vec2 u_sum_ = Vec2::Zero(), i_sum_ = Vec2::Zero();
   Vec2 gain_rate_per_s_ = Vec2::Zero();
   double n_sum_ = 0.0, u_reported_sum_ = 0.0;
-  Vec2 i_start_ = Vec2::Zero();   ///< the current at the block's start (the previous block's last sample)
+  Vec2 i_start_ = Vec2::Zero();  ///< the current at the block's start (the previous block's last sample)
   std::int64_t start_ns_ = 0;
   bool has_start_ = false;
 };

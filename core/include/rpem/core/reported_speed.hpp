@@ -31,8 +31,8 @@ struct SpeedRead {
 /// where another reader reset the means: the tracker's speed there is interpolated). `lag_s` is the
 /// tracker's ramp lag (pll_ramp_lag_s); 0 leaves the trapezoid of an instantaneous speed. Reads at the same
 /// instant give the speed as reported.
-[[nodiscard]] inline double window_mean_speed_rad_s(const SpeedRead& previous, const SpeedRead& now,
-                                                    std::int64_t t_start_ns, double lag_s) noexcept {
+[[nodiscard]] inline double window_mean_speed_rad_s(const SpeedRead& previous, const SpeedRead& now, std::int64_t t_start_ns,
+                                                    double lag_s) noexcept {
   const double between_s = to_seconds(now.t_ns - previous.t_ns);
   if (!(between_s > 0.0)) return now.omega_el_rad_s;
   const double slope = (now.omega_el_rad_s - previous.omega_el_rad_s) / between_s;  // of the tracker's speed

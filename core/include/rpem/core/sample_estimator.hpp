@@ -14,21 +14,30 @@
 namespace rpem::core {
 
 template <class E>
-concept SampleEstimator =
-    std::is_nothrow_constructible_v<E, const MachineSi&, const EstimatorSettings&> &&
-    requires(E& e, const E& c, const typename E::Sample& sample, const MachineSi& machine,
-             const EstimatorSettings& settings, double value, bool frozen) {
-      { e.step(sample) } noexcept -> std::same_as<Estimate>;  ///< real-time safe
-      { e.reset() } noexcept;
-      { e.resynchronize() } noexcept;
-      { e.set_frozen(frozen) } noexcept;
-      { e.set_estimates(value, value) } noexcept;
-      { e.reconfigure(machine, settings) } noexcept;
-      { c.psi_m_Wb() } noexcept -> std::same_as<double>;
-      { c.r_s_Ohm() } noexcept -> std::same_as<double>;
-      { c.core() } noexcept -> std::same_as<const RpemEstimator&>;
-      { c.base() } noexcept -> std::same_as<const PerUnitBase&>;
-    };
+concept SampleEstimator = std::is_nothrow_constructible_v<E, const MachineSi&, const EstimatorSettings&> &&
+    requires(E& e, const E& c, const typename E::Sample& sample, const MachineSi& machine, const EstimatorSettings& settings,
+             double value, bool frozen) {
+  { e.step(sample) }
+  noexcept->std::same_as<Estimate>;  ///< real-time safe
+  { e.reset() }
+  noexcept;
+  { e.resynchronize() }
+  noexcept;
+  { e.set_frozen(frozen) }
+  noexcept;
+  { e.set_estimates(value, value) }
+  noexcept;
+  { e.reconfigure(machine, settings) }
+  noexcept;
+  { c.psi_m_Wb() }
+  noexcept->std::same_as<double>;
+  { c.r_s_Ohm() }
+  noexcept->std::same_as<double>;
+  { c.core() }
+  noexcept->std::same_as<const RpemEstimator&>;
+  { c.base() }
+  noexcept->std::same_as<const PerUnitBase&>;
+};
 
 static_assert(SampleEstimator<DriveEstimator>);
 static_assert(SampleEstimator<AveragedDriveEstimator>);

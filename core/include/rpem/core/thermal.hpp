@@ -25,7 +25,7 @@ inline constexpr double kMaterialReference_C = 20.0;
 struct DriftLaw {
   double coeff_per_K = 0.0;  ///< α, relative to the value at reference_C [1/K]
   double reference_C = kMaterialReference_C;
-  double value_ref = 0.0;    ///< the value at reference_C in SI (Ω or Wb); 0: the machine's configured value
+  double value_ref = 0.0;  ///< the value at reference_C in SI (Ω or Wb); 0: the machine's configured value
 
   /// value(T)/value_ref.
   [[nodiscard]] constexpr double factor(double t_C) const noexcept { return 1.0 + coeff_per_K * (t_C - reference_C); }

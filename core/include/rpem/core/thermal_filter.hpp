@@ -46,7 +46,8 @@ struct ThermalFilterConfig {
   ThermalVec process_noise_K2_per_s = ThermalVec::Zero();  ///< Q_T: white noise on each node's dT/dt
   ThermalVec disturbance_W2_per_s = ThermalVec::Zero();    ///< q_d: the heat disturbances' drift
   /// σ_rel of each fitted loss term (form row, node column): its relative uncertainty.
-  Eigen::Matrix<double, kLossForms, kMaxThermalNodes> loss_rel_sigma = Eigen::Matrix<double, kLossForms, kMaxThermalNodes>::Zero();
+  Eigen::Matrix<double, kLossForms, kMaxThermalNodes> loss_rel_sigma =
+      Eigen::Matrix<double, kLossForms, kMaxThermalNodes>::Zero();
   double copper_rel_sigma = 0.1;  ///< σ_rel of the copper loss (R_s's law and reference)
   /// σ of the calibration states (Calibration order): [K, relative, K, relative].
   CalibrationVec calibration_sigma = CalibrationVec(1.0, kNdFeB.rel_sigma(), 1.0, kCopper.rel_sigma());

@@ -25,9 +25,9 @@ struct ThermalFusionConfig {
   ThermalFilterConfig filter;  ///< the network (its copper law is R_s's), the noises, the laws' calibration σ
   DriftLaw magnet_law;         ///< ψm(T_magnet) [Wb]
   ThermalObserverConfig observer;
-  double coolant_C = 25.0;             ///< where the samples carry no coolant temperature
+  double coolant_C = 25.0;              ///< where the samples carry no coolant temperature
   double winding_sensor_sigma_K = 0.0;  ///< a winding sensor's σ; 0: sensor not used
-  double initial_sigma_K = 10.0;       ///< σ of every node at the start (the coolant's temperature)
+  double initial_sigma_K = 10.0;        ///< σ of every node at the start (the coolant's temperature)
 };
 
 /// A node's fused temperature.
@@ -103,7 +103,7 @@ class ThermalFusion {
 
  private:
   void start(const ThermalStepData& s) noexcept;
-  void finish_step(const ThermalStepData& s, double dt_s) noexcept;
+  void finish_step(const ThermalStepData& d, double dt_s) noexcept;
 
   ThermalFusionConfig config_;
   ThermalObserver observer_;

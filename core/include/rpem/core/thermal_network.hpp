@@ -75,7 +75,7 @@ struct ThermalNetwork {
 /// The inputs of one step, held over it (their means over the step): eq. 14.4's zero-order hold.
 struct ThermalLoad {
   double dt_s = 0.0;
-  double current_sq_A2 = 0.0;  ///< mean of i_d² + i_q²
+  double current_sq_A2 = 0.0;              ///< mean of i_d² + i_q²
   std::array<double, kLossForms> basis{};  ///< mean of each form's basis
   double coolant_C = 0.0;
 };

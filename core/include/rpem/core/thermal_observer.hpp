@@ -38,29 +38,29 @@ struct ThermalObserverConfig {
 
 /// What the thermal block needs of a sample besides its Estimate.
 struct ThermalSample {
-  double dt_s = 0.0;  ///< the time the sample stands for (since the previous one)
-  double coolant_C = std::numeric_limits<double>::quiet_NaN();         ///< measured; NaN: the configured one
+  double dt_s = 0.0;                                            ///< the time the sample stands for (since the previous one)
+  double coolant_C = std::numeric_limits<double>::quiet_NaN();  ///< measured; NaN: the configured one
   double winding_sensor_C = std::numeric_limits<double>::quiet_NaN();  ///< NaN: none
 };
 
 /// One parameter's observation over a step, SI (Wb for ψm, Ω for R_s).
 struct ParameterObservation {
   bool valid = false;
-  double value = 0.0;         ///< mean estimate over the adapted samples
-  double cross = 0.0;         ///< κ in SI: the value's change per unit error of the other parameter
-  double other_held = 0.0;    ///< the other parameter's estimate (its held value)
-  double variance = 0.0;      ///< σ²_noise + σ²_model [SI²]
+  double value = 0.0;       ///< mean estimate over the adapted samples
+  double cross = 0.0;       ///< κ in SI: the value's change per unit error of the other parameter
+  double other_held = 0.0;  ///< the other parameter's estimate (its held value)
+  double variance = 0.0;    ///< σ²_noise + σ²_model [SI²]
   double variance_noise = 0.0;
   double time_constant_s = 0.0;
 };
 
 /// One step of the thermal filter.
 struct ThermalStepData {
-  std::int64_t t_ns = 0;                       ///< the step's end (its last sample)
+  std::int64_t t_ns = 0;  ///< the step's end (its last sample)
   ThermalLoad load;
-  std::array<ParameterObservation, 2> parameter;  ///< indexed by kPsiM, kRs
+  std::array<ParameterObservation, 2> parameter;                       ///< indexed by kPsiM, kRs
   double winding_sensor_C = std::numeric_limits<double>::quiet_NaN();  ///< the step's mean; NaN: none
-  double psi_m_Wb = 0.0, r_s_Ohm = 0.0;        ///< the estimates at the step's end
+  double psi_m_Wb = 0.0, r_s_Ohm = 0.0;                                ///< the estimates at the step's end
 };
 
 class ThermalObserver {
@@ -95,8 +95,8 @@ class ThermalObserver {
   Vec2 batch_sum_ = Vec2::Zero();  ///< the current batch's residuals
   double batch_dt_s_ = 0.0, batch_a_ = 0.0;
   int batch_count_ = 0;
-  Vec2 batch_mean_ = Vec2::Zero(); ///< the batch means' mean
-  Mat2 eps_cov_ = Mat2::Zero();    ///< Σ_ε = kBatch·Cov(batch means)
+  Vec2 batch_mean_ = Vec2::Zero();  ///< the batch means' mean
+  Mat2 eps_cov_ = Mat2::Zero();     ///< Σ_ε = kBatch·Cov(batch means)
   bool eps_started_ = false, batch_started_ = false;
   std::array<double, 2> settled_{};  ///< Σa over the current uninterrupted adaptation
   std::array<Accumulated, 2> acc_{};

@@ -7,7 +7,7 @@
 
 namespace rpem::core {
 
-inline constexpr double kRadPerSPerRpm = 2.0 * kPi / 60.0;  ///< 1 rpm in rad/s
+inline constexpr double kRadPerSPerRpm = 2.0 * kPi / 60.0;    ///< 1 rpm in rad/s
 inline constexpr double kRpmPerRadPerS = 60.0 / (2.0 * kPi);  ///< 1 rad/s in rpm
 
 [[nodiscard]] constexpr double rpm_to_rad_s(double n_rpm) noexcept { return n_rpm * kRadPerSPerRpm; }

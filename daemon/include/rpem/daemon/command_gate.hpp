@@ -128,7 +128,7 @@ class CommandGate {
   static constexpr std::size_t kMaxPending = 64;
   std::array<AdmittedCommand, kMaxPending> pending_{};
   std::size_t n_pending_ = 0;
-  Command queued_;  ///< what commit() pushes, one pending command at a time
+  Command queued_;                 ///< what commit() pushes, one pending command at a time
   std::int64_t queued_count_ = 0;  ///< commands queued for the loop
   std::int64_t last_accepted_seq_ = 0;
   std::int64_t durable_seq_ = 0;  ///< the last accepted sequence number that is persisted

@@ -34,7 +34,7 @@ struct ValidityConfig {
   double psi_m_after_s = 1.0;
   double max_hold_s = 20.0;
   double convergence_window_s = 2.0;
-  double convergence_band = 0.002;   ///< relative spread over the window
+  double convergence_band = 0.002;  ///< relative spread over the window
 };
 
 /// Whether RPEM_COMMAND must be authenticated (docs/rpemd.md, "Authentication"). `none` is accepted

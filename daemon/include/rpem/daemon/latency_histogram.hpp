@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <limits>
 
@@ -34,11 +35,13 @@ class LatencyHistogram {
   [[nodiscard]] double max() const noexcept { return max_; }
   [[nodiscard]] double mean() const noexcept { return n_ ? sum_ / static_cast<double>(n_) : 0.0; }
   /// Count in 1-µs bin `us` (the last bin holds everything beyond the range).
-  [[nodiscard]] std::int64_t bin(int us) const noexcept { return counts_[static_cast<std::size_t>(std::clamp(us, 0, kBins))]; }
+  [[nodiscard]] std::int64_t bin(int us) const noexcept {
+    return counts_[static_cast<std::size_t>(std::clamp(us, 0, kBins))];
+  }
   /// The upper edge of the bin holding the q-quantile (q in (0, 1]); the max if in the overflow bin.
   [[nodiscard]] double percentile(double q) const noexcept {
     if (n_ == 0) return 0.0;
-    const auto target = static_cast<std::int64_t>(q * static_cast<double>(n_) + 0.5);
+    const auto target = static_cast<std::int64_t>(std::floor(q * static_cast<double>(n_) + 0.5));  // ≥ 0: half up
     std::int64_t seen = 0;
     for (int b = 0; b <= kBins; ++b) {
       seen += counts_[static_cast<std::size_t>(b)];

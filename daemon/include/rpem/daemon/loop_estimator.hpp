@@ -16,8 +16,8 @@ namespace rpem::daemon {
 
 /// What the loop reports of the newest stepped sample, whatever its kind.
 struct SampleSummary {
-  std::int64_t t_ns = 0;   ///< drive time (phase) or the window's end (averaged, host time)
-  std::int64_t rx_ns = 0;  ///< kernel receive time (CLOCK_REALTIME); 0: unknown
+  std::int64_t t_ns = 0;      ///< drive time (phase) or the window's end (averaged, host time)
+  std::int64_t rx_ns = 0;     ///< kernel receive time (CLOCK_REALTIME); 0: unknown
   double theta_el_rad = 0.0;  ///< NaN for averaged samples (they carry no angle)
   double omega_el_rad_s = 0.0;
   double u_dc_V = 0.0;
@@ -28,7 +28,7 @@ struct SampleSummary {
 /// One of the estimators `E`, each a core::SampleEstimator, the k-th stepping a SourceSample's k-th
 /// alternative.
 template <core::SampleEstimator... E>
-  requires std::same_as<SourceSample, std::variant<typename E::Sample...>>
+requires std::same_as<SourceSample, std::variant<typename E::Sample...>>
 using OneOfEstimators = std::variant<E...>;
 
 class LoopEstimator {

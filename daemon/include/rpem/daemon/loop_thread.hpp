@@ -29,7 +29,7 @@ struct LoopCounters {
   std::int64_t samples = 0;
   std::int64_t resyncs = 0;
   std::int64_t rejected_non_finite = 0;
-  std::int64_t wrong_kind = 0;               ///< samples of the kind the source does not produce (never expected)
+  std::int64_t wrong_kind = 0;  ///< samples of the kind the source does not produce (never expected)
   std::int64_t predictor_resets = 0;
   std::int64_t projections = 0;
   std::int64_t output_queue_drops = 0;

@@ -32,7 +32,9 @@ class LoopTimer {
   /// Incremented every period: the watchdog's sign of life.
   [[nodiscard]] std::uint64_t heartbeat() const noexcept { return heartbeat_.load(std::memory_order_acquire); }
   /// The anticipation in use [ns]; with `wake_ahead_s: auto`, −1 until calibrated.
-  [[nodiscard]] std::int64_t wake_ahead_ns() const noexcept { return wake_ahead_published_ns_.load(std::memory_order_acquire); }
+  [[nodiscard]] std::int64_t wake_ahead_ns() const noexcept {
+    return wake_ahead_published_ns_.load(std::memory_order_acquire);
+  }
   /// Whole-run figures (read after the loop has stopped).
   [[nodiscard]] const LatencyHistogram& run_latency() const noexcept { return run_latency_; }
   [[nodiscard]] std::int64_t overruns() const noexcept { return overruns_; }

@@ -22,7 +22,9 @@ namespace rpem::daemon {
 
 enum class DaemonState : std::int8_t { kStarting = 0, kRunning = 1, kStale = 2, kStopping = 3 };
 /// estimate_t.state and diagnostics_t.state carry a DaemonState's number.
-[[nodiscard]] constexpr bool operator==(std::int8_t state, DaemonState s) noexcept { return state == static_cast<std::int8_t>(s); }
+[[nodiscard]] constexpr bool operator==(std::int8_t state, DaemonState s) noexcept {
+  return state == static_cast<std::int8_t>(s);
+}
 
 /// The verdict on an RPEM_COMMAND message (diagnostics_t.last_command_result; numbers never change).
 enum class CommandResult : std::int8_t {
@@ -32,7 +34,7 @@ enum class CommandResult : std::int8_t {
   kRejectedOldSequence = 3,
   kRejectedBadValues = 4,
   kRejectedUnknown = 5,
-  kRejectedBusy = 6,  ///< the loop's command queue was full; the same sequence number may be sent again
+  kRejectedBusy = 6,             ///< the loop's command queue was full; the same sequence number may be sent again
   kRejectedUnauthenticated = 7,  ///< unsigned (key id 0) while authentication is required
   kRejectedUnknownKey = 8,       ///< a key id rpemd does not hold
   kRejectedBadMac = 9,           ///< a known key id, a wrong MAC: forged or altered
@@ -43,16 +45,16 @@ inline constexpr int kCommandResults = 11;
 struct Command {
   enum class Kind : std::uint8_t { kReset, kFreeze, kUnfreeze, kSetValues, kReconfigure };
   Kind kind = Kind::kReset;
-  std::int64_t seq = 0;  ///< RPEM_COMMAND sequence number; 0 for a reload (SIGHUP)
+  std::int64_t seq = 0;   ///< RPEM_COMMAND sequence number; 0 for a reload (SIGHUP)
   double psi_m_Wb = 0.0;  ///< kSetValues
   double r_s_Ohm = 0.0;
-  LiveConfig live;        ///< kReconfigure: the whole reloaded configuration, as one object
+  LiveConfig live;  ///< kReconfigure: the whole reloaded configuration, as one object
 };
 
 /// RPEM_ESTIMATE's fields (the mirror of lcm_types/rpem_estimate_t.lcm; the publisher copies them all), and
 /// what the publisher needs besides.
 struct EstimateReport : mirror::estimate_t {
-  std::int64_t newest_rx_ns = 0;  ///< kernel receive time of the newest sample (CAN), 0 otherwise
+  std::int64_t newest_rx_ns = 0;                      ///< kernel receive time of the newest sample (CAN), 0 otherwise
   core::Algorithm algorithm = core::Algorithm::kSga;  ///< estimate_t.algorithm, which the publisher spells
   // The last values that were valid, converged and adapting (persisted by the publisher), and how long
   // ago they adapted.

@@ -85,8 +85,8 @@ class PersistingPublisher {
   const std::string estimate_channel_, measurement_channel_, diagnostics_channel_;
   std::string state_path_;
 
-  SourceReport source_;    ///< the newest from the source thread
-  ControlReport control_;  ///< the newest from the control thread
+  SourceReport source_;                 ///< the newest from the source thread
+  ControlReport control_;               ///< the newest from the control thread
   LatencyHistogram rx_to_publish_;      ///< since the last diagnostics message
   LatencyHistogram rx_to_publish_run_;  ///< the whole run
   EstimateReport last_estimate_;

@@ -23,9 +23,9 @@ struct SignalMapSource {
   static constexpr const char* kType = "signal_map";
   struct Options {
     std::string interface = "can0";
-    std::string map;  ///< the map file (relative paths: to the configuration's directory)
+    std::string map;                          ///< the map file (relative paths: to the configuration's directory)
     SampleKind kind = SampleKind::kAveraged;  ///< from the map, when it was loaded
-    bool gives_u_dc = false;                   ///< the map carries the DC link (a dead time in seconds needs it)
+    bool gives_u_dc = false;                  ///< the map carries the DC link (a dead time in seconds needs it)
     bool operator==(const Options&) const = default;
   };
   /// Loads the map (io::ConfigError naming the map file if it is bad or lacks a needed quantity).

@@ -19,8 +19,6 @@ enum class SampleKind : std::uint8_t { kPhase = 0, kAveraged = 1 };
 using SourceSample = std::variant<core::DriveSample, core::AveragedSample>;
 
 [[nodiscard]] inline SampleKind kind_of(const SourceSample& s) noexcept { return static_cast<SampleKind>(s.index()); }
-[[nodiscard]] inline const char* to_string(SampleKind k) noexcept {
-  return k == SampleKind::kPhase ? "phase" : "averaged";
-}
+[[nodiscard]] inline const char* to_string(SampleKind k) noexcept { return k == SampleKind::kPhase ? "phase" : "averaged"; }
 
 }  // namespace rpem::daemon

@@ -42,7 +42,7 @@ struct LoadedState {
 
 /// Reads and checks a state file: age against max_age_s (and not in the future), values against the
 /// bounds of D_M. A missing file is kNone; anything unreadable is kCorrupt (reported, not fatal).
-[[nodiscard]] LoadedState load_state_file(const std::string& path, double max_age_s, double psi_min_Wb,
-                                          double psi_max_Wb, double rs_min_Ohm, double rs_max_Ohm);
+[[nodiscard]] LoadedState load_state_file(const std::string& path, double max_age_s, double psi_min_Wb, double psi_max_Wb,
+                                          double rs_min_Ohm, double rs_max_Ohm);
 
 }  // namespace rpem::daemon

@@ -27,7 +27,7 @@ class ValidityTracker {
     bool valid = false;
     bool converged = false;
     double age_s = -1.0;
-    bool good = false;      ///< valid, converged and adapting: a value worth persisting
+    bool good = false;  ///< valid, converged and adapting: a value worth persisting
   };
 
   /// `report_rate_Hz`: how often report() is called (it samples the convergence window).

@@ -55,7 +55,7 @@ namespace rpem::daemon {
 struct VescPollerCounters {
   std::uint64_t polls = 0;
   std::uint64_t send_failures = 0;
-  std::uint64_t samples = 0;       ///< windows delivered
+  std::uint64_t samples = 0;  ///< windows delivered
   std::uint64_t timeouts = 0;
   std::uint64_t late = 0;
   std::uint64_t unrequested = 0;
@@ -71,7 +71,7 @@ class VescPoller {
     std::uint8_t controller_id = 0;
     std::uint8_t host_id = 254;
     std::int64_t period_ns = 5'000'000;
-    std::int64_t phase_ns = 0;    ///< in [0, period_ns)
+    std::int64_t phase_ns = 0;  ///< in [0, period_ns)
     std::int64_t timeout_ns = 4'500'000;
     std::uint32_t mask = can::vesc::kEstimatorMask;
     /// The reply's ERPM is the firmware's PLL speed at the read, lagging a ramp by k_p/k_i: each window's mean
@@ -119,13 +119,13 @@ class VescPoller {
   can::CanFrame poll_;
   can::vesc::VescDecoder decoder_;
   VescPollerCounters counters_;
-  std::int64_t next_due_ns_ = 0;     ///< 0: the first call to poll_due() is due
+  std::int64_t next_due_ns_ = 0;  ///< 0: the first call to poll_due() is due
   bool outstanding_ = false;
   std::int64_t deadline_ns_ = 0;
   bool timed_out_unanswered_ = false;
   std::int64_t timed_out_at_ns_ = 0;
   std::int64_t consecutive_timeouts_ = 0;
-  std::int64_t reply_start_ns_ = 0;   ///< receive time of the reply's first frame
+  std::int64_t reply_start_ns_ = 0;  ///< receive time of the reply's first frame
   bool has_window_start_ = false;
   std::int64_t window_start_ns_ = 0;  ///< the newest read of the controller seen
   core::SpeedRead previous_speed_;    ///< the PLL's speed in our previous reply, and when it was read

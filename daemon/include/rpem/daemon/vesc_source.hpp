@@ -18,9 +18,9 @@ struct VescSource {
   static constexpr const char* kType = "vesc";
   struct Options {
     std::string interface = "can0";
-    int controller_id = 0;       ///< the VESC's CAN id (its app configuration's controller_id), 0–254
-    int host_id = 254;           ///< rpemd's node id on the bus, where replies are addressed; no VESC may use it
-    double poll_rate_Hz = 200.0; ///< 1–2000 Hz
+    int controller_id = 0;        ///< the VESC's CAN id (its app configuration's controller_id), 0–254
+    int host_id = 254;            ///< rpemd's node id on the bus, where replies are addressed; no VESC may use it
+    double poll_rate_Hz = 200.0;  ///< 1–2000 Hz
     /// Where in each poll period this instance polls, as a fraction of the period: instances polling
     /// drives on one bus take different phases (docs/rpemd.md, "Several drives on one bus").
     double poll_phase = 0.0;

@@ -13,8 +13,7 @@ class CsvTable {
  public:
   /// Reads `path`. Non-numeric cells are errors unless their column is listed in `text_columns`
   /// (those read as NaN). "nan" cells are accepted only when `allow_nan` is true.
-  static CsvTable read(const std::string& path, bool allow_nan = false,
-                       const std::vector<std::string>& text_columns = {});
+  static CsvTable read(const std::string& path, bool allow_nan = false, const std::vector<std::string>& text_columns = {});
 
   [[nodiscard]] bool has(const std::string& name) const;
   /// The column's values; throws InputError naming the file if it is missing.

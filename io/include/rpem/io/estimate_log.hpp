@@ -17,7 +17,8 @@ class EstimateLogWriter {
   /// `thermal_nodes`: the names of the thermal network's nodes (their columns follow the estimator's);
   /// empty: no thermal columns.
   explicit EstimateLogWriter(const std::string& path, const std::vector<std::string>& thermal_nodes = {});
-  void write(const core::Estimate& e, const core::DriveEstimator& estimator, const core::ThermalEstimate* thermal = nullptr) {
+  void write(const core::Estimate& e, const core::DriveEstimator& estimator,
+             const core::ThermalEstimate* thermal = nullptr) {
     write(e, estimator.core(), thermal);
   }
   /// The same for any estimator built on RpemEstimator (the averaged one too).

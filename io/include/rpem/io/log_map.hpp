@@ -61,8 +61,8 @@ struct QuantityInfo {
 
 /// Where a mapped value is found: a header name, or (headerless files) a 1-based position.
 struct ColumnRef {
-  std::string name;        ///< header name; empty for a position
-  std::size_t position = 0;  ///< 1-based position when the file has no header
+  std::string name;                         ///< header name; empty for a position
+  std::size_t position = 0;                 ///< 1-based position when the file has no header
   [[nodiscard]] std::string label() const;  ///< the name, or the position as text
 };
 
@@ -81,15 +81,15 @@ struct MappedColumn {
 enum class Window : std::uint8_t {
   kInstantaneous,  ///< each row is a sample at its time (drive-log rows; t_start = t)
   kStartColumn,    ///< averaged over [t_start, t], t_start from its own column (our averaged log)
-  kPreviousRow,    ///< averaged since the previous row's time (VESC's read-and-reset means); the first row only opens a window
+  kPreviousRow,  ///< averaged since the previous row's time (VESC's read-and-reset means); the first row only opens a window
 };
 
 struct LogMap {
   std::string name;  ///< where the map comes from (a file, or a built-in format's name), for messages
   char separator = ',';
-  bool header = true;         ///< the first line read names the columns
+  bool header = true;          ///< the first line read names the columns
   std::size_t skip_lines = 0;  ///< lines before the header (or the first row) that are not read
-  char comment = '\0';        ///< lines starting with it (after blanks) are skipped; '\0': none
+  char comment = '\0';         ///< lines starting with it (after blanks) are skipped; '\0': none
   Window window = Window::kInstantaneous;
   /// Every mapped column may be absent from the header (the quantity is then absent): our own formats,
   /// where the header names the quantities. A user's map requires each of its columns.

@@ -32,8 +32,8 @@ struct MappedRow {
 
 /// What the time rules did while reading (for the tools' summary lines).
 struct TimeRepairs {
-  std::uint64_t wraps = 0;       ///< the time column wrapped (ms_today at midnight)
-  std::uint64_t tied_rows = 0;   ///< rows that shared their stamp with the row before, spread over its resolution
+  std::uint64_t wraps = 0;      ///< the time column wrapped (ms_today at midnight)
+  std::uint64_t tied_rows = 0;  ///< rows that shared their stamp with the row before, spread over its resolution
 };
 
 class MappedLogReader {

@@ -16,8 +16,8 @@ namespace rpem::io {
 
 /// One header version of the log, as VESC Tool's source writes it (vedderb/vesc_tool, vescinterface.cpp).
 struct VescToolHeader {
-  const char* versions;  ///< the VESC Tool releases that write it
-  const char* source;    ///< the commit that introduced it
+  const char* versions;                   ///< the VESC Tool releases that write it
+  const char* source;                     ///< the commit that introduced it
   std::vector<std::string_view> columns;  ///< without the empty cell after the trailing ';'
 };
 

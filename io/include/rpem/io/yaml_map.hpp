@@ -22,7 +22,7 @@ class YamlMap {
   /// Parses text (embedded defaults); `name` stands in for the file name in messages.
   static YamlMap load_string(const std::string& text, const std::string& name);
 
-  YamlMap(YAML::Node node, std::string file, std::string path);
+  YamlMap(const YAML::Node& node, std::string file, std::string path);
 
   [[nodiscard]] bool has(const std::string& key) const;
 

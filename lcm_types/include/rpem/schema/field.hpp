@@ -64,7 +64,9 @@ template <class Message>
 struct Schema;
 
 template <class Field>
-inline constexpr bool kMirrored = requires(const Field& f) { f.mirror; };
+inline constexpr bool kMirrored = requires(const Field& f) {
+  f.mirror;
+};
 
 /// Calls `f(field)` for every field of `Message` in declaration order (the authentication fields aside).
 template <class Message, class F>

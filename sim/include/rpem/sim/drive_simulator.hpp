@@ -88,18 +88,18 @@ class DriveSimulator {
   Sensors sensors_;
   std::int64_t period_ns_;
   std::int64_t samples_total_;
-  std::int64_t k_ = 0;             ///< index of the next logged sample
+  std::int64_t k_ = 0;  ///< index of the next logged sample
   std::int64_t warmup_periods_ = 0;
   int substeps_ = 1;
 
   PlantParameters parameters_;
   RegimeTimeline regimes_;
   RegimeNow regime_;
-  double theta_frame_rad_ = 0.0;   ///< open loop: the commanded angle (unwrapped)
-  double omega_frame_rad_s_ = 0.0; ///< open loop: the commanded speed (electrical)
+  double theta_frame_rad_ = 0.0;    ///< open loop: the commanded angle (unwrapped)
+  double omega_frame_rad_s_ = 0.0;  ///< open loop: the commanded speed (electrical)
   std::uint64_t rectifying_periods_ = 0;
   double torque_signal_Nm_ = 0.0;
-  double load_signal_Nm_ = 0.0;    ///< inertia mechanics' load
+  double load_signal_Nm_ = 0.0;  ///< inertia mechanics' load
   double u_dc_V_ = 0.0;
   core::Vec2 command_now_V_ = core::Vec2::Zero();   ///< acts over the current period
   core::Vec2 command_next_V_ = core::Vec2::Zero();  ///< computed this period, acts in the next

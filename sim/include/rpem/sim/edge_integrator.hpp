@@ -71,6 +71,15 @@ class EdgeIntegrator {
   /// current off zero over h_s, else the clamp voltage that keeps it at zero.
   template <class Flow>
   void start_at_zero(Flow& flow, const PmsmPlant& plant, int x, Legs& legs, double h_s) noexcept;
+  /// Each leg's command over an interval (at its midpoint t_mid) and each current's sign where it is clearly
+  /// off zero, one phase clamped at a time: the legs' voltages in `legs`; the clamped phase, or -1.
+  int select_legs(const std::array<LegSchedule, 3>& schedule, const core::Vec3& i, double t_mid, double u_dc_V,
+                  Legs& legs) noexcept;
+  /// The first zero crossing among the watched phases within [0, h_s]: its phase, its instant in
+  /// t_cross_s (which comes in as h_s); -1 (t_cross_s unchanged) if none.
+  template <class Flow>
+  int first_watched_crossing(const Flow& flow, const std::array<bool, 3>& watched, double h_s,
+                             double& t_cross_s) const noexcept;
   /// The first zero crossing of phase x (of sign `sign_[x]` at the start) within [0, h_s]; < 0: none.
   template <class Flow>
   [[nodiscard]] double first_crossing(const Flow& flow, int x, const PhaseCurrents& begin, const PhaseCurrents& end,
@@ -79,7 +88,7 @@ class EdgeIntegrator {
   Inverter inverter_;
   LinearFlow linear_;
   MapFlow map_;
-  bool signs_matter_;  ///< dead time or device drops: the currents' signs select leg voltages
+  bool signs_matter_;                 ///< dead time or device drops: the currents' signs select leg voltages
   std::array<int, 3> sign_{1, 1, 1};  ///< each phase current's sign: +1, −1, or 0 (clamped at zero)
   EdgeCounters counters_;
 };

@@ -13,8 +13,7 @@ namespace rpem::sim {
 class FluxMap {
  public:
   /// Grid axes (strictly increasing) and values, value(k_q, k_d) at index k_q·n_d + k_d.
-  FluxMap(std::vector<double> i_d_A, std::vector<double> i_q_A, std::vector<double> psi_d_Wb,
-          std::vector<double> psi_q_Wb);
+  FluxMap(std::vector<double> i_d_A, std::vector<double> i_q_A, std::vector<double> psi_d_Wb, std::vector<double> psi_q_Wb);
 
   /// Reads a CSV with columns i_d_A, i_q_A, psi_d_Vs, psi_q_Vs (one row per grid point, any order).
   static FluxMap load_csv(const std::string& path);

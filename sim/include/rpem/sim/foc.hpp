@@ -16,11 +16,11 @@ struct FocConfig {
   double period_s = 125e-6;
   double current_bandwidth_Hz = 400.0;
   double speed_bandwidth_Hz = 5.0;
-  double max_current_A = 0.0;     ///< |i| limit; 0: √2 × rated rms current
-  double voltage_margin = 0.95;   ///< field weakening keeps the steady-state |u| below this × u_dc/√3
+  double max_current_A = 0.0;    ///< |i| limit; 0: √2 × rated rms current
+  double voltage_margin = 0.95;  ///< field weakening keeps the steady-state |u| below this × u_dc/√3
   bool field_weakening = true;
-  bool speed_control = false;     ///< false: torque mode (the scenario commands torque); the initial mode
-  double inertia_kgm2 = 0.01;     ///< for tuning the speed loop
+  bool speed_control = false;  ///< false: torque mode (the scenario commands torque); the initial mode
+  double inertia_kgm2 = 0.01;  ///< for tuning the speed loop
 };
 
 struct FocInput {
@@ -59,8 +59,7 @@ class FocController {
 
  private:
   /// Field weakening on the nominal model's voltage ellipse, then the current limit.
-  [[nodiscard]] core::Vec2 field_weaken(core::Vec2 i_ref, double torque_Nm, double omega,
-                                        double u_limit) const noexcept;
+  [[nodiscard]] core::Vec2 field_weaken(core::Vec2 i_ref, double torque_Nm, double omega, double u_limit) const noexcept;
 
   FocConfig config_;
   core::MachineSi nominal_;
@@ -69,11 +68,11 @@ class FocController {
   double i_max_A_;
   core::Vec2 integral_V_ = core::Vec2::Zero();
   double speed_integral_Nm_ = 0.0;
-  double last_torque_ref_Nm_ = 0.0;               ///< the torque reference of the last step (0 when overridden)
-  bool was_speed_control_ = false;                ///< speed mode in the last step
-  double mtpa_torque_Nm_ = 0.0;                   ///< torque of the cached MTPA references
+  double last_torque_ref_Nm_ = 0.0;  ///< the torque reference of the last step (0 when overridden)
+  bool was_speed_control_ = false;   ///< speed mode in the last step
+  double mtpa_torque_Nm_ = 0.0;      ///< torque of the cached MTPA references
   core::Vec2 mtpa_i_A_ = core::Vec2::Zero();
-  core::RotationTracker rotation_;                ///< at the measured angle
+  core::RotationTracker rotation_;  ///< at the measured angle
 };
 
 }  // namespace rpem::sim

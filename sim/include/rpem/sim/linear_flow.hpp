@@ -41,7 +41,7 @@ class LinearFlow {
  private:
   [[nodiscard]] core::Vec2 flux_rate(double t_s) const noexcept;
 
-  core::Mat2 a_ = core::Mat2::Zero();   ///< A
+  core::Mat2 a_ = core::Mat2::Zero();      ///< A
   core::Mat2 k_ = core::Mat2::Identity();  ///< K: i_s = K·ψ − k0
   core::Vec2 k0_A_ = core::Vec2::Zero();
   core::Vec2 c_V_ = core::Vec2::Zero();

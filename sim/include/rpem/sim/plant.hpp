@@ -35,7 +35,7 @@ struct PlantState {
 /// The rotation by a small angle (a Taylor series within core::small_rotation's range, libm beyond).
 [[nodiscard]] inline core::Rotation rotation_by(double angle_rad) noexcept {
   return std::abs(angle_rad) <= core::RotationTracker::kLargestIncrement_rad ? core::small_rotation(angle_rad)
-                                                                              : core::Rotation::of(angle_rad);
+                                                                             : core::Rotation::of(angle_rad);
 }
 
 /// Phase currents a, b, c and their rates of change at one instant.
@@ -93,8 +93,7 @@ class PmsmPlant {
   [[nodiscard]] core::Vec2 derivative(const core::Vec2& psi, const core::Vec2& i, const core::Vec2& u_dq,
                                       double omega) const noexcept;
   /// Stator current i_s = i(ψ) + ω·J·ψ/R_fe from the magnetising current i(ψ).
-  [[nodiscard]] core::Vec2 stator_current(const core::Vec2& psi, const core::Vec2& i_flux,
-                                          double omega) const noexcept;
+  [[nodiscard]] core::Vec2 stator_current(const core::Vec2& psi, const core::Vec2& i_flux, double omega) const noexcept;
 
   [[nodiscard]] const PlantState& state() const noexcept { return state_; }
   [[nodiscard]] const PlantParameters& parameters() const noexcept { return parameters_; }
@@ -122,8 +121,8 @@ class PmsmPlant {
   double h_s_ = 1e-6;
   double load_torque_Nm_ = 0.0;
   double torque_integral_Nms_ = 0.0;  ///< ∫T_e dt over the edge-integrated period so far
-  double acceleration_el_ = 0.0;       ///< dω/dt over the last edge-integrated period
-  core::Rotation step_rotation_;  ///< rotation by ω·h, fixed over a period
+  double acceleration_el_ = 0.0;      ///< dω/dt over the last edge-integrated period
+  core::Rotation step_rotation_;      ///< rotation by ω·h, fixed over a period
   unsigned periods_since_exact_rotation_ = 0;
 };
 

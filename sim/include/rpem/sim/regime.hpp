@@ -33,11 +33,11 @@ struct RegimeEvent {
   ControlOverride control = ControlOverride::kScenario;  ///< closed loop (and an open loop's `then`)
   OffVoltageReport report = OffVoltageReport::kBackEmf;  ///< bridge off (and an open loop's `then`)
   // Open loop:
-  double current_A = 0.0;   ///< |i_q| held in the commanded frame (sign: the direction of speed_rpm)
-  double speed_rpm = 0.0;   ///< target speed, mechanical, signed
-  double lock_s = 0.0;      ///< foc_sl_openloop_time_lock
-  double ramp_s = 0.0;      ///< foc_sl_openloop_time_ramp
-  double hold_s = 0.05;     ///< foc_sl_openloop_time (mcconf_default.h: 0.05 s)
+  double current_A = 0.0;                       ///< |i_q| held in the commanded frame (sign: the direction of speed_rpm)
+  double speed_rpm = 0.0;                       ///< target speed, mechanical, signed
+  double lock_s = 0.0;                          ///< foc_sl_openloop_time_lock
+  double ramp_s = 0.0;                          ///< foc_sl_openloop_time_ramp
+  double hold_s = 0.05;                         ///< foc_sl_openloop_time (mcconf_default.h: 0.05 s)
   DriveRegime then = DriveRegime::kClosedLoop;  ///< after the hold: kClosedLoop or kBridgeOff
 };
 
@@ -46,7 +46,7 @@ struct RegimeNow {
   DriveRegime regime = DriveRegime::kClosedLoop;
   ControlOverride control = ControlOverride::kScenario;
   OffVoltageReport report = OffVoltageReport::kBackEmf;
-  int event = -1;                 ///< index of the event in force (−1: none yet)
+  int event = -1;                    ///< index of the event in force (−1: none yet)
   double open_loop_speed_rpm = 0.0;  ///< open loop: the commanded speed now (mechanical)
 };
 

@@ -19,22 +19,21 @@ namespace rpem::sim {
 
 /// Quantities a scenario can change over time.
 enum class Quantity : int {
-  kPsiM = 0,         ///< psi_m_Wb — magnet flux at the thermal reference temperature
-  kRs,               ///< r_s_Ohm — stator resistance at the thermal reference temperature
-  kLd,               ///< l_d_H (constant-inductance magnetics)
-  kLq,               ///< l_q_H
-  kSpeed,            ///< speed_rpm — imposed (dynamometer) or reference (speed control), mechanical
-  kTorque,           ///< torque_Nm — command (torque control) or load (inertia mechanics)
-  kUdc,              ///< u_dc_V
-  kTWinding,         ///< t_winding_C
-  kTMagnet,          ///< t_magnet_C
-  kLoadTorque,       ///< load_torque_Nm — inertia mechanics' load, when the scenario gives it (else torque_Nm)
+  kPsiM = 0,    ///< psi_m_Wb — magnet flux at the thermal reference temperature
+  kRs,          ///< r_s_Ohm — stator resistance at the thermal reference temperature
+  kLd,          ///< l_d_H (constant-inductance magnetics)
+  kLq,          ///< l_q_H
+  kSpeed,       ///< speed_rpm — imposed (dynamometer) or reference (speed control), mechanical
+  kTorque,      ///< torque_Nm — command (torque control) or load (inertia mechanics)
+  kUdc,         ///< u_dc_V
+  kTWinding,    ///< t_winding_C
+  kTMagnet,     ///< t_magnet_C
+  kLoadTorque,  ///< load_torque_Nm — inertia mechanics' load, when the scenario gives it (else torque_Nm)
   kCount
 };
 inline constexpr std::array<const char*, static_cast<int>(Quantity::kCount)> kQuantityNames = {
-    "psi_m_Wb", "r_s_Ohm", "l_d_H", "l_q_H", "speed_rpm", "torque_Nm", "u_dc_V", "t_winding_C", "t_magnet_C",
-    "load_torque_Nm"};
-
+    "psi_m_Wb",  "r_s_Ohm", "l_d_H",       "l_q_H",      "speed_rpm",
+    "torque_Nm", "u_dc_V",  "t_winding_C", "t_magnet_C", "load_torque_Nm"};
 
 /// How the plant is integrated at switching fidelity (docs/scenarios.md, `plant.integrator`): from one
 /// switching instant to the next (EdgeIntegrator), or in fixed steps of Heun's method with the
@@ -58,25 +57,25 @@ struct VescConfig {
 
 struct Scenario {
   std::string name;
-  std::string source;                 ///< file it was loaded from
-  io::MachineConfig machine;          ///< nominal machine + estimator settings
+  std::string source;         ///< file it was loaded from
+  io::MachineConfig machine;  ///< nominal machine + estimator settings
   double duration_s = 1.0;
-  double warmup_s = 0.2;              ///< simulated before t = 0, not logged
-  double sample_period_s = 125e-6;    ///< control and logging period (PWM double update)
+  double warmup_s = 0.2;            ///< simulated before t = 0, not logged
+  double sample_period_s = 125e-6;  ///< control and logging period (PWM double update)
   std::uint64_t seed = 1;
   InverterConfig inverter;
-  double inverter_delay_s = 0.0;      ///< the command acts this much late, < one period (hidden effect)
+  double inverter_delay_s = 0.0;                         ///< the command acts this much late, < one period (hidden effect)
   PlantIntegrator integrator = PlantIntegrator::kEdges;  ///< switching fidelity only
-  double plant_step_s = 1e-6;         ///< the fixed-step integrator's step
-  double plant_tolerance = 1e-9;      ///< edges with a flux map: relative local error per step
-  std::string flux_map_file;          ///< empty: constant inductances
+  double plant_step_s = 1e-6;                            ///< the fixed-step integrator's step
+  double plant_tolerance = 1e-9;                         ///< edges with a flux map: relative local error per step
+  std::string flux_map_file;                             ///< empty: constant inductances
   MechanicsConfig mechanics;
   FocConfig control;
   SensorConfig sensors;
   /// Temperature coupling (core/thermal.hpp): r_s and ψm signals are the values at the laws' reference
   /// temperature; the laws' value_ref is unused.
   core::ThermalModel thermal;
-  double r_fe_Ohm = 0.0;              ///< iron-loss resistance; 0: none (hidden effect)
+  double r_fe_Ohm = 0.0;  ///< iron-loss resistance; 0: none (hidden effect)
   std::array<Signal, static_cast<int>(Quantity::kCount)> signals;
   /// Inertia mechanics: the load is load_torque_Nm (given in `initial` or by an event) rather than torque_Nm.
   bool separate_load = false;

@@ -16,9 +16,9 @@ struct SensorConfig {
   double current_lsb_A = 0.0;    ///< ADC resolution; 0: none
   core::Vec3 current_offset_A = core::Vec3::Zero();
   core::Vec3 current_gain_error = core::Vec3::Zero();  ///< measured = true·(1 + gain) + offset
-  double encoder_counts = 0.0;       ///< counts per mechanical revolution; 0: ideal
-  double theta_offset_rad = 0.0;     ///< electrical; measured = true − offset
-  int speed_window = 8;              ///< samples over which the speed is differentiated
+  double encoder_counts = 0.0;                         ///< counts per mechanical revolution; 0: ideal
+  double theta_offset_rad = 0.0;                       ///< electrical; measured = true − offset
+  int speed_window = 8;                                ///< samples over which the speed is differentiated
   double u_dc_noise_V = 0.0;
   double u_dc_lsb_V = 0.0;
 };

@@ -27,8 +27,8 @@ namespace rpem::sim {
 struct VescSetupValues {
   double amp_hours_Ah = 0.0, amp_hours_charged_Ah = 0.0;
   double watt_hours_Wh = 0.0, watt_hours_charged_Wh = 0.0;
-  double battery_level = 0.0;   ///< 0–1
-  double battery_wh = 0.0;      ///< energy left
+  double battery_level = 0.0;  ///< 0–1
+  double battery_wh = 0.0;     ///< energy left
   double current_in_A = 0.0, current_motor_A = 0.0;
   double speed_m_s = 0.0;
   double distance_m = 0.0, distance_abs_m = 0.0;  ///< SETUP_VALUES tachometer, tachometer_abs
@@ -44,16 +44,61 @@ struct VescToolRow {
 };
 
 /// The header's names, in order (openRtLogFile).
-inline constexpr std::array<const char*, 55> kVescToolColumns = {
-    "ms_today", "input_voltage", "temp_mos_max", "temp_mos_1", "temp_mos_2", "temp_mos_3", "temp_motor",
-    "current_motor", "current_in", "d_axis_current", "q_axis_current", "erpm", "duty_cycle", "amp_hours_used",
-    "amp_hours_charged", "watt_hours_used", "watt_hours_charged", "tachometer", "tachometer_abs",
-    "encoder_position", "fault_code", "vesc_id", "d_axis_voltage", "q_axis_voltage", "ms_today_setup",
-    "amp_hours_setup", "amp_hours_charged_setup", "watt_hours_setup", "watt_hours_charged_setup",
-    "battery_level", "battery_wh_tot", "current_in_setup", "current_motor_setup", "speed_meters_per_sec",
-    "tacho_meters", "tacho_abs_meters", "num_vescs", "ms_today_imu", "roll", "pitch", "yaw", "accX", "accY",
-    "accZ", "gyroX", "gyroY", "gyroZ", "gnss_posTime", "gnss_lat", "gnss_lon", "gnss_alt", "gnss_gVel",
-    "gnss_vVel", "gnss_hAcc", "gnss_vAcc"};
+inline constexpr std::array<const char*, 55> kVescToolColumns = {"ms_today",
+                                                                 "input_voltage",
+                                                                 "temp_mos_max",
+                                                                 "temp_mos_1",
+                                                                 "temp_mos_2",
+                                                                 "temp_mos_3",
+                                                                 "temp_motor",
+                                                                 "current_motor",
+                                                                 "current_in",
+                                                                 "d_axis_current",
+                                                                 "q_axis_current",
+                                                                 "erpm",
+                                                                 "duty_cycle",
+                                                                 "amp_hours_used",
+                                                                 "amp_hours_charged",
+                                                                 "watt_hours_used",
+                                                                 "watt_hours_charged",
+                                                                 "tachometer",
+                                                                 "tachometer_abs",
+                                                                 "encoder_position",
+                                                                 "fault_code",
+                                                                 "vesc_id",
+                                                                 "d_axis_voltage",
+                                                                 "q_axis_voltage",
+                                                                 "ms_today_setup",
+                                                                 "amp_hours_setup",
+                                                                 "amp_hours_charged_setup",
+                                                                 "watt_hours_setup",
+                                                                 "watt_hours_charged_setup",
+                                                                 "battery_level",
+                                                                 "battery_wh_tot",
+                                                                 "current_in_setup",
+                                                                 "current_motor_setup",
+                                                                 "speed_meters_per_sec",
+                                                                 "tacho_meters",
+                                                                 "tacho_abs_meters",
+                                                                 "num_vescs",
+                                                                 "ms_today_imu",
+                                                                 "roll",
+                                                                 "pitch",
+                                                                 "yaw",
+                                                                 "accX",
+                                                                 "accY",
+                                                                 "accZ",
+                                                                 "gyroX",
+                                                                 "gyroY",
+                                                                 "gyroZ",
+                                                                 "gnss_posTime",
+                                                                 "gnss_lat",
+                                                                 "gnss_lon",
+                                                                 "gnss_alt",
+                                                                 "gnss_gVel",
+                                                                 "gnss_vVel",
+                                                                 "gnss_hAcc",
+                                                                 "gnss_vAcc"};
 
 /// Milliseconds in a day: ms_today wraps here.
 inline constexpr std::int64_t kMsPerDay = 86'400'000;

@@ -32,7 +32,7 @@ struct VescToolLink {
   double loss = 0.002;     ///< probability that a poll is lost
   double timeout_s = 1.0;  ///< VESC Tool's wait before it polls again (mTimeoutCount 100 × the 10 ms timer)
   std::uint64_t seed = 1;
-  std::int64_t start_ms_today = 12 * 3'600'000;  ///< UTC time of day at drive time 0 [ms]
+  std::int64_t start_ms_today = std::int64_t{12} * 3'600'000;  ///< UTC time of day at drive time 0 [ms]
 };
 
 /// The truth of one row: what happened over its window.

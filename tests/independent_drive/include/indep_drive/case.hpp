@@ -22,7 +22,7 @@ inline constexpr double kAuto = std::numeric_limits<double>::quiet_NaN();
 struct MachineDraw {
   double psi_m_span_rel = 0.08;
   double r_s_span_rel = 0.25;
-  double l_span_rel = 0.05;  // L_d and L_q, drawn independently
+  double l_span_rel = 0.05;                                    // L_d and L_q, drawn independently
   std::optional<double> psi_m_rel, r_s_rel, l_d_rel, l_q_rel;  // fixed true/configured − 1 instead of a draw
 };
 
@@ -48,9 +48,9 @@ struct PhaseErrorParams {
 };
 struct SaturationParams {
   bool ld = false, lq = false, cross = false;
-  std::string map_path;                   // "" : data/beckhoff-am8141-flux-maps/..._400rpm.csv of the source tree
-  double full_scale_current_A = kAuto;    // the map's largest |i_q| lands here; √2·I_n
-  double depth = 1.0;                     // multiplies the map's nonlinearity
+  std::string map_path;                 // "" : data/beckhoff-am8141-flux-maps/..._400rpm.csv of the source tree
+  double full_scale_current_A = kAuto;  // the map's largest |i_q| lands here; √2·I_n
+  double depth = 1.0;                   // multiplies the map's nonlinearity
   int degree = 4;
   [[nodiscard]] bool any() const { return ld || lq || cross; }
 };
@@ -74,7 +74,7 @@ struct Effects {
   ThetaOffsetParams theta_offset;
   PhaseErrorParams current_offset{false, {kAuto, 0.0, 0.0}};  // offset_A per phase; a: 0.015·√2·I_n
   PhaseErrorParams current_gain{false, {1.0, 1.03, 1.0}};     // measured/true per phase
-  SaturationParams saturation;                        // ld_saturation, lq_saturation, cross_saturation
+  SaturationParams saturation;                                // ld_saturation, lq_saturation, cross_saturation
   HarmonicParams flux_harmonic_6{false, {6, 0.02, 0.4, 0.012, -0.9}};
   HarmonicParams flux_harmonic_12{false, {12, 0.006, 1.1, 0.004, 0.2}};
   IronLossParams iron_loss;
@@ -96,13 +96,13 @@ void enable_effects(Effects& e, std::string_view names);
 std::vector<std::string> enabled_effects(const Effects& e);
 
 struct SensorSettings {
-  double current_noise_A = kAuto;     // 0.0035·√2·I_n
+  double current_noise_A = kAuto;  // 0.0035·√2·I_n
   int adc_bits = 12;
-  double adc_full_scale_A = kAuto;    // 2.5·√2·I_n
+  double adc_full_scale_A = kAuto;  // 2.5·√2·I_n
   std::int64_t encoder_counts_per_rev = 1 << 14;
-  double u_dc_noise_V = kAuto;        // 0.002·u_dc
+  double u_dc_noise_V = kAuto;  // 0.002·u_dc
   int u_dc_adc_bits = 12;
-  double u_dc_full_scale_V = kAuto;   // 1.5·u_dc
+  double u_dc_full_scale_V = kAuto;  // 1.5·u_dc
   double omega_noise_rad_s = 0.0;
   double temperature_noise_K = 0.0;
 };
@@ -115,14 +115,14 @@ struct InverterSettings {
 
 struct ControlSettings {
   double rate_Hz = 8000.0;
-  int substeps = 4;                   // RK4 steps per control period
-  double bandwidth_Hz = kAuto;        // rate/40
-  double current_limit_A = kAuto;     // 1.5·√2·I_n
+  int substeps = 4;                // RK4 steps per control period
+  double bandwidth_Hz = kAuto;     // rate/40
+  double current_limit_A = kAuto;  // 1.5·√2·I_n
   double angle_advance_periods = 0.5;
 };
 
 struct ProfileSettings {
-  std::vector<ProfilePoint> points;   // empty: default_profile
+  std::vector<ProfilePoint> points;  // empty: default_profile
   double max_speed_pu = 0.5;
   double max_torque_pu = 0.8;
 };
@@ -137,7 +137,7 @@ enum class AveragedSource { plant, drive };
 struct AveragedSettings {
   bool on = false;
   double rate_Hz = 200.0;
-  double jitter_rel = 0.3;      // each interval uniformly within (1 ± jitter)/rate
+  double jitter_rel = 0.3;  // each interval uniformly within (1 ± jitter)/rate
   double min_interval_s = 0.5e-3;
   double max_interval_s = 20e-3;
   AveragedSource source = AveragedSource::plant;

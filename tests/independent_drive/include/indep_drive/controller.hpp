@@ -17,20 +17,20 @@ namespace indep {
 Vec2 mtpa_current(double torque_Nm, const MachineParams& m, double i_max_A);
 
 struct ControllerConfig {
-  MachineParams model;             // what the drive believes
-  double period_s = 125e-6;        // T_c
-  double bandwidth_rad_s = 1257.0; // ω_bw: K_p = L·ω_bw, K_i = R·ω_bw
+  MachineParams model;              // what the drive believes
+  double period_s = 125e-6;         // T_c
+  double bandwidth_rad_s = 1257.0;  // ω_bw: K_p = L·ω_bw, K_i = R·ω_bw
   double current_limit_A = 10.0;
   double angle_advance_periods = 0.5;
-  double voltage_margin = 0.98;    // fraction of the linear range used
+  double voltage_margin = 0.98;  // fraction of the linear range used
   Modulation modulation = Modulation::space_vector;
 };
 
 struct ControllerOutput {
-  Vec2 i_ref_A;                      // rotor frame of the measured angle
-  Vec2 u_dq_V;                       // command, rotor frame of the measured angle
-  std::array<double, 3> u_abc_V{};   // command, stator frame (zero sum): what the log records
-  std::array<double, 3> duty{};      // issued leg duty cycles
+  Vec2 i_ref_A;                     // rotor frame of the measured angle
+  Vec2 u_dq_V;                      // command, rotor frame of the measured angle
+  std::array<double, 3> u_abc_V{};  // command, stator frame (zero sum): what the log records
+  std::array<double, 3> duty{};     // issued leg duty cycles
   bool saturated = false;
 };
 

@@ -27,14 +27,14 @@ FluxMapData read_flux_map(const std::string& path);
 /// 2 ≤ m+n ≤ degree with n even (ψ_d even and ψ_q odd in i_q), I_m the largest |i_q| of the map.
 struct FluxMapFit {
   double axis_rotation_rad = 0;  // δ: the map's frame turned by −δ so that ψ_q = 0 at its smallest current
-  double current_scale_A = 0;  // I_m
-  double psi0_Wb = 0;          // ψ_d at zero current
-  std::vector<PolyTerm> terms; // a_mn, including (2,0) and (0,2)
-  double rms_residual_Wb = 0;  // over both ψ_d and ψ_q of every point
+  double current_scale_A = 0;    // I_m
+  double psi0_Wb = 0;            // ψ_d at zero current
+  std::vector<PolyTerm> terms;   // a_mn, including (2,0) and (0,2)
+  double rms_residual_Wb = 0;    // over both ψ_d and ψ_q of every point
   double max_residual_Wb = 0;
   double max_abs_x_d = 0, max_abs_x_q = 0;  // extent of the data in x
-  [[nodiscard]] double l_d0_H() const;  // 2·a_20 / I_m
-  [[nodiscard]] double l_q0_H() const;  // 2·a_02 / I_m
+  [[nodiscard]] double l_d0_H() const;      // 2·a_20 / I_m
+  [[nodiscard]] double l_q0_H() const;      // 2·a_02 / I_m
 };
 
 FluxMapFit fit_flux_map(const FluxMapData& map, int degree = 4);

@@ -19,8 +19,8 @@ struct LogRow {
 /// The true plant per control period: state at t, applied voltage averaged over [t, t + T_c).
 struct PlantRow {
   double t_s = 0, theta_el_rad = 0, omega_el_rad_s = 0;
-  Vec2 i_A;         // true terminal current, true rotor frame
-  Vec2 u_applied_V; // applied voltage averaged over the period, true rotor frame
+  Vec2 i_A;             // true terminal current, true rotor frame
+  Vec2 u_applied_V;     // applied voltage averaged over the period, true rotor frame
   Vec2 u_applied_ab_V;  // the same in the stator frame (α, β)
   double psi_m_Wb = 0, r_s_Ohm = 0, torque_Nm = 0, T_winding_C = 0, T_magnet_C = 0;
 };

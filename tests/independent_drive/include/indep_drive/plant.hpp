@@ -20,7 +20,7 @@ namespace indep {
 ///   h(θ) = Σ_n [ h_lo·e^{jφ_lo}·e^{−jnθ} + h_hi·e^{jφ_hi}·e^{+jnθ} ]      (n = 6: 5th and 7th; n = 12: 11th and 13th)
 /// so the stator-frame magnet flux is ψm·(e^{jθ} + h_lo·e^{jφ_lo}·e^{−j(n−1)θ} + h_hi·e^{jφ_hi}·e^{j(n+1)θ}).
 struct HarmonicPair {
-  int order = 6;  // n
+  int order = 6;                            // n
   double h_lo_rel = 0.0, phi_lo_rad = 0.0;  // stator order n−1 (negative sequence)
   double h_hi_rel = 0.0, phi_hi_rad = 0.0;  // stator order n+1 (positive sequence)
 };
@@ -49,9 +49,9 @@ struct Operating {
 };
 
 struct PlantState {
-  Vec2 psi_Wb;          // rotor-frame flux linkage (harmonics included)
-  double theta_rad = 0; // true electrical angle, unwrapped
-  Vec2 i_m_A;           // magnetising current of the last evaluation (Newton's start)
+  Vec2 psi_Wb;           // rotor-frame flux linkage (harmonics included)
+  double theta_rad = 0;  // true electrical angle, unwrapped
+  Vec2 i_m_A;            // magnetising current of the last evaluation (Newton's start)
 };
 
 struct PlantEval {

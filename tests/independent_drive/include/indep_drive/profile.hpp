@@ -11,9 +11,9 @@ namespace indep {
 /// One breakpoint; the profile is piecewise linear between them, and two points at the same time make a step.
 struct ProfilePoint {
   double t_s = 0.0;
-  double speed_rpm = 0.0;       // mechanical
-  double torque_Nm = 0.0;       // command
-  double i_d_inject_A = 0.0;    // added to the MTPA d-axis current
+  double speed_rpm = 0.0;     // mechanical
+  double torque_Nm = 0.0;     // command
+  double i_d_inject_A = 0.0;  // added to the MTPA d-axis current
 };
 
 class OperatingProfile {

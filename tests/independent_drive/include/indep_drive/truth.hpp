@@ -28,7 +28,7 @@ struct Truth {
   double initial_theta_rad = 0;
   SensorSettings noise;
   ThermalSettings thermal;
-  double max_current_A = 0;  // largest true |i| at the samples
+  double max_current_A = 0;          // largest true |i| at the samples
   std::vector<EffectTruth> effects;  // the hidden ones, catalogue order
   [[nodiscard]] const EffectTruth* effect(const std::string& name) const;
 };

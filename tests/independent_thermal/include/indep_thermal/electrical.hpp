@@ -15,8 +15,7 @@ struct DqVoltage {
 };
 
 /// Steady-state dq voltage of the true machine at T_w, T_r.
-DqVoltage steady_state_voltage(const Parameters& p, const OperatingPoint& op, double t_winding_C,
-                               double t_rotor_C);
+DqVoltage steady_state_voltage(const Parameters& p, const OperatingPoint& op, double t_winding_C, double t_rotor_C);
 
 /// What the profile asks of the drive at one instant.
 struct Demand {

@@ -15,8 +15,8 @@
 namespace indep_thermal {
 
 struct Case {
-  Machine machine;     // the configured machine: what the drive knows, and what the nominal plant is sized from
-  Parameters params;   // the true plant
+  Machine machine;    // the configured machine: what the drive knows, and what the nominal plant is sized from
+  Parameters params;  // the true plant
   Profile profile;
   CoolantMode coolant = CoolantMode::loop;
   std::uint64_t seed = 1;

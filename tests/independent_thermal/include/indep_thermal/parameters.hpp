@@ -20,13 +20,13 @@ struct Parameters {
   double l_q_H = 0.0;
   double pole_pairs = 0.0;
   // Materials.
-  double copper_alpha20_per_K = 3.93e-3;   // dR/dT / R at 20 °C
-  double magnet_alpha20_per_K = -1.1e-3;   // dBr/dT / Br at 20 °C
-  double ac_factor_at_rated = 0.05;        // R_ac/R_dc − 1 at the rated electrical frequency
+  double copper_alpha20_per_K = 3.93e-3;  // dR/dT / R at 20 °C
+  double magnet_alpha20_per_K = -1.1e-3;  // dBr/dT / Br at 20 °C
+  double ac_factor_at_rated = 0.05;       // R_ac/R_dc − 1 at the rated electrical frequency
   // Rated references of the loss laws.
-  double rated_frequency_Hz = 0.0;         // electrical
-  double rated_speed_rad_s = 0.0;          // mechanical
-  double rated_current_A = 0.0;            // peak phase
+  double rated_frequency_Hz = 0.0;  // electrical
+  double rated_speed_rad_s = 0.0;   // mechanical
+  double rated_current_A = 0.0;     // peak phase
   // Geometry (inner rotor, water-jacket-cooled stator).
   double rotor_diameter_m = 0.0;
   double active_length_m = 0.0;
@@ -38,9 +38,9 @@ struct Parameters {
   double c_iron_J_K = 0.0;
   double c_rotor_J_K = 0.0;
   // Conduction paths.
-  double g_winding_iron_W_K = 0.0;   // slot liner and impregnation
-  double g_iron_coolant_W_K = 0.0;   // lamination-housing contact and water jacket
-  double g_shaft_W_K = 0.0;          // rotor - shaft - bearings - housing
+  double g_winding_iron_W_K = 0.0;  // slot liner and impregnation
+  double g_iron_coolant_W_K = 0.0;  // lamination-housing contact and water jacket
+  double g_shaft_W_K = 0.0;         // rotor - shaft - bearings - housing
   // End-space convection h = k1·(1 + k2·v^k3), v the rotor's peripheral speed [m/s].
   double endspace_k1_W_m2K = 15.0;
   double endspace_k2 = 0.4;
@@ -63,19 +63,19 @@ struct Parameters {
   double coolant_start_C = 20.0;
   double coolant_loop_capacity_J_K = 0.0;
   double coolant_radiator_W_K = 0.0;
-  double coolant_other_heat_share = 0.5;   // other heat on the loop (inverter) as a share of the machine's losses
+  double coolant_other_heat_share = 0.5;  // other heat on the loop (inverter) as a share of the machine's losses
   // Sensors and measurement noise.
   double sensor_winding_tau_s = 8.0;
   double sensor_winding_noise_K = 0.2;
   double sensor_winding_resolution_K = 0.1;
-  double sensor_placement_gain = 1.0;      // the sensor reads T_c + gain·(T_lag − T_c)
+  double sensor_placement_gain = 1.0;  // the sensor reads T_c + gain·(T_lag − T_c)
   double sensor_coolant_noise_K = 0.1;
   double sensor_coolant_resolution_K = 0.1;
-  double noise_current_rel = 1e-3;         // σ of i_d, i_q per row, relative to the rated peak current
-  double noise_voltage_rel = 5e-4;         // σ of u_d, u_q per row, relative to the rated peak phase voltage
+  double noise_current_rel = 1e-3;  // σ of i_d, i_q per row, relative to the rated peak current
+  double noise_voltage_rel = 5e-4;  // σ of u_d, u_q per row, relative to the rated peak phase voltage
   // The drive: voltage and current limits, thermal derating on the winding sensor.
-  double voltage_limit_rel = 0.95;         // of the rated peak phase voltage
-  double current_limit_rel = 1.5;          // of the rated peak current
+  double voltage_limit_rel = 0.95;  // of the rated peak phase voltage
+  double current_limit_rel = 1.5;   // of the rated peak current
   double derate_start_C = 150.0;
   double derate_end_C = 180.0;
   // Initial state: every node and the coolant start at coolant_start_C + initial_rise_K (coolant: + 0).

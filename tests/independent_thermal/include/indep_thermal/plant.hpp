@@ -25,7 +25,7 @@ enum StateIndex : int {
   kTRotor = 2,
   kTSensorLag = 3,  // the winding sensor's element, first-order lag of T_winding
   kTCoolant = 4,
-  kEWinding = 5,    // ∫ losses into each node [J]
+  kEWinding = 5,  // ∫ losses into each node [J]
   kEIron = 6,
   kERotor = 7,
   kECoolant = 8,    // ∫ heat into the coolant [J]
@@ -52,9 +52,9 @@ struct Snapshot {
   double r_s_dc_Ohm = 0.0;
   double r_s_ac_Ohm = 0.0;
   double psi_m_Wb = 0.0;
-  double sensor_reading_C = 0.0;   // T_c + gain·(T_lag − T_c), before noise
+  double sensor_reading_C = 0.0;  // T_c + gain·(T_lag − T_c), before noise
   double heat_to_coolant_W = 0.0;
-  double other_heat_W = 0.0;       // loop mode
+  double other_heat_W = 0.0;  // loop mode
   State y;
   State dydt;
 };

@@ -12,9 +12,9 @@
 namespace indep_thermal {
 
 struct LogColumns {
-  bool coolant = true;          // T_coolant [°C]
-  bool winding_sensor = true;   // T_winding [°C]
-  bool averaged = false;        // the averaged log: t_start after t, and window means (Case::averaged)
+  bool coolant = true;         // T_coolant [°C]
+  bool winding_sensor = true;  // T_winding [°C]
+  bool averaged = false;       // the averaged log: t_start after t, and window means (Case::averaged)
 };
 
 /// The drive log's header for these columns.

@@ -21,11 +21,11 @@ namespace indep::vesc {
 
 /// The firmware's numbers, resolved (the VESC's motor configuration is what its detection measured).
 struct FirmwareParams {
-  double dt_s = 80e-6;          // control period: 2/f_zv
+  double dt_s = 80e-6;  // control period: 2/f_zv
   double f_zv_Hz = 25000.0;
   double r_Ohm = 0.0, l_H = 0.0, psi_Wb = 0.0;  // foc_motor_r, foc_motor_l, foc_motor_flux_linkage
-  double kp = 0.0, ki = 0.0;    // foc_current_kp, foc_current_ki
-  Firmware conf;                // the rest of the configuration, as given
+  double kp = 0.0, ki = 0.0;                    // foc_current_kp, foc_current_ki
+  Firmware conf;                                // the rest of the configuration, as given
 };
 
 enum class AngleSource : std::uint8_t { off, observer, startup, openloop };
@@ -40,10 +40,10 @@ struct IsrInput {
 };
 
 struct IsrOutput {
-  bool modulating = false;                 // duties for the next update event; false: outputs off
+  bool modulating = false;  // duties for the next update event; false: outputs off
   std::array<double, 3> duty{0.5, 0.5, 0.5};
   AngleSource source = AngleSource::off;
-  double phase_rad = 0.0;                  // the frame of this cycle's i_d, i_q, v_d, v_q
+  double phase_rad = 0.0;  // the frame of this cycle's i_d, i_q, v_d, v_q
 };
 
 /// COMM_GET_VALUES as the firmware computes it, before the wire's scaling (commands.c,

@@ -28,35 +28,35 @@ struct RowTruth {
   double frame_error_mean_rad = 0.0;              // mean of wrap(frame − true d axis)
   double frame_error_max_abs_rad = 0.0;
   double omega_el_mean_rad_s = 0.0, omega_el_start_rad_s = 0.0, omega_el_end_rad_s = 0.0;
-  double i_d_mean_A = 0.0, i_q_mean_A = 0.0;      // the true current in the true rotor frame, mean of the samples
-  double i_d_avg_A = 0.0, i_q_avg_A = 0.0;        // ... and its mean over time (the two differ by the ripple
-                                                  //     the held voltage makes within each period)
-  double i_dev_rms_A = 0.0;                       // rms of the current vector about its window mean
-  double u_d_mean_V = 0.0, u_q_mean_V = 0.0;      // the voltage at the terminals in the true rotor frame
+  double i_d_mean_A = 0.0, i_q_mean_A = 0.0;  // the true current in the true rotor frame, mean of the samples
+  double i_d_avg_A = 0.0, i_q_avg_A = 0.0;    // ... and its mean over time (the two differ by the ripple
+                                              //     the held voltage makes within each period)
+  double i_dev_rms_A = 0.0;                   // rms of the current vector about its window mean
+  double u_d_mean_V = 0.0, u_q_mean_V = 0.0;  // the voltage at the terminals in the true rotor frame
   double psi_m_Wb = 0.0, r_s_Ohm = 0.0, T_winding_C = 0.0, T_magnet_C = 0.0;
-  SegmentKind segment = SegmentKind::off;         // the segment running at the read
+  SegmentKind segment = SegmentKind::off;  // the segment running at the read
   // Classification by TruthRules:
-  std::string bridge;        // modulating | bridge_off | mixed
-  std::string angle;         // observer | open_loop | mixed
+  std::string bridge;  // modulating | bridge_off | mixed
+  std::string angle;   // observer | open_loop | mixed
   bool angle_locked = false;
   bool excites_psi_m = false, excites_r_s = false, transient = false;
   double psi_m_term_V = 0.0, r_s_term_V = 0.0;
 };
 
 struct LogRow {
-  double t_reply_s = 0.0;    // the host's time of the row
-  RowContext context;        // what VESC Tool writes
+  double t_reply_s = 0.0;  // the host's time of the row
+  RowContext context;      // what VESC Tool writes
   RowTruth truth;
 };
 
 /// One control cycle, when Case::keep_cycle_trace is set.
 struct CycleRecord {
   double t_s = 0.0, theta_el_rad = 0.0, omega_el_rad_s = 0.0;
-  double phase_rad = 0.0;                 // the firmware's frame
+  double phase_rad = 0.0;  // the firmware's frame
   AngleSource source = AngleSource::off;
   bool modulating = false;
   Vec2 i_dq_true_A, i_dq_reported_A, v_dq_reported_V;
-  Vec2 v_dq_applied_V;                    // mean over the cycle, true rotor frame
+  Vec2 v_dq_applied_V;  // mean over the cycle, true rotor frame
   double psi_m_Wb = 0.0, r_s_Ohm = 0.0;
   double energy_in_J = 0.0, energy_cu_J = 0.0, energy_load_J = 0.0;
   double magnetic_energy_J = 0.0, kinetic_energy_J = 0.0;  // at the cycle's end
@@ -65,13 +65,13 @@ struct CycleRecord {
 struct Result {
   Case resolved;
   MachineValues configured, true_at_reference;
-  MachineValues vesc_configuration;          // the VESC's own (detected) R, L, ψ at the start
+  MachineValues vesc_configuration;             // the VESC's own (detected) R, L, ψ at the start
   std::optional<double> vesc_measured_flux_Wb;  // the emulated flux measurement's result
   FirmwareParams firmware;
   PlantParams plant;
   double control_period_s = 0.0;
   double initial_theta_rad = 0.0;
-  std::vector<LogRow> rows;                  // in the order VESC Tool writes them
+  std::vector<LogRow> rows;  // in the order VESC Tool writes them
   int reads = 0, lost_replies = 0;
   std::vector<SegmentSpan> spans;
   std::vector<CycleRecord> cycles;

@@ -24,9 +24,9 @@ struct PlantParams {
   int pole_pairs = 1;
   double inertia_kgm2 = 0.0;
   double coulomb_Nm = 0.0, coulomb_band_rad_s = 0.5, viscous_Nm_s = 0.0, drag_Nm_s2 = 0.0, external_Nm = 0.0;
-  double t_dead_s = 0.0;      // per-leg dead time
-  double f_sw_Hz = 12500.0;   // switching frequency
-  double dead_band_A = 0.5;   // the current over which the dead-time error changes sign
+  double t_dead_s = 0.0;     // per-leg dead time
+  double f_sw_Hz = 12500.0;  // switching frequency
+  double dead_band_A = 0.5;  // the current over which the dead-time error changes sign
 };
 
 struct PlantState {
@@ -37,12 +37,12 @@ struct PlantState {
 
 /// What one held interval did: means and integrals over it (RK4's weights 1, 2, 2, 1: Simpson's rule).
 struct IntervalResult {
-  Vec2 v_dq_mean_V;            // the applied voltage in the true rotor frame, mean over the interval
-  Vec2 i_dq_mean_A;            // the current in the true rotor frame, mean over the interval
-  double energy_in_J = 0.0;    // ∫1.5·v·i dt at the terminals (after the dead-time error)
-  double energy_cu_J = 0.0;    // ∫1.5·R_s·|i|² dt
-  double energy_load_J = 0.0;  // ∫T_load·ω_m dt (friction, drag, external)
-  double energy_shaft_J = 0.0; // ∫T_e·ω_m dt
+  Vec2 v_dq_mean_V;             // the applied voltage in the true rotor frame, mean over the interval
+  Vec2 i_dq_mean_A;             // the current in the true rotor frame, mean over the interval
+  double energy_in_J = 0.0;     // ∫1.5·v·i dt at the terminals (after the dead-time error)
+  double energy_cu_J = 0.0;     // ∫1.5·R_s·|i|² dt
+  double energy_load_J = 0.0;   // ∫T_load·ω_m dt (friction, drag, external)
+  double energy_shaft_J = 0.0;  // ∫T_e·ω_m dt
 };
 
 class Plant {

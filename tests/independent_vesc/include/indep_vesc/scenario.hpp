@@ -19,10 +19,10 @@ enum class SegmentKind {
 
 struct Segment {
   SegmentKind kind = SegmentKind::off;
-  double duration_s = 1.0;   // the longest it lasts (a flux measurement lasts as its sequence does)
+  double duration_s = 1.0;  // the longest it lasts (a flux measurement lasts as its sequence does)
   double current_A = 0.0;
-  double ramp_s = 0.0;       // current: linear from the previous command
-  double until_erpm = 0.0;   // current, brake: ends early once |ERPM| reaches (current) or falls below (brake) this
+  double ramp_s = 0.0;         // current: linear from the previous command
+  double until_erpm = 0.0;     // current, brake: ends early once |ERPM| reaches (current) or falls below (brake) this
   double erpm_per_s = 1800.0;  // flux_measurement: the open-loop ramp rate (conf_general_detect_apply_all)
   double external_Nm = 0.0;    // a torque on the shaft during the segment (a hand turning the rotor, a slope)
   double friction_Nm = 0.0;    // bearing-like friction added during the segment (a load to start against)
@@ -37,8 +37,8 @@ const char* to_string(SegmentKind k);
 /// the bridge is off: that back EMF hides in the phase voltages' resolution and the observer loses the angle.
 /// Starts are made against a load of 30–70 % of the torque the start current gives (`torque_per_A_Nm` per
 /// ampere): the rotor stays slow long enough for the firmware's open-loop start-up.
-std::vector<Segment> builtin_scenario(double duration_s, double l_current_max_A, double rated_erpm,
-                                      double creep_torque_Nm, double torque_per_A_Nm, std::uint64_t seed);
+std::vector<Segment> builtin_scenario(double duration_s, double l_current_max_A, double rated_erpm, double creep_torque_Nm,
+                                      double torque_per_A_Nm, std::uint64_t seed);
 
 /// A scenario file: CSV with header
 /// `kind,duration_s,current_A[,ramp_s,until_erpm,erpm_per_s,external_Nm,friction_Nm]`.

@@ -7,7 +7,9 @@
 // already in the model in J, so that what they already explain is not credited to a candidate, and what
 // they took of the candidate's residual while it was missing is.
 //
-// Nothing here holds a residual per sample (docs/diagnose.md, "Long recordings"). Every quantity is a sum
+// Nothing here holds a residual per sample (docs/diagnose.md, "Long recordings") but a fit's last cost-only
+// evaluation's training residuals, which the Jacobian Ceres asks for at the same point next takes as its base
+// point's instead of replaying them again. Every quantity is a sum
 // over the samples — JᵀJ, Jᵀr, rᵀr, the blocks' scores — accumulated as the models stream through a block
 // together, block by block on the replay's pool, and added in block order. Ceres is handed the fit in the
 // same reduced form: the least-squares problem ‖J·δ + r‖² over the training samples equals ‖R_J·δ + R_r‖²
@@ -91,7 +93,8 @@ enum class Identification {
 /// cluster-robust interval widened by the mismatch allowance, exactly where the report states the
 /// configuration off (calibration_findings). Away from the ±50 % bound in both cases.
 /// `misfit_A`: misfit_norm_A of the set.
-[[nodiscard]] Identification identification(const EffectSet& set, const CalibrationIntervals& ci, std::size_t i, double misfit_A);
+[[nodiscard]] Identification identification(const EffectSet& set, const CalibrationIntervals& ci, std::size_t i,
+                                            double misfit_A);
 
 /// A round's screening: for each candidate, its best start and the training gain the screening credits it
 /// with from there.
@@ -147,6 +150,9 @@ class EffectFitter {
   /// residuals[j] model j's (a miss of 1 kA per axis where a model predicts nothing finite), scaled by the loss.
   template <class Acc, class Add>
   std::vector<Acc> over_training(const std::vector<ExtendedModel>& models, const Acc& init, const Add& add) const;
+  /// The same with each block's own start (`out`, one per training block, in order, added to and returned).
+  template <class Acc, class Add>
+  std::vector<Acc> over_training_from(const std::vector<ExtendedModel>& models, std::vector<Acc> out, const Add& add) const;
 
   const ModelReplay& replay_;
   EffectContext context_;
@@ -154,7 +160,7 @@ class EffectFitter {
   std::vector<bool> fitted_;  ///< per sample: in a training block and replayed under the baseline
   std::size_t training_samples_ = 0;
   std::uint64_t training_block_samples_ = 0;  ///< every sample of the training blocks (a pass's work per model)
-  RobustLoss loss_;  ///< least squares unless outliers remain (diagnosis.cpp)
+  RobustLoss loss_;                           ///< least squares unless outliers remain (diagnosis.cpp)
 };
 
 }  // namespace rpem::analysis

@@ -44,18 +44,18 @@ struct TemperatureColumn {
 /// Facts of the log and the machine that the parametrisations and descriptions need.
 struct EffectContext {
   ModelMode mode = ModelMode::kTransient;
-  core::MachineSi machine;  ///< as configured
-  ExtendedModel base;       ///< the configuration's whole model (extensions and drift laws), the baseline
+  core::MachineSi machine;                  ///< as configured
+  ExtendedModel base;                       ///< the configuration's whole model (extensions and drift laws), the baseline
   double base_current_A = 0.0;              ///< I_b
   double max_i_d_A = 0.0, max_i_q_A = 0.0;  ///< largest |i_d|, |i_q| logged
   double extreme_i_d_A = 0.0;               ///< the logged i_d of largest magnitude, signed
   double min_i_d_A = 0.0, max_signed_i_d_A = 0.0;  ///< the logged i_d's range (1st to 99th percentile)
   double max_speed_rad_s = 0.0;
-  double speed_spread_rel = 0.0;            ///< LogData::speed_spread_rel
+  double speed_spread_rel = 0.0;  ///< LogData::speed_spread_rel
   double t_start_s = 0.0, t_span_s = 0.0;
   TemperatureColumn t_winding, t_magnet;
   double reference_C = core::kMaterialReference_C;  ///< temperature at which reported drift laws are referred
-  double sample_period_s = 0.0;       ///< median sample interval
+  double sample_period_s = 0.0;                     ///< median sample interval
   double mean_u_dc_V = 0.0;
   double switching_frequency_Hz = 0.0;  ///< 0: unknown (t_dead_s is then not reported)
 
@@ -113,12 +113,12 @@ struct Effect;
 /// One row of the catalogue.
 struct EffectRow {
   std::string_view name;
-  int parameters = 1;            ///< scaled parameters
-  bool per_phase = false;        ///< a candidate once per phase
-  bool steady_state = true;      ///< a steady-state log can show it
+  int parameters = 1;                    ///< scaled parameters
+  bool per_phase = false;                ///< a candidate once per phase
+  bool steady_state = true;              ///< a steady-state log can show it
   std::string_view not_in_steady_state;  ///< why it cannot (diagnosis.json not_identifiable)
-  std::string_view shows_as;     ///< the residual's signature (report, docs)
-  std::string_view enters;       ///< how it enters the model (docs)
+  std::string_view shows_as;             ///< the residual's signature (report, docs)
+  std::string_view enters;               ///< how it enters the model (docs)
   std::vector<Confusion> confusions;
   /// The calibrated constant (index into kCalibrated) the effect's law is referred to — a drift law holds
   /// the constant's value at the log's mean temperature (or mid-log) — and that is therefore fitted with the

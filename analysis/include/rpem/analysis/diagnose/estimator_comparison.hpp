@@ -35,8 +35,8 @@ struct ParameterTrack {
 [[nodiscard]] ParameterTrack load_truth(const std::string& path);
 
 struct EstimateSummary {
-  double psi_m_Wb = 0.0, r_s_Ohm = 0.0;     ///< mean over the last quarter of the log
-  std::optional<double> psi_m_error_pct;    ///< RMS error against truth over the second half
+  double psi_m_Wb = 0.0, r_s_Ohm = 0.0;   ///< mean over the last quarter of the log
+  std::optional<double> psi_m_error_pct;  ///< RMS error against truth over the second half
   std::optional<double> r_s_error_pct;
 };
 
@@ -55,13 +55,13 @@ struct EstimatorComparison {
 /// context's baseline.
 /// The two estimator runs go on `pool` at once; `monitor` (if any) is told the samples run and may stop them.
 [[nodiscard]] EstimatorComparison compare_estimates(const LogData& log, const io::MachineConfig& nominal,
-                                                    const io::MachineConfig& extended_config,
-                                                    const ExtendedModel& extended, const EffectContext& context,
-                                                    const ParameterTrack& truth, const WorkPool& pool = WorkPool::serial(),
-                                                    Monitor* monitor = nullptr);
+                                                    const io::MachineConfig& extended_config, const ExtendedModel& extended,
+                                                    const EffectContext& context, const ParameterTrack& truth,
+                                                    const WorkPool& pool = WorkPool::serial(), Monitor* monitor = nullptr);
 
 /// RMS of the RPEM estimator's prediction error ε over the held-out blocks when it runs over the whole
 /// log with `config` (docs/diagnose.md, "An extension must help the estimator") [A].
-[[nodiscard]] double estimator_heldout_rms_A(const LogData& log, const io::MachineConfig& config, Monitor* monitor = nullptr);
+[[nodiscard]] double estimator_heldout_rms_A(const LogData& log, const io::MachineConfig& config,
+                                             Monitor* monitor = nullptr);
 
 }  // namespace rpem::analysis

@@ -39,8 +39,8 @@ struct LogData {
   std::vector<std::int64_t> window_start_ns;
   double t_start_s = 0.0, t_end_s = 0.0;
   double median_dt_s = 0.0;
-  double max_current_A = 0.0;   ///< largest measured current amplitude
-  double max_speed_rad_s = 0.0; ///< largest |ω_el|
+  double max_current_A = 0.0;    ///< largest measured current amplitude
+  double max_speed_rad_s = 0.0;  ///< largest |ω_el|
   /// How far the speed varies in motion: the 10th to 90th percentile of |ω_el| over the samples above 5 %
   /// of the largest, relative to the largest (0: one speed).
   double speed_spread_rel = 0.0;
@@ -83,7 +83,8 @@ struct LogData {
   [[nodiscard]] std::size_t training_count() const noexcept;
   /// Heap bytes the log holds.
   [[nodiscard]] std::size_t bytes() const noexcept {
-    return samples.bytes() + block_first.capacity() * sizeof(std::size_t) + window_start_ns.capacity() * sizeof(std::int64_t);
+    return samples.bytes() + block_first.capacity() * sizeof(std::size_t) +
+           window_start_ns.capacity() * sizeof(std::int64_t);
   }
 };
 
@@ -100,9 +101,9 @@ struct LogOptions {
   bool voltage_is_command = false;
   double control_period_s = 0.0;
   double command_delay_s = 0.0;
-  int blocks = 40;                ///< training and held-out blocks, alternating, equal in time
-  int speed_half_window = 4;      ///< transient logs: replay speed from the angle over ±this many samples
-  std::string log_map;            ///< a column map (YAML) to read the log with; empty: detected (io::log_source)
+  int blocks = 40;            ///< training and held-out blocks, alternating, equal in time
+  int speed_half_window = 4;  ///< transient logs: replay speed from the angle over ±this many samples
+  std::string log_map;        ///< a column map (YAML) to read the log with; empty: detected (io::log_source)
 };
 
 /// Where the steady-state replay left out more than io::kExplainedShare of the rows as idle or in transition:

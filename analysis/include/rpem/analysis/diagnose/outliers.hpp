@@ -25,15 +25,16 @@ inline constexpr int kScaleIterations = 4;
 inline constexpr int kRobustRuns = 3;
 
 struct OutlierCheck {
-  OutlierTest test;             ///< of the final least-squares model's training residuals
-  RobustLoss loss;              ///< Huber at the settled threshold (set where test.outliers; the robust runs' last)
-  int robust_runs = 0;          ///< robust diagnoses run (0: least squares stood)
-  double largest_shift = 0.0;   ///< max over the free parameters of |θ_Huber − θ_LS| / its 95 % half-width
-  std::string parameter;        ///< whose shift that is (a constant's key, or "effect:index")
-  bool influential = false;     ///< largest_shift > 1: the diagnosis is run again under `loss`
+  OutlierTest test;            ///< of the final least-squares model's training residuals
+  RobustLoss loss;             ///< Huber at the settled threshold (set where test.outliers; the robust runs' last)
+  int robust_runs = 0;         ///< robust diagnoses run (0: least squares stood)
+  double largest_shift = 0.0;  ///< max over the free parameters of |θ_Huber − θ_LS| / its 95 % half-width
+  std::string parameter;       ///< whose shift that is (a constant's key, or "effect:index")
+  bool influential = false;    ///< largest_shift > 1: the diagnosis is run again under `loss`
 };
 
 /// `least_squares`: the fitter the diagnosis ran with; `fitted`, `ci`: its final model and intervals.
-[[nodiscard]] OutlierCheck check_outliers(const EffectFitter& least_squares, const EffectSet& fitted, const CalibrationIntervals& ci);
+[[nodiscard]] OutlierCheck check_outliers(const EffectFitter& least_squares, const EffectSet& fitted,
+                                          const CalibrationIntervals& ci);
 
 }  // namespace rpem::analysis

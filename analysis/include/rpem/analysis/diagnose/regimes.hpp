@@ -18,12 +18,12 @@
 namespace rpem::analysis {
 
 struct LogRegimes {
-  std::vector<core::Regime> regime;       ///< per sample of the log
-  io::SampleCounts counts;                ///< per regime, and the run's resyncs and outlier skips
+  std::vector<core::Regime> regime;  ///< per sample of the log
+  io::SampleCounts counts;           ///< per regime, and the run's resyncs and outlier skips
   /// Every rule that took more than io::kExplainedShare of the samples out — a regime's, the estimator's
   /// resynchronisation, the steady-state replay's idle and transitional rows — with the key that changes it.
   std::vector<std::string> explanations;
-  std::size_t excluded_used = 0;          ///< excluded samples the diagnosis would otherwise have used
+  std::size_t excluded_used = 0;  ///< excluded samples the diagnosis would otherwise have used
 };
 
 /// Runs the configured estimator over `log` (its rows; an averaged log's windows) and records each

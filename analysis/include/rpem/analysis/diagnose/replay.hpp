@@ -62,13 +62,13 @@ class ModelReplay {
   void replay_block(int b, std::span<const ExtendedModel> models, const Visit& visit) const;
 
   /// The blocks `blocks` selects that hold samples, in order.
-  [[nodiscard]] std::vector<int> blocks(Blocks blocks) const;
+  [[nodiscard]] std::vector<int> blocks(Blocks which) const;
 
   /// Runs per_block(i, b) for the i-th of `blocks` on the pool (checking between blocks whether to stop).
   void for_blocks(const std::vector<int>& blocks, const std::function<void(std::size_t i, int b)>& per_block) const;
 
   /// Replays `blocks` of the log with `model`, every sample kept (tests and small logs). Thread-safe (const).
-  void run(const ExtendedModel& model, ReplayOutput& out, Blocks blocks = Blocks::kAll) const;
+  void run(const ExtendedModel& model, ReplayOutput& out, Blocks which = Blocks::kAll) const;
 
   [[nodiscard]] const LogData& log() const noexcept { return log_; }
   [[nodiscard]] const WorkPool& pool() const noexcept { return pool_; }
@@ -76,6 +76,13 @@ class ModelReplay {
 
  private:
   class Chain;
+  /// One chain per distinct model (a model the same as an earlier one bit for bit steps none of its own):
+  /// appends them to `chains` and returns each model's chain.
+  std::vector<std::size_t> distinct_chains(std::span<const ExtendedModel> models, std::vector<Chain>& chains) const;
+  /// Per chain, the chain whose conditioner's samples it takes: the first that conditions alike (itself if
+  /// none before it does).
+  static std::vector<std::size_t> shared_conditioners(const std::vector<Chain>& chains);
+
   const LogData& log_;
   core::PerUnitBase base_;
   double max_interval_s_;

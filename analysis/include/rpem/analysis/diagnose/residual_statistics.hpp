@@ -23,15 +23,15 @@ struct BeforeAfter {
 };
 
 struct RegionStatistics {
-  std::string speed;     ///< e.g. "standstill", "+0.02…0.5 pu"
-  std::string load;      ///< "no load", "i_q > 0", "i_q < 0"
+  std::string speed;  ///< e.g. "standstill", "+0.02…0.5 pu"
+  std::string load;   ///< "no load", "i_q > 0", "i_q < 0"
   std::size_t samples = 0;
   BeforeAfter rms_A;
   BeforeAfter mean_d_A, mean_q_A;
 };
 
 struct HarmonicContent {
-  int order = 0;         ///< multiple of the electrical angle; 0 is the mean
+  int order = 0;  ///< multiple of the electrical angle; 0 is the mean
   BeforeAfter amplitude_A;
 };
 
@@ -43,15 +43,15 @@ struct PhaseSignStatistics {
 
 struct RegressorCorrelation {
   std::string regressor;
-  BeforeAfter d, q;      ///< Pearson correlation with the d and q residual
+  BeforeAfter d, q;  ///< Pearson correlation with the d and q residual
 };
 
 struct ResidualStatistics {
-  BeforeAfter rms_A;                          ///< all used samples
+  BeforeAfter rms_A;  ///< all used samples
   BeforeAfter standstill_rms_A, motion_rms_A;
   std::size_t standstill_samples = 0, motion_samples = 0;
-  std::vector<RegionStatistics> regions;      ///< regions holding at least 0.5 % of the samples
-  std::vector<HarmonicContent> harmonics;     ///< samples in motion; empty for steady-state logs
+  std::vector<RegionStatistics> regions;   ///< regions holding at least 0.5 % of the samples
+  std::vector<HarmonicContent> harmonics;  ///< samples in motion; empty for steady-state logs
   std::vector<PhaseSignStatistics> phase_signs;
   std::vector<RegressorCorrelation> correlations;
 };

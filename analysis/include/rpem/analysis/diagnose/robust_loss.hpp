@@ -22,12 +22,12 @@ inline constexpr double kOutlierP = 1e-3;
 
 /// The outlier test of one set of residuals.
 struct OutlierTest {
-  std::size_t samples = 0;     ///< residual vectors tested
-  double scale_A = 0.0;        ///< σ̂, per component, from the median of |r|²
+  std::size_t samples = 0;                                       ///< residual vectors tested
+  double scale_A = 0.0;                                          ///< σ̂, per component, from the median of |r|²
   double threshold_A = std::numeric_limits<double>::infinity();  ///< b = σ̂·√(2·ln N)
-  std::size_t beyond = 0;      ///< samples with |r| > b (1 expected)
-  double p_value = 1.0;        ///< P(Poisson(1) ≥ beyond)
-  bool outliers = false;       ///< p_value ≤ kOutlierP
+  std::size_t beyond = 0;                                        ///< samples with |r| > b (1 expected)
+  double p_value = 1.0;                                          ///< P(Poisson(1) ≥ beyond)
+  bool outliers = false;                                         ///< p_value ≤ kOutlierP
 };
 
 /// `residuals`: d and q interleaved (EffectFitter::training_residuals' layout).

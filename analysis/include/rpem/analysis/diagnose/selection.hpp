@@ -22,13 +22,13 @@
 namespace rpem::analysis {
 
 struct SelectionOptions {
-  double min_gain_pct = 2.0;   ///< held-out RMS gain an effect must bring
-  double max_p = 0.01;         ///< signed-rank p over the held-out blocks
+  double min_gain_pct = 2.0;  ///< held-out RMS gain an effect must bring
+  double max_p = 0.01;        ///< signed-rank p over the held-out blocks
   /// The held-out RMS² an effect removes must be at least (this × the noise floor)²: a model change below
   /// 0.4 of the sensors' noise (RMS) is not worth naming, however consistent.
   double min_change_of_floor = 0.4;
   int max_effects = 4;
-  int shortlist = 4;           ///< candidates fitted in full per round (at most) …
+  int shortlist = 4;              ///< candidates fitted in full per round (at most) …
   double shortlist_share = 0.05;  ///< … of those screened at this share of the best or more (at least 2);
   /// after the first `leaders` fits, a shortlisted candidate is fitted only if its screening credits it
   /// with this share of the training gain the best of them achieved (it could not rival it otherwise).
@@ -45,12 +45,12 @@ struct SelectionOptions {
 /// One candidate's result in one round (the report's audit trail).
 struct CandidateScore {
   Effect effect;
-  double screen_ssr = 0.0;        ///< predicted training gain [A²]
+  double screen_ssr = 0.0;  ///< predicted training gain [A²]
   bool fitted = false;
-  double gain_pct = 0.0;          ///< held-out RMS gain over the round's starting model
-  double p_value = 1.0;           ///< signed-rank test of the held-out block improvements
-  std::vector<double> start;       ///< the screening's best start (scaled, the catalogue's units)
-  std::vector<double> parameters;  ///< fitted (scaled)
+  double gain_pct = 0.0;                ///< held-out RMS gain over the round's starting model
+  double p_value = 1.0;                 ///< signed-rank test of the held-out block improvements
+  std::vector<double> start;            ///< the screening's best start (scaled, the catalogue's units)
+  std::vector<double> parameters;       ///< fitted (scaled)
   std::vector<double> block_log_ratio;  ///< ln(SSR before / SSR after) per held-out block
 };
 
@@ -71,7 +71,7 @@ struct ImplausibleEffect {
 };
 
 struct Selection {
-  EffectSet model;                     ///< the calibrated constants and the found (named) effects, fitted jointly
+  EffectSet model;  ///< the calibrated constants and the found (named) effects, fitted jointly
   std::vector<FoundEffect> found;
   std::vector<Unidentifiable> not_identifiable;
   std::vector<ImplausibleEffect> implausible;
@@ -81,7 +81,7 @@ struct Selection {
   /// against the model without it (the backward step after each effect found).
   std::vector<ImplausibleEffect> withdrawn;
   std::vector<std::vector<CandidateScore>> rounds;
-  double start_heldout_rms_A = 0.0;     ///< the model selection started from (the calibrated baseline)
+  double start_heldout_rms_A = 0.0;  ///< the model selection started from (the calibrated baseline)
   double extended_heldout_rms_A = 0.0;
 };
 
@@ -94,8 +94,8 @@ struct Selection {
 
 /// Frees the admissible constants `model` does not calibrate, refits, and keeps those then identified if
 /// the held-out residual (`scores`, updated) is no worse; whether any was kept.
-bool readmit_constants(const EffectFitter& fitter, double noise_floor_A, const std::array<bool, kCalibrated.size()>& admissible,
-                       EffectSet& model, BlockScores& scores);
+bool readmit_constants(const EffectFitter& fitter, double noise_floor_A,
+                       const std::array<bool, kCalibrated.size()>& admissible, EffectSet& model, BlockScores& scores);
 
 /// Held-out RMS of block scores [A].
 [[nodiscard]] double rms(const BlockScores& b);

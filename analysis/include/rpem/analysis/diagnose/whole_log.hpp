@@ -51,16 +51,19 @@ struct BaselinePass {
   std::size_t overlay_first = 0, overlay_last = 0;
   double speed_lo_rpm = std::numeric_limits<double>::infinity(), speed_hi_rpm = -std::numeric_limits<double>::infinity();
   double i_q_lo_A = std::numeric_limits<double>::infinity(), i_q_hi_A = -std::numeric_limits<double>::infinity();
-  double temperature_lo_C = std::numeric_limits<double>::infinity(), temperature_hi_C = -std::numeric_limits<double>::infinity();
+  double temperature_lo_C = std::numeric_limits<double>::infinity(),
+         temperature_hi_C = -std::numeric_limits<double>::infinity();
 };
 
 /// The baseline over the whole log.
-[[nodiscard]] BaselinePass baseline_pass(const ModelReplay& replay, const EffectContext& context, const ExtendedModel& baseline);
+[[nodiscard]] BaselinePass baseline_pass(const ModelReplay& replay, const EffectContext& context,
+                                         const ExtendedModel& baseline);
 
 /// The configuration (`baseline`) and the extended model over the whole log: the residual statistics and the
 /// figures' data.
 void comparison_pass(const ModelReplay& replay, const EffectContext& context, const ExtendedModel& baseline,
-                     const ExtendedModel& extended, const BaselinePass& pass, ResidualStatistics& statistics, FigureData& figures);
+                     const ExtendedModel& extended, const BaselinePass& pass, ResidualStatistics& statistics,
+                     FigureData& figures);
 
 /// The electrical speed in rpm of the machine's rotor.
 [[nodiscard]] double speed_rpm(const EffectContext& context, double omega_el_rad_s);

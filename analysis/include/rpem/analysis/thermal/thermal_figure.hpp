@@ -8,8 +8,8 @@
 namespace rpem::analysis {
 
 struct ThermalFigureInput {
-  std::string estimate_csv;    ///< `rpem estimate --thermal`'s CSV
-  std::string measured_csv;    ///< a CSV with a time column `t` [s] and the measured temperatures [°C]; empty: none
+  std::string estimate_csv;  ///< `rpem estimate --thermal`'s CSV
+  std::string measured_csv;  ///< a CSV with a time column `t` [s] and the measured temperatures [°C]; empty: none
   std::string magnet_column = "T_magnet";
   std::string winding_column = "T_winding";
   double judged_after_s = 0.0;  ///< a vertical line where a held-out part begins; 0: none

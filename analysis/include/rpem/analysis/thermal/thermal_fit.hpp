@@ -21,7 +21,7 @@ namespace rpem::analysis {
 struct ThermalFitOptions {
   /// Steps ending at or before this time train; the rest is held out. NaN: the first 75 % of the log's time.
   double fit_until_s = std::numeric_limits<double>::quiet_NaN();
-  int blocks = 8;                     ///< clusters of the training part for the robust intervals
+  int blocks = 8;  ///< clusters of the training part for the robust intervals
   /// The magnet law's ψ_ref from the first magnet observations at the soaked start (else as configured).
   bool anchor_magnet_reference = true;
   int max_iterations = 200;
@@ -55,7 +55,7 @@ struct ThermalFitResult {
   std::vector<std::string> notes;
   double process_noise_K2_per_s = 0.0;
   double disturbance_W2_per_s = 0.0;
-  double training_cost = 0.0;  ///< Σ of the squared weighted residuals
+  double training_cost = 0.0;                 ///< Σ of the squared weighted residuals
   std::vector<core::ThermalVec> open_loop_C;  ///< the model alone over the whole log, per step
 };
 

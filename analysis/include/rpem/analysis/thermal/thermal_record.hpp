@@ -15,7 +15,7 @@ namespace rpem::analysis {
 struct ThermalRecord {
   std::string log;
   std::vector<core::ThermalStepData> steps;
-  std::vector<double> t_s;     ///< each step's end [s]
+  std::vector<double> t_s;      ///< each step's end [s]
   bool winding_sensor = false;  ///< the log has T_winding
   bool coolant = false;         ///< the log has T_coolant (else thermal.coolant_C is used)
   bool averaged = false;

@@ -27,7 +27,8 @@ struct FilterStep {
 
 /// The filter over steps [0, end) (end 0: all); `use_winding_sensor_until_s`: the sensor's readings after
 /// this time are not used (the honest held-out test, docs/thermal.md).
-[[nodiscard]] std::vector<FilterStep> run_filter(const core::ThermalFusionConfig& c, const ThermalRecord& r, std::size_t end = 0,
-                                                 double use_winding_sensor_until_s = std::numeric_limits<double>::infinity());
+[[nodiscard]] std::vector<FilterStep> run_filter(
+    const core::ThermalFusionConfig& c, const ThermalRecord& r, std::size_t end = 0,
+    double use_winding_sensor_until_s = std::numeric_limits<double>::infinity());
 
 }  // namespace rpem::analysis

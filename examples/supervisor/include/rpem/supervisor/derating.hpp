@@ -25,10 +25,10 @@ namespace rpem::supervisor {
 
 /// A protected part's temperatures and the current it allows at its limit.
 struct PartLimits {
-  double warning_C = 0.0;  ///< W: full current up to here
-  double limit_C = 0.0;    ///< L: the floor current here, nothing above (> warning_C)
-  double floor_A = 0.0;    ///< F: in [0, rated_current_A]
-  double raw_sd_K = 0.0;   ///< σ of a raw RPEM-derived temperature while valid (thermal model off)
+  double warning_C = 0.0;     ///< W: full current up to here
+  double limit_C = 0.0;       ///< L: the floor current here, nothing above (> warning_C)
+  double floor_A = 0.0;       ///< F: in [0, rated_current_A]
+  double raw_sd_K = 0.0;      ///< σ of a raw RPEM-derived temperature while valid (thermal model off)
   double max_rate_K_s = 0.0;  ///< Ṫ_max: the fastest the part can heat while its value is not renewed
 };
 
@@ -44,6 +44,7 @@ struct TemperatureEstimate {
 [[nodiscard]] double upper_bound_C(const PartLimits& part, const TemperatureEstimate& t) noexcept;
 
 /// I_c(T⁺) by the law above; `t_upper_C` empty (unknown) gives the floor.
-[[nodiscard]] double part_current_A(const PartLimits& part, double rated_current_A, std::optional<double> t_upper_C) noexcept;
+[[nodiscard]] double part_current_A(const PartLimits& part, double rated_current_A,
+                                    std::optional<double> t_upper_C) noexcept;
 
 }  // namespace rpem::supervisor

@@ -26,10 +26,10 @@ struct PartReadings {
 
 /// The derated current at one moment, and why.
 struct CurrentLimit {
-  double current_A = 0.0;                ///< I_max
-  double magnet_A = 0.0, winding_A = 0.0;  ///< I_magnet, I_winding
+  double current_A = 0.0;                                 ///< I_max
+  double magnet_A = 0.0, winding_A = 0.0;                 ///< I_magnet, I_winding
   std::optional<double> magnet_upper_C, winding_upper_C;  ///< T⁺; empty: unknown
-  bool fresh = false;                    ///< built on an accepted estimate that is not stale
+  bool fresh = false;                                     ///< built on an accepted estimate that is not stale
 };
 
 /// The gate's verdict on a message, and its utime where it was decoded (authentic).
