@@ -242,9 +242,9 @@ void BM_ClassificationInStep(benchmark::State& state) {
   state.counters["ratio"] = (with_s - without_s) / with_s;
 }
 
-/// The same for averaged windows (the paper's machine, 200 Hz uneven windows at 0.4 pu under load): the
-/// classifier on the averaged estimator's inputs against AveragedDriveEstimator::step.
-void BM_AveragedClassificationOverStep(benchmark::State& state) {
+/// The averaged estimator's bench windows: the paper's machine (ψm 5 % below the configuration) at 0.4 pu
+/// under MTPA load with a small ripple on i_q, 200 Hz uneven windows.
+std::vector<core::AveragedSample> averaged_windows() {
   const core::PerUnitBase base = test::paper_base();
   test::AveragedDataGenerator gen;
   gen.base = base;
@@ -255,6 +255,14 @@ void BM_AveragedClassificationOverStep(benchmark::State& state) {
   gen.i_pu = [i](double t) -> core::Vec2 { return i + core::Vec2(0.0, 0.01 * std::sin(7.0 * t)); };
   std::vector<core::AveragedSample> windows;
   for (int k = 0; k < kSamples; ++k) windows.push_back(gen.next());
+  return windows;
+}
+
+/// The same for averaged windows (the paper's machine, 200 Hz uneven windows at 0.4 pu under load): the
+/// classifier on the averaged estimator's inputs against AveragedDriveEstimator::step.
+void BM_AveragedClassificationOverStep(benchmark::State& state) {
+  const core::PerUnitBase base = test::paper_base();
+  std::vector<core::AveragedSample> windows = averaged_windows();
   std::vector<core::RegimeInput> inputs;
   for (std::size_t k = 0; k < windows.size(); ++k) {
     const core::AveragedSample& w = windows[k];
@@ -297,6 +305,38 @@ void BM_AveragedClassificationOverStep(benchmark::State& state) {
   state.counters["ratio"] = classify_s / step_s;
 }
 
+/// The classification's cost inside the averaged step, as BM_ClassificationInStep: AveragedDriveEstimator::step
+/// with `estimator.regimes.enabled` and without (which takes the slope between window centres itself), in
+/// alternating blocks. ratio = (with − without)/with.
+void BM_AveragedClassificationInStep(benchmark::State& state) {
+  core::EstimatorSettings settings = test::paper_settings(core::Algorithm::kSga);
+  core::AveragedDriveEstimator with(test::paper_machine_si(), settings);
+  settings.regimes.enabled = false;
+  core::AveragedDriveEstimator without(test::paper_machine_si(), settings);
+  std::vector<core::AveragedSample> a = averaged_windows(), b = a;
+  const std::int64_t pass_ns = a.back().t_ns - a.front().t_start_ns;
+  const auto pass = [pass_ns](core::AveragedDriveEstimator& est, std::vector<core::AveragedSample>& windows) {
+    for (core::AveragedSample& w : windows) {
+      benchmark::DoNotOptimize(est.step(w));
+      w.t_start_ns += pass_ns;
+      w.t_ns += pass_ns;
+    }
+  };
+  double with_s = 0.0, without_s = 0.0;
+  for (auto _ : state) {
+    const double t0 = thread_cpu_s();
+    pass(without, b);
+    const double t1 = thread_cpu_s();
+    pass(with, a);
+    with_s += thread_cpu_s() - t1;
+    without_s += t1 - t0;
+  }
+  const double steps = static_cast<double>(state.iterations()) * kSamples;
+  state.counters["with_ns"] = 1e9 * with_s / steps;
+  state.counters["without_ns"] = 1e9 * without_s / steps;
+  state.counters["ratio"] = (with_s - without_s) / with_s;
+}
+
 BENCHMARK(BM_ClassificationInStep)
     ->MinTime(1.0)
     ->Repetitions(10)
@@ -308,6 +348,11 @@ BENCHMARK(BM_ClassificationOverStep)
     ->ComputeStatistics("max", max_of)
     ->ReportAggregatesOnly(true);
 BENCHMARK(BM_AveragedClassificationOverStep)
+    ->MinTime(1.0)
+    ->Repetitions(10)
+    ->ComputeStatistics("max", max_of)
+    ->ReportAggregatesOnly(true);
+BENCHMARK(BM_AveragedClassificationInStep)
     ->MinTime(1.0)
     ->Repetitions(10)
     ->ComputeStatistics("max", max_of)

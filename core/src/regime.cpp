@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <limits>
 
 #include "rpem/core/assert.hpp"
@@ -18,6 +19,16 @@ constexpr double kSigmaPerMedian = 1.4826022185056018;
 constexpr double kTrackUp = 1.0644944589178593;     // e^{1/16}
 constexpr double kTrackDown = 0.93941306281347581;  // e^{−1/16}
 
+/// regime_of() for every combination of the bits, by look-up: the precedence as a chain of conditional
+/// jumps on bits that vary from sample to sample costs a misprediction now and then.
+static_assert((regime_bit::kExcluded | regime_bit::kExcitesPsiM | regime_bit::kExcitesRs | regime_bit::kPreviousMixed) < 128,
+              "every classification's bits index the table");
+constexpr std::array<Regime, 128> kRegimeOfBits = [] {
+  std::array<Regime, 128> table{};
+  for (std::size_t b = 0; b < table.size(); ++b) table[b] = regime_of(static_cast<std::uint8_t>(b));
+  return table;
+}();
+
 /// One step of the median tracker m of |r|: up by e^η when |r| > m, down by e^{−η} otherwise; it settles
 /// where |r| exceeds m half the time. The first nonzero |r| starts it.
 double track_median(double m, double a) noexcept {
@@ -28,6 +39,46 @@ double track_median(double m, double a) noexcept {
   return m == 0.0 ? a : stepped;
 }
 
+/// Two doubles as one GCC vector: its comparisons give a lane mask and `?:` selects by it, one source that
+/// g++ and clang compile to packed SSE2 on x86-64 (NEON on aarch64, scalar code elsewhere) — branch-free,
+/// where Eigen's select() evaluates element by element with a conditional jump each. A comparison is the
+/// scalar comparison per lane (false where either side is NaN; ±0 equal).
+using Lanes = double __attribute__((vector_size(16)));
+static_assert(sizeof(Lanes) == sizeof(Vec2), "a Vec2 is two packed doubles");
+
+[[gnu::always_inline]] inline Lanes lanes(const Vec2& v) noexcept {
+  Lanes l;
+  std::memcpy(&l, v.data(), sizeof l);  // one 16-byte load
+  return l;
+}
+[[gnu::always_inline]] inline Vec2 vec(const Lanes& l) noexcept {
+  Vec2 v;
+  std::memcpy(v.data(), &l, sizeof l);
+  return v;
+}
+
+/// Per lane, a > b ? x : y.
+[[gnu::always_inline]] inline Vec2 select_greater(const Vec2& a, const Vec2& b, const Vec2& x, const Vec2& y) noexcept {
+  return vec(lanes(a) > lanes(b) ? lanes(x) : lanes(y));
+}
+
+/// Per lane, m == 0 ? x : y.
+[[gnu::always_inline]] inline Vec2 select_zero(const Vec2& m, const Vec2& x, const Vec2& y) noexcept {
+  return vec(lanes(m) == 0.0 ? lanes(x) : lanes(y));
+}
+
+/// track_median on two quantities at once (u and i), each lane as the scalar form steps it: the same
+/// factor, the same product, the same start (the pair is one packed operation where a scalar step was one each).
+[[gnu::always_inline]] inline Vec2 track_medians(const Vec2& m, const Vec2& a) noexcept {
+  const Vec2 stepped = m.cwiseProduct(select_greater(a, m, Vec2::Constant(kTrackUp), Vec2::Constant(kTrackDown)));
+  return select_zero(m, a, stepped);
+}
+
+/// The smallest nonzero |change| of two quantities at once (u and i): q = min(q, a > 0 ? a : q) per lane.
+[[gnu::always_inline]] inline Vec2 track_resolutions(const Vec2& q, const Vec2& a) noexcept {
+  return q.cwiseMin(select_greater(a, Vec2::Zero(), a, q));
+}
+
 /// The smallest nonzero |change|; whether it became smaller.
 bool track_resolution(double& q, double change) noexcept {
   const double a = std::abs(change), before = q;
@@ -35,16 +86,30 @@ bool track_resolution(double& q, double change) noexcept {
   return q < before;
 }
 
+/// A sample far from the previous one: the change of operating point between them excited a transient
+/// that has decayed to e^{−Δt/τ_el} of |Δi| (τ_el the slowest the model admits). Steady if that remnant is
+/// within the current's noise (its own estimate's noise, 2·decay²·σ_i², included). `dt_over_tau` = Δt/τ_el,
+/// `z_sq_var_i` = z²·σ_i². Out of line: the exp() call would otherwise make the common path spill.
+[[gnu::noinline]] std::uint8_t standalone_transient(double dt_over_tau, const Vec2& di, double z_sq_var_i) noexcept {
+  const double decay = std::exp(-dt_over_tau);
+  const Vec2 remnant = decay * di.cwiseAbs();
+  const double bound = z_sq_var_i * (1.0 + 2.0 * decay * decay);
+  return remnant.squaredNorm() > 0.0 && remnant.cwiseProduct(remnant).maxCoeff() > bound ? regime_bit::kTransient : 0;
+}
+
 /// Learns a sample's noise and resolution from the chain and takes it in as the chain's last. Returns
-/// whether a measured resolution changed.
-bool learn(RegimeState& s, const RegimeInput& in, double t_s) noexcept {
+/// whether a measured resolution changed. u's and i's trackers run as one pair (d's change first, then
+/// q's: a minimum does not depend on the order, a median tracker's two steps keep theirs).
+bool learn(RegimeState& s, const RegimeInput& in, double t_s, double w) noexcept {
   bool resolution_changed = false;
   if (s.points >= 1) {
     const Vec2 du = (in.u_pu - s.u_pu[0]).cwiseAbs(), di = (in.i_pu - s.i_pu[0]).cwiseAbs();
+    const Vec2 before(s.measured_resolution_pu[0], s.measured_resolution_pu[1]);
+    const Vec2 q = track_resolutions(track_resolutions(before, Vec2(du[0], di[0])), Vec2(du[1], di[1]));
+    s.measured_resolution_pu[0] = q[0];
+    s.measured_resolution_pu[1] = q[1];
     resolution_changed =
-        track_resolution(s.measured_resolution_pu[0], du[0]) | track_resolution(s.measured_resolution_pu[0], du[1]) |
-        track_resolution(s.measured_resolution_pu[1], di[0]) | track_resolution(s.measured_resolution_pu[1], di[1]) |
-        track_resolution(s.measured_resolution_pu[2], in.n_pu - s.n_pu[0]);
+        (q[0] < before[0]) | (q[1] < before[1]) | track_resolution(s.measured_resolution_pu[2], in.n_pu - s.n_pu[0]);
   }
   // Only a chain's samples are close enough for their second difference to be noise: a standalone
   // sample's neighbours are other operating points.
@@ -52,17 +117,19 @@ bool learn(RegimeState& s, const RegimeInput& in, double t_s) noexcept {
   const double span = t_s - s.t_s[1];
   if (s.points == 2 && chain && s.chained >= 1 && span > 0.0) {
     // The middle sample against the line through its neighbours, r = x₁ − (w·x₂ + (1 − w)·x₀) with
-    // w = (t₁ − t₀)/(t₂ − t₀): zero for a ramp at any spacing; for white noise of σ its variance is
-    // σ²·(1 + w² + (1 − w)²) = σ²·(3/2 + 2·d), d = (w − ½)² ∈ [0, ¼], whose root the factor removes:
+    // w = (t₁ − t₀)/(t₂ − t₀) (step() divides it beside the slope's 1/Δt): zero for a ramp at any
+    // spacing; for white noise of σ its variance is σ²·(1 + w² + (1 − w)²) = σ²·(3/2 + 2·d),
+    // d = (w − ½)² ∈ [0, ¼], whose root the factor removes:
     // (3/2 + 2d)^{−½} ≈ 0.81650 − 0.53215·d + 0.37763·d², within 2e-4 (no square root per sample).
-    const double w = (s.t_s[0] - s.t_s[1]) / span;
     const double d = (w - 0.5) * (w - 0.5);
     const double norm = 0.81649658 + d * (-0.53215 + d * 0.37763);
     const Vec2 ru = norm * (s.u_pu[0] - (w * in.u_pu + (1.0 - w) * s.u_pu[1])).cwiseAbs();
     const Vec2 ri = norm * (s.i_pu[0] - (w * in.i_pu + (1.0 - w) * s.i_pu[1])).cwiseAbs();
     const double rn = norm * std::abs(s.n_pu[0] - (w * in.n_pu + (1.0 - w) * s.n_pu[1]));
-    s.noise_median_pu[0] = track_median(track_median(s.noise_median_pu[0], ru[0]), ru[1]);
-    s.noise_median_pu[1] = track_median(track_median(s.noise_median_pu[1], ri[0]), ri[1]);
+    const Vec2 m = track_medians(track_medians(Vec2(s.noise_median_pu[0], s.noise_median_pu[1]), Vec2(ru[0], ri[0])),
+                                 Vec2(ru[1], ri[1]));
+    s.noise_median_pu[0] = m[0];
+    s.noise_median_pu[1] = m[1];
     s.noise_median_pu[2] = track_median(s.noise_median_pu[2], rn);
     s.noise_known = true;
   }
@@ -147,101 +214,48 @@ RegimeNoise RegimeClassifier::current_noise() const noexcept {
   return {variance(0), variance(1), variance(2)};
 }
 
-std::uint8_t RegimeClassifier::transient_bits(const RegimeInput& in, double dt_s) noexcept {
+/// What step() derives once from the sample and the chain for every test. The tests take these as locals,
+/// not back from the state step() has just stored them in (each such load would wait on its store, on the
+/// path from 1/Δt's division to every test).
+struct RegimeClassifier::Terms {
+  double dt_s = 0.0;          ///< from the chain's last window centre
+  Vec2 slope = Vec2::Zero();  ///< the current's slope this sample's correction takes [pu/s]
+  Vec2 previous_slope = Vec2::Zero();
+  double inv_dt = 0.0, previous_inv_dt = 0.0;
+  /// n²·x_q², n²·x_d² as every test forms them (n²·x·x), as one pair; and the voltage noise of a row, d and q
+  /// (the transient test's rows and ψm's noise begin with it): σ_u² + (r² + n²·x_o²)·σ_i².
+  Vec2 n2_x2 = Vec2::Zero();
+  Vec2 row_noise = Vec2::Zero();
+};
+
+std::uint8_t RegimeClassifier::bridge_bits(const RegimeInput& in) const noexcept {
   const RegimeConfig& c = config_;
-  const Constants& k = k_;
   const RegimeNoise& v = noise_;
-  const Vec2& i = in.i_pu;
   const double n = in.n_pu, n2 = n * n;
-  RegimeState& s = state_;
-  const Vec2& sl = s.slope_pu_s;
-  const Vec2 abs_sl = sl.cwiseAbs();
-  const double n2_xq2 = n2 * c.x_q_pu * c.x_q_pu, n2_xd2 = n2 * c.x_d_pu * c.x_d_pu;
-  std::uint8_t bits = 0;
-  if (in.timing == SampleTiming::kStandalone && s.points >= 1) [[unlikely]] {
-    // A sample far from the previous one: the change of operating point between them excited a transient
-    // that has decayed to e^{−Δt/τ_el} of |Δi| (τ_el the slowest the model admits). Steady if that
-    // remnant is within the current's noise (its own estimate's noise, 2·decay²·σ_i², included).
-    const double decay = std::exp(-dt_s / c.electrical_time_constant_s);
-    const Vec2 remnant = decay * (i - s.i_pu[0]).cwiseAbs();
-    const double bound = k.z_sq * v.i_sq * (1.0 + 2.0 * decay * decay);
-    if (remnant.squaredNorm() > 0.0 && remnant.cwiseProduct(remnant).maxCoeff() > bound) bits |= regime_bit::kTransient;
-  } else if (in.timing == SampleTiming::kContiguous && s.slope_valid) {
-    // Consecutive windows: what the steady state and the inductive correction (the slope between window
-    // centres) leave out, per row (d, q) in voltage:
-    //   (x/ω_n)·|s_k − s_{k−1}|   the slope changed: the correction is exact only for a ramp
-    //   (Δx/ω_n)·|s_k|            the inductance's tolerance on the correction
-    //   x_o·|Δn|·|Δi_o|/4          mean(n·x·i) − n̄·x·ī, bounded by the ranges' product over 4
-    // against the row's noise and the slope change's own noise.
-    const double dn = std::abs(n - s.n_pu[0]);
-    const Vec2 di = (i - s.i_pu[0]).cwiseAbs();
-    Vec2 t = k.inv_omega_n * k.dx.cwiseProduct(abs_sl) + (0.25 * dn) * k.x_swapped.cwiseProduct(di.reverse());
-    double slope_noise_sq = 0.0;  // Var(s_k − s_{k−1}) per σ_i²
-    if (s.previous_slope_valid) {
-      t += k.inv_omega_n * k.x.cwiseProduct((sl - s.previous_slope_pu_s).cwiseAbs());
-      const double a = s.inv_dt, p = s.previous_inv_dt;
-      slope_noise_sq = a * a + (a + p) * (a + p) + p * p;
-    }
-    const double slope_var = k.inv_omega_n_sq * slope_noise_sq * v.i_sq;
-    const double row_d = v.u_sq + (k.r_sq + n2_xq2) * v.i_sq + k.x_sq[0] * slope_var;
-    const double row_q = v.u_sq + (k.r_sq + n2_xd2) * v.i_sq + k.x_sq[1] * slope_var;
-    const bool own = t[0] * t[0] > k.z_sq * row_d || t[1] * t[1] > k.z_sq * row_q;
-    // A slope change shows only once both windows around the junction are in: the window after one is
-    // corrected with a slope that straddles it.
-    if (own || s.previous_transient) bits |= regime_bit::kTransient;
-    s.previous_transient = own;
+  // Bridge off: the reported voltage and the current are zero within their noise where a modulating bridge
+  // could not hold a zero current: with |u| inside the voltage's zero band √c₂·σ_u the machine would carry
+  // |i| = |M⁻¹·(u − e)| ≥ (|n|·ψ_min − √c₂·σ_u)/‖M‖, ‖M‖ ≤ ‖M‖_F = √(2·r² + n²·(x_d² + x_q²)) at D_M's largest r,
+  // beyond the current's zero band √c₂·σ_i.
+  if (in.u_reported_sq_pu <= c.chi2 * v.u_sq && in.i_pu.squaredNorm() <= c.chi2 * v.i_sq) [[unlikely]] {
+    const double r = k_.r_max;
+    const double emf_margin = std::abs(n) * c.psi_min_pu - std::sqrt(c.chi2 * v.u_sq);
+    const double m_sq = 2.0 * r * r + n2 * (c.x_d_pu * c.x_d_pu + c.x_q_pu * c.x_q_pu);
+    if (emf_margin > 0.0 && emf_margin * emf_margin > c.chi2 * v.i_sq * m_sq) return regime_bit::kBridgeOff;
   }
-  return bits;
+  return 0;
 }
 
-std::uint8_t RegimeClassifier::excitation_bits(const RegimeInput& in) const noexcept {
+std::uint8_t RegimeClassifier::lock_bits(const RegimeInput& in, const Terms& t) const noexcept {
   const RegimeConfig& c = config_;
   const Constants& k = k_;
-  const RegimeNoise& v = noise_;
-  const Vec2& i = in.i_pu;
-  const double n = in.n_pu, n2 = n * n;
-  const double abs_n = std::abs(n);
-  const Vec2 abs_i = i.cwiseAbs();
-  const double n2_xd2 = n2 * c.x_d_pu * c.x_d_pu;
-  const double i_sq = i.squaredNorm();
-  std::uint8_t bits = 0;
-  // Excitation: the parameter's term, at its smallest inside D_M, less what the other terms' uncertainty
-  // can put in its place, against its noise as the estimator's averaging leaves it: h² = γ/(2 − γ) of
-  // one sample's variance (an exponential filter of gain γ).
-  const double psi_term = abs_n * c.psi_min_pu - c.dr_pu * abs_i[1] - abs_n * c.dx_d_pu * abs_i[0];
-  if (psi_term > 0.0) {
-    const double h_sq = in.weight[0] / (2.0 - in.weight[0]);
-    const double noise = v.u_sq + (k.r_sq + n2_xd2) * v.i_sq + k.psi_max_sq * v.n_sq;
-    if (psi_term * psi_term > k.z_sq * h_sq * noise) bits |= regime_bit::kExcitesPsiM;
-  }
-  // r_min·|i| must at least exceed |n|·Δψ: checked on the squares before |i| is taken.
-  if (k.r_min_sq * i_sq > n2 * c.dpsi_pu * c.dpsi_pu) {
-    const double i_abs = std::sqrt(i_sq);
-    const double term = c.r_min_pu * i_abs - abs_n * (c.dpsi_pu + k.dx_max * i_abs);
-    if (term > 0.0) {
-      const double h_sq = in.weight[1] / (2.0 - in.weight[1]);
-      const double flux = c.psi_max_pu + k.x_max * i_abs;
-      const double noise = v.u_sq + (k.r_sq + n2 * k.x_max * k.x_max) * v.i_sq + flux * flux * v.n_sq;
-      if (term * term > k.z_sq * h_sq * noise) bits |= regime_bit::kExcitesRs;
-    }
-  }
-  return bits;
-}
-
-std::uint8_t RegimeClassifier::lock_bits(const RegimeInput& in) const noexcept {
-  const RegimeConfig& c = config_;
-  const Constants& k = k_;
-  const RegimeState& s = state_;
   const RegimeNoise& v = noise_;
   const Vec2& i = in.i_pu;
   const double n = in.n_pu, n2 = n * n, abs_n = std::abs(n);
   const Vec2 abs_i = i.cwiseAbs();
-  // n²·x_q², n²·x_d² as every test forms them (n²·x·x).
-  const double n2_xq2 = n2 * c.x_q_pu * c.x_q_pu, n2_xd2 = n2 * c.x_d_pu * c.x_d_pu;
   // Angle locked: e, what the model leaves to the magnet, lies in the cone of half-angle δ_tol about
   // sgn(n)·q, widened by what the configuration's uncertainty (r within D_M, x within its tolerance) and
   // the noise can put there. Independent of ψm's magnitude. Both axes at once: (d, q) in one vector.
-  const Vec2& sl = s.slope_pu_s;
+  const Vec2& sl = t.slope;
   const Vec2 abs_sl = sl.cwiseAbs();
   const Vec2 rotation = (n * k.x_swapped).cwiseProduct(i.reverse()).cwiseProduct(Vec2(1.0, -1.0));  // −n·J·x·i
   const Vec2 e = ((in.u_pu - c.r_pu * i) - k.x_over_omega_n.cwiseProduct(sl)) + rotation;
@@ -251,14 +265,101 @@ std::uint8_t RegimeClassifier::lock_bits(const RegimeInput& in) const noexcept {
   const double along = n2 > k.z_sq * v.n_sq ? (n > 0.0 ? e[1] : -e[1]) : std::abs(e[1]);
   const double lock = std::abs(e[0]) - c.tan_angle * (along + b[1]) - b[0];
   if (lock > 0.0) [[unlikely]] {
-    const double slope_sq = 2.0 * s.inv_dt * s.inv_dt;  // Var(s) per σ_i²
-    const double var_d =
-        v.u_sq + (k.r_sq + n2_xq2 + k.slope_var_x_sq[0] * slope_sq) * v.i_sq + c.x_q_pu * c.x_q_pu * i[1] * i[1] * v.n_sq;
+    const double slope_sq = 2.0 * t.inv_dt * t.inv_dt;  // Var(s) per σ_i²
+    const double var_d = v.u_sq + (k.r_sq + t.n2_x2[0] + k.slope_var_x_sq[0] * slope_sq) * v.i_sq +
+                         c.x_q_pu * c.x_q_pu * i[1] * i[1] * v.n_sq;
     const double flux_q = c.psi_max_pu + c.x_d_pu * abs_i[0];
-    const double var_q = v.u_sq + (k.r_sq + n2_xd2 + k.slope_var_x_sq[1] * slope_sq) * v.i_sq + flux_q * flux_q * v.n_sq;
+    const double var_q = v.u_sq + (k.r_sq + t.n2_x2[1] + k.slope_var_x_sq[1] * slope_sq) * v.i_sq + flux_q * flux_q * v.n_sq;
     if (lock * lock > k.z_sq * (var_d + c.tan_angle * c.tan_angle * var_q)) return regime_bit::kNotLocked;
   }
   return 0;
+}
+
+std::uint8_t RegimeClassifier::contiguous_transient_bits(const RegimeInput& in, const Terms& t) noexcept {
+  const Constants& k = k_;
+  const RegimeNoise& v = noise_;
+  RegimeState& s = state_;
+  // Consecutive windows: what the steady state and the inductive correction (the slope between window
+  // centres) leave out, per row (d, q) in voltage:
+  //   (x/ω_n)·|s_k − s_{k−1}|   the slope changed: the correction is exact only for a ramp
+  //   (Δx/ω_n)·|s_k|            the inductance's tolerance on the correction
+  //   x_o·|Δn|·|Δi_o|/4          mean(n·x·i) − n̄·x·ī, bounded by the ranges' product over 4
+  // against the row's noise and the slope change's own noise.
+  const double dn = std::abs(in.n_pu - s.n_pu[0]);
+  const Vec2 di = (in.i_pu - s.i_pu[0]).cwiseAbs();
+  Vec2 term = k.inv_omega_n * k.dx.cwiseProduct(t.slope.cwiseAbs()) + (0.25 * dn) * k.x_swapped.cwiseProduct(di.reverse());
+  double slope_noise_sq = 0.0;  // Var(s_k − s_{k−1}) per σ_i²
+  if (s.previous_slope_valid) {
+    term += k.inv_omega_n * k.x.cwiseProduct((t.slope - t.previous_slope).cwiseAbs());
+    const double a = t.inv_dt, p = t.previous_inv_dt;
+    slope_noise_sq = a * a + (a + p) * (a + p) + p * p;
+  }
+  const double slope_var = k.inv_omega_n_sq * slope_noise_sq * v.i_sq;
+  const Vec2 row = t.row_noise + k.x_sq * slope_var;  // σ² of the rows d and q
+  const Vec2 term_sq = term.cwiseProduct(term), bound = k.z_sq * row;
+  const bool own = (term_sq[0] > bound[0]) | (term_sq[1] > bound[1]);
+  // A slope change shows only once both windows around the junction are in: the window after one is
+  // corrected with a slope that straddles it.
+  const bool transient = own || s.previous_transient;
+  s.previous_transient = own;
+  return transient ? regime_bit::kTransient : 0;
+}
+
+std::uint8_t RegimeClassifier::excitation_bits(const RegimeInput& in, const Terms& t) const noexcept {
+  const RegimeConfig& c = config_;
+  const Constants& k = k_;
+  const RegimeNoise& v = noise_;
+  const Vec2& i = in.i_pu;
+  const double n = in.n_pu, n2 = n * n, abs_n = std::abs(n);
+  const Vec2 abs_i = i.cwiseAbs();
+  const double i_sq = i.squaredNorm();
+  std::uint8_t bits = 0;
+  // Excitation: the parameter's term, at its smallest inside D_M, less what the other terms' uncertainty
+  // can put in its place, against its noise as the estimator's averaging leaves it: h² = γ/(2 − γ) of
+  // one sample's variance (an exponential filter of gain γ).
+  const Vec2 h_sq = in.weight.array() / (2.0 - in.weight.array());  // ψm's and r_s' in one division of a pair
+  const double psi_term = abs_n * c.psi_min_pu - c.dr_pu * abs_i[1] - abs_n * c.dx_d_pu * abs_i[0];
+  if (psi_term > 0.0) {
+    const double noise = t.row_noise[1] + k.psi_max_sq * v.n_sq;
+    if (psi_term * psi_term > k.z_sq * h_sq[0] * noise) bits |= regime_bit::kExcitesPsiM;
+  }
+  // r_min·|i| must at least exceed |n|·Δψ: checked on the squares before |i| is taken.
+  if (k.r_min_sq * i_sq > n2 * c.dpsi_pu * c.dpsi_pu) {
+    const double i_abs = std::sqrt(i_sq);
+    const double term = c.r_min_pu * i_abs - abs_n * (c.dpsi_pu + k.dx_max * i_abs);
+    if (term > 0.0) {
+      const double flux = c.psi_max_pu + k.x_max * i_abs;
+      const double noise = v.u_sq + (k.r_sq + n2 * k.x_max * k.x_max) * v.i_sq + flux * flux * v.n_sq;
+      if (term * term > k.z_sq * h_sq[1] * noise) bits |= regime_bit::kExcitesRs;
+    }
+  }
+  return bits;
+}
+
+RegimeClassifier::Terms RegimeClassifier::take_slope(const RegimeInput& in, double dt_s) noexcept {
+  RegimeState& s = state_;
+  Terms t;
+  t.dt_s = dt_s;
+  // The current's slope: given (a block's end points), or between consecutive samples of a chain.
+  t.previous_slope = s.slope_pu_s;
+  t.previous_inv_dt = s.inv_dt;
+  s.previous_slope_pu_s = t.previous_slope;
+  s.previous_slope_valid = s.slope_valid;
+  s.previous_inv_dt = t.previous_inv_dt;
+  const bool linked =
+      s.points >= 1 && dt_s > 0.0 && (in.timing == SampleTiming::kDense || in.timing == SampleTiming::kContiguous);
+  t.inv_dt = linked ? 1.0 / dt_s : 0.0;
+  if (!linked) {
+    s.previous_transient = false;
+  } else if (std::isnan(in.di_dt_pu_s[0])) {
+    t.slope = (in.i_pu - s.i_pu[0]) * t.inv_dt;
+  } else {
+    t.slope = in.di_dt_pu_s;
+  }
+  s.inv_dt = t.inv_dt;
+  s.slope_valid = linked;
+  s.slope_pu_s = t.slope;
+  return t;
 }
 
 Classification RegimeClassifier::step(const RegimeInput& in) noexcept {
@@ -276,47 +377,22 @@ Classification RegimeClassifier::step(const RegimeInput& in) noexcept {
   }
   // Times are window centres (a mean stands for its centre), relative to the first sample.
   const double t_s = to_seconds(in.t_ns - s.t_origin_ns) - 0.5 * in.window_s;
-  const double dt_s = s.points >= 1 ? t_s - s.t_s[0] : 0.0;
-
-  // The current's slope: given (a block's end points), or between consecutive samples of a chain.
-  s.previous_slope_pu_s = s.slope_pu_s;
-  s.previous_slope_valid = s.slope_valid;
-  s.previous_inv_dt = s.inv_dt;
-  const bool linked =
-      s.points >= 1 && dt_s > 0.0 && (in.timing == SampleTiming::kDense || in.timing == SampleTiming::kContiguous);
-  s.inv_dt = linked ? 1.0 / dt_s : 0.0;
-  s.slope_valid = linked;
-  if (!linked) {
-    s.slope_pu_s.setZero();
-    s.previous_transient = false;
-  } else if (std::isnan(in.di_dt_pu_s[0])) {
-    s.slope_pu_s = (in.i_pu - s.i_pu[0]) * s.inv_dt;
-  } else {
-    s.slope_pu_s = in.di_dt_pu_s;
-  }
+  const double w = (s.t_s[0] - s.t_s[1]) / (t_s - s.t_s[1]);  // learn()'s w = (t₁ − t₀)/(t₂ − t₀)
+  Terms t = take_slope(in, s.points >= 1 ? t_s - s.t_s[0] : 0.0);
 
   noise_ = current_noise();
   const RegimeNoise& v = noise_;
-  const Vec2& i = in.i_pu;
-  const double n = in.n_pu, n2 = n * n, abs_n = std::abs(n);
-  std::uint8_t bits = 0;
+  const double n2 = in.n_pu * in.n_pu;
+  t.n2_x2 = (n2 * k.x_swapped).cwiseProduct(k.x_swapped);
+  t.row_noise = Vec2::Constant(v.u_sq) + (Vec2::Constant(k.r_sq) + t.n2_x2) * v.i_sq;
 
-  // Bridge off: the reported voltage and the current are zero within their noise where a modulating bridge
-  // could not hold a zero current: with |u| inside the voltage's zero band √c₂·σ_u the machine would carry
-  // |i| = |M⁻¹·(u − e)| ≥ (|n|·ψ_min − √c₂·σ_u)/‖M‖, ‖M‖ ≤ ‖M‖_F = √(2·r² + n²·(x_d² + x_q²)) at D_M's largest r,
-  // beyond the current's zero band √c₂·σ_i.
-  const double i_sq = i.squaredNorm();
-  if (in.u_reported_sq_pu <= c.chi2 * v.u_sq && i_sq <= c.chi2 * v.i_sq) [[unlikely]] {
-    const double r = k.r_max;
-    const double emf_margin = abs_n * c.psi_min_pu - std::sqrt(c.chi2 * v.u_sq);
-    const double m_sq = 2.0 * r * r + n2 * (c.x_d_pu * c.x_d_pu + c.x_q_pu * c.x_q_pu);
-    if (emf_margin > 0.0 && emf_margin * emf_margin > c.chi2 * v.i_sq * m_sq) bits |= regime_bit::kBridgeOff;
-  }
-
-  bits |= lock_bits(in);
-  bits |= transient_bits(in, dt_s);
-
-  bits |= excitation_bits(in);
+  std::uint8_t bits = bridge_bits(in) | lock_bits(in, t);
+  // A standalone sample's transient test calls exp(): judged last (below), so that across the call few values
+  // are live and the common path keeps its values in registers.
+  const bool standalone = in.timing == SampleTiming::kStandalone && s.points >= 1;
+  const Vec2 i_before = s.i_pu[0];
+  if (in.timing == SampleTiming::kContiguous && s.slope_valid) bits |= contiguous_transient_bits(in, t);
+  bits |= excitation_bits(in, t);
 
   // Before a chain has shown the data's noise, nothing in it is excluded on a threshold made of it.
   if (!s.noise_known && in.timing != SampleTiming::kStandalone) bits &= static_cast<std::uint8_t>(~regime_bit::kExcluded);
@@ -333,9 +409,11 @@ Classification RegimeClassifier::step(const RegimeInput& in) noexcept {
   }
   s.previous_window = window;
   s.previous_bridge_off = off;
-  if (learn(s, in, t_s)) [[unlikely]]
+  if (learn(s, in, t_s, w)) [[unlikely]]
     update_quantisation();
-  return Classification::of(bits);
+  if (standalone) [[unlikely]]
+    bits |= standalone_transient(t.dt_s / c.electrical_time_constant_s, in.i_pu - i_before, k.z_sq * v.i_sq);
+  return {kRegimeOfBits[bits], bits};
 }
 
 void StreamClassifier::clear_sums() noexcept {

@@ -268,11 +268,14 @@ class RegimeClassifier {
 
   /// Recomputes quantisation_var_ (after a resolution changed or the configuration did).
   void update_quantisation() noexcept;
-  /// step()'s parts: the transient bit of a standalone or contiguous sample (dt_s from the chain's last
-  /// sample), the excitation bits of ψm and Rs, and the angle-lock test — against noise_, with the slope step() has just taken.
-  [[nodiscard]] std::uint8_t transient_bits(const RegimeInput& in, double dt_s) noexcept;
-  [[nodiscard]] std::uint8_t excitation_bits(const RegimeInput& in) const noexcept;
-  [[nodiscard]] std::uint8_t lock_bits(const RegimeInput& in) const noexcept;  ///< kNotLocked or 0
+  /// step()'s parts, each against noise_ and the terms step() has just taken (regime.cpp): the slope and
+  /// its state; the bridge-off, angle-lock, contiguous windows' transient and excitation bits.
+  struct Terms;
+  [[nodiscard]] Terms take_slope(const RegimeInput& in, double dt_s) noexcept;
+  [[nodiscard]] std::uint8_t bridge_bits(const RegimeInput& in) const noexcept;                ///< kBridgeOff or 0
+  [[nodiscard]] std::uint8_t lock_bits(const RegimeInput& in, const Terms& t) const noexcept;  ///< kNotLocked or 0
+  [[nodiscard]] std::uint8_t contiguous_transient_bits(const RegimeInput& in, const Terms& t) noexcept;
+  [[nodiscard]] std::uint8_t excitation_bits(const RegimeInput& in, const Terms& t) const noexcept;
 
   RegimeConfig config_;
   Constants k_;
