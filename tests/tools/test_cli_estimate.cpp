@@ -194,7 +194,7 @@ TEST(CliEstimate, PaderbornAveragedRowsFollowEachRowsPsiMFromTheFirstRowsAtSpeed
   // 1 − e^{−λ·2.5 s} = 0.9985 (λ = γ_L/T_samp = 2.6/s for ψm), so ψ̂m is the row's own steady-state solution
   // (paderborn_row_psi_m, from the phase log of the same rows) up to 0.15 % of the previous row's error and the
   // d row's share of the least squares: within 0.5 % (≈ 4 K of magnet temperature at NdFeB's −0.12 %/K) from
-  // 20 s on, two rows after the speed reaches 5 000 rpm, to the end. This is what the thermal fit anchors the
+  // 20 s on, four rows after the speed reaches 5 000 rpm, to the end. This is what the thermal fit anchors the
   // magnet law on (the first magnet observations). The regression it guards against (docs/thermal.md, "Since
   // the regimes merge"): the rows as one chain, whose second differences over the run-up were taken for
   // noise, held ψ̂m at its start, 10 % off, until 80 s, and moved the validation's magnet by −8.6 K.
@@ -216,7 +216,10 @@ TEST(CliEstimate, PaderbornAveragedRowsFollowEachRowsPsiMFromTheFirstRowsAtSpeed
     if (t.rows[k][time] < 20.0 || !std::isfinite(per_row[k])) continue;
     ++judged;
     const double deviation = std::abs(t.rows[k][psi] / per_row[k] - 1.0);
-    if (deviation > worst) worst = deviation, worst_t = t.rows[k][time];
+    if (deviation > worst) {
+      worst = deviation;
+      worst_t = t.rows[k][time];
+    }
   }
   EXPECT_GT(judged, 2950U);  // of 3003 rows
   EXPECT_LE(worst, 0.005) << "psi_m off its row's steady-state value by " << worst << " at t = " << worst_t << " s";
