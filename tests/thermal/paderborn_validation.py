@@ -78,16 +78,15 @@ def main() -> int:
     m, wd = result["magnet"], result["winding"]
     # Met: the acceptance's coverage, on both; the winding with its sensor (circular, stated).
     check("winding fused 2σ coverage, no sensor in the cool-down (acceptance >= 0.9)", wd["fused"]["cover_2sigma"], 0.9, 1.0)
+    check("magnet fused 2σ coverage (acceptance >= 0.9)", m["fused"]["cover_2sigma"], 0.9, 1.0)
     check("winding fused with its sensor: RMS (acceptance <= 3 K; circular)", wd["fused_with_sensor"]["rms_K"], 0.0, 3.0)
     check("winding fused with its sensor: worst (acceptance <= 6 K; circular)", wd["fused_with_sensor"]["worst_K"], 0.0, 6.0)
-    # Not met (docs/thermal.md): the figures as measured, two-sided.
-    # The magnet's figures since the regimes merge (docs/thermal.md, "Since the regimes merge"): RPEM alone
-    # went from 3.25 to 9.2 K RMS (a mean of -8.6 K) with the estimator's new averaged-window contiguity
-    # (each 2.5 s row a steady-state observation), the classification off or on alike; on the thermal branch
-    # alone: fused 3.2 K RMS, 9.5 K worst, 2σ cover 100 %.
-    check("magnet fused 2σ coverage (acceptance 0.9, not met; measured 0.76)", m["fused"]["cover_2sigma"], 0.6, 0.9)
-    check("magnet fused RMS [K] (acceptance 3; measured 9.1)", m["fused"]["rms_K"], 7.0, 12.0)
-    check("magnet fused worst [K] (acceptance 6; measured 17.2)", m["fused"]["worst_K"], 14.0, 21.0)
+    # Not met (docs/thermal.md): the figures as measured, two-sided. The magnet's moved to 9.1 K RMS, 17.2 K
+    # worst, 76 % cover when the regimes merged, while config/paderborn-pmsm.yaml made the 2.5 s rows one chain
+    # whose run-up the classifier took for noise (docs/thermal.md, "Since the regimes merge"); with the rows
+    # standalone: 3.26 K RMS, 11.4 K worst (right after the load change), 100 %.
+    check("magnet fused RMS [K] (acceptance 3; measured 3.26)", m["fused"]["rms_K"], 2.5, 4.0)
+    check("magnet fused worst [K] (acceptance 6; measured 11.4)", m["fused"]["worst_K"], 9.0, 14.0)
     check("winding fused RMS without its sensor [K] (acceptance 3; measured 38)", wd["fused"]["rms_K"], 25.0, 50.0)
     # What the fusion must never do: be worse than what it fuses.
     check("magnet: fused RMS minus RPEM alone [K]", m["fused"]["rms_K"] - m["rpem"]["rms_K"], -3.0, 0.3)
