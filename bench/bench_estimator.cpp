@@ -218,21 +218,17 @@ void BM_ClassificationOverStep(benchmark::State& state) {
   state.counters["ratio"] = classify_s / step_s;
 }
 
-/// The classification's cost inside the step: DriveEstimator::step with `estimator.regimes.enabled` and
-/// without, in alternating blocks of 8192 samples on one thread. ratio = (with − without)/with: what the
-/// classification (and the outlier test it feeds) adds to the step.
-void BM_ClassificationInStep(benchmark::State& state) {
-  core::EstimatorSettings settings = test::paper_settings(core::Algorithm::kSga);
-  core::DriveEstimator with(test::paper_machine_si(), settings);
-  settings.regimes.enabled = false;
-  core::DriveEstimator without(test::paper_machine_si(), settings);
-  Replay a, b;
+/// A step's cost with the classification and without it: `without` and `with` each run one pass of kSamples
+/// steps, in alternating blocks on one thread, each timed on its CPU clock. ratio = (with − without)/with:
+/// what the classification (and the outlier test it feeds) adds to the step.
+template <class Without, class With>
+void time_with_and_without(benchmark::State& state, const Without& without, const With& with) {
   double with_s = 0.0, without_s = 0.0;
   for (auto _ : state) {
     const double t0 = thread_cpu_s();
-    for (int k = 0; k < kSamples; ++k) benchmark::DoNotOptimize(without.step(b.next()));
+    without();
     const double t1 = thread_cpu_s();
-    for (int k = 0; k < kSamples; ++k) benchmark::DoNotOptimize(with.step(a.next()));
+    with();
     with_s += thread_cpu_s() - t1;
     without_s += t1 - t0;
   }
@@ -240,6 +236,21 @@ void BM_ClassificationInStep(benchmark::State& state) {
   state.counters["with_ns"] = 1e9 * with_s / steps;
   state.counters["without_ns"] = 1e9 * without_s / steps;
   state.counters["ratio"] = (with_s - without_s) / with_s;
+}
+
+/// The classification's cost inside the step: DriveEstimator::step with `estimator.regimes.enabled` and
+/// without (time_with_and_without).
+void BM_ClassificationInStep(benchmark::State& state) {
+  core::EstimatorSettings settings = test::paper_settings(core::Algorithm::kSga);
+  core::DriveEstimator with(test::paper_machine_si(), settings);
+  settings.regimes.enabled = false;
+  core::DriveEstimator without(test::paper_machine_si(), settings);
+  Replay a, b;
+  const auto pass = [](core::DriveEstimator& est, Replay& replay) {
+    for (int k = 0; k < kSamples; ++k) benchmark::DoNotOptimize(est.step(replay.next()));
+  };
+  time_with_and_without(
+      state, [&] { pass(without, b); }, [&] { pass(with, a); });
 }
 
 /// The averaged estimator's bench windows: the paper's machine (ψm 5 % below the configuration) at 0.4 pu
@@ -322,19 +333,8 @@ void BM_AveragedClassificationInStep(benchmark::State& state) {
       w.t_ns += pass_ns;
     }
   };
-  double with_s = 0.0, without_s = 0.0;
-  for (auto _ : state) {
-    const double t0 = thread_cpu_s();
-    pass(without, b);
-    const double t1 = thread_cpu_s();
-    pass(with, a);
-    with_s += thread_cpu_s() - t1;
-    without_s += t1 - t0;
-  }
-  const double steps = static_cast<double>(state.iterations()) * kSamples;
-  state.counters["with_ns"] = 1e9 * with_s / steps;
-  state.counters["without_ns"] = 1e9 * without_s / steps;
-  state.counters["ratio"] = (with_s - without_s) / with_s;
+  time_with_and_without(
+      state, [&] { pass(without, b); }, [&] { pass(with, a); });
 }
 
 BENCHMARK(BM_ClassificationInStep)
