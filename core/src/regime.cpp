@@ -30,13 +30,35 @@ constexpr std::array<Regime, 128> kRegimeOfBits = [] {
 }();
 
 /// One step of the median tracker m of |r|: up by e^η when |r| > m, down by e^{−η} otherwise; it settles
-/// where |r| exceeds m half the time. The first nonzero |r| starts it.
+/// where |r| exceeds m half the time. The exact median of a warm-up's residuals starts it (track_noise).
 double track_median(double m, double a) noexcept {
   // The factor by table look-up, not a branch: |r| > m is a coin toss once m has settled, which a
   // conditional jump would mispredict half the time.
   static constexpr std::array<double, 2> kStep{kTrackDown, kTrackUp};
-  const double stepped = m * kStep[static_cast<std::size_t>(a > m)];
-  return m == 0.0 ? a : stepped;
+  return m * kStep[static_cast<std::size_t>(a > m)];
+}
+
+/// One residual |r| of quantity q (§13, "Noise"). A median of zero (nothing seen, or mostly exact zeros)
+/// stays so on a zero residual; a nonzero one starts a warm-up: the next kNoiseWarmUp residuals, zeros
+/// included, inserted into an ascending buffer, m the median of those taken so far — the lower middle one of
+/// an even count (a transient only inflates |r|: the lower one is robust to one more of them). Once warmed up,
+/// the tracker steps m from there (a median of zero waits for the next nonzero residual).
+double track_noise(RegimeState& s, std::size_t q, double a) noexcept {
+  int& left = s.noise_warm_up_left[q];
+  const double m = s.noise_median_pu[q];
+  if (left == 0) {
+    if (m != 0.0) return track_median(m, a);
+    if (!(a > 0.0)) return m;
+    left = kNoiseWarmUp;
+  }
+  std::array<double, kNoiseWarmUp>& sorted = s.noise_warm_up_pu[q];
+  const int taken = kNoiseWarmUp - left;
+  int k = taken;
+  for (; k > 0 && sorted[static_cast<std::size_t>(k - 1)] > a; --k)
+    sorted[static_cast<std::size_t>(k)] = sorted[static_cast<std::size_t>(k - 1)];
+  sorted[static_cast<std::size_t>(k)] = a;
+  --left;
+  return sorted[static_cast<std::size_t>(taken / 2)];  // taken + 1 residuals: the (lower) middle one
 }
 
 /// Two doubles as one GCC vector: its comparisons give a lane mask and `?:` selects by it, one source that
@@ -62,16 +84,10 @@ static_assert(sizeof(Lanes) == sizeof(Vec2), "a Vec2 is two packed doubles");
   return vec(lanes(a) > lanes(b) ? lanes(x) : lanes(y));
 }
 
-/// Per lane, m == 0 ? x : y.
-[[gnu::always_inline]] inline Vec2 select_zero(const Vec2& m, const Vec2& x, const Vec2& y) noexcept {
-  return vec(lanes(m) == 0.0 ? lanes(x) : lanes(y));
-}
-
 /// track_median on two quantities at once (u and i), each lane as the scalar form steps it: the same
-/// factor, the same product, the same start (the pair is one packed operation where a scalar step was one each).
+/// factor, the same product (the pair is one packed operation where a scalar step was one each).
 [[gnu::always_inline]] inline Vec2 track_medians(const Vec2& m, const Vec2& a) noexcept {
-  const Vec2 stepped = m.cwiseProduct(select_greater(a, m, Vec2::Constant(kTrackUp), Vec2::Constant(kTrackDown)));
-  return select_zero(m, a, stepped);
+  return m.cwiseProduct(select_greater(a, m, Vec2::Constant(kTrackUp), Vec2::Constant(kTrackDown)));
 }
 
 /// The smallest nonzero |change| of two quantities at once (u and i): q = min(q, a > 0 ? a : q) per lane.
@@ -95,6 +111,17 @@ bool track_resolution(double& q, double change) noexcept {
   const Vec2 remnant = decay * di.cwiseAbs();
   const double bound = z_sq_var_i * (1.0 + 2.0 * decay * decay);
   return remnant.squaredNorm() > 0.0 && remnant.cwiseProduct(remnant).maxCoeff() > bound ? regime_bit::kTransient : 0;
+}
+
+/// learn()'s noise medians while a quantity warms up or a nonzero residual meets a zero median (which starts
+/// a warm-up): each quantity's residuals in their order, d then q. Out of line: the common path stays as small as it was.
+[[gnu::noinline]] void learn_noise_warming(RegimeState& s, const Vec2& ru, const Vec2& ri, double rn) noexcept {
+  std::array<double, 3>& m = s.noise_median_pu;
+  m[0] = track_noise(s, 0, ru[0]);
+  m[0] = track_noise(s, 0, ru[1]);
+  m[1] = track_noise(s, 1, ri[0]);
+  m[1] = track_noise(s, 1, ri[1]);
+  m[2] = track_noise(s, 2, rn);
 }
 
 /// Learns a sample's noise and resolution from the chain and takes it in as the chain's last. Returns
@@ -126,11 +153,19 @@ bool learn(RegimeState& s, const RegimeInput& in, double t_s, double w) noexcept
     const Vec2 ru = norm * (s.u_pu[0] - (w * in.u_pu + (1.0 - w) * s.u_pu[1])).cwiseAbs();
     const Vec2 ri = norm * (s.i_pu[0] - (w * in.i_pu + (1.0 - w) * s.i_pu[1])).cwiseAbs();
     const double rn = norm * std::abs(s.n_pu[0] - (w * in.n_pu + (1.0 - w) * s.n_pu[1]));
-    const Vec2 m = track_medians(track_medians(Vec2(s.noise_median_pu[0], s.noise_median_pu[1]), Vec2(ru[0], ri[0])),
-                                 Vec2(ru[1], ri[1]));
-    s.noise_median_pu[0] = m[0];
-    s.noise_median_pu[1] = m[1];
-    s.noise_median_pu[2] = track_median(s.noise_median_pu[2], rn);
+    std::array<double, 3>& m = s.noise_median_pu;
+    const std::array<int, 3>& left = s.noise_warm_up_left;
+    // A zero median stepped is zero: on zero residuals (a constant quantity) it stays on this path.
+    const bool start =
+        ((m[0] == 0.0) & (ru[0] + ru[1] > 0.0)) | ((m[1] == 0.0) & (ri[0] + ri[1] > 0.0)) | ((m[2] == 0.0) & (rn > 0.0));
+    if (((left[0] | left[1] | left[2]) != 0) | start) [[unlikely]] {
+      learn_noise_warming(s, ru, ri, rn);
+    } else {
+      const Vec2 ui = track_medians(track_medians(Vec2(m[0], m[1]), Vec2(ru[0], ri[0])), Vec2(ru[1], ri[1]));
+      m[0] = ui[0];
+      m[1] = ui[1];
+      m[2] = track_median(m[2], rn);
+    }
     s.noise_known = true;
   }
   s.u_pu[1] = s.u_pu[0];

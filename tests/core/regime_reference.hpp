@@ -2,7 +2,8 @@
 // The regime classifier as it was formulated before its cost was cut (issue 23 item 7): the reference the
 // differential test (test_regime_differential.cpp) holds core::RegimeClassifier to, bit for bit. Kept
 // here, in the tests, so that production code has one formulation; do not "optimise" this one: its worth
-// is that it states the rules of docs/derivations.md §13 as they were derived and reviewed.
+// is that it states the rules of docs/derivations.md §13 as they were derived and reviewed. The noise
+// medians' start (§13, "Start (warm-up)") replaced the first-residual start in both, written here apart.
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -28,6 +29,9 @@ struct State {
   /// σ = median/0.6745), and the smallest nonzero change seen (its resolution; +∞: none yet).
   std::array<double, 3> noise_median_pu{};
   std::array<double, 3> measured_resolution_pu{};
+  /// Per quantity: the residuals of its warm-up in the order they came, and how many (docs/derivations.md §13).
+  std::array<std::array<double, core::kNoiseWarmUp>, 3> warm_up{};
+  std::array<int, 3> warm_up_count{};
   /// Whether a second difference of a chain has been seen: before, no test that excludes a chain's sample
   /// can be judged (a standalone sample is judged on the resolution at least).
   bool noise_known = false;
@@ -55,14 +59,23 @@ constexpr double kSigmaPerMedian = 1.4826022185056018;
 constexpr double kTrackUp = 1.0644944589178593;     // e^{1/16}
 constexpr double kTrackDown = 0.93941306281347581;  // e^{−1/16}
 
-/// One step of the median tracker m of |r|: up by e^η when |r| > m, down by e^{−η} otherwise; it settles
-/// where |r| exceeds m half the time. The first nonzero |r| starts it.
-inline double track_median(double m, double a) noexcept {
-  // The factor by table look-up, not a branch: |r| > m is a coin toss once m has settled, which a
-  // conditional jump would mispredict half the time.
-  static constexpr std::array<double, 2> kStep{kTrackDown, kTrackUp};
-  const double stepped = m * kStep[static_cast<std::size_t>(a > m)];
-  return m == 0.0 ? a : stepped;
+/// The noise median of one quantity after the residual a (§13, "Noise"): a warm-up of kNoiseWarmUp residuals
+/// runs from a nonzero one met by a zero median (none yet, or mostly zeros); during it, the median of those
+/// taken so far — the lower middle of an even count — found by selection on a copy of them in the order they
+/// came (production inserts into a sorted buffer); otherwise the tracker's step m·e^{±η}, up where |r| > m.
+template <typename State>
+inline double track_noise(State& s, std::size_t q, double a) noexcept {
+  int& n = s.warm_up_count[q];
+  const double m = s.noise_median_pu[q];
+  const bool warming = n > 0 && n < core::kNoiseWarmUp;
+  if (!warming && m == 0.0 && a > 0.0) n = 0;  // a warm-up starts
+  if (!warming && !(m == 0.0 && a > 0.0)) return a > m ? m * kTrackUp : m * kTrackDown;
+  s.warm_up[q][static_cast<std::size_t>(n)] = a;
+  ++n;
+  std::array<double, core::kNoiseWarmUp> taken = s.warm_up[q];
+  const auto middle = taken.begin() + (n - 1) / 2;
+  std::nth_element(taken.begin(), middle, taken.begin() + n);
+  return *middle;
 }
 
 /// The smallest nonzero |change|; whether it became smaller.
@@ -99,9 +112,11 @@ inline bool learn(State& s, const RegimeInput& in, double t_s) noexcept {
     const Vec2 ru = norm * (s.u_pu[0] - (w * in.u_pu + (1.0 - w) * s.u_pu[1])).cwiseAbs();
     const Vec2 ri = norm * (s.i_pu[0] - (w * in.i_pu + (1.0 - w) * s.i_pu[1])).cwiseAbs();
     const double rn = norm * std::abs(s.n_pu[0] - (w * in.n_pu + (1.0 - w) * s.n_pu[1]));
-    s.noise_median_pu[0] = track_median(track_median(s.noise_median_pu[0], ru[0]), ru[1]);
-    s.noise_median_pu[1] = track_median(track_median(s.noise_median_pu[1], ri[0]), ri[1]);
-    s.noise_median_pu[2] = track_median(s.noise_median_pu[2], rn);
+    s.noise_median_pu[0] = track_noise(s, 0, ru[0]);
+    s.noise_median_pu[0] = track_noise(s, 0, ru[1]);
+    s.noise_median_pu[1] = track_noise(s, 1, ri[0]);
+    s.noise_median_pu[1] = track_noise(s, 1, ri[1]);
+    s.noise_median_pu[2] = track_noise(s, 2, rn);
     s.noise_known = true;
   }
   s.u_pu[1] = s.u_pu[0];

@@ -188,6 +188,11 @@ struct RegimeInput {
   Vec2 weight = Vec2::Ones();
 };
 
+/// How many residuals |r| of a quantity start its noise median (docs/derivations.md §13, "Noise"): their exact
+/// median, robust to (K − 1)/2 = 8 transient ones among them (a run-up's two corners: ≤ 2 per lane each, u and
+/// i two lanes), before the tracker steps from it. From the quantity's first nonzero residual.
+inline constexpr int kNoiseWarmUp = 17;
+
 struct RegimeState {
   /// Per quantity (u, i, n): the running median of the normalised second difference |r| (its noise, with
   /// σ = median/0.6745), and the smallest nonzero change seen (its resolution; +∞: none yet).
@@ -210,6 +215,11 @@ struct RegimeState {
   bool previous_transient = false;  ///< the previous sample's own slope test failed (the junction straddles)
   /// The chain's previous sample: a window (averaged), and whether it was bridge off (mixed windows).
   bool previous_window = false, previous_bridge_off = false;
+  /// Per quantity, how many residuals its median's warm-up has still to take (0: none under way; a nonzero
+  /// residual where the median is zero starts one, §13), and those taken, |r| ascending (last: read only
+  /// during a warm-up).
+  std::array<int, 3> noise_warm_up_left{};
+  std::array<std::array<double, kNoiseWarmUp>, 3> noise_warm_up_pu{};
 };
 
 /// The noise of a quantity [pu]: σ² = (median/0.6745)² + q²/12 (the measured noise and the quantisation).
