@@ -8,6 +8,7 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <cstdint>
 #include <random>
 #include <vector>
 
@@ -45,6 +46,18 @@ RegimeInput steady(const MachinePu& plant, double n, const Vec2& i_frame, double
   in.n_pu = n;
   in.u_reported_sq_pu = in.u_pu.squaredNorm();
   in.weight = Vec2::Ones();
+  return in;
+}
+
+/// The j-th sample (0-based) of a contiguous chain ending at t_ns: the first starts the chain.
+RegimeInput chain_sample(int j, std::int64_t t_ns, const Vec2& u, const Vec2& i, double n) {
+  RegimeInput in;
+  in.timing = j == 0 ? SampleTiming::kFirst : SampleTiming::kContiguous;
+  in.t_ns = t_ns;
+  in.u_pu = u;
+  in.i_pu = i;
+  in.n_pu = n;
+  in.u_reported_sq_pu = u.squaredNorm();
   return in;
 }
 
@@ -390,14 +403,9 @@ TEST(Regime, NoiseAndResolutionAreMeasuredFromTheData) {
   int counted = 0;
   for (int j = 0; j < 40000; ++j) {
     t += 0.01 * spacing(rng);
-    RegimeInput in;
-    in.timing = j == 0 ? SampleTiming::kFirst : SampleTiming::kContiguous;
-    in.t_ns = std::llround(t * 1e9);
-    in.u_pu = Vec2(0.1 + 0.2 * t + nu(rng), 0.5 - 0.1 * t + nu(rng));
-    in.i_pu = Vec2(-0.1 + ni(rng), 0.3 + 0.05 * t + ni(rng));
-    in.n_pu = 0.5 + 0.01 * t + nn(rng);
-    in.u_reported_sq_pu = in.u_pu.squaredNorm();
-    (void)k.step(in);
+    const Vec2 u(0.1 + 0.2 * t + nu(rng), 0.5 - 0.1 * t + nu(rng));
+    const Vec2 i(-0.1 + ni(rng), 0.3 + 0.05 * t + ni(rng));
+    (void)k.step(chain_sample(j, std::llround(t * 1e9), u, i, 0.5 + 0.01 * t + nn(rng)));
     if (j >= 2000) {
       const RegimeNoise v = k.current_noise();
       mean_u += std::sqrt(v.u_sq), mean_i += std::sqrt(v.i_sq), mean_n += std::sqrt(v.n_sq);
@@ -413,15 +421,9 @@ TEST(Regime, NoiseAndResolutionAreMeasuredFromTheData) {
   RegimeClassifier q(c);
   const double quantum = 1e-3;
   for (int j = 0; j < 500; ++j) {
-    RegimeInput in;
-    in.timing = j == 0 ? SampleTiming::kFirst : SampleTiming::kContiguous;
-    in.t_ns = (j + 1) * 10'000'000LL;
     const double raw = 0.4 + 0.00037 * j + 1e-6 * nu(rng);
-    in.u_pu = Vec2(quantum * std::round(raw / quantum), quantum * std::round(0.5 * raw / quantum));
-    in.i_pu = Vec2(0.0, 0.2);
-    in.n_pu = 0.4;
-    in.u_reported_sq_pu = in.u_pu.squaredNorm();
-    (void)q.step(in);
+    const Vec2 u(quantum * std::round(raw / quantum), quantum * std::round(0.5 * raw / quantum));
+    (void)q.step(chain_sample(j, (j + 1) * 10'000'000LL, u, Vec2(0.0, 0.2), 0.4));
   }
   EXPECT_NEAR(q.state().measured_resolution_pu[0] / quantum, 1.0, 1e-9);
   EXPECT_GE(q.current_noise().u_sq, quantum * quantum / 12.0);
@@ -479,14 +481,9 @@ TEST(Regime, ANoiseMedianStartedByATransientIsTheNoisesAfterItsWarmUp) {
       for (int j = 0; j < 17; ++j) {
         // The operating point's change: a step from sample 2 on, or a ramp over samples 1–5.
         const double level = run_up ? std::clamp((j - 1) / 4.0, 0.0, 1.0) : (j >= 2 ? 1.0 : 0.0);
-        RegimeInput in;
-        in.timing = j == 0 ? SampleTiming::kFirst : SampleTiming::kContiguous;
-        in.t_ns = (j + 1) * 10'000'000LL;
-        in.u_pu = Vec2(0.05 + 0.5 * step[0] * level + sigma[0] * unit(rng), 0.3 + step[0] * level + sigma[0] * unit(rng));
-        in.i_pu = Vec2(-0.05 - 0.5 * step[1] * level + sigma[1] * unit(rng), 0.1 + step[1] * level + sigma[1] * unit(rng));
-        in.n_pu = 0.3 + step[2] * level + sigma[2] * unit(rng);
-        in.u_reported_sq_pu = in.u_pu.squaredNorm();
-        (void)k.step(in);
+        const Vec2 u(0.05 + 0.5 * step[0] * level + sigma[0] * unit(rng), 0.3 + step[0] * level + sigma[0] * unit(rng));
+        const Vec2 i(-0.05 - 0.5 * step[1] * level + sigma[1] * unit(rng), 0.1 + step[1] * level + sigma[1] * unit(rng));
+        (void)k.step(chain_sample(j, (j + 1) * 10'000'000LL, u, i, 0.3 + step[2] * level + sigma[2] * unit(rng)));
         for (std::size_t q = 0; q < 3; ++q)
           if (j + 1 == check_after[q]) ratio[q].push_back(k.state().noise_median_pu[q] / (kMedianOverSigma * sigma[q]));
       }
@@ -535,13 +532,7 @@ TEST(Regime, AfterItsWarmUpTheNoiseMedianStepsAsTheTrackerAlways) {
   int steps = 0, exact = 0;
   const double up = std::exp(1.0 / 16.0), down = std::exp(-1.0 / 16.0);
   for (int j = 0; j < 200'000; ++j) {
-    RegimeInput in;
-    in.timing = j == 0 ? SampleTiming::kFirst : SampleTiming::kContiguous;
-    in.t_ns = (j + 1) * 10'000'000LL;
-    in.u_pu = Vec2(0.05, 0.3);
-    in.i_pu = Vec2(-0.05, 0.1);
-    in.n_pu = 0.3 + noise(rng);
-    in.u_reported_sq_pu = in.u_pu.squaredNorm();
+    const RegimeInput in = chain_sample(j, (j + 1) * 10'000'000LL, Vec2(0.05, 0.3), Vec2(-0.05, 0.1), 0.3 + noise(rng));
     const double before = k.state().noise_median_pu[2];
     (void)k.step(in);
     n = {n[1], n[2], in.n_pu};
