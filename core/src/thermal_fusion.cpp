@@ -67,6 +67,10 @@ StepObservations step_observations(const ThermalFusionConfig& c, const ThermalSt
     // T' = T + e_ref + e_α·(T − T_ref), linearised at T̂ (eq. 14.10).
     o.h_c[static_cast<int>(r.offset)] = r.own_law.slope;
     o.h_c[static_cast<int>(r.coefficient)] = r.own_law.slope * (t_C[r.own] - r.reference_C);
+    // ... and the product e_α·(T − T̂) the linearisation leaves out, which the filter takes over its prior (14.10a).
+    o.bilinear = r.own_law.slope;
+    o.bilinear_node = r.own;
+    o.bilinear_state = r.coefficient;
     const double lag_K = dt_dt_K_per_s[r.own] * p.time_constant_s;
     o.variance = p.variance + r.own_law.slope * r.own_law.slope * lag_K * lag_K;
     out.present[j] = true;

@@ -2,12 +2,15 @@
 // and closed-form limits: the scalar update, a correlated update, Schmidt's consider states (the calibration
 // bounds what observations can teach), the gate, the prediction's covariance, and a heat disturbance the
 // filter learns from observations of one node; the blockwise prediction and sparse update against the dense
-// forms on all twelve states.
+// forms on all twelve states; a law's bilinear calibration term taken over the prior (eq. 14.10a).
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <random>
+#include <vector>
 
 #include "rpem/core/thermal_filter.hpp"
+#include "rpem/core/thermal_fusion.hpp"
 
 namespace rpem::core {
 namespace {
@@ -228,6 +231,92 @@ TEST(ThermalFilter, BlockwiseStepsAreTheDenseFormulasAndKeepPExactlySymmetric) {
   EXPECT_LT((f.covariance() - p2).cwiseAbs().maxCoeff(), tol_p);
   EXPECT_LT((state() - x2).cwiseAbs().maxCoeff(), 1e-12);
   EXPECT_TRUE(f.covariance() == f.covariance().transpose());
+}
+
+TEST(ThermalFilter, BilinearCalibrationTermMeanAndVarianceOverAGaussianPrior) {
+  // Eq. 14.10a: for (δT, δe) jointly Gaussian, zero mean, E[δT·δe] = P_Te and Var(δT·δe) = P_TT·P_ee + P_Te²
+  // (Isserlis). Checked by sampling, at 5 standard errors, at the Paderborn row 4 480 s's prior (docs/thermal.md,
+  // "What the fused worst error is made of": P_TT 90.6 K², P_Te −1.135 K, P_ee 0.01447).
+  const double p_tt = 90.607, p_te = -1.1347, p_ee = 0.0144676;
+  std::mt19937_64 rng(7);
+  std::normal_distribution<double> z;
+  const double l11 = std::sqrt(p_tt), l21 = p_te / l11, l22 = std::sqrt(p_ee - l21 * l21);
+  const int n = 400000;
+  std::vector<double> q(n);
+  double sum = 0.0;
+  for (double& v : q) {
+    const double z1 = z(rng), z2 = z(rng);
+    v = (l11 * z1) * (l21 * z1 + l22 * z2);
+    sum += v;
+  }
+  const double mean = sum / n;
+  double m2 = 0.0, m4 = 0.0;
+  for (const double v : q) m2 += (v - mean) * (v - mean), m4 += std::pow(v - mean, 4);
+  m2 /= n, m4 /= n;
+  const double var_expected = p_tt * p_ee + p_te * p_te;
+  EXPECT_NEAR(mean, p_te, 5.0 * std::sqrt(var_expected / n));
+  EXPECT_NEAR(m2, var_expected, 5.0 * std::sqrt((m4 - m2 * m2) / n));  // the sample variance's standard error
+}
+
+TEST(ThermalFilter, BilinearCalibrationTermEntersTheInnovationAndItsVariance) {
+  // A law reading y = T_m + e_ref + e_α·(T_m − T_ref) (slope 1), readings at T̂ − T_ref = 80 K teach P_Te ≈ −80·σ_α²;
+  // then one at 78.5 K. The filter must use ν = y − ŷ − b·P_Te and s = H·P·Hᵀ + r + b²·(P_TT·P_ee + P_Te²)
+  // (eq. 14.10a) with K = [P·Hᵀ/s; 0] as before (eq. 14.11). Before 14.10a, s lacked the last term: here it
+  // is 2.7 K² against a first-order s of 0.7 K², the gain on T_m exceeded 1/h and the posterior left the
+  // interval between prior and reading (Paderborn 4 480 s: −3.47 K for a −1.17 K innovation).
+  ThermalFilterConfig c = two_nodes();
+  c.calibration_sigma[static_cast<int>(Calibration::kMagnetOffset)] = 1.0;
+  c.calibration_sigma[static_cast<int>(Calibration::kMagnetCoefficient)] = 0.12;
+  c.gate_sigma = 100.0;
+  ThermalFilter f(c);
+  f.reset(100.0, 100.0);  // a vague prior: T's error ends almost wholly along the calibration's, as on Paderborn
+  const auto reading = [](double value, double d_K) {
+    ThermalObservation o = magnet_reading(value, 0.13);
+    o.h_c << 1.0, d_K, 0.0, 0.0;
+    o.bilinear = 1.0;
+    o.bilinear_node = 1;
+    o.bilinear_state = Calibration::kMagnetCoefficient;
+    return o;
+  };
+  for (int k = 0; k < 200; ++k) ASSERT_EQ(f.observe(reading(100.0, 80.0)), ObservationResult::kAccepted);
+  const ThermalStateMat p = f.covariance();
+  const int kt = 1, ke = 8 + static_cast<int>(Calibration::kMagnetCoefficient);
+  ASSERT_NEAR(p(kt, ke), -80.0 * 0.12 * 0.12, 0.05);  // the correlation the first readings taught
+  const double t0 = f.temperature_C()[kt];
+  const ThermalObservation o = reading(98.0, 78.5);
+  ThermalStateVec h = ThermalStateVec::Zero();
+  h[kt] = 1.0;
+  h.tail<4>() = o.h_c;
+  const double second = p(kt, kt) * p(ke, ke) + p(kt, ke) * p(kt, ke);
+  const double s = h.dot(p * h) + o.variance + second;
+  const double nu = o.value - t0 - p(kt, ke);
+  ASSERT_EQ(f.observe(o), ObservationResult::kAccepted);
+  EXPECT_NEAR(f.last_innovation_variance(), s, 1e-12 * s);
+  EXPECT_NEAR(f.last_innovation(), nu, 1e-12);
+  EXPECT_NEAR(f.temperature_C()[kt], t0 + (p * h)[kt] * nu / s, 1e-9);
+  // What the first order alone left out (2.67 against 0.18 K²), and its gain on the node, 9.9 > 1/h; now 0.61.
+  EXPECT_GT(second, 2.0 * (h.dot(p * h) + o.variance));
+  EXPECT_GT((p * h)[kt] / (h.dot(p * h) + o.variance), 1.0);
+  EXPECT_NEAR((p * h)[kt] / s, 0.61, 0.01);
+}
+
+TEST(ThermalFusion, EachLawsRowCarriesItsBilinearCalibrationTerm) {
+  // ψ̂m's row: b = the magnet law's slope ψ_ref·α on the magnet node and its coefficient state; r̂s's likewise.
+  ThermalFusionConfig c;
+  c.filter = two_nodes();
+  c.magnet_law = {-0.0012, 20.0, 0.1169};
+  ThermalStepData d;
+  for (ParameterObservation& p : d.parameter) p.valid = true, p.variance = 1e-9;
+  d.parameter[0].value = 0.106;
+  d.parameter[1].value = 0.06;
+  const StepObservations o = step_observations(c, d, ThermalVec(110.0, 95.0, 0.0, 0.0), ThermalVec::Zero());
+  ASSERT_TRUE(o.present[0] && o.present[1]);
+  EXPECT_DOUBLE_EQ(o.item[0].bilinear, 0.1169 * -0.0012);
+  EXPECT_EQ(o.item[0].bilinear_node, c.filter.network.magnet);
+  EXPECT_EQ(o.item[0].bilinear_state, Calibration::kMagnetCoefficient);
+  EXPECT_DOUBLE_EQ(o.item[1].bilinear, 0.05 * 0.00393);
+  EXPECT_EQ(o.item[1].bilinear_node, c.filter.network.winding);
+  EXPECT_EQ(o.item[1].bilinear_state, Calibration::kCopperCoefficient);
 }
 
 }  // namespace

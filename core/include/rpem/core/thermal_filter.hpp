@@ -30,13 +30,17 @@ using CalibrationVec = Eigen::Matrix<double, kCalibrationStates, 1>;
 /// The calibration states: which law, and offset or coefficient.
 enum class Calibration : int { kMagnetOffset = 0, kMagnetCoefficient = 1, kCopperOffset = 2, kCopperCoefficient = 3 };
 
-/// One scalar observation y = h·T + h_c·c + offset + v, v ~ N(0, variance).
+/// One scalar observation y = h·T + h_c·c + offset + b·δT_i·δc_k + v, v ~ N(0, variance); δ the errors of
+/// the prior mean. The bilinear term is a law's e_α·(T − T_ref) beyond its linearisation at T̂ (eq. 14.10, 14.10a).
 struct ThermalObservation {
   ThermalVec h = ThermalVec::Zero();
   CalibrationVec h_c = CalibrationVec::Zero();
   double offset = 0.0;
   double value = 0.0;
   double variance = 0.0;
+  double bilinear = 0.0;                                         ///< b (0: none)
+  int bilinear_node = 0;                                         ///< i
+  Calibration bilinear_state = Calibration::kMagnetCoefficient;  ///< k
 };
 
 enum class ObservationResult : std::uint8_t { kAccepted = 0, kRejectedGate = 1, kRejectedInvalid = 2 };
