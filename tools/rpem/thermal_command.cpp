@@ -75,8 +75,8 @@ int run_thermal_fit(const ThermalFitCliOptions& o) {
   }
   for (const std::string& s : fit.not_identifiable) std::printf("not identifiable together: %s\n", s.c_str());
   for (const std::string& s : fit.notes) std::printf("note: %s\n", s.c_str());
-  std::printf("process noise %.3g K^2/s, disturbance drift %.3g W^2/s; wrote %s\n", fit.process_noise_K2_per_s,
-              fit.disturbance_W2_per_s, o.out.c_str());
+  std::printf("process noise %.3g K^2/s, disturbance drift %.3g W^2/s, correlation time %.3g s; wrote %s\n",
+              fit.process_noise_K2_per_s, fit.disturbance_W2_per_s, fit.disturbance_time_constant_s, o.out.c_str());
   return kExitOk;
 }
 

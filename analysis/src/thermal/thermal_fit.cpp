@@ -449,14 +449,19 @@ void judge(const io::ThermalConfig& c, const ThermalRecord& r, std::size_t train
 
 /// The value of one of the filter's noise intensities (every node; `field` picks which) that maximises the
 /// filter's innovation likelihood over the training part: golden-section search on its log10 in [lo, hi].
+/// The filter's innovation log-likelihood over the training part.
+double training_log_likelihood(const io::ThermalConfig& c, const ThermalRecord& r, std::size_t training) {
+  double ll = 0.0;
+  for (const FilterStep& s : run_filter(c.fusion, r, training)) ll += s.log_likelihood;
+  return ll;
+}
+
 double maximum_likelihood(io::ThermalConfig& c, const ThermalRecord& r, std::size_t training,
                           core::ThermalVec core::ThermalFilterConfig::*field, double lo, double hi) {
   auto nll = [&](double log_q) {
     (c.fusion.filter.*field).setZero();
     (c.fusion.filter.*field).head(c.fusion.filter.network.nodes).setConstant(std::pow(10.0, log_q));
-    double ll = 0.0;
-    for (const FilterStep& s : run_filter(c.fusion, r, training)) ll += s.log_likelihood;
-    return -ll;
+    return -training_log_likelihood(c, r, training);
   };
   double a = lo, b = hi;
   const double g = 0.5 * (std::sqrt(5.0) - 1.0);
@@ -628,6 +633,30 @@ ThermalFitResult fit_thermal(const ThermalRecord& record, const io::ThermalConfi
       maximum_likelihood(out.config, record, training, &core::ThermalFilterConfig::process_noise_K2_per_s, -8.0, 1.0);
   out.disturbance_W2_per_s =
       maximum_likelihood(out.config, record, training, &core::ThermalFilterConfig::disturbance_W2_per_s, -6.0, 4.0);
+  // The disturbances' correlation time τ_d (eq. 14.19), one for the network, jointly with q_d: on a log-spaced
+  // grid (half decades from 300 s to 10⁵ s, beside the walk) q_d is refitted at each τ_d and the pair of the
+  // highest likelihood kept. A grid, not a search: the likelihood in τ_d is flat towards the walk and need not
+  // be unimodal, and seven points bracket the network's time constants (minutes) to the log's length (hours).
+  core::ThermalVec& tau = out.config.fusion.filter.disturbance_time_constant_s;
+  double best_ll = training_log_likelihood(out.config, record, training);
+  out.disturbance_time_constant_log_likelihood.emplace_back(std::numeric_limits<double>::infinity(), best_ll);
+  const core::ThermalVec walk_q = out.config.fusion.filter.disturbance_W2_per_s;
+  core::ThermalVec best_q = walk_q;
+  for (double log_tau = 2.5; log_tau <= 5.0 + 1e-9; log_tau += 0.5) {
+    tau.setConstant(std::pow(10.0, log_tau));
+    const double q =
+        maximum_likelihood(out.config, record, training, &core::ThermalFilterConfig::disturbance_W2_per_s, -6.0, 4.0);
+    const double ll = training_log_likelihood(out.config, record, training);
+    out.disturbance_time_constant_log_likelihood.emplace_back(tau[0], ll);
+    if (ll > best_ll) {
+      best_ll = ll;
+      out.disturbance_time_constant_s = tau[0];
+      out.disturbance_W2_per_s = q;
+      best_q = out.config.fusion.filter.disturbance_W2_per_s;
+    }
+  }
+  tau.setConstant(out.disturbance_time_constant_s);
+  out.config.fusion.filter.disturbance_W2_per_s = best_q;
   judge(out.config, record, training, out);
   return out;
 }

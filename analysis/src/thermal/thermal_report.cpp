@@ -64,6 +64,10 @@ void write_thermal_fit_json(const std::string& path, const ThermalFitResult& fit
   j["training_cost"] = fit.training_cost;
   j["process_noise_K2_per_s"] = fit.process_noise_K2_per_s;
   j["disturbance_W2_per_s"] = fit.disturbance_W2_per_s;
+  // +∞ (the random walk) is written as null.
+  j["disturbance_time_constant_s"] = fit.disturbance_time_constant_s;
+  for (const auto& [tau_s, ll] : fit.disturbance_time_constant_log_likelihood)
+    j["disturbance_time_constant_grid"].push_back({{"time_constant_s", tau_s}, {"log_likelihood", ll}});
   for (const FittedParameter& p : fit.parameters) {
     j["parameters"].push_back({{"name", p.name},
                                {"unit", p.unit},
@@ -107,7 +111,9 @@ void write_thermal_fit_report(const std::string& path, const ThermalFitResult& f
   }
   o << "\nProcess noise (maximum likelihood of the filter's innovations over the training part): "
     << fmt(fit.process_noise_K2_per_s) << " K²/s per node; the heat disturbances' drift " << fmt(fit.disturbance_W2_per_s)
-    << " W²/s per node.\n";
+    << " W²/s per node, correlation time "
+    << (std::isfinite(fit.disturbance_time_constant_s) ? fmt(fit.disturbance_time_constant_s) + " s" : "∞ (a random walk)")
+    << " (eq. 14.19).\n";
   if (!fit.not_identifiable.empty()) {
     o << "\n## Not identifiable\n\nParameters the log cannot tell apart (they move together along a direction the "
          "residuals barely change):\n\n";

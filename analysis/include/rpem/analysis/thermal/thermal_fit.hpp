@@ -11,6 +11,7 @@
 
 #include <limits>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "rpem/analysis/thermal/thermal_record.hpp"
@@ -55,6 +56,10 @@ struct ThermalFitResult {
   std::vector<std::string> notes;
   double process_noise_K2_per_s = 0.0;
   double disturbance_W2_per_s = 0.0;
+  /// τ_d of eq. 14.19 (+∞: the random walk), with q_d the pair of most likely over the training part.
+  double disturbance_time_constant_s = std::numeric_limits<double>::infinity();
+  /// The grid of τ_d tried (+∞ first) and the training part's log-likelihood at each, q_d refitted.
+  std::vector<std::pair<double, double>> disturbance_time_constant_log_likelihood;
   double training_cost = 0.0;                 ///< Σ of the squared weighted residuals
   std::vector<core::ThermalVec> open_loop_C;  ///< the model alone over the whole log, per step
 };
