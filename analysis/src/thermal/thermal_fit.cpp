@@ -567,6 +567,68 @@ io::ThermalConfig default_topology(const io::ThermalConfig& laws, const ThermalR
   return c;
 }
 
+/// The disturbances' correlation times τ_d (eq. 14.19) jointly with q_d, by the training part's innovation
+/// likelihood. On a log-spaced grid (half decades from 300 s to 10⁵ s, beside the walk) q_d is refitted at each
+/// τ_d and the pair of the highest likelihood kept. A grid, not a search: the likelihood in τ_d is flat towards
+/// the walk and need not be unimodal, and six points bracket the network's time constants (minutes) to a log's
+/// length (hours). Per node, each in turn (winding first, the others held at their choice so far): the nodes'
+/// disturbances have different causes (docs/thermal.md, "A Gauss–Markov disturbance": one τ_d for the network
+/// let the magnet's choice decide the winding's). A given τ_d is every node's.
+void choose_disturbance_time_constants(ThermalFitResult& out, const ThermalRecord& record, std::size_t training,
+                                       const ThermalFitOptions& options) {
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  core::ThermalFilterConfig& f = out.config.fusion.filter;
+  const int nodes = f.network.nodes;
+  f.disturbance_time_constant_s.setConstant(kInf);
+  std::vector<double> grid;
+  if (std::isnan(options.disturbance_time_constant_s)) {
+    for (double log_tau = 2.5; log_tau <= 5.0 + 1e-9; log_tau += 0.5) grid.push_back(std::pow(10.0, log_tau));
+  } else if (options.disturbance_time_constant_s < 1e9) {
+    grid.push_back(options.disturbance_time_constant_s);
+  }
+  const auto fit_q = [&] {
+    return maximum_likelihood(out.config, record, training, &core::ThermalFilterConfig::disturbance_W2_per_s, -6.0, 4.0);
+  };
+  double best_ll = training_log_likelihood(out.config, record, training);
+  out.disturbance_time_constant_log_likelihood.push_back({-1, kInf, best_ll});
+  const bool given = !std::isnan(options.disturbance_time_constant_s);
+  if (given) best_ll = -kInf;  // a given τ_d is kept whatever the walk's likelihood
+  std::vector<int> order;      // the network at once (−1), or each node in turn
+  if (!given) {
+    order.push_back(f.network.winding);
+    for (int i = 0; i < nodes; ++i)
+      if (i != f.network.winding) order.push_back(i);
+  } else {
+    order.push_back(-1);
+  }
+  core::ThermalVec best_tau = f.disturbance_time_constant_s;
+  core::ThermalVec best_q = f.disturbance_W2_per_s;
+  double best_q_scalar = out.disturbance_W2_per_s;
+  for (int node : order) {
+    for (double tau_s : grid) {
+      f.disturbance_time_constant_s = best_tau;
+      if (node < 0) {
+        f.disturbance_time_constant_s.head(nodes).setConstant(tau_s);
+      } else {
+        f.disturbance_time_constant_s[node] = tau_s;
+      }
+      const double q = fit_q();
+      const double ll = training_log_likelihood(out.config, record, training);
+      out.disturbance_time_constant_log_likelihood.push_back({node, tau_s, ll});
+      if (ll > best_ll) {
+        best_ll = ll;
+        best_q_scalar = q;
+        best_q = f.disturbance_W2_per_s;
+        best_tau = f.disturbance_time_constant_s;
+      }
+    }
+  }
+  f.disturbance_time_constant_s = best_tau;
+  f.disturbance_W2_per_s = best_q;
+  out.disturbance_W2_per_s = best_q_scalar;
+  out.disturbance_time_constant_s = best_tau;
+}
+
 ThermalFitResult fit_thermal(const ThermalRecord& record, const io::ThermalConfig& start_config,
                              const ThermalFitOptions& options) {
   if (record.steps.size() < 10) {
@@ -633,30 +695,7 @@ ThermalFitResult fit_thermal(const ThermalRecord& record, const io::ThermalConfi
       maximum_likelihood(out.config, record, training, &core::ThermalFilterConfig::process_noise_K2_per_s, -8.0, 1.0);
   out.disturbance_W2_per_s =
       maximum_likelihood(out.config, record, training, &core::ThermalFilterConfig::disturbance_W2_per_s, -6.0, 4.0);
-  // The disturbances' correlation time τ_d (eq. 14.19), one for the network, jointly with q_d: on a log-spaced
-  // grid (half decades from 300 s to 10⁵ s, beside the walk) q_d is refitted at each τ_d and the pair of the
-  // highest likelihood kept. A grid, not a search: the likelihood in τ_d is flat towards the walk and need not
-  // be unimodal, and seven points bracket the network's time constants (minutes) to the log's length (hours).
-  core::ThermalVec& tau = out.config.fusion.filter.disturbance_time_constant_s;
-  double best_ll = training_log_likelihood(out.config, record, training);
-  out.disturbance_time_constant_log_likelihood.emplace_back(std::numeric_limits<double>::infinity(), best_ll);
-  const core::ThermalVec walk_q = out.config.fusion.filter.disturbance_W2_per_s;
-  core::ThermalVec best_q = walk_q;
-  for (double log_tau = 2.5; log_tau <= 5.0 + 1e-9; log_tau += 0.5) {
-    tau.setConstant(std::pow(10.0, log_tau));
-    const double q =
-        maximum_likelihood(out.config, record, training, &core::ThermalFilterConfig::disturbance_W2_per_s, -6.0, 4.0);
-    const double ll = training_log_likelihood(out.config, record, training);
-    out.disturbance_time_constant_log_likelihood.emplace_back(tau[0], ll);
-    if (ll > best_ll) {
-      best_ll = ll;
-      out.disturbance_time_constant_s = tau[0];
-      out.disturbance_W2_per_s = q;
-      best_q = out.config.fusion.filter.disturbance_W2_per_s;
-    }
-  }
-  tau.setConstant(out.disturbance_time_constant_s);
-  out.config.fusion.filter.disturbance_W2_per_s = best_q;
+  choose_disturbance_time_constants(out, record, training, options);
   judge(out.config, record, training, out);
   return out;
 }
