@@ -120,9 +120,17 @@ const std::vector<core::ThermalStepData>& recorded_steps() {
   return v;
 }
 
-void BM_FilterStep(benchmark::State& state) {
+/// The loop's configuration with every node's disturbance Gauss–Markov (eq. 14.19): the decay's exponentials
+/// on every step, the filter's dearest form.
+core::ThermalFusionConfig gauss_markov_config() {
+  core::ThermalFusionConfig c = loop_config();
+  c.filter.disturbance_time_constant_s.setConstant(1000.0);
+  return c;
+}
+
+void filter_steps(benchmark::State& state, const core::ThermalFusionConfig& config) {
   const std::vector<core::ThermalStepData>& steps = recorded_steps();
-  const core::ThermalFusion initial(loop_config(), test::paper_base(), test::paper_machine_si());
+  const core::ThermalFusion initial(config, test::paper_base(), test::paper_machine_si());
   core::ThermalFusion fusion = initial;
   double cpu_s = 0.0;
   for (auto _ : state) {
@@ -138,6 +146,9 @@ void BM_FilterStep(benchmark::State& state) {
   state.counters["accepted"] = static_cast<double>(fusion.estimate().observations_accepted);
   state.counters["rejected"] = static_cast<double>(fusion.estimate().observations_rejected);
 }
+
+void BM_FilterStep(benchmark::State& state) { filter_steps(state, loop_config()); }
+void BM_FilterStepGaussMarkov(benchmark::State& state) { filter_steps(state, gauss_markov_config()); }
 
 void BM_FilterStepPaused(benchmark::State& state) {
   const std::vector<core::ThermalStepData>& steps = recorded_steps();
@@ -205,6 +216,7 @@ void BM_SampleWithFusion(benchmark::State& state) {
 
 BENCHMARK(BM_FusionPerSample)->Repetitions(10)->ComputeStatistics("max", max_of)->ReportAggregatesOnly(true);
 BENCHMARK(BM_FilterStep)->Repetitions(10)->ComputeStatistics("max", max_of)->ReportAggregatesOnly(true);
+BENCHMARK(BM_FilterStepGaussMarkov)->Repetitions(10)->ComputeStatistics("max", max_of)->ReportAggregatesOnly(true);
 BENCHMARK(BM_FilterStepPaused)->Repetitions(10)->ComputeStatistics("max", max_of)->ReportAggregatesOnly(true);
 BENCHMARK(BM_PauseResumePair)->Repetitions(10)->ComputeStatistics("max", max_of)->ReportAggregatesOnly(true);
 BENCHMARK(BM_SampleWithFusion)->MinTime(1.0)->Repetitions(10)->ComputeStatistics("max", max_of)->ReportAggregatesOnly(true);

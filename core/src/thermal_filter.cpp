@@ -40,7 +40,19 @@ void ThermalFilter::predict(const ThermalLoad& load) noexcept {
   const LossTerms terms = loss_terms(load);
   const LossTerms change = terms - previous_terms_;
   previous_terms_ = terms;
-  ThermalVec d_var = config_.disturbance_W2_per_s * load.dt_s;
+  // The Gauss–Markov decay a = e^{−Δt/τ_d} and the drift's variance over the step (eq. 14.19);
+  // τ_d = ∞ is the walk exactly (a = 1, q_d·Δt).
+  ThermalVec decay = ThermalVec::Ones();
+  ThermalVec d_var = ThermalVec::Zero();
+  for (int i = 0; i < n.nodes; ++i) {
+    const double tau = config_.disturbance_time_constant_s[i];
+    if (std::isinf(tau)) {
+      d_var[i] = config_.disturbance_W2_per_s[i] * load.dt_s;
+    } else {
+      decay[i] = std::exp(-load.dt_s / tau);
+      d_var[i] = config_.disturbance_W2_per_s[i] * 0.5 * tau * -std::expm1(-2.0 * load.dt_s / tau);
+    }
+  }
   for (int i = 0; i < n.nodes; ++i) {
     const double cu = config_.copper_rel_sigma * change(0, i);
     d_var[i] += cu * cu;
@@ -55,15 +67,21 @@ void ThermalFilter::predict(const ThermalLoad& load) noexcept {
   Eigen::Matrix<double, kN, kDynamic> g;
   g << tr.phi, tr.gamma_d;
   x_.head<kN>() = g * x_.head<kDynamic>() + tr.gamma;  // a product that may alias: Eigen evaluates it first
-  // P⁺ = F·P·Fᵀ + Q_d blockwise (docs/derivations.md §14, eq. 14.12): d and c are random walks, so only the
-  // rows and columns of T change — the rows of T become G·P[T,d rows], the columns their transpose, P_TT
-  // those rows times Gᵀ. Small fixed sizes: coefficient-wise products, no blocking.
-  const Eigen::Matrix<double, kN, kThermalStates> rows = g.lazyProduct(p_.topRows<kDynamic>());
+  x_.segment<kN>(kN).array() *= decay.array();         // eq. 14.20
+  // P⁺ = F·P·Fᵀ + Q_d blockwise (docs/derivations.md §14, eq. 14.12, 14.21): c is a random walk and d scales
+  // by A, so the rows of T become G·P[T,d rows] (from the prior P), the rows and columns of d scale by A, and
+  // the T–d block is then G·P[·,d]·A. Small fixed sizes: coefficient-wise products, no blocking.
+  Eigen::Matrix<double, kN, kThermalStates> rows = g.lazyProduct(p_.topRows<kDynamic>());
+  ThermalMat p_tt = rows.leftCols<kDynamic>().lazyProduct(g.transpose());
+  // P_dd(i, j)·(a_i·a_j): the same product for (i, j) and (j, i), so P_dd stays exactly symmetric; P_cd follows P_dc.
+  rows.middleCols<kN>(kN) *= decay.asDiagonal();
+  p_.block<kN, kN>(kN, kN).array() *= (decay * decay.transpose()).array();
+  p_.block<kN, kCalibrationStates>(kN, kDynamic) = decay.asDiagonal() * p_.block<kN, kCalibrationStates>(kN, kDynamic);
+  p_.block<kCalibrationStates, kN>(kDynamic, kN) = p_.block<kN, kCalibrationStates>(kN, kDynamic).transpose();
   p_.topRows<kN>() = rows;
   p_.leftCols<kN>() = rows.transpose();
   ThermalVec q = ThermalVec::Zero();  // Q_T, on the nodes in use
   for (int i = 0; i < n.nodes; ++i) q[i] = config_.process_noise_K2_per_s[i];
-  ThermalMat p_tt = rows.leftCols<kDynamic>().lazyProduct(g.transpose());
   p_tt += 0.5 * load.dt_s * ((tr.phi * q.asDiagonal()).lazyProduct(tr.phi.transpose()) + ThermalMat(q.asDiagonal()));
   // Rounding must not make P asymmetric: P_TT is the only block not symmetric by construction.
   p_.topLeftCorner<kN, kN>() = 0.5 * (p_tt + p_tt.transpose());

@@ -1,5 +1,7 @@
 #include "rpem/io/thermal_config.hpp"
 
+#include <cmath>
+#include <limits>
 #include <sstream>
 
 #include "rpem/core/per_unit.hpp"
@@ -106,6 +108,9 @@ void parse_nodes(YamlMap& t, ThermalConfig& c) {
     n.to_coolant_W_per_K[idx] = m.number_or("to_coolant_W_per_K", 0.0, 0.0, 1e6);
     f.filter.process_noise_K2_per_s[idx] = m.number_or("process_noise_K2_per_s", 0.0, 0.0, 1e3);
     f.filter.disturbance_W2_per_s[idx] = m.number_or("disturbance_W2_per_s", 0.0, 0.0, 1e12);
+    // τ_d of eq. 14.19; absent: the random walk (τ_d = ∞).
+    f.filter.disturbance_time_constant_s[idx] =
+        m.number_or("disturbance_time_constant_s", std::numeric_limits<double>::infinity(), 1.0, 1e9);
     m.finish();
   }
   for (int i = n.nodes; i < core::kMaxThermalNodes; ++i) {
@@ -253,7 +258,10 @@ std::string thermal_config_yaml(const ThermalConfig& c) {
       << ", capacitance_J_per_K: " << num(n.capacitance_J_per_K[i])
       << ", to_coolant_W_per_K: " << num(n.to_coolant_W_per_K[i])
       << ", process_noise_K2_per_s: " << num(f.filter.process_noise_K2_per_s[i])
-      << ", disturbance_W2_per_s: " << num(f.filter.disturbance_W2_per_s[i]) << "}\n";
+      << ", disturbance_W2_per_s: " << num(f.filter.disturbance_W2_per_s[i]);
+    if (std::isfinite(f.filter.disturbance_time_constant_s[i]))
+      o << ", disturbance_time_constant_s: " << num(f.filter.disturbance_time_constant_s[i]);
+    o << "}\n";
   }
   std::string between;
   for (int i = 0; i < n.nodes; ++i) {

@@ -218,10 +218,11 @@ TEST(RegimeAllocations, NoneThroughEveryRegimeAndTheSparsePath) {
 TEST(ThermalAllocations, NoneAcrossOneHundredThousandFusedSteps) {
   // The thermal fusion beside the estimator (rpemd's loop and `rpem estimate --thermal`): loss accumulation,
   // observations, a 3-node network's exact step every 1 ms (so the filter steps 10⁴ times), gate resets,
-  // coasting without samples, a reload and a non-finite sample.
+  // coasting without samples, a reload and a non-finite sample; one node's disturbance Gauss–Markov.
   const MachineSi machine = test::paper_machine_si();
   AveragedDriveEstimator est(machine, test::paper_settings());
-  const ThermalFusionConfig c = test::paper_thermal_fusion();
+  ThermalFusionConfig c = test::paper_thermal_fusion();
+  c.filter.disturbance_time_constant_s[0] = 600.0;  // one Gauss–Markov disturbance (eq. 14.19) beside the walks
   ThermalFusion fusion(c, test::paper_base(), machine);
   test::AveragedDataGenerator gen;
   gen.base = test::paper_base();

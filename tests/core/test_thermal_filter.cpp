@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <random>
 #include <vector>
 
@@ -145,12 +146,13 @@ TEST(ThermalFilter, LearnsAHeatDisturbanceFromOneNodesReadingsAndCorrectsTheOthe
   EXPECT_NEAR(f.temperature_C()[0], t[0], 1.0);
 }
 
-TEST(ThermalFilter, BlockwiseStepsAreTheDenseFormulasAndKeepPExactlySymmetric) {
-  // The filter predicts blockwise and updates with a sparse H (docs/derivations.md §14, eq. 14.11, 14.12);
-  // here the dense forms on all 12 states: P⁺ = F·P·Fᵀ + Q_d with F = [Φ Γ_d 0; 0 I 0; 0 0 I], and the Joseph
-  // form (I − K·H)·P·(I − K·H)ᵀ + K·r·Kᵀ with K = [P·Hᵀ/s on T and d; 0 on c]. Four nodes in use, so every row
-  // of the network moves, with a disturbance and cross-covariances built by earlier steps.
+// The filter predicts blockwise and updates with a sparse H (docs/derivations.md §14, eq. 14.11, 14.12, 14.21);
+// here the dense forms on all 12 states: P⁺ = F·P·Fᵀ + Q_d with F = [Φ Γ_d 0; 0 A 0; 0 0 I], A = diag(e^{−Δt/τ_d}),
+// and the Joseph form (I − K·H)·P·(I − K·H)ᵀ + K·r·Kᵀ with K = [P·Hᵀ/s on T and d; 0 on c]. Four nodes in use, so
+// every row of the network moves, with a disturbance and cross-covariances built by earlier steps.
+void expect_blockwise_steps_are_the_dense_formulas(const ThermalVec& tau_s) {
   ThermalFilterConfig c;
+  c.disturbance_time_constant_s = tau_s;
   ThermalNetwork& n = c.network;
   n.nodes = 4;
   n.winding = 0, n.magnet = 3;
@@ -205,10 +207,17 @@ TEST(ThermalFilter, BlockwiseStepsAreTheDenseFormulasAndKeepPExactlySymmetric) {
   ThermalStateMat big_f = ThermalStateMat::Identity();
   big_f.block<4, 4>(0, 0) = tr.phi;
   big_f.block<4, 4>(0, 4) = tr.gamma_d;
+  ThermalVec drift_var = c.disturbance_W2_per_s * l.dt_s;  // eq. 14.9, and 14.20 where τ_d is finite
+  for (int i = 0; i < 4; ++i) {
+    if (std::isinf(tau_s[i])) continue;
+    const double a = std::exp(-l.dt_s / tau_s[i]);
+    big_f(4 + i, 4 + i) = a;
+    drift_var[i] = c.disturbance_W2_per_s[i] * 0.5 * tau_s[i] * (1.0 - a * a);
+  }
   ThermalStateMat q_d = ThermalStateMat::Zero();
   const ThermalMat q_t = c.process_noise_K2_per_s.asDiagonal();
   q_d.block<4, 4>(0, 0) = 0.5 * l.dt_s * (tr.phi * q_t * tr.phi.transpose() + q_t);
-  q_d.block<4, 4>(4, 4) = (c.disturbance_W2_per_s * l.dt_s).asDiagonal();
+  q_d.block<4, 4>(4, 4) = drift_var.asDiagonal();
   const ThermalStateMat p1 = big_f * p0 * big_f.transpose() + q_d;
   ThermalStateVec x1 = big_f * x0;
   x1.head<4>() += tr.gamma;
@@ -231,6 +240,135 @@ TEST(ThermalFilter, BlockwiseStepsAreTheDenseFormulasAndKeepPExactlySymmetric) {
   EXPECT_LT((f.covariance() - p2).cwiseAbs().maxCoeff(), tol_p);
   EXPECT_LT((state() - x2).cwiseAbs().maxCoeff(), 1e-12);
   EXPECT_TRUE(f.covariance() == f.covariance().transpose());
+}
+
+TEST(ThermalFilter, BlockwiseStepsAreTheDenseFormulasAndKeepPExactlySymmetric) {
+  expect_blockwise_steps_are_the_dense_formulas(ThermalVec::Constant(std::numeric_limits<double>::infinity()));
+}
+
+TEST(ThermalFilter, BlockwiseStepsAreTheDenseFormulasWithGaussMarkovDisturbances) {
+  // Eq. 14.21: Δt = 7 s against τ_d from 20 s (a = 0.70, far from the walk) to 10⁴ s, one node a walk.
+  expect_blockwise_steps_are_the_dense_formulas(ThermalVec(20.0, 300.0, 1e4, std::numeric_limits<double>::infinity()));
+}
+
+TEST(ThermalFilter, GaussMarkovDisturbanceHasTheClosedFormVarianceAndCorrelation) {
+  // Eq. 14.19, 14.20: unobserved, d's variance from zero after k steps is σ_d²·(1 − a^{2k}), σ_d² = q_d·τ_d/2,
+  // for any step Δt (the discretisation is exact: two steps of Δt are one of 2Δt), and a learnt mean decays as
+  // a^k = e^{−kΔt/τ_d}: the autocorrelation of the stationary process at lag kΔt. Both to rounding (1e-12).
+  ThermalFilterConfig c = two_nodes();
+  c.disturbance_W2_per_s << 10.0, 4.0, 0.0, 0.0;
+  c.disturbance_time_constant_s << 600.0, 2400.0, 1.0, 1.0;
+  const ThermalVec sigma2 = c.disturbance_W2_per_s.cwiseProduct(c.disturbance_time_constant_s) * 0.5;
+  for (double dt : {1.0, 10.0, 60.0}) {
+    ThermalFilter f(c);
+    f.reset(25.0, 0.5);
+    ThermalLoad l;
+    l.dt_s = dt;
+    l.coolant_C = 25.0;
+    const int steps = static_cast<int>(std::lround(6000.0 / dt));
+    for (int k = 0; k < steps; ++k) f.predict(l);
+    for (int i = 0; i < 2; ++i) {
+      const double expected = sigma2[i] * -std::expm1(-2.0 * 6000.0 / c.disturbance_time_constant_s[i]);
+      EXPECT_NEAR(f.covariance()(kMaxThermalNodes + i, kMaxThermalNodes + i), expected, 1e-12 * expected)
+          << "dt " << dt << " node " << i;
+    }
+  }
+  // A learnt mean (the magnet's 400 W of the test above, read for 1 000 steps), then unobserved.
+  ThermalNetwork truth = c.network;
+  truth.loss_at_base_W(static_cast<int>(LossForm::kMagnetEddy), 1) = 400.0;
+  ThermalFilterConfig learn = c;
+  learn.disturbance_time_constant_s[1] = 1e5;
+  ThermalFilter f(learn);
+  f.reset(25.0, 0.5);
+  ThermalLoad l;
+  l.dt_s = 5.0;
+  l.coolant_C = 25.0;
+  l.basis[static_cast<std::size_t>(LossForm::kMagnetEddy)] = 1.0;
+  ThermalVec t = ThermalVec::Constant(25.0);
+  for (int k = 0; k < 1000; ++k) {
+    const ThermalTransition tr = thermal_transition(truth, l);
+    t = tr.phi * t + tr.gamma;
+    f.predict(l);
+    (void)f.observe(magnet_reading(t[1], 0.25));
+  }
+  const double d0 = f.disturbance_W()[1];
+  const double p0 = f.covariance()(kMaxThermalNodes + 1, kMaxThermalNodes + 1);
+  ASSERT_GT(d0, 100.0);
+  f.reconfigure(c);  // τ_d = 2 400 s from here
+  for (int k = 1; k <= 480; ++k) {
+    f.predict(l);
+    if (k % 120 != 0) continue;
+    const double a_k = std::exp(-k * l.dt_s / 2400.0);
+    EXPECT_NEAR(f.disturbance_W()[1], a_k * d0, 1e-12 * d0) << "step " << k;
+    const double p_k = a_k * a_k * p0 + sigma2[1] * (1.0 - a_k * a_k);
+    EXPECT_NEAR(f.covariance()(kMaxThermalNodes + 1, kMaxThermalNodes + 1), p_k, 1e-12 * p_k) << "step " << k;
+  }
+}
+
+TEST(ThermalFilter, GaussMarkovSamplesHaveTheStationaryVarianceAndAutocorrelation) {
+  // The discretised process itself, d⁺ = a·d + v with the filter's a and Var(v) (read off one unobserved step
+  // from d = 0, P_dd = 0): sampled from its stationary law, its variance is σ_d² and its autocorrelation at lag
+  // kΔt is e^{−kΔt/τ_d}. N = 200 000 samples at τ_d/Δt = 20 (a = 0.951): the AR(1) estimates' standard errors are
+  // σ²·√(2·(1+a²)/((1−a²)·N)) = 0.014·σ² for the variance and at most √((1+a²)/((1−a²)·N)) = 0.010 for a lag's
+  // correlation (Bartlett); asserted at 5 of them.
+  ThermalFilterConfig c = two_nodes();
+  c.disturbance_W2_per_s << 0.0, 2.0, 0.0, 0.0;
+  c.disturbance_time_constant_s << 1.0, 200.0, 1.0, 1.0;
+  const double dt = 10.0, tau = 200.0, sigma2 = 2.0 * tau / 2.0;
+  ThermalFilter f(c);
+  f.set_temperatures(ThermalVec::Constant(25.0), ThermalMat::Zero());
+  ThermalLoad l;
+  l.dt_s = dt;
+  l.coolant_C = 25.0;
+  f.predict(l);
+  const double var_v = f.covariance()(kMaxThermalNodes + 1, kMaxThermalNodes + 1);
+  const double a = std::exp(-dt / tau);
+  EXPECT_NEAR(var_v, sigma2 * (1.0 - a * a), 1e-12 * sigma2);
+  std::mt19937_64 rng(24);
+  std::normal_distribution<double> v(0.0, std::sqrt(var_v));
+  const int n = 200000;
+  std::vector<double> d(static_cast<std::size_t>(n));
+  double x = std::normal_distribution<double>(0.0, std::sqrt(sigma2))(rng);
+  for (double& di : d) di = x = a * x + v(rng);
+  double s2 = 0.0;
+  for (double di : d) s2 += di * di;
+  s2 /= n;
+  EXPECT_NEAR(s2, sigma2, 5.0 * 0.014 * sigma2);
+  for (int lag : {1, 5, 20}) {
+    double r = 0.0;
+    for (int k = 0; k + lag < n; ++k) r += d[static_cast<std::size_t>(k)] * d[static_cast<std::size_t>(k + lag)];
+    r /= (n - lag) * s2;
+    EXPECT_NEAR(r, std::exp(-lag * dt / tau), 5.0 * 0.010) << "lag " << lag;
+  }
+}
+
+TEST(ThermalFilter, GaussMarkovTendsToTheRandomWalk) {
+  // τ_d → ∞ (eq. 14.19): a = 1 − Δt/τ_d + …, Var(v) = q_d·Δt·(1 − Δt/τ_d + …); at τ_d = 10¹² s and Δt = 5 s
+  // both differ from the walk by 5·10⁻¹², so after 1 000 steps with readings every state and P agree to 1e-8
+  // relative (τ_d = +∞ itself is the walk's F and Q_d: the dense test above).
+  ThermalFilterConfig walk = two_nodes();
+  walk.disturbance_W2_per_s << 10.0, 10.0, 0.0, 0.0;
+  walk.process_noise_K2_per_s << 1e-4, 1e-4, 0.0, 0.0;
+  ThermalFilterConfig far = walk;
+  far.disturbance_time_constant_s.setConstant(1e12);
+  ThermalFilter fw(walk), ff(far);
+  for (ThermalFilter* f : {&fw, &ff}) f->reset(25.0, 0.5);
+  ThermalLoad l;
+  l.dt_s = 5.0;
+  l.current_sq_A2 = 120.0 * 120.0;
+  l.coolant_C = 25.0;
+  for (int k = 0; k < 1000; ++k) {
+    const double reading = 25.0 + 30.0 * (1.0 - std::exp(-k / 300.0));
+    for (ThermalFilter* f : {&fw, &ff}) {
+      f->predict(l);
+      (void)f->observe(magnet_reading(reading, 0.25));
+    }
+  }
+  ASSERT_GT(fw.disturbance_W().cwiseAbs().maxCoeff(), 10.0);  // a disturbance was learnt
+  EXPECT_LT((ff.covariance() - fw.covariance()).cwiseAbs().maxCoeff(), 1e-8 * fw.covariance().cwiseAbs().maxCoeff());
+  EXPECT_LT((ff.disturbance_W() - fw.disturbance_W()).cwiseAbs().maxCoeff(),
+            1e-8 * fw.disturbance_W().cwiseAbs().maxCoeff());
+  EXPECT_LT((ff.temperature_C() - fw.temperature_C()).cwiseAbs().maxCoeff(), 1e-8 * 100.0);
 }
 
 TEST(ThermalFilter, BilinearCalibrationTermMeanAndVarianceOverAGaussianPrior) {

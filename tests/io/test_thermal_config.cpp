@@ -3,6 +3,7 @@
 // come from the machine and the materials' table (core/thermal.hpp).
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <regex>
 
 #include "rpem/io/thermal_config.hpp"
@@ -136,6 +137,28 @@ TEST(ThermalConfig, BadSectionsNameFileLineKeyAndReason) {
   } catch (const ConfigError& e) {
     EXPECT_NE(std::string(e.what()).find("node 'magnet' has no path of conductances to the coolant"), std::string::npos)
         << e.what();
+  }
+}
+
+TEST(ThermalConfig, DisturbanceTimeConstantPerNodeAbsentIsTheWalk) {
+  // eq. 14.19: a node's τ_d; absent, +∞ (the random walk, eq. 14.9), and the writer then leaves it out.
+  const std::string text = std::regex_replace(std::string(kThreeNodes), std::regex("to_coolant_W_per_K: 95"),
+                                              "to_coolant_W_per_K: 95, disturbance_time_constant_s: 1800");
+  const ThermalConfig c = load_text(text);
+  const core::ThermalVec& tau = c.fusion.filter.disturbance_time_constant_s;
+  EXPECT_DOUBLE_EQ(tau[1], 1800.0);
+  EXPECT_TRUE(std::isinf(tau[0]) && tau[0] > 0.0);
+  EXPECT_TRUE(std::isinf(tau[2]) && tau[2] > 0.0);
+  const std::string written = thermal_config_yaml(c);
+  EXPECT_EQ(written.find("disturbance_time_constant_s"), written.rfind("disturbance_time_constant_s"));  // once
+  const ThermalConfig back = load_text(written);
+  EXPECT_EQ(back.fusion.filter.disturbance_time_constant_s, tau);
+  // Strict as the other keys: a number, inside [1 s, 10⁹ s], with file:line:column.
+  for (const char* bad : {"0.5", "-3", "2e9", "long", ".inf"}) {
+    const std::string e =
+        error_of("to_coolant_W_per_K: 95", std::string("to_coolant_W_per_K: 95, disturbance_time_constant_s: ") + bad);
+    EXPECT_NE(e.find(":4:"), std::string::npos) << bad << ": " << e;
+    EXPECT_NE(e.find("thermal.nodes[1].disturbance_time_constant_s"), std::string::npos) << bad << ": " << e;
   }
 }
 

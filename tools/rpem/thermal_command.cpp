@@ -25,6 +25,7 @@ struct ThermalFitCliOptions {
   double fit_until_s = std::numeric_limits<double>::quiet_NaN();
   double winding_sensor_sigma_K = 1.0;
   double period_s = 0.0;
+  double disturbance_time_constant_s = 0.0;  ///< 0: chosen by the likelihood
   bool keep_magnet_reference = false;
 };
 
@@ -48,6 +49,7 @@ int run_thermal_fit(const ThermalFitCliOptions& o) {
   analysis::ThermalFitOptions options;
   options.fit_until_s = o.fit_until_s;
   options.anchor_magnet_reference = !o.keep_magnet_reference;
+  if (o.disturbance_time_constant_s > 0.0) options.disturbance_time_constant_s = o.disturbance_time_constant_s;
   std::fprintf(stderr, "rpem thermal fit: %zu steps of %.3g s; fitting a %d-node network\n", record.steps.size(),
                start.fusion.observer.period_s, start.fusion.filter.network.nodes);
   const analysis::ThermalFitResult fit = analysis::fit_thermal(record, start, options);
@@ -75,8 +77,12 @@ int run_thermal_fit(const ThermalFitCliOptions& o) {
   }
   for (const std::string& s : fit.not_identifiable) std::printf("not identifiable together: %s\n", s.c_str());
   for (const std::string& s : fit.notes) std::printf("note: %s\n", s.c_str());
-  std::printf("process noise %.3g K^2/s, disturbance drift %.3g W^2/s; wrote %s\n", fit.process_noise_K2_per_s,
-              fit.disturbance_W2_per_s, o.out.c_str());
+  std::printf("process noise %.3g K^2/s, disturbance drift %.3g W^2/s, correlation times", fit.process_noise_K2_per_s,
+              fit.disturbance_W2_per_s);
+  for (int i = 0; i < fit.config.fusion.filter.network.nodes; ++i)
+    std::printf(" %s %.3g s", fit.config.node_names[static_cast<std::size_t>(i)].c_str(),
+                fit.disturbance_time_constant_s[i]);
+  std::printf("; wrote %s\n", o.out.c_str());
   return kExitOk;
 }
 
@@ -105,6 +111,10 @@ Runner add_thermal_command(CLI::App& app) {
       ->check(CLI::Range(1e-3, 100.0));
   fit->add_option("--period-s", opts->period_s, "the filter's step (default: thermal.yaml's, 1 s)")
       ->check(CLI::Range(1e-3, 3600.0));
+  fit->add_option("--disturbance-time-constant-s", opts->disturbance_time_constant_s,
+                  "every node's heat disturbance correlation time τ_d (eq. 14.19), given instead of chosen per node by "
+                  "the likelihood (1e9: the random walk)")
+      ->check(CLI::Range(1.0, 1e9));
   fit->add_flag(
       "--keep-magnet-reference", opts->keep_magnet_reference,
       "keep the magnet law's psi_m_ref as given (--start or the machine's) instead of anchoring it at the soaked start");

@@ -449,14 +449,19 @@ void judge(const io::ThermalConfig& c, const ThermalRecord& r, std::size_t train
 
 /// The value of one of the filter's noise intensities (every node; `field` picks which) that maximises the
 /// filter's innovation likelihood over the training part: golden-section search on its log10 in [lo, hi].
+/// The filter's innovation log-likelihood over the training part.
+double training_log_likelihood(const io::ThermalConfig& c, const ThermalRecord& r, std::size_t training) {
+  double ll = 0.0;
+  for (const FilterStep& s : run_filter(c.fusion, r, training)) ll += s.log_likelihood;
+  return ll;
+}
+
 double maximum_likelihood(io::ThermalConfig& c, const ThermalRecord& r, std::size_t training,
                           core::ThermalVec core::ThermalFilterConfig::*field, double lo, double hi) {
   auto nll = [&](double log_q) {
     (c.fusion.filter.*field).setZero();
     (c.fusion.filter.*field).head(c.fusion.filter.network.nodes).setConstant(std::pow(10.0, log_q));
-    double ll = 0.0;
-    for (const FilterStep& s : run_filter(c.fusion, r, training)) ll += s.log_likelihood;
-    return -ll;
+    return -training_log_likelihood(c, r, training);
   };
   double a = lo, b = hi;
   const double g = 0.5 * (std::sqrt(5.0) - 1.0);
@@ -562,6 +567,68 @@ io::ThermalConfig default_topology(const io::ThermalConfig& laws, const ThermalR
   return c;
 }
 
+/// The disturbances' correlation times τ_d (eq. 14.19) jointly with q_d, by the training part's innovation
+/// likelihood. On a log-spaced grid (half decades from 300 s to 10⁵ s, beside the walk) q_d is refitted at each
+/// τ_d and the pair of the highest likelihood kept. A grid, not a search: the likelihood in τ_d is flat towards
+/// the walk and need not be unimodal, and six points bracket the network's time constants (minutes) to a log's
+/// length (hours). Per node, each in turn (winding first, the others held at their choice so far): the nodes'
+/// disturbances have different causes (docs/thermal.md, "A Gauss–Markov disturbance": one τ_d for the network
+/// let the magnet's choice decide the winding's). A given τ_d is every node's.
+void choose_disturbance_time_constants(ThermalFitResult& out, const ThermalRecord& record, std::size_t training,
+                                       const ThermalFitOptions& options) {
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  core::ThermalFilterConfig& f = out.config.fusion.filter;
+  const int nodes = f.network.nodes;
+  f.disturbance_time_constant_s.setConstant(kInf);
+  std::vector<double> grid;
+  if (std::isnan(options.disturbance_time_constant_s)) {
+    for (double log_tau = 2.5; log_tau <= 5.0 + 1e-9; log_tau += 0.5) grid.push_back(std::pow(10.0, log_tau));
+  } else if (options.disturbance_time_constant_s < 1e9) {
+    grid.push_back(options.disturbance_time_constant_s);
+  }
+  const auto fit_q = [&] {
+    return maximum_likelihood(out.config, record, training, &core::ThermalFilterConfig::disturbance_W2_per_s, -6.0, 4.0);
+  };
+  double best_ll = training_log_likelihood(out.config, record, training);
+  out.disturbance_time_constant_log_likelihood.push_back({-1, kInf, best_ll});
+  const bool given = !std::isnan(options.disturbance_time_constant_s);
+  if (given) best_ll = -kInf;  // a given τ_d is kept whatever the walk's likelihood
+  std::vector<int> order;      // the network at once (−1), or each node in turn
+  if (!given) {
+    order.push_back(f.network.winding);
+    for (int i = 0; i < nodes; ++i)
+      if (i != f.network.winding) order.push_back(i);
+  } else {
+    order.push_back(-1);
+  }
+  core::ThermalVec best_tau = f.disturbance_time_constant_s;
+  core::ThermalVec best_q = f.disturbance_W2_per_s;
+  double best_q_scalar = out.disturbance_W2_per_s;
+  for (int node : order) {
+    for (double tau_s : grid) {
+      f.disturbance_time_constant_s = best_tau;
+      if (node < 0) {
+        f.disturbance_time_constant_s.head(nodes).setConstant(tau_s);
+      } else {
+        f.disturbance_time_constant_s[node] = tau_s;
+      }
+      const double q = fit_q();
+      const double ll = training_log_likelihood(out.config, record, training);
+      out.disturbance_time_constant_log_likelihood.push_back({node, tau_s, ll});
+      if (ll > best_ll) {
+        best_ll = ll;
+        best_q_scalar = q;
+        best_q = f.disturbance_W2_per_s;
+        best_tau = f.disturbance_time_constant_s;
+      }
+    }
+  }
+  f.disturbance_time_constant_s = best_tau;
+  f.disturbance_W2_per_s = best_q;
+  out.disturbance_W2_per_s = best_q_scalar;
+  out.disturbance_time_constant_s = best_tau;
+}
+
 ThermalFitResult fit_thermal(const ThermalRecord& record, const io::ThermalConfig& start_config,
                              const ThermalFitOptions& options) {
   if (record.steps.size() < 10) {
@@ -628,6 +695,7 @@ ThermalFitResult fit_thermal(const ThermalRecord& record, const io::ThermalConfi
       maximum_likelihood(out.config, record, training, &core::ThermalFilterConfig::process_noise_K2_per_s, -8.0, 1.0);
   out.disturbance_W2_per_s =
       maximum_likelihood(out.config, record, training, &core::ThermalFilterConfig::disturbance_W2_per_s, -6.0, 4.0);
+  choose_disturbance_time_constants(out, record, training, options);
   judge(out.config, record, training, out);
   return out;
 }

@@ -64,6 +64,13 @@ void write_thermal_fit_json(const std::string& path, const ThermalFitResult& fit
   j["training_cost"] = fit.training_cost;
   j["process_noise_K2_per_s"] = fit.process_noise_K2_per_s;
   j["disturbance_W2_per_s"] = fit.disturbance_W2_per_s;
+  // τ_d per node in use; +∞ (the random walk) is written as null.
+  for (int i = 0; i < fit.config.fusion.filter.network.nodes; ++i)
+    j["disturbance_time_constant_s"].push_back(fit.disturbance_time_constant_s[i]);
+  for (const ThermalFitResult::TimeConstantTrial& t : fit.disturbance_time_constant_log_likelihood) {
+    j["disturbance_time_constant_grid"].push_back(
+        {{"node", t.node}, {"time_constant_s", t.time_constant_s}, {"log_likelihood", t.log_likelihood}});
+  }
   for (const FittedParameter& p : fit.parameters) {
     j["parameters"].push_back({{"name", p.name},
                                {"unit", p.unit},
@@ -107,7 +114,13 @@ void write_thermal_fit_report(const std::string& path, const ThermalFitResult& f
   }
   o << "\nProcess noise (maximum likelihood of the filter's innovations over the training part): "
     << fmt(fit.process_noise_K2_per_s) << " K²/s per node; the heat disturbances' drift " << fmt(fit.disturbance_W2_per_s)
-    << " W²/s per node.\n";
+    << " W²/s per node; their correlation times (eq. 14.19)";
+  for (int i = 0; i < fit.config.fusion.filter.network.nodes; ++i) {
+    const double tau = fit.disturbance_time_constant_s[i];
+    o << (i ? ", " : " ") << fit.config.node_names[static_cast<std::size_t>(i)] << " "
+      << (std::isfinite(tau) ? fmt(tau) + " s" : "∞ (a random walk)");
+  }
+  o << ".\n";
   if (!fit.not_identifiable.empty()) {
     o << "\n## Not identifiable\n\nParameters the log cannot tell apart (they move together along a direction the "
          "residuals barely change):\n\n";

@@ -5,17 +5,20 @@
 // states: nothing in the data tells a calibration error from a model error), corrected by scalar linear
 // observations (a parameter estimate through its temperature law, a sensor).
 //
-//   state x = [T; d; c],  T⁺ = Φ·T + γ + Γ_d·d,  d⁺ = d + v,  c⁺ = c                    (eq. 14.4, 14.9)
+//   state x = [T; d; c],  T⁺ = Φ·T + γ + Γ_d·d,  d⁺ = a·d + v,  c⁺ = c            (eq. 14.4, 14.9, 14.19)
+//   a = e^{−Δt/τ_d} per node: a first-order Gauss–Markov disturbance, τ_d = ∞ (a = 1) the random walk
 //   c = [e_ref,magnet, e_α,magnet, e_ref,copper, e_α,copper]: a law's temperature reads T + e_ref + e_α·(T − T_ref)
-//   Var(v_i) = q_d,i·Δt + Σ_terms (σ_rel,term·ΔP_term,i)²: a loss model's error moves with the loss it
+//   Var(v_i) = q_d,i·(τ_d/2)·(1 − a²) [→ q_d,i·Δt as τ_d → ∞] + Σ_terms (σ_rel,term·ΔP_term,i)²: a loss model's error moves with the loss it
 //   models, so each change ΔP of a modelled loss term between steps adds its relative uncertainty squared
-//   P⁺ = F·P·Fᵀ + Q_d,  F = [Φ Γ_d 0; 0 I 0; 0 0 I],  Q_d = (Δt/2)·(Φ·Q_T·Φᵀ + Q_T) on T (trapezoidal rule),
+//   P⁺ = F·P·Fᵀ + Q_d,  F = [Φ Γ_d 0; 0 A 0; 0 0 I] (A = diag a),  Q_d = (Δt/2)·(Φ·Q_T·Φᵀ + Q_T) on T (trapezoidal rule),
 //        formed blockwise: only the rows and columns of T change (eq. 14.12)
 //   observe:  y = h·T + h_c·c + offset + v_y,  v_y ~ N(0, r);  ν = y − ŷ,  s = H·P·Hᵀ + r
 //             K = [P_xx·Hᵀ/s on T and d; 0 on c],  x += K·ν,  P −= rank-one terms of that gain (eq. 14.11)
 //
 // An observation whose innovation lies beyond `gate_sigma`·√s is rejected (counted by the caller), so one
 // wild estimate cannot pull the state. Real-time safe: fixed size, noexcept, no allocation.
+
+#include <limits>
 
 #include "rpem/core/thermal_network.hpp"
 
@@ -49,6 +52,8 @@ struct ThermalFilterConfig {
   ThermalNetwork network;
   ThermalVec process_noise_K2_per_s = ThermalVec::Zero();  ///< Q_T: white noise on each node's dT/dt
   ThermalVec disturbance_W2_per_s = ThermalVec::Zero();    ///< q_d: the heat disturbances' drift
+  /// τ_d: the disturbances' correlation time (eq. 14.19); +∞ (the default) is the random walk.
+  ThermalVec disturbance_time_constant_s = ThermalVec::Constant(std::numeric_limits<double>::infinity());
   /// σ_rel of each fitted loss term (form row, node column): its relative uncertainty.
   Eigen::Matrix<double, kLossForms, kMaxThermalNodes> loss_rel_sigma =
       Eigen::Matrix<double, kLossForms, kMaxThermalNodes>::Zero();

@@ -25,6 +25,8 @@ struct ThermalFitOptions {
   /// The magnet law's ψ_ref from the first magnet observations at the soaked start (else as configured).
   bool anchor_magnet_reference = true;
   int max_iterations = 200;
+  /// τ_d of eq. 14.19 for every node if given (≥ 1e9 s: the walk); NaN: each node's chosen with q_d by the likelihood.
+  double disturbance_time_constant_s = std::numeric_limits<double>::quiet_NaN();
 };
 
 struct FittedParameter {
@@ -55,6 +57,16 @@ struct ThermalFitResult {
   std::vector<std::string> notes;
   double process_noise_K2_per_s = 0.0;
   double disturbance_W2_per_s = 0.0;
+  /// τ_d of eq. 14.19 per node (+∞: the random walk), with q_d the most likely over the training part.
+  core::ThermalVec disturbance_time_constant_s = core::ThermalVec::Constant(std::numeric_limits<double>::infinity());
+  /// Each τ_d tried: the node (−1: all nodes), τ_d (+∞ first: the walk) and the training part's log-likelihood,
+  /// q_d refitted.
+  struct TimeConstantTrial {
+    int node = -1;
+    double time_constant_s = 0.0;
+    double log_likelihood = 0.0;
+  };
+  std::vector<TimeConstantTrial> disturbance_time_constant_log_likelihood;
   double training_cost = 0.0;                 ///< Σ of the squared weighted residuals
   std::vector<core::ThermalVec> open_loop_C;  ///< the model alone over the whole log, per step
 };
