@@ -574,6 +574,19 @@ io::ThermalConfig default_topology(const io::ThermalConfig& laws, const ThermalR
 /// length (hours). Per node, each in turn (winding first, the others held at their choice so far): the nodes'
 /// disturbances have different causes (docs/thermal.md, "A Gauss–Markov disturbance": one τ_d for the network
 /// let the magnet's choice decide the winding's). A given τ_d is every node's.
+/// The walk is the nested model (τ_d → ∞), so a finite τ_d is one more parameter: 2·ΔlnL > χ²₁(1 − 0.05/m) = z²,
+/// z the normal quantile at 1 − 0.05/(2m) (eq. 14.21a), found by bisection on erfc in [0, 10].
+double likelihood_ratio_threshold(std::size_t trials) {
+  constexpr double kAlpha = 0.05;  // the fit's 95 % intervals' level
+  const double tail = kAlpha / static_cast<double>(std::max<std::size_t>(trials, 1));
+  double lo = 0.0, hi = 10.0;
+  for (int k = 0; k < 100; ++k) {
+    const double z = 0.5 * (lo + hi);
+    (std::erfc(z / std::sqrt(2.0)) > tail ? lo : hi) = z;  // erfc(z/√2): two-sided tail of the normal
+  }
+  return 0.5 * lo * lo;
+}
+
 void choose_disturbance_time_constants(ThermalFitResult& out, const ThermalRecord& record, std::size_t training,
                                        const ThermalFitOptions& options) {
   constexpr double kInf = std::numeric_limits<double>::infinity();
@@ -604,7 +617,14 @@ void choose_disturbance_time_constants(ThermalFitResult& out, const ThermalRecor
   core::ThermalVec best_tau = f.disturbance_time_constant_s;
   core::ThermalVec best_q = f.disturbance_W2_per_s;
   double best_q_scalar = out.disturbance_W2_per_s;
+  // A given τ_d is taken whatever the likelihood; a chosen one must pass the test (eq. 14.21a).
+  const double threshold = given ? 0.0 : likelihood_ratio_threshold(grid.size());
+  out.disturbance_time_constant_threshold = threshold;
   for (int node : order) {
+    // The grid's best for this node (the grid's points have the same number of parameters: plain comparison),
+    // then against the choice so far (the walk, or what the nodes before chose) by the test.
+    double node_ll = -kInf, node_q_scalar = best_q_scalar;
+    core::ThermalVec node_tau = best_tau, node_q = best_q;
     for (double tau_s : grid) {
       f.disturbance_time_constant_s = best_tau;
       if (node < 0) {
@@ -615,12 +635,18 @@ void choose_disturbance_time_constants(ThermalFitResult& out, const ThermalRecor
       const double q = fit_q();
       const double ll = training_log_likelihood(out.config, record, training);
       out.disturbance_time_constant_log_likelihood.push_back({node, tau_s, ll});
-      if (ll > best_ll) {
-        best_ll = ll;
-        best_q_scalar = q;
-        best_q = f.disturbance_W2_per_s;
-        best_tau = f.disturbance_time_constant_s;
+      if (ll > node_ll) {
+        node_ll = ll;
+        node_q_scalar = q;
+        node_q = f.disturbance_W2_per_s;
+        node_tau = f.disturbance_time_constant_s;
       }
+    }
+    if (node_ll > best_ll + threshold) {
+      best_ll = node_ll;
+      best_q_scalar = node_q_scalar;
+      best_q = node_q;
+      best_tau = node_tau;
     }
   }
   f.disturbance_time_constant_s = best_tau;

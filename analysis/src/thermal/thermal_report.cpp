@@ -67,6 +67,7 @@ void write_thermal_fit_json(const std::string& path, const ThermalFitResult& fit
   // τ_d per node in use; +∞ (the random walk) is written as null.
   for (int i = 0; i < fit.config.fusion.filter.network.nodes; ++i)
     j["disturbance_time_constant_s"].push_back(fit.disturbance_time_constant_s[i]);
+  j["disturbance_time_constant_threshold"] = fit.disturbance_time_constant_threshold;
   for (const ThermalFitResult::TimeConstantTrial& t : fit.disturbance_time_constant_log_likelihood) {
     j["disturbance_time_constant_grid"].push_back(
         {{"node", t.node}, {"time_constant_s", t.time_constant_s}, {"log_likelihood", t.log_likelihood}});
@@ -120,7 +121,8 @@ void write_thermal_fit_report(const std::string& path, const ThermalFitResult& f
     o << (i ? ", " : " ") << fit.config.node_names[static_cast<std::size_t>(i)] << " "
       << (std::isfinite(tau) ? fmt(tau) + " s" : "∞ (a random walk)");
   }
-  o << ".\n";
+  o << " (a finite one kept only where it gains more than " << fmt(fit.disturbance_time_constant_threshold)
+    << " in log-likelihood over the walk: the likelihood-ratio test at 5 % over the grid, eq. 14.21a).\n";
   if (!fit.not_identifiable.empty()) {
     o << "\n## Not identifiable\n\nParameters the log cannot tell apart (they move together along a direction the "
          "residuals barely change):\n\n";

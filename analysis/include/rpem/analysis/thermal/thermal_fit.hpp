@@ -67,6 +67,8 @@ struct ThermalFitResult {
     double log_likelihood = 0.0;
   };
   std::vector<TimeConstantTrial> disturbance_time_constant_log_likelihood;
+  /// The gain in log-likelihood a chosen τ_d had to show over the walk (eq. 14.21a; 0 where τ_d was given).
+  double disturbance_time_constant_threshold = 0.0;
   double training_cost = 0.0;                 ///< Σ of the squared weighted residuals
   std::vector<core::ThermalVec> open_loop_C;  ///< the model alone over the whole log, per step
 };
@@ -74,6 +76,10 @@ struct ThermalFitResult {
 /// Fits `start` (its nodes, conductances and losses give the topology; their values the start) to the record.
 [[nodiscard]] ThermalFitResult fit_thermal(const ThermalRecord& record, const io::ThermalConfig& start,
                                            const ThermalFitOptions& options);
+
+/// The log-likelihood gain over the walk a node's correlation time τ_d chosen from `trials` grid points must show
+/// (eq. 14.21a): ½·χ²₁(1 − 0.05/trials), the likelihood-ratio test at 5 % with Bonferroni's correction.
+[[nodiscard]] double likelihood_ratio_threshold(std::size_t trials);
 
 /// The default topologies (docs/thermal.md, "The network"): 2 nodes (winding, magnet) or 3 (winding,
 /// stator_iron, magnet), with starting values scaled to the record's copper loss and temperature rise.
