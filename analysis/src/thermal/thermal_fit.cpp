@@ -24,8 +24,13 @@ constexpr double kLogRange = 10.3;
 /// loss's scale is known better: (3/2)·R_s·|i|² within a factor of 2 (AC resistance, stray load losses).
 constexpr double kPriorSigmaLog = 2.302585092994046;
 constexpr double kPriorSigmaLogCopper = 0.6931471805599453;
+/// The winding sensor's lag where the fit estimates it (eq. 14.19): the prior's centre, a thermistor or PT100
+/// in the end winding (seconds to tens of seconds), with kPriorSigmaLog. Kept when its 95 % interval spans at
+/// most a decade (half-width e^{ln(10)/2} − 1); otherwise the sensor is taken as the node (0) and a note says so.
+constexpr double kSensorLagPrior_s = 10.0;
+const double kSensorLagKeptHalfWidth = std::sqrt(10.0) - 1.0;
 
-enum class SlotKind { kCapacitance, kToCoolant, kBetween, kLoss, kCopperScale };
+enum class SlotKind { kCapacitance, kToCoolant, kBetween, kLoss, kCopperScale, kSensorLag };
 
 struct Slot {
   SlotKind kind;
@@ -45,9 +50,11 @@ struct LossTie {
 /// Where each fitted quantity lives in the network, and how the parameter vector maps onto a configuration.
 class Layout {
  public:
-  Layout(const io::ThermalConfig& start, const std::vector<LossTie>& ties) : start_(start) {
+  /// `sensor_lag`: the winding sensor's time constant is a parameter too (eq. 14.19).
+  Layout(const io::ThermalConfig& start, const std::vector<LossTie>& ties, bool sensor_lag) : start_(start) {
     const core::ThermalNetwork& n = start.fusion.filter.network;
     auto name = [&](int i) { return start.node_names[static_cast<std::size_t>(i)]; };
+    if (sensor_lag) slots_.push_back({SlotKind::kSensorLag, n.winding, 0, "winding sensor time constant", "s"});
     for (int i = 0; i < n.nodes; ++i) slots_.push_back({SlotKind::kCapacitance, i, 0, "C " + name(i), "J/K"});
     slots_.push_back({SlotKind::kCopperScale, n.winding, 0, "copper loss scale", "1"});
     for (int i = 0; i < n.nodes; ++i) {
@@ -105,6 +112,9 @@ class Layout {
         case SlotKind::kCopperScale:
           n.copper_scale = v;
           break;
+        case SlotKind::kSensorLag:
+          c.fusion.winding_sensor_time_constant_s = v;
+          break;
         case SlotKind::kToCoolant:
           n.to_coolant_W_per_K[s.i] = v;
           break;
@@ -130,6 +140,8 @@ class Layout {
         return n.capacitance_J_per_K[s.i];
       case SlotKind::kCopperScale:
         return n.copper_scale;
+      case SlotKind::kSensorLag:
+        return c.fusion.winding_sensor_time_constant_s;
       case SlotKind::kToCoolant:
         return n.to_coolant_W_per_K[s.i];
       case SlotKind::kBetween:
@@ -152,6 +164,16 @@ struct Point {
   double sigma_K;
 };
 
+/// The winding sensor's lag over step `s` of the open-loop network, at its temperatures `t` at the step's end
+/// (eq. 14.19, as the filter does it: core/thermal_sensor.hpp; the network's rate is exact here, variance 0).
+void advance_sensor_lag(const core::ThermalFusionConfig& f, const core::ThermalStepData& s, const core::ThermalVec& t,
+                        core::SensorLag& lag) {
+  if (!(f.winding_sensor_time_constant_s > 0.0)) return;
+  const core::ThermalRates rates = core::thermal_rates(f.filter.network, s.load);
+  const int w = f.filter.network.winding;
+  lag.advance(core::sensor_lag_step(f.winding_sensor_time_constant_s, s.load.dt_s), rates.a.row(w).dot(t) + rates.u[w], 0.0);
+}
+
 /// The observation's miss in kelvin: (y − h·T − c)/(∂y/∂T of its own node).
 double miss_K(const core::StepObservations& o, int kind, const core::ThermalVec& t, int own_node) {
   const core::ThermalObservation& x = o.item[static_cast<std::size_t>(kind)];
@@ -170,18 +192,21 @@ void residuals(const io::ThermalConfig& c, const ThermalRecord& r, std::size_t s
                double* out) {
   const core::ThermalFusionConfig& f = c.fusion;
   core::ThermalVec t = soaked_start(f, r);
+  core::SensorLag lag;
   std::size_t p = 0;
   for (std::size_t k = 0; k < steps && p < points.size(); ++k) {
     const core::ThermalStepData& s = r.steps[k];
     const core::ThermalTransition tr = core::thermal_transition(f.filter.network, s.load);
     t = tr.phi * t + tr.gamma;
     if (!(t.cwiseAbs().maxCoeff() < kRunawayBand_K)) break;
-    if (points[p].step != k) continue;
-    const core::StepObservations o = core::step_observations(f, s, t, core::ThermalVec::Zero());
-    for (; p < points.size() && points[p].step == k; ++p) {
-      const double m = miss_K(o, points[p].kind, t, own_node(f.filter.network, points[p].kind));
-      out[p] = std::isfinite(m) ? std::clamp(m / points[p].sigma_K, -kRunaway, kRunaway) : kRunaway;
+    if (points[p].step == k) {
+      const core::StepObservations o = core::step_observations(f, s, t, core::ThermalVec::Zero(), lag);
+      for (; p < points.size() && points[p].step == k; ++p) {
+        const double m = miss_K(o, points[p].kind, t, own_node(f.filter.network, points[p].kind));
+        out[p] = std::isfinite(m) ? std::clamp(m / points[p].sigma_K, -kRunaway, kRunaway) : kRunaway;
+      }
     }
+    advance_sensor_lag(f, s, t, lag);
   }
   for (; p < points.size(); ++p) out[p] = kRunaway;
 }
@@ -422,13 +447,18 @@ void judge(const io::ThermalConfig& c, const ThermalRecord& r, std::size_t train
   // The sensor is judged on every step that has one, whether or not the configuration fuses it.
   core::ThermalFusionConfig judged = f;
   if (judged.winding_sensor_sigma_K <= 0.0) judged.winding_sensor_sigma_K = 1.0;
+  std::vector<core::SensorLag> lag(r.steps.size());  // at each step's start
+  for (std::size_t k = 0; k + 1 < r.steps.size(); ++k) {
+    lag[k + 1] = lag[k];
+    advance_sensor_lag(judged, r.steps[k], out.open_loop_C[k], lag[k + 1]);
+  }
   for (int kind = 0; kind < 3; ++kind) {
     SignalFit s;
     s.name = names[kind];
     double fit2 = 0.0, held2 = 0.0;
     for (std::size_t k = 0; k < r.steps.size(); ++k) {
       const core::StepObservations o =
-          core::step_observations(judged, r.steps[k], out.open_loop_C[k], core::ThermalVec::Zero());
+          core::step_observations(judged, r.steps[k], out.open_loop_C[k], core::ThermalVec::Zero(), lag[k]);
       if (!o.present[static_cast<std::size_t>(kind)]) continue;
       const double m = miss_K(o, kind, out.open_loop_C[k], own_node(f.filter.network, kind));
       if (k < training) {
@@ -579,7 +609,11 @@ ThermalFitResult fit_thermal(const ThermalRecord& record, const io::ThermalConfi
 
   io::ThermalConfig start = start_config;
   const std::vector<LossTie> ties = tie_collinear_losses(start, record, training, out.notes);
-  const Layout layout(start, ties);
+  // A winding sensor without a configured lag: its time constant is fitted too (eq. 14.19), from the prior.
+  const bool fit_sensor_lag = record.winding_sensor && start.fusion.winding_sensor_sigma_K > 0.0 &&
+                              !(start.fusion.winding_sensor_time_constant_s > 0.0);
+  if (fit_sensor_lag) start.fusion.winding_sensor_time_constant_s = kSensorLagPrior_s;
+  const Layout layout(start, ties, fit_sensor_lag);
   const std::vector<double> prior = layout.values(start);
   // The magnet's reference: first at the soak temperature, then once more at the fitted network's magnet
   // temperatures of the anchor's steps (the rise since the soak), and the network fitted again.
@@ -596,7 +630,7 @@ ThermalFitResult fit_thermal(const ThermalRecord& record, const io::ThermalConfi
           "the training part holds no temperature the network can be fitted to (no winding sensor, "
           "and ψm and R_s never adapt and settle)");
     }
-    const Layout pass_layout(start, ties);
+    const Layout pass_layout(start, ties, fit_sensor_lag);
     // Three starts: the topology's time constants as they are, three times shorter and three times longer.
     best = Solved{};
     for (double scale : {1.0, 1.0 / 3.0, 3.0}) {
@@ -613,7 +647,7 @@ ThermalFitResult fit_thermal(const ThermalRecord& record, const io::ThermalConfi
       t_winding[k] = model[k][start.fusion.filter.network.winding];
     }
   }
-  const Layout fitted_layout(start, ties);
+  const Layout fitted_layout(start, ties, fit_sensor_lag);
   if (!std::isfinite(best.cost) || best.cost >= kRunaway * kRunaway) {
     throw std::invalid_argument(
         "the fit did not converge to a network that follows the log (it runs away or is not "
@@ -622,6 +656,15 @@ ThermalFitResult fit_thermal(const ThermalRecord& record, const io::ThermalConfi
   out.training_cost = best.cost;
   out.config = fitted_layout.apply(best.x.data());
   intervals(fitted_layout, record, training, points, best.x, options.blocks, out);
+  if (fit_sensor_lag) {
+    const FittedParameter& p = out.parameters.front();  // the layout's first slot
+    if (!(p.half_width_rel <= kSensorLagKeptHalfWidth)) {
+      out.notes.push_back("the winding sensor's time constant is not identified (fitted " + std::to_string(p.value) +
+                          " s, 95 % interval wider than a decade): the sensor is taken as the winding node "
+                          "(time_constant_s 0); give it in the start's thermal.winding_sensor to use a lag");
+      out.config.fusion.winding_sensor_time_constant_s = 0.0;
+    }
+  }
   // The filter's noise: the temperatures' white noise, then the disturbances' drift, each the most likely.
   out.config.fusion.filter.disturbance_W2_per_s.setZero();
   out.process_noise_K2_per_s =
