@@ -221,7 +221,8 @@ TEST(ThermalAllocations, NoneAcrossOneHundredThousandFusedSteps) {
   // coasting without samples, a reload and a non-finite sample.
   const MachineSi machine = test::paper_machine_si();
   AveragedDriveEstimator est(machine, test::paper_settings());
-  const ThermalFusionConfig c = test::paper_thermal_fusion();
+  ThermalFusionConfig c = test::paper_thermal_fusion();
+  c.winding_sensor_time_constant_s = 10.0;  // the lagging sensor's observation and lag (eq. 14.19) too
   ThermalFusion fusion(c, test::paper_base(), machine);
   test::AveragedDataGenerator gen;
   gen.base = test::paper_base();

@@ -24,13 +24,13 @@ constexpr double kLogRange = 10.3;
 /// loss's scale is known better: (3/2)·R_s·|i|² within a factor of 2 (AC resistance, stray load losses).
 constexpr double kPriorSigmaLog = 2.302585092994046;
 constexpr double kPriorSigmaLogCopper = 0.6931471805599453;
-/// The winding sensor's lag where the fit estimates it (eq. 14.19): the prior's centre, a thermistor or PT100
-/// in the end winding (seconds to tens of seconds), with kPriorSigmaLog. Kept when its 95 % interval spans at
-/// most a decade (half-width e^{ln(10)/2} − 1); otherwise the sensor is taken as the node (0) and a note says so.
-constexpr double kSensorLagPrior_s = 10.0;
-const double kSensorLagKeptHalfWidth = std::sqrt(10.0) - 1.0;
+/// The range searched for the winding sensor's time constant (eq. 14.19) [s]: from below the filter's step to
+/// beyond any end-winding sensor's.
+constexpr double kSensorLagLow_s = 0.1, kSensorLagHigh_s = 300.0;
+/// χ²₁(0.95)/2: the rise of the −log-likelihood that bounds a 95 % profile-likelihood interval (Wilks).
+constexpr double kHalfChi2_95 = 1.920729;
 
-enum class SlotKind { kCapacitance, kToCoolant, kBetween, kLoss, kCopperScale, kSensorLag };
+enum class SlotKind { kCapacitance, kToCoolant, kBetween, kLoss, kCopperScale };
 
 struct Slot {
   SlotKind kind;
@@ -50,11 +50,9 @@ struct LossTie {
 /// Where each fitted quantity lives in the network, and how the parameter vector maps onto a configuration.
 class Layout {
  public:
-  /// `sensor_lag`: the winding sensor's time constant is a parameter too (eq. 14.19).
-  Layout(const io::ThermalConfig& start, const std::vector<LossTie>& ties, bool sensor_lag) : start_(start) {
+  Layout(const io::ThermalConfig& start, const std::vector<LossTie>& ties) : start_(start) {
     const core::ThermalNetwork& n = start.fusion.filter.network;
     auto name = [&](int i) { return start.node_names[static_cast<std::size_t>(i)]; };
-    if (sensor_lag) slots_.push_back({SlotKind::kSensorLag, n.winding, 0, "winding sensor time constant", "s"});
     for (int i = 0; i < n.nodes; ++i) slots_.push_back({SlotKind::kCapacitance, i, 0, "C " + name(i), "J/K"});
     slots_.push_back({SlotKind::kCopperScale, n.winding, 0, "copper loss scale", "1"});
     for (int i = 0; i < n.nodes; ++i) {
@@ -112,9 +110,6 @@ class Layout {
         case SlotKind::kCopperScale:
           n.copper_scale = v;
           break;
-        case SlotKind::kSensorLag:
-          c.fusion.winding_sensor_time_constant_s = v;
-          break;
         case SlotKind::kToCoolant:
           n.to_coolant_W_per_K[s.i] = v;
           break;
@@ -140,8 +135,6 @@ class Layout {
         return n.capacitance_J_per_K[s.i];
       case SlotKind::kCopperScale:
         return n.copper_scale;
-      case SlotKind::kSensorLag:
-        return c.fusion.winding_sensor_time_constant_s;
       case SlotKind::kToCoolant:
         return n.to_coolant_W_per_K[s.i];
       case SlotKind::kBetween:
@@ -177,7 +170,8 @@ void advance_sensor_lag(const core::ThermalFusionConfig& f, const core::ThermalS
 /// The observation's miss in kelvin: (y − h·T − c)/(∂y/∂T of its own node).
 double miss_K(const core::StepObservations& o, int kind, const core::ThermalVec& t, int own_node) {
   const core::ThermalObservation& x = o.item[static_cast<std::size_t>(kind)];
-  return (x.value - x.h.dot(t) - x.offset) / x.h[own_node];
+  // A sensor reads kelvin: its miss is not scaled by its h on the node (1 − κ·A_ww with a lag, eq. 14.19).
+  return (x.value - x.h.dot(t) - x.offset) / (kind == 2 ? 1.0 : x.h[own_node]);
 }
 
 int own_node(const core::ThermalNetwork& n, int kind) { return kind == 0 ? n.magnet : n.winding; }
@@ -507,6 +501,62 @@ double maximum_likelihood(io::ThermalConfig& c, const ThermalRecord& r, std::siz
   return q;
 }
 
+/// The winding sensor's time constant τ_s (eq. 14.19) that maximises the filter's innovation likelihood over the
+/// training part, on the fitted network: golden-section search on log τ_s in [kSensorLagLow_s, kSensorLagHigh_s],
+/// its 95 % interval where the −log-likelihood has risen by χ²₁(0.95)/2 (a profile-likelihood interval; ∞ where
+/// it does not rise so far within the range). Used (written to the configuration) only where the no-lag model
+/// (τ_s = 0) lies outside that interval; otherwise 0 and a note. A network fit with τ_s among its parameters
+/// compares the open-loop network with the sensor, whose misses there are the network's own (2026-11-27,
+/// docs/thermal.md): the filter's innovations see the lag where the model does not hide it.
+void fit_sensor_lag(io::ThermalConfig& c, const ThermalRecord& r, std::size_t training, ThermalFitResult& out) {
+  auto nll = [&](double log_tau) {
+    c.fusion.winding_sensor_time_constant_s = log_tau == -kInf ? 0.0 : std::exp(log_tau);
+    double ll = 0.0;
+    for (const FilterStep& s : run_filter(c.fusion, r, training)) ll += s.log_likelihood;
+    return -ll;
+  };
+  double a = std::log(kSensorLagLow_s), b = std::log(kSensorLagHigh_s);
+  const double lo = a, hi = b;
+  const double g = 0.5 * (std::sqrt(5.0) - 1.0);
+  double x1 = b - g * (b - a), x2 = a + g * (b - a);
+  double f1 = nll(x1), f2 = nll(x2);
+  while (b - a > 0.01) {
+    if (f1 < f2) {
+      b = x2, x2 = x1, f2 = f1;
+      x1 = b - g * (b - a), f1 = nll(x1);
+    } else {
+      a = x1, x1 = x2, f1 = f2;
+      x2 = a + g * (b - a), f2 = nll(x2);
+    }
+  }
+  const double best = 0.5 * (a + b), f_best = nll(best), f_none = nll(-kInf);
+  // The interval's ends: bisection on log τ_s between the optimum and the range's end.
+  auto end = [&](double edge) {
+    if (nll(edge) - f_best < kHalfChi2_95) return edge == lo ? -kInf : kInf;
+    double in = best, outside = edge;
+    while (std::abs(outside - in) > 0.01) {
+      const double mid = 0.5 * (in + outside);
+      (nll(mid) - f_best < kHalfChi2_95 ? in : outside) = mid;
+    }
+    return 0.5 * (in + outside);
+  };
+  const double lower = end(lo), upper = end(hi);
+  FittedParameter p;
+  p.name = "winding sensor time constant";
+  p.unit = "s";
+  p.value = std::exp(best);
+  p.half_width_rel = std::isfinite(lower) && std::isfinite(upper) ? std::expm1(0.5 * (upper - lower)) : kInf;
+  p.excitation_half_width_rel = p.half_width_rel;
+  p.identified = p.half_width_rel <= kIdentifiedHalfWidth;
+  out.parameters.push_back(p);
+  const bool lag_shown = f_none - f_best >= kHalfChi2_95;
+  out.notes.push_back("winding sensor time constant: " + std::to_string(p.value) + " s, 95 % interval [" +
+                      std::to_string(std::exp(lower)) + ", " + std::to_string(std::exp(upper)) +
+                      "] s (profile likelihood of the filter's innovations); " +
+                      (lag_shown ? "used" : "no lag (0) is within it: not used, the sensor is taken as the node"));
+  c.fusion.winding_sensor_time_constant_s = lag_shown ? p.value : 0.0;
+}
+
 /// The magnet law's reference from the soaked start (docs/thermal.md, "The magnet's reference"): the mean of
 /// the first kAnchorSteps magnet observations, each corrected for the held R_s (κ·(R_s(T_w) − r̂s)), at the
 /// magnet temperatures `t_magnet_C` of those steps (the soak's, or the network's prediction of the small rise
@@ -609,11 +659,7 @@ ThermalFitResult fit_thermal(const ThermalRecord& record, const io::ThermalConfi
 
   io::ThermalConfig start = start_config;
   const std::vector<LossTie> ties = tie_collinear_losses(start, record, training, out.notes);
-  // A winding sensor without a configured lag: its time constant is fitted too (eq. 14.19), from the prior.
-  const bool fit_sensor_lag = record.winding_sensor && start.fusion.winding_sensor_sigma_K > 0.0 &&
-                              !(start.fusion.winding_sensor_time_constant_s > 0.0);
-  if (fit_sensor_lag) start.fusion.winding_sensor_time_constant_s = kSensorLagPrior_s;
-  const Layout layout(start, ties, fit_sensor_lag);
+  const Layout layout(start, ties);
   const std::vector<double> prior = layout.values(start);
   // The magnet's reference: first at the soak temperature, then once more at the fitted network's magnet
   // temperatures of the anchor's steps (the rise since the soak), and the network fitted again.
@@ -630,7 +676,7 @@ ThermalFitResult fit_thermal(const ThermalRecord& record, const io::ThermalConfi
           "the training part holds no temperature the network can be fitted to (no winding sensor, "
           "and ψm and R_s never adapt and settle)");
     }
-    const Layout pass_layout(start, ties, fit_sensor_lag);
+    const Layout pass_layout(start, ties);
     // Three starts: the topology's time constants as they are, three times shorter and three times longer.
     best = Solved{};
     for (double scale : {1.0, 1.0 / 3.0, 3.0}) {
@@ -647,7 +693,7 @@ ThermalFitResult fit_thermal(const ThermalRecord& record, const io::ThermalConfi
       t_winding[k] = model[k][start.fusion.filter.network.winding];
     }
   }
-  const Layout fitted_layout(start, ties, fit_sensor_lag);
+  const Layout fitted_layout(start, ties);
   if (!std::isfinite(best.cost) || best.cost >= kRunaway * kRunaway) {
     throw std::invalid_argument(
         "the fit did not converge to a network that follows the log (it runs away or is not "
@@ -656,21 +702,16 @@ ThermalFitResult fit_thermal(const ThermalRecord& record, const io::ThermalConfi
   out.training_cost = best.cost;
   out.config = fitted_layout.apply(best.x.data());
   intervals(fitted_layout, record, training, points, best.x, options.blocks, out);
-  if (fit_sensor_lag) {
-    const FittedParameter& p = out.parameters.front();  // the layout's first slot
-    if (!(p.half_width_rel <= kSensorLagKeptHalfWidth)) {
-      out.notes.push_back("the winding sensor's time constant is not identified (fitted " + std::to_string(p.value) +
-                          " s, 95 % interval wider than a decade): the sensor is taken as the winding node "
-                          "(time_constant_s 0); give it in the start's thermal.winding_sensor to use a lag");
-      out.config.fusion.winding_sensor_time_constant_s = 0.0;
-    }
-  }
   // The filter's noise: the temperatures' white noise, then the disturbances' drift, each the most likely.
   out.config.fusion.filter.disturbance_W2_per_s.setZero();
   out.process_noise_K2_per_s =
       maximum_likelihood(out.config, record, training, &core::ThermalFilterConfig::process_noise_K2_per_s, -8.0, 1.0);
   out.disturbance_W2_per_s =
       maximum_likelihood(out.config, record, training, &core::ThermalFilterConfig::disturbance_W2_per_s, -6.0, 4.0);
+  // A winding sensor without a configured lag: its time constant, the most likely under those noises.
+  if (record.winding_sensor && out.config.fusion.winding_sensor_sigma_K > 0.0 &&
+      !(out.config.fusion.winding_sensor_time_constant_s > 0.0))
+    fit_sensor_lag(out.config, record, training, out);
   judge(out.config, record, training, out);
   return out;
 }
