@@ -89,19 +89,20 @@ void ThermalFilter::predict(const ThermalLoad& load) noexcept {
 }
 
 ObservationResult ThermalFilter::observe(const ThermalObservation& o) noexcept {
-  if (!all_finite(o.h, o.h_c, o.offset, o.value, o.variance, o.bilinear) || !(o.variance > 0.0) || o.bilinear_node < 0 ||
-      o.bilinear_node >= kN)
+  if (!all_finite(o.h, o.h_d, o.h_c, o.offset, o.value, o.variance, o.bilinear) || !(o.variance > 0.0) ||
+      o.bilinear_node < 0 || o.bilinear_node >= kN)
     return ObservationResult::kRejectedInvalid;
-  // H = [h, 0, h_c]: no observation sees a disturbance, so a = P·Hᵀ takes the columns of T and c only.
-  const ThermalStateVec a = p_.leftCols<kN>().lazyProduct(o.h) + p_.rightCols<kCalibrationStates>().lazyProduct(o.h_c);
+  // H = [h, h_d, h_c]: h_d is zero but for a sensor that sees the winding's rate (eq. 14.22).
+  const ThermalStateVec a = p_.leftCols<kN>().lazyProduct(o.h) + p_.middleCols<kN>(kN).lazyProduct(o.h_d) +
+                            p_.rightCols<kCalibrationStates>().lazyProduct(o.h_c);
   // The bilinear term b·δT_i·δc_k over the Gaussian prior (eq. 14.10a): mean b·P_ik, variance b²·(P_ii·P_kk + P_ik²),
   // no covariance with the state (third moments vanish), so a is unchanged.
   const int k = kDynamic + static_cast<int>(o.bilinear_state), i = o.bilinear_node;
   const double p_ik = p_(i, k);
-  const double s = o.h.dot(a.head<kN>()) + o.h_c.dot(a.tail<kCalibrationStates>()) + o.variance +
-                   o.bilinear * o.bilinear * (p_(i, i) * p_(k, k) + p_ik * p_ik);
-  const double nu =
-      o.value - o.h.dot(x_.head<kN>()) - o.h_c.dot(x_.tail<kCalibrationStates>()) - o.offset - o.bilinear * p_ik;
+  const double s = o.h.dot(a.head<kN>()) + o.h_d.dot(a.segment<kN>(kN)) + o.h_c.dot(a.tail<kCalibrationStates>()) +
+                   o.variance + o.bilinear * o.bilinear * (p_(i, i) * p_(k, k) + p_ik * p_ik);
+  const double nu = o.value - o.h.dot(x_.head<kN>()) - o.h_d.dot(x_.segment<kN>(kN)) -
+                    o.h_c.dot(x_.tail<kCalibrationStates>()) - o.offset - o.bilinear * p_ik;
   innovation_ = nu;
   innovation_variance_ = s;
   if (nu * nu > config_.gate_sigma * config_.gate_sigma * s) return ObservationResult::kRejectedGate;

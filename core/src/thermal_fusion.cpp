@@ -40,7 +40,7 @@ ThermalNodeReport report_node(const ThermalEstimate& e, int node, std::int64_t t
 }
 
 StepObservations step_observations(const ThermalFusionConfig& c, const ThermalStepData& s, const ThermalVec& t_C,
-                                   const ThermalVec& dt_dt_K_per_s) noexcept {
+                                   const ThermalVec& dt_dt_K_per_s, const SensorLag& lag) noexcept {
   const ThermalNetwork& n = c.filter.network;
   const Line magnet = line_of(c.magnet_law), copper = line_of(n.copper);
   const int m = n.magnet, w = n.winding;
@@ -80,6 +80,15 @@ StepObservations step_observations(const ThermalFusionConfig& c, const ThermalSt
     o.h[w] = 1.0;
     o.value = s.winding_sensor_C;
     o.variance = c.winding_sensor_sigma_K * c.winding_sensor_sigma_K;
+    const SensorLagStep k = sensor_lag_step(c.winding_sensor_time_constant_s, s.load.dt_s);
+    if (k.rate_s > 0.0) {
+      // The step's mean reading T_w − κ·(A_w·T + u_w + d_w/C_w) − β·e (eq. 14.22); e's error in the variance.
+      const ThermalRates rates = thermal_rates(n, s.load);
+      o.h -= k.rate_s * rates.a.row(w).transpose();
+      o.h_d[w] = -k.rate_s / n.capacitance_J_per_K[w];
+      o.offset = -k.rate_s * rates.u[w] - k.carry * lag.lag_K;
+      o.variance += k.carry * k.carry * lag.variance_K2;
+    }
     out.present[2] = true;
   }
   return out;
@@ -107,6 +116,7 @@ void ThermalFusion::reconfigure(const ThermalFusionConfig& config, const PerUnit
 void ThermalFusion::start(const ThermalStepData& s) noexcept {
   // A soaked machine at the coolant's temperature, the winding at its sensor if there is one.
   filter_.reset(s.load.coolant_C, config_.initial_sigma_K);
+  sensor_lag_ = SensorLag{};  // soaked: the sensor at the winding's temperature
   if (config_.winding_sensor_sigma_K > 0.0 && std::isfinite(s.winding_sensor_C)) {
     ThermalVec t = filter_.temperature_C();
     t[config_.filter.network.winding] = s.winding_sensor_C;
@@ -143,7 +153,7 @@ void ThermalFusion::finish_step(const ThermalStepData& d, double dt_s) noexcept 
   const ThermalNetwork& n = config_.filter.network;
   const ThermalRates rates = thermal_rates(n, d.load);
   const ThermalVec slope = rates.a * filter_.temperature_C() + rates.u;
-  const StepObservations obs = step_observations(config_, d, filter_.temperature_C(), slope);
+  const StepObservations obs = step_observations(config_, d, filter_.temperature_C(), slope, sensor_lag_);
   const int node_of[3] = {n.magnet, n.winding, n.winding};
   std::array<bool, kMaxThermalNodes> observed{};
   for (std::size_t k = 0; k < obs.item.size(); ++k) {
@@ -166,6 +176,18 @@ void ThermalFusion::finish_step(const ThermalStepData& d, double dt_s) noexcept 
     } else {
       ++out_.observations_rejected;
     }
+  }
+  if (config_.winding_sensor_time_constant_s > 0.0) {
+    // The sensor's lag over this step at the posterior's rate of the winding (eq. 14.22), that rate's variance
+    // from the posterior covariance of [T; d] along g = [A_w, e_w/C_w].
+    const int w = n.winding;
+    Eigen::Matrix<double, 2 * kMaxThermalNodes, 1> g = Eigen::Matrix<double, 2 * kMaxThermalNodes, 1>::Zero();
+    g.head<kMaxThermalNodes>() = rates.a.row(w).transpose();
+    g[kMaxThermalNodes + w] = 1.0 / n.capacitance_J_per_K[w];
+    const double rate = g.head<kMaxThermalNodes>().dot(filter_.temperature_C()) + rates.u[w] +
+                        g[kMaxThermalNodes + w] * filter_.disturbance_W()[w];
+    const double rate_variance = g.dot(filter_.covariance().topLeftCorner<2 * kMaxThermalNodes, 2 * kMaxThermalNodes>() * g);
+    sensor_lag_.advance(sensor_lag_step(config_.winding_sensor_time_constant_s, dt_s), rate, rate_variance);
   }
   last_psi_m_Wb_ = d.psi_m_Wb;
   last_r_s_Ohm_ = d.r_s_Ohm;

@@ -226,6 +226,8 @@ ThermalConfig parse_thermal_config(YamlMap& section, const MachineConfig& machin
   f.coolant_C = section.number_or("coolant_C", f.coolant_C, -60.0, 300.0);
   if (auto s = section.optional_map("winding_sensor")) {
     f.winding_sensor_sigma_K = s->number("sigma_K", 1e-3, 100.0);
+    // Its lag behind the winding node (docs/derivations.md eq. 14.19); 0: the reading is the node.
+    f.winding_sensor_time_constant_s = s->number_or("time_constant_s", 0.0, 0.0, 3600.0);
     s->finish();
   }
   if (auto m = section.optional_map("filter")) {
@@ -296,7 +298,11 @@ std::string thermal_config_yaml(const ThermalConfig& c) {
     << ", coeff_per_K: " << num(m.coeff_per_K) << ", reference_sigma_K: " << s(core::Calibration::kMagnetOffset)
     << ", coeff_rel_sigma: " << s(core::Calibration::kMagnetCoefficient) << "}\n";
   o << "  coolant_C: " << num(f.coolant_C) << "\n";
-  if (f.winding_sensor_sigma_K > 0.0) o << "  winding_sensor: {sigma_K: " << num(f.winding_sensor_sigma_K) << "}\n";
+  if (f.winding_sensor_sigma_K > 0.0) {
+    o << "  winding_sensor: {sigma_K: " << num(f.winding_sensor_sigma_K);
+    if (f.winding_sensor_time_constant_s > 0.0) o << ", time_constant_s: " << num(f.winding_sensor_time_constant_s);
+    o << "}\n";
+  }
   o << "  filter: {period_s: " << num(f.observer.period_s) << ", initial_sigma_K: " << num(f.initial_sigma_K)
     << ", gate_sigma: " << num(f.filter.gate_sigma) << ", gate_reset_after: " << f.filter.gate_reset_after
     << ", residual_time_constant_s: " << num(f.observer.residual_time_constant_s)

@@ -223,6 +223,7 @@ TEST(ThermalAllocations, NoneAcrossOneHundredThousandFusedSteps) {
   AveragedDriveEstimator est(machine, test::paper_settings());
   ThermalFusionConfig c = test::paper_thermal_fusion();
   c.filter.disturbance_time_constant_s[0] = 600.0;  // one Gauss–Markov disturbance (eq. 14.19) beside the walks
+  c.winding_sensor_time_constant_s = 10.0;          // the lagging sensor's observation and lag (eq. 14.22) too
   ThermalFusion fusion(c, test::paper_base(), machine);
   test::AveragedDataGenerator gen;
   gen.base = test::paper_base();

@@ -24,6 +24,11 @@ constexpr double kLogRange = 10.3;
 /// loss's scale is known better: (3/2)·R_s·|i|² within a factor of 2 (AC resistance, stray load losses).
 constexpr double kPriorSigmaLog = 2.302585092994046;
 constexpr double kPriorSigmaLogCopper = 0.6931471805599453;
+/// The range searched for the winding sensor's time constant (eq. 14.22) [s]: from below the filter's step to
+/// beyond any end-winding sensor's.
+constexpr double kSensorLagLow_s = 0.1, kSensorLagHigh_s = 300.0;
+/// χ²₁(0.95)/2: the rise of the −log-likelihood that bounds a 95 % profile-likelihood interval (Wilks).
+constexpr double kHalfChi2_95 = 1.920729;
 
 enum class SlotKind { kCapacitance, kToCoolant, kBetween, kLoss, kCopperScale };
 
@@ -152,10 +157,21 @@ struct Point {
   double sigma_K;
 };
 
+/// The winding sensor's lag over step `s` of the open-loop network, at its temperatures `t` at the step's end
+/// (eq. 14.22, as the filter does it: core/thermal_sensor.hpp; the network's rate is exact here, variance 0).
+void advance_sensor_lag(const core::ThermalFusionConfig& f, const core::ThermalStepData& s, const core::ThermalVec& t,
+                        core::SensorLag& lag) {
+  if (!(f.winding_sensor_time_constant_s > 0.0)) return;
+  const core::ThermalRates rates = core::thermal_rates(f.filter.network, s.load);
+  const int w = f.filter.network.winding;
+  lag.advance(core::sensor_lag_step(f.winding_sensor_time_constant_s, s.load.dt_s), rates.a.row(w).dot(t) + rates.u[w], 0.0);
+}
+
 /// The observation's miss in kelvin: (y − h·T − c)/(∂y/∂T of its own node).
 double miss_K(const core::StepObservations& o, int kind, const core::ThermalVec& t, int own_node) {
   const core::ThermalObservation& x = o.item[static_cast<std::size_t>(kind)];
-  return (x.value - x.h.dot(t) - x.offset) / x.h[own_node];
+  // A sensor reads kelvin: its miss is not scaled by its h on the node (1 − κ·A_ww with a lag, eq. 14.22).
+  return (x.value - x.h.dot(t) - x.offset) / (kind == 2 ? 1.0 : x.h[own_node]);
 }
 
 int own_node(const core::ThermalNetwork& n, int kind) { return kind == 0 ? n.magnet : n.winding; }
@@ -170,18 +186,21 @@ void residuals(const io::ThermalConfig& c, const ThermalRecord& r, std::size_t s
                double* out) {
   const core::ThermalFusionConfig& f = c.fusion;
   core::ThermalVec t = soaked_start(f, r);
+  core::SensorLag lag;
   std::size_t p = 0;
   for (std::size_t k = 0; k < steps && p < points.size(); ++k) {
     const core::ThermalStepData& s = r.steps[k];
     const core::ThermalTransition tr = core::thermal_transition(f.filter.network, s.load);
     t = tr.phi * t + tr.gamma;
     if (!(t.cwiseAbs().maxCoeff() < kRunawayBand_K)) break;
-    if (points[p].step != k) continue;
-    const core::StepObservations o = core::step_observations(f, s, t, core::ThermalVec::Zero());
-    for (; p < points.size() && points[p].step == k; ++p) {
-      const double m = miss_K(o, points[p].kind, t, own_node(f.filter.network, points[p].kind));
-      out[p] = std::isfinite(m) ? std::clamp(m / points[p].sigma_K, -kRunaway, kRunaway) : kRunaway;
+    if (points[p].step == k) {
+      const core::StepObservations o = core::step_observations(f, s, t, core::ThermalVec::Zero(), lag);
+      for (; p < points.size() && points[p].step == k; ++p) {
+        const double m = miss_K(o, points[p].kind, t, own_node(f.filter.network, points[p].kind));
+        out[p] = std::isfinite(m) ? std::clamp(m / points[p].sigma_K, -kRunaway, kRunaway) : kRunaway;
+      }
     }
+    advance_sensor_lag(f, s, t, lag);
   }
   for (; p < points.size(); ++p) out[p] = kRunaway;
 }
@@ -422,13 +441,18 @@ void judge(const io::ThermalConfig& c, const ThermalRecord& r, std::size_t train
   // The sensor is judged on every step that has one, whether or not the configuration fuses it.
   core::ThermalFusionConfig judged = f;
   if (judged.winding_sensor_sigma_K <= 0.0) judged.winding_sensor_sigma_K = 1.0;
+  std::vector<core::SensorLag> lag(r.steps.size());  // at each step's start
+  for (std::size_t k = 0; k + 1 < r.steps.size(); ++k) {
+    lag[k + 1] = lag[k];
+    advance_sensor_lag(judged, r.steps[k], out.open_loop_C[k], lag[k + 1]);
+  }
   for (int kind = 0; kind < 3; ++kind) {
     SignalFit s;
     s.name = names[kind];
     double fit2 = 0.0, held2 = 0.0;
     for (std::size_t k = 0; k < r.steps.size(); ++k) {
       const core::StepObservations o =
-          core::step_observations(judged, r.steps[k], out.open_loop_C[k], core::ThermalVec::Zero());
+          core::step_observations(judged, r.steps[k], out.open_loop_C[k], core::ThermalVec::Zero(), lag[k]);
       if (!o.present[static_cast<std::size_t>(kind)]) continue;
       const double m = miss_K(o, kind, out.open_loop_C[k], own_node(f.filter.network, kind));
       if (k < training) {
@@ -480,6 +504,62 @@ double maximum_likelihood(io::ThermalConfig& c, const ThermalRecord& r, std::siz
   (c.fusion.filter.*field).setZero();
   (c.fusion.filter.*field).head(c.fusion.filter.network.nodes).setConstant(q);
   return q;
+}
+
+/// The winding sensor's time constant τ_s (eq. 14.22) that maximises the filter's innovation likelihood over the
+/// training part, on the fitted network: golden-section search on log τ_s in [kSensorLagLow_s, kSensorLagHigh_s],
+/// its 95 % interval where the −log-likelihood has risen by χ²₁(0.95)/2 (a profile-likelihood interval; ∞ where
+/// it does not rise so far within the range). Used (written to the configuration) only where the no-lag model
+/// (τ_s = 0) lies outside that interval; otherwise 0 and a note. A network fit with τ_s among its parameters
+/// compares the open-loop network with the sensor, whose misses there are the network's own (2026-11-27,
+/// docs/thermal.md): the filter's innovations see the lag where the model does not hide it.
+void fit_sensor_lag(io::ThermalConfig& c, const ThermalRecord& r, std::size_t training, ThermalFitResult& out) {
+  auto nll = [&](double log_tau) {
+    c.fusion.winding_sensor_time_constant_s = log_tau == -kInf ? 0.0 : std::exp(log_tau);
+    double ll = 0.0;
+    for (const FilterStep& s : run_filter(c.fusion, r, training)) ll += s.log_likelihood;
+    return -ll;
+  };
+  double a = std::log(kSensorLagLow_s), b = std::log(kSensorLagHigh_s);
+  const double lo = a, hi = b;
+  const double g = 0.5 * (std::sqrt(5.0) - 1.0);
+  double x1 = b - g * (b - a), x2 = a + g * (b - a);
+  double f1 = nll(x1), f2 = nll(x2);
+  while (b - a > 0.01) {
+    if (f1 < f2) {
+      b = x2, x2 = x1, f2 = f1;
+      x1 = b - g * (b - a), f1 = nll(x1);
+    } else {
+      a = x1, x1 = x2, f1 = f2;
+      x2 = a + g * (b - a), f2 = nll(x2);
+    }
+  }
+  const double best = 0.5 * (a + b), f_best = nll(best), f_none = nll(-kInf);
+  // The interval's ends: bisection on log τ_s between the optimum and the range's end.
+  auto end = [&](double edge) {
+    if (nll(edge) - f_best < kHalfChi2_95) return edge == lo ? -kInf : kInf;
+    double in = best, outside = edge;
+    while (std::abs(outside - in) > 0.01) {
+      const double mid = 0.5 * (in + outside);
+      (nll(mid) - f_best < kHalfChi2_95 ? in : outside) = mid;
+    }
+    return 0.5 * (in + outside);
+  };
+  const double lower = end(lo), upper = end(hi);
+  FittedParameter p;
+  p.name = "winding sensor time constant";
+  p.unit = "s";
+  p.value = std::exp(best);
+  p.half_width_rel = std::isfinite(lower) && std::isfinite(upper) ? std::expm1(0.5 * (upper - lower)) : kInf;
+  p.excitation_half_width_rel = p.half_width_rel;
+  p.identified = p.half_width_rel <= kIdentifiedHalfWidth;
+  out.parameters.push_back(p);
+  const bool lag_shown = f_none - f_best >= kHalfChi2_95;
+  out.notes.push_back("winding sensor time constant: " + std::to_string(p.value) + " s, 95 % interval [" +
+                      std::to_string(std::exp(lower)) + ", " + std::to_string(std::exp(upper)) +
+                      "] s (profile likelihood of the filter's innovations); " +
+                      (lag_shown ? "used" : "no lag (0) is within it: not used, the sensor is taken as the node"));
+  c.fusion.winding_sensor_time_constant_s = lag_shown ? p.value : 0.0;
 }
 
 /// The magnet law's reference from the soaked start (docs/thermal.md, "The magnet's reference"): the mean of
@@ -722,6 +802,10 @@ ThermalFitResult fit_thermal(const ThermalRecord& record, const io::ThermalConfi
   out.disturbance_W2_per_s =
       maximum_likelihood(out.config, record, training, &core::ThermalFilterConfig::disturbance_W2_per_s, -6.0, 4.0);
   choose_disturbance_time_constants(out, record, training, options);
+  // A winding sensor without a configured lag: its time constant, the most likely under those noises.
+  if (record.winding_sensor && out.config.fusion.winding_sensor_sigma_K > 0.0 &&
+      !(out.config.fusion.winding_sensor_time_constant_s > 0.0))
+    fit_sensor_lag(out.config, record, training, out);
   judge(out.config, record, training, out);
   return out;
 }

@@ -12,7 +12,7 @@
 //   models, so each change ΔP of a modelled loss term between steps adds its relative uncertainty squared
 //   P⁺ = F·P·Fᵀ + Q_d,  F = [Φ Γ_d 0; 0 A 0; 0 0 I] (A = diag a),  Q_d = (Δt/2)·(Φ·Q_T·Φᵀ + Q_T) on T (trapezoidal rule),
 //        formed blockwise: only the rows and columns of T change (eq. 14.12)
-//   observe:  y = h·T + h_c·c + offset + v_y,  v_y ~ N(0, r);  ν = y − ŷ,  s = H·P·Hᵀ + r
+//   observe:  y = h·T + h_d·d + h_c·c + offset + v_y,  v_y ~ N(0, r);  ν = y − ŷ,  s = H·P·Hᵀ + r
 //             K = [P_xx·Hᵀ/s on T and d; 0 on c],  x += K·ν,  P −= rank-one terms of that gain (eq. 14.11)
 //
 // An observation whose innovation lies beyond `gate_sigma`·√s is rejected (counted by the caller), so one
@@ -33,10 +33,11 @@ using CalibrationVec = Eigen::Matrix<double, kCalibrationStates, 1>;
 /// The calibration states: which law, and offset or coefficient.
 enum class Calibration : int { kMagnetOffset = 0, kMagnetCoefficient = 1, kCopperOffset = 2, kCopperCoefficient = 3 };
 
-/// One scalar observation y = h·T + h_c·c + offset + b·δT_i·δc_k + v, v ~ N(0, variance); δ the errors of
+/// One scalar observation y = h·T + h_d·d + h_c·c + offset + b·δT_i·δc_k + v, v ~ N(0, variance); δ the errors of
 /// the prior mean. The bilinear term is a law's e_α·(T − T_ref) beyond its linearisation at T̂ (eq. 14.10, 14.10a).
 struct ThermalObservation {
   ThermalVec h = ThermalVec::Zero();
+  ThermalVec h_d = ThermalVec::Zero();  ///< [K/W] on the heat disturbances: a sensor that sees a rate (eq. 14.22)
   CalibrationVec h_c = CalibrationVec::Zero();
   double offset = 0.0;
   double value = 0.0;

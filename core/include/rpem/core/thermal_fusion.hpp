@@ -8,7 +8,7 @@
 // The observations through the temperature laws (core/thermal.hpp; docs/derivations.md §14, eq. 14.5–14.8):
 //   ψ̂m = ψ_ref·(1 + α_m·(T_m' − T_ref)) + κ_ψ·(R_s(T_w) − r̂s)    while ψ̂m adapts (r̂s held)
 //   r̂s = R_ref·(1 + α_cu·(T_w' − T_ref)) + κ_r·(ψm(T_m) − ψ̂m)    while r̂s adapts (ψ̂m held)
-//   T_sensor = T_w
+//   T_sensor = T_w, or with a lagging sensor its step's mean T_w − κ·dT_w/dt − β·e (thermal_sensor.hpp, eq. 14.22)
 // where T' = T + e_ref + e_α·(T − T_ref) is what a law with calibration errors e reads (the filter's consider
 // states), with the variance of the estimator's own state (σ²_noise + σ²_model) and of the tracking lag
 // σ_T,lag = |dT̂/dt|·τ through the law's slope. Real-time safe.
@@ -18,6 +18,7 @@
 
 #include "rpem/core/thermal_filter.hpp"
 #include "rpem/core/thermal_observer.hpp"
+#include "rpem/core/thermal_sensor.hpp"
 
 namespace rpem::core {
 
@@ -25,9 +26,10 @@ struct ThermalFusionConfig {
   ThermalFilterConfig filter;  ///< the network (its copper law is R_s's), the noises, the laws' calibration σ
   DriftLaw magnet_law;         ///< ψm(T_magnet) [Wb]
   ThermalObserverConfig observer;
-  double coolant_C = 25.0;              ///< where the samples carry no coolant temperature
-  double winding_sensor_sigma_K = 0.0;  ///< a winding sensor's σ; 0: sensor not used
-  double initial_sigma_K = 10.0;        ///< σ of every node at the start (the coolant's temperature)
+  double coolant_C = 25.0;                      ///< where the samples carry no coolant temperature
+  double winding_sensor_sigma_K = 0.0;          ///< a winding sensor's σ; 0: sensor not used
+  double winding_sensor_time_constant_s = 0.0;  ///< its lag τ_s behind the winding node (eq. 14.22); 0: none
+  double initial_sigma_K = 10.0;                ///< σ of every node at the start (the coolant's temperature)
 };
 
 /// A node's fused temperature.
@@ -70,8 +72,10 @@ struct StepObservations {
   std::array<ThermalObservation, 3> item{};  ///< magnet (ψ̂m), winding (r̂s), winding sensor
   std::array<bool, 3> present{};
 };
+/// `lag`: the winding sensor's lag at the step's start (eq. 14.22; unused when the sensor has none).
 [[nodiscard]] StepObservations step_observations(const ThermalFusionConfig& c, const ThermalStepData& s,
-                                                 const ThermalVec& t_C, const ThermalVec& dt_dt_K_per_s) noexcept;
+                                                 const ThermalVec& t_C, const ThermalVec& dt_dt_K_per_s,
+                                                 const SensorLag& lag = SensorLag{}) noexcept;
 
 class ThermalFusion {
  public:
@@ -114,6 +118,7 @@ class ThermalFusion {
   std::array<bool, kMaxThermalNodes> ever_observed_{};
   std::array<ObservationReport, 3> reports_{};
   std::array<int, 3> rejected_in_a_row_{};
+  SensorLag sensor_lag_;  ///< the winding sensor's lag at the next step's start (eq. 14.22)
   double last_psi_m_Wb_ = 0.0, last_r_s_Ohm_ = 0.0;
 };
 

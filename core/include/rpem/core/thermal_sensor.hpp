@@ -1,0 +1,34 @@
+#pragma once
+// A winding sensor that lags the winding node (docs/derivations.md §14, eq. 14.22): a first-order element of
+// time constant τ_s, dT_s/dt = (T_w − T_s)/τ_s, read as its mean over the filter's step. With the lag
+// e = T_w − T_s and the winding's rate s = dT_w/dt held over a step Δt (the zero-order hold of eq. 14.4),
+//
+//   e⁺ = φ·e + τ_s·(1 − φ)·s,   φ = e^{−Δt/τ_s}
+//   mean reading = T_w⁺ − κ·s − β·e,   β = τ_s·(1 − φ)/Δt,   κ = Δt/2 + τ_s·(1 − β)          (eq. 14.22)
+//
+// exact for a rate held over the step; e the lag at the step's start. The filter and `rpem thermal fit` both
+// predict the sensor with these (one model). τ_s = 0: the reading is the node (no lag, no step-mean term).
+// Real-time safe: noexcept, no allocation.
+
+namespace rpem::core {
+
+/// The coefficients of eq. 14.22 for one step.
+struct SensorLagStep {
+  double carry = 0.0;   ///< β [1]: the weight of the lag at the step's start in the step's mean reading
+  double rate_s = 0.0;  ///< κ [s]: the weight of the step's rate
+  double decay = 0.0;   ///< φ [1]
+  double gain_s = 0.0;  ///< τ_s·(1 − φ) [s]
+};
+[[nodiscard]] SensorLagStep sensor_lag_step(double time_constant_s, double dt_s) noexcept;
+
+/// The sensor's lag e = T_w − T_s [K] at a step's start and its variance (the rates it was built from are
+/// estimates).
+struct SensorLag {
+  double lag_K = 0.0;
+  double variance_K2 = 0.0;
+  /// Advances over the step by the winding's rate and that rate's variance (eq. 14.22; the variance fully
+  /// correlated from step to step: σ_e⁺ = φ·σ_e + τ_s·(1 − φ)·σ_s, bounded by τ_s·σ_s at a steady σ_s).
+  void advance(const SensorLagStep& k, double rate_K_per_s, double rate_variance_K2_per_s2) noexcept;
+};
+
+}  // namespace rpem::core
