@@ -6,7 +6,7 @@ namespace rpem::core {
 namespace {
 
 constexpr int kN = kMaxThermalNodes;
-constexpr int kDynamic = 2 * kN;  ///< T and d: what the model moves and the filter estimates
+constexpr int kDynamic = kDynamicThermalStates;
 
 }  // namespace
 

@@ -199,7 +199,7 @@ void expect_blockwise_steps_are_the_dense_formulas(const ThermalVec& tau_s) {
   const ThermalStateVec x0 = state();
   const ThermalStateMat p0 = f.covariance();
   ASSERT_GT((p0.block<4, 4>(0, 4).cwiseAbs().minCoeff()), 0.0);  // T and d correlated: the blocks matter
-  ASSERT_GT((p0.block<4, 4>(0, 8).cwiseAbs().maxCoeff()), 0.0);
+  ASSERT_GT((p0.block<kMaxThermalNodes, kCalibrationStates>(0, kDynamicThermalStates).cwiseAbs().maxCoeff()), 0.0);
   EXPECT_TRUE(p0 == p0.transpose());
 
   f.predict(l);
@@ -418,7 +418,7 @@ TEST(ThermalFilter, BilinearCalibrationTermEntersTheInnovationAndItsVariance) {
   };
   for (int k = 0; k < 200; ++k) ASSERT_EQ(f.observe(reading(100.0, 80.0)), ObservationResult::kAccepted);
   const ThermalStateMat p = f.covariance();
-  const int kt = 1, ke = 8 + static_cast<int>(Calibration::kMagnetCoefficient);
+  const int kt = 1, ke = kDynamicThermalStates + static_cast<int>(Calibration::kMagnetCoefficient);
   ASSERT_NEAR(p(kt, ke), -80.0 * 0.12 * 0.12, 0.05);  // the correlation the first readings taught
   const double t0 = f.temperature_C()[kt];
   const ThermalObservation o = reading(98.0, 78.5);

@@ -25,7 +25,9 @@
 namespace rpem::core {
 
 inline constexpr int kCalibrationStates = 4;
-inline constexpr int kThermalStates = 2 * kMaxThermalNodes + kCalibrationStates;
+/// T and d: what the model moves and the filter estimates; the calibration states follow them.
+inline constexpr int kDynamicThermalStates = 2 * kMaxThermalNodes;
+inline constexpr int kThermalStates = kDynamicThermalStates + kCalibrationStates;
 using ThermalStateVec = Eigen::Matrix<double, kThermalStates, 1>;
 using ThermalStateMat = Eigen::Matrix<double, kThermalStates, kThermalStates>;
 using CalibrationVec = Eigen::Matrix<double, kCalibrationStates, 1>;
