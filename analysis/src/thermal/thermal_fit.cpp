@@ -27,8 +27,6 @@ constexpr double kPriorSigmaLogCopper = 0.6931471805599453;
 /// The range searched for the winding sensor's time constant (eq. 14.22) [s]: from below the filter's step to
 /// beyond any end-winding sensor's.
 constexpr double kSensorLagLow_s = 0.1, kSensorLagHigh_s = 300.0;
-/// χ²₁(0.95)/2: the rise of the −log-likelihood that bounds a 95 % profile-likelihood interval (Wilks).
-constexpr double kHalfChi2_95 = 1.920729;
 
 enum class SlotKind { kCapacitance, kToCoolant, kBetween, kLoss, kCopperScale };
 
@@ -471,8 +469,6 @@ void judge(const io::ThermalConfig& c, const ThermalRecord& r, std::size_t train
   }
 }
 
-/// The value of one of the filter's noise intensities (every node; `field` picks which) that maximises the
-/// filter's innovation likelihood over the training part: golden-section search on its log10 in [lo, hi].
 /// The filter's innovation log-likelihood over the training part.
 double training_log_likelihood(const io::ThermalConfig& c, const ThermalRecord& r, std::size_t training) {
   double ll = 0.0;
@@ -480,6 +476,27 @@ double training_log_likelihood(const io::ThermalConfig& c, const ThermalRecord& 
   return ll;
 }
 
+/// The minimum of a unimodal `f` on [a, b] by golden-section search, to a bracket narrower than `tolerance`:
+/// the bracket's middle.
+template <class F>
+double golden_section_minimum(F&& f, double a, double b, double tolerance) {
+  const double g = 0.5 * (std::sqrt(5.0) - 1.0);
+  double x1 = b - g * (b - a), x2 = a + g * (b - a);
+  double f1 = f(x1), f2 = f(x2);
+  while (b - a > tolerance) {
+    if (f1 < f2) {
+      b = x2, x2 = x1, f2 = f1;
+      x1 = b - g * (b - a), f1 = f(x1);
+    } else {
+      a = x1, x1 = x2, f1 = f2;
+      x2 = a + g * (b - a), f2 = f(x2);
+    }
+  }
+  return 0.5 * (a + b);
+}
+
+/// The value of one of the filter's noise intensities (every node; `field` picks which) that maximises the
+/// filter's innovation likelihood over the training part: golden-section search on its log10 in [lo, hi].
 double maximum_likelihood(io::ThermalConfig& c, const ThermalRecord& r, std::size_t training,
                           core::ThermalVec core::ThermalFilterConfig::*field, double lo, double hi) {
   auto nll = [&](double log_q) {
@@ -487,20 +504,7 @@ double maximum_likelihood(io::ThermalConfig& c, const ThermalRecord& r, std::siz
     (c.fusion.filter.*field).head(c.fusion.filter.network.nodes).setConstant(std::pow(10.0, log_q));
     return -training_log_likelihood(c, r, training);
   };
-  double a = lo, b = hi;
-  const double g = 0.5 * (std::sqrt(5.0) - 1.0);
-  double x1 = b - g * (b - a), x2 = a + g * (b - a);
-  double f1 = nll(x1), f2 = nll(x2);
-  while (b - a > 0.02) {
-    if (f1 < f2) {
-      b = x2, x2 = x1, f2 = f1;
-      x1 = b - g * (b - a), f1 = nll(x1);
-    } else {
-      a = x1, x1 = x2, f1 = f2;
-      x2 = a + g * (b - a), f2 = nll(x2);
-    }
-  }
-  const double q = std::pow(10.0, 0.5 * (a + b));
+  const double q = std::pow(10.0, golden_section_minimum(nll, lo, hi, 0.02));
   (c.fusion.filter.*field).setZero();
   (c.fusion.filter.*field).head(c.fusion.filter.network.nodes).setConstant(q);
   return q;
@@ -516,32 +520,19 @@ double maximum_likelihood(io::ThermalConfig& c, const ThermalRecord& r, std::siz
 void fit_sensor_lag(io::ThermalConfig& c, const ThermalRecord& r, std::size_t training, ThermalFitResult& out) {
   auto nll = [&](double log_tau) {
     c.fusion.winding_sensor_time_constant_s = log_tau == -kInf ? 0.0 : std::exp(log_tau);
-    double ll = 0.0;
-    for (const FilterStep& s : run_filter(c.fusion, r, training)) ll += s.log_likelihood;
-    return -ll;
+    return -training_log_likelihood(c, r, training);
   };
-  double a = std::log(kSensorLagLow_s), b = std::log(kSensorLagHigh_s);
-  const double lo = a, hi = b;
-  const double g = 0.5 * (std::sqrt(5.0) - 1.0);
-  double x1 = b - g * (b - a), x2 = a + g * (b - a);
-  double f1 = nll(x1), f2 = nll(x2);
-  while (b - a > 0.01) {
-    if (f1 < f2) {
-      b = x2, x2 = x1, f2 = f1;
-      x1 = b - g * (b - a), f1 = nll(x1);
-    } else {
-      a = x1, x1 = x2, f1 = f2;
-      x2 = a + g * (b - a), f2 = nll(x2);
-    }
-  }
-  const double best = 0.5 * (a + b), f_best = nll(best), f_none = nll(-kInf);
+  // χ²₁(0.95)/2: the rise of the −log-likelihood that bounds a 95 % profile-likelihood interval (Wilks).
+  const double half_chi2_95 = likelihood_ratio_threshold(1);
+  const double lo = std::log(kSensorLagLow_s), hi = std::log(kSensorLagHigh_s);
+  const double best = golden_section_minimum(nll, lo, hi, 0.01), f_best = nll(best), f_none = nll(-kInf);
   // The interval's ends: bisection on log τ_s between the optimum and the range's end.
   auto end = [&](double edge) {
-    if (nll(edge) - f_best < kHalfChi2_95) return edge == lo ? -kInf : kInf;
+    if (nll(edge) - f_best < half_chi2_95) return edge == lo ? -kInf : kInf;
     double in = best, outside = edge;
     while (std::abs(outside - in) > 0.01) {
       const double mid = 0.5 * (in + outside);
-      (nll(mid) - f_best < kHalfChi2_95 ? in : outside) = mid;
+      (nll(mid) - f_best < half_chi2_95 ? in : outside) = mid;
     }
     return 0.5 * (in + outside);
   };
@@ -554,7 +545,7 @@ void fit_sensor_lag(io::ThermalConfig& c, const ThermalRecord& r, std::size_t tr
   p.excitation_half_width_rel = p.half_width_rel;
   p.identified = p.half_width_rel <= kIdentifiedHalfWidth;
   out.parameters.push_back(p);
-  const bool lag_shown = f_none - f_best >= kHalfChi2_95;
+  const bool lag_shown = f_none - f_best >= half_chi2_95;
   out.notes.push_back("winding sensor time constant: " + std::to_string(p.value) + " s, 95 % interval [" +
                       std::to_string(std::exp(lower)) + ", " + std::to_string(std::exp(upper)) +
                       "] s (profile likelihood of the filter's innovations); " +
