@@ -128,6 +128,14 @@ core::ThermalFusionConfig gauss_markov_config() {
   return c;
 }
 
+/// ... and the winding sensor lagging by 10 s (eq. 14.22): its observation sees the winding's rate (h_d) and its
+/// lag is carried over every step — every form the filter has, at once.
+core::ThermalFusionConfig lagged_sensor_config() {
+  core::ThermalFusionConfig c = gauss_markov_config();
+  c.winding_sensor_time_constant_s = 10.0;
+  return c;
+}
+
 void filter_steps(benchmark::State& state, const core::ThermalFusionConfig& config) {
   const std::vector<core::ThermalStepData>& steps = recorded_steps();
   const core::ThermalFusion initial(config, test::paper_base(), test::paper_machine_si());
@@ -149,6 +157,7 @@ void filter_steps(benchmark::State& state, const core::ThermalFusionConfig& conf
 
 void BM_FilterStep(benchmark::State& state) { filter_steps(state, loop_config()); }
 void BM_FilterStepGaussMarkov(benchmark::State& state) { filter_steps(state, gauss_markov_config()); }
+void BM_FilterStepLaggedSensor(benchmark::State& state) { filter_steps(state, lagged_sensor_config()); }
 
 void BM_FilterStepPaused(benchmark::State& state) {
   const std::vector<core::ThermalStepData>& steps = recorded_steps();
@@ -217,6 +226,7 @@ void BM_SampleWithFusion(benchmark::State& state) {
 BENCHMARK(BM_FusionPerSample)->Repetitions(10)->ComputeStatistics("max", max_of)->ReportAggregatesOnly(true);
 BENCHMARK(BM_FilterStep)->Repetitions(10)->ComputeStatistics("max", max_of)->ReportAggregatesOnly(true);
 BENCHMARK(BM_FilterStepGaussMarkov)->Repetitions(10)->ComputeStatistics("max", max_of)->ReportAggregatesOnly(true);
+BENCHMARK(BM_FilterStepLaggedSensor)->Repetitions(10)->ComputeStatistics("max", max_of)->ReportAggregatesOnly(true);
 BENCHMARK(BM_FilterStepPaused)->Repetitions(10)->ComputeStatistics("max", max_of)->ReportAggregatesOnly(true);
 BENCHMARK(BM_PauseResumePair)->Repetitions(10)->ComputeStatistics("max", max_of)->ReportAggregatesOnly(true);
 BENCHMARK(BM_SampleWithFusion)->MinTime(1.0)->Repetitions(10)->ComputeStatistics("max", max_of)->ReportAggregatesOnly(true);
