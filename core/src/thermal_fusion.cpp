@@ -83,10 +83,10 @@ StepObservations step_observations(const ThermalFusionConfig& c, const ThermalSt
     const SensorLagStep k = sensor_lag_step(c.winding_sensor_time_constant_s, s.load.dt_s);
     if (k.rate_s > 0.0) {
       // The step's mean reading T_w − κ·(A_w·T + u_w + d_w/C_w) − β·e (eq. 14.22); e's error in the variance.
-      const ThermalRates rates = thermal_rates(n, s.load);
-      o.h -= k.rate_s * rates.a.row(w).transpose();
-      o.h_d[w] = -k.rate_s / n.capacitance_J_per_K[w];
-      o.offset = -k.rate_s * rates.u[w] - k.carry * lag.lag_K;
+      const WindingRate rate = winding_rate(n, thermal_rates(n, s.load));
+      o.h -= k.rate_s * rate.row.head<kMaxThermalNodes>();
+      o.h_d = -k.rate_s * rate.row.tail<kMaxThermalNodes>();
+      o.offset = -k.rate_s * rate.constant_K_per_s - k.carry * lag.lag_K;
       o.variance += k.carry * k.carry * lag.variance_K2;
     }
     out.present[2] = true;
@@ -179,14 +179,12 @@ void ThermalFusion::finish_step(const ThermalStepData& d, double dt_s) noexcept 
   }
   if (config_.winding_sensor_time_constant_s > 0.0) {
     // The sensor's lag over this step at the posterior's rate of the winding (eq. 14.22), that rate's variance
-    // from the posterior covariance of [T; d] along g = [A_w, e_w/C_w].
-    const int w = n.winding;
-    Eigen::Matrix<double, 2 * kMaxThermalNodes, 1> g = Eigen::Matrix<double, 2 * kMaxThermalNodes, 1>::Zero();
-    g.head<kMaxThermalNodes>() = rates.a.row(w).transpose();
-    g[kMaxThermalNodes + w] = 1.0 / n.capacitance_J_per_K[w];
-    const double rate = g.head<kMaxThermalNodes>().dot(filter_.temperature_C()) + rates.u[w] +
-                        g[kMaxThermalNodes + w] * filter_.disturbance_W()[w];
-    const double rate_variance = g.dot(filter_.covariance().topLeftCorner<2 * kMaxThermalNodes, 2 * kMaxThermalNodes>() * g);
+    // from the posterior covariance of [T; d] along its row.
+    const WindingRate g = winding_rate(n, rates);
+    const double rate = g.row.head<kMaxThermalNodes>().dot(filter_.temperature_C()) +
+                        g.row.tail<kMaxThermalNodes>().dot(filter_.disturbance_W()) + g.constant_K_per_s;
+    const double rate_variance =
+        g.row.dot(filter_.covariance().topLeftCorner<kDynamicThermalStates, kDynamicThermalStates>() * g.row);
     sensor_lag_.advance(sensor_lag_step(config_.winding_sensor_time_constant_s, dt_s), rate, rate_variance);
   }
   last_psi_m_Wb_ = d.psi_m_Wb;

@@ -5,6 +5,15 @@
 
 namespace rpem::core {
 
+WindingRate winding_rate(const ThermalNetwork& n, const ThermalRates& rates) noexcept {
+  WindingRate r;
+  const int w = n.winding;
+  r.row.head<kMaxThermalNodes>() = rates.a.row(w).transpose();
+  r.row[kMaxThermalNodes + w] = 1.0 / n.capacitance_J_per_K[w];
+  r.constant_K_per_s = rates.u[w];
+  return r;
+}
+
 SensorLagStep sensor_lag_step(double time_constant_s, double dt_s) noexcept {
   SensorLagStep k;
   if (!(time_constant_s > 0.0) || !(dt_s > 0.0)) return k;

@@ -160,9 +160,9 @@ struct Point {
 void advance_sensor_lag(const core::ThermalFusionConfig& f, const core::ThermalStepData& s, const core::ThermalVec& t,
                         core::SensorLag& lag) {
   if (!(f.winding_sensor_time_constant_s > 0.0)) return;
-  const core::ThermalRates rates = core::thermal_rates(f.filter.network, s.load);
-  const int w = f.filter.network.winding;
-  lag.advance(core::sensor_lag_step(f.winding_sensor_time_constant_s, s.load.dt_s), rates.a.row(w).dot(t) + rates.u[w], 0.0);
+  const core::WindingRate g = core::winding_rate(f.filter.network, core::thermal_rates(f.filter.network, s.load));
+  lag.advance(core::sensor_lag_step(f.winding_sensor_time_constant_s, s.load.dt_s),
+              g.row.head<core::kMaxThermalNodes>().dot(t) + g.constant_K_per_s, 0.0);
 }
 
 /// The observation's miss in kelvin: (y − h·T − c)/(∂y/∂T of its own node).

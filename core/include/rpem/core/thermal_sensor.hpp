@@ -10,7 +10,17 @@
 // predict the sensor with these (one model). τ_s = 0: the reading is the node (no lag, no step-mean term).
 // Real-time safe: noexcept, no allocation.
 
+#include "rpem/core/thermal_filter.hpp"
+
 namespace rpem::core {
+
+/// The winding's rate s = dT_w/dt = A_w·T + d_w/C_w + u_w as a row over the filter's [T; d] and its constant
+/// (eq. 14.22): what the lagging sensor's observation takes (h, h_d) and its lag advances by.
+struct WindingRate {
+  Eigen::Matrix<double, kDynamicThermalStates, 1> row = Eigen::Matrix<double, kDynamicThermalStates, 1>::Zero();
+  double constant_K_per_s = 0.0;
+};
+[[nodiscard]] WindingRate winding_rate(const ThermalNetwork& n, const ThermalRates& rates) noexcept;
 
 /// The coefficients of eq. 14.22 for one step.
 struct SensorLagStep {
