@@ -47,10 +47,8 @@ CommandPolicy CommandPolicy::of(const LiveConfig& live) noexcept {
 CommandVerdict admit_command(std::span<const std::uint8_t> message, const CommandPolicy& policy, const auth::Keyring& keys,
                              std::string_view channel, std::int64_t last_accepted_seq) noexcept {
   CommandVerdict v;
-  // 1. Decode: exactly one command_t (its fingerprint, its fields), no trailing bytes. Value-initialised: where
-  // g++ inlines more of LCM's decoder (a unity build, RPEM_UNITY_BUILD) it no longer sees that a decode that
-  // returns `size` wrote every field read below (-Wmaybe-uninitialized).
-  rpem::command_t m{};
+  // 1. Decode: exactly one command_t (its fingerprint, its fields), no trailing bytes.
+  rpem::command_t m;
   const int size = message.size() > static_cast<std::size_t>(INT32_MAX) ? -1 : static_cast<int>(message.size());
   if (size < 0 || m.decode(message.data(), 0, size) != size) return v;
   v.decoded = true;
