@@ -24,6 +24,7 @@ import re
 import shutil
 import subprocess
 import sys
+import tempfile
 import time
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
@@ -39,6 +40,9 @@ PRODUCTION_DIRS = ("analysis", "auth", "can", "core", "daemon", "io", "lcm_types
 EXCLUDED = ("data/*", "build/*", "*/third_party/*", "*/vendor/*", "*/generated/*")
 WARNING = re.compile(r"^(/[^:]+):(\d+):(\d+): warning: (.*) \[([\w.,-]+)\]$")
 FORMAT_WARNING = re.compile(r"^(.+):(\d+):(\d+): (?:warning|error): code should be clang-formatted")
+# A unity build's batch (RPEM_UNITY_BUILD, CMakeLists.txt): CMake's generated file of #include lines, one a source
+UNITY_BATCH = re.compile(r"/CMakeFiles/[^/]+\.dir/Unity/unity_\d+_cxx\.cxx$")
+UNITY_INCLUDE = re.compile(r'^#include "(/[^"]+)"$', re.M)
 
 
 def tool(name):
@@ -91,9 +95,30 @@ def fix_format():
     print(f"lint: clang-format applied to {len(files)} files (git diff --stat shows which changed)")
 
 
-def units_of(build, dirs, only):
+def compile_database(build):
+    """BUILD/compile_commands.json with each unity batch replaced by the sources it includes, each under the
+    batch's command with its own path for the batch's: the command CMake gives the source in a tree without unity
+    batches (a batch has its target's flags, nothing of its own). So clang-tidy checks the same units with the
+    same flags whether or not the tree was built in batches (scripts/test.sh builds build/ci so)."""
     with open(os.path.join(build, "compile_commands.json"), encoding="utf-8") as f:
         entries = json.load(f)
+    expanded = []
+    for e in entries:
+        batch = os.path.join(e["directory"], e["file"])
+        if not UNITY_BATCH.search(batch):
+            expanded.append(e)
+            continue
+        with open(batch, encoding="utf-8") as f:
+            sources = UNITY_INCLUDE.findall(f.read())
+        if not sources:
+            sys.exit(f"lint: {batch}: a unity batch that includes no source (has CMake's format changed?)")
+        for source in sources:
+            expanded.append({"directory": e["directory"], "file": source,
+                             "command": e["command"].replace(batch, source)})
+    return entries, expanded
+
+
+def units_of(entries, dirs, only):
     units = set()
     for e in entries:
         path = os.path.realpath(os.path.join(e["directory"], e["file"]))
@@ -105,11 +130,18 @@ def units_of(build, dirs, only):
 
 
 def run_tidy(build, jobs, dirs, only):
-    units = units_of(build, dirs, only)
+    entries, expanded = compile_database(build)
+    units = units_of(expanded, dirs, only)
+    database = build
+    if expanded != entries:  # a unity build: clang-tidy reads the expanded database from a directory of its own
+        scratch = tempfile.TemporaryDirectory(prefix="lint-tidy-")
+        database = scratch.name
+        with open(os.path.join(database, "compile_commands.json"), "w", encoding="utf-8") as f:
+            json.dump(expanded, f)
     # A header's findings: only for our own headers (never Eigen's, Ceres's, gtest's or the generated ones)
     header_filter = "^" + re.escape(ROOT) + "/(" + "|".join(re.escape(d) for d in OWN_DIRS) + ")/"
     # -w: the compiler of record is g++ (-Werror there); clang's own warnings are not this gate's
-    cmd = [tool("clang-tidy"), "-p", build, "--quiet", "--extra-arg=-w", f"--header-filter={header_filter}"]
+    cmd = [tool("clang-tidy"), "-p", database, "--quiet", "--extra-arg=-w", f"--header-filter={header_filter}"]
 
     def one(unit):
         r = subprocess.run([*cmd, unit], cwd=ROOT, capture_output=True, text=True)

@@ -7,11 +7,11 @@
 
 #include "rpem/core/assert.hpp"
 #include "rpem/core/clock.hpp"
+#include "rpem/core/non_finite.hpp"
 
 namespace rpem::core {
 namespace {
 
-constexpr double kInf = std::numeric_limits<double>::infinity();
 /// σ of a zero-mean normal over the median of its absolute value, 1/Φ⁻¹(3/4).
 constexpr double kSigmaPerMedian = 1.4826022185056018;
 /// The median tracker's step in log scale, η = 1/16: it moves by e^{±η} a sample, so the median of a

@@ -15,7 +15,7 @@ namespace {
 using Diag = rpem::diagnostics_t;
 
 // Where the decoder and the socket count each bad-input class, and where diagnostics publish it.
-constexpr std::array<CounterRow<can::DecoderCounters, std::uint64_t>, 13> kDecoderRows{{
+constexpr std::array<CounterRow<can::DecoderCounters, std::uint64_t>, 13> kCanDecoderRows{{
     {&can::DecoderCounters::frames, &Diag::can_frames},
     {&can::DecoderCounters::unknown_id, &Diag::can_unknown_id},
     {&can::DecoderCounters::wrong_dlc, &Diag::can_wrong_dlc},
@@ -30,7 +30,7 @@ constexpr std::array<CounterRow<can::DecoderCounters, std::uint64_t>, 13> kDecod
     {&can::DecoderCounters::incomplete, &Diag::can_incomplete},
     {&can::DecoderCounters::gaps, &Diag::can_gaps},
 }};
-static_assert(kDecoderRows.size() + kChannelRows.size() + 1 <= DiagnosticsRows::kMaxCounts);
+static_assert(kCanDecoderRows.size() + kChannelRows.size() + 1 <= DiagnosticsRows::kMaxCounts);
 
 class CanSampleSource final : public SampleSource {
  public:
@@ -58,7 +58,7 @@ class CanSampleSource final : public SampleSource {
           out.push(samples[k]);
         }
       }
-      report_when_due(out, channel, [&](DiagnosticsRows& rows) { rows.set_all(kDecoderRows, decoder.counters()); });
+      report_when_due(out, channel, [&](DiagnosticsRows& rows) { rows.set_all(kCanDecoderRows, decoder.counters()); });
     }
   }
   [[nodiscard]] std::string name() const override { return options_.interface; }

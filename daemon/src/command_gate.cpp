@@ -47,8 +47,11 @@ CommandPolicy CommandPolicy::of(const LiveConfig& live) noexcept {
 CommandVerdict admit_command(std::span<const std::uint8_t> message, const CommandPolicy& policy, const auth::Keyring& keys,
                              std::string_view channel, std::int64_t last_accepted_seq) noexcept {
   CommandVerdict v;
-  // 1. Decode: exactly one command_t (its fingerprint, its fields), no trailing bytes.
-  rpem::command_t m;
+  // 1. Decode: exactly one command_t (its fingerprint, its fields), no trailing bytes. Value-initialised: where
+  // g++ inlines more of LCM's decoder (a unity batch) it does not see that a decode returning `size` wrote every
+  // field read below (-Wmaybe-uninitialized); the decoder's integer stores into double fields are read back because
+  // every user of the generated types compiles with -fno-strict-aliasing (lcm_types/CMakeLists.txt).
+  rpem::command_t m{};
   const int size = message.size() > static_cast<std::size_t>(INT32_MAX) ? -1 : static_cast<int>(message.size());
   if (size < 0 || m.decode(message.data(), 0, size) != size) return v;
   v.decoded = true;

@@ -30,7 +30,7 @@ constexpr std::array<CounterRow<VescPollerCounters, std::uint64_t>, 10> kPollerR
     {&VescPollerCounters::empty_reads, &Diag::vesc_empty_reads},
     {&VescPollerCounters::long_windows, &Diag::vesc_long_windows},
 }};
-constexpr std::array<CounterRow<VescCounters, std::uint64_t>, 7> kDecoderRows{{
+constexpr std::array<CounterRow<VescCounters, std::uint64_t>, 7> kVescDecoderRows{{
     {&VescCounters::frames, &Diag::can_frames},
     {&VescCounters::foreign, &Diag::can_foreign},
     {&VescCounters::unknown_packet, &Diag::can_unknown_id},
@@ -39,7 +39,7 @@ constexpr std::array<CounterRow<VescCounters, std::uint64_t>, 7> kDecoderRows{{
     {&VescCounters::short_reply, &Diag::vesc_short_replies},
     {&VescCounters::statuses, &Diag::vesc_statuses},
 }};
-static_assert(kPollerRows.size() + kDecoderRows.size() + kChannelRows.size() + 3 <= DiagnosticsRows::kMaxCounts);
+static_assert(kPollerRows.size() + kVescDecoderRows.size() + kChannelRows.size() + 3 <= DiagnosticsRows::kMaxCounts);
 
 }  // namespace
 
@@ -61,7 +61,7 @@ std::int64_t reply_gather_ns(std::int64_t poll_period_ns) noexcept {
 void report_vesc_counters(const VescPoller& poller, DiagnosticsRows& rows) noexcept {
   rows.set_all(kPollerRows, poller.counters());
   const VescCounters& d = poller.decoder().counters();
-  rows.set_all(kDecoderRows, d);
+  rows.set_all(kVescDecoderRows, d);
   rows.set(&Diag::vesc_buffer_errors, static_cast<std::int64_t>(d.out_of_order + d.overflow + d.length_mismatch));
   rows.set(&Diag::vesc_bad_replies, static_cast<std::int64_t>(d.not_values + d.trailing + d.wrong_mask));
 }

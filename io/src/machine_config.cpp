@@ -7,13 +7,14 @@
 #include <stdexcept>
 #include <tuple>
 
+#include "rpem/core/non_finite.hpp"
 #include "rpem/core/per_unit.hpp"
 #include "rpem/io/number_format.hpp"
 
 namespace rpem::io {
 namespace {
 
-constexpr double kInf = std::numeric_limits<double>::infinity();
+using core::kInf;
 
 core::MachineSi parse_machine(YamlMap m) {
   core::MachineSi out;

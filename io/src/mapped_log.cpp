@@ -1,4 +1,5 @@
 #include "rpem/io/mapped_log.hpp"
+#include "rpem/core/non_finite.hpp"
 
 #include <algorithm>
 #include <charconv>
@@ -9,7 +10,7 @@
 namespace rpem::io {
 namespace {
 
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+using core::kNaN;
 
 bool blank(char c) { return c == ' ' || c == '\t' || c == '\r'; }
 

@@ -4,13 +4,14 @@
 #include <limits>
 #include <sstream>
 
+#include "rpem/core/non_finite.hpp"
 #include "rpem/core/per_unit.hpp"
 #include "rpem/io/number_format.hpp"
 
 namespace rpem::io {
 namespace {
 
-constexpr double kInf = std::numeric_limits<double>::infinity();
+using core::kInf;
 
 std::string num(double v) {
   std::string s;

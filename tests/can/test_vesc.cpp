@@ -23,8 +23,8 @@ namespace {
 
 using test::vesc_frames::ext;
 using test::vesc_frames::kController;
+using test::vesc_frames::kHost;  // the poller (rpemd)
 using test::vesc_frames::reply_frames;
-constexpr std::uint8_t kOwn = test::vesc_frames::kHost;  // the poller (rpemd)
 
 std::vector<VescDecoder::Event> feed(VescDecoder& dec, const std::vector<CanFrame>& frames) {
   std::vector<VescDecoder::Event> events;
@@ -33,7 +33,7 @@ std::vector<VescDecoder::Event> feed(VescDecoder& dec, const std::vector<CanFram
 }
 
 TEST(Vesc, PollRequestIsAShortBufferToTheController) {
-  const CanFrame f = values_request(kController, kOwn, kEstimatorMask);
+  const CanFrame f = values_request(kController, kHost, kEstimatorMask);
   EXPECT_TRUE(f.extended);
   EXPECT_EQ(f.id, 0x811U);  // 17 | CAN_PACKET_PROCESS_SHORT_BUFFER (8) << 8
   ASSERT_EQ(f.len, 7);
@@ -43,7 +43,7 @@ TEST(Vesc, PollRequestIsAShortBufferToTheController) {
 }
 
 TEST(Vesc, ReassemblesAndDecodesAGetValuesSelectiveReply) {
-  VescDecoder dec(kController, kOwn);
+  VescDecoder dec(kController, kHost);
   const auto events = feed(dec, reply_frames());
   for (std::size_t k = 0; k + 1 < events.size(); ++k) EXPECT_EQ(events[k], VescDecoder::Event::kNone);
   ASSERT_EQ(events.back(), VescDecoder::Event::kValues);
@@ -75,14 +75,14 @@ TEST(Vesc, ReassemblesAndDecodesAGetValuesSelectiveReply) {
 
 TEST(Vesc, ShortReplyInOneFrame) {
   // Mask bit 15 (fault code 3): a 6-byte reply, sent as PROCESS_SHORT_BUFFER [sender][commands_send][payload].
-  VescDecoder dec(kController, kOwn, bit(kFault));
+  VescDecoder dec(kController, kHost, bit(kFault));
   EXPECT_EQ(dec.decode(ext(0x87D, {0x11, 0x01, 0x32, 0x00, 0x00, 0x80, 0x00, 0x03})), VescDecoder::Event::kValues);
   EXPECT_EQ(dec.values().mask, 0x8000U);
   EXPECT_EQ(dec.values().fault, 3);
 }
 
 TEST(Vesc, StatusBroadcasts) {
-  VescDecoder dec(kController, kOwn);
+  VescDecoder dec(kController, kHost);
   // STATUS (9): ERPM −1500, current 12.3 A, duty 0.456.
   ASSERT_EQ(dec.decode(test::vesc_frames::status1()), VescDecoder::Event::kStatus);
   EXPECT_EQ(dec.status().number, 1);
@@ -123,7 +123,7 @@ bool kernel_passes(std::span<const KernelFilter> filters, const CanFrame& f, boo
 }
 
 TEST(Vesc, KernelFiltersPassWhatThePollerReadsAndNothingElse) {
-  const auto filters = kernel_filters(kController, kOwn);
+  const auto filters = kernel_filters(kController, kHost);
   // Passed: every frame of a reply to us (FILL_RX_BUFFER 5, PROCESS_RX_BUFFER 7), the other buffer packets
   // addressed to us (FILL_RX_BUFFER_LONG 6, PROCESS_SHORT_BUFFER 8), the controller's statuses 1-6, a second
   // poller's read of our controller and a read of every controller (id 255).
@@ -200,7 +200,7 @@ TEST(Vesc, ControllerKernelFiltersPassCommandsToItOrToAllAndNothingElse) {
 }
 
 TEST(VescBadInput, CrcErrorLengthMismatchAndLostFramesAreCountedAndDropped) {
-  VescDecoder dec(kController, kOwn);
+  VescDecoder dec(kController, kHost);
   auto frames = reply_frames();
   frames[2].data[3] ^= 0x01;  // one bit of i_q
   EXPECT_EQ(feed(dec, frames).back(), VescDecoder::Event::kNone);
@@ -223,7 +223,7 @@ TEST(VescBadInput, CrcErrorLengthMismatchAndLostFramesAreCountedAndDropped) {
 }
 
 TEST(VescBadInput, ForeignFramesAreCountedNotDecoded) {
-  VescDecoder dec(kController, kOwn);
+  VescDecoder dec(kController, kHost);
   CanFrame standard = reply_frames()[0];
   standard.extended = false;  // a standard ID 0x57D is someone else's protocol
   EXPECT_EQ(dec.decode(standard), VescDecoder::Event::kNone);
@@ -261,7 +261,7 @@ std::vector<CanFrame> frames_of(const std::vector<std::uint8_t>& p) {
 }
 
 TEST(VescBadInput, ShortTrailingWrongMaskAndOtherCommandRepliesAreCounted) {
-  VescDecoder dec(kController, kOwn);
+  VescDecoder dec(kController, kHost);
   std::vector<std::uint8_t> good = {0x32, 0x00, 0x18, 0x01, 0xB3, 0x01, 0x9D, 0x02, 0xA6, 0xFF, 0xFF,
                                     0xFE, 0xBF, 0x00, 0x00, 0x0A, 0xB9, 0x00, 0x00, 0x52, 0x08, 0x01,
                                     0xE2, 0xFF, 0xFF, 0xFB, 0x2E, 0x00, 0x00, 0x2E, 0x61};
@@ -290,7 +290,7 @@ TEST(VescBadInput, ShortTrailingWrongMaskAndOtherCommandRepliesAreCounted) {
 }
 
 TEST(VescBadInput, TooShortFramesAndOverflow) {
-  VescDecoder dec(kController, kOwn);
+  VescDecoder dec(kController, kHost);
   EXPECT_EQ(dec.decode(ext(0x57D, {0x00})), VescDecoder::Event::kNone);              // fill without data
   EXPECT_EQ(dec.decode(ext(0x77D, {0x11, 0x01, 0x00})), VescDecoder::Event::kNone);  // process too short
   EXPECT_EQ(dec.decode(ext(0x87D, {0x11, 0x01})), VescDecoder::Event::kNone);        // short buffer without command

@@ -15,7 +15,7 @@ namespace {
 
 using test::vesc_frames::ext;
 using test::vesc_frames::kController;
-constexpr std::uint8_t kOwn = test::vesc_frames::kHost;
+using test::vesc_frames::kHost;  // the poller (rpemd)
 
 void expect_same(const std::vector<CanFrame>& got, const std::vector<CanFrame>& want) {
   ASSERT_EQ(got.size(), want.size());
@@ -58,7 +58,7 @@ TEST(VescFirmware, TheReplyIsTheDocumentedBytes) {
   std::array<std::uint8_t, kMaxValuesPayload> payload{};
   const std::size_t len = encode_values(v, kEstimatorMask, payload);
   EXPECT_EQ(len, 31U);
-  expect_same(split({payload.data(), len}, kOwn, kController), test::vesc_frames::reply_frames());
+  expect_same(split({payload.data(), len}, kHost, kController), test::vesc_frames::reply_frames());
 }
 
 TEST(VescFirmware, ShortRepliesTravelInOneShortBuffer) {
@@ -67,7 +67,7 @@ TEST(VescFirmware, ShortRepliesTravelInOneShortBuffer) {
   std::array<std::uint8_t, kMaxValuesPayload> payload{};
   const std::size_t len = encode_values(v, bit(kFault), payload);
   ASSERT_EQ(len, 6U);
-  expect_same(split({payload.data(), len}, kOwn, kController),
+  expect_same(split({payload.data(), len}, kHost, kController),
               {ext(0x87D, {0x11, 0x01, 0x32, 0x00, 0x00, 0x80, 0x00, 0x03})});
 }
 
@@ -75,7 +75,7 @@ TEST(VescFirmware, LongBuffersSwitchToTwoByteOffsetsPastByte255) {
   // comm_can_send_buffer: FILL_RX_BUFFER at offsets 0, 7, …, 252 (37 frames), FILL_RX_BUFFER_LONG from 259.
   std::vector<std::uint8_t> p(300);
   for (std::size_t k = 0; k < p.size(); ++k) p[k] = static_cast<std::uint8_t>(k * 7 + 1);
-  const auto frames = split(p, kOwn, kController);
+  const auto frames = split(p, kHost, kController);
   ASSERT_EQ(frames.size(), 37U + 7U + 1U);  // 259 bytes in 37 short fills, 41 in 7 long ones, then process
   EXPECT_EQ(frames[36].id, 0x57DU);
   EXPECT_EQ(frames[36].data[0], 252);

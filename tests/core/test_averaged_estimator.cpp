@@ -13,7 +13,8 @@
 namespace rpem::core {
 namespace {
 
-test::AveragedDataGenerator generator(double rate_Hz, double n, double tau, double psi_scale = 1.0, double rs_scale = 1.0) {
+test::AveragedDataGenerator averaged_generator(double rate_Hz, double n, double tau, double psi_scale = 1.0,
+                                               double rs_scale = 1.0) {
   test::AveragedDataGenerator g;
   g.base = test::paper_base();
   g.plant = test::paper_machine_pu();
@@ -26,14 +27,14 @@ test::AveragedDataGenerator generator(double rate_Hz, double n, double tau, doub
   return g;
 }
 
-struct RunResult {
+struct AveragedRun {
   Estimate last;
   double psi_m_rel = 0.0;  ///< ψ̂m / true ψm
   double r_s_rel = 0.0;
 };
 
-RunResult run(AveragedDriveEstimator& est, test::AveragedDataGenerator& g, double seconds) {
-  RunResult r;
+AveragedRun run(AveragedDriveEstimator& est, test::AveragedDataGenerator& g, double seconds) {
+  AveragedRun r;
   while (g.t_s < seconds) r.last = est.step(g.next());
   r.psi_m_rel = est.psi_m_Wb() / g.base.flux_Wb_of(g.plant.psi_m_pu);
   r.r_s_rel = est.r_s_Ohm() / g.base.resistance_Ohm_of(g.plant.r_s_pu);
@@ -41,7 +42,7 @@ RunResult run(AveragedDriveEstimator& est, test::AveragedDataGenerator& g, doubl
 }
 
 TEST(AveragedEstimator, TrueParametersGiveZeroPredictionErrorOnSteadyWindows) {
-  auto g = generator(200.0, 0.4, 0.5);
+  auto g = averaged_generator(200.0, 0.4, 0.5);
   AveragedDriveEstimator est(test::paper_machine_si(), test::paper_settings());
   for (int k = 0; k < 200; ++k) {
     const Estimate e = est.step(g.next());
@@ -55,7 +56,7 @@ TEST(AveragedEstimator, TrueParametersGiveZeroPredictionErrorOnSteadyWindows) {
 
 TEST(AveragedEstimator, PredictionErrorIsEqEpsilonSteadyState) {
   // ψm 5 % low and R_s 10 % high in the machine: the first sample's ε is eq_epsilon_steadystate exactly.
-  auto g = generator(200.0, 0.4, 0.5, 0.95, 1.1);
+  auto g = averaged_generator(200.0, 0.4, 0.5, 0.95, 1.1);
   AveragedDriveEstimator est(test::paper_machine_si(), test::paper_settings());
   const AveragedSample s = g.next();
   const Estimate e = est.step(s);
@@ -69,7 +70,7 @@ TEST(AveragedEstimator, PredictionErrorIsEqEpsilonSteadyState) {
 /// log-linear between samples; measured after the start, so the first window, which only anchors the
 /// chain and is 20 ms long at 50 Hz, does not count).
 double psi_m_decay_time(double rate_Hz, std::uint64_t seed) {
-  auto g = generator(rate_Hz, 0.5, 0.4, 0.92);
+  auto g = averaged_generator(rate_Hz, 0.5, 0.4, 0.92);
   g.rng.seed(seed);
   AveragedDriveEstimator est(test::paper_machine_si(), test::paper_settings());
   const double truth = g.base.flux_Wb_of(g.plant.psi_m_pu);
@@ -105,18 +106,18 @@ TEST(AveragedEstimator, OneConfigurationGivesTheSameTimeConstantAtEveryRate) {
 class AtRate : public ::testing::TestWithParam<double> {};
 
 TEST_P(AtRate, PsiMConvergesAtSpeed) {
-  auto g = generator(GetParam(), -0.6, 0.5, 0.92);
+  auto g = averaged_generator(GetParam(), -0.6, 0.5, 0.92);
   AveragedDriveEstimator est(test::paper_machine_si(), test::paper_settings());
-  const RunResult r = run(est, g, 6.0);
+  const AveragedRun r = run(est, g, 6.0);
   EXPECT_NEAR(r.psi_m_rel, 1.0, 1e-3);
   EXPECT_DOUBLE_EQ(est.r_s_Ohm(), 2.25);  // scheduled out at speed
   EXPECT_TRUE(r.last.detail.flags & step_flag::kPsiMActive);
 }
 
 TEST_P(AtRate, RsConvergesAtStandstillUnderLoad) {
-  auto g = generator(GetParam(), 0.0, 0.4, 1.0, 1.15);
+  auto g = averaged_generator(GetParam(), 0.0, 0.4, 1.0, 1.15);
   AveragedDriveEstimator est(test::paper_machine_si(), test::paper_settings());
-  const RunResult r = run(est, g, 30.0);
+  const AveragedRun r = run(est, g, 30.0);
   EXPECT_NEAR(r.r_s_rel, 1.0, 1e-3);
   EXPECT_DOUBLE_EQ(est.psi_m_Wb(), 1.14);
   EXPECT_TRUE(r.last.detail.flags & step_flag::kRsActive);
@@ -129,7 +130,7 @@ TEST(AveragedEstimator, InductiveCorrectionIsExactOnACurrentRampAndNeededThere) 
   // i_q rises at 2 pu/s at n = 0.3 pu: the windows' means carry (x/ω_n)·di/dt, which the steady state
   // leaves out. With the correction (backward difference of window means: exact for a ramp) ε vanishes.
   auto make = [] {
-    auto g = generator(500.0, 0.3, 0.0);
+    auto g = averaged_generator(500.0, 0.3, 0.0);
     g.i_pu = [](double t) { return Vec2(-0.1, 0.2 + 2.0 * t); };
     g.di_pu_per_s = [](double) { return Vec2(0.0, 2.0); };
     return g;
@@ -159,7 +160,7 @@ TEST(AveragedEstimator, InductiveCorrectionIsExactOnACurrentRampAndNeededThere) 
 }
 
 TEST(AveragedEstimator, GapsAndLongIntervalsAdaptNothing) {
-  auto g = generator(200.0, 0.4, 0.5, 0.95);
+  auto g = averaged_generator(200.0, 0.4, 0.5, 0.95);
   AveragedDriveEstimator est(test::paper_machine_si(), test::paper_settings());
   EXPECT_EQ(est.step(g.next()).detail.code, StepCode::kSynchronized);
   EXPECT_EQ(est.step(g.next()).detail.code, StepCode::kAdapted);
@@ -182,7 +183,7 @@ TEST(AveragedEstimator, GapsAndLongIntervalsAdaptNothing) {
 
 TEST(AveragedEstimator, InstantaneousSamplesAreAcceptedWithTheirSpacing) {
   // A source that samples instead of averaging (t_start = t): consecutive samples continue the chain.
-  auto g = generator(200.0, 0.5, 0.4, 0.92);
+  auto g = averaged_generator(200.0, 0.5, 0.4, 0.92);
   AveragedDriveEstimator est(test::paper_machine_si(), test::paper_settings());
   Estimate e;
   while (g.t_s < 6.0) {
@@ -195,7 +196,7 @@ TEST(AveragedEstimator, InstantaneousSamplesAreAcceptedWithTheirSpacing) {
 }
 
 TEST(AveragedEstimator, NonFiniteSampleIsRejectedAndTheChainRestarts) {
-  auto g = generator(200.0, 0.4, 0.5, 0.95);
+  auto g = averaged_generator(200.0, 0.4, 0.5, 0.95);
   AveragedDriveEstimator est(test::paper_machine_si(), test::paper_settings());
   for (int k = 0; k < 10; ++k) (void)est.step(g.next());
   const Vec2 theta = est.core().state().theta_pu;
@@ -209,7 +210,7 @@ TEST(AveragedEstimator, NonFiniteSampleIsRejectedAndTheChainRestarts) {
 TEST(AveragedEstimator, DelayAndAngleOffsetExtensionsUndoTheirEffect) {
   // A drive whose voltage acts 150 µs late and whose angle reads 0.05 rad behind: its reported means are
   // the true ones turned by +ω·delay (voltage) and by −offset (both; true = logged + offset).
-  auto g = generator(200.0, 0.8, 0.5);
+  auto g = averaged_generator(200.0, 0.8, 0.5);
   EstimatorSettings settings = test::paper_settings();
   settings.extensions.delay_s = 150e-6;
   settings.extensions.theta_offset_rad = 0.05;

@@ -13,7 +13,7 @@
 namespace rpem::core {
 namespace {
 
-const double kOmegaN = 100.0 * kPi;
+using test::kOmegaN;
 
 struct RunResult {
   Vec2 theta;

@@ -12,13 +12,13 @@
 namespace rpem::core {
 namespace {
 
-constexpr double kOmega = 150.0;  // electrical speed of the test samples [rad/s]
+constexpr double kSampleOmega = 150.0;  // electrical speed of the test samples [rad/s]
 
 DriveSample dq_sample(std::int64_t t_ns, double theta, const Vec2& u_dq_V, const Vec2& i_dq_A) {
   DriveSample s;
   s.t_ns = t_ns;
   s.theta_el_rad = theta;
-  s.omega_el_rad_s = kOmega;
+  s.omega_el_rad_s = kSampleOmega;
   s.u_dc_V = 565.0;
   s.voltage_frame = s.current_frame = Frame::kDq;
   s.u_V = Vec3(u_dq_V[0], u_dq_V[1], 0.0);
@@ -52,7 +52,7 @@ TEST(FluxHarmonic, InducedVoltageIsTheAngleDerivativeOfTheFluxPlusItsRotation) {
     };
     const double theta = 0.83, step = 1e-6;
     const Vec2 dpsi = (psi(theta + step) - psi(theta - step)) / (2.0 * step);
-    const Vec2 e_V = kOmega * (dpsi + Vec2(-psi(theta)[1], psi(theta)[0]));
+    const Vec2 e_V = kSampleOmega * (dpsi + Vec2(-psi(theta)[1], psi(theta)[0]));
     const Vec2 change = end_voltage_change_pu(x, 0.8, theta, Vec2(-1.0, 3.0));
     EXPECT_LT((change * b.voltage_V + e_V).norm(), 1e-6 * e_V.norm()) << "order " << order;  // taken from u
   }
@@ -101,7 +101,7 @@ TEST(CrossSaturation, TheSecondTermAddsCTwoIdToBothHalves) {
   const EstimatorSample out = cond.condition(dq_sample(0, 0.3, Vec2(40.0, 180.0), i_A));
   EXPECT_NEAR(out.x_q_pu * b.inductance_H, m.x_q_pu * b.inductance_H + c2 * i_A[0] * i_A[0], 1e-15);
   const Vec2 change = end_voltage_change_pu(x, 0.3, 0.32, i_A);
-  EXPECT_NEAR(change[1] * b.voltage_V, -kOmega * c2 * i_A[0] * i_A[1] * i_A[1], 1e-12);
+  EXPECT_NEAR(change[1] * b.voltage_V, -kSampleOmega * c2 * i_A[0] * i_A[1] * i_A[1], 1e-12);
 }
 
 TEST(CrossSaturation, LqFollowsIdAndTheDAxisFluxFollowsTheLoad) {
@@ -119,10 +119,10 @@ TEST(CrossSaturation, LqFollowsIdAndTheDAxisFluxFollowsTheLoad) {
   EXPECT_NEAR(out.x_q_pu * b.inductance_H, m.x_q_pu * b.inductance_H + c * i_A[0], 1e-15);
   const Vec2 change = end_voltage_change_pu(x, 0.3, 0.32, i_A);
   EXPECT_NEAR(change[0], 0.0, 1e-15);
-  EXPECT_NEAR(change[1] * b.voltage_V, -kOmega * 0.5 * c * i_A[1] * i_A[1], 1e-12);
+  EXPECT_NEAR(change[1] * b.voltage_V, -kSampleOmega * 0.5 * c * i_A[1] * i_A[1], 1e-12);
   // In the steady state too (it is no harmonic).
   const SteadyStateInputs ss = cond.steady_state(dq_sample(0, 0.3, Vec2(40.0, 180.0), i_A));
-  EXPECT_NEAR(ss.u_pu[1] * b.voltage_V, 180.0 - kOmega * 0.5 * c * i_A[1] * i_A[1], 1e-12);
+  EXPECT_NEAR(ss.u_pu[1] * b.voltage_V, 180.0 - kSampleOmega * 0.5 * c * i_A[1] * i_A[1], 1e-12);
   EXPECT_NEAR(ss.x_q_pu, out.x_q_pu, 1e-15);
 }
 

@@ -13,8 +13,8 @@
 namespace rpem::core {
 namespace {
 
-const double kOmegaN = 100.0 * kPi;
-const double kDt = 125e-6;
+using test::kDt;
+using test::kOmegaN;
 
 /// Equilibrium of the discrete predictor under a constant rotor-frame input, found from the map itself:
 /// x ↦ F(x) is affine, so three evaluations give Φ and c, and (I − Φ)·x* = c. Also returns the

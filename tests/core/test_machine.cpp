@@ -12,7 +12,7 @@
 namespace rpem::core {
 namespace {
 
-const double kOmegaN = 100.0 * kPi;
+using test::kOmegaN;
 
 /// eq_epsilon_steadystate as printed, with i the plant's (measured) current.
 Vec2 printed_epsilon(const MachinePu& hat, double n, const Vec2& i, double d_psi, double d_rs, double d_xd, double d_xq) {

@@ -18,6 +18,7 @@
 #include <random>
 
 #include "core/regime_reference.hpp"
+#include "rpem/core/non_finite.hpp"
 #include "rpem/core/regime.hpp"
 #include "rpem/core/settings.hpp"
 #include "support/outrunner_machine.hpp"
@@ -26,9 +27,6 @@
 
 namespace rpem::core {
 namespace {
-
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-constexpr double kInf = std::numeric_limits<double>::infinity();
 
 /// Bit patterns equal (NaN against NaN too, +0 against −0 not): "the same number" for a differential test.
 bool same(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }

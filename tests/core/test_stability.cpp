@@ -11,8 +11,8 @@
 namespace rpem::core {
 namespace {
 
-const double kOmegaN = 100.0 * kPi;
-const double kDt = 125e-6;
+using test::kDt;
+using test::kOmegaN;
 
 double spectral_radius(Discretization d, double n) {
   Eigen::EigenSolver<Mat2> es(transition_matrix(test::paper_machine_pu(), kOmegaN, d, kDt, n));

@@ -12,6 +12,9 @@
 
 namespace rpem::test {
 
+/// A utime in 2026 [µs]: the instant the supervisor's and the gate's tests send their estimates at.
+inline constexpr std::int64_t kT0 = 1'790'000'000'000'000;
+
 /// A test key: bytes 0x40 + `salt`, 0x41 + `salt`, … under `id`.
 inline auth::Key test_key(std::int32_t id, std::uint8_t salt = 0) {
   std::array<std::uint8_t, auth::kKeyBytes> bytes{};

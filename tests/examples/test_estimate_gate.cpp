@@ -13,8 +13,8 @@
 namespace rpem::supervisor {
 namespace {
 
-constexpr std::int64_t kT0 = 1'790'000'000'000'000;  // a utime in 2026 [µs]
-constexpr Freshness kFreshness{500'000, 50'000};     // 0.5 s, 0.05 s
+using test::kT0;
+constexpr Freshness kFreshness{500'000, 50'000};  // 0.5 s, 0.05 s
 
 struct Gate : ::testing::Test {
   auth::Keyring keys;

@@ -16,7 +16,7 @@
 namespace rpem::supervisor {
 namespace {
 
-constexpr std::int64_t kT0 = 1'790'000'000'000'000;
+using test::kT0;
 
 /// examples/supervisor/supervisor.yaml's values.
 Config config() {

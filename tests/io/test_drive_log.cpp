@@ -18,7 +18,7 @@ namespace {
 const std::string kHeader = "t,theta_el,omega_el,u_dc,u_a,u_b,u_c,i_a,i_b,i_c\n";
 
 /// Reads a log and returns the error message (empty when it reads cleanly).
-std::string error_of(const std::string& content) {
+std::string drive_log_error_of(const std::string& content) {
   test::TempFile f("log.csv", content);
   try {
     (void)read_drive_log(f.path());
@@ -79,7 +79,7 @@ struct BadCase {
 class MalformedLog : public ::testing::TestWithParam<BadCase> {};
 
 TEST_P(MalformedLog, IsRejectedWithLineAndColumn) {
-  const std::string msg = error_of(GetParam().content);
+  const std::string msg = drive_log_error_of(GetParam().content);
   EXPECT_NE(msg.find(GetParam().expected), std::string::npos) << "message: " << msg;
   EXPECT_NE(msg.find("log.csv"), std::string::npos) << "message: " << msg;
 }

@@ -17,7 +17,7 @@ namespace {
 
 using namespace test::vesc_tool;
 
-std::string error_of(const std::string& content) {
+std::string vesc_tool_error_of(const std::string& content) {
   test::TempFile f("vesc.csv", content);
   try {
     const LogSource s = log_source(f.path());
@@ -93,7 +93,7 @@ TEST(VescToolLog, ReadsTheTestBuildHeaderOfVersion120) {
 }
 
 TEST(VescToolLog, AHeaderWithoutDqVoltagesNamesTheVersionThatAddedThem) {
-  const std::string msg = error_of(kHeader117 + values22(1000, 40, 50, 0, 1, 100) + "\n");
+  const std::string msg = vesc_tool_error_of(kHeader117 + values22(1000, 40, 50, 0, 1, 100) + "\n");
   EXPECT_NE(msg.find("vesc.csv:1: column d_axis_voltage: not in this VESC Tool realtime log (the header of VESC Tool "
                      "1.17 to 1.19)"),
             std::string::npos)
@@ -103,7 +103,8 @@ TEST(VescToolLog, AHeaderWithoutDqVoltagesNamesTheVersionThatAddedThem) {
 
 TEST(VescToolLog, TheHeaderlessLogOfVersions111To116IsRefusedWithWhy) {
   // 2323a806 (VESC Tool 1.11, 2019-05-06) wrote the 22 values with no header.
-  const std::string msg = error_of(values22(1000, 40, 50, 0, 1, 100) + "\n" + values22(1100, 40, 50, 0, 1, 100) + "\n");
+  const std::string msg =
+      vesc_tool_error_of(values22(1000, 40, 50, 0, 1, 100) + "\n" + values22(1100, 40, 50, 0, 1, 100) + "\n");
   EXPECT_NE(msg.find("vesc.csv:1: a VESC Tool realtime log without header (VESC Tool 1.11 to 1.16"), std::string::npos)
       << msg;
   EXPECT_NE(msg.find("d_axis_voltage, q_axis_voltage"), std::string::npos) << msg;
@@ -123,7 +124,8 @@ TEST(VescToolLog, MidnightWrapKeepsTimeMonotonic) {
 }
 
 TEST(VescToolLog, AStepBackShorterThanHalfADayIsAnErrorNotAWrap) {
-  const std::string msg = error_of(kHeader120 + row120(50000000, 0, 1, 100, 0, 1) + row120(49995000, 0, 1, 100, 0, 1));
+  const std::string msg =
+      vesc_tool_error_of(kHeader120 + row120(50000000, 0, 1, 100, 0, 1) + row120(49995000, 0, 1, 100, 0, 1));
   EXPECT_NE(msg.find("vesc.csv:3:1: column ms_today (t): time goes back by 5 s (the column wraps every 86400 s"),
             std::string::npos)
       << msg;
@@ -149,12 +151,12 @@ TEST(VescToolLog, RowsInTheSameMillisecondAreSpreadOverIt) {
 TEST(VescToolLog, ABadCellNamesTheFilesColumnAndTheQuantity) {
   std::string bad = row120(1100, 0, 1, 100, 0, 1);
   bad.replace(bad.find(";1.000000;100"), 9, ";x");  // q_axis_current, the 11th cell
-  const std::string msg = error_of(kHeader120 + row120(1000, 0, 1, 100, 0, 1) + bad);
+  const std::string msg = vesc_tool_error_of(kHeader120 + row120(1000, 0, 1, 100, 0, 1) + bad);
   EXPECT_NE(msg.find("vesc.csv:3:11: column q_axis_current (i_q): 'x' is not a number"), std::string::npos) << msg;
 }
 
 TEST(VescToolLog, OneRowHoldsNoSample) {
-  const std::string msg = error_of(kHeader120 + row120(1000, 0, 1, 100, 0, 1));
+  const std::string msg = vesc_tool_error_of(kHeader120 + row120(1000, 0, 1, 100, 0, 1));
   EXPECT_NE(msg.find("vesc.csv:2: no samples: the only row holds means since a read before the log began"),
             std::string::npos)
       << msg;

@@ -18,6 +18,11 @@ inline core::MachineSi paper_machine_si() {
   return m;
 }
 
+/// The paper machine's base electrical speed, 1000 rpm × 3 pole pairs = 100π rad/s.
+inline constexpr double kOmegaN = 100.0 * core::kPi;
+/// The paper's sample period (8 kHz).
+inline constexpr double kDt = 125e-6;
+
 inline core::PerUnitBase paper_base() { return core::PerUnitBase::from_rated(paper_machine_si().rated); }
 
 inline core::MachinePu paper_machine_pu() { return core::to_pu(paper_base(), paper_machine_si()); }
@@ -40,7 +45,7 @@ inline core::EstimatorSettings paper_settings(core::Algorithm algorithm = core::
   s.initial_r_s_Ohm = 2.25;
   s.initial_sga_hessian_pu = core::Vec2(1.0, 1.0);
   s.initial_gna_hessian_pu = core::Mat2::Identity();
-  s.nominal_sample_period_s = 125e-6;
+  s.nominal_sample_period_s = kDt;
   s.max_sample_interval_s = 1e-3;
   return s;
 }

@@ -21,8 +21,8 @@
 namespace rpem::tools {
 namespace {
 
-std::atomic<bool> g_stop{false};
-void on_signal(int) { g_stop = true; }
+std::atomic<bool> g_can_stop{false};
+void on_can_stop_signal(int) { g_can_stop = true; }
 
 struct ReplayOptions {
   std::string log;
@@ -38,9 +38,9 @@ int run_replay(const ReplayOptions& o) {
   TelemetryStreamer streamer(o.stream);
   io::DriveLogRow row;
   std::uint64_t n = 0;
-  std::signal(SIGINT, on_signal);
-  std::signal(SIGTERM, on_signal);
-  while (!g_stop && reader.next(row)) {
+  std::signal(SIGINT, on_can_stop_signal);
+  std::signal(SIGTERM, on_can_stop_signal);
+  while (!g_can_stop && reader.next(row)) {
     streamer.send(row.sample, can::protocol::status::kPwmEnabled);
     ++n;
   }
@@ -66,8 +66,8 @@ int run_record(const RecordOptions& o) {
   can::SocketCanChannel channel(co);
   can::TelemetryDecoder decoder;
   io::DriveLogWriter writer(o.out, io::DriveLogLayout{});
-  std::signal(SIGINT, on_signal);
-  std::signal(SIGTERM, on_signal);
+  std::signal(SIGINT, on_can_stop_signal);
+  std::signal(SIGTERM, on_can_stop_signal);
   std::fprintf(stderr, "rpem record: listening on %s\n", o.interface.c_str());
 
   std::vector<can::ReceivedFrame> frames(64);
@@ -76,7 +76,7 @@ int run_record(const RecordOptions& o) {
   std::uint64_t written = 0;
   const std::int64_t start = core::now_ns(CLOCK_MONOTONIC);
   std::int64_t last_data = start;
-  while (!g_stop) {
+  while (!g_can_stop) {
     const std::int64_t now = core::now_ns(CLOCK_MONOTONIC);
     if (o.duration_s > 0 && now - start > static_cast<std::int64_t>(o.duration_s * 1e9)) break;
     if (o.idle_timeout_s > 0 && written > 0 && now - last_data > static_cast<std::int64_t>(o.idle_timeout_s * 1e9)) break;

@@ -9,10 +9,10 @@ namespace rpem::tools {
 namespace {
 
 /// Set by the signal handlers: the diagnosis stops between blocks.
-std::atomic<bool> g_stop{false};
+std::atomic<bool> g_diagnose_stop{false};
 static_assert(std::atomic<bool>::is_always_lock_free);
 
-void on_signal(int) { g_stop.store(true); }
+void on_diagnose_stop_signal(int) { g_diagnose_stop.store(true); }
 
 /// A bar is drawn once the run has taken this long (a short run stays quiet) …
 constexpr auto kQuietFor = std::chrono::seconds(2);
@@ -33,9 +33,9 @@ std::string duration_text(double s) {
 }  // namespace
 
 TerminalMonitor::TerminalMonitor() : tty_(isatty(STDERR_FILENO) != 0) {
-  g_stop.store(false);
+  g_diagnose_stop.store(false);
   struct sigaction action {};
-  action.sa_handler = on_signal;
+  action.sa_handler = on_diagnose_stop_signal;
   sigemptyset(&action.sa_mask);
   action.sa_flags = SA_RESETHAND;  // a second Ctrl-C ends the process at once
   sigaction(SIGINT, &action, nullptr);
@@ -66,7 +66,7 @@ void TerminalMonitor::advance(std::uint64_t units) noexcept {
   draw(false);
 }
 
-bool TerminalMonitor::stop_requested() const noexcept { return g_stop.load(); }
+bool TerminalMonitor::stop_requested() const noexcept { return g_diagnose_stop.load(); }
 
 void TerminalMonitor::reading(std::uint64_t done, std::uint64_t total) noexcept {
   {

@@ -37,8 +37,8 @@
 namespace rpem::tools {
 namespace {
 
-std::atomic<bool> g_stop{false};
-void on_signal(int) { g_stop = true; }
+std::atomic<bool> g_lcm_stop{false};
+void on_lcm_stop_signal(int) { g_lcm_stop = true; }
 
 struct ListenOptions {
   std::string prefix;
@@ -198,10 +198,10 @@ int run_listen(const ListenOptions& o) {
   }
   lcm.subscribe(o.prefix + "RPEM_ESTIMATE", &Listener::on_estimate_bytes, &listener);
   lcm.subscribe(o.prefix + "RPEM_DIAGNOSTICS", &Listener::on_diagnostics_bytes, &listener);
-  std::signal(SIGINT, on_signal);
-  std::signal(SIGTERM, on_signal);
+  std::signal(SIGINT, on_lcm_stop_signal);
+  std::signal(SIGTERM, on_lcm_stop_signal);
   const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(o.duration_s > 0 ? o.duration_s : 1e9);
-  while (!g_stop && std::chrono::steady_clock::now() < end) lcm.handleTimeout(100);
+  while (!g_lcm_stop && std::chrono::steady_clock::now() < end) lcm.handleTimeout(100);
   std::fprintf(stderr, "rpem listen: %lld estimates, %lld diagnostics; %lld verified, %lld FORGED, %lld unverified",
                static_cast<long long>(listener.estimates), static_cast<long long>(listener.diagnostics),
                static_cast<long long>(listener.verified), static_cast<long long>(listener.forged),

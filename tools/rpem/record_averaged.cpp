@@ -22,8 +22,8 @@
 namespace rpem::tools {
 namespace {
 
-std::atomic<bool> g_stop{false};
-void on_signal(int) { g_stop = true; }
+std::atomic<bool> g_record_stop{false};
+void on_record_stop_signal(int) { g_record_stop = true; }
 
 /// One source of averaged samples on a CAN channel.
 class Feed {
@@ -141,8 +141,8 @@ int run_record_averaged(const RecordOptions& o) {
   co.interface = o.interface;
   can::SocketCanChannel channel(co);
   io::AveragedLogWriter writer(o.averaged_out, feed->layout());
-  std::signal(SIGINT, on_signal);
-  std::signal(SIGTERM, on_signal);
+  std::signal(SIGINT, on_record_stop_signal);
+  std::signal(SIGTERM, on_record_stop_signal);
   std::fprintf(stderr, "rpem record: listening on %s, writing averaged samples to %s\n", o.interface.c_str(),
                o.averaged_out.c_str());
   std::vector<can::ReceivedFrame> frames(64);
@@ -151,7 +151,7 @@ int run_record_averaged(const RecordOptions& o) {
   std::int64_t last_data = start;
   core::AveragedSample sample;
   std::int64_t origin_ns = 0;
-  while (!g_stop) {
+  while (!g_record_stop) {
     const std::int64_t now = core::now_ns(CLOCK_MONOTONIC);
     if (o.duration_s > 0 && now - start > static_cast<std::int64_t>(o.duration_s * 1e9)) break;
     if (o.idle_timeout_s > 0 && written > 0 && now - last_data > static_cast<std::int64_t>(o.idle_timeout_s * 1e9)) break;

@@ -5,11 +5,12 @@
 #include <limits>
 
 #include "rpem/analysis/diagnose/effects.hpp"
+#include "rpem/core/non_finite.hpp"
 
 namespace rpem::analysis {
 namespace {
 
-constexpr double kInf = std::numeric_limits<double>::infinity();
+using core::kInf;
 constexpr double kDeg = core::kPi / 180.0;
 
 // Scales: a scaled parameter of 1 is this much of the physical one.
@@ -27,7 +28,8 @@ constexpr double kMaxDelayPeriodsFitted = core::kMaxDelayPeriods + 0.9;
 
 std::pair<double, double> range(double lo, double hi) { return {lo, hi}; }
 
-std::string pct(double v) {
+/// v as a percentage with three significant digits (0.0123 → "1.23").
+std::string percent_three_significant(double v) {
   char b[32];
   std::snprintf(b, sizeof b, "%.3g", 100.0 * v);
   return b;
@@ -259,7 +261,8 @@ template <std::size_t N>
 std::string materials_text(const std::array<core::MaterialCoefficient, N>& materials) {
   std::string s;
   for (const core::MaterialCoefficient& m : materials) {
-    s += (s.empty() ? "" : ", ") + std::string(m.material) + " " + pct(m.min_per_K) + "…" + pct(m.max_per_K) + " %/K";
+    s += (s.empty() ? "" : ", ") + std::string(m.material) + " " + percent_three_significant(m.min_per_K) + "…" +
+         percent_three_significant(m.max_per_K) + " %/K";
   }
   char at[32];
   std::snprintf(at, sizeof at, " at %g °C", core::kMaterialReference_C);
@@ -335,18 +338,18 @@ EffectRow drift() {
     };
     if (kWinding) {
       if (overlaps(core::kWindingMaterials)) return std::nullopt;
-      return Implausibility{
-          "R_s would change by " + pct(alpha) + " %/K against T_winding (" + materials_text(core::kWindingMaterials) + ")",
-          "a temperature-dependent error that is not resistance — an inverter voltage error (dead time, "
-          "device drops) or an inductance that changes with the operating point the temperature follows; "
-          "standstill at two or more currents per temperature would separate them"};
+      return Implausibility{"R_s would change by " + percent_three_significant(alpha) + " %/K against T_winding (" +
+                                materials_text(core::kWindingMaterials) + ")",
+                            "a temperature-dependent error that is not resistance — an inverter voltage error (dead time, "
+                            "device drops) or an inductance that changes with the operating point the temperature follows; "
+                            "standstill at two or more currents per temperature would separate them"};
     }
     if (overlaps(core::kMagnetMaterials)) return std::nullopt;
-    return Implausibility{
-        "ψm would change by " + pct(alpha) + " %/K against T_magnet (" + materials_text(core::kMagnetMaterials) + ")",
-        "a flux error that follows the load the temperature follows — cross-saturation or an inductance "
-        "changing with the current — or a constant ψm error the calibration takes; operation at two or "
-        "more currents per temperature would separate them"};
+    return Implausibility{"ψm would change by " + percent_three_significant(alpha) + " %/K against T_magnet (" +
+                              materials_text(core::kMagnetMaterials) + ")",
+                          "a flux error that follows the load the temperature follows — cross-saturation or an inductance "
+                          "changing with the current — or a constant ψm error the calibration takes; operation at two or "
+                          "more currents per temperature would separate them"};
   };
   return r;
 }

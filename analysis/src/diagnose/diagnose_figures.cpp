@@ -11,12 +11,13 @@
 #include "rpem/analysis/gnuplot.hpp"
 #include "rpem/core/clock.hpp"
 #include "rpem/core/conditioner.hpp"
+#include "rpem/core/non_finite.hpp"
 #include "rpem/core/units.hpp"
 
 namespace rpem::analysis {
 namespace {
 
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+using core::kNaN;
 
 /// The temperature column a figure draws against (the winding's if logged), and whether it varies.
 const TemperatureColumn& drawn_temperature(const Diagnosis& d) {

@@ -11,7 +11,7 @@ namespace rpem::analysis {
 namespace {
 
 /// The calibrated constants' names in a person's words.
-constexpr std::array<const char*, kCalibrated.size()> kCalibratedText{"ψm", "R_s", "L_d", "L_q"};
+constexpr std::array<const char*, kCalibrated.size()> kCalibratedName{"ψm", "R_s", "L_d", "L_q"};
 
 nlohmann::json params_json(const std::vector<NamedValue>& values) {
   nlohmann::json p = nlohmann::json::object();
@@ -109,13 +109,15 @@ void write_text(const std::string& path, const std::string& text) {
   if (!f || !(f << text)) throw std::runtime_error("cannot write " + path);
 }
 
-std::string pct(double v) {
+/// |v| as a percentage with one decimal (0.0123 → "1.2").
+std::string abs_percent(double v) {
   char b[32];
   std::snprintf(b, sizeof b, "%.1f", 100.0 * std::abs(v));
   return b;
 }
 
-std::string num(double v) {
+/// v with four significant digits.
+std::string four_significant(double v) {
   char b[32];
   std::snprintf(b, sizeof b, "%.4g", v);
   return b;
@@ -151,11 +153,12 @@ std::vector<std::string> calibrated_despite_mismatch(const Diagnosis& d) {
   for (std::size_t i = 0; i < kCalibrated.size(); ++i) {
     if (!c.identifiable[i] || c.identification[i] != Identification::kRejectsConfiguration) continue;
     const double rel = c.value[i] / c.configured[i] - 1.0;
-    out.push_back(std::string(kCalibratedText[i]) + " " + num(c.value[i]) + " (" + (rel > 0.0 ? "+" : "−") + pct(rel) +
-                  " % of the configuration's " + num(c.configured[i]) + "): its cluster-robust 95 % interval, ±" +
-                  pct(c.intervals.half_width[i]) + " %, is wider than ±" + pct(kIdentifiedHalfWidth) +
+    out.push_back(std::string(kCalibratedName[i]) + " " + four_significant(c.value[i]) + " (" + (rel > 0.0 ? "+" : "−") +
+                  abs_percent(rel) + " % of the configuration's " + four_significant(c.configured[i]) +
+                  "): its cluster-robust 95 % interval, ±" + abs_percent(c.intervals.half_width[i]) + " %, is wider than ±" +
+                  abs_percent(kIdentifiedHalfWidth) +
                   " % — the model's misfit widens it — but even widened by the mismatch allowance, ±" +
-                  pct(mismatch_half_width(d, i)) + " %, it excludes the configured value: the log rejects it");
+                  abs_percent(mismatch_half_width(d, i)) + " %, it excludes the configured value: the log rejects it");
   }
   return out;
 }
@@ -170,7 +173,7 @@ std::vector<std::string> calibration_findings(const Diagnosis& d) {
     const double hw = std::isfinite(c.intervals.half_width[i]) ? c.intervals.half_width[i] : 0.0;
     const double mismatch = mismatch_half_width(d, i);
     if (std::abs(c.value[i] / c.configured[i] - 1.0) <= std::max(hw + mismatch, 0.005)) continue;
-    out.push_back(std::string("the configuration's ") + kCalibratedText[i] + " is " + pct(rel) + " % " +
+    out.push_back(std::string("the configuration's ") + kCalibratedName[i] + " is " + abs_percent(rel) + " % " +
                   (rel > 0.0 ? "high" : "low"));
   }
   return out;

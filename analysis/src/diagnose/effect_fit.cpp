@@ -16,12 +16,9 @@
 namespace rpem::analysis {
 namespace {
 
-/// Forward-difference step on the scaled parameters (1 = a typical magnitude): the intervals' absolute
-/// step, and the fit's relative one (Ceres' relative_step_size, with its floor √ε).
-constexpr double kStep = 1e-3;
 /// Columns a fit's or the intervals' per-sample rows hold at most (the calibrated constants and every
 /// effect's parameters; four effects of at most a few parameters use a fraction of it).
-constexpr int kMaxColumns = 64;
+constexpr int kMaxFitColumns = 64;
 
 /// A training block's residuals (scaled by the loss, as over_training gives them) and their sum of squares.
 struct TrainingResiduals {
@@ -62,7 +59,7 @@ class EffectFitter::FitCost final : public ceres::CostFunction {
   bool Evaluate(double const* const* parameters, double* residuals, double** jacobians) const override {
     const EffectSet set = at(parameters);
     const int p = parameters_;
-    assert(p < kMaxColumns);  // the row below holds the P columns and the residual
+    assert(p < kMaxFitColumns);  // the row below holds the P columns and the residual
     if (jacobians == nullptr) {
       cost_only(set, parameters, residuals);
       return true;
@@ -92,7 +89,7 @@ class EffectFitter::FitCost final : public ceres::CostFunction {
     std::vector<Block> factors =
         fitter_.over_training_from(models, std::move(inits), [&](Block& f, std::span<const core::Vec2> r) {
           const core::Vec2 r0 = f.base ? (*f.base)[f.next++] : r[0];
-          double row[kMaxColumns];
+          double row[kMaxFitColumns];
           for (int axis = 0; axis < 2; ++axis) {
             for (int j = 0; j < p; ++j)
               row[j] =
@@ -147,7 +144,7 @@ class EffectFitter::FitCost final : public ceres::CostFunction {
       for (std::int32_t i = 0; i < sizes[b]; ++i) {
         std::vector<double> block(parameters[b], parameters[b] + sizes[b]);
         const double delta = std::max(std::sqrt(std::numeric_limits<double>::epsilon()),
-                                      std::abs(block[static_cast<std::size_t>(i)]) * kStep);
+                                      std::abs(block[static_cast<std::size_t>(i)]) * kDifferenceStep);
         block[static_cast<std::size_t>(i)] += delta;
         std::vector<const double*> moved(parameters, parameters + sizes.size());
         moved[b] = block.data();
@@ -346,16 +343,17 @@ std::vector<ExtendedModel> stepped_models(const EffectSet& set, const EffectCont
   std::vector<ExtendedModel> models = {set.model(context)};
   for (std::size_t i = 0; i < kCalibrated.size(); ++i) {
     EffectSet moved = set;
-    moved.calibration[i] += kStep;
+    moved.calibration[i] += kDifferenceStep;
     models.push_back(moved.model(context));
-    steps.push_back(kStep);
+    steps.push_back(kDifferenceStep);
   }
   for (std::size_t j = 0; j < set.effects.size(); ++j) {
     for (std::size_t i = 0; i < set.parameters[j].size(); ++i) {
       EffectSet moved = set;
-      const double h = parameter_bounds(set.effects[j], context, static_cast<int>(i)).second >= set.parameters[j][i] + kStep
-                           ? kStep
-                           : -kStep;
+      const double h =
+          parameter_bounds(set.effects[j], context, static_cast<int>(i)).second >= set.parameters[j][i] + kDifferenceStep
+              ? kDifferenceStep
+              : -kDifferenceStep;
       moved.parameters[j][i] += h;
       models.push_back(moved.model(context));
       steps.push_back(h);
@@ -370,7 +368,7 @@ CalibrationIntervals EffectFitter::intervals(const EffectSet& set, double noise_
   std::vector<double> steps;
   const std::vector<ExtendedModel> models = stepped_models(set, context_, steps);
   const auto n = static_cast<Eigen::Index>(steps.size());
-  assert(n <= kMaxColumns);
+  assert(n <= kMaxFitColumns);
   // Per training block: JᵀJ, and the block's score vector g_b = J_bᵀ·r_b (the cluster-robust "meat").
   struct Block {
     least_squares::Gram gram;
@@ -378,7 +376,7 @@ CalibrationIntervals EffectFitter::intervals(const EffectSet& set, double noise_
   };
   const std::vector<Block> blocks = over_training(models, Block{least_squares::Gram(n), Eigen::VectorXd::Zero(n)},
                                                   [&](Block& b, std::span<const core::Vec2> r) {
-                                                    double c[2][kMaxColumns];
+                                                    double c[2][kMaxFitColumns];
                                                     for (Eigen::Index i = 0; i < n; ++i) {
                                                       const std::size_t m = static_cast<std::size_t>(i) + 1;
                                                       c[0][i] = (r[m][0] - r[0][0]) / steps[static_cast<std::size_t>(i)];

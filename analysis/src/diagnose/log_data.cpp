@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "median.hpp"
 #include "rpem/core/clock.hpp"
 #include "rpem/core/conditioner.hpp"
 #include "rpem/core/frames.hpp"
@@ -21,13 +22,6 @@ constexpr double kTransitionShare = 0.05;
 constexpr double kIdleShare = 0.02;
 /// Steady state when samples lie this many electrical time constants apart.
 constexpr double kSteadyStateTimeConstants = 5.0;
-
-double median(std::vector<double> v) {
-  if (v.empty()) return 0.0;
-  const auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
-  std::nth_element(v.begin(), mid, v.end());
-  return *mid;
-}
 
 }  // namespace
 

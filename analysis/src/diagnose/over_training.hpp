@@ -10,6 +10,10 @@ namespace rpem::analysis {
 /// A sample a model predicts nothing finite at counts as this large a miss on each axis rather than vanishing.
 inline constexpr double kMiss_A = 1e3;
 
+/// Forward-difference step on the scaled parameters (1 = a typical magnitude): the intervals' and the screening's
+/// absolute step, and the fit's relative one (Ceres' relative_step_size, with its floor √ε).
+inline constexpr double kDifferenceStep = 1e-3;
+
 template <class Acc, class Add>
 std::vector<Acc> EffectFitter::over_training(const std::vector<ExtendedModel>& models, const Acc& init,
                                              const Add& add) const {

@@ -6,11 +6,12 @@
 
 #include "rpem/core/averaged_estimator.hpp"
 #include "rpem/core/drive_estimator.hpp"
+#include "rpem/core/non_finite.hpp"
 
 namespace rpem::analysis {
 namespace {
 
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+using core::kNaN;
 
 /// An averaged log's row as the window it was read from (io::to_drive_log_row inverted).
 core::AveragedSample window_of(const LogData& log, std::size_t k) {

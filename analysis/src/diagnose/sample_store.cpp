@@ -1,4 +1,5 @@
 #include "rpem/analysis/diagnose/sample_store.hpp"
+#include "rpem/core/non_finite.hpp"
 
 #include <cassert>
 #include <cmath>
@@ -11,7 +12,7 @@ namespace {
 /// Whether x survives the round trip through float (NaN does: a missing reading stays missing).
 bool single_exact(double x) noexcept { return std::isnan(x) || static_cast<double>(static_cast<float>(x)) == x; }
 
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+using core::kNaN;
 
 }  // namespace
 

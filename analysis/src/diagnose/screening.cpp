@@ -12,34 +12,31 @@
 namespace rpem::analysis {
 namespace {
 
-/// Forward-difference step on the scaled parameters (as effect_fit.cpp's).
-constexpr double kStep = 1e-3;
-
 /// A column of the Jacobian: the model moved by h along one parameter.
 struct Column {
   ExtendedModel moved;
-  double h = kStep;
+  double h = kDifferenceStep;
 };
 
 /// The columns of the basis: the free calibrated constants, then the parameters of the effects in the
 /// model (the effects already in the model move with the candidate too: an effect fitted without the one
 /// still missing has taken part of its residual — a dead time fitted without the command delay — and a
 /// screening that held it fixed would credit the missing effect with only what is left; a parameter its
-/// bounds pin, width below kStep, stays where it is).
+/// bounds pin, width below kDifferenceStep, stays where it is).
 std::vector<Column> basis_columns(const EffectSet& base, const EffectContext& context) {
   std::vector<Column> out;
   for (std::size_t i = 0; i < kCalibrated.size(); ++i) {
     if (!base.calibrated[i]) continue;
     EffectSet moved = base;
-    moved.calibration[i] += kStep;
-    out.push_back({moved.model(context), kStep});
+    moved.calibration[i] += kDifferenceStep;
+    out.push_back({moved.model(context), kDifferenceStep});
   }
   for (std::size_t j = 0; j < base.effects.size(); ++j) {
     for (std::size_t i = 0; i < base.parameters[j].size(); ++i) {
       const auto [lo, hi] = parameter_bounds(base.effects[j], context, static_cast<int>(i));
-      if (hi - lo < kStep) continue;
+      if (hi - lo < kDifferenceStep) continue;
       EffectSet moved = base;
-      const double h = hi >= base.parameters[j][i] + kStep ? kStep : -kStep;
+      const double h = hi >= base.parameters[j][i] + kDifferenceStep ? kDifferenceStep : -kDifferenceStep;
       moved.parameters[j][i] += h;
       out.push_back({moved.model(context), h});
     }
@@ -63,7 +60,7 @@ std::vector<std::vector<double>> starts_of(const Effect& candidate, const Effect
 }
 
 /// Columns a screening's sums take at most (the basis' and a candidate's).
-constexpr Eigen::Index kMaxColumns = 64;
+constexpr Eigen::Index kMaxScreeningColumns = 64;
 
 /// The models of a pass: the basis (the round's model, then its columns) and after it whatever the pass
 /// adds; each sample's basis columns are computed once for all. After the first pass: the basis' sums.
@@ -75,7 +72,7 @@ struct Pass {
   [[nodiscard]] Eigen::Index basis_size() const noexcept { return static_cast<Eigen::Index>(basis_steps.size()); }
   /// The basis columns at one sample, axis by axis.
   void basis_columns(std::span<const core::Vec2> r, int axis, double* c) const {
-    assert(basis_steps.size() <= static_cast<std::size_t>(kMaxColumns));
+    assert(basis_steps.size() <= static_cast<std::size_t>(kMaxScreeningColumns));
     for (std::size_t i = 0; i < basis_steps.size(); ++i) c[i] = (r[i + 1][axis] - r[0][axis]) / basis_steps[i];
   }
 };
@@ -110,7 +107,7 @@ void judge_starts(const OverTraining& over_training, const EffectContext& contex
                    std::vector<Eigen::VectorXd>(start_models, Eigen::VectorXd::Zero(nb))};
   const std::vector<First> first = over_training(pass.models, init, [&](First& f, std::span<const core::Vec2> r) {
     for (int axis = 0; axis < 2; ++axis) {
-      double c[kMaxColumns];
+      double c[kMaxScreeningColumns];
       pass.basis_columns(r, axis, c);
       f.basis.add(c, r[0][axis]);
       for (std::size_t s = 0; s < start_models; ++s) {
@@ -178,14 +175,15 @@ void credit_gains(const OverTraining& over_training, const EffectContext& contex
     pass.models.push_back(at.model(context));
     if (const int k = e.row->fitted_constant(); k >= 0 && !base.calibrated[static_cast<std::size_t>(k)]) {
       EffectSet moved = at;
-      moved.calibration[static_cast<std::size_t>(k)] += kStep;
+      moved.calibration[static_cast<std::size_t>(k)] += kDifferenceStep;
       pass.models.push_back(moved.model(context));
-      l.steps.push_back(kStep);
+      l.steps.push_back(kDifferenceStep);
       l.constant = 1;
     }
     for (int i = 0; i < e.row->parameters; ++i) {
       const double value = at.parameters.back()[static_cast<std::size_t>(i)];
-      const double h = parameter_bounds(e, context, i).second >= value + kStep ? kStep : -kStep;
+      const double h =
+          parameter_bounds(e, context, i).second >= value + kDifferenceStep ? kDifferenceStep : -kDifferenceStep;
       EffectSet moved = at;
       moved.parameters.back()[static_cast<std::size_t>(i)] += h;
       pass.models.push_back(moved.model(context));
@@ -199,7 +197,7 @@ void credit_gains(const OverTraining& over_training, const EffectContext& contex
   const std::vector<std::vector<least_squares::Gram>> second =
       over_training(pass.models, init2, [&](std::vector<least_squares::Gram>& g, std::span<const core::Vec2> r) {
         for (int axis = 0; axis < 2; ++axis) {
-          double c[kMaxColumns];
+          double c[kMaxScreeningColumns];
           pass.basis_columns(r, axis, c);
           for (std::size_t j = 0; j < layout.size(); ++j) {
             const Candidate& l = layout[j];

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <cstdio>
 
+#include "median.hpp"
+
 namespace rpem::analysis {
 namespace {
 
@@ -12,14 +14,8 @@ constexpr double kMedianChiSquare1 = 0.454936;
 /// Var(r_{k+1} − 2·r_k + r_{k−1}) / Var(r) for white r.
 constexpr double kSecondDifferenceGain = 6.0;
 
-double median(std::vector<double> v) {
-  if (v.empty()) return 0.0;
-  const auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
-  std::nth_element(v.begin(), mid, v.end());
-  return *mid;
-}
-
-std::string num(double v) {
+/// v with three significant digits.
+std::string three_significant(double v) {
   char b[32];
   std::snprintf(b, sizeof b, "%.3g", v);
   return b;
@@ -131,29 +127,32 @@ Verdict verdict(double final_heldout_rms_A, const NoiseFloor& floor, const Resid
   } else {
     v.kind = VerdictKind::kUndetermined;
     v.findings.push_back("the noise floor cannot be measured on this log: " + floor.unknown_reason);
-    v.findings.push_back("the final model's held-out residual is " + num(final_heldout_rms_A) +
+    v.findings.push_back("the final model's held-out residual is " + three_significant(final_heldout_rms_A) +
                          " A RMS; whether that is the sensors' noise or a model error cannot be told without it");
   }
-  const std::string floor_text = floor.value_A ? "noise floor " + num(*floor.value_A) + " A" : "noise floor unknown";
+  const std::string floor_text =
+      floor.value_A ? "noise floor " + three_significant(*floor.value_A) + " A" : "noise floor unknown";
 
   // Where it lives: standstill against motion, and the region that carries the most.
   if (st.standstill_samples == 0) {
-    v.findings.push_back("no samples at standstill; in motion " + num(st.motion_rms_A.after) + " A RMS (" + floor_text +
-                         ")");
+    v.findings.push_back("no samples at standstill; in motion " + three_significant(st.motion_rms_A.after) + " A RMS (" +
+                         floor_text + ")");
   } else if (st.motion_samples == 0) {
-    v.findings.push_back("at standstill " + num(st.standstill_rms_A.after) + " A RMS, no samples in motion (" + floor_text +
-                         ")");
+    v.findings.push_back("at standstill " + three_significant(st.standstill_rms_A.after) + " A RMS, no samples in motion (" +
+                         floor_text + ")");
   } else {
-    v.findings.push_back("at standstill " + num(st.standstill_rms_A.after) + " A RMS, in motion " +
-                         num(st.motion_rms_A.after) + " A RMS (" + floor_text + ")");
+    v.findings.push_back("at standstill " + three_significant(st.standstill_rms_A.after) + " A RMS, in motion " +
+                         three_significant(st.motion_rms_A.after) + " A RMS (" + floor_text + ")");
   }
   const RegionStatistics* worst = nullptr;
   for (const RegionStatistics& r : st.regions) {
     if (!worst || r.rms_A.after > worst->rms_A.after) worst = &r;
   }
   if (worst) {
-    v.findings.push_back("largest in the region " + worst->speed + ", " + worst->load + ": " + num(worst->rms_A.after) +
-                         " A RMS, mean ε_d " + num(worst->mean_d_A.after) + " A, ε_q " + num(worst->mean_q_A.after) + " A");
+    v.findings.push_back("largest in the region " + worst->speed + ", " + worst->load + ": " +
+                         three_significant(worst->rms_A.after) + " A RMS, mean ε_d " +
+                         three_significant(worst->mean_d_A.after) + " A, ε_q " + three_significant(worst->mean_q_A.after) +
+                         " A");
   }
   // Against the electrical angle: the strongest harmonic, if it stands out of the noise.
   const HarmonicContent* strongest = nullptr;
@@ -162,8 +161,8 @@ Verdict verdict(double final_heldout_rms_A, const NoiseFloor& floor, const Resid
   }
   if (strongest && floor.value_A && strongest->amplitude_A.after > *floor.value_A) {
     v.findings.push_back("against the electrical angle the residual is strongest at harmonic " +
-                         std::to_string(strongest->order) + " (" + num(strongest->amplitude_A.after) + " A): most often " +
-                         harmonic_meaning(strongest->order));
+                         std::to_string(strongest->order) + " (" + three_significant(strongest->amplitude_A.after) +
+                         " A): most often " + harmonic_meaning(strongest->order));
   }
   // With what it moves.
   const RegressorCorrelation* best = nullptr;
@@ -176,7 +175,7 @@ Verdict verdict(double final_heldout_rms_A, const NoiseFloor& floor, const Resid
     }
   }
   if (best && best_r >= 0.3) {
-    v.findings.push_back("it correlates with " + best->regressor + " (" + num(best_r) +
+    v.findings.push_back("it correlates with " + best->regressor + " (" + three_significant(best_r) +
                          "): " + regressor_meaning(best->regressor));
   }
   if (!floor.value_A) {

@@ -5,12 +5,13 @@
 
 #include "rpem/analysis/diagnose/verdict.hpp"
 #include "rpem/core/conditioner.hpp"
+#include "rpem/core/non_finite.hpp"
 #include "rpem/core/units.hpp"
 
 namespace rpem::analysis {
 namespace {
 
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+using core::kNaN;
 /// The figures' ranges start from these (no sample: the range is then the figure's default).
 constexpr double kFar = 1e300;
 

@@ -8,13 +8,14 @@
 #include <vector>
 
 #include "rpem/analysis/gnuplot.hpp"
+#include "rpem/core/non_finite.hpp"
 #include "rpem/io/csv_table.hpp"
 #include "rpem/io/errors.hpp"
 
 namespace rpem::analysis {
 namespace {
 
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+using core::kNaN;
 
 /// The estimate's value at time t by linear interpolation between its rows (NaN outside them).
 double at(const std::vector<double>& t, const std::vector<double>& v, double when) {

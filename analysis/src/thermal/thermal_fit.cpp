@@ -9,12 +9,13 @@
 #include "rpem/analysis/cluster_robust.hpp"
 #include "rpem/analysis/diagnose/effect_fit.hpp"
 #include "rpem/analysis/thermal/thermal_replay.hpp"
+#include "rpem/core/non_finite.hpp"
 
 namespace rpem::analysis {
 namespace {
 
 constexpr double kZ = 1.959964;  // two-sided 95 %
-constexpr double kInf = std::numeric_limits<double>::infinity();
+using core::kInf;
 /// The floor of an observation's σ in the fit's weights: temperatures are not resolved finer [K].
 constexpr double kSigmaFloor_K = 0.5;
 /// Each log parameter stays within e^±this of its start (a factor of 3·10⁴): finite simulations only.

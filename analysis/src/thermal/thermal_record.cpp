@@ -5,13 +5,14 @@
 
 #include "rpem/core/averaged_estimator.hpp"
 #include "rpem/core/drive_estimator.hpp"
+#include "rpem/core/non_finite.hpp"
 #include "rpem/io/averaged_log.hpp"
 #include "rpem/io/drive_log.hpp"
 
 namespace rpem::analysis {
 namespace {
 
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+using core::kNaN;
 
 /// Feeds one sample to the observer and keeps a completed step.
 class Recorder {

@@ -19,7 +19,7 @@ std::ofstream open(const std::string& path) {
 }
 
 /// v with `digits` significant digits.
-std::string fmt(double v, int digits = 3) {
+std::string significant(double v, int digits = 3) {
   char buf[64];
   std::snprintf(buf, sizeof buf, "%.*g", digits, v);
   return buf;
@@ -28,7 +28,7 @@ std::string fmt(double v, int digits = 3) {
 /// A relative half-width as text; beyond ±1000 % the log does not bound the parameter at all.
 std::string percent(double rel) {
   if (!std::isfinite(rel)) return "not excited";
-  return rel > 10.0 ? std::string("unbounded (> 1000 %)") : fmt(100.0 * rel) + " %";
+  return rel > 10.0 ? std::string("unbounded (> 1000 %)") : significant(100.0 * rel) + " %";
 }
 
 nlohmann::json number_or_null(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); }
@@ -42,8 +42,9 @@ void write_thermal_yaml(const std::string& path, const ThermalFitResult& fit, co
   f << "# log: " << record.log << " (" << record.steps.size() << " steps), configuration: " << config_name << "\n";
   f << "# training: t <= " << fit.fit_until_s << " s (" << fit.training_steps << " steps); the rest held out\n";
   for (const SignalFit& s : fit.signals) {
-    f << "# " << s.name << ": fit " << fmt(s.fit_rms_K) << " K RMS (" << s.fit_points << "), held out "
-      << fmt(s.heldout_rms_K) << " K RMS, worst " << fmt(s.heldout_worst_K) << " K (" << s.heldout_points << ")\n";
+    f << "# " << s.name << ": fit " << significant(s.fit_rms_K) << " K RMS (" << s.fit_points << "), held out "
+      << significant(s.heldout_rms_K) << " K RMS, worst " << significant(s.heldout_worst_K) << " K (" << s.heldout_points
+      << ")\n";
   }
   for (const FittedParameter& p : fit.parameters) {
     if (!p.identified) f << "# not identified: " << p.name << " (95 % interval ±" << percent(p.half_width_rel) << ")\n";
@@ -103,25 +104,25 @@ void write_thermal_fit_report(const std::string& path, const ThermalFitResult& f
     << "); the rest is held out. The network runs open loop from a soaked start (every node at the coolant).\n\n";
   o << "| signal | fit RMS [K] | points | held-out RMS [K] | held-out worst [K] | points |\n|---|---|---|---|---|---|\n";
   for (const SignalFit& s : fit.signals) {
-    o << "| " << s.name << " | " << fmt(s.fit_rms_K) << " | " << s.fit_points << " | " << fmt(s.heldout_rms_K) << " | "
-      << fmt(s.heldout_worst_K) << " | " << s.heldout_points << " |\n";
+    o << "| " << s.name << " | " << significant(s.fit_rms_K) << " | " << s.fit_points << " | "
+      << significant(s.heldout_rms_K) << " | " << significant(s.heldout_worst_K) << " | " << s.heldout_points << " |\n";
   }
   o << "\n## Parameters (95 % intervals: cluster-robust over "
     << "blocks of the training part; excitation alone)\n\n";
   o << "| parameter | value | unit | robust | excitation | identified |\n|---|---|---|---|---|---|\n";
   for (const FittedParameter& p : fit.parameters) {
-    o << "| " << p.name << " | " << fmt(p.value, 5) << " | " << p.unit << " | ±" << percent(p.half_width_rel) << " | ±"
-      << percent(p.excitation_half_width_rel) << " | " << (p.identified ? "yes" : "**no**") << " |\n";
+    o << "| " << p.name << " | " << significant(p.value, 5) << " | " << p.unit << " | ±" << percent(p.half_width_rel)
+      << " | ±" << percent(p.excitation_half_width_rel) << " | " << (p.identified ? "yes" : "**no**") << " |\n";
   }
   o << "\nProcess noise (maximum likelihood of the filter's innovations over the training part): "
-    << fmt(fit.process_noise_K2_per_s) << " K²/s per node; the heat disturbances' drift " << fmt(fit.disturbance_W2_per_s)
-    << " W²/s per node; their correlation times (eq. 14.19)";
+    << significant(fit.process_noise_K2_per_s) << " K²/s per node; the heat disturbances' drift "
+    << significant(fit.disturbance_W2_per_s) << " W²/s per node; their correlation times (eq. 14.19)";
   for (int i = 0; i < fit.config.fusion.filter.network.nodes; ++i) {
     const double tau = fit.disturbance_time_constant_s[i];
     o << (i ? ", " : " ") << fit.config.node_names[static_cast<std::size_t>(i)] << " "
-      << (std::isfinite(tau) ? fmt(tau) + " s" : "∞ (a random walk)");
+      << (std::isfinite(tau) ? significant(tau) + " s" : "∞ (a random walk)");
   }
-  o << " (a finite one kept only where it gains more than " << fmt(fit.disturbance_time_constant_threshold)
+  o << " (a finite one kept only where it gains more than " << significant(fit.disturbance_time_constant_threshold)
     << " in log-likelihood over the walk: the likelihood-ratio test at 5 % over the grid, eq. 14.21a).\n";
   if (!fit.not_identifiable.empty()) {
     o << "\n## Not identifiable\n\nParameters the log cannot tell apart (they move together along a direction the "

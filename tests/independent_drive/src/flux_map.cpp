@@ -1,4 +1,5 @@
 #include "indep_drive/flux_map.hpp"
+#include "indep_drive/ipow.hpp"
 
 #include <Eigen/Dense>
 
@@ -29,12 +30,6 @@ std::vector<std::string> split(const std::string& line) {
     cells.push_back(cell);
   }
   return cells;
-}
-
-double ipow(double x, int k) {
-  double r = 1.0;
-  for (int j = 0; j < k; ++j) r *= x;
-  return r;
 }
 
 }  // namespace

@@ -4,18 +4,9 @@
 #include <stdexcept>
 #include <utility>
 
+#include "indep_drive/ipow.hpp"
+
 namespace indep {
-
-namespace {
-
-/// x^k for small non-negative k, with x^0 = 1 (also for x = 0) and x^(−1) unused (multiplied by 0).
-double ipow(double x, int k) {
-  double r = 1.0;
-  for (int j = 0; j < k; ++j) r *= x;
-  return r;
-}
-
-}  // namespace
 
 FluxModel::FluxModel(double l_d_H, double l_q_H, double current_scale_A, std::vector<PolyTerm> terms)
     : l_d_(l_d_H), l_q_(l_q_H), i_b_(current_scale_A), terms_(std::move(terms)) {

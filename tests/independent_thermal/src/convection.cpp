@@ -3,11 +3,9 @@
 #include <algorithm>
 #include <cmath>
 
-namespace indep_thermal {
+#include "indep_thermal/pi.hpp"
 
-namespace {
-constexpr double kPi = 3.14159265358979323846;
-}
+namespace indep_thermal {
 
 double taylor_number(const Parameters& p, double omega_mech_rad_s) {
   const double r_r = 0.5 * p.rotor_diameter_m;

@@ -4,12 +4,11 @@
 #include <cmath>
 
 #include "indep_thermal/materials.hpp"
+#include "indep_thermal/pi.hpp"
 
 namespace indep_thermal {
 
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
 
 // |u|² − U² of the configured machine's steady state as a quadratic a·i_d² + b·i_d + c in i_d.
 struct Quadratic {

@@ -3,12 +3,9 @@
 #include <cmath>
 
 #include "indep_thermal/materials.hpp"
+#include "indep_thermal/pi.hpp"
 
 namespace indep_thermal {
-
-namespace {
-constexpr double kPi = 3.14159265358979323846;
-}
 
 Losses compute_losses(const Parameters& p, const OperatingPoint& op, double t_winding_C, double t_rotor_C) {
   const double f = std::abs(op.omega_el_rad_s) / (2.0 * kPi);

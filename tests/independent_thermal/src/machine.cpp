@@ -5,12 +5,11 @@
 #include <cmath>
 
 #include "indep_thermal/errors.hpp"
+#include "indep_thermal/pi.hpp"
 
 namespace indep_thermal {
 
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
 
 [[noreturn]] void fail(const std::string& path, const YAML::Node& node, const std::string& key, const std::string& why) {
   const int line = node.IsDefined() ? node.Mark().line + 1 : 0;

@@ -3,13 +3,12 @@
 #include <cmath>
 
 #include "indep_thermal/errors.hpp"
+#include "indep_thermal/pi.hpp"
 #include "indep_thermal/random.hpp"
 
 namespace indep_thermal {
 
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
 
 // Volumetric heat capacities ρ·c [J/(m³·K)]: copper 8960·385, laminations 7650·460, aluminium 2700·900,
 // rotor (laminations, magnets, shaft) 3.5e6.

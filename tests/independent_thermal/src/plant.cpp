@@ -3,12 +3,9 @@
 #include <cmath>
 
 #include "indep_thermal/materials.hpp"
+#include "indep_thermal/pi.hpp"
 
 namespace indep_thermal {
-
-namespace {
-constexpr double kPi = 3.14159265358979323846;
-}
 
 Plant::Plant(const Machine& configured, const Parameters& p, const Profile& profile, CoolantMode mode)
     : configured_(configured), p_(p), profile_(profile), mode_(mode), c_(capacities(p)) {

@@ -18,11 +18,10 @@
 #include "fixtures.hpp"
 #include "indep_thermal/integrator.hpp"
 #include "indep_thermal/network.hpp"
+#include "indep_thermal/pi.hpp"
 
 namespace indep_thermal {
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
 
 TEST(IndepThermalIntegrator, ScalarOdeWithinItsTolerance) {
   // y' = −2·t·y, y(0) = 1: y = e^{−t²}.

@@ -16,12 +16,11 @@
 #include "indep_thermal/materials.hpp"
 #include "indep_thermal/network.hpp"
 #include "indep_thermal/parameters.hpp"
+#include "indep_thermal/pi.hpp"
 #include "indep_thermal/profile.hpp"
 
 namespace indep_thermal {
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
 
 TEST(IndepThermalMaterials, CopperIsLinearWithItsCoefficientAt20C) {
   Parameters p = nominal_parameters(test::paper_machine());

@@ -14,11 +14,10 @@
 #include "indep_thermal/losses.hpp"
 #include "indep_thermal/materials.hpp"
 #include "indep_thermal/network.hpp"
+#include "indep_thermal/pi.hpp"
 
 namespace indep_thermal {
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
 
 constexpr double kTolerance_K = 1e-6;
 
