@@ -1,6 +1,8 @@
 // The drift law every layer shares (core/thermal.hpp) against hand-worked values.
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include "rpem/core/thermal.hpp"
 
 namespace rpem::core {
@@ -22,6 +24,22 @@ TEST(DriftLaw, ReferredToAnotherTemperatureIsTheSameLine) {
   EXPECT_DOUBLE_EQ(b.value_ref, 2.0 * 1.24);
   EXPECT_DOUBLE_EQ(b.coeff_per_K, 0.004 / 1.24);
   for (double t : {-20.0, 20.0, 55.0, 140.0}) EXPECT_NEAR(b.at(t), a.at(t), 1e-12) << t;
+}
+
+// eq. 14.11a: σ is the larger of the uniform spread and half the distance to the range's farther end.
+TEST(Materials, TwoSigmaAboutTheTypicalValueHoldsTheWholeRange) {
+  // NdFeB: typical −0.12 %/K in [−0.13, −0.08]: the far end is 0.04 %/K away, σ = 0.02/0.12 (the uniform
+  // spread 0.05/√12 = 0.0144 %/K, 12.0 %, would leave −0.08 at 2.8σ).
+  EXPECT_NEAR(kNdFeB.rel_sigma(), 0.02 / 0.12, 1e-12);
+  // Copper, SmCo, ferrite: the typical value is the range's centre, σ the uniform spread.
+  EXPECT_NEAR(kCopper.rel_sigma(), 0.30 / std::sqrt(12.0), 1e-12);
+  EXPECT_NEAR(kSmCo.rel_sigma(), 0.0002 / std::sqrt(12.0) / 0.0004, 1e-12);
+  EXPECT_NEAR(kFerrite.rel_sigma(), 0.0004 / std::sqrt(12.0) / 0.002, 1e-12);
+  for (const MaterialCoefficient& m : {kNdFeB, kSmCo, kFerrite, kCopper}) {
+    const double two_sigma = 2.0 * m.rel_sigma() * std::abs(m.typical_per_K);
+    EXPECT_LE(m.typical_per_K - two_sigma, m.min_per_K + 1e-15) << m.material;
+    EXPECT_GE(m.typical_per_K + two_sigma, m.max_per_K - 1e-15) << m.material;
+  }
 }
 
 TEST(Materials, RangesHoldTheirTypicalValuesAndTellMagnetsApart) {

@@ -97,9 +97,12 @@ TEST(ThermalConfig, DefaultsComeFromTheMachineAndTheMaterials) {
   EXPECT_DOUBLE_EQ(c.fusion.magnet_law.value_ref, mc.machine.psi_m_Wb);
   EXPECT_DOUBLE_EQ(c.fusion.magnet_law.coeff_per_K, core::kNdFeB.typical_per_K);
   EXPECT_DOUBLE_EQ(c.fusion.filter.network.copper.value_ref, mc.machine.r_s_Ohm);
-  // σ of α: the material's range as a uniform spread, (max − min)/(√12·|typical|): 12.0 % for NdFeB.
+  // σ of α (eq. 14.11a): NdFeB's typical −0.12 %/K is 0.04 %/K from its range's farther end (−0.08), half of
+  // which is 16.7 % of it, more than the uniform spread's 0.05/(√12·0.12) = 12.0 %. Copper: the uniform's 8.7 %.
   EXPECT_NEAR(c.fusion.filter.calibration_sigma[static_cast<int>(core::Calibration::kMagnetCoefficient)],
-              0.0005 / (std::sqrt(12.0) * 0.0012), 1e-12);
+              0.5 * 0.0004 / 0.0012, 1e-12);
+  EXPECT_NEAR(c.fusion.filter.calibration_sigma[static_cast<int>(core::Calibration::kCopperCoefficient)],
+              0.3 / std::sqrt(12.0), 1e-12);
   const core::PerUnitBase base = core::PerUnitBase::from_rated(mc.machine.rated);
   EXPECT_DOUBLE_EQ(c.fusion.filter.network.base.omega_el_rad_s, base.omega_el_rad_s);
   EXPECT_DOUBLE_EQ(c.fusion.filter.network.base.current_A, base.current_A);

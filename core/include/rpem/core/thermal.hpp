@@ -50,9 +50,15 @@ struct MaterialCoefficient {
   double min_per_K;
   double max_per_K;
   [[nodiscard]] constexpr bool contains(double alpha) const noexcept { return alpha >= min_per_K && alpha <= max_per_K; }
-  /// The standard deviation of α over the range, uniform, relative to the typical value: (max − min)/(√12·|typical|).
+  /// σ of α relative to the typical value, for a prior centred on it (eq. 14.11a): the larger of the range's
+  /// uniform spread (max − min)/√12 and half the typical value's distance to the range's farther end, so that
+  /// ±2σ holds every coefficient of the material's range also where the typical value is off its centre.
   [[nodiscard]] constexpr double rel_sigma() const noexcept {
-    return (max_per_K - min_per_K) / (3.4641016151377544 * (typical_per_K < 0.0 ? -typical_per_K : typical_per_K));
+    const double typical = typical_per_K < 0.0 ? -typical_per_K : typical_per_K;
+    const double uniform = (max_per_K - min_per_K) / 3.4641016151377544;
+    const double below = typical_per_K - min_per_K, above = max_per_K - typical_per_K;
+    const double far_end = below > above ? below : above;
+    return (uniform > 0.5 * far_end ? uniform : 0.5 * far_end) / typical;
   }
 };
 
