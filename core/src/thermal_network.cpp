@@ -37,6 +37,7 @@ void LossAccumulator::add(const LossBase& base, double dt_s, const Vec2& i_dq_A,
   const std::array<double, kLossForms> b = loss_basis(base, i_dq_A, omega_el_rad_s, psi_dq_Wb);
   for (std::size_t f = 0; f < b.size(); ++f) basis_[f] += dt_s * b[f];
   current_sq_ += dt_s * i_dq_A.squaredNorm();
+  convection_ += dt_s * std::sqrt(std::abs(omega_el_rad_s) / base.omega_el_rad_s);
   coolant_ += dt_s * coolant_C;
   dt_s_ += dt_s;
 }
@@ -47,6 +48,7 @@ ThermalLoad LossAccumulator::take() noexcept {
   if (dt_s_ > 0.0) {
     const double w = 1.0 / dt_s_;
     l.current_sq_A2 = current_sq_ * w;
+    l.convection_basis = convection_ * w;
     l.coolant_C = coolant_ * w;
     for (std::size_t f = 0; f < basis_.size(); ++f) l.basis[f] = basis_[f] * w;
   }
@@ -63,14 +65,17 @@ ThermalRates thermal_rates(const ThermalNetwork& n, const ThermalLoad& l) noexce
   for (int i = 0; i < n.nodes; ++i) {
     double loss = 0.0;
     for (int f = 0; f < kLossForms; ++f) loss += n.loss_at_base_W(f, i) * l.basis[static_cast<std::size_t>(f)];
-    double g_total = n.to_coolant_W_per_K[i];
+    const double g_coolant =
+        n.to_coolant_W_per_K[i] + n.to_coolant_at_base_speed_W_per_K[i] * l.convection_basis;  // (14.1b)
+    double g_total = g_coolant;
     for (int j = 0; j < n.nodes; ++j) {
       if (j == i) continue;
-      out.a(i, j) = n.between_W_per_K(i, j);
-      g_total += n.between_W_per_K(i, j);
+      const double g = n.between_W_per_K(i, j) + n.between_at_base_speed_W_per_K(i, j) * l.convection_basis;  // (14.1b)
+      out.a(i, j) = g;
+      g_total += g;
     }
     out.a(i, i) = -g_total;
-    out.u[i] = loss + n.to_coolant_W_per_K[i] * l.coolant_C;
+    out.u[i] = loss + g_coolant * l.coolant_C;
     if (i == n.winding) {
       out.a(i, i) += copper_per_K;
       out.u[i] += copper_at_0C;

@@ -107,6 +107,8 @@ void parse_nodes(YamlMap& t, ThermalConfig& c) {
     if (name == "magnet") n.magnet = idx;
     n.capacitance_J_per_K[idx] = m.number("capacitance_J_per_K", 1e-6, 1e9);
     n.to_coolant_W_per_K[idx] = m.number_or("to_coolant_W_per_K", 0.0, 0.0, 1e6);
+    // eq. 14.1b's speed part; absent: a conductance that does not change with speed.
+    n.to_coolant_at_base_speed_W_per_K[idx] = m.number_or("to_coolant_at_base_speed_W_per_K", 0.0, 0.0, 1e6);
     f.filter.process_noise_K2_per_s[idx] = m.number_or("process_noise_K2_per_s", 0.0, 0.0, 1e3);
     f.filter.disturbance_W2_per_s[idx] = m.number_or("disturbance_W2_per_s", 0.0, 0.0, 1e12);
     // τ_d of eq. 14.19; absent: the random walk (τ_d = ∞).
@@ -117,6 +119,7 @@ void parse_nodes(YamlMap& t, ThermalConfig& c) {
   for (int i = n.nodes; i < core::kMaxThermalNodes; ++i) {
     n.capacitance_J_per_K[i] = 1.0;
     n.to_coolant_W_per_K[i] = 0.0;
+    n.to_coolant_at_base_speed_W_per_K[i] = 0.0;
   }
   if (n.winding < 0) t.fail("nodes", "a node named 'winding' is required (the copper loss heats it, R_s follows it)");
   if (n.magnet < 0) t.fail("nodes", "a node named 'magnet' is required (ψm follows it)");
@@ -126,6 +129,7 @@ void parse_nodes(YamlMap& t, ThermalConfig& c) {
 void parse_conductances(YamlMap& t, ThermalConfig& c) {
   core::ThermalNetwork& n = c.fusion.filter.network;
   n.between_W_per_K.setZero();
+  n.between_at_base_speed_W_per_K.setZero();
   if (t.has("conductances")) {
     for (YamlMap& m : t.maps("conductances")) {
       const std::string from = m.text("from"), to = m.text("to");
@@ -136,6 +140,9 @@ void parse_conductances(YamlMap& t, ThermalConfig& c) {
       if (n.between_W_per_K(a, b) != 0.0)
         m.fail("to", std::string("the conductance ").append(from).append("–").append(to).append(" is given twice"));
       n.between_W_per_K(a, b) = n.between_W_per_K(b, a) = m.number("W_per_K", 1e-9, 1e6);
+      // eq. 14.1b's speed part (the air gap's convection); absent: a conductance that does not change with speed.
+      n.between_at_base_speed_W_per_K(a, b) = n.between_at_base_speed_W_per_K(b, a) =
+          m.number_or("at_base_speed_W_per_K", 0.0, 0.0, 1e6);
       m.finish();
     }
   }
@@ -259,8 +266,10 @@ std::string thermal_config_yaml(const ThermalConfig& c) {
   for (int i = 0; i < n.nodes; ++i) {
     o << "    - {name: " << c.node_names[static_cast<std::size_t>(i)]
       << ", capacitance_J_per_K: " << num(n.capacitance_J_per_K[i])
-      << ", to_coolant_W_per_K: " << num(n.to_coolant_W_per_K[i])
-      << ", process_noise_K2_per_s: " << num(f.filter.process_noise_K2_per_s[i])
+      << ", to_coolant_W_per_K: " << num(n.to_coolant_W_per_K[i]);
+    if (n.to_coolant_at_base_speed_W_per_K[i] > 0.0)
+      o << ", to_coolant_at_base_speed_W_per_K: " << num(n.to_coolant_at_base_speed_W_per_K[i]);
+    o << ", process_noise_K2_per_s: " << num(f.filter.process_noise_K2_per_s[i])
       << ", disturbance_W2_per_s: " << num(f.filter.disturbance_W2_per_s[i]);
     if (std::isfinite(f.filter.disturbance_time_constant_s[i]))
       o << ", disturbance_time_constant_s: " << num(f.filter.disturbance_time_constant_s[i]);
@@ -271,7 +280,11 @@ std::string thermal_config_yaml(const ThermalConfig& c) {
     for (int j = i + 1; j < n.nodes; ++j) {
       if (n.between_W_per_K(i, j) <= 0.0) continue;
       between += "    - {from: " + c.node_names[static_cast<std::size_t>(i)] +
-                 ", to: " + c.node_names[static_cast<std::size_t>(j)] + ", W_per_K: " + num(n.between_W_per_K(i, j)) + "}\n";
+                 ", to: " + c.node_names[static_cast<std::size_t>(j)] + ", W_per_K: " + num(n.between_W_per_K(i, j)) +
+                 (n.between_at_base_speed_W_per_K(i, j) > 0.0
+                      ? ", at_base_speed_W_per_K: " + num(n.between_at_base_speed_W_per_K(i, j))
+                      : std::string()) +
+                 "}\n";
     }
   }
   if (!between.empty()) o << "  conductances:\n" << between;

@@ -156,7 +156,42 @@ TEST(LossAccumulator, GivesTimeWeightedMeansAndStartsOver) {
   EXPECT_DOUBLE_EQ(l.current_sq_A2, (100.0 + 3.0 * 400.0) / 4.0);  // the mean of i², not the square of the mean
   EXPECT_DOUBLE_EQ(l.coolant_C, 35.0);
   EXPECT_DOUBLE_EQ(l.basis[static_cast<std::size_t>(LossForm::kIronHysteresis)], (1.0 + 3.0 * 0.5) / 4.0);
+  EXPECT_DOUBLE_EQ(l.convection_basis, (1.0 + 3.0 * std::sqrt(0.5)) / 4.0);  // eq. 14.1b: the mean of √(|ω|/ω_b)
   EXPECT_EQ(acc.duration_s(), 0.0);
+}
+
+TEST(ThermalNetwork, SpeedPartOfTheCoolantConductanceGrowsAsTheSquareRootOfSpeed) {
+  // eq. 14.1b: G_m0(ω) = G_m0 + G_m0,ω·√(|ω|/ω_b). The magnet of decoupled() is one node heated by its own
+  // loss: T_∞ = T_c + P/G_m0(ω), τ = C/G_m0(ω) — at standstill the static part alone, at a quarter of the base
+  // speed (√ = 1/2) half the speed part more, through the same load's accumulated mean.
+  ThermalNetwork n = decoupled();
+  n.to_coolant_at_base_speed_W_per_K[1] = 10.0;
+  for (const double omega : {0.0, -250.0}) {
+    LossAccumulator acc;
+    acc.add(n.base, 2.0, Vec2(0.0, 100.0), omega, Vec2(0.1, 0.0), 30.0);
+    const ThermalLoad l = acc.take();
+    const double g = 6.0 + 10.0 * std::sqrt(std::abs(omega) / 1000.0);
+    const double p = 30.0 * l.basis[static_cast<std::size_t>(LossForm::kMagnetEddy)];
+    EXPECT_NEAR(thermal_steady_state(n, l)[1], 30.0 + p / g, 1e-9) << omega;
+    const ThermalRates r = thermal_rates(n, l);
+    EXPECT_NEAR(r.a(1, 1), -g / 9000.0, 1e-15) << omega;
+    EXPECT_NEAR(r.u[1], (p + g * 30.0) / 9000.0, 1e-12) << omega;
+  }
+  // The winding has no speed part: its conductance is the same at every speed.
+  ThermalLoad still, fast;
+  fast.convection_basis = 1.0;
+  EXPECT_EQ(thermal_rates(n, still).a(0, 0), thermal_rates(n, fast).a(0, 0));
+  // Across the air gap (between two nodes): G_wm(ω) = G_wm + G_wm,ω·√(|ω|/ω_b), symmetric, in both rows.
+  n.between_W_per_K(0, 1) = n.between_W_per_K(1, 0) = 3.0;
+  n.between_at_base_speed_W_per_K(0, 1) = n.between_at_base_speed_W_per_K(1, 0) = 8.0;
+  ThermalLoad gap;
+  gap.convection_basis = 0.75;
+  const ThermalRates r = thermal_rates(n, gap);
+  const double g_gap = 3.0 + 8.0 * 0.75;
+  EXPECT_NEAR(r.a(0, 1), g_gap / 4000.0, 1e-15);
+  EXPECT_NEAR(r.a(1, 0), g_gap / 9000.0, 1e-15);
+  EXPECT_NEAR(r.a(0, 0), -(25.0 + g_gap) / 4000.0, 1e-15);
+  EXPECT_NEAR(r.a(1, 1), -(6.0 + 10.0 * 0.75 + g_gap) / 9000.0, 1e-15);
 }
 
 }  // namespace

@@ -16,10 +16,10 @@ const char* kThreeNodes = R"(thermal:
   nodes:
     - {name: winding, capacitance_J_per_K: 4200, to_coolant_W_per_K: 3, process_noise_K2_per_s: 0.001, disturbance_W2_per_s: 2}
     - {name: stator_iron, capacitance_J_per_K: 11000, to_coolant_W_per_K: 95}
-    - {name: magnet, capacitance_J_per_K: 6500, to_coolant_W_per_K: 2.5}
+    - {name: magnet, capacitance_J_per_K: 6500, to_coolant_W_per_K: 2.5, to_coolant_at_base_speed_W_per_K: 4}
   conductances:
     - {from: winding, to: stator_iron, W_per_K: 44}
-    - {from: magnet, to: stator_iron, W_per_K: 13}
+    - {from: magnet, to: stator_iron, W_per_K: 13, at_base_speed_W_per_K: 6}
   losses:
     - {form: iron_hysteresis, node: stator_iron, at_base_W: 210, rel_sigma: 0.3}
     - {form: magnet_eddy, node: magnet, at_base_W: 35}
@@ -58,7 +58,12 @@ TEST(ThermalConfig, ReadsEveryKeyAndTheWriterReadsBack) {
   EXPECT_EQ(n.magnet, 2);
   EXPECT_EQ(c.node_names[1], "stator_iron");
   EXPECT_DOUBLE_EQ(n.capacitance_J_per_K[1], 11000.0);
+  EXPECT_DOUBLE_EQ(n.to_coolant_at_base_speed_W_per_K[2], 4.0);
+  EXPECT_DOUBLE_EQ(n.to_coolant_at_base_speed_W_per_K[1], 0.0);  // absent: no speed part
   EXPECT_DOUBLE_EQ(n.between_W_per_K(2, 1), 13.0);
+  EXPECT_DOUBLE_EQ(n.between_at_base_speed_W_per_K(1, 2), 6.0);  // the air gap's speed part, symmetric
+  EXPECT_DOUBLE_EQ(n.between_at_base_speed_W_per_K(2, 1), 6.0);
+  EXPECT_DOUBLE_EQ(n.between_at_base_speed_W_per_K(0, 1), 0.0);
   EXPECT_DOUBLE_EQ(n.between_W_per_K(0, 2), 0.0);
   EXPECT_DOUBLE_EQ(n.loss_at_base_W(static_cast<int>(core::LossForm::kIronHysteresis), 1), 210.0);
   EXPECT_DOUBLE_EQ(c.fusion.filter.loss_rel_sigma(static_cast<int>(core::LossForm::kIronHysteresis), 1), 0.3);
@@ -79,7 +84,9 @@ TEST(ThermalConfig, ReadsEveryKeyAndTheWriterReadsBack) {
   EXPECT_EQ(back.node_names, c.node_names);
   EXPECT_EQ(m.capacitance_J_per_K, n.capacitance_J_per_K);
   EXPECT_EQ(m.to_coolant_W_per_K, n.to_coolant_W_per_K);
+  EXPECT_EQ(m.to_coolant_at_base_speed_W_per_K, n.to_coolant_at_base_speed_W_per_K);
   EXPECT_EQ(m.between_W_per_K, n.between_W_per_K);
+  EXPECT_EQ(m.between_at_base_speed_W_per_K, n.between_at_base_speed_W_per_K);
   EXPECT_EQ(m.loss_at_base_W, n.loss_at_base_W);
   EXPECT_EQ(back.fusion.filter.loss_rel_sigma, c.fusion.filter.loss_rel_sigma);
   EXPECT_EQ(back.fusion.filter.calibration_sigma, c.fusion.filter.calibration_sigma);
@@ -129,6 +136,13 @@ TEST(ThermalConfig, BadSectionsNameFileLineKeyAndReason) {
                 .find("thermal.nodes[2].capacitance_J_per_K: -1 is outside"),
             std::string::npos);
   EXPECT_NE(error_of("coolant_C: 35", "coolant_C: 35\n  coolnat: 3").find("thermal.coolnat"), std::string::npos);
+  // eq. 14.1b's speed part: never negative, named with its place.
+  EXPECT_NE(error_of("to_coolant_at_base_speed_W_per_K: 4", "to_coolant_at_base_speed_W_per_K: -4")
+                .find("thermal.nodes[2].to_coolant_at_base_speed_W_per_K: -4 is outside"),
+            std::string::npos);
+  EXPECT_NE(error_of("at_base_speed_W_per_K: 6", "at_base_speed_W_per_K: -6")
+                .find("thermal.conductances[1].at_base_speed_W_per_K: -6 is outside"),
+            std::string::npos);
   // The sensor's lag: 0 (none) by default, never negative, a misspelt key named.
   EXPECT_DOUBLE_EQ(load_text(std::regex_replace(std::string(kThreeNodes), std::regex(", time_constant_s: 12"), ""))
                        .fusion.winding_sensor_time_constant_s,
@@ -143,10 +157,11 @@ TEST(ThermalConfig, BadSectionsNameFileLineKeyAndReason) {
   EXPECT_NE(error_of("coeff_per_K: -0.00105", "coeff_per_K: 0.00105").find("thermal.magnet_law.coeff_per_K"),
             std::string::npos);
   // A magnet cut off from everything: no steady state.
-  const std::string cut =
-      std::regex_replace(std::regex_replace(std::string(kThreeNodes),
-                                            std::regex("    - \\{from: magnet, to: stator_iron, W_per_K: 13\\}\n"), ""),
-                         std::regex("to_coolant_W_per_K: 2.5"), "to_coolant_W_per_K: 0");
+  const std::string cut = std::regex_replace(
+      std::regex_replace(std::string(kThreeNodes),
+                         std::regex("    - \\{from: magnet, to: stator_iron, W_per_K: 13, at_base_speed_W_per_K: 6\\}\n"),
+                         ""),
+      std::regex("to_coolant_W_per_K: 2.5"), "to_coolant_W_per_K: 0");
   try {
     (void)load_text(cut);
     ADD_FAILURE() << "accepted a node without a path to the coolant";

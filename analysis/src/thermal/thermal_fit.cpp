@@ -29,7 +29,7 @@ constexpr double kPriorSigmaLogCopper = 0.6931471805599453;
 /// beyond any end-winding sensor's.
 constexpr double kSensorLagLow_s = 0.1, kSensorLagHigh_s = 300.0;
 
-enum class SlotKind { kCapacitance, kToCoolant, kBetween, kLoss, kCopperScale };
+enum class SlotKind { kCapacitance, kToCoolant, kToCoolantAtSpeed, kBetween, kBetweenAtSpeed, kLoss, kCopperScale };
 
 struct Slot {
   SlotKind kind;
@@ -56,11 +56,16 @@ class Layout {
     slots_.push_back({SlotKind::kCopperScale, n.winding, 0, "copper loss scale", "1"});
     for (int i = 0; i < n.nodes; ++i) {
       if (n.to_coolant_W_per_K[i] > 0.0) slots_.push_back({SlotKind::kToCoolant, i, 0, "G " + name(i) + "–coolant", "W/K"});
+      if (n.to_coolant_at_base_speed_W_per_K[i] > 0.0)
+        slots_.push_back({SlotKind::kToCoolantAtSpeed, i, 0, "G " + name(i) + "–coolant at base speed (eq. 14.1b)", "W/K"});
     }
     for (int i = 0; i < n.nodes; ++i) {
       for (int j = i + 1; j < n.nodes; ++j) {
         if (n.between_W_per_K(i, j) > 0.0)
           slots_.push_back({SlotKind::kBetween, i, j, "G " + name(i) + "–" + name(j), "W/K"});
+        if (n.between_W_per_K(i, j) > 0.0 && n.between_at_base_speed_W_per_K(i, j) > 0.0)
+          slots_.push_back(
+              {SlotKind::kBetweenAtSpeed, i, j, "G " + name(i) + "–" + name(j) + " at base speed (eq. 14.1b)", "W/K"});
       }
     }
     const auto& forms = core::loss_forms();
@@ -112,8 +117,14 @@ class Layout {
         case SlotKind::kToCoolant:
           n.to_coolant_W_per_K[s.i] = v;
           break;
+        case SlotKind::kToCoolantAtSpeed:
+          n.to_coolant_at_base_speed_W_per_K[s.i] = v;
+          break;
         case SlotKind::kBetween:
           n.between_W_per_K(s.i, s.j) = n.between_W_per_K(s.j, s.i) = v;
+          break;
+        case SlotKind::kBetweenAtSpeed:
+          n.between_at_base_speed_W_per_K(s.i, s.j) = n.between_at_base_speed_W_per_K(s.j, s.i) = v;
           break;
         case SlotKind::kLoss:
           for (int f = 0; f < core::kLossForms; ++f) {
@@ -136,8 +147,12 @@ class Layout {
         return n.copper_scale;
       case SlotKind::kToCoolant:
         return n.to_coolant_W_per_K[s.i];
+      case SlotKind::kToCoolantAtSpeed:
+        return n.to_coolant_at_base_speed_W_per_K[s.i];
       case SlotKind::kBetween:
         return n.between_W_per_K(s.i, s.j);
+      case SlotKind::kBetweenAtSpeed:
+        return n.between_at_base_speed_W_per_K(s.i, s.j);
       case SlotKind::kLoss:
         return n.loss_at_base_W(s.j, s.i);  // the first form's
     }
@@ -607,8 +622,10 @@ io::ThermalConfig default_topology(const io::ThermalConfig& laws, const ThermalR
   const double g_W_per_K = std::max(copper_W / rise_K, 3.0 * feedback_W_per_K);
   n.nodes = nodes;
   n.between_W_per_K.setZero();
+  n.between_at_base_speed_W_per_K.setZero();
   n.loss_at_base_W.setZero();
   n.to_coolant_W_per_K.setZero();
+  n.to_coolant_at_base_speed_W_per_K.setZero();
   n.capacitance_J_per_K.setOnes();
   c.node_names = {};
   c.fusion.filter.process_noise_K2_per_s.setZero();
@@ -619,7 +636,9 @@ io::ThermalConfig default_topology(const io::ThermalConfig& laws, const ThermalR
     c.node_names[0] = "winding", c.node_names[1] = "magnet";
     n.winding = 0, n.magnet = 1;
     n.to_coolant_W_per_K << g_W_per_K, 0.2 * g_W_per_K, 0, 0;
-    n.between_W_per_K(0, 1) = n.between_W_per_K(1, 0) = 0.3 * g_W_per_K;
+    n.to_coolant_at_base_speed_W_per_K[1] = 0.2 * g_W_per_K;  // the rotor's convection (eq. 14.1b)
+    n.between_W_per_K(0, 1) = n.between_W_per_K(1, 0) = 0.15 * g_W_per_K;
+    n.between_at_base_speed_W_per_K(0, 1) = n.between_at_base_speed_W_per_K(1, 0) = 0.15 * g_W_per_K;  // the air gap
     n.capacitance_J_per_K << 300.0 * g_W_per_K, 1500.0 * 0.5 * g_W_per_K, 1, 1;
     n.loss_at_base_W(hyst, 0) = n.loss_at_base_W(eddy, 0) = 0.1 * copper_W / iron_basis;
     n.loss_at_base_W(eddy, 1) = 0.05 * copper_W / iron_basis;
@@ -629,8 +648,10 @@ io::ThermalConfig default_topology(const io::ThermalConfig& laws, const ThermalR
     c.node_names[0] = "winding", c.node_names[1] = "stator_iron", c.node_names[2] = "magnet";
     n.winding = 0, n.magnet = 2;
     n.to_coolant_W_per_K << 0.1 * g_W_per_K, 2.0 * g_W_per_K, 0.1 * g_W_per_K, 0;
+    n.to_coolant_at_base_speed_W_per_K[2] = 0.1 * g_W_per_K;  // the rotor's convection (eq. 14.1b)
     n.between_W_per_K(0, 1) = n.between_W_per_K(1, 0) = 1.5 * g_W_per_K;
-    n.between_W_per_K(1, 2) = n.between_W_per_K(2, 1) = 0.3 * g_W_per_K;
+    n.between_W_per_K(1, 2) = n.between_W_per_K(2, 1) = 0.15 * g_W_per_K;
+    n.between_at_base_speed_W_per_K(1, 2) = n.between_at_base_speed_W_per_K(2, 1) = 0.15 * g_W_per_K;  // the air gap
     n.capacitance_J_per_K << 100.0 * g_W_per_K, 600.0 * g_W_per_K, 1500.0 * 0.4 * g_W_per_K, 1;
     n.loss_at_base_W(hyst, 1) = n.loss_at_base_W(eddy, 1) = 0.1 * copper_W / iron_basis;
     n.loss_at_base_W(eddy, 2) = 0.05 * copper_W / iron_basis;

@@ -3,7 +3,9 @@
 // winding and the magnet — joined by thermal conductances, each node tied to the coolant by another, with
 // a heat capacity each, heated by the losses:
 //
-//   C_i·dT_i/dt = P_i − Σ_j G_ij·(T_i − T_j) − G_i0·(T_i − T_coolant)                    (eq. 14.1)
+//   C_i·dT_i/dt = P_i − Σ_j G_ij·(T_i − T_j) − G_i0(ω)·(T_i − T_coolant)                 (eq. 14.1)
+//   G(ω) = G + G_ω·√(|ω|/ω_b)   a conductance by convection grows with the rotor's speed   (eq. 14.1b)
+//                               (to the coolant G_i0, or across the air gap G_ij)
 //   P_winding  += s_cu·(3/2)·R_s(T_winding)·|i_dq|²   copper, R_s's own law (core/thermal.hpp)  (eq. 14.2)
 //   P_i        += Σ_forms k_form,i·basis_form(ω, ψ_s, |i|)     iron and magnet losses         (eq. 14.3)
 //
@@ -62,7 +64,11 @@ struct ThermalNetwork {
   int magnet = 1;   ///< the node ψm's temperature is
   ThermalVec capacitance_J_per_K = ThermalVec::Ones();
   ThermalVec to_coolant_W_per_K = ThermalVec::Zero();
+  /// G_i0,ω: the part of G_i0 that grows with speed as √(|ω|/ω_b), its value at the loss base's speed (eq. 14.1b).
+  ThermalVec to_coolant_at_base_speed_W_per_K = ThermalVec::Zero();
   ThermalMat between_W_per_K = ThermalMat::Zero();  ///< symmetric, zero diagonal
+  /// G_ij,ω: the part of G_ij that grows with speed as √(|ω|/ω_b), at the loss base's speed (eq. 14.1b).
+  ThermalMat between_at_base_speed_W_per_K = ThermalMat::Zero();  ///< symmetric, zero diagonal
   /// k per form (row) and node (column): the loss at the loss base [W].
   Eigen::Matrix<double, kLossForms, kMaxThermalNodes> loss_at_base_W =
       Eigen::Matrix<double, kLossForms, kMaxThermalNodes>::Zero();
@@ -77,6 +83,7 @@ struct ThermalLoad {
   double dt_s = 0.0;
   double current_sq_A2 = 0.0;              ///< mean of i_d² + i_q²
   std::array<double, kLossForms> basis{};  ///< mean of each form's basis
+  double convection_basis = 0.0;           ///< mean of √(|ω|/ω_b): eq. 14.1b's speed term
   double coolant_C = 0.0;
 };
 
@@ -91,7 +98,7 @@ class LossAccumulator {
   [[nodiscard]] ThermalLoad take() noexcept;
 
  private:
-  double dt_s_ = 0.0, current_sq_ = 0.0, coolant_ = 0.0;
+  double dt_s_ = 0.0, current_sq_ = 0.0, convection_ = 0.0, coolant_ = 0.0;
   std::array<double, kLossForms> basis_{};
 };
 
