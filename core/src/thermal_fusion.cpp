@@ -80,7 +80,7 @@ StepObservations step_observations(const ThermalFusionConfig& c, const ThermalSt
     o.h[w] = 1.0;
     o.value = s.winding_sensor_C;
     o.variance = c.winding_sensor_sigma_K * c.winding_sensor_sigma_K;
-    const SensorLagStep k = sensor_lag_step(c.winding_sensor_time_constant_s, s.load.dt_s);
+    const SensorLagStep k = sensor_lag_step(c.winding_sensor_time_constant_s, s.load.dt_s, s.winding_sensor_age);
     if (k.rate_s > 0.0) {
       // The step's mean reading T_w − κ·(A_w·T + u_w + d_w/C_w) − β·e (eq. 14.22); e's error in the variance.
       const WindingRate rate = winding_rate(n, thermal_rates(n, s.load));
@@ -185,7 +185,8 @@ void ThermalFusion::finish_step(const ThermalStepData& d, double dt_s) noexcept 
                         g.row.tail<kMaxThermalNodes>().dot(filter_.disturbance_W()) + g.constant_K_per_s;
     const double rate_variance =
         g.row.dot(filter_.covariance().topLeftCorner<kDynamicThermalStates, kDynamicThermalStates>() * g.row);
-    sensor_lag_.advance(sensor_lag_step(config_.winding_sensor_time_constant_s, dt_s), rate, rate_variance);
+    sensor_lag_.advance(sensor_lag_step(config_.winding_sensor_time_constant_s, dt_s, d.winding_sensor_age), rate,
+                        rate_variance);
   }
   last_psi_m_Wb_ = d.psi_m_Wb;
   last_r_s_Ohm_ = d.r_s_Ohm;

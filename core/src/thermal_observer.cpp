@@ -76,8 +76,11 @@ bool ThermalObserver::add(const Estimate& e, const ThermalSample& s) noexcept {
   const Vec2 psi(e.psi_m_Wb + machine_.l_d_H * i[0], machine_.l_q_H * i[1]);
   if (all_finite(i, omega, psi, coolant)) losses_.add(loss_base_, dt, i, omega, psi, coolant);
   if (std::isfinite(s.winding_sensor_C)) {
-    sensor_sum_ += s.winding_sensor_C * std::max(dt, 1e-9);
-    sensor_time_ += std::max(dt, 1e-9);
+    const double w = std::max(dt, 1e-9), elapsed = losses_.duration_s();  // read at this sample's time
+    sensor_sum_ += s.winding_sensor_C * w;
+    sensor_time_ += w;
+    sensor_elapsed_ += elapsed * w;
+    sensor_elapsed_sq_ += elapsed * elapsed * w;
   }
 
   if (e.detail.code == StepCode::kAdapted && all_finite(e.epsilon_A)) {
@@ -119,7 +122,13 @@ bool ThermalObserver::add(const Estimate& e, const ThermalSample& s) noexcept {
   step_.psi_m_Wb = e.psi_m_Wb;
   step_.r_s_Ohm = e.r_s_Ohm;
   step_.winding_sensor_C = sensor_time_ > 0.0 ? sensor_sum_ / sensor_time_ : std::numeric_limits<double>::quiet_NaN();
-  sensor_sum_ = sensor_time_ = 0.0;
+  step_.winding_sensor_age = ReadingAge{};
+  if (sensor_time_ > 0.0) {
+    const double mean_elapsed = sensor_elapsed_ / sensor_time_;
+    step_.winding_sensor_age = {std::max(0.0, duration - mean_elapsed),
+                                std::max(0.0, sensor_elapsed_sq_ / sensor_time_ - mean_elapsed * mean_elapsed)};
+  }
+  sensor_sum_ = sensor_time_ = sensor_elapsed_ = sensor_elapsed_sq_ = 0.0;
   for (std::size_t j = 0; j < 2; ++j) {
     Accumulated& acc = acc_[j];
     ParameterObservation& p = step_.parameter[j];

@@ -14,15 +14,19 @@ WindingRate winding_rate(const ThermalNetwork& n, const ThermalRates& rates) noe
   return r;
 }
 
-SensorLagStep sensor_lag_step(double time_constant_s, double dt_s) noexcept {
+SensorLagStep sensor_lag_step(double time_constant_s, double dt_s, const ReadingAge& age) noexcept {
   SensorLagStep k;
   if (!(time_constant_s > 0.0) || !(dt_s > 0.0)) return k;
   const double x = dt_s / time_constant_s;
   k.decay = std::exp(-x);
-  const double one_minus = -std::expm1(-x);  // 1 − φ without cancellation at small Δt/τ_s
-  k.gain_s = time_constant_s * one_minus;
-  k.carry = one_minus / x;
-  k.rate_s = 0.5 * dt_s + time_constant_s * (1.0 - k.carry);  // eq. 14.22
+  k.gain_s = time_constant_s * -std::expm1(-x);  // τ_s·(1 − φ) without cancellation at small Δt/τ_s
+  // β: the mean of e^{−elapsed/τ_s} over the readings, their elapsed times taken as spread evenly about their
+  // mean Δt − ā over a width √(12·v) (eq. 14.22a).
+  const double mean_age_s = std::clamp(age.mean_s, 0.0, dt_s);
+  const double half_width = std::sqrt(3.0 * std::max(age.variance_s2, 0.0)) / time_constant_s;
+  const double sinhc = half_width < 1e-4 ? 1.0 + half_width * half_width / 6.0 : std::sinh(half_width) / half_width;
+  k.carry = std::exp(-(dt_s - mean_age_s) / time_constant_s) * sinhc;
+  k.rate_s = mean_age_s + time_constant_s * (1.0 - k.carry);  // eq. 14.22
   return k;
 }
 

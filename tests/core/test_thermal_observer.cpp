@@ -109,5 +109,42 @@ TEST(ThermalObserver, NothingIsAnObservationBeforeTheEstimatorSettles) {
   EXPECT_FALSE(r.steps.front().parameter[kPsiM].valid);
 }
 
+/// The winding sensor's readings of one step of the observer (1 s), each at its sample's time, `dt_s` apart.
+ThermalStepData sensor_step(double dt_s) {
+  const MachineSi machine = test::paper_machine_si();
+  const PerUnitBase base = test::paper_base();
+  ThermalObserver observer(ThermalObserverConfig{}, base, machine, loss_base_of(base, machine), 25.0);
+  Estimate e;
+  e.speed_pu = 0.5;
+  e.i_meas_A = Vec2(1.0, 2.0);
+  e.psi_m_Wb = machine.psi_m_Wb;
+  ThermalSample s;
+  s.dt_s = dt_s;
+  for (int k = 1;; ++k) {
+    s.winding_sensor_C = 60.0 + static_cast<double>(k);  // the k-th reading
+    if (observer.add(e, s)) return observer.step();
+  }
+}
+
+TEST(ThermalObserver, SensorReadingsAgeIsTheirTimesMeanAndSpreadAtTheStepsEnd) {
+  // Rows 0.5 s apart: readings at 0.5 and 1 s of a 1 s step, each standing for 0.5 s — 0.25 s old on average,
+  // variance 0.25², the mean reading the two readings' mean (eq. 14.22a, docs/derivations.md).
+  const ThermalStepData two = sensor_step(0.5);
+  EXPECT_NEAR(two.load.dt_s, 1.0, 1e-12);
+  EXPECT_NEAR(two.winding_sensor_C, 61.5, 1e-12);
+  EXPECT_NEAR(two.winding_sensor_age.mean_s, 0.25, 1e-12);
+  EXPECT_NEAR(two.winding_sensor_age.variance_s2, 0.0625, 1e-12);
+  // One row a step: a reading at the step's end.
+  const ThermalStepData one = sensor_step(1.0);
+  EXPECT_NEAR(one.winding_sensor_age.mean_s, 0.0, 1e-12);
+  EXPECT_NEAR(one.winding_sensor_age.variance_s2, 0.0, 1e-12);
+  // N = 1024 readings at k/N s (≈ 1 kHz, exact in binary) are (N − 1)/(2N) s old on average, variance
+  // (N² − 1)/(12·N²) s² (a discrete uniform spread) — the continuous mean's Δt/2 and Δt²/12 as N grows.
+  const double n = 1024.0;
+  const ThermalStepData dense = sensor_step(1.0 / n);
+  EXPECT_NEAR(dense.winding_sensor_age.mean_s, (n - 1.0) / (2.0 * n), 1e-12);
+  EXPECT_NEAR(dense.winding_sensor_age.variance_s2, (n * n - 1.0) / (12.0 * n * n), 1e-12);
+}
+
 }  // namespace
 }  // namespace rpem::core

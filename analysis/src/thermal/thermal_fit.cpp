@@ -177,7 +177,7 @@ void advance_sensor_lag(const core::ThermalFusionConfig& f, const core::ThermalS
                         core::SensorLag& lag) {
   if (!(f.winding_sensor_time_constant_s > 0.0)) return;
   const core::WindingRate g = core::winding_rate(f.filter.network, core::thermal_rates(f.filter.network, s.load));
-  lag.advance(core::sensor_lag_step(f.winding_sensor_time_constant_s, s.load.dt_s),
+  lag.advance(core::sensor_lag_step(f.winding_sensor_time_constant_s, s.load.dt_s, s.winding_sensor_age),
               g.row.head<core::kMaxThermalNodes>().dot(t) + g.constant_K_per_s, 0.0);
 }
 

@@ -54,12 +54,22 @@ struct ParameterObservation {
   double time_constant_s = 0.0;
 };
 
+/// When a step's readings were taken, as their mean and variance of age at the step's end (weighted as the
+/// reading's mean is, by the time each stands for). A log's temperatures are readings at their row's t
+/// (docs/drive-log.md), so rows 0.5 s apart in a 1 s step are 0.25 s old on average, not the Δt/2 of a mean
+/// over the step; {Δt/2, Δt²/12} is that continuous mean, {0, 0} one reading at the step's end.
+struct ReadingAge {
+  double mean_s = 0.0;
+  double variance_s2 = 0.0;
+};
+
 /// One step of the thermal filter.
 struct ThermalStepData {
   std::int64_t t_ns = 0;  ///< the step's end (its last sample)
   ThermalLoad load;
   std::array<ParameterObservation, 2> parameter;                       ///< indexed by kPsiM, kRs
   double winding_sensor_C = std::numeric_limits<double>::quiet_NaN();  ///< the step's mean; NaN: none
+  ReadingAge winding_sensor_age;                                       ///< when its readings were taken
   double psi_m_Wb = 0.0, r_s_Ohm = 0.0;                                ///< the estimates at the step's end
 };
 
@@ -100,7 +110,8 @@ class ThermalObserver {
   bool eps_started_ = false, batch_started_ = false;
   std::array<double, 2> settled_{};  ///< Σa over the current uninterrupted adaptation
   std::array<Accumulated, 2> acc_{};
-  double sensor_sum_ = 0.0, sensor_time_ = 0.0;
+  // The sensor's readings: Σw·T, Σw, and Σw·τ, Σw·τ² of their times τ since the step's start (w: the time each stands for).
+  double sensor_sum_ = 0.0, sensor_time_ = 0.0, sensor_elapsed_ = 0.0, sensor_elapsed_sq_ = 0.0;
   ThermalStepData step_;
 };
 
