@@ -67,6 +67,36 @@ void ThermalObserver::add_parameter(int j, const Estimate& e, double dt_s) noexc
   ++acc.samples;
 }
 
+void ThermalObserver::add_residual(const EstimatorOutput& d, double dt_s) noexcept {
+  const Vec2 eps = d.epsilon_pu;
+  const double tau = config_.residual_time_constant_s;
+  eps_mean_ = eps_started_ ? Vec2(eps_mean_ - std::expm1(-dt_s / tau) * (eps - eps_mean_)) : eps;
+  eps_started_ = true;
+  batch_sum_ += eps;
+  batch_dt_s_ += dt_s;
+  double a = 0.0;
+  for (int j = 0; j < 2; ++j) a = std::max(a, d.gain.row(j).dot(d.gradient.col(j)));
+  batch_a_ += a;
+  if (++batch_count_ >= kMaxBatch || batch_a_ >= 0.25) {
+    // Batch means, exponentially weighted (West's update), weight w of this batch of M samples.
+    const double m = batch_count_;
+    const Vec2 b = batch_sum_ / m;
+    if (!batch_started_) {
+      batch_mean_ = b;
+      eps_cov_.setZero();
+      batch_started_ = true;
+    } else {
+      const double w = -std::expm1(-batch_dt_s_ / tau);
+      const Vec2 delta = b - batch_mean_;
+      batch_mean_ += w * delta;
+      eps_cov_ = (1.0 - w) * (eps_cov_ + (w * m) * delta * delta.transpose());
+    }
+    batch_sum_.setZero();
+    batch_dt_s_ = batch_a_ = 0.0;
+    batch_count_ = 0;
+  }
+}
+
 bool ThermalObserver::add(const Estimate& e, const ThermalSample& s) noexcept {
   const double dt = std::isfinite(s.dt_s) && s.dt_s > 0.0 ? s.dt_s : 0.0;
   const double coolant = std::isfinite(s.coolant_C) ? s.coolant_C : coolant_C_;
@@ -83,36 +113,7 @@ bool ThermalObserver::add(const Estimate& e, const ThermalSample& s) noexcept {
     sensor_elapsed_sq_ += elapsed * elapsed * w;
   }
 
-  if (e.detail.code == StepCode::kAdapted && all_finite(e.epsilon_A)) {
-    const Vec2 eps = e.detail.epsilon_pu;
-    const double tau = config_.residual_time_constant_s;
-    eps_mean_ = eps_started_ ? Vec2(eps_mean_ - std::expm1(-dt / tau) * (eps - eps_mean_)) : eps;
-    eps_started_ = true;
-    batch_sum_ += eps;
-    batch_dt_s_ += dt;
-    const EstimatorOutput& d = e.detail;
-    double a = 0.0;
-    for (int j = 0; j < 2; ++j) a = std::max(a, d.gain.row(j).dot(d.gradient.col(j)));
-    batch_a_ += a;
-    if (++batch_count_ >= kMaxBatch || batch_a_ >= 0.25) {
-      // Batch means, exponentially weighted (West's update), weight w of this batch of M samples.
-      const double m = batch_count_;
-      const Vec2 b = batch_sum_ / m;
-      if (!batch_started_) {
-        batch_mean_ = b;
-        eps_cov_.setZero();
-        batch_started_ = true;
-      } else {
-        const double w = -std::expm1(-batch_dt_s_ / tau);
-        const Vec2 delta = b - batch_mean_;
-        batch_mean_ += w * delta;
-        eps_cov_ = (1.0 - w) * (eps_cov_ + (w * m) * delta * delta.transpose());
-      }
-      batch_sum_.setZero();
-      batch_dt_s_ = batch_a_ = 0.0;
-      batch_count_ = 0;
-    }
-  }
+  if (e.detail.code == StepCode::kAdapted && all_finite(e.epsilon_A)) add_residual(e.detail, dt);
   for (int j = 0; j < 2; ++j) add_parameter(j, e, dt);
 
   if (losses_.duration_s() < config_.period_s) return false;

@@ -93,6 +93,8 @@ class ThermalObserver {
     int samples = 0;
   };
   void add_parameter(int j, const Estimate& e, double dt_s) noexcept;
+  /// ε̄ and Σ_ε (batch means) from an adapted sample's residual.
+  void add_residual(const EstimatorOutput& d, double dt_s) noexcept;
 
   ThermalObserverConfig config_;
   PerUnitBase base_;
