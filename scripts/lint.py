@@ -7,6 +7,8 @@
   scripts/lint.py --tidy [-p BUILD] [-j N] clang-tidy (.clang-tidy) over the production translation units in
                                            BUILD/compile_commands.json (default build/dev) and the headers
                                            they include: fails on any finding, naming file:line and the check
+                                           (a unity tree's batches: each batch one unit, its sources checked
+                                           through it; --per-source: each source alone)
   --only REGEX                             clang-tidy only the translation units whose path matches
   --tests                                  clang-tidy the test, benchmark and example units too (not gated)
 
@@ -95,67 +97,75 @@ def fix_format():
     print(f"lint: clang-format applied to {len(files)} files (git diff --stat shows which changed)")
 
 
-def compile_database(build):
-    """BUILD/compile_commands.json with each unity batch replaced by the sources it includes, each under the
-    batch's command with its own path for the batch's: the command CMake gives the source in a tree without unity
-    batches (a batch has its target's flags, nothing of its own). So clang-tidy checks the same units with the
-    same flags whether or not the tree was built in batches (scripts/test.sh builds build/ci so)."""
+def tidy_units(build, per_source):
+    """The units clang-tidy checks, as (file, its database directory, the sources it stands for). A tree without
+    unity batches: each source. A unity tree (RPEM_UNITY_BUILD, CMakeLists.txt; scripts/test.sh builds build/ci
+    so): each batch as one unit, the sources it includes checked through it as what it compiles — every check
+    the gate runs finds in a batch what it finds in each source alone, the shared headers parsed and matched
+    once a batch instead of once a source (docs/benchmarks.md, "Format and lint gates", measures both). With
+    per_source, each batch's sources alone under the batch's command (the one a source has without batches),
+    from an expanded database in a scratch directory."""
     with open(os.path.join(build, "compile_commands.json"), encoding="utf-8") as f:
         entries = json.load(f)
-    expanded = []
-    for e in entries:
-        batch = os.path.join(e["directory"], e["file"])
-        if not UNITY_BATCH.search(batch):
-            expanded.append(e)
-            continue
-        with open(batch, encoding="utf-8") as f:
-            sources = UNITY_INCLUDE.findall(f.read())
-        if not sources:
-            sys.exit(f"lint: {batch}: a unity batch that includes no source (has CMake's format changed?)")
-        for source in sources:
-            expanded.append({"directory": e["directory"], "file": source,
-                             "command": e["command"].replace(batch, source)})
-    return entries, expanded
-
-
-def units_of(entries, dirs, only):
-    units = set()
+    units, expanded = [], []
     for e in entries:
         path = os.path.realpath(os.path.join(e["directory"], e["file"]))
-        rel = os.path.relpath(path, ROOT)
-        if not is_own(rel, dirs) or (only and not re.search(only, rel)):
+        if not UNITY_BATCH.search(path):
+            units.append((path, build, [path]))
+            expanded.append(e)
             continue
-        units.add(path)
-    return sorted(units)
+        with open(path, encoding="utf-8") as f:
+            sources = [os.path.realpath(s) for s in UNITY_INCLUDE.findall(f.read())]
+        if not sources:
+            sys.exit(f"lint: {path}: a unity batch that includes no source (has CMake's format changed?)")
+        units.append((path, build, sources))
+        expanded += [{"directory": e["directory"], "file": s, "command": e["command"].replace(e["file"], s)}
+                     for s in sources]
+    if not per_source or len(expanded) == len(entries):
+        return units, None
+    scratch = tempfile.TemporaryDirectory(prefix="lint-tidy-")
+    with open(os.path.join(scratch.name, "compile_commands.json"), "w", encoding="utf-8") as f:
+        json.dump(expanded, f)
+    return [(s, scratch.name, [s]) for _, _, sources in units for s in sources], scratch
 
 
-def run_tidy(build, jobs, dirs, only):
-    entries, expanded = compile_database(build)
-    units = units_of(expanded, dirs, only)
-    database = build
-    if expanded != entries:  # a unity build: clang-tidy reads the expanded database from a directory of its own
-        scratch = tempfile.TemporaryDirectory(prefix="lint-tidy-")
-        database = scratch.name
-        with open(os.path.join(database, "compile_commands.json"), "w", encoding="utf-8") as f:
-            json.dump(expanded, f)
-    # A header's findings: only for our own headers (never Eigen's, Ceres's, gtest's or the generated ones)
+def selected(units, dirs, only):
+    """The units with a source of ours in dirs (matching only, if given); each file once."""
+    chosen = {}
+    for unit, database, sources in units:
+        rels = [os.path.relpath(s, ROOT) for s in sources]
+        if any(is_own(r, dirs) and (not only or re.search(only, r)) for r in rels):
+            chosen[unit] = (unit, database, sources)
+    return [chosen[u] for u in sorted(chosen)]
+
+
+def is_batch_include(path, check):
+    """A batch's own finding: CMake's #include of each source (a .cpp) is all a unity batch holds."""
+    return check == "bugprone-suspicious-include" and UNITY_BATCH.search(path) is not None
+
+
+def run_tidy(build, jobs, dirs, only, per_source):
+    units, scratch = tidy_units(build, per_source)  # scratch: the expanded database, kept until the runs end
+    units = selected(units, dirs, only)
+    # A header's findings: only for our own headers (never Eigen's, Ceres's, gtest's or the generated ones); a
+    # batch's sources are "headers" of the batch, so the same filter reports them
     header_filter = "^" + re.escape(ROOT) + "/(" + "|".join(re.escape(d) for d in OWN_DIRS) + ")/"
     # -w: the compiler of record is g++ (-Werror there); clang's own warnings are not this gate's
-    cmd = [tool("clang-tidy"), "-p", database, "--quiet", "--extra-arg=-w", f"--header-filter={header_filter}"]
+    cmd = [tool("clang-tidy"), "--quiet", "--extra-arg=-w", f"--header-filter={header_filter}"]
 
-    def one(unit):
-        r = subprocess.run([*cmd, unit], cwd=ROOT, capture_output=True, text=True)
+    def one(unit, database):
+        r = subprocess.run([*cmd, "-p", database, unit], cwd=ROOT, capture_output=True, text=True)
         return unit, r.returncode, r.stdout, r.stderr
 
     start = time.monotonic()
     findings = {}  # (file, line, column, check) -> message; a header's finding once, whichever unit saw it
     failed = []
     with concurrent.futures.ThreadPoolExecutor(max_workers=jobs) as pool:
-        for done in concurrent.futures.as_completed([pool.submit(one, unit) for unit in units]):
+        for done in concurrent.futures.as_completed([pool.submit(one, u, db) for u, db, _ in units]):
             unit, code, out, err = done.result()
             for line in out.splitlines():
                 m = WARNING.match(line)
-                if not m:
+                if not m or is_batch_include(m.group(1), m.group(5)):
                     continue
                 key = (os.path.relpath(m.group(1), ROOT), int(m.group(2)), int(m.group(3)), m.group(5))
                 if key not in findings:  # printed as found, so a long run's log shows them early
@@ -170,8 +180,9 @@ def run_tidy(build, jobs, dirs, only):
     if findings or failed:
         print("lint: tidy: fix each place above (docs/architecture.md, \"Format and lint\": a NOLINT only with its "
               "reason on the same line); again locally: scripts/lint.py --tidy -p BUILD [--only REGEX]")
-    print(f"lint: tidy: {len(units)} translation units in {time.monotonic() - start:.0f} s with {jobs} jobs: "
-          f"{len(findings)} findings, {len(failed)} units that did not compile")
+    sources = sum(len(s) for _, _, s in units)
+    print(f"lint: tidy: {len(units)} translation units ({sources} sources) in {time.monotonic() - start:.0f} s "
+          f"with {jobs} jobs: {len(findings)} findings, {len(failed)} units that did not compile")
     return not findings and not failed
 
 
@@ -182,6 +193,8 @@ def main():
     ap.add_argument("--tidy", action="store_true", help="run clang-tidy")
     ap.add_argument("--only", help="clang-tidy only the translation units whose path matches this regex")
     ap.add_argument("--tests", action="store_true", help="clang-tidy the tests, benchmarks and examples too")
+    ap.add_argument("--per-source", action="store_true",
+                    help="in a unity tree, clang-tidy each batch's sources alone (the same findings, slower)")
     ap.add_argument("-p", dest="build", default=os.path.join(ROOT, "build", "dev"), help="build tree")
     ap.add_argument("-j", dest="jobs", type=int, default=os.cpu_count() or 1, help="parallel clang-tidy runs")
     args = ap.parse_args()
@@ -196,7 +209,7 @@ def main():
         ok = check_format() and ok
     if args.tidy:
         dirs = OWN_DIRS if args.tests else PRODUCTION_DIRS
-        ok = run_tidy(os.path.abspath(args.build), args.jobs, dirs, args.only) and ok
+        ok = run_tidy(os.path.abspath(args.build), args.jobs, dirs, args.only, args.per_source) and ok
     return 0 if ok else 1
 
 

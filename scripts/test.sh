@@ -13,16 +13,17 @@
 # The sanitizer trees of 3 and 4 compile at nice 19 while step 2's tests run: they take only the CPU the
 # tests leave idle (the VM suites' real-time pacing, the serial package test, the last test's tail) and
 # yield it otherwise (CFS weight 15 against 1024), so a test's share of the CPU is what it was without them.
-# clang-tidy on the production units (the chosen checks: ≈ 970 s of CPU, ≈ 8 min at -j2 on two quiet cores;
-# docs/benchmarks.md, "Format and lint gates") follows them at nice 19 too: it yields to the sanitizer tests
-# and delays nothing a test waits for. Its CPU is paid for by what the trees no longer compile (same
+# clang-tidy on the production units (the chosen checks over build/ci's 22 unity batches: ≈ 400 s of CPU, a
+# third of what each source alone costs; docs/benchmarks.md, "Format and lint gates") follows them at nice 19
+# too: it yields to the sanitizer tests and delays nothing a test waits for. Its CPU is paid for by what the trees no longer compile (same
 # benchmarks section): build/ci is Release, the -O3 -DNDEBUG of RelWithDebInfo without -g (g++ emits the
 # same code with or without debug information, -fcompare-debug's guarantee: what runs is what ran), a third
 # less compiler time; the sanitizer trees keep line tables only (-g1: every report still names file:line).
 # All three trees are unity builds (RPEM_UNITY_BUILD, CMakeLists.txt): each target's sources compiled in batches,
 # the shared headers parsed once a batch (docs/benchmarks.md, "The README test command on a fresh clone", has the
-# compile CPU saved); developer trees are not. clang-tidy still checks each source as its own unit (scripts/lint.py
-# expands the batches of build/ci's compile_commands.json).
+# compile CPU saved); developer trees are not. clang-tidy checks each batch as one unit, its sources through it
+# (the same findings as each source alone, the shared headers matched once a batch: scripts/lint.py --per-source
+# is the slower way, the same benchmarks section compares them).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 jobs=$(nproc)
