@@ -9,7 +9,8 @@
                                            they include: fails on any finding, naming file:line and the check
                                            (a unity tree's batches: each batch one unit, its sources checked
                                            through it; --per-source: each source alone)
-  --only REGEX                             clang-tidy only the translation units whose path matches
+  --only REGEX                             clang-tidy only the units with a source whose path matches (a
+                                           unity batch whole)
   --tests                                  clang-tidy the test, benchmark and example units too (not gated)
 
 Files: what git tracks under our own directories (OWN_DIRS). Nothing generated (lcm-gen's and schema_gen.py's
@@ -100,9 +101,10 @@ def fix_format():
 def tidy_units(build, per_source):
     """The units clang-tidy checks, as (file, its database directory, the sources it stands for). A tree without
     unity batches: each source. A unity tree (RPEM_UNITY_BUILD, CMakeLists.txt; scripts/test.sh builds build/ci
-    so): each batch as one unit, the sources it includes checked through it as what it compiles — every check
-    the gate runs finds in a batch what it finds in each source alone, the shared headers parsed and matched
-    once a batch instead of once a source (docs/benchmarks.md, "Format and lint gates", measures both). With
+    so): each batch as one unit, the sources it includes checked through it as what it compiles, the shared
+    headers parsed and matched once a batch instead of once a source — the same findings as each source alone
+    wherever measured (defects of 20 checks of every enabled family; docs/benchmarks.md, "Format and lint
+    gates", has both modes' cost). With
     per_source, each batch's sources alone under the batch's command (the one a source has without batches),
     from an expanded database in a scratch directory."""
     with open(os.path.join(build, "compile_commands.json"), encoding="utf-8") as f:
@@ -191,7 +193,7 @@ def main():
     ap.add_argument("--format", action="store_true", help="check formatting")
     ap.add_argument("--fix-format", action="store_true", help="apply clang-format to every checked file")
     ap.add_argument("--tidy", action="store_true", help="run clang-tidy")
-    ap.add_argument("--only", help="clang-tidy only the translation units whose path matches this regex")
+    ap.add_argument("--only", help="clang-tidy only the units with a source whose path matches this regex")
     ap.add_argument("--tests", action="store_true", help="clang-tidy the tests, benchmarks and examples too")
     ap.add_argument("--per-source", action="store_true",
                     help="in a unity tree, clang-tidy each batch's sources alone (the same findings, slower)")

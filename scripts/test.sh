@@ -13,10 +13,10 @@
 # The sanitizer trees of 3 and 4 compile at nice 19 while step 2's tests run: they take only the CPU the
 # tests leave idle (the VM suites' real-time pacing, the serial package test, the last test's tail) and
 # yield it otherwise (CFS weight 15 against 1024), so a test's share of the CPU is what it was without them.
-# clang-tidy on the production units (the chosen checks over build/ci's 22 unity batches: ≈ 400 s of CPU, a
-# third of what each source alone costs; docs/benchmarks.md, "Format and lint gates") follows them at nice 19
-# too: it yields to the sanitizer tests and delays nothing a test waits for. Its CPU is paid for by what the trees no longer compile (same
-# benchmarks section): build/ci is Release, the -O3 -DNDEBUG of RelWithDebInfo without -g (g++ emits the
+# clang-tidy on the production units (the chosen checks over build/ci's 22 unity batches: ≈ 370 s of CPU, a
+# quarter of what each source alone costs; docs/benchmarks.md, "Format and lint gates") follows them at nice 19
+# too: it yields to the sanitizer tests and delays nothing a test waits for. Its CPU is paid for by what the
+# trees no longer compile (same benchmarks section): build/ci is Release, the -O3 -DNDEBUG of RelWithDebInfo without -g (g++ emits the
 # same code with or without debug information, -fcompare-debug's guarantee: what runs is what ran), a third
 # less compiler time; the sanitizer trees keep line tables only (-g1: every report still names file:line).
 # All three trees are unity builds (RPEM_UNITY_BUILD, CMakeLists.txt): each target's sources compiled in batches,
