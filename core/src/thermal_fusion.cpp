@@ -39,6 +39,19 @@ ThermalNodeReport report_node(const ThermalEstimate& e, int node, std::int64_t t
   return r;
 }
 
+WindingReadout winding_readout(const ThermalFusionConfig& c, const ThermalLoad& load) noexcept {
+  const ThermalNetwork& n = c.filter.network;
+  WindingReadout r;
+  r.row[n.winding] = 1.0;
+  if (c.winding_node_is_reading && c.winding_sensor_time_constant_s > 0.0) {
+    // A first-order sensor: dT_s/dt = (T_w − T_s)/τ_s, so T_w = T_s + τ_s·dT_s/dt exactly (eq. 14.24).
+    const WindingRate rate = winding_rate(n, thermal_rates(n, load));
+    r.row += c.winding_sensor_time_constant_s * rate.row;
+    r.constant_K = c.winding_sensor_time_constant_s * rate.constant_K_per_s;
+  }
+  return r;
+}
+
 StepObservations step_observations(const ThermalFusionConfig& c, const ThermalStepData& s, const ThermalVec& t_C,
                                    const ThermalVec& dt_dt_K_per_s, const SensorLag& lag) noexcept {
   const ThermalNetwork& n = c.filter.network;
@@ -73,6 +86,15 @@ StepObservations step_observations(const ThermalFusionConfig& c, const ThermalSt
     o.bilinear_state = r.coefficient;
     const double lag_K = dt_dt_K_per_s[r.own] * p.time_constant_s;
     o.variance = p.variance + r.own_law.slope * r.own_law.slope * lag_K * lag_K;
+    if (c.winding_node_is_reading) {
+      // r̂s and ψ̂m's κ term see the winding, which leads the node that stands for the reading (eq. 14.24).
+      const WindingReadout g = winding_readout(c, s.load);
+      const double h_w = o.h[w];
+      o.h[w] = 0.0;
+      o.h += h_w * g.row.head<kMaxThermalNodes>();
+      o.h_d += h_w * g.row.tail<kMaxThermalNodes>();
+      o.offset += h_w * g.constant_K;
+    }
     out.present[j] = true;
   }
   if (c.winding_sensor_sigma_K > 0.0 && std::isfinite(s.winding_sensor_C)) {
@@ -80,7 +102,9 @@ StepObservations step_observations(const ThermalFusionConfig& c, const ThermalSt
     o.h[w] = 1.0;
     o.value = s.winding_sensor_C;
     o.variance = c.winding_sensor_sigma_K * c.winding_sensor_sigma_K;
-    const SensorLagStep k = sensor_lag_step(c.winding_sensor_time_constant_s, s.load.dt_s, s.winding_sensor_age);
+    // With the node standing for the reading, the sensor observes it as it is (eq. 14.24).
+    const double lag_s = c.winding_node_is_reading ? 0.0 : c.winding_sensor_time_constant_s;
+    const SensorLagStep k = sensor_lag_step(lag_s, s.load.dt_s, s.winding_sensor_age);
     if (k.rate_s > 0.0) {
       // The step's mean reading T_w − κ·(A_w·T + u_w + d_w/C_w) − β·e (eq. 14.22); e's error in the variance.
       const WindingRate rate = winding_rate(n, thermal_rates(n, s.load));
@@ -177,7 +201,7 @@ void ThermalFusion::finish_step(const ThermalStepData& d, double dt_s) noexcept 
       ++out_.observations_rejected;
     }
   }
-  if (config_.winding_sensor_time_constant_s > 0.0) {
+  if (config_.winding_sensor_time_constant_s > 0.0 && !config_.winding_node_is_reading) {
     // The sensor's lag over this step at the posterior's rate of the winding (eq. 14.22), that rate's variance
     // from the posterior covariance of [T; d] along its row.
     const WindingRate g = winding_rate(n, rates);
@@ -192,11 +216,20 @@ void ThermalFusion::finish_step(const ThermalStepData& d, double dt_s) noexcept 
   last_r_s_Ohm_ = d.r_s_Ohm;
   out_.t_ns = d.t_ns;
   out_.coolant_C = d.load.coolant_C;
+  // The winding as reported: the node, or the node led by the sensor's τ_s (eq. 14.24), its variance g·P·gᵀ.
+  const WindingReadout g = winding_readout(config_, d.load);
+  const auto& p_dyn = filter_.covariance().topLeftCorner<kDynamicThermalStates, kDynamicThermalStates>();
+  Eigen::Matrix<double, kDynamicThermalStates, 1> x_dyn;
+  x_dyn << filter_.temperature_C(), filter_.disturbance_W();
   for (int i = 0; i < kMaxThermalNodes; ++i) {
     const auto k = static_cast<std::size_t>(i);
     ThermalNodeEstimate& node = out_.node[k];
     node.t_C = filter_.temperature_C()[i];
     node.sigma_K = filter_.sigma_K(i);
+    if (i == n.winding && config_.winding_node_is_reading) {
+      node.t_C = g.row.dot(x_dyn) + g.constant_K;
+      node.sigma_K = std::sqrt(std::max(g.row.dot(p_dyn * g.row), 0.0));
+    }
     node.observed = observed[k];
     if (observed[k]) {
       ever_observed_[k] = true;

@@ -236,6 +236,8 @@ ThermalConfig parse_thermal_config(YamlMap& section, const MachineConfig& machin
     f.winding_sensor_sigma_K = s->number("sigma_K", 1e-3, 100.0);
     // Its lag behind the winding node (docs/derivations.md eq. 14.19); 0: the reading is the node.
     f.winding_sensor_time_constant_s = s->number_or("time_constant_s", 0.0, 0.0, 3600.0);
+    // What the winding node stands for (eq. 14.24): the winding (the sensor lags it) or the sensor's reading.
+    f.winding_node_is_reading = s->choice_or("node", "winding", {"winding", "reading"}) == "reading";
     s->finish();
   }
   if (auto m = section.optional_map("filter")) {
@@ -315,6 +317,7 @@ std::string thermal_config_yaml(const ThermalConfig& c) {
   if (f.winding_sensor_sigma_K > 0.0) {
     o << "  winding_sensor: {sigma_K: " << num(f.winding_sensor_sigma_K);
     if (f.winding_sensor_time_constant_s > 0.0) o << ", time_constant_s: " << num(f.winding_sensor_time_constant_s);
+    if (f.winding_node_is_reading) o << ", node: reading";
     o << "}\n";
   }
   o << "  filter: {period_s: " << num(f.observer.period_s) << ", initial_sigma_K: " << num(f.initial_sigma_K)

@@ -218,13 +218,17 @@ TEST(RegimeAllocations, NoneThroughEveryRegimeAndTheSparsePath) {
 TEST(ThermalAllocations, NoneAcrossOneHundredThousandFusedSteps) {
   // The thermal fusion beside the estimator (rpemd's loop and `rpem estimate --thermal`): loss accumulation,
   // observations, a 3-node network's exact step every 1 ms (so the filter steps 10⁴ times), gate resets,
-  // coasting without samples, a reload and a non-finite sample; one node's disturbance Gauss–Markov.
+  // coasting without samples, a reload (to the reading node of eq. 14.24) and a non-finite sample; one node's
+  // disturbance Gauss–Markov.
   const MachineSi machine = test::paper_machine_si();
   AveragedDriveEstimator est(machine, test::paper_settings());
   ThermalFusionConfig c = test::paper_thermal_fusion();
   c.filter.disturbance_time_constant_s[0] = 600.0;  // one Gauss–Markov disturbance (eq. 14.19) beside the walks
   c.winding_sensor_time_constant_s = 10.0;          // the lagging sensor's observation and lag (eq. 14.22) too
   ThermalFusion fusion(c, test::paper_base(), machine);
+  // The reload switches the winding node to the sensor's reading (eq. 14.24): both forms run here.
+  ThermalFusionConfig reading = c;
+  reading.winding_node_is_reading = true;
   test::AveragedDataGenerator gen;
   gen.base = test::paper_base();
   gen.plant = test::paper_machine_pu();
@@ -247,7 +251,7 @@ TEST(ThermalAllocations, NoneAcrossOneHundredThousandFusedSteps) {
     s.coolant_C = 40.0;
     previous = samples[k].t_ns;
     fusion.step(e, s);
-    if (k == 50'000) fusion.reconfigure(c, test::paper_base(), machine);
+    if (k == 50'000) fusion.reconfigure(reading, test::paper_base(), machine);
     if (k % 20'000 == 0) fusion.coast(0.5);
     sink += fusion.estimate().magnet_node().t_C;
   }

@@ -207,3 +207,96 @@ TEST(SensorLag, ReadingsAtTheirRowsTimesAreModelledByTheirAge) {
 
 }  // namespace
 }  // namespace rpem::core
+
+namespace rpem::core {
+namespace {
+
+// The winding node standing for the sensor's reading (eq. 14.24): fed readings that follow the network exactly,
+// the filter reports the winding T_w = T_node + τ_s·dT_node/dt, which a first-order sensor of τ_s behind the
+// winding implies exactly; the rate is the network's at the node's temperatures (thermal_rates), computed here
+// independently of winding_readout(). Without the mode it reports the reading, τ_s·rate behind the winding.
+struct NodeRun {
+  double worst_K = 0.0;     ///< reported winding against T_node + τ_s·rate, after the first 30 steps of each load
+  double lead_K = 0.0;      ///< the largest τ_s·rate: what the reading lags by
+  double sigma_K = 0.0;     ///< the reported winding's σ at the end
+  double rs_h_error = 0.0;  ///< r̂s's observation row on [T; d] against slope·(e_w + τ_s·rate row)
+};
+
+NodeRun run_reading_node(bool node_is_reading) {
+  ThermalFusionConfig c;
+  ThermalNetwork& n = c.filter.network;
+  n.nodes = 2;
+  n.winding = 0, n.magnet = 1;
+  n.capacitance_J_per_K << 5000.0, 20000.0, 1.0, 1.0;
+  n.to_coolant_W_per_K << 30.0, 8.0, 0.0, 0.0;
+  n.between_W_per_K(0, 1) = n.between_W_per_K(1, 0) = 10.0;
+  n.copper = {0.00393, 20.0, 0.05};
+  n.base = {1000.0, 0.1, 100.0};
+  c.filter.process_noise_K2_per_s << 1e-4, 1e-4, 0.0, 0.0;
+  c.filter.disturbance_W2_per_s << 0.1, 0.1, 0.0, 0.0;
+  c.winding_sensor_sigma_K = 0.1;
+  c.winding_sensor_time_constant_s = 8.0;
+  c.winding_node_is_reading = node_is_reading;
+  c.initial_sigma_K = 0.1;
+  ThermalFusion fusion(c, PerUnitBase{}, MachineSi{});
+  ThermalVec t = ThermalVec::Constant(25.0);  // the exact network: T⁺ = Φ·T + γ under a held load (eq. 14.4)
+  NodeRun out;
+  std::int64_t k = 0;
+  for (double i_A : {200.0, 50.0, 150.0}) {
+    ThermalLoad l;
+    l.dt_s = 1.0;
+    l.current_sq_A2 = i_A * i_A;
+    l.coolant_C = 25.0;
+    for (int j = 1; j <= 300; ++j) {
+      const ThermalTransition tr = thermal_transition(n, l);
+      t = tr.phi * t + tr.gamma;
+      ThermalStepData d;
+      d.t_ns = ++k * 1000000000;
+      d.load = l;
+      d.winding_sensor_C = t[0];
+      d.winding_sensor_age = {0.0, 0.0};
+      fusion.apply(d);
+      const ThermalRates r = thermal_rates(n, l);
+      const double rate = r.a.row(0).dot(t) + r.u[0];
+      const double winding = t[0] + 8.0 * rate;
+      out.lead_K = std::max(out.lead_K, std::abs(8.0 * rate));
+      if (j > 30) out.worst_K = std::max(out.worst_K, std::abs(fusion.estimate().node[0].t_C - winding));
+      out.sigma_K = fusion.estimate().node[0].sigma_K;
+      if (j == 300) {
+        // r̂s adapting at this step: its row on the winding's temperature carries the lead too.
+        d.parameter[1].valid = true;
+        d.parameter[1].value = 0.05;
+        d.parameter[1].variance = 1e-8;
+        const StepObservations o = step_observations(c, d, t, ThermalVec::Zero());
+        const double slope = n.copper.value_ref * n.copper.coeff_per_K;
+        const double lead = node_is_reading ? 8.0 : 0.0;
+        out.rs_h_error = std::max(
+            {out.rs_h_error, std::abs(o.item[1].h[0] - slope * (1.0 + lead * r.a(0, 0))),
+             std::abs(o.item[1].h[1] - slope * lead * r.a(0, 1)),
+             std::abs(o.item[1].h_d[0] - slope * lead / n.capacitance_J_per_K[0]),
+             std::abs(o.item[1].offset - (n.copper.value_ref - slope * n.copper.reference_C + slope * lead * r.u[0]))});
+      }
+    }
+  }
+  return out;
+}
+
+TEST(SensorNode, TheWindingLeadsTheReadingByTauTimesTheNodesRate) {
+  const NodeRun reading = run_reading_node(true), winding = run_reading_node(false);
+  // The loads' changes make the reading lag the winding by up to several kelvin (τ_s·rate) ...
+  EXPECT_GT(reading.lead_K, 3.0);
+  // ... which the reading-node mode restores: the filter's d takes up what the readings' noise-free steps leave,
+  // so the remainder is the filter's settling, well inside the sensor's σ of 0.1 K.
+  EXPECT_LT(reading.worst_K, 0.1) << "lead " << reading.lead_K;
+  // Without it the report is the reading, behind the winding by nearly the whole lead.
+  EXPECT_GT(winding.worst_K, 0.5 * winding.lead_K);
+  // The band is the linear functional's g·P·gᵀ: finite, and more than the node's own (the rate's share).
+  EXPECT_GT(reading.sigma_K, 0.0);
+  EXPECT_LT(reading.sigma_K, 1.0);
+  // r̂s's observation row: slope·(e_w + τ_s·[A_w, 1/C_w]) and its offset the law's plus slope·τ_s·u_w.
+  EXPECT_LT(reading.rs_h_error, 1e-12);
+  EXPECT_LT(winding.rs_h_error, 1e-12);
+}
+
+}  // namespace
+}  // namespace rpem::core

@@ -27,7 +27,7 @@ const char* kThreeNodes = R"(thermal:
   copper: {r_s_ref_Ohm: 0.07, reference_C: 120, coeff_per_K: 0.0028, reference_sigma_K: 2, coeff_rel_sigma: 0.05, loss_rel_sigma: 0.08}
   magnet_law: {psi_m_ref_Wb: 0.117, reference_C: 20, coeff_per_K: -0.00105}
   coolant_C: 35
-  winding_sensor: {sigma_K: 1.5, time_constant_s: 12}
+  winding_sensor: {sigma_K: 1.5, time_constant_s: 12, node: reading}
   filter: {period_s: 0.5, initial_sigma_K: 5, gate_sigma: 4, gate_reset_after: 2, residual_time_constant_s: 8, settle_time_constants: 4}
 )";
 
@@ -74,6 +74,7 @@ TEST(ThermalConfig, ReadsEveryKeyAndTheWriterReadsBack) {
   EXPECT_DOUBLE_EQ(c.fusion.magnet_law.coeff_per_K, -0.00105);
   EXPECT_DOUBLE_EQ(c.fusion.winding_sensor_sigma_K, 1.5);
   EXPECT_DOUBLE_EQ(c.fusion.winding_sensor_time_constant_s, 12.0);
+  EXPECT_TRUE(c.fusion.winding_node_is_reading);
   EXPECT_DOUBLE_EQ(c.fusion.observer.period_s, 0.5);
   EXPECT_EQ(c.fusion.filter.gate_reset_after, 2);
   EXPECT_DOUBLE_EQ(c.fusion.filter.disturbance_W2_per_s[0], 2.0);
@@ -95,6 +96,7 @@ TEST(ThermalConfig, ReadsEveryKeyAndTheWriterReadsBack) {
   EXPECT_DOUBLE_EQ(back.fusion.magnet_law.value_ref, c.fusion.magnet_law.value_ref);
   EXPECT_DOUBLE_EQ(back.fusion.coolant_C, 35.0);
   EXPECT_DOUBLE_EQ(back.fusion.winding_sensor_time_constant_s, 12.0);
+  EXPECT_TRUE(back.fusion.winding_node_is_reading);
   EXPECT_DOUBLE_EQ(m.base.current_A, 150.0);
 }
 
@@ -154,6 +156,11 @@ TEST(ThermalConfig, BadSectionsNameFileLineKeyAndReason) {
   EXPECT_NE(error_of("time_constant_s: 12", "time_constnat_s: 12").find("thermal.winding_sensor.time_constnat_s"),
             std::string::npos)
       << error_of("time_constant_s: 12", "time_constnat_s: 12");
+  // What the winding node stands for (eq. 14.24): the winding unless `node: reading` says the sensor's reading.
+  EXPECT_FALSE(load_text(std::regex_replace(std::string(kThreeNodes), std::regex(", node: reading"), ""))
+                   .fusion.winding_node_is_reading);
+  EXPECT_NE(error_of("node: reading", "node: sensor").find("thermal.winding_sensor.node"), std::string::npos)
+      << error_of("node: reading", "node: sensor");
   EXPECT_NE(error_of("coeff_per_K: -0.00105", "coeff_per_K: 0.00105").find("thermal.magnet_law.coeff_per_K"),
             std::string::npos);
   // A magnet cut off from everything: no steady state.

@@ -175,7 +175,7 @@ struct Point {
 /// (eq. 14.22, as the filter does it: core/thermal_sensor.hpp; the network's rate is exact here, variance 0).
 void advance_sensor_lag(const core::ThermalFusionConfig& f, const core::ThermalStepData& s, const core::ThermalVec& t,
                         core::SensorLag& lag) {
-  if (!(f.winding_sensor_time_constant_s > 0.0)) return;
+  if (!(f.winding_sensor_time_constant_s > 0.0) || f.winding_node_is_reading) return;
   const core::WindingRate g = core::winding_rate(f.filter.network, core::thermal_rates(f.filter.network, s.load));
   lag.advance(core::sensor_lag_step(f.winding_sensor_time_constant_s, s.load.dt_s, s.winding_sensor_age),
               g.row.head<core::kMaxThermalNodes>().dot(t) + g.constant_K_per_s, 0.0);

@@ -28,8 +28,11 @@ struct ThermalFusionConfig {
   ThermalObserverConfig observer;
   double coolant_C = 25.0;                      ///< where the samples carry no coolant temperature
   double winding_sensor_sigma_K = 0.0;          ///< a winding sensor's σ; 0: sensor not used
-  double winding_sensor_time_constant_s = 0.0;  ///< its lag τ_s behind the winding node (eq. 14.22); 0: none
-  double initial_sigma_K = 10.0;                ///< σ of every node at the start (the coolant's temperature)
+  double winding_sensor_time_constant_s = 0.0;  ///< its lag τ_s behind the winding (eq. 14.22, 14.24); 0: none
+  /// What the network's winding node stands for: false, the winding (the sensor lags it, eq. 14.22); true, the
+  /// sensor's reading, which the winding leads: T_w = T_node + τ_s·dT_node/dt (eq. 14.24).
+  bool winding_node_is_reading = false;
+  double initial_sigma_K = 10.0;  ///< σ of every node at the start (the coolant's temperature)
 };
 
 /// A node's fused temperature.
@@ -66,6 +69,14 @@ struct ThermalNodeReport {
   double observed_age_s = -1.0;
 };
 [[nodiscard]] ThermalNodeReport report_node(const ThermalEstimate& e, int node, std::int64_t t_ns) noexcept;
+
+/// The winding's temperature as a linear function of the filter's [T; d]: T_w = row·[T; d] + constant_K. The
+/// winding node itself, or with `winding_node_is_reading` the node led by τ_s times its modelled rate (eq. 14.24).
+struct WindingReadout {
+  Eigen::Matrix<double, kDynamicThermalStates, 1> row = Eigen::Matrix<double, kDynamicThermalStates, 1>::Zero();
+  double constant_K = 0.0;
+};
+[[nodiscard]] WindingReadout winding_readout(const ThermalFusionConfig& c, const ThermalLoad& load) noexcept;
 
 /// The observations of one step as the filter takes them, from a step's data and the state they linearise at.
 struct StepObservations {
