@@ -8,6 +8,8 @@
 
 #include "rpem/analysis/cluster_robust.hpp"
 #include "rpem/analysis/diagnose/effect_fit.hpp"
+#include "rpem/analysis/thermal/golden_section.hpp"
+#include "rpem/analysis/thermal/sensor_lag.hpp"
 #include "rpem/analysis/thermal/thermal_replay.hpp"
 #include "rpem/core/non_finite.hpp"
 
@@ -492,25 +494,6 @@ double training_log_likelihood(const io::ThermalConfig& c, const ThermalRecord& 
   return ll;
 }
 
-/// The minimum of a unimodal `f` on [a, b] by golden-section search, to a bracket narrower than `tolerance`:
-/// the bracket's middle.
-template <class F>
-double golden_section_minimum(F&& f, double a, double b, double tolerance) {
-  const double g = 0.5 * (std::sqrt(5.0) - 1.0);
-  double x1 = b - g * (b - a), x2 = a + g * (b - a);
-  double f1 = f(x1), f2 = f(x2);
-  while (b - a > tolerance) {
-    if (f1 < f2) {
-      b = x2, x2 = x1, f2 = f1;
-      x1 = b - g * (b - a), f1 = f(x1);
-    } else {
-      a = x1, x1 = x2, f1 = f2;
-      x2 = a + g * (b - a), f2 = f(x2);
-    }
-  }
-  return 0.5 * (a + b);
-}
-
 /// The value of one of the filter's noise intensities (every node; `field` picks which) that maximises the
 /// filter's innovation likelihood over the training part: golden-section search on its log10 in [lo, hi].
 double maximum_likelihood(io::ThermalConfig& c, const ThermalRecord& r, std::size_t training,
@@ -524,6 +507,56 @@ double maximum_likelihood(io::ThermalConfig& c, const ThermalRecord& r, std::siz
   (c.fusion.filter.*field).setZero();
   (c.fusion.filter.*field).head(c.fusion.filter.network.nodes).setConstant(q);
   return q;
+}
+
+/// The winding sensor's τ_s without the network (eq. 14.25, rpem/analysis/thermal/sensor_lag.hpp) over the training
+/// part's runs of at least kStandstillRun steps in which r̂s adapts and the sensor reads. Used — τ_s set and the
+/// winding node taken as the sensor's reading (eq. 14.24) — where at least three runs give a 95 % interval that
+/// excludes no lag (its lower end above 0: the rule the likelihood's τ_s follows); otherwise a note, and the
+/// likelihood's τ_s after the network.
+void sensor_lag_at_standstill(io::ThermalConfig& c, const ThermalRecord& r, std::size_t training, ThermalFitResult& out) {
+  constexpr std::size_t kStandstillRun = 60, kWarm = 20;  // steps: a run, and what each lagged side needs to start
+  const core::DriftLaw& copper = c.fusion.filter.network.copper;
+  const auto rs = static_cast<std::size_t>(core::kRs);
+  std::vector<SensorLagRun> runs;
+  SensorLagRun run;
+  auto close = [&] {
+    if (run.sensor_C.size() >= kStandstillRun) runs.push_back(run);
+    run = SensorLagRun{};
+  };
+  for (std::size_t k = 0; k < training && k < r.steps.size(); ++k) {
+    const core::ParameterObservation& p = r.steps[k].parameter[rs];
+    const double sensor = r.steps[k].winding_sensor_C;
+    if (!p.valid || !std::isfinite(sensor) || !(p.time_constant_s >= 0.0)) {
+      close();
+      continue;
+    }
+    run.t_rs_C.push_back(copper.temperature_C(p.value));
+    run.sensor_C.push_back(sensor);
+    run.tau_r_s.push_back(p.time_constant_s);
+    run.dt_s.push_back(r.steps[k].load.dt_s);
+  }
+  close();
+  const SensorLagEstimate e = sensor_lag_without_network(runs, kSensorLagLow_s, kSensorLagHigh_s, kWarm);
+  if (!std::isfinite(e.tau_s)) return;
+  const double half = 0.5 * (e.upper_s - e.lower_s) / e.tau_s;
+  const bool used = e.runs >= 3 && e.lower_s > 0.0;
+  FittedParameter p;
+  p.name = "winding sensor time constant (standstill)";
+  p.unit = "s";
+  p.value = e.tau_s;
+  p.half_width_rel = std::isfinite(half) ? half : kInf;
+  p.excitation_half_width_rel = p.half_width_rel;
+  p.identified = p.half_width_rel <= kIdentifiedHalfWidth;
+  out.parameters.push_back(p);
+  out.notes.push_back("winding sensor time constant without the network (eq. 14.25, " + std::to_string(e.runs) +
+                      " standstill runs of r̂s beside the sensor): " + std::to_string(e.tau_s) + " s, 95 % interval [" +
+                      std::to_string(e.lower_s) + ", " + std::to_string(e.upper_s) + "] s; " +
+                      (used ? "used, the winding node standing for the sensor's reading (eq. 14.24)"
+                            : "not used (fewer than three runs, or no lag within the interval)"));
+  if (!used) return;
+  c.fusion.winding_sensor_time_constant_s = e.tau_s;
+  c.fusion.winding_node_is_reading = true;
 }
 
 /// The winding sensor's time constant τ_s (eq. 14.22) that maximises the filter's innovation likelihood over the
@@ -764,6 +797,11 @@ ThermalFitResult fit_thermal(const ThermalRecord& record, const io::ThermalConfi
   out.training_steps = training;
 
   io::ThermalConfig start = start_config;
+  // A winding sensor without a configured lag: τ_s from the standstills where r̂s reads the winding (eq. 14.25),
+  // before the network, which then stands for the sensor's reading (eq. 14.24).
+  if (record.winding_sensor && start.fusion.winding_sensor_sigma_K > 0.0 &&
+      !(start.fusion.winding_sensor_time_constant_s > 0.0))
+    sensor_lag_at_standstill(start, record, training, out);
   const std::vector<LossTie> ties = tie_collinear_losses(start, record, training, out.notes);
   const Layout layout(start, ties);
   const std::vector<double> prior = layout.values(start);

@@ -1,0 +1,37 @@
+#pragma once
+// The winding sensor's time constant τ_s without the thermal network (docs/derivations.md eq. 14.25): where r̂s
+// adapts (standstill with current) it reads the winding through its own law, lagging by the estimator's own
+// time constant τ_r; the sensor lags the same winding by τ_s. First-order lags commute, so
+//
+//   lag_τs(T_rs) = lag_τs(lag_τr(T_w)) = lag_τr(lag_τs(T_w)) = lag_τr(T_sensor)                        (14.25)
+//
+// whatever the winding did: over runs of steps where both read, τ_s is the least squares of that identity.
+// Each run's own least-squares τ_s gives the spread from which the estimate's interval comes.
+
+#include <cstddef>
+#include <limits>
+#include <vector>
+
+namespace rpem::analysis {
+
+/// One run of consecutive steps where r̂s adapts and the winding sensor reads.
+struct SensorLagRun {
+  std::vector<double> t_rs_C;    ///< the winding temperature r̂s reads through its law
+  std::vector<double> sensor_C;  ///< the sensor's reading
+  std::vector<double> tau_r_s;   ///< the estimator's own time constant over each step (the observer's Δt/a)
+  std::vector<double> dt_s;      ///< each step's length (from the previous step's end)
+};
+
+struct SensorLagEstimate {
+  double tau_s = std::numeric_limits<double>::quiet_NaN();  ///< pooled least squares over the runs; NaN: none
+  /// 95 % interval from the runs' own estimates (Student's t over their spread; ±∞ with fewer than three).
+  double lower_s = -std::numeric_limits<double>::infinity(), upper_s = std::numeric_limits<double>::infinity();
+  std::size_t runs = 0;
+};
+
+/// τ_s on [low_s, high_s] from the runs; each run judged after its first `warm` steps (the two
+/// lagged signals start from the same reading and need a few time constants to forget it).
+[[nodiscard]] SensorLagEstimate sensor_lag_without_network(const std::vector<SensorLagRun>& runs, double low_s,
+                                                           double high_s, std::size_t warm);
+
+}  // namespace rpem::analysis
