@@ -545,7 +545,7 @@ void sensor_lag_at_standstill(io::ThermalConfig& c, const ThermalRecord& r, std:
   p.name = "winding sensor time constant (standstill)";
   p.unit = "s";
   p.value = e.tau_s;
-  p.half_width_rel = std::isfinite(half) ? half : kInf;
+  p.half_width_rel = half;  // ∞ with fewer than three runs (the interval's ends are ±∞)
   p.excitation_half_width_rel = p.half_width_rel;
   p.identified = p.half_width_rel <= kIdentifiedHalfWidth;
   out.parameters.push_back(p);
