@@ -136,6 +136,14 @@ core::ThermalFusionConfig lagged_sensor_config() {
   return c;
 }
 
+/// ... and the winding node standing for that sensor's reading (eq. 14.24): the winding's readout g·[T; d] in the
+/// ψ̂m and r̂s observations and in the report, every step.
+core::ThermalFusionConfig reading_node_config() {
+  core::ThermalFusionConfig c = lagged_sensor_config();
+  c.winding_node_is_reading = true;
+  return c;
+}
+
 void filter_steps(benchmark::State& state, const core::ThermalFusionConfig& config) {
   const std::vector<core::ThermalStepData>& steps = recorded_steps();
   const core::ThermalFusion initial(config, test::paper_base(), test::paper_machine_si());
@@ -158,6 +166,7 @@ void filter_steps(benchmark::State& state, const core::ThermalFusionConfig& conf
 void BM_FilterStep(benchmark::State& state) { filter_steps(state, loop_config()); }
 void BM_FilterStepGaussMarkov(benchmark::State& state) { filter_steps(state, gauss_markov_config()); }
 void BM_FilterStepLaggedSensor(benchmark::State& state) { filter_steps(state, lagged_sensor_config()); }
+void BM_FilterStepReadingNode(benchmark::State& state) { filter_steps(state, reading_node_config()); }
 
 void BM_FilterStepPaused(benchmark::State& state) {
   const std::vector<core::ThermalStepData>& steps = recorded_steps();
@@ -227,6 +236,7 @@ BENCHMARK(BM_FusionPerSample)->Repetitions(10)->ComputeStatistics("max", max_of)
 BENCHMARK(BM_FilterStep)->Repetitions(10)->ComputeStatistics("max", max_of)->ReportAggregatesOnly(true);
 BENCHMARK(BM_FilterStepGaussMarkov)->Repetitions(10)->ComputeStatistics("max", max_of)->ReportAggregatesOnly(true);
 BENCHMARK(BM_FilterStepLaggedSensor)->Repetitions(10)->ComputeStatistics("max", max_of)->ReportAggregatesOnly(true);
+BENCHMARK(BM_FilterStepReadingNode)->Repetitions(10)->ComputeStatistics("max", max_of)->ReportAggregatesOnly(true);
 BENCHMARK(BM_FilterStepPaused)->Repetitions(10)->ComputeStatistics("max", max_of)->ReportAggregatesOnly(true);
 BENCHMARK(BM_PauseResumePair)->Repetitions(10)->ComputeStatistics("max", max_of)->ReportAggregatesOnly(true);
 BENCHMARK(BM_SampleWithFusion)->MinTime(1.0)->Repetitions(10)->ComputeStatistics("max", max_of)->ReportAggregatesOnly(true);
