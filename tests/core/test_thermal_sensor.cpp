@@ -109,14 +109,9 @@ struct LaggedRun {
   double remainder_bound_K = 0.0;
 };
 
-/// A machine soaked at the coolant, `current_A` for 20 min, then 0 A for 20 min, steps of 1 s; the filter reads a
-/// sensor of time constant `tau_true_s` — each step the exact mean of its continuous reading (`rows` = 0) or the
-/// mean of `rows` readings at the ends of equal rows (as a log's temperature columns are) — and models it with
-/// `tau_model_s` and the readings' age `model_age`.
-LaggedRun run_lagged(double tau_true_s, double tau_model_s, int rows = 0, ReadingAge model_age = continuous_mean(1.0),
-                     double current_A = 120.0) {
-  ThermalFusionConfig c;
-  ThermalNetwork& n = c.filter.network;
+/// The tests' network: winding and magnet, 5 kJ/K and 20 kJ/K, R_s 50 mΩ at 20 °C.
+ThermalNetwork two_node_network() {
+  ThermalNetwork n;
   n.nodes = 2;
   n.winding = 0, n.magnet = 1;
   n.capacitance_J_per_K << 5000.0, 20000.0, 1.0, 1.0;
@@ -124,6 +119,18 @@ LaggedRun run_lagged(double tau_true_s, double tau_model_s, int rows = 0, Readin
   n.between_W_per_K(0, 1) = n.between_W_per_K(1, 0) = 10.0;
   n.copper = {0.00393, 20.0, 0.05};
   n.base = {1000.0, 0.1, 100.0};
+  return n;
+}
+
+/// A machine soaked at the coolant, `current_A` for 20 min, then 0 A for 20 min, steps of 1 s; the filter reads a
+/// sensor of time constant `tau_true_s` — each step the exact mean of its continuous reading (`rows` = 0) or the
+/// mean of `rows` readings at the ends of equal rows (as a log's temperature columns are) — and models it with
+/// `tau_model_s` and the readings' age `model_age`.
+LaggedRun run_lagged(double tau_true_s, double tau_model_s, int rows = 0, ReadingAge model_age = continuous_mean(1.0),
+                     double current_A = 120.0) {
+  ThermalFusionConfig c;
+  c.filter.network = two_node_network();
+  const ThermalNetwork& n = c.filter.network;
   c.filter.calibration_sigma.setZero();
   c.filter.copper_rel_sigma = 0.0;
   // What a fit gives a model that is not exact: white noise on the rates and a drifting heat.
@@ -224,14 +231,8 @@ struct NodeRun {
 
 NodeRun run_reading_node(bool node_is_reading) {
   ThermalFusionConfig c;
-  ThermalNetwork& n = c.filter.network;
-  n.nodes = 2;
-  n.winding = 0, n.magnet = 1;
-  n.capacitance_J_per_K << 5000.0, 20000.0, 1.0, 1.0;
-  n.to_coolant_W_per_K << 30.0, 8.0, 0.0, 0.0;
-  n.between_W_per_K(0, 1) = n.between_W_per_K(1, 0) = 10.0;
-  n.copper = {0.00393, 20.0, 0.05};
-  n.base = {1000.0, 0.1, 100.0};
+  c.filter.network = two_node_network();
+  const ThermalNetwork& n = c.filter.network;
   c.filter.process_noise_K2_per_s << 1e-4, 1e-4, 0.0, 0.0;
   c.filter.disturbance_W2_per_s << 0.1, 0.1, 0.0, 0.0;
   c.winding_sensor_sigma_K = 0.1;
