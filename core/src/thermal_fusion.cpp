@@ -68,6 +68,7 @@ StepObservations step_observations(const ThermalFusionConfig& c, const ThermalSt
   const Row rows[2] = {
       {m, w, magnet, copper, c.magnet_law.reference_C, Calibration::kMagnetOffset, Calibration::kMagnetCoefficient},
       {w, m, copper, magnet, n.copper.reference_C, Calibration::kCopperOffset, Calibration::kCopperCoefficient}};
+  const WindingReadout g = winding_readout(c, s.load);  // the winding the parameters see (eq. 14.24)
   for (std::size_t j = 0; j < 2; ++j) {
     const ParameterObservation& p = s.parameter[j];
     if (!p.valid) continue;
@@ -88,7 +89,6 @@ StepObservations step_observations(const ThermalFusionConfig& c, const ThermalSt
     o.variance = p.variance + r.own_law.slope * r.own_law.slope * lag_K * lag_K;
     if (c.winding_node_is_reading) {
       // r̂s and ψ̂m's κ term see the winding, which leads the node that stands for the reading (eq. 14.24).
-      const WindingReadout g = winding_readout(c, s.load);
       const double h_w = o.h[w];
       o.h[w] = 0.0;
       o.h += h_w * g.row.head<kMaxThermalNodes>();
