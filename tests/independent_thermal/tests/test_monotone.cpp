@@ -30,7 +30,7 @@ TEST(IndepThermalMonotone, HeatUpAtStandstillIsMonotoneInEveryNode) {
 }
 
 Eigen::Vector3d final_temperatures(const Machine& m, const Parameters& p, double speed, double i_q) {
-  const Case c = test::exact_case(m, p, test::constant_profile(speed, -0.3 * i_q, i_q, 20000.0), 20000.0, 0.01);
+  const Case c = test::steady_case(m, p, speed, -0.3 * i_q, i_q, 20000.0, 0.01);
   return generate(c).rows.back().truth.y.head<3>();
 }
 

@@ -58,7 +58,7 @@ void expect_steady_state(const Machine& m, Parameters p, double speed_rpm, doubl
   const Eigen::Vector3d expected = n.m.partialPivLu().solve(n.rhs);
   const Eigen::Vector3d start = Eigen::Vector3d::Constant(p.coolant_start_C + p.initial_rise_K);
   const double duration = settling_time_s(p, n, start, expected);
-  Case c = test::exact_case(m, p, test::constant_profile(speed_rpm, i_d, i_q, duration), duration, 40.0 / duration);
+  const Case c = test::steady_case(m, p, speed_rpm, i_d, i_q, duration, 40.0 / duration);
   const Result r = generate(c);
   const Eigen::Vector3d got = r.rows.back().truth.y.head<3>();
   ASSERT_GT(expected(0) - p.coolant_start_C, 5.0);
