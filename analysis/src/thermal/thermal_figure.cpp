@@ -69,7 +69,9 @@ double panel(GnuplotFigure& fig, const io::CsvTable& est, const io::CsvTable* me
       covered += std::abs(vm[k] - f) <= 2.0 * s ? 1.0 : 0.0;
     }
     fig.add_data(m);
-    plot += ", $" + node + "_meas u 1:2 w l lw 1.5 lc rgb '#cb181d' title " + gp_quote("measured (" + measured_column + ")");
+    // A column's name is text, not markup: gnuplot's enhanced mode would set `T_magnet` as T with the subscript m.
+    plot += ", $" + node + "_meas u 1:2 w l lw 1.5 lc rgb '#cb181d' title " +
+            gp_quote("measured (" + measured_column + ")") + " noenhanced";
   }
   fig.add_line("set title " + gp_quote(node) + " noenhanced");
   fig.add_line("unset arrow");

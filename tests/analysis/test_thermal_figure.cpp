@@ -1,0 +1,45 @@
+// `rpem figures --thermal-estimate`: the ±2σ band's coverage of the measured points after the held-out line,
+// counted by hand on a constructed estimate, and the measured columns' names drawn as they are written.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <string>
+
+#include "rpem/analysis/thermal/thermal_figure.hpp"
+#include "support/temp_file.hpp"
+
+namespace rpem::analysis {
+namespace {
+
+TEST(ThermalFigure, CoverageCountsTheMeasuredPointsAfterTheLineInsideTheBand) {
+  // The estimate: magnet 50 ± 2·1 °C, winding 80 ± 2·2 °C at every second of 0…10 s.
+  std::string est =
+      "t,T_magnet_rpem,T_winding_rpem,t_magnet_fused_C,t_magnet_fused_sd_C,t_winding_fused_C,t_winding_fused_sd_C\n";
+  for (int k = 0; k <= 10; ++k) est += std::to_string(k) + ",49,81,50,1,80,2\n";
+  // Measured between the rows (interpolated there); the first point lies before the line at 2 s and is not
+  // counted, though it is outside both bands. After it: magnet 51 in, 53 out, 49 in, 47.9 out (2 of 4);
+  // winding 77 in, 83 in, 85 out, 80 in (3 of 4).
+  const std::string measured =
+      "t,T_magnet,T_winding\n"
+      "0.5,60,60\n"
+      "2.5,51,77\n"
+      "4.5,53,83\n"
+      "6.5,49,85\n"
+      "8.5,47.9,80\n";
+  const test::TempFile est_csv("est.csv", est), measured_csv("measured.csv", measured), png("fused.png"), script("fused.gp");
+  ThermalFigureInput in;
+  in.estimate_csv = est_csv.path();
+  in.measured_csv = measured_csv.path();
+  in.judged_after_s = 2.0;
+  const ThermalFigureCoverage c = write_thermal_figure(png.path(), in);
+  EXPECT_DOUBLE_EQ(c.magnet, 0.5);
+  EXPECT_DOUBLE_EQ(c.winding, 0.75);
+  EXPECT_GT(std::filesystem::file_size(png.path()), 1000U);
+  // The names are text: in gnuplot's enhanced mode `T_magnet` would read as T with the subscript m.
+  const std::string gp = test::read_file(script.path());
+  EXPECT_NE(gp.find("title \"measured (T_magnet)\" noenhanced"), std::string::npos) << gp.substr(gp.rfind("plot"));
+  EXPECT_NE(gp.find("title \"measured (T_winding)\" noenhanced"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace rpem::analysis
