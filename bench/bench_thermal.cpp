@@ -8,6 +8,7 @@
 //                          both parameter observations and a winding sensor (ThermalFusion::apply), timed as
 //                          a batch of kRecordedSteps prepared steps on this thread's CPU clock: what a step
 //                          costs, without the harness's per-step timer reads
+//   BM_FilterStepTwoNodes  the same with a 2-node network (`rpem thermal fit`'s default), its own steps
 //   BM_FilterStepPaused    the same steps one at a time between PauseTiming/ResumeTiming (how this file first
 //                          measured it), and BM_PauseResumePair an empty pair: the harness's share of that
 //   BM_SampleWithFusion    the estimator's step alone and with the fusion after it, alternating blocks on the
@@ -106,17 +107,43 @@ core::ThermalStepData step_data(const core::ThermalEstimate& out, std::int64_t k
 
 constexpr int kRecordedSteps = 1000;  // 1000 s of filter steps: the network heats most of the way
 
-/// kRecordedSteps steps recorded from a filter run once, replayed identically by every batch.
+/// kRecordedSteps steps recorded from a run of a filter with configuration c.
+std::vector<core::ThermalStepData> record_steps(const core::ThermalFusionConfig& c) {
+  core::ThermalFusion fusion(c, test::paper_base(), test::paper_machine_si());
+  std::vector<core::ThermalStepData> steps;
+  for (int k = 0; k < kRecordedSteps; ++k) {
+    steps.push_back(step_data(fusion.estimate(), k));
+    fusion.apply(steps.back());
+  }
+  return steps;
+}
+
+/// The loop configuration's steps, recorded once and replayed identically by every batch.
 const std::vector<core::ThermalStepData>& recorded_steps() {
-  static const std::vector<core::ThermalStepData> v = [] {
-    core::ThermalFusion fusion(loop_config(), test::paper_base(), test::paper_machine_si());
-    std::vector<core::ThermalStepData> steps;
-    for (int k = 0; k < kRecordedSteps; ++k) {
-      steps.push_back(step_data(fusion.estimate(), k));
-      fusion.apply(steps.back());
-    }
-    return steps;
-  }();
+  static const std::vector<core::ThermalStepData> v = record_steps(loop_config());
+  return v;
+}
+
+/// The loop's configuration with `rpem thermal fit`'s default topology: two nodes, winding and magnet (the
+/// network's exponential on their 2×2 block, core/src/thermal_network.cpp).
+core::ThermalFusionConfig two_node_config() {
+  core::ThermalFusionConfig c = loop_config();
+  core::ThermalNetwork& n = c.filter.network;
+  n.nodes = 2;
+  n.winding = 0, n.magnet = 1;
+  n.capacitance_J_per_K << 3000.0, 7000.0, 1.0, 1.0;
+  n.to_coolant_W_per_K << 30.0, 4.0, 0.0, 0.0;
+  n.between_W_per_K.setZero();
+  n.between_W_per_K(0, 1) = n.between_W_per_K(1, 0) = 12.0;
+  n.loss_at_base_W.setZero();
+  n.loss_at_base_W(static_cast<int>(core::LossForm::kIronEddy), 0) = 100.0;
+  n.loss_at_base_W(static_cast<int>(core::LossForm::kMagnetEddy), 1) = 20.0;
+  return c;
+}
+
+/// Its own steps (observations at its own predictions, so that they are accepted as the loop's are).
+const std::vector<core::ThermalStepData>& recorded_two_node_steps() {
+  static const std::vector<core::ThermalStepData> v = record_steps(two_node_config());
   return v;
 }
 
@@ -144,8 +171,8 @@ core::ThermalFusionConfig reading_node_config() {
   return c;
 }
 
-void filter_steps(benchmark::State& state, const core::ThermalFusionConfig& config) {
-  const std::vector<core::ThermalStepData>& steps = recorded_steps();
+void filter_steps(benchmark::State& state, const core::ThermalFusionConfig& config,
+                  const std::vector<core::ThermalStepData>& steps = recorded_steps()) {
   const core::ThermalFusion initial(config, test::paper_base(), test::paper_machine_si());
   core::ThermalFusion fusion = initial;
   double cpu_s = 0.0;
@@ -167,6 +194,7 @@ void BM_FilterStep(benchmark::State& state) { filter_steps(state, loop_config())
 void BM_FilterStepGaussMarkov(benchmark::State& state) { filter_steps(state, gauss_markov_config()); }
 void BM_FilterStepLaggedSensor(benchmark::State& state) { filter_steps(state, lagged_sensor_config()); }
 void BM_FilterStepReadingNode(benchmark::State& state) { filter_steps(state, reading_node_config()); }
+void BM_FilterStepTwoNodes(benchmark::State& state) { filter_steps(state, two_node_config(), recorded_two_node_steps()); }
 
 void BM_FilterStepPaused(benchmark::State& state) {
   const std::vector<core::ThermalStepData>& steps = recorded_steps();
@@ -237,6 +265,7 @@ BENCHMARK(BM_FilterStep)->Repetitions(10)->ComputeStatistics("max", max_of)->Rep
 BENCHMARK(BM_FilterStepGaussMarkov)->Repetitions(10)->ComputeStatistics("max", max_of)->ReportAggregatesOnly(true);
 BENCHMARK(BM_FilterStepLaggedSensor)->Repetitions(10)->ComputeStatistics("max", max_of)->ReportAggregatesOnly(true);
 BENCHMARK(BM_FilterStepReadingNode)->Repetitions(10)->ComputeStatistics("max", max_of)->ReportAggregatesOnly(true);
+BENCHMARK(BM_FilterStepTwoNodes)->Repetitions(10)->ComputeStatistics("max", max_of)->ReportAggregatesOnly(true);
 BENCHMARK(BM_FilterStepPaused)->Repetitions(10)->ComputeStatistics("max", max_of)->ReportAggregatesOnly(true);
 BENCHMARK(BM_PauseResumePair)->Repetitions(10)->ComputeStatistics("max", max_of)->ReportAggregatesOnly(true);
 BENCHMARK(BM_SampleWithFusion)->MinTime(1.0)->Repetitions(10)->ComputeStatistics("max", max_of)->ReportAggregatesOnly(true);

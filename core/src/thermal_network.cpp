@@ -96,9 +96,27 @@ ThermalVec node_losses_W(const ThermalNetwork& n, const ThermalLoad& l, const Th
   return p;
 }
 
+namespace {
+
+/// e^X and φ₁(X) of a block-diagonal X whose nodes past `nodes` are zero rows and columns (thermal_rates):
+/// for a 2-node network the series on its 2×2 block, the unused block's e^0 = φ₁(0) = I — the same matrices
+/// as the 4×4 series at an eighth of its products (a third less time for `rpem thermal fit`). Three nodes
+/// keep the 4×4 series: Eigen vectorises 4×4 products and not 3×3 ones, and the 3×3 block measured 15 %
+/// slower (docs/benchmarks.md, "Thermal fusion").
+ExponentialPair<kMaxThermalNodes> exponential_of_nodes_in_use(const ThermalMat& x, int nodes) noexcept {
+  if (nodes != 2) return exponential_and_phi1<kMaxThermalNodes>(x);
+  ExponentialPair<kMaxThermalNodes> out{ThermalMat::Identity(), ThermalMat::Identity()};
+  const ExponentialPair<2> e = exponential_and_phi1<2>(x.topLeftCorner<2, 2>());
+  out.exp.topLeftCorner<2, 2>() = e.exp;
+  out.phi1.topLeftCorner<2, 2>() = e.phi1;
+  return out;
+}
+
+}  // namespace
+
 ThermalTransition thermal_transition(const ThermalNetwork& n, const ThermalLoad& l) noexcept {
   const ThermalRates r = thermal_rates(n, l);
-  const ExponentialPair<kMaxThermalNodes> e = exponential_and_phi1<kMaxThermalNodes>(r.a * l.dt_s);
+  const ExponentialPair<kMaxThermalNodes> e = exponential_of_nodes_in_use(r.a * l.dt_s, n.nodes);
   ThermalTransition t;
   t.phi = e.exp;
   const ThermalMat integral = l.dt_s * e.phi1;  // ∫₀^Δt e^{A·s} ds

@@ -1,6 +1,7 @@
 // The thermal network (core/thermal_network.hpp, docs/derivations.md §13) against closed forms and an
 // independent integrator: the matrix exponential and φ₁, one node's exponential approach with the copper
-// loss's own temperature law, a coupled network stepped exactly against fine RK4, the loss forms' bases.
+// loss's own temperature law, two coupled nodes against their 2×2 exponential in closed form, a coupled network
+// stepped exactly against fine RK4, the loss forms' bases.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -88,6 +89,42 @@ TEST(ThermalNetwork, OneNodeApproachesItsSteadyStateExponentiallyWithTheCopperLa
   EXPECT_EQ(tr.phi(2, 2), 1.0);
   EXPECT_EQ(tr.gamma[3], 0.0);
   EXPECT_EQ(tr.gamma_d.col(3).norm(), 0.0);
+}
+
+TEST(ThermalNetwork, TwoCoupledNodesStepAsTheirTwoByTwoExponentialInClosedForm) {
+  // A 2-node network's step comes from the series on its 2×2 block (core/src/thermal_network.cpp). Here the
+  // block in closed form: A's eigenvalues λ₁ ≠ λ₂ (real and negative for a network with a path to the coolant),
+  // e^{AΔt} = (λ₁·e^{λ₂Δt} − λ₂·e^{λ₁Δt})/(λ₁ − λ₂)·I + (e^{λ₁Δt} − e^{λ₂Δt})/(λ₁ − λ₂)·A (Putzer), and the
+  // step's input ∫₀^Δt e^{As} ds·u = A⁻¹·(e^{AΔt} − I)·u.
+  ThermalNetwork n = decoupled();
+  n.between_W_per_K(0, 1) = n.between_W_per_K(1, 0) = 15.0;
+  n.between_at_base_speed_W_per_K(0, 1) = n.between_at_base_speed_W_per_K(1, 0) = 4.0;
+  ThermalLoad l;
+  l.dt_s = 90.0;
+  l.current_sq_A2 = 120.0 * 120.0;
+  l.coolant_C = 35.0;
+  l.convection_basis = 0.6;
+  l.basis = loss_basis(n.base, Vec2(-70.0, 110.0), 700.0, Vec2(0.06, 0.05));
+  const Eigen::Matrix2d a = thermal_rates(n, l).a.topLeftCorner<2, 2>();
+  const Eigen::Vector2d u = thermal_rates(n, l).u.head<2>();
+  const double mean = 0.5 * a.trace(),
+               half_gap = std::sqrt(0.25 * (a(0, 0) - a(1, 1)) * (a(0, 0) - a(1, 1)) + a(0, 1) * a(1, 0));
+  const double l1 = mean + half_gap, l2 = mean - half_gap, e1 = std::exp(l1 * l.dt_s), e2 = std::exp(l2 * l.dt_s);
+  ASSERT_LT(l1, 0.0);
+  const Eigen::Matrix2d phi = (l1 * e2 - l2 * e1) / (l1 - l2) * Eigen::Matrix2d::Identity() + (e1 - e2) / (l1 - l2) * a;
+  const Eigen::Vector2d gamma = a.inverse() * (phi - Eigen::Matrix2d::Identity()) * u;
+  const ThermalTransition tr = thermal_transition(n, l);
+  for (int i = 0; i < 2; ++i) {
+    EXPECT_NEAR(tr.gamma[i], gamma[i], 1e-12 * gamma.norm()) << i;
+    for (int j = 0; j < 2; ++j) EXPECT_NEAR(tr.phi(i, j), phi(i, j), 1e-14) << i << j;
+  }
+  // The unused block is the identity and takes no heat; nothing couples it to the nodes in use.
+  EXPECT_TRUE(tr.phi.bottomRightCorner(2, 2).isIdentity(0.0));
+  EXPECT_EQ(tr.phi.topRightCorner(2, 2).norm() + tr.phi.bottomLeftCorner(2, 2).norm(), 0.0);
+  EXPECT_EQ(tr.gamma.tail<2>().norm(), 0.0);
+  // The same network as four nodes of which two are unused rows: the 4×4 series gives the same step.
+  const ExponentialPair<kMaxThermalNodes> full = exponential_and_phi1<kMaxThermalNodes>(thermal_rates(n, l).a * l.dt_s);
+  EXPECT_LT((full.exp - tr.phi).cwiseAbs().maxCoeff(), 1e-15);
 }
 
 TEST(ThermalNetwork, ExactStepMatchesFineRungeKuttaOnACoupledNetwork) {
