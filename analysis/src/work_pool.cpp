@@ -101,10 +101,11 @@ void WorkPool::work() {
     std::shared_ptr<Loop> loop;
     {
       std::unique_lock lock(mutex_);
-      // The newest loop first: a nested one, whose caller waits for it inside an older loop's index.
-      wake_.wait(lock, [&] { return stopping_ || newest_open() != nullptr; });
+      // The newest loop first: a nested one, whose caller waits for it inside an older loop's index. The loop
+      // the wait found is the one taken: its indices are taken without the lock, so a second look may find
+      // none left (its run() then returns at once).
+      wake_.wait(lock, [&] { return stopping_ || (loop = newest_open()) != nullptr; });
       if (stopping_) return;
-      loop = newest_open();
     }
     loop->run();
   }

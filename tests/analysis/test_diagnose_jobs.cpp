@@ -117,5 +117,17 @@ TEST(WorkPool, ACallerWhoseIndicesAreDoneHelpsTheNestedLoopsStillRunning) {
   EXPECT_GT(nested_on_caller.load(), 0);
 }
 
+TEST(WorkPool, WorkersWokenForALoopWhoseIndicesAreTakenMeanwhileWaitAgain) {
+  // A worker woken for an open loop must take that loop, not look again after the wait: the loop's indices
+  // are taken without the pool's lock, so by a second look the last one may be gone (rpem diagnose crashed
+  // on a null loop once in about 16 runs with --jobs 2, found by the fresh-clone CI of ed48ea6). Many short
+  // loops, more threads than cores: each loop's caller races the woken workers for its two indices.
+  const analysis::WorkPool pool(8);
+  std::atomic<long> sum{0};
+  constexpr int kLoops = 200000;
+  for (int k = 0; k < kLoops; ++k) pool.parallel_for(2, [&](std::size_t i) { sum += static_cast<long>(i) + 1; });
+  EXPECT_EQ(sum.load(), 3L * kLoops);
+}
+
 }  // namespace
 }  // namespace rpem
