@@ -105,8 +105,9 @@ TEST(ThermalNetwork, TwoCoupledNodesStepAsTheirTwoByTwoExponentialInClosedForm) 
   l.coolant_C = 35.0;
   l.convection_basis = 0.6;
   l.basis = loss_basis(n.base, Vec2(-70.0, 110.0), 700.0, Vec2(0.06, 0.05));
-  const Eigen::Matrix2d a = thermal_rates(n, l).a.topLeftCorner<2, 2>();
-  const Eigen::Vector2d u = thermal_rates(n, l).u.head<2>();
+  const ThermalRates rates = thermal_rates(n, l);
+  const Eigen::Matrix2d a = rates.a.topLeftCorner<2, 2>();
+  const Eigen::Vector2d u = rates.u.head<2>();
   const double mean = 0.5 * a.trace(),
                half_gap = std::sqrt(0.25 * (a(0, 0) - a(1, 1)) * (a(0, 0) - a(1, 1)) + a(0, 1) * a(1, 0));
   const double l1 = mean + half_gap, l2 = mean - half_gap, e1 = std::exp(l1 * l.dt_s), e2 = std::exp(l2 * l.dt_s);
@@ -123,7 +124,7 @@ TEST(ThermalNetwork, TwoCoupledNodesStepAsTheirTwoByTwoExponentialInClosedForm) 
   EXPECT_EQ(tr.phi.topRightCorner(2, 2).norm() + tr.phi.bottomLeftCorner(2, 2).norm(), 0.0);
   EXPECT_EQ(tr.gamma.tail<2>().norm(), 0.0);
   // The same network as four nodes of which two are unused rows: the 4×4 series gives the same step.
-  const ExponentialPair<kMaxThermalNodes> full = exponential_and_phi1<kMaxThermalNodes>(thermal_rates(n, l).a * l.dt_s);
+  const ExponentialPair<kMaxThermalNodes> full = exponential_and_phi1<kMaxThermalNodes>(rates.a * l.dt_s);
   EXPECT_LT((full.exp - tr.phi).cwiseAbs().maxCoeff(), 1e-15);
 }
 
