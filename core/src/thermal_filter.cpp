@@ -32,10 +32,10 @@ ThermalFilter::LossTerms ThermalFilter::loss_terms(const ThermalLoad& l) const n
   return terms;
 }
 
-void ThermalFilter::predict(const ThermalLoad& load) noexcept {
+void ThermalFilter::predict(const ThermalLoad& load, const ThermalRates& rates) noexcept {
   if (!(load.dt_s > 0.0)) return;
   const ThermalNetwork& n = config_.network;
-  const ThermalTransition tr = thermal_transition(n, load);
+  const ThermalTransition tr = thermal_transition(n, rates, load.dt_s);
   // The disturbances' increments: their drift, and each modelled loss term's change times its uncertainty.
   const LossTerms terms = loss_terms(load);
   const LossTerms change = terms - previous_terms_;

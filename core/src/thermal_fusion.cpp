@@ -39,21 +39,21 @@ ThermalNodeReport report_node(const ThermalEstimate& e, int node, std::int64_t t
   return r;
 }
 
-WindingReadout winding_readout(const ThermalFusionConfig& c, const ThermalLoad& load) noexcept {
+WindingReadout winding_readout(const ThermalFusionConfig& c, const ThermalRates& rates) noexcept {
   const ThermalNetwork& n = c.filter.network;
   WindingReadout r;
   r.row[n.winding] = 1.0;
   if (c.winding_node_is_reading && c.winding_sensor_time_constant_s > 0.0) {
     // A first-order sensor: dT_s/dt = (T_w − T_s)/τ_s, so T_w = T_s + τ_s·dT_s/dt exactly (eq. 14.24).
-    const WindingRate rate = winding_rate(n, thermal_rates(n, load));
+    const WindingRate rate = winding_rate(n, rates);
     r.row += c.winding_sensor_time_constant_s * rate.row;
     r.constant_K = c.winding_sensor_time_constant_s * rate.constant_K_per_s;
   }
   return r;
 }
 
-StepObservations step_observations(const ThermalFusionConfig& c, const ThermalStepData& s, const ThermalVec& t_C,
-                                   const ThermalVec& dt_dt_K_per_s, const SensorLag& lag) noexcept {
+StepObservations step_observations(const ThermalFusionConfig& c, const ThermalStepData& s, const ThermalRates& rates,
+                                   const ThermalVec& t_C, const ThermalVec& dt_dt_K_per_s, const SensorLag& lag) noexcept {
   const ThermalNetwork& n = c.filter.network;
   const Line magnet = line_of(c.magnet_law), copper = line_of(n.copper);
   const int m = n.magnet, w = n.winding;
@@ -68,7 +68,7 @@ StepObservations step_observations(const ThermalFusionConfig& c, const ThermalSt
   const Row rows[2] = {
       {m, w, magnet, copper, c.magnet_law.reference_C, Calibration::kMagnetOffset, Calibration::kMagnetCoefficient},
       {w, m, copper, magnet, n.copper.reference_C, Calibration::kCopperOffset, Calibration::kCopperCoefficient}};
-  const WindingReadout g = winding_readout(c, s.load);  // the winding the parameters see (eq. 14.24)
+  const WindingReadout g = winding_readout(c, rates);  // the winding the parameters see (eq. 14.24)
   for (std::size_t j = 0; j < 2; ++j) {
     const ParameterObservation& p = s.parameter[j];
     if (!p.valid) continue;
@@ -107,7 +107,7 @@ StepObservations step_observations(const ThermalFusionConfig& c, const ThermalSt
     const SensorLagStep k = sensor_lag_step(lag_s, s.load.dt_s, s.winding_sensor_age);
     if (k.rate_s > 0.0) {
       // The step's mean reading T_w − κ·(A_w·T + u_w + d_w/C_w) − β·e (eq. 14.22); e's error in the variance.
-      const WindingRate rate = winding_rate(n, thermal_rates(n, s.load));
+      const WindingRate rate = winding_rate(n, rates);
       o.h -= k.rate_s * rate.row.head<kMaxThermalNodes>();
       o.h_d = -k.rate_s * rate.row.tail<kMaxThermalNodes>();
       o.offset = -k.rate_s * rate.constant_K_per_s - k.carry * lag.lag_K;
@@ -155,29 +155,30 @@ void ThermalFusion::step(const Estimate& e, const ThermalSample& s) noexcept {
 
 void ThermalFusion::apply(const ThermalStepData& d) noexcept {
   if (!out_.started) start(d);
-  filter_.predict(d.load);
+  const ThermalRates rates = thermal_rates(config_.filter.network, d.load);
+  filter_.predict(d.load, rates);
   last_load_ = d.load;
-  finish_step(d, d.load.dt_s);
+  finish_step(d, rates, d.load.dt_s);
 }
 
 void ThermalFusion::coast(double dt_s) noexcept {
   if (!out_.started || !(dt_s > 0.0)) return;
   ThermalLoad l = last_load_;
   l.dt_s = dt_s;
-  filter_.predict(l);
+  const ThermalRates rates = thermal_rates(config_.filter.network, l);
+  filter_.predict(l, rates);
   ThermalStepData none;
   none.t_ns = out_.t_ns + static_cast<std::int64_t>(dt_s * 1e9);
   none.load = l;
   none.psi_m_Wb = last_psi_m_Wb_;
   none.r_s_Ohm = last_r_s_Ohm_;
-  finish_step(none, dt_s);
+  finish_step(none, rates, dt_s);
 }
 
-void ThermalFusion::finish_step(const ThermalStepData& d, double dt_s) noexcept {
+void ThermalFusion::finish_step(const ThermalStepData& d, const ThermalRates& rates, double dt_s) noexcept {
   const ThermalNetwork& n = config_.filter.network;
-  const ThermalRates rates = thermal_rates(n, d.load);
   const ThermalVec slope = rates.a * filter_.temperature_C() + rates.u;
-  const StepObservations obs = step_observations(config_, d, filter_.temperature_C(), slope, sensor_lag_);
+  const StepObservations obs = step_observations(config_, d, rates, filter_.temperature_C(), slope, sensor_lag_);
   const int node_of[3] = {n.magnet, n.winding, n.winding};
   std::array<bool, kMaxThermalNodes> observed{};
   for (std::size_t k = 0; k < obs.item.size(); ++k) {
@@ -217,7 +218,7 @@ void ThermalFusion::finish_step(const ThermalStepData& d, double dt_s) noexcept 
   out_.t_ns = d.t_ns;
   out_.coolant_C = d.load.coolant_C;
   // The winding as reported: the node, or the node led by the sensor's τ_s (eq. 14.24), its variance g·P·gᵀ.
-  const WindingReadout g = winding_readout(config_, d.load);
+  const WindingReadout g = winding_readout(config_, rates);
   const auto& p_dyn = filter_.covariance().topLeftCorner<kDynamicThermalStates, kDynamicThermalStates>();
   Eigen::Matrix<double, kDynamicThermalStates, 1> x_dyn;
   x_dyn << filter_.temperature_C(), filter_.disturbance_W();

@@ -114,16 +114,19 @@ ExponentialPair<kMaxThermalNodes> exponential_of_nodes_in_use(const ThermalMat& 
 
 }  // namespace
 
-ThermalTransition thermal_transition(const ThermalNetwork& n, const ThermalLoad& l) noexcept {
-  const ThermalRates r = thermal_rates(n, l);
-  const ExponentialPair<kMaxThermalNodes> e = exponential_of_nodes_in_use(r.a * l.dt_s, n.nodes);
+ThermalTransition thermal_transition(const ThermalNetwork& n, const ThermalRates& r, double dt_s) noexcept {
+  const ExponentialPair<kMaxThermalNodes> e = exponential_of_nodes_in_use(r.a * dt_s, n.nodes);
   ThermalTransition t;
   t.phi = e.exp;
-  const ThermalMat integral = l.dt_s * e.phi1;  // ∫₀^Δt e^{A·s} ds
+  const ThermalMat integral = dt_s * e.phi1;  // ∫₀^Δt e^{A·s} ds
   t.gamma = integral * r.u;
   t.gamma_d = integral * n.capacitance_J_per_K.cwiseInverse().asDiagonal();
   for (int i = n.nodes; i < kMaxThermalNodes; ++i) t.gamma_d.col(i).setZero();  // unused nodes take no heat
   return t;
+}
+
+ThermalTransition thermal_transition(const ThermalNetwork& n, const ThermalLoad& l) noexcept {
+  return thermal_transition(n, thermal_rates(n, l), l.dt_s);
 }
 
 ThermalVec thermal_steady_state(const ThermalNetwork& n, const ThermalLoad& l) noexcept {

@@ -174,11 +174,12 @@ struct Point {
 };
 
 /// The winding sensor's lag over step `s` of the open-loop network, at its temperatures `t` at the step's end
-/// (eq. 14.22, as the filter does it: core/thermal_sensor.hpp; the network's rate is exact here, variance 0).
-void advance_sensor_lag(const core::ThermalFusionConfig& f, const core::ThermalStepData& s, const core::ThermalVec& t,
-                        core::SensorLag& lag) {
+/// (eq. 14.22, as the filter does it: core/thermal_sensor.hpp; the network's rate is exact here, variance 0);
+/// `rates`: the network's at s.load.
+void advance_sensor_lag(const core::ThermalFusionConfig& f, const core::ThermalStepData& s, const core::ThermalRates& rates,
+                        const core::ThermalVec& t, core::SensorLag& lag) {
   if (!(f.winding_sensor_time_constant_s > 0.0) || f.winding_node_is_reading) return;
-  const core::WindingRate g = core::winding_rate(f.filter.network, core::thermal_rates(f.filter.network, s.load));
+  const core::WindingRate g = core::winding_rate(f.filter.network, rates);
   lag.advance(core::sensor_lag_step(f.winding_sensor_time_constant_s, s.load.dt_s, s.winding_sensor_age),
               g.row.head<core::kMaxThermalNodes>().dot(t) + g.constant_K_per_s, 0.0);
 }
@@ -206,17 +207,18 @@ void residuals(const io::ThermalConfig& c, const ThermalRecord& r, std::size_t s
   std::size_t p = 0;
   for (std::size_t k = 0; k < steps && p < points.size(); ++k) {
     const core::ThermalStepData& s = r.steps[k];
-    const core::ThermalTransition tr = core::thermal_transition(f.filter.network, s.load);
+    const core::ThermalRates rates = core::thermal_rates(f.filter.network, s.load);  // once: three uses
+    const core::ThermalTransition tr = core::thermal_transition(f.filter.network, rates, s.load.dt_s);
     t = tr.phi * t + tr.gamma;
     if (!(t.cwiseAbs().maxCoeff() < kRunawayBand_K)) break;
     if (points[p].step == k) {
-      const core::StepObservations o = core::step_observations(f, s, t, core::ThermalVec::Zero(), lag);
+      const core::StepObservations o = core::step_observations(f, s, rates, t, core::ThermalVec::Zero(), lag);
       for (; p < points.size() && points[p].step == k; ++p) {
         const double m = miss_K(o, points[p].kind, t, own_node(f.filter.network, points[p].kind));
         out[p] = std::isfinite(m) ? std::clamp(m / points[p].sigma_K, -kRunaway, kRunaway) : kRunaway;
       }
     }
-    advance_sensor_lag(f, s, t, lag);
+    advance_sensor_lag(f, s, rates, t, lag);
   }
   for (; p < points.size(); ++p) out[p] = kRunaway;
 }
@@ -460,7 +462,8 @@ void judge(const io::ThermalConfig& c, const ThermalRecord& r, std::size_t train
   std::vector<core::SensorLag> lag(r.steps.size());  // at each step's start
   for (std::size_t k = 0; k + 1 < r.steps.size(); ++k) {
     lag[k + 1] = lag[k];
-    advance_sensor_lag(judged, r.steps[k], out.open_loop_C[k], lag[k + 1]);
+    advance_sensor_lag(judged, r.steps[k], core::thermal_rates(f.filter.network, r.steps[k].load), out.open_loop_C[k],
+                       lag[k + 1]);
   }
   for (int kind = 0; kind < 3; ++kind) {
     SignalFit s;

@@ -78,7 +78,9 @@ class ThermalFilter {
   /// Starts from given temperatures (disturbances zero) with this covariance of the temperatures.
   void set_temperatures(const ThermalVec& t_C, const ThermalMat& p) noexcept;
   /// Advances by load.dt_s under `load` (nothing when dt_s ≤ 0).
-  void predict(const ThermalLoad& load) noexcept;
+  void predict(const ThermalLoad& load) noexcept { predict(load, thermal_rates(config_.network, load)); }
+  /// The same with the load's rates (thermal_rates(network, load)) formed by the caller.
+  void predict(const ThermalLoad& load, const ThermalRates& rates) noexcept;
   /// Applies one observation unless it is not finite or its innovation lies beyond the gate.
   [[nodiscard]] ObservationResult observe(const ThermalObservation& o) noexcept;
   /// Adds `variance_K2` to one node's variance (the model has drifted: a gate reset).

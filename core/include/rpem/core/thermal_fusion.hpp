@@ -76,17 +76,26 @@ struct WindingReadout {
   Eigen::Matrix<double, kDynamicThermalStates, 1> row = Eigen::Matrix<double, kDynamicThermalStates, 1>::Zero();
   double constant_K = 0.0;
 };
-[[nodiscard]] WindingReadout winding_readout(const ThermalFusionConfig& c, const ThermalLoad& load) noexcept;
+/// `rates`: the network's at the step's load (thermal_rates).
+[[nodiscard]] WindingReadout winding_readout(const ThermalFusionConfig& c, const ThermalRates& rates) noexcept;
 
 /// The observations of one step as the filter takes them, from a step's data and the state they linearise at.
 struct StepObservations {
   std::array<ThermalObservation, 3> item{};  ///< magnet (ψ̂m), winding (r̂s), winding sensor
   std::array<bool, 3> present{};
 };
-/// `lag`: the winding sensor's lag at the step's start (eq. 14.22; unused when the sensor has none).
+/// `rates`: the network's at the step's load (thermal_rates(network, s.load)); `lag`: the winding sensor's lag at
+/// the step's start (eq. 14.22; unused when the sensor has none).
 [[nodiscard]] StepObservations step_observations(const ThermalFusionConfig& c, const ThermalStepData& s,
-                                                 const ThermalVec& t_C, const ThermalVec& dt_dt_K_per_s,
+                                                 const ThermalRates& rates, const ThermalVec& t_C,
+                                                 const ThermalVec& dt_dt_K_per_s,
                                                  const SensorLag& lag = SensorLag{}) noexcept;
+/// The same with the rates formed here.
+[[nodiscard]] inline StepObservations step_observations(const ThermalFusionConfig& c, const ThermalStepData& s,
+                                                        const ThermalVec& t_C, const ThermalVec& dt_dt_K_per_s,
+                                                        const SensorLag& lag = SensorLag{}) noexcept {
+  return step_observations(c, s, thermal_rates(c.filter.network, s.load), t_C, dt_dt_K_per_s, lag);
+}
 
 class ThermalFusion {
  public:
@@ -118,7 +127,8 @@ class ThermalFusion {
 
  private:
   void start(const ThermalStepData& s) noexcept;
-  void finish_step(const ThermalStepData& d, double dt_s) noexcept;
+  /// `rates`: the network's at d.load, as the prediction took them.
+  void finish_step(const ThermalStepData& d, const ThermalRates& rates, double dt_s) noexcept;
 
   ThermalFusionConfig config_;
   ThermalObserver observer_;

@@ -122,6 +122,9 @@ struct ThermalTransition {
   ThermalVec gamma = ThermalVec::Zero();
   ThermalMat gamma_d = ThermalMat::Zero();  ///< [K/W]
 };
+/// `r`: the step's rates (thermal_rates of its load), for a caller that needs them besides (ThermalFusion forms them
+/// once a step for the transition, the observations and the readout).
+[[nodiscard]] ThermalTransition thermal_transition(const ThermalNetwork& n, const ThermalRates& r, double dt_s) noexcept;
 [[nodiscard]] ThermalTransition thermal_transition(const ThermalNetwork& n, const ThermalLoad& l) noexcept;
 
 /// The steady state T_∞ = −A⁻¹·u of a load held for ever (the nodes in use; unused ones at the coolant).
