@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "rpem/core/clock.hpp"
+#include "rpem/core/flatten.hpp"
 
 namespace rpem::core {
 namespace {
@@ -207,7 +208,7 @@ Vec2 SampleConditioner::observed_current_dq_A(const DriveSample& s, const Rotati
   return park(i_ab_A, logged);
 }
 
-[[gnu::flatten]] EstimatorSample SampleConditioner::condition(const DriveSample& s) noexcept {
+RPEM_FLATTEN EstimatorSample SampleConditioner::condition(const DriveSample& s) noexcept {
   EstimatorSample out;
   if (!finite(s)) {
     has_previous_ = false;

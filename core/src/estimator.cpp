@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "rpem/core/assert.hpp"
+#include "rpem/core/flatten.hpp"
 
 namespace rpem::core {
 namespace {
@@ -232,7 +233,7 @@ EstimatorOutput RpemEstimator::held(StepCode code) const noexcept {
   return {theta, u.epsilon_pu, u.i_hat_pu, u.gradient, gain.gain, StepCode::kAdapted, flags};  // every member: no zero fill
 }
 
-[[gnu::flatten]] EstimatorOutput RpemEstimator::step(const EstimatorSample& sample, const Admission& admission) noexcept {
+RPEM_FLATTEN EstimatorOutput RpemEstimator::step(const EstimatorSample& sample, const Admission& admission) noexcept {
   if (!finite(sample)) {
     state_.synchronized = false;
     state_.epsilon_valid = false;
