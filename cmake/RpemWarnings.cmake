@@ -13,12 +13,5 @@ function(rpem_target_defaults target)
   if(RPEM_SANITIZE)
     target_compile_options(${target} PRIVATE -fsanitize=${RPEM_SANITIZE} -fno-omit-frame-pointer)
     target_link_options(${target} PRIVATE -fsanitize=${RPEM_SANITIZE})
-    # The libraries (not the tests) at -O1 after the tree's own level (a Debug tree's -O0): the code the tests drive
-    # runs several times faster under ASan, while the test units, whose GoogleTest and Eigen templates make -O1
-    # costly to compile, keep the tree's level (docs/benchmarks.md, "The README test command on a fresh clone").
-    get_target_property(type ${target} TYPE)
-    if(type STREQUAL "STATIC_LIBRARY")
-      target_compile_options(${target} PRIVATE -O1)
-    endif()
   endif()
 endfunction()

@@ -4,7 +4,6 @@
 #include <cmath>
 
 #include "rpem/core/clock.hpp"
-#include "rpem/core/flatten.hpp"
 
 namespace rpem::core {
 namespace {
@@ -208,7 +207,7 @@ Vec2 SampleConditioner::observed_current_dq_A(const DriveSample& s, const Rotati
   return park(i_ab_A, logged);
 }
 
-RPEM_FLATTEN EstimatorSample SampleConditioner::condition(const DriveSample& s) noexcept {
+[[gnu::flatten]] EstimatorSample SampleConditioner::condition(const DriveSample& s) noexcept {
   EstimatorSample out;
   if (!finite(s)) {
     has_previous_ = false;

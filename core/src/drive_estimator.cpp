@@ -2,7 +2,6 @@
 
 #include <algorithm>
 
-#include "rpem/core/flatten.hpp"
 #include "rpem/core/frames.hpp"
 
 namespace rpem::core {
@@ -48,7 +47,7 @@ Estimate DriveEstimator::estimate(const DriveSample& sample, const EstimatorOutp
           .regime = regime};
 }
 
-RPEM_FLATTEN Estimate DriveEstimator::step(const DriveSample& sample) noexcept {
+[[gnu::flatten]] Estimate DriveEstimator::step(const DriveSample& sample) noexcept {
   const EstimatorSample conditioned = conditioner_.condition(sample);
   const PredictorInterval& iv = conditioned.interval;
   if (iv.dt_s > sparse_after_s_ && !conditioned.resync) [[unlikely]]

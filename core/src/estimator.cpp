@@ -4,7 +4,6 @@
 #include <cmath>
 
 #include "rpem/core/assert.hpp"
-#include "rpem/core/flatten.hpp"
 
 namespace rpem::core {
 namespace {
@@ -233,7 +232,7 @@ EstimatorOutput RpemEstimator::held(StepCode code) const noexcept {
   return {theta, u.epsilon_pu, u.i_hat_pu, u.gradient, gain.gain, StepCode::kAdapted, flags};  // every member: no zero fill
 }
 
-RPEM_FLATTEN EstimatorOutput RpemEstimator::step(const EstimatorSample& sample, const Admission& admission) noexcept {
+[[gnu::flatten]] EstimatorOutput RpemEstimator::step(const EstimatorSample& sample, const Admission& admission) noexcept {
   if (!finite(sample)) {
     state_.synchronized = false;
     state_.epsilon_valid = false;
