@@ -13,6 +13,7 @@
 #include "commands.hpp"
 #include "rpem/analysis/thermal/thermal_fit.hpp"
 #include "rpem/analysis/thermal/thermal_report.hpp"
+#include "rpem/analysis/thermal/thermal_topology.hpp"
 #include "rpem/io/errors.hpp"
 #include "rpem/io/thermal_config.hpp"
 

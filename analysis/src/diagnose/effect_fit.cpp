@@ -397,24 +397,22 @@ CalibrationIntervals EffectFitter::intervals(const EffectSet& set, double noise_
   const ClusterRobustCovariance cov = cluster_robust_covariance(h, g);
   const Eigen::MatrixXd& h_inv = cov.excitation;
   const Eigen::MatrixXd& robust = cov.robust;
-  const Eigen::VectorXd& unexcited = cov.unexcited;
   const double sigma2 = 0.5 * noise_floor_A * noise_floor_A;  // per residual component
   CalibrationIntervals out;
-  constexpr double kZ = 1.959964;
   constexpr double kInf = std::numeric_limits<double>::infinity();
   for (std::size_t i = 0; i < kCalibrated.size(); ++i) {
     const auto k = static_cast<Eigen::Index>(i);
     const double factor = 1.0 + kCalibrationScale * set.calibration[i];
-    const bool excited = unexcited[k] < 0.5;
-    out.half_width[i] = excited ? kZ * kCalibrationScale * std::sqrt(std::max(robust(k, k), 0.0)) / factor : kInf;
+    const bool excited = cov.excited(k);
+    out.half_width[i] = excited ? kZ95 * kCalibrationScale * std::sqrt(std::max(robust(k, k), 0.0)) / factor : kInf;
     out.change_per_A[i] = excited ? kCalibrationScale * std::sqrt(std::max(h_inv(k, k), 0.0)) / factor : kInf;
-    out.excitation_half_width[i] = excited ? kZ * kCalibrationScale * std::sqrt(sigma2 * h_inv(k, k)) / factor : kInf;
+    out.excitation_half_width[i] = excited ? kZ95 * kCalibrationScale * std::sqrt(sigma2 * h_inv(k, k)) / factor : kInf;
   }
   auto k = static_cast<Eigen::Index>(kCalibrated.size());
   for (const auto& p : set.parameters) {
     std::vector<double> hw;
     for (std::size_t i = 0; i < p.size(); ++i, ++k) {
-      hw.push_back(unexcited[k] < 0.5 ? kZ * std::sqrt(std::max(robust(k, k), 0.0)) : kInf);
+      hw.push_back(cov.excited(k) ? kZ95 * std::sqrt(std::max(robust(k, k), 0.0)) : kInf);
     }
     out.effect_half_width.push_back(hw);
   }

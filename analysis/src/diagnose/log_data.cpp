@@ -4,7 +4,7 @@
 #include <cmath>
 #include <cstdio>
 
-#include "median.hpp"
+#include "../median.hpp"
 #include "rpem/core/clock.hpp"
 #include "rpem/core/conditioner.hpp"
 #include "rpem/core/frames.hpp"

@@ -4,7 +4,7 @@
 #include <cmath>
 #include <cstdio>
 
-#include "median.hpp"
+#include "../median.hpp"
 
 namespace rpem::analysis {
 namespace {

@@ -10,6 +10,9 @@
 
 namespace rpem::analysis {
 
+/// The standard normal's two-sided 95 % quantile: a 95 % interval is ±kZ95·σ.
+inline constexpr double kZ95 = 1.959964;
+
 struct ClusterRobustCovariance {
   Eigen::MatrixXd excitation;  ///< H⁺: the covariance per unit residual variance (white residuals)
   Eigen::MatrixXd robust;      ///< c·H⁺·G·Gᵀ·H⁺

@@ -81,8 +81,4 @@ struct ThermalFitResult {
 /// (eq. 14.21a): ½·χ²₁(1 − 0.05/trials), the likelihood-ratio test at 5 % with Bonferroni's correction.
 [[nodiscard]] double likelihood_ratio_threshold(std::size_t trials);
 
-/// The default topologies (docs/thermal.md, "The network"): 2 nodes (winding, magnet) or 3 (winding,
-/// stator_iron, magnet), with starting values scaled to the record's copper loss and temperature rise.
-[[nodiscard]] io::ThermalConfig default_topology(const io::ThermalConfig& laws, const ThermalRecord& record, int nodes);
-
 }  // namespace rpem::analysis

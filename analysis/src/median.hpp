@@ -1,6 +1,6 @@
 #pragma once
-// The median of a sample, shared by the log's sampling statistics (log_data.cpp) and the verdict's noise floor
-// (verdict.cpp).
+// The median of a sample, shared by the log's sampling statistics (diagnose/log_data.cpp), the verdict's noise
+// floor (diagnose/verdict.cpp) and the thermal fit's typical operating point (thermal/network_layout.cpp).
 #include <algorithm>
 #include <cstddef>
 #include <vector>
