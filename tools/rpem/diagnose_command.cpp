@@ -15,6 +15,7 @@
 
 #include "commands.hpp"
 #include "diagnose_monitor.hpp"
+#include "log_options.hpp"
 #include "rpem/analysis/diagnose/diagnose_output.hpp"
 #include "rpem/analysis/work_pool.hpp"
 #include "rpem/io/errors.hpp"
@@ -210,13 +211,7 @@ Runner add_diagnose_command(CLI::App& app) {
   auto o = std::make_shared<DiagnoseCliOptions>();
   CLI::App* cmd = app.add_subcommand(
       "diagnose", "Show what the model gets wrong on measured data, name the cause, extend the model, measure the gain");
-  cmd->add_option("--log", o->log,
-                  "drive log, averaged log or VESC Tool realtime log (detected by its header), or any CSV with --log-map "
-                  "(docs/drive-log.md)")
-      ->required()
-      ->check(CLI::ExistingFile);
-  cmd->add_option("--log-map", o->log_map, "column map (YAML) saying how to read --log (docs/drive-log.md, \"Column maps\")")
-      ->check(CLI::ExistingFile);
+  add_log_options(*cmd, o->log, o->log_map);
   cmd->add_option("--config", o->config,
                   "machine configuration YAML, the baseline: its whole model, extensions and drift laws (default: built-in "
                   "paper-ipmsm); an extended.yaml of another recording is one")

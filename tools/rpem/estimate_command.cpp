@@ -14,6 +14,7 @@
 #include <string>
 
 #include "commands.hpp"
+#include "log_options.hpp"
 #include "progress.hpp"
 #include "rpem/core/averaged_estimator.hpp"
 #include "rpem/core/drive_estimator.hpp"
@@ -215,14 +216,7 @@ int run_estimate(const EstimateOptions& o) {
 Runner add_estimate_command(CLI::App& app) {
   auto opts = std::make_shared<EstimateOptions>();
   CLI::App* cmd = app.add_subcommand("estimate", "Run the RPEM estimator offline over a drive log");
-  cmd->add_option("--log", opts->log,
-                  "drive log, averaged log or VESC Tool realtime log (detected by its header), or any CSV with --log-map "
-                  "(docs/drive-log.md)")
-      ->required()
-      ->check(CLI::ExistingFile);
-  cmd->add_option("--log-map", opts->log_map,
-                  "column map (YAML) saying how to read --log (docs/drive-log.md, \"Column maps\")")
-      ->check(CLI::ExistingFile);
+  add_log_options(*cmd, opts->log, opts->log_map);
   cmd->add_option("--config", opts->config, "machine and estimator YAML (default: built-in paper-ipmsm.yaml)")
       ->check(CLI::ExistingFile);
   cmd->add_option("--out", opts->out, "estimate CSV to write")->required();

@@ -12,6 +12,7 @@
 #include <optional>
 
 #include "commands.hpp"
+#include "log_options.hpp"
 #include "rpem/analysis/analysis_figures.hpp"
 #include "rpem/analysis/diagnose/diagnose_output.hpp"
 #include "rpem/analysis/diagnose/regimes.hpp"
@@ -73,14 +74,7 @@ Runner add_figures_command(CLI::App& app) {
       app.add_subcommand("figures", "Write the paper's analysis figures for a machine (PNG), and a log's regimes");
   cmd->add_option("--out", opts->out, "output directory")->required();
   cmd->add_option("--config", opts->config, "machine YAML (default: built-in paper-ipmsm.yaml)")->check(CLI::ExistingFile);
-  cmd->add_option("--log", opts->log,
-                  "also draw this log's timeline coloured by regime (regimes.png): a drive log, averaged log or VESC Tool "
-                  "realtime log (detected by its header), or any CSV with --log-map")
-      ->check(CLI::ExistingFile);
-  cmd->add_option("--log-map", opts->log_map,
-                  "column map (YAML) saying how to read --log (docs/drive-log.md, \"Column maps\")")
-      ->check(CLI::ExistingFile)
-      ->needs("--log");
+  add_log_options(*cmd, opts->log, opts->log_map, "also draw this log's timeline coloured by regime (regimes.png)");
   cmd->add_option("--thermal-estimate", opts->thermal.estimate_csv,
                   "instead: plot this `rpem estimate --thermal` CSV's fused temperatures with their ±2σ band")
       ->check(CLI::ExistingFile);

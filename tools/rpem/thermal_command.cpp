@@ -1,5 +1,6 @@
-// rpem thermal fit --log LOG.csv --config CFG.yaml --out thermal.yaml [--start THERMAL.yaml | --nodes 2|3]
-//                  [--fit-until-s S] [--winding-sensor-sigma-K K] [--period-s S] [--report DIR]
+// rpem thermal fit --log LOG.csv [--log-map MAP.yaml] --config CFG.yaml --out thermal.yaml
+//                  [--start THERMAL.yaml | --nodes 2|3] [--fit-until-s S] [--winding-sensor-sigma-K K] [--period-s S]
+//                  [--report DIR]
 // Fits the machine's thermal network to what a log shows of its temperatures — a winding sensor, the
 // coolant, the magnet temperature from ψ̂m and the winding's from r̂s (the estimator run over the log) —
 // and writes the `thermal` section rpemd and `rpem estimate --thermal` read (docs/thermal.md). A magnet
@@ -11,6 +12,7 @@
 #include <limits>
 
 #include "commands.hpp"
+#include "log_options.hpp"
 #include "rpem/analysis/thermal/thermal_fit.hpp"
 #include "rpem/analysis/thermal/thermal_report.hpp"
 #include "rpem/analysis/thermal/thermal_topology.hpp"
@@ -21,7 +23,7 @@ namespace rpem::tools {
 namespace {
 
 struct ThermalFitCliOptions {
-  std::string log, config, out, start, report;
+  std::string log, log_map, config, out, start, report;
   int nodes = 2;
   double fit_until_s = std::numeric_limits<double>::quiet_NaN();
   double winding_sensor_sigma_K = 1.0;
@@ -37,7 +39,8 @@ int run_thermal_fit(const ThermalFitCliOptions& o) {
                                            : io::load_thermal_config(o.start, machine, io::NetworkRequired::kNo);
   if (o.period_s > 0.0) laws.fusion.observer.period_s = o.period_s;
   std::fprintf(stderr, "rpem thermal fit: running the estimator over %s\n", o.log.c_str());
-  const analysis::ThermalRecord record = analysis::record_thermal(o.log, machine, laws);
+  const analysis::ThermalRecord record = analysis::record_thermal(io::log_source(o.log, o.log_map), machine, laws);
+  std::fprintf(stderr, "rpem thermal fit: %s\n", record.read_as.c_str());
   if (record.winding_sensor && laws.fusion.winding_sensor_sigma_K <= 0.0)
     laws.fusion.winding_sensor_sigma_K = o.winding_sensor_sigma_K;
   if (!record.coolant) {
@@ -94,9 +97,7 @@ Runner add_thermal_command(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand("thermal", "The machine's thermal network (docs/thermal.md)");
   cmd->require_subcommand(1);
   CLI::App* fit = cmd->add_subcommand("fit", "Fit the thermal network to a log and write thermal.yaml");
-  fit->add_option("--log", opts->log, "drive log, phase samples or averaged (docs/drive-log.md)")
-      ->required()
-      ->check(CLI::ExistingFile);
+  add_log_options(*fit, opts->log, opts->log_map);
   fit->add_option("--config", opts->config, "machine and estimator YAML (default: built-in paper-ipmsm.yaml)")
       ->check(CLI::ExistingFile);
   fit->add_option("--out", opts->out, "thermal.yaml to write")->required();

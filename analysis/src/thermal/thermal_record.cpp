@@ -38,24 +38,26 @@ class Recorder {
 
 }  // namespace
 
-ThermalRecord record_thermal(const std::string& log_path, const io::MachineConfig& machine,
+ThermalRecord record_thermal(const io::LogSource& source, const io::MachineConfig& machine,
                              const io::ThermalConfig& thermal) {
   ThermalRecord r;
-  r.log = log_path;
-  if (io::is_averaged_log(log_path)) {
+  r.log = source.path;
+  const io::DriveLogLimits limits = io::machine_limits(machine.machine);
+  if (source.averaged()) {
     r.averaged = true;
-    io::AveragedLogLayout layout;
-    const std::vector<core::AveragedSample> samples = io::read_averaged_log(log_path, &layout);
-    io::check_averaged_supports(machine, "configuration", layout.u_dc, log_path);
-    r.winding_sensor = layout.t_winding;
-    r.coolant = layout.t_coolant;
+    io::AveragedLogRead read;
+    const std::vector<core::AveragedSample> samples = io::read_averaged_log(source.path, source.map, limits, &read);
+    io::check_averaged_supports(machine, "configuration", read.layout.u_dc, source.path);
+    r.winding_sensor = read.layout.t_winding;
+    r.coolant = read.layout.t_coolant;
+    r.read_as = io::describe(source, read);
     core::AveragedDriveEstimator estimator(machine.machine, machine.estimator);
     Recorder rec(r, machine, thermal, estimator.base());
     for (const core::AveragedSample& s : samples) rec.add(estimator.step(s), s.t_ns, s.t_coolant_C, s.t_winding_C);
     return r;
   }
-  io::DriveLogReader reader(log_path, io::machine_limits(machine.machine));
-  io::check_log_supports(machine, "configuration", reader.layout().u_dc, log_path);
+  io::DriveLogReader reader(source.path, source.map, limits);
+  io::check_log_supports(machine, "configuration", reader.layout().u_dc, source.path);
   r.winding_sensor = reader.layout().t_winding;
   r.coolant = reader.layout().t_coolant;
   core::DriveEstimator estimator(machine.machine, machine.estimator);
@@ -64,6 +66,7 @@ ThermalRecord record_thermal(const std::string& log_path, const io::MachineConfi
   while (reader.next(row)) {
     rec.add(estimator.step(row.sample), row.sample.t_ns, row.t_coolant_C.value_or(kNaN), row.t_winding_C.value_or(kNaN));
   }
+  r.read_as = source.path + " as " + source.format + io::describe(reader.reader().repairs());
   return r;
 }
 

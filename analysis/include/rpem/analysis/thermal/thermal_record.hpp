@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "rpem/core/thermal_observer.hpp"
+#include "rpem/io/log_source.hpp"
 #include "rpem/io/machine_config.hpp"
 #include "rpem/io/thermal_config.hpp"
 
@@ -19,11 +20,14 @@ struct ThermalRecord {
   bool winding_sensor = false;  ///< the log has T_winding
   bool coolant = false;         ///< the log has T_coolant (else thermal.coolant_C is used)
   bool averaged = false;
+  std::string read_as;  ///< what the log was read as, for the tools (io::describe; the format for phase samples)
 };
 
-/// Runs the configured estimator over the log (averaged or phase samples) and its observer with the
-/// thermal configuration's observer settings. Throws io::DriveLogError / io::ConfigError on bad input.
-[[nodiscard]] ThermalRecord record_thermal(const std::string& log_path, const io::MachineConfig& machine,
+/// Runs the configured estimator over the log — read as `source` says, as `rpem estimate` reads it: our drive or
+/// averaged log, VESC Tool's realtime log, a user's column map; each cell held to the machine's limits — and its
+/// observer with the thermal configuration's observer settings. Throws io::DriveLogError / io::ConfigError on bad
+/// input.
+[[nodiscard]] ThermalRecord record_thermal(const io::LogSource& source, const io::MachineConfig& machine,
                                            const io::ThermalConfig& thermal);
 
 }  // namespace rpem::analysis

@@ -1,0 +1,21 @@
+#include "log_options.hpp"
+
+namespace rpem::tools {
+
+void add_log_options(CLI::App& cmd, std::string& log, std::string& log_map, const std::string& purpose) {
+  const std::string formats =
+      "drive log, averaged log or VESC Tool realtime log (detected by its header), or any CSV with --log-map "
+      "(docs/drive-log.md)";
+  CLI::Option* log_option =
+      cmd.add_option("--log", log, purpose.empty() ? formats : purpose + ": " + formats)->check(CLI::ExistingFile);
+  CLI::Option* map_option =
+      cmd.add_option("--log-map", log_map, "column map (YAML) saying how to read --log (docs/drive-log.md, \"Column maps\")")
+          ->check(CLI::ExistingFile);
+  if (purpose.empty()) {
+    log_option->required();
+  } else {
+    map_option->needs(log_option);
+  }
+}
+
+}  // namespace rpem::tools

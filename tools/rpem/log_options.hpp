@@ -1,0 +1,14 @@
+#pragma once
+// --log and --log-map, as every subcommand that reads a drive log takes them (docs/drive-log.md): one text for
+// what a log may be, one reading of it (io::log_source).
+
+#include <CLI/CLI.hpp>
+#include <string>
+
+namespace rpem::tools {
+
+/// Adds --log and --log-map to `cmd`. Without `purpose` --log is required; with it (what the subcommand does
+/// with a log, said before what a log may be) --log is optional and --log-map needs it.
+void add_log_options(CLI::App& cmd, std::string& log, std::string& log_map, const std::string& purpose = "");
+
+}  // namespace rpem::tools
