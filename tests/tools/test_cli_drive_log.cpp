@@ -64,18 +64,20 @@ TEST_P(EveryToolReadingADriveLog, RefusesAValueNoDriveProduces) {
 INSTANTIATE_TEST_SUITE_P(Tools, EveryToolReadingADriveLog,
                          ::testing::Values(Tool{"estimate", "estimate --log LOG --out OUT"},
                                            Tool{"diagnose", "diagnose --log LOG --out OUT"},
-                                           Tool{"replay", "replay LOG --candump OUT"}),
+                                           Tool{"replay", "replay LOG --candump OUT"},
+                                           Tool{"thermal_fit", "thermal fit --log LOG --out OUT"}),
                          [](const auto& p) { return std::string(p.param.name); });
 
 TEST(CliDriveLog, ToolsThatKnowTheMachineHoldCurrentsToTenTimesItsRating) {
   // The built-in paper machine: 10·I_b = 10·√2·4.93 A = 69.7 A; 100 A is refused by the tools that know
-  // the machine (estimate, diagnose) and passed on by replay, which does not.
+  // the machine (estimate, diagnose, thermal fit) and passed on by replay, which does not.
   const fs::path dir = test::temp_path("cli_drive_log_machine");
   fs::create_directories(dir);
   const std::string log = (dir / "amps.csv").string();
   std::ofstream(log) << kHeader << "0,0,0,220,1,2,3,0,100,-100\n";
   for (const std::string& sub : {"estimate --log " + log + " --out " + (dir / "est.csv").string(),
-                                 "diagnose --log " + log + " --out " + (dir / "d").string()}) {
+                                 "diagnose --log " + log + " --out " + (dir / "d").string(),
+                                 "thermal fit --log " + log + " --out " + (dir / "t.yaml").string()}) {
     const test::ProcessResult r = test::run_command(test::binary_dir() + "/tools/rpem " + sub);
     EXPECT_EQ(r.exit_code, 65) << sub << "\n" << r.output;
     EXPECT_NE(r.output.find("amps.csv:2:9: column i_b: 100 A is beyond the plausible ±69.7207 A (10 x the configured "

@@ -29,7 +29,10 @@
 namespace rpem {
 namespace {
 
+// One port per test: ctest -j runs the tests of one binary at once, and a listener hears everything on its port
+// (the other test's crafted message, or its five estimates, fail this one).
 const std::string kUrl = "udpm://239.255.76.67:7819?ttl=0";
+const std::string kCraftedUrl = "udpm://239.255.76.67:7820?ttl=0";
 
 std::string source_dir() {
   const char* env = std::getenv("RPEM_SOURCE_DIR");
@@ -172,10 +175,11 @@ TEST(CliListenFormat, AMessageThatDoesNotDecodeIsCountedNotACrash) {
   at[3] = 0;
 
   test::ProcessResult heard;
-  std::thread listener(
-      [&] { heard = test::run_command(test::binary_dir() + "/tools/rpem listen --duration 2.0 --lcm-url '" + kUrl + "'"); });
+  std::thread listener([&] {
+    heard = test::run_command(test::binary_dir() + "/tools/rpem listen --duration 2.0 --lcm-url '" + kCraftedUrl + "'");
+  });
   {
-    lcm::LCM lcm(kUrl);
+    lcm::LCM lcm(kCraftedUrl);
     ASSERT_TRUE(lcm.good());
     std::this_thread::sleep_for(std::chrono::milliseconds(800));  // the listener subscribes
     lcm.publish("RPEM_ESTIMATE", crafted.data(), static_cast<unsigned>(crafted.size()));

@@ -1,8 +1,9 @@
 // The logs people have, as a user runs the tools on them (docs/drive-log.md): a VESC Tool realtime log
 // (detected by its header, no flag), the Paderborn bench data as published and SimpleFOC's monitor output
 // (through their maps in config/log-maps/), each read end to end by `rpem estimate`, `rpem diagnose` and
-// `rpem figures --log`;
-// and the exit codes and messages of a bad map (78) and of a log a map cannot read (65).
+// `rpem figures --log`; `rpem replay` streaming a mapped log of phase samples and refusing a log of averaged windows;
+// and the exit codes and messages of a bad map (78) and of a log a map cannot read (65), from every subcommand
+// that takes a map.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -174,13 +175,29 @@ TEST_F(CliLogFormats, SimpleFocMonitorOutputThroughItsMap) {
   EXPECT_NE(e.output.find("40 samples, psi_m ="), std::string::npos) << e.output;
   const test::ProcessResult d = test::run_command(rpem() + " diagnose" + args + " --blocks 4 --out " + path("diag"));
   EXPECT_EQ(d.exit_code, 0) << d.output;
+  // Phase samples: rpem replay streams them as telemetry, read through the same map.
+  const test::ProcessResult r = test::run_command(rpem() + " replay " + log + " --log-map " + maps() +
+                                                  "simplefoc-monitor.yaml --candump " + path("frames.log"));
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("rpem replay: 40 samples in"), std::string::npos) << r.output;
+}
+
+TEST_F(CliLogFormats, AVescToolLogIsNotReplayedItsRowsAreWindows) {
+  const std::string log = vesc_log(20);
+  const test::ProcessResult r = test::run_command(rpem() + " replay " + log + " --candump " + path("frames.log"));
+  EXPECT_EQ(r.exit_code, 65) << r.output;
+  EXPECT_NE(r.output.find(log + ":1: read as VESC Tool realtime log (the header of VESC Tool 1.20 and later), whose "
+                                "rows are averaged windows; rpem replay streams instantaneous phase samples"),
+            std::string::npos)
+      << r.output;
+  EXPECT_EQ(r.output.find("samples in"), std::string::npos) << r.output;  // nothing streamed
 }
 
 TEST_F(CliLogFormats, ABadMapExits78WithFileLineColumn) {
   const std::string map = path("map.yaml"), log = path("log.csv");
   std::ofstream(map) << "samples: instantaneous\ntime: {column: t}\ncolumns:\n  omega_el: {column: w, unit: rpm}\n";
   std::ofstream(log) << "t,w\n0,1\n";
-  for (const std::string sub : {"estimate", "diagnose"}) {
+  for (const std::string sub : {"estimate", "diagnose", "thermal fit"}) {
     const test::ProcessResult r =
         test::run_command(rpem() + " " + sub + " --log " + log + " --log-map " + map + " --out " + path("o"));
     EXPECT_EQ(r.exit_code, 78) << sub << r.output;
@@ -195,7 +212,7 @@ TEST_F(CliLogFormats, ALogItsMapCannotReadExits65) {
                         "columns:\n  omega_el: {column: erpm, unit: erpm}\n  u_d: {column: vd}\n  u_q: {column: vq}\n"
                         "  i_d: {column: id}\n  i_q: {column: iq}\n";
   std::ofstream(log) << "ms,erpm,vd,vq,id\n0,100,0,1,0\n";
-  for (const std::string sub : {"estimate", "diagnose"}) {
+  for (const std::string sub : {"estimate", "diagnose", "thermal fit"}) {
     const test::ProcessResult r =
         test::run_command(rpem() + " " + sub + " --log " + log + " --log-map " + map + " --out " + path("o"));
     EXPECT_EQ(r.exit_code, 65) << sub << r.output;

@@ -1,4 +1,4 @@
-// rpem replay LOG.csv --can IFACE [--rate X] [--classic] …   streams a drive log as telemetry
+// rpem replay LOG.csv [--log-map MAP.yaml] --can IFACE [--rate X] [--classic] …   streams a drive log as telemetry
 // rpem record --can IFACE --out LOG.csv [--duration S] …     writes received telemetry as a drive log
 // rpem record --can IFACE --averaged-out AVG.csv [--signal-map MAP.yaml | --vesc-id N] …
 //                                                          writes averaged rotor-frame samples (record_averaged.hpp)
@@ -12,11 +12,14 @@
 
 #include "can_stream.hpp"
 #include "commands.hpp"
+#include "log_options.hpp"
 #include "record_averaged.hpp"
 #include "rpem/can/decoder.hpp"
 #include "rpem/can/protocol.hpp"
 #include "rpem/core/clock.hpp"
 #include "rpem/io/drive_log.hpp"
+#include "rpem/io/errors.hpp"
+#include "rpem/io/log_source.hpp"
 
 namespace rpem::tools {
 namespace {
@@ -25,7 +28,7 @@ std::atomic<bool> g_can_stop{false};
 void on_can_stop_signal(int) { g_can_stop = true; }
 
 struct ReplayOptions {
-  std::string log;
+  std::string log, log_map;
   StreamOptions stream;
 };
 
@@ -34,7 +37,16 @@ int run_replay(const ReplayOptions& o) {
     std::fprintf(stderr, "rpem replay: give --can IFACE and/or --candump FILE\n");
     return kExitUsage;
   }
-  io::DriveLogReader reader(o.log);
+  // Phase samples only: the telemetry carries instantaneous samples (docs/can-protocol.md), which a log of
+  // averaged windows does not hold.
+  const io::LogSource source = io::log_source(o.log, o.log_map);
+  if (source.averaged()) {
+    throw io::DriveLogError(o.log, 1, 0, "",
+                            "read as " + source.format +
+                                ", whose rows are averaged windows; rpem replay streams instantaneous phase samples "
+                                "(a drive log, or a CSV of them through --log-map)");
+  }
+  io::DriveLogReader reader(o.log, source.map, {});
   TelemetryStreamer streamer(o.stream);
   io::DriveLogRow row;
   std::uint64_t n = 0;
@@ -132,7 +144,10 @@ int run_record(const RecordOptions& o) {
 Runner add_replay_command(CLI::App& app) {
   auto opts = std::make_shared<ReplayOptions>();
   CLI::App* cmd = app.add_subcommand("replay", "Stream a drive log as rpem telemetry on a CAN interface");
-  cmd->add_option("log", opts->log, "drive-log CSV")->required()->check(CLI::ExistingFile);
+  cmd->add_option("log", opts->log, "drive log (phase samples), or a CSV of them with --log-map (docs/drive-log.md)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  add_log_map_option(*cmd, opts->log_map);
   cmd->add_option("--can", opts->stream.interface, "SocketCAN interface (e.g. vcan0)");
   add_stream_options(cmd, opts->stream);
   return [cmd, opts]() { return cmd->parsed() ? run_replay(*opts) : -1; };

@@ -8,14 +8,18 @@ void add_log_options(CLI::App& cmd, std::string& log, std::string& log_map, cons
       "(docs/drive-log.md)";
   CLI::Option* log_option =
       cmd.add_option("--log", log, purpose.empty() ? formats : purpose + ": " + formats)->check(CLI::ExistingFile);
-  CLI::Option* map_option =
-      cmd.add_option("--log-map", log_map, "column map (YAML) saying how to read --log (docs/drive-log.md, \"Column maps\")")
-          ->check(CLI::ExistingFile);
+  CLI::Option* map_option = add_log_map_option(cmd, log_map);
   if (purpose.empty()) {
     log_option->required();
   } else {
     map_option->needs(log_option);
   }
+}
+
+CLI::Option* add_log_map_option(CLI::App& cmd, std::string& log_map) {
+  return cmd
+      .add_option("--log-map", log_map, "column map (YAML) saying how to read the log (docs/drive-log.md, \"Column maps\")")
+      ->check(CLI::ExistingFile);
 }
 
 }  // namespace rpem::tools

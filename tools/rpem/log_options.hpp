@@ -11,4 +11,7 @@ namespace rpem::tools {
 /// with a log, said before what a log may be) --log is optional and --log-map needs it.
 void add_log_options(CLI::App& cmd, std::string& log, std::string& log_map, const std::string& purpose = "");
 
+/// Adds --log-map alone, for a subcommand whose log is a positional argument (rpem replay).
+CLI::Option* add_log_map_option(CLI::App& cmd, std::string& log_map);
+
 }  // namespace rpem::tools
