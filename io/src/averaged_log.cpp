@@ -9,30 +9,6 @@
 
 namespace rpem::io {
 
-bool is_averaged_log(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw DriveLogError(path, 0, 0, "", "cannot open file");
-  std::string header;
-  std::getline(in, header);
-  std::size_t start = 0;
-  while (start <= header.size()) {
-    const std::size_t comma = std::min(header.find(',', start), header.size());
-    std::string cell = header.substr(start, comma - start);
-    const auto first = cell.find_first_not_of(" \t\r\"");
-    const auto last = cell.find_last_not_of(" \t\r\"");
-    if (first != std::string::npos && cell.substr(first, last - first + 1) == "t_start") return true;
-    start = comma + 1;
-  }
-  return false;
-}
-
-std::vector<core::AveragedSample> read_averaged_log(const std::string& path, AveragedLogLayout* layout_out) {
-  AveragedLogRead read;
-  std::vector<core::AveragedSample> samples = read_averaged_log(path, averaged_log_map(), DriveLogLimits{}, &read);
-  if (layout_out) *layout_out = read.layout;
-  return samples;
-}
-
 std::vector<core::AveragedSample> read_averaged_log(const std::string& path, const LogMap& map, const DriveLogLimits& limits,
                                                     AveragedLogRead* read_out) {
   if (!map.averaged()) {

@@ -31,14 +31,6 @@ struct AveragedLogLayout {
   bool t_coolant = false;
 };
 
-/// True if the CSV's header has a t_start column (an averaged log); throws DriveLogError if unreadable.
-[[nodiscard]] bool is_averaged_log(const std::string& path);
-
-/// Reads a whole averaged log. Every problem throws DriveLogError naming file, line and column: a missing
-/// required column, a required cell that is not a finite number, t that does not increase, t_start after t.
-[[nodiscard]] std::vector<core::AveragedSample> read_averaged_log(const std::string& path,
-                                                                  AveragedLogLayout* layout = nullptr);
-
 /// What reading an averaged log through a map did besides delivering samples.
 struct AveragedLogRead {
   AveragedLogLayout layout;
