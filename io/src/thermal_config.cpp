@@ -68,6 +68,7 @@ ThermalConfig default_thermal_config(const MachineConfig& machine) {
   c.node_names[1] = "magnet";
   n.base = core::loss_base_of(core::PerUnitBase::from_rated(machine.machine.rated), machine.machine);
   n.copper = machine.rs_drift.law.value_or(core::DriftLaw{core::kCopper.typical_per_K, core::kMaterialReference_C, 0.0});
+  c.copper_reference_stated = machine.rs_drift.law.has_value();
   if (n.copper.value_ref <= 0.0) n.copper.value_ref = machine.machine.r_s_Ohm;
   core::DriftLaw& m = c.fusion.magnet_law;
   m = machine.psim_drift.law.value_or(core::DriftLaw{core::kNdFeB.typical_per_K, core::kMaterialReference_C, 0.0});
@@ -223,6 +224,7 @@ ThermalConfig parse_thermal_config(YamlMap& section, const MachineConfig& machin
     b->finish();
   }
   if (auto m = section.optional_map("copper")) {
+    c.copper_reference_stated = c.copper_reference_stated || m->has("reference_C");
     n.copper =
         parse_law(*m, "r_s_ref_Ohm", n.copper, 1e4, true, f.filter.calibration_sigma, core::Calibration::kCopperOffset,
                   core::Calibration::kCopperCoefficient, &f.filter.copper_rel_sigma, &n.copper_scale);

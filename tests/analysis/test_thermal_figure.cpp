@@ -4,8 +4,10 @@
 
 #include <filesystem>
 #include <string>
+#include <vector>
 
 #include "rpem/analysis/thermal/thermal_figure.hpp"
+#include "support/gnuplot_text.hpp"
 #include "support/temp_file.hpp"
 
 namespace rpem::analysis {
@@ -39,6 +41,7 @@ TEST(ThermalFigure, CoverageCountsTheMeasuredPointsAfterTheLineInsideTheBand) {
   const std::string gp = test::read_file(script.path());
   EXPECT_NE(gp.find("title \"measured (T_magnet)\" noenhanced"), std::string::npos) << gp.substr(gp.rfind("plot"));
   EXPECT_NE(gp.find("title \"measured (T_winding)\" noenhanced"), std::string::npos);
+  EXPECT_EQ(test::misprinted_gnuplot_text(gp), std::vector<std::string>{});
 }
 
 }  // namespace

@@ -106,6 +106,9 @@ TEST(ThermalConfig, DefaultsComeFromTheMachineAndTheMaterials) {
   EXPECT_DOUBLE_EQ(c.fusion.magnet_law.value_ref, mc.machine.psi_m_Wb);
   EXPECT_DOUBLE_EQ(c.fusion.magnet_law.coeff_per_K, core::kNdFeB.typical_per_K);
   EXPECT_DOUBLE_EQ(c.fusion.filter.network.copper.value_ref, mc.machine.r_s_Ohm);
+  // The built-in machine has no rs_drift: r_s_Ohm is assumed at copper's 20 °C, and the fit must say so.
+  EXPECT_DOUBLE_EQ(c.fusion.filter.network.copper.reference_C, 20.0);
+  EXPECT_FALSE(c.copper_reference_stated);
   // σ of α (eq. 14.11a): NdFeB's typical −0.12 %/K is 0.04 %/K from its range's farther end (−0.08), half of
   // which is 16.7 % of it, more than the uniform spread's 0.05/(√12·0.12) = 12.0 %. Copper: the uniform's 8.7 %.
   EXPECT_NEAR(c.fusion.filter.calibration_sigma[static_cast<int>(core::Calibration::kMagnetCoefficient)],
@@ -205,7 +208,15 @@ TEST(ThermalConfig, AFitsStartMayGiveTheLawsOnly) {
   const ThermalConfig c = load_thermal_config(f.path(), machine(), NetworkRequired::kNo);
   EXPECT_FALSE(c.has_network);
   EXPECT_DOUBLE_EQ(c.fusion.filter.network.copper.reference_C, 120.0);
+  EXPECT_TRUE(c.copper_reference_stated);
   EXPECT_THROW((void)load_thermal_config(f.path(), machine()), ConfigError);  // rpemd needs the network
+  // A copper map without reference_C states a scale, not where R_s was measured; the machine's rs_drift does.
+  test::TempFile scale("scale.yaml", "thermal:\n  copper: {loss_scale: 0.8}\n");
+  EXPECT_FALSE(load_thermal_config(scale.path(), machine(), NetworkRequired::kNo).copper_reference_stated);
+  MachineConfig drifting = machine();
+  drifting.rs_drift.law = core::DriftLaw{0.00393, 75.0, 0.0};
+  EXPECT_TRUE(default_thermal_config(drifting).copper_reference_stated);
+  EXPECT_DOUBLE_EQ(default_thermal_config(drifting).fusion.filter.network.copper.reference_C, 75.0);
   test::TempFile g("bad.yaml", "thermal:\n  losses: []\n");
   EXPECT_THROW((void)load_thermal_config(g.path(), machine(), NetworkRequired::kNo), ConfigError);
 }

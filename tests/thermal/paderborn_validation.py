@@ -49,6 +49,9 @@ def main() -> int:
                 sys.exit(f"{log} carries the magnet sensor")
     run([a.rpem, "thermal", "fit", "--log", w("full.csv"), "--config", cfg, "--start", start, "--fit-until-s", str(SPLIT_S),
          "--out", w("thermal.yaml"), "--report", w("fit")])
+    with open(w("thermal.yaml")) as f:
+        if "copper law takes" in f.read():  # the start states R_s's temperature: no assumption to note
+            sys.exit("thermal.yaml notes an assumed copper reference although the start gives reference_C")
     run([a.rpem, "estimate", "--log", w("honest.csv"), "--config", cfg, "--thermal", w("thermal.yaml"), "--out", w("honest_est.csv")])
     run([a.rpem, "estimate", "--log", w("full.csv"), "--config", cfg, "--thermal", w("thermal.yaml"), "--out", w("full_est.csv")])
 

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "support/data_file.hpp"
+#include "support/gnuplot_text.hpp"
 #include "support/process.hpp"
 #include "support/temp_file.hpp"
 
@@ -67,6 +68,7 @@ TEST(CliDiagnose, FindsAHiddenDeadTimeAndTheExtendedModelCarriesIntoTheTools) {
                         "residual_map.png", "overlay.png", "harmonics.png", "phase_sign.png", "estimates.png"}) {
     EXPECT_GT(fs::file_size(out + "/" + f), 1000U) << f;
   }
+  EXPECT_EQ(test::misprinted_gnuplot_text_in(out), std::vector<std::string>{});
   const nlohmann::json d = nlohmann::json::parse(read(out + "/diagnosis.json"));
   ASSERT_EQ(d["effects"].size(), 1U) << d.dump(2);
   EXPECT_EQ(d["effects"][0]["name"], "deadtime");
@@ -161,6 +163,9 @@ TEST(CliDiagnose, PaderbornWorkedExampleKeepsItsResult) {
   const nlohmann::json d = nlohmann::json::parse(read(dir + "/diagnosis/diagnosis.json"));
   EXPECT_EQ(d["log"]["model"], "steady_state");
   EXPECT_EQ(d["log"]["excluded_idle"], 2);
+  // The log's winding temperature gives the residual-against-temperature figure, whose axis names it.
+  ASSERT_TRUE(fs::exists(dir + "/diagnosis/residual_temperature.gp"));
+  EXPECT_EQ(test::misprinted_gnuplot_text_in(dir + "/diagnosis"), std::vector<std::string>{});
   const double baseline = d["baseline"]["heldout_rms"], extended = d["extended"]["heldout_rms"];
   EXPECT_GT(baseline, 7.5);
   EXPECT_LT(baseline, 9.5);

@@ -13,6 +13,7 @@
 #include <sstream>
 #include <string>
 
+#include "support/gnuplot_text.hpp"
 #include "support/process.hpp"
 #include "support/temp_file.hpp"
 #include "support/vesc_tool_vectors.hpp"
@@ -84,6 +85,7 @@ TEST_F(CliLogFormats, FiguresDrawAVescToolLogsRegimes) {
   EXPECT_NE(r.output.find("rpem figures: wrote " + path("fig") + "/regimes.png"), std::string::npos) << r.output;
   EXPECT_GT(fs::file_size(path("fig/regimes.png")), 10'000u);
   EXPECT_TRUE(fs::exists(path("fig/Fig_EigenTraj.png")));
+  EXPECT_EQ(test::misprinted_gnuplot_text_in(path("fig")), std::vector<std::string>{});
 }
 
 TEST_F(CliLogFormats, FiguresReadAMappedLogAndRefuseABadOneBeforeDrawing) {

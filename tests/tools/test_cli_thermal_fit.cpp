@@ -77,6 +77,11 @@ TEST_F(CliThermalFit, ReadsAVescToolLogItsMotorSensorTheWinding) {
   EXPECT_NE(r.output.find("vesc.csv as VESC Tool realtime log (the header of VESC Tool 1.20 and later)"), std::string::npos)
       << r.output;
   EXPECT_NE(r.output.find("has no T_coolant column"), std::string::npos) << r.output;
+  // The outrunner's configuration says nothing of where its 25 mOhm were measured: the fit says what it assumed,
+  // on the terminal and in thermal.yaml, where the user who reads it can correct it.
+  const std::string assumed = "the copper law takes r_s_ref 0.025 Ohm at 20 °C, an assumption";
+  EXPECT_NE(r.output.find("note: " + assumed), std::string::npos) << r.output;
+  EXPECT_NE(test::read_file(dir_ + "/thermal.yaml").find("# note: " + assumed), std::string::npos);
 
   // Every step of the filter has the motor sensor, and the network fitted on the first 75 % follows the held-out
   // quarter of a 30 K cool-down open loop within a few of the sensor's quanta (measured 0.11 K RMS, 0.17 K worst).

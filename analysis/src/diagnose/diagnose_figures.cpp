@@ -151,7 +151,7 @@ std::string residual_vs_temperature(const std::string& dir, const Diagnosis& d) 
   fig.add_data(std::move(b));
   fig.add_line(std::string("set title 'Mean residual against the ") + (winding ? "winding" : "magnet") +
                " temperature' noenhanced");
-  fig.add_line(std::string("set xlabel '") + (winding ? "T_winding" : "T_magnet") +
+  fig.add_line(std::string("set xlabel '") + (winding ? "T_{winding}" : "T_{magnet}") +
                " [°C]'; set ylabel 'mean ε [A]'; set grid; set key outside right");
   fig.add_line(
       "plot $t u 1:2 w lp pt 7 ps 0.6 lc rgb '#d62728' t 'ε_d configuration', '' u 1:3 w lp pt 7 ps 0.6 lc rgb '#ff7f0e' t 'ε_q configuration', "

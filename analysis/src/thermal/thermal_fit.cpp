@@ -5,6 +5,7 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 
 #include "filter_likelihood.hpp"
 #include "network_layout.hpp"
@@ -317,6 +318,18 @@ std::size_t anchor_magnet_reference(io::ThermalConfig& c, const ThermalRecord& r
   return used;
 }
 
+/// The note when the copper law's reference temperature was not stated but assumed (io::ThermalConfig).
+std::string assumed_copper_reference(const core::DriftLaw& copper) {
+  char text[384];
+  std::snprintf(text, sizeof text,
+                "the copper law takes r_s_ref %.5g Ohm at %.4g °C, an assumption: neither the machine's rs_drift nor "
+                "the start's copper says at what temperature R_s was measured. If it was measured hot, every "
+                "winding temperature r_s gives and the copper loss are off; say so with copper: {reference_C: …} "
+                "(docs/thermal.md)",
+                copper.value_ref, copper.reference_C);
+  return text;
+}
+
 }  // namespace
 
 ThermalFitResult fit_thermal(const ThermalRecord& record, const io::ThermalConfig& start_config,
@@ -335,6 +348,7 @@ ThermalFitResult fit_thermal(const ThermalRecord& record, const io::ThermalConfi
   out.training_steps = training;
 
   io::ThermalConfig start = start_config;
+  if (!start.copper_reference_stated) out.notes.push_back(assumed_copper_reference(start.fusion.filter.network.copper));
   // A winding sensor without a configured lag: τ_s from the standstills where r̂s reads the winding (eq. 14.25),
   // before the network, which then stands for the sensor's reading (eq. 14.24).
   if (record.winding_sensor && start.fusion.winding_sensor_sigma_K > 0.0 &&

@@ -17,6 +17,9 @@ struct ThermalConfig {
   core::ThermalFusionConfig fusion;
   std::array<std::string, core::kMaxThermalNodes> node_names{};
   bool has_network = true;  ///< `nodes` given (a fit's start may give the laws only)
+  /// Whether the temperature at which the copper law's r_s_ref holds was stated (the machine's `rs_drift` or
+  /// the section's `copper`), or the machine's r_s_Ohm was assumed to hold at copper's 20 °C reference.
+  bool copper_reference_stated = true;
 };
 
 /// Whether a section must give the network (rpemd, `rpem estimate`) or may give the laws only (a fit's start).
