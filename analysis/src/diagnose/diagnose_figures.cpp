@@ -5,8 +5,10 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 
+#include "../median.hpp"
 #include "rpem/analysis/diagnose/diagnose_output.hpp"
 #include "rpem/analysis/gnuplot.hpp"
 #include "rpem/core/clock.hpp"
@@ -241,6 +243,44 @@ std::string regime_timeline(const std::string& dir, const LogData& log, const Lo
 
 DataBlock track_block(const char* name, const ParameterTrack& t) { return {name, {t.t_s, t.psi_m_Wb, t.r_s_Ohm}}; }
 
+/// A panel's y range for the values rows imply: their median ± 6 robust standard deviations (1.4826·MAD), widened
+/// to the models' values, so that a few rows the steady-state model cannot represent (a transient inside a
+/// window, an unlocked start-up too slow to judge) do not shrink the rest to a line. Empty: autoscale (no spread).
+/// Steady-state logs only: the implied values are one per row of the models' tracks.
+/// `outside`: how many implied values the range leaves out.
+std::string robust_yrange(const std::vector<double>& implied, const std::vector<double>& nominal,
+                          const std::vector<double>& extended, std::size_t& outside) {
+  std::vector<double> v;
+  for (double x : implied) {
+    if (std::isfinite(x)) v.push_back(x);
+  }
+  outside = 0;
+  if (v.empty()) return "";
+  const double m = median(v);
+  std::vector<double> deviation(v.size());
+  std::transform(v.begin(), v.end(), deviation.begin(), [m](double x) { return std::abs(x - m); });
+  const double spread = 6.0 * 1.4826 * median(deviation);
+  if (!(spread > 1e-6 * std::abs(m))) return "";  // no spread to speak of: gnuplot's autoscale widens a constant
+  double lo = m - spread, hi = m + spread;
+  for (const std::vector<double>* model : {&nominal, &extended}) {
+    for (double x : *model) {
+      lo = std::min(lo, x);
+      hi = std::max(hi, x);
+    }
+  }
+  outside = static_cast<std::size_t>(std::count_if(v.begin(), v.end(), [&](double x) { return x < lo || x > hi; }));
+  const double pad = 0.05 * (hi - lo);
+  char range[96];
+  std::snprintf(range, sizeof range, "set yrange [%.17g:%.17g]; ", lo - pad, hi + pad);  // exact: a range may be narrow
+  return range;
+}
+
+/// A steady-state panel's title: what the rows leave out of the plotted range, if any.
+std::string implied_title(const char* title, std::size_t outside) {
+  return outside == 0 ? std::string(title)
+                      : std::string(title) + " (" + std::to_string(outside) + " implied values beyond the range)";
+}
+
 std::string estimates(const std::string& dir, const Diagnosis& d) {
   const EstimatorComparison& c = d.estimates;
   const bool rpem = c.method == "rpem";
@@ -260,12 +300,16 @@ std::string estimates(const std::string& dir, const Diagnosis& d) {
                      : "ψm and R_s as each model assumes them, and as each steady-state row implies them") +
                "' noenhanced");
   fig.add_line("set grid; set xlabel 't [s]'; set key outside right");
-  fig.add_line("set title 'magnet flux linkage'; set ylabel 'ψm [Wb]'; plot $nom u 1:2 " + style +
-               " lc rgb '#d62728' t 'configuration', $ext u 1:2 " + style + " lc rgb '#2ca02c' t 'extended'" +
-               with_truth(2));
-  fig.add_line("set title 'stator resistance'; set ylabel 'R_s [Ω]'; plot $nom u 1:3 " + style +
-               " lc rgb '#d62728' t 'configuration', $ext u 1:3 " + style + " lc rgb '#2ca02c' t 'extended'" +
-               with_truth(3));
+  std::size_t psi_outside = 0, r_outside = 0;
+  const std::string psi_range =
+      rpem ? "" : robust_yrange(c.truth.psi_m_Wb, c.nominal.psi_m_Wb, c.extended.psi_m_Wb, psi_outside);
+  const std::string r_range = rpem ? "" : robust_yrange(c.truth.r_s_Ohm, c.nominal.r_s_Ohm, c.extended.r_s_Ohm, r_outside);
+  fig.add_line(psi_range + "set title " + gp_quote(implied_title("magnet flux linkage", psi_outside)) +
+               "; set ylabel 'ψm [Wb]'; plot $nom u 1:2 " + style + " lc rgb '#d62728' t 'configuration', $ext u 1:2 " +
+               style + " lc rgb '#2ca02c' t 'extended'" + with_truth(2));
+  fig.add_line("set autoscale y; " + r_range + "set title " + gp_quote(implied_title("stator resistance", r_outside)) +
+               "; set ylabel 'R_s [Ω]'; plot $nom u 1:3 " + style + " lc rgb '#d62728' t 'configuration', $ext u 1:3 " +
+               style + " lc rgb '#2ca02c' t 'extended'" + with_truth(3));
   fig.add_line("unset multiplot");
   fig.render();
   return "estimates.png";

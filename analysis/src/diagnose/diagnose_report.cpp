@@ -333,8 +333,12 @@ void estimator(ReportDocument& doc, const Diagnosis& d) {
           : "A steady-state log cannot drive the recursive estimator (its samples lie seconds apart). Instead, "
             "each row's steady-state equations give the ψm and R_s the data implies — R_s = (u_d + ω·L_q·i_q)/i_d, "
             "ψm = (u_q − R_s·i_q)/ω − L_d·i_d, with the extended model's corrections — set against what the "
-            "configuration assumes and what the extended model assumes (its drifts). Values: "
-            "mean over the last quarter; errors: RMS against the implied values over the second half.");
+            "configuration assumes and what the extended model assumes (its drifts). A row implies a value only "
+            "where the data's noise determines it (the value beyond z of its standard deviation; not ψm near "
+            "standstill, not R_s where i_d is near zero). Values: mean over the last quarter; errors: the median "
+            "of the relative error's magnitude against the implied values over the second half (a few rows the "
+            "steady-state model cannot represent imply anything at all; the figure's range leaves them out and "
+            "says how many).");
   doc.figure("estimates.png", c.method == "rpem"
                                   ? "ψm and R_s estimated with the configuration (red) and the extended model (green)."
                                   : "ψm and R_s as the configuration (red) and the extended model (green) assume them, "

@@ -238,8 +238,8 @@ Diagnosis diagnose(LogData log, const io::MachineConfig& config, const DiagnoseO
   monitor.stage("comparing the models over the whole log", (transient ? 2 * n : 0) + 2 * n);
   pool.parallel_for(2, [&](std::size_t i) {
     if (i == 0) {
-      d.estimates =
-          compare_estimates(*d.log, config, d.extended_config, d.extended_model, d.context, truth, pool, options.monitor);
+      d.estimates = compare_estimates(*d.log, config, d.extended_config, d.extended_model, d.context, truth,
+                                      d.regimes.noise_pu, pool, options.monitor);
     } else {
       comparison_pass(replay, d.context, base, d.extended_model, baseline, d.statistics, d.figures);
     }

@@ -2,13 +2,18 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
+#include <optional>
 
+#include "../median.hpp"
 #include "rpem/core/clock.hpp"
 #include "rpem/core/drive_estimator.hpp"
 #include "rpem/io/csv_table.hpp"
 
 namespace rpem::analysis {
 namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 /// Points kept per track.
 constexpr std::size_t kTrackPoints = 2000;
@@ -24,11 +29,33 @@ double interpolate(const std::vector<double>& t, const std::vector<double>& v, d
   return v[j - 1] + w * (v[j] - v[j - 1]);
 }
 
+/// A relative error over the terms added where the truth was finite (determined there): the RMS against a true
+/// track; against what rows imply, the median of its magnitude, since a few rows the steady-state model cannot
+/// represent (a transient inside a window, an unlocked start-up too slow to judge) imply anything at all.
+struct RelativeError {
+  bool robust = false;
+  std::vector<double> magnitudes;
+  void add(double value, double truth) {
+    if (std::isfinite(truth)) magnitudes.push_back(std::abs(value / truth - 1.0));
+  }
+  [[nodiscard]] std::optional<double> pct() const {
+    if (magnitudes.empty()) return std::nullopt;
+    if (robust) return 100.0 * median(magnitudes);
+    double sum = 0.0;
+    for (double e : magnitudes) sum += e * e;
+    return 100.0 * std::sqrt(sum / static_cast<double>(magnitudes.size()));
+  }
+};
+
 EstimateSummary summarise(const ParameterTrack& track, const ParameterTrack& truth) {
   EstimateSummary s;
   if (track.empty()) return s;
+  // The steady-state method's truth holds a value per row of the track: compared row by row (a row where it
+  // is not determined is NaN, and interpolating would carry the NaN to its neighbours).
+  const bool by_row = truth.t_s == track.t_s;
   const double t0 = track.t_s.front(), t1 = track.t_s.back();
-  double psi = 0.0, r = 0.0, n = 0.0, e_psi = 0.0, e_r = 0.0, m = 0.0;
+  double psi = 0.0, r = 0.0, n = 0.0;
+  RelativeError e_psi{by_row, {}}, e_r{by_row, {}};
   for (std::size_t k = 0; k < track.t_s.size(); ++k) {
     const double t = track.t_s[k];
     if (t >= t0 + 0.75 * (t1 - t0)) {
@@ -37,17 +64,14 @@ EstimateSummary summarise(const ParameterTrack& track, const ParameterTrack& tru
       n += 1.0;
     }
     if (!truth.empty() && t >= t0 + 0.5 * (t1 - t0)) {
-      e_psi += std::pow(track.psi_m_Wb[k] / interpolate(truth.t_s, truth.psi_m_Wb, t) - 1.0, 2);
-      e_r += std::pow(track.r_s_Ohm[k] / interpolate(truth.t_s, truth.r_s_Ohm, t) - 1.0, 2);
-      m += 1.0;
+      e_psi.add(track.psi_m_Wb[k], by_row ? truth.psi_m_Wb[k] : interpolate(truth.t_s, truth.psi_m_Wb, t));
+      e_r.add(track.r_s_Ohm[k], by_row ? truth.r_s_Ohm[k] : interpolate(truth.t_s, truth.r_s_Ohm, t));
     }
   }
   s.psi_m_Wb = n > 0 ? psi / n : track.psi_m_Wb.back();
   s.r_s_Ohm = n > 0 ? r / n : track.r_s_Ohm.back();
-  if (m > 0) {
-    s.psi_m_error_pct = 100.0 * std::sqrt(e_psi / m);
-    s.r_s_error_pct = 100.0 * std::sqrt(e_r / m);
-  }
+  s.psi_m_error_pct = e_psi.pct();
+  s.r_s_error_pct = e_r.pct();
   return s;
 }
 
@@ -64,23 +88,37 @@ ParameterTrack run_rpem(const LogData& log, const io::MachineConfig& config, Mon
   return track;
 }
 
-/// Per used steady-state row: what the data implies (→ implied) and what each model assumes.
+/// Per used steady-state row: what the data implies (→ truth; NaN where the row does not determine it) and what
+/// each model assumes.
 void steady_state_tracks(const LogData& log, const EffectContext& context, const ExtendedModel& model,
-                         EstimatorComparison& c) {
+                         const core::RegimeNoise& noise, double z, EstimatorComparison& c) {
   const core::MachineSi& machine = context.base.machine;
   const core::PerUnitBase base = core::PerUnitBase::from_rated(machine.rated);
   const core::MachinePu pu = core::to_pu(base, model.machine);
   const core::SampleConditioner conditioner(base, pu, model.extensions);
+  const double z_sq = z * z;
   for (std::size_t k = 0; k < log.size(); ++k) {
     if (!log.used(k)) continue;
     const core::DriveSample sample = log.sample(k);
     const core::SteadyStateInputs in = conditioner.steady_state(sample);
-    if (std::abs(in.n_pu) < 1e-3 || std::abs(in.i_pu[0]) < 1e-6) continue;
     const double r_model = r_s_at(model, log, k), psi_model = psi_m_at(model, log, k);
-    const double r_implied = (in.u_pu[0] + in.n_pu * in.x_q_pu * in.i_pu[1]) / in.i_pu[0];
-    const double psi_implied = (in.u_pu[1] - base.resistance_pu(r_model) * in.i_pu[1]) / in.n_pu - in.x_d_pu * in.i_pu[0];
+    const double n = in.n_pu, i_d = in.i_pu[0], i_q = in.i_pu[1], r = base.resistance_pu(r_model);
+    // ψm = (u_q − r·i_q)/n − x_d·i_d, and its variance from the noise of u, i and n to first order.
+    const double psi_emf = in.u_pu[1] - r * i_q;
+    const double psi_implied = psi_emf / n - in.x_d_pu * i_d;
+    const double psi_var = (noise.u_sq + (r * r + n * n * in.x_d_pu * in.x_d_pu) * noise.i_sq) / (n * n) +
+                           (psi_emf * psi_emf) / (n * n * n * n) * noise.n_sq;
+    // r_s = (u_d + n·x_q·i_q)/i_d, likewise.
+    const double r_implied = (in.u_pu[0] + n * in.x_q_pu * i_q) / i_d;
+    const double r_var = (noise.u_sq + (n * n * in.x_q_pu * in.x_q_pu + r_implied * r_implied) * noise.i_sq +
+                          in.x_q_pu * in.x_q_pu * i_q * i_q * noise.n_sq) /
+                         (i_d * i_d);
+    // Determined where the value stands out of its noise by z (both false where n or i_d is 0: ∞ or NaN).
+    const bool psi_determined = psi_implied * psi_implied > z_sq * psi_var;
+    const bool r_determined = r_implied * r_implied > z_sq * r_var;
     const double t = core::to_seconds(sample.t_ns);
-    c.truth.add(t, base.flux_Wb_of(psi_implied), base.resistance_Ohm_of(r_implied));
+    c.truth.add(t, psi_determined ? base.flux_Wb_of(psi_implied) : kNaN,
+                r_determined ? base.resistance_Ohm_of(r_implied) : kNaN);
     c.nominal.add(t, psi_m_at(context.base, log, k), r_s_at(context.base, log, k));
     c.extended.add(t, psi_model, r_model);
   }
@@ -117,8 +155,8 @@ ParameterTrack load_truth(const std::string& path) {
 
 EstimatorComparison compare_estimates(const LogData& log, const io::MachineConfig& nominal,
                                       const io::MachineConfig& extended_config, const ExtendedModel& extended,
-                                      const EffectContext& context, const ParameterTrack& truth, const WorkPool& pool,
-                                      Monitor* monitor) {
+                                      const EffectContext& context, const ParameterTrack& truth,
+                                      const core::RegimeNoise& noise_pu, const WorkPool& pool, Monitor* monitor) {
   EstimatorComparison c;
   c.truth = truth;
   if (log.mode == ModelMode::kTransient) {
@@ -128,7 +166,7 @@ EstimatorComparison compare_estimates(const LogData& log, const io::MachineConfi
     });
   } else {
     c.method = "steady_state";
-    steady_state_tracks(log, context, extended, c);
+    steady_state_tracks(log, context, extended, noise_pu, nominal.estimator.regimes.significance_sigma, c);
   }
   c.nominal_summary = summarise(c.nominal, c.truth);
   c.extended_summary = summarise(c.extended, c.truth);

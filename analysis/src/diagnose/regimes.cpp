@@ -53,9 +53,11 @@ LogRegimes classify_regimes(const LogData& log, const io::MachineConfig& config,
     }
     core::AveragedDriveEstimator estimator(config.machine, settings);
     for (std::size_t k = 0; k < n; ++k) record(k, estimator.step(window_of(log, k)));
+    out.noise_pu = estimator.classifier().current_noise();
   } else {
     core::DriveEstimator estimator(config.machine, config.estimator);
     for (std::size_t k = 0; k < n; ++k) record(k, estimator.step(log.sample(k)));
+    out.noise_pu = estimator.classifier().current_noise();
   }
   report_work(monitor, n % kMonitorSamples);
   out.explanations = io::exclusion_explanations(out.counts);

@@ -7,6 +7,12 @@
 // corrections and inductances), set against what each model assumes — the nominal model constant
 // values, the extended one its drifts:
 //   R_s = (u_d + ω·L_q·i_q)/i_d,   ψm = (u_q − R_s·i_q)/ω − L_d·i_d   (R_s there: the extended model's)
+// A row implies a value only where the data's noise determines it: the value stands out of its standard
+// deviation (the noise of u, i and ω propagated to first order) by the classification's z (docs/diagnose.md,
+// "The estimator with the extended model"); elsewhere — ω near zero for ψm, i_d near zero for R_s, as on a
+// drive that holds i_d at 0 — the row implies nothing of that parameter (NaN). Set against them, a model's error
+// is the median of the relative error's magnitude: a few rows the steady-state model cannot represent imply
+// anything at all.
 
 #include <optional>
 #include <string>
@@ -16,13 +22,14 @@
 #include "rpem/analysis/diagnose/log_data.hpp"
 #include "rpem/analysis/diagnose/monitor.hpp"
 #include "rpem/analysis/work_pool.hpp"
+#include "rpem/core/regime.hpp"
 #include "rpem/io/machine_config.hpp"
 
 namespace rpem::analysis {
 
 /// Parameter trajectories, decimated, SI.
 struct ParameterTrack {
-  std::vector<double> t_s, psi_m_Wb, r_s_Ohm;
+  std::vector<double> t_s, psi_m_Wb, r_s_Ohm;  ///< NaN: not determined at that row (implied values)
   void add(double t, double psi, double r) {
     t_s.push_back(t);
     psi_m_Wb.push_back(psi);
@@ -35,8 +42,10 @@ struct ParameterTrack {
 [[nodiscard]] ParameterTrack load_truth(const std::string& path);
 
 struct EstimateSummary {
-  double psi_m_Wb = 0.0, r_s_Ohm = 0.0;   ///< mean over the last quarter of the log
-  std::optional<double> psi_m_error_pct;  ///< RMS error against truth over the second half
+  double psi_m_Wb = 0.0, r_s_Ohm = 0.0;  ///< mean over the last quarter of the log
+  /// The error against truth over the second half, at the rows where the truth is determined (none: empty): the
+  /// RMS against a true track (rpem), the median of its magnitude against what the rows imply (steady_state).
+  std::optional<double> psi_m_error_pct;
   std::optional<double> r_s_error_pct;
 };
 
@@ -53,10 +62,12 @@ struct EstimatorComparison {
 /// `extended` is the model with the found effects (drifts apply to the steady-state method only:
 /// the recursive estimator tracks ψm and R_s itself); the steady-state method's "nominal" is the
 /// context's baseline.
+/// `noise_pu` is the data's noise (LogRegimes::noise_pu), which decides where a steady-state row determines a value.
 /// The two estimator runs go on `pool` at once; `monitor` (if any) is told the samples run and may stop them.
 [[nodiscard]] EstimatorComparison compare_estimates(const LogData& log, const io::MachineConfig& nominal,
                                                     const io::MachineConfig& extended_config, const ExtendedModel& extended,
                                                     const EffectContext& context, const ParameterTrack& truth,
+                                                    const core::RegimeNoise& noise_pu,
                                                     const WorkPool& pool = WorkPool::serial(), Monitor* monitor = nullptr);
 
 /// RMS of the RPEM estimator's prediction error ε over the held-out blocks when it runs over the whole

@@ -24,6 +24,9 @@ struct LogRegimes {
   /// resynchronisation, the steady-state replay's idle and transitional rows — with the key that changes it.
   std::vector<std::string> explanations;
   std::size_t excluded_used = 0;  ///< excluded samples the diagnosis would otherwise have used
+  /// The data's noise as the classifier learnt it over the whole log: σ² of u, i and n per unit, the
+  /// quantisation of their resolution included (core::RegimeClassifier::current_noise).
+  core::RegimeNoise noise_pu{};
 };
 
 /// Runs the configured estimator over `log` (its rows; an averaged log's windows) and records each
