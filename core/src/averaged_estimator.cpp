@@ -137,6 +137,8 @@ Estimate AveragedDriveEstimator::step(const AveragedSample& sample) noexcept {
   in.i_pu = s.i_meas_pu;
   in.n_pu = s.n_pu;
   in.u_reported_sq_pu = sample.u_dq_V.squaredNorm() / (base_.voltage_V * base_.voltage_V);
+  in.u_reported_pu = Vec2(base_.voltage_pu(sample.u_dq_V[0]), base_.voltage_pu(sample.u_dq_V[1]));
+  in.i_reported_pu = Vec2(base_.current_pu(sample.i_dq_A[0]), base_.current_pu(sample.i_dq_A[1]));
   in.weight = gains.gain;
   const Classification regime = classifier_.step(in);
   // A release inside the previous window (§13, "Mixed windows"): what it adapted is undone.

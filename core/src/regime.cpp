@@ -129,8 +129,10 @@ bool track_resolution(double& q, double change) noexcept {
 /// q's: a minimum does not depend on the order, a median tracker's two steps keep theirs).
 bool learn(RegimeState& s, const RegimeInput& in, double t_s, double w) noexcept {
   bool resolution_changed = false;
+  const Vec2 u_reported = in.u_reported_pu.allFinite() ? in.u_reported_pu : in.u_pu;
+  const Vec2 i_reported = in.i_reported_pu.allFinite() ? in.i_reported_pu : in.i_pu;
   if (s.points >= 1) {
-    const Vec2 du = (in.u_pu - s.u_pu[0]).cwiseAbs(), di = (in.i_pu - s.i_pu[0]).cwiseAbs();
+    const Vec2 du = (u_reported - s.u_reported_pu).cwiseAbs(), di = (i_reported - s.i_reported_pu).cwiseAbs();
     const Vec2 before(s.measured_resolution_pu[0], s.measured_resolution_pu[1]);
     const Vec2 q = track_resolutions(track_resolutions(before, Vec2(du[0], di[0])), Vec2(du[1], di[1]));
     s.measured_resolution_pu[0] = q[0];
@@ -176,6 +178,8 @@ bool learn(RegimeState& s, const RegimeInput& in, double t_s, double w) noexcept
   s.i_pu[0] = in.i_pu;
   s.n_pu[0] = in.n_pu;
   s.t_s[0] = t_s;
+  s.u_reported_pu = u_reported;
+  s.i_reported_pu = i_reported;
   if (s.points < 2) ++s.points;
   s.chained = chain ? std::min(s.chained + 1, 2) : 0;
   return resolution_changed;

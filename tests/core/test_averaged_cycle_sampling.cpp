@@ -12,6 +12,7 @@
 
 #include <cmath>
 #include <complex>
+#include <string>
 
 #include "rpem/core/averaged_estimator.hpp"
 #include "support/paper_machine.hpp"
@@ -152,6 +153,53 @@ TEST(AveragedCycleSampling, ReportedCommandIsTurnedAndShortenedToTheMean) {
   EXPECT_LT(std::abs(psi_m_bias_of_command(0.5, true)), 3e-4);
   EXPECT_GT(std::abs(psi_m_bias_of_command(0.5, false)), 0.01);
 }
+
+/// `value` rounded to a multiple of `quantum`: what a logger that writes a fixed number of decimals reports.
+double rounded(double value, double quantum) { return std::round(value / quantum) * quantum; }
+
+class ReportedResolution : public ::testing::TestWithParam<bool> {};
+
+TEST_P(ReportedResolution, IsThatOfTheReportedValuesNotOfTheirCorrections) {
+  // VESC Tool writes currents to 10 mA and voltages to 1 mV. The sampled-means correction adds to each window's
+  // current a term c·n·(ω_n·T)²·J·u/x that moves with the speed, and a command reported for the mean is turned by
+  // ω·(δ + T/2) (the parameter: the firmware's command, VESC's half-period delay): after them no two windows' values
+  // are the same, and the smallest change between them — the resolution the classifier measures (§13) — would be
+  // the corrections' change, 10⁻¹³ here, instead of the quanta the data hold: the quantisation noise q²/12 of every
+  // excitation and outlier test would vanish. Measured on the reported values, it is the quantum.
+  constexpr double kCurrentQuantum_A = 0.01, kVoltageQuantum_V = 0.001;
+  EstimatorSettings st = settings(kT_s, 0.0);
+  if (GetParam()) {
+    st.averaged.voltage_is_command = true;
+    st.extensions.delay_s = 0.5 * kT_s;
+  }
+  AveragedDriveEstimator est(vesc_machine(), st);
+  const PerUnitBase base = PerUnitBase::from_rated(vesc_machine().rated);
+  for (int k = 1; k <= 400; ++k) {
+    // A slow ramp of 10 rpm over the 400 windows of 5 ms, and i_q that wanders across a few quanta.
+    const double omega = kOmega * (1.0 + 1.7e-3 * k / 400.0);
+    const cplx i(0.0, kIq_A + 0.02 * std::sin(0.05 * k));
+    const cplx u = (kR_Ohm + cplx(0.0, omega * kL_H)) * i + cplx(0.0, omega * kPsi_Wb);
+    AveragedSample s;
+    s.t_start_ns = (k - 1) * 5'000'000LL;
+    s.t_ns = k * 5'000'000LL;
+    s.i_dq_A = Vec2(rounded(i.real(), kCurrentQuantum_A), rounded(i.imag(), kCurrentQuantum_A));
+    s.u_dq_V = Vec2(rounded(u.real(), kVoltageQuantum_V), rounded(u.imag(), kVoltageQuantum_V));
+    s.omega_el_rad_s = omega;
+    s.u_dc_V = 48.0;
+    (void)est.step(s);
+  }
+  const RegimeState& state = est.classifier().state();
+  // The smallest nonzero change of two rounded values is one quantum, up to the doubles' rounding (≈ 10⁻¹³ A).
+  EXPECT_NEAR(state.measured_resolution_pu[1] / base.current_pu(kCurrentQuantum_A), 1.0, 1e-9);
+  EXPECT_NEAR(state.measured_resolution_pu[0] / base.voltage_pu(kVoltageQuantum_V), 1.0, 1e-9);
+  EXPECT_GE(est.classifier().current_noise().i_sq, 0.999 * std::pow(base.current_pu(kCurrentQuantum_A), 2) / 12.0);
+  EXPECT_GE(est.classifier().current_noise().u_sq, 0.999 * std::pow(base.voltage_pu(kVoltageQuantum_V), 2) / 12.0);
+}
+
+INSTANTIATE_TEST_SUITE_P(AveragedCycleSampling, ReportedResolution, ::testing::Bool(),
+                         [](const ::testing::TestParamInfo<bool>& p) {
+                           return p.param ? std::string("CommandReported") : std::string("MeanReported");
+                         });
 
 }  // namespace
 }  // namespace rpem::core

@@ -180,6 +180,13 @@ struct RegimeInput {
   Vec2 i_pu = Vec2::Zero();       ///< measured current (window mean)
   double n_pu = 0.0;              ///< speed (window mean)
   double u_reported_sq_pu = 0.0;  ///< |u|² as the drive reports it, before corrections (bridge off)
+  /// The voltage and current as the drive reported them, before the model's corrections (a command turned into
+  /// the applied mean, the sampled means' term): their resolution is measured here, since a correction's
+  /// continuous term makes every change nonzero and hides the quantum (docs/derivations.md §13, "Noise and
+  /// resolution, measured").
+  /// NaN (not given): u_pu and i_pu are as reported.
+  Vec2 u_reported_pu = Vec2::Constant(std::numeric_limits<double>::quiet_NaN());
+  Vec2 i_reported_pu = Vec2::Constant(std::numeric_limits<double>::quiet_NaN());
   /// The current's slope over the sample's window where the caller knows it (a block of a control-rate
   /// stream: its end points); otherwise (NaN) the classifier takes it between consecutive samples.
   Vec2 di_dt_pu_s = Vec2::Constant(std::numeric_limits<double>::quiet_NaN());
@@ -204,6 +211,8 @@ struct RegimeState {
   /// The chain's last two samples: u, i, n and the time of each [s, relative to t_origin_ns].
   std::array<Vec2, 2> u_pu{}, i_pu{};
   std::array<double, 2> n_pu{}, t_s{};
+  /// The chain's last sample as reported (RegimeInput::u_reported_pu): the next change the resolution is read from.
+  Vec2 u_reported_pu = Vec2::Zero(), i_reported_pu = Vec2::Zero();
   std::int64_t t_origin_ns = 0;  ///< the first sample's time (times are kept relative to it)
   bool has_origin = false;
   int points = 0;                  ///< samples held (0–2)
