@@ -44,5 +44,31 @@ TEST(ThermalFigure, CoverageCountsTheMeasuredPointsAfterTheLineInsideTheBand) {
   EXPECT_EQ(test::misprinted_gnuplot_text(gp), std::vector<std::string>{});
 }
 
+TEST(ThermalFigure, RpemAloneIsDrawnFromItsFirstAdaptationAndSaidWhereItNeverAdapted) {
+  // ψm adapts from the row at 4 s on (psi_m_active), R_s never: before 4 s T_magnet_rpem is the law's value at the
+  // configured ψm, which nothing observed (the Paderborn log read 102 °C there at a cold start), and T_winding_rpem
+  // is the configured R_s's 20 °C throughout (the same log's winding reached 123 °C).
+  std::string est =
+      "t,psi_m_active,r_s_active,T_magnet_rpem,T_winding_rpem,t_magnet_fused_C,t_magnet_fused_sd_C,t_winding_fused_C,"
+      "t_winding_fused_sd_C\n";
+  for (int k = 0; k <= 10; ++k)
+    est += std::to_string(k) + (k >= 4 ? ",1" : ",0") + ",0," + (k >= 4 ? "60" : "102") + ",20,55,1,80,2\n";
+  const test::TempFile est_csv("est.csv", est), png("alone.png"), script("alone.gp");
+  ThermalFigureInput in;
+  in.estimate_csv = est_csv.path();
+  (void)write_thermal_figure(png.path(), in);
+  ASSERT_GT(std::filesystem::file_size(png.path()), 1000U);
+  const std::string gp = test::read_file(script.path());
+  // The magnet's block: column 5 (RPEM alone) nan before 4 s, 60 from it; no 102 drawn anywhere.
+  EXPECT_EQ(gp.find("102"), std::string::npos) << gp;
+  EXPECT_NE(gp.find("\n3 55 53 57 nan\n"), std::string::npos) << gp;
+  EXPECT_NE(gp.find("\n4 55 53 57 60\n"), std::string::npos) << gp;
+  EXPECT_NE(gp.find("RPEM alone (from ψm's first adaptation, held)"), std::string::npos);
+  // The winding: no RPEM-alone curve, and the panel says why.
+  EXPECT_NE(gp.find("winding (RPEM alone: R_s never adapted in this log)"), std::string::npos);
+  EXPECT_EQ(gp.find("$winding_est u 1:5"), std::string::npos);
+  EXPECT_EQ(test::misprinted_gnuplot_text(gp), std::vector<std::string>{});
+}
+
 }  // namespace
 }  // namespace rpem::analysis

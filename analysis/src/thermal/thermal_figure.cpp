@@ -35,24 +35,38 @@ double panel(GnuplotFigure& fig, const io::CsvTable& est, const io::CsvTable* me
   const std::vector<double>& fused = est.column("t_" + node + "_fused_C");
   const std::vector<double>& sd = est.column("t_" + node + "_fused_sd_C");
   const std::vector<double>& alone = est.column("T_" + node + "_rpem");
+  // RPEM alone is the estimate's temperature from its first adaptation on (held where it does not adapt): before
+  // it, the column is the law's value at the configured start, which nothing has observed.
+  // (A CSV without the column, written by hand: every row counts.)
+  const std::string active_column = node == "magnet" ? "psi_m_active" : "r_s_active";
+  std::size_t first_adapted = 0;
+  if (est.has(active_column)) {
+    const std::vector<double>& active = est.column(active_column);
+    first_adapted = static_cast<std::size_t>(std::find(active.begin(), active.end(), 1.0) - active.begin());
+  }
   // At most ~4000 points per curve: the figure, not the data, is the product.
   const std::size_t stride = std::max<std::size_t>(1, t.size() / 4000);
   DataBlock e{node + "_est", std::vector<std::vector<double>>(5)};
   for (std::size_t k = 0; k < t.size(); k += stride) {
-    for (auto [c, v] :
-         {std::pair{0, t[k]}, {1, fused[k]}, {2, fused[k] - 2.0 * sd[k]}, {3, fused[k] + 2.0 * sd[k]}, {4, alone[k]}}) {
+    for (auto [c, v] : {std::pair{0, t[k]},
+                        {1, fused[k]},
+                        {2, fused[k] - 2.0 * sd[k]},
+                        {3, fused[k] + 2.0 * sd[k]},
+                        {4, k >= first_adapted ? alone[k] : kNaN}}) {
       e.columns[static_cast<std::size_t>(c)].push_back(std::isfinite(v) ? v : kNaN);
     }
   }
   fig.add_data(e);
   double covered = 0.0, counted = 0.0;
+  const std::string parameter = node == "magnet" ? "ψm" : "R_s";
   std::string plot = "plot $" + node +
                      "_est u 1:3:4 w filledcurves fc rgb '#c6dbef' title 'fused ±2σ', "
                      "$" +
-                     node +
-                     "_est u 1:2 w l lw 2 lc rgb '#08519c' title 'fused', "
-                     "$" +
-                     node + "_est u 1:5 w l dt 2 lc rgb '#636363' title 'RPEM alone (held where not adapting)'";
+                     node + "_est u 1:2 w l lw 2 lc rgb '#08519c' title 'fused'";
+  if (first_adapted < t.size()) {
+    plot += ", $" + node + "_est u 1:5 w l dt 2 lc rgb '#636363' title " +
+            gp_quote("RPEM alone (from " + parameter + "'s first adaptation, held)") + " noenhanced";
+  }
   if (measured != nullptr && measured->has(measured_column)) {
     const std::vector<double>& tm = measured->column("t");
     const std::vector<double>& vm = measured->column(measured_column);
@@ -73,7 +87,10 @@ double panel(GnuplotFigure& fig, const io::CsvTable& est, const io::CsvTable* me
     plot += ", $" + node + "_meas u 1:2 w l lw 1.5 lc rgb '#cb181d' title " +
             gp_quote("measured (" + measured_column + ")") + " noenhanced";
   }
-  fig.add_line("set title " + gp_quote(node) + " noenhanced");
+  fig.add_line(
+      "set title " +
+      gp_quote(first_adapted < t.size() ? node : node + " (RPEM alone: " + parameter + " never adapted in this log)") +
+      " noenhanced");
   fig.add_line("unset arrow");
   if (judged_after_s > 0.0) {
     fig.add_line("set arrow from " + std::to_string(judged_after_s) + ", graph 0 to " + std::to_string(judged_after_s) +
@@ -97,9 +114,12 @@ ThermalFigureCoverage write_thermal_figure(const std::string& png_path, const Th
       if (!measured->has(c)) throw io::InputError(in.measured_csv, 1, 0, c, "column missing from the header");
     }
   }
-  GnuplotFigure fig(png_path, 1200, 800);
+  GnuplotFigure fig(png_path, 1400, 800);
   fig.add_line("set multiplot layout 2,1");
-  fig.add_line("set xlabel 't [s]'; set ylabel 'T [°C]'; set key top left; set grid");
+  // The key beside the panels: inside, the band reaches whichever corner it stands in and hides it or the data.
+  // Both panels keep the keys' margin, so that their time axes align.
+  fig.add_line("set xlabel 't [s]'; set ylabel 'T [°C]'; set key outside right top; set grid");
+  fig.add_line("set lmargin at screen 0.06; set rmargin at screen 0.72");
   ThermalFigureCoverage c;
   const io::CsvTable* m = measured ? &*measured : nullptr;
   c.magnet = panel(fig, est, m, "magnet", in.magnet_column, in.judged_after_s);
