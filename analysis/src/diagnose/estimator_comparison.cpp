@@ -1,6 +1,7 @@
 #include "rpem/analysis/diagnose/estimator_comparison.hpp"
 
 #include <algorithm>
+#include <cassert>
 #include <cmath>
 #include <limits>
 #include <optional>
@@ -47,15 +48,17 @@ struct RelativeError {
   }
 };
 
-EstimateSummary summarise(const ParameterTrack& track, const ParameterTrack& truth) {
+/// `implied`: the truth is what the steady-state rows imply (one value per row of the track, NaN where not
+/// determined), else a true track (RPEM estimates against a simulation's truth).
+EstimateSummary summarise(const ParameterTrack& track, const ParameterTrack& truth, bool implied) {
   EstimateSummary s;
   if (track.empty()) return s;
-  // The steady-state method's truth holds a value per row of the track: compared row by row (a row where it
-  // is not determined is NaN, and interpolating would carry the NaN to its neighbours).
-  const bool by_row = truth.t_s == track.t_s;
+  // What the rows imply is compared row by row (a row where it is not determined is NaN, and interpolating would
+  // carry the NaN to its neighbours).
+  assert(!implied || truth.t_s == track.t_s);
   const double t0 = track.t_s.front(), t1 = track.t_s.back();
   double psi = 0.0, r = 0.0, n = 0.0;
-  RelativeError e_psi{by_row, {}}, e_r{by_row, {}};
+  RelativeError e_psi{implied, {}}, e_r{implied, {}};
   for (std::size_t k = 0; k < track.t_s.size(); ++k) {
     const double t = track.t_s[k];
     if (t >= t0 + 0.75 * (t1 - t0)) {
@@ -64,8 +67,8 @@ EstimateSummary summarise(const ParameterTrack& track, const ParameterTrack& tru
       n += 1.0;
     }
     if (!truth.empty() && t >= t0 + 0.5 * (t1 - t0)) {
-      e_psi.add(track.psi_m_Wb[k], by_row ? truth.psi_m_Wb[k] : interpolate(truth.t_s, truth.psi_m_Wb, t));
-      e_r.add(track.r_s_Ohm[k], by_row ? truth.r_s_Ohm[k] : interpolate(truth.t_s, truth.r_s_Ohm, t));
+      e_psi.add(track.psi_m_Wb[k], implied ? truth.psi_m_Wb[k] : interpolate(truth.t_s, truth.psi_m_Wb, t));
+      e_r.add(track.r_s_Ohm[k], implied ? truth.r_s_Ohm[k] : interpolate(truth.t_s, truth.r_s_Ohm, t));
     }
   }
   s.psi_m_Wb = n > 0 ? psi / n : track.psi_m_Wb.back();
@@ -168,8 +171,9 @@ EstimatorComparison compare_estimates(const LogData& log, const io::MachineConfi
     c.method = "steady_state";
     steady_state_tracks(log, context, extended, noise_pu, nominal.estimator.regimes.significance_sigma, c);
   }
-  c.nominal_summary = summarise(c.nominal, c.truth);
-  c.extended_summary = summarise(c.extended, c.truth);
+  const bool implied = c.method == "steady_state";
+  c.nominal_summary = summarise(c.nominal, c.truth, implied);
+  c.extended_summary = summarise(c.extended, c.truth, implied);
   return c;
 }
 
