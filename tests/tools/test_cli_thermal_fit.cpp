@@ -5,6 +5,7 @@
 // 70 °C towards a 25 °C ambient over 15 minutes (a plain first-order element there, which two nodes can hold).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -36,20 +37,51 @@ std::vector<std::string> cells(const std::string& line, char separator) {
   return out;
 }
 
-/// The last row's temp_motor of a VESC Tool log [°C].
-double last_motor_temperature_C(const std::string& log) {
+/// A VESC Tool log's temp_motor [°C] per row, with the row's time of day [s] (ms_today).
+struct MotorTemperatures {
+  std::vector<double> t_s, t_motor_C;
+};
+MotorTemperatures motor_temperatures(const std::string& log) {
   std::ifstream f(log);
-  std::string header, line, last;
+  std::string header, line;
   std::getline(f, header);
+  const std::vector<std::string> names = cells(header, ';');
+  const auto column = [&](const std::string& name) {
+    const auto it = std::find(names.begin(), names.end(), name);
+    return static_cast<std::size_t>(it - names.begin());
+  };
+  const std::size_t time = column("ms_today"), motor = column("temp_motor");
+  MotorTemperatures out;
+  if (time == names.size() || motor == names.size()) {
+    ADD_FAILURE() << "no ms_today or temp_motor in " << log;
+    return out;
+  }
   while (std::getline(f, line)) {
-    if (!line.empty()) last = line;
+    const std::vector<std::string> values = cells(line, ';');
+    if (values.size() <= std::max(time, motor)) continue;
+    out.t_s.push_back(std::stod(values[time]) / 1000.0);
+    out.t_motor_C.push_back(std::stod(values[motor]));
   }
-  const std::vector<std::string> names = cells(header, ';'), values = cells(last, ';');
-  for (std::size_t k = 0; k < names.size() && k < values.size(); ++k) {
-    if (names[k] == "temp_motor") return std::stod(values[k]);
+  return out;
+}
+
+/// The q-quantile (rank ⌊q·(n − 1)⌋) of the motor temperatures of the rows from `from_s` to `until_s`.
+double motor_quantile(const MotorTemperatures& m, double from_s, double until_s, double q) {
+  std::vector<double> v;
+  for (std::size_t k = 0; k < m.t_s.size(); ++k) {
+    if (m.t_s[k] >= from_s && m.t_s[k] <= until_s) v.push_back(m.t_motor_C[k]);
   }
-  ADD_FAILURE() << "no temp_motor in " << log;
-  return std::nan("");
+  std::sort(v.begin(), v.end());
+  return v.empty() ? std::nan("") : v[static_cast<std::size_t>(q * static_cast<double>(v.size() - 1))];
+}
+
+/// The winding sensor's signal of fit.json.
+nlohmann::json winding_sensor_signal(const nlohmann::json& fit) {
+  for (const nlohmann::json& s : fit.at("signals")) {
+    if (s.at("name") == "winding sensor") return s;
+  }
+  ADD_FAILURE() << "no winding sensor in " << fit.at("signals").dump();
+  return {};
 }
 
 class CliThermalFit : public ::testing::Test {
@@ -113,7 +145,59 @@ TEST_F(CliThermalFit, ReadsAVescToolLogItsMotorSensorTheWinding) {
   const io::CsvTable estimate = io::CsvTable::read(dir_ + "/estimate.csv", true);
   ASSERT_GT(estimate.rows(), 0U);
   const double fused_C = estimate.column("t_winding_fused_C").back();
-  EXPECT_NEAR(fused_C, last_motor_temperature_C(log), 5.0 * kSensorResolution_K);
+  EXPECT_NEAR(fused_C, motor_temperatures(log).t_motor_C.back(), 5.0 * kSensorResolution_K);
+}
+
+// What the training part observes, and what a fit that identifies nothing says of it. The cool-down above moves the
+// winding by tens of kelvin: the span the fit reports is the log's own temp_motor between its 5th and 95th
+// percentile over the training rows, within the difference a 1 s step's mean makes (the winding cools by at most
+// 0.1 K/s) and one quantum; the fit says the temperatures move. The same ride with the plant's temperatures held
+// (--isothermal) moves nothing: the fit says no temperature moves beyond its noise, and why nothing is identified.
+TEST_F(CliThermalFit, SaysWhatTheTrainingPartObserves) {
+  const std::string outrunner = " --config " + outrunner_config();
+  for (const bool isothermal : {false, true}) {
+    SCOPED_TRACE(isothermal ? "isothermal" : "cooling");
+    const std::string log = dir_ + (isothermal ? "/isothermal.csv" : "/cooling.csv");
+    const test::ProcessResult g = test::run_command(
+        test::binary_dir() + "/tests/independent_vesc/indep_vesc_log" + outrunner + " --seed 3 --duration-s 600 " +
+        (isothermal ? "--isothermal" : "--set thermal.winding_start_C=70 --set thermal.magnet_start_C=60") + " --out " +
+        log);
+    ASSERT_EQ(g.exit_code, 0) << g.output;
+    const std::string report = dir_ + (isothermal ? "/isothermal" : "/cooling");
+    const test::ProcessResult r = test::run_command(rpem_tool() + " thermal fit --log " + log + outrunner + " --out " +
+                                                    report + ".yaml --report " + report);
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    std::ifstream json(report + "/fit.json");
+    const nlohmann::json j = nlohmann::json::parse(json);
+    const nlohmann::json sensor = winding_sensor_signal(j);
+    // The training part: from the first step's start (the filter steps from the first adapted estimate on; each
+    // step's time in predictions.csv is its end, a step 1 s long) to fit_until_s.
+    std::ifstream predictions(report + "/predictions.csv");
+    std::string header, first;
+    ASSERT_TRUE(std::getline(predictions, header) && std::getline(predictions, first) && header.rfind("t,", 0) == 0);
+    const double from_s = std::stod(cells(first, ',').front()) - 1.0, until_s = j.at("fit_until_s").get<double>();
+    const MotorTemperatures m = motor_temperatures(log);
+    const double low_C = motor_quantile(m, from_s, until_s, 0.05), high_C = motor_quantile(m, from_s, until_s, 0.95);
+    EXPECT_NEAR(sensor.at("training_low_C").get<double>(), low_C, 2.0 * kSensorResolution_K);
+    EXPECT_NEAR(sensor.at("training_high_C").get<double>(), high_C, 2.0 * kSensorResolution_K);
+    // The σ the fit weighs the sensor with: the default 1 K beside the fit's 0.5 K floor.
+    EXPECT_NEAR(sensor.at("training_sigma_K").get<double>(), std::hypot(1.0, 0.5), 1e-9);
+    if (isothermal) {
+      EXPECT_LE(high_C - low_C, kSensorResolution_K + 1e-9);  // one quantum at most
+      EXPECT_NE(r.output.find("note: no parameter is identified: no temperature the training part observes moves beyond "
+                              "its noise"),
+                std::string::npos)
+          << r.output;
+    } else {
+      EXPECT_GT(high_C - low_C, 20.0);
+      EXPECT_EQ(r.output.find("moves beyond its noise"), std::string::npos) << r.output;
+    }
+    // The terminal's line of the signal says the same span.
+    char line[96];
+    std::snprintf(line, sizeof line, "winding sensor: %.1f–%.1f °C in training", sensor.at("training_low_C").get<double>(),
+                  sensor.at("training_high_C").get<double>());
+    EXPECT_NE(r.output.find(line), std::string::npos) << r.output;
+  }
 }
 
 }  // namespace

@@ -6,6 +6,8 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "../median.hpp"
+
 namespace rpem::analysis {
 namespace {
 
@@ -28,9 +30,7 @@ TemperatureColumn column(const LogData& log, bool logged,
   double sum = 0.0;
   for (double x : t) sum += x;
   c.mean_C = sum / static_cast<double>(t.size());
-  std::sort(t.begin(), t.end());
-  const auto at = [&](double q) { return t[static_cast<std::size_t>(q * static_cast<double>(t.size() - 1))]; };
-  c.span_K = at(0.95) - at(0.05);
+  c.span_K = quantile(t, 0.95) - quantile(t, 0.05);
   return c;
 }
 

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "../median.hpp"
 #include "filter_likelihood.hpp"
 #include "network_layout.hpp"
 #include "rpem/analysis/cluster_robust.hpp"
@@ -250,8 +251,10 @@ void intervals(const Layout& layout, const ThermalRecord& r, std::size_t steps, 
   }
 }
 
-/// RMS of the network's misses on each observed signal, training and held out.
-void judge(const io::ThermalConfig& c, const ThermalRecord& r, std::size_t training, ThermalFitResult& out) {
+/// RMS of the network's misses on each observed signal, training and held out; what the training part observes of
+/// each (the temperatures its `points` read, their σ).
+void judge(const io::ThermalConfig& c, const ThermalRecord& r, std::size_t training, const std::vector<Point>& points,
+           ThermalFitResult& out) {
   const core::ThermalFusionConfig& f = c.fusion;
   out.open_loop_C = simulate_open_loop(f, r);
   const char* names[3] = {"magnet (from psi_m)", "winding (from r_s)", "winding sensor"};
@@ -268,14 +271,19 @@ void judge(const io::ThermalConfig& c, const ThermalRecord& r, std::size_t train
     SignalFit s;
     s.name = names[kind];
     double fit2 = 0.0, held2 = 0.0;
+    std::vector<double> observed_C;
+    const int own = own_node(f.filter.network, kind);
     for (std::size_t k = 0; k < r.steps.size(); ++k) {
       const core::StepObservations o =
           core::step_observations(judged, r.steps[k], out.open_loop_C[k], core::ThermalVec::Zero(), lag[k]);
       if (!o.present[static_cast<std::size_t>(kind)]) continue;
-      const double m = miss_K(o, kind, out.open_loop_C[k], own_node(f.filter.network, kind));
+      const double m = miss_K(o, kind, out.open_loop_C[k], own);
       if (k < training) {
         fit2 += m * m;
         ++s.fit_points;
+        // The temperature observed: the sensor's reading; a parameter's, its node's at the network's other nodes
+        // (the observation is linear in T: y − c − h·T = h_own·m).
+        observed_C.push_back(kind == 2 ? r.steps[k].winding_sensor_C : out.open_loop_C[k][own] + m);
       } else {
         held2 += m * m;
         ++s.heldout_points;
@@ -283,6 +291,14 @@ void judge(const io::ThermalConfig& c, const ThermalRecord& r, std::size_t train
       }
     }
     if (s.fit_points + s.heldout_points == 0) continue;
+    s.training_low_C = quantile(observed_C, 0.05);
+    s.training_high_C = quantile(observed_C, 0.95);
+    std::vector<double> sigma_K;
+    for (const Point& p : points) {
+      if (p.kind == kind) sigma_K.push_back(p.sigma_K);
+    }
+    // A sensor the configuration does not fuse is not among the points: judged at its default σ.
+    s.training_sigma_K = sigma_K.empty() ? judged.winding_sensor_sigma_K : median(sigma_K);
     s.fit_rms_K = s.fit_points ? std::sqrt(fit2 / static_cast<double>(s.fit_points)) : 0.0;
     s.heldout_rms_K = s.heldout_points ? std::sqrt(held2 / static_cast<double>(s.heldout_points)) : 0.0;
     out.signals.push_back(s);
@@ -328,6 +344,53 @@ std::string assumed_copper_reference(const core::DriftLaw& copper) {
                 "(docs/thermal.md)",
                 copper.value_ref, copper.reference_C);
   return text;
+}
+
+/// The filter's noises for the fitted network: the temperatures' white noise, then the disturbances' drift, each the
+/// most likely; each node's disturbance correlation time; a winding sensor's lag where none is configured.
+void fit_filter_noises(const ThermalRecord& record, std::size_t training, const ThermalFitOptions& options,
+                       ThermalFitResult& out) {
+  out.config.fusion.filter.disturbance_W2_per_s.setZero();
+  out.process_noise_K2_per_s =
+      maximum_likelihood(out.config, record, training, &core::ThermalFilterConfig::process_noise_K2_per_s, -8.0, 1.0);
+  out.disturbance_W2_per_s =
+      maximum_likelihood(out.config, record, training, &core::ThermalFilterConfig::disturbance_W2_per_s, -6.0, 4.0);
+  choose_disturbance_time_constants(out, record, training, options);
+  // A winding sensor without a configured lag: its time constant, the most likely under those noises.
+  if (record.winding_sensor && out.config.fusion.winding_sensor_sigma_K > 0.0 &&
+      !(out.config.fusion.winding_sensor_time_constant_s > 0.0))
+    fit_sensor_lag(out.config, record, training, out);
+}
+
+/// Noise alone spans 2·Φ⁻¹(0.95) = 3.29 of its σ between its 5th and 95th percentile: a signal whose span is no wider
+/// shows no temperature change.
+constexpr double kNoiseSpan_sigma = 3.2897072539029457;
+
+/// The note when no parameter is identified: what the training part observed against the σ of an observation,
+/// and what that means.
+std::string nothing_identified(const ThermalFitResult& fit) {
+  std::string spans;
+  bool moves = false;
+  for (const SignalFit& s : fit.signals) {
+    if (s.fit_points == 0) continue;
+    const double span_K = s.training_high_C - s.training_low_C;
+    moves = moves || span_K > kNoiseSpan_sigma * s.training_sigma_K;
+    char part[192];
+    std::snprintf(part, sizeof part, "%s%s %.1f–%.1f °C (%.2g K against a σ of %.2g K)", spans.empty() ? "" : "; ",
+                  s.name.c_str(), s.training_low_C, s.training_high_C, span_K, s.training_sigma_K);
+    spans += part;
+  }
+  if (!moves) {
+    return "no parameter is identified: no temperature the training part observes moves beyond its noise (5th to "
+           "95th percentile: " +
+           spans +
+           "). A network shows only in temperatures the losses move by many times their σ: fit it on a log that "
+           "heats the machine (a longer or harder run), or start from a known network (--start)";
+  }
+  return "no parameter is identified although the training part's temperatures move (5th to 95th percentile: " + spans +
+         "): the log determines only combinations of the parameters (\"not identifiable together\": one operating "
+         "point, or a cool-down without load, shows the time constants and the losses' ratios to the conductances, "
+         "not each). A log with several loads and speeds separates them; or start from a known network (--start)";
 }
 
 }  // namespace
@@ -398,18 +461,10 @@ ThermalFitResult fit_thermal(const ThermalRecord& record, const io::ThermalConfi
   out.training_cost = best.cost;
   out.config = fitted_layout.apply(best.x.data());
   intervals(fitted_layout, record, training, points, best.x, options.blocks, out);
-  // The filter's noise: the temperatures' white noise, then the disturbances' drift, each the most likely.
-  out.config.fusion.filter.disturbance_W2_per_s.setZero();
-  out.process_noise_K2_per_s =
-      maximum_likelihood(out.config, record, training, &core::ThermalFilterConfig::process_noise_K2_per_s, -8.0, 1.0);
-  out.disturbance_W2_per_s =
-      maximum_likelihood(out.config, record, training, &core::ThermalFilterConfig::disturbance_W2_per_s, -6.0, 4.0);
-  choose_disturbance_time_constants(out, record, training, options);
-  // A winding sensor without a configured lag: its time constant, the most likely under those noises.
-  if (record.winding_sensor && out.config.fusion.winding_sensor_sigma_K > 0.0 &&
-      !(out.config.fusion.winding_sensor_time_constant_s > 0.0))
-    fit_sensor_lag(out.config, record, training, out);
-  judge(out.config, record, training, out);
+  fit_filter_noises(record, training, options, out);
+  judge(out.config, record, training, points, out);
+  if (std::none_of(out.parameters.begin(), out.parameters.end(), [](const FittedParameter& p) { return p.identified; }))
+    out.notes.push_back(nothing_identified(out));
   return out;
 }
 

@@ -25,10 +25,17 @@ std::string significant(double v, int digits = 3) {
   return buf;
 }
 
-/// A relative half-width as text; beyond ±1000 % the log does not bound the parameter at all.
-std::string percent(double rel) {
+/// A temperature as text, to the 0.1 K a sensor is read to.
+std::string celsius(double v_C) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.1f", v_C);
+  return buf;
+}
+
+/// A relative half-width as an interval's text; beyond ±1000 % the log does not bound the parameter at all.
+std::string interval(double rel) {
   if (!std::isfinite(rel)) return "not excited";
-  return rel > 10.0 ? std::string("unbounded (> 1000 %)") : significant(100.0 * rel) + " %";
+  return rel > 10.0 ? std::string("unbounded (> ±1000 %)") : "±" + significant(100.0 * rel) + " %";
 }
 
 nlohmann::json number_or_null(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); }
@@ -42,12 +49,13 @@ void write_thermal_yaml(const std::string& path, const ThermalFitResult& fit, co
   f << "# log: " << record.log << " (" << record.steps.size() << " steps), configuration: " << config_name << "\n";
   f << "# training: t <= " << fit.fit_until_s << " s (" << fit.training_steps << " steps); the rest held out\n";
   for (const SignalFit& s : fit.signals) {
-    f << "# " << s.name << ": fit " << significant(s.fit_rms_K) << " K RMS (" << s.fit_points << "), held out "
-      << significant(s.heldout_rms_K) << " K RMS, worst " << significant(s.heldout_worst_K) << " K (" << s.heldout_points
-      << ")\n";
+    f << "# " << s.name << ": " << celsius(s.training_low_C) << "–" << celsius(s.training_high_C)
+      << " °C in training (5–95 %, σ " << significant(s.training_sigma_K) << " K); fit " << significant(s.fit_rms_K)
+      << " K RMS (" << s.fit_points << "), held out " << significant(s.heldout_rms_K) << " K RMS, worst "
+      << significant(s.heldout_worst_K) << " K (" << s.heldout_points << ")\n";
   }
   for (const FittedParameter& p : fit.parameters) {
-    if (!p.identified) f << "# not identified: " << p.name << " (95 % interval ±" << percent(p.half_width_rel) << ")\n";
+    if (!p.identified) f << "# not identified: " << p.name << " (95 % interval " << interval(p.half_width_rel) << ")\n";
   }
   for (const std::string& s : fit.not_identifiable) f << "# move together: " << s << "\n";
   for (const std::string& s : fit.notes) f << "# note: " << s << "\n";
@@ -87,7 +95,10 @@ void write_thermal_fit_json(const std::string& path, const ThermalFitResult& fit
                             {"fit_rms_K", s.fit_rms_K},
                             {"heldout_points", s.heldout_points},
                             {"heldout_rms_K", s.heldout_rms_K},
-                            {"heldout_worst_K", s.heldout_worst_K}});
+                            {"heldout_worst_K", s.heldout_worst_K},
+                            {"training_low_C", s.training_low_C},
+                            {"training_high_C", s.training_high_C},
+                            {"training_sigma_K", s.training_sigma_K}});
   }
   j["not_identifiable"] = fit.not_identifiable;
   j["notes"] = fit.notes;
@@ -102,17 +113,19 @@ void write_thermal_fit_report(const std::string& path, const ThermalFitResult& f
   o << "Log `" << record.log << "` (" << record.steps.size() << " steps of the filter), configuration `" << config_name
     << "`. Training: the steps up to t = " << fit.fit_until_s << " s (" << fit.training_steps
     << "); the rest is held out. The network runs open loop from a soaked start (every node at the coolant).\n\n";
-  o << "| signal | fit RMS [K] | points | held-out RMS [K] | held-out worst [K] | points |\n|---|---|---|---|---|---|\n";
+  o << "| signal | observed in training, 5–95 % [°C] | σ [K] | fit RMS [K] | points | held-out RMS [K] | held-out worst "
+       "[K] | points |\n|---|---|---|---|---|---|---|---|\n";
   for (const SignalFit& s : fit.signals) {
-    o << "| " << s.name << " | " << significant(s.fit_rms_K) << " | " << s.fit_points << " | "
+    o << "| " << s.name << " | " << celsius(s.training_low_C) << "–" << celsius(s.training_high_C) << " | "
+      << significant(s.training_sigma_K) << " | " << significant(s.fit_rms_K) << " | " << s.fit_points << " | "
       << significant(s.heldout_rms_K) << " | " << significant(s.heldout_worst_K) << " | " << s.heldout_points << " |\n";
   }
   o << "\n## Parameters (95 % intervals: cluster-robust over "
     << "blocks of the training part; excitation alone)\n\n";
   o << "| parameter | value | unit | robust | excitation | identified |\n|---|---|---|---|---|---|\n";
   for (const FittedParameter& p : fit.parameters) {
-    o << "| " << p.name << " | " << significant(p.value, 5) << " | " << p.unit << " | ±" << percent(p.half_width_rel)
-      << " | ±" << percent(p.excitation_half_width_rel) << " | " << (p.identified ? "yes" : "**no**") << " |\n";
+    o << "| " << p.name << " | " << significant(p.value, 5) << " | " << p.unit << " | " << interval(p.half_width_rel)
+      << " | " << interval(p.excitation_half_width_rel) << " | " << (p.identified ? "yes" : "**no**") << " |\n";
   }
   o << "\nProcess noise (maximum likelihood of the filter's innovations over the training part): "
     << significant(fit.process_noise_K2_per_s) << " K²/s per node; the heat disturbances' drift "
