@@ -270,8 +270,9 @@ std::vector<core::AveragedSample> averaged_windows() {
 }
 
 /// The same for averaged windows (the paper's machine, 200 Hz uneven windows at 0.4 pu under load): the
-/// classifier on the averaged estimator's inputs against AveragedDriveEstimator::step.
-void BM_AveragedClassificationOverStep(benchmark::State& state) {
+/// classifier on the averaged estimator's inputs against AveragedDriveEstimator::step, the frame from a sensor or
+/// sensorless (`estimator.regimes.angle_source`: r_s' test takes the frame error the lock test leaves possible).
+void averaged_classification_over_step(benchmark::State& state, bool sensorless) {
   const core::PerUnitBase base = test::paper_base();
   std::vector<core::AveragedSample> windows = averaged_windows();
   std::vector<core::RegimeInput> inputs;
@@ -288,7 +289,8 @@ void BM_AveragedClassificationOverStep(benchmark::State& state) {
     in.weight = core::Vec2::Constant(0.01);
     inputs.push_back(in);
   }
-  const core::EstimatorSettings settings = test::paper_settings(core::Algorithm::kSga);
+  core::EstimatorSettings settings = test::paper_settings(core::Algorithm::kSga);
+  settings.regimes.sensorless = sensorless;
   core::AveragedDriveEstimator est(test::paper_machine_si(), settings);
   core::RegimeClassifier classifier(core::make_regime_config(base, test::paper_machine_si(), settings));
   const std::int64_t pass_ns = windows.back().t_ns - windows.front().t_start_ns;
@@ -315,6 +317,8 @@ void BM_AveragedClassificationOverStep(benchmark::State& state) {
   state.counters["step_ns"] = 1e9 * step_s / steps;
   state.counters["ratio"] = classify_s / step_s;
 }
+void BM_AveragedClassificationOverStep(benchmark::State& state) { averaged_classification_over_step(state, false); }
+void BM_AveragedClassificationOverStepSensorless(benchmark::State& state) { averaged_classification_over_step(state, true); }
 
 /// The classification's cost inside the averaged step, as BM_ClassificationInStep: AveragedDriveEstimator::step
 /// with `estimator.regimes.enabled` and without (which takes the slope between window centres itself), in
@@ -348,6 +352,11 @@ BENCHMARK(BM_ClassificationOverStep)
     ->ComputeStatistics("max", max_of)
     ->ReportAggregatesOnly(true);
 BENCHMARK(BM_AveragedClassificationOverStep)
+    ->MinTime(1.0)
+    ->Repetitions(10)
+    ->ComputeStatistics("max", max_of)
+    ->ReportAggregatesOnly(true);
+BENCHMARK(BM_AveragedClassificationOverStepSensorless)
     ->MinTime(1.0)
     ->Repetitions(10)
     ->ComputeStatistics("max", max_of)

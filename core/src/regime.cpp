@@ -227,6 +227,11 @@ void RegimeClassifier::reconfigure(const RegimeConfig& config) noexcept {
   k.slope_var_x_sq = Vec2(k.inv_omega_n_sq * c.x_d_pu * c.x_d_pu, k.inv_omega_n_sq * c.x_q_pu * c.x_q_pu);
   k.x_max = std::max(c.x_d_pu, c.x_q_pu);
   k.dx_max = std::max(c.dx_d_pu, c.dx_q_pu);
+  k.cos_angle = 1.0 / std::sqrt(1.0 + c.tan_angle * c.tan_angle);
+  k.sin_angle = c.tan_angle * k.cos_angle;
+  // A sensorless frame's error within the cone at least (a = 0): ψ_max·√(2·(1 − cos δ_tol)).
+  const double dpsi_frame = c.dpsi_pu + (c.sensorless ? c.psi_max_pu * std::sqrt(2.0 * (1.0 - k.cos_angle)) : 0.0);
+  k.dpsi_frame_sq = dpsi_frame * dpsi_frame;
   update_quantisation();
 }
 
@@ -265,6 +270,8 @@ struct RegimeClassifier::Terms {
   /// (the transient test's rows and ψm's noise begin with it): σ_u² + (r² + n²·x_o²)·σ_i².
   Vec2 n2_x2 = Vec2::Zero();
   Vec2 row_noise = Vec2::Zero();
+  /// B_d + tan δ_tol·B_q: what the configuration's uncertainty puts into the lock test's margin (lock_bits).
+  double lock_bias = 0.0;
 };
 
 std::uint8_t RegimeClassifier::bridge_bits(const RegimeInput& in) const noexcept {
@@ -284,7 +291,20 @@ std::uint8_t RegimeClassifier::bridge_bits(const RegimeInput& in) const noexcept
   return 0;
 }
 
-std::uint8_t RegimeClassifier::lock_bits(const RegimeInput& in, const Terms& t) const noexcept {
+double RegimeClassifier::lock_variance(const RegimeInput& in, const Terms& t) const noexcept {
+  const RegimeConfig& c = config_;
+  const Constants& k = k_;
+  const RegimeNoise& v = noise_;
+  const Vec2& i = in.i_pu;
+  const double slope_sq = 2.0 * t.inv_dt * t.inv_dt;  // Var(s) per σ_i²
+  const double var_d =
+      v.u_sq + (k.r_sq + t.n2_x2[0] + k.slope_var_x_sq[0] * slope_sq) * v.i_sq + c.x_q_pu * c.x_q_pu * i[1] * i[1] * v.n_sq;
+  const double flux_q = c.psi_max_pu + c.x_d_pu * std::abs(i[0]);
+  const double var_q = v.u_sq + (k.r_sq + t.n2_x2[1] + k.slope_var_x_sq[1] * slope_sq) * v.i_sq + flux_q * flux_q * v.n_sq;
+  return var_d + c.tan_angle * c.tan_angle * var_q;
+}
+
+std::uint8_t RegimeClassifier::lock_bits(const RegimeInput& in, Terms& t) const noexcept {
   const RegimeConfig& c = config_;
   const Constants& k = k_;
   const RegimeNoise& v = noise_;
@@ -300,18 +320,28 @@ std::uint8_t RegimeClassifier::lock_bits(const RegimeInput& in, const Terms& t) 
   const Vec2 e = ((in.u_pu - c.r_pu * i) - k.x_over_omega_n.cwiseProduct(sl)) + rotation;
   const Vec2 b =
       (c.dr_pu * abs_i + (abs_n * k.dx_swapped).cwiseProduct(abs_i.reverse())) + k.dx_over_omega_n.cwiseProduct(abs_sl);
+  t.lock_bias = b[0] + c.tan_angle * b[1];
   // The speed's sign where it stands out of its noise; else either direction of q.
   const double along = n2 > k.z_sq * v.n_sq ? (n > 0.0 ? e[1] : -e[1]) : std::abs(e[1]);
   const double lock = std::abs(e[0]) - c.tan_angle * (along + b[1]) - b[0];
   if (lock > 0.0) [[unlikely]] {
-    const double slope_sq = 2.0 * t.inv_dt * t.inv_dt;  // Var(s) per σ_i²
-    const double var_d = v.u_sq + (k.r_sq + t.n2_x2[0] + k.slope_var_x_sq[0] * slope_sq) * v.i_sq +
-                         c.x_q_pu * c.x_q_pu * i[1] * i[1] * v.n_sq;
-    const double flux_q = c.psi_max_pu + c.x_d_pu * abs_i[0];
-    const double var_q = v.u_sq + (k.r_sq + t.n2_x2[1] + k.slope_var_x_sq[1] * slope_sq) * v.i_sq + flux_q * flux_q * v.n_sq;
-    if (lock * lock > k.z_sq * (var_d + c.tan_angle * c.tan_angle * var_q)) return regime_bit::kNotLocked;
+    if (lock * lock > k.z_sq * lock_variance(in, t)) return regime_bit::kNotLocked;
   }
   return 0;
+}
+
+double RegimeClassifier::frame_flux(const RegimeInput& in, const Terms& t) const noexcept {
+  const RegimeConfig& c = config_;
+  const Constants& k = k_;
+  // The largest frame error the lock test passes: e = n·ψ·[sin δ, cos δ] hides while sin(δ − δ_tol) ≤ a, a =
+  // cos δ_tol·(B_d + tan δ_tol·B_q + z·σ_L)/(|n|·ψ_min); a frame turning with the rotor is within δ_tol + π/2
+  // (a ≥ 1: the test cannot judge it). Against the model's [0, n·ψ̂] it adds |n|·ψ·|[sin δ, cos δ − 1]| =
+  // |n|·ψ·2·sin(δ/2) to the magnet's voltage error: at most ψ_max·√(2·(1 − cos δ_max)) per unit of speed.
+  const double reach = k.cos_angle * (t.lock_bias + std::sqrt(k.z_sq * lock_variance(in, t)));
+  const double emf = std::abs(in.n_pu) * c.psi_min_pu;
+  const double a = reach < emf ? reach / emf : 1.0;
+  const double cos_max = k.cos_angle * std::sqrt(1.0 - a * a) - k.sin_angle * a;
+  return c.psi_max_pu * std::sqrt(2.0 * (1.0 - cos_max));
 }
 
 std::uint8_t RegimeClassifier::contiguous_transient_bits(const RegimeInput& in, const Terms& t) noexcept {
@@ -362,10 +392,12 @@ std::uint8_t RegimeClassifier::excitation_bits(const RegimeInput& in, const Term
     const double noise = t.row_noise[1] + k.psi_max_sq * v.n_sq;
     if (psi_term * psi_term > k.z_sq * h_sq[0] * noise) bits |= regime_bit::kExcitesPsiM;
   }
-  // r_min·|i| must at least exceed |n|·Δψ: checked on the squares before |i| is taken.
-  if (k.r_min_sq * i_sq > n2 * c.dpsi_pu * c.dpsi_pu) {
+  // r_min·|i| must at least exceed |n|·Δψ (and a sensorless frame's least error): checked on the squares before
+  // |i| is taken. A sensorless frame's possible error only where it is needed (two roots and a division).
+  if (k.r_min_sq * i_sq > n2 * k.dpsi_frame_sq) {
     const double i_abs = std::sqrt(i_sq);
-    const double term = c.r_min_pu * i_abs - abs_n * (c.dpsi_pu + k.dx_max * i_abs);
+    const double frame = c.sensorless && abs_n > 0.0 ? frame_flux(in, t) : 0.0;
+    const double term = c.r_min_pu * i_abs - abs_n * ((c.dpsi_pu + frame) + k.dx_max * i_abs);
     if (term > 0.0) {
       const double flux = c.psi_max_pu + k.x_max * i_abs;
       const double noise = v.u_sq + (k.r_sq + n2 * k.x_max * k.x_max) * v.i_sq + flux * flux * v.n_sq;

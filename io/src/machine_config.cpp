@@ -97,6 +97,8 @@ void parse_regimes(YamlMap& g, core::RegimeSettings& r) {
   r.speed_resolution_rad_s = g.number_or("speed_resolution_rad_s", r.speed_resolution_rad_s, 0.0, 1e4);
   r.inductance_tolerance = g.number_or("inductance_tolerance", r.inductance_tolerance, 0.0, 10.0);
   r.angle_tolerance_rad = g.number_or("angle_tolerance_rad", r.angle_tolerance_rad, 0.0, 1.5);
+  r.sensorless =
+      g.choice_or("angle_source", r.sensorless ? "sensorless" : "sensor", {"sensor", "sensorless"}) == "sensorless";
   g.finish();
 }
 

@@ -18,8 +18,10 @@ constexpr Rule kUnexcited{
     "adapted nothing (neither parameter excited)",
     "neither term stood out: ψm's back-EMF |ω|·ψ_min and R_s' drop R_min·|i| must exceed their noise as "
     "the gains average it and what the other parameters' uncertainty (D_M, the inductance tolerance) "
-    "can put in their place; zero-current coasting and standstill without current excite neither",
-    "estimator.bounds (narrower ψm bounds let R_s adapt at speed), estimator.regimes.significance_sigma, "
+    "can put in their place; zero-current coasting and standstill without current excite neither; a sensorless "
+    "frame (angle_source) keeps R_s from low speeds whose back-EMF cannot rule out a frame error",
+    "estimator.bounds (narrower ψm bounds let R_s adapt at speed), estimator.regimes.angle_source, "
+    "estimator.regimes.significance_sigma, "
     "estimator.regimes.inductance_tolerance"};
 constexpr Rule kTransient{"were transient",
                           "the window's current or speed changed more than the steady state with the inductive correction "

@@ -257,13 +257,22 @@ class Classifier {
     // The speed's sign where it stands out of its noise; else either direction of q.
     const double along = n2 > k.z_sq * v.n_sq ? (n > 0.0 ? e[1] : -e[1]) : std::abs(e[1]);
     const double lock = std::abs(e[0]) - c.tan_angle * (along + b[1]) - b[0];
-    if (lock > 0.0) [[unlikely]] {
-      const double slope_sq = 2.0 * s.inv_dt * s.inv_dt;  // Var(s) per σ_i²
-      const double var_d =
-          v.u_sq + (k.r_sq + n2_xq2 + k.slope_var_x_sq[0] * slope_sq) * v.i_sq + c.x_q_pu * c.x_q_pu * i[1] * i[1] * v.n_sq;
-      const double flux_q = c.psi_max_pu + c.x_d_pu * abs_i[0];
-      const double var_q = v.u_sq + (k.r_sq + n2_xd2 + k.slope_var_x_sq[1] * slope_sq) * v.i_sq + flux_q * flux_q * v.n_sq;
-      if (lock * lock > k.z_sq * (var_d + c.tan_angle * c.tan_angle * var_q)) bits |= regime_bit::kNotLocked;
+    const double slope_sq = 2.0 * s.inv_dt * s.inv_dt;  // Var(s) per σ_i²
+    const double var_d =
+        v.u_sq + (k.r_sq + n2_xq2 + k.slope_var_x_sq[0] * slope_sq) * v.i_sq + c.x_q_pu * c.x_q_pu * i[1] * i[1] * v.n_sq;
+    const double flux_q = c.psi_max_pu + c.x_d_pu * abs_i[0];
+    const double var_q = v.u_sq + (k.r_sq + n2_xd2 + k.slope_var_x_sq[1] * slope_sq) * v.i_sq + flux_q * flux_q * v.n_sq;
+    const double sigma_lock = std::sqrt(var_d + c.tan_angle * c.tan_angle * var_q);
+    if (lock > 0.0 && lock > c.z * sigma_lock) bits |= regime_bit::kNotLocked;
+    // A sensorless frame (an observer, an open-loop start-up) that passes: a frame error δ gives e = n·ψ·[sin δ, cos δ],
+    // which hides while sin(δ − δ_tol) ≤ cos δ_tol·(B_d + tan δ_tol·B_q + z·σ_L)/(|n|·ψ_min); a frame turning with
+    // the rotor stays within δ_tol + π/2. Its error beside the model's [0, n·ψ̂] is |n|·ψ·2·sin(δ/2).
+    double frame_flux = 0.0;
+    if (c.sensorless) {
+      const double delta_tol = std::atan(c.tan_angle);
+      const double reach = std::cos(delta_tol) * (b[0] + c.tan_angle * b[1] + c.z * sigma_lock);
+      const double delta_max = delta_tol + std::asin(std::min(1.0, reach / (abs_n * c.psi_min_pu)));
+      frame_flux = 2.0 * c.psi_max_pu * std::sin(0.5 * delta_max);
     }
 
     if (in.timing == SampleTiming::kStandalone && s.points >= 1) [[unlikely]] {
@@ -312,7 +321,7 @@ class Classifier {
     // r_min·|i| must at least exceed |n|·Δψ: checked on the squares before |i| is taken.
     if (k.r_min_sq * i_sq > n2 * c.dpsi_pu * c.dpsi_pu) {
       const double i_abs = std::sqrt(i_sq);
-      const double term = c.r_min_pu * i_abs - abs_n * (c.dpsi_pu + k.dx_max * i_abs);
+      const double term = c.r_min_pu * i_abs - abs_n * (c.dpsi_pu + frame_flux + k.dx_max * i_abs);
       if (term > 0.0) {
         const double h_sq = in.weight[1] / (2.0 - in.weight[1]);
         const double flux = c.psi_max_pu + k.x_max * i_abs;

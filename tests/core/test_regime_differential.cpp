@@ -187,15 +187,19 @@ constexpr int kSamplesPerConfig = 1'000'000;
 
 TEST(RegimeDifferential, TheCheaperClassifierDecidesAsTheDerivedRulesOnMillionsOfSamples) {
   const std::uint64_t seed = test::test_seed(23007);
-  // The outrunner with measured resolution and with a configured one, and the paper's machine.
+  // The outrunner with measured resolution and with a configured one, and the paper's machine, their angles measured.
   EstimatorSettings outrunner = test::outrunner_settings();
   run(make_regime_config(test::outrunner_base(), test::outrunner_machine_si(), outrunner), seed, kSamplesPerConfig);
   outrunner.regimes.voltage_resolution_V = 0.01;
   outrunner.regimes.current_resolution_A = 0.01;
   outrunner.regimes.speed_resolution_rad_s = 0.1;
   run(make_regime_config(test::outrunner_base(), test::outrunner_machine_si(), outrunner), seed + 1, kSamplesPerConfig);
-  const EstimatorSettings paper = test::paper_settings(Algorithm::kSga);
+  EstimatorSettings paper = test::paper_settings(Algorithm::kSga);
   run(make_regime_config(test::paper_base(), test::paper_machine_si(), paper), seed + 2, kSamplesPerConfig);
+  // Sensorless frames (r_s' test takes the frame error the lock test leaves possible): both machines.
+  outrunner.regimes.sensorless = paper.regimes.sensorless = true;
+  run(make_regime_config(test::outrunner_base(), test::outrunner_machine_si(), outrunner), seed + 3, kSamplesPerConfig);
+  run(make_regime_config(test::paper_base(), test::paper_machine_si(), paper), seed + 4, kSamplesPerConfig);
 }
 
 }  // namespace

@@ -172,6 +172,21 @@ TEST(MachineConfig, ReportedCommandIsReadAndNeedsTheControlPeriod) {
             std::string::npos);
 }
 
+TEST(MachineConfig, TheAnglesSourceIsReadAndChecked) {
+  // The paper's drive has a position sensor (the default); the VESC configurations are sensorless.
+  EXPECT_FALSE(load_machine_config(test::source_dir() + "/config/paper-ipmsm.yaml").estimator.regimes.sensorless);
+  for (const char* vesc : {"vesc-6374-outrunner.yaml", "vesc-6374-firmware.yaml"})
+    EXPECT_TRUE(load_machine_config(test::source_dir() + "/config/" + vesc).estimator.regimes.sensorless) << vesc;
+  const std::string edited =
+      std::regex_replace(paper_text(), std::regex("\n  floors:"),
+                         "\n  regimes: {angle_source: sensor}\n  floors:", std::regex_constants::format_first_only);
+  test::TempFile f("angle.yaml", edited);
+  EXPECT_FALSE(load_machine_config(f.path()).estimator.regimes.sensorless);
+  const std::string error = error_after_edit("\n  floors:", "\n  regimes: {angle_source: hall}\n  floors:");
+  EXPECT_NE(error.find("estimator.regimes.angle_source: 'hall' is not one of: sensor, sensorless"), std::string::npos)
+      << error;
+}
+
 TEST(MachineConfig, ModelExtensionsAreRead) {
   const std::string text = paper_text() +
                            "model_extensions:\n"

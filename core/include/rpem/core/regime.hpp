@@ -143,6 +143,11 @@ struct RegimeSettings {
   /// The largest angle between the back-EMF and ±q a locked frame shows: acos(0.98), the frame error
   /// that biases the q-axis flux by 2 %.
   double angle_tolerance_rad = 0.20033484232311968;
+  /// Where the drive's dq frame comes from. false (`angle_source: sensor`): a position sensor; the frame is the
+  /// rotor's but for a constant offset (`model_extensions`), wherever the lock test cannot judge it. true
+  /// (`sensorless`): an observer or an open-loop start-up; r_s is excited only beyond the frame error the lock
+  /// test leaves possible (docs/derivations.md §13, "Excitation").
+  bool sensorless = false;
 };
 
 /// The classifier's configuration, per unit (make_regime_config() in settings.hpp builds it).
@@ -155,6 +160,7 @@ struct RegimeConfig {
   double x_d_pu = 0.0, x_q_pu = 0.0;                         ///< nominal inductances
   double dx_d_pu = 0.0, dx_q_pu = 0.0;                       ///< their tolerance
   double tan_angle = 0.0;                                    ///< tan δ_tol
+  bool sensorless = false;                                   ///< RegimeSettings::sensorless
   /// Configured resolution of u, i, n [pu]; 0: measured.
   std::array<double, 3> resolution_pu{};
   /// τ_el = max(x)/(ω_n·r_min) [s]: the slowest decay of the electrical transient the model admits.
@@ -283,6 +289,8 @@ class RegimeClassifier {
     Vec2 x_sq = Vec2::Zero();                           ///< (x_d², x_q²)
     Vec2 slope_var_x_sq = Vec2::Zero();                 ///< (x_d², x_q²)/ω_n²
     double x_max = 0.0, dx_max = 0.0;                   ///< the larger inductance and tolerance
+    double cos_angle = 1.0, sin_angle = 0.0;            ///< cos δ_tol, sin δ_tol
+    double dpsi_frame_sq = 0.0;  ///< (Δψ + a sensorless frame's least error)²: r_s' test's first check
   };
 
   /// Recomputes quantisation_var_ (after a resolution changed or the configuration did).
@@ -291,8 +299,13 @@ class RegimeClassifier {
   /// its state; the bridge-off, angle-lock, contiguous windows' transient and excitation bits.
   struct Terms;
   [[nodiscard]] Terms take_slope(const RegimeInput& in, double dt_s) noexcept;
-  [[nodiscard]] std::uint8_t bridge_bits(const RegimeInput& in) const noexcept;                ///< kBridgeOff or 0
-  [[nodiscard]] std::uint8_t lock_bits(const RegimeInput& in, const Terms& t) const noexcept;  ///< kNotLocked or 0
+  [[nodiscard]] std::uint8_t bridge_bits(const RegimeInput& in) const noexcept;  ///< kBridgeOff or 0
+  /// kNotLocked or 0 (and Terms::lock_bias).
+  [[nodiscard]] std::uint8_t lock_bits(const RegimeInput& in, Terms& t) const noexcept;
+  /// σ_L²: the lock test's margin's variance.
+  [[nodiscard]] double lock_variance(const RegimeInput& in, const Terms& t) const noexcept;
+  /// A sensorless frame's largest possible error as a flux beside Δψ in r_s' test [pu] (after lock_bits).
+  [[nodiscard]] double frame_flux(const RegimeInput& in, const Terms& t) const noexcept;
   [[nodiscard]] std::uint8_t contiguous_transient_bits(const RegimeInput& in, const Terms& t) noexcept;
   [[nodiscard]] std::uint8_t excitation_bits(const RegimeInput& in, const Terms& t) const noexcept;
 
