@@ -393,7 +393,7 @@ std::uint8_t RegimeClassifier::excitation_bits(const RegimeInput& in, const Term
     if (psi_term * psi_term > k.z_sq * h_sq[0] * noise) bits |= regime_bit::kExcitesPsiM;
   }
   // r_min·|i| must at least exceed |n|·Δψ (and a sensorless frame's least error): checked on the squares before
-  // |i| is taken. A sensorless frame's possible error only where it is needed (two roots and a division).
+  // |i| is taken. A sensorless frame's possible error only where it is needed (three roots and a division).
   if (k.r_min_sq * i_sq > n2 * k.dpsi_frame_sq) {
     const double i_abs = std::sqrt(i_sq);
     const double frame = c.sensorless && abs_n > 0.0 ? frame_flux(in, t) : 0.0;

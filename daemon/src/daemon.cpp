@@ -9,12 +9,14 @@
 #include <cstdio>
 #include <cstdlib>
 #include <ctime>
+#include <string_view>
 
 #include "rpem/core/clock.hpp"
 #include "rpem/daemon/control.hpp"
 #include "rpem/daemon/credentials.hpp"
 #include "rpem/daemon/realtime.hpp"
 #include "rpem/daemon/state_file.hpp"
+#include "rpem/daemon/vesc_source.hpp"
 #include "rpem/io/exit_codes.hpp"
 
 namespace rpem::daemon {
@@ -77,6 +79,13 @@ void print_start(const DaemonConfig& config, const std::string& source_name, con
                    ? "unauthenticated (authentication: none, local only)"
                    : (ids.empty() ? std::string("need a key (none loaded)") : "authenticated with key id " + ids).c_str(),
                static_cast<long long>(commands.last_accepted_seq), commands.sequence_file.c_str(), signing.c_str());
+  // A VESC is mostly sensorless, the default frame a position sensor's (io::unstated_frame_note says the same of logs).
+  if (std::string_view(source_type) == VescSource::kType && !config.live.machine.angle_source_stated) {
+    std::fprintf(stderr,
+                 "rpemd: note: the machine configuration does not say where the VESC's dq frame comes from "
+                 "(estimator.regimes.angle_source): taken as a position sensor's; a VESC without sensors should say "
+                 "sensorless (docs/configuration.md)\n");
+  }
 }
 
 }  // namespace

@@ -51,7 +51,8 @@ LogSource log_source(const std::string& log_path, const std::string& map_path) {
     const VescToolHeader* version = identify_vesc_tool_header(cells);
     return {log_path, std::move(map),
             version ? std::string("VESC Tool realtime log (the header of VESC Tool ") + version->versions + ")"
-                    : std::string("VESC Tool realtime log (a header of no VESC Tool version known: columns read by name)")};
+                    : std::string("VESC Tool realtime log (a header of no VESC Tool version known: columns read by name)"),
+            true};
   }
   if (is_headerless_vesc_tool_row(line)) {
     throw DriveLogError(log_path, line_no, 0, "",
@@ -87,6 +88,14 @@ std::string describe(const LogSource& source, const AveragedLogRead& read) {
     s += lag;
   }
   return s + describe(read.repairs);
+}
+
+std::string unstated_frame_note(const LogSource& source, const MachineConfig& config) {
+  if (!source.vesc_tool || config.angle_source_stated) return "";
+  return "note: the configuration does not say where the drive's dq frame comes from "
+         "(estimator.regimes.angle_source): taken as a position sensor's. A VESC without sensors runs on an observer "
+         "and starts open loop; say angle_source: sensorless, so that R_s adapts only where the back EMF rules out "
+         "a frame error (docs/configuration.md)";
 }
 
 }  // namespace rpem::io

@@ -464,7 +464,9 @@ core::Algorithm parse_algorithm(const std::string& name) {
 MachineConfig parse_machine_config(YamlMap& root) {
   MachineConfig c;
   c.machine = parse_machine(root.map("machine"));
-  c.estimator = parse_estimator(root.map("estimator"), c.machine);
+  YamlMap estimator = root.map("estimator");
+  if (estimator.has("regimes")) c.angle_source_stated = estimator.map("regimes").has("angle_source");
+  c.estimator = parse_estimator(estimator, c.machine);
   if (auto x = root.optional_map("model_extensions")) parse_extensions(*x, c);
   return c;
 }

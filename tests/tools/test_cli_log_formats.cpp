@@ -73,6 +73,36 @@ TEST_F(CliLogFormats, AVescToolLogIsReadWithoutAFlag) {
   EXPECT_NE(d.output.find("119 samples, steady_state model"), std::string::npos) << d.output;
 }
 
+// A VESC Tool log read with a configuration that does not say where the dq frame comes from: the tools that adapt
+// R_s say what they assumed (a position sensor's frame, the default) and which key changes it; the outrunner's file
+// says sensorless: no note.
+TEST_F(CliLogFormats, AVescToolLogWithAnUnstatedFrameSourceIsNoted) {
+  const std::string log = vesc_log(120);
+  std::ifstream in(vesc_config());
+  std::stringstream text;
+  text << in.rdbuf();
+  const std::string stated = text.str(), key = "    angle_source: sensorless";
+  ASSERT_NE(stated.find(key), std::string::npos);
+  std::string unstated = stated;
+  unstated.replace(unstated.find(key), key.size(), "    significance_sigma: 4");
+  const std::string unstated_config = path("unstated.yaml");
+  std::ofstream(unstated_config) << unstated;
+  const std::string note =
+      "note: the configuration does not say where the drive's dq frame comes from "
+      "(estimator.regimes.angle_source)";
+  for (const std::string& tool :
+       {std::string("estimate --out ") + path("est.csv"), std::string("thermal fit --out ") + path("thermal.yaml")}) {
+    SCOPED_TRACE(tool);
+    const test::ProcessResult with =
+        test::run_command(rpem() + " " + tool + " --log " + log + " --config " + unstated_config);
+    EXPECT_NE(with.output.find(note), std::string::npos) << with.output;
+    EXPECT_NE(with.output.find("say angle_source: sensorless"), std::string::npos) << with.output;
+    const test::ProcessResult without =
+        test::run_command(rpem() + " " + tool + " --log " + log + " --config " + vesc_config());
+    EXPECT_EQ(without.output.find(note), std::string::npos) << without.output;
+  }
+}
+
 TEST_F(CliLogFormats, FiguresDrawAVescToolLogsRegimes) {
   // Every row modulates at a locked angle and excites ψm (ω·ψm ≈ 3–7 V against VESC Tool's 10 mV): nothing is
   // bridge off or not locked, and the timeline is drawn.

@@ -160,6 +160,8 @@ int run_averaged(const EstimateOptions& o, const io::LogSource& source, const io
   const std::vector<core::AveragedSample> samples =
       io::read_averaged_log(o.log, source.map, io::machine_limits(cfg.machine), &read);
   std::fprintf(stderr, "rpem estimate: %s\n", io::describe(source, read).c_str());
+  if (const std::string note = io::unstated_frame_note(source, cfg); !note.empty())
+    std::fprintf(stderr, "rpem estimate: %s\n", note.c_str());
   io::check_averaged_supports(cfg, config_name, read.layout.u_dc, o.log);
   core::AveragedDriveEstimator estimator(cfg.machine, cfg.estimator);
   ThermalRun thermal(o, cfg, estimator.base());

@@ -16,7 +16,9 @@
 //                a mixed window: the bridge was released or took over inside it (the window next to a
 //                bridge-off one; the release shows one window late: kPreviousMixed)
 //   excites ψm   |n|·ψ_min − Δr·|i_q| − |n|·Δx_d·|i_d| > z·h_ψ·N_ψ   (h² = γ/(2 − γ): the estimator's averaging)
-//   excites r_s  r_min·|i| − |n|·(Δψ + Δx·|i|)       > z·h_r·N_r
+//   excites r_s  r_min·|i| − |n|·(Δψ + F + Δx·|i|)   > z·h_r·N_r
+//                F = 0 for a sensor's frame; sensorless: ψ_max·2·sin(δ_max/2), the largest frame error the lock test
+//                passes, δ_max = δ_tol + asin(min(1, cos δ_tol·(B_d + tan δ_tol·B_q + z·σ_L)/(|n|·ψ_min)))
 // Real-time safe: noexcept, no allocation, fixed size.
 
 #include <array>

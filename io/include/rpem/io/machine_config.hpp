@@ -28,6 +28,8 @@ struct MachineConfig {
   core::EstimatorSettings estimator;
   ParameterDrift rs_drift;
   ParameterDrift psim_drift;
+  /// The file said estimator.regimes.angle_source (else a position sensor's frame was assumed: unstated_frame_note).
+  bool angle_source_stated = false;
 };
 
 /// Reads the `machine`, `estimator` and optional `model_extensions` sections of `root`
