@@ -79,12 +79,10 @@ void print_start(const DaemonConfig& config, const std::string& source_name, con
                    ? "unauthenticated (authentication: none, local only)"
                    : (ids.empty() ? std::string("need a key (none loaded)") : "authenticated with key id " + ids).c_str(),
                static_cast<long long>(commands.last_accepted_seq), commands.sequence_file.c_str(), signing.c_str());
-  // A VESC is mostly sensorless, the default frame a position sensor's (io::unstated_frame_note says the same of logs).
-  if (std::string_view(source_type) == VescSource::kType && !config.live.machine.angle_source_stated) {
-    std::fprintf(stderr,
-                 "rpemd: note: the machine configuration does not say where the VESC's dq frame comes from "
-                 "(estimator.regimes.angle_source): taken as a position sensor's; a VESC without sensors should say "
-                 "sensorless (docs/configuration.md)\n");
+  // A VESC is mostly sensorless, the default frame a position sensor's.
+  if (std::string_view(source_type) == VescSource::kType) {
+    if (const std::string note = io::unstated_frame_note(config.live.machine); !note.empty())
+      std::fprintf(stderr, "rpemd: %s\n", note.c_str());
   }
 }
 

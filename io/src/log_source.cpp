@@ -91,11 +91,7 @@ std::string describe(const LogSource& source, const AveragedLogRead& read) {
 }
 
 std::string unstated_frame_note(const LogSource& source, const MachineConfig& config) {
-  if (!source.vesc_tool || config.angle_source_stated) return "";
-  return "note: the configuration does not say where the drive's dq frame comes from "
-         "(estimator.regimes.angle_source): taken as a position sensor's. A VESC without sensors runs on an observer "
-         "and starts open loop; say angle_source: sensorless, so that R_s adapts only where the back EMF rules out "
-         "a frame error (docs/configuration.md)";
+  return source.vesc_tool ? unstated_frame_note(config) : "";
 }
 
 }  // namespace rpem::io

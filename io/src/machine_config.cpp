@@ -471,6 +471,14 @@ MachineConfig parse_machine_config(YamlMap& root) {
   return c;
 }
 
+std::string unstated_frame_note(const MachineConfig& config) {
+  if (config.angle_source_stated) return "";
+  return "note: the configuration does not say where the drive's dq frame comes from "
+         "(estimator.regimes.angle_source): taken as a position sensor's. A VESC without sensors runs on an observer "
+         "and starts open loop; say angle_source: sensorless, so that R_s adapts only where the back EMF rules out "
+         "a frame error (docs/configuration.md)";
+}
+
 MachineConfig load_machine_config(const std::string& path) {
   YamlMap root = YamlMap::load_file(path);
   MachineConfig c = parse_machine_config(root);

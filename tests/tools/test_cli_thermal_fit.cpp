@@ -197,6 +197,31 @@ TEST_F(CliThermalFit, SaysWhatTheTrainingPartObserves) {
     std::snprintf(line, sizeof line, "winding sensor: %.1f–%.1f °C in training", sensor.at("training_low_C").get<double>(),
                   sensor.at("training_high_C").get<double>());
     EXPECT_NE(r.output.find(line), std::string::npos) << r.output;
+
+    // Trained only on the steps before the first magnet observation: the magnet's signal is held out alone, and
+    // the fit says the training part has none of it (not a span of zeros).
+    if (isothermal) continue;
+    const std::vector<std::string> names = cells(header, ',');
+    const auto observed =
+        static_cast<std::size_t>(std::find(names.begin(), names.end(), "T_magnet_observed") - names.begin());
+    ASSERT_LT(observed, names.size()) << header;
+    double first_magnet_s = std::nan("");
+    for (std::string row; std::getline(predictions, row);) {
+      const std::vector<std::string> c = cells(row, ',');
+      if (c.size() > observed && !c[observed].empty()) {
+        first_magnet_s = std::stod(c[0]);
+        break;
+      }
+    }
+    ASSERT_TRUE(std::isfinite(first_magnet_s));
+    const double until_magnet_s = first_magnet_s - 1.5;
+    ASSERT_GT(until_magnet_s - from_s, 12.0);  // at least the fit's 10 steps before it
+    const test::ProcessResult early =
+        test::run_command(rpem_tool() + " thermal fit --log " + log + outrunner + " --out " + report +
+                          "_early.yaml --fit-until-s " + std::to_string(until_magnet_s));
+    ASSERT_EQ(early.exit_code, 0) << early.output;
+    EXPECT_NE(early.output.find("magnet (from psi_m): none in training"), std::string::npos) << early.output;
+    EXPECT_NE(test::read_file(report + "_early.yaml").find("# magnet (from psi_m): none in training"), std::string::npos);
   }
 }
 

@@ -71,9 +71,8 @@ int run_thermal_fit(const ThermalFitCliOptions& o) {
     analysis::write_thermal_predictions(o.report + "/predictions.csv", fit, record);
   }
   for (const analysis::SignalFit& s : fit.signals) {
-    std::printf("%s: %.1f–%.1f °C in training (σ %.2g K); fit %.3g K RMS, held out %.3g K RMS (worst %.3g K)\n",
-                s.name.c_str(), s.training_low_C, s.training_high_C, s.training_sigma_K, s.fit_rms_K, s.heldout_rms_K,
-                s.heldout_worst_K);
+    std::printf("%s: %s in training (σ %.2g K); fit %.3g K RMS, held out %.3g K RMS (worst %.3g K)\n", s.name.c_str(),
+                analysis::training_span(s).c_str(), s.training_sigma_K, s.fit_rms_K, s.heldout_rms_K, s.heldout_worst_K);
   }
   for (const analysis::FittedParameter& p : fit.parameters) {
     if (p.half_width_rel <= 10.0) {

@@ -13,6 +13,7 @@
 #include "rpem/analysis/cluster_robust.hpp"
 #include "rpem/analysis/diagnose/effect_fit.hpp"
 #include "rpem/analysis/thermal/thermal_replay.hpp"
+#include "rpem/analysis/thermal/thermal_report.hpp"
 #include "rpem/core/non_finite.hpp"
 
 namespace rpem::analysis {
@@ -291,8 +292,8 @@ void judge(const io::ThermalConfig& c, const ThermalRecord& r, std::size_t train
       }
     }
     if (s.fit_points + s.heldout_points == 0) continue;
-    s.training_low_C = quantile(observed_C, 0.05);
-    s.training_high_C = quantile(observed_C, 0.95);
+    s.training_low_C = observed_C.empty() ? core::kNaN : quantile(observed_C, 0.05);
+    s.training_high_C = observed_C.empty() ? core::kNaN : quantile(observed_C, 0.95);
     std::vector<double> sigma_K;
     for (const Point& p : points) {
       if (p.kind == kind) sigma_K.push_back(p.sigma_K);
@@ -375,10 +376,9 @@ std::string nothing_identified(const ThermalFitResult& fit) {
     if (s.fit_points == 0) continue;
     const double span_K = s.training_high_C - s.training_low_C;
     moves = moves || span_K > kNoiseSpan_sigma * s.training_sigma_K;
-    char part[192];
-    std::snprintf(part, sizeof part, "%s%s %.1f–%.1f °C (%.2g K against a σ of %.2g K)", spans.empty() ? "" : "; ",
-                  s.name.c_str(), s.training_low_C, s.training_high_C, span_K, s.training_sigma_K);
-    spans += part;
+    char part[64];
+    std::snprintf(part, sizeof part, " (%.2g K against a σ of %.2g K)", span_K, s.training_sigma_K);
+    spans += (spans.empty() ? "" : "; ") + s.name + " " + training_span(s) + part;
   }
   if (!moves) {
     return "no parameter is identified: no temperature the training part observes moves beyond its noise (5th to "

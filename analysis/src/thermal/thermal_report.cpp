@@ -42,6 +42,11 @@ nlohmann::json number_or_null(double v) { return std::isfinite(v) ? nlohmann::js
 
 }  // namespace
 
+std::string training_span(const SignalFit& s) {
+  if (!std::isfinite(s.training_low_C)) return "none";
+  return celsius(s.training_low_C) + "–" + celsius(s.training_high_C) + " °C";
+}
+
 void write_thermal_yaml(const std::string& path, const ThermalFitResult& fit, const ThermalRecord& record,
                         const std::string& config_name) {
   std::ofstream f = open(path);
@@ -49,10 +54,10 @@ void write_thermal_yaml(const std::string& path, const ThermalFitResult& fit, co
   f << "# log: " << record.log << " (" << record.steps.size() << " steps), configuration: " << config_name << "\n";
   f << "# training: t <= " << fit.fit_until_s << " s (" << fit.training_steps << " steps); the rest held out\n";
   for (const SignalFit& s : fit.signals) {
-    f << "# " << s.name << ": " << celsius(s.training_low_C) << "–" << celsius(s.training_high_C)
-      << " °C in training (5–95 %, σ " << significant(s.training_sigma_K) << " K); fit " << significant(s.fit_rms_K)
-      << " K RMS (" << s.fit_points << "), held out " << significant(s.heldout_rms_K) << " K RMS, worst "
-      << significant(s.heldout_worst_K) << " K (" << s.heldout_points << ")\n";
+    f << "# " << s.name << ": " << training_span(s) << " in training (5–95 %, σ " << significant(s.training_sigma_K)
+      << " K); fit " << significant(s.fit_rms_K) << " K RMS (" << s.fit_points << "), held out "
+      << significant(s.heldout_rms_K) << " K RMS, worst " << significant(s.heldout_worst_K) << " K (" << s.heldout_points
+      << ")\n";
   }
   for (const FittedParameter& p : fit.parameters) {
     if (!p.identified) f << "# not identified: " << p.name << " (95 % interval " << interval(p.half_width_rel) << ")\n";
@@ -96,8 +101,8 @@ void write_thermal_fit_json(const std::string& path, const ThermalFitResult& fit
                             {"heldout_points", s.heldout_points},
                             {"heldout_rms_K", s.heldout_rms_K},
                             {"heldout_worst_K", s.heldout_worst_K},
-                            {"training_low_C", s.training_low_C},
-                            {"training_high_C", s.training_high_C},
+                            {"training_low_C", number_or_null(s.training_low_C)},
+                            {"training_high_C", number_or_null(s.training_high_C)},
                             {"training_sigma_K", s.training_sigma_K}});
   }
   j["not_identifiable"] = fit.not_identifiable;
@@ -113,12 +118,12 @@ void write_thermal_fit_report(const std::string& path, const ThermalFitResult& f
   o << "Log `" << record.log << "` (" << record.steps.size() << " steps of the filter), configuration `" << config_name
     << "`. Training: the steps up to t = " << fit.fit_until_s << " s (" << fit.training_steps
     << "); the rest is held out. The network runs open loop from a soaked start (every node at the coolant).\n\n";
-  o << "| signal | observed in training, 5–95 % [°C] | σ [K] | fit RMS [K] | points | held-out RMS [K] | held-out worst "
+  o << "| signal | observed in training, 5–95 % | σ [K] | fit RMS [K] | points | held-out RMS [K] | held-out worst "
        "[K] | points |\n|---|---|---|---|---|---|---|---|\n";
   for (const SignalFit& s : fit.signals) {
-    o << "| " << s.name << " | " << celsius(s.training_low_C) << "–" << celsius(s.training_high_C) << " | "
-      << significant(s.training_sigma_K) << " | " << significant(s.fit_rms_K) << " | " << s.fit_points << " | "
-      << significant(s.heldout_rms_K) << " | " << significant(s.heldout_worst_K) << " | " << s.heldout_points << " |\n";
+    o << "| " << s.name << " | " << training_span(s) << " | " << significant(s.training_sigma_K) << " | "
+      << significant(s.fit_rms_K) << " | " << s.fit_points << " | " << significant(s.heldout_rms_K) << " | "
+      << significant(s.heldout_worst_K) << " | " << s.heldout_points << " |\n";
   }
   o << "\n## Parameters (95 % intervals: cluster-robust over "
     << "blocks of the training part; excitation alone)\n\n";

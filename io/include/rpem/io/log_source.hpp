@@ -35,9 +35,8 @@ struct LogSource {
 /// The time rules' part of it (empty when they did nothing).
 [[nodiscard]] std::string describe(const TimeRepairs& repairs);
 
-/// Where a VESC Tool log meets a configuration that does not say where the drive's dq frame comes from
-/// (estimator.regimes.angle_source): a note that the default, a position sensor's frame, was assumed, while most
-/// VESCs run sensorless (an observer, open-loop start-ups). Empty otherwise.
+/// Where a VESC Tool log meets a configuration that does not say where the drive's dq frame comes from: the note of
+/// unstated_frame_note(config). Empty otherwise.
 [[nodiscard]] std::string unstated_frame_note(const LogSource& source, const MachineConfig& config);
 
 }  // namespace rpem::io

@@ -36,6 +36,11 @@ struct MachineConfig {
 /// (other sections are left for the caller, who calls root.finish()).
 [[nodiscard]] MachineConfig parse_machine_config(YamlMap& root);
 
+/// Where the configuration does not say where the drive's dq frame comes from (estimator.regimes.angle_source), for a
+/// VESC's data (most VESCs run sensorless, the default is a position sensor's frame): a note saying so and which key
+/// changes it. Empty where the file says it.
+[[nodiscard]] std::string unstated_frame_note(const MachineConfig& config);
+
 /// Loads a whole file that holds only those sections.
 [[nodiscard]] MachineConfig load_machine_config(const std::string& path);
 

@@ -43,9 +43,9 @@ struct SignalFit {
   std::string name;
   std::size_t fit_points = 0, heldout_points = 0;
   double fit_rms_K = 0.0, heldout_rms_K = 0.0, heldout_worst_K = 0.0;
-  /// What the training part observes: the temperatures between its 5th and 95th percentile [°C], and the σ of one
-  /// observation as the fit weighs it (the median over the training part) [K]. A network is identified only by
-  /// temperatures the losses move by many of these σ.
+  /// What the training part observes: the temperatures between its 5th and 95th percentile [°C] (NaN where it has
+  /// none of this signal), and the σ of one observation as the fit weighs it (the median over the training part) [K].
+  /// A network is identified only by temperatures the losses move by many of these σ.
   double training_low_C = 0.0, training_high_C = 0.0, training_sigma_K = 0.0;
 };
 

@@ -20,4 +20,7 @@ void write_thermal_fit_report(const std::string& path, const ThermalFitResult& f
 /// inverses where they are observations, else empty) and the winding sensor.
 void write_thermal_predictions(const std::string& path, const ThermalFitResult& fit, const ThermalRecord& record);
 
+/// What the training part observed of a signal, for every output: "24.9–25.0 °C", or "none" where it has none of it.
+[[nodiscard]] std::string training_span(const SignalFit& s);
+
 }  // namespace rpem::analysis
