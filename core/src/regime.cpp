@@ -21,10 +21,10 @@ constexpr double kTrackDown = 0.93941306281347581;  // e^{−1/16}
 
 /// regime_of() for every combination of the bits, by look-up: the precedence as a chain of conditional
 /// jumps on bits that vary from sample to sample costs a misprediction now and then.
-static_assert((regime_bit::kExcluded | regime_bit::kExcitesPsiM | regime_bit::kExcitesRs | regime_bit::kPreviousMixed) < 128,
-              "every classification's bits index the table");
-constexpr std::array<Regime, 128> kRegimeOfBits = [] {
-  std::array<Regime, 128> table{};
+/// Every value of the bits' byte has its entry.
+constexpr std::size_t kBitCombinations = std::size_t{std::numeric_limits<std::uint8_t>::max()} + 1;
+constexpr std::array<Regime, kBitCombinations> kRegimeOfBits = [] {
+  std::array<Regime, kBitCombinations> table{};
   for (std::size_t b = 0; b < table.size(); ++b) table[b] = regime_of(static_cast<std::uint8_t>(b));
   return table;
 }();
@@ -396,12 +396,20 @@ std::uint8_t RegimeClassifier::excitation_bits(const RegimeInput& in, const Term
   // |i| is taken. A sensorless frame's possible error only where it is needed (three roots and a division).
   if (k.r_min_sq * i_sq > n2 * k.dpsi_frame_sq) {
     const double i_abs = std::sqrt(i_sq);
-    const double frame = c.sensorless && abs_n > 0.0 ? frame_flux(in, t) : 0.0;
-    const double term = c.r_min_pu * i_abs - abs_n * ((c.dpsi_pu + frame) + k.dx_max * i_abs);
-    if (term > 0.0) {
+    const auto term = [&](double frame) { return c.r_min_pu * i_abs - abs_n * ((c.dpsi_pu + frame) + k.dx_max * i_abs); };
+    const double own = term(c.sensorless && abs_n > 0.0 ? frame_flux(in, t) : 0.0);
+    if (own > 0.0) {
       const double flux = c.psi_max_pu + k.x_max * i_abs;
       const double noise = v.u_sq + (k.r_sq + n2 * k.x_max * k.x_max) * v.i_sq + flux * flux * v.n_sq;
-      if (term * term > k.z_sq * h_sq[1] * noise) bits |= regime_bit::kExcitesRs;
+      const double bound_sq = k.z_sq * h_sq[1] * noise;
+      if (own * own > bound_sq) {
+        bits |= regime_bit::kExcitesRs;
+        // A sensor's frame only assumed: would a sensorless frame's possible error have kept the term down?
+        if (c.angle_source_assumed && abs_n > 0.0) {
+          const double sensorless = term(frame_flux(in, t));
+          if (!(sensorless > 0.0 && sensorless * sensorless > bound_sq)) bits |= regime_bit::kRsOnAssumedFrame;
+        }
+      }
     }
   }
   return bits;

@@ -54,6 +54,7 @@ RegimeConfig make_regime_config(const PerUnitBase& base, const MachineSi& m, con
   c.dx_q_pu = g.inductance_tolerance * nominal.x_q_pu;
   c.tan_angle = std::tan(g.angle_tolerance_rad);
   c.sensorless = g.sensorless;
+  c.angle_source_assumed = g.angle_source_assumed && !g.sensorless;
   c.resolution_pu = {base.voltage_pu(g.voltage_resolution_V), base.current_pu(g.current_resolution_A),
                      base.speed_pu(g.speed_resolution_rad_s)};
   // The slowest decay of Eq_FullOrderModel: Re λ ≥ −ω_n·r/x per axis, slowest with D_M's smallest r_s.

@@ -51,8 +51,7 @@ LogSource log_source(const std::string& log_path, const std::string& map_path) {
     const VescToolHeader* version = identify_vesc_tool_header(cells);
     return {log_path, std::move(map),
             version ? std::string("VESC Tool realtime log (the header of VESC Tool ") + version->versions + ")"
-                    : std::string("VESC Tool realtime log (a header of no VESC Tool version known: columns read by name)"),
-            true};
+                    : std::string("VESC Tool realtime log (a header of no VESC Tool version known: columns read by name)")};
   }
   if (is_headerless_vesc_tool_row(line)) {
     throw DriveLogError(log_path, line_no, 0, "",
@@ -88,10 +87,6 @@ std::string describe(const LogSource& source, const AveragedLogRead& read) {
     s += lag;
   }
   return s + describe(read.repairs);
-}
-
-std::string unstated_frame_note(const LogSource& source, const MachineConfig& config) {
-  return source.vesc_tool ? unstated_frame_note(config) : "";
 }
 
 }  // namespace rpem::io

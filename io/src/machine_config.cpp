@@ -97,6 +97,7 @@ void parse_regimes(YamlMap& g, core::RegimeSettings& r) {
   r.speed_resolution_rad_s = g.number_or("speed_resolution_rad_s", r.speed_resolution_rad_s, 0.0, 1e4);
   r.inductance_tolerance = g.number_or("inductance_tolerance", r.inductance_tolerance, 0.0, 10.0);
   r.angle_tolerance_rad = g.number_or("angle_tolerance_rad", r.angle_tolerance_rad, 0.0, 1.5);
+  r.angle_source_assumed = !g.has("angle_source");
   r.sensorless =
       g.choice_or("angle_source", r.sensorless ? "sensorless" : "sensor", {"sensor", "sensorless"}) == "sensorless";
   g.finish();
@@ -168,6 +169,7 @@ core::EstimatorSettings parse_estimator(YamlMap e, const core::MachineSi& machin
   parse_initial_hessians(e.map("initial_hessian"), s);
   parse_floors(e.map("floors"), s);
   if (auto a = e.optional_map("averaged")) parse_averaged(*a, s);
+  s.regimes.angle_source_assumed = true;  // unless the file says it (parse_regimes)
   if (auto g = e.optional_map("regimes")) parse_regimes(*g, s.regimes);
   e.finish();
   return s;
@@ -465,14 +467,13 @@ MachineConfig parse_machine_config(YamlMap& root) {
   MachineConfig c;
   c.machine = parse_machine(root.map("machine"));
   YamlMap estimator = root.map("estimator");
-  if (estimator.has("regimes")) c.angle_source_stated = estimator.map("regimes").has("angle_source");
   c.estimator = parse_estimator(estimator, c.machine);
   if (auto x = root.optional_map("model_extensions")) parse_extensions(*x, c);
   return c;
 }
 
 std::string unstated_frame_note(const MachineConfig& config) {
-  if (config.angle_source_stated) return "";
+  if (!config.estimator.regimes.angle_source_assumed) return "";
   return "note: the configuration does not say where the drive's dq frame comes from "
          "(estimator.regimes.angle_source): taken as a position sensor's. A VESC without sensors runs on an observer "
          "and starts open loop; say angle_source: sensorless, so that R_s adapts only where the back EMF rules out "

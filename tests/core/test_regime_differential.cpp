@@ -202,5 +202,45 @@ TEST(RegimeDifferential, TheCheaperClassifierDecidesAsTheDerivedRulesOnMillionsO
   run(make_regime_config(test::paper_base(), test::paper_machine_si(), paper), seed + 4, kSamplesPerConfig);
 }
 
+/// A frame assumed a sensor's (angle_source not given): every decision a sensor's frame's, and the flag exactly where
+/// r_s' term stands out for a sensor's frame and not for a sensorless one — three classifiers over one stream (the
+/// frame's source enters only r_s' test, so the three learn the same state).
+void run_assumed(EstimatorSettings settings, const PerUnitBase& base, const MachineSi& machine, std::uint64_t seed,
+                 int samples) {
+  settings.regimes.sensorless = false;
+  RegimeClassifier sensor(make_regime_config(base, machine, settings));
+  settings.regimes.angle_source_assumed = true;
+  RegimeClassifier assumed(make_regime_config(base, machine, settings));
+  settings.regimes.angle_source_assumed = false;
+  settings.regimes.sensorless = true;
+  RegimeClassifier sensorless(make_regime_config(base, machine, settings));
+  Stream stream(seed);
+  std::uint64_t flagged = 0, kept = 0;
+  for (int k = 0; k < samples; ++k) {
+    if (stream.uniform(0.0, 1.0) < 0.002) {
+      for (RegimeClassifier* c : {&sensor, &assumed, &sensorless}) c->break_chain();
+    }
+    const RegimeInput in = stream.next();
+    const Classification a = assumed.step(in), s = sensor.step(in), l = sensorless.step(in);
+    const bool flag = (a.bits & regime_bit::kRsOnAssumedFrame) != 0;
+    ASSERT_EQ(a.bits & ~regime_bit::kRsOnAssumedFrame, s.bits) << "sample " << k;
+    ASSERT_EQ(a.regime, s.regime) << "sample " << k;
+    ASSERT_EQ(flag, (s.bits & regime_bit::kExcitesRs) != 0 && (l.bits & regime_bit::kExcitesRs) == 0) << "sample " << k;
+    ASSERT_EQ(s.bits & ~regime_bit::kExcitesRs, l.bits & ~regime_bit::kExcitesRs) << "sample " << k;
+    flagged += flag ? 1 : 0;
+    kept += (s.bits & l.bits & regime_bit::kExcitesRs) != 0 ? 1 : 0;
+  }
+  // Not vacuous: the stream holds windows of both kinds.
+  EXPECT_GT(flagged, 0U);
+  EXPECT_GT(kept, 0U);
+}
+
+TEST(RegimeDifferential, AnAssumedFrameDecidesAsASensorsAndFlagsWhatOnlyItExcites) {
+  const std::uint64_t seed = test::test_seed(23011);
+  run_assumed(test::outrunner_settings(), test::outrunner_base(), test::outrunner_machine_si(), seed, kSamplesPerConfig / 4);
+  run_assumed(test::paper_settings(Algorithm::kSga), test::paper_base(), test::paper_machine_si(), seed + 1,
+              kSamplesPerConfig / 4);
+}
+
 }  // namespace
 }  // namespace rpem::core

@@ -6,6 +6,7 @@
 #include <regex>
 #include <sstream>
 
+#include "rpem/core/settings.hpp"
 #include "rpem/io/machine_config.hpp"
 #include "support/temp_file.hpp"
 
@@ -173,16 +174,36 @@ TEST(MachineConfig, ReportedCommandIsReadAndNeedsTheControlPeriod) {
 }
 
 TEST(MachineConfig, TheAnglesSourceIsReadAndChecked) {
-  // The paper's drive has a position sensor (the default); the VESC configurations are sensorless.
-  EXPECT_FALSE(load_machine_config(test::source_dir() + "/config/paper-ipmsm.yaml").estimator.regimes.sensorless);
-  for (const char* vesc : {"vesc-6374-outrunner.yaml", "vesc-6374-firmware.yaml"})
-    EXPECT_TRUE(load_machine_config(test::source_dir() + "/config/" + vesc).estimator.regimes.sensorless) << vesc;
-  const std::string edited =
-      std::regex_replace(paper_text(), std::regex("\n  floors:"),
-                         "\n  regimes: {angle_source: sensor}\n  floors:", std::regex_constants::format_first_only);
-  test::TempFile f("angle.yaml", edited);
-  EXPECT_FALSE(load_machine_config(f.path()).estimator.regimes.sensorless);
-  const std::string error = error_after_edit("\n  floors:", "\n  regimes: {angle_source: hall}\n  floors:");
+  // The paper's drive has a position sensor (its Section I), the VESC configurations are sensorless: each file says so.
+  const MachineConfig paper = load_machine_config(test::source_dir() + "/config/paper-ipmsm.yaml");
+  EXPECT_FALSE(paper.estimator.regimes.sensorless);
+  EXPECT_FALSE(paper.estimator.regimes.angle_source_assumed);
+  for (const char* vesc : {"vesc-6374-outrunner.yaml", "vesc-6374-firmware.yaml"}) {
+    const MachineConfig c = load_machine_config(test::source_dir() + "/config/" + vesc);
+    EXPECT_TRUE(c.estimator.regimes.sensorless) << vesc;
+    EXPECT_FALSE(c.estimator.regimes.angle_source_assumed) << vesc;
+  }
+  // A file that does not say it — in a regimes section, or without one — gets a sensor's frame, assumed: decided as a
+  // sensor's, with the windows that rest on it flagged (core::regime_bit::kRsOnAssumedFrame) and the note.
+  const std::regex stated("\n  regimes:\n    angle_source: sensor[^\n]*");
+  for (const char* replacement : {"\n  regimes:\n    significance_sigma: 4", ""}) {
+    const std::string edited = std::regex_replace(paper_text(), stated, replacement);
+    ASSERT_NE(edited, paper_text());
+    test::TempFile f("angle.yaml", edited);
+    const MachineConfig c = load_machine_config(f.path());
+    EXPECT_FALSE(c.estimator.regimes.sensorless) << replacement;
+    EXPECT_TRUE(c.estimator.regimes.angle_source_assumed) << replacement;
+    EXPECT_TRUE(core::make_regime_config(core::PerUnitBase::from_rated(c.machine.rated), c.machine, c.estimator)
+                    .angle_source_assumed);
+    EXPECT_NE(unstated_frame_note(c).find("say angle_source: sensorless"), std::string::npos);
+  }
+  EXPECT_EQ(unstated_frame_note(paper), "");
+  // A sensorless frame is never an assumed one.
+  core::EstimatorSettings both = paper.estimator;
+  both.regimes.sensorless = both.regimes.angle_source_assumed = true;
+  EXPECT_FALSE(core::make_regime_config(core::PerUnitBase::from_rated(paper.machine.rated), paper.machine, both)
+                   .angle_source_assumed);
+  const std::string error = error_after_edit("angle_source: sensor", "angle_source: hall");
   EXPECT_NE(error.find("estimator.regimes.angle_source: 'hall' is not one of: sensor, sensorless"), std::string::npos)
       << error;
 }

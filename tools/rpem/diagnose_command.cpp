@@ -186,6 +186,8 @@ int diagnose_and_write(const DiagnoseCliOptions& o, const io::MachineConfig& con
   monitor.finish();
   std::fprintf(stderr, "rpem diagnose: %s\n", io::regime_summary(d.regimes.counts).c_str());
   for (const std::string& why : d.regimes.explanations) std::fprintf(stderr, "rpem diagnose: %s\n", why.c_str());
+  if (const std::string note = io::assumed_frame_note(d.regimes.counts); !note.empty())
+    std::fprintf(stderr, "rpem diagnose: note: %s\n", note.c_str());
 
   StagedOutput staged(o.out);
   try {

@@ -108,11 +108,14 @@ struct Tally {
                   static_cast<unsigned long long>(counts.resyncs));
     return text;
   }
-  /// The regimes' counts, and why, where more than a tenth of the samples adapted nothing.
+  /// The regimes' counts, and why, where more than a tenth of the samples adapted nothing (and where R_s adapted
+  /// only on an assumed frame).
   void explain() const {
     std::fprintf(stderr, "rpem estimate: %s\n", io::regime_summary(counts).c_str());
     for (const std::string& why : io::exclusion_explanations(counts))
       std::fprintf(stderr, "rpem estimate: %s\n", why.c_str());
+    if (const std::string note = io::assumed_frame_note(counts); !note.empty())
+      std::fprintf(stderr, "rpem estimate: note: %s\n", note.c_str());
   }
 };
 
@@ -160,8 +163,6 @@ int run_averaged(const EstimateOptions& o, const io::LogSource& source, const io
   const std::vector<core::AveragedSample> samples =
       io::read_averaged_log(o.log, source.map, io::machine_limits(cfg.machine), &read);
   std::fprintf(stderr, "rpem estimate: %s\n", io::describe(source, read).c_str());
-  if (const std::string note = io::unstated_frame_note(source, cfg); !note.empty())
-    std::fprintf(stderr, "rpem estimate: %s\n", note.c_str());
   io::check_averaged_supports(cfg, config_name, read.layout.u_dc, o.log);
   core::AveragedDriveEstimator estimator(cfg.machine, cfg.estimator);
   ThermalRun thermal(o, cfg, estimator.base());

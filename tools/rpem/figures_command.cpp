@@ -18,6 +18,7 @@
 #include "rpem/analysis/diagnose/regimes.hpp"
 #include "rpem/analysis/thermal/thermal_figure.hpp"
 #include "rpem/io/machine_config.hpp"
+#include "rpem/io/sample_counts.hpp"
 
 namespace rpem::tools {
 namespace {
@@ -57,6 +58,8 @@ int run_figures(const FiguresOptions& o) {
     regimes = analysis::classify_regimes(*log, cfg);
     std::fprintf(stderr, "rpem figures: %s\n", io::regime_summary(regimes.counts).c_str());
     for (const std::string& why : regimes.explanations) std::fprintf(stderr, "rpem figures: %s\n", why.c_str());
+    if (const std::string note = io::assumed_frame_note(regimes.counts); !note.empty())
+      std::fprintf(stderr, "rpem figures: note: %s\n", note.c_str());
   }
   std::filesystem::create_directories(o.out);
   auto files = analysis::write_analysis_figures(o.out, cfg.machine, cfg.estimator.nominal_sample_period_s);

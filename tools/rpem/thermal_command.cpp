@@ -17,6 +17,7 @@
 #include "rpem/analysis/thermal/thermal_report.hpp"
 #include "rpem/analysis/thermal/thermal_topology.hpp"
 #include "rpem/io/errors.hpp"
+#include "rpem/io/sample_counts.hpp"
 #include "rpem/io/thermal_config.hpp"
 
 namespace rpem::tools {
@@ -42,8 +43,8 @@ int run_thermal_fit(const ThermalFitCliOptions& o) {
   const io::LogSource source = io::log_source(o.log, o.log_map);
   const analysis::ThermalRecord record = analysis::record_thermal(source, machine, laws);
   std::fprintf(stderr, "rpem thermal fit: %s\n", record.read_as.c_str());
-  if (const std::string note = io::unstated_frame_note(source, machine); !note.empty())
-    std::fprintf(stderr, "rpem thermal fit: %s\n", note.c_str());
+  if (const std::string note = io::assumed_frame_note(record.counts); !note.empty())
+    std::fprintf(stderr, "rpem thermal fit: note: %s\n", note.c_str());
   if (record.winding_sensor && laws.fusion.winding_sensor_sigma_K <= 0.0)
     laws.fusion.winding_sensor_sigma_K = o.winding_sensor_sigma_K;
   if (!record.coolant) {

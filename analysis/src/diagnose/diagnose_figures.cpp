@@ -15,6 +15,7 @@
 #include "rpem/core/conditioner.hpp"
 #include "rpem/core/non_finite.hpp"
 #include "rpem/core/units.hpp"
+#include "rpem/io/number_format.hpp"
 
 namespace rpem::analysis {
 namespace {
@@ -66,29 +67,48 @@ std::string residual_map(const std::string& dir, const Diagnosis& d) {
   const double s_lo = f.speed_lo_rpm, s_hi = f.speed_hi_rpm, q_lo = f.i_q_lo_A, q_hi = f.i_q_hi_A;
   DataBlock b{"map", std::vector<std::vector<double>>(4)};
   double lo = 1e300, hi = 0.0;  // one colour scale for both maps, so the improvement shows
+  bool exact = false;           // a cell the model fits exactly (RMS 0: noise-free data) has no place on a log scale
   for (const auto& cell : f.map) {
     if (cell[2] == 0.0) continue;
     for (double v : {std::sqrt(cell[0] / cell[2]), std::sqrt(cell[1] / cell[2])}) {
       if (v > 0.0) lo = std::min(lo, v);
+      exact = exact || v == 0.0;
       hi = std::max(hi, v);
     }
   }
+  const bool log_scale = hi > 0.0;
+  // An exact cell is drawn at the scale's low end, and the title says so.
+  const auto rms = [&](double sum_sq, double n) {
+    if (n == 0.0) return kNaN;
+    const double v = std::sqrt(sum_sq / n);
+    return v > 0.0 || !log_scale ? v : lo;
+  };
   for (int y = 0; y < kY; ++y) {
     for (int x = 0; x < kX; ++x) {
       const auto& cell = f.map[static_cast<std::size_t>(y) * kX + static_cast<std::size_t>(x)];
       b.columns[0].push_back(s_lo + (x + 0.5) * (s_hi - s_lo) / kX);
       b.columns[1].push_back(q_lo + (y + 0.5) * (q_hi - q_lo) / kY);
-      b.columns[2].push_back(cell[2] != 0.0 ? std::sqrt(cell[0] / cell[2]) : kNaN);
-      b.columns[3].push_back(cell[2] != 0.0 ? std::sqrt(cell[1] / cell[2]) : kNaN);
+      b.columns[2].push_back(rms(cell[0], cell[2]));
+      b.columns[3].push_back(rms(cell[1], cell[2]));
     }
   }
   GnuplotFigure fig(dir + "/residual_map.png", 1400, 600);
   fig.add_data(std::move(b));
-  fig.add_line("set multiplot layout 1,2 title 'Residual RMS over the operating plane (speed × i_q)' noenhanced");
-  fig.add_line("set xlabel 'speed [rpm]'; set ylabel 'i_q [A]'; set cblabel '|ε| RMS [A]'; set logscale cb");
+  fig.add_line(std::string("set multiplot layout 1,2 title 'Residual RMS over the operating plane (speed × i_q)") +
+               (exact && log_scale ? "; cells fitted exactly (RMS 0) at the scale's low end" : "") + "' noenhanced");
+  fig.add_line(std::string("set xlabel 'speed [rpm]'; set ylabel 'i_q [A]'; set cblabel '|ε| RMS [A]'") +
+               (log_scale ? "; set logscale cb" : ""));
   fig.add_line("set palette defined (0 '#313695', 1 '#74add1', 2 '#ffffbf', 3 '#f46d43', 4 '#a50026')");
   fig.add_line("set view map; set datafile missing NaN");
-  if (hi > lo) fig.add_line("set cbrange [" + std::to_string(lo) + ":" + std::to_string(hi) + "]");
+  if (hi > lo) {
+    std::string range = "set cbrange [";  // round-trip digits: std::to_string's six decimals made 3e-9 a zero
+    io::append_number(range, lo);
+    range += ':';
+    io::append_number(range, hi);
+    fig.add_line(range + "]");
+  } else if (!log_scale) {
+    fig.add_line("set cbrange [0:1]");  // every cell exact: a scale that starts at zero
+  }
   fig.add_line("set title 'configuration'; plot $map u 1:2:3 w points pt 5 ps 2.2 lc palette notitle");
   fig.add_line("set title 'extended model'; plot $map u 1:2:4 w points pt 5 ps 2.2 lc palette notitle");
   fig.add_line("unset multiplot");

@@ -136,6 +136,7 @@ void regimes(ReportDocument& doc, const Diagnosis& d) {
                   "what changes it:");
     doc.bullets(r.explanations);
   }
+  if (const std::string note = io::assumed_frame_note(r.counts); !note.empty()) doc.paragraph("Note: " + note + ".");
   doc.figure("regimes.png",
              "The log against time, coloured by regime: speed and current amplitude of each regime's samples.");
 }

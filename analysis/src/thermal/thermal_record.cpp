@@ -20,6 +20,7 @@ class Recorder {
   Recorder(ThermalRecord& r, const io::MachineConfig& m, const io::ThermalConfig& t, const core::PerUnitBase& base)
       : record_(r), observer_(t.fusion.observer, base, m.machine, t.fusion.filter.network.base, t.fusion.coolant_C) {}
   void add(const core::Estimate& e, std::int64_t t_ns, double coolant_C, double winding_C) {
+    record_.counts.add(e);
     core::ThermalSample s;
     s.dt_s = previous_ns_ ? 1e-9 * static_cast<double>(t_ns - *previous_ns_) : 0.0;
     s.coolant_C = coolant_C;
@@ -45,6 +46,7 @@ ThermalRecord record_thermal(const io::LogSource& source, const io::MachineConfi
   const io::DriveLogLimits limits = io::machine_limits(machine.machine);
   if (source.averaged()) {
     r.averaged = true;
+    r.counts.averaged = true;
     io::AveragedLogRead read;
     const std::vector<core::AveragedSample> samples = io::read_averaged_log(source.path, source.map, limits, &read);
     io::check_averaged_supports(machine, "configuration", read.layout.u_dc, source.path);

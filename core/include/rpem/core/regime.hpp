@@ -19,6 +19,8 @@
 //   excites r_s  r_min·|i| − |n|·(Δψ + F + Δx·|i|)   > z·h_r·N_r
 //                F = 0 for a sensor's frame; sensorless: ψ_max·2·sin(δ_max/2), the largest frame error the lock test
 //                passes, δ_max = δ_tol + asin(min(1, cos δ_tol·(B_d + tan δ_tol·B_q + z·σ_L)/(|n|·ψ_min)))
+//                a frame assumed a sensor's (angle_source not given): decided with F = 0, and flagged where only
+//                F = 0 lets the term stand out (kRsOnAssumedFrame)
 // Real-time safe: noexcept, no allocation, fixed size.
 
 #include <array>
@@ -56,6 +58,10 @@ inline constexpr std::uint8_t kInvalid = 1U << 5;
 /// bridge off, that one was not — so that one is mixed, transient from now on (docs/derivations.md §13,
 /// "Mixed windows"). An online consumer retracts what it adapted there; counts move it (RegimeCounts).
 inline constexpr std::uint8_t kPreviousMixed = 1U << 6;
+/// Not a test of its own: r_s' term stood out only because the frame's source was not given and a position
+/// sensor's was assumed (RegimeSettings::angle_source_assumed); a sensorless frame's possible error would have
+/// kept it below its noise. Decides nothing; the tools count it and say which key settles it.
+inline constexpr std::uint8_t kRsOnAssumedFrame = 1U << 7;
 inline constexpr std::uint8_t kExcluded = kBridgeOff | kNotLocked | kTransient | kInvalid;
 }  // namespace regime_bit
 
@@ -150,6 +156,9 @@ struct RegimeSettings {
   /// (`sensorless`): an observer or an open-loop start-up; r_s is excited only beyond the frame error the lock
   /// test leaves possible (docs/derivations.md §13, "Excitation").
   bool sensorless = false;
+  /// The configuration did not say where the frame comes from: decided as a sensor's (sensorless false), and a
+  /// window whose r_s excitation a sensorless frame would not have is flagged (regime_bit::kRsOnAssumedFrame).
+  bool angle_source_assumed = false;
 };
 
 /// The classifier's configuration, per unit (make_regime_config() in settings.hpp builds it).
@@ -163,6 +172,7 @@ struct RegimeConfig {
   double dx_d_pu = 0.0, dx_q_pu = 0.0;                       ///< their tolerance
   double tan_angle = 0.0;                                    ///< tan δ_tol
   bool sensorless = false;                                   ///< RegimeSettings::sensorless
+  bool angle_source_assumed = false;                         ///< RegimeSettings::angle_source_assumed
   /// Configured resolution of u, i, n [pu]; 0: measured.
   std::array<double, 3> resolution_pu{};
   /// τ_el = max(x)/(ω_n·r_min) [s]: the slowest decay of the electrical transient the model admits.

@@ -8,7 +8,6 @@
 
 #include "rpem/io/averaged_log.hpp"
 #include "rpem/io/log_map.hpp"
-#include "rpem/io/machine_config.hpp"
 #include "rpem/io/mapped_log.hpp"
 
 namespace rpem::io {
@@ -16,8 +15,7 @@ namespace rpem::io {
 struct LogSource {
   std::string path;
   LogMap map;
-  std::string format;      ///< what was detected or given, for the tools' messages
-  bool vesc_tool = false;  ///< detected as VESC Tool's realtime log by its header
+  std::string format;  ///< what was detected or given, for the tools' messages
   [[nodiscard]] bool averaged() const noexcept { return map.averaged(); }
 };
 
@@ -34,9 +32,5 @@ struct LogSource {
 [[nodiscard]] std::string describe(const LogSource& source, const AveragedLogRead& read);
 /// The time rules' part of it (empty when they did nothing).
 [[nodiscard]] std::string describe(const TimeRepairs& repairs);
-
-/// Where a VESC Tool log meets a configuration that does not say where the drive's dq frame comes from: the note of
-/// unstated_frame_note(config). Empty otherwise.
-[[nodiscard]] std::string unstated_frame_note(const LogSource& source, const MachineConfig& config);
 
 }  // namespace rpem::io

@@ -28,17 +28,16 @@ struct MachineConfig {
   core::EstimatorSettings estimator;
   ParameterDrift rs_drift;
   ParameterDrift psim_drift;
-  /// The file said estimator.regimes.angle_source (else a position sensor's frame was assumed: unstated_frame_note).
-  bool angle_source_stated = false;
 };
 
 /// Reads the `machine`, `estimator` and optional `model_extensions` sections of `root`
 /// (other sections are left for the caller, who calls root.finish()).
 [[nodiscard]] MachineConfig parse_machine_config(YamlMap& root);
 
-/// Where the configuration does not say where the drive's dq frame comes from (estimator.regimes.angle_source), for a
-/// VESC's data (most VESCs run sensorless, the default is a position sensor's frame): a note saying so and which key
-/// changes it. Empty where the file says it.
+/// Where the configuration does not say where the drive's dq frame comes from (estimator.regimes.angle_source), for
+/// rpemd's VESC source at start (most VESCs run sensorless, the default is a position sensor's frame): a note saying
+/// so and which key changes it. Empty where the file says it. (The log tools say it from the data instead:
+/// io::assumed_frame_note.)
 [[nodiscard]] std::string unstated_frame_note(const MachineConfig& config);
 
 /// Loads a whole file that holds only those sections.

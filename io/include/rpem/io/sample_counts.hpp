@@ -20,6 +20,10 @@ struct SampleCounts {
   std::uint64_t resyncs = 0;   ///< StepCode kSynchronized and kPredictorDiverged: a new chain, nothing adapted
   std::uint64_t outliers = 0;  ///< StepCode kOutlier
   bool averaged = false;       ///< an averaged log (its resyncs are gaps and late windows)
+  /// Admitted samples that excited R_s only because the frame was assumed a position sensor's (the configuration
+  /// does not say estimator.regimes.angle_source; core::regime_bit::kRsOnAssumedFrame).
+  std::uint64_t r_s_on_assumed_frame = 0;
+  bool last_on_assumed_frame = false;  ///< the last sample was one of them (a later kPreviousMixed takes it back)
 
   /// Counts one estimator output.
   void add(const core::Estimate& e) noexcept;
@@ -27,6 +31,10 @@ struct SampleCounts {
 
 /// "regimes: excites_both 12, excites_psi_m 8012, …, resyncs 3, outliers 0".
 [[nodiscard]] std::string regime_summary(const SampleCounts& c);
+
+/// Where samples excited R_s only on the assumed frame: how many, why it matters and which key settles it (the tools
+/// print it as a note). Empty where none did (a stated angle_source, or nothing that depended on it).
+[[nodiscard]] std::string assumed_frame_note(const SampleCounts& c);
 
 /// The share of the samples above which a rule is explained.
 inline constexpr double kExplainedShare = 0.10;

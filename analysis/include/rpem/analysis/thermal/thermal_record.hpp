@@ -9,6 +9,7 @@
 #include "rpem/core/thermal_observer.hpp"
 #include "rpem/io/log_source.hpp"
 #include "rpem/io/machine_config.hpp"
+#include "rpem/io/sample_counts.hpp"
 #include "rpem/io/thermal_config.hpp"
 
 namespace rpem::analysis {
@@ -20,7 +21,8 @@ struct ThermalRecord {
   bool winding_sensor = false;  ///< the log has T_winding
   bool coolant = false;         ///< the log has T_coolant (else thermal.coolant_C is used)
   bool averaged = false;
-  std::string read_as;  ///< what the log was read as, for the tools (io::describe; the format for phase samples)
+  std::string read_as;      ///< what the log was read as, for the tools (io::describe; the format for phase samples)
+  io::SampleCounts counts;  ///< what the estimator run did with the samples (its regimes)
 };
 
 /// Runs the configured estimator over the log — read as `source` says, as `rpem estimate` reads it: our drive or
