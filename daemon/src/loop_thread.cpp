@@ -234,6 +234,7 @@ void LoopThread::report_stats() noexcept {
   for (std::size_t k = 0; k < core::kRegimeCount; ++k) {
     r.rows.set(kRegimeFields[k], static_cast<std::int64_t>(counters_.regimes.n[k]));
   }
+  r.rows.set(&Diag::r_s_on_assumed_frame, static_cast<std::int64_t>(counters_.regimes.r_s_on_assumed_frame));
   timer_.report(r.rows);
   const double n = eps_n_ > 0 ? static_cast<double>(eps_n_) : 1.0;
   r.rows.set(&Diag::epsilon_rms_d_A, std::sqrt(eps2_d_ / n));

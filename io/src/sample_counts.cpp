@@ -74,10 +74,6 @@ std::string sentence(std::uint64_t n, std::uint64_t total, const Rule& r) {
 void SampleCounts::add(const core::Estimate& e) noexcept {
   ++samples;
   regimes.add(e.regime);
-  // A window found mixed afterwards adapted nothing (RegimeCounts moves it to transient).
-  if ((e.regime.bits & core::regime_bit::kPreviousMixed) && last_on_assumed_frame) --r_s_on_assumed_frame;
-  last_on_assumed_frame = e.regime.excites_r_s() && (e.regime.bits & core::regime_bit::kRsOnAssumedFrame) != 0;
-  if (last_on_assumed_frame) ++r_s_on_assumed_frame;
   switch (e.detail.code) {
     case core::StepCode::kSynchronized:
     case core::StepCode::kPredictorDiverged:
@@ -106,9 +102,9 @@ std::string regime_summary(const SampleCounts& c) {
 }
 
 std::string assumed_frame_note(const SampleCounts& c) {
-  if (c.r_s_on_assumed_frame == 0) return "";
+  if (c.regimes.r_s_on_assumed_frame == 0) return "";
   const std::uint64_t excited = c.regimes[core::Regime::kExcitesRs] + c.regimes[core::Regime::kExcitesBoth];
-  return std::to_string(c.r_s_on_assumed_frame) + " of the " + std::to_string(excited) +
+  return std::to_string(c.regimes.r_s_on_assumed_frame) + " of the " + std::to_string(excited) +
          " samples that excited R_s did so only because the drive's dq frame was taken as a position sensor's: the "
          "configuration does not say where it comes from (estimator.regimes.angle_source). On an observer or an "
          "open-loop start-up (a sensorless drive: most VESCs) the back EMF there could not rule out a frame error "

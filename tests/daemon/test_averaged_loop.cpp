@@ -4,6 +4,7 @@
 // counted and not stepped. Data: the machine equations averaged over each window (support/averaged_data.hpp).
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 
 #include "rpem/core/clock.hpp"
@@ -28,8 +29,9 @@ struct AveragedRig {
   bool have_next = false;
   core::AveragedSample next;
 
-  explicit AveragedRig(double rate_Hz, double psi_scale = 1.0) {
+  explicit AveragedRig(double rate_Hz, double psi_scale = 1.0, bool angle_source_assumed = false) {
     config.fixed.source = VescSource::Options{};
+    config.live.machine.estimator.regimes.angle_source_assumed = angle_source_assumed;
     loop = std::make_unique<LoopThread>(config, std::move(queues.loop));
     gen.base = test::paper_base();
     gen.plant = test::paper_machine_pu();
@@ -109,6 +111,29 @@ TEST_P(AtRate, EveryWindowIsSteppedOnceAndPsiMConverges) {
   const LoopStatsReport& s = rig.stats;
   EXPECT_EQ(s.rows.get(&diagnostics_t::samples_wrong_kind), 0);
   EXPECT_EQ(s.rows.get(&diagnostics_t::resyncs), 1);  // the first window only anchors the chain
+}
+
+// A machine file that does not say where the frame comes from: beside the regimes, RPEM_DIAGNOSTICS counts the windows
+// whose R_s excitation rests on the sensor's frame assumed in its place. At 0.015 pu with |i| = 1 pu the paper
+// machine's R_s term stands out on a sensor's frame (r_min·|i| = 0.0213 against |n|·(Δψ + Δx·|i|) = 0.0144 pu) and not
+// on a sensorless one, whose error the lock test cannot bound at that back EMF (|n|·F = 0.015·2.55 pu more:
+// docs/derivations.md §13): every window that excites R_s is one of them; a file that says sensor counts none, and
+// both decide alike.
+TEST(AveragedLoop, WindowsThatExciteRsOnlyOnAnAssumedFrameAreCounted) {
+  std::array<std::int64_t, 2> excited{};
+  for (const bool assumed : {false, true}) {
+    AveragedRig rig(200.0, 1.0, assumed);
+    rig.gen.n_pu = [](double) { return 0.015; };
+    rig.gen.i_pu = [](double) { return core::Vec2(0.0, 1.0); };
+    rig.run(5.0);
+    rig.drain();
+    const LoopStatsReport& s = rig.stats;
+    excited[assumed ? 1 : 0] =
+        s.rows.get(&diagnostics_t::regime_excites_r_s) + s.rows.get(&diagnostics_t::regime_excites_both);
+    EXPECT_EQ(s.rows.get(&diagnostics_t::r_s_on_assumed_frame), assumed ? excited[1] : 0) << assumed;
+  }
+  EXPECT_GT(excited[1], 500);  // 5 s of 200 Hz windows
+  EXPECT_EQ(excited[0], excited[1]);
 }
 
 INSTANTIATE_TEST_SUITE_P(Rates, AtRate, ::testing::Values(50.0, 200.0, 1000.0),

@@ -1,6 +1,6 @@
-// io::SampleCounts: the samples that excited R_s only because a position sensor's frame was assumed (the
-// configuration does not say estimator.regimes.angle_source) are counted where they adapted, and the tools' note
-// says how many of all that excited R_s.
+// io::SampleCounts (its core::RegimeCounts): the samples that excited R_s only because a position sensor's frame was
+// assumed (the configuration does not say estimator.regimes.angle_source) are counted where they adapted, and the
+// tools' note says how many of all that excited R_s.
 #include <gtest/gtest.h>
 
 #include <cstdint>
@@ -27,9 +27,9 @@ TEST(SampleCounts, WhatExcitedRsOnlyOnAnAssumedFrameIsCountedWhereItAdapted) {
   c.add(estimate(kExcitesRs));                                   // on any frame
   c.add(estimate(kExcitesRs | kRsOnAssumedFrame));               // only on the assumed one
   c.add(estimate(kTransient | kExcitesRs | kRsOnAssumedFrame));  // excluded: adapted nothing
-  EXPECT_EQ(c.r_s_on_assumed_frame, 1U);
+  EXPECT_EQ(c.regimes.r_s_on_assumed_frame, 1U);
   c.add(estimate(kExcitesPsiM | kExcitesRs | kRsOnAssumedFrame));
-  EXPECT_EQ(c.r_s_on_assumed_frame, 2U);
+  EXPECT_EQ(c.regimes.r_s_on_assumed_frame, 2U);
   EXPECT_EQ(assumed_frame_note(c).rfind("2 of the 3 samples that excited R_s did so only because the drive's dq frame "
                                         "was taken as a position sensor's",
                                         0),
@@ -38,14 +38,14 @@ TEST(SampleCounts, WhatExcitedRsOnlyOnAnAssumedFrameIsCountedWhereItAdapted) {
   // The next window shows the last one mixed (the bridge released inside it): it moves to transient and is taken
   // back, as RegimeCounts moves it.
   c.add(estimate(kBridgeOff | kPreviousMixed));
-  EXPECT_EQ(c.r_s_on_assumed_frame, 1U);
+  EXPECT_EQ(c.regimes.r_s_on_assumed_frame, 1U);
   EXPECT_EQ(c.regimes[core::Regime::kExcitesBoth], 0U);
   EXPECT_NE(assumed_frame_note(c).find("1 of the 2 samples"), std::string::npos) << assumed_frame_note(c);
   EXPECT_NE(assumed_frame_note(c).find("say angle_source: sensorless"), std::string::npos);
   // A mixed window after one that did not rest on the frame takes nothing back.
   c.add(estimate(kExcitesRs));
   c.add(estimate(kBridgeOff | kPreviousMixed));
-  EXPECT_EQ(c.r_s_on_assumed_frame, 1U);
+  EXPECT_EQ(c.regimes.r_s_on_assumed_frame, 1U);
 }
 
 }  // namespace

@@ -92,5 +92,46 @@ TEST(CliDriveLog, ToolsThatKnowTheMachineHoldCurrentsToTenTimesItsRating) {
   fs::remove_all(dir);
 }
 
+TEST(CliDriveLog, ToolsThatNeedALongerLogSaySoWithTheDataErrorsExit) {
+  // Five valid rows (125 µs apart): estimate runs on them; diagnose's blocks and thermal fit's filter steps need more,
+  // which is the log's fault, not the program's — exit 65 (EX_DATAERR) naming the file, as any bad log.
+  const fs::path dir = test::temp_path("cli_drive_log_short");
+  fs::create_directories(dir);
+  const std::string log = (dir / "short.csv").string();
+  {
+    std::ofstream out(log);
+    out << kHeader;
+    for (int k = 0; k < 5; ++k) out << 125e-6 * k << ",0,0,220,1,2,-3,0.5,-0.25,-0.25\n";
+  }
+  const test::ProcessResult e =
+      test::run_command(test::binary_dir() + "/tools/rpem estimate --log " + log + " --out " + (dir / "e.csv").string());
+  EXPECT_EQ(e.exit_code, 0) << e.output;
+  const test::ProcessResult d =
+      test::run_command(test::binary_dir() + "/tools/rpem diagnose --log " + log + " --out " + (dir / "d").string());
+  EXPECT_EQ(d.exit_code, 65) << d.output;
+  EXPECT_NE(d.output.find("short.csv:6: a log to diagnose needs at least"), std::string::npos) << d.output;
+  const test::ProcessResult t =
+      test::run_command(test::binary_dir() + "/tools/rpem thermal fit --log " + log + " --out " + (dir / "t.yaml").string());
+  EXPECT_EQ(t.exit_code, 65) << t.output;
+  EXPECT_NE(t.output.find("short.csv: the log gives 0 steps of the thermal filter; a fit needs at least 10"),
+            std::string::npos)
+      << t.output;
+  EXPECT_FALSE(fs::exists(dir / "t.yaml"));
+  // 15 s of rows: enough filter steps (1 s each), but not before a training part's end at 3 s.
+  {
+    std::ofstream out(log);
+    out << kHeader;
+    for (int k = 0; k <= 150; ++k) out << 0.1 * k << ",0,0,220,1,2,-3,0.5,-0.25,-0.25\n";
+  }
+  const test::ProcessResult u = test::run_command(test::binary_dir() + "/tools/rpem thermal fit --log " + log +
+                                                  " --fit-until-s 3 --out " + (dir / "t.yaml").string());
+  EXPECT_EQ(u.exit_code, 65) << u.output;
+  EXPECT_NE(u.output.find("short.csv: fewer than 10 steps of the thermal filter end before the training part's end "
+                          "(--fit-until-s 3.000000 s; the log runs from 1"),
+            std::string::npos)
+      << u.output;
+  fs::remove_all(dir);
+}
+
 }  // namespace
 }  // namespace rpem

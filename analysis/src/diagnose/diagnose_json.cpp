@@ -203,7 +203,7 @@ void write_diagnosis_json(const std::string& path, const Diagnosis& d, const std
       {"excluded_regime", d.regimes.excluded_used},
       {"estimator_resyncs", d.regimes.counts.resyncs},
       {"estimator_outliers", d.regimes.counts.outliers},
-      {"r_s_on_assumed_frame", d.regimes.counts.r_s_on_assumed_frame},
+      {"r_s_on_assumed_frame", d.regimes.counts.regimes.r_s_on_assumed_frame},
       {"exclusion_explanations", d.regimes.explanations}};
   out["machine_config"] = config_path;
   out["verdict"] = to_string(d.verdict.kind);

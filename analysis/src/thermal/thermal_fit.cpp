@@ -15,6 +15,7 @@
 #include "rpem/analysis/thermal/thermal_replay.hpp"
 #include "rpem/analysis/thermal/thermal_report.hpp"
 #include "rpem/core/non_finite.hpp"
+#include "rpem/io/errors.hpp"
 
 namespace rpem::analysis {
 namespace {
@@ -397,17 +398,23 @@ std::string nothing_identified(const ThermalFitResult& fit) {
 
 ThermalFitResult fit_thermal(const ThermalRecord& record, const io::ThermalConfig& start_config,
                              const ThermalFitOptions& options) {
-  if (record.steps.size() < 10) {
-    throw std::invalid_argument(
+  if (record.steps.size() < 10) {  // the data's fault, not the program's: exit 65, the file named
+    throw io::DriveLogError(
+        record.log, 0, 0, "",
         "the log gives " + std::to_string(record.steps.size()) +
-        " steps of the thermal filter; a fit needs at least 10 (a longer log, or a shorter filter.period_s)");
+            " steps of the thermal filter; a fit needs at least 10 (a longer log, or a shorter filter.period_s)");
   }
   ThermalFitResult out;
   const double t0 = record.t_s.front(), t_end = record.t_s.back();
   out.fit_until_s = std::isnan(options.fit_until_s) ? t0 + 0.75 * (t_end - t0) : options.fit_until_s;
   std::size_t training = 0;
   while (training < record.steps.size() && record.t_s[training] <= out.fit_until_s) ++training;
-  if (training < 10) throw std::invalid_argument("fewer than 10 steps end before fit_until_s");
+  if (training < 10) {
+    throw io::DriveLogError(record.log, 0, 0, "",
+                            "fewer than 10 steps of the thermal filter end before the training part's end (--fit-until-s " +
+                                std::to_string(out.fit_until_s) + " s; the log runs from " + std::to_string(t0) + " to " +
+                                std::to_string(t_end) + " s)");
+  }
   out.training_steps = training;
 
   io::ThermalConfig start = start_config;
@@ -431,9 +438,9 @@ ThermalFitResult fit_thermal(const ThermalRecord& record, const io::ThermalConfi
     if (options.anchor_magnet_reference) anchor_magnet_reference(start, record, t_magnet, t_winding, out.notes);
     points = training_points(start, record, training);
     if (points.empty()) {
-      throw std::invalid_argument(
-          "the training part holds no temperature the network can be fitted to (no winding sensor, "
-          "and ψm and R_s never adapt and settle)");
+      throw io::DriveLogError(record.log, 0, 0, "",
+                              "the training part holds no temperature the network can be fitted to (no winding sensor, "
+                              "and ψm and R_s never adapt and settle)");
     }
     const Layout pass_layout(start, ties);
     // Three starts: the topology's time constants as they are, three times shorter and three times longer.

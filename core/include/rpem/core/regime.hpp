@@ -113,18 +113,24 @@ inline constexpr std::array<RegimeInfo, kRegimeCount> kRegimes{{
 [[nodiscard]] constexpr Regime as_mixed(Regime r) noexcept { return info(r).excluded ? r : Regime::kTransient; }
 
 /// Samples per regime; a sample found mixed by the next one's kPreviousMixed moves to its regime as_mixed().
+/// Beside them, the admitted samples that excited r_s only on an assumed sensor's frame (kRsOnAssumedFrame).
 /// Real-time safe.
 struct RegimeCounts {
   std::array<std::uint64_t, kRegimeCount> n{};
-  Regime last = Regime::kInvalid;  ///< the regime the last sample counted in
+  std::uint64_t r_s_on_assumed_frame = 0;
+  Regime last = Regime::kInvalid;      ///< the regime the last sample counted in
+  bool last_on_assumed_frame = false;  ///< the last sample counted in r_s_on_assumed_frame
   bool has_last = false;
   void add(Classification c) noexcept {
     if ((c.bits & regime_bit::kPreviousMixed) && has_last) {
       --n[static_cast<std::size_t>(last)];
       ++n[static_cast<std::size_t>(as_mixed(last))];
+      r_s_on_assumed_frame -= last_on_assumed_frame ? 1 : 0;  // mixed: transient, it adapted nothing
     }
     ++n[static_cast<std::size_t>(c.regime)];
     last = c.regime;
+    last_on_assumed_frame = c.excites_r_s() && (c.bits & regime_bit::kRsOnAssumedFrame) != 0;
+    r_s_on_assumed_frame += last_on_assumed_frame ? 1 : 0;
     has_last = true;
   }
   [[nodiscard]] std::uint64_t operator[](Regime r) const noexcept { return n[static_cast<std::size_t>(r)]; }

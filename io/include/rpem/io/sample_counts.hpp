@@ -20,10 +20,6 @@ struct SampleCounts {
   std::uint64_t resyncs = 0;   ///< StepCode kSynchronized and kPredictorDiverged: a new chain, nothing adapted
   std::uint64_t outliers = 0;  ///< StepCode kOutlier
   bool averaged = false;       ///< an averaged log (its resyncs are gaps and late windows)
-  /// Admitted samples that excited R_s only because the frame was assumed a position sensor's (the configuration
-  /// does not say estimator.regimes.angle_source; core::regime_bit::kRsOnAssumedFrame).
-  std::uint64_t r_s_on_assumed_frame = 0;
-  bool last_on_assumed_frame = false;  ///< the last sample was one of them (a later kPreviousMixed takes it back)
 
   /// Counts one estimator output.
   void add(const core::Estimate& e) noexcept;
