@@ -93,7 +93,7 @@ TEST(CliDriveLog, ToolsThatKnowTheMachineHoldCurrentsToTenTimesItsRating) {
 }
 
 TEST(CliDriveLog, ToolsThatNeedALongerLogSaySoWithTheDataErrorsExit) {
-  // Five valid rows (125 µs apart): estimate runs on them; diagnose's blocks and thermal fit's filter steps need more,
+  // Five valid rows (125 µs apart): estimate and figures run on them; diagnose's blocks and thermal fit's filter steps need more,
   // which is the log's fault, not the program's — exit 65 (EX_DATAERR) naming the file, as any bad log.
   const fs::path dir = test::temp_path("cli_drive_log_short");
   fs::create_directories(dir);
@@ -109,7 +109,14 @@ TEST(CliDriveLog, ToolsThatNeedALongerLogSaySoWithTheDataErrorsExit) {
   const test::ProcessResult d =
       test::run_command(test::binary_dir() + "/tools/rpem diagnose --log " + log + " --out " + (dir / "d").string());
   EXPECT_EQ(d.exit_code, 65) << d.output;
-  EXPECT_NE(d.output.find("short.csv:6: a log to diagnose needs at least"), std::string::npos) << d.output;
+  EXPECT_NE(d.output.find("short.csv:6: the log has 5 rows; 40 training and held-out blocks need at least 80 rows"),
+            std::string::npos)
+      << d.output;
+  // rpem figures draws the regime timeline of the same five rows (it splits no blocks).
+  const test::ProcessResult f =
+      test::run_command(test::binary_dir() + "/tools/rpem figures --log " + log + " --out " + (dir / "f").string());
+  EXPECT_EQ(f.exit_code, 0) << f.output;
+  EXPECT_TRUE(fs::exists(dir / "f" / "regimes.png")) << f.output;
   const test::ProcessResult t =
       test::run_command(test::binary_dir() + "/tools/rpem thermal fit --log " + log + " --out " + (dir / "t.yaml").string());
   EXPECT_EQ(t.exit_code, 65) << t.output;

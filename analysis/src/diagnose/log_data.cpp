@@ -63,8 +63,10 @@ std::size_t LogData::training_count() const noexcept {
 void prepare_log(LogData& d, const core::MachineSi& machine, const LogOptions& options) {
   const std::size_t n = d.samples.size();
   if (n < 2 * static_cast<std::size_t>(std::max(2, options.blocks))) {
-    throw io::DriveLogError(d.path, n + 1, 0, "",
-                            "a log to diagnose needs at least " + std::to_string(2 * std::max(2, options.blocks)) + " rows");
+    throw io::DriveLogError(
+        d.path, n + 1, 0, "",
+        "the log has " + std::to_string(n) + (n == 1 ? " row; " : " rows; ") + std::to_string(std::max(2, options.blocks)) +
+            " training and held-out blocks need at least " + std::to_string(2 * std::max(2, options.blocks)) + " rows");
   }
   d.t_start_s = d.t_s(0);
   d.t_end_s = d.t_s(n - 1);
