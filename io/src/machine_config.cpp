@@ -466,8 +466,7 @@ core::Algorithm parse_algorithm(const std::string& name) {
 MachineConfig parse_machine_config(YamlMap& root) {
   MachineConfig c;
   c.machine = parse_machine(root.map("machine"));
-  YamlMap estimator = root.map("estimator");
-  c.estimator = parse_estimator(estimator, c.machine);
+  c.estimator = parse_estimator(root.map("estimator"), c.machine);
   if (auto x = root.optional_map("model_extensions")) parse_extensions(*x, c);
   return c;
 }

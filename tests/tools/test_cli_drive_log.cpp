@@ -98,40 +98,36 @@ TEST(CliDriveLog, ToolsThatNeedALongerLogSaySoWithTheDataErrorsExit) {
   const fs::path dir = test::temp_path("cli_drive_log_short");
   fs::create_directories(dir);
   const std::string log = (dir / "short.csv").string();
-  {
+  const auto write_rows = [&](int rows, double dt_s) {
     std::ofstream out(log);
     out << kHeader;
-    for (int k = 0; k < 5; ++k) out << 125e-6 * k << ",0,0,220,1,2,-3,0.5,-0.25,-0.25\n";
-  }
-  const test::ProcessResult e =
-      test::run_command(test::binary_dir() + "/tools/rpem estimate --log " + log + " --out " + (dir / "e.csv").string());
+    for (int k = 0; k < rows; ++k) out << dt_s * k << ",0,0,220,1,2,-3,0.5,-0.25,-0.25\n";
+  };
+  const auto rpem = [&](const std::string& tool, const std::string& out) {
+    return test::run_command(test::binary_dir() + "/tools/rpem " + tool + " --log " + log + " --out " +
+                             (dir / out).string());
+  };
+  write_rows(5, 125e-6);
+  const test::ProcessResult e = rpem("estimate", "e.csv");
   EXPECT_EQ(e.exit_code, 0) << e.output;
-  const test::ProcessResult d =
-      test::run_command(test::binary_dir() + "/tools/rpem diagnose --log " + log + " --out " + (dir / "d").string());
+  const test::ProcessResult d = rpem("diagnose", "d");
   EXPECT_EQ(d.exit_code, 65) << d.output;
   EXPECT_NE(d.output.find("short.csv:6: the log has 5 rows; 40 training and held-out blocks need at least 80 rows"),
             std::string::npos)
       << d.output;
   // rpem figures draws the regime timeline of the same five rows (it splits no blocks).
-  const test::ProcessResult f =
-      test::run_command(test::binary_dir() + "/tools/rpem figures --log " + log + " --out " + (dir / "f").string());
+  const test::ProcessResult f = rpem("figures", "f");
   EXPECT_EQ(f.exit_code, 0) << f.output;
   EXPECT_TRUE(fs::exists(dir / "f" / "regimes.png")) << f.output;
-  const test::ProcessResult t =
-      test::run_command(test::binary_dir() + "/tools/rpem thermal fit --log " + log + " --out " + (dir / "t.yaml").string());
+  const test::ProcessResult t = rpem("thermal fit", "t.yaml");
   EXPECT_EQ(t.exit_code, 65) << t.output;
   EXPECT_NE(t.output.find("short.csv: the log gives 0 steps of the thermal filter; a fit needs at least 10"),
             std::string::npos)
       << t.output;
   EXPECT_FALSE(fs::exists(dir / "t.yaml"));
   // 15 s of rows: enough filter steps (1 s each), but not before a training part's end at 3 s.
-  {
-    std::ofstream out(log);
-    out << kHeader;
-    for (int k = 0; k <= 150; ++k) out << 0.1 * k << ",0,0,220,1,2,-3,0.5,-0.25,-0.25\n";
-  }
-  const test::ProcessResult u = test::run_command(test::binary_dir() + "/tools/rpem thermal fit --log " + log +
-                                                  " --fit-until-s 3 --out " + (dir / "t.yaml").string());
+  write_rows(151, 0.1);
+  const test::ProcessResult u = rpem("thermal fit --fit-until-s 3", "t.yaml");
   EXPECT_EQ(u.exit_code, 65) << u.output;
   EXPECT_NE(u.output.find("short.csv: fewer than 10 steps of the thermal filter end before the training part's end "
                           "(--fit-until-s 3.000000 s; the log runs from 1"),

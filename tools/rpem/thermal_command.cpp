@@ -40,8 +40,7 @@ int run_thermal_fit(const ThermalFitCliOptions& o) {
                                            : io::load_thermal_config(o.start, machine, io::NetworkRequired::kNo);
   if (o.period_s > 0.0) laws.fusion.observer.period_s = o.period_s;
   std::fprintf(stderr, "rpem thermal fit: running the estimator over %s\n", o.log.c_str());
-  const io::LogSource source = io::log_source(o.log, o.log_map);
-  const analysis::ThermalRecord record = analysis::record_thermal(source, machine, laws);
+  const analysis::ThermalRecord record = analysis::record_thermal(io::log_source(o.log, o.log_map), machine, laws);
   std::fprintf(stderr, "rpem thermal fit: %s\n", record.read_as.c_str());
   if (const std::string note = io::assumed_frame_note(record.counts); !note.empty())
     std::fprintf(stderr, "rpem thermal fit: note: %s\n", note.c_str());
