@@ -229,8 +229,11 @@ void RegimeClassifier::reconfigure(const RegimeConfig& config) noexcept {
   k.dx_max = std::max(c.dx_d_pu, c.dx_q_pu);
   k.cos_angle = 1.0 / std::sqrt(1.0 + c.tan_angle * c.tan_angle);
   k.sin_angle = c.tan_angle * k.cos_angle;
-  // A sensorless frame's error within the cone at least (a = 0): ψ_max·√(2·(1 − cos δ_tol)).
-  const double dpsi_frame = c.dpsi_pu + (c.sensorless ? c.psi_max_pu * std::sqrt(2.0 * (1.0 - k.cos_angle)) : 0.0);
+  k.cos_hall = c.hall_frame_error_rad > 0.0 ? std::cos(c.hall_frame_error_rad) : -1.0;
+  // A sensorless frame's error within the cone at least (a = 0): ψ_max·√(2·(1 − cos δ_tol)), or within the Hall
+  // sensors' error where that is smaller.
+  const double cos_least = std::max(k.cos_angle, k.cos_hall);
+  const double dpsi_frame = c.dpsi_pu + (c.sensorless ? c.psi_max_pu * std::sqrt(2.0 * (1.0 - cos_least)) : 0.0);
   k.dpsi_frame_sq = dpsi_frame * dpsi_frame;
   update_quantisation();
 }
@@ -340,7 +343,9 @@ double RegimeClassifier::frame_flux(const RegimeInput& in, const Terms& t) const
   const double reach = k.cos_angle * (t.lock_bias + std::sqrt(k.z_sq * lock_variance(in, t)));
   const double emf = std::abs(in.n_pu) * c.psi_min_pu;
   const double a = reach < emf ? reach / emf : 1.0;
-  const double cos_max = k.cos_angle * std::sqrt(1.0 - a * a) - k.sin_angle * a;
+  double cos_max = k.cos_angle * std::sqrt(1.0 - a * a) - k.sin_angle * a;
+  // Below their speed, Hall sensors put the frame within their own error of the rotor's: the smaller bound holds.
+  if (std::abs(in.n_pu) < c.hall_below_n_pu) cos_max = std::max(cos_max, k.cos_hall);
   return c.psi_max_pu * std::sqrt(2.0 * (1.0 - cos_max));
 }
 

@@ -54,6 +54,8 @@ RegimeConfig make_regime_config(const PerUnitBase& base, const MachineSi& m, con
   c.dx_q_pu = g.inductance_tolerance * nominal.x_q_pu;
   c.tan_angle = std::tan(g.angle_tolerance_rad);
   c.sensorless = g.sensorless;
+  c.hall_frame_error_rad = g.sensorless ? g.hall_frame_error_rad : 0.0;
+  c.hall_below_n_pu = c.hall_frame_error_rad > 0.0 ? base.speed_pu(g.hall_below_speed_rad_s) : 0.0;
   c.angle_source_assumed = g.angle_source_assumed && !g.sensorless;
   c.resolution_pu = {base.voltage_pu(g.voltage_resolution_V), base.current_pu(g.current_resolution_A),
                      base.speed_pu(g.speed_resolution_rad_s)};

@@ -7,9 +7,45 @@
 
 #include <CLI/CLI.hpp>
 #include <cstdio>
+#include <cstdlib>
+#include <exception>
+#include <string>
 
+#include "rpem/auth/key.hpp"
+#include "rpem/daemon/credentials.hpp"
 #include "rpem/daemon/daemon.hpp"
 #include "rpem/io/exit_codes.hpp"
+
+namespace {
+
+/// --check-config: the file, and the command keys as the service will see them (systemd's LoadCredential= puts
+/// them in $CREDENTIALS_DIRECTORY, which a shell outside the service does not have: then said, not guessed).
+int check_configuration(const rpem::daemon::DaemonConfig& config) {
+  using namespace rpem;
+  const char* directory = std::getenv("CREDENTIALS_DIRECTORY");
+  const bool has_credentials = directory != nullptr && *directory != '\0';
+  try {
+    auth::initialise();
+    const daemon::DaemonKeys keys = daemon::load_credential_keys(directory);
+    if (const std::string problem = daemon::command_key_problem(config.live, keys.command); !problem.empty()) {
+      if (has_credentials) {
+        std::fprintf(stderr, "rpemd: configuration error: %s\n", problem.c_str());
+        return io::kExitConfig;
+      }
+      std::fprintf(stderr,
+                   "rpemd: note: the command keys are not checked here (CREDENTIALS_DIRECTORY is not set; the "
+                   "service gets them from LoadCredential=): without one rpemd will refuse to start: %s\n",
+                   problem.c_str());
+    }
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "rpemd: configuration error: %s\n", e.what());
+    return io::kExitConfig;
+  }
+  std::printf("rpemd: %s is valid\n", config.source_file.c_str());
+  return io::kExitOk;
+}
+
+}  // namespace
 
 int main(int argc, char** argv) {  // NOLINT(bugprone-exception-escape): only a defect escapes; terminate() shows it
   using namespace rpem;
@@ -21,13 +57,15 @@ int main(int argc, char** argv) {  // NOLINT(bugprone-exception-escape): only a 
   app.add_flag("--check-config", check_only, "validate the configuration and exit");
   app.add_option("--latency-histogram", options.histogram_path,
                  "at exit, write the loop's wake-up latency histogram (µs, count; as cyclictest -h) to this file");
-  CLI11_PARSE(app, argc, argv);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int code = app.exit(e);  // the help, or the error and the usage
+    return code == 0 ? io::kExitOk : io::kExitUsage;
+  }
   try {
     daemon::DaemonConfig config = daemon::load_configuration(options);
-    if (check_only) {
-      std::printf("rpemd: %s is valid\n", config.source_file.c_str());
-      return io::kExitOk;
-    }
+    if (check_only) return check_configuration(config);
     return daemon::Daemon(options, std::move(config)).run();
   } catch (const io::InputError& e) {
     std::fprintf(stderr, "rpemd: configuration error: %s\n", e.what());

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cassert>
 #include <numbers>
+#include <string>
+#include <string_view>
 
 #include "rpem/core/reported_speed.hpp"
 
@@ -312,6 +314,9 @@ LogMap parse(YamlMap root) {
   m.name = root.file();
   m.separator = one_character(root, "separator", ',');
   if (m.separator == '"' || m.separator == '\n' || m.separator == '\r') root.fail("separator", "cannot separate cells");
+  // A character of a number ("-1.5e+3") would split the numbers themselves.
+  if (std::string_view("0123456789.+-eE").find(m.separator) != std::string_view::npos)
+    root.fail("separator", std::string("'") + m.separator + "' is part of a number and cannot separate cells");
   m.header = root.boolean_or("header", true);
   m.skip_lines = static_cast<std::size_t>(root.integer_or("skip_lines", 0, 0, 1000000));
   m.comment = one_character(root, "comment", '\0');

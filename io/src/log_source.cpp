@@ -1,7 +1,9 @@
 #include "rpem/io/log_source.hpp"
 
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
+#include <system_error>
 #include <vector>
 
 #include "rpem/io/errors.hpp"
@@ -31,6 +33,14 @@ std::vector<std::string> header_cells(const std::string& line, char separator) {
 }  // namespace
 
 LogSource log_source(const std::string& log_path, const std::string& map_path) {
+  // The tools read a log more than once (its format detected, its size for progress, its rows): a pipe would give
+  // its rows to the first reading only.
+  std::error_code ec;
+  if (std::filesystem::exists(log_path, ec) && !std::filesystem::is_regular_file(log_path, ec)) {
+    throw InputError(log_path, 0, 0, "",
+                     "is not a regular file (a pipe, a device or a directory): the log is read more than once; write "
+                     "it to a file first");
+  }
   if (!map_path.empty()) return {log_path, load_log_map(map_path), "CSV read through the map " + map_path};
 
   std::ifstream in(log_path, std::ios::binary);

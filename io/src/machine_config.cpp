@@ -98,8 +98,16 @@ void parse_regimes(YamlMap& g, core::RegimeSettings& r) {
   r.inductance_tolerance = g.number_or("inductance_tolerance", r.inductance_tolerance, 0.0, 10.0);
   r.angle_tolerance_rad = g.number_or("angle_tolerance_rad", r.angle_tolerance_rad, 0.0, 1.5);
   r.angle_source_assumed = !g.has("angle_source");
-  r.sensorless =
-      g.choice_or("angle_source", r.sensorless ? "sensorless" : "sensor", {"sensor", "sensorless"}) == "sensorless";
+  const std::string source =
+      g.choice_or("angle_source", r.sensorless ? "sensorless" : "sensor", {"sensor", "sensorless", "hall"});
+  r.sensorless = source != "sensor";
+  for (const char* key : {"hall_frame_error_rad", "hall_below_speed_rad_s"}) {
+    if (source != "hall" && g.has(key)) g.fail(key, "applies to angle_source: hall only");
+  }
+  if (source == "hall") {
+    r.hall_frame_error_rad = g.number_or("hall_frame_error_rad", core::kHallFrameErrorRad, 1e-3, core::kPi / 2.0);
+    r.hall_below_speed_rad_s = g.number_or("hall_below_speed_rad_s", core::kHallBelowSpeedRadS, 0.0, 1e5);
+  }
   g.finish();
 }
 
@@ -476,7 +484,7 @@ std::string unstated_frame_note(const MachineConfig& config) {
   return "note: the configuration does not say where the drive's dq frame comes from "
          "(estimator.regimes.angle_source): taken as a position sensor's. A VESC without sensors runs on an observer "
          "and starts open loop; say angle_source: sensorless, so that R_s adapts only where the back EMF rules out "
-         "a frame error (docs/configuration.md)";
+         "a frame error, or angle_source: hall with Hall sensors (docs/configuration.md)";
 }
 
 MachineConfig load_machine_config(const std::string& path) {

@@ -99,7 +99,11 @@ void MappedLogReader::read_header() {
   column_.fill(nullptr);
   for (std::size_t k = 0; k < map_.skip_lines; ++k) {
     std::string skipped;
-    if (!std::getline(in_, skipped)) break;
+    if (!std::getline(in_, skipped)) {
+      throw DriveLogError(path_, line_, 0, "",
+                          "the file ends after " + std::to_string(line_) + " lines, within the map's skip_lines (" +
+                              std::to_string(map_.skip_lines) + ")");
+    }
     ++line_;
     bytes_read_ += skipped.size() + 1;
   }
@@ -252,6 +256,17 @@ bool MappedLogReader::read_raw(MappedRow& row) {
     if (std::abs(t_s) > limits_.time_s.max_abs) {
       fail_cell(time_index_, time_label_,
                 g6(t_s) + " s is beyond the plausible ±" + g6(limits_.time_s.max_abs) + " s (" + limits_.time_s.why + ")");
+    }
+    if (map_.wrap_s > 0.0) {
+      // A wrapping clock's value lies within one period of its zero (ms_today: 0 to a day): what lies outside is
+      // not that clock, and would unwrap to a window years long or a wrap that never happened.
+      const MappedColumn& c = *map_.time;
+      const double zero_s = c.unit_factor * c.offset + c.unit_offset;  // the column's 0 in seconds
+      if (!(t_s >= zero_s && t_s < zero_s + map_.wrap_s)) {
+        fail_cell(time_index_, time_label_,
+                  g6(t_s - zero_s) + " s is outside the column's period [0, " + g6(map_.wrap_s) + ") s (it wraps every " +
+                      g6(map_.wrap_s) + " s)");
+      }
     }
     if (previous_cell_s_ && map_.wrap_s > 0.0 && t_s < *previous_cell_s_ - 0.5 * map_.wrap_s) {
       // A step back by more than half the period is the column wrapping (ms_today at midnight): the

@@ -108,8 +108,9 @@ std::string assumed_frame_note(const SampleCounts& c) {
          " samples that excited R_s did so only because the drive's dq frame was taken as a position sensor's: the "
          "configuration does not say where it comes from (estimator.regimes.angle_source). On an observer or an "
          "open-loop start-up (a sensorless drive: most VESCs) the back EMF there could not rule out a frame error "
-         "that outweighs R_s' drop: say angle_source: sensorless and R_s does not adapt on them; with an encoder or a "
-         "resolver say angle_source: sensor (docs/configuration.md)";
+         "that outweighs R_s' drop: say angle_source: sensorless and R_s does not adapt on them; with Hall sensors say "
+         "angle_source: hall (their frame is within 30° of the rotor's below the observer's speed); with an encoder or "
+         "a resolver say angle_source: sensor (docs/configuration.md)";
 }
 
 std::vector<std::string> exclusion_explanations(const SampleCounts& c, double share) {

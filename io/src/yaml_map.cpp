@@ -4,6 +4,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <set>
 #include <sstream>
 #include <system_error>
 
@@ -44,7 +45,16 @@ YamlMap YamlMap::load_string(const std::string& text, const std::string& name) {
 }
 
 YamlMap::YamlMap(const YAML::Node& node, std::string file, std::string path)
-    : node_(node), file_(std::move(file)), path_(std::move(path)) {}
+    : node_(node), file_(std::move(file)), path_(std::move(path)) {
+  // A key given twice: yaml-cpp keeps both and a lookup finds the first, so the second would be ignored silently.
+  if (!node_.IsMap()) return;
+  std::set<std::string> keys;
+  for (const auto& entry : node_) {
+    if (!entry.first.IsScalar()) continue;  // a complex key: no reader asks for one, finish() names it
+    const std::string key = entry.first.Scalar();
+    if (!keys.insert(key).second) fail_at(entry.first, key, "given twice in this mapping (the first would be used)");
+  }
+}
 
 std::string YamlMap::field(const std::string& key) const {
   if (key.empty()) return path_;

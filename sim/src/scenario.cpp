@@ -80,6 +80,13 @@ void parse_sensors(io::YamlMap m, Scenario& s) {
   c.current_gain_error = vec3(m, "current_gain_error", -0.5, 0.5);
   c.encoder_counts = m.number_or("encoder_counts", 0.0, 0.0, 1e9);
   c.theta_offset_rad = m.number_or("theta_offset_rad", 0.0, -3.2, 3.2);
+  if (std::optional<io::YamlMap> hall = m.optional_map("hall")) {
+    if (c.encoder_counts > 0.0) hall->fail("", "Hall sensors or an encoder (encoder_counts), not both");
+    c.hall.enabled = true;
+    c.hall.interp_erpm = hall->number_or("interp_erpm", c.hall.interp_erpm, 0.0, 1e6);
+    c.hall.observer_erpm = hall->number_or("observer_erpm", c.hall.observer_erpm, 0.0, 1e7);
+    hall->finish();
+  }
   c.speed_window = static_cast<int>(m.integer_or("speed_window", 8, 1, 10000));
   c.u_dc_noise_V = m.number_or("u_dc_noise_V", 0.0, 0.0, 1e3);
   c.u_dc_lsb_V = m.number_or("u_dc_lsb_V", 0.0, 0.0, 1e3);

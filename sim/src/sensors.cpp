@@ -12,6 +12,7 @@ Sensors::Sensors(const SensorConfig& config, int pole_pairs, double period_s, st
       pole_pairs_(pole_pairs),
       period_s_(period_s),
       normal_(seed),
+      hall_(config.hall, period_s),
       angle_history_mech_(static_cast<std::size_t>(std::max(2, config.speed_window + 1)), 0.0) {
   inv_current_lsb_ = config.current_lsb_A > 0.0 ? 1.0 / config.current_lsb_A : 0.0;
   inv_u_dc_lsb_ = config.u_dc_lsb_V > 0.0 ? 1.0 / config.u_dc_lsb_V : 0.0;
@@ -40,7 +41,9 @@ core::Vec3 Sensors::currents(const core::Vec3& i_abc_A) noexcept {
 
 double Sensors::angle(double theta_el_true_rad) noexcept {
   double mech = theta_el_true_rad * inv_pole_pairs_;
-  if (config_.encoder_counts > 0.0) {
+  if (config_.hall.enabled) {
+    mech = hall_.angle(theta_el_true_rad) * inv_pole_pairs_;
+  } else if (config_.encoder_counts > 0.0) {
     const double counts = mech * inv_encoder_step_;
     const auto truncated = static_cast<double>(static_cast<long long>(counts));
     mech = encoder_step_rad_ * (truncated > counts ? truncated - 1.0 : truncated);  // floor, without a libm call

@@ -203,6 +203,13 @@ TEST(Regime, RsIsExcitedWhereItsDropStandsOutOfNoiseAndTheFluxsUncertainty) {
   EXPECT_GT(moving, 10.0 * still);  // the flux's uncertainty, not the noise, sets it there
 }
 
+/// r_s' excitation edge at speed n from both sides: excited 1 % above `edge` (the current), not 1 % below.
+template <typename At>
+void expect_rs_edge(const At& at, const RegimeConfig& c, double n, double edge) {
+  EXPECT_TRUE(at(c, n, 1.01 * edge).bits & regime_bit::kExcitesRs) << "n " << n << ", edge " << edge;
+  EXPECT_FALSE(at(c, n, 0.99 * edge).bits & regime_bit::kExcitesRs) << "n " << n << ", edge " << edge;
+}
+
 // A sensorless frame (`angle_source: sensorless`): the lock test passes a frame error δ while
 // sin(δ − δ_tol) ≤ a = cos δ_tol·(B_d + tan δ_tol·B_q + z·σ_L)/(|n|·ψ_min) (a frame turning with the rotor stays
 // within δ_tol + π/2), and such an error adds |n|·ψ·2·sin(δ/2) to the magnet's voltage error: r_s is excited where
@@ -252,8 +259,7 @@ TEST(Regime, ASensorlessFramesRsIsExcitedOnlyBeyondTheFrameErrorTheLockTestLeave
     const double edge = hi;
     SCOPED_TRACE(::testing::Message() << "r_s ±" << r_s_spread << ", edge " << edge << ", a " << reach(n, edge));
     (reach(n, edge) >= 1.0 ? undecided : judged) = true;
-    EXPECT_TRUE(at(c, n, 1.01 * edge).bits & regime_bit::kExcitesRs);
-    EXPECT_FALSE(at(c, n, 0.99 * edge).bits & regime_bit::kExcitesRs);
+    expect_rs_edge(at, c, n, edge);
     EXPECT_FALSE(at(c, -n, 0.99 * edge).bits & regime_bit::kExcitesRs);
     // With a sensor the frame is the rotor's: the edge of the test above, below.
     const double measured = (c.z * noise + n * c.dpsi_pu) / (c.r_min_pu - n * c.dx_q_pu);
@@ -261,9 +267,7 @@ TEST(Regime, ASensorlessFramesRsIsExcitedOnlyBeyondTheFrameErrorTheLockTestLeave
     EXPECT_TRUE(at(sensor, n, 1.01 * measured).bits & regime_bit::kExcitesRs);
     EXPECT_FALSE(at(c, n, 1.01 * measured).bits & regime_bit::kExcitesRs);
     // At standstill no frame error reaches the voltage: the edge is the sensor's.
-    const double still = c.z * noise / c.r_min_pu;
-    EXPECT_TRUE(at(c, 0.0, 1.01 * still).bits & regime_bit::kExcitesRs);
-    EXPECT_FALSE(at(c, 0.0, 0.99 * still).bits & regime_bit::kExcitesRs);
+    expect_rs_edge(at, c, 0.0, c.z * noise / c.r_min_pu);
   }
   EXPECT_TRUE(judged);
   EXPECT_TRUE(undecided);
@@ -286,6 +290,77 @@ TEST(Regime, ASensorlessFramesRsIsExcitedOnlyBeyondTheFrameErrorTheLockTestLeave
   EXPECT_NEAR(implied - s.nominal.r_s_pu, n * s.nominal.psi_m_pu * (std::cos(delta) - 1.0) / current,
               1e-3 * s.nominal.r_s_pu);
   EXPECT_GT(std::abs(implied / s.nominal.r_s_pu - 1.0), 0.05);
+}
+
+// Hall sensors (`angle_source: hall`): below their speed the frame is within their own error δ_h of the rotor's, so
+// r_s' frame term takes the smaller of the two bounds, δ_max = min(δ_tol + asin(min(1, a)), δ_h) — the edge found by
+// bisection on that form and checked from both sides, where the Hall bound decides and where the lock test's does;
+// above their speed (the observer's frame) the sensorless edge; at standstill the sensor's. The edge lies between
+// a sensor's and a sensorless frame's wherever the Hall bound is the smaller.
+TEST(Regime, HallSensorsBoundTheFrameErrorBelowTheirSpeed) {
+  const double gamma = 1e-3, n = 2e-3;
+  bool hall_decided = false, lock_decided = false;
+  for (const double r_s_spread : {0.0, 0.05}) {
+    for (const double hall_error : {kHallFrameErrorRad, 1.2}) {
+      Outrunner s;
+      if (r_s_spread > 0.0) {
+        s.settings.r_s_min_Ohm = s.machine.r_s_Ohm * (1.0 - r_s_spread);
+        s.settings.r_s_max_Ohm = s.machine.r_s_Ohm * (1.0 + r_s_spread);
+      }
+      s.settings.regimes.sensorless = true;
+      const RegimeConfig sensorless = s.config();
+      s.settings.regimes.hall_frame_error_rad = hall_error;
+      s.settings.regimes.hall_below_speed_rad_s = 2.0 * n * s.base.omega_el_rad_s;
+      const RegimeConfig c = s.config();
+      s.settings.regimes.hall_below_speed_rad_s = 0.5 * n * s.base.omega_el_rad_s;
+      const RegimeConfig observer = s.config();  // n is above the Hall sensors' speed: the observer's frame
+      const double sigma_u = c.resolution_pu[0] / std::sqrt(12.0);  // σ_i = σ_n = 0: probes repeat one sample
+      const double noise = std::sqrt(gamma / (2.0 - gamma)) * sigma_u;
+      const double delta_tol = s.settings.regimes.angle_tolerance_rad, tan_tol = std::tan(delta_tol);
+      const double sigma_lock = sigma_u * std::sqrt(1.0 + tan_tol * tan_tol);
+      const auto reach = [&](double current) {  // i = [0, I]: B_d = |n|·Δx_q·I, B_q = Δr·I
+        return std::cos(delta_tol) * (n * c.dx_q_pu * current + tan_tol * c.dr_pu * current + c.z * sigma_lock) /
+               (n * c.psi_min_pu);
+      };
+      const auto lock_bound = [&](double current) { return delta_tol + std::asin(std::min(1.0, reach(current))); };
+      const auto edge_of = [&](double cap) {
+        const auto term = [&](double current) {
+          const double frame = 2.0 * c.psi_max_pu * std::sin(0.5 * std::min(lock_bound(current), cap));
+          return c.r_min_pu * current - n * (c.dpsi_pu + frame + c.dx_q_pu * current) - c.z * noise;
+        };
+        double lo = 0.0, hi = 50.0;
+        EXPECT_LT(term(lo), 0.0);
+        EXPECT_GT(term(hi), 0.0);
+        for (int k = 0; k < 200; ++k) (term(0.5 * (lo + hi)) > 0.0 ? hi : lo) = 0.5 * (lo + hi);
+        return hi;
+      };
+      const auto at = [&](const RegimeConfig& config, double speed, double current) {
+        RegimeInput in = steady(s.nominal, speed, Vec2(0.0, current));
+        in.weight = Vec2::Constant(gamma);
+        return probe(config, in);
+      };
+      const double edge = edge_of(hall_error), open_edge = edge_of(kPi);
+      const bool hall_smaller = hall_error < lock_bound(edge);
+      SCOPED_TRACE(::testing::Message() << "r_s ±" << r_s_spread << ", δ_h " << hall_error << ", edge " << edge
+                                        << ", lock bound " << lock_bound(edge));
+      (hall_smaller ? hall_decided : lock_decided) = true;
+      expect_rs_edge(at, c, n, edge);
+      EXPECT_FALSE(at(c, -n, 0.99 * edge).bits & regime_bit::kExcitesRs);
+      if (hall_smaller) {
+        EXPECT_LT(edge, 0.99 * open_edge);  // the Hall bound lets r_s adapt where a sensorless frame would not
+        EXPECT_FALSE(at(sensorless, n, 1.01 * edge).bits & regime_bit::kExcitesRs);
+        EXPECT_FALSE(at(observer, n, 1.01 * edge).bits & regime_bit::kExcitesRs);
+      } else {
+        EXPECT_DOUBLE_EQ(edge, open_edge);
+      }
+      // Above the Hall sensors' speed: the sensorless edge. At standstill no frame error reaches the voltage: the
+      // sensor's edge.
+      expect_rs_edge(at, observer, n, open_edge);
+      expect_rs_edge(at, c, 0.0, c.z * noise / c.r_min_pu);
+    }
+  }
+  EXPECT_TRUE(hall_decided);
+  EXPECT_TRUE(lock_decided);
 }
 
 /// Contiguous windows of `h` seconds at speed n, the current's q component given at each window's centre by

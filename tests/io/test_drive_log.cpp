@@ -97,6 +97,9 @@ INSTANTIATE_TEST_SUITE_P(
         BadCase{"duplicate", "t,t,theta_el,omega_el,u_dc,u_a,u_b,u_c,i_a,i_b,i_c\n", "column t: column appears twice"},
         BadCase{"non_numeric", kHeader + "0,0,0,220,1,2,3,abc,0,0\n", ":2:8: column i_a: 'abc' is not a number"},
         BadCase{"trailing_garbage", kHeader + "0,0,0,220,1,2,3,1.5x,0,0\n", ":2:8: column i_a: '1.5x'"},
+        // A control character in a cell is written out: a NUL would end the message where it is printed.
+        BadCase{"nul_in_cell", kHeader + "0,0,0,220,1,2,3,1.5" + '\0' + "x,0,0\n",
+                ":2:8: column i_a: '1.5\\x00x' is not a number"},
         BadCase{"nan", kHeader + "0,0,0,220,1,2,3,0,0,0\n0.1,0,0,nan,1,2,3,0,0,0\n", ":3:4: column u_dc: NaN"},
         BadCase{"inf", kHeader + "0,0,0,220,1,2,inf,0,0,0\n", ":2:7: column u_c: 'inf' is not finite"},
         BadCase{"empty_cell", kHeader + "0,0,,220,1,2,3,0,0,0\n", ":2:3: column omega_el: empty cell"},

@@ -100,6 +100,11 @@ INSTANTIATE_TEST_SUITE_P(
     ::testing::Values(
         BadEdit{"unknown_top", "\nmachine:", "\nmachnie_typo: 1\nmachine:", ":3:1: machnie_typo: unknown key"},
         BadEdit{"unknown_nested", "r_s_Ohm: 2.25", "r_s_Ohm: 2.25\n  r_s_ohm: 2.25", "machine.r_s_ohm: unknown key"},
+        // A key given twice: yaml-cpp would hand the first to a lookup and drop the second silently.
+        BadEdit{"duplicate_key", "r_s_Ohm: 2.25", "r_s_Ohm: 2.25\n  r_s_Ohm: 9.0",
+                ":12:3: machine.r_s_Ohm: given twice in this mapping (the first would be used)"},
+        BadEdit{"duplicate_flow_key", "initial: \\{psi_m_Wb: 1.14", "initial: {psi_m_Wb: 1.2, psi_m_Wb: 1.14",
+                "estimator.initial.psi_m_Wb: given twice"},
         BadEdit{"out_of_range_gain", "gain: 3.25e-4", "gain: 3.25",
                 "estimator.gains.sga.psi_m.gain: 3.25 is outside [0, 1]"},
         BadEdit{"negative_resistance", "r_s_Ohm: 2.25", "r_s_Ohm: -2.25", "machine.r_s_Ohm: -2.25 is outside"},
@@ -203,9 +208,31 @@ TEST(MachineConfig, TheAnglesSourceIsReadAndChecked) {
   both.regimes.sensorless = both.regimes.angle_source_assumed = true;
   EXPECT_FALSE(core::make_regime_config(core::PerUnitBase::from_rated(paper.machine.rated), paper.machine, both)
                    .angle_source_assumed);
-  const std::string error = error_after_edit("angle_source: sensor", "angle_source: hall");
-  EXPECT_NE(error.find("estimator.regimes.angle_source: 'hall' is not one of: sensor, sensorless"), std::string::npos)
+  const std::string error = error_after_edit("angle_source: sensor", "angle_source: halls");
+  EXPECT_NE(error.find("estimator.regimes.angle_source: 'halls' is not one of: sensor, sensorless, hall"), std::string::npos)
       << error;
+  // Hall sensors: a frame not a sensor's, bounded by their error below their speed (defaults: VESC's six states and
+  // foc_sl_erpm); the two keys apply to them only and are checked.
+  const auto hall = [](const std::string& keys) {
+    test::TempFile f("hall.yaml",
+                     std::regex_replace(paper_text(), std::regex("angle_source: sensor"), "angle_source: hall" + keys));
+    return load_machine_config(f.path()).estimator.regimes;
+  };
+  const core::RegimeSettings defaults = hall("");
+  EXPECT_TRUE(defaults.sensorless);
+  EXPECT_FALSE(defaults.angle_source_assumed);
+  EXPECT_DOUBLE_EQ(defaults.hall_frame_error_rad, core::kPi / 6.0);
+  EXPECT_NEAR(defaults.hall_below_speed_rad_s, 209.43951, 1e-5);  // 2000 erpm
+  const core::RegimeSettings given = hall("\n    hall_frame_error_rad: 0.35\n    hall_below_speed_rad_s: 400");
+  EXPECT_DOUBLE_EQ(given.hall_frame_error_rad, 0.35);
+  EXPECT_DOUBLE_EQ(given.hall_below_speed_rad_s, 400.0);
+  EXPECT_DOUBLE_EQ(paper.estimator.regimes.hall_frame_error_rad, 0.0);
+  const std::string misplaced =
+      error_after_edit("angle_source: sensor", "angle_source: sensorless\n    hall_frame_error_rad: 0.5");
+  EXPECT_NE(misplaced.find("estimator.regimes.hall_frame_error_rad: applies to angle_source: hall only"), std::string::npos)
+      << misplaced;
+  const std::string wide = error_after_edit("angle_source: sensor", "angle_source: hall\n    hall_frame_error_rad: 2");
+  EXPECT_NE(wide.find("hall_frame_error_rad"), std::string::npos) << wide;
 }
 
 TEST(MachineConfig, ModelExtensionsAreRead) {

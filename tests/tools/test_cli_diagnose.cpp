@@ -131,7 +131,7 @@ TEST(CliDiagnose, BadInputGetsAClearErrorAndItsExitCode) {
   r = test::run_command(rpem_tool() + " diagnose --log " + dir + "/short.csv --out " + dir + "/o");
   EXPECT_EQ(r.exit_code, 65) << r.output;
   EXPECT_NE(r.output.find("short.csv"), std::string::npos) << r.output;
-  EXPECT_NE(r.output.find("at least 80 rows"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("at least 80 are needed"), std::string::npos) << r.output;
 
   // A dead time in seconds needs u_dc, which a rotor-frame-only log may lack: refused, naming both files.
   std::ofstream(dir + "/dt.yaml") << read(test::source_dir() + "/config/paper-ipmsm.yaml")

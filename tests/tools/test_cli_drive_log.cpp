@@ -112,8 +112,9 @@ TEST(CliDriveLog, ToolsThatNeedALongerLogSaySoWithTheDataErrorsExit) {
   EXPECT_EQ(e.exit_code, 0) << e.output;
   const test::ProcessResult d = rpem("diagnose", "d");
   EXPECT_EQ(d.exit_code, 65) << d.output;
-  EXPECT_NE(d.output.find("short.csv:6: the log has 5 rows; 40 training and held-out blocks need at least 80 rows"),
-            std::string::npos)
+  EXPECT_NE(
+      d.output.find("short.csv: the log gives 5 samples; at least 80 are needed (40 training and held-out blocks, 2 each)"),
+      std::string::npos)
       << d.output;
   // rpem figures draws the regime timeline of the same five rows (it splits no blocks).
   const test::ProcessResult f = rpem("figures", "f");

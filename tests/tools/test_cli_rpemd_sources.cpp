@@ -24,6 +24,32 @@ TEST(CliRpemdSources, ShippedVescAndSignalMapConfigurationsCheckOut) {
   }
 }
 
+// --check-config checks what rpemd checks at start: with commands enabled and no command key rpemd refuses to start
+// (exit 78), so --check-config refuses too where it sees the service's credentials ($CREDENTIALS_DIRECTORY,
+// systemd's LoadCredential=), and says it did not check them where it does not; a bad command line is exit 64.
+TEST(CliRpemdSources, CheckConfigChecksTheCommandKeysWhereItSeesThem) {
+  const std::string config = rpem::test::source_dir() + "/config/rpemd-can.yaml";  // commands: {enabled: true}
+  const auto outside =
+      rpem::test::run_command("env -u CREDENTIALS_DIRECTORY " + rpemd() + " --check-config --config " + config);
+  EXPECT_EQ(outside.exit_code, 0) << outside.output;
+  EXPECT_NE(outside.output.find("the command keys are not checked here (CREDENTIALS_DIRECTORY is not set"),
+            std::string::npos)
+      << outside.output;
+  EXPECT_NE(outside.output.find("is valid"), std::string::npos) << outside.output;
+  const rpem::test::TempFile empty("credentials");
+  std::filesystem::create_directories(empty.path());
+  const auto service = rpem::test::run_command("CREDENTIALS_DIRECTORY=" + empty.path() + " " + rpemd() +
+                                               " --check-config --config " + config);
+  EXPECT_EQ(service.exit_code, 78) << service.output;
+  EXPECT_NE(service.output.find("commands are enabled but no command key is configured"), std::string::npos)
+      << service.output;
+  EXPECT_EQ(service.output.find("is valid"), std::string::npos) << service.output;
+  for (const char* bad : {" --bogus", " --can", " extra"}) {
+    const auto r = rpem::test::run_command(rpemd() + bad);
+    EXPECT_EQ(r.exit_code, 64) << bad << ": " << r.output;
+  }
+}
+
 // Each "### `source: X`" section of docs/rpemd.md gives a complete configuration in its first yaml block; written
 // beside the shipped config/ files (which its relative paths name, as a user's copy in config/ would), rpemd
 // must accept it.

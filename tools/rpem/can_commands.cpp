@@ -13,6 +13,7 @@
 #include "can_stream.hpp"
 #include "commands.hpp"
 #include "log_options.hpp"
+#include "option_checks.hpp"
 #include "record_averaged.hpp"
 #include "rpem/can/decoder.hpp"
 #include "rpem/can/protocol.hpp"
@@ -157,9 +158,10 @@ Runner add_record_command(CLI::App& app) {
   auto opts = std::make_shared<RecordOptions>();
   CLI::App* cmd = app.add_subcommand("record", "Write what a drive sends on CAN as a drive log or an averaged log");
   cmd->add_option("--can", opts->interface, "SocketCAN interface")->required();
-  cmd->add_option("--out", opts->out, "drive-log CSV to write (rpem's native telemetry, phase samples)");
-  cmd->add_option("--averaged-out", opts->averaged_out,
-                  "averaged rotor-frame log to write (docs/drive-log.md): from --signal-map, --vesc-id or native telemetry")
+  writes_file(cmd->add_option("--out", opts->out, "drive-log CSV to write (rpem's native telemetry, phase samples)"));
+  writes_file(cmd->add_option(
+                  "--averaged-out", opts->averaged_out,
+                  "averaged rotor-frame log to write (docs/drive-log.md): from --signal-map, --vesc-id or native telemetry"))
       ->excludes("--out");
   cmd->add_option("--signal-map", opts->signal_map, "read the drive's own frames through this map (docs/sources.md)")
       ->check(CLI::ExistingFile);

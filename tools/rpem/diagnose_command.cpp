@@ -172,7 +172,9 @@ int diagnose_and_write(const DiagnoseCliOptions& o, const io::MachineConfig& con
   monitor.finish();
   std::fprintf(stderr, "rpem diagnose: read %s\n", log.format.c_str());
   io::check_log_supports(config, config_name, log.layout.u_dc, o.log);
-  const analysis::ParameterTrack truth = o.truth.empty() ? analysis::ParameterTrack{} : analysis::load_truth(o.truth);
+  const double judged_from_s = log.t_start_s + analysis::kJudgedFromFraction * (log.t_end_s - log.t_start_s);
+  const analysis::ParameterTrack truth =
+      o.truth.empty() ? analysis::ParameterTrack{} : analysis::load_truth(o.truth, judged_from_s, log.t_end_s);
 
   analysis::DiagnoseOptions options;
   options.reference_C = o.reference_C;

@@ -15,6 +15,7 @@
 
 #include "commands.hpp"
 #include "log_options.hpp"
+#include "option_checks.hpp"
 #include "progress.hpp"
 #include "rpem/core/averaged_estimator.hpp"
 #include "rpem/core/drive_estimator.hpp"
@@ -222,7 +223,7 @@ Runner add_estimate_command(CLI::App& app) {
   add_log_options(*cmd, opts->log, opts->log_map);
   cmd->add_option("--config", opts->config, "machine and estimator YAML (default: built-in paper-ipmsm.yaml)")
       ->check(CLI::ExistingFile);
-  cmd->add_option("--out", opts->out, "estimate CSV to write")->required();
+  writes_file(cmd->add_option("--out", opts->out, "estimate CSV to write"))->required();
   cmd->add_option("--algorithm", opts->algorithm, "override the configured gain algorithm")
       ->check(CLI::IsMember({"sga", "gna", "phyint"}));
   CLI::Option* every = cmd->add_option("--every", opts->every, "write every N-th sample's estimate (default 1: all)")
@@ -230,7 +231,7 @@ Runner add_estimate_command(CLI::App& app) {
   cmd->add_option("--rate", opts->rate_Hz,
                   "write estimates at this rate [Hz] of the log's time (the first sample at or after each 1/rate), "
                   "e.g. 100 for an 8 kHz log: 1/80 of the file (docs/drive-log.md, \"Estimate CSV\")")
-      ->check(CLI::PositiveNumber)
+      ->check(CLI::Range(1e-9, 1e9))  // a grid of 1 ns to 32 years: its period in ns fits the log's int64 time
       ->excludes(every);
   cmd->add_option("--thermal", opts->thermal,
                   "thermal.yaml: run the thermal network's filter beside the estimator (docs/thermal.md)")

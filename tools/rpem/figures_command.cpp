@@ -7,9 +7,10 @@
 // with --thermal-estimate, the fused temperatures of `rpem estimate --thermal` against measured ones with
 // the ±2σ band (thermal_fused.png; docs/thermal.md, "Figures").
 
+#include <cmath>
 #include <cstdio>
-#include <filesystem>
 #include <optional>
+#include <string>
 
 #include "commands.hpp"
 #include "log_options.hpp"
@@ -17,6 +18,7 @@
 #include "rpem/analysis/diagnose/diagnose_output.hpp"
 #include "rpem/analysis/diagnose/regimes.hpp"
 #include "rpem/analysis/thermal/thermal_figure.hpp"
+#include "rpem/io/errors.hpp"
 #include "rpem/io/machine_config.hpp"
 #include "rpem/io/sample_counts.hpp"
 
@@ -33,12 +35,19 @@ struct FiguresOptions {
 
 int run_figures(const FiguresOptions& o) {
   if (!o.thermal.estimate_csv.empty()) {
-    std::filesystem::create_directories(o.out);
+    io::create_output_directory(o.out);
     const std::string png = o.out + "/thermal_fused.png";
     const analysis::ThermalFigureCoverage c = analysis::write_thermal_figure(png, o.thermal);
     std::fprintf(stderr, "rpem figures: wrote %s", png.c_str());
     if (!o.thermal.measured_csv.empty()) {
-      std::fprintf(stderr, " (measured inside ±2σ: magnet %.1f %%, winding %.1f %%)", 100.0 * c.magnet, 100.0 * c.winding);
+      const auto share = [](double inside) {  // NaN: no measured point was judged (none after --judged-after-s)
+        if (std::isnan(inside)) return std::string("no point judged");
+        char text[32];
+        std::snprintf(text, sizeof text, "%.1f %%", 100.0 * inside);
+        return std::string(text);
+      };
+      std::fprintf(stderr, " (measured inside ±2σ: magnet %s, winding %s)", share(c.magnet).c_str(),
+                   share(c.winding).c_str());
     }
     std::fprintf(stderr, "\n");
     return kExitOk;
@@ -62,7 +71,7 @@ int run_figures(const FiguresOptions& o) {
     if (const std::string note = io::assumed_frame_note(regimes.counts); !note.empty())
       std::fprintf(stderr, "rpem figures: note: %s\n", note.c_str());
   }
-  std::filesystem::create_directories(o.out);
+  io::create_output_directory(o.out);
   auto files = analysis::write_analysis_figures(o.out, cfg.machine, cfg.estimator.nominal_sample_period_s);
   if (log)
     files.push_back(o.out + "/" + analysis::write_regime_timeline(o.out, *log, regimes, cfg.machine.rated.pole_pairs));
@@ -79,17 +88,24 @@ Runner add_figures_command(CLI::App& app) {
   cmd->add_option("--out", opts->out, "output directory")->required();
   cmd->add_option("--config", opts->config, "machine YAML (default: built-in paper-ipmsm.yaml)")->check(CLI::ExistingFile);
   add_log_options(*cmd, opts->log, opts->log_map, "also draw this log's timeline coloured by regime (regimes.png)");
-  cmd->add_option("--thermal-estimate", opts->thermal.estimate_csv,
-                  "instead: plot this `rpem estimate --thermal` CSV's fused temperatures with their ±2σ band")
-      ->check(CLI::ExistingFile);
-  cmd->add_option("--measured", opts->thermal.measured_csv, "CSV with t [s] and measured temperatures [°C] to plot against")
-      ->check(CLI::ExistingFile);
+  CLI::Option* thermal = cmd->add_option("--thermal-estimate", opts->thermal.estimate_csv,
+                                         "instead: plot this `rpem estimate --thermal` CSV's fused temperatures with "
+                                         "their ±2σ band")
+                             ->check(CLI::ExistingFile)
+                             ->excludes("--log");
+  CLI::Option* measured = cmd->add_option("--measured", opts->thermal.measured_csv,
+                                          "CSV with t [s] and measured temperatures [°C] to plot against")
+                              ->check(CLI::ExistingFile)
+                              ->needs(thermal);
   cmd->add_option("--magnet-column", opts->thermal.magnet_column,
-                  "the measured magnet temperature's column (default T_magnet)");
+                  "the measured magnet temperature's column (default T_magnet)")
+      ->needs(measured);
   cmd->add_option("--winding-column", opts->thermal.winding_column,
-                  "the measured winding temperature's column (default T_winding)");
+                  "the measured winding temperature's column (default T_winding)")
+      ->needs(measured);
   cmd->add_option("--judged-after-s", opts->thermal.judged_after_s,
-                  "mark where a held-out part begins; coverage counted after it");
+                  "mark where a held-out part begins; coverage counted after it")
+      ->needs(thermal);
   return [cmd, opts]() { return cmd->parsed() ? run_figures(*opts) : -1; };
 }
 

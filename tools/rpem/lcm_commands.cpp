@@ -25,6 +25,7 @@
 #include <vector>
 
 #include "commands.hpp"
+#include "option_checks.hpp"
 #include "rpem/auth/key_file.hpp"
 #include "rpem/command_t.hpp"
 #include "rpem/core/clock.hpp"
@@ -319,7 +320,7 @@ Runner add_listen_command(CLI::App& app) {
   cmd->add_option("--prefix", opts->prefix, "channel prefix of the rpemd instance");
   cmd->add_option("--lcm-url", opts->url, "LCM URL (default: LCM's default)");
   cmd->add_option("--duration", opts->duration_s, "stop after this many seconds");
-  cmd->add_option("--csv", opts->csv, "also write every estimate to this CSV");
+  writes_file(cmd->add_option("--csv", opts->csv, "also write every estimate to this CSV"));
   cmd->add_flag("--diagnostics", opts->diagnostics, "print RPEM_DIAGNOSTICS too");
   cmd->add_option("--key", opts->key_file, "verify each message with this key file (rpemd's publish key)");
   return [cmd, opts]() { return cmd->parsed() ? run_listen(*opts) : -1; };

@@ -2,9 +2,11 @@
 
 #include <cstdio>
 #include <exception>
+#include <string>
 #include <vector>
 
 #include "commands.hpp"
+#include "option_checks.hpp"
 #include "rpem/auth/key.hpp"
 #include "rpem/io/errors.hpp"
 
@@ -25,11 +27,16 @@ int main(int argc, char** argv) {  // NOLINT(bugprone-exception-escape): only a 
   runners.push_back(add_command_command(app));
   runners.push_back(add_publish_estimate_command(app));
   runners.push_back(add_keygen_command(app));
+  require_finite_numbers(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     const int code = app.exit(e);
     return code == 0 ? kExitOk : kExitUsage;
+  }
+  if (const std::string clash = written_file_clash(app); !clash.empty()) {
+    std::fprintf(stderr, "rpem: %s\n", clash.c_str());
+    return kExitUsage;
   }
   try {
     rpem::auth::initialise();  // libsodium, once, before any key exists

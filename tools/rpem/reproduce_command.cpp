@@ -4,12 +4,12 @@
 
 #include <atomic>
 #include <cstdio>
-#include <filesystem>
 #include <mutex>
 #include <thread>
 
 #include "commands.hpp"
 #include "rpem/analysis/reproduction_report.hpp"
+#include "rpem/io/errors.hpp"
 
 namespace rpem::tools {
 namespace {
@@ -29,7 +29,7 @@ int run_reproduce(const ReproduceOptions& o) {
     std::fprintf(stderr, "rpem reproduce: no case matches '%s'\n", o.only.c_str());
     return kExitUsage;
   }
-  std::filesystem::create_directories(o.out);
+  io::create_output_directory(o.out);
   std::vector<analysis::CaseResult> results(cases.size());
   std::atomic<std::size_t> next{0};
   std::mutex print;

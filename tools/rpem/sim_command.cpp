@@ -13,6 +13,7 @@
 
 #include "can_stream.hpp"
 #include "commands.hpp"
+#include "option_checks.hpp"
 #include "progress.hpp"
 #include "rpem/can/protocol.hpp"
 #include "rpem/core/drive_estimator.hpp"
@@ -144,12 +145,13 @@ Runner add_sim_command(CLI::App& app) {
   auto opts = std::make_shared<SimOptions>();
   CLI::App* cmd = app.add_subcommand("sim", "Simulate the drive of a scenario and write its drive log");
   cmd->add_option("--scenario", opts->scenario, "scenario YAML (docs/scenarios.md)")->required()->check(CLI::ExistingFile);
-  cmd->add_option("--out", opts->out, "drive-log CSV to write");
-  cmd->add_option("--truth", opts->truth, "also write the true parameters and state (CSV)");
-  cmd->add_option("--estimate", opts->estimate, "also run the estimator in the loop and write its CSV");
+  writes_file(cmd->add_option("--out", opts->out, "drive-log CSV to write"));
+  writes_file(cmd->add_option("--truth", opts->truth, "also write the true parameters and state (CSV)"));
+  writes_file(cmd->add_option("--estimate", opts->estimate, "also run the estimator in the loop and write its CSV"));
   cmd->add_option("--can", opts->stream.interface, "stream the drive's telemetry on this SocketCAN interface, in real time");
-  cmd->add_option("--averaged-out", opts->averaged_out,
-                  "also write averaged rotor-frame samples as a drive averaging every control cycle reports them");
+  writes_file(
+      cmd->add_option("--averaged-out", opts->averaged_out,
+                      "also write averaged rotor-frame samples as a drive averaging every control cycle reports them"));
   cmd->add_option("--averaged-rate", opts->averaged_rate_Hz, "mean rate of the averaged samples [Hz]")
       ->check(CLI::Range(50.0, 2000.0));
   cmd->add_option("--averaged-jitter", opts->averaged_jitter, "window lengths uniform in (1 +- jitter)/rate")

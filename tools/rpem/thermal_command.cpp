@@ -8,11 +8,11 @@
 
 #include <cmath>
 #include <cstdio>
-#include <filesystem>
 #include <limits>
 
 #include "commands.hpp"
 #include "log_options.hpp"
+#include "option_checks.hpp"
 #include "rpem/analysis/thermal/thermal_fit.hpp"
 #include "rpem/analysis/thermal/thermal_report.hpp"
 #include "rpem/analysis/thermal/thermal_topology.hpp"
@@ -25,7 +25,7 @@ namespace {
 
 struct ThermalFitCliOptions {
   std::string log, log_map, config, out, start, report;
-  int nodes = 2;
+  int nodes = 0;  ///< --nodes; 0: not given (2 without a network to start from)
   double fit_until_s = std::numeric_limits<double>::quiet_NaN();
   double winding_sensor_sigma_K = 1.0;
   double period_s = 0.0;
@@ -39,6 +39,13 @@ int run_thermal_fit(const ThermalFitCliOptions& o) {
   io::ThermalConfig laws = o.start.empty() ? io::default_thermal_config(machine)
                                            : io::load_thermal_config(o.start, machine, io::NetworkRequired::kNo);
   if (o.period_s > 0.0) laws.fusion.observer.period_s = o.period_s;
+  if (laws.has_network && o.nodes > 0) {
+    std::fprintf(stderr,
+                 "rpem thermal fit: --nodes %d: --start %s has a network of %d nodes to start from; give --nodes "
+                 "with a start of laws only, or neither\n",
+                 o.nodes, o.start.c_str(), laws.fusion.filter.network.nodes);
+    return kExitUsage;
+  }
   std::fprintf(stderr, "rpem thermal fit: running the estimator over %s\n", o.log.c_str());
   const analysis::ThermalRecord record = analysis::record_thermal(io::log_source(o.log, o.log_map), machine, laws);
   std::fprintf(stderr, "rpem thermal fit: %s\n", record.read_as.c_str());
@@ -52,7 +59,8 @@ int run_thermal_fit(const ThermalFitCliOptions& o) {
                  "(thermal.coolant_C); a coolant that moves shows as a model error (docs/thermal.md)\n",
                  o.log.c_str(), laws.fusion.coolant_C);
   }
-  const io::ThermalConfig start = laws.has_network ? laws : analysis::default_topology(laws, record, o.nodes);
+  const io::ThermalConfig start =
+      laws.has_network ? laws : analysis::default_topology(laws, record, o.nodes > 0 ? o.nodes : 2);
   analysis::ThermalFitOptions options;
   options.fit_until_s = o.fit_until_s;
   options.anchor_magnet_reference = !o.keep_magnet_reference;
@@ -63,16 +71,19 @@ int run_thermal_fit(const ThermalFitCliOptions& o) {
 
   analysis::write_thermal_yaml(o.out, fit, record, config_name);
   if (!o.report.empty()) {
-    std::error_code ec;
-    std::filesystem::create_directories(o.report, ec);
-    if (ec) throw io::InputError(o.report, 0, 0, "", "cannot create directory: " + ec.message());
+    io::create_output_directory(o.report);
     analysis::write_thermal_fit_json(o.report + "/fit.json", fit, record, config_name);
     analysis::write_thermal_fit_report(o.report + "/report.md", fit, record, config_name);
     analysis::write_thermal_predictions(o.report + "/predictions.csv", fit, record);
   }
   for (const analysis::SignalFit& s : fit.signals) {
-    std::printf("%s: %s in training (σ %.2g K); fit %.3g K RMS, held out %.3g K RMS (worst %.3g K)\n", s.name.c_str(),
-                analysis::training_span(s).c_str(), s.training_sigma_K, s.fit_rms_K, s.heldout_rms_K, s.heldout_worst_K);
+    std::printf("%s: %s in training (σ %.2g K); fit %.3g K RMS, ", s.name.c_str(), analysis::training_span(s).c_str(),
+                s.training_sigma_K, s.fit_rms_K);
+    if (s.heldout_points == 0) {
+      std::printf("nothing held out (the training part, to %.6g s, takes the whole log)\n", fit.fit_until_s);
+    } else {
+      std::printf("held out %.3g K RMS (worst %.3g K)\n", s.heldout_rms_K, s.heldout_worst_K);
+    }
   }
   for (const analysis::FittedParameter& p : fit.parameters) {
     if (p.half_width_rel <= 10.0) {
@@ -103,7 +114,7 @@ Runner add_thermal_command(CLI::App& app) {
   add_log_options(*fit, opts->log, opts->log_map);
   fit->add_option("--config", opts->config, "machine and estimator YAML (default: built-in paper-ipmsm.yaml)")
       ->check(CLI::ExistingFile);
-  fit->add_option("--out", opts->out, "thermal.yaml to write")->required();
+  writes_file(fit->add_option("--out", opts->out, "thermal.yaml to write"))->required();
   fit->add_option(
          "--start", opts->start,
          "thermal section to start from: its laws, filter settings and, if it has `nodes`, its network (topology and values)")

@@ -51,27 +51,39 @@ constexpr std::int64_t kSettleNs = 2'000'000;
 }  // namespace
 
 void add_vesc_emulator_options(CLI::App* cmd, VescEmulatorOptions& o) {
-  cmd->add_option(
+  CLI::Option* vesc = cmd->add_option(
       "--vesc", o.interface,
       "answer as a VESC on this SocketCAN interface, the drive run on demand up to each poll (docs/can-vesc.md)");
-  cmd->add_option("--controller-id", o.controller_id, "the emulated VESC's controller id")->check(CLI::Range(0, 254));
-  cmd->add_option("--fet-temperature", o.temp_fet_C, "the emulated power stage's temperature [C]");
+  cmd->add_option("--controller-id", o.controller_id, "the emulated VESC's controller id")
+      ->check(CLI::Range(0, 254))
+      ->needs(vesc);
+  cmd->add_option("--fet-temperature", o.temp_fet_C, "the emulated power stage's temperature [C]")->needs(vesc);
   cmd->add_option("--status-rate-1", o.status_rate_1_Hz, "rate of status thread 1 [Hz], 0: off")
-      ->check(CLI::Range(0.0, 1000.0));
-  cmd->add_option("--status-msgs-1", o.status_msgs_1, "statuses of thread 1, bit k = status k+1")->check(CLI::Range(0, 63));
+      ->check(CLI::Range(0.0, 1000.0))
+      ->needs(vesc);
+  cmd->add_option("--status-msgs-1", o.status_msgs_1, "statuses of thread 1, bit k = status k+1")
+      ->check(CLI::Range(0, 63))
+      ->needs(vesc);
   cmd->add_option("--status-rate-2", o.status_rate_2_Hz, "rate of status thread 2 [Hz], 0: off")
-      ->check(CLI::Range(0.0, 1000.0));
-  cmd->add_option("--status-msgs-2", o.status_msgs_2, "statuses of thread 2, bit k = status k+1")->check(CLI::Range(0, 63));
-  cmd->add_option("--silent-at", o.silent_at_s, "test aid: go silent (no replies, no statuses) at this time [s]");
+      ->check(CLI::Range(0.0, 1000.0))
+      ->needs(vesc);
+  cmd->add_option("--status-msgs-2", o.status_msgs_2, "statuses of thread 2, bit k = status k+1")
+      ->check(CLI::Range(0, 63))
+      ->needs(vesc);
+  cmd->add_option("--silent-at", o.silent_at_s, "test aid: go silent (no replies, no statuses) at this time [s]")
+      ->needs(vesc);
   cmd->add_option("--silent-for", o.silent_for_s, "test aid: …for this long [s] (SIGUSR1 toggles silence too)")
-      ->check(CLI::NonNegativeNumber);
-  cmd->add_option("--duration", o.duration_s, "stop after this long [s] (default: the scenario's duration)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(CLI::NonNegativeNumber)
+      ->needs(vesc);
+  cmd->add_option("--duration", o.duration_s, "with --vesc: stop after this long [s] (default: the scenario's duration)")
+      ->check(CLI::NonNegativeNumber)
+      ->needs(vesc);
   cmd->add_option("--idle-step", o.idle_step_s,
                   "while no poll is pending: drive time run ahead per look at the socket, and the longest wait "
                   "for a poll between looks [s]")
       ->check(CLI::Range(1.0e-4, 1.0))
-      ->capture_default_str();
+      ->capture_default_str()
+      ->needs(vesc);
 }
 
 namespace {

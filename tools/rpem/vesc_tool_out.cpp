@@ -5,15 +5,17 @@
 #include <optional>
 
 #include "commands.hpp"
+#include "option_checks.hpp"
 #include "progress.hpp"
 #include "rpem/sim/vesc_tool_log.hpp"
 
 namespace rpem::tools {
 
 void add_vesc_tool_options(CLI::App* cmd, VescToolOptions& o) {
-  cmd->add_option("--vesc-tool-out", o.out,
-                  "write the emulated VESC's reads as VESC Tool's realtime-data log (semicolon CSV, docs/scenarios.md)");
-  cmd->add_option("--vesc-tool-truth", o.truth, "also write the truth of every row (CSV)");
+  writes_file(cmd->add_option(
+      "--vesc-tool-out", o.out,
+      "write the emulated VESC's reads as VESC Tool's realtime-data log (semicolon CSV, docs/scenarios.md)"));
+  writes_file(cmd->add_option("--vesc-tool-truth", o.truth, "also write the truth of every row (CSV)"));
   cmd->add_option("--vesc-tool-rate", o.link.rate_Hz, "mean rows per second [Hz]")
       ->check(CLI::Range(0.5, 100.0))
       ->capture_default_str();

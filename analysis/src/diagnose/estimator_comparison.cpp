@@ -5,11 +5,13 @@
 #include <cmath>
 #include <limits>
 #include <optional>
+#include <string>
 
 #include "../median.hpp"
 #include "rpem/core/clock.hpp"
 #include "rpem/core/drive_estimator.hpp"
 #include "rpem/io/csv_table.hpp"
+#include "rpem/io/errors.hpp"
 
 namespace rpem::analysis {
 namespace {
@@ -66,7 +68,7 @@ EstimateSummary summarise(const ParameterTrack& track, const ParameterTrack& tru
       r += track.r_s_Ohm[k];
       n += 1.0;
     }
-    if (!truth.empty() && t >= t0 + 0.5 * (t1 - t0)) {
+    if (!truth.empty() && t >= t0 + kJudgedFromFraction * (t1 - t0)) {
       e_psi.add(track.psi_m_Wb[k], implied ? truth.psi_m_Wb[k] : interpolate(truth.t_s, truth.psi_m_Wb, t));
       e_r.add(track.r_s_Ohm[k], implied ? truth.r_s_Ohm[k] : interpolate(truth.t_s, truth.r_s_Ohm, t));
     }
@@ -147,12 +149,39 @@ double estimator_heldout_rms_A(const LogData& log, const io::MachineConfig& conf
   return n ? std::sqrt(sum / static_cast<double>(n)) : 0.0;
 }
 
-ParameterTrack load_truth(const std::string& path) {
-  const io::CsvTable table = io::CsvTable::read(path);
+ParameterTrack load_truth(const std::string& path, double judged_from_s, double judged_to_s) {
   ParameterTrack t;
-  t.t_s = table.column("t");
-  t.psi_m_Wb = table.column("psi_m");
-  t.r_s_Ohm = table.column("r_s");
+  try {  // the truth is data: its faults are the data's (exit 65), as a log's
+    const io::CsvTable table = io::CsvTable::read(path);
+    t.t_s = table.column("t");
+    t.psi_m_Wb = table.column("psi_m");
+    t.r_s_Ohm = table.column("r_s");
+  } catch (const io::DriveLogError&) {
+    throw;
+  } catch (const io::InputError& e) {
+    throw io::DriveLogError(e.file(), e.line(), 0, e.field(), e.reason());
+  }
+  if (t.empty()) throw io::DriveLogError(path, 0, 0, "", "the truth has no rows");
+  for (std::size_t k = 0; k < t.t_s.size(); ++k) {
+    const std::size_t line = k + 2;  // after the header
+    if (k > 0 && !(t.t_s[k] > t.t_s[k - 1]))
+      throw io::DriveLogError(
+          path, line, 0, "t",
+          "the time does not increase (" + std::to_string(t.t_s[k]) + " s after " + std::to_string(t.t_s[k - 1]) + " s)");
+    if (!(t.psi_m_Wb[k] > 0.0) || !std::isfinite(t.psi_m_Wb[k]))
+      throw io::DriveLogError(path, line, 0, "psi_m", "not a positive finite flux linkage");
+    if (!(t.r_s_Ohm[k] > 0.0) || !std::isfinite(t.r_s_Ohm[k]))
+      throw io::DriveLogError(path, line, 0, "r_s", "not a positive finite resistance");
+  }
+  // Covered up to the truth's own step at either end (a truth sampled more coarsely than the log).
+  double step = 0.0;
+  for (std::size_t k = 1; k < t.t_s.size(); ++k) step = std::max(step, t.t_s[k] - t.t_s[k - 1]);
+  if (t.t_s.size() > 1 && (t.t_s.front() > judged_from_s + step || t.t_s.back() < judged_to_s - step)) {
+    throw io::DriveLogError(path, 0, 0, "t",
+                            "the truth covers " + std::to_string(t.t_s.front()) + " to " + std::to_string(t.t_s.back()) +
+                                " s; the estimates are judged over the log's second half, " + std::to_string(judged_from_s) +
+                                " to " + std::to_string(judged_to_s) + " s");
+  }
   return t;
 }
 

@@ -60,14 +60,26 @@ std::size_t LogData::training_count() const noexcept {
   return n;
 }
 
-void prepare_log(LogData& d, const core::MachineSi& machine, const LogOptions& options) {
+namespace {
+
+/// Enough samples for the training and held-out blocks (2 each); else the log's fault.
+void check_enough_samples(const LogData& d, const LogOptions& options) {
   const std::size_t n = d.samples.size();
   if (n < 2 * static_cast<std::size_t>(std::max(2, options.blocks))) {
-    throw io::DriveLogError(
-        d.path, n + 1, 0, "",
-        "the log has " + std::to_string(n) + (n == 1 ? " row; " : " rows; ") + std::to_string(std::max(2, options.blocks)) +
-            " training and held-out blocks need at least " + std::to_string(2 * std::max(2, options.blocks)) + " rows");
+    // Samples, not rows: an averaged or VESC Tool log's first row only opens the first window.
+    const int blocks = std::max(2, options.blocks);
+    throw io::DriveLogError(d.path, 0, 0, "",
+                            "the log gives " + std::to_string(n) + (n == 1 ? " sample" : " samples") + "; at least " +
+                                std::to_string(2 * blocks) + " are needed (" + std::to_string(blocks) +
+                                " training and held-out blocks, 2 each)");
   }
+}
+
+}  // namespace
+
+void prepare_log(LogData& d, const core::MachineSi& machine, const LogOptions& options) {
+  const std::size_t n = d.samples.size();
+  check_enough_samples(d, options);
   d.t_start_s = d.t_s(0);
   d.t_end_s = d.t_s(n - 1);
   {
@@ -213,8 +225,9 @@ LogData load_log(const std::string& path, const core::MachineSi& machine, const 
   if (source.averaged()) {
     // Window means carry no transient to replay: the steady-state model, whatever the spacing.
     if (options.mode == ModelMode::kTransient) {
-      throw io::DriveLogError(path, 1, 0, "column t_start",
-                              "an averaged log replays only the steady-state model (give --model auto or steady_state)");
+      throw io::DriveLogError(path, 0, 0, "",
+                              "a log of averaged windows (" + source.format +
+                                  ") replays only the steady-state model: give --model auto or steady_state");
     }
     io::AveragedLogRead read;
     std::vector<core::AveragedSample> samples = io::read_averaged_log(path, source.map, limits, &read);

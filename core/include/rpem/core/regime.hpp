@@ -19,6 +19,7 @@
 //   excites r_s  r_min·|i| − |n|·(Δψ + F + Δx·|i|)   > z·h_r·N_r
 //                F = 0 for a sensor's frame; sensorless: ψ_max·2·sin(δ_max/2), the largest frame error the lock test
 //                passes, δ_max = δ_tol + asin(min(1, cos δ_tol·(B_d + tan δ_tol·B_q + z·σ_L)/(|n|·ψ_min)))
+//                Hall sensors (below their speed): δ_max no larger than their own frame error
 //                a frame assumed a sensor's (angle_source not given): decided with F = 0, and flagged where only
 //                F = 0 lets the term stand out (kRsOnAssumedFrame)
 // Real-time safe: noexcept, no allocation, fixed size.
@@ -138,6 +139,12 @@ struct RegimeCounts {
   [[nodiscard]] std::uint64_t excluded() const noexcept;
 };
 
+/// `angle_source: hall`'s defaults: the nearest of six 60° states (a VESC below foc_hall_interp_erpm reads the
+/// state's angle from its table: mcpwm_foc.c / foc_math.c, foc_correct_hall), and the speed above which a VESC in
+/// Hall mode takes its observer's angle (foc_sl_erpm, mcconf_default.h: 2000 erpm, electrical).
+inline constexpr double kHallFrameErrorRad = kPi / 6.0;
+inline constexpr double kHallBelowSpeedRadS = 2000.0 * 2.0 * kPi / 60.0;
+
 /// The classification's keys as users give them (`estimator.regimes`, docs/configuration.md), SI.
 struct RegimeSettings {
   /// false: no sample is classified (every one admitted as exciting both parameters, none judged as an
@@ -159,9 +166,16 @@ struct RegimeSettings {
   double angle_tolerance_rad = 0.20033484232311968;
   /// Where the drive's dq frame comes from. false (`angle_source: sensor`): a position sensor; the frame is the
   /// rotor's but for a constant offset (`model_extensions`), wherever the lock test cannot judge it. true
-  /// (`sensorless`): an observer or an open-loop start-up; r_s is excited only beyond the frame error the lock
-  /// test leaves possible (docs/derivations.md §13, "Excitation").
+  /// (`sensorless`, `hall`): an observer or an open-loop start-up; r_s is excited only beyond the frame error the lock
+  /// test leaves possible (docs/derivations.md §13, "Excitation") — with Hall sensors, below hall_below_speed_rad_s,
+  /// beyond the smaller of that and hall_frame_error_rad.
   bool sensorless = false;
+  /// `angle_source: hall`: the largest error of the Hall sensors' frame (π/6: the nearest of six 60° states, as a
+  /// VESC reads them below foc_hall_interp_erpm); 0: no Hall sensors.
+  double hall_frame_error_rad = 0.0;
+  /// The electrical speed below which the frame is the Hall sensors' (a VESC's foc_sl_erpm, 2000 erpm by default;
+  /// the observer's above).
+  double hall_below_speed_rad_s = 0.0;
   /// The configuration did not say where the frame comes from: decided as a sensor's (sensorless false), and a
   /// window whose r_s excitation a sensorless frame would not have is flagged (regime_bit::kRsOnAssumedFrame).
   bool angle_source_assumed = false;
@@ -178,6 +192,8 @@ struct RegimeConfig {
   double dx_d_pu = 0.0, dx_q_pu = 0.0;                       ///< their tolerance
   double tan_angle = 0.0;                                    ///< tan δ_tol
   bool sensorless = false;                                   ///< RegimeSettings::sensorless
+  double hall_frame_error_rad = 0.0;                         ///< RegimeSettings::hall_frame_error_rad (0: none)
+  double hall_below_n_pu = 0.0;                              ///< RegimeSettings::hall_below_speed_rad_s / ω_n
   bool angle_source_assumed = false;                         ///< RegimeSettings::angle_source_assumed
   /// Configured resolution of u, i, n [pu]; 0: measured.
   std::array<double, 3> resolution_pu{};
@@ -308,6 +324,7 @@ class RegimeClassifier {
     Vec2 slope_var_x_sq = Vec2::Zero();                 ///< (x_d², x_q²)/ω_n²
     double x_max = 0.0, dx_max = 0.0;                   ///< the larger inductance and tolerance
     double cos_angle = 1.0, sin_angle = 0.0;            ///< cos δ_tol, sin δ_tol
+    double cos_hall = -1.0;                             ///< cos of the Hall sensors' largest frame error (−1: none)
     double dpsi_frame_sq = 0.0;  ///< (Δψ + a sensorless frame's least error)²: r_s' test's first check
   };
 

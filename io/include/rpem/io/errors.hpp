@@ -35,4 +35,8 @@ class DriveLogError : public InputError {
   using InputError::InputError;
 };
 
+/// Creates `directory` (and its parents) for a tool's output; InputError naming it and why where it cannot be (a
+/// file in its place, no permission).
+void create_output_directory(const std::string& directory);
+
 }  // namespace rpem::io

@@ -1,6 +1,6 @@
 #pragma once
 // What the drive measures: phase currents (gain error, offset, noise, ADC quantisation), the
-// encoder angle (resolution, misalignment), a speed from the encoder angle over a window, and the
+// encoder angle (resolution, misalignment) or a VESC's Hall sensors' reading, a speed from the encoder angle over a window, and the
 // DC-link voltage (noise, quantisation). The sensor errors are the effects rpem diagnose must find.
 
 #include <cstdint>
@@ -8,6 +8,7 @@
 
 #include "rpem/core/types.hpp"
 #include "rpem/sim/gaussian.hpp"
+#include "rpem/sim/hall_sensors.hpp"
 
 namespace rpem::sim {
 
@@ -18,6 +19,7 @@ struct SensorConfig {
   core::Vec3 current_gain_error = core::Vec3::Zero();  ///< measured = true·(1 + gain) + offset
   double encoder_counts = 0.0;                         ///< counts per mechanical revolution; 0: ideal
   double theta_offset_rad = 0.0;                       ///< electrical; measured = true − offset
+  HallConfig hall;                                     ///< Hall sensors instead of the encoder (hall_sensors.hpp)
   int speed_window = 8;                                ///< samples over which the speed is differentiated
   double u_dc_noise_V = 0.0;
   double u_dc_lsb_V = 0.0;
@@ -45,6 +47,7 @@ class Sensors {
   double inv_current_lsb_ = 0.0, inv_u_dc_lsb_ = 0.0, inv_pole_pairs_ = 1.0;
   double encoder_step_rad_ = 0.0, inv_encoder_step_ = 0.0;  ///< mechanical angle per count
   GaussianNoise normal_;
+  HallSensors hall_;
   std::vector<double> angle_history_mech_;  ///< unwrapped measured mechanical angles, ring buffer
   std::size_t head_ = 0;
   std::size_t count_ = 0;

@@ -38,8 +38,12 @@ struct ParameterTrack {
   [[nodiscard]] bool empty() const noexcept { return t_s.empty(); }
 };
 
-/// The true parameters of a simulated log (`rpem sim --truth`: columns t, psi_m, r_s).
-[[nodiscard]] ParameterTrack load_truth(const std::string& path);
+/// The estimates are judged against a truth over the log's second half (the first is the estimator's start).
+inline constexpr double kJudgedFromFraction = 0.5;
+
+/// A truth CSV (t, psi_m, r_s: `rpem sim --truth`) that covers [judged_from_s, judged_to_s]: times increasing, values
+/// finite and positive; one row is a constant truth. Else io::DriveLogError naming the file, the row and why.
+[[nodiscard]] ParameterTrack load_truth(const std::string& path, double judged_from_s, double judged_to_s);
 
 struct EstimateSummary {
   double psi_m_Wb = 0.0, r_s_Ohm = 0.0;  ///< mean over the last quarter of the log

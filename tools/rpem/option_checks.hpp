@@ -1,0 +1,21 @@
+#pragma once
+// What every subcommand's options are checked for, beyond each option's own check: numbers are finite, and a file a
+// command writes is none of the files it reads or writes otherwise (main.cpp runs both for every subcommand).
+
+#include <CLI/CLI.hpp>
+#include <string>
+
+namespace rpem::tools {
+
+/// Marks `option` as a file the command writes (returns it, to chain).
+CLI::Option* writes_file(CLI::Option* option);
+
+/// Adds a check to every number option of every subcommand: CLI11 reads "nan" and "inf" as numbers, and a NaN
+/// passes any range check (each comparison is false), so without it `--max-p nan` would run with it.
+void require_finite_numbers(CLI::App& app);
+
+/// After parsing: "" if no file the selected command writes names a file it also reads or writes through another
+/// option; else why (an input would be truncated before it is read: `--out run.csv --log run.csv`).
+[[nodiscard]] std::string written_file_clash(const CLI::App& app);
+
+}  // namespace rpem::tools
