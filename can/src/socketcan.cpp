@@ -232,10 +232,10 @@ bool SocketCanChannel::send(const CanFrame& frame, int timeout_ms) {
 
 void require_interface(const std::string& interface) {
   if (if_nametoindex(interface.c_str()) == 0) {
-    throw std::runtime_error("CAN interface '" + interface + "' does not exist (bring it up first, docs/can-protocol.md)");
+    throw InterfaceError("CAN interface '" + interface + "' does not exist (bring it up first, docs/can-protocol.md)");
   }
   const int fd = ::socket(PF_CAN, SOCK_RAW | SOCK_CLOEXEC, CAN_RAW);
-  if (fd < 0) throw std::runtime_error(errno_text("socket(PF_CAN): this kernel has no SocketCAN"));
+  if (fd < 0) throw InterfaceError(errno_text("socket(PF_CAN): this kernel has no SocketCAN"));
   ::close(fd);
 }
 

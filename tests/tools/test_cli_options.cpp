@@ -6,6 +6,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <iomanip>
 #include <sstream>
 #include <string>
 
@@ -124,6 +125,8 @@ TEST_F(CliOptions, OutputsAndInputsThatCannotBeUsedSaySo) {
   std::ofstream(path("f")) << "a file\n";
   EXPECT_REFUSED(rpem("figures --out " + path("f") + " --log " + log_), 74,
                  path("f") + ": cannot create the output directory");
+  // A CAN interface that is not there: exit 74 naming it (it ended as an unexpected error, exit 1).
+  EXPECT_REFUSED(rpem("replay " + log_ + " --can rpem_absent0"), 74, "CAN interface 'rpem_absent0' does not exist");
   // A log from a pipe: the tools read a log more than once, so it is refused by name instead of misread.
   EXPECT_REFUSED(test::run_command("cat " + log_ + " | " + test::binary_dir() +
                                    "/tools/rpem estimate --log /dev/stdin --out " + path("e.csv")),
@@ -146,6 +149,22 @@ TEST_F(CliOptions, ATruthThatDoesNotCoverTheJudgedHalfIsBadData) {
   EXPECT_REFUSED(diagnose_with("0,1.0,2.0\n0.03,1.0,-2.0\n"), 65, path("truth.csv") + ":3: r_s: not a positive finite");
   EXPECT_REFUSED(diagnose_with("0,1.0\n"), 65, path("truth.csv") + ":2: row has 2 cells, header has 3");
   EXPECT_FALSE(fs::exists(path("d")));
+}
+
+TEST_F(CliOptions, ALogWithAGapSaysWhichBlocksItLeavesEmpty) {
+  // 100 rows, 1000 s without any, 100 rows: of diagnose's 40 blocks of equal duration 38 hold no sample, and the
+  // verdict rests on the other two — said before anything is fitted (a truth that covers nothing stops it there).
+  std::ofstream out(log_);
+  out << kHeader << std::setprecision(12);
+  for (int k = 0; k < 200; ++k) out << 125e-6 * k + (k >= 100 ? 1000.0 : 0.0) << ",0,0,220,1,2,-3,0.5,-0.25,-0.25\n";
+  out.close();
+  std::ofstream(path("truth.csv")) << "t,psi_m,r_s\n5000,1.0,2.0\n5001,1.0,2.0\n";
+  const test::ProcessResult r = rpem("diagnose --log " + log_ + " --out " + path("d") + " --truth " + path("truth.csv"));
+  EXPECT_EQ(r.exit_code, 65) << r.output;
+  EXPECT_NE(r.output.find("note: 38 of the 40 training and held-out blocks (equal in time) hold no sample: the log's "
+                          "time has gaps (the longest 1000"),
+            std::string::npos)
+      << r.output;
 }
 
 TEST_F(CliOptions, AWrappingClocksValueLiesWithinOnePeriod) {

@@ -8,6 +8,7 @@
 #include "commands.hpp"
 #include "option_checks.hpp"
 #include "rpem/auth/key.hpp"
+#include "rpem/can/socketcan.hpp"
 #include "rpem/io/errors.hpp"
 
 int main(int argc, char** argv) {  // NOLINT(bugprone-exception-escape): only a defect escapes; terminate() shows it
@@ -51,6 +52,9 @@ int main(int argc, char** argv) {  // NOLINT(bugprone-exception-escape): only a 
     std::fprintf(stderr, "rpem: drive-log error: %s\n", e.what());
     return kExitDataError;
   } catch (const rpem::io::InputError& e) {
+    std::fprintf(stderr, "rpem: %s\n", e.what());
+    return kExitIoError;
+  } catch (const rpem::can::InterfaceError& e) {
     std::fprintf(stderr, "rpem: %s\n", e.what());
     return kExitIoError;
   } catch (const std::exception& e) {

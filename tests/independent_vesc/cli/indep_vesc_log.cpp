@@ -59,7 +59,7 @@ void write(const std::string& path, const std::string& text) {
 
 int main(int argc, char** argv) {
   CLI::App app{
-      "Independent VESC Tool log generator: a sensorless VESC driving an outrunner, read by VESC Tool "
+      "Independent VESC Tool log generator: a sensorless (or Hall-sensored) VESC driving an outrunner, read by VESC Tool "
       "(tests/independent_vesc/README.md)"};
   std::string config, out, truth_path, scenario, start_time, off_voltage = "measured", trace;
   int trace_every = 125;
@@ -67,7 +67,7 @@ int main(int argc, char** argv) {
   double duration = 600.0, rate = 11.0, poll_rate = 50.0;
   std::optional<double> psi_rel, r_rel;
   int header = indep::vesc::kNewestHeaderVersion;
-  bool midnight = false, crlf = false, isothermal = false, no_vdq_filter = false, invert = false;
+  bool midnight = false, crlf = false, isothermal = false, no_vdq_filter = false, invert = false, hall = false;
   bool list_parameters = false;
   std::vector<std::string> sets;
   app.add_option("--config", config, "configuration YAML (its machine section)");
@@ -84,12 +84,16 @@ int main(int argc, char** argv) {
   app.add_flag("--midnight", midnight, "start so that ms_today wraps at a third of the log");
   app.add_flag("--crlf", crlf, "Windows line ends");
   app.add_option("--scenario", scenario,
-                 "scenario CSV (kind,duration_s,current_A[,ramp_s,until_erpm,erpm_per_s,external_Nm,friction_Nm])");
+                 "scenario CSV (kind,duration_s,current_A[,ramp_s,until_erpm,erpm_per_s,external_Nm,friction_Nm,"
+                 "viscous_Nm_s])");
   app.add_option("--off-voltage", off_voltage, "what v_d, v_q report with the bridge off: measured (firmware) or zero")
       ->check(CLI::IsMember({"measured", "zero"}));
   app.add_flag("--isothermal", isothermal, "constant temperatures (R_s and psi_m stay at their start values)");
   app.add_flag("--no-vdq-filter", no_vdq_filter, "firmware before 5.03: no speed-dependent filter on v_d, v_q");
   app.add_flag("--invert-direction", invert, "the VESC's m_invert_direction");
+  app.add_flag("--hall", hall,
+               "Hall-sensor mode (foc_sensor_mode = FOC_SENSOR_MODE_HALL, ideal sensors, the detected table); "
+               "without --scenario the built-in Hall ride");
   app.add_option("--trace", trace, "per-cycle trace CSV of plant and firmware (every --trace-every cycles)");
   app.add_option("--trace-every", trace_every, "cycles between trace rows")->check(CLI::PositiveNumber);
   app.add_option("--set", sets, "numeric parameter key=value (repeatable; --list-parameters)");
@@ -129,6 +133,7 @@ int main(int argc, char** argv) {
     c.thermal.on = !isothermal;
     c.firmware.vdq_filter = !no_vdq_filter;
     c.firmware.invert_direction = invert;
+    c.firmware.hall = hall;
     c.keep_cycle_trace = !trace.empty();
     c.trace_every = trace_every;
     c.firmware.off_voltage = off_voltage == "zero" ? indep::vesc::OffVoltage::zero : indep::vesc::OffVoltage::measured;

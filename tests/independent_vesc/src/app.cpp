@@ -21,6 +21,8 @@ double App::external_torque_Nm() const { return done_ || !started_ ? 0.0 : segme
 
 double App::added_friction_Nm() const { return done_ || !started_ ? 0.0 : segments_[index_].friction_Nm; }
 
+double App::added_viscous_Nm_s() const { return done_ || !started_ ? 0.0 : segments_[index_].viscous_Nm_s; }
+
 void App::begin(std::size_t index, double t_s, VescFirmware& fw) {
   index_ = index;
   t_begin_ = t_s;

@@ -106,6 +106,10 @@ Case resolve_defaults(Case c) {
   in_range(f.l_max_duty, 0.1, 0.99, "firmware.l_max_duty");
   in_range(f.openloop_erpm, 0.0, 1e5, "firmware.openloop_erpm");
   in_range(f.sl_openloop_hyst_s, 0.001, 10.0, "firmware.sl_openloop_hyst_s");
+  in_range(f.hall_interp_erpm, 0.0, 1e5, "firmware.hall_interp_erpm");
+  in_range(f.sl_erpm_start, 0.0, 1e5, "firmware.sl_erpm_start");
+  in_range(f.sl_erpm, f.sl_erpm_start + 1.0, 2e5, "firmware.sl_erpm (above firmware.sl_erpm_start)");
+  in_range(s.hall_offset_deg, -360.0, 360.0, "sensors.hall_offset_deg");
 
   Poller& p = c.poller;
   in_range(p.poll_rate_Hz, 1.0, 1000.0, "poller.poll_rate_Hz");
@@ -171,6 +175,7 @@ const std::vector<ParameterEntry>& parameter_catalogue() {
       INDEP_VESC_PARAM("sensors.phase_voltage_gain", "1", sensors.phase_voltage_gain),
       INDEP_VESC_PARAM("sensors.motor_temp_noise_K", "K", sensors.motor_temp_noise_K),
       INDEP_VESC_PARAM("sensors.fet_temp_start_C", "degC", sensors.fet_temp_start_C),
+      INDEP_VESC_PARAM("sensors.hall_offset_deg", "deg", sensors.hall_offset_deg),
       INDEP_VESC_PARAM("firmware.f_zv_Hz", "Hz", firmware.f_zv_Hz),
       INDEP_VESC_PARAM("firmware.foc_dt_us", "us", firmware.foc_dt_us),
       INDEP_VESC_PARAM("firmware.current_tc_s", "s", firmware.current_tc_s),
@@ -196,6 +201,9 @@ const std::vector<ParameterEntry>& parameter_catalogue() {
       INDEP_VESC_PARAM("firmware.mag_vd_max", "1", firmware.mag_vd_max),
       INDEP_VESC_PARAM("firmware.overmod_factor", "1", firmware.overmod_factor),
       INDEP_VESC_PARAM("firmware.current_filter_const", "1", firmware.current_filter_const),
+      INDEP_VESC_PARAM("firmware.hall_interp_erpm", "ERPM", firmware.hall_interp_erpm),
+      INDEP_VESC_PARAM("firmware.sl_erpm_start", "ERPM", firmware.sl_erpm_start),
+      INDEP_VESC_PARAM("firmware.sl_erpm", "ERPM", firmware.sl_erpm),
       INDEP_VESC_PARAM("poller.rate_Hz", "Hz", poller.rate_Hz),
       INDEP_VESC_PARAM("poller.poll_rate_Hz", "Hz", poller.poll_rate_Hz),
       INDEP_VESC_PARAM("poller.rtt_sigma_log", "1", poller.rtt_sigma_log),

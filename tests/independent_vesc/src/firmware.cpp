@@ -29,6 +29,10 @@ const char* to_string(AngleSource s) {
       return "startup";
     case AngleSource::openloop:
       return "openloop";
+    case AngleSource::hall:
+      return "hall";
+    case AngleSource::hall_blend:
+      return "hall_blend";
   }
   return "?";
 }
@@ -37,6 +41,7 @@ VescFirmware::VescFirmware(const FirmwareParams& p)
     : p_(p),
       observer_(p.r_Ohm, p.l_H, p.psi_Wb),
       pll_(p.conf.pll_kp, p.conf.pll_ki),
+      hall_(HallSettings{p.hall_table, p.conf.hall_interp_erpm, p.conf.sl_erpm_start, p.conf.sl_erpm}),
       psi_(p.psi_Wb),
       observer_gain_(p.conf.observer_gain_factor / (p.psi_Wb * p.psi_Wb)),
       gamma_now_(4.0 * p.conf.observer_gain_slow * observer_gain_) {}
@@ -107,7 +112,11 @@ IsrOutput VescFirmware::isr(const IsrInput& in) {
     run_observer(v_ab_, i_ab, 0.5 + c.observer_offset);
     phase = phase_observer_;
     out.source = AngleSource::observer;
-    if (override_) {
+    if (c.hall) {
+      // FOC_SENSOR_MODE_HALL: the Hall angle (the start-up's angle only while the state read is invalid; the
+      // observer is not forced and no boost is added in this mode).
+      phase = hall_phase(in.hall_state, out);
+    } else if (override_) {
       phase = phase_override_;
       observer_.force(override_observer_angle_, i_ab);
       iq_set += c.sl_openloop_boost_q_A * sign(iq_set);
@@ -118,6 +127,8 @@ IsrOutput VescFirmware::isr(const IsrInput& in) {
       openloop_angle_ = wrap_pi(openloop_angle_ + p_.dt_s * openloop_speed_);
       phase = openloop_angle_;
       out.source = AngleSource::openloop;
+      out.hall_weight = 0.0;
+      out.hall_interpolating = false;
     }
     iq_set = clamp_abs(iq_set, c.l_current_max_A);  // sensorless: i_d = 0; symmetric current limits
     control_current(phase, i_ab, 0.0, iq_set);
@@ -138,6 +149,7 @@ IsrOutput VescFirmware::isr(const IsrInput& in) {
     v_ab_ = v_meas;
     run_observer(v_ab_, {0.0, 0.0}, c.observer_offset);
     phase = phase_observer_;
+    if (c.hall) phase = hall_phase(in.hall_state, out);  // the undriven branch corrects with the Halls too
     const Vec2 v_dq = park(v_ab_, phase);
     vd_ += 0.2 * (v_dq.x - vd_);
     vq_ += 0.2 * (v_dq.y - vq_);
@@ -148,6 +160,7 @@ IsrOutput VescFirmware::isr(const IsrInput& in) {
     mod_q_filter_ = std::clamp(mod_q_filter_ + 0.2 * (mod_q_ - mod_q_filter_), -1.0, 1.0);
     out.source = AngleSource::off;
   }
+  out.observer_phase_rad = phase_observer_;
   phase_ = phase;
   duty_now_ = sign(vq_) * std::hypot(mod_d_, mod_q_) * (2.0 / kSqrt3) / c.overmod_factor;
   speed_and_tachometer(phase);
@@ -164,6 +177,17 @@ double VescFirmware::voltage_filter_const() const {
 void VescFirmware::run_observer(Vec2 v_ab, Vec2 i_ab, double offset_cycles) {
   observer_.update(v_ab, i_ab, p_.dt_s, gamma_now_);
   phase_observer_ = wrap_pi(observer_.angle_rad() + pll_.speed_rad_s() * p_.dt_s * offset_cycles);
+}
+
+double VescFirmware::hall_phase(int state, IsrOutput& out) {
+  const bool valid = state >= 0 && state < 8 && p_.hall_table[static_cast<std::size_t>(state)] <= 200;
+  const double phase = hall_.correct(phase_observer_, pll_.speed_rad_s(), state, p_.dt_s, override_, phase_override_);
+  out.hall_weight = hall_.weight();
+  out.hall_interpolating = valid && !hall_.nearest();
+  if (out.hall_weight > 0.0) {
+    out.source = !valid ? AngleSource::startup : out.hall_weight < 1.0 ? AngleSource::hall_blend : AngleSource::hall;
+  }
+  return phase;
 }
 
 void VescFirmware::control_current(double phase, Vec2 i_ab, double id_target, double iq_target) {

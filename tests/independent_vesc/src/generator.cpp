@@ -4,6 +4,7 @@
 #include <cmath>
 #include <random>
 
+#include "indep_vesc/hall.hpp"
 #include "indep_vesc/poller.hpp"
 #include "indep_vesc/random_streams.hpp"
 #include "indep_vesc/scenario.hpp"
@@ -15,7 +16,8 @@ namespace {
 
 /// The truth of one firmware window, accumulated cycle by cycle (README "Truth").
 struct Window {
-  int cycles = 0, modulating = 0, open_loop = 0;
+  int cycles = 0, modulating = 0, open_loop = 0, hall = 0, hall_interpolated = 0;
+  double hall_weight_sum = 0.0;
   double eps_sum = 0.0, eps_max = 0.0;
   double w_sum = 0.0, w_first = 0.0, w_last = 0.0;
   Vec2 i_sum;
@@ -30,6 +32,9 @@ struct Window {
     ++cycles;
     modulating += out.modulating ? 1 : 0;
     open_loop += out.source == AngleSource::startup || out.source == AngleSource::openloop ? 1 : 0;
+    hall += out.hall_weight > 0.0 && out.source != AngleSource::startup ? 1 : 0;
+    hall_weight_sum += out.hall_weight;
+    hall_interpolated += out.hall_weight > 0.0 && out.hall_interpolating ? 1 : 0;
     eps_sum += eps;
     eps_max = std::max(eps_max, std::fabs(eps));
     w_sum += omega_el;
@@ -52,6 +57,9 @@ struct Window {
     const double n = cycles;
     t.modulating_fraction = modulating / n;
     t.open_loop_fraction = open_loop / n;
+    t.hall_fraction = hall / n;
+    t.hall_weight_mean = hall_weight_sum / n;
+    t.hall_interpolated_fraction = hall_interpolated / n;
     t.frame_error_mean_rad = eps_sum / n;
     t.frame_error_max_abs_rad = eps_max;
     t.omega_el_mean_rad_s = w_sum / n;
@@ -72,7 +80,10 @@ struct Window {
     t.T_winding_C = tw_sum / n;
     t.T_magnet_C = tm_sum / n;
     t.bridge = modulating == cycles ? "modulating" : modulating == 0 ? "bridge_off" : "mixed";
-    t.angle = open_loop == 0 ? "observer" : open_loop == cycles ? "open_loop" : "mixed";
+    t.angle = open_loop == cycles           ? "open_loop"
+              : hall == cycles              ? "hall"
+              : open_loop == 0 && hall == 0 ? "observer"
+                                            : "mixed";
     t.angle_locked = open_loop == 0 && eps_max <= rules.locked_max_frame_error_rad;
     t.psi_m_term_V = std::fabs(t.omega_el_mean_rad_s) * t.psi_m_Wb;
     t.r_s_term_V = t.r_s_Ohm * std::sqrt(i_mean2);
@@ -133,6 +144,8 @@ Result generate(const Case& input) {
   fp.psi_Wb = psi_at(t_m) * (1.0 + c.firmware.detect_psi_rel);
   fp.kp = fp.l_H / c.firmware.current_tc_s;
   fp.ki = fp.r_Ohm / c.firmware.current_tc_s;
+  const double hall_offset_rad = c.sensors.hall_offset_deg * kPi / 180.0;
+  if (c.firmware.hall) fp.hall_table = detect_hall_table(hall_offset_rad);  // VESC Tool's Hall detection
   res.firmware = fp;
   res.vesc_configuration = {fp.psi_Wb, fp.r_Ohm, fp.l_H, fp.l_H, mp.pole_pairs};
   VescFirmware fw(fp);
@@ -165,9 +178,12 @@ Result generate(const Case& input) {
   for (double& o : adc_offset) o = c.sensors.current_offset_residual_lsb * normal(offsets_rng);
 
   const double rated_erpm = c.machine.rated.speed_rpm * mp.pole_pairs;
-  App app(c.scenario.empty() ? builtin_scenario(c.duration_s, c.firmware.l_current_max_A, rated_erpm,
-                                                0.9 * c.mechanics.coulomb_Nm, 1.5 * mp.pole_pairs * mp.psi_m_Wb, c.seed)
-                             : c.scenario);
+  const double torque_per_A = 1.5 * mp.pole_pairs * mp.psi_m_Wb;  // the configured machine's
+  App app(!c.scenario.empty() ? c.scenario
+          : c.firmware.hall
+              ? builtin_hall_scenario(c.duration_s, c.firmware.l_current_max_A, torque_per_A, mp.pole_pairs, c.seed)
+              : builtin_scenario(c.duration_s, c.firmware.l_current_max_A, rated_erpm, 0.9 * c.mechanics.coulomb_Nm,
+                                 torque_per_A, c.seed));
   const std::vector<ReadEvent> reads = poll_schedule(c.poller, c.duration_s, c.seed);
   std::mt19937_64 adc_rng = stream_rng(c.seed, Stream::adc);
 
@@ -195,6 +211,7 @@ Result generate(const Case& input) {
       app.step_1ms(static_cast<double>(ms) * 1e-3, fw);
       plant.set_external_torque(c.mechanics.external_Nm + app.external_torque_Nm());
       plant.set_coulomb(c.mechanics.coulomb_Nm + app.added_friction_Nm());
+      plant.set_viscous(c.mechanics.viscous_Nm_s + app.added_viscous_Nm_s());
       fw.timer_1ms();
       const double fet = c.sensors.fet_temp_start_C + 0.3 * (t_w - th.winding_start_C);
       fw.temperatures_1ms(t_w + c.sensors.motor_temp_noise_K * normal(adc_rng), fet);
@@ -213,6 +230,7 @@ Result generate(const Case& input) {
       in.i_meas_A[p] =
           adc(i_abc[p], c.sensors.current_lsb_A, adc_offset[p], c.sensors.current_noise_lsb, 2048.0, adc_rng, normal);
     }
+    if (c.firmware.hall) in.hall_state = hall_state(x.theta_el_rad, hall_offset_rad);  // read in the interrupt
     in.v_bus_meas_V =
         adc(c.sensors.bus_gain * v_dc, c.sensors.voltage_lsb_V, 0.0, c.sensors.voltage_noise_lsb, 0.0, adc_rng, normal);
     const double omega_el = mp.pole_pairs * x.omega_m_rad_s;
@@ -294,6 +312,10 @@ Result generate(const Case& input) {
       r.theta_el_rad = theta_sample;
       r.omega_el_rad_s = omega_el;
       r.phase_rad = out.phase_rad;
+      r.observer_phase_rad = out.observer_phase_rad;
+      r.hall_state = in.hall_state;
+      r.hall_weight = out.hall_weight;
+      r.hall_interpolating = out.hall_interpolating;
       r.source = out.source;
       r.modulating = out.modulating;
       r.i_dq_true_A = i_dq_true;

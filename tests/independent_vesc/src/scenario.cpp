@@ -75,6 +75,53 @@ std::vector<Segment> builtin_scenario(double duration_s, double l_current_max_A,
   return s;
 }
 
+std::vector<Segment> builtin_hall_scenario(double duration_s, double l_current_max_A, double torque_per_A_Nm, int pole_pairs,
+                                           std::uint64_t seed) {
+  std::mt19937_64 rng = stream_rng(seed, Stream::scenario);
+  auto u = [&](double lo, double hi) { return std::uniform_real_distribution<double>(lo, hi)(rng); };
+  const double i_max = l_current_max_A;
+  // The viscous load b that holds the shaft at `erpm` with the current i on the configured machine: b·ω_m = k_t·i.
+  auto viscous_for = [&](double erpm, double i_A) {
+    const double omega_m = erpm * 2.0 * 3.14159265358979323846 / 60.0 / pole_pairs;
+    return torque_per_A_Nm * std::fabs(i_A) / omega_m;
+  };
+  std::vector<Segment> s;
+  double total = 0.0;
+  auto add = [&](Segment seg) {
+    s.push_back(seg);
+    total += seg.duration_s;
+  };
+  add({SegmentKind::off, u(1.0, 2.0)});  // standstill, the bridge off
+  for (int episode = 0; total < duration_s; ++episode) {
+    const double sign = episode % 3 == 2 ? -1.0 : 1.0;
+    // Holding at standstill: a current against a brake (friction ten times its torque: the rotor yields by a few
+    // degrees a second).
+    Segment hold{SegmentKind::current, u(1.5, 2.5), sign * u(0.1, 0.2) * i_max, 0.1};
+    hold.friction_Nm = 10.0 * torque_per_A_Nm * std::fabs(hold.current_A);
+    add(hold);
+    // Crawling, well below foc_hall_interp_erpm (500): 25–60 ERPM (a sector takes 0.17–0.4 s), then 150–280.
+    Segment crawl{SegmentKind::current, u(4.0, 6.0), sign * u(0.08, 0.15) * i_max, 0.2};
+    crawl.viscous_Nm_s = viscous_for(u(25.0, 60.0), crawl.current_A);
+    add(crawl);
+    Segment faster{SegmentKind::current, u(1.5, 2.5), sign * u(0.08, 0.15) * i_max, 0.2};
+    faster.viscous_Nm_s = viscous_for(u(150.0, 280.0), faster.current_A);
+    add(faster);
+    // Interpolated: 900–1600 ERPM, between foc_hall_interp_erpm and foc_sl_erpm_start (2500).
+    Segment interp{SegmentKind::current, u(3.0, 4.0), sign * u(0.08, 0.15) * i_max, 0.2};
+    interp.viscous_Nm_s = viscous_for(u(900.0, 1600.0), interp.current_A);
+    add(interp);
+    // Above foc_sl_erpm (3500): 6000–10 000 ERPM, through the blend on the way.
+    Segment fast{SegmentKind::current, u(3.0, 4.0), sign * u(0.1, 0.2) * i_max, 0.2};
+    fast.viscous_Nm_s = viscous_for(u(6000.0, 10000.0), fast.current_A);
+    add(fast);
+    // Zero current: the bridge modulating at 0 A while bearings and drag run the shaft down through the blend, the
+    // interpolated range and crawling; then the bridge off.
+    add({SegmentKind::coast, u(3.0, 5.0)});
+    add({SegmentKind::off, u(1.0, 2.0)});
+  }
+  return s;
+}
+
 namespace {
 
 [[noreturn]] void fail(const std::string& path, int line, const std::string& why) {
@@ -102,8 +149,8 @@ std::vector<Segment> read_scenario_csv(const std::string& path) {
   int n = 0;
   std::vector<std::string> header;
   std::vector<Segment> segments;
-  const std::vector<std::string> known = {"kind",       "duration_s", "current_A",   "ramp_s",
-                                          "until_erpm", "erpm_per_s", "external_Nm", "friction_Nm"};
+  const std::vector<std::string> known = {"kind",       "duration_s",  "current_A",   "ramp_s",      "until_erpm",
+                                          "erpm_per_s", "external_Nm", "friction_Nm", "viscous_Nm_s"};
   while (std::getline(in, line)) {
     ++n;
     if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
@@ -139,8 +186,8 @@ std::vector<Segment> read_scenario_csv(const std::string& path) {
       seg.kind = SegmentKind::flux_measurement;
     else
       fail(path, n, "kind '" + kind + "' (known: off, current, coast, brake, flux_measurement)");
-    double* fields[] = {&seg.duration_s, &seg.current_A,   &seg.ramp_s,     &seg.until_erpm,
-                        &seg.erpm_per_s, &seg.external_Nm, &seg.friction_Nm};
+    double* fields[] = {&seg.duration_s, &seg.current_A,   &seg.ramp_s,      &seg.until_erpm,
+                        &seg.erpm_per_s, &seg.external_Nm, &seg.friction_Nm, &seg.viscous_Nm_s};
     for (std::size_t c = 1; c < cells.size(); ++c) {
       double v = 0.0;
       try {
@@ -154,8 +201,9 @@ std::vector<Segment> read_scenario_csv(const std::string& path) {
       *fields[c - 1] = v;
     }
     if (seg.duration_s <= 0.0) fail(path, n, "duration_s must be positive");
-    if (seg.ramp_s < 0.0 || seg.until_erpm < 0.0 || seg.erpm_per_s <= 0.0 || seg.friction_Nm < 0.0) {
-      fail(path, n, "ramp_s, until_erpm and friction_Nm must be >= 0, erpm_per_s > 0");
+    if (seg.ramp_s < 0.0 || seg.until_erpm < 0.0 || seg.erpm_per_s <= 0.0 || seg.friction_Nm < 0.0 ||
+        seg.viscous_Nm_s < 0.0) {
+      fail(path, n, "ramp_s, until_erpm, friction_Nm and viscous_Nm_s must be >= 0, erpm_per_s > 0");
     }
     segments.push_back(seg);
   }

@@ -3,6 +3,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <map>
 
 #include "indep_vesc/generator.hpp"
@@ -27,9 +28,11 @@ std::string vesc_tool_csv(const Result& r) {
 }
 
 std::string cycle_trace_csv(const Result& r) {
+  const bool hall = r.resolved.firmware.hall;
   std::string out =
       "t,theta_el,omega_el,phase,frame_error,source,modulating,i_d_true,i_q_true,i_d_reported,i_q_reported,"
-      "u_d_reported,u_q_reported,u_d_applied,u_q_applied,psi_m,r_s\n";
+      "u_d_reported,u_q_reported,u_d_applied,u_q_applied,psi_m,r_s";
+  out += hall ? ",observer_phase,hall_state,hall_weight,hall_interpolating\n" : "\n";
   char buf[512];
   for (const CycleRecord& c : r.cycles) {
     const double eps = std::remainder(c.phase_rad - c.theta_el_rad, 2.0 * kPi);
@@ -37,6 +40,11 @@ std::string cycle_trace_csv(const Result& r) {
                   c.t_s, std::remainder(c.theta_el_rad, 2.0 * kPi), c.omega_el_rad_s, c.phase_rad, eps, to_string(c.source),
                   c.modulating ? 1 : 0, c.i_dq_true_A.x, c.i_dq_true_A.y, c.i_dq_reported_A.x, c.i_dq_reported_A.y,
                   c.v_dq_reported_V.x, c.v_dq_reported_V.y, c.v_dq_applied_V.x, c.v_dq_applied_V.y, c.psi_m_Wb, c.r_s_Ohm);
+    if (hall) {
+      out.append(buf, std::strlen(buf) - 1);  // the line without its end
+      std::snprintf(buf, sizeof buf, ",%.6f,%d,%.4f,%d\n", c.observer_phase_rad, c.hall_state, c.hall_weight,
+                    c.hall_interpolating ? 1 : 0);
+    }
     out += buf;
   }
   return out;
@@ -52,41 +60,47 @@ nlohmann::json machine_json(const MachineValues& m) {
           {"pole_pairs", m.pole_pairs}};
 }
 
-nlohmann::json row_json(const LogRow& row, int line) {
+nlohmann::json row_json(const LogRow& row, int line, bool hall) {
   const RowTruth& t = row.truth;
-  return {{"line", line},
-          {"ms_today", row.context.ms_today},
-          {"t_s", row.t_reply_s},
-          {"t_read_s", t.t_read_s},
-          {"t_window_start_s", t.t_window_start_s},
-          {"cycles", t.cycles},
-          {"segment", to_string(t.segment)},
-          {"bridge", t.bridge},
-          {"modulating_fraction", t.modulating_fraction},
-          {"angle", t.angle},
-          {"open_loop_fraction", t.open_loop_fraction},
-          {"angle_locked", t.angle_locked},
-          {"frame_error_mean_rad", t.frame_error_mean_rad},
-          {"frame_error_max_abs_rad", t.frame_error_max_abs_rad},
-          {"excites_psi_m", t.excites_psi_m},
-          {"excites_r_s", t.excites_r_s},
-          {"transient", t.transient},
-          {"psi_m_term_V", t.psi_m_term_V},
-          {"r_s_term_V", t.r_s_term_V},
-          {"omega_el_mean_rad_s", t.omega_el_mean_rad_s},
-          {"omega_el_start_rad_s", t.omega_el_start_rad_s},
-          {"omega_el_end_rad_s", t.omega_el_end_rad_s},
-          {"i_d_mean_A", t.i_d_mean_A},
-          {"i_q_mean_A", t.i_q_mean_A},
-          {"i_d_avg_A", t.i_d_avg_A},
-          {"i_q_avg_A", t.i_q_avg_A},
-          {"i_dev_rms_A", t.i_dev_rms_A},
-          {"u_d_mean_V", t.u_d_mean_V},
-          {"u_q_mean_V", t.u_q_mean_V},
-          {"psi_m_Wb", t.psi_m_Wb},
-          {"r_s_Ohm", t.r_s_Ohm},
-          {"T_winding_C", t.T_winding_C},
-          {"T_magnet_C", t.T_magnet_C}};
+  nlohmann::json j = {{"line", line},
+                      {"ms_today", row.context.ms_today},
+                      {"t_s", row.t_reply_s},
+                      {"t_read_s", t.t_read_s},
+                      {"t_window_start_s", t.t_window_start_s},
+                      {"cycles", t.cycles},
+                      {"segment", to_string(t.segment)},
+                      {"bridge", t.bridge},
+                      {"modulating_fraction", t.modulating_fraction},
+                      {"angle", t.angle},
+                      {"open_loop_fraction", t.open_loop_fraction},
+                      {"angle_locked", t.angle_locked},
+                      {"frame_error_mean_rad", t.frame_error_mean_rad},
+                      {"frame_error_max_abs_rad", t.frame_error_max_abs_rad},
+                      {"excites_psi_m", t.excites_psi_m},
+                      {"excites_r_s", t.excites_r_s},
+                      {"transient", t.transient},
+                      {"psi_m_term_V", t.psi_m_term_V},
+                      {"r_s_term_V", t.r_s_term_V},
+                      {"omega_el_mean_rad_s", t.omega_el_mean_rad_s},
+                      {"omega_el_start_rad_s", t.omega_el_start_rad_s},
+                      {"omega_el_end_rad_s", t.omega_el_end_rad_s},
+                      {"i_d_mean_A", t.i_d_mean_A},
+                      {"i_q_mean_A", t.i_q_mean_A},
+                      {"i_d_avg_A", t.i_d_avg_A},
+                      {"i_q_avg_A", t.i_q_avg_A},
+                      {"i_dev_rms_A", t.i_dev_rms_A},
+                      {"u_d_mean_V", t.u_d_mean_V},
+                      {"u_q_mean_V", t.u_q_mean_V},
+                      {"psi_m_Wb", t.psi_m_Wb},
+                      {"r_s_Ohm", t.r_s_Ohm},
+                      {"T_winding_C", t.T_winding_C},
+                      {"T_magnet_C", t.T_magnet_C}};
+  if (hall) {
+    j["hall_fraction"] = t.hall_fraction;
+    j["hall_weight_mean"] = t.hall_weight_mean;
+    j["hall_interpolated_fraction"] = t.hall_interpolated_fraction;
+  }
+  return j;
 }
 
 }  // namespace
@@ -149,6 +163,16 @@ std::string truth_json(const Result& r) {
                     {"viscous_Nm_s", c.mechanics.viscous_Nm_s},
                     {"drag_Nm_s2", c.mechanics.drag_Nm_s2},
                     {"external_Nm", c.mechanics.external_Nm}};
+  if (c.firmware.hall) {  // only in Hall mode: the sensorless file stays as it was
+    j["vesc"]["foc_sensor_mode"] = "hall";
+    nlohmann::json table = nlohmann::json::array();
+    for (const int v : r.firmware.hall_table) table.push_back(v);
+    j["vesc"]["foc_hall_table"] = table;
+    j["vesc"]["foc_hall_interp_erpm"] = c.firmware.hall_interp_erpm;
+    j["vesc"]["foc_sl_erpm_start"] = c.firmware.sl_erpm_start;
+    j["vesc"]["foc_sl_erpm"] = c.firmware.sl_erpm;
+    j["sensors"]["hall_offset_deg"] = c.sensors.hall_offset_deg;
+  }
   j["reads"] = {{"poll_rate_Hz", c.poller.poll_rate_Hz},
                 {"rate_Hz", c.poller.rate_Hz},
                 {"rtt_median_s", rtt_median_s(c.poller)},
@@ -183,7 +207,7 @@ std::string truth_json(const Result& r) {
     counts["excites_r_s"] += t.excites_r_s ? 1 : 0;
     counts["transient"] += t.transient ? 1 : 0;
     ++counts[std::string("segment.") + to_string(t.segment)];
-    rows.push_back(row_json(r.rows[k], first_line + static_cast<int>(k)));
+    rows.push_back(row_json(r.rows[k], first_line + static_cast<int>(k), c.firmware.hall));
   }
   j["counts"] = counts;
   j["rows"] = rows;

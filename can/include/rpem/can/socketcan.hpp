@@ -6,6 +6,7 @@
 
 #include <cstdint>
 #include <span>
+#include <stdexcept>
 #include <string>
 #include <utility>
 #include <vector>
@@ -108,7 +109,12 @@ class SocketCanChannel {
   std::string last_error_;
 };
 
-/// Throws std::runtime_error with the reason if the interface cannot be opened now (start-up check).
+/// An interface that cannot be opened: absent, or a kernel without SocketCAN (the tools exit 74 on it).
+class InterfaceError : public std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+/// Throws InterfaceError with the reason if the interface cannot be opened now (start-up check).
 void require_interface(const std::string& interface);
 
 }  // namespace rpem::can

@@ -37,6 +37,8 @@ class App {
   /// The running segment's torque on the shaft and its added friction [Nm].
   [[nodiscard]] double external_torque_Nm() const;
   [[nodiscard]] double added_friction_Nm() const;
+  /// The running segment's added viscous load [Nm·s] (a brake proportional to the shaft speed).
+  [[nodiscard]] double added_viscous_Nm_s() const;
   /// What the emulated flux measurement found, if it ran to its end.
   [[nodiscard]] std::optional<double> measured_flux_linkage_Wb() const { return flux_; }
 

@@ -69,6 +69,7 @@ struct Sensors {
   double phase_voltage_gain = 1.0;  // measured/true phase voltage (undriven back-EMF tracking)
   double motor_temp_noise_K = 0.3;
   double fet_temp_start_C = kAuto;  // ambient
+  double hall_offset_deg = 0.0;     // Hall mode: sensor 1's electrical position from phase a (hall.hpp)
 };
 
 enum class OffVoltage { measured, zero };
@@ -98,6 +99,12 @@ struct Firmware {
   OffVoltage off_voltage = OffVoltage::measured;
   bool invert_direction = false;  // m_invert_direction: iq, vq, erpm, duty, tachometer negated
   int controller_id = 0;
+  // Hall mode (foc_sensor_mode = FOC_SENSOR_MODE_HALL; README "Hall mode"); the table is what the emulated
+  // detection finds for the sensors (hall.hpp).
+  bool hall = false;
+  double hall_interp_erpm = 500.0;  // foc_hall_interp_erpm
+  double sl_erpm_start = 2500.0;    // foc_sl_erpm_start
+  double sl_erpm = 3500.0;          // foc_sl_erpm
 };
 
 /// VESC Tool's polling of COMM_GET_VALUES and the link's timing (README "Reads").

@@ -10,11 +10,14 @@
 //  - mc_interface_mc_timer_isr (motor/mc_interface.c): single-precision sums of i_d, i_q, v_d, v_q and the
 //    motor and input currents every cycle, read and reset by mc_interface_read_reset_avg_*;
 //  - the 1 kHz timer thread (mcpwm_foc.c, timer_update): the sensorless open-loop start-up and the switching
-//    off of the bridge when the current command is below cc_min_current.
+//    off of the bridge when the current command is below cc_min_current;
+//  - in Hall mode (Firmware::hall), the angle from the Hall sensors (hall.hpp: foc_correct_hall) in both branches of
+//    the interrupt, the observer's above foc_sl_erpm.
 #include <array>
 #include <cstdint>
 
 #include "indep_vesc/case.hpp"
+#include "indep_vesc/hall.hpp"
 #include "indep_vesc/observer.hpp"
 
 namespace indep::vesc {
@@ -25,10 +28,13 @@ struct FirmwareParams {
   double f_zv_Hz = 25000.0;
   double r_Ohm = 0.0, l_H = 0.0, psi_Wb = 0.0;  // foc_motor_r, foc_motor_l, foc_motor_flux_linkage
   double kp = 0.0, ki = 0.0;                    // foc_current_kp, foc_current_ki
-  Firmware conf;                                // the rest of the configuration, as given
+  std::array<int, 8> hall_table{kHallInvalid, kHallInvalid, kHallInvalid, kHallInvalid,
+                                kHallInvalid, kHallInvalid, kHallInvalid, kHallInvalid};  // foc_hall_table
+  Firmware conf;  // the rest of the configuration, as given
 };
 
-enum class AngleSource : std::uint8_t { off, observer, startup, openloop };
+// hall: the Hall angle alone; hall_blend: blended with the observer's (between foc_sl_erpm_start and foc_sl_erpm).
+enum class AngleSource : std::uint8_t { off, observer, startup, openloop, hall, hall_blend };
 const char* to_string(AngleSource s);
 
 enum class ControlMode : std::uint8_t { none, current, openloop };
@@ -37,13 +43,17 @@ struct IsrInput {
   std::array<double, 3> i_meas_A{};  // the phase currents the ADC sampled, after offset and scale
   double v_bus_meas_V = 0.0;         // the input-voltage ADC
   Vec2 v_terminal_ab_V;              // the phase voltages the ADC measures (used while undriven)
+  int hall_state = -1;               // the Hall sensors (utils_read_hall), Hall mode only
 };
 
 struct IsrOutput {
   bool modulating = false;  // duties for the next update event; false: outputs off
   std::array<double, 3> duty{0.5, 0.5, 0.5};
   AngleSource source = AngleSource::off;
-  double phase_rad = 0.0;  // the frame of this cycle's i_d, i_q, v_d, v_q
+  double phase_rad = 0.0;           // the frame of this cycle's i_d, i_q, v_d, v_q
+  double observer_phase_rad = 0.0;  // the observer's angle this cycle (m_phase_now_observer)
+  double hall_weight = 0.0;         // Hall mode: the Hall angle's weight in phase_rad (0: the observer's alone)
+  bool hall_interpolating = false;  // Hall mode: the Hall angle interpolated (not the nearest state's)
 };
 
 /// COMM_GET_VALUES as the firmware computes it, before the wire's scaling (commands.c,
@@ -108,6 +118,7 @@ class VescFirmware {
   [[nodiscard]] bool startup_override() const { return override_; }
   [[nodiscard]] double psi_Wb() const { return psi_; }
   [[nodiscard]] const FirmwareParams& params() const { return p_; }
+  [[nodiscard]] const HallAngle& hall() const { return hall_; }
   /// This cycle's values as they enter the sums (mcpwm_foc_get_id/iq/vd/vq, direction not applied).
   [[nodiscard]] Vec2 i_dq_A() const { return {id_, iq_}; }
   [[nodiscard]] Vec2 v_dq_V() const { return {vd_, vq_}; }
@@ -117,6 +128,8 @@ class VescFirmware {
   void control_current(double phase, Vec2 i_ab, double id_target, double iq_target);
   Vec2 reported_voltage(Vec2 mod_ab_raw, double phase);
   void run_observer(Vec2 v_ab, Vec2 i_ab, double offset_cycles);
+  /// Hall mode: foc_correct_hall on this cycle's observer angle; sets out's source and weight.
+  double hall_phase(int state, IsrOutput& out);
   [[nodiscard]] double voltage_filter_const() const;
   void speed_and_tachometer(double phase);
   void accumulate(double input_voltage);
@@ -125,6 +138,7 @@ class VescFirmware {
   FirmwareParams p_;
   FluxObserver observer_;
   Pll pll_;
+  HallAngle hall_;
   double psi_;
   double observer_gain_;
   double gamma_now_;  // the observer's gain this millisecond (timer_update schedules it on the duty cycle)

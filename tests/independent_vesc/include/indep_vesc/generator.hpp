@@ -25,6 +25,10 @@ struct RowTruth {
   int cycles = 0;                                 // control cycles averaged
   double modulating_fraction = 0.0;               // cycles with the bridge on
   double open_loop_fraction = 0.0;                // cycles framed by an open-loop angle (start-up or openloop)
+  double hall_fraction = 0.0;                     // Hall mode: cycles framed by the Hall angle (alone or blended)
+  double hall_weight_mean = 0.0;                  // ... the Hall angle's mean weight in the frame (0: the observer's)
+  double hall_interpolated_fraction = 0.0;        // ... cycles framed by an interpolated Hall angle (not the nearest
+                                                  //     state's: above foc_hall_interp_erpm by the transition times)
   double frame_error_mean_rad = 0.0;              // mean of wrap(frame − true d axis)
   double frame_error_max_abs_rad = 0.0;
   double omega_el_mean_rad_s = 0.0, omega_el_start_rad_s = 0.0, omega_el_end_rad_s = 0.0;
@@ -37,7 +41,7 @@ struct RowTruth {
   SegmentKind segment = SegmentKind::off;  // the segment running at the read
   // Classification by TruthRules:
   std::string bridge;  // modulating | bridge_off | mixed
-  std::string angle;   // observer | open_loop | mixed
+  std::string angle;   // observer | open_loop | hall | mixed
   bool angle_locked = false;
   bool excites_psi_m = false, excites_r_s = false, transient = false;
   double psi_m_term_V = 0.0, r_s_term_V = 0.0;
@@ -54,6 +58,10 @@ struct CycleRecord {
   double t_s = 0.0, theta_el_rad = 0.0, omega_el_rad_s = 0.0;
   double phase_rad = 0.0;  // the firmware's frame
   AngleSource source = AngleSource::off;
+  double observer_phase_rad = 0.0;  // the observer's angle (Hall mode: what the frame is above foc_sl_erpm)
+  int hall_state = -1;              // Hall mode: the sensors' state read
+  double hall_weight = 0.0;         // Hall mode: the Hall angle's weight in phase_rad
+  bool hall_interpolating = false;  // Hall mode: interpolated, not the nearest state's angle
   bool modulating = false;
   Vec2 i_dq_true_A, i_dq_reported_A, v_dq_reported_V;
   Vec2 v_dq_applied_V;  // mean over the cycle, true rotor frame

@@ -55,6 +55,7 @@ class Plant {
   void set_psi_m(double psi_m_Wb);
   void set_external_torque(double t_Nm) { p_.external_Nm = t_Nm; }
   void set_coulomb(double t_Nm) { p_.coulomb_Nm = t_Nm; }
+  void set_viscous(double b_Nm_s) { p_.viscous_Nm_s = b_Nm_s; }
 
   [[nodiscard]] Vec2 current_dq(const PlantState& x) const;
   [[nodiscard]] Vec2 current_ab(const PlantState& x) const;

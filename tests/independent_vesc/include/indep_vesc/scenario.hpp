@@ -26,6 +26,8 @@ struct Segment {
   double erpm_per_s = 1800.0;  // flux_measurement: the open-loop ramp rate (conf_general_detect_apply_all)
   double external_Nm = 0.0;    // a torque on the shaft during the segment (a hand turning the rotor, a slope)
   double friction_Nm = 0.0;    // bearing-like friction added during the segment (a load to start against)
+  double viscous_Nm_s = 0.0;   // a load proportional to the shaft speed added during the segment (an eddy-current
+                               // brake, a dynamometer): with a constant current it sets a steady speed
 };
 
 const char* to_string(SegmentKind k);
@@ -40,8 +42,17 @@ const char* to_string(SegmentKind k);
 std::vector<Segment> builtin_scenario(double duration_s, double l_current_max_A, double rated_erpm, double creep_torque_Nm,
                                       double torque_per_A_Nm, std::uint64_t seed);
 
+/// The built-in Hall ride (README "Hall mode"), drawn from the seed: a Hall drive starts in closed loop, so no
+/// open-loop start-ups: standstill, then episodes (forwards, forwards, backwards) of a holding current against a
+/// brake, crawling well below foc_hall_interp_erpm, a speed in the interpolated range, one above foc_sl_erpm, each
+/// set by a current against a viscous load (sized on the configured machine: `torque_per_A_Nm`, the true machine's
+/// ψm moves the speed with it), then zero current with the bridge on while the shaft runs down through every
+/// range, and the bridge off.
+std::vector<Segment> builtin_hall_scenario(double duration_s, double l_current_max_A, double torque_per_A_Nm, int pole_pairs,
+                                           std::uint64_t seed);
+
 /// A scenario file: CSV with header
-/// `kind,duration_s,current_A[,ramp_s,until_erpm,erpm_per_s,external_Nm,friction_Nm]`.
+/// `kind,duration_s,current_A[,ramp_s,until_erpm,erpm_per_s,external_Nm,friction_Nm,viscous_Nm_s]`.
 struct ScenarioError : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
