@@ -74,9 +74,13 @@ TEST_F(CliOptions, AFileWrittenIsNeverOneReadOrAnotherWritten) {
                      ": it would be "
                      "overwritten by both");
   EXPECT_FALSE(fs::exists(path("s.csv")));
-  // A different file is fine.
+  // A different file is fine, also where a number option's value happens to spell the output's name.
   const test::ProcessResult ok = rpem("estimate --log " + log_ + " --out " + path("e.csv"));
   EXPECT_EQ(ok.exit_code, 0) << ok.output;
+  const std::string here = "cd " + dir_.string() + " && ";
+  const test::ProcessResult number =
+      test::run_command(here + test::binary_dir() + "/tools/rpem estimate --log " + log_ + " --every 2 --out 2");
+  EXPECT_EQ(number.exit_code, 0) << number.output;
 }
 
 TEST_F(CliOptions, NumbersAreFinite) {

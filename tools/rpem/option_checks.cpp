@@ -62,7 +62,8 @@ std::string written_file_clash(const CLI::App& app) {
     if (out->count() == 0) continue;
     const std::string path = out->as<std::string>();
     for (const CLI::Option* other : given) {
-      if (other == out) continue;
+      // Paths are text: a number option's value ("--every 2") is never one, whatever file it happens to name.
+      if (other == out || other->get_type_name().rfind("TEXT", 0) != 0) continue;
       for (const std::string& value : other->results()) {
         if (value.empty() || !same_file(path, value)) continue;
         const bool written = std::find(written_options().begin(), written_options().end(), other) != written_options().end();

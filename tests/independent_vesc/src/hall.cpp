@@ -26,7 +26,7 @@ double norm_rad(double a) {
 /// The shorter signed difference a − b.
 double difference(double a, double b) { return norm_rad(a - b); }
 
-double sign(double x) { return x < 0.0 ? -1.0 : 1.0; }
+double direction_of(double x) { return x < 0.0 ? -1.0 : 1.0; }
 
 /// A table value (1/200 of a turn) as an angle.
 double table_rad(int v) { return static_cast<double>(v) / 200.0 * kTwoPi; }
@@ -103,7 +103,7 @@ double HallAngle::correct(double observer_rad, double pll_speed_rad_s, int state
       if (step < -100) step += 200;
       // The time since the previous transition, signed by the direction; on a reversal the last time is kept and
       // only its sign flips.
-      if (sign(step) == sign(dt_last_)) {
+      if (direction_of(step) == direction_of(dt_last_)) {
         dt_last_ = step > 0 ? dt_now_ : -dt_now_;
       } else {
         dt_last_ = -dt_last_;
@@ -121,7 +121,7 @@ double HallAngle::correct(double observer_rad, double pll_speed_rad_s, int state
       nearest_ = true;
     } else {
       const double ahead = difference(ang_, state_rad);
-      if (std::fabs(ahead) < kTwoPi / 12.0 || sign(ahead) != sign(hall_rad_s)) {
+      if (std::fabs(ahead) < kTwoPi / 12.0 || direction_of(ahead) != direction_of(hall_rad_s)) {
         ang_ += hall_rad_s * dt_s;  // on at the speed of the last transitions
       } else {
         ang_ -= 0.01 * ahead;  // 30° past the state's angle: held there, drawn back slowly
@@ -132,7 +132,7 @@ double HallAngle::correct(double observer_rad, double pll_speed_rad_s, int state
     // The angle handed on moves at most 1.5× the Hall speed (at least foc_hall_interp_erpm's) per cycle.
     const double max_step = 1.5 * std::max(hall_erpm_abs, s_.interp_erpm) / 60.0 * kTwoPi * dt_s;
     const double gap = difference(ang_, ang_limited_);
-    ang_limited_ = std::fabs(gap) < max_step ? ang_ : ang_limited_ + max_step * sign(gap);
+    ang_limited_ = std::fabs(gap) < max_step ? ang_ : ang_limited_ + max_step * direction_of(gap);
     ang_limited_ = norm_rad(ang_limited_);
 
     if (using_hall) {
