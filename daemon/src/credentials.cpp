@@ -44,4 +44,10 @@ std::string command_key_problem(const LiveConfig& live, const auth::Keyring& com
          "daemon.commands.authentication: none";
 }
 
+CredentialCheck check_credentials(const LiveConfig& live, const char* directory) {
+  CredentialCheck check{load_credential_keys(directory), ""};
+  check.problem = command_key_problem(live, check.keys.command);
+  return check;
+}
+
 }  // namespace rpem::daemon

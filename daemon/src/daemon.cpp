@@ -147,10 +147,9 @@ int Daemon::run() {
   commands.sequence_file = command_sequence_file(resolve_state_file(fixed.state));
   try {
     auth::initialise();  // libsodium, once, before any key exists
-    keys = load_credential_keys(std::getenv("CREDENTIALS_DIRECTORY"));
-    if (const std::string problem = command_key_problem(config_.live, keys.command); !problem.empty()) {
-      throw std::runtime_error(problem);
-    }
+    CredentialCheck check = check_credentials(config_.live, std::getenv("CREDENTIALS_DIRECTORY"));
+    if (!check.problem.empty()) throw std::runtime_error(check.problem);
+    keys = std::move(check.keys);
     commands.keys.keys = std::move(keys.command);  // the control thread's command gate holds them
     commands.last_accepted_seq = load_command_sequence(commands.sequence_file);
   } catch (const std::exception& e) {

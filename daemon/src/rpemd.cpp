@@ -26,8 +26,7 @@ int check_configuration(const rpem::daemon::DaemonConfig& config) {
   const bool has_credentials = directory != nullptr && *directory != '\0';
   try {
     auth::initialise();
-    const daemon::DaemonKeys keys = daemon::load_credential_keys(directory);
-    if (const std::string problem = daemon::command_key_problem(config.live, keys.command); !problem.empty()) {
+    if (const std::string problem = daemon::check_credentials(config.live, directory).problem; !problem.empty()) {
       if (has_credentials) {
         std::fprintf(stderr, "rpemd: configuration error: %s\n", problem.c_str());
         return io::kExitConfig;

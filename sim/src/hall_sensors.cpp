@@ -14,8 +14,7 @@ constexpr double kErpmToRadS = 2.0 * core::kPi / 60.0;
 }  // namespace
 
 HallSensors::HallSensors(const HallConfig& config, double period_s)
-    : config_(config),
-      period_s_(period_s),
+    : period_s_(period_s),
       interp_rad_s_(config.interp_erpm * kErpmToRadS),
       observer_rad_s_(config.observer_erpm * kErpmToRadS) {}
 

@@ -26,4 +26,12 @@ struct DaemonKeys {
 /// authentication required, no key.
 [[nodiscard]] std::string command_key_problem(const LiveConfig& live, const auth::Keyring& command_keys);
 
+/// The keys in `directory` for a service running `live`, and why it cannot run with them ("" if it can): start-up
+/// and --check-config read them alike. Throws as load_credential_keys.
+struct CredentialCheck {
+  DaemonKeys keys;
+  std::string problem;
+};
+[[nodiscard]] CredentialCheck check_credentials(const LiveConfig& live, const char* directory);
+
 }  // namespace rpem::daemon

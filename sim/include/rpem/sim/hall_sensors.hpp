@@ -25,7 +25,6 @@ class HallSensors {
   [[nodiscard]] double angle(double theta_el_rad) noexcept;
 
  private:
-  HallConfig config_;
   double period_s_;
   double interp_rad_s_, observer_rad_s_;  ///< the two speeds, electrical
   std::int64_t samples_ = 0;
