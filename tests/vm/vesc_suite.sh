@@ -15,6 +15,11 @@ step() { echo "vesc_suite: $*"; }
 # A recorder is ready once it says it listens (its socket is open): a fixed sleep loses the first frames
 # under a loaded emulator.
 wait_listening() { i=0; until grep -q "listening on" "$1" 2>/dev/null || [ $i -ge 600 ]; do sleep 0.1; i=$((i + 1)); done; }
+# rpemd has estimated every sample it was sent once its status line says STALE after the sender finished (the
+# loop found its queue empty for stale_timeout_s): under a loaded emulator the estimator runs slower than the
+# replay and drains its queue seconds later, so a fixed sleep kills it mid-queue. $2: STALE lines before.
+stale_lines() { n=$(grep -c "^rpemd STALE" "$1" 2>/dev/null); echo "${n:-0}"; }
+wait_drained() { i=0; until [ "$(stale_lines "$1")" -gt "$2" ] || [ $i -ge 1200 ]; do sleep 0.1; i=$((i + 1)); done; }
 echo 16777216 > /proc/sys/net/core/rmem_max 2>/dev/null
 
 step "emulated VESC 17, polled by cangen, captured by candump"
@@ -67,7 +72,7 @@ if [ -f ./rpemd-map-vcan.yaml ]; then
   r=$!
   sleep 2
   rpem replay "$out/native_sent.csv" --can vcan0 --classic --rate 1 || fail=1
-  sleep 2
+  wait_drained "$out/rpemd_map.txt" "$(stale_lines "$out/rpemd_map.txt")"
   kill -TERM $r; wait $r || fail=1
   tail -n 3 "$out/rpemd_map.txt"
 fi
@@ -82,7 +87,8 @@ if [ -f ./rpemd-ax8000-vcan.yaml ] && [ -f "$out/ax8000_pdos.log" ]; then
   l=$!
   sleep 2
   canplayer -I /tmp/ax8000_pdos.log vcan0=vcan0 || fail=1
-  sleep 3
+  wait_drained "$out/ax8000_rpemd.txt" "$(stale_lines "$out/ax8000_rpemd.txt")"
+  sleep 1   # the last estimates reach rpem listen
   kill -TERM $r; wait $r || fail=1
   kill -INT $l; wait $l
   tail -n 2 "$out/ax8000_rpemd.txt"
