@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "rpem/core/clock.hpp"
+#include "rpem/core/reported_speed.hpp"
 
 namespace rpem::core {
 namespace {
@@ -15,11 +16,11 @@ ModelExtensions rotor_frame_extensions(const ModelExtensions& x) noexcept {
   return r;
 }
 
-DriveSample as_dq_sample(const AveragedSample& a) noexcept {
+DriveSample as_dq_sample(const AveragedSample& a, double staircase_below_rad_s) noexcept {
   DriveSample d;
   d.t_ns = a.t_ns;
   d.theta_el_rad = 0.0;  // dq in, dq out: the angle cancels
-  d.omega_el_rad_s = a.omega_el_rad_s;
+  d.omega_el_rad_s = window_speed_rad_s(a, staircase_below_rad_s);
   d.u_dc_V = std::isnan(a.u_dc_V) ? 0.0 : a.u_dc_V;
   d.voltage_frame = Frame::kDq;
   d.u_V = Vec3(a.u_dq_V[0], a.u_dq_V[1], 0.0);
@@ -44,10 +45,11 @@ void AveragedDriveEstimator::configure(const EstimatorSettings& settings) noexce
   options_ = settings.averaged;
   options_classify_ = settings.regimes.enabled;
   delay_s_ = settings.extensions.delay_s;
+  staircase_below_rad_s_ = settings.regimes.hall_interpolation_speed_rad_s;
 }
 
 SteadyStateSample AveragedDriveEstimator::condition(const AveragedSample& a) noexcept {
-  const SteadyStateInputs in = conditioner_.steady_state(as_dq_sample(a));
+  const SteadyStateInputs in = conditioner_.steady_state(as_dq_sample(a, staircase_below_rad_s_));
   SteadyStateSample s;
   s.u_pu = in.u_pu;
   s.i_meas_pu = in.i_pu;

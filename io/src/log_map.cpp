@@ -36,6 +36,7 @@ constexpr std::array kUnits{
     Unit{QuantityKind::kAngle, "deg", kDeg, 0.0, false},
     Unit{QuantityKind::kAngle, "rad_mech", 1.0, 0.0, true},
     Unit{QuantityKind::kAngle, "deg_mech", kDeg, 0.0, true},
+    Unit{QuantityKind::kAngle, "step60", kTwoPi / 6.0, 0.0, false},  // a six-state count (VESC's tachometer)
     Unit{QuantityKind::kSpeed, "rad/s", 1.0, 0.0, false},
     Unit{QuantityKind::kSpeed, "Hz", kTwoPi, 0.0, false},
     Unit{QuantityKind::kSpeed, "erpm", kTwoPi / 60.0, 0.0, false},
@@ -74,6 +75,7 @@ constexpr std::array<QuantityInfo, kQuantityCount> kQuantities{{
     {Quantity::kTorqueCmd, "torque_cmd", QuantityKind::kTorque, false},
     {Quantity::kTStart, "t_start", QuantityKind::kTime, false},
     {Quantity::kTCoolant, "T_coolant", QuantityKind::kTemperature, false},
+    {Quantity::kTravelEl, "travel_el", QuantityKind::kAngle, false},
 }};
 
 const char* si_unit(QuantityKind k) {
@@ -129,6 +131,11 @@ MappedColumn parse_column(YamlMap& m, Quantity q, QuantityKind kind, bool header
   c.scale = m.number_or("scale", 1.0, -1e12, 1e12);
   if (c.scale == 0.0) m.fail("scale", "0 would make every value the offset");
   c.offset = m.number_or("offset", 0.0, -1e12, 1e12);
+  c.optional = m.boolean_or("optional", false);
+  if (c.optional && !header) m.fail("optional", "needs a header: a position is in every row, or the row is short");
+  if (c.optional && kind != QuantityKind::kTemperature && q != Quantity::kTravelEl) {
+    m.fail("optional", "only a quantity every log may lack (T_winding, T_magnet, T_drive, T_coolant, travel_el)");
+  }
   m.finish();
   return c;
 }
@@ -201,7 +208,7 @@ LogMap averaged_log_map(const std::string& name) {
 
 std::optional<LayoutProblem> drive_log_layout_problem(const QuantitySet& p) {
   if (!present(p, Quantity::kOmegaEl)) return LayoutProblem{"omega_el", "required"};
-  for (Quantity q : {Quantity::kTStart, Quantity::kTDrive}) {
+  for (Quantity q : {Quantity::kTStart, Quantity::kTDrive, Quantity::kTravelEl}) {
     if (present(p, q)) return LayoutProblem{info(q).name, "not a quantity of instantaneous samples (averaged logs only)"};
   }
   struct Group {
@@ -250,7 +257,7 @@ std::optional<LayoutProblem> averaged_log_layout_problem(const QuantitySet& p) {
     if (present(p, q)) {
       return LayoutProblem{info(q).name,
                            "not a quantity of averaged samples (their means are rotor-frame: i_d, i_q, "
-                           "u_d, u_q, omega_el, u_dc, T_winding, T_magnet, T_drive)"};
+                           "u_d, u_q, omega_el, u_dc, T_winding, T_magnet, T_drive, T_coolant; and travel_el)"};
     }
   }
   return std::nullopt;

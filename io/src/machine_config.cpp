@@ -101,12 +101,14 @@ void parse_regimes(YamlMap& g, core::RegimeSettings& r) {
   const std::string source =
       g.choice_or("angle_source", r.sensorless ? "sensorless" : "sensor", {"sensor", "sensorless", "hall"});
   r.sensorless = source != "sensor";
-  for (const char* key : {"hall_frame_error_rad", "hall_below_speed_rad_s"}) {
+  for (const char* key : {"hall_frame_error_rad", "hall_below_speed_rad_s", "hall_interpolation_speed_rad_s"}) {
     if (source != "hall" && g.has(key)) g.fail(key, "applies to angle_source: hall only");
   }
   if (source == "hall") {
     r.hall_frame_error_rad = g.number_or("hall_frame_error_rad", core::kHallFrameErrorRad, 1e-3, core::kPi / 2.0);
     r.hall_below_speed_rad_s = g.number_or("hall_below_speed_rad_s", core::kHallBelowSpeedRadS, 0.0, 1e5);
+    r.hall_interpolation_speed_rad_s =
+        g.number_or("hall_interpolation_speed_rad_s", core::kHallInterpolationSpeedRadS, 0.0, 1e5);
   }
   g.finish();
 }

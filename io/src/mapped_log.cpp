@@ -155,7 +155,7 @@ void MappedLogReader::read_header() {
     index_[q] = find(c.column.name, label(c.quantity));
     if (index_[q] < 0) {
       column_[q] = nullptr;
-      if (!map_.columns_optional) {
+      if (!map_.columns_optional && !c.optional) {
         column_[q] = &c;
         missing(label(c.quantity));
       }

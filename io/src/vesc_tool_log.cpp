@@ -41,7 +41,9 @@ void check_vesc_tool_header(const std::string& path, std::size_t line, const std
   const LogMap map = vesc_tool_log_map();
   std::vector<std::string> read;
   if (map.time) read.push_back(map.time->column.name);
-  for (const MappedColumn& c : map.columns) read.push_back(c.column.name);
+  for (const MappedColumn& c : map.columns) {
+    if (!c.optional) read.push_back(c.column.name);
+  }
   for (const std::string& name : read) {
     if (std::find(cells.begin(), cells.end(), name) != cells.end()) continue;
     // The first version whose header has the column added it.

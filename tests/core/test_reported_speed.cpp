@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <functional>
+#include <numbers>
 #include <vector>
 
 #include "rpem/core/frames.hpp"
@@ -17,8 +18,11 @@
 
 namespace {
 
+using rpem::core::AveragedSample;
+using rpem::core::counted_mean_speed_rad_s;
 using rpem::core::SpeedRead;
 using rpem::core::window_mean_speed_rad_s;
+using rpem::core::window_speed_rad_s;
 
 constexpr double kKp = 2000.0, kKi = 30000.0;  // vedderb/bldc motor/mcconf_default.h's defaults
 constexpr double kDt = 80e-6;                  // one control cycle
@@ -109,6 +113,22 @@ TEST(ReportedSpeed, ConstantSpeedAndDegenerateReads) {
   EXPECT_DOUBLE_EQ(window_mean_speed_rad_s({5, 100.0}, {5, 700.0}, 5, 0.0667), 700.0);
   // ω̂ from 100 to 200 over 100 ms: slope 1000/s; the window [50 ms, 100 ms] has trapezoid 175 and lag 66.7 ms.
   EXPECT_NEAR(window_mean_speed_rad_s({0, 100.0}, {100'000'000, 200.0}, 50'000'000, 0.0667), 175.0 + 66.7, 1e-9);
+}
+
+// A count of the angle's steps: the run's mean speed is travel over time; the window's speed is the count's only
+// below the staircase speed (strictly), and the reported one without a count, above it, or with no staircase.
+TEST(ReportedSpeed, TheCountsSpeedReplacesTheReportedOneOnlyBelowTheStaircaseSpeed) {
+  constexpr double kStep = std::numbers::pi / 3.0;
+  EXPECT_DOUBLE_EQ(counted_mean_speed_rad_s(4.0 * kStep, 0, 7.0 * kStep, 300'000'000), 3.0 * kStep / 0.3);
+  EXPECT_DOUBLE_EQ(counted_mean_speed_rad_s(7.0 * kStep, 0, 4.0 * kStep, 200'000'000), -3.0 * kStep / 0.2);
+  EXPECT_TRUE(std::isnan(counted_mean_speed_rad_s(0.0, 5, 1.0, 5)));
+  AveragedSample a;
+  a.omega_el_rad_s = 2.0;
+  EXPECT_DOUBLE_EQ(window_speed_rad_s(a, 52.36), 2.0);  // no count
+  a.omega_counted_el_rad_s = -7.5;
+  EXPECT_DOUBLE_EQ(window_speed_rad_s(a, 52.36), -7.5);
+  EXPECT_DOUBLE_EQ(window_speed_rad_s(a, 7.5), 2.0);  // at the staircase speed: reported
+  EXPECT_DOUBLE_EQ(window_speed_rad_s(a, 0.0), 2.0);  // no staircase (not angle_source: hall)
 }
 
 }  // namespace

@@ -71,6 +71,35 @@ TEST(LogMap, APllSpeedIsASpeedAtTheReadsOfPreviousRowWindows) {
             std::string::npos);
 }
 
+// `optional: true` reads a column where the header has it and leaves the quantity absent where not; only for what
+// every log may lack (temperatures, travel_el) and only by header name.
+TEST(LogMap, AnOptionalColumnIsReadWhereTheHeaderHasIt) {
+  const std::string map_text = kMinimal + "  T_winding: {column: tw, optional: true}\n";
+  const LogMap m = parse_log_map(map_text, "map.yaml");
+  const test::TempFile with("with.csv", "time,w,ud,uq,id,iq,tw\n0,1,2,3,4,5,61.5\n"),
+      without("without.csv", "time,w,ud,uq,id,iq\n0,1,2,3,4,5\n");
+  DriveLogReader a(with.path(), m, DriveLogLimits{}), b(without.path(), m, DriveLogLimits{});
+  DriveLogRow r;
+  ASSERT_TRUE(a.next(r));
+  ASSERT_TRUE(r.t_winding_C.has_value());
+  EXPECT_DOUBLE_EQ(*r.t_winding_C, 61.5);
+  EXPECT_TRUE(a.layout().t_winding);
+  ASSERT_TRUE(b.next(r));
+  EXPECT_FALSE(r.t_winding_C.has_value());
+  EXPECT_FALSE(b.layout().t_winding);
+  // Without `optional` the same file is refused.
+  const LogMap strict = parse_log_map(kMinimal + "  T_winding: {column: tw}\n", "map.yaml");
+  EXPECT_THROW(DriveLogReader(without.path(), strict, DriveLogLimits{}), DriveLogError);
+  EXPECT_NE(map_error(kMinimal + "  u_dc: {column: udc, optional: true}\n")
+                .find("columns.u_dc.optional: only a quantity every log may lack"),
+            std::string::npos);
+  EXPECT_NE(map_error("header: false\nsamples: instantaneous\ntime: {column: 1, unit: ms}\ncolumns:\n"
+                      "  omega_el: {column: 2}\n  u_d: {column: 3}\n  u_q: {column: 4}\n  i_d: {column: 5}\n"
+                      "  i_q: {column: 6}\n  T_winding: {column: 7, optional: true}\n")
+                .find("optional: needs a header"),
+            std::string::npos);
+}
+
 struct BadMap {
   const char* name;
   std::string yaml;
@@ -111,7 +140,8 @@ INSTANTIATE_TEST_SUITE_P(
                "samples: averaged\nwindow: previous_row\ntime: {period_s: 1}\ncolumns:\n  omega_el: {column: w}\n"
                "  u_d: {column: ud}\n  u_q: {column: uq}\n  i_d: {column: id}\n  i_q: {column: iq}\n  i_a: {column: ia}\n",
                "5:3: columns: i_a: not a quantity of averaged samples (their means are rotor-frame: i_d, i_q, u_d, u_q, "
-               "omega_el, u_dc, T_winding, T_magnet, T_drive) in an averaged log, which this map gives"},
+               "omega_el, u_dc, T_winding, T_magnet, T_drive, T_coolant; and travel_el) in an averaged log, which this "
+               "map gives"},
         BadMap{"averaged_without_window", "samples: averaged\ntime: {period_s: 1}\ncolumns: {omega_el: {column: w}}\n",
                "1:1: window: required key is missing"},
         BadMap{"window_t_start_without_column",

@@ -83,6 +83,26 @@ TEST(VescToolLog, ReadsTheCurrentHeaderAsAveragedSamplesSinceThePreviousRow) {
   EXPECT_TRUE(read.layout.u_dc && read.layout.t_winding && read.layout.t_drive && !read.layout.t_magnet);
 }
 
+TEST(VescToolLog, EachWindowsCountedSpeedIsTheTachometersOverItAndItsNeighbours) {
+  // GIVEN four reads at 0, 90, 200 and 290 ms whose tachometer (60° steps, six per electrical turn) reads
+  // 1234, 1235, 1235, 1237 WHEN read THEN each window's counted speed is the steps over the centred run of it and
+  // the windows beside it, over the run's time (docs/derivations.md §13, "The count's speed at a crawl"): the
+  // first window's run starts at the opening read, the last one's ends at the last read.
+  test::TempFile f("vesc.csv", kHeader120 + row120(45000000, 0.0, 8.0, 30, 0.0, 0.2, 1234) +
+                                   row120(45000090, 0.0, 8.0, 40, 0.0, 0.2, 1235) +
+                                   row120(45000200, 0.0, 8.0, 20, 0.0, 0.2, 1235) +
+                                   row120(45000290, 0.0, 8.0, 60, 0.0, 0.2, 1237));
+  const LogSource source = log_source(f.path());
+  const auto s = read_averaged_log(f.path(), source.map, DriveLogLimits{});
+  ASSERT_EQ(s.size(), 3U);
+  constexpr double kStep = std::numbers::pi / 3.0;
+  EXPECT_NEAR(s[0].omega_counted_el_rad_s, 1.0 * kStep / 0.200, 1e-9);  // windows 1–2: 1234 → 1235 in 200 ms
+  EXPECT_NEAR(s[1].omega_counted_el_rad_s, 3.0 * kStep / 0.290, 1e-9);  // windows 1–3: 1234 → 1237 in 290 ms
+  EXPECT_NEAR(s[2].omega_counted_el_rad_s, 2.0 * kStep / 0.200, 1e-9);  // windows 2–3: 1235 → 1237 in 200 ms
+  // The reported speed stays the PLL's rebuilt mean; which one a window stands for is the configuration's.
+  EXPECT_NEAR(s[2].omega_el_rad_s, (60.0 + 40.0 * (2000.0 / 30000.0 / 0.090 - 0.5)) * 2.0 * std::numbers::pi / 60.0, 1e-9);
+}
+
 TEST(VescToolLog, ReadsTheTestBuildHeaderOfVersion120) {
   test::TempFile f("vesc.csv", kHeader120Test + row120test(1000, 0, 1, 100, 0, 0.5) + row120test(1100, 0, 2, 200, 0, 1.0));
   const LogSource source = log_source(f.path());

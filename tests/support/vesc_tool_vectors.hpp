@@ -30,15 +30,17 @@ inline const std::string kHeader120 =
     "gnss_posTime;gnss_lat;gnss_lon;gnss_alt;gnss_gVel;gnss_vVel;gnss_hAcc;gnss_vAcc;\n";
 
 /// One row of the 22 values every version writes first (v_in, temps, currents, erpm, …, vesc_id).
-inline std::string values22(long ms, double v_in, double t_motor, double i_d, double i_q, double erpm) {
+/// `tachometer`: the firmware's count of 60° steps (signed; tachometer_abs is left at 1300).
+inline std::string values22(long ms, double v_in, double t_motor, double i_d, double i_q, double erpm,
+                            long tachometer = 1234) {
   return std::to_string(ms) + ";" + std::to_string(v_in) + ";41.3;41.3;40.9;40.2;" + std::to_string(t_motor) + ";12.5;7.1;" +
-         std::to_string(i_d) + ";" + std::to_string(i_q) + ";" + std::to_string(erpm) +
-         ";0.31;0.0123;0;0.51;0;1234;1300;178.5;0;17;";
+         std::to_string(i_d) + ";" + std::to_string(i_q) + ";" + std::to_string(erpm) + ";0.31;0.0123;0;0.51;0;" +
+         std::to_string(tachometer) + ";1300;178.5;0;17;";
 }
 /// A row of the 1.20 header: the 22 values, v_d, v_q, 13 setup, 10 IMU (their times −1: never received,
 /// as VESC Tool writes them), 8 GNSS (posTime −1: no position).
-inline std::string row120(long ms, double i_d, double i_q, double erpm, double v_d, double v_q) {
-  return values22(ms, 40.1, 55.0, i_d, i_q, erpm) + std::to_string(v_d) + ";" + std::to_string(v_q) + ";" +
+inline std::string row120(long ms, double i_d, double i_q, double erpm, double v_d, double v_q, long tachometer = 1234) {
+  return values22(ms, 40.1, 55.0, i_d, i_q, erpm, tachometer) + std::to_string(v_d) + ";" + std::to_string(v_q) + ";" +
          "-1;0;0;0;0;0;0;0;0;0;0;0;0;" + "-1;0;0;0;0;0;0;0;0;0;" + "-1;0.00000000;0.00000000;0;0;0;0;0;\n";
 }
 inline std::string row120test(long ms, double i_d, double i_q, double erpm, double v_d, double v_q) {

@@ -161,12 +161,9 @@ int run_diagnose(const DiagnoseCliOptions& o) {
   const io::MachineConfig config = o.config.empty() ? io::builtin_paper_config() : io::load_machine_config(o.config);
   const std::string config_name = o.config.empty() ? "builtin:paper-ipmsm" : o.config;
 
-  analysis::LogOptions log_options;
+  analysis::LogOptions log_options = analysis::log_options(config);
   log_options.blocks = o.blocks;
   log_options.log_map = o.log_map;
-  log_options.voltage_is_command = config.estimator.averaged.voltage_is_command;
-  log_options.control_period_s = config.estimator.averaged.control_period_s;
-  log_options.command_delay_s = config.estimator.extensions.delay_s;
   if (o.model != "auto") {
     log_options.mode = o.model == "transient" ? analysis::ModelMode::kTransient : analysis::ModelMode::kSteadyState;
   }

@@ -57,11 +57,8 @@ int run_figures(const FiguresOptions& o) {
   std::optional<analysis::LogData> log;
   analysis::LogRegimes regimes;
   if (!o.log.empty()) {
-    analysis::LogOptions options;
+    analysis::LogOptions options = analysis::log_options(cfg);
     options.log_map = o.log_map;
-    options.voltage_is_command = cfg.estimator.averaged.voltage_is_command;
-    options.control_period_s = cfg.estimator.averaged.control_period_s;
-    options.command_delay_s = cfg.estimator.extensions.delay_s;
     options.blocks = 2;  // the timeline uses no blocks: the fewest the log's preparation takes, so short logs draw
     log = analysis::load_log(o.log, cfg.machine, options);
     std::fprintf(stderr, "rpem figures: read %s\n", log->format.c_str());

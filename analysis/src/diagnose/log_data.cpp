@@ -8,6 +8,7 @@
 #include "rpem/core/clock.hpp"
 #include "rpem/core/conditioner.hpp"
 #include "rpem/core/frames.hpp"
+#include "rpem/core/reported_speed.hpp"
 #include "rpem/io/averaged_log.hpp"
 #include "rpem/io/log_source.hpp"
 #include "rpem/io/machine_config.hpp"
@@ -216,6 +217,15 @@ std::string apply_reported_command(std::vector<core::AveragedSample>& samples, c
 
 }  // namespace
 
+LogOptions log_options(const io::MachineConfig& config) {
+  LogOptions o;
+  o.voltage_is_command = config.estimator.averaged.voltage_is_command;
+  o.control_period_s = config.estimator.averaged.control_period_s;
+  o.command_delay_s = config.estimator.extensions.delay_s;
+  o.staircase_below_rad_s = config.estimator.regimes.hall_interpolation_speed_rad_s;
+  return o;
+}
+
 LogData load_log(const std::string& path, const core::MachineSi& machine, const LogOptions& options,
                  const std::function<void(std::uint64_t, std::uint64_t)>& progress) {
   const io::LogSource source = io::log_source(path, options.log_map);
@@ -231,6 +241,7 @@ LogData load_log(const std::string& path, const core::MachineSi& machine, const 
     }
     io::AveragedLogRead read;
     std::vector<core::AveragedSample> samples = io::read_averaged_log(path, source.map, limits, &read);
+    for (core::AveragedSample& s : samples) s.omega_el_rad_s = core::window_speed_rad_s(s, options.staircase_below_rad_s);
     const bool turn = options.voltage_is_command && options.control_period_s > 0.0;
     const std::string voltage = turn ? apply_reported_command(samples, options) : "";
     d.layout = io::rotor_frame_layout(read.layout);

@@ -75,7 +75,8 @@ class AveragedDriveEstimator {
   std::int64_t previous_centre2_ns_ = 0;  ///< t_start + t of the previous window (twice its centre)
   Vec2 previous_i_pu_ = Vec2::Zero();
   double delay_s_ = 0.0;
-  bool has_previous_ = false;  ///< the next sample continues the chain of the previous one
+  double staircase_below_rad_s_ = 0.0;  ///< estimator.regimes.hall_interpolation_speed_rad_s (window_speed_rad_s)
+  bool has_previous_ = false;           ///< the next sample continues the chain of the previous one
   std::optional<std::int64_t> previous_t_ns_;
   SampleTiming timing_ = SampleTiming::kFirst;  ///< of the sample being stepped
   /// The core's adaptation before the previous sample: what a release found inside that window retracts (§13).

@@ -17,7 +17,11 @@ struct AveragedSample {
   std::int64_t t_ns = 0;        ///< window end: the host time that closed the window
   Vec2 i_dq_A = Vec2::Zero();   ///< mean measured current, rotor frame
   Vec2 u_dq_V = Vec2::Zero();   ///< mean voltage the drive reports (its command, or its estimate of the applied voltage)
-  double omega_el_rad_s = 0.0;  ///< mean electrical speed
+  double omega_el_rad_s = 0.0;  ///< mean electrical speed (as the drive reports it, rebuilt to the window's mean)
+  /// The mean electrical speed the drive's own count of its angle's steps gives over this window and its two
+  /// neighbours (VESC's tachometer: docs/derivations.md §13, "The count's speed at a crawl"); NaN: not counted.
+  /// Taken instead of omega_el_rad_s where the drive's angle is a staircase (core::window_speed_rad_s).
+  double omega_counted_el_rad_s = std::numeric_limits<double>::quiet_NaN();
   double u_dc_V = std::numeric_limits<double>::quiet_NaN();       ///< mean DC link; NaN: not reported
   double t_winding_C = std::numeric_limits<double>::quiet_NaN();  ///< NaN: not reported
   double t_magnet_C = std::numeric_limits<double>::quiet_NaN();   ///< NaN: not reported

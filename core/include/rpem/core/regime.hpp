@@ -144,6 +144,9 @@ struct RegimeCounts {
 /// Hall mode takes its observer's angle (foc_sl_erpm, mcconf_default.h: 2000 erpm, electrical).
 inline constexpr double kHallFrameErrorRad = kPi / 6.0;
 inline constexpr double kHallBelowSpeedRadS = 2000.0 * 2.0 * kPi / 60.0;
+/// ... and the speed below which it holds each state's angle instead of interpolating between transitions
+/// (foc_hall_interp_erpm, mcconf_default.h: 500 erpm, electrical).
+inline constexpr double kHallInterpolationSpeedRadS = 500.0 * 2.0 * kPi / 60.0;
 
 /// The classification's keys as users give them (`estimator.regimes`, docs/configuration.md), SI.
 struct RegimeSettings {
@@ -176,6 +179,10 @@ struct RegimeSettings {
   /// The electrical speed below which the frame is the Hall sensors' (a VESC's foc_sl_erpm, 2000 erpm by default;
   /// the observer's above).
   double hall_below_speed_rad_s = 0.0;
+  /// The electrical speed below which the Hall sensors' angle is a staircase (a VESC's foc_hall_interp_erpm, 500 erpm
+  /// by default): there an averaged sample's speed is its step count's where it has one (core::window_speed_rad_s);
+  /// 0: no Hall sensors.
+  double hall_interpolation_speed_rad_s = 0.0;
   /// The configuration did not say where the frame comes from: decided as a sensor's (sensorless false), and a
   /// window whose r_s excitation a sensorless frame would not have is flagged (regime_bit::kRsOnAssumedFrame).
   bool angle_source_assumed = false;

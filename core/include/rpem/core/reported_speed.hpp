@@ -11,8 +11,10 @@
 // and the previous one), exact for a ramp. The same function serves every reader of such speeds (the VESC
 // Tool log's reader, rpemd's VESC source): pure and allocation-free.
 
+#include <cmath>
 #include <cstdint>
 
+#include "rpem/core/averaged_sample.hpp"
 #include "rpem/core/clock.hpp"
 
 namespace rpem::core {
@@ -38,6 +40,22 @@ struct SpeedRead {
   const double slope = (now.omega_el_rad_s - previous.omega_el_rad_s) / between_s;  // of the tracker's speed
   // Its mean over the window (trapezoid) is ω̂ − slope·h/2; the rotor led it by lag·slope.
   return now.omega_el_rad_s - slope * (0.5 * to_seconds(now.t_ns - t_start_ns) - lag_s);
+}
+
+/// The mean speed over [start, end] from a count of the angle it travelled (a drive's step count, in rad):
+/// exact but for one step at each end, so within a step over the run (docs/derivations.md §13, "The count's
+/// speed at a crawl"). NaN where the run has no length.
+[[nodiscard]] inline double counted_mean_speed_rad_s(double travel_start_rad, std::int64_t start_ns, double travel_end_rad,
+                                                     std::int64_t end_ns) noexcept {
+  const double run_s = to_seconds(end_ns - start_ns);
+  return run_s > 0.0 ? (travel_end_rad - travel_start_rad) / run_s : std::nan("");
+}
+
+/// The speed a window stands for: the count's where the drive's angle is a staircase — its counted speed below
+/// `staircase_below_rad_s` (a VESC in Hall mode below foc_hall_interp_erpm holds each state's angle, and its
+/// PLL's speed at a read is not the window's mean) — else the reported one. 0, or no count: the reported one.
+[[nodiscard]] inline double window_speed_rad_s(const AveragedSample& a, double staircase_below_rad_s) noexcept {
+  return std::abs(a.omega_counted_el_rad_s) < staircase_below_rad_s ? a.omega_counted_el_rad_s : a.omega_el_rad_s;
 }
 
 }  // namespace rpem::core

@@ -40,6 +40,7 @@ enum class Quantity : std::uint8_t {
   kTorqueCmd,
   kTStart,
   kTCoolant,  ///< the machine's coolant (issue 24: the thermal network's boundary)
+  kTravelEl,  ///< the electrical angle the drive has counted (VESC's tachometer, 60° steps): averaged logs only
   kCount
 };
 inline constexpr std::size_t kQuantityCount = static_cast<std::size_t>(Quantity::kCount);
@@ -75,6 +76,9 @@ struct MappedColumn {
   double unit_factor = 1.0;  ///< the map's unit in SI (1 mA = 1e-3 A; 1 rpm with p pole pairs = 2πp/60 rad/s)
   double unit_offset = 0.0;  ///< added after the factor (kelvin → °C: −273.15)
   std::string unit = "SI";   ///< as the map wrote it, for messages
+  /// Read where the header has it, the quantity absent where not (`optional: true`; a header map's temperatures
+  /// and travel_el only: quantities every log may lack).
+  bool optional = false;
 };
 
 /// How a sample's window is known (averaged logs).

@@ -16,6 +16,7 @@
 #include "rpem/core/settings.hpp"
 #include "rpem/core/types.hpp"
 #include "rpem/io/drive_log.hpp"
+#include "rpem/io/machine_config.hpp"
 
 namespace rpem::analysis {
 
@@ -101,10 +102,17 @@ struct LogOptions {
   bool voltage_is_command = false;
   double control_period_s = 0.0;
   double command_delay_s = 0.0;
+  /// estimator.regimes.hall_interpolation_speed_rad_s: below it an averaged window's speed is its step count's
+  /// (core::window_speed_rad_s); 0: the reported speed everywhere.
+  double staircase_below_rad_s = 0.0;
   int blocks = 40;            ///< training and held-out blocks, alternating, equal in time
   int speed_half_window = 4;  ///< transient logs: replay speed from the angle over ±this many samples
   std::string log_map;        ///< a column map (YAML) to read the log with; empty: detected (io::log_source)
 };
+
+/// The options a configuration decides (the reported voltage's kind, the command's timing, the Hall staircase);
+/// the rest at their defaults.
+[[nodiscard]] LogOptions log_options(const io::MachineConfig& config);
 
 /// Where the steady-state replay left out more than io::kExplainedShare of the rows as idle or in transition:
 /// one sentence per rule, how many, why, and what changes it (docs/diagnose.md, "The replay").
