@@ -3,6 +3,8 @@
 // values with theta_el in big-endian extended frames, averaged; or IEEE 754 floats (binary32 and binary64,
 // both byte orders, averaged) — and the rest is a stream of frames
 //   [a frame record, fuzz_frame.hpp][t step, 2 bytes]
+// The rotor-frame map stamps samples with a 4-bit drive clock (wrapping every 16 counts, the wraps told by
+// the receive times), the float map with a binary64 one (any value, NaN and ±∞ among them).
 // The decoder must never crash, deliver only finite samples (optional quantities finite or NaN, "not
 // reported", never ±∞) with t_start ≤ t and increasing t, and count every frame once. The dictionary
 // (corpus_signal_map.dict) holds IEEE NaN, ±∞, −0, subnormals and the largest finite values in both orders.
@@ -11,6 +13,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <cstdlib>
+#include <limits>
 
 #include "fuzz_frame.hpp"
 #include "rpem/can/signal_map.hpp"
@@ -33,8 +36,10 @@ rpem::can::SignalMap rotor_frame_map() {
   m.frames.push_back(
       {0x20,
        false,
-       6,
-       {{SampleField::kSpeedMechRpm, 0, 32, false, true, 1.0, 0.0}, {SampleField::kUdcV, 32, 16, false, false, 0.1, -5.0}}});
+       7,
+       {{SampleField::kSpeedMechRpm, 0, 32, false, true, 1.0, 0.0},
+        {SampleField::kUdcV, 32, 16, false, false, 0.1, -5.0},
+        {SampleField::kTSampleS, 48, 4, false, false, 1e-5, 0.0}}});  // the drive's clock: wraps every 16 counts
   m.pole_pairs = 7;
   return m;
 }
@@ -78,6 +83,7 @@ rpem::can::SignalMap float_map() {
   m.frames.push_back({0x32, false, 8, {f(SampleField::kOmegaElRadS, 7, 64, true, k64)}});
   m.frames.push_back({0x33, false, 8, {f(SampleField::kUdcV, 0, 64, false, k64, 1e12)}});
   m.frames.push_back({0x34, false, 4, {f(SampleField::kTWindingC, 7, 32, true, k32, 0.1, -40.0)}});
+  m.frames.push_back({0x35, false, 8, {f(SampleField::kTSampleS, 0, 64, false, k64, 1e-3)}});  // the drive's ms
   return m;
 }
 
@@ -93,7 +99,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   if (!rpem::can::check_layout(map).empty() || !rpem::can::missing_quantities(map).empty()) std::abort();
   rpem::can::SignalMapDecoder decoder(map);
   std::size_t at = 1;
-  std::int64_t t = 0, last_t = -1;
+  std::int64_t t = 0, last_t = std::numeric_limits<std::int64_t>::min();  // a drive clock may read negative
   std::uint64_t samples = 0, offered = 0;
   rpem::can::CanFrame f;
   while (rpem::can::fuzz::read_frame(data, size, at, f)) {

@@ -15,24 +15,10 @@ struct FieldInfo {
   std::string_view name, unit;
 };
 constexpr std::array<FieldInfo, kSampleFieldCount> kFields = {{
-    {"i_d", "A"},
-    {"i_q", "A"},
-    {"u_d", "V"},
-    {"u_q", "V"},
-    {"i_a", "A"},
-    {"i_b", "A"},
-    {"i_c", "A"},
-    {"u_a", "V"},
-    {"u_b", "V"},
-    {"u_c", "V"},
-    {"theta_el", "rad"},
-    {"omega_el", "rad/s"},
-    {"erpm", "rpm"},
-    {"speed_mech", "rpm"},
-    {"u_dc", "V"},
-    {"T_winding", "degC"},
-    {"T_magnet", "degC"},
-    {"T_drive", "degC"},
+    {"i_d", "A"},          {"i_q", "A"},          {"u_d", "V"},        {"u_q", "V"},          {"i_a", "A"},
+    {"i_b", "A"},          {"i_c", "A"},          {"u_a", "V"},        {"u_b", "V"},          {"u_c", "V"},
+    {"theta_el", "rad"},   {"omega_el", "rad/s"}, {"erpm", "rpm"},     {"speed_mech", "rpm"}, {"u_dc", "V"},
+    {"T_winding", "degC"}, {"T_magnet", "degC"},  {"T_drive", "degC"}, {"t_sample", "s"},
 }};
 
 /// DBC bit positions of a signal, MSB first for big endian (the "sawtooth" numbering: bit 7 of byte 0 is
@@ -86,6 +72,7 @@ bool parse_field(std::string_view name, SampleField& out) noexcept {
 }
 
 std::string check_layout(const SignalMap& map) {
+  int clocks = 0;
   for (std::size_t i = 0; i < map.frames.size(); ++i) {
     const FrameSpec& f = map.frames[i];
     if (f.length > 64) return "frame " + std::to_string(f.id) + ": length above 64 bytes";
@@ -102,6 +89,10 @@ std::string check_layout(const SignalMap& map) {
       if (!std::isfinite(s.scale) || s.scale == 0.0 || !std::isfinite(s.offset))
         return where + ": scale must be finite and non-zero, offset finite";
       if (const std::string e = float_problem(s); !e.empty()) return std::string(where).append(": ").append(e);
+      if (s.field == SampleField::kTSampleS) {
+        if (++clocks > 1) return where + ": t_sample is mapped twice (one clock stamps a sample)";
+        if (s.scale < 0.0 || s.is_signed) return where + ": t_sample counts forward: unsigned, scale positive";
+      }
     }
   }
   bool trigger = false;
@@ -166,7 +157,11 @@ double physical_value(const CanFrame& f, const SignalSpec& s) noexcept {
 
 SignalMapDecoder::SignalMapDecoder(SignalMap map) : map_(std::move(map)) {
   for (const FrameSpec& f : map_.frames) {
-    for (const SignalSpec& s : f.signals) mapped_[static_cast<std::size_t>(s.field)] = true;
+    for (const SignalSpec& s : f.signals) {
+      mapped_[static_cast<std::size_t>(s.field)] = true;
+      if (s.field == SampleField::kTSampleS)
+        clock_.emplace(s.length, s.value_type != ValueType::kInteger, s.scale, s.offset);
+    }
   }
 }
 
@@ -207,6 +202,8 @@ bool SignalMapDecoder::decode(const CanFrame& f, std::int64_t t_ns, core::Averag
   for (const SignalSpec& s : spec->signals) {
     values_[static_cast<std::size_t>(s.field)] = physical_value(f, s);
     fresh_[static_cast<std::size_t>(s.field)] = true;
+    if (s.field == SampleField::kTSampleS)
+      clock_->on_value(static_cast<std::uint64_t>(extract_raw(f, s)), values_[static_cast<std::size_t>(s.field)]);
   }
   if (!trigger) return false;
   return complete(t_ns, out);
@@ -225,10 +222,22 @@ bool SignalMapDecoder::complete(std::int64_t t_ns, core::AveragedSample& out) no
       has(F::kIaA) && has(F::kIbA) && (has(F::kIcA) || !mapped_[static_cast<std::size_t>(F::kIcA)]) && has(F::kThetaElRad);
   const bool abc_u = has(F::kUaV) && has(F::kUbV) && has(F::kUcV) && has(F::kThetaElRad);
   const bool speed = has(F::kOmegaElRadS) || has(F::kErpm) || (has(F::kSpeedMechRpm) && map_.pole_pairs > 0);
-  if (!((dq_i || abc_i) && (dq_u || abc_u) && speed)) {
+  const bool time = !clock_ || has(F::kTSampleS);
+  if (!((dq_i || abc_i) && (dq_u || abc_u) && speed && time)) {
     ++counters_.incomplete;
     has_previous_ = false;  // the next window does not start here
     return false;
+  }
+  if (clock_) {
+    // The drive's time replaces the receive time; a clock that restarted starts a new chain.
+    const std::int64_t rx_ns = t_ns;
+    const SampleClock::Step step = clock_->close(rx_ns, t_ns);
+    if (step == SampleClock::Step::kStale) {
+      ++counters_.stale;
+      has_previous_ = false;
+      return false;
+    }
+    if (step == SampleClock::Step::kFirst) has_previous_ = false;
   }
   core::AveragedSample s;
   s.t_ns = t_ns;

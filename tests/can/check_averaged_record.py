@@ -6,8 +6,9 @@ with its own Clarke/Park and no project code.
   the mean of the sent samples' rotor-frame currents whose times lie in [t_start, t), and u_d, u_q the
   mean over those periods of the held phase voltages turned into the rotor frame along the angle's sweep
   (midpoint quadrature); window lengths 1/rate.
-- Without (a signal map of instantaneous samples, stamped with host receive times): the k-th recorded
-  sample is the k-th sent row in the rotor frame.
+- Without (a signal map of instantaneous samples, stamped with the drive's own time, its t_sample signal):
+  the k-th recorded sample is the k-th sent row in the rotor frame, at the row's time (the drive's clock
+  counts µs) however the frames were delayed on the way.
 
   check_averaged_record.py SENT.csv AVERAGED.csv [--rate HZ]
 """
@@ -75,6 +76,11 @@ def main():
                 break
             d, q = rot[best + k]
             worst_i = max(worst_i, abs(w['i_d'] - d), abs(w['i_q'] - q))
+            step = (w['t'] - avg[0]['t']) - (sent[best + k]['t'] - sent[best]['t'])
+            if abs(step) > 1.5e-6:
+                errors.append('sample %d at %+.6f s from the first, the drive sent it at %+.6f s'
+                              % (k, w['t'] - avg[0]['t'], sent[best + k]['t'] - sent[best]['t']))
+                break
             if w['t'] != w['t_start']:
                 errors.append('an instantaneous sample with a window at %g' % w['t'])
                 break

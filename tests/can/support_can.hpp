@@ -6,6 +6,7 @@
 
 #include "rpem/can/decoder.hpp"
 #include "rpem/can/encoder.hpp"
+#include "rpem/can/signal_map.hpp"
 #include "rpem/core/frames.hpp"
 
 namespace rpem::test {
@@ -41,6 +42,17 @@ inline std::vector<core::DriveSample> decode_all(can::TelemetryDecoder& dec, con
   for (const auto& f : frames) {
     const std::size_t n = dec.decode(f, buf);
     out.insert(out.end(), buf.begin(), buf.begin() + static_cast<long>(n));
+  }
+  return out;
+}
+
+/// The samples a signal map's decoder completes from the frames, every frame received at rx_ns.
+inline std::vector<core::AveragedSample> decode_all(can::SignalMapDecoder& dec, const std::vector<can::CanFrame>& frames,
+                                                    std::int64_t rx_ns) {
+  std::vector<core::AveragedSample> out;
+  core::AveragedSample s;
+  for (const auto& f : frames) {
+    if (dec.decode(f, rx_ns, s)) out.push_back(s);
   }
   return out;
 }

@@ -227,11 +227,7 @@ TEST(SignalMapExamples, NativeFramesThroughTheMapAgreeWithTheNativeDecoder) {
   ASSERT_EQ(reference.size(), samples.size());
 
   SignalMapDecoder dec(map);
-  std::vector<core::AveragedSample> got;
-  core::AveragedSample s;
-  for (const CanFrame& f : frames) {
-    if (dec.decode(f, 0, s)) got.push_back(s);
-  }
+  const std::vector<core::AveragedSample> got = test::decode_all(dec, frames, 0);
   ASSERT_EQ(got.size(), reference.size());
   for (std::size_t k = 0; k < got.size(); ++k) {
     const core::DriveSample& r = reference[k];
@@ -243,6 +239,7 @@ TEST(SignalMapExamples, NativeFramesThroughTheMapAgreeWithTheNativeDecoder) {
     EXPECT_NEAR(got[k].u_dq_V[1], u[1], 1e-9);
     EXPECT_NEAR(got[k].omega_el_rad_s, r.omega_el_rad_s, 1e-9);
     EXPECT_NEAR(got[k].u_dc_V, r.u_dc_V, 1e-9);
+    EXPECT_EQ(got[k].t_ns, r.t_ns);  // the drive's T_low (t_sample), not the receive time (0 here)
   }
   EXPECT_EQ(dec.counters().incomplete, 0U);
 }

@@ -62,7 +62,8 @@ TEST(SignalMapSource, ARotorFrameMapGivesAveragedSamplesAtTheTriggersTime) {
 
 // rpem's native frames through a map (RPEM_TELEMETRY_A…E, docs/can-protocol.md; values little endian from
 // bit 24): i_a 1 A, i_b −0.5 A, i_c −0.5 A, θ_el = 16384·2π/65536 = π/2, u_a 10 V, u_b −5 V, u_c −5 V,
-// ω_el 100 rad/s, u_dc 48 V. At θ = π/2 the α-axis current (1 A) lies on −q: i_dq = (0, −1) A.
+// ω_el 100 rad/s, u_dc 48 V, the drive's time T_low 0x003039 µs = 12.345 ms (t_sample: the sample's time,
+// not the receive time). At θ = π/2 the α-axis current (1 A) lies on −q: i_dq = (0, −1) A.
 TEST(SignalMapSource, APhaseMapWithTheAngleGivesPhaseSamplesForDriveEstimator) {
   SignalMapSampler s(shipped("rpem-native-classic.yaml"));
   ASSERT_EQ(s.kind(), SampleKind::kPhase);
@@ -71,10 +72,10 @@ TEST(SignalMapSource, APhaseMapWithTheAngleGivesPhaseSamplesForDriveEstimator) {
   EXPECT_FALSE(s.on_frame(frame(0x111, {0, 0, 0, 0x0C, 0xFE, 0x00, 0x40, 0}), 20, out));
   EXPECT_FALSE(s.on_frame(frame(0x112, {0, 0, 0, 0xF4, 0x01, 0x06, 0xFF, 0}), 30, out));
   EXPECT_FALSE(s.on_frame(frame(0x113, {0, 0, 0, 0x06, 0xFF, 0xD0, 0x07, 0}), 40, out));
-  ASSERT_TRUE(s.on_frame(frame(0x114, {0, 0, 0, 0x60, 0x09, 0, 0, 0}), 50, out));
+  ASSERT_TRUE(s.on_frame(frame(0x114, {0, 0, 0, 0x60, 0x09, 0x39, 0x30, 0x00}), 50, out));
   const auto* p = std::get_if<core::DriveSample>(&out);
   ASSERT_NE(p, nullptr);
-  EXPECT_EQ(p->t_ns, 50);
+  EXPECT_EQ(p->t_ns, 12'345'000);
   EXPECT_EQ(p->rx_ns, 50);
   EXPECT_NEAR(p->theta_el_rad, std::numbers::pi / 2.0, 1e-12);
   EXPECT_NEAR(p->omega_el_rad_s, 100.0, 1e-12);

@@ -26,7 +26,7 @@ for a in "$@"; do [[ $a != -* && -d $a ]] && a=$(cd "$a" && pwd); args+=("$a"); 
 set -- "${args[@]}"
 
 core=("$repo"/core/src/*.cpp)
-io=("$repo"/io/src/*.cpp "$build"/io/*.cpp "$repo/can/src/signal_map.cpp")  # io's generated sources (compiled-in
+io=("$repo"/io/src/*.cpp "$build"/io/*.cpp "$repo"/can/src/{signal_map,sample_clock}.cpp)  # io's generated sources (compiled-in
 # configuration and log map) are configure_file outputs in $build/io; io reads signal maps
 # The YAML readers' inputs cost yaml-cpp about one allocation per byte, and under ASan an allocation is most
 # of the cost (docs/benchmarks.md, "Fuzzing"). -max_len: every key of the reader in one file is 2.1 kB
@@ -43,7 +43,7 @@ case $target in
                        corpus=can/fuzz/corpus ;;
   fuzz_vesc)           main=can/fuzz/fuzz_vesc.cpp;           objs=("$repo/can/src/vesc.cpp" "$repo/can/src/e2e.cpp")
                        corpus=can/fuzz/corpus_vesc ;;
-  fuzz_signal_map)     main=can/fuzz/fuzz_signal_map.cpp;     objs=("$repo/can/src/signal_map.cpp")
+  fuzz_signal_map)     main=can/fuzz/fuzz_signal_map.cpp;     objs=("$repo"/can/src/{signal_map,sample_clock}.cpp)
                        corpus=can/fuzz/corpus_signal_map ;;
   fuzz_drive_log)      main=io/fuzz/fuzz_drive_log.cpp;       objs=("${io[@]}" "${core[@]}")
                        corpus=io/fuzz/corpus/drive_log ;;

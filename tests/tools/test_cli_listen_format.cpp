@@ -154,8 +154,13 @@ print(json.dumps(out))
   EXPECT_EQ(j["est"]["auth"], "unverified");
   // check_ax8000_rpemd.py's signal_map counters, in the source's terms.
   const std::map<std::string, std::int64_t> signal_map{
-      {"frames", d.can_frames},         {"unknown_id", d.can_unknown_id},    {"wrong_length", d.can_wrong_dlc},
-      {"incomplete", d.can_incomplete}, {"non_finite", d.can_invalid_value}, {"kernel_drops", d.can_kernel_drops},
+      {"frames", d.can_frames},
+      {"unknown_id", d.can_unknown_id},
+      {"wrong_length", d.can_wrong_dlc},
+      {"incomplete", d.can_incomplete},
+      {"non_finite", d.can_invalid_value},
+      {"stale", d.can_stale},
+      {"kernel_drops", d.can_kernel_drops},
   };
   const auto signal_map_heard = j["signal_map"].get<std::map<std::string, std::int64_t>>();
   EXPECT_EQ(signal_map_heard, signal_map) << heard.output;

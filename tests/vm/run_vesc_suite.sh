@@ -60,7 +60,8 @@ python3 "$repo/tests/can/check_averaged_record.py" "$out/classic_sent.csv" "$out
 if [[ -f $out/rpemd_vesc_skipped ]]; then
   echo "run_vesc_suite: rpemd's 'source: vesc' not in this build — its part did not run"
 else
-  python3 "$here/check_map_rpemd.py" "$out/rpemd_map.txt"
+  "$build/tools/rpem" estimate --log "$out/native_sent.csv" --out "$out/map_offline_est.csv" > /dev/null
+  python3 "$here/check_map_rpemd.py" "$out/rpemd_map.txt" "$out/map_offline_est.csv"
   python3 "$here/check_ax8000_rpemd.py" "$out"
   for run in r200 r1k; do python3 "$here/check_vesc_rpemd.py" "$out" "$run"; done
 fi

@@ -96,12 +96,13 @@ struct SourceCounter {
   std::string_view label;
   std::int64_t rpem::diagnostics_t::*field;
 };
-constexpr std::array<SourceCounter, 6> kSignalMapCounters{{
+constexpr std::array<SourceCounter, 7> kSignalMapCounters{{
     {"frames", &rpem::diagnostics_t::can_frames},
     {"unknown_id", &rpem::diagnostics_t::can_unknown_id},
     {"wrong_length", &rpem::diagnostics_t::can_wrong_dlc},
     {"incomplete", &rpem::diagnostics_t::can_incomplete},
     {"non_finite", &rpem::diagnostics_t::can_invalid_value},
+    {"stale", &rpem::diagnostics_t::can_stale},
     {"kernel_drops", &rpem::diagnostics_t::can_kernel_drops},
 }};
 

@@ -85,7 +85,7 @@ class SignalMapFeed final : public Feed {
     return "signal map '" + decoder_.map().name + "': frames " + std::to_string(c.frames) + ", samples " +
            std::to_string(c.samples) + ", unknown id " + std::to_string(c.unknown_id) + ", wrong length " +
            std::to_string(c.wrong_length) + ", incomplete " + std::to_string(c.incomplete) + ", non-finite " +
-           std::to_string(c.non_finite);
+           std::to_string(c.non_finite) + ", stale " + std::to_string(c.stale);
   }
   [[nodiscard]] io::AveragedLogLayout layout() const override { return {true, true, true, true}; }
 

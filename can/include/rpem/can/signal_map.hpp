@@ -7,11 +7,13 @@
 
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
 
 #include "rpem/can/frame.hpp"
+#include "rpem/can/sample_clock.hpp"
 #include "rpem/core/averaged_sample.hpp"
 
 namespace rpem::can {
@@ -36,6 +38,7 @@ enum class SampleField : std::uint8_t {
   kTWindingC,
   kTMagnetC,
   kTDriveC,
+  kTSampleS,  // the drive's own time of the sample (SampleClock)
   kCount
 };
 inline constexpr std::size_t kSampleFieldCount = static_cast<std::size_t>(SampleField::kCount);
@@ -99,6 +102,7 @@ struct SignalMapCounters {
   std::uint64_t wrong_length = 0;  ///< shorter than the map's DLC, or FD where classic is mapped
   std::uint64_t incomplete = 0;    ///< a trigger before every needed quantity arrived since the last sample
   std::uint64_t non_finite = 0;    ///< a frame with a NaN or infinite value (dropped), or a sample that came out so
+  std::uint64_t stale = 0;         ///< a sample the drive stamped (t_sample) at or before the previous one (dropped)
   std::uint64_t error_frames = 0;
 };
 
@@ -107,7 +111,8 @@ class SignalMapDecoder {
   /// The map must pass check_layout and missing_quantities (the caller refuses it otherwise).
   explicit SignalMapDecoder(SignalMap map);
 
-  /// Reads one frame received at t_ns; true when it completed a sample (written to `out`).
+  /// Reads one frame received at t_ns; true when it completed a sample (written to `out`), stamped t_ns, or
+  /// with the drive's own time when the map carries t_sample.
   [[nodiscard]] bool decode(const CanFrame& f, std::int64_t t_ns, core::AveragedSample& out) noexcept;
   [[nodiscard]] const SignalMapCounters& counters() const noexcept { return counters_; }
   [[nodiscard]] const SignalMap& map() const noexcept { return map_; }
@@ -124,6 +129,7 @@ class SignalMapDecoder {
   std::array<bool, kSampleFieldCount> mapped_{};  ///< some signal carries it
   bool has_previous_ = false;
   std::int64_t previous_t_ns_ = 0;
+  std::optional<SampleClock> clock_;  ///< when the map carries t_sample: the samples' times are the drive's
   SignalMapCounters counters_;
 };
 
