@@ -42,7 +42,7 @@ void BM_Decode(benchmark::State& state) {
   std::int64_t samples = 0;
   for (auto _ : state) {
     can::TelemetryDecoder dec;
-    for (const auto& f : input) samples += static_cast<std::int64_t>(dec.decode(f, out));
+    for (const auto& f : input) samples += static_cast<std::int64_t>(dec.decode(f, 0, out));
     benchmark::DoNotOptimize(out);
   }
   state.counters["samples_per_s"] = benchmark::Counter(static_cast<double>(samples), benchmark::Counter::kIsRate);

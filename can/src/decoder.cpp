@@ -80,20 +80,21 @@ TelemetryDecoder::Sequence TelemetryDecoder::check_sequence(std::uint8_t counter
   return Sequence::kLost;
 }
 
-std::int64_t TelemetryDecoder::unwrap_us(std::uint32_t t_us, int bits) noexcept {
-  const std::int64_t span = std::int64_t{1} << bits;
-  if (!has_epoch_) {
-    has_epoch_ = true;
-    epoch_us_ = 0;
-    last_raw_us_ = t_us;
-    return t_us;
+bool TelemetryDecoder::drive_time(SampleClock& clock, std::uint32_t t_us, std::int64_t rx_ns, int samples,
+                                  std::int64_t& t_ns) noexcept {
+  clock.on_value(t_us, 0.0);
+  switch (clock.close(rx_ns, t_ns)) {
+    case SampleClock::Step::kStale:
+      counters_.stale += static_cast<std::uint64_t>(samples);
+      gap_pending_ = true;
+      return false;
+    case SampleClock::Step::kFirst:  // the first, or the drive's clock restarted
+      gap_pending_ = true;
+      return true;
+    case SampleClock::Step::kNext:
+      return true;
   }
-  const std::int64_t delta = (static_cast<std::int64_t>(t_us) - last_raw_us_) & (span - 1);
-  // Forward by less than half the range: continue; otherwise it is a step back in time.
-  std::int64_t next = epoch_us_ + last_raw_us_ + (delta < span / 2 ? delta : delta - span);
-  epoch_us_ = next - t_us;
-  last_raw_us_ = t_us;
-  return next;
+  return false;
 }
 
 bool TelemetryDecoder::accept(core::DriveSample& s) noexcept {
@@ -112,20 +113,20 @@ bool TelemetryDecoder::accept(core::DriveSample& s) noexcept {
   return true;
 }
 
-std::size_t TelemetryDecoder::decode(const CanFrame& f, std::span<core::DriveSample> out) noexcept {
+std::size_t TelemetryDecoder::decode(const CanFrame& f, std::int64_t rx_ns, std::span<core::DriveSample> out) noexcept {
   ++counters_.frames;
   if (f.error) return 0;  // error frames are counted by the transport
   if (f.extended) {       // telemetry uses standard IDs only; an extended one (e.g. a VESC's) is not ours
     ++counters_.unknown_id;
     return 0;
   }
-  if (f.id == p::kFdId) return decode_fd(f, out);
-  if (f.id >= p::kClassicFirstId && f.id < p::kClassicFirstId + p::kClassicFrames) return decode_classic(f, out);
+  if (f.id == p::kFdId) return decode_fd(f, rx_ns, out);
+  if (f.id >= p::kClassicFirstId && f.id < p::kClassicFirstId + p::kClassicFrames) return decode_classic(f, rx_ns, out);
   ++counters_.unknown_id;
   return 0;
 }
 
-std::size_t TelemetryDecoder::decode_fd(const CanFrame& f, std::span<core::DriveSample> out) noexcept {
+std::size_t TelemetryDecoder::decode_fd(const CanFrame& f, std::int64_t rx_ns, std::span<core::DriveSample> out) noexcept {
   if (!f.fd || f.len != p::kFdLength) {
     ++counters_.wrong_dlc;
     return 0;
@@ -158,13 +159,14 @@ std::size_t TelemetryDecoder::decode_fd(const CanFrame& f, std::span<core::Drive
     case Sequence::kNext:
       break;
   }
-  const std::int64_t t0_us = unwrap_us(p::get_u32(f, 4), 32);
   const std::uint16_t period_us = p::get_u16(f, 8);
   if (n > 1 && period_us == 0) {
     ++counters_.invalid_value;
     gap_pending_ = true;
     return 0;
   }
+  std::int64_t t0_ns = 0;
+  if (!drive_time(fd_clock_, p::get_u32(f, 4), rx_ns, n, t0_ns)) return 0;
   const std::uint16_t u_dc = p::get_u16(f, 10);
   const std::uint8_t status = f.data[12];
   std::size_t delivered = 0;
@@ -174,7 +176,7 @@ std::size_t TelemetryDecoder::decode_fd(const CanFrame& f, std::span<core::Drive
     const std::array<std::int16_t, 3> u = {p::get_i16(f, at + 6), p::get_i16(f, at + 8), p::get_i16(f, at + 10)};
     core::DriveSample& s = out[delivered];
     s = core::DriveSample{};
-    s.t_ns = (t0_us + static_cast<std::int64_t>(j) * period_us) * 1000;
+    s.t_ns = t0_ns + static_cast<std::int64_t>(j) * period_us * 1000;
     if (!build(i, u, p::get_u16(f, at + 12), p::get_i16(f, at + 14), u_dc, status, counters_, s)) {
       gap_pending_ = true;
       continue;
@@ -184,7 +186,8 @@ std::size_t TelemetryDecoder::decode_fd(const CanFrame& f, std::span<core::Drive
   return delivered;
 }
 
-std::size_t TelemetryDecoder::decode_classic(const CanFrame& f, std::span<core::DriveSample> out) noexcept {
+std::size_t TelemetryDecoder::decode_classic(const CanFrame& f, std::int64_t rx_ns,
+                                             std::span<core::DriveSample> out) noexcept {
   if (f.fd || f.len != p::kClassicLength) {
     ++counters_.wrong_dlc;
     return 0;
@@ -262,7 +265,7 @@ std::size_t TelemetryDecoder::decode_classic(const CanFrame& f, std::span<core::
   }
   core::DriveSample& s = out[0];
   s = core::DriveSample{};
-  s.t_ns = unwrap_us(classic_t_, 24) * 1000;
+  if (!drive_time(classic_clock_, classic_t_, rx_ns, 1, s.t_ns)) return 0;
   if (!build(classic_i_, classic_u_, classic_theta_, classic_omega_, classic_udc_, classic_status_, counters_, s)) {
     gap_pending_ = true;
     return 0;

@@ -23,6 +23,13 @@ void SampleClock::on_value(std::uint64_t raw_bits, double value_s) noexcept {
   }
 }
 
+bool SampleClock::forward_of(std::uint64_t earlier_raw) const noexcept {
+  const std::uint64_t delta = raw_ - earlier_raw;
+  if (span_ == 0) return static_cast<std::int64_t>(delta) > 0;
+  const std::uint64_t wrapped = delta & static_cast<std::uint64_t>(span_ - 1);
+  return wrapped > 0 && wrapped < static_cast<std::uint64_t>(span_ / 2);
+}
+
 SampleClock::Step SampleClock::close(std::int64_t rx_ns, std::int64_t& t_ns) noexcept {
   // A time or step beyond kMaxClockS is no drive's clock (and would overflow nanoseconds): stale.
   const double now_s = is_float_ ? value_s_ : static_cast<double>(raw_) * scale_s_ + offset_s_;
@@ -48,7 +55,12 @@ SampleClock::Step SampleClock::close(std::int64_t rx_ns, std::int64_t& t_ns) noe
     step_s = counts * scale_s_;
   }
   if (!(step_s > 0.0 && step_s < kMaxClockS)) {
-    if (++stale_run_ < kRestartAfterStale) return Step::kStale;
+    // A restarted clock runs: stale samples that advance among themselves. A stopped one never restarts.
+    const bool advances = is_float_ ? value_s_ > stale_value_s_ : forward_of(stale_raw_);
+    stale_run_ = stale_run_ > 0 && advances ? stale_run_ + 1 : 1;
+    stale_raw_ = raw_;
+    stale_value_s_ = value_s_;
+    if (stale_run_ < kRestartAfterStale) return Step::kStale;
     // The drive's clock restarted: go on from the previous time by the receive step, as a gap.
     t_ns = previous_t_ns_ + std::max<std::int64_t>(rx_step_ns, 1);
     remember(rx_ns, t_ns);

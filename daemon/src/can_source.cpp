@@ -47,12 +47,13 @@ class CanSampleSource final : public SampleSource {
     bool was_open = channel.is_open();
     while (!stop.load(std::memory_order_relaxed)) {
       const std::size_t n = channel.receive(frames, 50);
+      const std::int64_t now = core::now_ns(CLOCK_REALTIME);
       if (channel.is_open() != was_open) {
         was_open = channel.is_open();
         if (!was_open) decoder.resynchronize();  // whatever arrives after the outage starts a new stream
       }
       for (std::size_t f = 0; f < n; ++f) {
-        const std::size_t got = decoder.decode(frames[f].frame, samples);
+        const std::size_t got = decoder.decode(frames[f].frame, receive_time_ns(frames[f], now), samples);
         for (std::size_t k = 0; k < got; ++k) {
           samples[k].rx_ns = frames[f].kernel_rx_ns;
           out.push(samples[k]);

@@ -243,6 +243,47 @@ TEST(LogData, SteadyStateLeavesOutIdleAndTransitionalRowsAndBlocksAlternate) {
   EXPECT_EQ(log.block(log.size() - 1), 39);
 }
 
+TEST(LogData, BlocksAreEqualInTheTimeTheLogSampledItsPausesLeftOut) {
+  // Two recordings joined: 400 rows 2.5 s apart, a pause of 10⁵ s, 400 rows. In sampled time (798 intervals of
+  // 2.5 s) each of the 40 blocks spans 19.95 intervals: 20 rows each but where a boundary falls between, and
+  // both recordings train and are held out. Rows 60 ms to 1.7 s apart at random (a VESC Tool log) do not pause.
+  auto log_of = [](const std::vector<double>& t_s) {
+    std::vector<io::DriveLogRow> rows;
+    for (const double t : t_s) {
+      io::DriveLogRow r;
+      r.sample.t_ns = std::llround(t * 1e9);
+      r.sample.voltage_frame = r.sample.current_frame = core::Frame::kDq;
+      r.sample.omega_el_rad_s = 300.0;
+      r.sample.i_A = core::Vec3(-3.0, 4.0, 0.0);
+      r.sample.u_V = core::Vec3(10.0, 200.0, 0.0);
+      rows.push_back(r);
+    }
+    return prepare_log(std::move(rows), io::DriveLogLayout{}, test::paper_machine_si(), {});
+  };
+  std::vector<double> joined;
+  for (int k = 0; k < 800; ++k) joined.push_back(2.5 * k + (k >= 400 ? 1e5 : 0.0));
+  const LogData log = log_of(joined);
+  EXPECT_EQ(log.pauses, 1U);
+  EXPECT_DOUBLE_EQ(log.longest_pause_s, 1e5 + 2.5);
+  ASSERT_EQ(log.blocks, 40);
+  for (int b = 0; b < log.blocks; ++b) {
+    const std::size_t rows = log.block_first[static_cast<std::size_t>(b) + 1] - log.block_first[static_cast<std::size_t>(b)];
+    EXPECT_GE(rows, 19U) << b;
+    EXPECT_LE(rows, 21U) << b;
+  }
+  // The pause takes no sampled time: the rows either side of it (399, 400) lie at 399 intervals of 798, the
+  // boundary of blocks 19 and 20.
+  EXPECT_EQ(log.block(398), 19);
+  EXPECT_EQ(log.block(399), 20);
+  EXPECT_EQ(log.block(400), 20);
+
+  std::mt19937_64 rng(4);
+  std::uniform_real_distribution<double> spacing(0.06, 1.7);
+  std::vector<double> irregular{0.0};
+  for (int k = 1; k < 400; ++k) irregular.push_back(irregular.back() + spacing(rng));
+  EXPECT_EQ(log_of(irregular).pauses, 0U);
+}
+
 TEST(ReportedCommand, AppliedMeanIsTheHeldVectorAveragedInTheRotorFrame) {
   // Independently: the stator-frame vector e^{jθ(t)}·v held over [d − ½, d + ½]·T after the sample, seen from
   // the rotor (angle θ(t) + ω·s), averaged by the midpoint rule over 20 000 steps (error ~1e-9 relative).

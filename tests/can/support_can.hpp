@@ -40,7 +40,7 @@ inline std::vector<core::DriveSample> decode_all(can::TelemetryDecoder& dec, con
   std::vector<core::DriveSample> out;
   std::array<core::DriveSample, 3> buf;
   for (const auto& f : frames) {
-    const std::size_t n = dec.decode(f, buf);
+    const std::size_t n = dec.decode(f, 0, buf);  // received at once: the drive's clock alone tells time
     out.insert(out.end(), buf.begin(), buf.begin() + static_cast<long>(n));
   }
   return out;

@@ -39,9 +39,9 @@ TEST(BadInput, WrongDlcAndFrameType) {
   auto c = stream(BusMode::kClassic, 1).frames[0];
   c.len = 7;
   std::array<core::DriveSample, 3> out;
-  EXPECT_EQ(dec.decode(short_fd, out), 0U);
-  EXPECT_EQ(dec.decode(classic_as_fd, out), 0U);
-  EXPECT_EQ(dec.decode(c, out), 0U);
+  EXPECT_EQ(dec.decode(short_fd, 0, out), 0U);
+  EXPECT_EQ(dec.decode(classic_as_fd, 0, out), 0U);
+  EXPECT_EQ(dec.decode(c, 0, out), 0U);
   EXPECT_EQ(dec.counters().wrong_dlc, 3U);
 }
 
@@ -51,7 +51,7 @@ TEST(BadInput, UnknownIdsAreCountedNotDecoded) {
   f.id = 0x7FF;
   f.len = 8;
   std::array<core::DriveSample, 3> out;
-  EXPECT_EQ(dec.decode(f, out), 0U);
+  EXPECT_EQ(dec.decode(f, 0, out), 0U);
   EXPECT_EQ(dec.counters().unknown_id, 1U);
 }
 

@@ -3,6 +3,7 @@
 // wrong (a burst, a late frame, a silence longer than the counter's wrap).
 #include <gtest/gtest.h>
 
+#include <array>
 #include <bit>
 #include <random>
 
@@ -70,6 +71,32 @@ TEST(SampleClock, ABurstOfLateFramesKeepsTheDrivesSteps) {
   EXPECT_EQ(dec.counters().stale, 0U);
 }
 
+TEST(SampleClock, TheNativeDecoderKeepsTheDrivesTimeOverSilencesLongerThanHalfAWrap) {
+  // rpem's classic frames carry 24 bits of µs (a wrap every 16.777216 s). Ten samples, 10 s of silence
+  // (more than half a wrap: a rule of "forward by less than half the range" reads it as a step back and
+  // drops what follows as stale), ten samples, 20 s of silence (more than a wrap), ten samples; each sample's
+  // frames received 3 ms after the drive stamped it. Every sample comes out at the time it was sent.
+  std::mt19937_64 rng(8);
+  std::vector<core::DriveSample> samples;
+  for (const std::int64_t pause_ns : {0LL, 10'000'000'000LL, 20'000'000'000LL}) {
+    const std::int64_t t0 = (samples.empty() ? 1'000'000'000 : samples.back().t_ns + 125'000) + pause_ns;
+    for (int k = 0; k < 10; ++k) samples.push_back(test::random_sample(rng, t0 + k * 125'000LL));
+  }
+  TelemetryEncoder enc(BusMode::kClassic);
+  TelemetryDecoder native;
+  std::vector<core::DriveSample> got;
+  std::array<core::DriveSample, 3> out;
+  for (const core::DriveSample& sent : samples) {
+    for (const CanFrame& f : test::encode_all(enc, {sent})) {
+      const std::size_t n = native.decode(f, sent.t_ns + 3 * kMs, out);
+      got.insert(got.end(), out.begin(), out.begin() + static_cast<long>(n));
+    }
+  }
+  ASSERT_EQ(got.size(), samples.size());
+  for (std::size_t k = 0; k < got.size(); ++k) EXPECT_EQ(got[k].t_ns, samples[k].t_ns) << k;
+  EXPECT_EQ(native.counters().stale, 0U);
+}
+
 TEST(SampleClock, WrapsAndASilenceLongerThanTheWrapAreCountedFromTheReceiveTimes) {
   SignalMapDecoder dec(millisecond_map());
   core::AveragedSample s;
@@ -119,6 +146,10 @@ TEST(SampleClock, AClockThatRestartsIsFollowedAfterEightStaleSamples) {
   EXPECT_EQ(s.t_ns, (100 + 9) * kMs);
   EXPECT_FALSE(s.gap_before);
   EXPECT_EQ(dec.counters().stale, 7U);
+  // A clock that stops (frozen telemetry) is not a restart: its samples stay stale however many come.
+  for (int k = 0; k < 3 * SampleClock::kRestartAfterStale; ++k)
+    EXPECT_FALSE(dec.decode(at_count(8), (10 + k) * kMs, s)) << k;
+  EXPECT_EQ(dec.counters().stale, 7U + 3 * SampleClock::kRestartAfterStale);
 }
 
 TEST(SampleClock, AFloatClockIsTheDrivesSecondsAndDoesNotWrap) {

@@ -319,7 +319,7 @@ TEST(VescBadInput, TheNativeDecoderIgnoresExtendedFramesOnASharedBus) {
   std::array<core::DriveSample, 3> out;
   CanFrame f = ext(protocol::kFdId | (9U << 11), {0, 0, 0, 0, 0, 0, 0, 0});
   f.id = protocol::kFdId;
-  EXPECT_EQ(native.decode(f, out), 0U);
+  EXPECT_EQ(native.decode(f, 0, out), 0U);
   EXPECT_EQ(native.counters().unknown_id, 1U);
   EXPECT_EQ(native.counters().wrong_dlc, 0U);
 }

@@ -39,7 +39,7 @@ yaml_opts=(-max_len=3072)
 yaml_asan=quarantine_size_mb=16
 opts=() asan= lcm=
 case $target in
-  fuzz_decoder)        main=can/fuzz/fuzz_decoder.cpp;        objs=("$repo/can/src/decoder.cpp" "$repo/can/src/e2e.cpp")
+  fuzz_decoder)        main=can/fuzz/fuzz_decoder.cpp;        objs=("$repo"/can/src/{decoder,e2e,sample_clock}.cpp)
                        corpus=can/fuzz/corpus ;;
   fuzz_vesc)           main=can/fuzz/fuzz_vesc.cpp;           objs=("$repo/can/src/vesc.cpp" "$repo/can/src/e2e.cpp")
                        corpus=can/fuzz/corpus_vesc ;;

@@ -95,8 +95,9 @@ int run_record(const RecordOptions& o) {
     if (o.idle_timeout_s > 0 && written > 0 && now - last_data > static_cast<std::int64_t>(o.idle_timeout_s * 1e9)) break;
     if (o.samples > 0 && written >= o.samples) break;
     const std::size_t n = channel.receive(frames, 100);
+    const std::int64_t received_ns = core::now_ns(CLOCK_REALTIME);
     for (std::size_t f = 0; f < n; ++f) {
-      const std::size_t got = decoder.decode(frames[f].frame, samples);
+      const std::size_t got = decoder.decode(frames[f].frame, can::receive_time_ns(frames[f], received_ns), samples);
       if (got > 0) last_data = core::now_ns(CLOCK_MONOTONIC);
       for (std::size_t k = 0; k < got; ++k) {
         writer.write({samples[k], {}, {}, {}, {}});

@@ -135,22 +135,32 @@ void print_summary(const analysis::Diagnosis& d) {
   for (const std::string& f : d.verdict.findings) std::printf("  %s\n", f.c_str());
 }
 
-/// The blocks of equal duration that hold no sample (the log's time has gaps): the held-out test then rests on the
-/// others alone, which a user should know before reading its verdict. "" where every block holds samples.
-std::string empty_blocks_note(const analysis::LogData& log) {
+/// What the blocks' time leaves out (the log's pauses), and any block that holds no sample all the same: the fits
+/// and the held-out test rest on the blocks that hold samples, which a user should know before reading the verdict.
+/// "" where the log does not pause and every block holds samples.
+std::string blocks_note(const analysis::LogData& log) {
   int empty = 0;
   for (int b = 0; b < log.blocks; ++b) {
     empty += log.block_first[static_cast<std::size_t>(b)] == log.block_first[static_cast<std::size_t>(b) + 1] ? 1 : 0;
   }
-  if (empty == 0) return "";
-  double longest = 0.0;
-  for (std::size_t k = 1; k < log.size(); ++k) longest = std::max(longest, log.t_s(k) - log.t_s(k - 1));
+  std::string note;
   char text[320];
-  std::snprintf(text, sizeof text,
-                "%d of the %d training and held-out blocks (equal in time) hold no sample: the log's time has gaps (the "
-                "longest %.6g s); the fits and the held-out test rest on the other blocks",
-                empty, log.blocks, longest);
-  return text;
+  if (log.pauses > 0) {
+    std::snprintf(text, sizeof text,
+                  "the log's time pauses %zu time%s (the longest %.6g s; a pause: an interval over %g times the median "
+                  "one, %.6g s): the %d training and held-out blocks are equal in the time it sampled, the pauses left out",
+                  log.pauses, log.pauses == 1 ? "" : "s", log.longest_pause_s, analysis::LogData::kPauseMedianIntervals,
+                  log.median_dt_s, log.blocks);
+    note = text;
+  }
+  if (empty > 0) {
+    std::snprintf(text, sizeof text,
+                  "%s%d of the %d training and held-out blocks hold no sample: the fits and the held-out test rest on the "
+                  "other blocks",
+                  note.empty() ? "" : "; ", empty, log.blocks);
+    note += text;
+  }
+  return note;
 }
 
 int diagnose_and_write(const DiagnoseCliOptions& o, const io::MachineConfig& config, const std::string& config_text,
@@ -188,8 +198,8 @@ int diagnose_and_write(const DiagnoseCliOptions& o, const io::MachineConfig& con
   monitor.finish();
   std::fprintf(stderr, "rpem diagnose: read %s\n", log.format.c_str());
   io::check_log_supports(config, config_name, log.layout.u_dc, o.log);
-  if (const std::string gaps = empty_blocks_note(log); !gaps.empty()) {
-    std::fprintf(stderr, "rpem diagnose: note: %s\n", gaps.c_str());
+  if (const std::string note = blocks_note(log); !note.empty()) {
+    std::fprintf(stderr, "rpem diagnose: note: %s\n", note.c_str());
   }
   const double judged_from_s = log.t_start_s + analysis::kJudgedFromFraction * (log.t_end_s - log.t_start_s);
   const analysis::ParameterTrack truth =

@@ -44,8 +44,8 @@ class Feed {
 class NativeFeed final : public Feed {
  public:
   explicit NativeFeed(double window_rate_Hz) : windows_(window_rate_Hz, 0.0, 1) {}
-  bool on_frame(const can::ReceivedFrame& f, std::int64_t, core::AveragedSample& out) override {
-    const std::size_t n = decoder_.decode(f.frame, samples_);
+  bool on_frame(const can::ReceivedFrame& f, std::int64_t rx_ns, core::AveragedSample& out) override {
+    const std::size_t n = decoder_.decode(f.frame, rx_ns, samples_);
     bool got = false;
     for (std::size_t k = 0; k < n; ++k) {
       if (const auto cycle = cycles_.add(io::DriveLogRow{samples_[k], {}, {}, {}, {}})) {
@@ -159,7 +159,7 @@ int run_record_averaged(const RecordOptions& o) {
     feed->on_time(core::now_ns(CLOCK_REALTIME), channel);
     const std::size_t n = channel.receive(frames, 1);
     for (std::size_t k = 0; k < n; ++k) {
-      const std::int64_t rx = frames[k].kernel_rx_ns > 0 ? frames[k].kernel_rx_ns : core::now_ns(CLOCK_REALTIME);
+      const std::int64_t rx = can::receive_time_ns(frames[k], core::now_ns(CLOCK_REALTIME));
       if (!feed->on_frame(frames[k], rx, sample)) continue;
       // The log's time starts at 0 with the first window (host CLOCK_REALTIME or drive time before).
       if (written == 0) origin_ns = sample.t_start_ns;

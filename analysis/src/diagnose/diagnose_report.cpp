@@ -353,17 +353,18 @@ void estimator(ReportDocument& doc, const Diagnosis& d) {
 
 void selection(ReportDocument& doc, const Diagnosis& d) {
   doc.heading(1, "How the effects were selected");
-  doc.paragraph("The log is cut into " + std::to_string(d.log->blocks) +
-                " blocks of equal duration; even blocks train, odd blocks are held out. Each round ranks every remaining "
-                "candidate by the training gain its first Gauss–Newton step predicts, fits the best " +
-                std::to_string(d.options.selection.shortlist) +
-                " jointly with the effects already found (Ceres), and accepts the one that lowers the held-out residual "
-                "most — if it lowers its RMS by at least " +
-                num(d.options.selection.min_gain_pct, 3) +
-                " % and the held-out blocks agree (one-sided Wilcoxon signed-rank test on the per-block log ratios, p ≤ " +
-                num(d.options.selection.max_p, 3) +
-                "). Candidates the held-out blocks cannot tell from the winner, and that change the model alike, make "
-                "it a guess: the group is reported as not identifiable and nobody is named for that residual.");
+  doc.paragraph(
+      "The log is cut into " + std::to_string(d.log->blocks) +
+      " blocks of equal duration in the time it sampled (its pauses left out); even blocks train, odd blocks are held out. Each round ranks every remaining "
+      "candidate by the training gain its first Gauss–Newton step predicts, fits the best " +
+      std::to_string(d.options.selection.shortlist) +
+      " jointly with the effects already found (Ceres), and accepts the one that lowers the held-out residual "
+      "most — if it lowers its RMS by at least " +
+      num(d.options.selection.min_gain_pct, 3) +
+      " % and the held-out blocks agree (one-sided Wilcoxon signed-rank test on the per-block log ratios, p ≤ " +
+      num(d.options.selection.max_p, 3) +
+      "). Candidates the held-out blocks cannot tell from the winner, and that change the model alike, make "
+      "it a guess: the group is reported as not identifiable and nobody is named for that residual.");
   for (std::size_t r = 0; r < d.selection.rounds.size(); ++r) {
     std::vector<std::vector<std::string>> rows;
     for (const CandidateScore& c : d.selection.rounds[r]) {

@@ -24,6 +24,23 @@ constexpr double kIdleShare = 0.02;
 /// Steady state when samples lie this many electrical time constants apart.
 constexpr double kSteadyStateTimeConstants = 5.0;
 
+/// Each sample's time since the first with the log's pauses left out (an interval longer than
+/// LogData::kPauseMedianIntervals median intervals counts nothing); counts the pauses into `d`.
+std::vector<double> sampled_time_s(LogData& d) {
+  std::vector<double> sampled(d.size(), 0.0);
+  const double pause_s = LogData::kPauseMedianIntervals * d.median_dt_s;
+  for (std::size_t k = 1; k < d.size(); ++k) {
+    const double step_s = d.t_s(k) - d.t_s(k - 1);
+    const bool pause = d.median_dt_s > 0.0 && step_s > pause_s;
+    sampled[k] = sampled[k - 1] + (pause ? 0.0 : step_s);
+    if (pause) {
+      ++d.pauses;
+      d.longest_pause_s = std::max(d.longest_pause_s, step_s);
+    }
+  }
+  return sampled;
+}
+
 }  // namespace
 
 const char* to_string(ModelMode m) noexcept { return m == ModelMode::kTransient ? "transient" : "steady_state"; }
@@ -138,14 +155,16 @@ void prepare_log(LogData& d, const core::MachineSi& machine, const LogOptions& o
     }
   }
 
-  // Block b holds the samples whose time lies in [b, b + 1)·span/blocks (the last one's end included).
+  // Block b holds the samples whose sampled time lies in [b, b + 1)·span/blocks (the last one's end included):
+  // the time since the first sample with the pauses left out, so that a log of two recordings joined still
+  // trains and holds out on every part of both.
+  const std::vector<double> sampled = sampled_time_s(d);
   d.blocks = std::max(2, options.blocks);
   d.block_first.assign(static_cast<std::size_t>(d.blocks) + 1, n);
-  const double span = std::max(d.t_end_s - d.t_start_s, 1e-12);
+  const double span = std::max(sampled.empty() ? 0.0 : sampled.back(), 1e-12);
   int next = 0;
   for (std::size_t k = 0; k < n; ++k) {
-    const double t = d.t_s(k) - d.t_start_s;
-    const int b = std::min(d.blocks - 1, static_cast<int>(t / span * d.blocks));
+    const int b = std::min(d.blocks - 1, static_cast<int>(sampled[k] / span * d.blocks));
     for (; next <= b; ++next) d.block_first[static_cast<std::size_t>(next)] = k;
   }
 }

@@ -7,6 +7,7 @@
 #include <span>
 
 #include "rpem/can/frame.hpp"
+#include "rpem/can/sample_clock.hpp"
 #include "rpem/core/drive_sample.hpp"
 
 namespace rpem::can {
@@ -31,8 +32,9 @@ struct DecoderCounters {
 
 class TelemetryDecoder {
  public:
-  /// Decodes one frame into up to three samples (SI, phase frames). Returns how many.
-  [[nodiscard]] std::size_t decode(const CanFrame& frame, std::span<core::DriveSample> out) noexcept;
+  /// Decodes one frame, received at rx_ns (the host's clock: it tells how often the drive's time wrapped over
+  /// a silence), into up to three samples (SI, phase frames, at the drive's time). Returns how many.
+  [[nodiscard]] std::size_t decode(const CanFrame& frame, std::int64_t rx_ns, std::span<core::DriveSample> out) noexcept;
 
   /// Forgets the stream state (counters are kept): the next frame starts a new stream with a gap.
   void resynchronize() noexcept;
@@ -42,9 +44,12 @@ class TelemetryDecoder {
  private:
   enum class Sequence { kNext, kFirst, kLost, kDuplicate, kReordered };
   [[nodiscard]] Sequence check_sequence(std::uint8_t counter, bool& has_last, std::uint8_t& last) noexcept;
-  [[nodiscard]] std::size_t decode_fd(const CanFrame& f, std::span<core::DriveSample> out) noexcept;
-  [[nodiscard]] std::size_t decode_classic(const CanFrame& f, std::span<core::DriveSample> out) noexcept;
-  [[nodiscard]] std::int64_t unwrap_us(std::uint32_t t_us, int bits) noexcept;
+  [[nodiscard]] std::size_t decode_fd(const CanFrame& f, std::int64_t rx_ns, std::span<core::DriveSample> out) noexcept;
+  [[nodiscard]] std::size_t decode_classic(const CanFrame& f, std::int64_t rx_ns, std::span<core::DriveSample> out) noexcept;
+  /// The drive's time [ns] of a frame's T_first (FD) or T_low (classic), or false when the clock says stale
+  /// (its `samples` counted stale).
+  [[nodiscard]] bool drive_time(SampleClock& clock, std::uint32_t t_us, std::int64_t rx_ns, int samples,
+                                std::int64_t& t_ns) noexcept;
   /// Accepts a sample at time t: rejects it as stale, else marks a pending gap. True if accepted.
   [[nodiscard]] bool accept(core::DriveSample& s) noexcept;
 
@@ -55,10 +60,9 @@ class TelemetryDecoder {
   bool has_last_classic_counter_ = false;
   std::uint8_t last_classic_counter_ = 0;
   bool has_time_ = false;
-  std::int64_t last_time_us_ = 0;  ///< unwrapped drive time of the last delivered sample
-  bool has_epoch_ = false;
-  std::int64_t epoch_us_ = 0;  ///< unwrapping state
-  std::uint32_t last_raw_us_ = 0;
+  std::int64_t last_time_us_ = 0;                    ///< unwrapped drive time of the last delivered sample
+  SampleClock fd_clock_{32, false, 1e-6, 0.0};       ///< T_first: 32 bits of µs
+  SampleClock classic_clock_{24, false, 1e-6, 0.0};  ///< T_low: 24 bits of µs
 
   // Classic assembly of one sample from five frames.
   std::uint8_t classic_counter_ = 0;

@@ -6,8 +6,9 @@
 // An integer signal wraps every 2^length counts; the number of wraps between two samples is the one that
 // brings the drive's step nearest the receive times' step, so a silence longer than the wrap is still
 // counted right (the receive clock only has to be good to half a wrap). A sample the drive stamped before
-// the previous one (reordered, duplicated) is stale; kRestartAfterStale stale samples in a row mean the
-// drive's clock restarted, and the chain goes on from the previous time plus the receive step, as a gap.
+// the previous one (reordered, duplicated) is stale; kRestartAfterStale stale samples in a row, each after
+// the one before, mean the drive's clock restarted, and the chain goes on from the previous time plus the
+// receive step, as a gap (a clock that stopped stays stale).
 // Pure: no I/O, no allocation, no exceptions.
 
 #include <cstdint>
@@ -36,6 +37,8 @@ class SampleClock {
   [[nodiscard]] Step close(std::int64_t rx_ns, std::int64_t& t_ns) noexcept;
 
  private:
+  /// The newest raw reading lies after `earlier_raw` by less than half a wrap (integers).
+  [[nodiscard]] bool forward_of(std::uint64_t earlier_raw) const noexcept;
   void remember(std::int64_t rx_ns, std::int64_t t_ns) noexcept;
 
   bool is_float_ = false;
@@ -47,7 +50,9 @@ class SampleClock {
   std::uint64_t previous_raw_ = 0;
   double previous_value_s_ = 0.0;
   std::int64_t previous_t_ns_ = 0, previous_rx_ns_ = 0;
-  int stale_run_ = 0;
+  int stale_run_ = 0;  ///< stale samples in a row, each after the one before (a clock that restarted)
+  std::uint64_t stale_raw_ = 0;
+  double stale_value_s_ = 0.0;
   bool started_ = false;
 };
 

@@ -23,6 +23,12 @@ struct ReceivedFrame {
   std::int64_t kernel_rx_ns = 0;  ///< kernel receive timestamp (CLOCK_REALTIME), 0 if unavailable
 };
 
+/// When a frame arrived: the kernel's receive stamp (CLOCK_REALTIME), else `fallback_ns` (read by the caller
+/// from CLOCK_REALTIME once per batch).
+[[nodiscard]] inline std::int64_t receive_time_ns(const ReceivedFrame& f, std::int64_t fallback_ns) noexcept {
+  return f.kernel_rx_ns != 0 ? f.kernel_rx_ns : fallback_ns;
+}
+
 struct ChannelCounters {
   std::uint64_t rx_frames = 0;
   std::uint64_t tx_frames = 0;

@@ -31,10 +31,7 @@ inline constexpr std::array<CounterRow<can::ChannelCounters, std::uint64_t>, 6> 
   return name;
 }
 
-/// When a frame arrived: the kernel's receive stamp (CLOCK_REALTIME), else `fallback_ns`.
-[[nodiscard]] inline std::int64_t receive_time_ns(const can::ReceivedFrame& f, std::int64_t fallback_ns) noexcept {
-  return f.kernel_rx_ns != 0 ? f.kernel_rx_ns : fallback_ns;
-}
+using can::receive_time_ns;
 
 /// Sends the source's report when due: `fill(rows)` adds the decoder's rows, the socket's are added here.
 template <class Fill>

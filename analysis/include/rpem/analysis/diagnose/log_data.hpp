@@ -51,10 +51,15 @@ struct LogData {
   /// The estimator runs see the logged speed, as the drive gave it.
   int speed_half_window = 0;
   std::size_t excluded_idle = 0, excluded_transitional = 0;
-  /// Training and held-out blocks, alternating, equal in time: block b holds the samples
-  /// [block_first[b], block_first[b + 1]) (possibly none); even blocks train, odd blocks are held out.
+  /// Training and held-out blocks, alternating, equal in the time the log sampled (its pauses left out):
+  /// block b holds the samples [block_first[b], block_first[b + 1]); even blocks train, odd blocks are held out.
   int blocks = 0;
   std::vector<std::size_t> block_first;
+  /// The log's pauses — intervals longer than kPauseMedianIntervals times the median one (two recordings
+  /// joined, a logger paused) — which the blocks' time leaves out: how many and the longest [s].
+  static constexpr double kPauseMedianIntervals = 20.0;
+  std::size_t pauses = 0;
+  double longest_pause_s = 0.0;
 
   [[nodiscard]] std::size_t size() const noexcept { return samples.size(); }
   /// Sample k as logged.
@@ -105,7 +110,7 @@ struct LogOptions {
   /// estimator.regimes.hall_interpolation_speed_rad_s: below it an averaged window's speed is its step count's
   /// (core::window_speed_rad_s); 0: the reported speed everywhere.
   double staircase_below_rad_s = 0.0;
-  int blocks = 40;            ///< training and held-out blocks, alternating, equal in time
+  int blocks = 40;            ///< training and held-out blocks, alternating, equal in sampled time
   int speed_half_window = 4;  ///< transient logs: replay speed from the angle over ±this many samples
   std::string log_map;        ///< a column map (YAML) to read the log with; empty: detected (io::log_source)
 };
