@@ -28,6 +28,8 @@ constexpr double kSteadyStateTimeConstants = 5.0;
 /// LogData::kPauseMedianIntervals median intervals counts nothing); counts the pauses into `d`.
 std::vector<double> sampled_time_s(LogData& d) {
   std::vector<double> sampled(d.size(), 0.0);
+  d.pauses = 0;
+  d.longest_pause_s = 0.0;
   const double pause_s = LogData::kPauseMedianIntervals * d.median_dt_s;
   for (std::size_t k = 1; k < d.size(); ++k) {
     const double step_s = d.t_s(k) - d.t_s(k - 1);
