@@ -40,8 +40,10 @@ SampleClock::Step SampleClock::close(std::int64_t rx_ns, std::int64_t& t_ns) noe
     return Step::kFirst;
   }
   const std::int64_t rx_step_ns = rx_ns - previous_rx_ns_;
-  double step_s = now_s - previous_value_s_;
-  if (!is_float_) {
+  double step_s = 0.0;
+  if (is_float_) {
+    step_s = value_s_ - previous_value_s_;
+  } else {
     // The drive's step in counts: the wrapped difference plus the whole wraps that bring it nearest the
     // receive step (none for a counter that does not wrap); behind the previous sample: negative.
     const auto delta = static_cast<std::int64_t>(raw_ - previous_raw_);

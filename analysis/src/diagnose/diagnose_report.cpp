@@ -355,8 +355,8 @@ void selection(ReportDocument& doc, const Diagnosis& d) {
   doc.heading(1, "How the effects were selected");
   doc.paragraph(
       "The log is cut into " + std::to_string(d.log->blocks) +
-      " blocks of equal duration in the time it sampled (its pauses left out); even blocks train, odd blocks are held out. Each round ranks every remaining "
-      "candidate by the training gain its first Gauss–Newton step predicts, fits the best " +
+      " blocks of equal duration in the time it sampled (its pauses left out); even blocks train, odd blocks are "
+      "held out. Each round ranks every remaining candidate by the training gain its first Gauss–Newton step predicts, fits the best " +
       std::to_string(d.options.selection.shortlist) +
       " jointly with the effects already found (Ceres), and accepts the one that lowers the held-out residual "
       "most — if it lowers its RMS by at least " +
