@@ -80,9 +80,15 @@ void print_start(const DaemonConfig& config, const std::string& source_name, con
                    : (ids.empty() ? std::string("need a key (none loaded)") : "authenticated with key id " + ids).c_str(),
                static_cast<long long>(commands.last_accepted_seq), commands.sequence_file.c_str(), signing.c_str());
   // A VESC is mostly sensorless, the default frame a position sensor's.
-  if (std::string_view(source_type) == VescSource::kType) {
+  if (const auto* v = std::get_if<VescSource::Options>(&config.fixed.source)) {
     if (const std::string note = io::unstated_frame_note(config.live.machine); !note.empty())
       std::fprintf(stderr, "rpemd: %s\n", note.c_str());
+    if (v->count_horizon_s > 0.0) {
+      std::fprintf(stderr,
+                   "rpemd: a Hall drive (regimes.angle_source: hall): the polls ask for the tachometer, and each window "
+                   "waits %.2f s for its speed to be counted over the reads around it (docs/rpemd.md)\n",
+                   v->count_horizon_s);
+    }
   }
 }
 

@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <variant>
 
+#include "rpem/core/reported_speed.hpp"
 #include "rpem/io/averaged_log.hpp"
 #include "rpem/io/thermal_config.hpp"
 
@@ -170,6 +171,10 @@ DaemonConfig parse(io::YamlMap& root, const std::string& name, const std::string
   }
   if (d) parse_daemon(*d, c, base_dir);
   root.finish();
+  // A Hall drive's staircase angle: the VESC source counts each window's speed from the tachometer (CountDelay).
+  if (auto* v = std::get_if<VescSource::Options>(&c.fixed.source)) {
+    v->count_horizon_s = machine.estimator.regimes.hall_interpolation_speed_rad_s > 0.0 ? core::kCountRunSideMaxS : 0.0;
+  }
   fill_defaults(machine, c.live.temperature);
   check_source_supports(c);
   return c;

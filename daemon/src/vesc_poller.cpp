@@ -100,6 +100,8 @@ bool VescPoller::on_frame(const can::CanFrame& f, std::int64_t rx_ns, core::Aver
 
   const std::int64_t t = reply_start_ns_ != 0 ? reply_start_ns_ : rx_ns;
   reply_start_ns_ = 0;
+  ++reads_;
+  last_read_ = {t, decoder_.values().tachometer * vesc::kTachometerStepRad};
   // With reply_timeout_s ≥ the period, polls overlap their predecessors' replies by design: the controller
   // answers them in turn, so a poll that timed out unanswered takes the first reply, before the poll sent
   // after it. With a shorter timeout a reply while the next poll is out is that poll's (the timed-out one's

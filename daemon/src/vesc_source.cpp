@@ -4,11 +4,13 @@
 #include <array>
 #include <cmath>
 #include <ctime>
+#include <memory>
 #include <optional>
 
 #include "rpem/can/socketcan.hpp"
 #include "rpem/can/vesc.hpp"
 #include "rpem/core/clock.hpp"
+#include "rpem/daemon/count_delay.hpp"
 #include "rpem/daemon/socketcan_source.hpp"
 #include "rpem/daemon/vesc_poller.hpp"
 
@@ -51,6 +53,7 @@ VescPoller::Config poller_config(const VescSource::Options& o) noexcept {
   c.phase_ns = std::llround(o.poll_phase * static_cast<double>(c.period_ns));
   c.timeout_ns = std::llround(o.reply_timeout_s * 1e9);
   c.speed_lag_s = core::pll_ramp_lag_s(o.pll_kp, o.pll_ki);
+  c.mask = o.count_horizon_s > 0.0 ? can::vesc::kCountingMask : can::vesc::kEstimatorMask;
   return c;
 }
 
@@ -85,6 +88,10 @@ class VescSampleSource final : public SampleSource {
     VescPoller poller(poller_config(options_));
     std::array<can::ReceivedFrame, 64> frames;
     core::AveragedSample sample;
+    // Counting: windows wait for the reads after them (allocated once, here; the loop below allocates nothing).
+    const bool counting = options_.count_horizon_s > 0.0;
+    const auto delay = counting ? std::make_unique<CountDelay>(can::vesc::kTachometerStepRad, options_.count_horizon_s)
+                                : std::unique_ptr<CountDelay>();
     const std::int64_t gather_ns = reply_gather_ns(poller_config(options_).period_ns);
     const timespec gather{0, static_cast<long>(gather_ns)};
     while (!stop.load(std::memory_order_relaxed)) {
@@ -97,10 +104,21 @@ class VescSampleSource final : public SampleSource {
       now = core::now_ns(CLOCK_REALTIME);
       bool completed = false;
       for (std::size_t f = 0; f < n; ++f) {
-        if (poller.on_frame(frames[f].frame, receive_time_ns(frames[f], now), sample)) {
-          out.push(sample);
-          completed = true;
+        const std::uint64_t reads_before = poller.reads();
+        const bool sampled = poller.on_frame(frames[f].frame, receive_time_ns(frames[f], now), sample);
+        completed = completed || sampled;
+        if (!counting) {
+          if (sampled) out.push(sample);
+          continue;
         }
+        if (poller.reads() != reads_before) delay->add_read(poller.last_read());
+        if (!sampled) continue;
+        core::AveragedSample due;
+        while (delay->full() && delay->release(now, due)) out.push(due);
+        delay->add_window(sample);
+      }
+      if (counting) {
+        for (core::AveragedSample due; delay->release(now, due);) out.push(due);
       }
       // Frames but no complete reply: the rest of it is on its way — take it in one wake-up, not one per frame.
       if (n > 0 && !completed) nanosleep(&gather, nullptr);

@@ -1,8 +1,6 @@
 #include "rpem/io/averaged_log.hpp"
 
-#include <array>
 #include <cmath>
-#include <limits>
 #include <vector>
 
 #include "rpem/core/clock.hpp"
@@ -12,18 +10,27 @@
 namespace rpem::io {
 namespace {
 
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+/// The count's quantum as the log shows it: the smallest change between consecutive reads (0: it never changed).
+double count_step_rad(const std::vector<core::CountRead>& reads) {
+  double step = 0.0;
+  for (std::size_t j = 1; j < reads.size(); ++j) {
+    const double change = std::abs(reads[j].travel_el_rad - reads[j - 1].travel_el_rad);
+    if (change > 0.0 && (step == 0.0 || change < step)) step = change;
+  }
+  return step;
+}
 
-/// Each window's counted speed over the centred run of it and its neighbours that continue it (docs/derivations.md
-/// §13, "The count's speed at a crawl"): a symmetric run's mean is the middle window's under a constant
-/// acceleration, and its count is exact but for a step at each end, a third of the error of the window's own.
-void set_counted_speeds(std::vector<core::AveragedSample>& out, const std::vector<std::array<double, 2>>& travel_rad) {
-  const std::size_t n = out.size();
-  for (std::size_t k = 0; k < n; ++k) {
-    const std::size_t a = k > 0 && out[k].t_start_ns == out[k - 1].t_ns ? k - 1 : k;
-    const std::size_t b = k + 1 < n && out[k + 1].t_start_ns == out[k].t_ns ? k + 1 : k;
-    out[k].omega_counted_el_rad_s =
-        core::counted_mean_speed_rad_s(travel_rad[a][0], out[a].t_start_ns, travel_rad[b][1], out[b].t_ns);
+/// Each window's counted speed over the centred run of reads around it, grown while its sides agree
+/// (core::grown_count_speed_rad_s; docs/derivations.md §13). `ends[k]` is the read that ends window k; a window
+/// that does not start at the read before it (a log of windows with their own starts) has no count.
+void set_counted_speeds(std::vector<core::AveragedSample>& out, const std::vector<core::CountRead>& reads,
+                        const std::vector<std::size_t>& ends) {
+  const double step_rad = count_step_rad(reads);
+  const auto side_max_ns = static_cast<std::int64_t>(core::kCountRunSideMaxS * 1e9);
+  for (std::size_t k = 0; k < out.size(); ++k) {
+    const std::size_t e = ends[k];
+    if (e == 0 || reads[e - 1].t_ns != out[k].t_start_ns) continue;
+    out[k].omega_counted_el_rad_s = core::grown_count_speed_rad_s(reads, e - 1, e, step_rad, side_max_ns);
   }
 }
 
@@ -56,10 +63,11 @@ std::vector<core::AveragedSample> read_averaged_log(const std::string& path, con
   MappedRow r;
   std::optional<std::int64_t> previous_t_ns;
   double previous_omega_rad_s = 0.0;  // the previous row's speed as the column gives it
-  // The drive's count of its angle (travel_el) at each sample's two reads: the counted speeds, after the rows.
+  // The drive's count of its angle (travel_el) at every row's read, and the read that ends each sample: the
+  // counted speeds, after the rows.
   const bool counted = reader.has(Quantity::kTravelEl);
-  double previous_travel_rad = kNaN;
-  std::vector<std::array<double, 2>> travel_rad;
+  std::vector<core::CountRead> reads;
+  std::vector<std::size_t> read_ending;
   std::size_t first_line = 0;
   while (reader.next(r)) {
     ++read.rows;
@@ -72,7 +80,7 @@ std::vector<core::AveragedSample> read_averaged_log(const std::string& path, con
       // The means of the first row ran since a read before the log began: an unknown window.
       previous_t_ns = r.t_ns;
       previous_omega_rad_s = r[Quantity::kOmegaEl];
-      if (counted) previous_travel_rad = r[Quantity::kTravelEl];
+      if (counted) reads.push_back({r.t_ns, r[Quantity::kTravelEl]});
       first_line = r.line;
       ++read.opening_rows;
       continue;
@@ -95,14 +103,12 @@ std::vector<core::AveragedSample> read_averaged_log(const std::string& path, con
     s.t_drive_C = r[Quantity::kTDrive];
     s.t_coolant_C = r[Quantity::kTCoolant];
     if (counted) {
-      // A window continues the previous row where it starts at its read (always, with previous_row windows).
-      const bool continues = !out.empty() ? out.back().t_ns == s.t_start_ns : map.window == Window::kPreviousRow;
-      travel_rad.push_back({continues ? previous_travel_rad : kNaN, r[Quantity::kTravelEl]});
-      previous_travel_rad = r[Quantity::kTravelEl];
+      read_ending.push_back(reads.size());
+      reads.push_back({r.t_ns, r[Quantity::kTravelEl]});
     }
     out.push_back(s);
   }
-  if (counted) set_counted_speeds(out, travel_rad);
+  if (counted) set_counted_speeds(out, reads, read_ending);
   if (out.empty()) {
     throw DriveLogError(path, first_line, 0, "",
                         "no samples: the only row holds means since a read before the log began (an unknown window); "

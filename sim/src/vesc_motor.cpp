@@ -1,5 +1,6 @@
 #include "rpem/sim/vesc_motor.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include "rpem/core/clock.hpp"
@@ -73,7 +74,16 @@ void VescMotor::account(const ControlCycle& c) noexcept {
   const double i_in = input_current_A(c);
   last_input_current_A_ = i_in;
   input_current_sum_A_ += i_in;
-  const double steps = 6.0 * c.omega_el_rad_s * dt_s / (2.0 * core::kPi);
+  // The tachometer counts the 60° sectors the angle in use crosses, once per cycle (mcpwm_foc.c, "Update
+  // tachometer"): sector ⌊(θ + π)/(2π)·6⌋ of the wrapped angle, the change taken in (−3, 3].
+  const int sector = std::clamp(
+      static_cast<int>(std::floor((core::wrap_angle(c.theta_el_rad) + core::kPi) / (2.0 * core::kPi) * 6.0)), 0, 5);
+  if (!has_sector_) tacho_sector_ = sector;
+  has_sector_ = true;
+  int steps = sector - tacho_sector_;
+  tacho_sector_ = sector;
+  if (steps > 3) steps -= 6;
+  if (steps < -2) steps += 6;
   tacho_steps_ += steps;
   tacho_abs_steps_ += std::abs(steps);
   const double ah = std::abs(i_in) * dt_s / 3600.0;

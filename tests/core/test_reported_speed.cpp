@@ -19,7 +19,9 @@
 namespace {
 
 using rpem::core::AveragedSample;
-using rpem::core::counted_mean_speed_rad_s;
+using rpem::core::CountRead;
+using rpem::core::grown_count_speed_rad_s;
+using rpem::core::kCountRunSideMaxS;
 using rpem::core::SpeedRead;
 using rpem::core::window_mean_speed_rad_s;
 using rpem::core::window_speed_rad_s;
@@ -118,10 +120,6 @@ TEST(ReportedSpeed, ConstantSpeedAndDegenerateReads) {
 // A count of the angle's steps: the run's mean speed is travel over time; the window's speed is the count's only
 // below the staircase speed (strictly), and the reported one without a count, above it, or with no staircase.
 TEST(ReportedSpeed, TheCountsSpeedReplacesTheReportedOneOnlyBelowTheStaircaseSpeed) {
-  constexpr double kStep = std::numbers::pi / 3.0;
-  EXPECT_DOUBLE_EQ(counted_mean_speed_rad_s(4.0 * kStep, 0, 7.0 * kStep, 300'000'000), 3.0 * kStep / 0.3);
-  EXPECT_DOUBLE_EQ(counted_mean_speed_rad_s(7.0 * kStep, 0, 4.0 * kStep, 200'000'000), -3.0 * kStep / 0.2);
-  EXPECT_TRUE(std::isnan(counted_mean_speed_rad_s(0.0, 5, 1.0, 5)));
   AveragedSample a;
   a.omega_el_rad_s = 2.0;
   EXPECT_DOUBLE_EQ(window_speed_rad_s(a, 52.36), 2.0);  // no count
@@ -129,6 +127,67 @@ TEST(ReportedSpeed, TheCountsSpeedReplacesTheReportedOneOnlyBelowTheStaircaseSpe
   EXPECT_DOUBLE_EQ(window_speed_rad_s(a, 52.36), -7.5);
   EXPECT_DOUBLE_EQ(window_speed_rad_s(a, 7.5), 2.0);  // at the staircase speed: reported
   EXPECT_DOUBLE_EQ(window_speed_rad_s(a, 0.0), 2.0);  // no staircase (not angle_source: hall)
+}
+
+// Reads of a count of 60° steps (floor of the rotor's angle over a step) every `period_s` (jittered ±20 %) of
+// a rotor at angle θ(t); the count's speed of the window ending at the read nearest `at_s`, and that window's
+// true mean speed (travel over its time, exactly).
+struct CountedWindow {
+  double counted_rad_s = 0.0, true_rad_s = 0.0, run_s = 0.0;
+};
+CountedWindow count_window(const std::function<double(double)>& theta, double period_s, double duration_s, double at_s) {
+  constexpr double kStep = std::numbers::pi / 3.0;
+  std::vector<CountRead> reads;
+  std::uint32_t lcg = 12345;
+  for (double t = 0.0; t < duration_s;) {
+    reads.push_back({static_cast<std::int64_t>(std::llround(t * 1e9)), kStep * std::floor(theta(t) / kStep)});
+    lcg = lcg * 1664525u + 1013904223u;
+    t += period_s * (0.8 + 0.4 * (lcg >> 8) / 16777216.0);
+  }
+  std::size_t e = 1;
+  while (e + 1 < reads.size() && rpem::core::to_seconds(reads[e].t_ns) < at_s) ++e;
+  CountedWindow w;
+  w.counted_rad_s = grown_count_speed_rad_s(reads, e - 1, e, kStep, static_cast<std::int64_t>(kCountRunSideMaxS * 1e9));
+  const double t0 = rpem::core::to_seconds(reads[e - 1].t_ns), t1 = rpem::core::to_seconds(reads[e].t_ns);
+  w.true_rad_s = (theta(t1) - theta(t0)) / (t1 - t0);
+  return w;
+}
+
+// At a constant speed the run grows to its horizon on both sides (the sides agree within their resolution), so
+// a 5 ms window at a crawl is counted over ≈ 0.5 s: within one step over the run (2.1 rad/s) of its speed, where
+// the window's own count (0 or 1 step in 5 ms) is off by up to 209 rad/s. Under a constant acceleration the
+// centred run's mean is the window's (a symmetric run in reads, jittered: within the step bound and the
+// acceleration times the centres' offset, ≤ a·20 % of a read).
+TEST(ReportedSpeed, AWindowsCountGrowsOverAConstantSpeedToItsHorizon) {
+  constexpr double kStep = std::numbers::pi / 3.0;
+  for (const double w : {3.0, 20.0, -40.0}) {
+    const CountedWindow c = count_window([w](double t) { return 0.7 + w * t; }, 0.005, 3.0, 1.5);
+    EXPECT_NEAR(c.counted_rad_s, c.true_rad_s, kStep / (2.0 * kCountRunSideMaxS - 0.02)) << w;
+  }
+  const double a = 40.0;  // rad/s², 10 → 70 rad/s over 1.5 s
+  const CountedWindow c = count_window([a](double t) { return 10.0 * t + 0.5 * a * t * t; }, 0.005, 2.0, 1.0);
+  EXPECT_NEAR(c.counted_rad_s, c.true_rad_s, kStep / (2.0 * kCountRunSideMaxS - 0.02) + a * 0.002);
+}
+
+// A rotor that stops: 40 rad/s until 1 s, then standing. 100 ms after the stop the side reaching back into the
+// motion counts ≈ 4 steps where the other counts none, so the run stops growing before it: the window's counted
+// speed is near 0 (within the step over the shortest run, 3 reads ≈ 15 ms, i.e. 70 rad/s at worst; here it is
+// within 2·step over the 0.2 s run the sides allowed), not the ≈ 12 rad/s of a run over the horizon.
+TEST(ReportedSpeed, AWindowsCountStopsGrowingWhereItsSidesDisagree) {
+  const auto theta = [](double t) { return 40.0 * std::min(t, 1.0); };
+  const CountedWindow c = count_window(theta, 0.005, 2.0, 1.1);
+  EXPECT_DOUBLE_EQ(c.true_rad_s, 0.0);
+  EXPECT_LT(std::abs(c.counted_rad_s), 2.0 * (std::numbers::pi / 3.0) / 0.19) << c.counted_rad_s;
+}
+
+// Degenerate runs: no window (s ≥ e), reads at one instant.
+TEST(ReportedSpeed, ACountWithoutARunIsNotANumber) {
+  const std::vector<CountRead> reads{{0, 0.0}, {0, 1.0}, {10, 2.0}};
+  EXPECT_TRUE(std::isnan(grown_count_speed_rad_s(reads, 1, 1, 1.0, 1'000'000)));
+  EXPECT_TRUE(std::isnan(grown_count_speed_rad_s(reads, 2, 1, 1.0, 1'000'000)));
+  const std::vector<CountRead> same{{5, 0.0}, {5, 1.0}};
+  EXPECT_TRUE(std::isnan(grown_count_speed_rad_s(same, 0, 1, 1.0, 1'000'000)));
+  EXPECT_DOUBLE_EQ(grown_count_speed_rad_s(reads, 1, 2, 1.0, 1'000'000), 2.0 / 10e-9);  // m = 1: reads 0 to 2
 }
 
 }  // namespace

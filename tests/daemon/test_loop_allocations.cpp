@@ -6,11 +6,14 @@
 #include <array>
 #include <atomic>
 #include <cstdlib>
+#include <memory>
 #include <new>
 #include <variant>
 
+#include "rpem/can/vesc.hpp"
 #include "rpem/command_t.hpp"
 #include "rpem/daemon/command_gate.hpp"
+#include "rpem/daemon/count_delay.hpp"
 #include "rpem/daemon/loop_thread.hpp"
 #include "support/averaged_data.hpp"
 #include "support/loop_queues.hpp"
@@ -155,6 +158,27 @@ TEST(LoopAllocations, NoneOnTheAveragedPath) {
   }
   EXPECT_EQ(g_allocations.load() - before, 0);
   EXPECT_GT(next, 19'000u);
+}
+
+// The VESC source's count delay (a Hall drive's windows held for their counted speeds; its thread's per-reply
+// work) allocates nothing once made: 20 s of replies at 2 kHz, the ring full at times (a 0.6 s horizon).
+TEST(LoopAllocations, NoneInTheVescSourcesCountDelay) {
+  const auto delay = std::make_unique<CountDelay>(can::vesc::kTachometerStepRad, 0.6);
+  const long before = g_allocations.load();
+  core::AveragedSample window, due;
+  std::size_t released = 0;
+  for (std::int64_t k = 0; k < 40'000; ++k) {
+    const std::int64_t t = k * 500'000;
+    delay->add_read({t, can::vesc::kTachometerStepRad * static_cast<double>(k / 100)});
+    if (k == 0) continue;
+    window.t_start_ns = t - 500'000;
+    window.t_ns = t;
+    while (delay->full() && delay->release(t, due)) ++released;
+    delay->add_window(window);
+    while (delay->release(t, due)) ++released;
+  }
+  EXPECT_EQ(g_allocations.load() - before, 0);
+  EXPECT_EQ(released + delay->held(), 39'999U);
 }
 
 // RPEM_COMMAND's entry point (control thread) promises no allocation either, whatever the bytes —

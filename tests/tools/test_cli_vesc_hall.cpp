@@ -9,10 +9,13 @@
 #include <nlohmann/json.hpp>
 
 #include <cmath>
+#include <cstdio>
 #include <fstream>
+#include <functional>
 #include <regex>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include "support/process.hpp"
 #include "support/temp_file.hpp"
@@ -50,7 +53,8 @@ Estimated estimate(const std::string& log, const std::string& source, const std:
   const std::string edited =
       std::regex_replace(text.str(), std::regex("angle_source: sensorless"), "angle_source: " + source);
   EXPECT_TRUE(source == "sensorless" || edited != text.str());
-  const test::TempFile cfg("hall_" + source + ".yaml", edited), out("hall_estimates.csv");
+  const test::TempFile cfg("hall_" + std::to_string(std::hash<std::string>{}(source)) + ".yaml", edited),
+      out("hall_estimates.csv");
   Estimated run;
   const std::string csv = estimates.empty() ? out.path() : estimates;
   const test::ProcessResult r =
@@ -196,6 +200,88 @@ TEST(CliVescHall, TheIndependentGeneratorsHallRideAdaptsRsOnlyWhereItsSensorsBou
     EXPECT_NEAR(run.psi_m_Wb / psi_true, 1.0, 0.02) << source << run.output;
     EXPECT_NEAR(run.r_s_Ohm / t.at("true_at_end").at("r_s_Ohm").get<double>(), 1.0, 0.05) << source << run.output;
   }
+}
+
+}  // namespace
+}  // namespace rpem
+
+namespace rpem {
+namespace {
+
+/// The speed each window of an estimate CSV stood for [rad/s] (n_pu times the base, the base from the reads above
+/// 500 rad/s, where every speed is the PLL's rebuilt one and within a fraction of a percent of the truth's mean).
+std::vector<double> speeds_used(const std::string& csv, const nlohmann::json& rows) {
+  std::ifstream in(csv);
+  std::string line;
+  std::getline(in, line);
+  const std::size_t n_column = column_of(line, "n_pu");
+  std::vector<double> n_pu;
+  while (std::getline(in, line)) {
+    std::stringstream row(line);
+    std::string cell;
+    for (std::size_t c = 0; c <= n_column; ++c) std::getline(row, cell, ',');
+    n_pu.push_back(std::stod(cell));
+  }
+  double num = 0.0, den = 0.0;
+  for (std::size_t k = 0; k < n_pu.size() && k + 1 < rows.size(); ++k) {
+    const double w = rows[k + 1].at("omega_el_mean_rad_s").get<double>();
+    if (std::abs(w) > 500.0) {
+      num += n_pu[k] * w;
+      den += n_pu[k] * n_pu[k];
+    }
+  }
+  for (double& n : n_pu) n *= num / den;
+  return n_pu;
+}
+
+// rpemd's poll rate (200 Hz reads: the independent generator's Hall ride with VESC Tool's link replaced by a CAN
+// poller's: no loss, no stall — tests/independent_vesc): a 5 ms window holds no step of the tachometer or one, so the three-read run
+// alone would count 0 or ±70 rad/s; the run grown while its sides agree (docs/derivations.md §13, "The count's speed
+// over a grown run" — what rpemd's VESC source counts too, daemon/count_delay.hpp) puts each crawling window's
+// speed within the count's bound over a full run (2 steps over 0.5 s: 4.2 rad/s) of the truth's mean in RMS, where
+// the PLL's rebuilt speed is off by several times that; ψm ends within 2 % and R_s within 5 % or declared.
+TEST(CliVescHall, AtRpemdsPollRateEachCrawlingWindowsSpeedIsCountedOverAGrownRun) {
+  const test::TempFile log("indep_hall_200.csv"), truth("indep_hall_200.json");
+  const test::TempFile counted("hall_200_counted.csv"), pll("hall_200_pll.csv");
+  const test::ProcessResult gen =
+      test::run_command(test::binary_dir() + "/tests/independent_vesc/indep_vesc_log --config " + test::source_dir() +
+                        "/config/vesc-6374-outrunner.yaml --hall --seed 4 --duration-s 70 --psi-m-rel 0.2 --r-s-rel -0.15 "
+                        "--poll-rate-Hz 200 --rate-Hz 180 --set poller.rtt_min_s=0.0005 --set poller.rtt_sigma_log=0.05 "
+                        "--set poller.loss_probability=0 --set poller.stall_probability=0 --out " +
+                        log.path() + " --truth " + truth.path());
+  ASSERT_EQ(gen.exit_code, 0) << gen.output;
+  const nlohmann::json t = nlohmann::json::parse(std::ifstream(truth.path()));
+  const nlohmann::json& rows = t.at("rows");
+  ASSERT_GT(rows.size(), 13'000U);
+
+  const Estimated hall = estimate(log.path(), "hall", "vesc-6374-firmware.yaml", counted.path());
+  EXPECT_NEAR(hall.psi_m_Wb / t.at("true_at_end").at("psi_m_Wb").get<double>(), 1.0, 0.02) << hall.output;
+  if (hall.output.find("r_s not identifiable") == std::string::npos) {
+    EXPECT_NEAR(hall.r_s_Ohm / t.at("true_at_end").at("r_s_Ohm").get<double>(), 1.0, 0.05) << hall.output;
+  }
+  // The same with the count never taken: the PLL's rebuilt speed everywhere (rpemd before it counted).
+  (void)estimate(log.path(), "hall\n    hall_interpolation_speed_rad_s: 0", "vesc-6374-firmware.yaml", pll.path());
+
+  const std::vector<double> with_count = speeds_used(counted.path(), rows), with_pll = speeds_used(pll.path(), rows);
+  ASSERT_EQ(with_count.size(), with_pll.size());
+  double count_sq = 0.0, pll_sq = 0.0;
+  int n = 0;
+  for (std::size_t k = 0; k < with_count.size() && k + 1 < rows.size(); ++k) {
+    const nlohmann::json& r = rows[k + 1];
+    const double w = r.at("omega_el_mean_rad_s").get<double>();
+    if (std::abs(w) >= 52.0 || r.at("bridge").get<std::string>() != "modulating" ||
+        std::abs(r.at("i_q_mean_A").get<double>()) <= 3.0) {
+      continue;
+    }
+    count_sq += std::pow(with_count[k] - w, 2);
+    pll_sq += std::pow(with_pll[k] - w, 2);
+    ++n;
+  }
+  ASSERT_GT(n, 3000);
+  const double count_rms = std::sqrt(count_sq / n), pll_rms = std::sqrt(pll_sq / n);
+  std::printf("[ crawl    ] %d windows: counted RMS %.2f rad/s, the PLL's %.2f rad/s\n", n, count_rms, pll_rms);
+  EXPECT_LT(count_rms, 2.0 * (M_PI / 3.0) / 0.5);
+  EXPECT_GT(pll_rms, 3.0 * count_rms);
 }
 
 }  // namespace

@@ -17,18 +17,19 @@ else
   out=$(mktemp -d)
   trap 'rm -rf "$out"' EXIT
 fi
-cp "$repo/scenarios/can-stream.yaml" "$repo/scenarios/vesc-6374.yaml" "$repo/config/vesc-6374-outrunner.yaml" \
-   "$repo/config/signal-maps/rpem-native-classic.yaml" "$out/"
-# The scenario names its machine relative to itself (../config/…): give it that layout.
+cp "$repo/scenarios/can-stream.yaml" "$repo/scenarios/vesc-6374.yaml" "$repo/scenarios/vesc-tool-hall.yaml" \
+   "$repo/config/vesc-6374-outrunner.yaml" "$repo/config/signal-maps/rpem-native-classic.yaml" "$out/"
+# The scenarios name their machine relative to themselves (../config/…): give them that layout.
 mkdir -p "$out/config" && cp "$repo/config/vesc-6374-outrunner.yaml" "$out/config/"
-sed -i 's|^machine: ../config/|machine: config/|' "$out/vesc-6374.yaml"
+sed -i 's|^machine: ../config/|machine: config/|' "$out/vesc-6374.yaml" "$out/vesc-tool-hall.yaml"
 
 # rpemd's part runs where the tree has `source: vesc` (daemon/src/vesc_source.cpp, branch vesc-12).
 rpemd_files=()
 if [[ ${2:-} == --rpemd && -f $repo/daemon/src/vesc_source.cpp && -x $build/daemon/rpemd ]]; then
   cp "$here/vesc_rpemd.sh" "$here/rpemd-vesc-vcan.yaml" "$here/rpemd-map-vcan.yaml" "$out/"
   rpemd_files=(--file "$build/daemon/rpemd" --file "$here/vesc_rpemd.sh" --file "$here/rpemd-vesc-vcan.yaml"
-               --file "$here/rpemd-map-vcan.yaml" --file "$repo/config/vesc-6374-outrunner.yaml")
+               --file "$here/rpemd-map-vcan.yaml" --file "$repo/config/vesc-6374-outrunner.yaml"
+               --file "$out/vesc-tool-hall.yaml")
   # The AX8000 part: its drive simulated and its TxPDOs built here (the VM has no python), replayed there.
   echo "run_vesc_suite: simulating the AX8000 drive (tests/vm/ax8000-vcan.yaml) and building its TxPDOs"
   "$build/tools/rpem" sim --scenario "$here/ax8000-vcan.yaml" --out "$out/ax8000_drive.csv" \
@@ -64,5 +65,6 @@ else
   python3 "$here/check_map_rpemd.py" "$out/rpemd_map.txt" "$out/map_offline_est.csv"
   python3 "$here/check_ax8000_rpemd.py" "$out"
   for run in r200 r1k; do python3 "$here/check_vesc_rpemd.py" "$out" "$run"; done
+  python3 "$here/check_vesc_hall_rpemd.py" "$out"
 fi
 echo "run_vesc_suite: passed"

@@ -83,6 +83,10 @@ enum Field : int {
 /// motor temperature.
 inline constexpr std::uint32_t kEstimatorMask =
     bit(kTempFet) | bit(kTempMotor) | bit(kId) | bit(kIq) | bit(kRpm) | bit(kVin) | bit(kVd) | bit(kVq);
+/// The estimator's fields and the tachometer, for a drive whose speed is counted (a Hall drive at a crawl).
+inline constexpr std::uint32_t kCountingMask = kEstimatorMask | bit(kTachometer);
+/// The tachometer's step: a 60° sector of the angle in use (mcpwm_foc.c, "Update tachometer"), six per turn.
+inline constexpr double kTachometerStepRad = core::kPi / 3.0;
 
 [[nodiscard]] constexpr std::uint32_t extended_id(std::uint8_t controller_id, Packet p) noexcept {
   return controller_id | (static_cast<std::uint32_t>(p) << 8);

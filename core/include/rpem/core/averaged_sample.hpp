@@ -18,8 +18,8 @@ struct AveragedSample {
   Vec2 i_dq_A = Vec2::Zero();   ///< mean measured current, rotor frame
   Vec2 u_dq_V = Vec2::Zero();   ///< mean voltage the drive reports (its command, or its estimate of the applied voltage)
   double omega_el_rad_s = 0.0;  ///< mean electrical speed (as the drive reports it, rebuilt to the window's mean)
-  /// The mean electrical speed the drive's own count of its angle's steps gives over this window and its two
-  /// neighbours (VESC's tachometer: docs/derivations.md §13, "The count's speed at a crawl"); NaN: not counted.
+  /// The mean electrical speed the drive's own count of its angle's steps gives over a run of reads centred on this
+  /// window (VESC's tachometer: core::grown_count_speed_rad_s, docs/derivations.md §13); NaN: not counted.
   /// Taken instead of omega_el_rad_s where the drive's angle is a staircase (core::window_speed_rad_s).
   double omega_counted_el_rad_s = std::numeric_limits<double>::quiet_NaN();
   double u_dc_V = std::numeric_limits<double>::quiet_NaN();       ///< mean DC link; NaN: not reported

@@ -12,6 +12,7 @@
 // Tool log's reader, rpemd's VESC source): pure and allocation-free.
 
 #include <cmath>
+#include <cstddef>
 #include <cstdint>
 
 #include "rpem/core/averaged_sample.hpp"
@@ -42,13 +43,43 @@ struct SpeedRead {
   return now.omega_el_rad_s - slope * (0.5 * to_seconds(now.t_ns - t_start_ns) - lag_s);
 }
 
-/// The mean speed over [start, end] from a count of the angle it travelled (a drive's step count, in rad):
-/// exact but for one step at each end, so within a step over the run (docs/derivations.md §13, "The count's
-/// speed at a crawl"). NaN where the run has no length.
-[[nodiscard]] inline double counted_mean_speed_rad_s(double travel_start_rad, std::int64_t start_ns, double travel_end_rad,
-                                                     std::int64_t end_ns) noexcept {
-  const double run_s = to_seconds(end_ns - start_ns);
-  return run_s > 0.0 ? (travel_end_rad - travel_start_rad) / run_s : std::nan("");
+/// One read of a drive's count of the angle it travelled (VESC's tachometer: six steps per electrical turn).
+struct CountRead {
+  std::int64_t t_ns = 0;
+  double travel_el_rad = 0.0;
+};
+
+/// The longest time on each side of a window over which its speed is counted (docs/derivations.md §13, "The count's
+/// speed over a grown run"): what rpemd's VESC source holds each window back by when it counts.
+inline constexpr double kCountRunSideMaxS = 0.25;
+
+/// The counted mean speed of the window between reads `s` and `e` (s < e) of `reads` (random access: size(),
+/// [j].t_ns, [j].travel_el_rad; times increasing) — docs/derivations.md §13, "The count's speed at a crawl" and
+/// "… over a grown run". The run of reads a = s − m … b = e + m centred on the window: m = 1 (or the reads there
+/// are), grown while both sides stay within `side_max_ns` and the speeds counted on the two sides agree within
+/// their resolutions. A count is within 2·step of the rotor's travel (one step for where each end falls inside its
+/// step, one for the angle in use leading or lagging the rotor by up to half a step at each end, a Hall state's
+/// centre), so a side of length s_i resolves 2·step/s_i; sides that differ by more saw the speed change, and the
+/// run stops before them. Symmetric, the run's mean is the window's under a constant acceleration. NaN: no run.
+template <class Reads>
+[[nodiscard]] double grown_count_speed_rad_s(const Reads& reads, std::size_t s, std::size_t e, double step_rad,
+                                             std::int64_t side_max_ns) noexcept {
+  const std::size_t n = reads.size();
+  if (!(s < e && e < n)) return std::nan("");
+  const auto rate = [&](std::size_t a, std::size_t b) {
+    const double run_s = to_seconds(reads[b].t_ns - reads[a].t_ns);
+    return run_s > 0.0 ? (reads[b].travel_el_rad - reads[a].travel_el_rad) / run_s : std::nan("");
+  };
+  std::size_t a = s > 0 ? s - 1 : s, b = e + 1 < n ? e + 1 : e;
+  for (std::size_t m = 2; m <= s && e + m < n; ++m) {
+    const std::int64_t left_ns = reads[s].t_ns - reads[s - m].t_ns, right_ns = reads[e + m].t_ns - reads[e].t_ns;
+    if (left_ns > side_max_ns || right_ns > side_max_ns || left_ns <= 0 || right_ns <= 0) break;
+    const double resolution = 2.0 * step_rad * (1.0 / to_seconds(left_ns) + 1.0 / to_seconds(right_ns));
+    if (std::abs(rate(s - m, s) - rate(e, e + m)) > resolution) break;
+    a = s - m;
+    b = e + m;
+  }
+  return rate(a, b);
 }
 
 /// The speed a window stands for: the count's where the drive's angle is a staircase — its counted speed below

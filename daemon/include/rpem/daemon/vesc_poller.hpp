@@ -103,6 +103,11 @@ class VescPoller {
   /// sample (written to `sample`).
   [[nodiscard]] bool on_frame(const can::CanFrame& f, std::int64_t rx_ns, core::AveragedSample& sample) noexcept;
 
+  /// Replies decoded so far, and the newest one's read of the tachometer (its time, the steps as an angle; 0
+  /// where the mask leaves it out): what CountDelay counts the windows' speeds from.
+  [[nodiscard]] std::uint64_t reads() const noexcept { return reads_; }
+  [[nodiscard]] const core::CountRead& last_read() const noexcept { return last_read_; }
+
   [[nodiscard]] const VescPollerCounters& counters() const noexcept { return counters_; }
   [[nodiscard]] const can::vesc::VescDecoder& decoder() const noexcept { return decoder_; }
   /// True while no reply came for the last poll(s): the controller is silent.
@@ -129,8 +134,10 @@ class VescPoller {
   bool has_window_start_ = false;
   std::int64_t window_start_ns_ = 0;  ///< the newest read of the controller seen
   core::SpeedRead previous_speed_;    ///< the PLL's speed in our previous reply, and when it was read
-  bool gap_ = true;                   ///< windows before the next may be lost
-  bool gap_before_timeout_ = true;    ///< gap_ as it was before the newest timeout (a late reply restores it)
+  std::uint64_t reads_ = 0;
+  core::CountRead last_read_;
+  bool gap_ = true;                 ///< windows before the next may be lost
+  bool gap_before_timeout_ = true;  ///< gap_ as it was before the newest timeout (a late reply restores it)
 };
 
 }  // namespace rpem::daemon

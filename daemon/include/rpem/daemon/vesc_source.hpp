@@ -31,6 +31,10 @@ struct VescSource {
     /// speed ramp by k_p/k_i, which each window's mean speed allows for (docs/rpemd.md, "source: vesc").
     double pll_kp = can::vesc::kDefaultPllKp;
     double pll_ki = can::vesc::kDefaultPllKi;
+    /// How long each window waits for its speed to be counted from the tachometer, which the polls then ask
+    /// for (CountDelay; core::kCountRunSideMaxS): not a key of the section, but the machine's — set where its
+    /// angle is a Hall drive's staircase (regimes.angle_source: hall), 0 otherwise (no count, no wait).
+    double count_horizon_s = 0.0;
     bool operator==(const Options&) const = default;
   };
   [[nodiscard]] static Options parse(io::YamlMap& section, const std::string& base_dir);

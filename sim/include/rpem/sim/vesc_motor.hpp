@@ -74,8 +74,10 @@ class VescMotor {
   int pll_cycles_ = 0;
   bool started_ = false;
   double input_current_sum_A_ = 0.0;  ///< m_input_current_sum: power-balance input current per cycle
-  double tacho_steps_ = 0.0;          ///< 6 per electrical revolution (mc_interface_get_tachometer_value)
-  double tacho_abs_steps_ = 0.0;
+  std::int64_t tacho_steps_ = 0;      ///< 6 per electrical revolution (mc_interface_get_tachometer_value)
+  std::int64_t tacho_abs_steps_ = 0;
+  int tacho_sector_ = 0;  ///< m_tacho_step_last: the sector of the last cycle's angle in use
+  bool has_sector_ = false;
   double amp_hours_ = 0.0, amp_hours_charged_ = 0.0, watt_hours_ = 0.0, watt_hours_charged_ = 0.0;
   double last_input_current_A_ = 0.0;
 };
