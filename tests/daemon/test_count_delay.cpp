@@ -29,7 +29,7 @@ namespace {
 
 namespace vesc = can::vesc;
 constexpr double kStep = vesc::kTachometerStepRad;
-constexpr std::int64_t kMs = 1'000'000;
+constexpr std::int64_t kMillisecondNs = 1'000'000;
 
 core::AveragedSample window(std::int64_t start_ns, std::int64_t end_ns) {
   core::AveragedSample w;
@@ -48,24 +48,25 @@ TEST(CountDelay, HoldsEachWindowForItsHorizonAndCountsItsSpeed) {
   std::vector<core::CountRead> reads;
   core::AveragedSample due;
   for (int k = 0; k <= 400; ++k) {
-    const std::int64_t t = k * 5 * kMs;
+    const std::int64_t t = k * 5 * kMillisecondNs;
     reads.push_back({t, kStep * std::floor(0.3 + 20.0 * core::to_seconds(t) / kStep)});
     delay.add_read(reads.back());
-    if (k > 0) delay.add_window(window(t - 5 * kMs, t));
+    if (k > 0) delay.add_window(window(t - 5 * kMillisecondNs, t));
     while (delay.release(t, due)) out.push_back(due);
   }
   ASSERT_EQ(out.size(), 350U);  // windows ending at 5 … 1 750 ms: 1 750 + 250 ≤ 2 000
   for (std::size_t j = 0; j < out.size(); ++j) {
-    EXPECT_EQ(out[j].t_ns, static_cast<std::int64_t>(j + 1) * 5 * kMs);
+    EXPECT_EQ(out[j].t_ns, static_cast<std::int64_t>(j + 1) * 5 * kMillisecondNs);
     EXPECT_DOUBLE_EQ(out[j].omega_el_rad_s, 1.0);  // the reported speed is left as it was
     if (j >= 50) {
       EXPECT_NEAR(out[j].omega_counted_el_rad_s, 20.0, kStep / 0.49) << j;
     }
     // What rpem estimate counts over the same reads (io's reader takes the same function over all of them).
-    EXPECT_EQ(out[j].omega_counted_el_rad_s, core::grown_count_speed_rad_s(reads, j, j + 1, kStep, 250 * kMs)) << j;
+    EXPECT_EQ(out[j].omega_counted_el_rad_s, core::grown_count_speed_rad_s(reads, j, j + 1, kStep, 250 * kMillisecondNs))
+        << j;
   }
   EXPECT_EQ(delay.held(), 50U);
-  while (delay.release(2'001 * kMs + 250 * kMs, due)) out.push_back(due);
+  while (delay.release(2'001 * kMillisecondNs + 250 * kMillisecondNs, due)) out.push_back(due);
   EXPECT_EQ(out.size(), 400U);  // the source keeps calling release() while the drive is silent: none is lost
 }
 
@@ -77,11 +78,11 @@ TEST(CountDelay, AFullRingReleasesItsOldestEarlyAndLosesNone) {
   core::AveragedSample due;
   const std::size_t n = CountDelay::kReads + 10;
   for (std::size_t k = 0; k < n; ++k) {
-    const auto t = static_cast<std::int64_t>(k) * kMs;
+    const auto t = static_cast<std::int64_t>(k) * kMillisecondNs;
     delay.add_read({t, 0.0});
     if (k == 0) continue;
     while (delay.full() && delay.release(t, due)) out.push_back(due);
-    delay.add_window(window(t - kMs, t));
+    delay.add_window(window(t - kMillisecondNs, t));
     if (!delay.full()) {
       EXPECT_FALSE(delay.release(t, due));  // neither due nor full
     }
@@ -93,10 +94,10 @@ TEST(CountDelay, AFullRingReleasesItsOldestEarlyAndLosesNone) {
   // Reads with no window (replies whose windows were dropped) overwrite the oldest: the oldest held window, which
   // ends at read n − kWindows, loses the read before it, where it starts.
   for (std::size_t k = n; k < n + CountDelay::kReads - CountDelay::kWindows; ++k) {
-    delay.add_read({static_cast<std::int64_t>(k) * kMs, 0.0});
+    delay.add_read({static_cast<std::int64_t>(k) * kMillisecondNs, 0.0});
   }
   ASSERT_TRUE(delay.release(std::int64_t{1} << 60, due));
-  EXPECT_EQ(due.t_ns, static_cast<std::int64_t>(n - CountDelay::kWindows) * kMs);
+  EXPECT_EQ(due.t_ns, static_cast<std::int64_t>(n - CountDelay::kWindows) * kMillisecondNs);
   EXPECT_TRUE(std::isnan(due.omega_counted_el_rad_s)) << due.omega_counted_el_rad_s;
   ASSERT_TRUE(delay.release(std::int64_t{1} << 60, due));  // the next one still has its start
   EXPECT_DOUBLE_EQ(due.omega_counted_el_rad_s, 0.0);
@@ -134,7 +135,7 @@ HallRun run_hall_crawl(double duration_s) {
   const auto release = [&](std::int64_t now) {
     while (delay.release(now, due)) run.windows.push_back(due);
   };
-  for (std::int64_t t = 10 * kMs;; t += 5 * kMs) {
+  for (std::int64_t t = 10 * kMillisecondNs;; t += 5 * kMillisecondNs) {
     poller.polled(t, true);
     const auto read = drive.poll(t, ignore);
     if (!read) break;
