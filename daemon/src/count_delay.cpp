@@ -1,13 +1,14 @@
 #include "rpem/daemon/count_delay.hpp"
 
-#include <cassert>
 #include <cmath>
+
+#include "rpem/core/assert.hpp"
 
 namespace rpem::daemon {
 
 CountDelay::CountDelay(double step_rad, double side_max_s) noexcept
     : step_rad_(step_rad), side_max_ns_(std::llround(side_max_s * 1e9)) {
-  assert(step_rad > 0.0 && side_max_s >= 0.0);
+  RPEM_ASSERT(step_rad > 0.0 && side_max_s >= 0.0, "a count has a step and a window waits no negative time");
 }
 
 void CountDelay::add_read(const core::CountRead& read) noexcept {
@@ -20,7 +21,8 @@ void CountDelay::add_read(const core::CountRead& read) noexcept {
 }
 
 void CountDelay::add_window(const core::AveragedSample& window) noexcept {
-  assert(reads_held_ > 0 && !full());  // a window ends at a read; the caller releases a full ring's oldest first
+  RPEM_ASSERT(reads_held_ > 0, "a window ends at a read, added before it");
+  RPEM_ASSERT(!full(), "the caller releases a full ring's oldest window first");
   windows_[(first_window_ + windows_held_) % kWindows] = {window, first_read_ + reads_held_ - 1};
   ++windows_held_;
 }
