@@ -1,5 +1,6 @@
 #include "rpem/io/averaged_log.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <vector>
 
@@ -24,14 +25,100 @@ double count_step_rad(const std::vector<core::CountRead>& reads) {
 /// (core::grown_count_speed_rad_s; docs/derivations.md §13). `ends[k]` is the read that ends window k; a window
 /// that does not start at the read before it (a log of windows with their own starts) has no count.
 void set_counted_speeds(std::vector<core::AveragedSample>& out, const std::vector<core::CountRead>& reads,
-                        const std::vector<std::size_t>& ends) {
-  const double step_rad = count_step_rad(reads);
+                        const std::vector<std::size_t>& ends, double step_rad) {
   const auto side_max_ns = static_cast<std::int64_t>(core::kCountRunSideMaxS * 1e9);
   for (std::size_t k = 0; k < out.size(); ++k) {
     const std::size_t e = ends[k];
     if (e == 0 || reads[e - 1].t_ns != out[k].t_start_ns) continue;
     out[k].omega_counted_el_rad_s = core::grown_count_speed_rad_s(reads, e - 1, e, step_rad, side_max_ns);
   }
+}
+
+/// One row of a log whose windows run from the row before (window: previous_row), as read.
+struct PreviousRowRead {
+  core::AveragedSample sample;          ///< t_ns and the means; the window and its speed once they are known
+  double omega_at_read_rad_s = 0.0;     ///< the speed column as it is (a PLL's at the read, or the window's mean)
+  double travel_el_rad = std::nan("");  ///< the drive's count at the read (NaN: the log has none)
+};
+
+/// Which reads' times and which windows a previous_row log leaves unknown (docs/drive-log.md, "Rows stamped late").
+struct UnknownTiming {
+  std::vector<bool> read;    ///< row k's read may lie long before its stamp
+  std::vector<bool> window;  ///< row k's window (from row k − 1's read) is unknown
+};
+
+/// A read at an unknown time ends one window and starts the next, so both are unknown. A read is:
+/// - row k, `request_timeout_s` or more after row k − 1: the logger asked again, and the request it gave up on may
+///   have been read (the means reset then) and be answered only now;
+/// - row k − 1, where window k's count moved further than the reads can lie apart: a logger that asks only while no
+///   request is outstanding took read k − 1 after row k − 2 arrived and read k before row k did, so the count moves
+///   at most the faster of the two speeds read over t_k − t_{k−2}, plus the rotor's lead over a PLL's speed
+///   (lag·|Δω̂|) and the count's 2 steps (core::grown_count_speed_rad_s). More: read k − 1 is older than row k − 2,
+///   a stale reply arriving out of order (or read k − 1 is right and row k is the stale one: then the test of window
+///   k + 1 takes read k).
+UnknownTiming unknown_timing(const std::vector<PreviousRowRead>& rows, const LogMap& map, double step_rad) {
+  const std::size_t n = rows.size();
+  UnknownTiming u{std::vector<bool>(n, false), std::vector<bool>(n, false)};
+  const auto unknown_read = [&](std::size_t j) {
+    u.read[j] = true;
+    u.window[j] = true;
+    if (j + 1 < n) u.window[j + 1] = true;
+  };
+  if (n > 0) u.window[0] = true;  // the first row's window began before the log
+  for (std::size_t k = 1; k < n; ++k) {
+    const PreviousRowRead& a = rows[k - 1];
+    const PreviousRowRead& b = rows[k];
+    if (map.request_timeout_s > 0.0 && core::to_seconds(b.sample.t_ns - a.sample.t_ns) >= map.request_timeout_s) {
+      unknown_read(k);
+    }
+    if (k < 2) continue;  // the first read's time has no bound from before
+    // Read k − 1 came after row k − 2 arrived, read k before row k did: the reads lie at most this far apart.
+    const double reads_apart_s = core::to_seconds(b.sample.t_ns - rows[k - 2].sample.t_ns);
+    const double travel_rad = std::abs(b.travel_el_rad - a.travel_el_rad);  // NaN without a count: no test
+    const double speed_rad_s = std::max(std::abs(a.omega_at_read_rad_s), std::abs(b.omega_at_read_rad_s));
+    const double allowed_rad = speed_rad_s * reads_apart_s +
+                               map.speed_lag_s * std::abs(b.omega_at_read_rad_s - a.omega_at_read_rad_s) + 2.0 * step_rad;
+    if (step_rad > 0.0 && travel_rad > allowed_rad) unknown_read(k - 1);
+  }
+  return u;
+}
+
+/// The samples of a previous_row log's rows (rows not empty): each window from the read before it, its speed rebuilt
+/// where the column is a PLL's, its count where the log has one; the windows next to a read whose time is unknown
+/// left out, and counted in `read`.
+void previous_row_samples(const std::vector<PreviousRowRead>& rows, const LogMap& map, bool counted,
+                          std::vector<core::AveragedSample>& out, AveragedLogRead& read) {
+  // The counts at the reads whose times are known, and the read that ends each sample: the counted speeds.
+  std::vector<core::CountRead> reads;
+  std::vector<std::size_t> read_ending;
+  std::vector<core::CountRead> all_reads;
+  all_reads.reserve(rows.size());
+  for (const PreviousRowRead& row : rows) all_reads.push_back({row.sample.t_ns, row.travel_el_rad});
+  const double step_rad = counted ? count_step_rad(all_reads) : 0.0;
+  const UnknownTiming unknown = unknown_timing(rows, map, step_rad);
+  read.opening_rows = 1;
+  bool after_unknown = false;
+  for (std::size_t k = 0; k < rows.size(); ++k) {
+    if (counted && !unknown.read[k]) reads.push_back(all_reads[k]);
+    if (unknown.window[k]) {
+      if (k > 0) ++read.unknown_windows;
+      after_unknown = k > 0;
+      continue;
+    }
+    core::AveragedSample s = rows[k].sample;
+    const PreviousRowRead& previous = rows[k - 1];
+    s.t_start_ns = previous.sample.t_ns;
+    s.gap_before = after_unknown;
+    after_unknown = false;
+    if (map.speed_lag_s > 0.0) {
+      // A PLL's speed at each read: the window's mean from this read's and the previous one's (§13).
+      s.omega_el_rad_s = core::window_mean_speed_rad_s({previous.sample.t_ns, previous.omega_at_read_rad_s},
+                                                       {s.t_ns, rows[k].omega_at_read_rad_s}, s.t_start_ns, map.speed_lag_s);
+    }
+    if (counted) read_ending.push_back(reads.size() - 1);
+    out.push_back(s);
+  }
+  if (counted) set_counted_speeds(out, reads, read_ending, step_rad);
 }
 
 }  // namespace
@@ -59,60 +146,53 @@ std::vector<core::AveragedSample> read_averaged_log(const std::string& path, con
   read.layout.t_drive = reader.has(Quantity::kTDrive);
   read.layout.t_coolant = reader.has(Quantity::kTCoolant);
 
+  // Every row as read; a previous_row log's windows (and the speeds rebuilt over them) once all are in.
+  const bool counted = reader.has(Quantity::kTravelEl);
+  std::vector<PreviousRowRead> rows;
+  std::vector<core::CountRead> start_column_reads;  // window: t_start: the count at each row's read
+  std::vector<std::size_t> start_column_ends;
   std::vector<core::AveragedSample> out;
   MappedRow r;
-  std::optional<std::int64_t> previous_t_ns;
-  double previous_omega_rad_s = 0.0;  // the previous row's speed as the column gives it
-  // The drive's count of its angle (travel_el) at every row's read, and the read that ends each sample: the
-  // counted speeds, after the rows.
-  const bool counted = reader.has(Quantity::kTravelEl);
-  std::vector<core::CountRead> reads;
-  std::vector<std::size_t> read_ending;
   std::size_t first_line = 0;
   while (reader.next(r)) {
-    ++read.rows;
-    core::AveragedSample s;
+    if (read.rows++ == 0) first_line = r.line;
+    PreviousRowRead row;
+    core::AveragedSample& s = row.sample;
     s.t_ns = r.t_ns;
-    if (map.window == Window::kStartColumn) {
-      s.t_start_ns = std::llround(r[Quantity::kTStart] * 1e9);
-      if (s.t_start_ns > s.t_ns) reader.fail_at(r.line, Quantity::kTStart, "window starts after it ends (t_start > t)");
-    } else if (!previous_t_ns) {
-      // The means of the first row ran since a read before the log began: an unknown window.
-      previous_t_ns = r.t_ns;
-      previous_omega_rad_s = r[Quantity::kOmegaEl];
-      if (counted) reads.push_back({r.t_ns, r[Quantity::kTravelEl]});
-      first_line = r.line;
-      ++read.opening_rows;
-      continue;
-    } else {
-      s.t_start_ns = *previous_t_ns;
-    }
     s.i_dq_A = {r[Quantity::kID], r[Quantity::kIQ]};
     s.u_dq_V = {r[Quantity::kUD], r[Quantity::kUQ]};
     s.omega_el_rad_s = r[Quantity::kOmegaEl];
-    if (map.speed_lag_s > 0.0) {
-      // A PLL's speed at each read: the window's mean from this read's and the previous one's (§13).
-      s.omega_el_rad_s = core::window_mean_speed_rad_s({*previous_t_ns, previous_omega_rad_s}, {r.t_ns, s.omega_el_rad_s},
-                                                       s.t_start_ns, map.speed_lag_s);
-    }
-    previous_t_ns = r.t_ns;
-    previous_omega_rad_s = r[Quantity::kOmegaEl];
     s.u_dc_V = r[Quantity::kUDc];
     s.t_winding_C = r[Quantity::kTWinding];
     s.t_magnet_C = r[Quantity::kTMagnet];
     s.t_drive_C = r[Quantity::kTDrive];
     s.t_coolant_C = r[Quantity::kTCoolant];
-    if (counted) {
-      read_ending.push_back(reads.size());
-      reads.push_back({r.t_ns, r[Quantity::kTravelEl]});
+    if (map.window == Window::kStartColumn) {
+      s.t_start_ns = std::llround(r[Quantity::kTStart] * 1e9);
+      if (s.t_start_ns > s.t_ns) reader.fail_at(r.line, Quantity::kTStart, "window starts after it ends (t_start > t)");
+      if (counted) {
+        start_column_ends.push_back(start_column_reads.size());
+        start_column_reads.push_back({r.t_ns, r[Quantity::kTravelEl]});
+      }
+      out.push_back(s);
+      continue;
     }
-    out.push_back(s);
+    row.omega_at_read_rad_s = r[Quantity::kOmegaEl];
+    if (counted) row.travel_el_rad = r[Quantity::kTravelEl];
+    rows.push_back(row);
   }
-  if (counted) set_counted_speeds(out, reads, read_ending);
+
+  if (!rows.empty()) previous_row_samples(rows, map, counted, out, read);
+  if (counted && map.window == Window::kStartColumn) {
+    set_counted_speeds(out, start_column_reads, start_column_ends, count_step_rad(start_column_reads));
+  }
   if (out.empty()) {
     throw DriveLogError(path, first_line, 0, "",
-                        "no samples: the only row holds means since a read before the log began (an unknown window); "
-                        "a sample needs the row before it");
+                        read.unknown_windows > 0
+                            ? "no samples: every window is unknown (the first row's began before the log; the others "
+                              "follow a read whose time is unknown: see docs/drive-log.md, \"Rows stamped late\")"
+                            : "no samples: the only row holds means since a read before the log began (an unknown "
+                              "window); a sample needs the row before it");
   }
   read.repairs = reader.repairs();
   if (read_out) *read_out = read;

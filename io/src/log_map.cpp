@@ -338,6 +338,10 @@ LogMap parse(YamlMap root) {
   } else if (root.has("window")) {
     root.fail("window", "only averaged samples have windows");
   }
+  if (root.has("request_timeout_s") && m.window != Window::kPreviousRow) {
+    root.fail("request_timeout_s", "a logger's request timeout matters only with window: previous_row");
+  }
+  m.request_timeout_s = root.number_or("request_timeout_s", 0.0, 1e-3, 1e6);
 
   YamlMap columns = root.map("columns");
   bool mechanical = false;

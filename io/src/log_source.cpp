@@ -88,8 +88,13 @@ std::string describe(const TimeRepairs& r) {
 
 std::string describe(const LogSource& source, const AveragedLogRead& read) {
   std::string s = source.path + " as " + source.format + ": " + std::to_string(read.rows) + " rows, " +
-                  std::to_string(read.rows - read.opening_rows) + " averaged samples";
+                  std::to_string(read.rows - read.opening_rows - read.unknown_windows) + " averaged samples";
   if (read.opening_rows > 0) s += " (the first row opens the first window: its own began before the log)";
+  if (read.unknown_windows > 0) {
+    s += "; " + std::to_string(read.unknown_windows) +
+         " windows unknown, not used: each begins or ends at a read stamped perhaps long after it was taken (a row " +
+         "after the logger asked again, or a count its stamps cannot hold; docs/drive-log.md, \"Rows stamped late\")";
+  }
   if (source.map.speed_lag_s > 0.0) {
     char lag[160];
     std::snprintf(lag, sizeof lag, "; each window's mean speed rebuilt from the PLL speeds at its two reads (lag %.4g ms)",

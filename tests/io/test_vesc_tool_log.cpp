@@ -103,6 +103,65 @@ TEST(VescToolLog, EachWindowsCountedSpeedIsTheTachometersOverItAndItsNeighbours)
   EXPECT_NEAR(s[2].omega_el_rad_s, (60.0 + 40.0 * (2000.0 / 30000.0 / 0.090 - 0.5)) * 2.0 * std::numbers::pi / 60.0, 1e-9);
 }
 
+// A rotor at 6 000 erpm (628 rad/s electrical: 600 of the tachometer's 60° steps a second) read at `read_ms`: the
+// row VESC Tool writes when the reply arrives at `stamp_ms`.
+std::string steady_row(long stamp_ms, long read_ms) {
+  return row120(stamp_ms, 0.0, 2.0, 6000, 0.0, 2.9, 100000 + read_ms * 3 / 5);
+}
+
+TEST(VescToolLog, ARowAfterVescToolAskedAgainAndTheRowAfterItHaveUnknownWindows) {
+  // GIVEN rows 90 ms apart but for one 1 020 ms after the row before (VESC Tool gives an unanswered request up
+  // after 0.99 s and asks again; the one it gave up on may have been read, the means reset then) and one 980 ms
+  // after it WHEN read THEN the window that ends at the late row and the one that starts there are unknown and
+  // not used, the next sample says a gap lies before it, and the 980 ms window is a sample.
+  test::TempFile f("vesc.csv", kHeader120 + steady_row(0, 0) + steady_row(90, 80) + steady_row(180, 170) +
+                                   steady_row(1200, 1190) + steady_row(1290, 1280) + steady_row(1380, 1370) +
+                                   steady_row(2360, 2350) + steady_row(2450, 2440));
+  const LogSource source = log_source(f.path());
+  AveragedLogRead read;
+  const auto s = read_averaged_log(f.path(), source.map, DriveLogLimits{}, &read);
+  ASSERT_EQ(s.size(), 5U);
+  EXPECT_EQ(read.unknown_windows, 2U);
+  EXPECT_EQ(s[1].t_ns, 180'000'000);
+  EXPECT_EQ(s[2].t_start_ns, 1'290'000'000);
+  EXPECT_TRUE(s[2].gap_before);
+  EXPECT_FALSE(s[1].gap_before || s[3].gap_before || s[4].gap_before);
+  EXPECT_EQ(s[3].t_start_ns, 1'380'000'000);  // 980 ms: VESC Tool still waited for this reply
+  EXPECT_NE(describe(source, read).find("5 averaged samples"), std::string::npos) << describe(source, read);
+  EXPECT_NE(describe(source, read).find("2 windows unknown, not used"), std::string::npos) << describe(source, read);
+}
+
+TEST(VescToolLog, AStaleReplyArrivingOutOfOrderIsFoundByItsCount) {
+  // GIVEN a steady rotor read every 90 ms, and between two rows a reply read 585 ms before it arrives (its request
+  // stalled; VESC Tool logs every reply) WHEN read THEN its count is 342 steps behind, more than the rotor can travel
+  // between reads taken after the row before the previous arrived (95 ms at 628 rad/s: 57 steps, and 2 of
+  // resolution): the windows on both sides of the stale read are unknown, and the one before it too, which is
+  // where the test must look for the stale read without knowing which of the two is stale.
+  test::TempFile f("vesc.csv", kHeader120 + steady_row(0, 0) + steady_row(90, 80) + steady_row(180, 170) +
+                                   steady_row(185, -400) + steady_row(270, 260) + steady_row(360, 350));
+  const LogSource source = log_source(f.path());
+  AveragedLogRead read;
+  const auto s = read_averaged_log(f.path(), source.map, DriveLogLimits{}, &read);
+  ASSERT_EQ(s.size(), 2U);
+  EXPECT_EQ(read.unknown_windows, 3U);
+  EXPECT_EQ(s[0].t_ns, 90'000'000);
+  EXPECT_EQ(s[1].t_start_ns, 270'000'000);
+  EXPECT_TRUE(s[1].gap_before);
+}
+
+TEST(VescToolLog, RepliesArrivingAfterTheirReadsByAVaryingLatencyAreNotStale) {
+  // GIVEN reads 20–40 ms before their rows arrive (a link's latency), so that a window's count over its stamps'
+  // spacing is off by up to ±20 ms of travel WHEN read THEN no window is unknown: each read lies after the row
+  // before the previous one arrived.
+  test::TempFile f("vesc.csv", kHeader120 + steady_row(0, -30) + steady_row(60, 40) + steady_row(170, 130) +
+                                   steady_row(230, 210) + steady_row(380, 340) + steady_row(420, 400));
+  const LogSource source = log_source(f.path());
+  AveragedLogRead read;
+  const auto s = read_averaged_log(f.path(), source.map, DriveLogLimits{}, &read);
+  EXPECT_EQ(s.size(), 5U);
+  EXPECT_EQ(read.unknown_windows, 0U);
+}
+
 TEST(VescToolLog, ReadsTheTestBuildHeaderOfVersion120) {
   test::TempFile f("vesc.csv", kHeader120Test + row120test(1000, 0, 1, 100, 0, 0.5) + row120test(1100, 0, 2, 200, 0, 1.0));
   const LogSource source = log_source(f.path());

@@ -38,6 +38,9 @@ struct AveragedLogRead {
   /// Rows that only open the first window (window: previous_row: the first row, whose own window began at
   /// a read before the log started; it is read and checked, but is no sample).
   std::uint64_t opening_rows = 0;
+  /// Windows after a read whose time is unknown (window: previous_row; docs/drive-log.md, "Rows stamped late"):
+  /// read and checked, but no samples.
+  std::uint64_t unknown_windows = 0;
   TimeRepairs repairs;
 };
 

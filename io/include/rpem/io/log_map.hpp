@@ -114,6 +114,11 @@ struct LogMap {
   /// from it and the previous row's (core::window_mean_speed_rad_s). 0: the column is the window's mean speed.
   /// window: previous_row only.
   double speed_lag_s = 0.0;
+  /// How long the logger waits for a reply before it asks again (VESC Tool: 0.99 s). A request it gave up on
+  /// may still have been read, and a read resets the means, so a row this long after the one before has an
+  /// unknown window and is stamped perhaps long after its read. 0: the logger never asks again.
+  /// window: previous_row only.
+  double request_timeout_s = 0.0;
 
   [[nodiscard]] bool averaged() const noexcept { return window != Window::kInstantaneous; }
   [[nodiscard]] const MappedColumn* find(Quantity q) const noexcept;
