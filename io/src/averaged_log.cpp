@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <vector>
 
 #include "rpem/core/clock.hpp"
@@ -48,8 +49,11 @@ struct UnknownTiming {
 };
 
 /// A read at an unknown time ends one window and starts the next, so both are unknown. A read is:
-/// - row k, `request_timeout_s` or more after row k − 1: the logger asked again, and the request it gave up on may
-///   have been read (the means reset then) and be answered only now;
+/// - row k, `request_timeout_s` or more after row k − 1 and at least 1.5 of the log's median spacing: the logger asked
+///   again, and the request it gave up on may have been read (the means reset then) and be answered only now. A
+///   logger polling slower than its timeout spaces its rows by about its poll period P (each reply in before the
+///   next tick), and a request it gave up on costs a tick: 2P, so a row is judged against the midpoint as well;
+///   polling faster, the timeout decides;
 /// - row k − 1, where window k's count moved further than the reads can lie apart: a logger that asks only while no
 ///   request is outstanding took read k − 1 after row k − 2 arrived and read k before row k did, so the count moves
 ///   at most the faster of the two speeds read over t_k − t_{k−2}, plus the rotor's lead over a PLL's speed
@@ -58,6 +62,16 @@ struct UnknownTiming {
 ///   k + 1 takes read k).
 UnknownTiming unknown_timing(const std::vector<PreviousRowRead>& rows, const LogMap& map, double step_rad) {
   const std::size_t n = rows.size();
+  std::vector<std::int64_t> spacing_ns;
+  spacing_ns.reserve(n);
+  for (std::size_t k = 1; k < n; ++k) spacing_ns.push_back(rows[k].sample.t_ns - rows[k - 1].sample.t_ns);
+  double median_spacing_s = 0.0;
+  if (!spacing_ns.empty()) {
+    const auto middle = spacing_ns.begin() + static_cast<std::ptrdiff_t>(spacing_ns.size() / 2);
+    std::nth_element(spacing_ns.begin(), middle, spacing_ns.end());
+    median_spacing_s = core::to_seconds(*middle);
+  }
+  const double asked_again_s = std::max(map.request_timeout_s, 1.5 * median_spacing_s);
   UnknownTiming u{std::vector<bool>(n, false), std::vector<bool>(n, false)};
   const auto unknown_read = [&](std::size_t j) {
     u.read[j] = true;
@@ -68,9 +82,7 @@ UnknownTiming unknown_timing(const std::vector<PreviousRowRead>& rows, const Log
   for (std::size_t k = 1; k < n; ++k) {
     const PreviousRowRead& a = rows[k - 1];
     const PreviousRowRead& b = rows[k];
-    if (map.request_timeout_s > 0.0 && core::to_seconds(b.sample.t_ns - a.sample.t_ns) >= map.request_timeout_s) {
-      unknown_read(k);
-    }
+    if (map.request_timeout_s > 0.0 && core::to_seconds(b.sample.t_ns - a.sample.t_ns) >= asked_again_s) unknown_read(k);
     if (k < 2) continue;  // the first read's time has no bound from before
     // Read k − 1 came after row k − 2 arrived, read k before row k did: the reads lie at most this far apart.
     const double reads_apart_s = core::to_seconds(b.sample.t_ns - rows[k - 2].sample.t_ns);

@@ -131,6 +131,23 @@ TEST(VescToolLog, ARowAfterVescToolAskedAgainAndTheRowAfterItHaveUnknownWindows)
   EXPECT_NE(describe(source, read).find("2 windows unknown, not used"), std::string::npos) << describe(source, read);
 }
 
+TEST(VescToolLog, PolledSlowerThanItsTimeoutARowIsJudgedAgainstTheLogsOwnSpacing) {
+  // GIVEN rows 1.7 s apart (VESC Tool polling at 0.6 Hz, each reply in before the next tick) but for one 3.4 s after
+  // the row before (a request lost: the next left a tick later) WHEN read THEN the 1.7 s windows are samples, and
+  // the 3.4 s one and the one after it are unknown: 3.4 s is more than 1.5 times the median spacing.
+  test::TempFile f("vesc.csv", kHeader120 + steady_row(0, 0) + steady_row(1700, 1690) + steady_row(3400, 3390) +
+                                   steady_row(6800, 6790) + steady_row(8500, 8490) + steady_row(10200, 10190) +
+                                   steady_row(11900, 11890));
+  const LogSource source = log_source(f.path());
+  AveragedLogRead read;
+  const auto s = read_averaged_log(f.path(), source.map, DriveLogLimits{}, &read);
+  ASSERT_EQ(s.size(), 4U);
+  EXPECT_EQ(read.unknown_windows, 2U);
+  EXPECT_EQ(s[1].t_ns, 3'400'000'000);
+  EXPECT_EQ(s[2].t_start_ns, 8'500'000'000);
+  EXPECT_TRUE(s[2].gap_before);
+}
+
 TEST(VescToolLog, AStaleReplyArrivingOutOfOrderIsFoundByItsCount) {
   // GIVEN a steady rotor read every 90 ms, and between two rows a reply read 585 ms before it arrives (its request
   // stalled; VESC Tool logs every reply) WHEN read THEN its count is 342 steps behind, more than the rotor can travel

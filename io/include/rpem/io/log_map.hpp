@@ -116,7 +116,8 @@ struct LogMap {
   double speed_lag_s = 0.0;
   /// How long the logger waits for a reply before it asks again (VESC Tool: 0.99 s). A request it gave up on
   /// may still have been read, and a read resets the means, so a row this long after the one before has an
-  /// unknown window and is stamped perhaps long after its read. 0: the logger never asks again.
+  /// unknown window and is stamped perhaps long after its read (where it is also 1.5 median spacings: a logger
+  /// polling slower than this spaces its rows by its poll period). 0: the logger never asks again.
   /// window: previous_row only.
   double request_timeout_s = 0.0;
 
