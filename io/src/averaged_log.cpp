@@ -54,12 +54,12 @@ struct UnknownTiming {
 ///   logger polling slower than its timeout spaces its rows by about its poll period P (each reply in before the
 ///   next tick), and a request it gave up on costs a tick: 2P, so a row is judged against the midpoint as well;
 ///   polling faster, the timeout decides;
-/// - row k − 1, where window k's count moved further than the reads can lie apart: a logger that asks only while no
-///   request is outstanding took read k − 1 after row k − 2 arrived and read k before row k did, so the count moves
-///   at most the faster of the two speeds read over t_k − t_{k−2}, plus the rotor's lead over a PLL's speed
-///   (lag·|Δω̂|) and the count's 2 steps (core::grown_count_speed_rad_s). More: read k − 1 is older than row k − 2,
-///   a stale reply arriving out of order (or read k − 1 is right and row k is the stale one: then the test of window
-///   k + 1 takes read k).
+/// - row k, a stale reply arriving out of order: its count steps back against the motion and forward again, each
+///   step further than the reads can lie apart. A logger that asks only while no request is outstanding took read
+///   j − 1 after row j − 2 arrived and read j before row j did, so window j's count moves at most the faster of its
+///   two speeds read over t_j − t_{j−2}, plus the rotor's lead over a PLL's speed (lag·|Δω̂|) and the count's 2
+///   steps (core::grown_count_speed_rad_s). One window beyond that could be a speed read wrong (a Hall drive's PLL
+///   at a crawl follows a staircase); two beside one read, in opposite directions, is a read out of its place.
 UnknownTiming unknown_timing(const std::vector<PreviousRowRead>& rows, const LogMap& map, double step_rad) {
   const std::size_t n = rows.size();
   std::vector<std::int64_t> spacing_ns;
@@ -79,18 +79,22 @@ UnknownTiming unknown_timing(const std::vector<PreviousRowRead>& rows, const Log
     if (j + 1 < n) u.window[j + 1] = true;
   };
   if (n > 0) u.window[0] = true;  // the first row's window began before the log
-  for (std::size_t k = 1; k < n; ++k) {
-    const PreviousRowRead& a = rows[k - 1];
-    const PreviousRowRead& b = rows[k];
-    if (map.request_timeout_s > 0.0 && core::to_seconds(b.sample.t_ns - a.sample.t_ns) >= asked_again_s) unknown_read(k);
-    if (k < 2) continue;  // the first read's time has no bound from before
-    // Read k − 1 came after row k − 2 arrived, read k before row k did: the reads lie at most this far apart.
-    const double reads_apart_s = core::to_seconds(b.sample.t_ns - rows[k - 2].sample.t_ns);
-    const double travel_rad = std::abs(b.travel_el_rad - a.travel_el_rad);  // NaN without a count: no test
+  // Window j's count beyond what the reads allow, signed by its direction (0: within, or no bound: j < 2, no count).
+  const auto excess = [&](std::size_t j) {
+    const PreviousRowRead& a = rows[j - 1];
+    const PreviousRowRead& b = rows[j];
+    const double travel_rad = b.travel_el_rad - a.travel_el_rad;
+    const double reads_apart_s = core::to_seconds(b.sample.t_ns - rows[j - 2].sample.t_ns);
     const double speed_rad_s = std::max(std::abs(a.omega_at_read_rad_s), std::abs(b.omega_at_read_rad_s));
     const double allowed_rad = speed_rad_s * reads_apart_s +
                                map.speed_lag_s * std::abs(b.omega_at_read_rad_s - a.omega_at_read_rad_s) + 2.0 * step_rad;
-    if (step_rad > 0.0 && travel_rad > allowed_rad) unknown_read(k - 1);
+    return step_rad > 0.0 && std::abs(travel_rad) > allowed_rad ? travel_rad : 0.0;
+  };
+  for (std::size_t k = 1; k < n; ++k) {
+    if (map.request_timeout_s > 0.0 && core::to_seconds(rows[k].sample.t_ns - rows[k - 1].sample.t_ns) >= asked_again_s) {
+      unknown_read(k);
+    }
+    if (k >= 2 && k + 1 < n && excess(k) * excess(k + 1) < 0.0) unknown_read(k);
   }
   return u;
 }

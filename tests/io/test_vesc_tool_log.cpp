@@ -150,20 +150,35 @@ TEST(VescToolLog, PolledSlowerThanItsTimeoutARowIsJudgedAgainstTheLogsOwnSpacing
 
 TEST(VescToolLog, AStaleReplyArrivingOutOfOrderIsFoundByItsCount) {
   // GIVEN a steady rotor read every 90 ms, and between two rows a reply read 585 ms before it arrives (its request
-  // stalled; VESC Tool logs every reply) WHEN read THEN its count is 342 steps behind, more than the rotor can travel
-  // between reads taken after the row before the previous arrived (95 ms at 628 rad/s: 57 steps, and 2 of
-  // resolution): the windows on both sides of the stale read are unknown, and the one before it too, which is
-  // where the test must look for the stale read without knowing which of the two is stale.
+  // stalled; VESC Tool logs every reply) WHEN read THEN its count is 342 steps behind the row before and 396 behind
+  // the row after, each more than the rotor can travel between reads taken after the row before the previous
+  // arrived (95 ms at 628 rad/s: 57 steps, 90 ms: 54, and 2 of resolution), and in opposite directions: the two
+  // windows beside the stale read are unknown.
   test::TempFile f("vesc.csv", kHeader120 + steady_row(0, 0) + steady_row(90, 80) + steady_row(180, 170) +
                                    steady_row(185, -400) + steady_row(270, 260) + steady_row(360, 350));
   const LogSource source = log_source(f.path());
   AveragedLogRead read;
   const auto s = read_averaged_log(f.path(), source.map, DriveLogLimits{}, &read);
-  ASSERT_EQ(s.size(), 2U);
-  EXPECT_EQ(read.unknown_windows, 3U);
-  EXPECT_EQ(s[0].t_ns, 90'000'000);
-  EXPECT_EQ(s[1].t_start_ns, 270'000'000);
-  EXPECT_TRUE(s[1].gap_before);
+  ASSERT_EQ(s.size(), 3U);
+  EXPECT_EQ(read.unknown_windows, 2U);
+  EXPECT_EQ(s[1].t_ns, 180'000'000);
+  EXPECT_EQ(s[2].t_start_ns, 270'000'000);
+  EXPECT_TRUE(s[2].gap_before);
+}
+
+TEST(VescToolLog, ACountAheadOfASpeedReadWrongIsNoStaleReply) {
+  // GIVEN a Hall drive at a crawl, whose PLL follows the firmware's staircase angle and reads 0 erpm while the count
+  // moves 5 steps in one window (more than the speeds read and 2 steps of resolution allow), then 1 WHEN read THEN
+  // no window is unknown: one window beyond the bound is a speed read wrong; a stale read puts two beside it, in
+  // opposite directions.
+  test::TempFile f("vesc.csv", kHeader120 + row120(0, 0.0, 8.0, 0, 0.0, 0.2, 1000) +
+                                   row120(90, 0.0, 8.0, 0, 0.0, 0.2, 1000) + row120(180, 0.0, 8.0, 0, 0.0, 0.2, 1005) +
+                                   row120(270, 0.0, 8.0, 0, 0.0, 0.2, 1006) + row120(360, 0.0, 8.0, 0, 0.0, 0.2, 1006));
+  const LogSource source = log_source(f.path());
+  AveragedLogRead read;
+  const auto s = read_averaged_log(f.path(), source.map, DriveLogLimits{}, &read);
+  EXPECT_EQ(s.size(), 4U);
+  EXPECT_EQ(read.unknown_windows, 0U);
 }
 
 TEST(VescToolLog, RepliesArrivingAfterTheirReadsByAVaryingLatencyAreNotStale) {
