@@ -5,6 +5,7 @@
 #include <cmath>
 #include <numbers>
 #include <string>
+#include <vector>
 
 #include "rpem/io/averaged_log.hpp"
 #include "rpem/io/log_source.hpp"
@@ -109,6 +110,12 @@ std::string steady_row(long stamp_ms, long read_ms) {
   return row120(stamp_ms, 0.0, 2.0, 6000, 0.0, 2.9, 100000 + read_ms * 3 / 5);
 }
 
+/// The samples of a log of `rows` under VESC Tool's current header, and in `read` what reading it did.
+std::vector<core::AveragedSample> read_rows(const std::string& rows, AveragedLogRead& read) {
+  const test::TempFile f("vesc.csv", kHeader120 + rows);
+  return read_averaged_log(f.path(), log_source(f.path()).map, DriveLogLimits{}, &read);
+}
+
 TEST(VescToolLog, ARowAfterVescToolAskedAgainAndTheRowAfterItHaveUnknownWindows) {
   // GIVEN rows 90 ms apart but for one 1 020 ms after the row before (VESC Tool gives an unanswered request up
   // after 0.99 s and asks again; the one it gave up on may have been read, the means reset then) and one 980 ms
@@ -132,20 +139,20 @@ TEST(VescToolLog, ARowAfterVescToolAskedAgainAndTheRowAfterItHaveUnknownWindows)
 }
 
 TEST(VescToolLog, PolledSlowerThanItsTimeoutARowIsJudgedAgainstTheLogsOwnSpacing) {
-  // GIVEN rows 1.7 s apart (VESC Tool polling at 0.6 Hz, each reply in before the next tick) but for one 3.4 s after
-  // the row before (a request lost: the next left a tick later) WHEN read THEN the 1.7 s windows are samples, and
-  // the 3.4 s one and the one after it are unknown: 3.4 s is more than 1.5 times the median spacing.
-  test::TempFile f("vesc.csv", kHeader120 + steady_row(0, 0) + steady_row(1700, 1690) + steady_row(3400, 3390) +
-                                   steady_row(6800, 6790) + steady_row(8500, 8490) + steady_row(10200, 10190) +
-                                   steady_row(11900, 11890));
-  const LogSource source = log_source(f.path());
+  // GIVEN rows 1.005 s apart (VESC Tool polling at 1 Hz, its slowest, each reply in 5 ms, before the next tick: every
+  // spacing over the 0.99 s timeout) but for one 2.01 s after the row before (a request lost: the next left a tick
+  // later) WHEN read THEN the 1.005 s windows are samples, and the 2.01 s one and the one after it are unknown:
+  // 2.01 s is more than 1.5 times the median spacing.
   AveragedLogRead read;
-  const auto s = read_averaged_log(f.path(), source.map, DriveLogLimits{}, &read);
+  const auto s = read_rows(steady_row(0, 0) + steady_row(1005, 1000) + steady_row(2010, 2005) + steady_row(4020, 4015) +
+                               steady_row(5025, 5020) + steady_row(6030, 6025) + steady_row(7035, 7030),
+                           read);
   ASSERT_EQ(s.size(), 4U);
   EXPECT_EQ(read.unknown_windows, 2U);
-  EXPECT_EQ(s[1].t_ns, 3'400'000'000);
-  EXPECT_EQ(s[2].t_start_ns, 8'500'000'000);
+  EXPECT_EQ(s[1].t_ns, 2'010'000'000);
+  EXPECT_EQ(s[2].t_start_ns, 5'025'000'000);
   EXPECT_TRUE(s[2].gap_before);
+  EXPECT_FALSE(s[3].gap_before);
 }
 
 TEST(VescToolLog, AStaleReplyArrivingOutOfOrderIsFoundByItsCount) {
@@ -154,11 +161,10 @@ TEST(VescToolLog, AStaleReplyArrivingOutOfOrderIsFoundByItsCount) {
   // the row after, each more than the rotor can travel between reads taken after the row before the previous
   // arrived (95 ms at 628 rad/s: 57 steps, 90 ms: 54, and 2 of resolution), and in opposite directions: the two
   // windows beside the stale read are unknown.
-  test::TempFile f("vesc.csv", kHeader120 + steady_row(0, 0) + steady_row(90, 80) + steady_row(180, 170) +
-                                   steady_row(185, -400) + steady_row(270, 260) + steady_row(360, 350));
-  const LogSource source = log_source(f.path());
   AveragedLogRead read;
-  const auto s = read_averaged_log(f.path(), source.map, DriveLogLimits{}, &read);
+  const auto s = read_rows(steady_row(0, 0) + steady_row(90, 80) + steady_row(180, 170) + steady_row(185, -400) +
+                               steady_row(270, 260) + steady_row(360, 350),
+                           read);
   ASSERT_EQ(s.size(), 3U);
   EXPECT_EQ(read.unknown_windows, 2U);
   EXPECT_EQ(s[1].t_ns, 180'000'000);
@@ -171,12 +177,11 @@ TEST(VescToolLog, ACountAheadOfASpeedReadWrongIsNoStaleReply) {
   // moves 5 steps in one window (more than the speeds read and 2 steps of resolution allow), then 1 WHEN read THEN
   // no window is unknown: one window beyond the bound is a speed read wrong; a stale read puts two beside it, in
   // opposite directions.
-  test::TempFile f("vesc.csv", kHeader120 + row120(0, 0.0, 8.0, 0, 0.0, 0.2, 1000) +
-                                   row120(90, 0.0, 8.0, 0, 0.0, 0.2, 1000) + row120(180, 0.0, 8.0, 0, 0.0, 0.2, 1005) +
-                                   row120(270, 0.0, 8.0, 0, 0.0, 0.2, 1006) + row120(360, 0.0, 8.0, 0, 0.0, 0.2, 1006));
-  const LogSource source = log_source(f.path());
   AveragedLogRead read;
-  const auto s = read_averaged_log(f.path(), source.map, DriveLogLimits{}, &read);
+  const auto s = read_rows(row120(0, 0.0, 8.0, 0, 0.0, 0.2, 1000) + row120(90, 0.0, 8.0, 0, 0.0, 0.2, 1000) +
+                               row120(180, 0.0, 8.0, 0, 0.0, 0.2, 1005) + row120(270, 0.0, 8.0, 0, 0.0, 0.2, 1006) +
+                               row120(360, 0.0, 8.0, 0, 0.0, 0.2, 1006),
+                           read);
   EXPECT_EQ(s.size(), 4U);
   EXPECT_EQ(read.unknown_windows, 0U);
 }
@@ -185,11 +190,10 @@ TEST(VescToolLog, RepliesArrivingAfterTheirReadsByAVaryingLatencyAreNotStale) {
   // GIVEN reads 20–40 ms before their rows arrive (a link's latency), so that a window's count over its stamps'
   // spacing is off by up to ±20 ms of travel WHEN read THEN no window is unknown: each read lies after the row
   // before the previous one arrived.
-  test::TempFile f("vesc.csv", kHeader120 + steady_row(0, -30) + steady_row(60, 40) + steady_row(170, 130) +
-                                   steady_row(230, 210) + steady_row(380, 340) + steady_row(420, 400));
-  const LogSource source = log_source(f.path());
   AveragedLogRead read;
-  const auto s = read_averaged_log(f.path(), source.map, DriveLogLimits{}, &read);
+  const auto s = read_rows(steady_row(0, -30) + steady_row(60, 40) + steady_row(170, 130) + steady_row(230, 210) +
+                               steady_row(380, 340) + steady_row(420, 400),
+                           read);
   EXPECT_EQ(s.size(), 5U);
   EXPECT_EQ(read.unknown_windows, 0U);
 }
