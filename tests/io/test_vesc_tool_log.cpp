@@ -139,7 +139,7 @@ TEST(VescToolLog, ARowAfterVescToolAskedAgainAndTheRowAfterItHaveUnknownWindows)
 }
 
 TEST(VescToolLog, PolledSlowerThanItsTimeoutARowIsJudgedAgainstTheLogsOwnSpacing) {
-  // GIVEN rows 1.005 s apart (VESC Tool polling at 1 Hz, its slowest, each reply in 5 ms, before the next tick: every
+  // GIVEN rows 1.005 s apart (VESC Tool polling at 1 Hz, each reply in 5 ms, before the next tick: every
   // spacing over the 0.99 s timeout) but for one 2.01 s after the row before (a request lost: the next left a tick
   // later) WHEN read THEN the 1.005 s windows are samples, and the 2.01 s one and the one after it are unknown:
   // 2.01 s is more than 1.5 times the median spacing.
