@@ -79,7 +79,8 @@ UnknownTiming unknown_timing(const std::vector<PreviousRowRead>& rows, const Log
     if (j + 1 < n) u.window[j + 1] = true;
   };
   if (n > 0) u.window[0] = true;  // the first row's window began before the log
-  // Window j's count beyond what the reads allow, signed by its direction (0: within, or no bound: j < 2, no count).
+  // Window j's count beyond what the reads allow, signed by its direction (0: within, or no count); j ≥ 2, since the
+  // bound needs row j − 2's arrival.
   const auto excess = [&](std::size_t j) {
     const PreviousRowRead& a = rows[j - 1];
     const PreviousRowRead& b = rows[j];
