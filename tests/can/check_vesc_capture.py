@@ -12,14 +12,19 @@ decode_msg, comm_can_send_status1..6; commands.c commands_process_packet; buffer
   matching the replies;
 - during the silent interval the controller sends nothing.
 
-  check_vesc_capture.py CAPTURE TRUTH --controller 17 --poller 0x7D --silent T0 T1   (seconds from the
-  emulator's start, which is taken as the first status frame's time)
+  check_vesc_capture.py CAPTURE TRUTH EMULATOR_LOG --controller 17 --poller 0x7D --silent T0 T1
+
+Times are the emulator's own, from what it printed (EMULATOR_LOG, its stderr): its origin on CLOCK_REALTIME, the
+clock candump stamps frames with, and the moments it actually went silent and came back. --silent is what the
+emulator was asked for; the moments it printed must match it. (The first status frame is no origin: under TCG
+it can leave tens of ms late, which once moved frames after the silence into it.)
 """
 import argparse
 import binascii
 import bisect
 import csv
 import math
+import re
 import struct
 import sys
 
@@ -36,6 +41,20 @@ def frames(path):
         if len(ident) != 8:  # VESC frames are extended (8 hex digits in candump -L)
             continue
         yield float(parts[0].strip('()')), int(ident, 16), bytes.fromhex(data)
+
+
+def emulator_times(path, asked):
+    """(origin on CLOCK_REALTIME [s], went silent [s], came back [s]) from rpem sim's stderr."""
+    text = open(path).read()
+    origin = re.search(r'rpem sim: t = 0 at CLOCK_REALTIME ([0-9.]+) s', text)
+    silent = re.search(r'rpem sim: VESC \d+ silent at ([0-9.]+) s', text)
+    back = re.search(r'rpem sim: VESC \d+ back at ([0-9.]+) s', text)
+    if not (origin and silent and back):
+        sys.exit('check_vesc_capture: %s lacks the emulator\'s origin, silence or return' % path)
+    s0, s1 = float(silent.group(1)), float(back.group(1))
+    if not (abs(s0 - asked[0]) < 0.1 and abs(s1 - asked[1]) < 0.1):
+        sys.exit('check_vesc_capture: silent %.3f-%.3f s, asked for %g-%g s' % (s0, s1, asked[0], asked[1]))
+    return float(origin.group(1)), s0, s1
 
 
 def decode_reply(p):
@@ -85,6 +104,7 @@ def main():
     ap = argparse.ArgumentParser()
     ap.add_argument('capture')
     ap.add_argument('truth')
+    ap.add_argument('emulator_log')
     ap.add_argument('--controller', type=int, required=True)
     ap.add_argument('--poller', type=lambda s: int(s, 0), required=True)
     ap.add_argument('--silent', type=float, nargs=2, required=True)
@@ -138,11 +158,12 @@ def main():
             from_ctrl.append(t)
     if not statuses[1]:
         sys.exit('check_vesc_capture: no STATUS frame from controller %d' % cid)
-    t0 = statuses[1][0][0] - 0.02  # the first status leaves right at the start (cancom_status_thread)
-    s0, s1 = a.silent
+    t0, s0, s1 = emulator_times(a.emulator_log, a.silent)
+    first_status_s = statuses[1][0][0] - t0  # cancom_status_thread's first leaves at the start, TCG permitting
     quiet = [t for t in from_ctrl if s0 + 0.05 < t - t0 < s1 - 0.05]
     if quiet:
-        errors.append('%d frames from the controller while it was silent' % len(quiet))
+        errors.append('%d frames from the controller while it was silent, at %s s' % (
+            len(quiet), ', '.join('%.3f' % (t - t0) for t in quiet[:8])))
     end = statuses[1][-1][0]  # the emulator's last status: polls after it go unanswered
     heard = [t for t in polls if not (s0 - 0.05 < t - t0 < s1 + 0.05) and t < end - 0.05]
     if len(replies) < 0.97 * len(heard) or len(heard) < 100:  # (100 at ~30 Hz under TCG)
@@ -196,9 +217,10 @@ def main():
             break
 
     print('check_vesc_capture: %d polls, %d replies (%d at speed compared with the truth), statuses %s; '
-          'worst: i_q %.2f %%, ERPM %.2f %%, u_d %.3f V, u_q %.2f %%, T_motor %.2f K'
-          % (len(polls), len(replies), checked, {n: len(v) for n, v in statuses.items()}, 100 * worst['i_q'],
-             100 * worst['erpm'], worst['u_d'], 100 * worst['u_q'], worst['t_motor']))
+          'worst: i_q %.2f %%, ERPM %.2f %%, u_d %.3f V, u_q %.2f %%, T_motor %.2f K; silent %.3f-%.3f s, first status '
+          'at %.1f ms' % (len(polls), len(replies), checked, {n: len(v) for n, v in statuses.items()},
+                          100 * worst['i_q'], 100 * worst['erpm'], worst['u_d'], 100 * worst['u_q'], worst['t_motor'],
+                          s0, s1, 1e3 * first_status_s))
     if errors:
         print('check_vesc_capture: FAILED\n  ' + '\n  '.join(errors[:20]))
         sys.exit(1)

@@ -54,7 +54,8 @@ else
 fi
 
 echo "run_vesc_suite: checking the outputs on the host"
-python3 "$repo/tests/can/check_vesc_capture.py" "$out/vesc_capture.log" "$out/vesc_truth.csv" --controller 17 \
+python3 "$repo/tests/can/check_vesc_capture.py" "$out/vesc_capture.log" "$out/vesc_truth.csv" \
+  "$out/vesc_emulator.txt" --controller 17 \
   --poller 0x7D --silent 6 8 --record "$out/vesc_avg.csv" "$out/vesc_record_truth.csv" --record-rate 100
 python3 "$repo/tests/can/check_averaged_record.py" "$out/native_sent.csv" "$out/native_avg.csv" --rate 200
 python3 "$repo/tests/can/check_averaged_record.py" "$out/classic_sent.csv" "$out/map_avg.csv"
