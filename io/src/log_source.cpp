@@ -1,5 +1,7 @@
 #include "rpem/io/log_source.hpp"
 
+#include <algorithm>
+#include <charconv>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -28,6 +30,20 @@ std::vector<std::string> header_cells(const std::string& line, char separator) {
   }
   if (cells.size() > 1 && cells.back().empty()) cells.pop_back();
   return cells;
+}
+
+/// A line of numbers only (two or more, at either separator): a data row where a header belongs.
+bool numbers_only(const std::string& line) {
+  for (char separator : {',', ';'}) {
+    const std::vector<std::string> cells = header_cells(line, separator);
+    const auto number = [](const std::string& c) {
+      double v = 0.0;
+      const auto [end, ec] = std::from_chars(c.data(), c.data() + c.size(), v);
+      return !c.empty() && ec == std::errc() && end == c.data() + c.size();
+    };
+    if (cells.size() >= 2 && std::all_of(cells.begin(), cells.end(), number)) return true;
+  }
+  return false;
 }
 
 }  // namespace
@@ -69,19 +85,30 @@ LogSource log_source(const std::string& log_path, const std::string& map_path) {
                         "its 22 values per row hold no d_axis_voltage, q_axis_voltage, which rpem needs; VESC Tool 1.20 "
                         "added them (vedderb/vesc_tool 5986063b)");
   }
+  if (numbers_only(line)) {
+    throw DriveLogError(log_path, line_no, 0, "",
+                        "holds numbers, not column names: the file has no header (cut from a longer log?). rpem reads "
+                        "columns by the header's names: put the logger's header line first (VESC Tool's by version: "
+                        "docs/drive-log.md, \"Header versions\"), or read the file through a map with `header: false` "
+                        "(--log-map)");
+  }
   for (const std::string& cell : header_cells(line, ',')) {
     if (cell == "t_start") return {log_path, averaged_log_map(), "averaged log"};
   }
   return {log_path, drive_log_map(), "drive log"};
 }
 
-std::string describe(const TimeRepairs& r) {
+std::string describe(const ReadRepairs& r) {
   std::string s;
   if (r.wraps > 0)
     s += "; " + std::to_string(r.wraps) + (r.wraps == 1 ? " wrap" : " wraps") + " of the time column (midnight)";
   if (r.tied_rows > 0) {
     s += "; " + std::to_string(r.tied_rows) +
          " rows shared their time stamp with the row before (spread over its resolution)";
+  }
+  if (r.cut_line > 0) {
+    s += "; its last line (" + std::to_string(r.cut_line) +
+         ") is a row cut off while the file was written (unfinished, no newline after it): not read";
   }
   return s;
 }

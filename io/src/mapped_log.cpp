@@ -91,7 +91,17 @@ void MappedLogReader::split(const std::string& line) {
   }
   cells_.resize(n);
   // VESC Tool ends every line with its separator: the empty cell after it is no column.
-  if (trailing_separator_ && cells_.size() == width_ + 1 && cells_.back().empty()) cells_.pop_back();
+  closed_ = trailing_separator_ && cells_.size() == width_ + 1 && cells_.back().empty();
+  if (closed_) cells_.pop_back();
+}
+
+// A logger writes a row at a time and ends it with a newline (VESC Tool flushes each row: vedderb/vesc_tool
+// vescinterface.cpp, the valuesReceived handler), so a file copied while logging, or left by a logger killed or out
+// of space, ends inside its last row: no newline after it, and cells or the closing separator missing. Only that
+// line is taken for a cut row, and only after a whole one: a short row anywhere else is the error it always was.
+bool MappedLogReader::cut_off() const {
+  if (!in_.eof() || data_rows_ == 0) return false;  // the line ended with a newline, or no whole row came before
+  return cells_.size() != width_ || (trailing_separator_ && !closed_);
 }
 
 void MappedLogReader::read_header() {
@@ -128,6 +138,7 @@ void MappedLogReader::read_header() {
   split(header_line);
   if (trailing_separator_ && !cells_.empty() && cells_.back().empty()) cells_.pop_back();
   header_ = cells_;
+  header_line_ = line_;
   width_ = header_.size();
 
   auto find = [&](const std::string& name, const std::string& label) {
@@ -168,7 +179,15 @@ double MappedLogReader::cell(int index, const std::string& label, const MappedCo
   if (s.empty()) fail_cell(index, label, "empty cell");
   double v = 0.0;
   const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
-  if (ec != std::errc() || end != s.data() + s.size()) fail_cell(index, label, "'" + s + "' is not a number");
+  if (ec != std::errc() || end != s.data() + s.size()) {
+    // A spreadsheet saving the file in a locale with a decimal comma writes "24,9" (and ';' between cells).
+    const bool decimal_comma = std::count(s.begin(), s.end(), ',') == 1 && end != s.data() && *end == ',';
+    fail_cell(index, label,
+              "'" + s + "' is not a number" +
+                  (decimal_comma ? " (a decimal comma: saved by a spreadsheet in a locale that writes them? rpem reads "
+                                   "a decimal point, as VESC Tool and most loggers write it)"
+                                 : ""));
+  }
   if (std::isnan(v)) {
     if (allow_nan) return kNaN;
     fail_cell(index, label, "NaN");
@@ -222,10 +241,19 @@ void MappedLogReader::check(const MappedRow& row, int index, const std::string& 
   }
 }
 
-bool MappedLogReader::read_raw(MappedRow& row) {
+bool MappedLogReader::next_cells() {
   std::string text;
   if (!next_line(text)) return false;
   split(text);
+  if (cut_off()) {
+    repairs_.cut_line = line_;
+    return false;
+  }
+  if (map_.header && cells_ == header_) {
+    fail_at(line_, "*",
+            "the header again (as on line " + std::to_string(header_line_) +
+                "): two logs joined into one file? Read each log on its own");
+  }
   if (!map_.header && width_ == 0) {
     width_ = cells_.size();
     for (std::size_t q = 0; q < kQuantityCount; ++q) {
@@ -246,6 +274,11 @@ bool MappedLogReader::read_raw(MappedRow& row) {
             "row has " + std::to_string(cells_.size()) + " cells, " + (map_.header ? "header has " : "the first row has ") +
                 std::to_string(width_));
   }
+  return true;
+}
+
+bool MappedLogReader::read_raw(MappedRow& row) {
+  if (!next_cells()) return false;
   row.line = line_;
   row.value.fill(kNaN);
 

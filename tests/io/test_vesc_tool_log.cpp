@@ -238,6 +238,63 @@ TEST(VescToolLog, MidnightWrapKeepsTimeMonotonic) {
   EXPECT_EQ(s[2].t_ns, 86'400'120'000'000);
 }
 
+TEST(VescToolLog, ALastRowCutOffWhileTheLogWasWrittenIsLeftOutAndSaidSo) {
+  // VESC Tool writes a row at a time, newline last: a log copied while logging, or left by an app killed or out of
+  // space, ends inside a row. Cut after 60 of its characters (cells missing), just before its closing ';' (every
+  // cell there, the last perhaps short) or before its last cell, it is left out and named; the rows before it are read.
+  const std::string rows =
+      kHeader120 + row120(1000, 0, 1, 100, 0, 1) + row120(1100, 0, 1, 100, 0, 1) + row120(1200, 0, 1, 100, 0, 1);
+  const std::string last = row120(1300, 0, 1, 100, 0, 1);
+  for (const std::size_t keep : {std::size_t{60}, last.size() - 2, last.size() - 3}) {
+    test::TempFile f("vesc.csv", rows + last.substr(0, keep));
+    const LogSource source = log_source(f.path());
+    AveragedLogRead read;
+    const auto s = read_averaged_log(f.path(), source.map, DriveLogLimits{}, &read);
+    EXPECT_EQ(s.size(), 2U) << keep;
+    EXPECT_EQ(read.repairs.cut_line, 5U) << keep;
+    EXPECT_NE(describe(source, read).find("its last line (5) is a row cut off while the file was written"),
+              std::string::npos)
+        << describe(source, read);
+  }
+}
+
+TEST(VescToolLog, AWholeLastRowWithoutItsNewlineAndAShortRowInsideAreNoCutRow) {
+  // GIVEN the last row whole but for its newline THEN it is read; GIVEN a short row followed by another THEN the
+  // file is refused there, as any row of the wrong width is.
+  const std::string rows = kHeader120 + row120(1000, 0, 1, 100, 0, 1) + row120(1100, 0, 1, 100, 0, 1);
+  const std::string last = row120(1200, 0, 1, 100, 0, 1);
+  test::TempFile f("vesc.csv", rows + last.substr(0, last.size() - 1));
+  AveragedLogRead read;
+  EXPECT_EQ(read_averaged_log(f.path(), log_source(f.path()).map, DriveLogLimits{}, &read).size(), 2U);
+  EXPECT_EQ(read.repairs.cut_line, 0U);
+  const std::string msg = vesc_tool_error_of(rows + last.substr(0, 60) + "\n" + last);
+  EXPECT_NE(msg.find("vesc.csv:4: column *: row has"), std::string::npos) << msg;
+}
+
+TEST(VescToolLog, ADecimalCommaIsRefusedWithItsLikelyCause) {
+  // A spreadsheet in a locale with decimal commas saves 40.1 V as "40,1" (';' between cells, as VESC Tool's).
+  std::string row = row120(1000, 0, 1, 100, 0, 1);
+  row.replace(row.find("40.100000"), 9, "40,100000");
+  const std::string msg = vesc_tool_error_of(kHeader120 + row120(900, 0, 1, 100, 0, 1) + row);
+  EXPECT_NE(msg.find("vesc.csv:3:2: column input_voltage (u_dc): '40,100000' is not a number (a decimal comma"),
+            std::string::npos)
+      << msg;
+}
+
+TEST(VescToolLog, TwoLogsJoinedIntoOneFileAreRefusedAtTheSecondHeader) {
+  const std::string log = kHeader120 + row120(1000, 0, 1, 100, 0, 1) + row120(1100, 0, 1, 100, 0, 1);
+  const std::string msg = vesc_tool_error_of(log + log);
+  EXPECT_NE(msg.find("vesc.csv:4: column *: the header again (as on line 1): two logs joined into one file?"),
+            std::string::npos)
+      << msg;
+}
+
+TEST(VescToolLog, ALogWithoutItsHeaderLineIsRefusedWithWhy) {
+  // Rows of VESC Tool 1.20 and later (55 values) with the header line gone: not a drive log missing its t column.
+  const std::string msg = vesc_tool_error_of(row120(1000, 0, 1, 100, 0, 1) + row120(1100, 0, 1, 100, 0, 1));
+  EXPECT_NE(msg.find("vesc.csv:1: holds numbers, not column names: the file has no header"), std::string::npos) << msg;
+}
+
 TEST(VescToolLog, AStepBackShorterThanHalfADayIsAnErrorNotAWrap) {
   const std::string msg =
       vesc_tool_error_of(kHeader120 + row120(50000000, 0, 1, 100, 0, 1) + row120(49995000, 0, 1, 100, 0, 1));

@@ -41,7 +41,7 @@ struct AveragedLogRead {
   /// Windows after a read whose time is unknown (window: previous_row; docs/drive-log.md, "Rows stamped late"):
   /// read and checked, but no samples.
   std::uint64_t unknown_windows = 0;
-  TimeRepairs repairs;
+  ReadRepairs repairs;
 };
 
 /// Reads a whole log of averaged samples as `map` describes it (our averaged log: averaged_log_map();

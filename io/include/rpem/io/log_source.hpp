@@ -31,6 +31,6 @@ struct LogSource {
 /// first window); 1 midnight wrap; 12 rows shared their millisecond with the row before").
 [[nodiscard]] std::string describe(const LogSource& source, const AveragedLogRead& read);
 /// The time rules' part of it (empty when they did nothing).
-[[nodiscard]] std::string describe(const TimeRepairs& repairs);
+[[nodiscard]] std::string describe(const ReadRepairs& repairs);
 
 }  // namespace rpem::io

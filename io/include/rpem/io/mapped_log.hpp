@@ -30,10 +30,12 @@ struct MappedRow {
   [[nodiscard]] double operator[](Quantity q) const noexcept { return value[static_cast<std::size_t>(q)]; }
 };
 
-/// What the time rules did while reading (for the tools' summary lines).
-struct TimeRepairs {
+/// What the reader repaired or left out while reading (for the tools' summary lines).
+struct ReadRepairs {
   std::uint64_t wraps = 0;      ///< the time column wrapped (ms_today at midnight)
   std::uint64_t tied_rows = 0;  ///< rows that shared their stamp with the row before, spread over its resolution
+  /// The file's last line, cut off while the file was written (0: none): not read (MappedLogReader::cut_off).
+  std::size_t cut_line = 0;
 };
 
 class MappedLogReader {
@@ -54,7 +56,7 @@ class MappedLogReader {
   [[nodiscard]] std::size_t line() const noexcept { return line_; }
   [[nodiscard]] std::uint64_t bytes_total() const noexcept { return bytes_total_; }
   [[nodiscard]] std::uint64_t bytes_read() const noexcept { return bytes_read_; }
-  [[nodiscard]] const TimeRepairs& repairs() const noexcept { return repairs_; }
+  [[nodiscard]] const ReadRepairs& repairs() const noexcept { return repairs_; }
 
   /// The message's name of a quantity's column ("i_q"; "q_axis_current (i_q)" where a map renames it).
   [[nodiscard]] std::string label(Quantity q) const;
@@ -65,8 +67,10 @@ class MappedLogReader {
  private:
   void read_header();
   bool next_line(std::string& text);
+  bool next_cells();  ///< the next row's cells, of the file's width; false at the end (or at a cut last row)
   bool read_raw(MappedRow& row);
   void split(const std::string& line);
+  [[nodiscard]] bool cut_off() const;
   [[nodiscard]] double cell(int index, const std::string& label, const MappedColumn& c, bool allow_nan) const;
   void check(const MappedRow& row, int index, const std::string& label, Quantity q, double v) const;
   [[noreturn]] void fail_cell(int index, const std::string& label, const std::string& reason) const;
@@ -81,8 +85,10 @@ class MappedLogReader {
   std::uint64_t bytes_total_ = 0;
   std::uint64_t bytes_read_ = 0;
   std::vector<std::string> header_;
-  std::size_t width_ = 0;  ///< cells per row (the header's, or a headerless file's first row's)
+  std::size_t header_line_ = 0;  ///< the file's line the header was read from
+  std::size_t width_ = 0;        ///< cells per row (the header's, or a headerless file's first row's)
   bool trailing_separator_ = false;
+  bool closed_ = false;  ///< the row just split ended with the separator its header ends with
   std::vector<std::string> cells_;
   std::array<int, kQuantityCount> index_{};  ///< 0-based cell of each quantity; −1 absent
   std::array<const MappedColumn*, kQuantityCount> column_{};
@@ -96,7 +102,7 @@ class MappedLogReader {
   std::optional<MappedRow> lookahead_;
   std::deque<MappedRow> ready_;
   std::uint64_t data_rows_ = 0;
-  TimeRepairs repairs_;
+  ReadRepairs repairs_;
 };
 
 }  // namespace rpem::io
