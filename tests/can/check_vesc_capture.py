@@ -52,7 +52,9 @@ def emulator_times(path, asked):
     if not (origin and silent and back):
         sys.exit('check_vesc_capture: %s lacks the emulator\'s origin, silence or return' % path)
     s0, s1 = float(silent.group(1)), float(back.group(1))
-    if not (abs(s0 - asked[0]) < 0.1 and abs(s1 - asked[1]) < 0.1):
+    # The emulator looks at its clock at least every millisecond; 0.5 s leaves room for a TCG stall at the edge
+    # (the frames are judged against the printed moments, not the asked ones).
+    if not (abs(s0 - asked[0]) < 0.5 and abs(s1 - asked[1]) < 0.5):
         sys.exit('check_vesc_capture: silent %.3f-%.3f s, asked for %g-%g s' % (s0, s1, asked[0], asked[1]))
     return float(origin.group(1)), s0, s1
 

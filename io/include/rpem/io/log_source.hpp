@@ -30,7 +30,7 @@ struct LogSource {
 /// ("vesc.csv as VESC Tool realtime log (…): 8567 rows, 8566 averaged samples (the first row opens the
 /// first window); 1 midnight wrap; 12 rows shared their millisecond with the row before").
 [[nodiscard]] std::string describe(const LogSource& source, const AveragedLogRead& read);
-/// The time rules' part of it (empty when they did nothing).
+/// The reader's part of it: wraps, ties, a cut last row (empty when there were none).
 [[nodiscard]] std::string describe(const ReadRepairs& repairs);
 
 }  // namespace rpem::io
