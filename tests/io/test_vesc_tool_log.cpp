@@ -242,32 +242,27 @@ TEST(VescToolLog, ALastRowCutOffWhileTheLogWasWrittenIsLeftOutAndSaidSo) {
   // VESC Tool writes a row at a time, newline last: a log copied while logging, or left by an app killed or out of
   // space, ends inside a row. Cut after 60 of its characters (cells missing), just before its closing ';' (every
   // cell there, the last perhaps short) or before its last cell, it is left out and named; the rows before it are read.
-  const std::string rows =
-      kHeader120 + row120(1000, 0, 1, 100, 0, 1) + row120(1100, 0, 1, 100, 0, 1) + row120(1200, 0, 1, 100, 0, 1);
+  const std::string rows = row120(1000, 0, 1, 100, 0, 1) + row120(1100, 0, 1, 100, 0, 1) + row120(1200, 0, 1, 100, 0, 1);
   const std::string last = row120(1300, 0, 1, 100, 0, 1);
   for (const std::size_t keep : {std::size_t{60}, last.size() - 2, last.size() - 3}) {
-    test::TempFile f("vesc.csv", rows + last.substr(0, keep));
-    const LogSource source = log_source(f.path());
     AveragedLogRead read;
-    const auto s = read_averaged_log(f.path(), source.map, DriveLogLimits{}, &read);
-    EXPECT_EQ(s.size(), 2U) << keep;
+    EXPECT_EQ(read_rows(rows + last.substr(0, keep), read).size(), 2U) << keep;
     EXPECT_EQ(read.repairs.cut_line, 5U) << keep;
-    EXPECT_NE(describe(source, read).find("its last line (5) is a row cut off while the file was written"),
+    EXPECT_NE(describe(read.repairs).find("its last line (5) is a row cut off while the file was written"),
               std::string::npos)
-        << describe(source, read);
+        << describe(read.repairs);
   }
 }
 
 TEST(VescToolLog, AWholeLastRowWithoutItsNewlineAndAShortRowInsideAreNoCutRow) {
   // GIVEN the last row whole but for its newline THEN it is read; GIVEN a short row followed by another THEN the
   // file is refused there, as any row of the wrong width is.
-  const std::string rows = kHeader120 + row120(1000, 0, 1, 100, 0, 1) + row120(1100, 0, 1, 100, 0, 1);
+  const std::string rows = row120(1000, 0, 1, 100, 0, 1) + row120(1100, 0, 1, 100, 0, 1);
   const std::string last = row120(1200, 0, 1, 100, 0, 1);
-  test::TempFile f("vesc.csv", rows + last.substr(0, last.size() - 1));
   AveragedLogRead read;
-  EXPECT_EQ(read_averaged_log(f.path(), log_source(f.path()).map, DriveLogLimits{}, &read).size(), 2U);
+  EXPECT_EQ(read_rows(rows + last.substr(0, last.size() - 1), read).size(), 2U);
   EXPECT_EQ(read.repairs.cut_line, 0U);
-  const std::string msg = vesc_tool_error_of(rows + last.substr(0, 60) + "\n" + last);
+  const std::string msg = vesc_tool_error_of(kHeader120 + rows + last.substr(0, 60) + "\n" + last);
   EXPECT_NE(msg.find("vesc.csv:4: column *: row has"), std::string::npos) << msg;
 }
 
