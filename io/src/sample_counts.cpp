@@ -42,8 +42,8 @@ constexpr Rule kBridgeOff{"had the bridge off",
                           "estimator.regimes.voltage_resolution_V, estimator.regimes.current_resolution_A"};
 constexpr Rule kInvalid{"were not finite", "NaN or infinite values", "none (the data)"};
 constexpr Rule kOutlier{"were skipped as outliers",
-                        "the prediction error lay further than the bound times its noise beyond what any parameter inside "
-                        "D_M explains",
+                        "the prediction error's pull on ψm or R_s (along the parameter's gradient, what the update moves "
+                        "it by) lay further than the bound times its noise beyond what any parameter inside D_M explains",
                         "estimator.outlier_bound_sigma (0: never skip)"};
 constexpr Rule kResyncPhase{"resynchronised",
                             "each was more than estimator.max_sample_interval_s after the previous one but within "

@@ -239,7 +239,7 @@ std::vector<double> speeds_used(const std::string& csv, const nlohmann::json& ro
 // alone would count 0 or ±70 rad/s; the run grown while its sides agree (docs/derivations.md §13, "The count's speed
 // over a grown run" — what rpemd's VESC source counts too, daemon/count_delay.hpp) puts each crawling window's
 // speed within the count's bound over a full run (2 steps over 0.5 s: 4.2 rad/s) of the truth's mean in RMS, where
-// the PLL's rebuilt speed is off by several times that; ψm ends within 2 % and R_s within 5 % or declared.
+// the PLL's rebuilt speed is off by several times that; ψm ends within 2 % and R_s within 5 %.
 TEST(CliVescHall, AtRpemdsPollRateEachCrawlingWindowsSpeedIsCountedOverAGrownRun) {
   const test::TempFile log("indep_hall_200.csv"), truth("indep_hall_200.json");
   const test::TempFile counted("hall_200_counted.csv"), pll("hall_200_pll.csv");
@@ -256,9 +256,11 @@ TEST(CliVescHall, AtRpemdsPollRateEachCrawlingWindowsSpeedIsCountedOverAGrownRun
 
   const Estimated hall = estimate(log.path(), "hall", "vesc-6374-firmware.yaml", counted.path());
   EXPECT_NEAR(hall.psi_m_Wb / t.at("true_at_end").at("psi_m_Wb").get<double>(), 1.0, 0.02) << hall.output;
-  if (hall.output.find("r_s not identifiable") == std::string::npos) {
-    EXPECT_NEAR(hall.r_s_Ohm / t.at("true_at_end").at("r_s_Ohm").get<double>(), 1.0, 0.05) << hall.output;
-  }
+  // R_s identified, not declared: the crawl's reads carry an inverter's d-axis voltage error no parameter explains
+  // but none moves either; judged on the per-row error they were skipped as outliers (31 % of the reads) and R_s
+  // adapted on too few to be identified (docs/derivations.md §14).
+  EXPECT_EQ(hall.output.find("r_s not identifiable"), std::string::npos) << hall.output;
+  EXPECT_NEAR(hall.r_s_Ohm / t.at("true_at_end").at("r_s_Ohm").get<double>(), 1.0, 0.05) << hall.output;
   // The same with the count never taken: the PLL's rebuilt speed everywhere (rpemd before it counted).
   (void)estimate(log.path(), "hall\n    hall_interpolation_speed_rad_s: 0", "vesc-6374-firmware.yaml", pll.path());
 
@@ -303,9 +305,9 @@ TEST(CliVescHall, OverVescToolsLinkAtItsFastestTheWindowsAroundALateReadAreNotUs
   const Estimated hall = estimate(log.path(), "hall", "vesc-6374-firmware.yaml");
   EXPECT_NE(hall.output.find("windows unknown, not used"), std::string::npos) << hall.output;
   EXPECT_NEAR(hall.psi_m_Wb / t.at("true_at_end").at("psi_m_Wb").get<double>(), 1.0, 0.02) << hall.output;
-  if (hall.output.find("r_s not identifiable") == std::string::npos) {
-    EXPECT_NEAR(hall.r_s_Ohm / t.at("true_at_end").at("r_s_Ohm").get<double>(), 1.0, 0.05) << hall.output;
-  }
+  // R_s identified, not declared (as at rpemd's poll rate above).
+  EXPECT_EQ(hall.output.find("r_s not identifiable"), std::string::npos) << hall.output;
+  EXPECT_NEAR(hall.r_s_Ohm / t.at("true_at_end").at("r_s_Ohm").get<double>(), 1.0, 0.05) << hall.output;
 }
 
 }  // namespace

@@ -229,9 +229,13 @@ class RpemEstimator {
   /// The update both sample kinds share: gain (SGA, GNA, PhyInt), eq:GainSchedule, θ̂ += L·ε, projection
   /// onto D_M (eq:paramsubset); the sample's output.
   EstimatorOutput update(const Update& u, const Vec2& gamma_r, const Vec2& gamma_l, const Admission& admission) noexcept;
-  /// Whether ε lies beyond the bound: in a row, further than ν_max·σ_ε beyond the largest error a θ in
-  /// D_M explains (docs/derivations.md §14).
+  /// Whether ε lies beyond the bound: its evidence Ψ_jᵀε on a parameter further than ν_max of its noise
+  /// beyond the largest a θ in D_M gives (docs/derivations.md §14).
   [[nodiscard]] bool outlier(const Update& u, const Admission& admission) const noexcept;
+  /// Per parameter, |Ψ_jᵀε| less the largest Ψ_jᵀΨ·Δθ over D_M (> 0: the noise decides).
+  [[nodiscard]] Vec2 beyond_explained(const Update& u) const noexcept;
+  /// Whether a `beyond` > 0 exceeds ν_max times the evidence's noise.
+  [[nodiscard]] bool beyond_noise(const Update& u, const Admission& admission, const Vec2& beyond) const noexcept;
   /// The output of a sample predicted but not adapted (excluded, outlier): ε and î as predicted.
   [[nodiscard]] EstimatorOutput predicted_only(StepCode code, const Vec2& epsilon, const Vec2& i_hat) const noexcept;
   [[nodiscard]] Mat2 select_gradient(const MachinePu& model, double n_pu) const noexcept;
