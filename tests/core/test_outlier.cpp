@@ -84,6 +84,8 @@ TEST(Outlier, FalseSkipRateUnderGaussianNoiseIsTheDerivedOne) {
   EXPECT_NEAR(1.0 - both_within(3.0, 0.0), 1.0 - (1.0 - one) * (1.0 - one), 1e-9);
   const double expected = p * kSamples, spread = std::sqrt(kSamples * p * (1.0 - p));
   EXPECT_NEAR(static_cast<double>(skipped), expected, 4.0 * spread) << "seed " << seed << ", rho " << rho;
+  // The default bound's rate at its worst (two independent evidences), derived the same way.
+  EXPECT_NEAR(1.0 - both_within(5.0, 0.0), 1.1466e-6, 1e-9);
 }
 
 TEST(Outlier, AGlitchIsSkippedAndCountedAndAdaptsNothing) {
@@ -129,7 +131,7 @@ TEST(Outlier, APredictionErrorAWrongPsiMExplainsIsNotSkippedHoweverSuddenly) {
 TEST(Outlier, AnErrorAlongNoParametersGradientMovesNothingAndIsNotSkipped) {
   // A crawl with i_d held at 0: both gradient columns lie along q to within n·x_q/r (0.005 here, as a VESC
   // Hall drive's crawl at 10 rad/s), so a d error moves neither parameter. The d voltage carries an
-  // inverter's error (0.05·u_q: hundreds of the noise's σ, and five times what any θ in D_M puts on the d row),
+  // inverter's error (0.05·u_q: hundreds of the noise's σ, and about five times what any θ in D_M puts on the d row),
   // and r̂s starts 20 % high: the sample adapts r̂s towards the machine, as one without the d error does,
   // instead of being skipped for a d row no parameter explains.
   EstimatorConfig cfg = test::paper_config();
