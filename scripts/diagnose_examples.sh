@@ -40,7 +40,7 @@ cp "$work/off-truth.json" "$figures/offnominal/truth.json"
 
 echo "== paderborn"
 python3 scripts/paderborn_to_drive_log.py data/paderborn-motor-temperature/profile_A_every5th.csv "$work/profile.csv" \
-  --pole-pairs 4
+  --pole-pairs 4 --sample-period-s 2.5
 "$rpem" diagnose --log "$work/profile.csv" --config config/paderborn-pmsm.yaml --out "$work/pb" 2>/dev/null
 keep "$work/pb" paderborn
 

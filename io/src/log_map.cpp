@@ -343,6 +343,17 @@ LogMap parse(YamlMap root) {
   }
   m.request_timeout_s = root.number_or("request_timeout_s", 0.0, 1e-3, 1e6);
 
+  if (std::optional<YamlMap> session = root.optional_map("session")) {
+    ColumnRef s;
+    if (m.header) {
+      s.name = session->text("column");
+    } else {
+      s.position = static_cast<std::size_t>(session->integer("column", 1, 100000));
+    }
+    session->finish();
+    m.session = s;
+  }
+
   YamlMap columns = root.map("columns");
   bool mechanical = false;
   const QuantitySet present = parse_columns(columns, m, pole_pairs, mechanical);

@@ -104,6 +104,17 @@ bool MappedLogReader::cut_off() const {
   return cells_.size() != width_ || (trailing_separator_ && !closed_);
 }
 
+// Positions are checked against the first row's width when it is read.
+void MappedLogReader::index_positions() {
+  for (const MappedColumn& c : map_.columns) {
+    index_[static_cast<std::size_t>(c.quantity)] = static_cast<int>(c.column.position) - 1;
+    column_[static_cast<std::size_t>(c.quantity)] = &c;
+  }
+  if (map_.time) time_index_ = static_cast<int>(map_.time->column.position) - 1;
+  if (map_.time) time_label_ = map_.time->column.label() + " (t)";
+  if (map_.session) session_index_ = static_cast<int>(map_.session->position) - 1;
+}
+
 void MappedLogReader::read_header() {
   index_.fill(-1);
   column_.fill(nullptr);
@@ -118,13 +129,7 @@ void MappedLogReader::read_header() {
     bytes_read_ += skipped.size() + 1;
   }
   if (!map_.header) {
-    // Positions are checked against the first row's width when it is read.
-    for (const MappedColumn& c : map_.columns) {
-      index_[static_cast<std::size_t>(c.quantity)] = static_cast<int>(c.column.position) - 1;
-      column_[static_cast<std::size_t>(c.quantity)] = &c;
-    }
-    if (map_.time) time_index_ = static_cast<int>(map_.time->column.position) - 1;
-    if (map_.time) time_label_ = map_.time->column.label() + " (t)";
+    index_positions();
     return;
   }
   std::string header_line;
@@ -155,6 +160,7 @@ void MappedLogReader::read_header() {
             map_.columns_optional ? "required column is missing from the header"
                                   : "is missing from the header (the map " + map_.name + " reads it)");
   };
+  if (map_.session) session_index_ = find(map_.session->name, map_.session->name);  // where the file has it
   if (map_.time) {
     time_label_ = map_.time->column.name == "t" ? "t" : map_.time->column.name + " (t)";
     time_index_ = find(map_.time->column.name, time_label_);
@@ -274,7 +280,35 @@ bool MappedLogReader::next_cells() {
             "row has " + std::to_string(cells_.size()) + " cells, " + (map_.header ? "header has " : "the first row has ") +
                 std::to_string(width_));
   }
+  if (session_index_ >= 0) check_session();
   return true;
+}
+
+void MappedLogReader::check_session() {
+  if (session_index_ >= static_cast<int>(width_)) {
+    fail_at(line_, map_.session->label(),
+            "the map's session column is cell " + std::to_string(session_index_ + 1) + ", the row has " +
+                std::to_string(width_) + " cells");
+  }
+  const std::string& here = cells_[static_cast<std::size_t>(session_index_)];
+  if (session_line_ == 0) {
+    session_ = here;
+    session_line_ = line_;
+    return;
+  }
+  if (here == session_) return;
+  // A different spelling of one number ("4", "4.0") is the same recording.
+  double a = 0.0, b = 0.0;
+  const auto [ea, xa] = std::from_chars(here.data(), here.data() + here.size(), a);
+  const auto [eb, xb] = std::from_chars(session_.data(), session_.data() + session_.size(), b);
+  if (xa == std::errc() && xb == std::errc() && ea == here.data() + here.size() && eb == session_.data() + session_.size() &&
+      a == b)
+    return;
+  fail_cell(session_index_, map_.session->label(),
+            "a second recording begins here ('" + here + "'; the rows from line " + std::to_string(session_line_) +
+                " are '" + session_ +
+                "'): each starts from its own state and the time between them is not in the "
+                "file. Read one recording at a time: cut its rows into a file of their own");
 }
 
 bool MappedLogReader::read_raw(MappedRow& row) {

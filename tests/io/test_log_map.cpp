@@ -165,7 +165,12 @@ INSTANTIATE_TEST_SUITE_P(
                "5:22: columns.omega_el.column: 'w' is not an integer"},
         BadMap{"zero_scale", kMinimal + "  T_winding: {column: tw, scale: 0}\n",
                "9:34: columns.T_winding.scale: 0 would make every value the offset"},
-        BadMap{"samples_missing", "time: {period_s: 1}\ncolumns: {}\n", "1:1: samples: required key is missing"}),
+        BadMap{"samples_missing", "time: {period_s: 1}\ncolumns: {}\n", "1:1: samples: required key is missing"},
+        BadMap{"session_without_column", kMinimal + "session: {name: profile_id}\n",
+               "9:10: session.column: required key is missing"},
+        BadMap{"headerless_session_by_name",
+               "header: false\nsession: {column: profile_id}\nsamples: instantaneous\ntime: {period_s: 1}\ncolumns: {}\n",
+               "2:19: session.column: 'profile_id' is not an integer"}),
     [](const auto& p) { return std::string(p.param.name); });
 
 TEST(LogMap, ADriveLogThroughAMapReadsAsTheDriveLogItself) {
@@ -235,6 +240,32 @@ TEST(LogMap, DataErrorsNameTheFilesColumnAndTheQuantity) {
   EXPECT_NE(
       data_error(wide, "1\t2\t3\t4\t5\n1\t2\t3\t4\n").find("log.csv:2: column *: row has 4 cells, the first row has 5"),
       std::string::npos);
+}
+
+// A session column (the Paderborn bench's profile_id) names the recording a row belongs to: the published file
+// holds 69 one after another, each from its own state, with no time between them. Read as one log they would be
+// one session with jumps; refused where the second begins. One number spelt two ways is one recording; a header
+// without the column reads as before.
+TEST(LogMap, ASecondRecordingInOneFileIsRefusedWhereItBegins) {
+  const std::string map = kMinimal + "session: {column: profile_id}\n";
+  EXPECT_EQ(data_error(map, "time,w,ud,uq,id,iq,profile_id\n1,1,2,3,4,5,4\n2,1,2,3,4,5,4.0\n3,1,2,3,4,5,4\n"), "");
+  EXPECT_EQ(data_error(map, "time,w,ud,uq,id,iq\n1,1,2,3,4,5\n2,1,2,3,4,5\n"), "");
+  EXPECT_NE(
+      data_error(map, "time,w,ud,uq,id,iq,profile_id\n1,1,2,3,4,5,4\n2,1,2,3,4,5,4\n3,1,2,3,4,5,6\n")
+          .find("log.csv:4:7: column profile_id: a second recording begins here ('6'; the rows from line 2 are '4'): each "
+                "starts from its own state and the time between them is not in the file. Read one recording at a time: cut "
+                "its rows into a file of their own"),
+      std::string::npos);
+  const std::string headerless =
+      "header: false\nsession: {column: 7}\nsamples: instantaneous\ntime: {column: 1, unit: "
+      "ms}\ncolumns:\n  omega_el: {column: 2}\n  u_d: {column: 3}\n  u_q: {column: 4}\n"
+      "  i_d: {column: 5}\n  i_q: {column: 6}\n";
+  EXPECT_NE(data_error(headerless, "1,1,2,3,4,5,a\n2,1,2,3,4,5,b\n").find("log.csv:2:7: column 7: a second recording"),
+            std::string::npos);
+  EXPECT_NE(data_error(headerless, "1,1,2,3,4,5\n")
+                .find("log.csv:1: column 7: the map's session column is cell 7, the "
+                      "row has 6 cells"),
+            std::string::npos);
 }
 
 TEST(LogMap, EqualStampsAreAnErrorWithoutAResolution) {

@@ -40,8 +40,8 @@ def main() -> int:
     conv = os.path.join(a.source_dir, "scripts/paderborn_to_drive_log.py")
     w = lambda name: os.path.join(a.work, name)
     # The logs the tools see: no T_magnet; the honest one without T_winding after the split.
-    run([sys.executable, conv, src, w("full.csv"), "--pole-pairs", "4", "--averaged", "--coolant", "--no-magnet"])
-    run([sys.executable, conv, src, w("honest.csv"), "--pole-pairs", "4", "--averaged", "--coolant", "--no-magnet",
+    run([sys.executable, conv, src, w("full.csv"), "--pole-pairs", "4", "--sample-period-s", "2.5", "--averaged", "--coolant", "--no-magnet"])
+    run([sys.executable, conv, src, w("honest.csv"), "--pole-pairs", "4", "--sample-period-s", "2.5", "--averaged", "--coolant", "--no-magnet",
          "--winding-until-s", str(SPLIT_S)])
     for log in ("full.csv", "honest.csv"):
         with open(w(log)) as f:
@@ -66,7 +66,7 @@ def main() -> int:
                 result, ("model", "rpem", "fused", "fused_with_sensor"))
     # The figure (docs/thermal.md, "Figures"): measured pm only here, for the plot; its coverage is computed
     # apart (interpolated at the measured times) and must agree with the table's.
-    run([sys.executable, conv, src, w("measured.csv"), "--pole-pairs", "4", "--averaged", "--coolant"])
+    run([sys.executable, conv, src, w("measured.csv"), "--pole-pairs", "4", "--sample-period-s", "2.5", "--averaged", "--coolant"])
     fig_out = run([a.rpem, "figures", "--out", w("figures"), "--thermal-estimate", w("honest_est.csv"),
                    "--measured", w("measured.csv"), "--judged-after-s", str(SPLIT_S)])
     fig_cover = re.search(r"magnet ([0-9.]+) %, winding ([0-9.]+) %", fig_out)

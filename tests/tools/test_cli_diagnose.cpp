@@ -155,7 +155,7 @@ TEST(CliDiagnose, PaderbornWorkedExampleKeepsItsResult) {
   const std::string source = test::data_file("paderborn-motor-temperature/profile_A_every5th.csv");
   const std::string dir = out_dir("paderborn");
   auto r = test::run_command("python3 " + test::source_dir() + "/scripts/paderborn_to_drive_log.py " + source + " " + dir +
-                             "/profile.csv --pole-pairs 4");
+                             "/profile.csv --pole-pairs 4 --sample-period-s 2.5");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   r = test::run_command(rpem_tool() + " diagnose --log " + dir + "/profile.csv --config " + test::source_dir() +
                         "/config/paderborn-pmsm.yaml --out " + dir + "/diagnosis");
@@ -222,7 +222,7 @@ TEST(CliDiagnose, AModelExtendedOnOneRecordingIsTheBaselineOfTheNext) {
   const std::string source = test::data_file("paderborn-motor-temperature/profile_A_every5th.csv");
   const std::string dir = out_dir("carry");
   auto r = test::run_command("python3 " + test::source_dir() + "/scripts/paderborn_to_drive_log.py " + source + " " + dir +
-                             "/profile.csv --pole-pairs 4");
+                             "/profile.csv --pole-pairs 4 --sample-period-s 2.5");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   std::ifstream in(dir + "/profile.csv");
   std::ofstream heat(dir + "/heatup.csv"), cool(dir + "/cooldown.csv");
@@ -268,7 +268,7 @@ TEST(CliDiagnose, ASparseDynamicProfileHasNoNoiseFloorAndSaysWhy) {
   const std::string source = test::data_file("paderborn-motor-temperature/profile_A_every5th.csv");
   const std::string dir = out_dir("sparse");
   auto r = test::run_command("python3 " + test::source_dir() + "/scripts/paderborn_to_drive_log.py " + source + " " + dir +
-                             "/profile.csv --pole-pairs 4");
+                             "/profile.csv --pole-pairs 4 --sample-period-s 2.5");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   std::vector<std::string> heat, cool;
   std::string header, line;

@@ -149,7 +149,7 @@ std::vector<double> paderborn_row_psi_m(const std::string& log) {
 void convert_paderborn(const std::string& out, const std::string& options) {
   const std::string source = test::data_file("paderborn-motor-temperature/profile_A_every5th.csv");
   const auto r = test::run_command("python3 " + test::source_dir() + "/scripts/paderborn_to_drive_log.py " + source + " " +
-                                   out + " --pole-pairs 4" + options);
+                                   out + " --pole-pairs 4 --sample-period-s 2.5" + options);
   ASSERT_EQ(r.exit_code, 0) << r.output;
 }
 

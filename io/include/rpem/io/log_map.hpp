@@ -109,6 +109,11 @@ struct LogMap {
 
   std::vector<MappedColumn> columns;
 
+  /// The column naming the recording each row belongs to (`session: {column: …}`; the Paderborn bench's
+  /// profile_id): a file whose rows come from two recordings is refused where the second begins, since each starts
+  /// from its own state and the time between them is not in the file. Read where the header has it.
+  std::optional<ColumnRef> session;
+
   /// The speed column is a tracking loop's speed at the read, lagging a ramp by this much (omega_el's
   /// `pll: {kp, ki}`: k_p/k_i; VESC's erpm, 66.7 ms by default): the reader rebuilds each window's mean speed
   /// from it and the previous row's (core::window_mean_speed_rad_s). 0: the column is the window's mean speed.

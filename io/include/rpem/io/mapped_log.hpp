@@ -66,9 +66,11 @@ class MappedLogReader {
 
  private:
   void read_header();
+  void index_positions();  ///< a headerless map's cells: its columns' positions
   bool next_line(std::string& text);
   bool next_cells();  ///< the next row's cells, of the file's width; false at the end (or at a cut last row)
   bool read_raw(MappedRow& row);
+  void check_session();  ///< the row belongs to the first row's recording (LogMap::session), else a DriveLogError
   void split(const std::string& line);
   [[nodiscard]] bool cut_off() const;
   [[nodiscard]] double cell(int index, const std::string& label, const MappedColumn& c, bool allow_nan) const;
@@ -94,6 +96,9 @@ class MappedLogReader {
   std::array<const MappedColumn*, kQuantityCount> column_{};
   int time_index_ = -1;
   std::string time_label_;
+  int session_index_ = -1;        ///< the map's session column's cell; −1: none (or not in the header)
+  std::string session_;           ///< the first row's session cell
+  std::size_t session_line_ = 0;  ///< its line
 
   // Time: the previous raw (unwrapped, untied) stamp, the wraps so far, rows held to spread a tie.
   std::optional<std::int64_t> previous_raw_ns_;
