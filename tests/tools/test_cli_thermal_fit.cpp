@@ -225,5 +225,63 @@ TEST_F(CliThermalFit, SaysWhatTheTrainingPartObserves) {
   }
 }
 
+// A log that does not start soaked (the VESC ride above: winding 70 °C, magnet 60 °C, ambient 25 °C). The magnet law's
+// reference is anchored at the first magnet observations, whose temperature a soaked start gives (the coolant); here
+// the winding sensor shows the start is not (44.9 K above the coolant, 1 K sensor), and the magnet's temperature is
+// unknown. Anchored at the coolant, as before, every magnet temperature read 35 K cold with a σ of 4 K: the true
+// magnet outside the band on every row, on the side a derating fails. Now the fit says so, anchors at the winding's
+// reading and widens the reference's σ to the winding's distance from the coolant: the band holds the true magnet
+// (the generator's truth, its own thermal plant) on at least 90 % of the rows, and the anchored ψ_ref is within
+// the error that σ allows, |α|·44.9 K ≈ 5.4 %, of the true one.
+TEST_F(CliThermalFit, ALogThatDoesNotStartSoakedIsAnchoredAtItsWindingWithTheBandWidened) {
+  const std::string log = dir_ + "/vesc.csv", truth = dir_ + "/truth.json";
+  const test::ProcessResult g = test::run_command(
+      test::binary_dir() + "/tests/independent_vesc/indep_vesc_log --config " + outrunner_config() +
+      " --seed 3 --duration-s 900 --set thermal.winding_start_C=70 --set thermal.magnet_start_C=60 --out " + log +
+      " --truth " + truth);
+  ASSERT_EQ(g.exit_code, 0) << g.output;
+  const test::ProcessResult r = test::run_command(rpem_tool() + " thermal fit --log " + log + " --config " +
+                                                  outrunner_config() + " --out " + dir_ + "/thermal.yaml");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("note: the log does not start soaked: at its first step the winding sensor reads 69.9 °C, "
+                          "44.9 K from the coolant's 25.0 °C"),
+            std::string::npos)
+      << r.output;
+  const std::string yaml = test::read_file(dir_ + "/thermal.yaml");
+  const std::size_t law = yaml.find("magnet_law: {psi_m_ref_Wb: ");
+  ASSERT_NE(law, std::string::npos) << yaml;
+  const double psi_ref_Wb = std::stod(yaml.substr(law + 27));
+  const std::size_t sigma = yaml.find("reference_sigma_K: ", law);
+  ASSERT_NE(sigma, std::string::npos) << yaml;
+  EXPECT_NEAR(std::stod(yaml.substr(sigma + 19)), 44.9, 0.05);
+
+  const nlohmann::json t = nlohmann::json::parse(std::ifstream(truth));
+  const nlohmann::json& plant = t.at("thermal");
+  const double true_ref_Wb = t.at("true_machine").at("psi_m_Wb").get<double>() *
+                             (1.0 + plant.at("psi_m_coeff_per_K").get<double>() *
+                                        (20.0 - t.at("true_machine").at("reference_temperature_C").get<double>()));
+  EXPECT_NEAR(psi_ref_Wb / true_ref_Wb - 1.0, 0.0, 0.0012 * 44.9) << psi_ref_Wb << " against " << true_ref_Wb;
+
+  const test::ProcessResult e =
+      test::run_command(rpem_tool() + " estimate --log " + log + " --config " + outrunner_config() + " --thermal " + dir_ +
+                        "/thermal.yaml --out " + dir_ + "/estimate.csv");
+  ASSERT_EQ(e.exit_code, 0) << e.output;
+  const io::CsvTable estimate = io::CsvTable::read(dir_ + "/estimate.csv", true);
+  const std::vector<double>& est_t = estimate.column("t");
+  const std::vector<double>& fused = estimate.column("t_magnet_fused_C");
+  const std::vector<double>& sd = estimate.column("t_magnet_fused_sd_C");
+  const nlohmann::json& rows = t.at("rows");
+  const double t0_s = t.at("start_ms_today").get<double>() / 1000.0;
+  std::size_t judged = 0, covered = 0, k = 0;
+  for (std::size_t n = 0; n < estimate.rows(); ++n) {
+    if (!std::isfinite(fused[n])) continue;
+    while (k + 1 < rows.size() && rows[k + 1].at("t_s").get<double>() <= est_t[n] - t0_s) ++k;
+    ++judged;
+    covered += std::abs(fused[n] - rows[k].at("T_magnet_C").get<double>()) <= 2.0 * sd[n] ? 1 : 0;
+  }
+  ASSERT_GT(judged, 500U);
+  EXPECT_GE(static_cast<double>(covered), 0.9 * static_cast<double>(judged)) << covered << " of " << judged;
+}
+
 }  // namespace
 }  // namespace rpem

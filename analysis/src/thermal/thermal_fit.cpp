@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <optional>
 
 #include "../median.hpp"
 #include "filter_likelihood.hpp"
@@ -253,6 +254,9 @@ void intervals(const Layout& layout, const ThermalRecord& r, std::size_t steps, 
   }
 }
 
+/// A winding sensor's σ where the configuration fuses none: the sensor is still read (judged, the soak test).
+constexpr double kUnfusedWindingSensorSigma_K = 1.0;
+
 /// RMS of the network's misses on each observed signal, training and held out; what the training part observes of
 /// each (the temperatures its `points` read, their σ).
 void judge(const io::ThermalConfig& c, const ThermalRecord& r, std::size_t training, const std::vector<Point>& points,
@@ -262,7 +266,7 @@ void judge(const io::ThermalConfig& c, const ThermalRecord& r, std::size_t train
   const char* names[3] = {"magnet (from psi_m)", "winding (from r_s)", "winding sensor"};
   // The sensor is judged on every step that has one, whether or not the configuration fuses it.
   core::ThermalFusionConfig judged = f;
-  if (judged.winding_sensor_sigma_K <= 0.0) judged.winding_sensor_sigma_K = 1.0;
+  if (judged.winding_sensor_sigma_K <= 0.0) judged.winding_sensor_sigma_K = kUnfusedWindingSensorSigma_K;
   std::vector<core::SensorLag> lag(r.steps.size());  // at each step's start
   for (std::size_t k = 0; k + 1 < r.steps.size(); ++k) {
     lag[k + 1] = lag[k];
@@ -307,7 +311,7 @@ void judge(const io::ThermalConfig& c, const ThermalRecord& r, std::size_t train
   }
 }
 
-/// The magnet law's reference from the soaked start (docs/thermal.md, "The magnet's reference"): the mean of
+/// The magnet law's reference from the soaked start (docs/thermal.md, "A log that does not start soaked"): the mean of
 /// the first kAnchorSteps magnet observations, each corrected for the held R_s (κ·(R_s(T_w) − r̂s)), at the
 /// magnet temperatures `t_magnet_C` of those steps (the soak's, or the network's prediction of the small rise
 /// since), referred to the law's reference temperature. Returns the steps used (0: none within the first
@@ -334,6 +338,44 @@ std::size_t anchor_magnet_reference(io::ThermalConfig& c, const ThermalRecord& r
   }
   law.value_ref = sum / static_cast<double>(used);
   return used;
+}
+
+/// Two sensors at one temperature disagree beyond this many σ of their difference once in 370 (two-sided normal).
+constexpr double kSoakBound_sigma = 3.0;
+
+/// Whether the log starts soaked, as the anchor and the open-loop start assume (every node at the coolant): where
+/// it has a winding sensor, its first reading within kSoakBound_sigma of the sensor's σ from the coolant. Returns
+/// the winding sensor's first reading where it does not (and a note saying what the fit does instead).
+std::optional<double> unsoaked_start_C(const io::ThermalConfig& c, const ThermalRecord& r, std::vector<std::string>& notes) {
+  if (!r.winding_sensor || r.steps.empty() || !std::isfinite(r.steps.front().winding_sensor_C)) return std::nullopt;
+  const core::ThermalFusionConfig& f = c.fusion;
+  const double sigma_K = f.winding_sensor_sigma_K > 0.0 ? f.winding_sensor_sigma_K : kUnfusedWindingSensorSigma_K;
+  const double winding_C = r.steps.front().winding_sensor_C, coolant_C = r.steps.front().load.coolant_C;
+  if (std::abs(winding_C - coolant_C) <= kSoakBound_sigma * sigma_K) return std::nullopt;
+  char text[768];
+  std::snprintf(text, sizeof text,
+                "the log does not start soaked: at its first step the winding sensor reads %.1f °C, %.1f K from the "
+                "coolant's %.1f °C (more than %.0f times the sensor's σ of %.2g K). The magnet's temperature there is "
+                "not known: the magnet law's reference is anchored at the winding's reading instead of the coolant, "
+                "and its σ (reference_sigma_K) widened to that %.1f K, so that the band holds a magnet anywhere from "
+                "the coolant to as far above the winding (a magnet left hotter than its winding by a cool-down, or "
+                "colder by a heat-up). A log that starts with the machine at rest and cooled anchors it to the "
+                "sensor's σ (docs/thermal.md, \"A log that does not start soaked\")",
+                winding_C, winding_C - coolant_C, coolant_C, kSoakBound_sigma, sigma_K, std::abs(winding_C - coolant_C));
+  notes.emplace_back(text);
+  return winding_C;
+}
+
+/// A start that is not soaked (unsoaked_start_C): the anchor's magnet temperatures at the winding's reading, the
+/// magnet reference's σ widened to the winding's distance from the soak's magnet. Returns whether it was not.
+bool anchor_unsoaked_start(io::ThermalConfig& c, const ThermalRecord& r, const core::ThermalVec& soak,
+                           std::vector<double>& t_magnet_C, std::vector<std::string>& notes) {
+  const std::optional<double> start_C = unsoaked_start_C(c, r, notes);
+  if (!start_C) return false;
+  std::fill(t_magnet_C.begin(), t_magnet_C.end(), *start_C);
+  double& sigma_K = c.fusion.filter.calibration_sigma[static_cast<int>(core::Calibration::kMagnetOffset)];
+  sigma_K = std::max(sigma_K, std::abs(*start_C - soak[c.fusion.filter.network.magnet]));
+  return true;
 }
 
 /// The note when the copper law's reference temperature was not stated but assumed (io::ThermalConfig).
@@ -432,9 +474,12 @@ ThermalFitResult fit_thermal(const ThermalRecord& record, const io::ThermalConfi
   const core::ThermalVec soak = soaked_start(start.fusion, record);
   std::vector<double> t_magnet(record.steps.size(), soak[start.fusion.filter.network.magnet]);
   std::vector<double> t_winding(record.steps.size(), soak[start.fusion.filter.network.winding]);
+  // A start that is not soaked: anchored at the winding's reading, in one pass (the network's rise since the soak
+  // does not apply).
+  const bool unsoaked = options.anchor_magnet_reference && anchor_unsoaked_start(start, record, soak, t_magnet, out.notes);
   Solved best;
   std::vector<Point> points;
-  for (int pass = 0; pass < (options.anchor_magnet_reference ? 2 : 1); ++pass) {
+  for (int pass = 0; pass < (options.anchor_magnet_reference && !unsoaked ? 2 : 1); ++pass) {
     if (options.anchor_magnet_reference) anchor_magnet_reference(start, record, t_magnet, t_winding, out.notes);
     points = training_points(start, record, training);
     if (points.empty()) {
