@@ -143,8 +143,18 @@ void ThermalFusion::start(const ThermalStepData& s) noexcept {
   sensor_lag_ = SensorLag{};  // soaked: the sensor at the winding's temperature
   if (config_.winding_sensor_sigma_K > 0.0 && std::isfinite(s.winding_sensor_C)) {
     ThermalVec t = filter_.temperature_C();
+    ThermalMat p = filter_.covariance().topLeftCorner<kMaxThermalNodes, kMaxThermalNodes>();
+    // The sensor says the machine is not soaked (a restart on a warm machine): every node from the winding's
+    // reading, within its distance from the coolant — a magnet anywhere from the coolant to as far above the winding.
+    const double excess_K = unsoaked_excess_K(s.winding_sensor_C, s.load.coolant_C, config_.winding_sensor_sigma_K);
+    if (excess_K != 0.0) {
+      for (int i = 0; i < config_.filter.network.nodes; ++i) {
+        t[i] = s.winding_sensor_C;
+        p(i, i) = std::max(p(i, i), excess_K * excess_K);
+      }
+    }
     t[config_.filter.network.winding] = s.winding_sensor_C;
-    filter_.set_temperatures(t, filter_.covariance().topLeftCorner<kMaxThermalNodes, kMaxThermalNodes>());
+    filter_.set_temperatures(t, p);
   }
   out_.started = true;
 }

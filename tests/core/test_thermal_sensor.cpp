@@ -299,5 +299,40 @@ TEST(SensorNode, TheWindingLeadsTheReadingByTauTimesTheNodesRate) {
   EXPECT_LT(winding.rs_h_error, 1e-12);
 }
 
+// A start the winding sensor shows is not soaked (a restart on a warm machine, a log cut from a longer run): the
+// coolant says nothing of the nodes, so each starts from the winding's reading within its distance from the coolant
+// (docs/thermal.md, "A log that does not start soaked") — a magnet anywhere from the coolant to as far above the
+// winding inside 1σ (never narrower than a soaked start's σ). A reading within 3σ of the sensor from the coolant is
+// a soaked start, as before.
+TEST(ThermalFusionStart, AMachineNotSoakedStartsEveryNodeAtTheWindingWithinItsDistanceFromTheCoolant) {
+  ThermalFusionConfig c;
+  c.filter.network = two_node_network();
+  c.winding_sensor_sigma_K = 1.0;
+  c.initial_sigma_K = 10.0;
+  const int magnet = c.filter.network.magnet;
+  for (const double winding_C : {70.0, 27.9, 28.1}) {
+    SCOPED_TRACE(winding_C);
+    ThermalFusion fusion(c, PerUnitBase{}, MachineSi{});
+    ThermalStepData d;
+    d.t_ns = 1000000000;
+    d.load.dt_s = 1.0;
+    d.load.coolant_C = 25.0;
+    d.winding_sensor_C = winding_C;
+    d.winding_sensor_age = continuous_mean(1.0);
+    fusion.apply(d);
+    const ThermalNodeEstimate& m = fusion.estimate().node[static_cast<std::size_t>(magnet)];
+    const double excess_K = winding_C - 25.0;
+    if (excess_K > 3.0) {  // beyond 3σ of the sensor: not soaked
+      // One second of the network's cooling (its shortest time constant is minutes) moves it by well under 1 %.
+      EXPECT_NEAR(m.t_C, winding_C, 0.01 * excess_K);
+      EXPECT_NEAR(m.sigma_K, std::max(c.initial_sigma_K, excess_K), 0.01 * excess_K);  // never narrower than a soak's
+    } else {
+      EXPECT_NEAR(m.t_C, 25.0, 0.05 * excess_K);
+      EXPECT_NEAR(m.sigma_K, 10.0, 0.1);
+    }
+    EXPECT_EQ(unsoaked_excess_K(winding_C, 25.0, 1.0), excess_K > 3.0 ? excess_K : 0.0);
+  }
+}
+
 }  // namespace
 }  // namespace rpem::core

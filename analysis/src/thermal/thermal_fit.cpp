@@ -340,18 +340,15 @@ std::size_t anchor_magnet_reference(io::ThermalConfig& c, const ThermalRecord& r
   return used;
 }
 
-/// Two sensors at one temperature disagree beyond this many σ of their difference once in 370 (two-sided normal).
-constexpr double kSoakBound_sigma = 3.0;
-
 /// Whether the log starts soaked, as the anchor and the open-loop start assume (every node at the coolant): where
-/// it has a winding sensor, its first reading within kSoakBound_sigma of the sensor's σ from the coolant. Returns
+/// it has a winding sensor, its first reading within core::kSoakBound_sigma of the sensor's σ from the coolant. Returns
 /// the winding sensor's first reading where it does not (and a note saying what the fit does instead).
 std::optional<double> unsoaked_start_C(const io::ThermalConfig& c, const ThermalRecord& r, std::vector<std::string>& notes) {
   if (!r.winding_sensor || r.steps.empty() || !std::isfinite(r.steps.front().winding_sensor_C)) return std::nullopt;
   const core::ThermalFusionConfig& f = c.fusion;
   const double sigma_K = f.winding_sensor_sigma_K > 0.0 ? f.winding_sensor_sigma_K : kUnfusedWindingSensorSigma_K;
   const double winding_C = r.steps.front().winding_sensor_C, coolant_C = r.steps.front().load.coolant_C;
-  if (std::abs(winding_C - coolant_C) <= kSoakBound_sigma * sigma_K) return std::nullopt;
+  if (core::unsoaked_excess_K(winding_C, coolant_C, sigma_K) == 0.0) return std::nullopt;
   char text[768];
   std::snprintf(text, sizeof text,
                 "the log does not start soaked: at its first step the winding sensor reads %.1f °C, %.1f K from the "
@@ -361,7 +358,8 @@ std::optional<double> unsoaked_start_C(const io::ThermalConfig& c, const Thermal
                 "the coolant to as far above the winding (a magnet left hotter than its winding by a cool-down, or "
                 "colder by a heat-up). A log that starts with the machine at rest and cooled anchors it to the "
                 "sensor's σ (docs/thermal.md, \"A log that does not start soaked\")",
-                winding_C, winding_C - coolant_C, coolant_C, kSoakBound_sigma, sigma_K, std::abs(winding_C - coolant_C));
+                winding_C, winding_C - coolant_C, coolant_C, core::kSoakBound_sigma, sigma_K,
+                std::abs(winding_C - coolant_C));
   notes.emplace_back(text);
   return winding_C;
 }

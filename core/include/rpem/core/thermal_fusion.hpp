@@ -14,6 +14,7 @@
 // σ_T,lag = |dT̂/dt|·τ through the law's slope. Real-time safe.
 
 #include <array>
+#include <cmath>
 #include <cstdint>
 
 #include "rpem/core/thermal_filter.hpp"
@@ -34,6 +35,17 @@ struct ThermalFusionConfig {
   bool winding_node_is_reading = false;
   double initial_sigma_K = 10.0;  ///< σ of every node at the start (the coolant's temperature)
 };
+
+/// Two sensors at one temperature differ by more than this many σ once in 370 (two-sided normal): the soak test.
+inline constexpr double kSoakBound_sigma = 3.0;
+
+/// The soak test at a start (docs/thermal.md, "A log that does not start soaked"): the winding sensor's distance
+/// from the coolant where it exceeds kSoakBound_sigma of the sensor's σ — the machine is not soaked, and no node's
+/// temperature is known from the coolant — else 0.
+[[nodiscard]] inline double unsoaked_excess_K(double winding_sensor_C, double coolant_C, double sensor_sigma_K) noexcept {
+  const double excess_K = winding_sensor_C - coolant_C;
+  return std::abs(excess_K) > kSoakBound_sigma * sensor_sigma_K ? excess_K : 0.0;
+}
 
 /// A node's fused temperature.
 struct ThermalNodeEstimate {
