@@ -365,14 +365,14 @@ std::optional<double> unsoaked_start_C(const io::ThermalConfig& c, const Thermal
 }
 
 /// A start that is not soaked (unsoaked_start_C): the anchor's magnet temperatures at the winding's reading, the
-/// magnet reference's σ widened to the winding's distance from the soak's magnet. Returns whether it was not.
-bool anchor_unsoaked_start(io::ThermalConfig& c, const ThermalRecord& r, const core::ThermalVec& soak,
-                           std::vector<double>& t_magnet_C, std::vector<std::string>& notes) {
+/// magnet reference's σ widened to the winding's distance from the coolant. Returns whether it was not.
+bool anchor_unsoaked_start(io::ThermalConfig& c, const ThermalRecord& r, std::vector<double>& t_magnet_C,
+                           std::vector<std::string>& notes) {
   const std::optional<double> start_C = unsoaked_start_C(c, r, notes);
   if (!start_C) return false;
   std::fill(t_magnet_C.begin(), t_magnet_C.end(), *start_C);
   double& sigma_K = c.fusion.filter.calibration_sigma[static_cast<int>(core::Calibration::kMagnetOffset)];
-  sigma_K = std::max(sigma_K, std::abs(*start_C - soak[c.fusion.filter.network.magnet]));
+  sigma_K = std::max(sigma_K, std::abs(*start_C - r.steps.front().load.coolant_C));
   return true;
 }
 
@@ -474,7 +474,7 @@ ThermalFitResult fit_thermal(const ThermalRecord& record, const io::ThermalConfi
   std::vector<double> t_winding(record.steps.size(), soak[start.fusion.filter.network.winding]);
   // A start that is not soaked: anchored at the winding's reading, in one pass (the network's rise since the soak
   // does not apply).
-  const bool unsoaked = options.anchor_magnet_reference && anchor_unsoaked_start(start, record, soak, t_magnet, out.notes);
+  const bool unsoaked = options.anchor_magnet_reference && anchor_unsoaked_start(start, record, t_magnet, out.notes);
   Solved best;
   std::vector<Point> points;
   for (int pass = 0; pass < (options.anchor_magnet_reference && !unsoaked ? 2 : 1); ++pass) {

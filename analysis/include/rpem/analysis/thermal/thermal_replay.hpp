@@ -11,7 +11,8 @@
 namespace rpem::analysis {
 
 /// Where the network starts: every node at the first step's coolant temperature (a soaked machine), the
-/// winding at its sensor where the configuration uses one and the first step has a reading.
+/// winding at its sensor where the configuration uses one and the first step has a reading — and every node there
+/// where that reading says the machine is not soaked (core::unsoaked_excess_K), as core::ThermalFusion starts.
 [[nodiscard]] core::ThermalVec soaked_start(const core::ThermalFusionConfig& c, const ThermalRecord& r);
 
 /// The network's temperatures at the end of each step, open loop from the soaked start.
