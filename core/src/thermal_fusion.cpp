@@ -137,25 +137,28 @@ void ThermalFusion::reconfigure(const ThermalFusionConfig& config, const PerUnit
   out_.magnet = config.filter.network.magnet;
 }
 
-void ThermalFusion::start(const ThermalStepData& s) noexcept {
-  // A soaked machine at the coolant's temperature, the winding at its sensor if there is one.
-  filter_.reset(s.load.coolant_C, config_.initial_sigma_K);
-  sensor_lag_ = SensorLag{};  // soaked: the sensor at the winding's temperature
-  if (config_.winding_sensor_sigma_K > 0.0 && std::isfinite(s.winding_sensor_C)) {
-    ThermalVec t = filter_.temperature_C();
-    ThermalMat p = filter_.covariance().topLeftCorner<kMaxThermalNodes, kMaxThermalNodes>();
-    // The sensor says the machine is not soaked (a restart on a warm machine): every node from the winding's
-    // reading, within its distance from the coolant — a magnet anywhere from the coolant to as far above the winding.
-    const double excess_K = unsoaked_excess_K(s.winding_sensor_C, s.load.coolant_C, config_.winding_sensor_sigma_K);
-    if (excess_K != 0.0) {
-      for (int i = 0; i < config_.filter.network.nodes; ++i) {
-        t[i] = s.winding_sensor_C;
-        p(i, i) = std::max(p(i, i), excess_K * excess_K);
-      }
+ThermalVec start_temperatures_C(const ThermalFusionConfig& c, const ThermalStepData& s) noexcept {
+  ThermalVec t = ThermalVec::Constant(s.load.coolant_C);
+  if (c.winding_sensor_sigma_K > 0.0 && std::isfinite(s.winding_sensor_C)) {
+    if (unsoaked_excess_K(s.winding_sensor_C, s.load.coolant_C, c.winding_sensor_sigma_K) != 0.0) {
+      for (int i = 0; i < c.filter.network.nodes; ++i) t[i] = s.winding_sensor_C;
     }
-    t[config_.filter.network.winding] = s.winding_sensor_C;
-    filter_.set_temperatures(t, p);
+    t[c.filter.network.winding] = s.winding_sensor_C;
   }
+  return t;
+}
+
+void ThermalFusion::start(const ThermalStepData& s) noexcept {
+  filter_.reset(s.load.coolant_C, config_.initial_sigma_K);
+  sensor_lag_ = SensorLag{};  // the sensor at the winding's temperature
+  ThermalMat p = filter_.covariance().topLeftCorner<kMaxThermalNodes, kMaxThermalNodes>();
+  // Not soaked (a restart on a warm machine): each node within the winding's distance from the coolant — a magnet
+  // anywhere from the coolant to as far above the winding.
+  const double excess_K = config_.winding_sensor_sigma_K > 0.0 && std::isfinite(s.winding_sensor_C)
+                              ? unsoaked_excess_K(s.winding_sensor_C, s.load.coolant_C, config_.winding_sensor_sigma_K)
+                              : 0.0;
+  for (int i = 0; i < config_.filter.network.nodes; ++i) p(i, i) = std::max(p(i, i), excess_K * excess_K);
+  filter_.set_temperatures(start_temperatures_C(config_, s), p);
   out_.started = true;
 }
 

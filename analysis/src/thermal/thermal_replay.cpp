@@ -5,16 +5,8 @@
 namespace rpem::analysis {
 
 core::ThermalVec soaked_start(const core::ThermalFusionConfig& c, const ThermalRecord& r) {
-  core::ThermalVec t = core::ThermalVec::Constant(r.steps.empty() ? c.coolant_C : r.steps.front().load.coolant_C);
-  if (!r.steps.empty() && c.winding_sensor_sigma_K > 0.0 && std::isfinite(r.steps.front().winding_sensor_C)) {
-    const core::ThermalStepData& s = r.steps.front();
-    // As core::ThermalFusion::start: a start the sensor shows is not soaked has every node at the winding's reading.
-    if (core::unsoaked_excess_K(s.winding_sensor_C, s.load.coolant_C, c.winding_sensor_sigma_K) != 0.0) {
-      for (int i = 0; i < c.filter.network.nodes; ++i) t[i] = s.winding_sensor_C;
-    }
-    t[c.filter.network.winding] = s.winding_sensor_C;
-  }
-  return t;
+  if (r.steps.empty()) return core::ThermalVec::Constant(c.coolant_C);
+  return core::start_temperatures_C(c, r.steps.front());  // where core::ThermalFusion starts
 }
 
 std::vector<core::ThermalVec> simulate_open_loop(const core::ThermalFusionConfig& c, const ThermalRecord& r) {

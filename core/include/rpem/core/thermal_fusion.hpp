@@ -47,6 +47,11 @@ inline constexpr double kSoakBound_sigma = 3.0;
   return std::abs(excess_K) > kSoakBound_sigma * sensor_sigma_K ? excess_K : 0.0;
 }
 
+/// Where the network starts at a log's or a run's first step: every node at the coolant (a soaked machine), the
+/// winding at its sensor where the configuration fuses one and the step has a reading — and every node there where
+/// the reading says the machine is not soaked (unsoaked_excess_K). ThermalFusion starts here; so do the fit's replays.
+[[nodiscard]] ThermalVec start_temperatures_C(const ThermalFusionConfig& c, const ThermalStepData& s) noexcept;
+
 /// A node's fused temperature.
 struct ThermalNodeEstimate {
   double t_C = 0.0;

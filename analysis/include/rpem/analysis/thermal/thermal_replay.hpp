@@ -10,9 +10,8 @@
 
 namespace rpem::analysis {
 
-/// Where the network starts: every node at the first step's coolant temperature (a soaked machine), the
-/// winding at its sensor where the configuration uses one and the first step has a reading — and every node there
-/// where that reading says the machine is not soaked (core::unsoaked_excess_K), as core::ThermalFusion starts.
+/// Where the network starts: core::start_temperatures_C at the first step (every node at the coolant, the winding
+/// at its sensor; every node there where the sensor says the machine is not soaked), as core::ThermalFusion starts.
 [[nodiscard]] core::ThermalVec soaked_start(const core::ThermalFusionConfig& c, const ThermalRecord& r);
 
 /// The network's temperatures at the end of each step, open loop from the soaked start.
