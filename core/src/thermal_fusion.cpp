@@ -149,9 +149,8 @@ ThermalVec start_temperatures_C(const ThermalFusionConfig& c, const ThermalStepD
 }
 
 void ThermalFusion::start(const ThermalStepData& s) noexcept {
-  filter_.reset(s.load.coolant_C, config_.initial_sigma_K);
   sensor_lag_ = SensorLag{};  // the sensor at the winding's temperature
-  ThermalMat p = filter_.covariance().topLeftCorner<kMaxThermalNodes, kMaxThermalNodes>();
+  ThermalMat p = ThermalMat::Identity() * (config_.initial_sigma_K * config_.initial_sigma_K);
   // Not soaked (a restart on a warm machine): each node within the winding's distance from the coolant — a magnet
   // anywhere from the coolant to as far above the winding.
   const double excess_K = config_.winding_sensor_sigma_K > 0.0 && std::isfinite(s.winding_sensor_C)
