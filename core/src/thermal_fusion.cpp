@@ -148,8 +148,33 @@ ThermalVec start_temperatures_C(const ThermalFusionConfig& c, const ThermalStepD
   return t;
 }
 
+ThermalSnapshot ThermalFusion::snapshot() const noexcept {
+  ThermalSnapshot s;
+  if (!out_.started) return s;
+  const ThermalNetwork& n = config_.filter.network;
+  s.nodes = n.nodes;
+  s.winding = n.winding;
+  s.magnet = n.magnet;
+  s.t_C = filter_.temperature_C();
+  s.p_K2 = filter_.covariance().topLeftCorner<kMaxThermalNodes, kMaxThermalNodes>();
+  s.load = last_load_;
+  return s;
+}
+
+bool ThermalFusion::resume(const ThermalSnapshot& saved, double gap_s) noexcept {
+  if (!fits_network(saved, config_.filter.network)) return false;
+  resumed_ = across_unknown_load(config_.filter, saved, gap_s, config_.observer.period_s);
+  return true;
+}
+
 void ThermalFusion::start(const ThermalStepData& s) noexcept {
   sensor_lag_ = SensorLag{};  // the sensor at the winding's temperature
+  // A restart: where the saved state stands now.
+  if (fits_network(resumed_, config_.filter.network)) {
+    filter_.set_temperatures(resumed_.t_C, resumed_.p_K2);
+    out_.started = true;
+    return;
+  }
   ThermalMat p = ThermalMat::Identity() * (config_.initial_sigma_K * config_.initial_sigma_K);
   // Not soaked (a restart on a warm machine): each node within the winding's distance from the coolant — a magnet
   // anywhere from the coolant to as far above the winding.

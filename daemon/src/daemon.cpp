@@ -125,6 +125,25 @@ void Daemon::seed_from_state_file() {
   };
   loop_->seed(seed(e.psi_m_Wb, e.psi_m_adapted_unix_s), seed(e.r_s_Ohm, e.r_s_adapted_unix_s),
               core::now_ns(CLOCK_MONOTONIC));
+  resume_thermal(e.thermal, now_s);
+}
+
+void Daemon::resume_thermal(const PersistedThermal& saved, std::int64_t now_s) {
+  const core::ThermalSnapshot& t = saved.state;
+  if (t.nodes == 0 || !config_.live.thermal_active) return;
+  const std::int64_t gap_s = std::max<std::int64_t>(0, now_s - saved.at_unix_s);
+  if (loop_->resume_thermal(t, static_cast<double>(gap_s))) {
+    resumed_thermal_ = saved;
+    std::fprintf(stderr,
+                 "rpemd: the thermal network resumes from the state file (magnet %.1f C, winding %.1f C %ld s ago; the "
+                 "load since unknown: between none and the last)\n",
+                 t.t_C[t.magnet], t.t_C[t.winding], static_cast<long>(gap_s));
+  } else {
+    std::fprintf(stderr,
+                 "rpemd: the state file's thermal state (%d nodes, winding %d, magnet %d) is not the configured "
+                 "network's: it starts from the coolant\n",
+                 t.nodes, t.winding, t.magnet);
+  }
 }
 
 void Daemon::start_threads() {
@@ -176,7 +195,7 @@ int Daemon::run() {
   seed_from_state_file();
   const char* source_type = SourceCatalogue::type(fixed.source);
   publisher_ = std::make_unique<PersistingPublisher>(
-      fixed, PersistingPublisher::Identity{source_type, source_name_, state_file_status_},
+      fixed, PersistingPublisher::Identity{source_type, source_name_, state_file_status_, resumed_thermal_},
       PersistingPublisher::Queues{std::move(reports_.consumer), std::move(source_reports_.consumer),
                                   std::move(control_reports_.consumer)},
       std::move(keys.publish));  // the publisher thread holds it

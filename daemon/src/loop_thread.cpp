@@ -64,6 +64,10 @@ void LoopThread::seed(const std::optional<SeedValue>& psi_m, const std::optional
   if (r_s) keep(core::kRs, *r_s);
 }
 
+bool LoopThread::resume_thermal(const core::ThermalSnapshot& saved, double gap_s) noexcept {
+  return live_.thermal_active && thermal_.resume(saved, gap_s);
+}
+
 void LoopThread::push(const Report& r) noexcept {
   if (!queues_.reports.push(r)) ++counters_.output_queue_drops;
 }
@@ -223,6 +227,7 @@ void LoopThread::report_thermal(EstimateReport& r) const noexcept {
   r.t_winding_fused_sd_C = w.sd_K;
   r.t_winding_source = w.source;
   r.t_winding_observed_age_s = w.observed_age_s;
+  r.thermal = r.thermal_active ? thermal_.snapshot() : core::ThermalSnapshot{};
 }
 
 void LoopThread::report_stats() noexcept {

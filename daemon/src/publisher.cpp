@@ -69,7 +69,8 @@ PersistingPublisher::PersistingPublisher(const FixedConfig& config, Identity ide
       estimate_channel_(config.lcm.channel_prefix + "RPEM_ESTIMATE"),
       measurement_channel_(config.lcm.channel_prefix + "RPEM_MEASUREMENT"),
       diagnostics_channel_(config.lcm.channel_prefix + "RPEM_DIAGNOSTICS"),
-      state_path_(resolve_state_file(config.state)) {}
+      state_path_(resolve_state_file(config.state)),
+      thermal_(identity_.resumed_thermal) {}
 
 PersistingPublisher::~PersistingPublisher() = default;
 
@@ -142,13 +143,16 @@ void PersistingPublisher::publish_diagnostics(const LoopStatsReport& r) {
 void PersistingPublisher::maybe_write_state(bool force) {
   if (!have_estimate_) return;
   const EstimateReport& r = last_estimate_;
-  if (!r.has_good_psi_m && !r.has_good_r_s) return;
+  const double report_s = 1e-6 * static_cast<double>(r.utime);
+  if (r.thermal.nodes > 0) thermal_ = {r.thermal, static_cast<std::int64_t>(report_s)};
   const std::int64_t now_s = std::time(nullptr);
+  if (static_cast<double>(now_s - thermal_.at_unix_s) > config_.state.max_age_s) thermal_ = PersistedThermal{};
+  if (!r.has_good_psi_m && !r.has_good_r_s && thermal_.state.nodes == 0) return;
   if (!force && now_s < next_state_write_s_) return;
   next_state_write_s_ = now_s + static_cast<std::int64_t>(config_.state.write_interval_s);
-  const double report_s = 1e-6 * static_cast<double>(r.utime);
   PersistedEstimates e;
   e.written_unix_s = now_s;
+  e.thermal = thermal_;
   if (r.has_good_psi_m) {
     e.psi_m_Wb = r.good_psi_m_Wb;
     e.psi_m_adapted_unix_s = static_cast<std::int64_t>(report_s - r.good_psi_m_age_s);

@@ -3,6 +3,8 @@
 #include <fcntl.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <array>
 #include <cerrno>
 #include <cmath>
 #include <cstring>
@@ -51,6 +53,75 @@ std::string write_atomically(const std::string& path, const std::string& text) {
   return "";
 }
 
+nlohmann::json thermal_to_json(const core::ThermalSnapshot& s) {
+  const int n = s.nodes;
+  nlohmann::json t = nlohmann::json::array(), p = nlohmann::json::array();
+  for (int i = 0; i < n; ++i) {
+    t.push_back(s.t_C[i]);
+    nlohmann::json row = nlohmann::json::array();
+    for (int j = 0; j < n; ++j) row.push_back(s.p_K2(i, j));
+    p.push_back(row);
+  }
+  const core::ThermalLoad& l = s.load;
+  return {{"nodes", n},
+          {"winding", s.winding},
+          {"magnet", s.magnet},
+          {"t_C", t},
+          {"p_K2", p},
+          {"load",
+           {{"current_sq_A2", l.current_sq_A2},
+            {"basis", l.basis},
+            {"convection_basis", l.convection_basis},
+            {"coolant_C", l.coolant_C}}}};
+}
+
+/// Throws (the file is corrupt) where a value is missing or of another shape than thermal_to_json writes.
+core::ThermalSnapshot thermal_from_json(const nlohmann::json& j) {
+  core::ThermalSnapshot s;
+  s.nodes = j.at("nodes").get<int>();
+  if (s.nodes < 2 || s.nodes > core::kMaxThermalNodes)
+    throw std::runtime_error("thermal.nodes " + std::to_string(s.nodes) + " outside 2.." +
+                             std::to_string(core::kMaxThermalNodes));
+  s.winding = j.at("winding").get<int>();
+  s.magnet = j.at("magnet").get<int>();
+  const nlohmann::json& t = j.at("t_C");
+  const nlohmann::json& p = j.at("p_K2");
+  const auto n = static_cast<std::size_t>(s.nodes);
+  if (t.size() != n || p.size() != n) throw std::runtime_error("thermal.t_C and thermal.p_K2 need one entry a node");
+  for (int i = 0; i < s.nodes; ++i) {
+    s.t_C[i] = t.at(static_cast<std::size_t>(i)).get<double>();
+    const nlohmann::json& row = p.at(static_cast<std::size_t>(i));
+    if (row.size() != n) throw std::runtime_error("thermal.p_K2 is not square");
+    for (int k = 0; k < s.nodes; ++k) s.p_K2(i, k) = row.at(static_cast<std::size_t>(k)).get<double>();
+  }
+  const nlohmann::json& l = j.at("load");
+  s.load.current_sq_A2 = l.at("current_sq_A2").get<double>();
+  s.load.basis = l.at("basis").get<std::array<double, core::kLossForms>>();
+  s.load.convection_basis = l.at("convection_basis").get<double>();
+  s.load.coolant_C = l.at("coolant_C").get<double>();
+  return s;
+}
+
+/// Empty, or why a well-formed thermal state cannot be a machine's: nodes out of range, a temperature below
+/// absolute zero, a covariance that is not one (asymmetric, a negative variance), a load that is not one.
+std::string thermal_implausibility(const core::ThermalSnapshot& s) {
+  constexpr double kAbsoluteZero_C = -273.15;
+  const int n = s.nodes;
+  if (s.winding < 0 || s.winding >= n || s.magnet < 0 || s.magnet >= n || s.winding == s.magnet)
+    return "its winding and magnet are not two of its nodes";
+  const auto t = s.t_C.head(n);
+  const auto p = s.p_K2.topLeftCorner(n, n);
+  if (!t.allFinite() || (t.array() <= kAbsoluteZero_C).any()) return "a temperature is not finite or below absolute zero";
+  if (!p.allFinite() || (p.diagonal().array() < 0.0).any()) return "a variance is not finite or negative";
+  if (!p.isApprox(p.transpose(), 1e-9)) return "its covariance is not symmetric";
+  const core::ThermalLoad& l = s.load;
+  const bool basis_ok = std::all_of(l.basis.begin(), l.basis.end(), [](double b) { return std::isfinite(b) && b >= 0.0; });
+  if (!(l.current_sq_A2 >= 0.0) || !std::isfinite(l.current_sq_A2) || !basis_ok || !(l.convection_basis >= 0.0) ||
+      !std::isfinite(l.convection_basis) || !std::isfinite(l.coolant_C) || l.coolant_C <= kAbsoluteZero_C)
+    return "its load is not finite and non-negative";
+  return "";
+}
+
 }  // namespace
 
 std::string write_state_file(const std::string& path, const PersistedEstimates& e) {
@@ -61,6 +132,10 @@ std::string write_state_file(const std::string& path, const PersistedEstimates& 
   j["r_s_Ohm"] = e.r_s_Ohm ? nlohmann::json(*e.r_s_Ohm) : nlohmann::json(nullptr);
   if (e.psi_m_Wb) j["psi_m_adapted_unix_s"] = e.psi_m_adapted_unix_s;
   if (e.r_s_Ohm) j["r_s_adapted_unix_s"] = e.r_s_adapted_unix_s;
+  if (e.thermal.state.nodes > 0) {
+    j["thermal"] = thermal_to_json(e.thermal.state);
+    j["thermal"]["at_unix_s"] = e.thermal.at_unix_s;
+  }
   return write_atomically(path, j.dump(2) + "\n");
 }
 
@@ -112,29 +187,54 @@ LoadedState load_state_file(const std::string& path, double max_age_s, double ps
     if (!j.at("r_s_Ohm").is_null()) s.estimates.r_s_Ohm = j.at("r_s_Ohm").get<double>();
     s.estimates.psi_m_adapted_unix_s = j.value("psi_m_adapted_unix_s", s.estimates.written_unix_s);
     s.estimates.r_s_adapted_unix_s = j.value("r_s_adapted_unix_s", s.estimates.written_unix_s);
+    if (j.contains("thermal")) {
+      s.estimates.thermal.state = thermal_from_json(j.at("thermal"));
+      s.estimates.thermal.at_unix_s = j.at("thermal").at("at_unix_s").get<std::int64_t>();
+    }
   } catch (const std::exception& e) {
     s.status = StateFileStatus::kCorrupt;
     s.message = path + ": corrupt state file ignored (" + e.what() + ")";
     return s;
   }
-  const double age = static_cast<double>(std::time(nullptr) - s.estimates.written_unix_s);
+  const std::int64_t now_s = std::time(nullptr);
+  const double age = static_cast<double>(now_s - s.estimates.written_unix_s);
+  const std::string limit = " s old (limit " + std::to_string(static_cast<long>(max_age_s)) + " s)";
   if (age < -60.0 || age > max_age_s) {
     s.status = StateFileStatus::kTooOld;
-    s.message = path + ": state file is " + std::to_string(static_cast<long>(age)) + " s old (limit " +
-                std::to_string(static_cast<long>(max_age_s)) + " s), ignored";
+    s.message = path + ": state file is " + std::to_string(static_cast<long>(age)) + limit + ", ignored";
     return s;
   }
+  std::string note;  // what is left out of a file that is loaded
+  if (PersistedThermal& t = s.estimates.thermal; t.state.nodes > 0) {
+    const double thermal_age = static_cast<double>(now_s - t.at_unix_s);
+    if (thermal_age < -60.0 || thermal_age > max_age_s) {
+      note = "; its thermal state is " + std::to_string(static_cast<long>(thermal_age)) + limit + ", left out";
+      t = PersistedThermal{};
+      if (!s.estimates.psi_m_Wb && !s.estimates.r_s_Ohm) {
+        s.status = StateFileStatus::kTooOld;
+        s.message = path + ": state file holds nothing else" + note;
+        return s;
+      }
+    }
+  }
+  const bool has_thermal = s.estimates.thermal.state.nodes > 0;
   auto plausible = [](const std::optional<double>& v, double lo, double hi) {
     return !v || (std::isfinite(*v) && *v >= lo && *v <= hi);
   };
   if (!plausible(s.estimates.psi_m_Wb, psi_min, psi_max) || !plausible(s.estimates.r_s_Ohm, rs_min, rs_max) ||
-      (!s.estimates.psi_m_Wb && !s.estimates.r_s_Ohm)) {
+      (!s.estimates.psi_m_Wb && !s.estimates.r_s_Ohm && !has_thermal)) {
     s.status = StateFileStatus::kImplausible;
     s.message = path + ": state file values outside the configured bounds, ignored";
     return s;
   }
+  if (const std::string why = has_thermal ? thermal_implausibility(s.estimates.thermal.state) : ""; !why.empty()) {
+    s.status = StateFileStatus::kImplausible;
+    s.message = path + ": state file's thermal state is not a machine's (" + why + "), ignored";
+    return s;
+  }
   s.status = StateFileStatus::kLoaded;
-  s.message = path + ": resuming from estimates " + std::to_string(static_cast<long>(age)) + " s old";
+  const char* what = s.estimates.psi_m_Wb || s.estimates.r_s_Ohm ? "estimates " : "a thermal state ";
+  s.message = path + ": resuming from " + what + std::to_string(static_cast<long>(age)) + " s old" + note;
   return s;
 }
 

@@ -4,12 +4,15 @@
 
 #include <algorithm>
 #include <cmath>
+#include <ctime>
+#include <functional>
 #include <sstream>
 #include <string>
 #include <variant>
 #include <vector>
 
 #include "rpem/daemon/loop_thread.hpp"
+#include "rpem/daemon/state_file.hpp"
 #include "rpem/estimate_t.hpp"
 #include "rpem/io/estimate_log.hpp"
 #include "rpem/schema/text.hpp"
@@ -23,9 +26,12 @@ namespace rpem::daemon {
 namespace {
 
 /// Runs `seconds` of the model's phase samples at 8 kHz (n = 0.4 pu: ψm adapts) through a loop; the last estimate.
-EstimateReport run_loop(const DaemonConfig& config, int seconds) {
+/// `before` sees the loop before it runs (as rpemd's start-up does).
+EstimateReport run_loop(
+    const DaemonConfig& config, int seconds, const std::function<void(LoopThread&)>& before = [](LoopThread&) {}) {
   auto [input, commands, output, ends] = test::loop_queues(4096, 16, 1 << 12);
   LoopThread loop(config, std::move(ends));
+  before(loop);
   test::ModelDataGenerator gen;
   gen.plant = test::paper_machine_pu();
   gen.omega_n_rad_s = test::paper_base().omega_el_rad_s;
@@ -46,6 +52,15 @@ EstimateReport run_loop(const DaemonConfig& config, int seconds) {
   return last;
 }
 
+/// The built-in configuration with the paper machine's network, its coolant at 40 °C.
+DaemonConfig with_network() {
+  DaemonConfig config = builtin_daemon_config();
+  config.live.thermal = test::paper_thermal_fusion();
+  config.live.thermal.coolant_C = 40.0;
+  config.live.thermal_active = true;
+  return config;
+}
+
 TEST(LoopThermal, WithoutANetworkTheFieldsSayNone) {
   const EstimateReport e = run_loop(builtin_daemon_config(), 2);
   EXPECT_FALSE(e.thermal_active);
@@ -57,10 +72,7 @@ TEST(LoopThermal, WithoutANetworkTheFieldsSayNone) {
 }
 
 TEST(LoopThermal, WithANetworkTheFusedTemperaturesAreReported) {
-  DaemonConfig config = builtin_daemon_config();
-  config.live.thermal = test::paper_thermal_fusion();
-  config.live.thermal.coolant_C = 40.0;
-  config.live.thermal_active = true;
+  DaemonConfig config = with_network();
   const EstimateReport e = run_loop(config, 10);
   ASSERT_TRUE(e.thermal_active);
   // Ten seconds against time constants of minutes, from a soaked machine at the coolant: near 40 °C, and the
@@ -73,6 +85,50 @@ TEST(LoopThermal, WithANetworkTheFusedTemperaturesAreReported) {
   EXPECT_TRUE(e.t_winding_source == 1 || e.t_winding_source == 2);
   EXPECT_GE(e.t_magnet_observed_age_s, 0.0);  // observed at least once
   EXPECT_LT(e.t_magnet_observed_age_s, 10.0);
+}
+
+// A restart (docs/thermal.md, "A restart"): the state the loop reports goes through the state file and starts
+// the next loop's fusion where it stands after the gap (core::across_unknown_load), not at the coolant. The
+// second run makes no observation (its observer does not settle), so what it reports is the resumed state carried
+// one second by the network.
+TEST(LoopThermal, ARestartResumesTheReportedStateThroughTheStateFile) {
+  DaemonConfig config = with_network();
+  const EstimateReport first = run_loop(config, 10);
+  const core::ThermalSnapshot& reported = first.thermal;
+  ASSERT_EQ(reported.nodes, 3);
+  EXPECT_EQ(reported.magnet, config.live.thermal.filter.network.magnet);
+  EXPECT_EQ(reported.t_C[reported.magnet], first.t_magnet_fused_C);
+  EXPECT_EQ(std::sqrt(reported.p_K2(reported.magnet, reported.magnet)), first.t_magnet_fused_sd_C);
+
+  PersistedEstimates saved;  // the machine 50 K hotter than this run made it
+  saved.written_unix_s = std::time(nullptr) - 20;
+  saved.thermal = {reported, saved.written_unix_s};
+  saved.thermal.state.t_C.head(3).array() += 50.0;
+  const test::TempFile f("estimates.json");
+  ASSERT_EQ(write_state_file(f.path(), saved), "");
+  const LoadedState loaded = load_state_file(f.path(), 3600.0, 0.5, 1.7, 1.0, 4.5);
+  ASSERT_EQ(loaded.status, StateFileStatus::kLoaded) << loaded.message;
+
+  config.live.thermal.observer.settle_time_constants = 1e6;
+  const double gap_s = 20.0;
+  const core::ThermalSnapshot expected =
+      core::across_unknown_load(config.live.thermal.filter, loaded.estimates.thermal.state, gap_s, 0.01);
+  const EstimateReport resumed =
+      run_loop(config, 1, [&](LoopThread& l) { ASSERT_TRUE(l.resume_thermal(loaded.estimates.thermal.state, gap_s)); });
+  const int m = reported.magnet;
+  // One second against the network's minutes: within 0.5 K of where the gap left it, far above the fresh start.
+  EXPECT_NEAR(resumed.t_magnet_fused_C, expected.t_C[m], 0.5);
+  EXPECT_GT(resumed.t_magnet_fused_sd_C, 0.0);
+  const EstimateReport fresh = run_loop(config, 1);
+  EXPECT_NEAR(fresh.t_magnet_fused_C, 40.0, 0.5);
+  EXPECT_GT(resumed.t_magnet_fused_C - fresh.t_magnet_fused_C, 25.0);  // half the 50 K, after 20 s of cooling
+
+  // Another network, or none: not resumed.
+  core::ThermalSnapshot other = loaded.estimates.thermal.state;
+  other.nodes = 2;
+  (void)run_loop(config, 0, [&](LoopThread& l) { EXPECT_FALSE(l.resume_thermal(other, gap_s)); });
+  config.live.thermal_active = false;
+  (void)run_loop(config, 0, [&](LoopThread& l) { EXPECT_FALSE(l.resume_thermal(loaded.estimates.thermal.state, gap_s)); });
 }
 
 TEST(LoopThermal, TheEstimateCsvNamesTheColumnsAsRpemListensCsv) {

@@ -19,6 +19,7 @@
 
 #include "rpem/core/thermal_filter.hpp"
 #include "rpem/core/thermal_observer.hpp"
+#include "rpem/core/thermal_resume.hpp"
 #include "rpem/core/thermal_sensor.hpp"
 
 namespace rpem::core {
@@ -127,6 +128,11 @@ class ThermalFusion {
   void coast(double dt_s) noexcept;
   /// The estimator was reset or given new values: observations wait until it settles again.
   void restart_observations() noexcept { observer_.restart(); }
+  /// The filter's state for a restart (rpemd's state file); nodes 0 before the first step. Real-time safe.
+  [[nodiscard]] ThermalSnapshot snapshot() const noexcept;
+  /// The first step starts from a state saved `gap_s` ago (across_unknown_load, in observer steps) instead of
+  /// the coolant; false, and nothing changes, where the snapshot is not of this network. Before the loop runs.
+  bool resume(const ThermalSnapshot& saved, double gap_s) noexcept;
   /// A reload: new model, laws and observer settings; the temperatures and their covariance are kept.
   void reconfigure(const ThermalFusionConfig& config, const PerUnitBase& base, const MachineSi& machine) noexcept;
 
@@ -158,6 +164,7 @@ class ThermalFusion {
   std::array<int, 3> rejected_in_a_row_{};
   SensorLag sensor_lag_;  ///< the winding sensor's lag at the next step's start (eq. 14.22)
   double last_psi_m_Wb_ = 0.0, last_r_s_Ohm_ = 0.0;
+  ThermalSnapshot resumed_;  ///< where the first step starts (resume); nodes 0: from the coolant
 };
 
 /// The loss base of a machine: rated electrical speed, its ψm and rated peak current (per_unit.hpp's base).

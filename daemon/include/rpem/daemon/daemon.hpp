@@ -19,6 +19,7 @@
 #include "rpem/daemon/publisher.hpp"
 #include "rpem/daemon/source.hpp"
 #include "rpem/daemon/spsc_queue.hpp"
+#include "rpem/daemon/state_file.hpp"
 
 namespace rpem::daemon {
 
@@ -48,6 +49,8 @@ class Daemon {
 
  private:
   void seed_from_state_file();
+  /// The thermal fusion starts from the file's state where it is of the configured network (or says why not).
+  void resume_thermal(const PersistedThermal& saved, std::int64_t now_s);
   void start_threads();
   void stop_threads();
   void print_summary() const;
@@ -63,6 +66,7 @@ class Daemon {
   std::unique_ptr<SampleSource> source_;
   std::string source_name_;
   StateFileStatus state_file_status_ = StateFileStatus::kNone;
+  PersistedThermal resumed_thermal_;  ///< the state file's thermal state where the fusion resumed it
   std::unique_ptr<LoopThread> loop_;
   std::unique_ptr<PersistingPublisher> publisher_;
   SourceOutput source_output_{std::move(samples_.producer), std::move(source_reports_.producer)};

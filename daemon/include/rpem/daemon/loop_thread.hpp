@@ -58,6 +58,9 @@ class LoopThread {
 
   /// Seeds the estimates (from the state file) before the loop runs; `now_ns` on the loop's clock.
   void seed(const std::optional<SeedValue>& psi_m_Wb, const std::optional<SeedValue>& r_s_Ohm, std::int64_t now_ns);
+  /// The thermal fusion's first step starts from a state saved `gap_s` ago (core::ThermalFusion::resume); false
+  /// where no network runs or the state is not of its network. Before the loop runs.
+  bool resume_thermal(const core::ThermalSnapshot& saved, double gap_s) noexcept;
 
   /// The thread body: runs until `stop` is set, then reports a last estimate. Sets up the thread's
   /// real-time policy first (problems: setup_problems(), then started()).

@@ -13,6 +13,7 @@
 
 #include "rpem/core/drive_sample.hpp"
 #include "rpem/core/settings.hpp"
+#include "rpem/core/thermal_resume.hpp"
 #include "rpem/daemon/daemon_config.hpp"
 #include "rpem/daemon/diagnostics_rows.hpp"
 #include "rpem/mirror/estimate_t.hpp"
@@ -61,6 +62,7 @@ struct EstimateReport : mirror::estimate_t {
   bool has_good_psi_m = false, has_good_r_s = false;
   double good_psi_m_Wb = 0.0, good_r_s_Ohm = 0.0;
   double good_psi_m_age_s = 0.0, good_r_s_age_s = 0.0;
+  core::ThermalSnapshot thermal;  ///< the fusion's state (persisted: a restart resumes it); nodes 0: none
 };
 
 /// RPEM_MEASUREMENT's fields (the mirror of lcm_types/rpem_measurement_t.lcm).

@@ -47,6 +47,9 @@ class PersistingPublisher {
     std::string source_type;  ///< diagnostics_t.source
     std::string source_name;  ///< diagnostics_t.source_name
     StateFileStatus state_file_status = StateFileStatus::kNone;
+    /// The state file's thermal state where the fusion resumed it: written again, with its own time, until the
+    /// fusion reports its own (a restart while no sample arrives keeps it for the next).
+    PersistedThermal resumed_thermal;
   };
 
   /// `config` is the fixed part: nothing the publisher uses changes on a reload.
@@ -91,6 +94,7 @@ class PersistingPublisher {
   LatencyHistogram rx_to_publish_run_;  ///< the whole run
   EstimateReport last_estimate_;
   bool have_estimate_ = false;
+  PersistedThermal thermal_;  ///< the fusion's newest state (or the resumed one), persisted
   std::int64_t next_state_write_s_ = 0;
   std::int64_t next_status_us_ = 0;
 };

@@ -7,7 +7,16 @@
 #include <optional>
 #include <string>
 
+#include "rpem/core/thermal_resume.hpp"
+
 namespace rpem::daemon {
+
+/// The thermal fusion's node temperatures, covariance and load, and when they were the fusion's (docs/thermal.md,
+/// "A restart"): a restart on a hot machine starts there, not at the coolant.
+struct PersistedThermal {
+  core::ThermalSnapshot state;  ///< nodes 0: none
+  std::int64_t at_unix_s = 0;
+};
 
 struct PersistedEstimates {
   std::optional<double> psi_m_Wb;  ///< present if ψm had converged
@@ -17,6 +26,7 @@ struct PersistedEstimates {
   /// rpemd): when it was written.
   std::int64_t psi_m_adapted_unix_s = 0;
   std::int64_t r_s_adapted_unix_s = 0;
+  PersistedThermal thermal;
 };
 
 /// Writes atomically; returns an empty string or the reason it failed.
@@ -41,7 +51,9 @@ struct LoadedState {
 };
 
 /// Reads and checks a state file: age against max_age_s (and not in the future), values against the
-/// bounds of D_M. A missing file is kNone; anything unreadable is kCorrupt (reported, not fatal).
+/// bounds of D_M, a thermal state's against physics (above absolute zero, a covariance's symmetry and
+/// variances) and its own age (older than max_age_s: left out, said in the message). A missing file is
+/// kNone; anything unreadable is kCorrupt (reported, not fatal).
 [[nodiscard]] LoadedState load_state_file(const std::string& path, double max_age_s, double psi_min_Wb, double psi_max_Wb,
                                           double rs_min_Ohm, double rs_max_Ohm);
 
