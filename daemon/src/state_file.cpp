@@ -3,6 +3,7 @@
 #include <fcntl.h>
 #include <unistd.h>
 
+#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <array>
 #include <cerrno>
@@ -103,7 +104,8 @@ core::ThermalSnapshot thermal_from_json(const nlohmann::json& j) {
 }
 
 /// Empty, or why a well-formed thermal state cannot be a machine's: nodes out of range, a temperature below
-/// absolute zero, a covariance that is not one (asymmetric, a negative variance), a load that is not one.
+/// absolute zero, a covariance that is not one (asymmetric, a negative variance or eigenvalue), a load that is not
+/// one.
 std::string thermal_implausibility(const core::ThermalSnapshot& s) {
   constexpr double kAbsoluteZero_C = -273.15;
   const int n = s.nodes;
@@ -114,6 +116,9 @@ std::string thermal_implausibility(const core::ThermalSnapshot& s) {
   if (!t.allFinite() || (t.array() <= kAbsoluteZero_C).any()) return "a temperature is not finite or below absolute zero";
   if (!p.allFinite() || (p.diagonal().array() < 0.0).any()) return "a variance is not finite or negative";
   if (!p.isApprox(p.transpose(), 1e-9)) return "its covariance is not symmetric";
+  // A covariance has no negative eigenvalue (rounding aside: the filter's own are ≥ −1e-9 of its largest variance).
+  const Eigen::VectorXd eig = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(p, Eigen::EigenvaluesOnly).eigenvalues();
+  if (eig.minCoeff() < -1e-9 * p.diagonal().maxCoeff()) return "its covariance has a negative eigenvalue";
   const core::ThermalLoad& l = s.load;
   const bool basis_ok = std::all_of(l.basis.begin(), l.basis.end(), [](double b) { return std::isfinite(b) && b >= 0.0; });
   if (!(l.current_sq_A2 >= 0.0) || !std::isfinite(l.current_sq_A2) || !basis_ok || !(l.convection_basis >= 0.0) ||

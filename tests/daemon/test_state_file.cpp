@@ -159,6 +159,8 @@ TEST(StateFile, AThermalStateThatIsNotOneIsReportedAndIgnored) {
       {[](nlohmann::json& t) { t["t_C"][2] = -300.0; }, StateFileStatus::kImplausible},
       {[](nlohmann::json& t) { t["p_K2"][1][1] = -1.0; }, StateFileStatus::kImplausible},
       {[](nlohmann::json& t) { t["p_K2"][0][2] = 2.0; }, StateFileStatus::kImplausible},
+      // Symmetric with positive variances, but a correlation above 1 (7² > 4·9): not a covariance.
+      {[](nlohmann::json& t) { t["p_K2"][0][2] = t["p_K2"][2][0] = 7.0; }, StateFileStatus::kImplausible},
       {[](nlohmann::json& t) { t["magnet"] = 0; }, StateFileStatus::kImplausible},
       {[](nlohmann::json& t) { t["winding"] = 3; }, StateFileStatus::kImplausible},
       {[](nlohmann::json& t) { t["load"]["current_sq_A2"] = -1.0; }, StateFileStatus::kImplausible},
