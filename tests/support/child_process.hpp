@@ -3,14 +3,14 @@
 // stopped with SIGTERM when the test is done with it (or at the end of the scope).
 
 #include <fcntl.h>
-#include <signal.h>
 #include <spawn.h>
 #include <sys/wait.h>
 
+#include <csignal>
 #include <string>
 #include <vector>
 
-extern char** environ;
+extern char** environ;  // NOLINT(readability-redundant-declaration): <unistd.h> declares it only under _GNU_SOURCE
 
 namespace rpem::test {
 
