@@ -80,15 +80,21 @@ core::ThermalSnapshot saved_thermal_state() {
   return t;
 }
 
+/// Written now, with ψm where `with_estimates`, beside saved_thermal_state() of age `thermal_age_s`.
+PersistedEstimates with_thermal(bool with_estimates, std::int64_t thermal_age_s) {
+  PersistedEstimates e;
+  if (with_estimates) e.psi_m_Wb = 1.1;
+  e.written_unix_s = std::time(nullptr);
+  e.thermal = {saved_thermal_state(), e.written_unix_s - thermal_age_s};
+  return e;
+}
+
 // The thermal fusion's state round-trips exactly (docs/rpemd.md, "Persistence"), alone or beside the estimates.
 TEST(StateFile, TheThermalStateRoundTripsExactly) {
   for (const bool with_estimates : {true, false}) {
     SCOPED_TRACE(with_estimates);
     test::TempFile f("estimates.json");
-    PersistedEstimates e;
-    if (with_estimates) e.psi_m_Wb = 1.1;
-    e.written_unix_s = std::time(nullptr);
-    e.thermal = {saved_thermal_state(), e.written_unix_s - 3};
+    const PersistedEstimates e = with_thermal(with_estimates, 3);
     ASSERT_EQ(write_state_file(f.path(), e), "");
     const LoadedState s = load(f.path());
     ASSERT_EQ(s.status, StateFileStatus::kLoaded) << s.message;
@@ -121,10 +127,7 @@ TEST(StateFile, AThermalStateOlderThanTheLimitIsLeftOut) {
   for (const bool with_estimates : {true, false}) {
     SCOPED_TRACE(with_estimates);
     test::TempFile f("estimates.json");
-    PersistedEstimates e;
-    if (with_estimates) e.r_s_Ohm = 2.4;
-    e.written_unix_s = std::time(nullptr);
-    e.thermal = {saved_thermal_state(), e.written_unix_s - 4000};
+    const PersistedEstimates e = with_thermal(with_estimates, 4000);
     ASSERT_EQ(write_state_file(f.path(), e), "");
     const LoadedState s = load(f.path());
     EXPECT_EQ(s.status, with_estimates ? StateFileStatus::kLoaded : StateFileStatus::kTooOld);
@@ -137,10 +140,7 @@ TEST(StateFile, AThermalStateOlderThanTheLimitIsLeftOut) {
 // A thermal section of another shape is a corrupt file; one that cannot be a machine's is implausible — each
 // ignored with the reason (the whole file: a half-trusted state is not resumed).
 TEST(StateFile, AThermalStateThatIsNotOneIsReportedAndIgnored) {
-  PersistedEstimates e;
-  e.psi_m_Wb = 1.1;
-  e.written_unix_s = std::time(nullptr);
-  e.thermal = {saved_thermal_state(), e.written_unix_s - 3};
+  const PersistedEstimates e = with_thermal(true, 3);
   test::TempFile good("good.json");
   ASSERT_EQ(write_state_file(good.path(), e), "");
   std::ifstream in(good.path());

@@ -13,6 +13,7 @@
 
 #include "rpem/core/thermal_resume.hpp"
 #include "rpem/daemon/daemon_config.hpp"
+#include "rpem/daemon/state_file.hpp"
 #include "support/child_process.hpp"
 #include "support/process.hpp"
 #include "support/temp_file.hpp"
@@ -65,18 +66,12 @@ TEST(RpemdThermalRestart, AKilledRpemdRestartsItsFusionWhereTheSavedStateStandsN
   saved["written_unix_s"] = at_s;
   std::ofstream(state.path()) << saved.dump();
   const rpem::daemon::DaemonConfig c = rpem::daemon::load_daemon_config(config.path());
-  rpem::core::ThermalSnapshot hot;
-  hot.nodes = 2, hot.winding = 0, hot.magnet = 1;
-  hot.t_C << 95.0, 88.0, 0.0, 0.0;
-  const auto& p = saved["thermal"]["p_K2"];
-  for (int i = 0; i < 2; ++i)
-    for (int j = 0; j < 2; ++j) hot.p_K2(i, j) = p[static_cast<std::size_t>(i)][static_cast<std::size_t>(j)];
-  hot.load.current_sq_A2 = saved["thermal"]["load"]["current_sq_A2"];
-  hot.load.basis = saved["thermal"]["load"]["basis"];
-  hot.load.convection_basis = saved["thermal"]["load"]["convection_basis"];
-  hot.load.coolant_C = saved["thermal"]["load"]["coolant_C"];
-  const rpem::core::ThermalSnapshot expected =
-      rpem::core::across_unknown_load(c.live.thermal.filter, hot, 30.0, c.live.thermal.observer.period_s);
+  const rpem::core::EstimatorSettings& est = c.live.machine.estimator;
+  const rpem::daemon::LoadedState hot = rpem::daemon::load_state_file(
+      state.path(), c.fixed.state.max_age_s, est.psi_m_min_Wb, est.psi_m_max_Wb, est.r_s_min_Ohm, est.r_s_max_Ohm);
+  ASSERT_EQ(hot.status, rpem::daemon::StateFileStatus::kLoaded) << hot.message;
+  const rpem::core::ThermalSnapshot expected = rpem::core::across_unknown_load(
+      c.live.thermal.filter, hot.estimates.thermal.state, 30.0, c.live.thermal.observer.period_s);
 
   const std::string log = run_rpemd(config.path(), 3.0, SIGTERM);
   EXPECT_NE(log.find("rpemd: the thermal network resumes from the state file (magnet 88.0 C, winding 95.0 C 3"),
