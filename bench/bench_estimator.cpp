@@ -271,10 +271,18 @@ std::vector<core::AveragedSample> averaged_windows() {
 
 /// The same for averaged windows (the paper's machine, 200 Hz uneven windows at 0.4 pu under load): the
 /// classifier on the averaged estimator's inputs against AveragedDriveEstimator::step, the frame from a sensor or
-/// sensorless (`estimator.regimes.angle_source`: r_s' test takes the frame error the lock test leaves possible).
-void averaged_classification_over_step(benchmark::State& state, bool sensorless) {
+/// sensorless (`estimator.regimes.angle_source`: r_s' test takes the frame error the lock test leaves possible);
+/// `rebuilt`: each window's speed a PLL's reads rebuilt, with the error they show (a VESC's: its test runs on every
+/// window; docs/derivations.md §13, "… where the acceleration changes").
+void averaged_classification_over_step(benchmark::State& state, bool sensorless, bool rebuilt = false) {
   const core::PerUnitBase base = test::paper_base();
   std::vector<core::AveragedSample> windows = averaged_windows();
+  if (rebuilt) {
+    for (core::AveragedSample& w : windows) {
+      w.omega_el_error_rad_s = 1e-3 * w.omega_el_rad_s;
+      w.omega_el_error_noise_rad_s = 0.5e-3 * w.omega_el_rad_s;
+    }
+  }
   std::vector<core::RegimeInput> inputs;
   for (std::size_t k = 0; k < windows.size(); ++k) {
     const core::AveragedSample& w = windows[k];
@@ -285,6 +293,8 @@ void averaged_classification_over_step(benchmark::State& state, bool sensorless)
     in.u_pu = w.u_dq_V / base.voltage_V;
     in.i_pu = w.i_dq_A / base.current_A;
     in.n_pu = w.omega_el_rad_s / base.omega_el_rad_s;
+    in.n_error_pu = w.omega_el_error_rad_s / base.omega_el_rad_s;
+    in.n_error_noise_pu = w.omega_el_error_noise_rad_s / base.omega_el_rad_s;
     in.u_reported_sq_pu = in.u_pu.squaredNorm();
     in.weight = core::Vec2::Constant(0.01);
     inputs.push_back(in);
@@ -319,6 +329,9 @@ void averaged_classification_over_step(benchmark::State& state, bool sensorless)
 }
 void BM_AveragedClassificationOverStep(benchmark::State& state) { averaged_classification_over_step(state, false); }
 void BM_AveragedClassificationOverStepSensorless(benchmark::State& state) { averaged_classification_over_step(state, true); }
+void BM_AveragedClassificationOverStepRebuiltSpeed(benchmark::State& state) {
+  averaged_classification_over_step(state, false, true);
+}
 
 /// The classification's cost inside the averaged step, as BM_ClassificationInStep: AveragedDriveEstimator::step
 /// with `estimator.regimes.enabled` and without (which takes the slope between window centres itself), in
@@ -357,6 +370,11 @@ BENCHMARK(BM_AveragedClassificationOverStep)
     ->ComputeStatistics("max", max_of)
     ->ReportAggregatesOnly(true);
 BENCHMARK(BM_AveragedClassificationOverStepSensorless)
+    ->MinTime(1.0)
+    ->Repetitions(10)
+    ->ComputeStatistics("max", max_of)
+    ->ReportAggregatesOnly(true);
+BENCHMARK(BM_AveragedClassificationOverStepRebuiltSpeed)
     ->MinTime(1.0)
     ->Repetitions(10)
     ->ComputeStatistics("max", max_of)

@@ -225,6 +225,7 @@ void RegimeClassifier::reconfigure(const RegimeConfig& config) noexcept {
   k.dx_over_omega_n = Vec2(k.inv_omega_n * c.dx_d_pu, k.inv_omega_n * c.dx_q_pu);
   k.x_sq = Vec2(c.x_d_pu * c.x_d_pu, c.x_q_pu * c.x_q_pu);
   k.slope_var_x_sq = Vec2(k.inv_omega_n_sq * c.x_d_pu * c.x_d_pu, k.inv_omega_n_sq * c.x_q_pu * c.x_q_pu);
+  k.flux_q = Vec2(0.0, c.psi_max_pu);
   k.x_max = std::max(c.x_d_pu, c.x_q_pu);
   k.dx_max = std::max(c.dx_d_pu, c.dx_q_pu);
   k.cos_angle = 1.0 / std::sqrt(1.0 + c.tan_angle * c.tan_angle);
@@ -379,6 +380,21 @@ std::uint8_t RegimeClassifier::contiguous_transient_bits(const RegimeInput& in, 
   return transient ? regime_bit::kTransient : 0;
 }
 
+// A speed off by up to E (a tracker's reads rebuilt to the window's mean, §13 "Speed at the read", "… where the
+// acceleration changes"): the steady state's speed terms n·(−x_q·i_q, x_d·i_d + ψm) are then off by up to
+// E·(x_q·|i_q|, x_d·|i_d| + ψ_max), which the inductive correction and the slope terms do not see where the current
+// holds (a stop at constant current). Against the row's noise with the speed's own and E's (the reads' changes of
+// acceleration around the window) through the same coefficients: an E within them (reads jittering at a crawl) is
+// not told from noise.
+std::uint8_t RegimeClassifier::speed_error_bits(const RegimeInput& in, const Terms& t) const noexcept {
+  const Vec2 coeff = k_.x_swapped.cwiseProduct(in.i_pu.cwiseAbs().reverse()) + k_.flux_q;
+  const Vec2 coeff_sq = coeff.cwiseProduct(coeff);
+  const Vec2 term_sq = (in.n_error_pu * in.n_error_pu) * coeff_sq;
+  const double speed_var = noise_.n_sq + in.n_error_noise_pu * in.n_error_noise_pu;
+  const Vec2 bound = k_.z_sq * (t.row_noise + speed_var * coeff_sq);
+  return (term_sq[0] > bound[0]) | (term_sq[1] > bound[1]) ? regime_bit::kTransient : 0;
+}
+
 std::uint8_t RegimeClassifier::excitation_bits(const RegimeInput& in, const Terms& t) const noexcept {
   const RegimeConfig& c = config_;
   const Constants& k = k_;
@@ -476,6 +492,7 @@ Classification RegimeClassifier::step(const RegimeInput& in) noexcept {
   const bool standalone = in.timing == SampleTiming::kStandalone && s.points >= 1;
   const Vec2 i_before = s.i_pu[0];
   if (in.timing == SampleTiming::kContiguous && s.slope_valid) bits |= contiguous_transient_bits(in, t);
+  if (in.n_error_pu > 0.0) bits |= speed_error_bits(in, t);
   bits |= excitation_bits(in, t);
 
   // Before a chain has shown the data's noise, nothing in it is excluded on a threshold made of it.

@@ -1,6 +1,8 @@
 #include "rpem/daemon/vesc_poller.hpp"
 
 #include <algorithm>
+#include <array>
+#include <cmath>
 
 #include "rpem/core/units.hpp"
 
@@ -11,7 +13,9 @@ namespace vesc = can::vesc;
 VescPoller::VescPoller(const Config& config) noexcept
     : config_(config),
       poll_(vesc::values_request(config.controller_id, config.host_id, config.mask)),
-      decoder_(config.controller_id, config.host_id, config.mask) {}
+      decoder_(config.controller_id, config.host_id, config.mask) {
+  accel_changes_.fill(std::nan(""));
+}
 
 std::int64_t VescPoller::next_poll_ns(std::int64_t now_ns) const noexcept {
   const std::int64_t T = config_.period_ns;
@@ -119,8 +123,11 @@ bool VescPoller::on_frame(const can::CanFrame& f, std::int64_t rx_ns, core::Aver
   }
   timed_out_unanswered_ = false;
 
-  const core::SpeedRead previous_speed = previous_speed_;
+  const core::SpeedRead earlier_speed = earlier_speed_, previous_speed = previous_speed_;
+  const bool three_reads = speeds_seen_ == 2;
+  earlier_speed_ = previous_speed_;
   previous_speed_ = {t, core::rpm_to_rad_s(decoder_.values().erpm)};
+  speeds_seen_ = std::min(speeds_seen_ + 1, 2);
   if (!has_window_start_) {  // the first reply only opens the first window
     has_window_start_ = true;
     window_start_ns_ = t;
@@ -134,7 +141,18 @@ bool VescPoller::on_frame(const can::CanFrame& f, std::int64_t rx_ns, core::Aver
   }
   sample = vesc::to_averaged_sample(decoder_.values(), window_start_ns_, t);
   sample.omega_el_rad_s =
-      core::window_mean_speed_rad_s(previous_speed, previous_speed_, window_start_ns_, config_.speed_lag_s);
+      core::window_mean_speed_rad_s(previous_speed, previous_speed_, window_start_ns_, config_.pll.ramp_lag_s());
+  if (three_reads) {
+    // The error the last three replies show, and its noise from the latest changes (causal: the end read only).
+    const double change = core::read_accel_change_rad_s2(earlier_speed, previous_speed, previous_speed_);
+    accel_changes_[next_accel_change_] = change;
+    next_accel_change_ = (next_accel_change_ + 1) % accel_changes_.size();
+    std::array<double, core::kAccelChangeRunReads> run = accel_changes_;
+    const double h_s = core::to_seconds(t - window_start_ns_);
+    sample.omega_el_error_rad_s = core::window_mean_speed_error_rad_s(config_.pll, change, h_s);
+    sample.omega_el_error_noise_rad_s =
+        core::window_mean_speed_error_rad_s(config_.pll, core::accel_change_sigma_rad_s2(run), h_s);
+  }
   sample.gap_before = gap_;
   gap_ = false;
   window_start_ns_ = t;

@@ -52,7 +52,7 @@ VescPoller::Config poller_config(const VescSource::Options& o) noexcept {
   c.period_ns = std::llround(1e9 / o.poll_rate_Hz);
   c.phase_ns = std::llround(o.poll_phase * static_cast<double>(c.period_ns));
   c.timeout_ns = std::llround(o.reply_timeout_s * 1e9);
-  c.speed_lag_s = core::pll_ramp_lag_s(o.pll_kp, o.pll_ki);
+  c.pll = {o.pll_kp, o.pll_ki};
   c.mask = o.count_horizon_s > 0.0 ? can::vesc::kCountingMask : can::vesc::kEstimatorMask;
   return c;
 }

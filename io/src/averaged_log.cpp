@@ -1,6 +1,7 @@
 #include "rpem/io/averaged_log.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <vector>
@@ -88,7 +89,8 @@ UnknownTiming unknown_timing(const std::vector<PreviousRowRead>& rows, const Log
     const double reads_apart_s = core::to_seconds(b.sample.t_ns - rows[j - 2].sample.t_ns);
     const double speed_rad_s = std::max(std::abs(a.omega_at_read_rad_s), std::abs(b.omega_at_read_rad_s));
     const double allowed_rad = speed_rad_s * reads_apart_s +
-                               map.speed_lag_s * std::abs(b.omega_at_read_rad_s - a.omega_at_read_rad_s) + 2.0 * step_rad;
+                               map.speed_pll.ramp_lag_s() * std::abs(b.omega_at_read_rad_s - a.omega_at_read_rad_s) +
+                               2.0 * step_rad;
     return step_rad > 0.0 && std::abs(travel_rad) > allowed_rad ? travel_rad : 0.0;
   };
   for (std::size_t k = 1; k < n; ++k) {
@@ -98,6 +100,18 @@ UnknownTiming unknown_timing(const std::vector<PreviousRowRead>& rows, const Log
     if (k >= 2 && k + 1 < n && excess(k) * excess(k + 1) < 0.0) unknown_read(k);
   }
   return u;
+}
+
+/// The change of the PLL's mean acceleration at each read j, over reads j − 2, j − 1, j (core::read_accel_change_rad_s2);
+/// NaN where either window is unknown, or at the first two reads.
+std::vector<double> accel_changes(const std::vector<PreviousRowRead>& rows, const UnknownTiming& unknown) {
+  std::vector<double> out(rows.size(), std::nan(""));
+  const auto read_at = [&](std::size_t j) { return core::SpeedRead{rows[j].sample.t_ns, rows[j].omega_at_read_rad_s}; };
+  for (std::size_t j = 2; j < rows.size(); ++j) {
+    if (!unknown.window[j - 1] && !unknown.window[j])
+      out[j] = core::read_accel_change_rad_s2(read_at(j - 2), read_at(j - 1), read_at(j));
+  }
+  return out;
 }
 
 /// The samples of a previous_row log's rows (rows not empty): each window from the read before it, its speed rebuilt
@@ -113,6 +127,7 @@ void previous_row_samples(const std::vector<PreviousRowRead>& rows, const LogMap
   for (const PreviousRowRead& row : rows) all_reads.push_back({row.sample.t_ns, row.travel_el_rad});
   const double step_rad = counted ? count_step_rad(all_reads) : 0.0;
   const UnknownTiming unknown = unknown_timing(rows, map, step_rad);
+  const std::vector<double> accel_change = map.speed_pll.given() ? accel_changes(rows, unknown) : std::vector<double>{};
   read.opening_rows = 1;
   bool after_unknown = false;
   for (std::size_t k = 0; k < rows.size(); ++k) {
@@ -127,10 +142,23 @@ void previous_row_samples(const std::vector<PreviousRowRead>& rows, const LogMap
     s.t_start_ns = previous.sample.t_ns;
     s.gap_before = after_unknown;
     after_unknown = false;
-    if (map.speed_lag_s > 0.0) {
-      // A PLL's speed at each read: the window's mean from this read's and the previous one's (§13).
-      s.omega_el_rad_s = core::window_mean_speed_rad_s({previous.sample.t_ns, previous.omega_at_read_rad_s},
-                                                       {s.t_ns, rows[k].omega_at_read_rad_s}, s.t_start_ns, map.speed_lag_s);
+    if (map.speed_pll.given()) {
+      // A PLL's speed at each read: the window's mean from this read's and the previous one's (§13), its error from
+      // the larger change of acceleration the reads show at the window's two ends (a change inside the window shows
+      // in the PLL's speed by the next read, not yet at this one), and that error's noise from the changes around it.
+      s.omega_el_rad_s =
+          core::window_mean_speed_rad_s({previous.sample.t_ns, previous.omega_at_read_rad_s},
+                                        {s.t_ns, rows[k].omega_at_read_rad_s}, s.t_start_ns, map.speed_pll.ramp_lag_s());
+      const double h_s = core::to_seconds(s.t_ns - s.t_start_ns);
+      const double after = k + 1 < rows.size() ? accel_change[k + 1] : std::nan("");
+      const double change = std::fmax(std::fabs(accel_change[k]), std::fabs(after));  // fmax: a NaN side left out
+      if (std::isfinite(change)) s.omega_el_error_rad_s = core::window_mean_speed_error_rad_s(map.speed_pll, change, h_s);
+      std::array<double, core::kAccelChangeRunReads> run;
+      run.fill(std::nan(""));
+      const std::size_t half = core::kAccelChangeRunReads / 2, first = k > half ? k - half : 0;
+      for (std::size_t j = first; j < rows.size() && j - first < run.size(); ++j) run[j - first] = accel_change[j];
+      s.omega_el_error_noise_rad_s =
+          core::window_mean_speed_error_rad_s(map.speed_pll, core::accel_change_sigma_rad_s2(run), h_s);
     }
     if (counted) read_ending.push_back(reads.size() - 1);
     out.push_back(s);

@@ -308,7 +308,7 @@ QuantitySet parse_columns(YamlMap& columns, LogMap& m, long pole_pairs, bool& me
       const double kp = pll->number("kp", 1e-3, 1e7);
       const double ki = pll->number("ki", 1e-3, 1e10);
       pll->finish();
-      m.speed_lag_s = core::pll_ramp_lag_s(kp, ki);
+      m.speed_pll = {kp, ki};
     }
     m.columns.push_back(parse_column(*c, q.quantity, q.kind, m.header, pole_pairs, mechanical));
     present[static_cast<std::size_t>(q.quantity)] = true;

@@ -122,10 +122,10 @@ std::string describe(const LogSource& source, const AveragedLogRead& read) {
          " windows unknown, not used: each begins or ends at a read stamped perhaps long after it was taken (a row " +
          "after the logger asked again, or a count its stamps cannot hold; docs/drive-log.md, \"Rows stamped late\")";
   }
-  if (source.map.speed_lag_s > 0.0) {
+  if (source.map.speed_pll.given()) {
     char lag[160];
     std::snprintf(lag, sizeof lag, "; each window's mean speed rebuilt from the PLL speeds at its two reads (lag %.4g ms)",
-                  1e3 * source.map.speed_lag_s);
+                  1e3 * source.map.speed_pll.ramp_lag_s());
     s += lag;
   }
   return s + describe(read.repairs);

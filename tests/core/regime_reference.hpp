@@ -308,6 +308,18 @@ class Classifier {
       if (own || s.previous_transient) bits |= regime_bit::kTransient;
       s.previous_transient = own;
     }
+    // A speed off by up to E (a tracker's reads rebuilt to the window's mean, §13 "… where the acceleration
+    // changes"): the speed terms' error E·(x_q·|i_q|, x_d·|i_d| + ψ_max) per row against the row's noise with the
+    // speed's own noise and E's through the same coefficients.
+    if (in.n_error_pu > 0.0) {
+      const double coeff_d = c.x_q_pu * abs_i[1], coeff_q = c.x_d_pu * abs_i[0] + c.psi_max_pu;
+      const double cd2 = coeff_d * coeff_d, cq2 = coeff_q * coeff_q, e2 = in.n_error_pu * in.n_error_pu;
+      const double row_d = v.u_sq + (k.r_sq + n2_xq2) * v.i_sq, row_q = v.u_sq + (k.r_sq + n2_xd2) * v.i_sq;
+      const double speed_var = v.n_sq + in.n_error_noise_pu * in.n_error_noise_pu;
+      if (e2 * cd2 > k.z_sq * (row_d + speed_var * cd2) || e2 * cq2 > k.z_sq * (row_q + speed_var * cq2)) {
+        bits |= regime_bit::kTransient;
+      }
+    }
 
     // Excitation: the parameter's term, at its smallest inside D_M, less what the other terms' uncertainty
     // can put in its place, against its noise as the estimator's averaging leaves it: h² = γ/(2 − γ) of

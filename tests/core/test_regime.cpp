@@ -430,6 +430,63 @@ TEST(Regime, AStepInsideAWindowMakesItAndTheNextTransient) {
   for (int j = 9; j < 12; ++j) EXPECT_FALSE(v[j].excluded()) << j;
 }
 
+// §13, "… where the acceleration changes": a window whose speed is off by up to E (a PLL's reads rebuilt to the
+// window's mean) is transient where E·(x_q·|i_q|, x_d·|i_d| + ψ_max) stands out of z times the row's noise together with
+// the speed's own through the same coefficients. The current holds (a stop at constant current), so no other test
+// sees it; a speed whose noise covers E (reads that jitter) leaves the window as it was.
+TEST(Regime, ASpeedKnownWithinItsRebuildsErrorIsTransientWhereItStandsOutOfTheSpeedsNoise) {
+  Outrunner s;
+  s.settings.regimes.current_resolution_A = 0.01;
+  s.settings.regimes.speed_resolution_rad_s = 0.10472;  // 1 erpm
+  const double n = 0.4, h = 0.09;
+  const Vec2 i(-0.05, 0.2);
+  // Steady contiguous windows, exact (their noise is the resolutions' quantisation); the last one's speed off by E.
+  const auto last = [&](const RegimeConfig& c, double error_pu, double error_noise_pu = 0.0) {
+    RegimeClassifier k(c);
+    Classification out;
+    for (int j = 0; j < 8; ++j) {
+      RegimeInput in = steady(s.nominal, n, i);
+      in.timing = j == 0 ? SampleTiming::kFirst : SampleTiming::kContiguous;
+      in.t_ns = std::llround((j + 1) * h * 1e9);
+      in.window_s = h;
+      in.n_error_pu = j == 7 ? error_pu : 0.0;
+      in.n_error_noise_pu = j == 7 ? error_noise_pu : 0.0;
+      out = k.step(in);
+    }
+    return out;
+  };
+  // The edge written out: the smaller of the rows' E at which E²·coeff² = z²·(row + coeff²·σ_n²).
+  const auto edge = [&](const RegimeConfig& c) {
+    const auto var = [&](std::size_t q) { return c.resolution_pu[q] * c.resolution_pu[q] / 12.0; };
+    const double coeff_d = c.x_q_pu * std::abs(i[1]), coeff_q = c.x_d_pu * std::abs(i[0]) + c.psi_max_pu;
+    const double row_d = var(0) + (c.r_pu * c.r_pu + n * n * c.x_q_pu * c.x_q_pu) * var(1);
+    const double row_q = var(0) + (c.r_pu * c.r_pu + n * n * c.x_d_pu * c.x_d_pu) * var(1);
+    return std::min(c.z * std::sqrt(row_d / (coeff_d * coeff_d) + var(2)),
+                    c.z * std::sqrt(row_q / (coeff_q * coeff_q) + var(2)));
+  };
+  const RegimeConfig c = s.config();
+  const double e = edge(c);
+  EXPECT_FALSE(last(c, 0.0).excluded());
+  EXPECT_FALSE(last(c, 0.99 * e).excluded());
+  EXPECT_EQ(last(c, 1.01 * e).regime, Regime::kTransient);
+  EXPECT_TRUE(last(c, 1.01 * e).bits & regime_bit::kExcitesPsiM);  // excited, and excluded all the same
+  // Its size: a few rad/s (1.6 here) against the 101 rad/s of seed 1's stop (docs/derivations.md).
+  EXPECT_LT(e * s.base.omega_el_rad_s, 5.0);
+  // Speed readings in steps 100 times as coarse: the same E lies within their noise.
+  s.settings.regimes.speed_resolution_rad_s = 100.0 * 0.10472;
+  const RegimeConfig jittery = s.config();
+  EXPECT_GT(edge(jittery), 5.0 * e);
+  EXPECT_FALSE(last(jittery, 1.01 * e).excluded());
+  EXPECT_EQ(last(jittery, 1.01 * edge(jittery)).regime, Regime::kTransient);
+  // E's own noise (the reads' changes of acceleration around the window) adds to the speed's: an E of 3 times its
+  // noise σ_E, with z = 4, is within it; the edge moves to z·√(edge²/z² + σ_E²).
+  const double sigma_e = 10.0 * e;
+  EXPECT_FALSE(last(c, 3.0 * sigma_e, sigma_e).excluded());
+  const double moved = c.z * std::sqrt(e * e / (c.z * c.z) + sigma_e * sigma_e);
+  EXPECT_FALSE(last(c, 0.99 * moved, sigma_e).excluded());
+  EXPECT_EQ(last(c, 1.01 * moved, sigma_e).regime, Regime::kTransient);
+}
+
 /// Windows of h at speed n over a timeline: the bridge modulates (current i_mod, the machine's steady-state
 /// voltage) until t_release, is off (a drive that reports zeros while off: u = i = 0) until t_take_over and
 /// modulates again afterwards. Each window's means are its parts' time-weighted means; `share` the part of

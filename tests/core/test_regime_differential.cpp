@@ -90,6 +90,15 @@ class Stream {
     in.window_s = wr < 0.2 ? 0.0 : wr < 0.25 ? uniform(0.0, 1.0) : std::max(0.0, step_s);
     in.u_reported_sq_pu = mode < 0.05 ? in.u_pu.squaredNorm() : (u + Vec2(gauss(noise), gauss(noise))).squaredNorm();
     if (uniform(0.0, 1.0) < 0.3) in.di_dt_pu_s = Vec2(gauss(1.0), gauss(1.0));
+    // A speed rebuilt from a tracker's reads: its error, from nothing to far beyond the noise, now and then not finite.
+    const double speed_error = uniform(0.0, 1.0);
+    if (speed_error < 0.3) in.n_error_pu = std::pow(10.0, uniform(-8.0, -1.0));
+    if (speed_error < 0.2) in.n_error_noise_pu = std::pow(10.0, uniform(-8.0, -1.0));
+    if (speed_error < 0.001) {
+      in.n_error_pu = kNaN;
+    } else if (speed_error < 0.002) {
+      in.n_error_pu = kInf;
+    }
     const double g = uniform(0.0, 1.0);
     in.weight = g < 0.05 ? Vec2(0.0, 1.0) : g < 0.08 ? Vec2(2.0, 1e-12) : Vec2(uniform(0.0, 0.2), uniform(0.0, 0.2));
 

@@ -11,6 +11,7 @@
 #include <variant>
 #include <vector>
 
+#include "rpem/core/reported_speed.hpp"
 #include "rpem/daemon/daemon_config.hpp"
 #include "rpem/daemon/vesc_source.hpp"
 #include "support/temp_file.hpp"
@@ -142,6 +143,13 @@ TEST(VescPoller, TheWindowsSpeedIsRebuiltFromThePllSpeedsAtItsTwoReads) {
     const auto c = poll_and_receive(p, kT0 + 10 * kMs, test::vesc_frames::reply_frames_22000_erpm());
     ASSERT_TRUE(c.has_value());
     EXPECT_NEAR(c->omega_el_rad_s, kRadSPerErpm * 22000.0, 1e-9);
+    // The error the reads show (docs/derivations.md §13, "… where the acceleration changes"): none from two reads;
+    // from three, the PLL's mean acceleration went from 1000 ERPM a period to none at the window's end read.
+    EXPECT_EQ(s->omega_el_error_rad_s, 0.0);
+    const double change = -kRadSPerErpm * 1000.0 / h;
+    const double expected = core::window_mean_speed_error_rad_s({kp, 30000.0}, change, h);
+    EXPECT_NEAR(c->omega_el_error_rad_s, expected, 1e-9 * expected) << kp;
+    EXPECT_GT(c->omega_el_error_rad_s, 0.01);
   }
 }
 

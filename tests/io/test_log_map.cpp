@@ -56,9 +56,11 @@ TEST(LogMap, APllSpeedIsASpeedAtTheReadsOfPreviousRowWindows) {
       "  u_d: {column: ud}\n  u_q: {column: uq}\n  i_q: {column: iq}\n";
   const LogMap m = parse_log_map(
       head + "  i_d: {column: id}\n  omega_el: {column: w, unit: erpm, pll: {kp: 2000, ki: 30000}}\n", "map.yaml");
-  EXPECT_DOUBLE_EQ(m.speed_lag_s, 2000.0 / 30000.0);
-  EXPECT_EQ(parse_log_map(head + "  i_d: {column: id}\n  omega_el: {column: w}\n", "map.yaml").speed_lag_s, 0.0);
-  EXPECT_DOUBLE_EQ(vesc_tool_log_map().speed_lag_s, 2000.0 / 30000.0);  // the firmware's defaults
+  EXPECT_DOUBLE_EQ(m.speed_pll.kp_per_s, 2000.0);
+  EXPECT_DOUBLE_EQ(m.speed_pll.ki_per_s2, 30000.0);
+  EXPECT_DOUBLE_EQ(m.speed_pll.ramp_lag_s(), 2000.0 / 30000.0);
+  EXPECT_FALSE(parse_log_map(head + "  i_d: {column: id}\n  omega_el: {column: w}\n", "map.yaml").speed_pll.given());
+  EXPECT_DOUBLE_EQ(vesc_tool_log_map().speed_pll.ramp_lag_s(), 2000.0 / 30000.0);  // the firmware's defaults
   EXPECT_NE(map_error(head + "  omega_el: {column: w}\n  i_d: {column: id, pll: {kp: 1, ki: 1}}\n")
                 .find("columns.i_d.pll: only a speed (omega_el) comes from a PLL"),
             std::string::npos);

@@ -22,10 +22,12 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include "support/process.hpp"
 #include "support/temp_file.hpp"
@@ -102,12 +104,45 @@ TEST(CliVescFieldEstimate, OurEmulatorsFieldRide) {
   expect_field_accuracy(estimate(log.path(), config("vesc-6374-outrunner.yaml")), t, "vesc-tool-field");
 }
 
-/// The independent generator's log and its truth at the log's end (its thermal laws move R_s a little).
-void independent_case(const std::string& options, const std::string& what, bool r_s_required) {
+/// A log rewritten as a logger that writes VESC Tool's header prints it: every value it holds as a float with two
+/// decimals (Arduino's Print::print(float); the ESP32/Arduino SD loggers that write this header print so), the
+/// counters and times as integers.
+void print_as_a_third_party_logger(const std::string& path) {
+  std::istringstream in(test::read_file(path));
+  std::string header, line, out;
+  std::getline(in, header);
+  out = header + "\n";
+  std::vector<bool> integer;
+  std::stringstream names(header);
+  for (std::string name; std::getline(names, name, ';');) {
+    integer.push_back(name == "ms_today" || name == "tachometer" || name == "tachometer_abs" || name == "fault_code" ||
+                      name == "vesc_id" || name.rfind("ms_today_", 0) == 0 || name == "num_vescs" ||
+                      name.rfind("gnss_", 0) == 0);
+  }
+  while (std::getline(in, line)) {
+    std::stringstream cells(line);
+    std::size_t k = 0;
+    for (std::string cell; std::getline(cells, cell, ';'); ++k) {
+      if (k < integer.size() && !integer[k]) {
+        char printed[64];
+        std::snprintf(printed, sizeof printed, "%.2f", std::stod(cell));
+        cell = printed;
+      }
+      out += cell + ";";
+    }
+    out += "\n";
+  }
+  std::ofstream(path) << out;
+}
+
+/// The independent generator's log and its truth at the log's end (its thermal laws move R_s a little);
+/// `third_party`: printed as print_as_a_third_party_logger does.
+void independent_case(const std::string& options, const std::string& what, bool r_s_required, bool third_party = false) {
   test::TempFile log("indep.csv"), truth("indep-truth.json");
   const auto gen = test::run_command(indep_vesc_log() + " --config " + config("vesc-6374-outrunner.yaml") + " " + options +
                                      " --out " + log.path() + " --truth " + truth.path());
   ASSERT_EQ(gen.exit_code, 0) << gen.output;
+  if (third_party) print_as_a_third_party_logger(log.path());
   const nlohmann::json j = nlohmann::json::parse(test::read_file(truth.path()));
   const Truth t{j.at("true_at_end").at("psi_m_Wb").get<double>(), j.at("true_at_end").at("r_s_Ohm").get<double>()};
   expect_field_accuracy(estimate(log.path(), config("vesc-6374-firmware.yaml")), t, what, r_s_required);
@@ -119,6 +154,15 @@ TEST(CliVescFieldEstimate, IndependentGeneratorMeasuredBackEmf) {
 
 TEST(CliVescFieldEstimate, IndependentGeneratorZerosWhileOffAcrossMidnight) {
   independent_case("--seed 2 --psi-m-rel -0.15 --r-s-rel 0.2 --off-voltage zero --midnight", "independent seed 2", true);
+}
+
+// Seed 1 as a third-party logger prints it (two decimals: the voltages in 10 mV steps). Its hard stop at 581.7 s
+// (−32 000 erpm to standstill in 0.37 s at a constant 14 A) holds a window whose speed the PLL's reads rebuild
+// 101 rad/s off (docs/derivations.md §13, "… where the acceleration changes"); with the coarser voltage no slope
+// test flagged it, and that one window moved ψm by +7.8 %. It is transient now: ψm +0.01 %, R_s −0.4 % (2026-12-01).
+TEST(CliVescFieldEstimate, IndependentGeneratorAsAThirdPartyLoggerPrintsIt) {
+  independent_case("--seed 1 --duration-s 600 --psi-m-rel 0.2 --r-s-rel -0.25", "independent seed 1, two decimals", true,
+                   true);
 }
 
 }  // namespace

@@ -18,6 +18,11 @@ struct AveragedSample {
   Vec2 i_dq_A = Vec2::Zero();   ///< mean measured current, rotor frame
   Vec2 u_dq_V = Vec2::Zero();   ///< mean voltage the drive reports (its command, or its estimate of the applied voltage)
   double omega_el_rad_s = 0.0;  ///< mean electrical speed (as the drive reports it, rebuilt to the window's mean)
+  /// The error of omega_el_rad_s its reader states (a tracker's speeds rebuilt to the window's mean, from the change
+  /// of acceleration its reads show: core::window_mean_speed_error_rad_s), and the same for the noise of such changes
+  /// around the window (core::accel_change_sigma_rad_s2); 0: the window's own mean, as far as the reader knows.
+  double omega_el_error_rad_s = 0.0;
+  double omega_el_error_noise_rad_s = 0.0;
   /// The mean electrical speed the drive's own count of its angle's steps gives over a run of reads centred on this
   /// window (VESC's tachometer: core::grown_count_speed_rad_s, docs/derivations.md §13); NaN: not counted.
   /// Taken instead of omega_el_rad_s where the drive's angle is a staircase (core::window_speed_rad_s).

@@ -221,11 +221,15 @@ enum class SampleTiming : std::uint8_t {
 /// One sample as the classifier takes it: rotor frame, per unit, the model's corrections applied.
 struct RegimeInput {
   SampleTiming timing = SampleTiming::kFirst;
-  std::int64_t t_ns = 0;          ///< end of the sample (of its window)
-  double window_s = 0.0;          ///< length of its averaging window (0: instantaneous)
-  Vec2 u_pu = Vec2::Zero();       ///< the voltage the model takes (mean over the interval or window)
-  Vec2 i_pu = Vec2::Zero();       ///< measured current (window mean)
-  double n_pu = 0.0;              ///< speed (window mean)
+  std::int64_t t_ns = 0;     ///< end of the sample (of its window)
+  double window_s = 0.0;     ///< length of its averaging window (0: instantaneous)
+  Vec2 u_pu = Vec2::Zero();  ///< the voltage the model takes (mean over the interval or window)
+  Vec2 i_pu = Vec2::Zero();  ///< measured current (window mean)
+  double n_pu = 0.0;         ///< speed (window mean)
+  /// The error of n_pu the caller states, and its noise (a tracker's speeds rebuilt to the window's mean:
+  /// AveragedSample::omega_el_error_rad_s, omega_el_error_noise_rad_s); 0: the speed is the window's own.
+  double n_error_pu = 0.0;
+  double n_error_noise_pu = 0.0;
   double u_reported_sq_pu = 0.0;  ///< |u|² as the drive reports it, before corrections (bridge off)
   /// The voltage and current as the drive reported them, before the model's corrections (a command turned into
   /// the applied mean, the sampled means' term): their resolution is measured here, since a correction's
@@ -329,6 +333,7 @@ class RegimeClassifier {
     Vec2 dx_over_omega_n = Vec2::Zero();                ///< (Δx_d, Δx_q)/ω_n
     Vec2 x_sq = Vec2::Zero();                           ///< (x_d², x_q²)
     Vec2 slope_var_x_sq = Vec2::Zero();                 ///< (x_d², x_q²)/ω_n²
+    Vec2 flux_q = Vec2::Zero();                         ///< (0, ψ_max): the speed terms' flux, q row
     double x_max = 0.0, dx_max = 0.0;                   ///< the larger inductance and tolerance
     double cos_angle = 1.0, sin_angle = 0.0;            ///< cos δ_tol, sin δ_tol
     double cos_hall = -1.0;                             ///< cos of the Hall sensors' largest frame error (−1: none)
@@ -349,6 +354,7 @@ class RegimeClassifier {
   /// A sensorless frame's largest possible error as a flux beside Δψ in r_s' test [pu] (after lock_bits).
   [[nodiscard]] double frame_flux(const RegimeInput& in, const Terms& t) const noexcept;
   [[nodiscard]] std::uint8_t contiguous_transient_bits(const RegimeInput& in, const Terms& t) noexcept;
+  [[nodiscard]] std::uint8_t speed_error_bits(const RegimeInput& in, const Terms& t) const noexcept;
   [[nodiscard]] std::uint8_t excitation_bits(const RegimeInput& in, const Terms& t) const noexcept;
 
   RegimeConfig config_;

@@ -14,6 +14,7 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <span>
 
 #include "rpem/core/averaged_sample.hpp"
 #include "rpem/core/clock.hpp"
@@ -22,6 +23,15 @@ namespace rpem::core {
 
 /// The lag of a type-2 PLL's speed behind a speed ramp, k_p/k_i [s] (k_p in 1/s, k_i in 1/s²).
 [[nodiscard]] constexpr double pll_ramp_lag_s(double kp_per_s, double ki_per_s2) noexcept { return kp_per_s / ki_per_s2; }
+
+/// A type-2 PLL's gains (VESC: foc_pll_kp, foc_pll_ki); zero: the speed is not a tracker's.
+struct PllGains {
+  double kp_per_s = 0.0;
+  double ki_per_s2 = 0.0;
+  [[nodiscard]] constexpr bool given() const noexcept { return kp_per_s > 0.0 && ki_per_s2 > 0.0; }
+  /// pll_ramp_lag_s, or 0 (the speed is the window's own: the rebuild leaves the trapezoid).
+  [[nodiscard]] constexpr double ramp_lag_s() const noexcept { return given() ? pll_ramp_lag_s(kp_per_s, ki_per_s2) : 0.0; }
+};
 
 /// One reported speed and when it was read.
 struct SpeedRead {
@@ -42,6 +52,32 @@ struct SpeedRead {
   // Its mean over the window (trapezoid) is ω̂ − slope·h/2; the rotor led it by lag·slope.
   return now.omega_el_rad_s - slope * (0.5 * to_seconds(now.t_ns - t_start_ns) - lag_s);
 }
+
+/// The tracker's mean acceleration over the window ending at `now` less that over the window before it, from its
+/// speeds at three consecutive reads [rad/s²]; 0 where two reads share an instant.
+[[nodiscard]] inline double read_accel_change_rad_s2(const SpeedRead& earlier, const SpeedRead& previous,
+                                                     const SpeedRead& now) noexcept {
+  const double before_s = to_seconds(previous.t_ns - earlier.t_ns), after_s = to_seconds(now.t_ns - previous.t_ns);
+  if (!(before_s > 0.0 && after_s > 0.0)) return 0.0;
+  return (now.omega_el_rad_s - previous.omega_el_rad_s) / after_s -
+         (previous.omega_el_rad_s - earlier.omega_el_rad_s) / before_s;
+}
+
+/// window_mean_speed_rad_s's error over a window of `window_s` across which the tracker's acceleration changed by
+/// `accel_change_rad_s2` (read_accel_change_rad_s2; docs/derivations.md §13, "Speed at the read", "… where the
+/// acceleration changes"): the trapezoid's h²/12·|ω̂''| with |ω̂''| up to |Δa|·g_max, g_max the peak of the PLL's
+/// impulse response k_i/(s² + k_p·s + k_i), and the dropped (ω̂'(t) − ω̂'(t_s))/(k_i·h). 0 where the gains are
+/// not given (the speed is the window's own mean).
+[[nodiscard]] double window_mean_speed_error_rad_s(const PllGains& pll, double accel_change_rad_s2,
+                                                   double window_s) noexcept;
+
+/// How many reads' changes of acceleration a window's noise of them is the median of (centred on the window in a log,
+/// the latest in rpemd): robust to 8 of them being the rotor's own (a stop's 2–3), as a noise median's warm-up.
+inline constexpr std::size_t kAccelChangeRunReads = 17;
+
+/// The noise σ of the changes of acceleration a run of reads shows (reads that jitter, a sensorless observer's PLL at
+/// a crawl): 1.4826·median|Δâ|, a normal's; NaNs left out; 0 with fewer than three. Reorders `changes`; no allocation.
+[[nodiscard]] double accel_change_sigma_rad_s2(std::span<double> changes) noexcept;
 
 /// One read of a drive's count of the angle it travelled (VESC's tachometer: six steps per electrical turn).
 struct CountRead {
@@ -87,6 +123,17 @@ template <class Reads>
 /// PLL's speed at a read is not the window's mean) — else the reported one. 0, or no count: the reported one.
 [[nodiscard]] inline double window_speed_rad_s(const AveragedSample& a, double staircase_below_rad_s) noexcept {
   return std::abs(a.omega_counted_el_rad_s) < staircase_below_rad_s ? a.omega_counted_el_rad_s : a.omega_el_rad_s;
+}
+
+/// The error of window_speed_rad_s its reader states, and that error's noise: the reported speed's
+/// (AveragedSample::omega_el_error_rad_s, omega_el_error_noise_rad_s), none where the count's is taken.
+struct SpeedError {
+  double error_rad_s = 0.0;
+  double noise_rad_s = 0.0;
+};
+[[nodiscard]] inline SpeedError window_speed_error(const AveragedSample& a, double staircase_below_rad_s) noexcept {
+  if (std::abs(a.omega_counted_el_rad_s) < staircase_below_rad_s) return {};
+  return {a.omega_el_error_rad_s, a.omega_el_error_noise_rad_s};
 }
 
 }  // namespace rpem::core

@@ -44,6 +44,8 @@
 // Reads by a poller the bus does not show (VESC Tool over USB or UART) shorten windows invisibly: the
 // reply carries no count of the cycles averaged (docs/rpemd.md says what that costs).
 
+#include <array>
+#include <cstddef>
 #include <cstdint>
 
 #include "rpem/can/vesc.hpp"
@@ -75,9 +77,10 @@ class VescPoller {
     std::int64_t timeout_ns = 4'500'000;
     std::uint32_t mask = can::vesc::kEstimatorMask;
     /// The reply's ERPM is the firmware's PLL speed at the read, lagging a ramp by k_p/k_i: each window's mean
-    /// speed is rebuilt from it and the previous reply's (core::window_mean_speed_rad_s; docs/derivations.md
-    /// §13, "Speed at the read").
-    double speed_lag_s = core::pll_ramp_lag_s(can::vesc::kDefaultPllKp, can::vesc::kDefaultPllKi);
+    /// speed is rebuilt from it and the previous reply's (core::window_mean_speed_rad_s), its error bounded from
+    /// the change of acceleration the last three replies show (core::window_mean_speed_error_rad_s;
+    /// docs/derivations.md §13, "Speed at the read").
+    core::PllGains pll{can::vesc::kDefaultPllKp, can::vesc::kDefaultPllKi};
   };
   /// Shorter windows are not measurements (a few of VESC's control cycles at most).
   static constexpr std::int64_t kMinWindowNs = 200'000;
@@ -134,6 +137,11 @@ class VescPoller {
   bool has_window_start_ = false;
   std::int64_t window_start_ns_ = 0;  ///< the newest read of the controller seen
   core::SpeedRead previous_speed_;    ///< the PLL's speed in our previous reply, and when it was read
+  core::SpeedRead earlier_speed_;     ///< the same in the reply before it
+  int speeds_seen_ = 0;               ///< replies whose speed is in previous_speed_ and earlier_speed_ (at most 2)
+  /// The latest changes of acceleration the replies showed (a ring; NaN: none yet): their noise.
+  std::array<double, core::kAccelChangeRunReads> accel_changes_{};
+  std::size_t next_accel_change_ = 0;
   std::uint64_t reads_ = 0;
   core::CountRead last_read_;
   bool gap_ = true;                 ///< windows before the next may be lost

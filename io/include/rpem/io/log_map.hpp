@@ -15,6 +15,7 @@
 #include <string_view>
 #include <vector>
 
+#include "rpem/core/reported_speed.hpp"
 #include "rpem/io/yaml_map.hpp"
 
 namespace rpem::io {
@@ -114,11 +115,12 @@ struct LogMap {
   /// from its own state and the time between them is not in the file. Read where the header has it.
   std::optional<ColumnRef> session;
 
-  /// The speed column is a tracking loop's speed at the read, lagging a ramp by this much (omega_el's
-  /// `pll: {kp, ki}`: k_p/k_i; VESC's erpm, 66.7 ms by default): the reader rebuilds each window's mean speed
-  /// from it and the previous row's (core::window_mean_speed_rad_s). 0: the column is the window's mean speed.
+  /// The speed column is a type-2 PLL's speed at the read (omega_el's `pll: {kp, ki}`; VESC's erpm, lagging a
+  /// ramp by k_p/k_i = 66.7 ms by default): the reader rebuilds each window's mean speed from it and the previous
+  /// row's (core::window_mean_speed_rad_s) and states the rebuild's error bound
+  /// (core::window_mean_speed_error_rad_s). Not given: the column is the window's mean speed.
   /// window: previous_row only.
-  double speed_lag_s = 0.0;
+  core::PllGains speed_pll;
   /// How long the logger waits for a reply before it asks again (VESC Tool: 0.99 s). A request it gave up on
   /// may still have been read, and a read resets the means, so a row this long after the one before has an
   /// unknown window and is stamped perhaps long after its read (where it is also 1.5 median spacings: a logger
