@@ -36,7 +36,7 @@ bool same(const Vec2& a, const Vec2& b) { return same(a[0], b[0]) && same(a[1], 
 /// else — the bridge released, the frame turned, a step, a far sample, a degenerate or non-finite value.
 class Stream {
  public:
-  explicit Stream(std::uint64_t seed) : rng_(seed) {}
+  explicit Stream(std::uint64_t seed) : rng_(seed), speed_error_rng_(~seed) {}
 
   RegimeInput next() {
     RegimeInput in;
@@ -90,10 +90,12 @@ class Stream {
     in.window_s = wr < 0.2 ? 0.0 : wr < 0.25 ? uniform(0.0, 1.0) : std::max(0.0, step_s);
     in.u_reported_sq_pu = mode < 0.05 ? in.u_pu.squaredNorm() : (u + Vec2(gauss(noise), gauss(noise))).squaredNorm();
     if (uniform(0.0, 1.0) < 0.3) in.di_dt_pu_s = Vec2(gauss(1.0), gauss(1.0));
-    // A speed rebuilt from a tracker's reads: its error, from nothing to far beyond the noise, now and then not finite.
-    const double speed_error = uniform(0.0, 1.0);
-    if (speed_error < 0.3) in.n_error_pu = std::pow(10.0, uniform(-8.0, -1.0));
-    if (speed_error < 0.2) in.n_error_noise_pu = std::pow(10.0, uniform(-8.0, -1.0));
+    // A speed rebuilt from a tracker's reads: its error, from nothing to far beyond the noise, now and then not finite
+    // (drawn apart, so that the stream's other values are as they were without it).
+    const auto draw = [this](double a, double b) { return std::uniform_real_distribution<double>(a, b)(speed_error_rng_); };
+    const double speed_error = draw(0.0, 1.0);
+    if (speed_error < 0.3) in.n_error_pu = std::pow(10.0, draw(-8.0, -1.0));
+    if (speed_error < 0.2) in.n_error_noise_pu = std::pow(10.0, draw(-8.0, -1.0));
     if (speed_error < 0.001) {
       in.n_error_pu = kNaN;
     } else if (speed_error < 0.002) {
@@ -140,6 +142,7 @@ class Stream {
   double gauss(double s) { return std::normal_distribution<double>(0.0, s)(rng_); }
 
   std::mt19937_64 rng_;
+  std::mt19937_64 speed_error_rng_;
   double n_ = 0.4;
   Vec2 i_ = Vec2(-0.1, 0.5);
   Vec2 last_u_ = Vec2::Zero(), last_i_ = Vec2::Zero();
