@@ -180,9 +180,40 @@ void MappedLogReader::read_header() {
   }
 }
 
-double MappedLogReader::cell(int index, const std::string& label, const MappedColumn& c, bool allow_nan) const {
+void MappedLogReader::fail_empty_cell(int index, const std::string& label) {
+  const std::size_t at = line_, column = static_cast<std::size_t>(index);
+  const bool first_row = line_ == first_data_line_;
+  std::uint64_t rows = 1, empty = 1;
+  std::size_t recorded_at = 0;  // the first line after this one that has the cell
+  for (std::string text; next_line(text);) {
+    split(text);
+    if (cells_.size() <= column) continue;  // a short row is its own error, at its turn
+    ++rows;
+    if (cells_[column].empty()) {
+      ++empty;
+    } else if (recorded_at == 0) {
+      recorded_at = line_;
+    }
+  }
+  line_ = at;  // the error names the row where the read stopped
+  std::string reason = "empty cell";
+  if (empty == rows) {
+    reason += first_row ? ", and so on every row (" + std::to_string(rows) +
+                              "): the logger names the column in its header but recorded no value in it — a logger "
+                              "or firmware that does not report this quantity; rpem cannot read the log without it"
+                        : ", and so on every row from here to the end (" + std::to_string(rows) +
+                              "): the logger stopped recording it; cut the rows from here off to read the rest";
+  } else {
+    reason += " (" + std::to_string(empty) + " of the " + std::to_string(rows) + " rows from here leave it empty; line " +
+              std::to_string(recorded_at) + " is the first after it that has it" +
+              (first_row ? ": the logger filled it in after its first rows — delete the rows before it)" : ")");
+  }
+  fail_cell(index, label, reason);
+}
+
+double MappedLogReader::cell(int index, const std::string& label, const MappedColumn& c, bool allow_nan) {
   const std::string& s = cells_[static_cast<std::size_t>(index)];
-  if (s.empty()) fail_cell(index, label, "empty cell");
+  if (s.empty()) fail_empty_cell(index, label);
   double v = 0.0;
   const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
   if (ec != std::errc() || end != s.data() + s.size()) {
@@ -313,6 +344,7 @@ void MappedLogReader::check_session() {
 
 bool MappedLogReader::read_raw(MappedRow& row) {
   if (!next_cells()) return false;
+  if (data_rows_ == 0) first_data_line_ = line_;
   row.line = line_;
   row.value.fill(kNaN);
 

@@ -103,6 +103,17 @@ INSTANTIATE_TEST_SUITE_P(
         BadCase{"nan", kHeader + "0,0,0,220,1,2,3,0,0,0\n0.1,0,0,nan,1,2,3,0,0,0\n", ":3:4: column u_dc: NaN"},
         BadCase{"inf", kHeader + "0,0,0,220,1,2,inf,0,0,0\n", ":2:7: column u_c: 'inf' is not finite"},
         BadCase{"empty_cell", kHeader + "0,0,,220,1,2,3,0,0,0\n", ":2:3: column omega_el: empty cell"},
+        // An empty cell says whether the column stays empty: a logger that names a column it never records (a
+        // third-party logger writing VESC Tool's header), one that stops recording it, one that fills it in late.
+        BadCase{"column_never_recorded", kHeader + "0,0,,220,1,2,3,0,0,0\n0.1,0,,220,1,2,3,0,0,0\n0.2,0,,220,1,2,3,0,0,0\n",
+                ":2:3: column omega_el: empty cell, and so on every row (3): the logger names the column in its header "
+                "but recorded no value in it"},
+        BadCase{"column_no_longer_recorded",
+                kHeader + "0,0,1,220,1,2,3,0,0,0\n0.1,0,,220,1,2,3,0,0,0\n0.2,0,,220,1,2,3,0,0,0\n",
+                ":3:3: column omega_el: empty cell, and so on every row from here to the end (2): the logger stopped"},
+        BadCase{"column_recorded_late", kHeader + "0,0,,220,1,2,3,0,0,0\n0.1,0,,220,1,2,3,0,0,0\n0.2,0,5,220,1,2,3,0,0,0\n",
+                ":2:3: column omega_el: empty cell (2 of the 3 rows from here leave it empty; line 4 is the first after "
+                "it that has it: the logger filled it in after its first rows — delete the rows before it)"},
         BadCase{"time_backwards", kHeader + "0.2,0,0,220,1,2,3,0,0,0\n0.1,0,0,220,1,2,3,0,0,0\n",
                 ":3:1: column t: time does not increase"},
         BadCase{"time_repeats", kHeader + "0.2,0,0,220,1,2,3,0,0,0\n0.2,0,0,220,1,2,3,0,0,0\n", ":3:1: column t"},

@@ -73,7 +73,10 @@ class MappedLogReader {
   void check_session();  ///< the row belongs to the first row's recording (LogMap::session), else a DriveLogError
   void split(const std::string& line);
   [[nodiscard]] bool cut_off() const;
-  [[nodiscard]] double cell(int index, const std::string& label, const MappedColumn& c, bool allow_nan) const;
+  [[nodiscard]] double cell(int index, const std::string& label, const MappedColumn& c, bool allow_nan);
+  /// An empty cell: the error says how many rows from here leave the column empty (read to the file's end: the
+  /// error ends the read anyway) — every one is a column the logger names and never recorded.
+  [[noreturn]] void fail_empty_cell(int index, const std::string& label);
   void check(const MappedRow& row, int index, const std::string& label, Quantity q, double v) const;
   [[noreturn]] void fail_cell(int index, const std::string& label, const std::string& reason) const;
 
@@ -107,6 +110,7 @@ class MappedLogReader {
   std::optional<MappedRow> lookahead_;
   std::deque<MappedRow> ready_;
   std::uint64_t data_rows_ = 0;
+  std::size_t first_data_line_ = 0;  ///< the file's line of the first data row
   ReadRepairs repairs_;
 };
 
