@@ -13,9 +13,7 @@ namespace vesc = can::vesc;
 VescPoller::VescPoller(const Config& config) noexcept
     : config_(config),
       poll_(vesc::values_request(config.controller_id, config.host_id, config.mask)),
-      decoder_(config.controller_id, config.host_id, config.mask) {
-  accel_changes_.fill(std::nan(""));
-}
+      decoder_(config.controller_id, config.host_id, config.mask) {}
 
 std::int64_t VescPoller::next_poll_ns(std::int64_t now_ns) const noexcept {
   const std::int64_t T = config_.period_ns;
@@ -106,6 +104,7 @@ bool VescPoller::on_frame(const can::CanFrame& f, std::int64_t rx_ns, core::Aver
   reply_start_ns_ = 0;
   ++reads_;
   last_read_ = {t, decoder_.values().tachometer * vesc::kTachometerStepRad};
+  last_accel_change_rad_s2_ = std::nan("");
   // With reply_timeout_s ≥ the period, polls overlap their predecessors' replies by design: the controller
   // answers them in turn, so a poll that timed out unanswered takes the first reply, before the poll sent
   // after it. With a shorter timeout a reply while the next poll is out is that poll's (the timed-out one's
@@ -142,17 +141,9 @@ bool VescPoller::on_frame(const can::CanFrame& f, std::int64_t rx_ns, core::Aver
   sample = vesc::to_averaged_sample(decoder_.values(), window_start_ns_, t);
   sample.omega_el_rad_s =
       core::window_mean_speed_rad_s(previous_speed, previous_speed_, window_start_ns_, config_.pll.ramp_lag_s());
-  if (three_reads) {
-    // The error the last three replies show, and its noise from the latest changes (causal: the end read only).
-    const double change = core::read_accel_change_rad_s2(earlier_speed, previous_speed, previous_speed_);
-    accel_changes_[next_accel_change_] = change;
-    next_accel_change_ = (next_accel_change_ + 1) % accel_changes_.size();
-    std::array<double, core::kAccelChangeRunReads> run = accel_changes_;
-    const double h_s = core::to_seconds(t - window_start_ns_);
-    sample.omega_el_error_rad_s = core::window_mean_speed_error_rad_s(config_.pll, change, h_s);
-    sample.omega_el_error_noise_rad_s =
-        core::window_mean_speed_error_rad_s(config_.pll, core::accel_change_sigma_rad_s2(run), h_s);
-  }
+  // The change of acceleration the last three replies show: SpeedErrorDelay judges the window by it and the next's.
+  if (three_reads)
+    last_accel_change_rad_s2_ = core::read_accel_change_rad_s2(earlier_speed, previous_speed, previous_speed_);
   sample.gap_before = gap_;
   gap_ = false;
   window_start_ns_ = t;

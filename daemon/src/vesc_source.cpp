@@ -12,6 +12,7 @@
 #include "rpem/core/clock.hpp"
 #include "rpem/daemon/count_delay.hpp"
 #include "rpem/daemon/socketcan_source.hpp"
+#include "rpem/daemon/speed_error_delay.hpp"
 #include "rpem/daemon/vesc_poller.hpp"
 
 namespace rpem::daemon {
@@ -88,7 +89,9 @@ class VescSampleSource final : public SampleSource {
     VescPoller poller(poller_config(options_));
     std::array<can::ReceivedFrame, 64> frames;
     core::AveragedSample sample;
-    // Counting: windows wait for the reads after them (allocated once, here; the loop below allocates nothing).
+    // Each window waits for the next reply, which shows whether its speed's rebuild holds (SpeedErrorDelay); counting,
+    // then for the reads after it (CountDelay; allocated once, here: the loop below allocates nothing).
+    SpeedErrorDelay judged(poller_config(options_).pll);
     const bool counting = options_.count_horizon_s > 0.0;
     const auto delay = counting ? std::make_unique<CountDelay>(can::vesc::kTachometerStepRad, options_.count_horizon_s)
                                 : std::unique_ptr<CountDelay>();
@@ -107,15 +110,20 @@ class VescSampleSource final : public SampleSource {
         const std::uint64_t reads_before = poller.reads();
         const bool sampled = poller.on_frame(frames[f].frame, receive_time_ns(frames[f], now), sample);
         completed = completed || sampled;
-        if (!counting) {
-          if (sampled) out.push(sample);
-          continue;
-        }
-        if (poller.reads() != reads_before) delay->add_read(poller.last_read());
-        if (!sampled) continue;
+        if (poller.reads() == reads_before) continue;
+        // A reply: the window held is judged and goes on — to CountDelay before this read, which ends no window of
+        // its yet (add_window takes a window ending at its newest read).
         core::AveragedSample due;
-        while (delay->full() && delay->release(now, due)) out.push(due);
-        delay->add_window(sample);
+        if (judged.on_read(poller.last_accel_change_rad_s2(), due)) {
+          if (!counting) {
+            out.push(due);
+          } else {
+            for (core::AveragedSample early; delay->full() && delay->release(now, early);) out.push(early);
+            delay->add_window(due);
+          }
+        }
+        if (counting) delay->add_read(poller.last_read());
+        if (sampled) judged.hold(sample);
       }
       if (counting) {
         for (core::AveragedSample due; delay->release(now, due);) out.push(due);

@@ -1,7 +1,6 @@
-// core::window_mean_speed_rad_s against a type-2 PLL run as VESC's firmware runs it (written from the PLL's
-// equations, docs/derivations.md §13 "Speed at the read": θ̂ += (ω̂ + k_p·e)·dt, ω̂ += k_i·e·dt, e = θ − θ̂,
-// once per control cycle) on a rotor whose speed profile is known, read every h: each window's rebuilt mean
-// speed against the rotor's true mean over the window, with the derived error bounds.
+// core::window_mean_speed_rad_s against a type-2 PLL run as VESC's firmware runs it (support/pll_reads.hpp) on a
+// rotor whose speed profile is known, read every h: each window's rebuilt mean speed against the rotor's true mean
+// over the window, with the derived error bounds.
 
 #include <gtest/gtest.h>
 
@@ -17,6 +16,7 @@
 
 #include "rpem/core/frames.hpp"
 #include "rpem/core/reported_speed.hpp"
+#include "support/pll_reads.hpp"
 
 namespace {
 
@@ -28,43 +28,14 @@ using rpem::core::SpeedRead;
 using rpem::core::window_mean_speed_rad_s;
 using rpem::core::window_speed_rad_s;
 
-constexpr double kKp = 2000.0, kKi = 30000.0;  // vedderb/bldc motor/mcconf_default.h's defaults
-constexpr double kDt = 80e-6;                  // one control cycle
-constexpr std::int64_t kDtNs = 80'000;
+using rpem::test::kPllKi;
+using rpem::test::kPllKp;
+using Window = rpem::test::PllWindow;
+constexpr double kKp = kPllKp, kKi = kPllKi;
+constexpr double kDt = rpem::test::kPllCycleS;
 
-struct Window {
-  double true_mean = 0.0;  // the rotor's mean speed over the window
-  double rebuilt = 0.0;    // window_mean_speed_rad_s from the PLL's speeds at its reads
-  double at_read = 0.0;    // the PLL's speed at the read, as reported
-  double t_s = 0.0;        // the read's time
-};
-
-/// Runs the rotor (speed ω(t)) and the PLL for `duration_s`, read every `read_cycles` cycles.
 std::vector<Window> run(const std::function<double(double)>& omega, double duration_s, int read_cycles) {
-  double theta = 0.0, theta_hat = 0.0, omega_hat = omega(0.0);
-  std::vector<Window> out;
-  SpeedRead previous{0, omega_hat};
-  double sum = 0.0;
-  const auto cycles = static_cast<std::int64_t>(duration_s / kDt);
-  for (std::int64_t n = 1; n <= cycles; ++n) {
-    const double t = static_cast<double>(n - 1) * kDt;
-    // The rotor over the cycle (midpoint rule: exact for the piecewise-linear profiles below).
-    const double w = omega(t + 0.5 * kDt);
-    theta = rpem::core::wrap_angle(theta + w * kDt);
-    sum += w * kDt;
-    const double e = rpem::core::wrap_angle(theta - theta_hat);
-    theta_hat = rpem::core::wrap_angle(theta_hat + (omega_hat + kKp * e) * kDt);
-    omega_hat += kKi * e * kDt;
-    if (n % read_cycles == 0) {
-      const SpeedRead now{n * kDtNs, omega_hat};
-      const double h = static_cast<double>(read_cycles) * kDt;
-      out.push_back({sum / h, window_mean_speed_rad_s(previous, now, previous.t_ns, rpem::core::pll_ramp_lag_s(kKp, kKi)),
-                     omega_hat, t + kDt});
-      previous = now;
-      sum = 0.0;
-    }
-  }
-  return out;
+  return rpem::test::run_pll(omega, duration_s, read_cycles);
 }
 
 // A steady ramp: the PLL's speed lags it by k_p/k_i, so the speed at the read is off the window's mean by

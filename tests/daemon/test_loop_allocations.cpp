@@ -15,6 +15,7 @@
 #include "rpem/daemon/command_gate.hpp"
 #include "rpem/daemon/count_delay.hpp"
 #include "rpem/daemon/loop_thread.hpp"
+#include "rpem/daemon/speed_error_delay.hpp"
 #include "support/averaged_data.hpp"
 #include "support/loop_queues.hpp"
 #include "support/model_data.hpp"
@@ -179,6 +180,24 @@ TEST(LoopAllocations, NoneInTheVescSourcesCountDelay) {
   }
   EXPECT_EQ(g_allocations.load() - before, 0);
   EXPECT_EQ(released + delay->held(), 39'999U);
+}
+
+// The VESC source's speed-error delay (each window held one reply, judged by the changes at both its ends and the
+// latest changes' noise) allocates nothing either: 20 s of replies at 2 kHz.
+TEST(LoopAllocations, NoneInTheVescSourcesSpeedErrorDelay) {
+  SpeedErrorDelay delay(core::PllGains{can::vesc::kDefaultPllKp, can::vesc::kDefaultPllKi});
+  const long before = g_allocations.load();
+  core::AveragedSample window, due;
+  std::size_t released = 0;
+  for (std::int64_t k = 1; k < 40'000; ++k) {
+    const std::int64_t t = k * 500'000;
+    if (delay.on_read(k % 7 == 0 ? 300.0 : -20.0 * static_cast<double>(k % 3), due)) ++released;
+    window.t_start_ns = t - 500'000;
+    window.t_ns = t;
+    delay.hold(window);
+  }
+  EXPECT_EQ(g_allocations.load() - before, 0);
+  EXPECT_EQ(released, 39'998U);
 }
 
 // RPEM_COMMAND's entry point (control thread) promises no allocation either, whatever the bytes —

@@ -118,11 +118,16 @@ template <class Reads>
   return rate(a, b);
 }
 
-/// The speed a window stands for: the count's where the drive's angle is a staircase — its counted speed below
+/// Whether a window stands for the count's speed: the drive's angle is a staircase there — its counted speed below
 /// `staircase_below_rad_s` (a VESC in Hall mode below foc_hall_interp_erpm holds each state's angle, and its
-/// PLL's speed at a read is not the window's mean) — else the reported one. 0, or no count: the reported one.
+/// PLL's speed at a read is not the window's mean). 0, or no count (NaN): never.
+[[nodiscard]] inline bool counted_speed_taken(const AveragedSample& a, double staircase_below_rad_s) noexcept {
+  return std::abs(a.omega_counted_el_rad_s) < staircase_below_rad_s;
+}
+
+/// The speed a window stands for: the count's where counted_speed_taken, else the reported one.
 [[nodiscard]] inline double window_speed_rad_s(const AveragedSample& a, double staircase_below_rad_s) noexcept {
-  return std::abs(a.omega_counted_el_rad_s) < staircase_below_rad_s ? a.omega_counted_el_rad_s : a.omega_el_rad_s;
+  return counted_speed_taken(a, staircase_below_rad_s) ? a.omega_counted_el_rad_s : a.omega_el_rad_s;
 }
 
 /// The error of window_speed_rad_s its reader states, and that error's noise: the reported speed's
@@ -132,7 +137,7 @@ struct SpeedError {
   double noise_rad_s = 0.0;
 };
 [[nodiscard]] inline SpeedError window_speed_error(const AveragedSample& a, double staircase_below_rad_s) noexcept {
-  if (std::abs(a.omega_counted_el_rad_s) < staircase_below_rad_s) return {};
+  if (counted_speed_taken(a, staircase_below_rad_s)) return {};
   return {a.omega_el_error_rad_s, a.omega_el_error_noise_rad_s};
 }
 

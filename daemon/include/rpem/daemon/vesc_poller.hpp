@@ -47,6 +47,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 
 #include "rpem/can/vesc.hpp"
 #include "rpem/core/averaged_sample.hpp"
@@ -77,9 +78,8 @@ class VescPoller {
     std::int64_t timeout_ns = 4'500'000;
     std::uint32_t mask = can::vesc::kEstimatorMask;
     /// The reply's ERPM is the firmware's PLL speed at the read, lagging a ramp by k_p/k_i: each window's mean
-    /// speed is rebuilt from it and the previous reply's (core::window_mean_speed_rad_s), its error bounded from
-    /// the change of acceleration the last three replies show (core::window_mean_speed_error_rad_s;
-    /// docs/derivations.md §13, "Speed at the read").
+    /// speed is rebuilt from it and the previous reply's (core::window_mean_speed_rad_s; docs/derivations.md §13,
+    /// "Speed at the read"). Its error is SpeedErrorDelay's, from last_accel_change_rad_s2 at both its ends.
     core::PllGains pll{can::vesc::kDefaultPllKp, can::vesc::kDefaultPllKi};
   };
   /// Shorter windows are not measurements (a few of VESC's control cycles at most).
@@ -110,6 +110,9 @@ class VescPoller {
   /// where the mask leaves it out): what CountDelay counts the windows' speeds from.
   [[nodiscard]] std::uint64_t reads() const noexcept { return reads_; }
   [[nodiscard]] const core::CountRead& last_read() const noexcept { return last_read_; }
+  /// The change of the PLL's mean acceleration the newest reply shows over the last three
+  /// (core::read_accel_change_rad_s2); NaN where that reply closed no sample or fewer than three were read.
+  [[nodiscard]] double last_accel_change_rad_s2() const noexcept { return last_accel_change_rad_s2_; }
 
   [[nodiscard]] const VescPollerCounters& counters() const noexcept { return counters_; }
   [[nodiscard]] const can::vesc::VescDecoder& decoder() const noexcept { return decoder_; }
@@ -139,9 +142,7 @@ class VescPoller {
   core::SpeedRead previous_speed_;    ///< the PLL's speed in our previous reply, and when it was read
   core::SpeedRead earlier_speed_;     ///< the same in the reply before it
   int speeds_seen_ = 0;               ///< replies whose speed is in previous_speed_ and earlier_speed_ (at most 2)
-  /// The latest changes of acceleration the replies showed (a ring; NaN: none yet): their noise.
-  std::array<double, core::kAccelChangeRunReads> accel_changes_{};
-  std::size_t next_accel_change_ = 0;
+  double last_accel_change_rad_s2_ = std::numeric_limits<double>::quiet_NaN();
   std::uint64_t reads_ = 0;
   core::CountRead last_read_;
   bool gap_ = true;                 ///< windows before the next may be lost
