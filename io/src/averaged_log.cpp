@@ -4,6 +4,8 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
+#include <string>
 #include <vector>
 
 #include "rpem/core/clock.hpp"
@@ -299,6 +301,29 @@ DriveLogLayout rotor_frame_layout(const AveragedLogLayout& layout) {
   l.t_magnet = layout.t_magnet;
   l.t_coolant = layout.t_coolant;
   return l;
+}
+
+void check_voltages_recorded(const std::vector<core::AveragedSample>& samples, double psi_m_Wb,
+                             const std::string& log_path) {
+  double emf_V = 0.0, emf_at_s = 0.0, current_A = 0.0;
+  for (const core::AveragedSample& s : samples) {
+    if (s.u_dq_V.x() != 0.0 || s.u_dq_V.y() != 0.0) return;
+    if (const double e = std::abs(s.omega_el_rad_s) * psi_m_Wb; e > emf_V) {
+      emf_V = e;
+      emf_at_s = core::to_seconds(s.t_ns);
+    }
+    current_A = std::max(current_A, s.i_dq_A.norm());
+  }
+  if (!(emf_V > 0.0 || current_A > 0.0)) return;
+  char text[720];
+  std::snprintf(text, sizeof text,
+                "exactly 0 in every one of the %zu samples, while the machine's turning implies a back EMF of up to "
+                "%.4g V (|omega| x the configured psi_m %.4g Wb, at t = %.6g s) and the current reaches %.4g A: the "
+                "log carries no voltages (a logger that writes zeros for values it does not read, a bridge off "
+                "throughout whose logger writes zeros then, or voltages below the column's resolution throughout; "
+                "docs/drive-log.md, \"Errors\"), and nothing in it can be estimated or diagnosed",
+                samples.size(), emf_V, psi_m_Wb, emf_at_s, current_A);
+  throw DriveLogError(log_path, 0, 0, "columns u_d, u_q", text);
 }
 
 void check_averaged_supports(const MachineConfig& c, const std::string& config_name, bool has_u_dc,

@@ -329,6 +329,33 @@ TEST(VescToolLog, OneRowHoldsNoSample) {
       << msg;
 }
 
+// A logger that writes zeros for the voltages it does not read (one built on a library that keeps no d/q quantities):
+// the error names the back EMF the speeds imply at the configured ψm and the largest current, so that a reader sees
+// the zeros cannot be the machine's; one voltage in the log, or a machine at rest unexcited, and there is no error.
+TEST(AveragedLog, VoltagesZeroInEverySampleOfATurningMachineAreAnError) {
+  std::vector<core::AveragedSample> samples(3);
+  for (std::size_t k = 0; k < samples.size(); ++k) {
+    samples[k].t_ns = static_cast<std::int64_t>(k + 1) * 1'000'000'000;
+    samples[k].omega_el_rad_s = -400.0 * static_cast<double>(k);  // 800 rad/s at t = 3 s: 4 V at 5 mWb
+    samples[k].i_dq_A = {-3.0, 4.0 * static_cast<double>(k)};     // |i| up to √(9 + 64) A
+  }
+  std::string msg;
+  try {
+    check_voltages_recorded(samples, 5e-3, "zeros.csv");
+  } catch (const DriveLogError& e) {
+    msg = e.what();
+  }
+  EXPECT_NE(msg.find("zeros.csv: columns u_d, u_q: exactly 0 in every one of the 3 samples"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("back EMF of up to 4 V (|omega| x the configured psi_m 0.005 Wb, at t = 3 s)"), std::string::npos)
+      << msg;
+  EXPECT_NE(msg.find("the current reaches 8.544 A"), std::string::npos) << msg;
+
+  samples[1].u_dq_V = {0.0, 0.01};  // one reported voltage: the columns are recorded
+  EXPECT_NO_THROW(check_voltages_recorded(samples, 5e-3, "zeros.csv"));
+  const std::vector<core::AveragedSample> at_rest(4);  // no speed, no current: nothing was there to record
+  EXPECT_NO_THROW(check_voltages_recorded(at_rest, 5e-3, "rest.csv"));
+}
+
 TEST(VescToolLog, ACommaSeparatedCopyAndAnUnknownVariantAreReadByName) {
   // VESC Tool's own loader also splits at ','; a third-party logger writing the same names in another
   // order (and without the trailing separator) is read by name.

@@ -209,6 +209,31 @@ TEST_F(CliLogFormats, ABadCellOfAVescToolLogExits65WithFileLineColumn) {
   EXPECT_NE(r.output.find("bad.csv:3:11: column q_axis_current (i_q): NaN"), std::string::npos) << r.output;
 }
 
+// A logger that writes VESC Tool's header with zeros for the d/q voltages it does not read: every tool that runs the
+// estimator over the log refuses it (65), naming the back EMF the speeds imply (a 6374 ramping 3 000 to 6 900 ERPM
+// read every 90 ms: the last window's mean rebuilt from the PLL's speeds is 6 900 + 100·(66.7/90 − ½) = 6 924 ERPM,
+// at psi_m 4.633 mWb 3.359 V) and the largest current (|(−1, 12)| A).
+TEST_F(CliLogFormats, AVescToolLogWhoseVoltagesAreAllZeroExits65WithTheBackEmfItImplies) {
+  const std::string log = path("zeros.csv");
+  {
+    std::ofstream out(log);
+    out << test::vesc_tool::kHeader120;
+    for (int k = 0; k < 40; ++k) out << test::vesc_tool::row120(36'000'000 + 90 * k, -1.0, 12.0, 3000.0 + 100.0 * k, 0, 0);
+  }
+  const std::string config = " --config " + test::source_dir() + "/config/vesc-6374-outrunner.yaml";
+  for (const std::string& tool : {std::string(" estimate --out ") + path("o.csv"), " diagnose --out " + path("d"),
+                                  " thermal fit --out " + path("t.yaml")}) {
+    const test::ProcessResult r = test::run_command(rpem() + tool + " --log " + log + config);
+    EXPECT_EQ(r.exit_code, 65) << tool << r.output;
+    EXPECT_NE(r.output.find("zeros.csv: columns u_d, u_q: exactly 0 in every one of the 39 samples, while the "
+                            "machine's turning implies a back EMF of up to 3.359 V"),
+              std::string::npos)
+        << tool << r.output;
+    EXPECT_NE(r.output.find("the current reaches 12.04 A: the log carries no voltages"), std::string::npos)
+        << tool << r.output;
+  }
+}
+
 TEST_F(CliLogFormats, ThePaderbornDataAsPublishedThroughItsMap) {
   // The first 41 rows of the carried profile (header + 40), read as they are.
   const std::string log = path("profile.csv");

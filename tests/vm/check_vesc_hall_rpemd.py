@@ -4,7 +4,8 @@ scenarios/vesc-tool-hall.yaml's first 30 s, the machine file saying `angle_sourc
 
 - rpemd says at start that it counts the Hall drive's speed (docs/rpemd.md, "A Hall drive at a crawl");
 - its windows reach the loop after the count's horizon: the diagnostics' receive-to-publish median lies between
-  0.25 s (core::kCountRunSideMaxS) and 0.25 s plus 0.25 s of the VM's scheduling;
+  0.25 s (core::kCountRunSideMaxS) and 0.25 s plus 0.25 s of the VM's scheduling and the poll period each window
+  waits for the next reply (daemon::SpeedErrorDelay);
 - the polls asked for the tachometer and every reply carried it (no bad reply, replies became samples);
 - R_s, which adapts at standstill and at the crawl, ends within 5 % of the plant's (issue 23's accuracy), off its
   configuration by +25 % at the start. (ψm has not adapted yet — it does at speed, after these 30 s — and its

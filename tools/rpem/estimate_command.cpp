@@ -164,6 +164,7 @@ int run_averaged(const EstimateOptions& o, const io::LogSource& source, const io
   const std::vector<core::AveragedSample> samples =
       io::read_averaged_log(o.log, source.map, io::machine_limits(cfg.machine), &read);
   std::fprintf(stderr, "rpem estimate: %s\n", io::describe(source, read).c_str());
+  io::check_voltages_recorded(samples, cfg.machine.psi_m_Wb, o.log);
   io::check_averaged_supports(cfg, config_name, read.layout.u_dc, o.log);
   core::AveragedDriveEstimator estimator(cfg.machine, cfg.estimator);
   ThermalRun thermal(o, cfg, estimator.base());

@@ -262,6 +262,7 @@ LogData load_log(const std::string& path, const core::MachineSi& machine, const 
     }
     io::AveragedLogRead read;
     std::vector<core::AveragedSample> samples = io::read_averaged_log(path, source.map, limits, &read);
+    io::check_voltages_recorded(samples, machine.psi_m_Wb, path);
     for (core::AveragedSample& s : samples) s.omega_el_rad_s = core::window_speed_rad_s(s, options.staircase_below_rad_s);
     const bool turn = options.voltage_is_command && options.control_period_s > 0.0;
     const std::string voltage = turn ? apply_reported_command(samples, options) : "";

@@ -50,6 +50,7 @@ ThermalRecord record_thermal(const io::LogSource& source, const io::MachineConfi
     io::AveragedLogRead read;
     const std::vector<core::AveragedSample> samples = io::read_averaged_log(source.path, source.map, limits, &read);
     io::check_averaged_supports(machine, "configuration", read.layout.u_dc, source.path);
+    io::check_voltages_recorded(samples, machine.machine.psi_m_Wb, source.path);
     r.winding_sensor = read.layout.t_winding;
     r.coolant = read.layout.t_coolant;
     r.read_as = io::describe(source, read);

@@ -69,6 +69,14 @@ class AveragedLogWriter {
 /// The drive-log layout of such rows.
 [[nodiscard]] DriveLogLayout rotor_frame_layout(const AveragedLogLayout& layout);
 
+/// Throws DriveLogError where a log of averaged windows carries no voltages: u_d and u_q exactly 0 in every sample
+/// while the machine turned or carried current — zeros a logger wrote for values it does not read (docs/drive-log.md,
+/// "Errors"), a bridge off throughout whose logger writes zeros then, or voltages below the column's resolution
+/// throughout: in each case nothing in the log can be estimated or diagnosed. The error names the back EMF the
+/// speeds imply at the configured `psi_m_Wb` and the largest current, so that the reader can judge. A machine at rest
+/// unexcited throughout is no error (nothing was there to record; the tools say that nothing adapted).
+void check_voltages_recorded(const std::vector<core::AveragedSample>& samples, double psi_m_Wb, const std::string& log_path);
+
 /// Throws ConfigError when the configuration needs what averaged samples cannot carry: per-phase current
 /// offsets and gains (no rotor-frame mean), or a dead time in seconds without the log's u_dc.
 void check_averaged_supports(const MachineConfig& c, const std::string& config_name, bool has_u_dc,
