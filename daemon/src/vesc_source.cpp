@@ -91,7 +91,7 @@ class VescSampleSource final : public SampleSource {
     core::AveragedSample sample;
     // Each window waits for the next reply, which shows whether its speed's rebuild holds (SpeedErrorDelay); counting,
     // then for the reads after it (CountDelay; allocated once, here: the loop below allocates nothing).
-    SpeedErrorDelay judged(poller_config(options_).pll);
+    SpeedErrorDelay speed_error(poller_config(options_).pll);
     const bool counting = options_.count_horizon_s > 0.0;
     const auto delay = counting ? std::make_unique<CountDelay>(can::vesc::kTachometerStepRad, options_.count_horizon_s)
                                 : std::unique_ptr<CountDelay>();
@@ -114,7 +114,7 @@ class VescSampleSource final : public SampleSource {
         // A reply: the window held is judged and goes on — to CountDelay before this read, which ends no window of
         // its yet (add_window takes a window ending at its newest read).
         core::AveragedSample due;
-        if (judged.on_read(poller.last_accel_change_rad_s2(), due)) {
+        if (speed_error.on_read(poller.last_accel_change_rad_s2(), due)) {
           if (!counting) {
             out.push(due);
           } else {
@@ -123,7 +123,7 @@ class VescSampleSource final : public SampleSource {
           }
         }
         if (counting) delay->add_read(poller.last_read());
-        if (sampled) judged.hold(sample);
+        if (sampled) speed_error.hold(sample);
       }
       if (counting) {
         for (core::AveragedSample due; delay->release(now, due);) out.push(due);
