@@ -7,13 +7,11 @@
 
 namespace rpem::daemon {
 
-SpeedErrorDelay::SpeedErrorDelay(const core::PllGains& pll) noexcept
-    : pll_(pll), held_change_rad_s2_(std::nan("")), newest_change_rad_s2_(std::nan("")) {
+SpeedErrorDelay::SpeedErrorDelay(const core::PllGains& pll) noexcept : pll_(pll), held_change_rad_s2_(std::nan("")) {
   changes_.fill(std::nan(""));
 }
 
 bool SpeedErrorDelay::on_read(double accel_change_rad_s2, core::AveragedSample& released) noexcept {
-  newest_change_rad_s2_ = accel_change_rad_s2;
   changes_[next_change_] = accel_change_rad_s2;
   next_change_ = (next_change_ + 1) % changes_.size();
   if (!holding_) return false;
@@ -32,7 +30,7 @@ bool SpeedErrorDelay::on_read(double accel_change_rad_s2, core::AveragedSample& 
 void SpeedErrorDelay::hold(const core::AveragedSample& window) noexcept {
   RPEM_ASSERT(!holding_, "the reply that closed this window released the one before it (on_read first)");
   held_ = window;
-  held_change_rad_s2_ = newest_change_rad_s2_;
+  held_change_rad_s2_ = changes_[(next_change_ + changes_.size() - 1) % changes_.size()];  // the newest reply's
   holding_ = true;
 }
 

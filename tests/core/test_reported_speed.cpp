@@ -34,9 +34,7 @@ using Window = rpem::test::PllWindow;
 constexpr double kKp = kPllKp, kKi = kPllKi;
 constexpr double kDt = rpem::test::kPllCycleS;
 
-std::vector<Window> run(const std::function<double(double)>& omega, double duration_s, int read_cycles) {
-  return rpem::test::run_pll(omega, duration_s, read_cycles);
-}
+using rpem::test::run_pll;
 
 // A steady ramp: the PLL's speed lags it by k_p/k_i, so the speed at the read is off the window's mean by
 // a·(h/2 − k_p/k_i); rebuilt, the mean is exact to the loop's discretisation (measured: the discrete PLL lags
@@ -44,7 +42,7 @@ std::vector<Window> run(const std::function<double(double)>& omega, double durat
 TEST(ReportedSpeed, ARampsWindowMeanIsRebuiltExactlyWhereTheReadIsOffByTheLag) {
   constexpr double a = 500.0;                 // rad/s² electrical
   for (const int read_cycles : {1125, 62}) {  // 90 ms (VESC Tool at 11 Hz) and ~5 ms (rpemd at 200 Hz)
-    const std::vector<Window> w = run([](double t) { return 100.0 + a * t; }, 3.0, read_cycles);
+    const std::vector<Window> w = run_pll([](double t) { return 100.0 + a * t; }, 3.0, read_cycles);
     const double h = read_cycles * kDt;
     for (const Window& x : w) {
       if (x.t_s < 1.0) continue;  // the PLL's start-up: e^{−15 t} below 1e-6 of the lag
@@ -62,7 +60,7 @@ TEST(ReportedSpeed, WhereTheAccelerationChangesTheErrorIsWithinTheTrapezoidsBoun
   constexpr double a = 2000.0;  // a hard acceleration: 0 to 2000 rad/s in 1 s, then steady
   for (const int read_cycles : {1125, 62}) {
     const std::vector<Window> w =
-        run([](double t) { return t < 0.5 ? 50.0 : 50.0 + a * std::min(t - 0.5, 1.0); }, 3.0, read_cycles);
+        run_pll([](double t) { return t < 0.5 ? 50.0 : 50.0 + a * std::min(t - 0.5, 1.0); }, 3.0, read_cycles);
     const double h = read_cycles * kDt;
     const double root = std::sqrt(kKp * kKp - 4.0 * kKi);
     const double bound = h * h / 12.0 * a * kKi / root + std::min(a / (kKi * h), a / root) + 2.0 * a * kDt;
@@ -109,7 +107,7 @@ TEST(ReportedSpeed, TheErrorTheReadsShowCoversTheRebuildWhereTheAccelerationChan
   for (const auto& [name, omega] : profiles) {
     for (const int read_cycles : {62, 700, 1125, 3000, 12500}) {  // 5 ms … 1 s
       const double h = read_cycles * kDt;
-      const std::vector<Window> w = run(omega, 4.5, read_cycles);
+      const std::vector<Window> w = run_pll(omega, 4.5, read_cycles);
       double worst_beyond = 0.0, least_ratio = 1e300;
       for (std::size_t k = 1; k < w.size(); ++k) {  // the first window starts at the PLL's start, before any read
         if (w[k].t_s < 0.3) continue;               // the PLL's start-up
@@ -130,7 +128,7 @@ TEST(ReportedSpeed, TheErrorTheReadsShowCoversTheRebuildWhereTheAccelerationChan
     }
   }
   // A steady ramp after its start: no change of acceleration, no error, E nothing (the loop's discretisation only).
-  const std::vector<Window> ramp = run([](double t) { return 100.0 + 500.0 * t; }, 3.0, 1125);
+  const std::vector<Window> ramp = run_pll([](double t) { return 100.0 + 500.0 * t; }, 3.0, 1125);
   for (std::size_t k = 0; k < ramp.size(); ++k) {
     if (ramp[k].t_s > 1.0) {
       EXPECT_LT(error_the_reads_show(ramp, k, 1125 * kDt), 1e-3) << ramp[k].t_s;

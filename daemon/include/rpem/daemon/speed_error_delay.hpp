@@ -38,7 +38,6 @@ class SpeedErrorDelay {
   core::AveragedSample held_;
   bool holding_ = false;
   double held_change_rad_s2_ = 0.0;  ///< the change at the held window's end read (NaN: none)
-  double newest_change_rad_s2_ = 0.0;
   /// The latest changes (a ring; NaN: none yet): their noise.
   std::array<double, core::kAccelChangeRunReads> changes_{};
   std::size_t next_change_ = 0;
