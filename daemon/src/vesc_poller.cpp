@@ -105,12 +105,14 @@ bool VescPoller::on_frame(const can::CanFrame& f, std::int64_t rx_ns, core::Aver
   ++reads_;
   last_read_ = {t, decoder_.values().tachometer * vesc::kTachometerStepRad};
   last_accel_change_rad_s2_ = std::nan("");
-  // With reply_timeout_s ≥ the period, polls overlap their predecessors' replies by design: the controller
-  // answers them in turn, so a poll that timed out unanswered takes the first reply, before the poll sent
-  // after it. With a shorter timeout a reply while the next poll is out is that poll's (the timed-out one's
-  // reply was lost, and the window spans its read: a gap).
-  const bool in_turn = config_.timeout_ns >= config_.period_ns || !outstanding_;
-  if (timed_out_unanswered_ && in_turn && t - timed_out_at_ns_ <= config_.period_ns) {
+  // Which poll it answers, where one timed out unanswered within the period: that one's if the reply began before
+  // the poll now out went out (it was under way: its frames straddle that poll, as at 1 kHz on a 1 Mbit/s bus) or if
+  // no poll is out; else the outstanding poll's. A reply that began after the next poll went out is later than the
+  // timeout allows; taking it as the timed-out poll's would leave the outstanding one to time out in turn, and one
+  // lost reply would make every later reply "late" and every poll a timeout.
+  const bool timed_out_pending = timed_out_unanswered_ && t - timed_out_at_ns_ <= config_.period_ns;
+  const bool began_before_outstanding = t < deadline_ns_ - config_.timeout_ns;  // the outstanding poll's send
+  if (timed_out_pending && (!outstanding_ || began_before_outstanding)) {
     ++counters_.late;
     consecutive_timeouts_ = 0;
     gap_ = gap_before_timeout_;  // the read it feared lost is this one: the chain holds

@@ -289,6 +289,69 @@ TEST(VescPoller, RepliesSlowerThanAPeriodAreAnsweredInTurnAndChain) {
   }
 }
 
+/// A poller whose reply timeout is its whole period (the most `reply_timeout_s` allows), `rate_Hz` polls a second.
+VescPoller make_poller_timeout_a_period(double rate_Hz) {
+  VescSource::Options o;
+  o.controller_id = kController;
+  o.host_id = kHost;
+  o.poll_rate_Hz = rate_Hz;
+  o.reply_timeout_s = 1.0 / rate_Hz;
+  return VescPoller(poller_config(o));
+}
+
+// 10 Hz, the timeout a whole period: the first poll goes unanswered (the controller not yet up), every later one is
+// answered 3 ms after it. Each reply began after its own poll went out, so it is that poll's: one timeout, no late
+// reply, and the windows chain without gaps. (Taken as the timed-out poll's, every reply would be "late" and every
+// poll a timeout for the rest of the run: 20 and 20 here.)
+TEST(VescPoller, APollLostOnceLeavesNoChainOfLateReplies) {
+  VescPoller p = make_poller_timeout_a_period(10.0);
+  constexpr std::int64_t kPeriod = 100 * kMs, kLatency = 3 * kMs;
+  std::vector<core::AveragedSample> samples;
+  for (int k = 0; k <= 20; ++k) {
+    const std::int64_t t = kT0 + k * kPeriod;
+    p.on_time(t);
+    ASSERT_TRUE(p.poll_due(t));
+    p.polled(t, true);
+    if (k == 0) continue;  // unanswered
+    p.on_time(t + kLatency);
+    if (const auto s = reply(p, t + kLatency)) samples.push_back(*s);
+  }
+  EXPECT_EQ(p.counters().polls, 21U);
+  EXPECT_EQ(p.counters().timeouts, 1U);
+  EXPECT_EQ(p.counters().late, 0U);
+  EXPECT_EQ(p.counters().unrequested, 0U);
+  EXPECT_FALSE(p.silent());
+  ASSERT_EQ(samples.size(), 19U);  // the first reply opens the first window
+  for (const core::AveragedSample& s : samples) {
+    EXPECT_EQ(s.t_ns - s.t_start_ns, kPeriod);
+    EXPECT_FALSE(s.gap_before);
+  }
+}
+
+// The same poller, replies prompt, one of them lost (poll 5's): the window after it spans the read the controller may
+// have made for it, so it follows a gap; the reply to poll 6 is poll 6's, not a late one for poll 5.
+TEST(VescPoller, AReplyLostAmongPromptOnesKeepsItsGap) {
+  VescPoller p = make_poller_timeout_a_period(10.0);
+  constexpr std::int64_t kPeriod = 100 * kMs, kLatency = 3 * kMs;
+  std::vector<core::AveragedSample> samples;
+  for (int k = 0; k <= 8; ++k) {
+    const std::int64_t t = kT0 + k * kPeriod;
+    p.on_time(t);
+    p.polled(t, true);
+    if (k == 5) continue;  // lost
+    p.on_time(t + kLatency);
+    if (const auto s = reply(p, t + kLatency)) samples.push_back(*s);
+  }
+  EXPECT_EQ(p.counters().timeouts, 1U);
+  EXPECT_EQ(p.counters().late, 0U);
+  ASSERT_EQ(samples.size(), 7U);  // replies 1-4 and 6-8 close windows
+  for (std::size_t i = 0; i < samples.size(); ++i) {
+    const bool after_loss = i == 4;  // the window from reply 4 to reply 6
+    EXPECT_EQ(samples[i].gap_before, after_loss) << i;
+    EXPECT_EQ(samples[i].t_ns - samples[i].t_start_ns, (after_loss ? 2 : 1) * kPeriod) << i;
+  }
+}
+
 // Another poller reading our controller on the bus (node 0x42, the same poll the docs show for us): its
 // read resets the averages, so it is counted and our next window starts at it.
 TEST(VescPoller, AnotherPollersReadIsCountedAndStartsTheWindow) {

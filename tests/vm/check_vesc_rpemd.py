@@ -8,9 +8,13 @@
 - it publishes magnet and winding temperatures (finite; not compared with the plant's: they follow from the
   configuration's reference values, which are off the plant's on purpose);
 - it survives the silence 45-48 s: estimates keep coming and its sample count grows again after it;
-- it counts the second poller (cangen from 55 s to 60 s) stealing its averages.
+- it counts the second poller (cangen from 55 s to 60 s) stealing its averages;
+- with --prompt-replies (a poll slow enough that every reply comes well within its period: 10 Hz), it times out
+  only the polls nobody answered — those of the emulator's silence, which the emulator counts, and those sent
+  before it listens and after it stops (a second at each end: tests/vm/vesc_rpemd.sh) — and takes no reply as late (at most 1 % of them, for a VM
+  that stalls a whole period).
 
-  check_vesc_rpemd.py DIR NAME
+  check_vesc_rpemd.py DIR NAME [--prompt-replies]
 """
 import bisect
 import csv
@@ -81,11 +85,31 @@ def main():
     report.append('stolen reads counted: %s' % (max(stolen) if stolen else 'none'))
     if not stolen or max(stolen) == 0:
         errors.append('the second poller was not counted')
+    if '--prompt-replies' in sys.argv[3:]:
+        check_prompt_replies(emu, text, report, errors)
     print('check_vesc_rpemd %s: %d estimates; %s' % (name, len(est), '; '.join(report)))
     if errors:
         print('check_vesc_rpemd %s: FAILED\n  %s' % (name, '\n  '.join(errors)))
         sys.exit(1)
     print('check_vesc_rpemd %s: passed' % name)
+
+
+def check_prompt_replies(emu, text, report, errors):
+    """Timeouts only where nobody answered; no chain of late replies after them."""
+    unheard = int(re.search(r'(\d+) unheard while silent', emu).group(1))
+    counters = re.findall(r'vesc_polls (\d+) .*?vesc_replies (\d+) vesc_timeouts (\d+) vesc_late_replies (\d+)', text)
+    if not counters:
+        errors.append('no VESC poller counters in the diagnostics')
+        return
+    polls, replies, timeouts, late = (int(x) for x in counters[-1])
+    rate_hz = polls / 70.0  # the emulator's 70 s
+    allowed = unheard + 2 * math.ceil(rate_hz)  # the silence, and a second at each end
+    report.append('timeouts %d of %d polls (%d unheard while silent), late replies %d of %d'
+                  % (timeouts, polls, unheard, late, replies))
+    if timeouts > allowed:
+        errors.append('%d timeouts, more than the %d polls nobody answered (silence, a second at each end)' % (timeouts, allowed))
+    if late > 0.01 * replies:
+        errors.append('%d of %d replies taken as late' % (late, replies))
 
 
 if __name__ == '__main__':

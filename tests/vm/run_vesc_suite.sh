@@ -66,6 +66,7 @@ else
   python3 "$here/check_map_rpemd.py" "$out/rpemd_map.txt" "$out/map_offline_est.csv"
   python3 "$here/check_ax8000_rpemd.py" "$out"
   for run in r200 r1k; do python3 "$here/check_vesc_rpemd.py" "$out" "$run"; done
+  python3 "$here/check_vesc_rpemd.py" "$out" r10 --prompt-replies
   python3 "$here/check_vesc_hall_rpemd.py" "$out"
 fi
 echo "run_vesc_suite: passed"

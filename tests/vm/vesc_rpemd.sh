@@ -1,5 +1,5 @@
 #!/bin/sh
-# rpemd (source: vesc) against the emulated VESC 17 over vcan0, at 200 Hz and at 1 kHz: 70 s each, the
+# rpemd (source: vesc) against the emulated VESC 17 over vcan0, at 200 Hz, 1 kHz and 10 Hz: 70 s each, the
 # emulator silent from 45 s to 48 s, a second poller (cangen, host id 0xC8) stealing averages at
 # 20 Hz from 55 s to 60 s; then 30 s of a Hall drive crawling. Outputs in $1; tests/vm/check_vesc_rpemd.py and
 # check_vesc_hall_rpemd.py check them on the host.
@@ -28,6 +28,7 @@ run() {  # name poll-rate reply-timeout
 }
 run r200 200 0.005
 run r1k 1000 0.001
+run r10 10 0.1   # a slow poll, its timeout the whole period: the replies are prompt (check_vesc_rpemd.py --prompt-replies)
 # A Hall drive crawling (vesc-tool-hall.yaml, its first 30 s: standstill under load, 5, 15, 30 rpm) with the machine
 # file saying `hall`: rpemd asks for the tachometer and counts each window's speed (docs/rpemd.md, "A Hall drive at
 # a crawl"); tests/vm/check_vesc_hall_rpemd.py checks it.

@@ -21,12 +21,13 @@
 //                     (it ends a read), so it is used.
 //   late              a reply to a poll that had timed out (within one period of the timeout): used, and
 //                     the gap the timeout feared is lifted (this reply is that read). A reply under way is
-//                     never discarded by a timeout. With reply_timeout_s ≥ the period (replies slower than
-//                     a period, e.g. 1 kHz on a 1 Mbit/s bus where a reply alone takes 0.9 ms) polls
-//                     overlap replies and are answered in turn: a late reply is the timed-out poll's even
-//                     when the next poll is out — a reply lost outright there lifts that gap wrongly once
-//                     (its successor's window spans the lost read). With a shorter timeout a reply while
-//                     the next poll is out is that poll's.
+//                     never discarded by a timeout. While the next poll is out, a reply is the timed-out
+//                     poll's only if it began before that poll went out (its frames straddle it: 1 kHz on a
+//                     1 Mbit/s bus, where a reply alone takes 0.9 ms); one that began after it is the
+//                     outstanding poll's. So a poll lost once (a silence, the controller not yet up) leaves
+//                     no chain of "late" replies and timeouts behind it, and a reply lost later keeps its
+//                     gap. Replies slower than a whole period are taken one poll on, their windows
+//                     unchanged: one gap where they start being so slow, one `unrequested` where they stop.
 //   timeouts          a poll unanswered within reply_timeout_s (silent controller, lost frames). Whether
 //                     the controller read (and reset) is unknown, so the next window follows a gap.
 //   short_windows     a window shorter than kMinWindow: the firmware divides sums of (nearly) no control
