@@ -1,6 +1,8 @@
 #include "rpem/daemon/daemon_config.hpp"
 
 #include <algorithm>
+#include <array>
+#include <charconv>
 #include <cstdlib>
 #include <filesystem>
 #include <variant>
@@ -72,13 +74,37 @@ void parse_state(io::YamlMap& s, StateConfig& c) {
   s.finish();
 }
 
+/// A time for a message, to 3 significant digits (2·0.1 + 0.02 reads 0.22).
+std::string seconds_text(double s) {
+  std::array<char, 32> buf{};
+  const auto [end, ec] = std::to_chars(buf.data(), buf.data() + buf.size(), s, std::chars_format::general, 3);
+  return ec == std::errc() ? std::string(buf.data(), end) : std::string("?");
+}
+
+/// `stale_timeout_s`, after the source: where the source spaces its samples (a poller), the default outlasts one lost
+/// reply, and a timeout within the normal spacing is refused — the loop would go stale, and start over, between two
+/// samples (docs/rpemd.md, "Configuration").
+void parse_stale_timeout(io::YamlMap& d, FixedConfig& f) {
+  const SampleSpacing spacing = SourceCatalogue::sample_spacing(f.source);
+  const double default_s = std::max(f.loop.stale_timeout_s, spacing.one_lost_s);
+  f.loop.stale_timeout_s = d.number_or("stale_timeout_s", default_s, 1e-3, 60.0);
+  if (f.loop.stale_timeout_s <= spacing.normal_s) {
+    d.fail("stale_timeout_s", seconds_text(f.loop.stale_timeout_s) + " s is within the " + seconds_text(spacing.normal_s) +
+                                  " s the " + SourceCatalogue::type(f.source) +
+                                  " source's samples may come apart (one poll period and reply_timeout_s): rpemd would "
+                                  "go stale, and start over, between two of them; leave it out (then " +
+                                  seconds_text(spacing.one_lost_s) +
+                                  " s, two periods and the timeout: one lost reply) or give more");
+  }
+}
+
 void parse_daemon(io::YamlMap d, DaemonConfig& c, const std::string& base_dir) {
   FixedConfig& f = c.fixed;
   if (auto s = d.optional_map("source")) f.source = SourceCatalogue::parse(*s, base_dir);
   if (auto l = d.optional_map("loop")) parse_loop(*l, f.loop);
   if (auto t = d.optional_map("receive_thread")) f.receive_thread = parse_thread(*t, f.receive_thread);
   if (auto t = d.optional_map("publish_thread")) f.publish_thread = parse_thread(*t, f.publish_thread);
-  f.loop.stale_timeout_s = d.number_or("stale_timeout_s", f.loop.stale_timeout_s, 1e-3, 60.0);
+  parse_stale_timeout(d, f);
   if (auto l = d.optional_map("lcm")) parse_lcm(*l, f.lcm);
   if (auto cmd = d.optional_map("commands")) {
     c.live.commands_enabled = cmd->boolean_or("enabled", c.live.commands_enabled);

@@ -112,6 +112,24 @@ TEST(DaemonConfig, SourcesComeFromTheCatalogueAndOnlyTheChosenOneIsKept) {
   EXPECT_STREQ(SourceCatalogue::type(builtin_daemon_config().fixed.source), "sim");
 }
 
+// A VESC source sets how often samples come: a reply every poll period T, up to reply_timeout_s after its poll. The
+// stale timeout's default outlasts one lost reply (2·T + timeout) and never falls below the loop's own 0.1 s.
+TEST(DaemonConfig, AVescSourcesStaleTimeoutOutlastsOneLostReply) {
+  const auto stale_s = [](const std::string& vesc, const std::string& rest = "") {
+    const test::TempFile f(
+        "vesc.yaml", "daemon:\n  source: {type: vesc, vesc: {interface: vcan0, controller_id: 17, " + vesc + "}}\n" + rest);
+    return load_daemon_config(f.path()).fixed.loop.stale_timeout_s;
+  };
+  EXPECT_NEAR(stale_s("poll_rate_Hz: 10"), 2 * 0.1 + 0.02, 1e-12);  // the default timeout: 20 ms at most
+  EXPECT_NEAR(stale_s("poll_rate_Hz: 1, reply_timeout_s: 0.5"), 2 * 1.0 + 0.5, 1e-12);
+  EXPECT_EQ(stale_s("poll_rate_Hz: 200"), 0.1);  // 2·5 ms + 4.5 ms is less than the loop's default
+  EXPECT_EQ(stale_s("poll_rate_Hz: 10", "  stale_timeout_s: 0.15\n"), 0.15);  // stale on one lost reply: allowed
+  EXPECT_EQ(
+      load_daemon_config(test::TempFile("can.yaml", "daemon:\n  source: {type: can, can: {interface: vcan0}}\n").path())
+          .fixed.loop.stale_timeout_s,
+      0.1);  // the drive pushes: nothing to go by
+}
+
 TEST(DaemonConfig, FixedDifferenceNamesWhatOnlyARestartApplies) {
   const DaemonConfig a = builtin_daemon_config();
   DaemonConfig b = a;
@@ -163,7 +181,13 @@ INSTANTIATE_TEST_SUITE_P(
                           "give the machine inline or daemon.machine_config"},
                       Bad{"iface", "daemon:\n  source: {type: can, can: {interface: ''}}\n", "not an interface name"},
                       Bad{"coefficient_sign", "daemon:\n  temperature: {psi_m_coeff_per_K: 0.001}\n",
-                          "psi_m_coeff_per_K: 0.001 is outside"}),
+                          "psi_m_coeff_per_K: 0.001 is outside"},
+                      Bad{"stale_between_polls",
+                          "daemon:\n  source: {type: vesc, vesc: {interface: vcan0, controller_id: 17, poll_rate_Hz: 10}}\n"
+                          "  stale_timeout_s: 0.1\n",
+                          ":3:20: daemon.stale_timeout_s: 0.1 s is within the 0.12 s the vesc source's samples may "
+                          "come apart (one poll period and reply_timeout_s): rpemd would go stale, and start over, "
+                          "between two of them; leave it out (then 0.22 s"}),
     [](const auto& p) { return std::string(p.param.name); });
 
 }  // namespace

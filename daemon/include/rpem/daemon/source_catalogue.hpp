@@ -1,8 +1,9 @@
 #pragma once
 // The sample sources rpemd knows. `daemon.source.type` names one; `daemon.source.<type>` holds its
 // options (sections of the other types may be present and are checked too). A new source is one
-// implementation — a struct with kType, Options, parse(), sample_kind() and make(), and its SampleSource
-// — and one entry in SourceCatalogue below. The first entry is the default.
+// implementation — a struct with kType, Options, parse(), sample_kind() and make() (and sample_spacing() where
+// the source, not the drive, sets how often samples come), and its SampleSource — and one entry in SourceCatalogue
+// below. The first entry is the default.
 
 #include <memory>
 #include <string>
@@ -32,6 +33,10 @@ struct Catalogue {
   [[nodiscard]] static SampleKind sample_kind(const Options& o) noexcept {
     return sample_kind(o, std::index_sequence_for<Kinds...>{});
   }
+  /// How far apart the configured source's samples come, where it sets that (a kind with sample_spacing()).
+  [[nodiscard]] static SampleSpacing sample_spacing(const Options& o) noexcept {
+    return sample_spacing(o, std::index_sequence_for<Kinds...>{});
+  }
   /// Builds the configured source (throws io::ConfigError if it cannot be, e.g. a bad scenario).
   [[nodiscard]] static std::unique_ptr<SampleSource> make(const Options& o) {
     return make(o, std::index_sequence_for<Kinds...>{});
@@ -46,6 +51,18 @@ struct Catalogue {
     SampleKind kind = SampleKind::kPhase;
     ((o.index() == I ? (kind = Kind<I>::sample_kind(*std::get_if<I>(&o)), 0) : 0), ...);
     return kind;
+  }
+
+  template <std::size_t... I>
+  static SampleSpacing sample_spacing(const Options& o, std::index_sequence<I...>) noexcept {
+    SampleSpacing spacing;
+    auto one = [&]<std::size_t K>(std::integral_constant<std::size_t, K>) {
+      if constexpr (requires(const typename Kind<K>::Options& k) { Kind<K>::sample_spacing(k); }) {
+        if (o.index() == K) spacing = Kind<K>::sample_spacing(*std::get_if<K>(&o));
+      }
+    };
+    (one(std::integral_constant<std::size_t, I>{}), ...);
+    return spacing;
   }
 
   template <std::size_t... I>

@@ -18,6 +18,13 @@ enum class SampleKind : std::uint8_t { kPhase = 0, kAveraged = 1 };
 
 using SourceSample = std::variant<core::DriveSample, core::AveragedSample>;
 
+/// How far apart a source's samples come where the source itself sets that (a poller: docs/rpemd.md,
+/// `stale_timeout_s`); both 0 where the drive pushes them at a rate rpemd is not told.
+struct SampleSpacing {
+  double normal_s = 0.0;    ///< the longest interval between two samples in normal operation
+  double one_lost_s = 0.0;  ///< the same where one reply in between is lost
+};
+
 [[nodiscard]] inline SampleKind kind_of(const SourceSample& s) noexcept { return static_cast<SampleKind>(s.index()); }
 [[nodiscard]] inline const char* to_string(SampleKind k) noexcept { return k == SampleKind::kPhase ? "phase" : "averaged"; }
 

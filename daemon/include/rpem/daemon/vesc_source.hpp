@@ -39,6 +39,12 @@ struct VescSource {
   };
   [[nodiscard]] static Options parse(io::YamlMap& section, const std::string& base_dir);
   [[nodiscard]] static SampleKind sample_kind(const Options&) noexcept { return SampleKind::kAveraged; }
+  /// A reply, and with it a window, every poll period T, each up to reply_timeout_s after its poll: T + timeout
+  /// apart at most, 2·T + timeout where one reply is lost (the longest window VescPoller keeps).
+  [[nodiscard]] static SampleSpacing sample_spacing(const Options& o) noexcept {
+    const double period_s = 1.0 / o.poll_rate_Hz;
+    return {period_s + o.reply_timeout_s, 2.0 * period_s + o.reply_timeout_s};
+  }
   [[nodiscard]] static std::unique_ptr<SampleSource> make(const Options& options);
 };
 
