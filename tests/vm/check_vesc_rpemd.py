@@ -9,10 +9,11 @@
   configuration's reference values, which are off the plant's on purpose);
 - it survives the silence 45-48 s: estimates keep coming and its sample count grows again after it;
 - it counts the second poller (cangen from 55 s to 60 s) stealing its averages;
-- with --prompt-replies (a poll slow enough that every reply comes well within its period: 10 Hz), it times out
-  only the polls nobody answered — those of the emulator's silence, which the emulator counts, and those sent
-  before it listens and after it stops (a second at each end: tests/vm/vesc_rpemd.sh) — and takes no reply as late (at most 1 % of them, for a VM
-  that stalls a whole period).
+- with --prompt-replies (a poll slow enough that every reply comes well within its period: 10 Hz, run with the
+  stale timeout rpemd chooses for it), no estimate is stale but in the silence and after the emulator stops; it
+  times out only the polls nobody answered — those of the emulator's silence, which the emulator counts, and those
+  sent before it listens and after it stops (a second at each end: tests/vm/vesc_rpemd.sh) — and takes no reply
+  as late (at most 1 % of them, for a VM that stalls a whole period).
 
   check_vesc_rpemd.py DIR NAME [--prompt-replies]
 """
@@ -86,7 +87,7 @@ def main():
     if not stolen or max(stolen) == 0:
         errors.append('the second poller was not counted')
     if '--prompt-replies' in sys.argv[3:]:
-        check_prompt_replies(emu, text, report, errors)
+        check_prompt_replies(emu, text, est, report, errors)
     print('check_vesc_rpemd %s: %d estimates; %s' % (name, len(est), '; '.join(report)))
     if errors:
         print('check_vesc_rpemd %s: FAILED\n  %s' % (name, '\n  '.join(errors)))
@@ -94,8 +95,11 @@ def main():
     print('check_vesc_rpemd %s: passed' % name)
 
 
-def check_prompt_replies(emu, text, report, errors):
-    """Timeouts only where nobody answered; no chain of late replies after them."""
+def check_prompt_replies(emu, text, est, report, errors):
+    """Timeouts only where nobody answered; no chain of late replies after them; stale only where nobody answered."""
+    stale = [e['te'] for e in est if e['state'] == 2 and not 45.0 <= e['te'] <= 49.0 and e['te'] < 69.5]
+    if stale:
+        errors.append('%d estimates stale outside the silence, the first at %.1f s' % (len(stale), stale[0]))
     unheard = int(re.search(r'(\d+) unheard while silent', emu).group(1))
     counters = re.findall(r'vesc_polls (\d+) .*?vesc_replies (\d+) vesc_timeouts (\d+) vesc_late_replies (\d+)', text)
     if not counters:
