@@ -253,7 +253,7 @@ void Daemon::print_summary() const {
       std::fclose(f);
     }
   }
-  const LatencyHistogram& rx = publisher_->rx_to_publish();
+  const WideLatencyHistogram& rx = publisher_->rx_to_publish();
   if (rx.count() > 0) {
     std::fprintf(stderr, "rpemd: CAN receive -> LCM publish [us]: p50 %.0f, p99 %.0f, max %.1f (%lld estimates)\n",
                  rx.percentile(0.5), rx.percentile(0.99), rx.max(), static_cast<long long>(rx.count()));

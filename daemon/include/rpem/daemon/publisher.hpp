@@ -63,7 +63,7 @@ class PersistingPublisher {
   void run(const std::atomic<bool>& stop);
 
   /// CAN receive → LCM publish over the whole run (read after the thread has stopped).
-  [[nodiscard]] const LatencyHistogram& rx_to_publish() const noexcept { return rx_to_publish_run_; }
+  [[nodiscard]] const WideLatencyHistogram& rx_to_publish() const noexcept { return rx_to_publish_run_; }
 
  private:
   struct Lcm;
@@ -88,10 +88,10 @@ class PersistingPublisher {
   const std::string estimate_channel_, measurement_channel_, diagnostics_channel_;
   std::string state_path_;
 
-  SourceReport source_;                 ///< the newest from the source thread
-  ControlReport control_;               ///< the newest from the control thread
-  LatencyHistogram rx_to_publish_;      ///< since the last diagnostics message
-  LatencyHistogram rx_to_publish_run_;  ///< the whole run
+  SourceReport source_;                     ///< the newest from the source thread
+  ControlReport control_;                   ///< the newest from the control thread
+  WideLatencyHistogram rx_to_publish_;      ///< since the last diagnostics message
+  WideLatencyHistogram rx_to_publish_run_;  ///< the whole run
   EstimateReport last_estimate_;
   bool have_estimate_ = false;
   PersistedThermal thermal_;  ///< the fusion's newest state (or the resumed one), persisted
