@@ -160,7 +160,7 @@ TEST(VescPoller, ASilentControllerTimesOutAndItsFirstLongWindowIsDropped) {
   VescPoller p = make_poller();
   (void)poll_and_reply(p, kT0);
   for (int k = 1; k <= 4; ++k) {
-    const std::int64_t t = kT0 + k * 5 * kMs;
+    const std::int64_t t = kT0 + std::int64_t{k} * 5 * kMs;
     p.on_time(t);
     ASSERT_TRUE(p.poll_due(t));
     p.polled(t, true);
@@ -299,23 +299,31 @@ VescPoller make_poller_timeout_a_period(double rate_Hz) {
   return VescPoller(poller_config(o));
 }
 
+constexpr std::int64_t kPeriod10Hz = 100 * kMs;
+
+/// Polls 0…last at 10 Hz, each answered 3 ms after it but poll `lost`: the samples the replies close.
+std::vector<core::AveragedSample> poll_at_10_Hz_answered_in_3_ms(VescPoller& p, int last, int lost) {
+  constexpr std::int64_t kLatency = 3 * kMs;
+  std::vector<core::AveragedSample> samples;
+  for (int k = 0; k <= last; ++k) {
+    const std::int64_t t = kT0 + k * kPeriod10Hz;
+    p.on_time(t);
+    EXPECT_TRUE(p.poll_due(t)) << k;
+    p.polled(t, true);
+    if (k == lost) continue;
+    p.on_time(t + kLatency);
+    if (const auto s = reply(p, t + kLatency)) samples.push_back(*s);
+  }
+  return samples;
+}
+
 // 10 Hz, the timeout a whole period: the first poll goes unanswered (the controller not yet up), every later one is
 // answered 3 ms after it. Each reply began after its own poll went out, so it is that poll's: one timeout, no late
 // reply, and the windows chain without gaps. (Taken as the timed-out poll's, every reply would be "late" and every
 // poll a timeout for the rest of the run: 20 and 20 here.)
 TEST(VescPoller, APollLostOnceLeavesNoChainOfLateReplies) {
   VescPoller p = make_poller_timeout_a_period(10.0);
-  constexpr std::int64_t kPeriod = 100 * kMs, kLatency = 3 * kMs;
-  std::vector<core::AveragedSample> samples;
-  for (int k = 0; k <= 20; ++k) {
-    const std::int64_t t = kT0 + k * kPeriod;
-    p.on_time(t);
-    ASSERT_TRUE(p.poll_due(t));
-    p.polled(t, true);
-    if (k == 0) continue;  // unanswered
-    p.on_time(t + kLatency);
-    if (const auto s = reply(p, t + kLatency)) samples.push_back(*s);
-  }
+  const std::vector<core::AveragedSample> samples = poll_at_10_Hz_answered_in_3_ms(p, 20, 0);
   EXPECT_EQ(p.counters().polls, 21U);
   EXPECT_EQ(p.counters().timeouts, 1U);
   EXPECT_EQ(p.counters().late, 0U);
@@ -323,7 +331,7 @@ TEST(VescPoller, APollLostOnceLeavesNoChainOfLateReplies) {
   EXPECT_FALSE(p.silent());
   ASSERT_EQ(samples.size(), 19U);  // the first reply opens the first window
   for (const core::AveragedSample& s : samples) {
-    EXPECT_EQ(s.t_ns - s.t_start_ns, kPeriod);
+    EXPECT_EQ(s.t_ns - s.t_start_ns, kPeriod10Hz);
     EXPECT_FALSE(s.gap_before);
   }
 }
@@ -332,23 +340,14 @@ TEST(VescPoller, APollLostOnceLeavesNoChainOfLateReplies) {
 // have made for it, so it follows a gap; the reply to poll 6 is poll 6's, not a late one for poll 5.
 TEST(VescPoller, AReplyLostAmongPromptOnesKeepsItsGap) {
   VescPoller p = make_poller_timeout_a_period(10.0);
-  constexpr std::int64_t kPeriod = 100 * kMs, kLatency = 3 * kMs;
-  std::vector<core::AveragedSample> samples;
-  for (int k = 0; k <= 8; ++k) {
-    const std::int64_t t = kT0 + k * kPeriod;
-    p.on_time(t);
-    p.polled(t, true);
-    if (k == 5) continue;  // lost
-    p.on_time(t + kLatency);
-    if (const auto s = reply(p, t + kLatency)) samples.push_back(*s);
-  }
+  const std::vector<core::AveragedSample> samples = poll_at_10_Hz_answered_in_3_ms(p, 8, 5);
   EXPECT_EQ(p.counters().timeouts, 1U);
   EXPECT_EQ(p.counters().late, 0U);
   ASSERT_EQ(samples.size(), 7U);  // replies 1-4 and 6-8 close windows
   for (std::size_t i = 0; i < samples.size(); ++i) {
     const bool after_loss = i == 4;  // the window from reply 4 to reply 6
     EXPECT_EQ(samples[i].gap_before, after_loss) << i;
-    EXPECT_EQ(samples[i].t_ns - samples[i].t_start_ns, (after_loss ? 2 : 1) * kPeriod) << i;
+    EXPECT_EQ(samples[i].t_ns - samples[i].t_start_ns, (after_loss ? 2 : 1) * kPeriod10Hz) << i;
   }
 }
 
