@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 
+#include "rpem/core/assert.hpp"
 #include "rpem/core/units.hpp"
 
 namespace rpem::daemon {
@@ -13,7 +14,10 @@ namespace vesc = can::vesc;
 VescPoller::VescPoller(const Config& config) noexcept
     : config_(config),
       poll_(vesc::values_request(config.controller_id, config.host_id, config.mask)),
-      decoder_(config.controller_id, config.host_id, config.mask) {}
+      decoder_(config.controller_id, config.host_id, config.mask) {
+  RPEM_ASSERT(config.timeout_ns <= config.period_ns,
+              "a reply times out within its poll period: on_frame takes one begun after the next poll as that poll's");
+}
 
 std::int64_t VescPoller::next_poll_ns(std::int64_t now_ns) const noexcept {
   const std::int64_t T = config_.period_ns;

@@ -52,7 +52,8 @@ VescPoller::Config poller_config(const VescSource::Options& o) noexcept {
   c.host_id = static_cast<std::uint8_t>(o.host_id);
   c.period_ns = std::llround(1e9 / o.poll_rate_Hz);
   c.phase_ns = std::llround(o.poll_phase * static_cast<double>(c.period_ns));
-  c.timeout_ns = std::llround(o.reply_timeout_s * 1e9);
+  c.timeout_ns =
+      std::min<std::int64_t>(c.period_ns, std::llround(o.reply_timeout_s * 1e9));  // ≤ the period, as parsed, to the ns
   c.pll = {o.pll_kp, o.pll_ki};
   c.mask = o.count_horizon_s > 0.0 ? can::vesc::kCountingMask : can::vesc::kEstimatorMask;
   return c;
