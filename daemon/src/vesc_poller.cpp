@@ -27,8 +27,18 @@ std::int64_t VescPoller::next_poll_ns(std::int64_t now_ns) const noexcept {
   return k * T + config_.phase_ns;
 }
 
+bool VescPoller::reply_under_way() const noexcept {
+  return outstanding_ && reply_start_ns_ != 0 && reply_start_ns_ >= sent_ns_ && reply_start_ns_ <= deadline_ns_;
+}
+
+std::int64_t VescPoller::outstanding_deadline_ns() const noexcept {
+  return reply_under_way() ? deadline_ns_ + config_.period_ns : deadline_ns_;
+}
+
 std::int64_t VescPoller::wake_ns(std::int64_t now_ns) const noexcept {
-  const std::int64_t next = outstanding_ ? std::min(next_due_ns_, deadline_ns_) : next_due_ns_;
+  std::int64_t next = next_due_ns_;
+  if (outstanding_) next = std::min(next, outstanding_deadline_ns());
+  if (answering_) next = std::min(next, answering_deadline_ns_);
   return std::max(next, now_ns);
 }
 
@@ -40,22 +50,39 @@ void VescPoller::polled(std::int64_t now_ns, bool sent) noexcept {
     ++counters_.send_failures;
     return;
   }
-  if (outstanding_) time_out();  // a previous poll still unanswered (reply_timeout_s ≥ the period)
+  if (outstanding_) {
+    if (reply_under_way()) {
+      // Its reply began in time and is still arriving (1 kHz on a 1 Mbit/s bus: a reply alone takes 0.9 ms):
+      // the poll is answered, and keeps the second slot until the reply completes, fails or runs out of time.
+      if (answering_) time_out(answering_deadline_ns_);
+      answering_ = true;
+      answering_deadline_ns_ = deadline_ns_ + config_.period_ns;
+    } else {
+      time_out(deadline_ns_);  // unanswered, where on_time did not see its deadline pass
+    }
+  }
   ++counters_.polls;
   outstanding_ = true;
+  sent_ns_ = now_ns;
   deadline_ns_ = now_ns + config_.timeout_ns;
 }
 
 void VescPoller::on_time(std::int64_t now_ns) noexcept {
-  if (outstanding_ && now_ns > deadline_ns_) time_out();
+  if (answering_ && now_ns > answering_deadline_ns_) {
+    answering_ = false;
+    time_out(answering_deadline_ns_);
+  }
+  if (outstanding_ && now_ns > outstanding_deadline_ns()) {
+    outstanding_ = false;
+    time_out(deadline_ns_);
+  }
 }
 
-void VescPoller::time_out() noexcept {
-  outstanding_ = false;
+void VescPoller::time_out(std::int64_t deadline_ns) noexcept {
   ++counters_.timeouts;
   ++consecutive_timeouts_;
   timed_out_unanswered_ = true;
-  timed_out_at_ns_ = deadline_ns_;
+  timed_out_at_ns_ = deadline_ns;
   // The decoder's buffer is kept: the reply may be under way (its frames straddling the deadline or the
   // next poll, as at 1 kHz on a busy bus); a new reply restarts it at offset 0 all the same.
   gap_before_timeout_ = gap_;
@@ -76,6 +103,13 @@ bool VescPoller::starts_reply(const can::CanFrame& f) const noexcept {
   const std::uint32_t packet = f.id >> 8;
   if (packet == static_cast<std::uint32_t>(vesc::Packet::kProcessShortBuffer)) return true;
   return packet == static_cast<std::uint32_t>(vesc::Packet::kFillRxBuffer) && f.len >= 1 && f.data[0] == 0;
+}
+
+bool VescPoller::ends_reply(const can::CanFrame& f) const noexcept {
+  if (f.error || !f.extended || (f.id & 0xFF) != config_.host_id) return false;
+  const std::uint32_t packet = f.id >> 8;
+  return packet == static_cast<std::uint32_t>(vesc::Packet::kProcessShortBuffer) ||
+         packet == static_cast<std::uint32_t>(vesc::Packet::kProcessRxBuffer);
 }
 
 bool VescPoller::plausible_window(std::int64_t t) noexcept {
@@ -101,8 +135,18 @@ bool VescPoller::on_frame(const can::CanFrame& f, std::int64_t rx_ns, core::Aver
     ++counters_.stolen_reads;
     window_start_ns_ = rx_ns;  // the controller's averages restart here
   }
-  if (starts_reply(f)) reply_start_ns_ = rx_ns;
-  if (decoder_.decode(f) != vesc::VescDecoder::Event::kValues) return false;
+  if (starts_reply(f)) {
+    // A reply the second slot still waited for can no longer complete: the decoder restarts at this one.
+    if (answering_ && outstanding_ && rx_ns >= sent_ns_) {
+      answering_ = false;
+      time_out(answering_deadline_ns_);
+    }
+    reply_start_ns_ = rx_ns;
+  }
+  if (decoder_.decode(f) != vesc::VescDecoder::Event::kValues) {
+    if (ends_reply(f)) reply_start_ns_ = 0;  // decoded and refused (CRC, length, mask): no reply is under way
+    return false;
+  }
 
   const std::int64_t t = reply_start_ns_ != 0 ? reply_start_ns_ : rx_ns;
   reply_start_ns_ = 0;
@@ -115,8 +159,11 @@ bool VescPoller::on_frame(const can::CanFrame& f, std::int64_t rx_ns, core::Aver
   // timeout allows; taking it as the timed-out poll's would leave the outstanding one to time out in turn, and one
   // lost reply would make every later reply "late" and every poll a timeout.
   const bool timed_out_pending = timed_out_unanswered_ && t - timed_out_at_ns_ <= config_.period_ns;
-  const bool began_before_outstanding = t < deadline_ns_ - config_.timeout_ns;  // the outstanding poll's send
-  if (timed_out_pending && (!outstanding_ || began_before_outstanding)) {
+  const bool began_before_outstanding = t < sent_ns_;
+  if (answering_ && (!outstanding_ || began_before_outstanding)) {
+    answering_ = false;  // the reply that began in time: its poll is answered
+    consecutive_timeouts_ = 0;
+  } else if (timed_out_pending && (!outstanding_ || began_before_outstanding)) {
     ++counters_.late;
     consecutive_timeouts_ = 0;
     gap_ = gap_before_timeout_;  // the read it feared lost is this one: the chain holds

@@ -244,47 +244,51 @@ TEST(VescPoller, AReplyAfterItsTimeoutIsLateAndStillUsed) {
   EXPECT_FALSE(s->gap_before);
 }
 
-// Replies slower than a period (1 kHz, reply_timeout_s = the period): every poll times out when the next
-// goes out, and each reply — its frames straddling that next poll — is the timed-out poll's, answered in
-// turn. No reply is lost to the timeout, and the windows chain without gaps.
-TEST(VescPoller, RepliesSlowerThanAPeriodAreAnsweredInTurnAndChain) {
-  VescSource::Options o;
-  o.controller_id = kController;
-  o.host_id = kHost;
-  o.poll_rate_Hz = 1000.0;
-  o.reply_timeout_s = 1e-3;
-  VescPoller p(poller_config(o));
-  const std::vector<can::CanFrame> frames = reply_frames();
-  std::vector<core::AveragedSample> samples;
-  // Poll k goes out at k ms; its reply's six frames arrive 130 µs apart from 0.8 ms after it: two before
-  // the next poll, four after it.
-  const auto deliver = [&](int poll, std::int64_t from_ns, std::int64_t to_ns) {
-    for (std::size_t i = 0; i < frames.size(); ++i) {
-      const std::int64_t rx = kT0 + poll * kMs + 800'000 + static_cast<std::int64_t>(i) * 130'000;
-      if (rx < from_ns || rx >= to_ns) continue;
-      p.on_time(rx);
-      core::AveragedSample s;
-      if (p.on_frame(frames[i], rx, s)) samples.push_back(s);
+// Replies that take longer than a period on the bus (1 kHz, reply_timeout_s 0.9 ms or 1 ms): each begins before the
+// next poll goes out and completes after it. Each is its own poll's, answered in time — no timeout, no late reply —
+// and the windows chain without gaps. (Before 2026-12-01 every poll counted as a timeout and every reply as late.)
+TEST(VescPoller, RepliesStraddlingTheNextPollAnswerTheirOwnAndChain) {
+  for (const double timeout_s : {0.9e-3, 1e-3}) {  // the default at 1 kHz, and the most allowed
+    SCOPED_TRACE(timeout_s);
+    VescSource::Options o;
+    o.controller_id = kController;
+    o.host_id = kHost;
+    o.poll_rate_Hz = 1000.0;
+    o.reply_timeout_s = timeout_s;
+    VescPoller p(poller_config(o));
+    const std::vector<can::CanFrame> frames = reply_frames();
+    std::vector<core::AveragedSample> samples;
+    // Poll k goes out at k ms; its reply's six frames arrive 130 µs apart from 0.8 ms after it: two before
+    // the next poll, four after it.
+    const auto deliver = [&](int poll, std::int64_t from_ns, std::int64_t to_ns) {
+      for (std::size_t i = 0; i < frames.size(); ++i) {
+        const std::int64_t rx = kT0 + poll * kMs + 800'000 + static_cast<std::int64_t>(i) * 130'000;
+        if (rx < from_ns || rx >= to_ns) continue;
+        p.on_time(rx);
+        core::AveragedSample s;
+        if (p.on_frame(frames[i], rx, s)) samples.push_back(s);
+      }
+    };
+    for (int k = 0; k <= 21; ++k) {
+      const std::int64_t t = kT0 + k * kMs;
+      if (k > 0) deliver(k - 1, t - kMs, t);
+      p.on_time(t);
+      ASSERT_TRUE(p.poll_due(t));
+      p.polled(t, true);
+      if (k > 0) deliver(k - 1, t, t + kMs);
     }
-  };
-  for (int k = 0; k <= 21; ++k) {
-    const std::int64_t t = kT0 + k * kMs;
-    if (k > 0) deliver(k - 1, t - kMs, t);
-    p.on_time(t);
-    ASSERT_TRUE(p.poll_due(t));
-    p.polled(t, true);
-    if (k > 0) deliver(k - 1, t, t + kMs);
-  }
-  EXPECT_EQ(p.counters().polls, 22U);
-  EXPECT_EQ(p.counters().late, 21U);
-  EXPECT_EQ(p.counters().unrequested, 0U);
-  EXPECT_EQ(p.decoder().counters().out_of_order + p.decoder().counters().length_mismatch, 0U);
-  ASSERT_EQ(samples.size(), 20U);  // the first reply opens the first window
-  for (std::size_t i = 0; i < samples.size(); ++i) {
-    EXPECT_EQ(samples[i].t_ns - samples[i].t_start_ns, kMs) << i;
-    if (i > 0) {
-      EXPECT_FALSE(samples[i].gap_before) << i;
-      EXPECT_EQ(samples[i].t_start_ns, samples[i - 1].t_ns) << i;
+    EXPECT_EQ(p.counters().polls, 22U);
+    EXPECT_EQ(p.counters().timeouts, 0U);
+    EXPECT_EQ(p.counters().late, 0U);
+    EXPECT_EQ(p.counters().unrequested, 0U);
+    EXPECT_EQ(p.decoder().counters().out_of_order + p.decoder().counters().length_mismatch, 0U);
+    ASSERT_EQ(samples.size(), 20U);  // the first reply opens the first window
+    for (std::size_t i = 0; i < samples.size(); ++i) {
+      EXPECT_EQ(samples[i].t_ns - samples[i].t_start_ns, kMs) << i;
+      if (i > 0) {
+        EXPECT_FALSE(samples[i].gap_before) << i;
+        EXPECT_EQ(samples[i].t_start_ns, samples[i - 1].t_ns) << i;
+      }
     }
   }
 }
@@ -417,6 +421,57 @@ TEST(VescPoller, ABrokenReplyIsCountedAndItsPollTimesOut) {
   EXPECT_EQ(rows.get(&diagnostics_t::vesc_timeouts), 1);
   EXPECT_EQ(rows.get(&diagnostics_t::vesc_polls), 2);
   EXPECT_EQ(rows.get(&diagnostics_t::vesc_replies), 0);
+}
+
+/// 200 Hz (timeout 2.5 ms): poll 0 answered, poll 1 (at 5 ms) answered from 5.3 ms by all but the reply's last frame.
+VescPoller poll_with_a_reply_begun_and_never_completed() {
+  VescPoller p = make_poller();
+  (void)poll_and_reply(p, kT0);
+  p.on_time(kT0 + 5 * kMs);
+  p.polled(kT0 + 5 * kMs, true);
+  const std::vector<can::CanFrame> frames = reply_frames();
+  core::AveragedSample unused;
+  for (std::size_t i = 0; i + 1 < frames.size(); ++i)
+    EXPECT_FALSE(p.on_frame(frames[i], kT0 + 5'300'000 + static_cast<std::int64_t>(i) * 20'000, unused));
+  return p;
+}
+
+// A reply whose first frame came in time answers its poll: its deadline (7.5 ms) passes without a timeout, and
+// the poll keeps the second slot when the next goes out. Its last frame never comes: it times out a period after
+// its deadline (12.5 ms), and the next window follows a gap (the controller read and reset for it).
+TEST(VescPoller, AReplyBegunInTimeButNeverCompletedTimesOutAPeriodAfterItsDeadline) {
+  VescPoller p = poll_with_a_reply_begun_and_never_completed();
+  p.on_time(kT0 + 8 * kMs);
+  EXPECT_EQ(p.counters().timeouts, 0U);
+  EXPECT_EQ(p.wake_ns(kT0 + 8 * kMs), kT0 + 10 * kMs);  // the next poll, before the extended deadline
+  p.on_time(kT0 + 10 * kMs);
+  p.polled(kT0 + 10 * kMs, true);
+  EXPECT_EQ(p.wake_ns(kT0 + 10'100'000), kT0 + 12'500'000);  // the new poll's deadline and the second slot's
+  p.on_time(kT0 + 12'500'000);
+  EXPECT_EQ(p.counters().timeouts, 0U);
+  p.on_time(kT0 + 12'500'001);
+  EXPECT_EQ(p.counters().timeouts, 2U);       // the second slot's, and the new poll's (its reply has not begun)
+  const auto s = reply(p, kT0 + 12'600'000);  // a window of 12.3 ms: within the 12.5 ms one lost read explains
+  ASSERT_TRUE(s.has_value());
+  EXPECT_EQ(p.counters().late, 1U);  // the newer poll's reply, after its timeout
+  EXPECT_TRUE(s->gap_before);
+}
+
+// The same, but the next poll's reply begins while the second slot still waits: the decoder restarts at it, so the
+// unfinished reply can no longer complete and its poll times out there; the new reply is its own poll's, after a gap.
+TEST(VescPoller, AReplyBegunInTimeButNeverCompletedTimesOutWhenTheNextBegins) {
+  VescPoller p = poll_with_a_reply_begun_and_never_completed();
+  p.on_time(kT0 + 10 * kMs);
+  p.polled(kT0 + 10 * kMs, true);
+  const auto s = reply(p, kT0 + 10'300'000);
+  EXPECT_EQ(p.counters().timeouts, 1U);
+  EXPECT_EQ(p.counters().late, 0U);
+  ASSERT_TRUE(s.has_value());
+  EXPECT_EQ(s->t_start_ns, kT0 + 300'000);
+  EXPECT_EQ(s->t_ns, kT0 + 10'300'000);
+  EXPECT_TRUE(s->gap_before);
+  p.on_time(kT0 + 20 * kMs);
+  EXPECT_EQ(p.counters().timeouts, 1U);
 }
 
 TEST(VescPoller, TheDefaultTimeoutLeavesTheReplyMostOfThePeriod) {

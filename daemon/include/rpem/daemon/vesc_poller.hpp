@@ -6,8 +6,8 @@
 // this read and the previous one (the reply's ERPM is the PLL's at the read).
 //
 // Schedule: polls at t = k·T + φ·T on the host's clock (T = 1/poll_rate_Hz, φ = poll_phase), so
-// instances polling drives on one bus interleave instead of colliding. One poll is outstanding at a time;
-// it times out after reply_timeout_s.
+// instances polling drives on one bus interleave instead of colliding. One poll awaits its reply at a time
+// (a second may still be receiving one: "answered" below); it times out after reply_timeout_s.
 //
 // Windows: VESC's i_d, i_q, v_d, v_q are averages since the previous read by anyone, reset by each read
 // (docs/can-vesc.md, "What the values mean"). A reply's window therefore ends at the receive time of its
@@ -19,17 +19,23 @@
 //   unrequested       a values reply to our id with no poll of ours outstanding or timed out unanswered
 //                     in the last period: another poller uses our host id. Its window is still right
 //                     (it ends a read), so it is used.
+//   (answered)        a poll whose reply's first frame came within reply_timeout_s is answered, however long
+//                     the rest of the reply takes on the bus: at 1 kHz on a 1 Mbit/s bus a reply alone takes
+//                     0.9 ms and its frames straddle the next poll. That poll then takes the outstanding slot
+//                     and the one being answered a second slot, until its reply completes (counted as
+//                     neither timeout nor late), is refused by the decoder, gives way to a newer reply, or
+//                     runs a further period past its deadline (then it times out).
 //   late              a reply to a poll that had timed out (within one period of the timeout): used, and
 //                     the gap the timeout feared is lifted (this reply is that read). A reply under way is
 //                     never discarded by a timeout. While the next poll is out, a reply is the timed-out
-//                     poll's only if it began before that poll went out (its frames straddle it: 1 kHz on a
-//                     1 Mbit/s bus, where a reply alone takes 0.9 ms); one that began after it is the
+//                     poll's only if it began before that poll went out; one that began after it is the
 //                     outstanding poll's. So a poll lost once (a silence, the controller not yet up) leaves
 //                     no chain of "late" replies and timeouts behind it, and a reply lost later keeps its
 //                     gap. Replies slower than a whole period are taken one poll on, their windows
 //                     unchanged: one gap where they start being so slow, one `unrequested` where they stop.
-//   timeouts          a poll unanswered within reply_timeout_s (silent controller, lost frames). Whether
-//                     the controller read (and reset) is unknown, so the next window follows a gap.
+//   timeouts          a poll whose reply did not begin within reply_timeout_s (silent controller, lost
+//                     frames), or began and never completed. Whether the controller read (and reset) is
+//                     unknown, so the next window follows a gap.
 //   short_windows     a window shorter than kMinWindow: the firmware divides sums of (nearly) no control
 //                     cycles — not a measurement; dropped, the next window follows a gap.
 //   empty_reads       a reply whose i_d, i_q, v_d, v_q are all exactly 0: what the firmware sends for a read
@@ -121,9 +127,16 @@ class VescPoller {
   [[nodiscard]] bool silent() const noexcept { return consecutive_timeouts_ > 0; }
 
  private:
-  void time_out() noexcept;
+  /// Counts a poll that timed out at `deadline_ns` (the caller has cleared its slot).
+  void time_out(std::int64_t deadline_ns) noexcept;
+  /// The outstanding poll's reply has begun, within its timeout, and is still arriving.
+  [[nodiscard]] bool reply_under_way() const noexcept;
+  /// When the outstanding poll times out: its deadline, or a period later while its reply is under way.
+  [[nodiscard]] std::int64_t outstanding_deadline_ns() const noexcept;
   [[nodiscard]] bool is_values_read_of_controller(const can::CanFrame& f) const noexcept;
   [[nodiscard]] bool starts_reply(const can::CanFrame& f) const noexcept;
+  /// The frame that closes a reply to us (the decoder processes the reply at it).
+  [[nodiscard]] bool ends_reply(const can::CanFrame& f) const noexcept;
   /// Drops a window that is no measurement (counted); true when `t` closes a usable one.
   [[nodiscard]] bool plausible_window(std::int64_t t) noexcept;
 
@@ -132,8 +145,11 @@ class VescPoller {
   can::vesc::VescDecoder decoder_;
   VescPollerCounters counters_;
   std::int64_t next_due_ns_ = 0;  ///< 0: the first call to poll_due() is due
-  bool outstanding_ = false;
-  std::int64_t deadline_ns_ = 0;
+  bool outstanding_ = false;      ///< the newest poll, awaiting its reply
+  std::int64_t sent_ns_ = 0;      ///< when it went out
+  std::int64_t deadline_ns_ = 0;  ///< sent_ns_ + timeout: its reply's first frame is due by then
+  bool answering_ = false;        ///< the second slot: an earlier poll whose reply began in time, still arriving
+  std::int64_t answering_deadline_ns_ = 0;
   bool timed_out_unanswered_ = false;
   std::int64_t timed_out_at_ns_ = 0;
   std::int64_t consecutive_timeouts_ = 0;

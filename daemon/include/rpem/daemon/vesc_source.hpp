@@ -24,8 +24,8 @@ struct VescSource {
     /// Where in each poll period this instance polls, as a fraction of the period: instances polling
     /// drives on one bus take different phases (docs/rpemd.md, "Several drives on one bus").
     double poll_phase = 0.0;
-    /// A reply not complete this long after its poll is a timeout (default: 0.9 poll periods, at most 20 ms:
-    /// the reply alone takes ~0.9 ms of a 1 Mbit/s bus).
+    /// A reply not begun this long after its poll is a timeout (default: 0.9 poll periods, at most 20 ms); one begun
+    /// in time may take longer to complete (the reply alone takes ~0.9 ms of a 1 Mbit/s bus: VescPoller).
     double reply_timeout_s = 0.0;
     /// The firmware's PLL gains (its motor configuration's foc_pll_kp, foc_pll_ki): the ERPM it reports lags a
     /// speed ramp by k_p/k_i, which each window's mean speed allows for (docs/rpemd.md, "source: vesc").
