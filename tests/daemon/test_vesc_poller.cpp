@@ -4,9 +4,11 @@
 // Frames are written byte by byte from docs/can-vesc.md (support/vesc_frames.hpp), not by our encoder.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <optional>
+#include <random>
 #include <string>
 #include <variant>
 #include <vector>
@@ -472,6 +474,107 @@ TEST(VescPoller, AReplyBegunInTimeButNeverCompletedTimesOutWhenTheNextBegins) {
   EXPECT_TRUE(s->gap_before);
   p.on_time(kT0 + 20 * kMs);
   EXPECT_EQ(p.counters().timeouts, 1U);
+}
+
+/// What a 1 kHz poller (the default 0.9 ms timeout) counts and delivers over 2 000 polls on a 1 Mbit/s bus: each
+/// reply begins 0.05–0.85 ms after its poll (uniform), or when the previous reply has left the bus, and its six
+/// frames come 130 µs apart, so that most replies straddle the next poll; the last frame of each reply is lost with
+/// probability `p_lost`. Returns the samples, and in `lost` the indices of the replies that lost their frame.
+std::vector<core::AveragedSample> run_1_kHz_random_replies(VescPoller& p, double p_lost, unsigned seed,
+                                                           std::vector<int>& lost) {
+  struct Rx {
+    std::int64_t t;
+    std::size_t frame;
+  };
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  const std::vector<can::CanFrame> frames = reply_frames();
+  constexpr std::int64_t kFrameNs = 130'000;
+  std::vector<Rx> on_bus;
+  std::vector<core::AveragedSample> samples;
+  std::int64_t bus_free = 0;
+  const auto deliver_until = [&](std::int64_t now) {
+    std::size_t k = 0;
+    for (; k < on_bus.size() && on_bus[k].t <= now; ++k) {
+      p.on_time(on_bus[k].t);
+      core::AveragedSample s;
+      if (p.on_frame(frames[on_bus[k].frame], on_bus[k].t, s)) samples.push_back(s);
+    }
+    on_bus.erase(on_bus.begin(), on_bus.begin() + static_cast<std::ptrdiff_t>(k));
+  };
+  for (int poll = 0; poll < 2000; ++poll) {
+    const std::int64_t t = kT0 + poll * kMs;
+    deliver_until(t - 1);
+    p.on_time(t);
+    EXPECT_TRUE(p.poll_due(t)) << poll;
+    p.polled(t, true);
+    const std::int64_t start =
+        std::max(t + static_cast<std::int64_t>((0.05 + 0.8 * unit(rng)) * static_cast<double>(kMs)), bus_free);
+    const bool lose_last = unit(rng) < p_lost;
+    if (lose_last) lost.push_back(poll);
+    for (std::size_t i = 0; i < frames.size(); ++i) {
+      if (!(lose_last && i + 1 == frames.size())) on_bus.push_back({start + static_cast<std::int64_t>(i) * kFrameNs, i});
+    }
+    bus_free = start + static_cast<std::int64_t>(frames.size()) * kFrameNs;
+  }
+  deliver_until(kT0 + 2002 * kMs);  // the last reply has left the bus by 2 001.5 ms
+  p.on_time(kT0 + 2003 * kMs);      // and its poll timed out, were it lost
+  return samples;
+}
+
+VescPoller make_poller_1_kHz() {
+  VescSource::Options o;
+  o.controller_id = kController;
+  o.host_id = kHost;
+  o.poll_rate_Hz = 1000.0;
+  o.reply_timeout_s = 0.9e-3;  // the default at 1 kHz (TheDefaultTimeoutLeavesTheReplyMostOfThePeriod)
+  return VescPoller(poller_config(o));
+}
+
+// Every reply begins within the timeout (at most 0.85 ms after its poll, and the previous reply has left the bus by
+// 0.5 ms after it), so every poll is answered: no timeout, no late or unrequested reply, whatever the replies' jitter
+// and however many of them straddle the next poll; the windows run from reply to reply without a gap.
+TEST(VescPoller, RandomRepliesBegunInTimeAreAllAnsweredAndChain) {
+  VescPoller p = make_poller_1_kHz();
+  std::vector<int> lost;
+  const std::vector<core::AveragedSample> samples = run_1_kHz_random_replies(p, 0.0, 1, lost);
+  EXPECT_EQ(p.counters().polls, 2000U);
+  EXPECT_EQ(p.counters().timeouts, 0U);
+  EXPECT_EQ(p.counters().late, 0U);
+  EXPECT_EQ(p.counters().unrequested, 0U);
+  ASSERT_EQ(samples.size(), 1999U);  // the first reply opens the first window
+  for (std::size_t i = 1; i < samples.size(); ++i) {
+    EXPECT_FALSE(samples[i].gap_before) << i;
+    EXPECT_EQ(samples[i].t_start_ns, samples[i - 1].t_ns) << i;
+  }
+}
+
+// The same with 2 % of the replies losing their last frame: each such poll times out (its reply never completes),
+// and only those; the window after each follows a gap — the controller read and reset for the lost reply — and no
+// other window does.
+TEST(VescPoller, RandomRepliesThatLoseTheirLastFrameTimeOutAndLeaveAGap) {
+  VescPoller p = make_poller_1_kHz();
+  std::vector<int> lost;
+  const std::vector<core::AveragedSample> samples = run_1_kHz_random_replies(p, 0.02, 2, lost);
+  ASSERT_GT(lost.size(), 20U);
+  EXPECT_EQ(p.counters().timeouts, lost.size());
+  EXPECT_EQ(p.counters().late, 0U);
+  EXPECT_EQ(p.counters().unrequested, 0U);
+  // The samples in order, each closed by the next completed reply after the first; which follow a gap.
+  std::vector<bool> expected_gaps;
+  bool opened = false, gap = false;
+  for (int poll = 0; poll < 2000; ++poll) {
+    if (std::find(lost.begin(), lost.end(), poll) != lost.end()) {
+      gap = gap || opened;
+    } else if (!opened) {
+      opened = true;  // the first completed reply opens the first window
+    } else {
+      expected_gaps.push_back(gap);
+      gap = false;
+    }
+  }
+  ASSERT_EQ(samples.size(), expected_gaps.size());
+  for (std::size_t i = 0; i < samples.size(); ++i) EXPECT_EQ(samples[i].gap_before, expected_gaps[i]) << i;
 }
 
 TEST(VescPoller, TheDefaultTimeoutLeavesTheReplyMostOfThePeriod) {
