@@ -153,11 +153,12 @@ bool VescPoller::on_frame(const can::CanFrame& f, std::int64_t rx_ns, core::Aver
   ++reads_;
   last_read_ = {t, decoder_.values().tachometer * vesc::kTachometerStepRad};
   last_accel_change_rad_s2_ = std::nan("");
-  // Which poll it answers, where one timed out unanswered within the period: that one's if the reply began before
-  // the poll now out went out (it was under way: its frames straddle that poll, as at 1 kHz on a 1 Mbit/s bus) or if
-  // no poll is out; else the outstanding poll's. A reply that began after the next poll went out is later than the
-  // timeout allows; taking it as the timed-out poll's would leave the outstanding one to time out in turn, and one
-  // lost reply would make every later reply "late" and every poll a timeout.
+  // Which poll it answers. The second slot's, if one waits for its reply and the reply began before the poll now
+  // out went out (it began in time and straddles that poll, as at 1 kHz on a 1 Mbit/s bus). Else, where a poll timed
+  // out unanswered within the period, that one's if the reply began before the poll now out went out (it began after
+  // its deadline) or if no poll is out. Else the outstanding poll's: a reply that began after the next poll went out
+  // is later than the timeout allows, and taking it as the timed-out poll's would leave the outstanding one to time
+  // out in turn, so that one lost reply would make every later reply "late" and every poll a timeout.
   const bool timed_out_pending = timed_out_unanswered_ && t - timed_out_at_ns_ <= config_.period_ns;
   const bool began_before_outstanding = t < sent_ns_;
   if (answering_ && (!outstanding_ || began_before_outstanding)) {
