@@ -27,12 +27,14 @@ std::int64_t VescPoller::next_poll_ns(std::int64_t now_ns) const noexcept {
   return k * T + config_.phase_ns;
 }
 
+std::int64_t VescPoller::deadline_ns() const noexcept { return sent_ns_ + config_.timeout_ns; }
+
 bool VescPoller::reply_under_way() const noexcept {
-  return outstanding_ && reply_start_ns_ != 0 && reply_start_ns_ >= sent_ns_ && reply_start_ns_ <= deadline_ns_;
+  return outstanding_ && reply_start_ns_ != 0 && reply_start_ns_ >= sent_ns_ && reply_start_ns_ <= deadline_ns();
 }
 
 std::int64_t VescPoller::outstanding_deadline_ns() const noexcept {
-  return reply_under_way() ? deadline_ns_ + config_.period_ns : deadline_ns_;
+  return reply_under_way() ? deadline_ns() + config_.period_ns : deadline_ns();
 }
 
 std::int64_t VescPoller::wake_ns(std::int64_t now_ns) const noexcept {
@@ -56,15 +58,14 @@ void VescPoller::polled(std::int64_t now_ns, bool sent) noexcept {
       // the poll is answered, and keeps the second slot until the reply completes, fails or runs out of time.
       if (answering_) time_out(answering_deadline_ns_);
       answering_ = true;
-      answering_deadline_ns_ = deadline_ns_ + config_.period_ns;
+      answering_deadline_ns_ = deadline_ns() + config_.period_ns;
     } else {
-      time_out(deadline_ns_);  // unanswered, where on_time did not see its deadline pass
+      time_out(deadline_ns());  // unanswered, where on_time did not see its deadline pass
     }
   }
   ++counters_.polls;
   outstanding_ = true;
   sent_ns_ = now_ns;
-  deadline_ns_ = now_ns + config_.timeout_ns;
 }
 
 void VescPoller::on_time(std::int64_t now_ns) noexcept {
@@ -74,17 +75,17 @@ void VescPoller::on_time(std::int64_t now_ns) noexcept {
   }
   if (outstanding_ && now_ns > outstanding_deadline_ns()) {
     outstanding_ = false;
-    time_out(deadline_ns_);
+    time_out(deadline_ns());
   }
 }
 
-void VescPoller::time_out(std::int64_t deadline_ns) noexcept {
+void VescPoller::time_out(std::int64_t at_ns) noexcept {
   ++counters_.timeouts;
   ++consecutive_timeouts_;
   timed_out_unanswered_ = true;
-  timed_out_at_ns_ = deadline_ns;
-  // The decoder's buffer is kept: the reply may be under way (its frames straddling the deadline or the
-  // next poll, as at 1 kHz on a busy bus); a new reply restarts it at offset 0 all the same.
+  timed_out_at_ns_ = at_ns;
+  // The decoder's buffer is kept: a reply that began after the deadline may still complete (and is then late);
+  // a new reply restarts it at offset 0 all the same.
   gap_before_timeout_ = gap_;
   gap_ = true;  // the controller may have read (and reset) with its reply lost
 }

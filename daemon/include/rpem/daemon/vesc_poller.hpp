@@ -127,8 +127,10 @@ class VescPoller {
   [[nodiscard]] bool silent() const noexcept { return consecutive_timeouts_ > 0; }
 
  private:
-  /// Counts a poll that timed out at `deadline_ns` (the caller has cleared its slot).
-  void time_out(std::int64_t deadline_ns) noexcept;
+  /// Counts a poll that timed out at `at_ns`, its deadline (the caller has cleared its slot).
+  void time_out(std::int64_t at_ns) noexcept;
+  /// When the outstanding poll's reply must have begun: sent_ns_ + timeout.
+  [[nodiscard]] std::int64_t deadline_ns() const noexcept;
   /// The outstanding poll's reply has begun, within its timeout, and is still arriving.
   [[nodiscard]] bool reply_under_way() const noexcept;
   /// When the outstanding poll times out: its deadline, or a period later while its reply is under way.
@@ -146,8 +148,7 @@ class VescPoller {
   VescPollerCounters counters_;
   std::int64_t next_due_ns_ = 0;  ///< 0: the first call to poll_due() is due
   bool outstanding_ = false;      ///< the newest poll, awaiting its reply
-  std::int64_t sent_ns_ = 0;      ///< when it went out
-  std::int64_t deadline_ns_ = 0;  ///< sent_ns_ + timeout: its reply's first frame is due by then
+  std::int64_t sent_ns_ = 0;      ///< when it went out; its reply's first frame is due by deadline_ns()
   bool answering_ = false;        ///< the second slot: an earlier poll whose reply began in time, still arriving
   std::int64_t answering_deadline_ns_ = 0;
   bool timed_out_unanswered_ = false;
