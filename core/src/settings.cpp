@@ -35,6 +35,12 @@ std::array<GainSequences, 3> averaged_rates_per_s(const EstimatorSettings& s) no
   return rates;
 }
 
+EstimatorSettings for_applied_voltages(EstimatorSettings s) noexcept {
+  s.averaged.voltage_is_command = false;
+  s.extensions.delay_s = 0.0;
+  return s;
+}
+
 RegimeConfig make_regime_config(const PerUnitBase& base, const MachineSi& m, const EstimatorSettings& s) noexcept {
   const RegimeSettings& g = s.regimes;
   RegimeConfig c;

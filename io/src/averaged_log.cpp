@@ -43,7 +43,20 @@ struct PreviousRowRead {
   core::AveragedSample sample;          ///< t_ns and the means; the window and its speed once they are known
   double omega_at_read_rad_s = 0.0;     ///< the speed column as it is (a PLL's at the read, or the window's mean)
   double travel_el_rad = std::nan("");  ///< the drive's count at the read (NaN: the log has none)
+  double duty = std::nan("");           ///< the duty cycle at the read (NaN: the log has none)
+  double i_motor_A = std::nan("");      ///< the motor current's mean (NaN: the log has none)
 };
+
+/// A sample's own values beside its means, and the duty at the read that starts its window (`start`; none: not
+/// known): kept with the samples, in their order.
+void keep_extras(const PreviousRowRead& row, const PreviousRowRead* start, AveragedLogRead& read) {
+  if (read.layout.duty) {
+    read.duty.push_back(row.duty);
+    read.duty_at_start.push_back(start ? start->duty : std::nan(""));
+    read.u_dc_at_start_V.push_back(start ? start->sample.u_dc_V : std::nan(""));
+  }
+  if (read.layout.i_motor) read.i_motor_A.push_back(row.i_motor_A);
+}
 
 /// Which reads' times and which windows a previous_row log leaves unknown (docs/drive-log.md, "Rows stamped late").
 struct UnknownTiming {
@@ -164,6 +177,7 @@ void previous_row_samples(const std::vector<PreviousRowRead>& rows, const LogMap
     }
     if (counted) read_ending.push_back(reads.size() - 1);
     out.push_back(s);
+    keep_extras(rows[k], &previous, read);
   }
   if (counted) set_counted_speeds(out, reads, read_ending, step_rad);
 }
@@ -176,15 +190,16 @@ std::vector<core::AveragedSample> read_averaged_log(const std::string& path, con
     throw ConfigError(map.name, 0, 0, "samples", "a map of instantaneous samples does not give averaged samples");
   }
   MappedLogReader reader(path, map, limits);
-  if (map.columns_optional) {
-    // Our own format names its quantities in the header: what an averaged log needs is checked here.
-    if (map.window == Window::kStartColumn && !reader.has(Quantity::kTStart)) {
-      reader.fail_at(reader.line(), "t_start", "required column is missing from the header");
-    }
-    if (const std::optional<LayoutProblem> p = averaged_log_layout_problem(reader.present())) {
-      reader.fail_at(reader.line(), p->column,
-                     p->reason == "required" ? "required column is missing from the header" : p->reason);
-    }
+  if (map.columns_optional && map.window == Window::kStartColumn && !reader.has(Quantity::kTStart)) {
+    reader.fail_at(reader.line(), "t_start", "required column is missing from the header");
+  }
+  // Our own format names its quantities in the header, a map's optional columns may be absent from it: what an
+  // averaged log needs is checked against what the header has.
+  if (const std::optional<LayoutProblem> p = averaged_log_layout_problem(reader.present())) {
+    reader.fail_at(reader.line(), p->column,
+                   p->reason.rfind("required", 0) == 0
+                       ? "required column is missing from the header" + p->reason.substr(std::string("required").size())
+                       : p->reason);
   }
   AveragedLogRead read;
   read.layout.u_dc = reader.has(Quantity::kUDc);
@@ -192,6 +207,10 @@ std::vector<core::AveragedSample> read_averaged_log(const std::string& path, con
   read.layout.t_magnet = reader.has(Quantity::kTMagnet);
   read.layout.t_drive = reader.has(Quantity::kTDrive);
   read.layout.t_coolant = reader.has(Quantity::kTCoolant);
+  read.layout.u_dq = reader.has(Quantity::kUD);
+  read.layout.i_dq = reader.has(Quantity::kID);
+  read.layout.duty = reader.has(Quantity::kDuty);
+  read.layout.i_motor = reader.has(Quantity::kIMotor);
 
   // Every row as read; a previous_row log's windows (and the speeds rebuilt over them) once all are in.
   const bool counted = reader.has(Quantity::kTravelEl);
@@ -214,6 +233,8 @@ std::vector<core::AveragedSample> read_averaged_log(const std::string& path, con
     s.t_magnet_C = r[Quantity::kTMagnet];
     s.t_drive_C = r[Quantity::kTDrive];
     s.t_coolant_C = r[Quantity::kTCoolant];
+    row.duty = r[Quantity::kDuty];
+    row.i_motor_A = r[Quantity::kIMotor];
     if (map.window == Window::kStartColumn) {
       s.t_start_ns = std::llround(r[Quantity::kTStart] * 1e9);
       if (s.t_start_ns > s.t_ns) reader.fail_at(r.line, Quantity::kTStart, "window starts after it ends (t_start > t)");
@@ -222,6 +243,7 @@ std::vector<core::AveragedSample> read_averaged_log(const std::string& path, con
         start_column_reads.push_back({r.t_ns, r[Quantity::kTravelEl]});
       }
       out.push_back(s);
+      keep_extras(row, nullptr, read);
       continue;
     }
     row.omega_at_read_rad_s = r[Quantity::kOmegaEl];

@@ -5,6 +5,7 @@
 #include <numbers>
 #include <string>
 #include <string_view>
+#include <utility>
 
 #include "rpem/core/reported_speed.hpp"
 
@@ -53,6 +54,8 @@ constexpr std::array kUnits{
     Unit{QuantityKind::kTemperature, "K", 1.0, -273.15, false},
     Unit{QuantityKind::kTorque, "Nm", 1.0, 0.0, false},
     Unit{QuantityKind::kTorque, "mNm", 1e-3, 0.0, false},
+    Unit{QuantityKind::kRatio, "1", 1.0, 0.0, false},
+    Unit{QuantityKind::kRatio, "%", 1e-2, 0.0, false},
 };
 
 constexpr std::array<QuantityInfo, kQuantityCount> kQuantities{{
@@ -76,6 +79,8 @@ constexpr std::array<QuantityInfo, kQuantityCount> kQuantities{{
     {Quantity::kTStart, "t_start", QuantityKind::kTime, false},
     {Quantity::kTCoolant, "T_coolant", QuantityKind::kTemperature, false},
     {Quantity::kTravelEl, "travel_el", QuantityKind::kAngle, false},
+    {Quantity::kDuty, "duty", QuantityKind::kRatio, false},
+    {Quantity::kIMotor, "i_motor", QuantityKind::kCurrent, false},
 }};
 
 const char* si_unit(QuantityKind k) {
@@ -118,7 +123,8 @@ bool apply_unit(YamlMap& m, MappedColumn& c, QuantityKind kind, long pole_pairs)
 }
 
 /// One `column: NAME` (header) or `column: N` (headerless) entry, with unit, scale and offset.
-MappedColumn parse_column(YamlMap& m, Quantity q, QuantityKind kind, bool header, long pole_pairs, bool& mechanical) {
+MappedColumn parse_column(YamlMap& m, Quantity q, QuantityKind kind, bool header, bool averaged, long pole_pairs,
+                          bool& mechanical) {
   MappedColumn c;
   c.quantity = q;
   if (header) {
@@ -133,8 +139,14 @@ MappedColumn parse_column(YamlMap& m, Quantity q, QuantityKind kind, bool header
   c.offset = m.number_or("offset", 0.0, -1e12, 1e12);
   c.optional = m.boolean_or("optional", false);
   if (c.optional && !header) m.fail("optional", "needs a header: a position is in every row, or the row is short");
-  if (c.optional && kind != QuantityKind::kTemperature && q != Quantity::kTravelEl) {
-    m.fail("optional", "only a quantity every log may lack (T_winding, T_magnet, T_drive, T_coolant, travel_el)");
+  // What a log may lack: temperatures, the count, VESC's duty and motor current; and, in an averaged log, the
+  // rotor-frame voltage or current where the other is given (the layout is then checked against the header).
+  const bool rotor_frame = q == Quantity::kUD || q == Quantity::kUQ || q == Quantity::kID || q == Quantity::kIQ;
+  if (c.optional && kind != QuantityKind::kTemperature && q != Quantity::kTravelEl && q != Quantity::kDuty &&
+      q != Quantity::kIMotor && !(rotor_frame && averaged)) {
+    m.fail("optional",
+           "only a quantity every log may lack (T_winding, T_magnet, T_drive, T_coolant, travel_el, duty, i_motor; "
+           "in an averaged log also u_d, u_q, i_d, i_q where duty and u_dc or i_motor stand for them)");
   }
   m.finish();
   return c;
@@ -208,7 +220,7 @@ LogMap averaged_log_map(const std::string& name) {
 
 std::optional<LayoutProblem> drive_log_layout_problem(const QuantitySet& p) {
   if (!present(p, Quantity::kOmegaEl)) return LayoutProblem{"omega_el", "required"};
-  for (Quantity q : {Quantity::kTStart, Quantity::kTDrive, Quantity::kTravelEl}) {
+  for (Quantity q : {Quantity::kTStart, Quantity::kTDrive, Quantity::kTravelEl, Quantity::kDuty, Quantity::kIMotor}) {
     if (present(p, q)) return LayoutProblem{info(q).name, "not a quantity of instantaneous samples (averaged logs only)"};
   }
   struct Group {
@@ -249,15 +261,32 @@ std::optional<LayoutProblem> drive_log_layout_problem(const QuantitySet& p) {
 }
 
 std::optional<LayoutProblem> averaged_log_layout_problem(const QuantitySet& p) {
+  // The rotor-frame voltage, or the duty cycle and the DC link it is rebuilt from; the rotor-frame current, or
+  // the motor current (rotor_frame_rebuild.hpp).
+  const bool voltage_from_duty = present(p, Quantity::kDuty) && present(p, Quantity::kUDc);
+  const bool current_from_motor = present(p, Quantity::kIMotor);
   for (Quantity q : {Quantity::kID, Quantity::kIQ, Quantity::kUD, Quantity::kUQ, Quantity::kOmegaEl}) {
-    if (!present(p, q)) return LayoutProblem{info(q).name, "required"};
+    const bool rebuilt = ((q == Quantity::kUD || q == Quantity::kUQ) && voltage_from_duty) ||
+                         ((q == Quantity::kID || q == Quantity::kIQ) && current_from_motor);
+    if (!present(p, q) && !rebuilt) {
+      if (q == Quantity::kUD || q == Quantity::kUQ) return LayoutProblem{info(q).name, "required (or duty and u_dc)"};
+      if (q == Quantity::kID || q == Quantity::kIQ) return LayoutProblem{info(q).name, "required (or i_motor)"};
+      return LayoutProblem{info(q).name, "required"};
+    }
+  }
+  for (const auto& [a, b] : {std::pair{Quantity::kUD, Quantity::kUQ}, std::pair{Quantity::kID, Quantity::kIQ}}) {
+    if (present(p, a) != present(p, b)) {
+      return LayoutProblem{info(present(p, a) ? b : a).name,
+                           "required with " + std::string(info(present(p, a) ? a : b).name)};
+    }
   }
   for (Quantity q : {Quantity::kThetaEl, Quantity::kUA, Quantity::kUB, Quantity::kUC, Quantity::kIA, Quantity::kIB,
                      Quantity::kIC, Quantity::kTorqueCmd}) {
     if (present(p, q)) {
-      return LayoutProblem{info(q).name,
-                           "not a quantity of averaged samples (their means are rotor-frame: i_d, i_q, "
-                           "u_d, u_q, omega_el, u_dc, T_winding, T_magnet, T_drive, T_coolant; and travel_el)"};
+      return LayoutProblem{
+          info(q).name,
+          "not a quantity of averaged samples (their means are rotor-frame: i_d, i_q, "
+          "u_d, u_q, omega_el, u_dc, T_winding, T_magnet, T_drive, T_coolant; and travel_el, duty, i_motor)"};
     }
   }
   return std::nullopt;
@@ -310,7 +339,7 @@ QuantitySet parse_columns(YamlMap& columns, LogMap& m, long pole_pairs, bool& me
       pll->finish();
       m.speed_pll = {kp, ki};
     }
-    m.columns.push_back(parse_column(*c, q.quantity, q.kind, m.header, pole_pairs, mechanical));
+    m.columns.push_back(parse_column(*c, q.quantity, q.kind, m.header, m.averaged(), pole_pairs, mechanical));
     present[static_cast<std::size_t>(q.quantity)] = true;
   }
   return present;

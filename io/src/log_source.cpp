@@ -82,8 +82,9 @@ LogSource log_source(const std::string& log_path, const std::string& map_path) {
   if (is_headerless_vesc_tool_row(line)) {
     throw DriveLogError(log_path, line_no, 0, "",
                         "a VESC Tool realtime log without header (VESC Tool 1.11 to 1.16, vedderb/vesc_tool 2323a806): "
-                        "its 22 values per row hold no d_axis_voltage, q_axis_voltage, which rpem needs; VESC Tool 1.20 "
-                        "added them (vedderb/vesc_tool 5986063b)");
+                        "rpem reads columns by name, and its 22 values per row are those VESC Tool 1.17 to 1.19 named "
+                        "(vedderb/vesc_tool 95f18604): put that header line first (docs/drive-log.md, \"Header "
+                        "versions\"); its d/q voltages are then rebuilt from duty_cycle (\"Logs without d/q values\")");
   }
   if (numbers_only(line)) {
     throw DriveLogError(log_path, line_no, 0, "",

@@ -258,6 +258,9 @@ void MappedLogReader::check(const MappedRow& row, int index, const std::string& 
     case QuantityKind::kTorque:
       bound = &limits_.torque_Nm, unit = "Nm";
       break;
+    case QuantityKind::kRatio:
+      bound = &limits_.duty, unit = "x u_dc/√3";
+      break;
     case QuantityKind::kTemperature:
       if (v < limits_.temperature_min_C || v > limits_.temperature_max_C) {
         fail_cell(index, label,

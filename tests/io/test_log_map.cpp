@@ -8,6 +8,7 @@
 #include <cstdlib>
 #include <numbers>
 #include <string>
+#include <vector>
 
 #include "rpem/io/averaged_log.hpp"
 #include "rpem/io/csv_table.hpp"
@@ -75,6 +76,48 @@ TEST(LogMap, APllSpeedIsASpeedAtTheReadsOfPreviousRowWindows) {
 
 // `optional: true` reads a column where the header has it and leaves the quantity absent where not; only for what
 // every log may lack (temperatures, travel_el) and only by header name.
+// A logger built on VescUart (duty, input voltage, erpm, motor current; no d/q values) read through a map: duty in
+// percent, the motor current in mA; what the rebuild needs reaches the read (rotor_frame_rebuild.hpp). Optional d/q
+// columns are read where the header has them, and a header without them and without duty is refused at the read.
+TEST(LogMap, ALoggerWithoutDqValuesReadsThroughAMapOfItsDutyAndMotorCurrent) {
+  const LogMap m = parse_log_map("samples: averaged\nwindow: previous_row\ntime: {column: ms, unit: ms}\ncolumns:\n"
+                                 "  omega_el: {column: erpm, unit: erpm}\n  u_dc: {column: vin, unit: V}\n"
+                                 "  duty: {column: duty_pct, unit: \"%\"}\n  i_motor: {column: im, unit: mA}\n"
+                                 "  u_d: {column: vd, optional: true}\n  u_q: {column: vq, optional: true}\n",
+                                 "map.yaml");
+  const test::TempFile log("uart.csv", "ms,erpm,vin,duty_pct,im\n0,1000,48,50,-2500\n100,1000,48,-25,2500\n");
+  AveragedLogRead read;
+  const std::vector<core::AveragedSample> s = read_averaged_log(log.path(), m, DriveLogLimits{}, &read);
+  ASSERT_EQ(s.size(), 1U);
+  EXPECT_FALSE(read.layout.u_dq || read.layout.i_dq);
+  ASSERT_EQ(read.duty.size(), 1U);
+  EXPECT_DOUBLE_EQ(read.duty[0], -0.25);
+  EXPECT_DOUBLE_EQ(read.duty_at_start[0], 0.5);
+  EXPECT_DOUBLE_EQ(read.u_dc_at_start_V[0], 48.0);
+  EXPECT_DOUBLE_EQ(read.i_motor_A[0], 2.5);
+  const LogMap no_duty = parse_log_map("samples: averaged\nwindow: previous_row\ntime: {column: ms, unit: ms}\n"
+                                       "columns:\n  omega_el: {column: erpm, unit: erpm}\n  u_dc: {column: vin}\n"
+                                       "  i_motor: {column: im}\n  u_d: {column: vd, optional: true}\n"
+                                       "  u_q: {column: vq, optional: true}\n  duty: {column: d, optional: true}\n",
+                                       "map.yaml");
+  const test::TempFile bare("bare.csv", "ms,erpm,vin,im\n0,1000,48,1\n100,1000,48,1\n");
+  try {
+    (void)read_averaged_log(bare.path(), no_duty, DriveLogLimits{});
+    FAIL() << "no error";
+  } catch (const DriveLogError& e) {
+    EXPECT_NE(std::string(e.what()).find("bare.csv:1: column u_d: required column is missing from the header (or duty "
+                                         "and u_dc)"),
+              std::string::npos)
+        << e.what();
+  }
+  // In a drive log (instantaneous samples) the rotor-frame columns are never optional.
+  EXPECT_NE(map_error("samples: instantaneous\ntime: {column: time, unit: ms}\ncolumns:\n  omega_el: {column: w}\n"
+                      "  u_d: {column: ud, optional: true}\n  u_q: {column: uq}\n  i_d: {column: id}\n"
+                      "  i_q: {column: iq}\n")
+                .find("columns.u_d.optional: only a quantity"),
+            std::string::npos);
+}
+
 TEST(LogMap, AnOptionalColumnIsReadWhereTheHeaderHasIt) {
   const std::string map_text = kMinimal + "  T_winding: {column: tw, optional: true}\n";
   const LogMap m = parse_log_map(map_text, "map.yaml");
@@ -137,13 +180,21 @@ INSTANTIATE_TEST_SUITE_P(
         BadMap{"averaged_without_i_q",
                "samples: averaged\nwindow: previous_row\ntime: {period_s: 1}\ncolumns:\n  omega_el: {column: w}\n"
                "  u_d: {column: ud}\n  u_q: {column: uq}\n  i_d: {column: id}\n",
-               "5:3: columns: i_q: required in an averaged log, which this map gives"},
+               "5:3: columns: i_q: required (or i_motor) in an averaged log, which this map gives"},
+        BadMap{"averaged_duty_without_u_dc",
+               "samples: averaged\nwindow: previous_row\ntime: {period_s: 1}\ncolumns:\n  omega_el: {column: w}\n"
+               "  duty: {column: duty}\n  i_motor: {column: im}\n",
+               "5:3: columns: u_d: required (or duty and u_dc) in an averaged log, which this map gives"},
+        BadMap{"instantaneous_duty",
+               kMinimal + "  duty: {column: duty}\n",
+               "4:3: columns: duty: not a quantity of instantaneous samples (averaged logs only) in a drive log, which "
+               "this map gives"},
         BadMap{"averaged_phase_current",
                "samples: averaged\nwindow: previous_row\ntime: {period_s: 1}\ncolumns:\n  omega_el: {column: w}\n"
                "  u_d: {column: ud}\n  u_q: {column: uq}\n  i_d: {column: id}\n  i_q: {column: iq}\n  i_a: {column: ia}\n",
                "5:3: columns: i_a: not a quantity of averaged samples (their means are rotor-frame: i_d, i_q, u_d, u_q, "
-               "omega_el, u_dc, T_winding, T_magnet, T_drive, T_coolant; and travel_el) in an averaged log, which this "
-               "map gives"},
+               "omega_el, u_dc, T_winding, T_magnet, T_drive, T_coolant; and travel_el, duty, i_motor) in an averaged log, "
+               "which this map gives"},
         BadMap{"averaged_without_window", "samples: averaged\ntime: {period_s: 1}\ncolumns: {omega_el: {column: w}}\n",
                "1:1: window: required key is missing"},
         BadMap{"window_t_start_without_column",

@@ -72,8 +72,11 @@ Final estimate(const std::string& log, const std::string& cfg) {
 void expect_field_accuracy(const Final& f, const Truth& truth, const std::string& what, bool r_s_required = false) {
   EXPECT_NEAR(f.psi_m_Wb / truth.psi_m_Wb, 1.0, 0.02) << what << "\n" << f.output;
   const bool declared = f.output.find("r_s not identifiable") != std::string::npos;
-  if (declared) {
-    EXPECT_NE(f.output.find("its start still decides"), std::string::npos) << f.output;
+  if (declared) {  // with a reason: its start, or voltages rebuilt from a magnitude that no lock test can judge
+    EXPECT_TRUE(f.output.find("its start still decides") != std::string::npos ||
+                f.output.find("the angle-lock test cannot exclude a sensorless drive's open-loop start-ups") !=
+                    std::string::npos)
+        << f.output;
   }
   if (!declared || r_s_required) {
     EXPECT_NEAR(f.r_s_Ohm / truth.r_s_Ohm, 1.0, 0.05) << what << "\n" << f.output;
@@ -146,6 +149,74 @@ void independent_case(const std::string& options, const std::string& what, bool 
   const nlohmann::json j = nlohmann::json::parse(test::read_file(truth.path()));
   const Truth t{j.at("true_at_end").at("psi_m_Wb").get<double>(), j.at("true_at_end").at("r_s_Ohm").get<double>()};
   expect_field_accuracy(estimate(log.path(), config("vesc-6374-firmware.yaml")), t, what, r_s_required);
+}
+
+/// The log as a logger without d/q values writes it (docs/drive-log.md, "Logs without d/q values"): VESC Tool's
+/// header with 0 in every d/q cell — an SD logger built on COMM_GET_VALUES that keeps the duty cycle, input voltage,
+/// erpm and motor current — printing each as it does (the duty with 4 decimals, the voltage with 1, currents with 2,
+/// erpm whole) and, with `every_other`, writing a row for every second read only (a logger polling twice as fast as
+/// it writes: each row's means then span the read before only).
+void print_as_a_logger_without_dq(const std::string& path, bool every_other) {
+  std::istringstream in(test::read_file(path));
+  std::string header, line, out;
+  std::getline(in, header);
+  out = header + "\n";
+  std::vector<std::string> names;
+  std::stringstream split(header);
+  for (std::string name; std::getline(split, name, ';');) names.push_back(name);
+  const auto printed = [](const std::string& name, const std::string& cell) -> std::string {
+    const int decimals = name == "duty_cycle"                              ? 4
+                         : name == "input_voltage"                         ? 1
+                         : name == "current_motor" || name == "current_in" ? 2
+                         : name == "erpm"                                  ? 0
+                                                                           : -1;
+    if (name == "d_axis_current" || name == "q_axis_current" || name == "d_axis_voltage" || name == "q_axis_voltage")
+      return "0";
+    if (decimals < 0) return cell;
+    char text[64];
+    std::snprintf(text, sizeof text, "%.*f", decimals, std::stod(cell));
+    return text;
+  };
+  for (std::size_t row = 0; std::getline(in, line); ++row) {
+    if (every_other && row % 2 == 1) continue;
+    std::stringstream cells(line);
+    std::size_t k = 0;
+    for (std::string cell; std::getline(cells, cell, ';'); ++k)
+      out += (k < names.size() ? printed(names[k], cell) : cell) + ";";
+    out += "\n";
+  }
+  std::ofstream(path) << out;
+}
+
+// The d/q values rebuilt from the duty cycle and the motor current (2026-12-01): seed 2 (zeros while off, across
+// midnight) ψm −0.98 % (−1.18 % from its d/q values), R_s +15 %, declared not identifiable: a magnitude carries no
+// back-EMF direction, so no lock test excludes the open-loop start-ups where R_s is excited; seed 1 written for every
+// second read, ψm +0.34 %.
+TEST(CliVescFieldEstimate, IndependentGeneratorWithoutDqValues) {
+  test::TempFile log("indep-nodq.csv"), truth("indep-nodq-truth.json");
+  const auto gen = test::run_command(indep_vesc_log() + " --config " + config("vesc-6374-outrunner.yaml") +
+                                     " --seed 2 --psi-m-rel -0.15 --r-s-rel 0.2 --off-voltage zero --midnight --out " +
+                                     log.path() + " --truth " + truth.path());
+  ASSERT_EQ(gen.exit_code, 0) << gen.output;
+  print_as_a_logger_without_dq(log.path(), false);
+  const nlohmann::json j = nlohmann::json::parse(test::read_file(truth.path()));
+  const Truth t{j.at("true_at_end").at("psi_m_Wb").get<double>(), j.at("true_at_end").at("r_s_Ohm").get<double>()};
+  const Final f = estimate(log.path(), config("vesc-6374-firmware.yaml"));
+  EXPECT_NE(f.output.find("the log has no d/q values: i_d = 0, i_q = sign(duty)·i_motor"), std::string::npos) << f.output;
+  expect_field_accuracy(f, t, "independent seed 2 without d/q values");
+}
+
+TEST(CliVescFieldEstimate, IndependentGeneratorWithoutDqValuesWrittenForEverySecondRead) {
+  test::TempFile log("indep-nodq2.csv"), truth("indep-nodq2-truth.json");
+  const auto gen = test::run_command(indep_vesc_log() + " --config " + config("vesc-6374-outrunner.yaml") +
+                                     " --seed 1 --duration-s 600 --psi-m-rel 0.2 --r-s-rel -0.25 --out " + log.path() +
+                                     " --truth " + truth.path());
+  ASSERT_EQ(gen.exit_code, 0) << gen.output;
+  print_as_a_logger_without_dq(log.path(), true);
+  const nlohmann::json j = nlohmann::json::parse(test::read_file(truth.path()));
+  const Truth t{j.at("true_at_end").at("psi_m_Wb").get<double>(), j.at("true_at_end").at("r_s_Ohm").get<double>()};
+  expect_field_accuracy(estimate(log.path(), config("vesc-6374-firmware.yaml")), t,
+                        "independent seed 1 without d/q values, every second read");
 }
 
 TEST(CliVescFieldEstimate, IndependentGeneratorMeasuredBackEmf) {

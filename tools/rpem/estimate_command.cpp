@@ -24,6 +24,7 @@
 #include "rpem/io/estimate_log.hpp"
 #include "rpem/io/log_source.hpp"
 #include "rpem/io/machine_config.hpp"
+#include "rpem/io/rotor_frame_rebuild.hpp"
 #include "rpem/io/sample_counts.hpp"
 #include "rpem/io/thermal_config.hpp"
 
@@ -133,8 +134,18 @@ struct Identifiability {
 };
 
 void check_identifiable(const std::vector<core::AveragedSample>& samples, const io::MachineConfig& cfg,
-                        const core::Estimate& last, const std::array<std::uint64_t, 2>& adapted) {
+                        const core::Estimate& last, const std::array<std::uint64_t, 2>& adapted,
+                        const io::RotorFrameRebuild& rebuilt) {
   const core::EstimatorSettings& e = cfg.estimator;
+  if (rebuilt.voltages && e.regimes.sensorless) {
+    // A magnitude carries no back EMF's direction: nothing rules out the open-loop frame where R_s is excited.
+    std::fprintf(stderr,
+                 "rpem estimate: r_s not identifiable from this log: its voltages are rebuilt from the duty cycle's "
+                 "magnitude, which carries no back-EMF direction, so the angle-lock test cannot exclude a sensorless "
+                 "drive's open-loop start-ups, where R_s is excited (docs/drive-log.md, \"Logs without d/q values\"); "
+                 "%.5g Ohm is not an identification\n",
+                 last.r_s_Ohm);
+  }
   std::array<Identifiability, 2> p{
       {{"psi_m", "Wb", 0.02, e.psi_m_min_Wb, e.psi_m_max_Wb}, {"r_s", "Ohm", 0.05, e.r_s_min_Ohm, e.r_s_max_Ohm}}};
   const std::array<double, 2> estimate{last.psi_m_Wb, last.r_s_Ohm};
@@ -147,7 +158,7 @@ void check_identifiable(const std::vector<core::AveragedSample>& samples, const 
       (high ? p[k].from_hi : p[k].from_lo) = k == 0 ? run.psi_m_Wb() : run.r_s_Ohm();
     }
     const double half = 0.5 * std::abs(p[k].from_hi - p[k].from_lo) / std::abs(estimate[k]);
-    if (half <= p[k].tolerance) continue;
+    if (half <= p[k].tolerance || (k == 1 && rebuilt.voltages && e.regimes.sensorless)) continue;
     std::fprintf(
         stderr,
         "rpem estimate: %s not identifiable from this log: started at the ends of its bounds (%.5g, %.5g %s) "
@@ -158,14 +169,18 @@ void check_identifiable(const std::vector<core::AveragedSample>& samples, const 
   }
 }
 
-int run_averaged(const EstimateOptions& o, const io::LogSource& source, const io::MachineConfig& cfg,
+int run_averaged(const EstimateOptions& o, const io::LogSource& source, const io::MachineConfig& config,
                  const std::string& config_name) {
   io::AveragedLogRead read;
-  const std::vector<core::AveragedSample> samples =
-      io::read_averaged_log(o.log, source.map, io::machine_limits(cfg.machine), &read);
+  std::vector<core::AveragedSample> samples =
+      io::read_averaged_log(o.log, source.map, io::machine_limits(config.machine), &read);
   std::fprintf(stderr, "rpem estimate: %s\n", io::describe(source, read).c_str());
-  io::check_voltages_recorded(samples, cfg.machine.psi_m_Wb, o.log);
-  io::check_averaged_supports(cfg, config_name, read.layout.u_dc, o.log);
+  const io::RotorFrameRebuild rebuilt =
+      io::complete_rotor_frame(samples, read, config.machine, io::command_hold_s(config.estimator), o.log);
+  if (rebuilt.voltages || rebuilt.currents) std::fprintf(stderr, "rpem estimate: %s\n", rebuilt.describe().c_str());
+  io::check_averaged_supports(config, config_name, read.layout.u_dc, o.log);
+  io::MachineConfig cfg = config;
+  cfg.estimator = io::estimator_settings(config, rebuilt);
   core::AveragedDriveEstimator estimator(cfg.machine, cfg.estimator);
   ThermalRun thermal(o, cfg, estimator.base());
   io::EstimateLogWriter writer(o.out, thermal.node_names());
@@ -180,7 +195,7 @@ int run_averaged(const EstimateOptions& o, const io::LogSource& source, const io
   }
   std::fprintf(stderr, "rpem estimate: %s\n", tally.summary(cfg.estimator.algorithm, "averaged samples").c_str());
   tally.explain();
-  if (!samples.empty()) check_identifiable(samples, cfg, tally.last, tally.adapted);
+  if (!samples.empty()) check_identifiable(samples, cfg, tally.last, tally.adapted, rebuilt);
   return kExitOk;
 }
 

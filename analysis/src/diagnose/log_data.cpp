@@ -12,6 +12,7 @@
 #include "rpem/io/averaged_log.hpp"
 #include "rpem/io/log_source.hpp"
 #include "rpem/io/machine_config.hpp"
+#include "rpem/io/rotor_frame_rebuild.hpp"
 #include "rpem/io/sample_counts.hpp"
 
 namespace rpem::analysis {
@@ -262,9 +263,11 @@ LogData load_log(const std::string& path, const core::MachineSi& machine, const 
     }
     io::AveragedLogRead read;
     std::vector<core::AveragedSample> samples = io::read_averaged_log(path, source.map, limits, &read);
-    io::check_voltages_recorded(samples, machine.psi_m_Wb, path);
     for (core::AveragedSample& s : samples) s.omega_el_rad_s = core::window_speed_rad_s(s, options.staircase_below_rad_s);
-    const bool turn = options.voltage_is_command && options.control_period_s > 0.0;
+    const io::RotorFrameRebuild rebuilt =
+        io::complete_rotor_frame(samples, read, machine, options.voltage_is_command ? options.control_period_s : 0.0, path);
+    // Rebuilt voltages are applied rotor-frame means already: not turned again.
+    const bool turn = options.voltage_is_command && options.control_period_s > 0.0 && !rebuilt.voltages;
     const std::string voltage = turn ? apply_reported_command(samples, options) : "";
     d.layout = io::rotor_frame_layout(read.layout);
     d.samples = SampleStore(d.layout);
@@ -278,8 +281,9 @@ LogData load_log(const std::string& path, const core::MachineSi& machine, const 
     steady.mode = ModelMode::kSteadyState;
     prepare_log(d, machine, steady);
     d.averaged = true;
-    d.format = io::describe(source, read) + voltage;
-    d.voltage_applied = turn;
+    d.format =
+        io::describe(source, read) + voltage + (rebuilt.voltages || rebuilt.currents ? "; " + rebuilt.describe() : "");
+    d.voltage_applied = turn || rebuilt.voltages;
     return d;
   }
   io::DriveLogReader reader(path, source.map, limits);

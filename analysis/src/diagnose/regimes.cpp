@@ -7,6 +7,7 @@
 #include "rpem/core/averaged_estimator.hpp"
 #include "rpem/core/drive_estimator.hpp"
 #include "rpem/core/non_finite.hpp"
+#include "rpem/core/settings.hpp"
 
 namespace rpem::analysis {
 namespace {
@@ -46,11 +47,8 @@ LogRegimes classify_regimes(const LogData& log, const io::MachineConfig& config,
   if (log.averaged) {
     assert(log.window_start_ns.size() == n);
     // Commands already turned into applied means at reading are not turned again.
-    core::EstimatorSettings settings = config.estimator;
-    if (log.voltage_applied) {
-      settings.averaged.voltage_is_command = false;
-      settings.extensions.delay_s = 0.0;
-    }
+    const core::EstimatorSettings settings =
+        log.voltage_applied ? core::for_applied_voltages(config.estimator) : config.estimator;
     core::AveragedDriveEstimator estimator(config.machine, settings);
     for (std::size_t k = 0; k < n; ++k) record(k, estimator.step(window_of(log, k)));
     out.noise_pu = estimator.classifier().current_noise();

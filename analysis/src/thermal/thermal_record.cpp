@@ -8,6 +8,7 @@
 #include "rpem/core/non_finite.hpp"
 #include "rpem/io/averaged_log.hpp"
 #include "rpem/io/drive_log.hpp"
+#include "rpem/io/rotor_frame_rebuild.hpp"
 
 namespace rpem::analysis {
 namespace {
@@ -48,13 +49,14 @@ ThermalRecord record_thermal(const io::LogSource& source, const io::MachineConfi
     r.averaged = true;
     r.counts.averaged = true;
     io::AveragedLogRead read;
-    const std::vector<core::AveragedSample> samples = io::read_averaged_log(source.path, source.map, limits, &read);
+    std::vector<core::AveragedSample> samples = io::read_averaged_log(source.path, source.map, limits, &read);
     io::check_averaged_supports(machine, "configuration", read.layout.u_dc, source.path);
-    io::check_voltages_recorded(samples, machine.machine.psi_m_Wb, source.path);
+    const io::RotorFrameRebuild rebuilt =
+        io::complete_rotor_frame(samples, read, machine.machine, io::command_hold_s(machine.estimator), source.path);
     r.winding_sensor = read.layout.t_winding;
     r.coolant = read.layout.t_coolant;
-    r.read_as = io::describe(source, read);
-    core::AveragedDriveEstimator estimator(machine.machine, machine.estimator);
+    r.read_as = io::describe(source, read) + (rebuilt.voltages || rebuilt.currents ? "; " + rebuilt.describe() : "");
+    core::AveragedDriveEstimator estimator(machine.machine, io::estimator_settings(machine, rebuilt));
     Recorder rec(r, machine, thermal, estimator.base());
     for (const core::AveragedSample& s : samples) rec.add(estimator.step(s), s.t_ns, s.t_coolant_C, s.t_winding_C);
     return r;

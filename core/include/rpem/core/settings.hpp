@@ -42,6 +42,10 @@ struct EstimatorSettings : EstimatorOptions {
 /// The gain rates [1/s] for each algorithm where samples come at their own times (averaged windows, sparse
 /// rows): `averaged.rates_per_s` where given, else γ_0/sample_period_s of `gains`.
 [[nodiscard]] std::array<GainSequences, 3> averaged_rates_per_s(const EstimatorSettings& s) noexcept;
+/// The settings for averaged samples whose voltages are already the applied rotor-frame means (a reported command
+/// turned at reading, or voltages rebuilt in the rotor frame from their magnitude): neither the reported command's
+/// turn (averaged.voltage_is_command) nor the delay's is made again.
+[[nodiscard]] EstimatorSettings for_applied_voltages(EstimatorSettings s) noexcept;
 /// The classifier's configuration: the nominal machine, D_M, the tolerances and resolutions, per unit.
 [[nodiscard]] RegimeConfig make_regime_config(const PerUnitBase& base, const MachineSi& m,
                                               const EstimatorSettings& s) noexcept;

@@ -29,6 +29,10 @@ struct AveragedLogLayout {
   bool t_magnet = false;
   bool t_drive = false;
   bool t_coolant = false;
+  bool u_dq = false;     ///< u_d, u_q columns (else rebuilt from duty and u_dc: rotor_frame_rebuild.hpp)
+  bool i_dq = false;     ///< i_d, i_q columns (else rebuilt from i_motor)
+  bool duty = false;     ///< VESC's duty cycle
+  bool i_motor = false;  ///< VESC's motor current
 };
 
 /// What reading an averaged log through a map did besides delivering samples.
@@ -42,6 +46,13 @@ struct AveragedLogRead {
   /// read and checked, but no samples.
   std::uint64_t unknown_windows = 0;
   ReadRepairs repairs;
+  /// Each sample's duty cycle at its read, and at the read that starts its window with the DC link there (NaN:
+  /// not known, a window from its own t_start), and its motor current, in the samples' order (empty: the log has
+  /// none): what rotor_frame_rebuild.hpp completes a log without d/q values from.
+  std::vector<double> duty;
+  std::vector<double> duty_at_start;
+  std::vector<double> u_dc_at_start_V;
+  std::vector<double> i_motor_A;
 };
 
 /// Reads a whole log of averaged samples as `map` describes it (our averaged log: averaged_log_map();

@@ -23,6 +23,8 @@ struct DriveLogLimits {
   Bound voltage_V{1.0e5, "beyond the highest drive DC links (tens of kV)"};
   Bound current_A{1.0e5, "beyond the largest drives' phase currents (tens of kA)"};
   Bound torque_Nm{1.0e7, "beyond the largest machines' torque (MN m)"};
+  /// The duty cycle as VESC scales it, 1 at |u_dq| = u_dc/√3 (rotor_frame_rebuild.hpp).
+  Bound duty{1.2, "a six-step bridge's fundamental, 2·u_dc/π, is 1.10 x u_dc/√3 (a duty cycle of 1)"};
   double temperature_min_C = -273.15;  ///< absolute zero
   double temperature_max_C = 1000.0;   ///< every winding insulation and magnet has failed long before
   /// A voltage command may be at most this multiple of the same row's u_dc (when u_dc ≥ 1 V): a two-level

@@ -42,12 +42,16 @@ enum class Quantity : std::uint8_t {
   kTStart,
   kTCoolant,  ///< the machine's coolant (issue 24: the thermal network's boundary)
   kTravelEl,  ///< the electrical angle the drive has counted (VESC's tachometer, 60° steps): averaged logs only
+  /// The duty cycle as VESC reports it, |u_dq|·√3/u_dc signed by u_q (rotor_frame_rebuild.hpp): averaged logs only
+  kDuty,
+  /// The motor current as VESC reports it, |i_dq| signed by u_q·i_q: averaged logs only
+  kIMotor,
   kCount
 };
 inline constexpr std::size_t kQuantityCount = static_cast<std::size_t>(Quantity::kCount);
 
 /// The physical kind of a quantity: its SI unit, the units a map may give it in, and its plausibility bound.
-enum class QuantityKind : std::uint8_t { kTime, kAngle, kSpeed, kVoltage, kCurrent, kTemperature, kTorque };
+enum class QuantityKind : std::uint8_t { kTime, kAngle, kSpeed, kVoltage, kCurrent, kTemperature, kTorque, kRatio };
 
 struct QuantityInfo {
   Quantity quantity;
