@@ -80,11 +80,12 @@ TEST(LogMap, APllSpeedIsASpeedAtTheReadsOfPreviousRowWindows) {
 // percent, the motor current in mA; what the rebuild needs reaches the read (rotor_frame_rebuild.hpp). Optional d/q
 // columns are read where the header has them, and a header without them and without duty is refused at the read.
 TEST(LogMap, ALoggerWithoutDqValuesReadsThroughAMapOfItsDutyAndMotorCurrent) {
-  const LogMap m = parse_log_map("samples: averaged\nwindow: previous_row\ntime: {column: ms, unit: ms}\ncolumns:\n"
-                                 "  omega_el: {column: erpm, unit: erpm}\n  u_dc: {column: vin, unit: V}\n"
-                                 "  duty: {column: duty_pct, unit: \"%\"}\n  i_motor: {column: im, unit: mA}\n"
-                                 "  u_d: {column: vd, optional: true}\n  u_q: {column: vq, optional: true}\n",
-                                 "map.yaml");
+  const LogMap m = parse_log_map(
+      "samples: averaged\nwindow: previous_row\ntime: {column: ms, unit: ms}\ncolumns:\n"
+      "  omega_el: {column: erpm, unit: erpm}\n  u_dc: {column: vin, unit: V}\n"
+      "  duty: {column: duty_pct, unit: \"%\"}\n  i_motor: {column: im, unit: mA}\n"
+      "  u_d: {column: vd, optional: true}\n  u_q: {column: vq, optional: true}\n",
+      "map.yaml");
   const test::TempFile log("uart.csv", "ms,erpm,vin,duty_pct,im\n0,1000,48,50,-2500\n100,1000,48,-25,2500\n");
   AveragedLogRead read;
   const std::vector<core::AveragedSample> s = read_averaged_log(log.path(), m, DriveLogLimits{}, &read);
@@ -95,11 +96,12 @@ TEST(LogMap, ALoggerWithoutDqValuesReadsThroughAMapOfItsDutyAndMotorCurrent) {
   EXPECT_DOUBLE_EQ(read.duty_at_start[0], 0.5);
   EXPECT_DOUBLE_EQ(read.u_dc_at_start_V[0], 48.0);
   EXPECT_DOUBLE_EQ(read.i_motor_A[0], 2.5);
-  const LogMap no_duty = parse_log_map("samples: averaged\nwindow: previous_row\ntime: {column: ms, unit: ms}\n"
-                                       "columns:\n  omega_el: {column: erpm, unit: erpm}\n  u_dc: {column: vin}\n"
-                                       "  i_motor: {column: im}\n  u_d: {column: vd, optional: true}\n"
-                                       "  u_q: {column: vq, optional: true}\n  duty: {column: d, optional: true}\n",
-                                       "map.yaml");
+  const LogMap no_duty = parse_log_map(
+      "samples: averaged\nwindow: previous_row\ntime: {column: ms, unit: ms}\n"
+      "columns:\n  omega_el: {column: erpm, unit: erpm}\n  u_dc: {column: vin}\n"
+      "  i_motor: {column: im}\n  u_d: {column: vd, optional: true}\n"
+      "  u_q: {column: vq, optional: true}\n  duty: {column: d, optional: true}\n",
+      "map.yaml");
   const test::TempFile bare("bare.csv", "ms,erpm,vin,im\n0,1000,48,1\n100,1000,48,1\n");
   try {
     (void)read_averaged_log(bare.path(), no_duty, DriveLogLimits{});
@@ -185,8 +187,7 @@ INSTANTIATE_TEST_SUITE_P(
                "samples: averaged\nwindow: previous_row\ntime: {period_s: 1}\ncolumns:\n  omega_el: {column: w}\n"
                "  duty: {column: duty}\n  i_motor: {column: im}\n",
                "5:3: columns: u_d: required (or duty and u_dc) in an averaged log, which this map gives"},
-        BadMap{"instantaneous_duty",
-               kMinimal + "  duty: {column: duty}\n",
+        BadMap{"instantaneous_duty", kMinimal + "  duty: {column: duty}\n",
                "4:3: columns: duty: not a quantity of instantaneous samples (averaged logs only) in a drive log, which "
                "this map gives"},
         BadMap{"averaged_phase_current",
