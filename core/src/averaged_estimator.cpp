@@ -4,6 +4,7 @@
 
 #include "rpem/core/clock.hpp"
 #include "rpem/core/reported_speed.hpp"
+#include "rpem/core/sinc.hpp"
 
 namespace rpem::core {
 namespace {
@@ -66,7 +67,7 @@ SteadyStateSample AveragedDriveEstimator::condition(const AveragedSample& a) noe
     // Reported command (§11): held over one period from the delay on, its mean in the rotor frame at the
     // sample is the command turned by −ω·(delay + T_c/2) and shortened by sinc(ω·T_c/2); the delay's turn is above.
     const double half = 0.5 * s.n_pu * omega_n * options_.control_period_s;
-    const double sinc = std::abs(half) < 1e-4 ? 1.0 - half * half / 6.0 : std::sin(half) / half;
+    const double sinc = core::sinc(half);
     const Rotation back = Rotation::of(-half);
     s.u_pu = sinc * Vec2(back.cos * s.u_pu[0] - back.sin * s.u_pu[1], back.sin * s.u_pu[0] + back.cos * s.u_pu[1]);
   }

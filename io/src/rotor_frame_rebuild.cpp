@@ -7,6 +7,7 @@
 
 #include "rpem/core/clock.hpp"
 #include "rpem/core/settings.hpp"
+#include "rpem/core/sinc.hpp"
 #include "rpem/io/errors.hpp"
 
 namespace rpem::io {
@@ -73,7 +74,7 @@ RotorFrameRebuild complete_rotor_frame(std::vector<core::AveragedSample>& sample
     const double w = s.omega_el_rad_s;
     // A command held for T_c turning at ω averages to sinc(ω·T_c/2) of its length (docs/derivations.md §11).
     const double half = 0.5 * w * command_hold_s;
-    const double sinc = std::abs(half) < 1e-4 ? 1.0 - half * half / 6.0 : std::sin(half) / half;
+    const double sinc = core::sinc(half);
     // The duty is read at the window's end, the currents and speed are its means: where the duty at the window's
     // start is known, the mean of the two is the window's (exact for a linear change; docs/derivations.md §13).
     const double end_V = std::abs(read.duty[k]) * s.u_dc_V;

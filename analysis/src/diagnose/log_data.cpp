@@ -9,6 +9,7 @@
 #include "rpem/core/conditioner.hpp"
 #include "rpem/core/frames.hpp"
 #include "rpem/core/reported_speed.hpp"
+#include "rpem/core/sinc.hpp"
 #include "rpem/io/averaged_log.hpp"
 #include "rpem/io/log_source.hpp"
 #include "rpem/io/machine_config.hpp"
@@ -214,7 +215,7 @@ core::Vec2 applied_mean_V(const core::Vec2& command_V, double omega_el_rad_s, do
                           double delay_periods) noexcept {
   const double wt = omega_el_rad_s * control_period_s;
   const double half = 0.5 * wt;
-  const double sinc = std::abs(half) < 1e-6 ? 1.0 - half * half / 6.0 : std::sin(half) / half;
+  const double sinc = core::sinc(half);
   // Turned by −d·ω·T_c: the Park transform by the angle the rotor advances before the hold's centre.
   return sinc * core::park(command_V, core::Rotation::of(delay_periods * wt));
 }
