@@ -111,6 +111,11 @@ std::string describe(const ReadRepairs& r) {
     s += "; its last line (" + std::to_string(r.cut_line) +
          ") is a row cut off while the file was written (unfinished, no newline after it): not read";
   }
+  if (!r.never_recorded.empty()) {
+    s += "; column" + std::string(r.never_recorded.size() > 1 ? "s " : " ");
+    for (std::size_t k = 0; k < r.never_recorded.size(); ++k) s += (k > 0 ? ", " : "") + r.never_recorded[k];
+    s += " named in the header but empty on every row: read as absent (the map marks them optional)";
+  }
   return s;
 }
 

@@ -178,6 +178,37 @@ void MappedLogReader::read_header() {
       }
     }
   }
+  drop_columns_never_recorded();
+}
+
+void MappedLogReader::drop_columns_never_recorded() {
+  std::vector<const MappedColumn*> unseen;  // optional columns in the header without a value so far
+  for (const MappedColumn& c : map_.columns) {
+    if (c.optional && index_[static_cast<std::size_t>(c.quantity)] >= 0) unseen.push_back(&c);
+  }
+  const std::istream::pos_type start = in_.tellg();
+  if (unseen.empty() || start == std::istream::pos_type(-1)) return;  // nothing to look for, or a stream read once
+  const std::size_t line = line_;
+  const std::uint64_t bytes = bytes_read_;
+  bool any_row = false;
+  for (std::string text; !unseen.empty() && next_line(text);) {
+    split(text);
+    any_row = true;
+    std::erase_if(unseen, [&](const MappedColumn* c) {
+      const auto k = static_cast<std::size_t>(index_[static_cast<std::size_t>(c->quantity)]);
+      return k < cells_.size() && !cells_[k].empty();
+    });
+  }
+  in_.clear();
+  in_.seekg(start);
+  line_ = line;
+  bytes_read_ = bytes;
+  if (!any_row) return;  // a file without rows: its own error, at the first read
+  for (const MappedColumn* c : unseen) {
+    repairs_.never_recorded.push_back(label(c->quantity));
+    index_[static_cast<std::size_t>(c->quantity)] = -1;
+    column_[static_cast<std::size_t>(c->quantity)] = nullptr;
+  }
 }
 
 void MappedLogReader::fail_empty_cell(int index, const std::string& label) {

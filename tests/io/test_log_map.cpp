@@ -137,6 +137,33 @@ TEST(LogMap, AnOptionalColumnIsReadWhereTheHeaderHasIt) {
   // Without `optional` the same file is refused.
   const LogMap strict = parse_log_map(kMinimal + "  T_winding: {column: tw}\n", "map.yaml");
   EXPECT_THROW(DriveLogReader(without.path(), strict, DriveLogLimits{}), DriveLogError);
+  // Named in the header but empty on every row (a logger printing a format's whole header): absent, and said; the
+  // rows are read from the first (the look ahead returns). Empty on the first rows only: the empty cell's error.
+  const test::TempFile never("never.csv", "time,w,ud,uq,id,iq,tw\n0,1,2,3,4,5,\n1,6,7,8,9,10,\n2,1,2,3,4,5,\n"),
+      late("late.csv", "time,w,ud,uq,id,iq,tw\n0,1,2,3,4,5,\n1,6,7,8,9,10,70\n");
+  DriveLogReader c(never.path(), m, DriveLogLimits{});
+  EXPECT_FALSE(c.layout().t_winding);
+  ASSERT_EQ(c.reader().repairs().never_recorded, std::vector<std::string>{"tw (T_winding)"});
+  for (const double w : {1.0, 6.0, 1.0}) {
+    ASSERT_TRUE(c.next(r));
+    EXPECT_DOUBLE_EQ(r.sample.omega_el_rad_s, w);
+    EXPECT_FALSE(r.t_winding_C.has_value());
+  }
+  EXPECT_FALSE(c.next(r));
+  DriveLogReader d(late.path(), m, DriveLogLimits{});
+  EXPECT_TRUE(d.layout().t_winding);
+  try {
+    (void)d.next(r);
+    FAIL() << "no error";
+  } catch (const DriveLogError& e) {
+    EXPECT_NE(std::string(e.what()).find("late.csv:2:7: column tw (T_winding): empty cell (1 of the 2 rows from here"),
+              std::string::npos)
+        << e.what();
+  }
+  // Not optional: empty on every row is the logger's missing quantity, refused.
+  const test::TempFile no_id("no_id.csv", "time,w,ud,uq,id,iq\n0,1,2,3,,5\n1,1,2,3,,5\n");
+  DriveLogReader e(no_id.path(), m, DriveLogLimits{});
+  EXPECT_THROW((void)e.next(r), DriveLogError);
   EXPECT_NE(map_error(kMinimal + "  u_dc: {column: udc, optional: true}\n")
                 .find("columns.u_dc.optional: only a quantity every log may lack"),
             std::string::npos);

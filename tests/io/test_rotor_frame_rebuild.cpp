@@ -125,7 +125,7 @@ TEST(RotorFrameRebuild, ZerosInEveryRowAreRebuiltRecordedValuesAreKept) {
   recorded.read.layout.u_dq = recorded.read.layout.i_dq = true;
   for (core::AveragedSample& s : recorded.samples) s.u_dq_V = {-0.5, 12.0}, s.i_dq_A = {0.0, 9.0};
   const RotorFrameRebuild kept = complete_rotor_frame(recorded.samples, recorded.read, rebuild_machine(), 0.0, "log.csv");
-  EXPECT_FALSE(kept.voltages || kept.currents);
+  EXPECT_FALSE(kept.any());
   EXPECT_TRUE(kept.describe().empty());
   EXPECT_DOUBLE_EQ(recorded.samples[0].u_dq_V[1], 12.0);
 

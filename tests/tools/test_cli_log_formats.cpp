@@ -186,23 +186,34 @@ TEST_F(CliLogFormats, FiguresReadAMappedLogAndRefuseABadOneBeforeDrawing) {
   EXPECT_EQ(test::run_command(rpem() + " figures" + map + " --out " + path("bad")).exit_code, 64);
 }
 
-// Logs without d/q voltages — VESC Tool 1.17 to 1.19, which wrote none, and a logger that writes zeros in VESC Tool's
-// d/q columns but keeps the duty cycle — are read by every tool that runs the estimator, their voltages rebuilt from
-// the duty cycle (docs/drive-log.md, "Logs without d/q values"), and each tool says so.
+// Logs without d/q voltages — VESC Tool 1.17 to 1.19, which wrote none, and loggers that write zeros in VESC Tool's
+// d/q columns, or leave them empty, but keep the duty cycle — are read by every tool that runs the estimator, their
+// voltages rebuilt from the duty cycle (docs/drive-log.md, "Logs without d/q values"), and each tool says so.
 TEST_F(CliLogFormats, VescToolLogsWithoutDqVoltagesAreRebuiltFromTheDutyCycle) {
-  const std::string old_log = path("old.csv"), zeros_log = path("zeros-with-duty.csv");
+  const std::string old_log = path("old.csv"), zeros_log = path("zeros-with-duty.csv"), empty_log = path("empty-dq.csv");
   {
-    std::ofstream old(old_log), zeros(zeros_log);
+    std::ofstream old(old_log), zeros(zeros_log), empty(empty_log);
     old << test::vesc_tool::kHeader117;
     zeros << test::vesc_tool::kHeader120;
+    empty << test::vesc_tool::kHeader120;
     for (int k = 0; k < 150; ++k) {  // 13.4 s: diagnose's 80 samples, thermal fit's 10 steps of 1 s
       const long ms = 36'000'000 + 90 * k;
       old << test::vesc_tool::values22(ms, 40, 50, -1.0, 12.0, 3000.0 + 20.0 * k) << "\n";
-      zeros << test::vesc_tool::row120(ms, -1.0, 12.0, 3000.0 + 20.0 * k, 0, 0);
+      std::string row = test::vesc_tool::row120(ms, -1.0, 12.0, 3000.0 + 20.0 * k, 0, 0);
+      zeros << row;
+      const std::size_t v_dq = row.find(";0.000000;0.000000;-1;");
+      ASSERT_NE(v_dq, std::string::npos) << row;
+      empty << row.replace(v_dq, 19, ";;;");
     }
   }
   const std::string config = " --config " + test::source_dir() + "/config/vesc-6374-outrunner.yaml";
-  for (const std::string& log : {old_log, zeros_log}) {
+  const test::ProcessResult read =
+      test::run_command(rpem() + " estimate --out " + path("o.csv") + " --log " + empty_log + config);
+  EXPECT_NE(read.output.find("; columns d_axis_voltage (u_d), q_axis_voltage (u_q) named in the header but empty on every "
+                             "row: read as absent (the map marks them optional)"),
+            std::string::npos)
+      << read.output;
+  for (const std::string& log : {old_log, zeros_log, empty_log}) {
     for (const std::string& tool : {std::string(" estimate --out ") + path("o.csv"), " diagnose --out " + path("d"),
                                     " thermal fit --out " + path("t.yaml")}) {
       const test::ProcessResult r = test::run_command(rpem() + tool + " --log " + log + config);

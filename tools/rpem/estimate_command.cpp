@@ -1,19 +1,21 @@
-// rpem estimate --log LOG.csv [--log-map MAP.yaml] --config CFG.yaml --out EST.csv [--algorithm sga|gna|phyint]
-//              [--every N | --rate HZ] [--thermal THERMAL.yaml]
+// rpem estimate --log LOG.csv|FOLDER [--log-map MAP.yaml] --config CFG.yaml --out EST.csv|DIR
+//              [--algorithm sga|gna|phyint] [--every N | --rate HZ] [--thermal THERMAL.yaml]
 // Runs the estimator offline over a drive log, exactly as rpemd would run it online: a log of instantaneous
 // samples through DriveEstimator, a log of averaged samples (our averaged log, VESC Tool's realtime log, a
 // map of averaged samples; docs/drive-log.md) through AveragedDriveEstimator. With --thermal, the thermal
 // network's filter runs beside it as in rpemd (core::ThermalFusion, docs/thermal.md) and the estimate CSV
-// gains the fused temperatures.
+// gains the fused temperatures. A folder of logs: each log on its own, as if it were the only one (log_folder.hpp).
 
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <limits>
 #include <optional>
 #include <string>
 
 #include "commands.hpp"
+#include "log_folder.hpp"
 #include "log_options.hpp"
 #include "option_checks.hpp"
 #include "progress.hpp"
@@ -92,12 +94,16 @@ class ThermalRun {
   std::optional<std::int64_t> previous_ns_;
 };
 
-/// What the run did, for its summary on stderr: the last estimate and the samples per regime.
+/// What the run did, for its summary on stderr (and a folder's summary.csv): the last estimate and the samples per
+/// regime.
 struct Tally {
   io::SampleCounts counts;
   core::Estimate last;
-  std::array<std::uint64_t, 2> adapted{};  ///< samples in which ψm, R_s adapted
+  std::optional<std::int64_t> first_t_ns;
+  std::array<std::uint64_t, 2> adapted{};           ///< samples in which ψm, R_s adapted
+  std::array<std::optional<bool>, 2> identifiable;  ///< ψm, R_s: check_identifiable's verdict, where it ran
   void count(const core::Estimate& e) {
+    if (!first_t_ns) first_t_ns = e.t_ns;
     last = e;
     counts.add(e);
     adapted[0] += (e.detail.flags & core::step_flag::kPsiMActive) ? 1 : 0;
@@ -133,11 +139,14 @@ struct Identifiability {
   double from_lo = 0.0, from_hi = 0.0;
 };
 
-void check_identifiable(const std::vector<core::AveragedSample>& samples, const io::MachineConfig& cfg,
-                        const core::Estimate& last, const std::array<std::uint64_t, 2>& adapted,
-                        const io::RotorFrameRebuild& rebuilt) {
+std::array<std::optional<bool>, 2> check_identifiable(const std::vector<core::AveragedSample>& samples,
+                                                      const io::MachineConfig& cfg, const core::Estimate& last,
+                                                      const std::array<std::uint64_t, 2>& adapted,
+                                                      const io::RotorFrameRebuild& rebuilt) {
   const core::EstimatorSettings& e = cfg.estimator;
-  if (rebuilt.voltages && e.regimes.sensorless) {
+  std::array<std::optional<bool>, 2> identifiable;
+  const bool r_s_declared = rebuilt.voltages && e.regimes.sensorless;
+  if (r_s_declared) {
     // A magnitude carries no back EMF's direction: nothing rules out the open-loop frame where R_s is excited.
     std::fprintf(stderr,
                  "rpem estimate: r_s not identifiable from this log: its voltages are rebuilt from the duty cycle's "
@@ -158,7 +167,8 @@ void check_identifiable(const std::vector<core::AveragedSample>& samples, const 
       (high ? p[k].from_hi : p[k].from_lo) = k == 0 ? run.psi_m_Wb() : run.r_s_Ohm();
     }
     const double half = 0.5 * std::abs(p[k].from_hi - p[k].from_lo) / std::abs(estimate[k]);
-    if (half <= p[k].tolerance || (k == 1 && rebuilt.voltages && e.regimes.sensorless)) continue;
+    identifiable[k] = half <= p[k].tolerance && !(k == 1 && r_s_declared);
+    if (half <= p[k].tolerance || (k == 1 && r_s_declared)) continue;
     std::fprintf(
         stderr,
         "rpem estimate: %s not identifiable from this log: started at the ends of its bounds (%.5g, %.5g %s) "
@@ -167,23 +177,25 @@ void check_identifiable(const std::vector<core::AveragedSample>& samples, const 
         p[k].name, p[k].lo, p[k].hi, p[k].unit, p[k].from_lo, p[k].from_hi, p[k].unit, 100.0 * half, estimate[k], p[k].unit,
         100.0 * p[k].tolerance, static_cast<unsigned long long>(adapted[k]));
   }
+  return identifiable;
 }
 
-int run_averaged(const EstimateOptions& o, const io::LogSource& source, const io::MachineConfig& config,
-                 const std::string& config_name) {
+/// One log through AveragedDriveEstimator, its estimates to `out`.
+Tally run_averaged(const EstimateOptions& o, const std::string& log, const std::string& out, const io::LogSource& source,
+                   const io::MachineConfig& config, const std::string& config_name) {
   io::AveragedLogRead read;
   std::vector<core::AveragedSample> samples =
-      io::read_averaged_log(o.log, source.map, io::machine_limits(config.machine), &read);
+      io::read_averaged_log(log, source.map, io::machine_limits(config.machine), &read);
   std::fprintf(stderr, "rpem estimate: %s\n", io::describe(source, read).c_str());
   const io::RotorFrameRebuild rebuilt =
-      io::complete_rotor_frame(samples, read, config.machine, io::command_hold_s(config.estimator), o.log);
-  if (rebuilt.voltages || rebuilt.currents) std::fprintf(stderr, "rpem estimate: %s\n", rebuilt.describe().c_str());
-  io::check_averaged_supports(config, config_name, read.layout.u_dc, o.log);
+      io::complete_rotor_frame(samples, read, config.machine, io::command_hold_s(config.estimator), log);
+  if (rebuilt.any()) std::fprintf(stderr, "rpem estimate: %s\n", rebuilt.describe().c_str());
+  io::check_averaged_supports(config, config_name, read.layout.u_dc, log);
   io::MachineConfig cfg = config;
   cfg.estimator = io::estimator_settings(config, rebuilt);
   core::AveragedDriveEstimator estimator(cfg.machine, cfg.estimator);
   ThermalRun thermal(o, cfg, estimator.base());
-  io::EstimateLogWriter writer(o.out, thermal.node_names());
+  io::EstimateLogWriter writer(out, thermal.node_names());
   Tally tally;
   tally.counts.averaged = true;
   Decimation decimation(o);
@@ -195,24 +207,20 @@ int run_averaged(const EstimateOptions& o, const io::LogSource& source, const io
   }
   std::fprintf(stderr, "rpem estimate: %s\n", tally.summary(cfg.estimator.algorithm, "averaged samples").c_str());
   tally.explain();
-  if (!samples.empty()) check_identifiable(samples, cfg, tally.last, tally.adapted, rebuilt);
-  return kExitOk;
+  if (!samples.empty()) tally.identifiable = check_identifiable(samples, cfg, tally.last, tally.adapted, rebuilt);
+  return tally;
 }
 
-int run_estimate(const EstimateOptions& o) {
-  io::MachineConfig cfg = o.config.empty() ? io::builtin_paper_config() : io::load_machine_config(o.config);
-  if (!o.algorithm.empty()) cfg.estimator.algorithm = io::parse_algorithm(o.algorithm);
-  const std::string config_name = o.config.empty() ? "builtin:paper-ipmsm" : o.config;
-  const io::LogSource source = io::log_source(o.log, o.log_map);
-  if (source.averaged()) return run_averaged(o, source, cfg, config_name);
-
-  io::DriveLogReader reader(o.log, source.map, io::machine_limits(cfg.machine));
+/// One log through DriveEstimator, its estimates to `out`.
+Tally run_instantaneous(const EstimateOptions& o, const std::string& log, const std::string& out,
+                        const io::LogSource& source, const io::MachineConfig& cfg, const std::string& config_name) {
+  io::DriveLogReader reader(log, source.map, io::machine_limits(cfg.machine));
   if (!source.map.columns_optional)
-    std::fprintf(stderr, "rpem estimate: reading %s as %s\n", o.log.c_str(), source.format.c_str());
-  io::check_log_supports(cfg, config_name, reader.layout().u_dc, o.log);
+    std::fprintf(stderr, "rpem estimate: reading %s as %s\n", log.c_str(), source.format.c_str());
+  io::check_log_supports(cfg, config_name, reader.layout().u_dc, log);
   core::DriveEstimator estimator(cfg.machine, cfg.estimator);
   ThermalRun thermal(o, cfg, estimator.base());
-  io::EstimateLogWriter writer(o.out, thermal.node_names());
+  io::EstimateLogWriter writer(out, thermal.node_names());
   Progress progress("rpem estimate");
 
   io::DriveLogRow row;
@@ -228,6 +236,70 @@ int run_estimate(const EstimateOptions& o) {
   }
   progress.finish(tally.summary(cfg.estimator.algorithm, "samples") + io::describe(reader.reader().repairs()));
   tally.explain();
+  return tally;
+}
+
+Tally run_log(const EstimateOptions& o, const std::string& log, const std::string& out, const io::MachineConfig& cfg,
+              const std::string& config_name) {
+  const io::LogSource source = io::log_source(log, o.log_map);
+  return source.averaged() ? run_averaged(o, log, out, source, cfg, config_name)
+                           : run_instantaneous(o, log, out, source, cfg, config_name);
+}
+
+LogOutcome outcome_of(const Tally& t) {
+  LogOutcome o;
+  o.kind = t.counts.averaged ? "averaged" : "instantaneous";
+  o.samples = t.counts.samples;
+  o.resyncs = t.counts.resyncs;
+  o.outliers = t.counts.outliers;
+  o.excluded = t.counts.regimes.excluded();
+  o.adapted = t.adapted;
+  o.identifiable = t.identifiable;
+  if (t.first_t_ns) {
+    o.t_first_s = core::to_seconds(*t.first_t_ns);
+    o.t_last_s = core::to_seconds(t.last.t_ns);
+    o.psi_m_Wb = t.last.psi_m_Wb;
+    o.r_s_Ohm = t.last.r_s_Ohm;
+  }
+  return o;
+}
+
+/// Each log of the folder on its own, from the configuration's start: logs are not taken to follow one another
+/// (the machine cools between sessions). A log that cannot be read is skipped with its error, in the summary and on
+/// stderr, and the others go on (exit 65 at the end); a configuration error ends the run (78), as it would every log.
+int run_folder(const EstimateOptions& o, const io::MachineConfig& cfg, const std::string& config_name) {
+  const std::vector<std::filesystem::path> logs = logs_in_folder(o.log);
+  io::create_output_directory(o.out);
+  const std::string summary_path = (std::filesystem::path(o.out) / "summary.csv").string();
+  FolderSummary summary(summary_path);
+  std::size_t skipped = 0;
+  for (std::size_t k = 0; k < logs.size(); ++k) {
+    const std::string log = logs[k].string();
+    std::fprintf(stderr, "rpem estimate: log %zu of %zu: %s\n", k + 1, logs.size(), log.c_str());
+    LogOutcome outcome;
+    try {
+      outcome = outcome_of(run_log(o, log, estimate_path(o.out, logs[k]), cfg, config_name));
+    } catch (const io::ConfigError&) {
+      throw;
+    } catch (const io::InputError& e) {
+      ++skipped;
+      std::fprintf(stderr, "rpem estimate: skipped: %s\n", e.what());
+      outcome.error = e.what();
+    }
+    outcome.log = logs[k].filename().string();
+    summary.add(outcome);
+  }
+  std::fprintf(stderr, "rpem estimate: %zu logs: %zu estimated, %zu skipped; summary in %s\n", logs.size(),
+               logs.size() - skipped, skipped, summary_path.c_str());
+  return skipped > 0 ? kExitDataError : kExitOk;
+}
+
+int run_estimate(const EstimateOptions& o) {
+  io::MachineConfig cfg = o.config.empty() ? io::builtin_paper_config() : io::load_machine_config(o.config);
+  if (!o.algorithm.empty()) cfg.estimator.algorithm = io::parse_algorithm(o.algorithm);
+  const std::string config_name = o.config.empty() ? "builtin:paper-ipmsm" : o.config;
+  if (std::filesystem::is_directory(o.log)) return run_folder(o, cfg, config_name);
+  (void)run_log(o, o.log, o.out, cfg, config_name);
   return kExitOk;
 }
 
@@ -236,10 +308,13 @@ int run_estimate(const EstimateOptions& o) {
 Runner add_estimate_command(CLI::App& app) {
   auto opts = std::make_shared<EstimateOptions>();
   CLI::App* cmd = app.add_subcommand("estimate", "Run the RPEM estimator offline over a drive log");
-  add_log_options(*cmd, opts->log, opts->log_map);
+  add_log_options(*cmd, opts->log, opts->log_map, "", LogPath::kFileOrFolder);
   cmd->add_option("--config", opts->config, "machine and estimator YAML (default: built-in paper-ipmsm.yaml)")
       ->check(CLI::ExistingFile);
-  writes_file(cmd->add_option("--out", opts->out, "estimate CSV to write"))->required();
+  writes_file(cmd->add_option("--out", opts->out,
+                              "estimate CSV to write; with a folder of logs, the folder to write each log's estimate "
+                              "and summary.csv in"))
+      ->required();
   cmd->add_option("--algorithm", opts->algorithm, "override the configured gain algorithm")
       ->check(CLI::IsMember({"sga", "gna", "phyint"}));
   CLI::Option* every = cmd->add_option("--every", opts->every, "write every N-th sample's estimate (default 1: all)")

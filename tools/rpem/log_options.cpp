@@ -2,12 +2,14 @@
 
 namespace rpem::tools {
 
-void add_log_options(CLI::App& cmd, std::string& log, std::string& log_map, const std::string& purpose) {
-  const std::string formats =
+void add_log_options(CLI::App& cmd, std::string& log, std::string& log_map, const std::string& purpose, LogPath path) {
+  std::string formats =
       "drive log, averaged log or VESC Tool realtime log (detected by its header), or any CSV with --log-map "
       "(docs/drive-log.md)";
+  if (path == LogPath::kFileOrFolder) formats += "; or a folder of them, each on its own (\"A folder of logs\")";
   CLI::Option* log_option =
-      cmd.add_option("--log", log, purpose.empty() ? formats : purpose + ": " + formats)->check(CLI::ExistingFile);
+      cmd.add_option("--log", log, purpose.empty() ? formats : purpose + ": " + formats)
+          ->check(path == LogPath::kFile ? CLI::Validator(CLI::ExistingFile) : CLI::Validator(CLI::ExistingPath));
   CLI::Option* map_option = add_log_map_option(cmd, log_map);
   if (purpose.empty()) {
     log_option->required();

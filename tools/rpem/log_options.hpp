@@ -7,9 +7,13 @@
 
 namespace rpem::tools {
 
+/// What --log may name: a log, or also a folder of them (rpem estimate: log_folder.hpp).
+enum class LogPath { kFile, kFileOrFolder };
+
 /// Adds --log and --log-map to `cmd`. Without `purpose` --log is required; with it (what the subcommand does
 /// with a log, said before what a log may be) --log is optional and --log-map needs it.
-void add_log_options(CLI::App& cmd, std::string& log, std::string& log_map, const std::string& purpose = "");
+void add_log_options(CLI::App& cmd, std::string& log, std::string& log_map, const std::string& purpose = "",
+                     LogPath path = LogPath::kFile);
 
 /// Adds --log-map alone, for a subcommand whose log is a positional argument (rpem replay).
 CLI::Option* add_log_map_option(CLI::App& cmd, std::string& log_map);

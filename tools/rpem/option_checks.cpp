@@ -68,6 +68,12 @@ std::string written_file_clash(const CLI::App& app) {
         if (value.empty() || !same_file(path, value)) continue;
         const bool written = std::find(written_options().begin(), written_options().end(), other) != written_options().end();
         std::string clash = out->get_name();
+        std::error_code ec;
+        if (std::filesystem::is_directory(path, ec)) {  // rpem estimate --log FOLDER --out FOLDER
+          clash += " " + path + " names the same folder as " + other->get_name();
+          clash += " " + value + ": what is written there would be read with it: give another folder";
+          return clash;
+        }
         clash += " " + path + " names the same file as " + other->get_name();
         clash += " " + value + ": it would be overwritten ";
         clash += written ? "by both" : "before it is read";

@@ -282,8 +282,7 @@ LogData load_log(const std::string& path, const core::MachineSi& machine, const 
     steady.mode = ModelMode::kSteadyState;
     prepare_log(d, machine, steady);
     d.averaged = true;
-    d.format =
-        io::describe(source, read) + voltage + (rebuilt.voltages || rebuilt.currents ? "; " + rebuilt.describe() : "");
+    d.format = io::describe(source, read) + voltage + (rebuilt.any() ? "; " + rebuilt.describe() : "");
     d.voltage_applied = turn || rebuilt.voltages;
     return d;
   }

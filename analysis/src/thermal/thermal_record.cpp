@@ -55,7 +55,7 @@ ThermalRecord record_thermal(const io::LogSource& source, const io::MachineConfi
         io::complete_rotor_frame(samples, read, machine.machine, io::command_hold_s(machine.estimator), source.path);
     r.winding_sensor = read.layout.t_winding;
     r.coolant = read.layout.t_coolant;
-    r.read_as = io::describe(source, read) + (rebuilt.voltages || rebuilt.currents ? "; " + rebuilt.describe() : "");
+    r.read_as = io::describe(source, read) + (rebuilt.any() ? "; " + rebuilt.describe() : "");
     core::AveragedDriveEstimator estimator(machine.machine, io::estimator_settings(machine, rebuilt));
     Recorder rec(r, machine, thermal, estimator.base());
     for (const core::AveragedSample& s : samples) rec.add(estimator.step(s), s.t_ns, s.t_coolant_C, s.t_winding_C);

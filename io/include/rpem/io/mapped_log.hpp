@@ -36,6 +36,9 @@ struct ReadRepairs {
   std::uint64_t tied_rows = 0;  ///< rows that shared their stamp with the row before, spread over its resolution
   /// The file's last line, cut off while the file was written (0: none): not read (MappedLogReader::cut_off).
   std::size_t cut_line = 0;
+  /// Columns the header names, optional in the map, that hold no value on any row: read as absent (a logger that
+  /// prints a format's whole header but leaves the cells of what it does not read empty).
+  std::vector<std::string> never_recorded;
 };
 
 class MappedLogReader {
@@ -66,6 +69,9 @@ class MappedLogReader {
 
  private:
   void read_header();
+  /// After the header: an optional column empty on every row is taken as absent (ReadRepairs::never_recorded).
+  /// Reads ahead only while some optional column's cells have all been empty, then returns to the first row.
+  void drop_columns_never_recorded();
   void index_positions();  ///< a headerless map's cells: its columns' positions
   bool next_line(std::string& text);
   bool next_cells();  ///< the next row's cells, of the file's width; false at the end (or at a cut last row)

@@ -26,6 +26,8 @@ struct RotorFrameRebuild {
   /// Samples whose magnitude |u| is below the model's |u_d| (not in steady state, or L_q off): u_d is held to ±|u|
   /// and u_q is 0 there.
   std::uint64_t short_magnitude = 0;
+  /// Whether anything was rebuilt.
+  [[nodiscard]] bool any() const noexcept { return voltages || currents; }
   /// For the tools' summary: what was rebuilt and from what (empty: nothing).
   [[nodiscard]] std::string describe() const;
 };

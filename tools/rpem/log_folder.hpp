@@ -1,0 +1,50 @@
+#pragma once
+// A folder of logs as VESC Tool leaves them (one CSV per logging session, named by the session's start:
+// 2026-11-26_10-15-02.csv): `rpem estimate --log FOLDER --out DIR` runs the estimator over each log on its own
+// and writes DIR/<log's stem>.estimate.csv per log and DIR/summary.csv, one row per log (docs/drive-log.md,
+// "A folder of logs").
+
+#include <array>
+#include <cstdint>
+#include <filesystem>
+#include <fstream>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace rpem::tools {
+
+/// The logs in `folder`: its regular files (not hidden) whose names end in ".csv" in any case, in name order —
+/// VESC Tool names a log by its session's start, so name order is time order. Subfolders are not entered.
+/// io::InputError naming the folder where it cannot be read or holds no such file.
+[[nodiscard]] std::vector<std::filesystem::path> logs_in_folder(const std::string& folder);
+
+/// Where the estimate of `log` goes: `out_dir`/<its stem>.estimate.csv. Distinct logs get distinct names, and none
+/// is summary.csv.
+[[nodiscard]] std::string estimate_path(const std::string& out_dir, const std::filesystem::path& log);
+
+/// What one log's run ended with: its figures, or why it was skipped.
+struct LogOutcome {
+  std::string log;    ///< the file's name in the folder
+  std::string error;  ///< empty: estimated; else the error that skipped it (file:line: why)
+  std::string kind;   ///< "averaged" or "instantaneous"
+  std::uint64_t samples = 0, resyncs = 0, outliers = 0, excluded = 0;
+  std::array<std::uint64_t, 2> adapted{};  ///< samples in which ψm, R_s adapted
+  std::optional<double> t_first_s, t_last_s, psi_m_Wb, r_s_Ohm;
+  /// Whether the log determines ψm, R_s (the averaged path's check; unset where none was made).
+  std::array<std::optional<bool>, 2> identifiable;
+};
+
+/// DIR/summary.csv: its header at construction, a row per log as each ends (flushed, so a run stopped part-way
+/// leaves the logs it finished).
+class FolderSummary {
+ public:
+  explicit FolderSummary(const std::string& path);
+  void add(const LogOutcome& outcome);
+
+ private:
+  std::string path_;
+  std::ofstream out_;
+};
+
+}  // namespace rpem::tools
