@@ -4,6 +4,7 @@
 // log in time order; and the folders it refuses.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -134,6 +135,70 @@ TEST_F(CliLogFolder, EachLogIsEstimatedOnItsOwnAndSummarised) {
       test::run_command(rpem_tool() + " estimate --log " + logs.string() + outrunner_config() + " --out " + at("out"));
   EXPECT_EQ(clean.exit_code, 0) << clean.output;
   EXPECT_EQ(read_summary(at("out/summary.csv")).size(), 2U);
+}
+
+/// A column of a CSV with a header, by name, as numbers ("nan" where not yet estimated).
+std::vector<double> csv_column(const std::string& path, const std::string& name) {
+  std::ifstream in(path);
+  std::string line, cell;
+  std::getline(in, line);
+  std::stringstream header(line);
+  std::size_t index = 0;
+  while (std::getline(header, cell, ',') && cell != name) ++index;
+  std::vector<double> values;
+  while (std::getline(in, line)) {
+    std::stringstream row(line);
+    for (std::size_t k = 0; k <= index; ++k) std::getline(row, cell, ',');
+    values.push_back(std::stod(cell));
+  }
+  return values;
+}
+
+// With --thermal each session's summary row carries the fused magnet's and winding's peaks and the peaks of T + 2σ (what
+// a derating on T + 2σ acts on): the extremes of the columns its own estimate CSV holds, and the hot magnet's session
+// the hotter. Without --thermal those cells are empty.
+TEST_F(CliLogFolder, WithAThermalNetworkEachSessionsPeakTemperaturesAreSummarised) {
+  const fs::path logs = dir_ / "logs";
+  write_session(logs / "2026-11-30_09-05-10.csv", 32'710'000, 0.004633);
+  write_session(logs / "2026-11-30_18-40-00.csv", 67'200'000, 0.004633 * 0.9);  // NdFeB's −0.12 %/K: 103 °C
+  std::ofstream(at("thermal.yaml")) << "thermal:\n  nodes:\n"
+                                       "    - {name: winding, capacitance_J_per_K: 400, to_coolant_W_per_K: 2}\n"
+                                       "    - {name: magnet, capacitance_J_per_K: 300, to_coolant_W_per_K: 1}\n"
+                                       "  conductances: [{from: winding, to: magnet, W_per_K: 0.5}]\n"
+                                       "  magnet_law: {psi_m_ref_Wb: 0.004633, reference_C: 20, coeff_per_K: -0.0012}\n"
+                                       "  coolant_C: 25\n";
+  const test::ProcessResult r = test::run_command(rpem_tool() + " estimate --log " + logs.string() + outrunner_config() +
+                                                  " --thermal " + at("thermal.yaml") + " --out " + at("out"));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const std::vector<std::map<std::string, std::string>> rows = read_summary(at("out/summary.csv"));
+  ASSERT_EQ(rows.size(), 2U);
+  std::vector<double> magnet_peaks;
+  for (const auto& row : rows) {
+    const std::string estimate = at("out/" + fs::path(row.at("log")).stem().string() + ".estimate.csv");
+    for (const std::string node : {"magnet", "winding"}) {
+      const std::vector<double> t = csv_column(estimate, "t_" + node + "_fused_C"),
+                                sd = csv_column(estimate, "t_" + node + "_fused_sd_C");
+      ASSERT_EQ(t.size(), 299U);
+      double peak = -1e9, peak_2sd = -1e9;
+      for (std::size_t k = 0; k < t.size(); ++k) {
+        if (std::isnan(t[k])) continue;
+        peak = std::max(peak, t[k]);
+        peak_2sd = std::max(peak_2sd, t[k] + 2.0 * sd[k]);
+      }
+      EXPECT_DOUBLE_EQ(std::stod(row.at("t_" + node + "_peak_C")), peak) << row.at("log") << node;
+      EXPECT_DOUBLE_EQ(std::stod(row.at("t_" + node + "_peak_2sd_C")), peak_2sd) << row.at("log") << node;
+      if (node == "magnet") magnet_peaks.push_back(peak);
+    }
+  }
+  EXPECT_GT(magnet_peaks[1], magnet_peaks[0] + 20.0);  // 103 °C against 20 °C, as far as 30 s of filtering reach
+
+  const test::ProcessResult plain =
+      test::run_command(rpem_tool() + " estimate --log " + logs.string() + outrunner_config() + " --out " + at("plain"));
+  ASSERT_EQ(plain.exit_code, 0) << plain.output;
+  for (const auto& row : read_summary(at("plain/summary.csv"))) {
+    EXPECT_EQ(row.at("t_magnet_peak_C"), "");
+    EXPECT_EQ(row.at("t_winding_peak_2sd_C"), "");
+  }
 }
 
 TEST_F(CliLogFolder, FoldersItCannotUseAreRefused) {

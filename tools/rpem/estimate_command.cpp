@@ -85,10 +85,20 @@ class ThermalRun {
     s.winding_sensor_C = winding_C;
     previous_ns_ = t_ns;
     fusion_->step(e, s);
+    const core::ThermalEstimate& now = fusion_->estimate();
+    if (!now.started) return;
+    for (auto [node, peak] : {std::pair{now.magnet, &magnet_}, std::pair{now.winding, &winding_}}) {
+      const core::ThermalNodeReport r = core::report_node(now, node, t_ns);
+      peak->add(r.t_C, r.sd_K);
+    }
   }
   [[nodiscard]] const core::ThermalEstimate* estimate() const { return fusion_ ? &fusion_->estimate() : nullptr; }
+  /// The fused temperatures' peaks so far, as the estimate CSV reports them at each sample.
+  [[nodiscard]] const TemperaturePeak& magnet_peak() const { return magnet_; }
+  [[nodiscard]] const TemperaturePeak& winding_peak() const { return winding_; }
 
  private:
+  TemperaturePeak magnet_, winding_;
   std::vector<std::string> names_;
   std::optional<core::ThermalFusion> fusion_;
   std::optional<std::int64_t> previous_ns_;
@@ -102,6 +112,11 @@ struct Tally {
   std::optional<std::int64_t> first_t_ns;
   std::array<std::uint64_t, 2> adapted{};           ///< samples in which ψm, R_s adapted
   std::array<std::optional<bool>, 2> identifiable;  ///< ψm, R_s: check_identifiable's verdict, where it ran
+  TemperaturePeak magnet, winding;                  ///< with --thermal
+  void take_peaks(const ThermalRun& t) {
+    magnet = t.magnet_peak();
+    winding = t.winding_peak();
+  }
   void count(const core::Estimate& e) {
     if (!first_t_ns) first_t_ns = e.t_ns;
     last = e;
@@ -208,6 +223,7 @@ Tally run_averaged(const EstimateOptions& o, const std::string& log, const std::
   std::fprintf(stderr, "rpem estimate: %s\n", tally.summary(cfg.estimator.algorithm, "averaged samples").c_str());
   tally.explain();
   if (!samples.empty()) tally.identifiable = check_identifiable(samples, cfg, tally.last, tally.adapted, rebuilt);
+  tally.take_peaks(thermal);
   return tally;
 }
 
@@ -236,6 +252,7 @@ Tally run_instantaneous(const EstimateOptions& o, const std::string& log, const 
   }
   progress.finish(tally.summary(cfg.estimator.algorithm, "samples") + io::describe(reader.reader().repairs()));
   tally.explain();
+  tally.take_peaks(thermal);
   return tally;
 }
 
@@ -255,6 +272,8 @@ LogOutcome outcome_of(const Tally& t) {
   o.excluded = t.counts.regimes.excluded();
   o.adapted = t.adapted;
   o.identifiable = t.identifiable;
+  o.magnet = t.magnet;
+  o.winding = t.winding;
   if (t.first_t_ns) {
     o.t_first_s = core::to_seconds(*t.first_t_ns);
     o.t_last_s = core::to_seconds(t.last.t_ns);

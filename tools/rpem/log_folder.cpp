@@ -59,7 +59,8 @@ std::string estimate_path(const std::string& out_dir, const fs::path& log) {
 FolderSummary::FolderSummary(const std::string& path) : path_(path), out_(path, std::ios::binary | std::ios::trunc) {
   if (!out_) throw io::InputError(path, 0, 0, "", "cannot create file");
   out_ << "log,status,kind,samples,t_first_s,t_last_s,psi_m_Wb,r_s_Ohm,psi_m_adapted,r_s_adapted,resyncs,outliers,"
-          "excluded,psi_m_identifiable,r_s_identifiable,error\n"
+          "excluded,psi_m_identifiable,r_s_identifiable,t_magnet_peak_C,t_magnet_peak_2sd_C,t_winding_peak_C,"
+          "t_winding_peak_2sd_C,error\n"
        << std::flush;
 }
 
@@ -75,6 +76,7 @@ void FolderSummary::add(const LogOutcome& o) {
     if (o.error.empty()) line += std::to_string(n);
   }
   for (const auto& v : o.identifiable) append_optional(line, v);
+  for (const auto& v : {o.magnet.t_C, o.magnet.t_2sd_C, o.winding.t_C, o.winding.t_2sd_C}) append_optional(line, v);
   line += ',' + csv_cell(o.error) + '\n';
   out_ << line << std::flush;
   if (!out_) throw io::InputError(path_, 0, 0, "", "cannot write the summary");

@@ -4,7 +4,9 @@
 // and writes DIR/<log's stem>.estimate.csv per log and DIR/summary.csv, one row per log (docs/drive-log.md,
 // "A folder of logs").
 
+#include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
@@ -23,6 +25,17 @@ namespace rpem::tools {
 /// is summary.csv.
 [[nodiscard]] std::string estimate_path(const std::string& out_dir, const std::filesystem::path& log);
 
+/// A temperature's peak over a session, and the peak of T + 2σ (what a derating on T + 2σ acts on) [°C]; unset
+/// where it was never estimated.
+struct TemperaturePeak {
+  std::optional<double> t_C, t_2sd_C;
+  void add(double t, double sd_K) {
+    if (!std::isfinite(t) || !std::isfinite(sd_K)) return;
+    t_C = t_C ? std::max(*t_C, t) : t;
+    t_2sd_C = t_2sd_C ? std::max(*t_2sd_C, t + 2.0 * sd_K) : t + 2.0 * sd_K;
+  }
+};
+
 /// What one log's run ended with: its figures, or why it was skipped.
 struct LogOutcome {
   std::string log;    ///< the file's name in the folder
@@ -33,6 +46,7 @@ struct LogOutcome {
   std::optional<double> t_first_s, t_last_s, psi_m_Wb, r_s_Ohm;
   /// Whether the log determines ψm, R_s (the averaged path's check; unset where none was made).
   std::array<std::optional<bool>, 2> identifiable;
+  TemperaturePeak magnet, winding;  ///< the fused temperatures' peaks (--thermal)
 };
 
 /// DIR/summary.csv: its header at construction, a row per log as each ends (flushed, so a run stopped part-way
