@@ -73,11 +73,12 @@ class CliLogFolder : public ::testing::Test {
   fs::path dir_;
 };
 
-// Two sessions of one machine, the later with its magnet 10 % weaker (hot), listed out of time order on disk by
-// nothing but their names; beside them a file of another program, a text file, a hidden CSV and a subfolder.
+// Two sessions of one machine, the later with its magnet 10 % weaker (hot), ordered by nothing but their names (the
+// later named as older VESC Tools name a log, with colons); beside them a file of another program, a text file, a
+// hidden CSV and a subfolder.
 TEST_F(CliLogFolder, EachLogIsEstimatedOnItsOwnAndSummarised) {
   const fs::path logs = dir_ / "logs";
-  write_session(logs / "2026-11-30_18-40-00.csv", 67'200'000, 0.004633 * 0.9);
+  write_session(logs / "2026-11-30_18:40:00.csv", 67'200'000, 0.004633 * 0.9);
   write_session(logs / "2026-11-30_09-05-10.csv", 32'710'000, 0.004633);
   std::ofstream(logs / "2026-11-30_12-00-00.CSV") << "hello;world\n1;2\n";
   std::ofstream(logs / "notes.txt") << "battery swapped\n";
@@ -99,14 +100,16 @@ TEST_F(CliLogFolder, EachLogIsEstimatedOnItsOwnAndSummarised) {
   ASSERT_EQ(rows.size(), 3U);
   EXPECT_EQ(rows[0].at("log"), "2026-11-30_09-05-10.csv");
   EXPECT_EQ(rows[1].at("log"), "2026-11-30_12-00-00.CSV");
-  EXPECT_EQ(rows[2].at("log"), "2026-11-30_18-40-00.csv");
+  EXPECT_EQ(rows[2].at("log"), "2026-11-30_18:40:00.csv");
+  EXPECT_EQ(rows[0].at("started"), "2026-11-30T09:05:10");  // VESC Tool's name: the session's local start
+  EXPECT_EQ(rows[2].at("started"), "2026-11-30T18:40:00");  // as older VESC Tools name it
   EXPECT_EQ(rows[1].at("status"), "skipped");
   EXPECT_NE(rows[1].at("error").find("2026-11-30_12-00-00.CSV:1: column t: required column is missing"), std::string::npos)
       << rows[1].at("error");
   EXPECT_EQ(rows[1].at("psi_m_Wb"), "");
 
   // Each estimated log: its estimate is what the tool writes for it alone, and the summary is that estimate's end.
-  const std::map<std::string, double> truth{{"2026-11-30_09-05-10", 0.004633}, {"2026-11-30_18-40-00", 0.004633 * 0.9}};
+  const std::map<std::string, double> truth{{"2026-11-30_09-05-10", 0.004633}, {"2026-11-30_18:40:00", 0.004633 * 0.9}};
   for (const auto& [stem, psi_m_Wb] : truth) {
     const test::ProcessResult alone =
         test::run_command(rpem_tool() + " estimate --log " + (logs / (stem + ".csv")).string() + outrunner_config() +

@@ -306,6 +306,7 @@ int run_folder(const EstimateOptions& o, const io::MachineConfig& cfg, const std
       outcome.error = e.what();
     }
     outcome.log = logs[k].filename().string();
+    outcome.started = session_start(logs[k]);
     summary.add(outcome);
   }
   std::fprintf(stderr, "rpem estimate: %zu logs: %zu estimated, %zu skipped; summary in %s\n", logs.size(),

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <regex>
 #include <system_error>
 
 #include "rpem/io/errors.hpp"
@@ -52,20 +53,28 @@ std::vector<fs::path> logs_in_folder(const std::string& folder) {
   return logs;
 }
 
+std::string session_start(const fs::path& log) {
+  static const std::regex kName(R"(^(\d{4}-\d{2}-\d{2})_(\d{2})([-:])(\d{2})\3(\d{2})$)");
+  std::smatch m;
+  const std::string stem = log.stem().string();
+  if (!std::regex_match(stem, m, kName)) return "";
+  return m.str(1) + "T" + m.str(2) + ":" + m.str(4) + ":" + m.str(5);
+}
+
 std::string estimate_path(const std::string& out_dir, const fs::path& log) {
   return (fs::path(out_dir) / (log.stem().string() + ".estimate.csv")).string();
 }
 
 FolderSummary::FolderSummary(const std::string& path) : path_(path), out_(path, std::ios::binary | std::ios::trunc) {
   if (!out_) throw io::InputError(path, 0, 0, "", "cannot create file");
-  out_ << "log,status,kind,samples,t_first_s,t_last_s,psi_m_Wb,r_s_Ohm,psi_m_adapted,r_s_adapted,resyncs,outliers,"
+  out_ << "log,started,status,kind,samples,t_first_s,t_last_s,psi_m_Wb,r_s_Ohm,psi_m_adapted,r_s_adapted,resyncs,outliers,"
           "excluded,psi_m_identifiable,r_s_identifiable,t_magnet_peak_C,t_magnet_peak_2sd_C,t_winding_peak_C,"
           "t_winding_peak_2sd_C,error\n"
        << std::flush;
 }
 
 void FolderSummary::add(const LogOutcome& o) {
-  std::string line = csv_cell(o.log);
+  std::string line = csv_cell(o.log) + ',' + o.started;
   line += o.error.empty() ? ",estimated," : ",skipped,";
   line += o.kind;
   line += ',';

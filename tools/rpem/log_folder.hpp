@@ -21,6 +21,11 @@ namespace rpem::tools {
 /// io::InputError naming the folder where it cannot be read or holds no such file.
 [[nodiscard]] std::vector<std::filesystem::path> logs_in_folder(const std::string& folder);
 
+/// The session's start as VESC Tool names its log (vedderb/vesc_tool vescinterface.cpp, openRtLogFile: the local
+/// date and time at opening, yyyy-MM-dd_hh-mm-ss.csv; hh:mm:ss in older versions), as ISO 8601 local time
+/// ("2026-11-30T09:05:10"); "" where the name is not of that form.
+[[nodiscard]] std::string session_start(const std::filesystem::path& log);
+
 /// Where the estimate of `log` goes: `out_dir`/<its stem>.estimate.csv. Distinct logs get distinct names, and none
 /// is summary.csv.
 [[nodiscard]] std::string estimate_path(const std::string& out_dir, const std::filesystem::path& log);
@@ -38,9 +43,10 @@ struct TemperaturePeak {
 
 /// What one log's run ended with: its figures, or why it was skipped.
 struct LogOutcome {
-  std::string log;    ///< the file's name in the folder
-  std::string error;  ///< empty: estimated; else the error that skipped it (file:line: why)
-  std::string kind;   ///< "averaged" or "instantaneous"
+  std::string log;      ///< the file's name in the folder
+  std::string error;    ///< empty: estimated; else the error that skipped it (file:line: why)
+  std::string kind;     ///< "averaged" or "instantaneous"
+  std::string started;  ///< session_start of its name
   std::uint64_t samples = 0, resyncs = 0, outliers = 0, excluded = 0;
   std::array<std::uint64_t, 2> adapted{};  ///< samples in which ψm, R_s adapted
   std::optional<double> t_first_s, t_last_s, psi_m_Wb, r_s_Ohm;
