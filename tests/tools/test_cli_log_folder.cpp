@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "rpem/io/csv_table.hpp"
 #include "support/process.hpp"
 #include "support/temp_file.hpp"
 #include "support/vesc_tool_vectors.hpp"
@@ -140,23 +141,6 @@ TEST_F(CliLogFolder, EachLogIsEstimatedOnItsOwnAndSummarised) {
   EXPECT_EQ(read_summary(at("out/summary.csv")).size(), 2U);
 }
 
-/// A column of a CSV with a header, by name, as numbers ("nan" where not yet estimated).
-std::vector<double> csv_column(const std::string& path, const std::string& name) {
-  std::ifstream in(path);
-  std::string line, cell;
-  std::getline(in, line);
-  std::stringstream header(line);
-  std::size_t index = 0;
-  while (std::getline(header, cell, ',') && cell != name) ++index;
-  std::vector<double> values;
-  while (std::getline(in, line)) {
-    std::stringstream row(line);
-    for (std::size_t k = 0; k <= index; ++k) std::getline(row, cell, ',');
-    values.push_back(std::stod(cell));
-  }
-  return values;
-}
-
 // With --thermal each session's summary row carries the fused magnet's and winding's peaks and the peaks of T + 2σ (what
 // a derating on T + 2σ acts on): the extremes of the columns its own estimate CSV holds, and the hot magnet's session
 // the hotter. Without --thermal those cells are empty.
@@ -177,10 +161,11 @@ TEST_F(CliLogFolder, WithAThermalNetworkEachSessionsPeakTemperaturesAreSummarise
   ASSERT_EQ(rows.size(), 2U);
   std::vector<double> magnet_peaks;
   for (const auto& row : rows) {
-    const std::string estimate = at("out/" + fs::path(row.at("log")).stem().string() + ".estimate.csv");
+    const io::CsvTable estimate =
+        io::CsvTable::read(at("out/" + fs::path(row.at("log")).stem().string() + ".estimate.csv"), true);
     for (const std::string node : {"magnet", "winding"}) {
-      const std::vector<double> t = csv_column(estimate, "t_" + node + "_fused_C"),
-                                sd = csv_column(estimate, "t_" + node + "_fused_sd_C");
+      const std::vector<double>& t = estimate.column("t_" + node + "_fused_C");
+      const std::vector<double>& sd = estimate.column("t_" + node + "_fused_sd_C");
       ASSERT_EQ(t.size(), 299U);
       double peak = -1e9, peak_2sd = -1e9;
       for (std::size_t k = 0; k < t.size(); ++k) {
@@ -202,6 +187,27 @@ TEST_F(CliLogFolder, WithAThermalNetworkEachSessionsPeakTemperaturesAreSummarise
     EXPECT_EQ(row.at("t_magnet_peak_C"), "");
     EXPECT_EQ(row.at("t_winding_peak_2sd_C"), "");
   }
+}
+
+// A drive log of phase samples whose fourth row has a bad cell: read part-way (its estimate streamed) and skipped; its
+// partial estimate is removed, so the estimates beside summary.csv are the estimated rows'.
+TEST_F(CliLogFolder, ALogReadPartWayLeavesNoEstimate) {
+  const fs::path logs = dir_ / "logs";
+  write_session(logs / "2026-11-30_09-05-10.csv", 32'710'000, 0.004633);
+  std::ofstream(logs / "bench.csv") << "t,theta_el,omega_el,u_dc,u_a,u_b,u_c,i_a,i_b,i_c\n"
+                                       "0,0,100,48,1,-0.5,-0.5,2,-1,-1\n0.0001,0.01,100,48,1,-0.5,-0.5,2,-1,-1\n"
+                                       "0.0002,0.02,100,48,1,-0.5,-0.5,2,-1,-1\n0.0003,0.03,100,48,x,-0.5,-0.5,2,-1,-1\n";
+  const test::ProcessResult r =
+      test::run_command(rpem_tool() + " estimate --log " + logs.string() + outrunner_config() + " --out " + at("out"));
+  EXPECT_EQ(r.exit_code, 65) << r.output;
+  EXPECT_NE(r.output.find("bench.csv:5:5: column u_a: 'x' is not a number"), std::string::npos) << r.output;
+  EXPECT_TRUE(fs::exists(at("out/2026-11-30_09-05-10.estimate.csv")));
+  EXPECT_FALSE(fs::exists(at("out/bench.estimate.csv")));
+  const std::vector<std::map<std::string, std::string>> rows = read_summary(at("out/summary.csv"));
+  ASSERT_EQ(rows.size(), 2U);
+  EXPECT_EQ(rows[1].at("log"), "bench.csv");
+  EXPECT_EQ(rows[1].at("started"), "");
+  EXPECT_EQ(rows[1].at("status"), "skipped");
 }
 
 TEST_F(CliLogFolder, FoldersItCannotUseAreRefused) {

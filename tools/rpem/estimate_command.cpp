@@ -295,15 +295,18 @@ int run_folder(const EstimateOptions& o, const io::MachineConfig& cfg, const std
   for (std::size_t k = 0; k < logs.size(); ++k) {
     const std::string log = logs[k].string();
     std::fprintf(stderr, "rpem estimate: log %zu of %zu: %s\n", k + 1, logs.size(), log.c_str());
+    const std::string out = estimate_path(o.out, logs[k]);
     LogOutcome outcome;
     try {
-      outcome = outcome_of(run_log(o, log, estimate_path(o.out, logs[k]), cfg, config_name));
+      outcome = outcome_of(run_log(o, log, out, cfg, config_name));
     } catch (const io::ConfigError&) {
       throw;
     } catch (const io::InputError& e) {
       ++skipped;
       std::fprintf(stderr, "rpem estimate: skipped: %s\n", e.what());
       outcome.error = e.what();
+      std::error_code ec;
+      std::filesystem::remove(out, ec);  // a log read part-way leaves no estimate beside the others
     }
     outcome.log = logs[k].filename().string();
     outcome.started = session_start(logs[k]);
