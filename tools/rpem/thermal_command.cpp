@@ -1,16 +1,20 @@
-// rpem thermal fit --log LOG.csv [--log-map MAP.yaml] --config CFG.yaml --out thermal.yaml
+// rpem thermal fit --log LOG.csv|FOLDER [--log-map MAP.yaml] --config CFG.yaml --out thermal.yaml
 //                  [--start THERMAL.yaml | --nodes 2|3] [--fit-until-s S] [--winding-sensor-sigma-K K] [--period-s S]
 //                  [--report DIR]
 // Fits the machine's thermal network to what a log shows of its temperatures — a winding sensor, the
 // coolant, the magnet temperature from ψ̂m and the winding's from r̂s (the estimator run over the log) —
 // and writes the `thermal` section rpemd and `rpem estimate --thermal` read (docs/thermal.md). A magnet
-// sensor in the log (T_magnet) is never used.
+// sensor in the log (T_magnet) is never used. A folder's logs are one machine's sessions, each recorded on its own and
+// fitted together, each from its own start (docs/thermal.md, "A folder of logs").
 
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <limits>
+#include <vector>
 
 #include "commands.hpp"
+#include "log_folder.hpp"
 #include "log_options.hpp"
 #include "option_checks.hpp"
 #include "rpem/analysis/thermal/thermal_fit.hpp"
@@ -25,13 +29,54 @@ namespace {
 
 struct ThermalFitCliOptions {
   std::string log, log_map, config, out, start, report;
-  int nodes = 0;  ///< --nodes; 0: not given (2 without a network to start from)
+  int nodes = 0;              ///< --nodes; 0: not given (2 without a network to start from)
+  int held_out_sessions = 0;  ///< --held-out-sessions: a folder's last sessions, judged and not fitted
   double fit_until_s = std::numeric_limits<double>::quiet_NaN();
   double winding_sensor_sigma_K = 1.0;
   double period_s = 0.0;
   double disturbance_time_constant_s = 0.0;  ///< 0: chosen by the likelihood
   bool keep_magnet_reference = false;
 };
+
+/// The estimator run over --log: one log, or each log of a folder on its own, joined as one machine's sessions (a
+/// folder's log that gives no step of the filter is left out, and said so). What each was read as and assumed goes
+/// to stderr.
+analysis::ThermalRecord record_sessions(const ThermalFitCliOptions& o, const io::MachineConfig& machine,
+                                        const io::ThermalConfig& laws) {
+  const bool folder = std::filesystem::is_directory(o.log);
+  std::vector<std::string> logs;
+  if (folder) {
+    for (const std::filesystem::path& p : logs_in_folder(o.log)) logs.push_back(p.string());
+  } else {
+    logs.push_back(o.log);
+  }
+  std::vector<analysis::ThermalRecord> sessions;
+  for (const std::string& log : logs) {
+    std::fprintf(stderr, "rpem thermal fit: running the estimator over %s\n", log.c_str());
+    analysis::ThermalRecord r = analysis::record_thermal(io::log_source(log, o.log_map), machine, laws);
+    std::fprintf(stderr, "rpem thermal fit: %s\n", r.read_as.c_str());
+    if (const std::string note = io::assumed_frame_note(r.counts); !note.empty())
+      std::fprintf(stderr, "rpem thermal fit: note: %s\n", note.c_str());
+    if (!r.coolant) {
+      std::fprintf(stderr,
+                   "rpem thermal fit: %s has no T_coolant column: the coolant is taken as %.4g °C throughout "
+                   "(thermal.coolant_C); a coolant that moves shows as a model error (docs/thermal.md)\n",
+                   log.c_str(), laws.fusion.coolant_C);
+    }
+    if (folder && r.steps.empty()) {
+      std::fprintf(stderr, "rpem thermal fit: %s gives no step of the thermal filter (%.3g s): left out\n", log.c_str(),
+                   laws.fusion.observer.period_s);
+      continue;
+    }
+    sessions.push_back(std::move(r));
+  }
+  if (!folder) return std::move(sessions.front());
+  if (sessions.empty()) {
+    throw io::DriveLogError(o.log, 0, 0, "", "no log in the folder gives a step of the thermal filter");
+  }
+  std::fprintf(stderr, "rpem thermal fit: %zu sessions of %s, each from its own start\n", sessions.size(), o.log.c_str());
+  return analysis::join_sessions(std::move(sessions), o.log);
+}
 
 int run_thermal_fit(const ThermalFitCliOptions& o) {
   const io::MachineConfig machine = o.config.empty() ? io::builtin_paper_config() : io::load_machine_config(o.config);
@@ -46,23 +91,26 @@ int run_thermal_fit(const ThermalFitCliOptions& o) {
                  o.nodes, o.start.c_str(), laws.fusion.filter.network.nodes);
     return kExitUsage;
   }
-  std::fprintf(stderr, "rpem thermal fit: running the estimator over %s\n", o.log.c_str());
-  const analysis::ThermalRecord record = analysis::record_thermal(io::log_source(o.log, o.log_map), machine, laws);
-  std::fprintf(stderr, "rpem thermal fit: %s\n", record.read_as.c_str());
-  if (const std::string note = io::assumed_frame_note(record.counts); !note.empty())
-    std::fprintf(stderr, "rpem thermal fit: note: %s\n", note.c_str());
+  const analysis::ThermalRecord record = record_sessions(o, machine, laws);
   if (record.winding_sensor && laws.fusion.winding_sensor_sigma_K <= 0.0)
     laws.fusion.winding_sensor_sigma_K = o.winding_sensor_sigma_K;
-  if (!record.coolant) {
-    std::fprintf(stderr,
-                 "rpem thermal fit: %s has no T_coolant column: the coolant is taken as %.4g °C throughout "
-                 "(thermal.coolant_C); a coolant that moves shows as a model error (docs/thermal.md)\n",
-                 o.log.c_str(), laws.fusion.coolant_C);
-  }
   const io::ThermalConfig start =
       laws.has_network ? laws : analysis::default_topology(laws, record, o.nodes > 0 ? o.nodes : 2);
   analysis::ThermalFitOptions options;
   options.fit_until_s = o.fit_until_s;
+  if (o.held_out_sessions > 0) {
+    const std::size_t sessions = record.session_first_step.size();
+    if (static_cast<std::size_t>(o.held_out_sessions) >= sessions) {
+      std::fprintf(stderr,
+                   "rpem thermal fit: --held-out-sessions %d: %s gives %zu session%s with steps of the filter; at least "
+                   "one must be left to fit\n",
+                   o.held_out_sessions, o.log.c_str(), sessions, sessions == 1 ? "" : "s");
+      return kExitUsage;
+    }
+    // The training part ends with the last step before the first held-out session.
+    options.fit_until_s =
+        record.t_s[record.session_first_step[sessions - static_cast<std::size_t>(o.held_out_sessions)] - 1];
+  }
   options.anchor_magnet_reference = !o.keep_magnet_reference;
   if (o.disturbance_time_constant_s > 0.0) options.disturbance_time_constant_s = o.disturbance_time_constant_s;
   std::fprintf(stderr, "rpem thermal fit: %zu steps of %.3g s; fitting a %d-node network\n", record.steps.size(),
@@ -111,7 +159,7 @@ Runner add_thermal_command(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand("thermal", "The machine's thermal network (docs/thermal.md)");
   cmd->require_subcommand(1);
   CLI::App* fit = cmd->add_subcommand("fit", "Fit the thermal network to a log and write thermal.yaml");
-  add_log_options(*fit, opts->log, opts->log_map);
+  add_log_options(*fit, opts->log, opts->log_map, "", LogPath::kFileOrSessions);
   fit->add_option("--config", opts->config, "machine and estimator YAML (default: built-in paper-ipmsm.yaml)")
       ->check(CLI::ExistingFile);
   writes_file(fit->add_option("--out", opts->out, "thermal.yaml to write"))->required();
@@ -122,7 +170,13 @@ Runner add_thermal_command(CLI::App& app) {
   fit->add_option("--nodes", opts->nodes,
                   "without a network to start from: 2 (winding, magnet) or 3 (winding, stator_iron, magnet)")
       ->check(CLI::IsMember({2, 3}));
-  fit->add_option("--fit-until-s", opts->fit_until_s, "train on the log up to this time, judge the rest (default: 75 %)");
+  CLI::Option* until = fit->add_option("--fit-until-s", opts->fit_until_s,
+                                       "train on the log up to this time, judge the rest (default: 75 %; a folder's "
+                                       "sessions one after another on one time axis, as the report lists them)");
+  fit->add_option("--held-out-sessions", opts->held_out_sessions,
+                  "a folder: judge its last N sessions, fit the ones before (instead of --fit-until-s)")
+      ->check(CLI::PositiveNumber)
+      ->excludes(until);
   fit->add_option("--winding-sensor-sigma-K", opts->winding_sensor_sigma_K, "σ of the log's winding sensor (default 1 K)")
       ->check(CLI::Range(1e-3, 100.0));
   fit->add_option("--period-s", opts->period_s, "the filter's step (default: thermal.yaml's, 1 s)")

@@ -60,6 +60,7 @@ void sensor_lag_at_standstill(io::ThermalConfig& c, const ThermalRecord& r, std:
     run = SensorLagRun{};
   };
   for (std::size_t k = 0; k < training && k < r.steps.size(); ++k) {
+    if (r.starts_session(k)) close();  // a run does not span two sessions
     const core::ParameterObservation& p = r.steps[k].parameter[rs];
     const double sensor = r.steps[k].winding_sensor_C;
     if (!p.valid || !std::isfinite(sensor) || !(p.time_constant_s >= 0.0)) {

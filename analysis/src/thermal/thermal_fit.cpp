@@ -72,11 +72,15 @@ constexpr double kRunaway = 1e6;
 void residuals(const io::ThermalConfig& c, const ThermalRecord& r, std::size_t steps, const std::vector<Point>& points,
                double* out) {
   const core::ThermalFusionConfig& f = c.fusion;
-  core::ThermalVec t = soaked_start(f, r);
+  core::ThermalVec t;
   core::SensorLag lag;
   std::size_t p = 0;
   for (std::size_t k = 0; k < steps && p < points.size(); ++k) {
     const core::ThermalStepData& s = r.steps[k];
+    if (r.starts_session(k)) {  // each session from its own start (as simulate_open_loop)
+      t = core::start_temperatures_C(f, s);
+      lag = core::SensorLag{};
+    }
     const core::ThermalRates rates = core::thermal_rates(f.filter.network, s.load);  // once: three uses
     const core::ThermalTransition tr = core::thermal_transition(f.filter.network, rates, s.load.dt_s);
     t = tr.phi * t + tr.gamma;
@@ -269,6 +273,7 @@ void judge(const io::ThermalConfig& c, const ThermalRecord& r, std::size_t train
   if (judged.winding_sensor_sigma_K <= 0.0) judged.winding_sensor_sigma_K = kUnfusedWindingSensorSigma_K;
   std::vector<core::SensorLag> lag(r.steps.size());  // at each step's start
   for (std::size_t k = 0; k + 1 < r.steps.size(); ++k) {
+    if (r.starts_session(k + 1)) continue;  // a session's first step starts without a lag
     lag[k + 1] = lag[k];
     advance_sensor_lag(judged, r.steps[k], core::thermal_rates(f.filter.network, r.steps[k].load), out.open_loop_C[k],
                        lag[k + 1]);
@@ -311,69 +316,144 @@ void judge(const io::ThermalConfig& c, const ThermalRecord& r, std::size_t train
   }
 }
 
+/// The steps [first, end) of session j.
+struct SessionSpan {
+  std::size_t first = 0, end = 0;
+};
+SessionSpan session_span(const ThermalRecord& r, std::size_t j) {
+  const std::vector<std::size_t>& f = r.session_first_step;
+  return {f[j], j + 1 < f.size() ? f[j + 1] : r.steps.size()};
+}
+
 /// The magnet law's reference from the soaked start (docs/thermal.md, "A log that does not start soaked"): the mean of
-/// the first kAnchorSteps magnet observations, each corrected for the held R_s (κ·(R_s(T_w) − r̂s)), at the
-/// magnet temperatures `t_magnet_C` of those steps (the soak's, or the network's prediction of the small rise
-/// since), referred to the law's reference temperature. Returns the steps used (0: none within the first
-/// kAnchorWithin_s).
-std::size_t anchor_magnet_reference(io::ThermalConfig& c, const ThermalRecord& r, const std::vector<double>& t_magnet_C,
-                                    const std::vector<double>& t_winding_C, std::vector<std::string>& notes) {
+/// the first kAnchorSteps magnet observations of each session in `sessions`, each corrected for the held R_s
+/// (κ·(R_s(T_w) − r̂s)), at the magnet temperatures `t_magnet_C` of those steps (the soak's, or the network's
+/// prediction of the small rise since), referred to the law's reference temperature. Returns the steps used (0: none
+/// within the first kAnchorWithin_s of those sessions).
+std::size_t anchor_magnet_reference(io::ThermalConfig& c, const ThermalRecord& r, const std::vector<std::size_t>& sessions,
+                                    const std::vector<double>& t_magnet_C, const std::vector<double>& t_winding_C,
+                                    std::vector<std::string>& notes) {
   constexpr std::size_t kAnchorSteps = 4;
   constexpr double kAnchorWithin_s = 300.0;
   core::DriftLaw& law = c.fusion.magnet_law;
   const core::DriftLaw& copper = c.fusion.filter.network.copper;
   double sum = 0.0;
   std::size_t used = 0;
-  for (std::size_t k = 0; k < r.steps.size() && used < kAnchorSteps && r.t_s[k] - r.t_s.front() <= kAnchorWithin_s; ++k) {
-    const core::ParameterObservation& p = r.steps[k].parameter[core::kPsiM];
-    if (!p.valid) continue;
-    const double psi = p.value - p.cross * (copper.at(t_winding_C[k]) - p.other_held);
-    sum += psi / (1.0 + law.coeff_per_K * (t_magnet_C[k] - law.reference_C));  // ψ at the reference temperature
-    ++used;
+  for (std::size_t j : sessions) {
+    const SessionSpan span = session_span(r, j);
+    std::size_t used_here = 0;
+    for (std::size_t k = span.first;
+         k < span.end && used_here < kAnchorSteps && r.t_s[k] - r.t_s[span.first] <= kAnchorWithin_s; ++k) {
+      const core::ParameterObservation& p = r.steps[k].parameter[core::kPsiM];
+      if (!p.valid) continue;
+      const double psi = p.value - p.cross * (copper.at(t_winding_C[k]) - p.other_held);
+      sum += psi / (1.0 + law.coeff_per_K * (t_magnet_C[k] - law.reference_C));  // ψ at the reference temperature
+      ++used_here;
+    }
+    used += used_here;
   }
   if (used == 0) {
-    notes.push_back("no magnet observation within the first 300 s: the magnet law's reference is kept as configured (" +
-                    std::to_string(law.value_ref) + " Wb at " + std::to_string(law.reference_C) + " °C)");
+    notes.push_back(std::string("no magnet observation within the first 300 s") +
+                    (r.session_first_step.size() > 1 ? " of a session that anchors it" : "") +
+                    ": the magnet law's reference is kept as configured (" + std::to_string(law.value_ref) + " Wb at " +
+                    std::to_string(law.reference_C) + " °C)");
     return 0;
   }
   law.value_ref = sum / static_cast<double>(used);
   return used;
 }
 
-/// Whether the log starts soaked, as the anchor and the open-loop start assume (every node at the coolant): where
-/// it has a winding sensor, its first reading within core::kSoakBound_sigma of the sensor's σ from the coolant. Returns
-/// the winding sensor's first reading where it does not (and a note saying what the fit does instead).
-std::optional<double> unsoaked_start_C(const io::ThermalConfig& c, const ThermalRecord& r, std::vector<std::string>& notes) {
-  if (!r.winding_sensor || r.steps.empty() || !std::isfinite(r.steps.front().winding_sensor_C)) return std::nullopt;
-  const core::ThermalFusionConfig& f = c.fusion;
-  const double sigma_K = f.winding_sensor_sigma_K > 0.0 ? f.winding_sensor_sigma_K : kUnfusedWindingSensorSigma_K;
-  const double winding_C = r.steps.front().winding_sensor_C, coolant_C = r.steps.front().load.coolant_C;
-  if (core::unsoaked_excess_K(winding_C, coolant_C, sigma_K) == 0.0) return std::nullopt;
-  char text[768];
-  std::snprintf(text, sizeof text,
-                "the log does not start soaked: at its first step the winding sensor reads %.1f °C, %.1f K from the "
-                "coolant's %.1f °C (more than %.0f times the sensor's σ of %.2g K). The magnet's temperature there is "
-                "not known: the magnet law's reference is anchored at the winding's reading instead of the coolant, "
-                "and its σ (reference_sigma_K) widened to that %.1f K, so that the band holds a magnet anywhere from "
-                "the coolant to as far above the winding (a magnet left hotter than its winding by a cool-down, or "
-                "colder by a heat-up). A log that starts with the machine at rest and cooled anchors it to the "
-                "sensor's σ (docs/thermal.md, \"A log that does not start soaked\")",
-                winding_C, winding_C - coolant_C, coolant_C, core::kSoakBound_sigma, sigma_K,
-                std::abs(winding_C - coolant_C));
-  notes.emplace_back(text);
+/// The winding sensor's σ the soak test takes: the fused one, else kUnfusedWindingSensorSigma_K.
+double soak_test_sigma_K(const core::ThermalFusionConfig& f) {
+  return f.winding_sensor_sigma_K > 0.0 ? f.winding_sensor_sigma_K : kUnfusedWindingSensorSigma_K;
+}
+
+/// Whether the session starting at step `first` starts soaked, as the anchor and the open-loop start assume (every
+/// node at the coolant): where it has a winding sensor, its first reading within core::kSoakBound_sigma of the
+/// sensor's σ from the coolant. Returns that first reading where it does not.
+std::optional<double> unsoaked_start_C(const io::ThermalConfig& c, const ThermalRecord& r, std::size_t first) {
+  if (!r.winding_sensor || first >= r.steps.size() || !std::isfinite(r.steps[first].winding_sensor_C)) return std::nullopt;
+  const double winding_C = r.steps[first].winding_sensor_C, coolant_C = r.steps[first].load.coolant_C;
+  if (core::unsoaked_excess_K(winding_C, coolant_C, soak_test_sigma_K(c.fusion)) == 0.0) return std::nullopt;
   return winding_C;
 }
 
-/// A start that is not soaked (unsoaked_start_C): the anchor's magnet temperatures at the winding's reading, the
-/// magnet reference's σ widened to the winding's distance from the coolant. Returns whether it was not.
-bool anchor_unsoaked_start(io::ThermalConfig& c, const ThermalRecord& r, std::vector<double>& t_magnet_C,
-                           std::vector<std::string>& notes) {
-  const std::optional<double> start_C = unsoaked_start_C(c, r, notes);
-  if (!start_C) return false;
-  std::fill(t_magnet_C.begin(), t_magnet_C.end(), *start_C);
+/// Each step's magnet and winding temperatures at its session's start (core::start_temperatures_C at its first step):
+/// where the anchor takes them before a network is fitted.
+void session_start_temperatures(const core::ThermalFusionConfig& f, const ThermalRecord& r, std::vector<double>& t_magnet_C,
+                                std::vector<double>& t_winding_C) {
+  t_magnet_C.resize(r.steps.size());
+  t_winding_C.resize(r.steps.size());
+  for (std::size_t j = 0; j < r.session_first_step.size(); ++j) {
+    const SessionSpan span = session_span(r, j);
+    const core::ThermalVec soak = core::start_temperatures_C(f, r.steps[span.first]);
+    for (std::size_t k = span.first; k < span.end; ++k) {
+      t_magnet_C[k] = soak[f.filter.network.magnet];
+      t_winding_C[k] = soak[f.filter.network.winding];
+    }
+  }
+}
+
+/// Where the magnet law's reference is anchored, and in how many passes.
+struct AnchorPlan {
+  std::vector<std::size_t> sessions;  ///< whose first magnet observations anchor it
+  bool refine = true;                 ///< a second pass at the fitted network's rise since the soak
+};
+
+/// The sessions that anchor the magnet law's reference (docs/thermal.md, "A log that does not start soaked", "A folder
+/// of logs"): those that start soaked, at the soak's temperatures refined by the network's rise. Where none does, every
+/// session at its winding sensor's first reading (`t_magnet_C` set so over each), in one pass, the magnet reference's σ
+/// widened to the largest distance of such a reading from its coolant. Notes say which and why.
+AnchorPlan plan_anchor(io::ThermalConfig& c, const ThermalRecord& r, std::vector<double>& t_magnet_C,
+                       std::vector<std::string>& notes) {
+  const std::size_t sessions = r.session_first_step.size();
+  AnchorPlan plan;
+  std::vector<std::optional<double>> unsoaked(sessions);
+  std::string unsoaked_names;
+  for (std::size_t j = 0; j < sessions; ++j) {
+    unsoaked[j] = unsoaked_start_C(c, r, r.session_first_step[j]);
+    if (!unsoaked[j]) {
+      plan.sessions.push_back(j);
+    } else {
+      char reading[96];
+      std::snprintf(reading, sizeof reading, " (winding %.1f °C, coolant %.1f °C)", *unsoaked[j],
+                    r.steps[r.session_first_step[j]].load.coolant_C);
+      unsoaked_names += (unsoaked_names.empty() ? "" : ", ") + r.session_logs[j] + reading;
+    }
+  }
+  if (!plan.sessions.empty()) {
+    if (!unsoaked_names.empty()) {
+      notes.push_back("sessions that do not start soaked (their winding sensor's first reading more than " +
+                      std::to_string(static_cast<int>(core::kSoakBound_sigma)) + " σ from the coolant): " + unsoaked_names +
+                      "; the magnet law's reference is anchored at the starts of the " +
+                      std::to_string(plan.sessions.size()) + " that do, where the magnet is at the coolant");
+    }
+    return plan;
+  }
+  // No session starts soaked: the magnet's temperature at any start is not known.
+  plan.refine = false;
   double& sigma_K = c.fusion.filter.calibration_sigma[static_cast<int>(core::Calibration::kMagnetOffset)];
-  sigma_K = std::max(sigma_K, std::abs(*start_C - r.steps.front().load.coolant_C));
-  return true;
+  for (std::size_t j = 0; j < sessions; ++j) {
+    const SessionSpan span = session_span(r, j);
+    const double start_C = *unsoaked[j], coolant_C = r.steps[span.first].load.coolant_C;
+    std::fill(t_magnet_C.begin() + static_cast<std::ptrdiff_t>(span.first),
+              t_magnet_C.begin() + static_cast<std::ptrdiff_t>(span.end), start_C);
+    sigma_K = std::max(sigma_K, std::abs(start_C - coolant_C));
+    plan.sessions.push_back(j);
+    char text[768];
+    std::snprintf(text, sizeof text,
+                  "%s does not start soaked: at its first step the winding sensor reads %.1f °C, %.1f K from the "
+                  "coolant's %.1f °C (more than %.0f times the sensor's σ of %.2g K). The magnet's temperature there is "
+                  "not known: the magnet law's reference is anchored at the winding's reading instead of the coolant, "
+                  "and its σ (reference_sigma_K) widened to that %.1f K, so that the band holds a magnet anywhere from "
+                  "the coolant to as far above the winding (a magnet left hotter than its winding by a cool-down, or "
+                  "colder by a heat-up). A log that starts with the machine at rest and cooled anchors it to the "
+                  "sensor's σ (docs/thermal.md, \"A log that does not start soaked\")",
+                  sessions == 1 ? "the log" : ("the session " + r.session_logs[j]).c_str(), start_C, start_C - coolant_C,
+                  coolant_C, core::kSoakBound_sigma, soak_test_sigma_K(c.fusion), std::abs(start_C - coolant_C));
+    notes.emplace_back(text);
+  }
+  return plan;
 }
 
 /// The note when the copper law's reference temperature was not stated but assumed (io::ThermalConfig).
@@ -469,16 +549,17 @@ ThermalFitResult fit_thermal(const ThermalRecord& record, const io::ThermalConfi
   const std::vector<double> prior = layout.values(start);
   // The magnet's reference: first at the soak temperature, then once more at the fitted network's magnet
   // temperatures of the anchor's steps (the rise since the soak), and the network fitted again.
-  const core::ThermalVec soak = soaked_start(start.fusion, record);
-  std::vector<double> t_magnet(record.steps.size(), soak[start.fusion.filter.network.magnet]);
-  std::vector<double> t_winding(record.steps.size(), soak[start.fusion.filter.network.winding]);
+  std::vector<double> t_magnet, t_winding;
+  session_start_temperatures(start.fusion, record, t_magnet, t_winding);
   // A start that is not soaked: anchored at the winding's reading, in one pass (the network's rise since the soak
   // does not apply).
-  const bool unsoaked = options.anchor_magnet_reference && anchor_unsoaked_start(start, record, t_magnet, out.notes);
+  const AnchorPlan anchor =
+      options.anchor_magnet_reference ? plan_anchor(start, record, t_magnet, out.notes) : AnchorPlan{{}, false};
   Solved best;
   std::vector<Point> points;
-  for (int pass = 0; pass < (options.anchor_magnet_reference && !unsoaked ? 2 : 1); ++pass) {
-    if (options.anchor_magnet_reference) anchor_magnet_reference(start, record, t_magnet, t_winding, out.notes);
+  for (int pass = 0; pass < (options.anchor_magnet_reference && anchor.refine ? 2 : 1); ++pass) {
+    if (options.anchor_magnet_reference)
+      anchor_magnet_reference(start, record, anchor.sessions, t_magnet, t_winding, out.notes);
     points = training_points(start, record, training);
     if (points.empty()) {
       throw io::DriveLogError(record.log, 0, 0, "",

@@ -1,7 +1,10 @@
 #include "rpem/analysis/thermal/thermal_record.hpp"
 
+#include <algorithm>
+#include <cassert>
 #include <limits>
 #include <optional>
+#include <stdexcept>
 
 #include "rpem/core/averaged_estimator.hpp"
 #include "rpem/core/drive_estimator.hpp"
@@ -40,10 +43,45 @@ class Recorder {
 
 }  // namespace
 
+bool ThermalRecord::starts_session(std::size_t k) const {
+  return std::binary_search(session_first_step.begin(), session_first_step.end(), k);
+}
+
+ThermalRecord join_sessions(std::vector<ThermalRecord> sessions, const std::string& name) {
+  if (sessions.empty()) throw std::invalid_argument("join_sessions: no session");
+  ThermalRecord out;
+  out.log = name;
+  out.session_first_step.clear();
+  out.coolant = true;
+  out.averaged = true;
+  for (ThermalRecord& s : sessions) {
+    if (s.steps.empty()) throw std::invalid_argument("join_sessions: " + s.log + " has no step of the thermal filter");
+    assert(s.session_first_step.size() == 1);  // a session is one log
+    // One step after the session before: the session's first step keeps its own length.
+    const double shift_s = out.t_s.empty() ? 0.0 : out.t_s.back() + s.steps.front().load.dt_s - s.t_s.front();
+    out.session_first_step.push_back(out.steps.size());
+    out.session_logs.push_back(s.log);
+    out.steps.insert(out.steps.end(), s.steps.begin(), s.steps.end());
+    for (double t : s.t_s) out.t_s.push_back(t + shift_s);
+    out.winding_sensor = out.winding_sensor || s.winding_sensor;
+    out.coolant = out.coolant && s.coolant;
+    out.averaged = out.averaged && s.averaged;
+    out.read_as += (out.read_as.empty() ? "" : "; ") + s.read_as;
+    for (std::size_t k = 0; k < s.counts.regimes.n.size(); ++k) out.counts.regimes.n[k] += s.counts.regimes.n[k];
+    out.counts.regimes.r_s_on_assumed_frame += s.counts.regimes.r_s_on_assumed_frame;
+    out.counts.samples += s.counts.samples;
+    out.counts.resyncs += s.counts.resyncs;
+    out.counts.outliers += s.counts.outliers;
+  }
+  out.counts.averaged = out.averaged;
+  return out;
+}
+
 ThermalRecord record_thermal(const io::LogSource& source, const io::MachineConfig& machine,
                              const io::ThermalConfig& thermal) {
   ThermalRecord r;
   r.log = source.path;
+  r.session_logs = {source.path};
   const io::DriveLogLimits limits = io::machine_limits(machine.machine);
   if (source.averaged()) {
     r.averaged = true;

@@ -1,19 +1,17 @@
 #include "rpem/analysis/thermal/thermal_replay.hpp"
 
 #include <cmath>
+#include <optional>
 
 namespace rpem::analysis {
-
-core::ThermalVec soaked_start(const core::ThermalFusionConfig& c, const ThermalRecord& r) {
-  if (r.steps.empty()) return core::ThermalVec::Constant(c.coolant_C);
-  return core::start_temperatures_C(c, r.steps.front());  // where core::ThermalFusion starts
-}
 
 std::vector<core::ThermalVec> simulate_open_loop(const core::ThermalFusionConfig& c, const ThermalRecord& r) {
   std::vector<core::ThermalVec> out;
   out.reserve(r.steps.size());
-  core::ThermalVec t = soaked_start(c, r);
-  for (const core::ThermalStepData& s : r.steps) {
+  core::ThermalVec t;
+  for (std::size_t k = 0; k < r.steps.size(); ++k) {
+    const core::ThermalStepData& s = r.steps[k];
+    if (r.starts_session(k)) t = core::start_temperatures_C(c, s);  // each session from its own start
     const core::ThermalTransition tr = core::thermal_transition(c.filter.network, s.load);
     t = tr.phi * t + tr.gamma;
     out.push_back(t);
@@ -25,17 +23,18 @@ std::vector<FilterStep> run_filter(const core::ThermalFusionConfig& c, const The
                                    double use_winding_sensor_until_s) {
   const std::size_t n = end == 0 ? r.steps.size() : std::min(end, r.steps.size());
   // The fusion block needs a base and machine only for its observer, which a replay does not use.
-  core::ThermalFusion fusion(c, core::PerUnitBase{}, core::MachineSi{});
+  std::optional<core::ThermalFusion> fusion;  // started afresh at each session's first step
   std::vector<FilterStep> out;
   out.reserve(n);
   const double gate2 = c.filter.gate_sigma * c.filter.gate_sigma;
   for (std::size_t k = 0; k < n; ++k) {
     core::ThermalStepData s = r.steps[k];
     if (r.t_s[k] > use_winding_sensor_until_s) s.winding_sensor_C = std::numeric_limits<double>::quiet_NaN();
-    fusion.apply(s);
+    if (r.starts_session(k)) fusion.emplace(c, core::PerUnitBase{}, core::MachineSi{});
+    fusion->apply(s);
     FilterStep f;
-    f.estimate = fusion.estimate();
-    f.observations = fusion.last_observations();
+    f.estimate = fusion->estimate();
+    f.observations = fusion->last_observations();
     for (const auto& o : f.observations) {
       if (!o.present || o.result == core::ObservationResult::kRejectedInvalid) continue;
       const double z2 = o.result == core::ObservationResult::kAccepted ? o.innovation * o.innovation / o.variance : gate2;

@@ -52,6 +52,11 @@ void write_thermal_yaml(const std::string& path, const ThermalFitResult& fit, co
   std::ofstream f = open(path);
   f << "# Thermal network fitted by `rpem thermal fit` (docs/thermal.md)\n";
   f << "# log: " << record.log << " (" << record.steps.size() << " steps), configuration: " << config_name << "\n";
+  if (record.session_first_step.size() > 1) {
+    f << "# sessions, one after another on the fit's time axis:";
+    for (const std::string& log : record.session_logs) f << " " << log;
+    f << "\n";
+  }
   f << "# training: t <= " << fit.fit_until_s << " s (" << fit.training_steps << " steps); the rest held out\n";
   for (const SignalFit& s : fit.signals) {
     f << "# " << s.name << ": " << training_span(s) << " in training (5–95 %, σ " << significant(s.training_sigma_K)
@@ -73,6 +78,11 @@ void write_thermal_fit_json(const std::string& path, const ThermalFitResult& fit
   j["log"] = record.log;
   j["configuration"] = config_name;
   j["steps"] = record.steps.size();
+  j["sessions"] = nlohmann::json::array();
+  for (std::size_t k = 0; k < record.session_first_step.size(); ++k) {
+    const std::size_t first = record.session_first_step[k];
+    j["sessions"].push_back({{"log", record.session_logs[k]}, {"first_step", first}, {"t_first_s", record.t_s[first]}});
+  }
   j["fit_until_s"] = fit.fit_until_s;
   j["training_steps"] = fit.training_steps;
   j["training_cost"] = fit.training_cost;
@@ -117,7 +127,20 @@ void write_thermal_fit_report(const std::string& path, const ThermalFitResult& f
   o << "# Thermal network fit\n\n";
   o << "Log `" << record.log << "` (" << record.steps.size() << " steps of the filter), configuration `" << config_name
     << "`. Training: the steps up to t = " << fit.fit_until_s << " s (" << fit.training_steps
-    << "); the rest is held out. The network runs open loop from a soaked start (every node at the coolant).\n\n";
+    << "); the rest is held out. The network runs open loop from a soaked start (every node at the coolant)"
+    << (record.session_first_step.size() > 1 ? ", each session from its own" : "") << ".\n\n";
+  if (record.session_first_step.size() > 1) {
+    o << "Sessions, one after another on the fit's time axis `t` (each from its own start; predictions.csv's "
+         "`session`):\n\n| session | log | steps | t from [s] |\n|---|---|---|---|\n";
+    for (std::size_t k = 0; k < record.session_first_step.size(); ++k) {
+      const std::size_t first = record.session_first_step[k];
+      const std::size_t end =
+          k + 1 < record.session_first_step.size() ? record.session_first_step[k + 1] : record.steps.size();
+      o << "| " << k << " | `" << record.session_logs[k] << "` | " << end - first << " | "
+        << significant(record.t_s[first], 6) << " |\n";
+    }
+    o << "\n";
+  }
   o << "| signal | observed in training, 5–95 % | σ [K] | fit RMS [K] | points | held-out RMS [K] | held-out worst "
        "[K] | points |\n|---|---|---|---|---|---|---|---|\n";
   for (const SignalFit& s : fit.signals) {
@@ -161,9 +184,11 @@ void write_thermal_predictions(const std::string& path, const ThermalFitResult& 
   const core::ThermalNetwork& n = c.fusion.filter.network;
   f << "t";
   for (int i = 0; i < n.nodes; ++i) f << ",T_" << c.node_names[static_cast<std::size_t>(i)] << "_model";
-  f << ",T_magnet_observed,T_winding_observed,T_winding_sensor,T_coolant,copper_loss_W\n";
+  f << ",T_magnet_observed,T_winding_observed,T_winding_sensor,T_coolant,copper_loss_W,session\n";
   std::string line;
+  std::size_t session = 0;
   for (std::size_t k = 0; k < record.steps.size(); ++k) {
+    if (k > 0 && record.starts_session(k)) ++session;
     const core::ThermalStepData& s = record.steps[k];
     line.clear();
     io::append_number(line, record.t_s[k]);
@@ -178,7 +203,7 @@ void write_thermal_predictions(const std::string& path, const ThermalFitResult& 
     if (std::isfinite(s.winding_sensor_C)) io::append_number(line, s.winding_sensor_C);
     io::append_number(line += ',', s.load.coolant_C);
     io::append_number(line += ',', 1.5 * s.load.current_sq_A2 * n.copper.at(fit.open_loop_C[k][n.winding]));
-    f << line << '\n';
+    f << line << ',' << session << '\n';
   }
 }
 

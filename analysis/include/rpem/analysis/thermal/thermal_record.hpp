@@ -23,6 +23,14 @@ struct ThermalRecord {
   bool averaged = false;
   std::string read_as;      ///< what the log was read as, for the tools (io::describe; the format for phase samples)
   io::SampleCounts counts;  ///< what the estimator run did with the samples (its regimes)
+  /// The first step of each logging session, ascending, the first 0 (docs/thermal.md, "A folder of logs"): one log is
+  /// one session. Each session starts from its own state — the network, the filter and the sensor's lag restart at
+  /// its first step (core::start_temperatures_C) — and its steps' t_s follow the session before's end.
+  std::vector<std::size_t> session_first_step{0};
+  std::vector<std::string> session_logs;  ///< each session's log, in that order
+
+  /// Whether step k is the first of a session.
+  [[nodiscard]] bool starts_session(std::size_t k) const;
 };
 
 /// Runs the configured estimator over the log — read as `source` says, as `rpem estimate` reads it: our drive or
@@ -31,5 +39,11 @@ struct ThermalRecord {
 /// input.
 [[nodiscard]] ThermalRecord record_thermal(const io::LogSource& source, const io::MachineConfig& machine,
                                            const io::ThermalConfig& thermal);
+
+/// The sessions of one machine (a folder of logs, each recorded on its own: record_thermal) as one record named
+/// `name`: their steps one after another, each session's t_s shifted to begin one step after the one before ends.
+/// It has a winding sensor where any session has one, the coolant where every session has it. Throws
+/// std::invalid_argument on no session, or on a session without steps.
+[[nodiscard]] ThermalRecord join_sessions(std::vector<ThermalRecord> sessions, const std::string& name);
 
 }  // namespace rpem::analysis

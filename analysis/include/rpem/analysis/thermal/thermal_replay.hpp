@@ -1,6 +1,7 @@
 #pragma once
 // The thermal network over a recorded log (thermal_record.hpp), two ways: open loop from the soaked start
 // (the model alone), and the fusion filter as rpemd runs it (core::ThermalFusion::apply on each recorded step).
+// Both start afresh at each session's first step (ThermalRecord::session_first_step).
 
 #include <functional>
 #include <vector>
@@ -10,11 +11,9 @@
 
 namespace rpem::analysis {
 
-/// Where the network starts: core::start_temperatures_C at the first step (every node at the coolant, the winding
-/// at its sensor; every node there where the sensor says the machine is not soaked), as core::ThermalFusion starts.
-[[nodiscard]] core::ThermalVec soaked_start(const core::ThermalFusionConfig& c, const ThermalRecord& r);
-
-/// The network's temperatures at the end of each step, open loop from the soaked start.
+/// The network's temperatures at the end of each step, open loop from each session's start: core::start_temperatures_C
+/// at its first step (every node at the coolant, the winding at its sensor; every node there where the sensor says the
+/// machine is not soaked), where core::ThermalFusion starts.
 [[nodiscard]] std::vector<core::ThermalVec> simulate_open_loop(const core::ThermalFusionConfig& c, const ThermalRecord& r);
 
 /// One step of the filter's run.

@@ -17,7 +17,8 @@ void write_thermal_fit_json(const std::string& path, const ThermalFitResult& fit
 void write_thermal_fit_report(const std::string& path, const ThermalFitResult& fit, const ThermalRecord& record,
                               const std::string& config_name);
 /// t, the model's node temperatures, the magnet and winding temperatures the estimates imply (their laws'
-/// inverses where they are observations, else empty) and the winding sensor.
+/// inverses where they are observations, else empty), the winding sensor, the coolant, the copper loss and the session
+/// (0, 1, …: ThermalRecord::session_first_step).
 void write_thermal_predictions(const std::string& path, const ThermalFitResult& fit, const ThermalRecord& record);
 
 /// What the training part observed of a signal, for every output: "24.9–25.0 °C", or "none" where it has none of it.
