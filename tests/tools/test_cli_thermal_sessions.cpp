@@ -55,9 +55,9 @@ class CliThermalSessions : public ::testing::Test {
     }
     const test::ProcessResult r = test::run_command(
         test::binary_dir() + "/tests/independent_thermal/indep_thermal_plant" + pmsm_config() + " --profile " +
-        at(name + "_profile.csv") + " --coolant constant --set coolant.start_C=25 --duration-s " +
-        std::to_string(length_s) + " --rate-Hz 1 --seed 1 --out " + at(name + ".csv") + " --truth " +
-        at(name + "_truth.csv") + " --parameters " + at(name + ".json") + " " + plant_options);
+        at(name + "_profile.csv") + " --coolant constant --set coolant.start_C=25 --duration-s " + std::to_string(length_s) +
+        " --rate-Hz 1 --seed 1 --out " + at(name + ".csv") + " --truth " + at(name + "_truth.csv") + " --parameters " +
+        at(name + ".json") + " " + plant_options);
     ASSERT_EQ(r.exit_code, 0) << r.output;
   }
 
@@ -66,7 +66,9 @@ class CliThermalSessions : public ::testing::Test {
   void write_start(const std::string& plant_json) const {
     std::ifstream in(at(plant_json));
     const nlohmann::json p = nlohmann::json::parse(in).at("parameters");
-    const auto referred = [](double alpha20, double reference_C) { return alpha20 / (1.0 + alpha20 * (reference_C - 20.0)); };
+    const auto referred = [](double alpha20, double reference_C) {
+      return alpha20 / (1.0 + alpha20 * (reference_C - 20.0));
+    };
     const double rc = p.at("electrical.r_s_reference_C"), mc = p.at("electrical.psi_m_reference_C");
     std::ofstream out(at("start.yaml"));
     out.precision(17);
@@ -141,9 +143,8 @@ TEST_F(CliThermalSessions, ASecondOperatingPointPredictsAHeldOutSession) {
   write_folder("abc", {"a", "b", "c"});
   for (const std::string folder : {"ac", "abc"}) {
     const test::ProcessResult r =
-        test::run_command(rpem_tool() + " thermal fit --log " + at(folder) + pmsm_config() + " --start " +
-                          at("start.yaml") + " --held-out-sessions 1 --out " + at(folder + ".yaml") + " --report " +
-                          at(folder + "_report"));
+        test::run_command(rpem_tool() + " thermal fit --log " + at(folder) + pmsm_config() + " --start " + at("start.yaml") +
+                          " --held-out-sessions 1 --out " + at(folder + ".yaml") + " --report " + at(folder + "_report"));
     ASSERT_EQ(r.exit_code, 0) << r.output;
     EXPECT_NE(r.output.find(std::to_string(folder.size()) + " sessions of " + at(folder) + ", each from its own start"),
               std::string::npos)
@@ -156,8 +157,7 @@ TEST_F(CliThermalSessions, ASecondOperatingPointPredictsAHeldOutSession) {
   EXPECT_LT(fit.at("fit_until_s").get<double>(), c_first_s);
   EXPECT_GE(fit.at("fit_until_s").get<double>(), c_first_s - 1.0 - 1e-9);  // the last step of B, 1 s long
   for (std::size_t k = 0; k < 3; ++k) {
-    EXPECT_NE(fit.at("sessions")[k].at("log").get<std::string>().find("/" + std::to_string(k + 1) + "_"),
-              std::string::npos);
+    EXPECT_NE(fit.at("sessions")[k].at("log").get<std::string>().find("/" + std::to_string(k + 1) + "_"), std::string::npos);
   }
 
   // Each session starts from its own soaked start: the model's winding at B's first step is at the coolant, though A
