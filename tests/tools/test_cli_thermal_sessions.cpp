@@ -259,6 +259,26 @@ TEST_F(CliThermalSessions, TheMagnetReferenceIsAnchoredWhereASessionStartsSoaked
   EXPECT_NEAR(magnet_law("warm_only").second, 30.0, 0.5);
 }
 
+// Sessions unlike one another: one without a winding sensor (the fit takes the sensor where a session has it), and
+// one too short for a step of the filter, left out and said so; the held-out part, in the sensorless session, has no
+// sensor reading to judge, and the line says that rather than that nothing was held out.
+TEST_F(CliThermalSessions, SessionsWithoutASensorOrAStepAreTakenAsTheyAre) {
+  write_session("sensor", 5000.0, 110.0, -70.0, 900.0);
+  write_session("no_sensor", 5000.0, 110.0, -70.0, 900.0, "--no-winding-sensor");
+  write_start("sensor.json");
+  write_folder("uneven", {"sensor", "no_sensor"});
+  { std::ofstream(at("uneven/3_short.csv")) << "t,i_d,i_q,u_d,u_q,omega_el\n0,0,0,0,0,0\n0.5,0,0,0,0,0\n"; }
+  const test::ProcessResult r = test::run_command(rpem_tool() + " thermal fit --log " + at("uneven") + pmsm_config() +
+                                                  " --start " + at("start.yaml") + " --out " + at("uneven.yaml"));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find(at("uneven") + "/3_short.csv gives no step of the thermal filter (1 s): left out"),
+            std::string::npos)
+      << r.output;
+  EXPECT_NE(r.output.find("2 sessions of " + at("uneven")), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("nothing held out (none after the training part's end at "), std::string::npos) << r.output;
+  EXPECT_EQ(r.output.find("takes the whole log"), std::string::npos) << r.output;
+}
+
 // The folders and options it refuses: a log that cannot be read ends the fit with its file:line (65), since a fit
 // without it would be another fit; holding out every session (64); --held-out-sessions beside --fit-until-s (64).
 TEST_F(CliThermalSessions, RefusesWhatCannotBeFitted) {

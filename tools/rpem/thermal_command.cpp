@@ -128,7 +128,11 @@ int run_thermal_fit(const ThermalFitCliOptions& o) {
     std::printf("%s: %s in training (σ %.2g K); fit %.3g K RMS, ", s.name.c_str(), analysis::training_span(s).c_str(),
                 s.training_sigma_K, s.fit_rms_K);
     if (s.heldout_points == 0) {
-      std::printf("nothing held out (the training part, to %.6g s, takes the whole log)\n", fit.fit_until_s);
+      if (fit.training_steps == record.steps.size()) {
+        std::printf("nothing held out (the training part, to %.6g s, takes the whole log)\n", fit.fit_until_s);
+      } else {  // e.g. a held-out session without a winding sensor
+        std::printf("nothing held out (none after the training part's end at %.6g s)\n", fit.fit_until_s);
+      }
     } else {
       std::printf("held out %.3g K RMS (worst %.3g K)\n", s.heldout_rms_K, s.heldout_worst_K);
     }
