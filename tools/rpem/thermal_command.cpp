@@ -1,6 +1,6 @@
 // rpem thermal fit --log LOG.csv|FOLDER [--log-map MAP.yaml] --config CFG.yaml --out thermal.yaml
-//                  [--start THERMAL.yaml | --nodes 2|3] [--fit-until-s S] [--winding-sensor-sigma-K K] [--period-s S]
-//                  [--report DIR]
+//                  [--start THERMAL.yaml | --nodes 2|3] [--fit-until-s S | --held-out-sessions N]
+//                  [--winding-sensor-sigma-K K] [--period-s S] [--report DIR]
 // Fits the machine's thermal network to what a log shows of its temperatures — a winding sensor, the
 // coolant, the magnet temperature from ψ̂m and the winding's from r̂s (the estimator run over the log) —
 // and writes the `thermal` section rpemd and `rpem estimate --thermal` read (docs/thermal.md). A magnet

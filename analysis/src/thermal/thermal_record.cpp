@@ -67,13 +67,7 @@ ThermalRecord join_sessions(std::vector<ThermalRecord> sessions, const std::stri
     out.coolant = out.coolant && s.coolant;
     out.averaged = out.averaged && s.averaged;
     out.read_as += (out.read_as.empty() ? "" : "; ") + s.read_as;
-    for (std::size_t k = 0; k < s.counts.regimes.n.size(); ++k) out.counts.regimes.n[k] += s.counts.regimes.n[k];
-    out.counts.regimes.r_s_on_assumed_frame += s.counts.regimes.r_s_on_assumed_frame;
-    out.counts.samples += s.counts.samples;
-    out.counts.resyncs += s.counts.resyncs;
-    out.counts.outliers += s.counts.outliers;
   }
-  out.counts.averaged = out.averaged;
   return out;
 }
 

@@ -42,7 +42,8 @@ struct ThermalRecord {
 
 /// The sessions of one machine (a folder of logs, each recorded on its own: record_thermal) as one record named
 /// `name`: their steps one after another, each session's t_s shifted to begin one step after the one before ends.
-/// It has a winding sensor where any session has one, the coolant where every session has it. Throws
+/// It has a winding sensor where any session has one, the coolant where every session has it; its `counts` are
+/// empty (each session's are its own, for the tools to say as it is recorded). Throws
 /// std::invalid_argument on no session, or on a session without steps.
 [[nodiscard]] ThermalRecord join_sessions(std::vector<ThermalRecord> sessions, const std::string& name);
 
