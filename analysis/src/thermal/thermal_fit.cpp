@@ -320,10 +320,7 @@ void judge(const io::ThermalConfig& c, const ThermalRecord& r, std::size_t train
 struct SessionSpan {
   std::size_t first = 0, end = 0;
 };
-SessionSpan session_span(const ThermalRecord& r, std::size_t j) {
-  const std::vector<std::size_t>& f = r.session_first_step;
-  return {f[j], j + 1 < f.size() ? f[j + 1] : r.steps.size()};
-}
+SessionSpan session_span(const ThermalRecord& r, std::size_t j) { return {r.session_first_step[j], r.session_end(j)}; }
 
 /// The magnet law's reference from the soaked start (docs/thermal.md, "A log that does not start soaked"): the mean of
 /// the first kAnchorSteps magnet observations of each session in `sessions`, each corrected for the held R_s

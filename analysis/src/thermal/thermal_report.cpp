@@ -134,9 +134,7 @@ void write_thermal_fit_report(const std::string& path, const ThermalFitResult& f
          "`session`):\n\n| session | log | steps | t from [s] |\n|---|---|---|---|\n";
     for (std::size_t k = 0; k < record.session_first_step.size(); ++k) {
       const std::size_t first = record.session_first_step[k];
-      const std::size_t end =
-          k + 1 < record.session_first_step.size() ? record.session_first_step[k + 1] : record.steps.size();
-      o << "| " << k << " | `" << record.session_logs[k] << "` | " << end - first << " | "
+      o << "| " << k << " | `" << record.session_logs[k] << "` | " << record.session_end(k) - first << " | "
         << significant(record.t_s[first], 6) << " |\n";
     }
     o << "\n";

@@ -31,6 +31,10 @@ struct ThermalRecord {
 
   /// Whether step k is the first of a session.
   [[nodiscard]] bool starts_session(std::size_t k) const;
+  /// One past session j's last step.
+  [[nodiscard]] std::size_t session_end(std::size_t j) const {
+    return j + 1 < session_first_step.size() ? session_first_step[j + 1] : steps.size();
+  }
 };
 
 /// Runs the configured estimator over the log — read as `source` says, as `rpem estimate` reads it: our drive or
