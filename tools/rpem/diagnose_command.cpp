@@ -1,4 +1,4 @@
-// rpem diagnose --log LOG.csv --config MACHINE.yaml --out DIR [--truth TRUTH.csv] …
+// rpem diagnose --log LOG.csv|FOLDER --config MACHINE.yaml --out DIR [--truth TRUTH.csv] …
 // Shows what the nominal model gets wrong on measured data, names the cause from the catalogue of
 // effects, extends the model and measures the gain (docs/diagnose.md). Writes DIR/report.html,
 // DIR/report.md, the figures, DIR/diagnosis.json and DIR/extended.yaml — all at once at the end: they are
@@ -13,9 +13,11 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include "commands.hpp"
 #include "diagnose_monitor.hpp"
+#include "log_folder.hpp"
 #include "log_options.hpp"
 #include "rpem/analysis/diagnose/diagnose_output.hpp"
 #include "rpem/analysis/work_pool.hpp"
@@ -166,7 +168,18 @@ std::string blocks_note(const analysis::LogData& log) {
 int diagnose_and_write(const DiagnoseCliOptions& o, const io::MachineConfig& config, const std::string& config_text,
                        const std::string& config_name, const analysis::LogOptions& log_options, TerminalMonitor& monitor);
 
+/// A folder's logs, in the order `rpem estimate --log FOLDER` takes them.
+std::vector<std::string> folder_logs(const std::string& folder) {
+  std::vector<std::string> logs;
+  for (const fs::path& p : logs_in_folder(folder)) logs.push_back(p.string());
+  return logs;
+}
+
 int run_diagnose(const DiagnoseCliOptions& o) {
+  if (!o.truth.empty() && fs::is_directory(o.log)) {
+    std::fprintf(stderr, "rpem diagnose: --truth is one log's truth: with --log a folder, give none\n");
+    return kExitUsage;
+  }
   const std::string config_text = o.config.empty() ? io::builtin_paper_config_text() : read_text(o.config);
   const io::MachineConfig config = o.config.empty() ? io::builtin_paper_config() : io::load_machine_config(o.config);
   const std::string config_name = o.config.empty() ? "builtin:paper-ipmsm" : o.config;
@@ -190,13 +203,24 @@ int run_diagnose(const DiagnoseCliOptions& o) {
 int diagnose_and_write(const DiagnoseCliOptions& o, const io::MachineConfig& config, const std::string& config_text,
                        const std::string& config_name, const analysis::LogOptions& log_options, TerminalMonitor& monitor) {
   std::fprintf(stderr, "rpem diagnose: reading %s\n", o.log.c_str());
-  analysis::LogData log =
-      analysis::load_log(o.log, config.machine, log_options, [&](std::uint64_t done, std::uint64_t total) {
-        monitor.reading(done, total);
-        if (monitor.stop_requested()) throw analysis::Interrupted();
-      });
+  const auto progress = [&](std::uint64_t done, std::uint64_t total) {
+    monitor.reading(done, total);
+    if (monitor.stop_requested()) throw analysis::Interrupted();
+  };
+  analysis::LogData log = fs::is_directory(o.log)
+                              ? analysis::load_sessions(o.log, folder_logs(o.log), config.machine, log_options, progress)
+                              : analysis::load_log(o.log, config.machine, log_options, progress);
   monitor.finish();
-  std::fprintf(stderr, "rpem diagnose: read %s\n", log.format.c_str());
+  std::istringstream formats(log.format);
+  for (std::string line; std::getline(formats, line);) std::fprintf(stderr, "rpem diagnose: read %s\n", line.c_str());
+  if (log.sessions() > 1) {
+    std::fprintf(stderr, "rpem diagnose: %zu logs joined as one machine's sessions, each from the configuration:\n",
+                 log.sessions());
+    for (std::size_t j = 0; j < log.sessions(); ++j) {
+      std::fprintf(stderr, "rpem diagnose:   %s: %zu samples from t = %.6g s\n", log.session_logs[j].c_str(),
+                   log.session_end(j) - log.session_first[j], log.t_s(log.session_first[j]));
+    }
+  }
   io::check_log_supports(config, config_name, log.layout.u_dc, o.log);
   if (const std::string note = blocks_note(log); !note.empty()) {
     std::fprintf(stderr, "rpem diagnose: note: %s\n", note.c_str());
@@ -244,7 +268,7 @@ Runner add_diagnose_command(CLI::App& app) {
   auto o = std::make_shared<DiagnoseCliOptions>();
   CLI::App* cmd = app.add_subcommand(
       "diagnose", "Show what the model gets wrong on measured data, name the cause, extend the model, measure the gain");
-  add_log_options(*cmd, o->log, o->log_map);
+  add_log_options(*cmd, o->log, o->log_map, "", LogPath::kFileOrSessions);
   cmd->add_option("--config", o->config,
                   "machine configuration YAML, the baseline: its whole model, extensions and drift laws (default: built-in "
                   "paper-ipmsm); an extended.yaml of another recording is one")

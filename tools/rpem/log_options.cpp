@@ -8,7 +8,7 @@ void add_log_options(CLI::App& cmd, std::string& log, std::string& log_map, cons
       "(docs/drive-log.md)";
   if (path == LogPath::kFileOrFolder) formats += "; or a folder of them, each on its own (\"A folder of logs\")";
   if (path == LogPath::kFileOrSessions)
-    formats += "; or a folder of them, one machine's sessions fitted together (docs/thermal.md, \"A folder of logs\")";
+    formats += "; or a folder of them, one machine's sessions taken together (docs/drive-log.md, \"A folder of logs\")";
   CLI::Option* log_option =
       cmd.add_option("--log", log, purpose.empty() ? formats : purpose + ": " + formats)
           ->check(path == LogPath::kFile ? CLI::Validator(CLI::ExistingFile) : CLI::Validator(CLI::ExistingPath));

@@ -8,7 +8,8 @@
 namespace rpem::tools {
 
 /// What --log may name: a log; or also a folder of them, each log on its own (rpem estimate: log_folder.hpp) or the
-/// logs as one machine's sessions, together (rpem thermal fit: analysis::join_sessions).
+/// logs as one machine's sessions, together (rpem thermal fit: analysis::join_sessions; rpem diagnose:
+/// analysis::load_sessions).
 enum class LogPath { kFile, kFileOrFolder, kFileOrSessions };
 
 /// Adds --log and --log-map to `cmd`. Without `purpose` --log is required; with it (what the subcommand does

@@ -287,9 +287,10 @@ EffectRow drift() {
     r.confusions = {{"ld_saturation", "operation at two or more d-axis currents"},
                     {"iron_loss", "the same torque at two or more speeds"}};
   }
+  // Against time only within one session: each session of a folder starts at its own temperature.
   r.applies = [](const EffectContext& c) {
     const TemperatureColumn& col = kWinding ? c.t_winding : c.t_magnet;
-    return !col.logged || col.span_K >= kMinDriftSpan_K;
+    return col.logged ? col.span_K >= kMinDriftSpan_K : c.sessions == 1;
   };
   r.apply = [](const Effect&, const double* p, const EffectContext& c, ExtendedModel& m) {
     const TemperatureColumn& col = kWinding ? c.t_winding : c.t_magnet;

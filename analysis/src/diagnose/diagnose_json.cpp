@@ -205,6 +205,17 @@ void write_diagnosis_json(const std::string& path, const Diagnosis& d, const std
       {"estimator_outliers", d.regimes.counts.outliers},
       {"r_s_on_assumed_frame", d.regimes.counts.regimes.r_s_on_assumed_frame},
       {"exclusion_explanations", d.regimes.explanations}};
+  // A folder's logs, joined: each session's samples and its span on the joined time axis.
+  nlohmann::json sessions = nlohmann::json::array();
+  for (std::size_t j = 0; j < log.sessions(); ++j) {
+    const std::size_t first = log.session_first[j], end = log.session_end(j);
+    sessions.push_back({{"log", log.session_logs[j]},
+                        {"first_sample", first},
+                        {"samples", end - first},
+                        {"t_first_s", log.t_s(first)},
+                        {"t_last_s", log.t_s(end - 1)}});
+  }
+  out["log"]["sessions"] = sessions;
   out["machine_config"] = config_path;
   out["verdict"] = to_string(d.verdict.kind);
   out["noise_floor_A"] = optional_json(d.verdict.noise_floor_A);

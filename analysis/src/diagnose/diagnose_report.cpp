@@ -55,6 +55,7 @@ void summary(ReportDocument& doc, const Diagnosis& d, const std::string& config_
   doc.paragraph(text);
   text = "The configuration (`" + config_path +
          "`, its whole model: model extensions and drift laws) replayed on the inputs of `" + log.path + "` (" +
+         (log.sessions() > 1 ? "its " + std::to_string(log.sessions()) + " logs joined as sessions, below; " : "") +
          std::to_string(log.size()) + " samples over " + num(log.t_end_s - log.t_start_s, 3) + " s, " +
          (log.mode == ModelMode::kTransient ? "transient: the open-loop discrete predictor"
                                             : "steady state: the closed-form steady-state model") +
@@ -106,6 +107,31 @@ void summary(ReportDocument& doc, const Diagnosis& d, const std::string& config_
     doc.paragraph("Not identifiable from this log:");
     doc.bullets(items);
   }
+}
+
+/// A folder's logs, joined as one machine's sessions (nothing for one log).
+void sessions(ReportDocument& doc, const Diagnosis& d) {
+  const LogData& log = *d.log;
+  if (log.sessions() < 2) return;
+  doc.heading(1, "Sessions");
+  doc.paragraph(
+      "The folder's " + std::to_string(log.sessions()) +
+      " logs are one machine's sessions, diagnosed together: each is read as it would be alone, and they lie one "
+      "after another on the time axis (t below and in the figures), " +
+      num(core::to_seconds(LogData::kSessionGap_ns), 2) +
+      " s apart. Every replay and the estimator start afresh at each session's first sample (the estimator from the "
+      "configuration, as on its log alone); the training and held-out blocks are cut in the time the sessions "
+      "sampled, so a block may hold the end of one session and the start of the next. A drift against time is no "
+      "candidate here: each session starts at its own temperature (a drift against a logged temperature is).");
+  std::vector<std::vector<std::string>> rows;
+  for (std::size_t j = 0; j < log.sessions(); ++j) {
+    const std::size_t first = log.session_first[j], end = log.session_end(j);
+    std::size_t used = 0;
+    for (std::size_t k = first; k < end; ++k) used += log.used(k) ? 1 : 0;
+    rows.push_back({"`" + log.session_logs[j] + "`", std::to_string(end - first), std::to_string(used),
+                    num(log.t_s(first), 6), num(log.t_s(end - 1), 6)});
+  }
+  doc.table({"log", "samples", "in the fits", "t first [s]", "t last [s]"}, rows);
 }
 
 void regimes(ReportDocument& doc, const Diagnosis& d) {
@@ -388,6 +414,7 @@ void write_diagnose_report(const std::string& dir, const Diagnosis& d, const std
   const std::vector<std::string> figures = write_diagnose_figures(dir, d);
   ReportDocument doc("Diagnosis of " + d.log->path);
   summary(doc, d, config_path);
+  sessions(doc, d);
   regimes(doc, d);
   calibration(doc, d);
   loss(doc, d);

@@ -95,6 +95,7 @@ EffectContext EffectContext::of(const LogData& log, const core::MachineSi& machi
   c.speed_spread_rel = log.speed_spread_rel;
   c.t_start_s = log.t_start_s;
   c.t_span_s = std::max(log.t_end_s - log.t_start_s, 1e-9);
+  c.sessions = log.sessions();
   c.t_winding = winding_column(log);
   c.t_magnet = magnet_column(log);
   c.reference_C = reference_C;

@@ -85,6 +85,7 @@ ParameterTrack run_rpem(const LogData& log, const io::MachineConfig& config, Mon
   ParameterTrack track;
   const std::size_t every = std::max<std::size_t>(1, log.size() / kTrackPoints);
   for (std::size_t k = 0; k < log.size(); ++k) {
+    if (log.starts_session(k)) estimator.reset();  // each session from the configuration, as its log alone
     const core::Estimate e = estimator.step(log.sample(k));
     if (k % every == 0) track.add(core::to_seconds(e.t_ns), e.psi_m_Wb, e.r_s_Ohm);
     if ((k + 1) % kMonitorSamples == 0) report_work(monitor, kMonitorSamples);
@@ -138,6 +139,7 @@ double estimator_heldout_rms_A(const LogData& log, const io::MachineConfig& conf
   for (int b = 0; b < log.blocks; ++b) {
     for (std::size_t k = log.block_first[static_cast<std::size_t>(b)]; k < log.block_first[static_cast<std::size_t>(b) + 1];
          ++k) {
+      if (log.starts_session(k)) estimator.reset();
       const core::Estimate e = estimator.step(log.sample(k));
       if ((k + 1) % kMonitorSamples == 0) report_work(monitor, kMonitorSamples);
       if (b % 2 != 1 || !log.used(k) || e.detail.code != core::StepCode::kAdapted) continue;

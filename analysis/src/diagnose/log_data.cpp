@@ -1,6 +1,7 @@
 #include "rpem/analysis/diagnose/log_data.hpp"
 
 #include <algorithm>
+#include <cassert>
 #include <cmath>
 #include <cstdio>
 
@@ -27,7 +28,8 @@ constexpr double kIdleShare = 0.02;
 constexpr double kSteadyStateTimeConstants = 5.0;
 
 /// Each sample's time since the first with the log's pauses left out (an interval longer than
-/// LogData::kPauseMedianIntervals median intervals counts nothing); counts the pauses into `d`.
+/// LogData::kPauseMedianIntervals median intervals counts nothing), and the time between sessions; counts the
+/// pauses into `d`.
 std::vector<double> sampled_time_s(LogData& d) {
   std::vector<double> sampled(d.size(), 0.0);
   d.pauses = 0;
@@ -35,6 +37,10 @@ std::vector<double> sampled_time_s(LogData& d) {
   const double pause_s = LogData::kPauseMedianIntervals * d.median_dt_s;
   for (std::size_t k = 1; k < d.size(); ++k) {
     const double step_s = d.t_s(k) - d.t_s(k - 1);
+    if (d.starts_session(k)) {
+      sampled[k] = sampled[k - 1];
+      continue;
+    }
     const bool pause = d.median_dt_s > 0.0 && step_s > pause_s;
     sampled[k] = sampled[k - 1] + (pause ? 0.0 : step_s);
     if (pause) {
@@ -102,12 +108,17 @@ void check_enough_samples(const LogData& d, const LogOptions& options) {
 void prepare_log(LogData& d, const core::MachineSi& machine, const LogOptions& options) {
   const std::size_t n = d.samples.size();
   check_enough_samples(d, options);
+  if (d.session_logs.empty()) d.session_logs.push_back(d.path);  // rows from memory: one session
+  assert(d.session_logs.size() == d.session_first.size() && d.session_first.front() == 0);
+  assert(std::is_sorted(d.session_first.begin(), d.session_first.end()) && d.session_first.back() < n);
   d.t_start_s = d.t_s(0);
   d.t_end_s = d.t_s(n - 1);
   {
     std::vector<double> dts;
     dts.reserve(n - 1);
-    for (std::size_t k = 1; k < n; ++k) dts.push_back(core::to_seconds(d.samples.t_ns(k) - d.samples.t_ns(k - 1)));
+    for (std::size_t k = 1; k < n; ++k) {
+      if (!d.starts_session(k)) dts.push_back(core::to_seconds(d.samples.t_ns(k) - d.samples.t_ns(k - 1)));
+    }
     d.median_dt_s = median(std::move(dts));
   }
 
@@ -148,7 +159,8 @@ void prepare_log(LogData& d, const core::MachineSi& machine, const LogOptions& o
         continue;
       }
       for (std::size_t j : {k - 1, k + 1}) {
-        if (j >= n) continue;  // k − 1 wraps for k = 0
+        if (j >= n) continue;                            // k − 1 wraps for k = 0
+        if (d.starts_session(std::max(j, k))) continue;  // another session's sample is no neighbour
         if (std::abs(current(j) - current(k)) > kTransitionShare * i_span ||
             std::abs(speed(j) - speed(k)) > kTransitionShare * n_span) {
           d.samples.set_mark(k, sample_mark::kLeftOut, true);
@@ -220,26 +232,6 @@ core::Vec2 applied_mean_V(const core::Vec2& command_V, double omega_el_rad_s, do
   return sinc * core::park(command_V, core::Rotation::of(delay_periods * wt));
 }
 
-namespace {
-
-/// Turns a drive's reported commands into the applied means (LogOptions::voltage_is_command); returns what it
-/// did, for the log's description.
-std::string apply_reported_command(std::vector<core::AveragedSample>& samples, const LogOptions& options) {
-  // Held one period from the delay on: its centre d·T_c = delay + T_c/2 after the sample. Every sample, the
-  // bridge-off ones too: at VESC Tool's 0.01 A a modulating bridge at zero current reads i = 0 as well, and the
-  // undriven branch's measured back EMF is then turned too (docs/drive-log.md, "The voltage is the command").
-  const double d = (options.command_delay_s + 0.5 * options.control_period_s) / options.control_period_s;
-  for (core::AveragedSample& s : samples) s.u_dq_V = applied_mean_V(s.u_dq_V, s.omega_el_rad_s, options.control_period_s, d);
-  char text[200];
-  std::snprintf(text, sizeof text,
-                "; voltages reported as the drive's command, turned into the applied mean (by −%.3g·ω·T_c, times "
-                "sinc(ω·T_c/2), T_c = %.3g µs)",
-                d, 1e6 * options.control_period_s);
-  return text;
-}
-
-}  // namespace
-
 LogOptions log_options(const io::MachineConfig& config) {
   LogOptions o;
   o.voltage_is_command = config.estimator.averaged.voltage_is_command;
@@ -247,58 +239,6 @@ LogOptions log_options(const io::MachineConfig& config) {
   o.command_delay_s = config.estimator.extensions.delay_s;
   o.staircase_below_rad_s = config.estimator.regimes.hall_interpolation_speed_rad_s;
   return o;
-}
-
-LogData load_log(const std::string& path, const core::MachineSi& machine, const LogOptions& options,
-                 const std::function<void(std::uint64_t, std::uint64_t)>& progress) {
-  const io::LogSource source = io::log_source(path, options.log_map);
-  const io::DriveLogLimits limits = io::machine_limits(machine);
-  LogData d;
-  d.path = path;
-  if (source.averaged()) {
-    // Window means carry no transient to replay: the steady-state model, whatever the spacing.
-    if (options.mode == ModelMode::kTransient) {
-      throw io::DriveLogError(path, 0, 0, "",
-                              "a log of averaged windows (" + source.format +
-                                  ") replays only the steady-state model: give --model auto or steady_state");
-    }
-    io::AveragedLogRead read;
-    std::vector<core::AveragedSample> samples = io::read_averaged_log(path, source.map, limits, &read);
-    for (core::AveragedSample& s : samples) s.omega_el_rad_s = core::window_speed_rad_s(s, options.staircase_below_rad_s);
-    const io::RotorFrameRebuild rebuilt =
-        io::complete_rotor_frame(samples, read, machine, options.voltage_is_command ? options.control_period_s : 0.0, path);
-    // Rebuilt voltages are applied rotor-frame means already: not turned again.
-    const bool turn = options.voltage_is_command && options.control_period_s > 0.0 && !rebuilt.voltages;
-    const std::string voltage = turn ? apply_reported_command(samples, options) : "";
-    d.layout = io::rotor_frame_layout(read.layout);
-    d.samples = SampleStore(d.layout);
-    d.window_start_ns.reserve(samples.size());
-    for (const core::AveragedSample& s : samples) {
-      d.samples.push_back(io::to_drive_log_row(s));
-      d.window_start_ns.push_back(s.t_start_ns);
-    }
-    d.samples.finish();
-    LogOptions steady = options;
-    steady.mode = ModelMode::kSteadyState;
-    prepare_log(d, machine, steady);
-    d.averaged = true;
-    d.format = io::describe(source, read) + voltage + (rebuilt.any() ? "; " + rebuilt.describe() : "");
-    d.voltage_applied = turn || rebuilt.voltages;
-    return d;
-  }
-  io::DriveLogReader reader(path, source.map, limits);
-  d.layout = reader.layout();
-  d.samples = SampleStore(d.layout);
-  io::DriveLogRow row;
-  while (reader.next(row)) {
-    d.samples.push_back(row);
-    if (progress && (d.samples.size() & 0xFFFF) == 0) progress(reader.bytes_read(), reader.bytes_total());
-  }
-  d.samples.finish();
-  prepare_log(d, machine, options);
-  d.format =
-      path + " as " + source.format + ": " + std::to_string(d.size()) + " rows" + io::describe(reader.reader().repairs());
-  return d;
 }
 
 }  // namespace rpem::analysis

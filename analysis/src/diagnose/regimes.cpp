@@ -50,11 +50,17 @@ LogRegimes classify_regimes(const LogData& log, const io::MachineConfig& config,
     const core::EstimatorSettings settings =
         log.voltage_applied ? core::for_applied_voltages(config.estimator) : config.estimator;
     core::AveragedDriveEstimator estimator(config.machine, settings);
-    for (std::size_t k = 0; k < n; ++k) record(k, estimator.step(window_of(log, k)));
+    for (std::size_t k = 0; k < n; ++k) {
+      if (log.starts_session(k)) estimator.reset();  // each session from the configuration, as its log alone
+      record(k, estimator.step(window_of(log, k)));
+    }
     out.noise_pu = estimator.classifier().current_noise();
   } else {
     core::DriveEstimator estimator(config.machine, config.estimator);
-    for (std::size_t k = 0; k < n; ++k) record(k, estimator.step(log.sample(k)));
+    for (std::size_t k = 0; k < n; ++k) {
+      if (log.starts_session(k)) estimator.reset();
+      record(k, estimator.step(log.sample(k)));
+    }
     out.noise_pu = estimator.classifier().current_noise();
   }
   report_work(monitor, n % kMonitorSamples);

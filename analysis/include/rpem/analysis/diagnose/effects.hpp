@@ -53,6 +53,7 @@ struct EffectContext {
   double max_speed_rad_s = 0.0;
   double speed_spread_rel = 0.0;  ///< LogData::speed_spread_rel
   double t_start_s = 0.0, t_span_s = 0.0;
+  std::size_t sessions = 1;  ///< LogData::sessions: a drift against time has no meaning across several
   TemperatureColumn t_winding, t_magnet;
   double reference_C = core::kMaterialReference_C;  ///< temperature at which reported drift laws are referred
   double sample_period_s = 0.0;                     ///< median sample interval

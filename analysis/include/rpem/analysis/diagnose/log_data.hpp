@@ -28,7 +28,7 @@ enum class ModelMode { kTransient, kSteadyState };
 
 struct LogData {
   std::string path;
-  std::string format;  ///< what the log was read as, and what reading it did (io::describe)
+  std::string format;  ///< what the log was read as, and what reading it did (io::describe); a line per session
   /// The drive's reported commands were turned into the applied means at reading (LogOptions::voltage_is_command):
   /// whatever runs over the rows must not turn them again.
   bool voltage_applied = false;
@@ -60,8 +60,25 @@ struct LogData {
   static constexpr double kPauseMedianIntervals = 20.0;
   std::size_t pauses = 0;
   double longest_pause_s = 0.0;
+  /// A folder's logs are one machine's sessions, joined (load_sessions): session j holds the samples
+  /// [session_first[j], session_first[j + 1]) (the last to the end) and was read from session_logs[j]. Each
+  /// session's samples follow the last one's after kSessionGap_ns (1 s) on t; its first is marked gap_before, so that
+  /// every replay and estimator starts afresh there, and the blocks' time counts nothing between sessions.
+  /// One log is one session.
+  static constexpr std::int64_t kSessionGap_ns = core::kNsPerS;
+  std::vector<std::size_t> session_first{0};
+  std::vector<std::string> session_logs;
 
   [[nodiscard]] std::size_t size() const noexcept { return samples.size(); }
+  [[nodiscard]] std::size_t sessions() const noexcept { return session_first.size(); }
+  /// One past session j's last sample.
+  [[nodiscard]] std::size_t session_end(std::size_t j) const noexcept {
+    return j + 1 < session_first.size() ? session_first[j + 1] : size();
+  }
+  /// Whether sample k opens a session after the first (the replays and estimators restart there).
+  [[nodiscard]] bool starts_session(std::size_t k) const noexcept {
+    return k > 0 && std::binary_search(session_first.begin(), session_first.end(), k);
+  }
   /// Sample k as logged.
   [[nodiscard]] core::DriveSample sample(std::size_t k) const noexcept { return samples.sample(k); }
   /// Sample k as the replay takes it: with the centred speed (see speed_half_window).
@@ -128,6 +145,14 @@ struct LogOptions {
 /// bytes read of the file's total as it goes.
 [[nodiscard]] LogData load_log(const std::string& path, const core::MachineSi& machine, const LogOptions& options,
                                const std::function<void(std::uint64_t, std::uint64_t)>& progress = {});
+
+/// The logs of a folder (in `paths`' order, at least one), one machine's sessions, named `name` (the folder): each
+/// read as load_log reads it, then joined one after another on one time axis (LogData::session_first). The logs
+/// must be alike — all averaged or all instantaneous, with the same columns — and each must give its samples: else
+/// io::DriveLogError naming the log (a diagnosis without one of them would be another diagnosis).
+[[nodiscard]] LogData load_sessions(const std::string& name, const std::vector<std::string>& paths,
+                                    const core::MachineSi& machine, const LogOptions& options,
+                                    const std::function<void(std::uint64_t, std::uint64_t)>& progress = {});
 
 /// The same from rows already in memory (tests, the simulator).
 [[nodiscard]] LogData prepare_log(const std::vector<io::DriveLogRow>& rows, const io::DriveLogLayout& layout,
