@@ -1,4 +1,4 @@
-// `rpem diagnose --log FOLDER` as a VESC user runs it on the folder VESC Tool fills: two rides of one machine,
+// `rpem diagnose --log FOLDER` (and `rpem figures`) as a VESC user runs it on the folder VESC Tool fills: two rides of one machine,
 // logged by the independent generator (tests/independent_vesc/, its forms not ours) with clocks that overlap (both
 // start at 10:00:00), diagnosed together as one machine's sessions; and what it refuses.
 #include <gtest/gtest.h>
@@ -97,6 +97,13 @@ TEST_F(CliDiagnoseSessions, TwoRidesDiagnosedTogether) {
   report << std::ifstream(dir_ + "/diag/report.md").rdbuf();
   EXPECT_NE(report.str().find("## Sessions"), std::string::npos);
   EXPECT_NE(report.str().find("its 2 logs joined as sessions"), std::string::npos);
+
+  // `rpem figures` draws the folder's regimes timeline, the sessions joined as diagnose joins them.
+  const test::ProcessResult fig = test::run_command(rpem_tool() + " figures --log " + dir_ + "/rides --config " +
+                                                    firmware_config() + " --out " + dir_ + "/fig");
+  ASSERT_EQ(fig.exit_code, 0) << fig.output;
+  EXPECT_NE(fig.output.find("rpem figures: 2 logs joined as one machine's sessions"), std::string::npos) << fig.output;
+  EXPECT_TRUE(fs::exists(dir_ + "/fig/regimes.png"));
 }
 
 TEST_F(CliDiagnoseSessions, RefusesWhatCannotBeJoined) {

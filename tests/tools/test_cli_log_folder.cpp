@@ -228,9 +228,10 @@ TEST_F(CliLogFolder, FoldersItCannotUseAreRefused) {
   const test::ProcessResult file = test::run_command(rpem_tool() + " estimate --log " + logs + " --out " + at("a-file"));
   EXPECT_EQ(file.exit_code, 74) << file.output;
   EXPECT_NE(file.output.find("a-file: cannot create the output directory"), std::string::npos) << file.output;
-  // The other subcommands take one log.
-  const test::ProcessResult diagnose = test::run_command(rpem_tool() + " diagnose --log " + logs + " --out " + at("d"));
-  EXPECT_EQ(diagnose.exit_code, 64) << diagnose.output;
+  // `rpem replay` streams one log (diagnose, figures and thermal fit join a folder's: test_cli_diagnose_sessions,
+  // test_cli_thermal_sessions).
+  const test::ProcessResult replay = test::run_command(rpem_tool() + " replay " + logs);
+  EXPECT_EQ(replay.exit_code, 64) << replay.output;
 }
 
 }  // namespace

@@ -13,12 +13,11 @@
 #include <fstream>
 #include <sstream>
 #include <string>
-#include <vector>
 
 #include "commands.hpp"
 #include "diagnose_monitor.hpp"
-#include "log_folder.hpp"
 #include "log_options.hpp"
+#include "log_sessions.hpp"
 #include "rpem/analysis/diagnose/diagnose_output.hpp"
 #include "rpem/analysis/work_pool.hpp"
 #include "rpem/io/errors.hpp"
@@ -168,13 +167,6 @@ std::string blocks_note(const analysis::LogData& log) {
 int diagnose_and_write(const DiagnoseCliOptions& o, const io::MachineConfig& config, const std::string& config_text,
                        const std::string& config_name, const analysis::LogOptions& log_options, TerminalMonitor& monitor);
 
-/// A folder's logs, in the order `rpem estimate --log FOLDER` takes them.
-std::vector<std::string> folder_logs(const std::string& folder) {
-  std::vector<std::string> logs;
-  for (const fs::path& p : logs_in_folder(folder)) logs.push_back(p.string());
-  return logs;
-}
-
 int run_diagnose(const DiagnoseCliOptions& o) {
   if (!o.truth.empty() && fs::is_directory(o.log)) {
     std::fprintf(stderr, "rpem diagnose: --truth is one log's truth: with --log a folder, give none\n");
@@ -207,20 +199,9 @@ int diagnose_and_write(const DiagnoseCliOptions& o, const io::MachineConfig& con
     monitor.reading(done, total);
     if (monitor.stop_requested()) throw analysis::Interrupted();
   };
-  analysis::LogData log = fs::is_directory(o.log)
-                              ? analysis::load_sessions(o.log, folder_logs(o.log), config.machine, log_options, progress)
-                              : analysis::load_log(o.log, config.machine, log_options, progress);
+  analysis::LogData log = load_log_or_sessions(o.log, config.machine, log_options, progress);
   monitor.finish();
-  std::istringstream formats(log.format);
-  for (std::string line; std::getline(formats, line);) std::fprintf(stderr, "rpem diagnose: read %s\n", line.c_str());
-  if (log.sessions() > 1) {
-    std::fprintf(stderr, "rpem diagnose: %zu logs joined as one machine's sessions, each from the configuration:\n",
-                 log.sessions());
-    for (std::size_t j = 0; j < log.sessions(); ++j) {
-      std::fprintf(stderr, "rpem diagnose:   %s: %zu samples from t = %.6g s\n", log.session_logs[j].c_str(),
-                   log.session_end(j) - log.session_first[j], log.t_s(log.session_first[j]));
-    }
-  }
+  print_log_read("rpem diagnose", log);
   io::check_log_supports(config, config_name, log.layout.u_dc, o.log);
   if (const std::string note = blocks_note(log); !note.empty()) {
     std::fprintf(stderr, "rpem diagnose: note: %s\n", note.c_str());

@@ -1,9 +1,10 @@
-// rpem figures --out DIR [--config CFG.yaml] [--log LOG.csv [--log-map MAP.yaml]]
+// rpem figures --out DIR [--config CFG.yaml] [--log LOG.csv|FOLDER [--log-map MAP.yaml]]
 // rpem figures --out DIR --thermal-estimate EST.csv [--measured CSV [--magnet-column C] [--winding-column C]]
 //              [--judged-after-s T]
 // The paper's analysis figures (Fig_EigenTraj, Fig_sensitivity, fig_PEG_analytical, fig_hesscompstatic)
 // for the configured machine; with --log also the log's timeline coloured by regime (regimes.png, as
-// `rpem diagnose` draws it), for any log `rpem estimate` and `rpem diagnose` read (io::log_source); or,
+// `rpem diagnose` draws it), for any log `rpem estimate` and `rpem diagnose` read (io::log_source) or a folder of
+// them joined as sessions; or,
 // with --thermal-estimate, the fused temperatures of `rpem estimate --thermal` against measured ones with
 // the ±2σ band (thermal_fused.png; docs/thermal.md, "Figures").
 
@@ -14,6 +15,7 @@
 
 #include "commands.hpp"
 #include "log_options.hpp"
+#include "log_sessions.hpp"
 #include "rpem/analysis/analysis_figures.hpp"
 #include "rpem/analysis/diagnose/diagnose_output.hpp"
 #include "rpem/analysis/diagnose/regimes.hpp"
@@ -60,8 +62,8 @@ int run_figures(const FiguresOptions& o) {
     analysis::LogOptions options = analysis::log_options(cfg);
     options.log_map = o.log_map;
     options.blocks = 2;  // the timeline uses no blocks: the fewest the log's preparation takes, so short logs draw
-    log = analysis::load_log(o.log, cfg.machine, options);
-    std::fprintf(stderr, "rpem figures: read %s\n", log->format.c_str());
+    log = load_log_or_sessions(o.log, cfg.machine, options);
+    print_log_read("rpem figures", *log);
     regimes = analysis::classify_regimes(*log, cfg);
     std::fprintf(stderr, "rpem figures: %s\n", io::regime_summary(regimes.counts).c_str());
     for (const std::string& why : regimes.explanations) std::fprintf(stderr, "rpem figures: %s\n", why.c_str());
@@ -84,7 +86,8 @@ Runner add_figures_command(CLI::App& app) {
       app.add_subcommand("figures", "Write the paper's analysis figures for a machine (PNG), and a log's regimes");
   cmd->add_option("--out", opts->out, "output directory")->required();
   cmd->add_option("--config", opts->config, "machine YAML (default: built-in paper-ipmsm.yaml)")->check(CLI::ExistingFile);
-  add_log_options(*cmd, opts->log, opts->log_map, "also draw this log's timeline coloured by regime (regimes.png)");
+  add_log_options(*cmd, opts->log, opts->log_map, "also draw this log's timeline coloured by regime (regimes.png)",
+                  LogPath::kFileOrSessions);
   CLI::Option* thermal = cmd->add_option("--thermal-estimate", opts->thermal.estimate_csv,
                                          "instead: plot this `rpem estimate --thermal` CSV's fused temperatures with "
                                          "their ±2σ band")

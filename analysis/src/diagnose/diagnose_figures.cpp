@@ -248,10 +248,19 @@ std::string regime_timeline(const std::string& dir, const LogData& log, const Lo
   GnuplotFigure fig(dir + "/regimes.png", 1400, 800);
   fig.add_data(std::move(b));
   fig.add_line(
-      "set multiplot layout 2,1 title 'The log by regime: what the estimator and the fits take, and what they leave out' noenhanced");
+      std::string("set multiplot layout 2,1 title 'The log by regime: what the estimator and the fits take, and what they "
+                  "leave out") +
+      (log.sessions() > 1 ? " (dashed: a session starts)" : "") + "' noenhanced");
   // Regime names hold underscores (not subscripts); both panels keep the key's margin so their time axes align.
   fig.add_line("set termoption noenhanced; set grid; set xlabel 't [s]'; set key outside right; set datafile missing NaN");
   fig.add_line("set lmargin at screen 0.07; set rmargin at screen 0.78");
+  // A folder's sessions (LogData::session_first): a dashed line where each after the first starts.
+  for (std::size_t j = 1; j < log.sessions(); ++j) {
+    char arrow[160];
+    std::snprintf(arrow, sizeof arrow, "set arrow from %.9g, graph 0 to %.9g, graph 1 nohead dt 2 lc rgb 'black'",
+                  log.t_s(log.session_first[j]), log.t_s(log.session_first[j]));
+    fig.add_line(arrow);
+  }
   fig.add_line("set title 'speed'; set ylabel 'speed [rpm]'");
   fig.add_line(speed_plot);
   fig.add_line("set title 'current amplitude'; set ylabel '|i| [A]'");

@@ -103,6 +103,32 @@ void check_enough_samples(const LogData& d, const LogOptions& options) {
   }
 }
 
+/// The steady-state replay's rows with nothing to fit (idle: current and speed both near zero) and those not at a
+/// steady operating point (in transition: a neighbour in the same session differs), marked left out and counted.
+void leave_out_idle_and_transitional(LogData& d) {
+  const std::size_t n = d.samples.size();
+  const double i_span = std::max(d.max_current_A, 1e-9), n_span = std::max(d.max_speed_rad_s, 1e-9);
+  auto current = [&](std::size_t k) { return d.logged_i_dq_A(k).norm(); };
+  auto speed = [&](std::size_t k) { return d.samples.omega_el_rad_s(k); };
+  for (std::size_t k = 0; k < n; ++k) {
+    if (current(k) < kIdleShare * i_span && std::abs(speed(k)) < kIdleShare * n_span) {
+      d.samples.set_mark(k, sample_mark::kLeftOut, true);
+      ++d.excluded_idle;
+      continue;
+    }
+    for (std::size_t j : {k - 1, k + 1}) {
+      if (j >= n) continue;                            // k − 1 wraps for k = 0
+      if (d.starts_session(std::max(j, k))) continue;  // another session's sample is no neighbour
+      if (std::abs(current(j) - current(k)) > kTransitionShare * i_span ||
+          std::abs(speed(j) - speed(k)) > kTransitionShare * n_span) {
+        d.samples.set_mark(k, sample_mark::kLeftOut, true);
+        ++d.excluded_transitional;
+        break;
+      }
+    }
+  }
+}
+
 }  // namespace
 
 void prepare_log(LogData& d, const core::MachineSi& machine, const LogOptions& options) {
@@ -148,28 +174,7 @@ void prepare_log(LogData& d, const core::MachineSi& machine, const LogOptions& o
                                                                                               : ModelMode::kTransient);
   d.speed_half_window = d.mode == ModelMode::kTransient ? std::max(0, options.speed_half_window) : 0;
 
-  if (d.mode == ModelMode::kSteadyState) {
-    const double i_span = std::max(d.max_current_A, 1e-9), n_span = std::max(d.max_speed_rad_s, 1e-9);
-    auto current = [&](std::size_t k) { return d.logged_i_dq_A(k).norm(); };
-    auto speed = [&](std::size_t k) { return d.samples.omega_el_rad_s(k); };
-    for (std::size_t k = 0; k < n; ++k) {
-      if (current(k) < kIdleShare * i_span && std::abs(speed(k)) < kIdleShare * n_span) {
-        d.samples.set_mark(k, sample_mark::kLeftOut, true);
-        ++d.excluded_idle;
-        continue;
-      }
-      for (std::size_t j : {k - 1, k + 1}) {
-        if (j >= n) continue;                            // k − 1 wraps for k = 0
-        if (d.starts_session(std::max(j, k))) continue;  // another session's sample is no neighbour
-        if (std::abs(current(j) - current(k)) > kTransitionShare * i_span ||
-            std::abs(speed(j) - speed(k)) > kTransitionShare * n_span) {
-          d.samples.set_mark(k, sample_mark::kLeftOut, true);
-          ++d.excluded_transitional;
-          break;
-        }
-      }
-    }
-  }
+  if (d.mode == ModelMode::kSteadyState) leave_out_idle_and_transitional(d);
 
   // Block b holds the samples whose sampled time lies in [b, b + 1)·span/blocks (the last one's end included):
   // the time since the first sample with the pauses left out, so that a log of two recordings joined still
