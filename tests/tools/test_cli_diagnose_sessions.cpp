@@ -3,6 +3,7 @@
 // start at 10:00:00), diagnosed together as one machine's sessions; and what it refuses.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -84,14 +85,15 @@ TEST_F(CliDiagnoseSessions, TwoRidesDiagnosedTogether) {
   EXPECT_GT(sessions[0]["t_first_s"].get<double>(), 36000.0);
   for (const auto& s : sessions) EXPECT_GT(s["samples"].get<int>(), 2000) << s.dump();  // 300 s at ~11 Hz
 
-  // Both rides are one machine whose ψm is 5.5596 mWb at 25 °C: calibrated within 2 %, as on one 600 s ride; and
-  // the two together pin it down more tightly than either alone (measured: 95 % intervals 28 µWb wide against 47
-  // and 38 µWb; the interval is cluster-robust over the blocks, so twice the blocks' data narrows it).
+  // Both rides are one machine whose ψm is 5.5596 mWb at 25 °C: calibrated within 2 %, as on one 600 s ride. Joining
+  // does not cost precision: ψm's interval is cluster-robust over the blocks, so for two rides of equal length its
+  // width is about ½·√(w_A² + w_B²) ≤ 0.71·max(w_A, w_B) (the between-ride spread of ψm adds to it), and never
+  // wider than the worse ride's alone (measured on seed pairs 1/3, 2/4, 5/6, 7/8: 0.60, 0.70, 0.37, 0.75 of it).
   EXPECT_NEAR(d["calibration"]["psi_m_Wb"].get<double>() / 5.5596e-3, 1.0, 0.02);
   const nlohmann::json& ci = d["calibration"]["psi_m_Wb_ci95"];
   const double together_Wb = ci[1].get<double>() - ci[0].get<double>();
-  EXPECT_LT(together_Wb, psi_m_interval_alone_Wb("2026-11-30_10-00-00.csv"));
-  EXPECT_LT(together_Wb, psi_m_interval_alone_Wb("2026-12-01_10-00-00.csv"));
+  EXPECT_LT(together_Wb, std::max(psi_m_interval_alone_Wb("2026-11-30_10-00-00.csv"),
+                                  psi_m_interval_alone_Wb("2026-12-01_10-00-00.csv")));
 
   std::stringstream report;
   report << std::ifstream(dir_ + "/diag/report.md").rdbuf();
