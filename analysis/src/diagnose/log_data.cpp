@@ -9,12 +9,8 @@
 #include "rpem/core/clock.hpp"
 #include "rpem/core/conditioner.hpp"
 #include "rpem/core/frames.hpp"
-#include "rpem/core/reported_speed.hpp"
 #include "rpem/core/sinc.hpp"
-#include "rpem/io/averaged_log.hpp"
-#include "rpem/io/log_source.hpp"
 #include "rpem/io/machine_config.hpp"
-#include "rpem/io/rotor_frame_rebuild.hpp"
 #include "rpem/io/sample_counts.hpp"
 
 namespace rpem::analysis {
