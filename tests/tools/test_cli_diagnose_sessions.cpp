@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -22,6 +23,12 @@ namespace fs = std::filesystem;
 
 std::string rpem_tool() { return test::binary_dir() + "/tools/rpem"; }
 std::string firmware_config() { return test::source_dir() + "/config/vesc-6374-firmware.yaml"; }
+/// A figure's gnuplot script (written beside its PNG), whole; empty if there is none.
+std::string figure_script(const std::string& path) {
+  std::stringstream text;
+  text << std::ifstream(path).rdbuf();
+  return text.str();
+}
 
 class CliDiagnoseSessions : public ::testing::Test {
  protected:
@@ -99,6 +106,24 @@ TEST_F(CliDiagnoseSessions, TwoRidesDiagnosedTogether) {
   report << std::ifstream(dir_ + "/diag/report.md").rdbuf();
   EXPECT_NE(report.str().find("## Sessions"), std::string::npos);
   EXPECT_NE(report.str().find("its 2 logs joined as sessions"), std::string::npos);
+
+  // Every figure against time marks where the second ride starts (the estimates restart from the configuration
+  // there), and says so in its title; a ride diagnosed alone has no mark.
+  char mark[96];
+  std::snprintf(mark, sizeof mark, "set arrow from %.9g, graph 0", sessions[1]["t_first_s"].get<double>());
+  for (const char* figure : {"residual_time", "regimes", "overlay", "estimates"}) {
+    const std::string gp = figure_script(dir_ + "/diag/" + figure + ".gp");
+    ASSERT_FALSE(gp.empty()) << figure;
+    EXPECT_NE(gp.find(mark), std::string::npos) << figure << " has no line at the second session's start (" << mark << ")";
+    EXPECT_EQ(gp.find("set arrow", gp.find(mark) + 1), std::string::npos) << figure << ": one session start, one line";
+    EXPECT_NE(gp.find("(dashed: a session starts)"), std::string::npos) << figure;
+  }
+  for (const char* figure : {"residual_time", "regimes", "overlay", "estimates"}) {
+    const std::string gp = figure_script(dir_ + "/alone_2026-11-30_10-00-00.csv/" + figure + ".gp");
+    ASSERT_FALSE(gp.empty()) << figure;
+    EXPECT_EQ(gp.find("set arrow"), std::string::npos) << figure;
+    EXPECT_EQ(gp.find("a session starts"), std::string::npos) << figure;
+  }
 
   // `rpem figures` draws the folder's regimes timeline, the sessions joined as diagnose joins them.
   const test::ProcessResult fig = test::run_command(rpem_tool() + " figures --log " + dir_ + "/rides --config " +

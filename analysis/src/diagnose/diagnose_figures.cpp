@@ -31,6 +31,23 @@ bool temperature_varies(const Diagnosis& d) {
   return c.logged && c.span_K >= 1.0;
 }
 
+/// A folder's sessions (LogData::session_first), on every figure against time: the title's note, and a dashed line
+/// where each session after the first starts, for the starts inside [t_from_s, t_to_s] (the figure's time axis).
+std::string sessions_note(const LogData& log) { return log.sessions() > 1 ? " (dashed: a session starts)" : ""; }
+void mark_session_starts(GnuplotFigure& fig, const LogData& log, double t_from_s, double t_to_s) {
+  for (std::size_t j = 1; j < log.sessions(); ++j) {
+    const double t_s = log.t_s(log.session_first[j]);
+    if (t_s < t_from_s || t_s > t_to_s) continue;
+    char arrow[160];
+    std::snprintf(arrow, sizeof arrow, "set arrow from %.9g, graph 0 to %.9g, graph 1 nohead dt 2 lc rgb 'black'", t_s, t_s);
+    fig.add_line(arrow);
+  }
+}
+/// The whole log's time axis.
+void mark_session_starts(GnuplotFigure& fig, const LogData& log) {
+  if (log.size() > 0) mark_session_starts(fig, log, log.t_s(0), log.t_s(log.size() - 1));
+}
+
 /// Time-binned profile and residual statistics (every sample for short logs).
 DataBlock time_bins(const Diagnosis& d) {
   DataBlock b{"time", std::vector<std::vector<double>>(8)};  // t, speed, i_q, rms before, rms after, mean d, mean q, T
@@ -44,8 +61,10 @@ std::string residual_time(const std::string& dir, const Diagnosis& d) {
   const bool temps = temperature_varies(d);
   GnuplotFigure fig(dir + "/residual_time.png", 1400, 1000);
   fig.add_data(time_bins(d));
-  fig.add_line("set multiplot layout 3,1 title 'What the model gets wrong, against time' noenhanced");
+  fig.add_line("set multiplot layout 3,1 title 'What the model gets wrong, against time" + sessions_note(*d.log) +
+               "' noenhanced");
   fig.add_line("set grid; set xlabel 't [s]'; set key outside right");
+  mark_session_starts(fig, *d.log);
   fig.add_line("set title 'operating profile'; set ylabel 'speed [rpm]'; set y2label 'i_q [A]" +
                std::string(temps ? ", temperature [°C]" : "") + "'; set y2tics; set ytics nomirror");
   fig.add_line(std::string("plot $time u 1:2 w l lw 2 t 'speed', '' u 1:3 axes x1y2 w l lw 2 t 'i_q'") +
@@ -191,9 +210,11 @@ std::string overlay(const std::string& dir, const Diagnosis& d) {
   const std::string style = d.log->mode == ModelMode::kTransient ? "w l lw 2" : "w p pt 7 ps 0.5";
   GnuplotFigure fig(dir + "/overlay.png", 1400, 800);
   fig.add_data(std::move(b));
-  fig.add_line(
-      "set multiplot layout 2,1 title 'Logged current against the configuration and the extended model' noenhanced");
+  fig.add_line("set multiplot layout 2,1 title 'Logged current against the configuration and the extended model" +
+               sessions_note(*d.log) + "' noenhanced");
   fig.add_line("set grid; set xlabel 't [s]'; set key outside right");
+  if (!d.figures.overlay.empty())
+    mark_session_starts(fig, *d.log, d.figures.overlay.front()[0], d.figures.overlay.back()[0]);
   fig.add_line("set title 'd axis'; set ylabel 'i_d [A]'; plot $o u 1:2 " + style + " lc rgb 'black' t 'logged', '' u 1:4 " +
                style + " lc rgb '#d62728' t 'configuration', '' u 1:6 " + style + " lc rgb '#2ca02c' t 'extended'");
   fig.add_line("set title 'q axis'; set ylabel 'i_q [A]'; plot $o u 1:3 " + style + " lc rgb 'black' t 'logged', '' u 1:5 " +
@@ -250,17 +271,11 @@ std::string regime_timeline(const std::string& dir, const LogData& log, const Lo
   fig.add_line(
       std::string("set multiplot layout 2,1 title 'The log by regime: what the estimator and the fits take, and what they "
                   "leave out") +
-      (log.sessions() > 1 ? " (dashed: a session starts)" : "") + "' noenhanced");
+      sessions_note(log) + "' noenhanced");
   // Regime names hold underscores (not subscripts); both panels keep the key's margin so their time axes align.
   fig.add_line("set termoption noenhanced; set grid; set xlabel 't [s]'; set key outside right; set datafile missing NaN");
   fig.add_line("set lmargin at screen 0.07; set rmargin at screen 0.78");
-  // A folder's sessions (LogData::session_first): a dashed line where each after the first starts.
-  for (std::size_t j = 1; j < log.sessions(); ++j) {
-    char arrow[160];
-    std::snprintf(arrow, sizeof arrow, "set arrow from %.9g, graph 0 to %.9g, graph 1 nohead dt 2 lc rgb 'black'",
-                  log.t_s(log.session_first[j]), log.t_s(log.session_first[j]));
-    fig.add_line(arrow);
-  }
+  mark_session_starts(fig, log);
   fig.add_line("set title 'speed'; set ylabel 'speed [rpm]'");
   fig.add_line(speed_plot);
   fig.add_line("set title 'current amplitude'; set ylabel '|i| [A]'");
@@ -327,8 +342,9 @@ std::string estimates(const std::string& dir, const Diagnosis& d) {
   fig.add_line(std::string("set multiplot layout 2,1 title '") +
                (rpem ? "RPEM estimates with the configuration and the extended model"
                      : "ψm and R_s as each model assumes them, and as each steady-state row implies them") +
-               "' noenhanced");
+               sessions_note(*d.log) + "' noenhanced");
   fig.add_line("set grid; set xlabel 't [s]'; set key outside right");
+  mark_session_starts(fig, *d.log);
   std::size_t psi_outside = 0, r_outside = 0;
   const std::string psi_range =
       rpem ? "" : robust_yrange(c.truth.psi_m_Wb, c.nominal.psi_m_Wb, c.extended.psi_m_Wb, psi_outside);
