@@ -23,12 +23,6 @@ namespace fs = std::filesystem;
 
 std::string rpem_tool() { return test::binary_dir() + "/tools/rpem"; }
 std::string firmware_config() { return test::source_dir() + "/config/vesc-6374-firmware.yaml"; }
-/// A figure's gnuplot script (written beside its PNG), whole; empty if there is none.
-std::string figure_script(const std::string& path) {
-  std::stringstream text;
-  text << std::ifstream(path).rdbuf();
-  return text.str();
-}
 
 class CliDiagnoseSessions : public ::testing::Test {
  protected:
@@ -112,7 +106,7 @@ TEST_F(CliDiagnoseSessions, TwoRidesDiagnosedTogether) {
   char mark[96];
   std::snprintf(mark, sizeof mark, "set arrow from %.9g, graph 0", sessions[1]["t_first_s"].get<double>());
   for (const char* figure : {"residual_time", "regimes", "overlay", "estimates"}) {
-    const std::string gp = figure_script(dir_ + "/diag/" + figure + ".gp");
+    const std::string gp = test::read_file(dir_ + "/diag/" + figure + ".gp");
     ASSERT_FALSE(gp.empty()) << figure;
     EXPECT_NE(gp.find(mark), std::string::npos) << figure << " has no line at the second session's start (" << mark << ")";
     std::size_t lines = 0;
@@ -121,7 +115,7 @@ TEST_F(CliDiagnoseSessions, TwoRidesDiagnosedTogether) {
     EXPECT_NE(gp.find("(dashed: a session starts)"), std::string::npos) << figure;
   }
   for (const char* figure : {"residual_time", "regimes", "overlay", "estimates"}) {
-    const std::string gp = figure_script(dir_ + "/alone_2026-11-30_10-00-00.csv/" + figure + ".gp");
+    const std::string gp = test::read_file(dir_ + "/alone_2026-11-30_10-00-00.csv/" + figure + ".gp");
     ASSERT_FALSE(gp.empty()) << figure;
     EXPECT_EQ(gp.find("set arrow"), std::string::npos) << figure;
     EXPECT_EQ(gp.find("a session starts"), std::string::npos) << figure;
