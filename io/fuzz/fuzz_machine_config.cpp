@@ -1,22 +1,31 @@
 // libFuzzer target for the YAML configuration reader (machine, estimator and model-extension sections;
-// docs/configuration.md): the input is the file's bytes. The reader must never crash and may fail only
-// with ConfigError; a configuration it accepts must give an estimator that starts and, on a few samples
-// of a loaded machine at speed, keeps its estimates finite and inside D_M.
+// docs/configuration.md; and the thermal section as rpemd reads it inline, docs/thermal.md): the input is the
+// file's bytes. The reader must never crash and may fail only with ConfigError; a configuration it accepts must
+// give an estimator that starts and, on a few samples of a loaded machine at speed, keeps its estimates finite
+// and inside D_M; and its thermal fusion, fed those estimates over four of its steps, temperatures and σ finite.
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <cstdlib>
+#include <optional>
 #include <string>
 
 #include "rpem/core/drive_estimator.hpp"
+#include "rpem/core/thermal_fusion.hpp"
 #include "rpem/io/machine_config.hpp"
+#include "rpem/io/thermal_config.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   using namespace rpem;
   io::MachineConfig c;
+  std::optional<io::ThermalConfig> thermal;
   try {
     io::YamlMap root = io::YamlMap::load_string(std::string(reinterpret_cast<const char*>(data), size), "fuzz.yaml");
     c = io::parse_machine_config(root);
+    if (root.has("thermal")) {  // as rpemd reads it (daemon/src/daemon_config.cpp): the network required
+      io::YamlMap t = root.map("thermal");
+      thermal = io::parse_thermal_config(t, c);
+    }
     root.finish();
   } catch (const io::ConfigError&) {
     return 0;
@@ -35,12 +44,28 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   auto inside = [](double v, double lo, double hi) {
     return std::isfinite(v) && v >= lo * (1.0 - 1e-12) && v <= hi * (1.0 + 1e-12);
   };
+  std::optional<core::ThermalFusion> fusion;
+  if (thermal) fusion.emplace(thermal->fusion, estimator.base(), c.machine);
+  core::ThermalSample heat;
+  if (thermal) heat.dt_s = thermal->fusion.observer.period_s / 4.0;  // 16 samples: four of the filter's steps
   for (int k = 0; k < 16; ++k) {
     x.t_ns = 125'000LL * k;
     x.theta_el_rad = std::fmod(x.omega_el_rad_s * 125e-6 * k, 6.283185307179586);
     const core::Estimate e = estimator.step(x);
     if (!inside(e.psi_m_Wb, s.psi_m_min_Wb, s.psi_m_max_Wb) || !inside(e.r_s_Ohm, s.r_s_min_Ohm, s.r_s_max_Ohm)) {
       std::abort();
+    }
+    if (fusion) {
+      heat.winding_sensor_C = k % 2 == 0 ? 60.0 : std::nan("");  // a reading on every other sample
+      fusion->step(e, heat);
+    }
+  }
+  if (fusion) {
+    const core::ThermalEstimate& t = fusion->estimate();
+    if (!t.started) std::abort();
+    for (int n = 0; n < t.nodes; ++n) {
+      const core::ThermalNodeEstimate& node = t.node[static_cast<std::size_t>(n)];
+      if (!std::isfinite(node.t_C) || !std::isfinite(node.sigma_K) || node.sigma_K < 0.0) std::abort();
     }
   }
   return 0;

@@ -5,6 +5,8 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <iomanip>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -45,6 +47,7 @@ struct PreviousRowRead {
   double travel_el_rad = std::nan("");  ///< the drive's count at the read (NaN: the log has none)
   double duty = std::nan("");           ///< the duty cycle at the read (NaN: the log has none)
   double i_motor_A = std::nan("");      ///< the motor current's mean (NaN: the log has none)
+  std::size_t line = 0;                 ///< where the row is, for errors
 };
 
 /// A sample's own values beside its means, and the duty at the read that starts its window (`start`; none: not
@@ -132,7 +135,23 @@ std::vector<double> accel_changes(const std::vector<PreviousRowRead>& rows, cons
 /// The samples of a previous_row log's rows (rows not empty): each window from the read before it, its speed rebuilt
 /// where the column is a PLL's, its count where the log has one; the windows next to a read whose time is unknown
 /// left out, and counted in `read`.
+/// A window's speed rebuilt from a tracker's reads (core::window_mean_speed_rad_s) is held to the speed's bound as a
+/// cell is: reads too close for the log's clock, or a column that is not a speed, extrapolate beyond any drive's.
+void check_rebuilt_speed(const MappedLogReader& reader, const DriveLogLimits& limits, const PreviousRowRead& previous,
+                         const PreviousRowRead& row, const core::AveragedSample& s) {
+  if (std::abs(s.omega_el_rad_s) <= limits.speed_rad_s.max_abs) return;
+  std::ostringstream why;
+  why << std::setprecision(6) << "the window's mean speed rebuilt from the tracker's speeds at this read and at line "
+      << previous.line << " (" << previous.omega_at_read_rad_s << " and " << row.omega_at_read_rad_s << " rad/s, "
+      << 1e3 * core::to_seconds(row.sample.t_ns - previous.sample.t_ns) << " ms apart) is " << s.omega_el_rad_s
+      << " rad/s, beyond the plausible ±" << limits.speed_rad_s.max_abs << " rad/s (" << limits.speed_rad_s.why
+      << "): reads this close or this far apart in speed give the tracker no slope (docs/drive-log.md, \"Speed at "
+         "the read\")";
+  reader.fail_at(row.line, Quantity::kOmegaEl, why.str());
+}
+
 void previous_row_samples(const std::vector<PreviousRowRead>& rows, const LogMap& map, bool counted,
+                          const MappedLogReader& reader, const DriveLogLimits& limits,
                           std::vector<core::AveragedSample>& out, AveragedLogRead& read) {
   // The counts at the reads whose times are known, and the read that ends each sample: the counted speeds.
   std::vector<core::CountRead> reads;
@@ -164,6 +183,7 @@ void previous_row_samples(const std::vector<PreviousRowRead>& rows, const LogMap
       s.omega_el_rad_s =
           core::window_mean_speed_rad_s({previous.sample.t_ns, previous.omega_at_read_rad_s},
                                         {s.t_ns, rows[k].omega_at_read_rad_s}, s.t_start_ns, map.speed_pll.ramp_lag_s());
+      check_rebuilt_speed(reader, limits, previous, rows[k], s);
       const double h_s = core::to_seconds(s.t_ns - s.t_start_ns);
       const double after = k + 1 < rows.size() ? accel_change[k + 1] : std::nan("");
       const double change = std::fmax(std::fabs(accel_change[k]), std::fabs(after));  // fmax: a NaN side left out
@@ -235,6 +255,7 @@ std::vector<core::AveragedSample> read_averaged_log(const std::string& path, con
     s.t_coolant_C = r[Quantity::kTCoolant];
     row.duty = r[Quantity::kDuty];
     row.i_motor_A = r[Quantity::kIMotor];
+    row.line = r.line;
     if (map.window == Window::kStartColumn) {
       s.t_start_ns = std::llround(r[Quantity::kTStart] * 1e9);
       if (s.t_start_ns > s.t_ns) reader.fail_at(r.line, Quantity::kTStart, "window starts after it ends (t_start > t)");
@@ -251,7 +272,7 @@ std::vector<core::AveragedSample> read_averaged_log(const std::string& path, con
     rows.push_back(row);
   }
 
-  if (!rows.empty()) previous_row_samples(rows, map, counted, out, read);
+  if (!rows.empty()) previous_row_samples(rows, map, counted, reader, limits, out, read);
   if (counted && map.window == Window::kStartColumn) {
     set_counted_speeds(out, start_column_reads, start_column_ends, count_step_rad(start_column_reads));
   }

@@ -1,11 +1,13 @@
 #include "rpem/io/thermal_config.hpp"
 
 #include <cmath>
+#include <iomanip>
 #include <limits>
 #include <sstream>
 
 #include "rpem/core/non_finite.hpp"
 #include "rpem/core/per_unit.hpp"
+#include "rpem/core/thermal_stability.hpp"
 #include "rpem/io/number_format.hpp"
 
 namespace rpem::io {
@@ -197,6 +199,30 @@ void parse_losses(YamlMap& t, ThermalConfig& c) {
 }
 
 /// `nodes`, `conductances` and `losses`.
+/// A network accepted only if it settles at the machine's rated point (eq. 14.27): the rated current is one the
+/// machine carries for ever, so its winding reaches a steady temperature there.
+void check_settles_at_rating(const YamlMap& t, const ThermalConfig& c, const MachineConfig& machine) {
+  const core::ThermalNetwork& n = c.fusion.filter.network;
+  const core::PerUnitBase rated = core::PerUnitBase::from_rated(machine.machine.rated);
+  core::ThermalLoad load;
+  load.current_sq_A2 = rated.current_A * rated.current_A;
+  load.convection_basis = std::sqrt(std::abs(rated.omega_el_rad_s) / n.base.omega_el_rad_s);
+  if (core::thermal_settles(n, load)) return;
+  const int w = n.winding;
+  double conducted = n.to_coolant_W_per_K[w] + n.to_coolant_at_base_speed_W_per_K[w] * load.convection_basis;
+  for (int j = 0; j < n.nodes; ++j) {
+    if (j != w) conducted += n.between_W_per_K(w, j) + n.between_at_base_speed_W_per_K(w, j) * load.convection_basis;
+  }
+  std::ostringstream why;
+  why << std::setprecision(4) << "the network has no steady state at the machine's rated point (" << rated.current_A
+      << " A peak at " << rated.omega_el_rad_s << " rad/s electrical, machine.rated): the copper loss grows by "
+      << n.copper_scale * 1.5 * load.current_sq_A2 * n.copper.value_ref * n.copper.coeff_per_K
+      << " W/K with the winding's temperature (copper: loss_scale, r_s_ref_Ohm, coeff_per_K) against the " << conducted
+      << " W/K the winding conducts to its neighbours and the coolant: a winding that runs away at the current it "
+         "is rated to carry (docs/derivations.md, eq. 14.27)";
+  t.fail("nodes", why.str());
+}
+
 void parse_network(YamlMap& t, ThermalConfig& c) {
   parse_nodes(t, c);
   parse_conductances(t, c);
@@ -252,6 +278,7 @@ ThermalConfig parse_thermal_config(YamlMap& section, const MachineConfig& machin
     f.observer.settle_time_constants = m->number_or("settle_time_constants", f.observer.settle_time_constants, 0.0, 100.0);
     m->finish();
   }
+  if (c.has_network) check_settles_at_rating(section, c, machine);
   section.finish();
   return c;
 }

@@ -10,6 +10,7 @@
 
 #include "rpem/core/matrix_exponential.hpp"
 #include "rpem/core/thermal_network.hpp"
+#include "rpem/core/thermal_stability.hpp"
 
 namespace rpem::core {
 namespace {
@@ -230,6 +231,41 @@ TEST(ThermalNetwork, SpeedPartOfTheCoolantConductanceGrowsAsTheSquareRootOfSpeed
   EXPECT_NEAR(r.a(1, 0), g_gap / 9000.0, 1e-15);
   EXPECT_NEAR(r.a(0, 0), -(25.0 + g_gap) / 4000.0, 1e-15);
   EXPECT_NEAR(r.a(1, 1), -(6.0 + 10.0 * 0.75 + g_gap) / 9000.0, 1e-15);
+}
+
+TEST(ThermalNetwork, SettlesExactlyWhileTheCopperLossRisesSlowerThanTheWindingConducts) {
+  // eq. 14.27 on two nodes: −C·A = [[G_w0 + G_wm − K, −G_wm], [−G_wm, G_m0(ω) + G_wm]] is positive definite iff
+  // K < K* = G_w0 + G_wm·G_m0(ω)/(G_wm + G_m0(ω)): the winding's conductance to the coolant, directly and in
+  // series through the magnet. K = s_cu·(3/2)·R_ref·α·|i|², so the current at which the winding runs away is
+  // |i|*² = K*/(s_cu·(3/2)·R_ref·α); the check must turn there, at standstill and with the speed part.
+  ThermalNetwork n = decoupled();
+  n.between_W_per_K(0, 1) = n.between_W_per_K(1, 0) = 3.0;
+  n.to_coolant_at_base_speed_W_per_K[1] = 10.0;
+  n.copper_scale = 1.3;
+  for (const double basis : {0.0, 0.6}) {
+    const double g_m0 = 6.0 + 10.0 * basis;
+    const double k_star = 25.0 + 3.0 * g_m0 / (3.0 + g_m0);
+    const double i2_star = k_star / (1.3 * 1.5 * n.copper.value_ref * n.copper.coeff_per_K);
+    ThermalLoad l;
+    l.convection_basis = basis;
+    for (const double ratio : {0.0, 0.5, 0.999}) {
+      l.current_sq_A2 = ratio * i2_star;
+      EXPECT_TRUE(thermal_settles(n, l)) << basis << " " << ratio;
+    }
+    l.current_sq_A2 = 1.001 * i2_star;
+    EXPECT_FALSE(thermal_settles(n, l)) << basis;
+    // Below K*, the steady state holds: a step long against every time constant lands on it.
+    l.current_sq_A2 = 0.9 * i2_star;
+    l.dt_s = 1e7;
+    const ThermalTransition tr = thermal_transition(n, l);
+    const ThermalVec t = tr.phi * ThermalVec(25.0, 25.0, 0.0, 0.0) + tr.gamma;
+    EXPECT_NEAR(t[0], thermal_steady_state(n, l)[0], 1e-6 * std::abs(t[0])) << basis;
+  }
+  // No path to the coolant at all: the Laplacian alone is singular, so nothing settles even without current.
+  ThermalNetwork closed = n;
+  closed.to_coolant_W_per_K.setZero();
+  closed.to_coolant_at_base_speed_W_per_K.setZero();
+  EXPECT_FALSE(thermal_settles(closed, ThermalLoad{}));
 }
 
 }  // namespace

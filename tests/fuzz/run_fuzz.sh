@@ -45,8 +45,8 @@ case $target in
                        corpus=can/fuzz/corpus_vesc ;;
   fuzz_signal_map)     main=can/fuzz/fuzz_signal_map.cpp;     objs=("$repo"/can/src/{signal_map,sample_clock}.cpp)
                        corpus=can/fuzz/corpus_signal_map ;;
-  fuzz_drive_log)      main=io/fuzz/fuzz_drive_log.cpp;       objs=("${io[@]}" "${core[@]}")
-                       corpus=io/fuzz/corpus/drive_log ;;
+  fuzz_log_source)     main=io/fuzz/fuzz_log_source.cpp;      objs=("${io[@]}" "${core[@]}")
+                       corpus=io/fuzz/corpus/log_source; asan=$yaml_asan ;;
   fuzz_machine_config) main=io/fuzz/fuzz_machine_config.cpp;  objs=("${io[@]}" "${core[@]}")
                        corpus=io/fuzz/corpus/machine_config; opts=("${yaml_opts[@]}") asan=$yaml_asan ;;
   fuzz_scenario)       main=sim/fuzz/fuzz_scenario.cpp;       objs=("$repo"/sim/src/*.cpp "$repo"/can/src/{vesc_firmware,vesc,e2e}.cpp "${io[@]}" "${core[@]}")

@@ -181,6 +181,21 @@ TEST(ThermalConfig, BadSectionsNameFileLineKeyAndReason) {
   }
 }
 
+TEST(ThermalConfig, ANetworkWhoseWindingRunsAwayAtTheRatingIsRefused) {
+  // eq. 14.27 at the machine's rated point (the built-in paper machine: 4.93 A rms, so |i|² = 48.6 A²). The
+  // winding's conductance to the coolant, directly (3 W/K) and through the stator iron (44 W/K in series with
+  // the iron's 95 W/K and the magnet's path), is about 33 W/K; copper's rise K = 1.5·R_ref·α·|i|² is 0.014 W/K at
+  // the section's 0.07 Ω and 143 W/K at 700 Ω: refused, naming the key, the rated point and both figures.
+  const std::string error = error_of("r_s_ref_Ohm: 0.07,", "r_s_ref_Ohm: 700,");
+  EXPECT_NE(error.find(":3:5: thermal.nodes: the network has no steady state at the machine's rated point (6.972 A peak"),
+            std::string::npos)
+      << error;
+  EXPECT_NE(error.find("the copper loss grows by 142.9 W/K"), std::string::npos) << error;
+  EXPECT_NE(error.find("eq. 14.27"), std::string::npos) << error;
+  // The same network at 10 Ω settles (K = 2.04 W/K): the check is the steady state's, not a bound on R_ref.
+  EXPECT_EQ(error_of("r_s_ref_Ohm: 0.07,", "r_s_ref_Ohm: 10,"), "");
+}
+
 TEST(ThermalConfig, DisturbanceTimeConstantPerNodeAbsentIsTheWalk) {
   // eq. 14.19: a node's τ_d; absent, +∞ (the random walk, eq. 14.9), and the writer then leaves it out.
   const std::string text = std::regex_replace(std::string(kThreeNodes), std::regex("to_coolant_W_per_K: 95"),

@@ -335,6 +335,24 @@ TEST(VescToolLog, RowsInTheSameMillisecondAreSpreadOverIt) {
   EXPECT_EQ(s[3].t_ns, 1'040'000'000);
 }
 
+TEST(VescToolLog, ASpeedRebuiltBeyondAnyDrivesIsRefusedAtItsRow) {
+  // Each cell within the absolute bound (9e6 erpm = 9.4e5 rad/s < 1e6), but two replies in one millisecond
+  // (0.5 ms apart once spread) that differ by all of it give the PLL's speed a slope of 1.9e9 rad/s², which the
+  // rebuild's lag term k_p/k_i = 67 ms (docs/derivations.md §13, "Speed at the read") carries to −1.3e8 rad/s. Found by
+  // fuzz_log_source (docs/benchmarks.md, "Fuzzing"): the bound holds for the rebuilt speed as for a cell.
+  const std::string msg = vesc_tool_error_of(kHeader120 + row120(1000, 0, 1, 9e6, 0, 1) + row120(1020, 0, 1, 9e6, 0, 1) +
+                                             row120(1020, 0, 1, 0, 0, 1) + row120(1040, 0, 1, 0, 0, 1));
+  EXPECT_NE(msg.find("vesc.csv:4:12: column erpm (omega_el): the window's mean speed rebuilt from the tracker's speeds at "
+                     "this read and at line 3 (942478 and 0 rad/s, 0.5 ms apart) is "),
+            std::string::npos)
+      << msg;
+  EXPECT_NE(msg.find("beyond the plausible ±1e+06 rad/s"), std::string::npos) << msg;
+  // A hard acceleration (3 140 rad/s in 20 ms, the rebuild's lag term 8.9e3 rad/s more): within the bound.
+  EXPECT_EQ(vesc_tool_error_of(kHeader120 + row120(1000, 0, 1, 100, 0, 1) + row120(1020, 0, 1, 30000, 0, 1) +
+                               row120(1040, 0, 1, 30000, 0, 1) + row120(1060, 0, 1, 30000, 0, 1)),
+            "");
+}
+
 TEST(VescToolLog, ABadCellNamesTheFilesColumnAndTheQuantity) {
   std::string bad = row120(1100, 0, 1, 100, 0, 1);
   bad.replace(bad.find(";1.000000;100"), 9, ";x");  // q_axis_current, the 11th cell
