@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "rpem/core/matrix_exponential.hpp"
+#include "rpem/core/thermal_terms.hpp"
 
 namespace rpem::core {
 namespace {
@@ -59,18 +60,17 @@ ThermalLoad LossAccumulator::take() noexcept {
 ThermalRates thermal_rates(const ThermalNetwork& n, const ThermalLoad& l) noexcept {
   // Copper (eq. 14.2): (3/2)·R_ref·(1 + α·(T_w − T_ref))·i² = a + b·T_w.
   const DriftLaw& r = n.copper;
-  const double copper_per_K = n.copper_scale * 1.5 * l.current_sq_A2 * r.value_ref * r.coeff_per_K;
+  const double copper_per_K = copper_loss_per_K(n, l);
   const double copper_at_0C = n.copper_scale * 1.5 * l.current_sq_A2 * r.value_ref * (1.0 - r.coeff_per_K * r.reference_C);
   ThermalRates out;
   for (int i = 0; i < n.nodes; ++i) {
     double loss = 0.0;
     for (int f = 0; f < kLossForms; ++f) loss += n.loss_at_base_W(f, i) * l.basis[static_cast<std::size_t>(f)];
-    const double g_coolant =
-        n.to_coolant_W_per_K[i] + n.to_coolant_at_base_speed_W_per_K[i] * l.convection_basis;  // (14.1b)
+    const double g_coolant = coolant_conductance_W_per_K(n, l, i);  // (14.1b)
     double g_total = g_coolant;
     for (int j = 0; j < n.nodes; ++j) {
       if (j == i) continue;
-      const double g = n.between_W_per_K(i, j) + n.between_at_base_speed_W_per_K(i, j) * l.convection_basis;  // (14.1b)
+      const double g = node_conductance_W_per_K(n, l, i, j);  // (14.1b)
       out.a(i, j) = g;
       g_total += g;
     }

@@ -132,9 +132,6 @@ std::vector<double> accel_changes(const std::vector<PreviousRowRead>& rows, cons
   return out;
 }
 
-/// The samples of a previous_row log's rows (rows not empty): each window from the read before it, its speed rebuilt
-/// where the column is a PLL's, its count where the log has one; the windows next to a read whose time is unknown
-/// left out, and counted in `read`.
 /// A window's speed rebuilt from a tracker's reads (core::window_mean_speed_rad_s) is held to the speed's bound as a
 /// cell is: reads too close for the log's clock, or a column that is not a speed, extrapolate beyond any drive's.
 void check_rebuilt_speed(const MappedLogReader& reader, const DriveLogLimits& limits, const PreviousRowRead& previous,
@@ -150,6 +147,9 @@ void check_rebuilt_speed(const MappedLogReader& reader, const DriveLogLimits& li
   reader.fail_at(row.line, Quantity::kOmegaEl, why.str());
 }
 
+/// The samples of a previous_row log's rows (rows not empty): each window from the read before it, its speed rebuilt
+/// where the column is a PLL's, its count where the log has one; the windows next to a read whose time is unknown
+/// left out, and counted in `read`.
 void previous_row_samples(const std::vector<PreviousRowRead>& rows, const LogMap& map, bool counted,
                           const MappedLogReader& reader, const DriveLogLimits& limits,
                           std::vector<core::AveragedSample>& out, AveragedLogRead& read) {

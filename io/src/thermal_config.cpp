@@ -8,6 +8,7 @@
 #include "rpem/core/non_finite.hpp"
 #include "rpem/core/per_unit.hpp"
 #include "rpem/core/thermal_stability.hpp"
+#include "rpem/core/thermal_terms.hpp"
 #include "rpem/io/number_format.hpp"
 
 namespace rpem::io {
@@ -198,7 +199,6 @@ void parse_losses(YamlMap& t, ThermalConfig& c) {
   }
 }
 
-/// `nodes`, `conductances` and `losses`.
 /// A network accepted only if it settles at the machine's rated point (eq. 14.27): the rated current is one the
 /// machine carries for ever, so its winding reaches a steady temperature there.
 void check_settles_at_rating(const YamlMap& t, const ThermalConfig& c, const MachineConfig& machine) {
@@ -209,20 +209,21 @@ void check_settles_at_rating(const YamlMap& t, const ThermalConfig& c, const Mac
   load.convection_basis = std::sqrt(std::abs(rated.omega_el_rad_s) / n.base.omega_el_rad_s);
   if (core::thermal_settles(n, load)) return;
   const int w = n.winding;
-  double conducted = n.to_coolant_W_per_K[w] + n.to_coolant_at_base_speed_W_per_K[w] * load.convection_basis;
+  double conducted = core::coolant_conductance_W_per_K(n, load, w);
   for (int j = 0; j < n.nodes; ++j) {
-    if (j != w) conducted += n.between_W_per_K(w, j) + n.between_at_base_speed_W_per_K(w, j) * load.convection_basis;
+    if (j != w) conducted += core::node_conductance_W_per_K(n, load, w, j);
   }
   std::ostringstream why;
   why << std::setprecision(4) << "the network has no steady state at the machine's rated point (" << rated.current_A
       << " A peak at " << rated.omega_el_rad_s << " rad/s electrical, machine.rated): the copper loss grows by "
-      << n.copper_scale * 1.5 * load.current_sq_A2 * n.copper.value_ref * n.copper.coeff_per_K
+      << core::copper_loss_per_K(n, load)
       << " W/K with the winding's temperature (copper: loss_scale, r_s_ref_Ohm, coeff_per_K) against the " << conducted
       << " W/K the winding conducts to its neighbours and the coolant: a winding that runs away at the current it "
          "is rated to carry (docs/derivations.md, eq. 14.27)";
   t.fail("nodes", why.str());
 }
 
+/// `nodes`, `conductances` and `losses`.
 void parse_network(YamlMap& t, ThermalConfig& c) {
   parse_nodes(t, c);
   parse_conductances(t, c);
