@@ -132,16 +132,20 @@ std::vector<double> accel_changes(const std::vector<PreviousRowRead>& rows, cons
   return out;
 }
 
-/// A window's speed rebuilt from a tracker's reads (core::window_mean_speed_rad_s) is held to the speed's bound as a
-/// cell is: reads too close for the log's clock, or a column that is not a speed, extrapolate beyond any drive's.
-void check_rebuilt_speed(const MappedLogReader& reader, const DriveLogLimits& limits, const PreviousRowRead& previous,
-                         const PreviousRowRead& row, const core::AveragedSample& s) {
-  if (std::abs(s.omega_el_rad_s) <= limits.speed_rad_s.max_abs) return;
+/// A window's speed rebuilt from a tracker's reads (core::window_mean_speed_rad_s) is held to the absolute bound a cell
+/// is held to: reads too close for the log's clock, or a column that is not a speed, extrapolate beyond any drive's.
+/// Within it, a rebuilt speed off beyond the machine's plausible one carries the error its reads show and is judged
+/// transient there (docs/drive-log.md, "Speed at the read"); a reader's machine bound would refuse a whole real log
+/// for one jittery pair of tied reads.
+void check_rebuilt_speed(const MappedLogReader& reader, const PreviousRowRead& previous, const PreviousRowRead& row,
+                         const core::AveragedSample& s) {
+  static const Bound bound = DriveLogLimits{}.speed_rad_s;
+  if (std::abs(s.omega_el_rad_s) <= bound.max_abs) return;
   std::ostringstream why;
   why << std::setprecision(6) << "the window's mean speed rebuilt from the tracker's speeds at this read and at line "
       << previous.line << " (" << previous.omega_at_read_rad_s << " and " << row.omega_at_read_rad_s << " rad/s, "
       << 1e3 * core::to_seconds(row.sample.t_ns - previous.sample.t_ns) << " ms apart) is " << s.omega_el_rad_s
-      << " rad/s, beyond the plausible ±" << limits.speed_rad_s.max_abs << " rad/s (" << limits.speed_rad_s.why
+      << " rad/s, beyond the plausible ±" << bound.max_abs << " rad/s (" << bound.why
       << "): reads this close or this far apart in speed give the tracker no slope (docs/drive-log.md, \"Speed at "
          "the read\")";
   reader.fail_at(row.line, Quantity::kOmegaEl, why.str());
@@ -151,8 +155,7 @@ void check_rebuilt_speed(const MappedLogReader& reader, const DriveLogLimits& li
 /// where the column is a PLL's, its count where the log has one; the windows next to a read whose time is unknown
 /// left out, and counted in `read`.
 void previous_row_samples(const std::vector<PreviousRowRead>& rows, const LogMap& map, bool counted,
-                          const MappedLogReader& reader, const DriveLogLimits& limits,
-                          std::vector<core::AveragedSample>& out, AveragedLogRead& read) {
+                          const MappedLogReader& reader, std::vector<core::AveragedSample>& out, AveragedLogRead& read) {
   // The counts at the reads whose times are known, and the read that ends each sample: the counted speeds.
   std::vector<core::CountRead> reads;
   std::vector<std::size_t> read_ending;
@@ -183,7 +186,7 @@ void previous_row_samples(const std::vector<PreviousRowRead>& rows, const LogMap
       s.omega_el_rad_s =
           core::window_mean_speed_rad_s({previous.sample.t_ns, previous.omega_at_read_rad_s},
                                         {s.t_ns, rows[k].omega_at_read_rad_s}, s.t_start_ns, map.speed_pll.ramp_lag_s());
-      check_rebuilt_speed(reader, limits, previous, rows[k], s);
+      check_rebuilt_speed(reader, previous, rows[k], s);
       const double h_s = core::to_seconds(s.t_ns - s.t_start_ns);
       const double after = k + 1 < rows.size() ? accel_change[k + 1] : std::nan("");
       const double change = std::fmax(std::fabs(accel_change[k]), std::fabs(after));  // fmax: a NaN side left out
@@ -272,7 +275,7 @@ std::vector<core::AveragedSample> read_averaged_log(const std::string& path, con
     rows.push_back(row);
   }
 
-  if (!rows.empty()) previous_row_samples(rows, map, counted, reader, limits, out, read);
+  if (!rows.empty()) previous_row_samples(rows, map, counted, reader, out, read);
   if (counted && map.window == Window::kStartColumn) {
     set_counted_speeds(out, start_column_reads, start_column_ends, count_step_rad(start_column_reads));
   }
