@@ -14,6 +14,7 @@
 #include <string_view>
 #include <vector>
 
+#include "estimate_in_bounds.hpp"
 #include "rpem/core/averaged_estimator.hpp"
 #include "rpem/core/drive_estimator.hpp"
 #include "rpem/io/averaged_log.hpp"
@@ -37,19 +38,10 @@ bool within(double v, const rpem::io::Bound& b) { return std::isfinite(v) && std
 /// An optional quantity: not reported (NaN) or within its bound.
 bool absent_or_within(double v, const rpem::io::Bound& b) { return std::isnan(v) || within(v, b); }
 
-/// Inside D_M to rounding: the estimator projects in pu, and the SI value carries the conversion's rounding.
-bool inside(double v, double lo, double hi) {
-  return std::isfinite(v) && v >= lo * (1.0 - 1e-12) && v <= hi * (1.0 + 1e-12);
-}
-
 void write_file(const char* path, std::string_view bytes) {
   std::ofstream out(path, std::ios::binary | std::ios::trunc);
   out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
   check(static_cast<bool>(out));
-}
-
-void check_estimate(const rpem::core::Estimate& e, const rpem::core::EstimatorSettings& s) {
-  check(inside(e.psi_m_Wb, s.psi_m_min_Wb, s.psi_m_max_Wb) && inside(e.r_s_Ohm, s.r_s_min_Ohm, s.r_s_max_Ohm));
 }
 
 /// As `rpem estimate` runs an averaged log (tools/rpem/estimate_command.cpp, run_averaged).
@@ -78,7 +70,7 @@ void run_averaged(const rpem::io::LogSource& source, const rpem::io::MachineConf
   io::check_averaged_supports(config, "builtin", read.layout.u_dc, source.path);
   const core::EstimatorSettings settings = io::estimator_settings(config, rebuilt);
   core::AveragedDriveEstimator estimator(config.machine, settings);
-  for (const core::AveragedSample& x : samples) check_estimate(estimator.step(x), settings);
+  for (const core::AveragedSample& x : samples) check(fuzz::estimate_in_bounds(estimator.step(x), settings));
 }
 
 /// As `rpem estimate` runs a log of instantaneous samples (run_instantaneous).
@@ -103,7 +95,7 @@ void run_instantaneous(const rpem::io::LogSource& source, const rpem::io::Machin
     check(x.current_frame == (layout.current_abc ? core::Frame::kAbc : core::Frame::kDq));
     for (int k = 0; k < 3; ++k) check(within(x.u_V[k], limits.voltage_V) && within(x.i_A[k], limits.current_A));
     check(!row.t_magnet_C || (*row.t_magnet_C >= limits.temperature_min_C && *row.t_magnet_C <= limits.temperature_max_C));
-    check_estimate(estimator.step(x), config.estimator);
+    check(fuzz::estimate_in_bounds(estimator.step(x), config.estimator));
   }
   check(rows > 0);  // a log without samples must have thrown
 }

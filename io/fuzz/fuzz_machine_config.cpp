@@ -10,6 +10,7 @@
 #include <optional>
 #include <string>
 
+#include "estimate_in_bounds.hpp"
 #include "rpem/core/drive_estimator.hpp"
 #include "rpem/core/thermal_fusion.hpp"
 #include "rpem/io/machine_config.hpp"
@@ -40,10 +41,6 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   x.u_dc_V = 2.0 * base.voltage_V;
   x.u_V = {-0.1 * base.voltage_V, 0.4 * base.voltage_V, 0.0};
   x.i_A = {-0.1 * base.current_A, 0.4 * base.current_A, 0.0};
-  // Inside D_M to rounding: the estimator projects in pu, and the SI value carries the conversion's rounding.
-  auto inside = [](double v, double lo, double hi) {
-    return std::isfinite(v) && v >= lo * (1.0 - 1e-12) && v <= hi * (1.0 + 1e-12);
-  };
   std::optional<core::ThermalFusion> fusion;
   if (thermal) fusion.emplace(thermal->fusion, estimator.base(), c.machine);
   core::ThermalSample heat;
@@ -52,9 +49,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     x.t_ns = 125'000LL * k;
     x.theta_el_rad = std::fmod(x.omega_el_rad_s * 125e-6 * k, 6.283185307179586);
     const core::Estimate e = estimator.step(x);
-    if (!inside(e.psi_m_Wb, s.psi_m_min_Wb, s.psi_m_max_Wb) || !inside(e.r_s_Ohm, s.r_s_min_Ohm, s.r_s_max_Ohm)) {
-      std::abort();
-    }
+    if (!fuzz::estimate_in_bounds(e, s)) std::abort();
     if (fusion) {
       heat.winding_sensor_C = k % 2 == 0 ? 60.0 : std::nan("");  // a reading on every other sample
       fusion->step(e, heat);
