@@ -1,10 +1,11 @@
 // libFuzzer target for every log the tools read (docs/drive-log.md): a log given as its header makes it (our drive
 // log, our averaged log, VESC Tool's realtime log) or through a user's column map (`--log-map`), read the way
 // `rpem estimate` reads it. The input is a file's bytes, or a column map's YAML, a line "%%csv", then the file.
-// The reading may fail only with a DriveLogError, or a ConfigError where a map is given; every sample it delivers is finite where
-// required, within DriveLogLimits (the absolute ones: the seeds come from machines larger than the paper's), later
-// than the one before, in the frames the header promises and, averaged, a window that ends no earlier than it starts;
-// a log without samples throws; and the estimator (the built-in paper machine) keeps its estimates finite inside D_M.
+// The reading may fail only with a DriveLogError, or a ConfigError where a map is given; every sample it delivers
+// is finite where required, within DriveLogLimits (the absolute ones: the seeds come from machines larger than the
+// paper's), later than the one before, in the frames the header promises and, averaged, a window that ends no
+// earlier than it starts; a log without samples throws; and the estimator (the built-in paper machine) keeps its
+// estimates finite inside D_M.
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -37,6 +38,10 @@ void check(bool ok) {
 bool within(double v, const rpem::io::Bound& b) { return std::isfinite(v) && std::abs(v) <= b.max_abs; }
 /// An optional quantity: not reported (NaN) or within its bound.
 bool absent_or_within(double v, const rpem::io::Bound& b) { return std::isnan(v) || within(v, b); }
+/// An optional temperature: not reported (NaN) or within the limits' range.
+bool absent_or_plausible_C(double t, const rpem::io::DriveLogLimits& limits) {
+  return std::isnan(t) || (t >= limits.temperature_min_C && t <= limits.temperature_max_C);
+}
 
 void write_file(const char* path, std::string_view bytes) {
   std::ofstream out(path, std::ios::binary | std::ios::trunc);
@@ -56,9 +61,7 @@ void run_averaged(const rpem::io::LogSource& source, const rpem::io::MachineConf
     check(x.t_start_ns <= x.t_ns && x.t_ns > last_t_ns);
     last_t_ns = x.t_ns;
     check(absent_or_within(x.u_dc_V, limits.voltage_V));
-    for (double t : {x.t_winding_C, x.t_magnet_C, x.t_coolant_C}) {
-      check(std::isnan(t) || (t >= limits.temperature_min_C && t <= limits.temperature_max_C));
-    }
+    for (double t : {x.t_winding_C, x.t_magnet_C, x.t_coolant_C}) check(absent_or_plausible_C(t, limits));
   }
   (void)io::describe(source, read);
   const io::RotorFrameRebuild rebuilt =
@@ -94,7 +97,7 @@ void run_instantaneous(const rpem::io::LogSource& source, const rpem::io::Machin
     check(x.voltage_frame == (layout.voltage_abc ? core::Frame::kAbc : core::Frame::kDq));
     check(x.current_frame == (layout.current_abc ? core::Frame::kAbc : core::Frame::kDq));
     for (int k = 0; k < 3; ++k) check(within(x.u_V[k], limits.voltage_V) && within(x.i_A[k], limits.current_A));
-    check(!row.t_magnet_C || (*row.t_magnet_C >= limits.temperature_min_C && *row.t_magnet_C <= limits.temperature_max_C));
+    check(absent_or_plausible_C(row.t_magnet_C.value_or(std::nan("")), limits));
     check(fuzz::estimate_in_bounds(estimator.step(x), config.estimator));
   }
   check(rows > 0);  // a log without samples must have thrown
