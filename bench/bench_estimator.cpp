@@ -21,6 +21,7 @@
 #include "rpem/core/clock.hpp"
 #include "rpem/core/drive_estimator.hpp"
 #include "rpem/core/frames.hpp"
+#include "rpem/core/plausibility.hpp"
 #include "rpem/core/regime.hpp"
 #include "rpem/core/settings.hpp"
 #include "support/averaged_data.hpp"
@@ -354,6 +355,48 @@ void BM_AveragedClassificationInStep(benchmark::State& state) {
       state, [&] { pass(without, b); }, [&] { pass(with, a); });
 }
 
+/// The loop's plausibility check (core::within against core::machine_plausible: docs/rpemd.md, "Values no drive
+/// produces") against the step it guards, on the same samples, each timed on this thread's CPU clock in one run:
+/// phase samples (range 0) against DriveEstimator::step, averaged windows (range 1) against
+/// AveragedDriveEstimator::step. ratio = check/step.
+void BM_PlausibilityOverStep(benchmark::State& state) {
+  const bool averaged = state.range(0) == 1;
+  const core::PlausibleMagnitudes limits = core::machine_plausible(test::paper_machine_si().rated);
+  const core::EstimatorSettings settings = test::paper_settings(core::Algorithm::kSga);
+  core::DriveEstimator phase(test::paper_machine_si(), settings);
+  core::AveragedDriveEstimator windowed(test::paper_machine_si(), settings);
+  Replay replay;
+  std::vector<core::AveragedSample> windows = averaged_windows();
+  const std::int64_t pass_ns = windows.back().t_ns - windows.front().t_start_ns;
+  double check_s = 0.0, step_s = 0.0;
+  unsigned sink = 0;
+  for (auto _ : state) {
+    const double t0 = thread_cpu_s();
+    if (averaged) {
+      for (const core::AveragedSample& w : windows) sink += core::within(w, limits) ? 1U : 0U;
+    } else {
+      for (const core::DriveSample& d : samples()) sink += core::within(d, limits) ? 1U : 0U;
+    }
+    const double t1 = thread_cpu_s();
+    if (averaged) {
+      for (core::AveragedSample& w : windows) {
+        benchmark::DoNotOptimize(windowed.step(w));
+        w.t_start_ns += pass_ns;
+        w.t_ns += pass_ns;
+      }
+    } else {
+      for (int k = 0; k < kSamples; ++k) benchmark::DoNotOptimize(phase.step(replay.next()));
+    }
+    step_s += thread_cpu_s() - t1;
+    check_s += t1 - t0;
+  }
+  if (sink != static_cast<unsigned>(state.iterations()) * kSamples) state.SkipWithError("a bench sample is implausible");
+  const double steps = static_cast<double>(state.iterations()) * kSamples;
+  state.counters["check_ns"] = 1e9 * check_s / steps;
+  state.counters["step_ns"] = 1e9 * step_s / steps;
+  state.counters["ratio"] = check_s / step_s;
+}
+
 BENCHMARK(BM_ClassificationInStep)
     ->MinTime(1.0)
     ->Repetitions(10)
@@ -380,6 +423,14 @@ BENCHMARK(BM_AveragedClassificationOverStepRebuiltSpeed)
     ->ComputeStatistics("max", max_of)
     ->ReportAggregatesOnly(true);
 BENCHMARK(BM_AveragedClassificationInStep)
+    ->MinTime(1.0)
+    ->Repetitions(10)
+    ->ComputeStatistics("max", max_of)
+    ->ReportAggregatesOnly(true);
+
+BENCHMARK(BM_PlausibilityOverStep)
+    ->ArgName("averaged")
+    ->DenseRange(0, 1)
     ->MinTime(1.0)
     ->Repetitions(10)
     ->ComputeStatistics("max", max_of)

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <variant>
 
 #include "rpem/core/assert.hpp"
 #include "rpem/core/clock.hpp"
@@ -13,10 +14,11 @@ namespace {
 
 using Diag = rpem::diagnostics_t;
 
-constexpr std::array<CounterRow<LoopCounters>, 11> kLoopRows{{
+constexpr std::array<CounterRow<LoopCounters>, 12> kLoopRows{{
     {&LoopCounters::samples, &Diag::samples},
     {&LoopCounters::resyncs, &Diag::resyncs},
     {&LoopCounters::rejected_non_finite, &Diag::rejected_non_finite},
+    {&LoopCounters::rejected_implausible, &Diag::rejected_implausible},
     {&LoopCounters::wrong_kind, &Diag::samples_wrong_kind},
     {&LoopCounters::predictor_resets, &Diag::predictor_resets},
     {&LoopCounters::projections, &Diag::projections},
@@ -36,12 +38,20 @@ std::int64_t interval_ns(double rate_Hz) noexcept {
   return rate_Hz > 0.0 ? static_cast<std::int64_t>(1e9 / rate_Hz) : INT64_MAX / 4;
 }
 
+/// Whether a sample of either kind holds only values within `m` (no std::visit: no bad_variant_access to throw).
+bool within(const SourceSample& s, const core::PlausibleMagnitudes& m) noexcept {
+  if (const auto* d = std::get_if<core::DriveSample>(&s)) return core::within(*d, m);
+  if (const auto* a = std::get_if<core::AveragedSample>(&s)) return core::within(*a, m);
+  return false;
+}
+
 }  // namespace
 
 LoopThread::LoopThread(const DaemonConfig& config, Queues queues)
     : live_(config.live),
       loop_config_(config.fixed.loop),
       queues_(std::move(queues)),
+      plausible_(core::machine_plausible(config.live.machine.machine.rated)),
       estimator_(SourceCatalogue::sample_kind(config.fixed.source), config.live.machine.machine,
                  config.live.machine.estimator),
       validity_(config.live.validity, config.fixed.lcm.estimate_rate_Hz),
@@ -92,6 +102,7 @@ void LoopThread::apply(const Command& c) noexcept {
       break;
     case Command::Kind::kReconfigure:
       live_ = c.live;
+      plausible_ = core::machine_plausible(live_.machine.machine.rated);
       estimator_.reconfigure(live_.machine.machine, live_.machine.estimator);
       validity_.reconfigure(live_.validity);
       // The temperatures and their covariance are kept (a new network starts from the old one's state).
@@ -109,6 +120,11 @@ void LoopThread::apply(const Command& c) noexcept {
 }
 
 void LoopThread::step(const SourceSample& s, std::int64_t now_ns) noexcept {
+  if (!within(s, plausible_)) {
+    ++counters_.rejected_implausible;
+    estimator_.resynchronize();  // the next sample does not continue across the one left out
+    return;
+  }
   double dt_s = 0.0;
   if (!estimator_.step(s, last_, dt_s, last_sample_)) {
     ++counters_.wrong_kind;

@@ -9,6 +9,7 @@
 
 #include "rpem/core/non_finite.hpp"
 #include "rpem/core/per_unit.hpp"
+#include "rpem/core/plausibility.hpp"
 #include "rpem/io/number_format.hpp"
 
 namespace rpem::io {
@@ -346,18 +347,18 @@ void check_log_supports(const MachineConfig& c, const std::string& config_name, 
 
 DriveLogLimits machine_limits(const core::MachineSi& machine) {
   const core::PerUnitBase base = core::PerUnitBase::from_rated(machine.rated);
+  const core::PlausibleMagnitudes narrowed = core::machine_plausible(machine.rated);
   DriveLogLimits limits;
-  auto narrow = [](Bound& bound, double base_value, const char* what, const char* unit) {
-    const double max_abs = kRatedMultipleLimit * base_value;
+  auto narrow = [](Bound& bound, double max_abs, double base_value, const char* what, const char* unit) {
     if (!(max_abs < bound.max_abs)) return;
     char why[160];
-    std::snprintf(why, sizeof why, "%g x the configured machine's %s %.4g %s, machine.rated", kRatedMultipleLimit, what,
-                  base_value, unit);
+    std::snprintf(why, sizeof why, "%g x the configured machine's %s %.4g %s, machine.rated", core::kRatedMultipleLimit,
+                  what, base_value, unit);
     bound = {max_abs, why};
   };
-  narrow(limits.current_A, base.current_A, "rated peak phase current", "A");
-  narrow(limits.voltage_V, base.voltage_V, "rated peak phase voltage", "V");
-  narrow(limits.speed_rad_s, base.omega_el_rad_s, "rated electrical speed", "rad/s");
+  narrow(limits.current_A, narrowed.current_A, base.current_A, "rated peak phase current", "A");
+  narrow(limits.voltage_V, narrowed.voltage_V, base.voltage_V, "rated peak phase voltage", "V");
+  narrow(limits.speed_rad_s, narrowed.speed_rad_s, base.omega_el_rad_s, "rated electrical speed", "rad/s");
   return limits;
 }
 

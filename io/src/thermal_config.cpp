@@ -3,6 +3,7 @@
 #include <cmath>
 #include <iomanip>
 #include <limits>
+#include <optional>
 #include <sstream>
 
 #include "rpem/core/non_finite.hpp"
@@ -199,30 +200,6 @@ void parse_losses(YamlMap& t, ThermalConfig& c) {
   }
 }
 
-/// A network accepted only if it settles at the machine's rated point (eq. 14.27): the rated current is one the
-/// machine carries for ever, so its winding reaches a steady temperature there.
-void check_settles_at_rating(const YamlMap& t, const ThermalConfig& c, const MachineConfig& machine) {
-  const core::ThermalNetwork& n = c.fusion.filter.network;
-  const core::PerUnitBase rated = core::PerUnitBase::from_rated(machine.machine.rated);
-  core::ThermalLoad load;
-  load.current_sq_A2 = rated.current_A * rated.current_A;
-  load.convection_basis = std::sqrt(std::abs(rated.omega_el_rad_s) / n.base.omega_el_rad_s);
-  if (core::thermal_settles(n, load)) return;
-  const int w = n.winding;
-  double conducted = core::coolant_conductance_W_per_K(n, load, w);
-  for (int j = 0; j < n.nodes; ++j) {
-    if (j != w) conducted += core::node_conductance_W_per_K(n, load, w, j);
-  }
-  std::ostringstream why;
-  why << std::setprecision(4) << "the network has no steady state at the machine's rated point (" << rated.current_A
-      << " A peak at " << rated.omega_el_rad_s << " rad/s electrical, machine.rated): the copper loss grows by "
-      << core::copper_loss_per_K(n, load)
-      << " W/K with the winding's temperature (copper: loss_scale, r_s_ref_Ohm, coeff_per_K) against the " << conducted
-      << " W/K the winding conducts to its neighbours and the coolant: a winding that runs away at the current it "
-         "is rated to carry (docs/derivations.md, eq. 14.27)";
-  t.fail("nodes", why.str());
-}
-
 /// `nodes`, `conductances` and `losses`.
 void parse_network(YamlMap& t, ThermalConfig& c) {
   parse_nodes(t, c);
@@ -279,9 +256,33 @@ ThermalConfig parse_thermal_config(YamlMap& section, const MachineConfig& machin
     f.observer.settle_time_constants = m->number_or("settle_time_constants", f.observer.settle_time_constants, 0.0, 100.0);
     m->finish();
   }
-  if (c.has_network) check_settles_at_rating(section, c, machine);
+  if (c.has_network) {
+    if (const std::optional<std::string> why = runaway_at_rating(c, machine)) section.fail("nodes", *why);
+  }
   section.finish();
   return c;
+}
+
+std::optional<std::string> runaway_at_rating(const ThermalConfig& c, const MachineConfig& machine) {
+  const core::ThermalNetwork& n = c.fusion.filter.network;
+  const core::PerUnitBase rated = core::PerUnitBase::from_rated(machine.machine.rated);
+  core::ThermalLoad load;
+  load.current_sq_A2 = rated.current_A * rated.current_A;
+  load.convection_basis = std::sqrt(std::abs(rated.omega_el_rad_s) / n.base.omega_el_rad_s);
+  if (core::thermal_settles(n, load)) return std::nullopt;
+  const int w = n.winding;
+  double conducted = core::coolant_conductance_W_per_K(n, load, w);
+  for (int j = 0; j < n.nodes; ++j) {
+    if (j != w) conducted += core::node_conductance_W_per_K(n, load, w, j);
+  }
+  std::ostringstream why;
+  why << std::setprecision(4) << "the network has no steady state at the machine's rated point (" << rated.current_A
+      << " A peak at " << rated.omega_el_rad_s << " rad/s electrical, machine.rated): the copper loss grows by "
+      << core::copper_loss_per_K(n, load)
+      << " W/K with the winding's temperature (copper: loss_scale, r_s_ref_Ohm, coeff_per_K) against the " << conducted
+      << " W/K the winding conducts to its neighbours and the coolant: a winding that runs away at the current it "
+         "is rated to carry (docs/derivations.md, eq. 14.27)";
+  return why.str();
 }
 
 ThermalConfig load_thermal_config(const std::string& path, const MachineConfig& machine, NetworkRequired network) {

@@ -210,5 +210,34 @@ TEST(AveragedLoop, APhaseSampleIsCountedNotStepped) {
   EXPECT_EQ(rig.stats.rows.get(&diagnostics_t::samples_wrong_kind), 1);
 }
 
+// A window holding a value no drive of this machine produces is counted and not estimated on, and the next window
+// starts a new chain (core::within; docs/rpemd.md, "Values no drive produces"): a speed of 2^31 ERPM (VESC's 32-bit field, as a
+// corrupted read or a wrong scale in a signal map gives it) and a winding sensor at 3276.7 °C (VESC's 16-bit
+// temperature field at its maximum). ψm converges as it does without them.
+TEST(AveragedLoop, AWindowBeyondWhatTheMachineProducesIsCountedAndNotEstimatedOn) {
+  AveragedRig rig(200.0, 0.92);
+  rig.run(5.0);
+  auto change_next = [&](auto change) {  // the next window the rig pushes, in its turn
+    if (!rig.have_next) {
+      rig.next = rig.gen.next();
+      rig.next.t_start_ns += 1'000'000'000;
+      rig.next.t_ns += 1'000'000'000;
+      rig.have_next = true;
+    }
+    change(rig.next);
+    rig.run(5.0);
+  };
+  change_next([](core::AveragedSample& w) { w.omega_el_rad_s = 2147483647.0 * 2.0 * M_PI / 60.0; });
+  change_next([](core::AveragedSample& w) { w.t_winding_C = 3276.7; });
+  rig.run(5.0);
+  rig.drain();
+  const LoopStatsReport& s = rig.stats;
+  EXPECT_EQ(s.rows.get(&diagnostics_t::rejected_implausible), 2);
+  EXPECT_EQ(s.rows.get(&diagnostics_t::resyncs), 3);  // the first window, and the one after each left out
+  EXPECT_EQ(s.rows.get(&diagnostics_t::rejected_non_finite), 0);
+  EXPECT_LE(rig.estimate.samples, rig.pushed - 2);
+  EXPECT_NEAR(rig.estimate.psi_m_Wb / (0.92 * 1.14), 1.0, 1e-2);
+}
+
 }  // namespace
 }  // namespace rpem::daemon

@@ -282,5 +282,23 @@ TEST(EstimatorLoop, GapsResynchroniseAndNonFiniteSamplesAreCounted) {
   EXPECT_GE(stats.rows.get(&diagnostics_t::epsilon_rms_d_A), 0.0);
 }
 
+// A phase sample beyond what the machine produces (a current of 11·I_b: a wrong scale) is counted, not estimated on,
+// and the sample after it resynchronises, as after a non-finite one (core::within).
+TEST(EstimatorLoop, ASampleBeyondWhatTheMachineProducesIsCountedAndNotEstimatedOn) {
+  Rig rig;
+  rig.gen.n_pu = 0.4;
+  rig.gen.i_ref_pu = core::mtpa_reference(rig.gen.plant, 0.2);
+  rig.run(0.5);
+  core::DriveSample bad = rig.gen.next_si(rig.base, rig.t_ns);
+  bad.i_A[0] = 11.0 * rig.base.current_A;
+  ASSERT_TRUE(rig.input.push(bad));
+  rig.run(1.2);
+  const LoopStatsReport stats = rig.last_stats();
+  EXPECT_EQ(stats.rows.get(&diagnostics_t::rejected_implausible), 1);
+  EXPECT_EQ(stats.rows.get(&diagnostics_t::rejected_non_finite), 0);
+  EXPECT_EQ(stats.rows.get(&diagnostics_t::resyncs), 2);  // the first sample, the sample after the one left out
+  EXPECT_LT(stats.rows.get(&diagnostics_t::epsilon_rms_d_A), 1e-3);
+}
+
 }  // namespace
 }  // namespace rpem::daemon

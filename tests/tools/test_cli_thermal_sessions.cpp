@@ -302,5 +302,36 @@ TEST_F(CliThermalSessions, RefusesWhatCannotBeFitted) {
   EXPECT_NE(both.output.find("excludes"), std::string::npos) << both.output;
 }
 
+// A fit whose network would run away at the configured rating (eq. 14.27) is not written: every reader would refuse
+// it. Here the log is the machine's own, but the configuration claims 50 times its rated current (8 kA rms): the
+// copper loss at that current grows faster with the winding's temperature than the fitted winding sheds heat. The
+// same log with the machine's own rating writes its network; the refused fit still writes its report.
+TEST_F(CliThermalSessions, ANetworkThatRunsAwayAtTheConfiguredRatingIsNotWritten) {
+  write_session("a", 3500.0, 174.0, -60.0, 900.0);
+  std::string yaml = test::read_file(test::source_dir() + "/config/paderborn-pmsm.yaml");
+  const std::string rated = "current_rms_A: 160 ";
+  const std::size_t at_rated = yaml.find(rated);
+  ASSERT_NE(at_rated, std::string::npos);
+  yaml.replace(at_rated, rated.size(), "current_rms_A: 8000 ");
+  { std::ofstream(at("overrated.yaml")) << yaml; }
+  const std::string fit = rpem_tool() + " thermal fit --log " + at("a.csv") + " --config ";
+
+  const test::ProcessResult refused =
+      test::run_command(fit + at("overrated.yaml") + " --out " + at("refused.yaml") + " --report " + at("report"));
+  EXPECT_EQ(refused.exit_code, 65) << refused.output;
+  EXPECT_NE(refused.output.find(at("refused.yaml") + " not written: the network has no steady state at the machine's "
+                                                     "rated point (1.131e+04 A peak"),
+            std::string::npos)
+      << refused.output;
+  EXPECT_NE(refused.output.find("Either machine.rated in " + at("overrated.yaml")), std::string::npos) << refused.output;
+  EXPECT_FALSE(fs::exists(at("refused.yaml")));
+  EXPECT_TRUE(fs::exists(at("report/fit.json")));
+
+  const test::ProcessResult own =
+      test::run_command(fit + test::source_dir() + "/config/paderborn-pmsm.yaml --out " + at("own.yaml"));
+  EXPECT_EQ(own.exit_code, 0) << own.output;
+  EXPECT_TRUE(fs::exists(at("own.yaml")));
+}
+
 }  // namespace
 }  // namespace rpem

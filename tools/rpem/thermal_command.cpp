@@ -11,6 +11,8 @@
 #include <cstdio>
 #include <filesystem>
 #include <limits>
+#include <optional>
+#include <string>
 #include <vector>
 
 #include "commands.hpp"
@@ -117,7 +119,9 @@ int run_thermal_fit(const ThermalFitCliOptions& o) {
                start.fusion.observer.period_s, start.fusion.filter.network.nodes);
   const analysis::ThermalFitResult fit = analysis::fit_thermal(record, start, options);
 
-  analysis::write_thermal_yaml(o.out, fit, record, config_name);
+  // A network every reader would refuse is not written (its report is: it shows what the log bounds).
+  const std::optional<std::string> runaway = io::runaway_at_rating(fit.config, machine);
+  if (!runaway) analysis::write_thermal_yaml(o.out, fit, record, config_name);
   if (!o.report.empty()) {
     io::create_output_directory(o.report);
     analysis::write_thermal_fit_json(o.report + "/fit.json", fit, record, config_name);
@@ -152,6 +156,16 @@ int run_thermal_fit(const ThermalFitCliOptions& o) {
   for (int i = 0; i < fit.config.fusion.filter.network.nodes; ++i)
     std::printf(" %s %.3g s", fit.config.node_names[static_cast<std::size_t>(i)].c_str(),
                 fit.disturbance_time_constant_s[i]);
+  if (runaway) {
+    std::printf("\n");
+    std::fprintf(stderr,
+                 "rpem thermal fit: %s not written: %s. rpemd and `rpem estimate --thermal` "
+                 "would refuse it. Either machine.rated in %s is not this machine's rating, or the log does not "
+                 "bound how the winding sheds heat (see the parameters above): a log at currents near the rated one "
+                 "does\n",
+                 o.out.c_str(), runaway->c_str(), config_name.c_str());
+    return kExitDataError;
+  }
   std::printf("; wrote %s\n", o.out.c_str());
   return kExitOk;
 }

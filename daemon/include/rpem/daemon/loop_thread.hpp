@@ -13,6 +13,7 @@
 #include <optional>
 #include <string>
 
+#include "rpem/core/plausibility.hpp"
 #include "rpem/core/regime.hpp"
 #include "rpem/core/thermal_fusion.hpp"
 #include "rpem/daemon/daemon_config.hpp"
@@ -29,7 +30,8 @@ struct LoopCounters {
   std::int64_t samples = 0;
   std::int64_t resyncs = 0;
   std::int64_t rejected_non_finite = 0;
-  std::int64_t wrong_kind = 0;  ///< samples of the kind the source does not produce (never expected)
+  std::int64_t rejected_implausible = 0;  ///< samples with a value beyond what the machine produces (plausible_)
+  std::int64_t wrong_kind = 0;            ///< samples of the kind the source does not produce (never expected)
   std::int64_t predictor_resets = 0;
   std::int64_t projections = 0;
   std::int64_t output_queue_drops = 0;
@@ -87,6 +89,9 @@ class LoopThread {
   LiveConfig live_;
   const LoopConfig loop_config_;
   Queues queues_;
+  /// What the configured machine's samples may hold (core::machine_plausible): a live source's value beyond it —
+  /// a corrupted read, a wrong scale in a signal map — is not estimated on (docs/rpemd.md, "Values no drive produces").
+  core::PlausibleMagnitudes plausible_;
   LoopEstimator estimator_;
   ValidityTracker validity_;
   core::ThermalFusion thermal_;  ///< stepped only while live_.thermal_active

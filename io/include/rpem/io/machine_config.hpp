@@ -52,10 +52,7 @@ struct MachineConfig {
 void check_log_supports(const MachineConfig& c, const std::string& config_name, bool log_has_u_dc,
                         const std::string& log_path);
 
-/// How many times its name plate a drive-log value may reach before it is refused (docs/drive-log.md).
-inline constexpr double kRatedMultipleLimit = 10.0;
-
-/// The drive-log limits narrowed to a machine: phase currents within 10·I_b, voltages (commands and DC
+/// The drive-log limits narrowed to a machine (core::machine_plausible): phase currents within 10·I_b, voltages (commands and DC
 /// link) within 10·U_b, speed within 10·ω_b (peak phase base, docs/per-unit.md) — beyond any drive's
 /// overload and field-weakening range, so a value there means the log's units or the configured name
 /// plate are wrong. Never wider than the absolute limits.

@@ -5,6 +5,7 @@
 // out of range are ConfigErrors naming file:line:column and the key.
 
 #include <array>
+#include <optional>
 #include <string>
 
 #include "rpem/core/thermal_fusion.hpp"
@@ -34,6 +35,12 @@ enum class NetworkRequired : bool { kNo = false, kYes = true };
 /// whole rpemd configuration can be given).
 [[nodiscard]] ThermalConfig load_thermal_config(const std::string& path, const MachineConfig& machine,
                                                 NetworkRequired network = NetworkRequired::kYes);
+
+/// Why the network has no steady state at the machine's rated point, or nothing if it settles there (eq. 14.27,
+/// core::thermal_settles). The rated current is one the machine carries for ever, so its winding reaches a steady
+/// temperature there: the reader refuses a section whose network does not (at `nodes`), and `rpem thermal fit`
+/// does not write one.
+[[nodiscard]] std::optional<std::string> runaway_at_rating(const ThermalConfig& c, const MachineConfig& machine);
 
 /// The defaults a fit starts from (docs/thermal.md; no network: has_network false): the laws of the machine's
 /// drifts or of copper and NdFeB (core/thermal.hpp) about the machine's values at 20 °C, the loss base
