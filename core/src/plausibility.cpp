@@ -34,14 +34,14 @@ PlausibleMagnitudes machine_plausible(const RatedData& rated) noexcept {
 }
 
 bool within(const DriveSample& s, const PlausibleMagnitudes& m) noexcept {
-  return below(s.theta_el_rad, m.angle_rad) && below(s.omega_el_rad_s, m.speed_rad_s) && below(s.u_dc_V, m.voltage_V) &&
+  return below(s.theta_el_rad, m.angle_rad) && below(s.omega_el_rad_s, m.speed_rad_s) && below(s.u_dc_V, m.dc_link_V) &&
          all_below(s.u_V, m.voltage_V) && all_below(s.i_A, m.current_A);
 }
 
 bool within(const AveragedSample& s, const PlausibleMagnitudes& m) noexcept {
   return below(s.omega_el_rad_s, m.speed_rad_s) && below(s.omega_el_error_rad_s, m.speed_rad_s) &&
          below(s.omega_el_error_noise_rad_s, m.speed_rad_s) && below(s.omega_counted_el_rad_s, m.speed_rad_s) &&
-         below(s.u_dc_V, m.voltage_V) && all_below(s.u_dq_V, m.voltage_V) && all_below(s.i_dq_A, m.current_A) &&
+         below(s.u_dc_V, m.dc_link_V) && all_below(s.u_dq_V, m.voltage_V) && all_below(s.i_dq_A, m.current_A) &&
          temperature_within(s.t_winding_C, m) && temperature_within(s.t_magnet_C, m) && temperature_within(s.t_drive_C, m) &&
          temperature_within(s.t_coolant_C, m);
 }

@@ -280,8 +280,8 @@ void MappedLogReader::check(const MappedRow& row, int index, const std::string& 
     case QuantityKind::kSpeed:
       bound = &limits_.speed_rad_s, unit = "rad/s";
       break;
-    case QuantityKind::kVoltage:
-      bound = &limits_.voltage_V, unit = "V";
+    case QuantityKind::kVoltage:  // the DC link is the inverter's: its own bound, never narrowed to a machine
+      bound = q == Quantity::kUDc ? &limits_.dc_link_V : &limits_.voltage_V, unit = "V";
       break;
     case QuantityKind::kCurrent:
       bound = &limits_.current_A, unit = "A";

@@ -26,6 +26,11 @@ TEST(Plausibility, TheMachineNarrowsCurrentVoltageAndSpeedToTenTimesItsBase) {
   EXPECT_NEAR(m.voltage_V, 10.0 * std::sqrt(2.0) * 400.0 / std::sqrt(3.0), 1e-9);
   EXPECT_NEAR(m.speed_rad_s, 10.0 * 100.0 * M_PI, 1e-9);
   EXPECT_EQ(m.angle_rad, PlausibleMagnitudes{}.angle_rad);
+  EXPECT_EQ(m.dc_link_V, PlausibleMagnitudes{}.dc_link_V);  // the inverter's, not the machine's
+  // The AX8000 rig (tests/vm/ax8000-vcan.yaml): an AM8141 rated at 34 V line-to-line (10·U_b = 278 V) on a 560 V link.
+  DriveSample am8141_on_560V;
+  am8141_on_560V.u_dc_V = 560.0;
+  EXPECT_TRUE(within(am8141_on_560V, machine_plausible(RatedData{34.0, 8.0, 1000.0, 4})));
   // A name plate beyond the absolute magnitudes never widens them.
   const PlausibleMagnitudes huge = machine_plausible(RatedData{1e5, 1e5, 1e6, 100});
   EXPECT_EQ(huge.current_A, PlausibleMagnitudes{}.current_A);
@@ -38,7 +43,7 @@ TEST(Plausibility, APhaseSampleAtItsLimitsPassesAndOneStepBeyondAnyOfThemDoesNot
   DriveSample at;
   at.theta_el_rad = -m.angle_rad;
   at.omega_el_rad_s = m.speed_rad_s;
-  at.u_dc_V = m.voltage_V;
+  at.u_dc_V = m.dc_link_V;
   at.u_V = Vec3(m.voltage_V, -m.voltage_V, 0.0);
   at.i_A = Vec3(0.0, m.current_A, -m.current_A);
   EXPECT_TRUE(within(at, m));
@@ -67,7 +72,7 @@ TEST(Plausibility, AnAveragedWindowIsHeldToTheSameMagnitudesAndItsTemperaturesTo
   at.omega_el_error_rad_s = m.speed_rad_s;
   at.omega_el_error_noise_rad_s = m.speed_rad_s;
   at.omega_counted_el_rad_s = m.speed_rad_s;
-  at.u_dc_V = m.voltage_V;
+  at.u_dc_V = m.dc_link_V;
   at.t_winding_C = m.temperature_max_C;
   at.t_magnet_C = m.temperature_min_C;
   at.t_drive_C = 25.0;

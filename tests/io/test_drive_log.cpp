@@ -178,6 +178,12 @@ TEST(DriveLog, MachineLimitsNarrowTheBoundsToTenTimesTheNamePlate) {
               std::string::npos)
         << e.what();
   }
+  // The DC link is the inverter's: a link of 5 kV, above 10·U_b = 3266 V, is read; a command above 10·U_b is not.
+  test::TempFile link("link.csv", kHeader + "0,0,0,5000,0,0,0,0,0,0\n");
+  EXPECT_EQ(read_drive_log(link.path(), l).size(), 1U);
+  EXPECT_EQ(l.dc_link_V.max_abs, DriveLogLimits{}.voltage_V.max_abs);
+  test::TempFile command("command.csv", kHeader + "0,0,0,5000,3266.1,0,0,0,0,0\n");
+  EXPECT_THROW((void)read_drive_log(command.path(), l), DriveLogError);
   // A name plate far above the absolute limits never widens them.
   m.rated = {1e5, 1e5, 1e6, 100};
   EXPECT_EQ(machine_limits(m).current_A.max_abs, DriveLogLimits{}.current_A.max_abs);

@@ -13,10 +13,13 @@ namespace rpem::core {
 
 /// Largest magnitudes, SI. The defaults are absolute: no drive, whatever its machine, produces a value beyond them.
 struct PlausibleMagnitudes {
-  double time_s = 9.0e9;               ///< integer nanoseconds in 64 bits hold up to 9.2e9 s
-  double angle_rad = 1.0e9;            ///< beyond it a double resolves an angle no finer than 1.2e-7 rad
-  double speed_rad_s = 1.0e6;          ///< 10 x the fastest electric machines' electrical speed (1e5 rad/s)
-  double voltage_V = 1.0e5;            ///< beyond the highest drive DC links (tens of kV)
+  double time_s = 9.0e9;       ///< integer nanoseconds in 64 bits hold up to 9.2e9 s
+  double angle_rad = 1.0e9;    ///< beyond it a double resolves an angle no finer than 1.2e-7 rad
+  double speed_rad_s = 1.0e6;  ///< 10 x the fastest electric machines' electrical speed (1e5 rad/s)
+  double voltage_V = 1.0e5;    ///< beyond the highest drive DC links (tens of kV)
+  /// The DC link is the inverter's, not the machine's: held to the absolute figure only, never narrowed to a
+  /// machine (a machine rated for a 48 V link may run on a 560 V one, as the AX8000 rig's AM8141 does).
+  double dc_link_V = 1.0e5;
   double current_A = 1.0e5;            ///< beyond the largest drives' phase currents (tens of kA)
   double torque_Nm = 1.0e7;            ///< beyond the largest machines' torque (MN m)
   double temperature_min_C = -273.15;  ///< absolute zero
@@ -28,8 +31,8 @@ struct PlausibleMagnitudes {
 /// overload by 1.5–3 x and weaken the field to about 4 x base speed.
 inline constexpr double kRatedMultipleLimit = 10.0;
 
-/// The absolute magnitudes, with current, voltage and speed narrowed to kRatedMultipleLimit x the machine's base
-/// where that is narrower.
+/// The absolute magnitudes, with current, voltage (the phase voltages, not the DC link) and speed narrowed to
+/// kRatedMultipleLimit x the machine's base where that is narrower.
 [[nodiscard]] PlausibleMagnitudes machine_plausible(const RatedData& rated) noexcept;
 
 /// Whether every value of the sample is within the magnitudes (|x| ≤ its limit; a temperature between its two).

@@ -25,6 +25,8 @@ struct DriveLogLimits {
   Bound angle_rad{kAbsolute.angle_rad, "beyond 1e9 rad a double resolves the angle no finer than 1.2e-7 rad"};
   Bound speed_rad_s{kAbsolute.speed_rad_s, "10x the fastest electric machines (1e5 rad/s electrical)"};
   Bound voltage_V{kAbsolute.voltage_V, "beyond the highest drive DC links (tens of kV)"};
+  /// u_dc: the inverter's, never narrowed to a machine (core::PlausibleMagnitudes::dc_link_V).
+  Bound dc_link_V{kAbsolute.dc_link_V, "beyond the highest drive DC links (tens of kV)"};
   Bound current_A{kAbsolute.current_A, "beyond the largest drives' phase currents (tens of kA)"};
   Bound torque_Nm{kAbsolute.torque_Nm, "beyond the largest machines' torque (MN m)"};
   /// The duty cycle as VESC scales it, 1 at |u_dq| = u_dc/√3 (rotor_frame_rebuild.hpp).
