@@ -1,5 +1,6 @@
 #include "rpem/can/signal_map.hpp"
 
+#include <algorithm>
 #include <bit>
 #include <cmath>
 #include <limits>
@@ -56,6 +57,24 @@ std::string float_problem(const SignalSpec& s) {
   return {};
 }
 
+/// What is wrong with a signal's no-reading value, or "": a temperature's only, an integer's, and one its bits hold.
+std::string no_reading_problem(const SignalSpec& s) {
+  if (!s.no_reading_raw) return {};
+  if (s.field != SampleField::kTWindingC && s.field != SampleField::kTMagnetC && s.field != SampleField::kTDriveC)
+    return "no_reading is a temperature sensor's (T_winding, T_magnet, T_drive)";
+  if (s.value_type != ValueType::kInteger) return "no_reading is an integer signal's raw value (a float's is NaN)";
+  const int bits = std::clamp(s.length, 1, 64);
+  const std::int64_t raw = *s.no_reading_raw;
+  const bool fits = s.is_signed
+                        ? bits == 64 || (raw >= -(std::int64_t{1} << (bits - 1)) && raw < (std::int64_t{1} << (bits - 1)))
+                        : raw >= 0 && (bits >= 63 || raw < (std::int64_t{1} << bits));
+  if (!fits) {
+    return "no_reading " + std::to_string(raw) + " is not a raw value of " + std::to_string(bits) +
+           (s.is_signed ? " signed" : " unsigned") + " bits";
+  }
+  return {};
+}
+
 }  // namespace
 
 std::string_view field_name(SampleField f) noexcept { return kFields[static_cast<std::size_t>(f)].name; }
@@ -89,6 +108,7 @@ std::string check_layout(const SignalMap& map) {
       if (!std::isfinite(s.scale) || s.scale == 0.0 || !std::isfinite(s.offset))
         return where + ": scale must be finite and non-zero, offset finite";
       if (const std::string e = float_problem(s); !e.empty()) return std::string(where).append(": ").append(e);
+      if (const std::string e = no_reading_problem(s); !e.empty()) return std::string(where).append(": ").append(e);
       if (s.field == SampleField::kTSampleS) {
         if (++clocks > 1) return where + ": t_sample is mapped twice (one clock stamps a sample)";
         if (s.scale < 0.0 || s.is_signed) return where + ": t_sample counts forward: unsigned, scale positive";
@@ -187,10 +207,11 @@ bool SignalMapDecoder::decode(const CanFrame& f, std::int64_t t_ns, core::Averag
     return false;
   }
   const bool trigger = f.id == map_.trigger_id && f.extended == map_.trigger_extended;
+  auto no_reading = [&](const SignalSpec& s) { return s.no_reading_raw && extract_raw(f, s) == *s.no_reading_raw; };
   // A frame with a NaN or infinite value (an IEEE float signal) is dropped whole: none of its values is
   // delivered, and a dropped trigger ends the chain as an incomplete sample does.
   for (const SignalSpec& s : spec->signals) {
-    if (!std::isfinite(physical_value(f, s))) {
+    if (!no_reading(s) && !std::isfinite(physical_value(f, s))) {
       ++counters_.non_finite;
       if (trigger) {
         fresh_.fill(false);
@@ -200,6 +221,10 @@ bool SignalMapDecoder::decode(const CanFrame& f, std::int64_t t_ns, core::Averag
     }
   }
   for (const SignalSpec& s : spec->signals) {
+    if (no_reading(s)) {  // the sensor gave none: the field is not received (a temperature: absent from the sample)
+      ++counters_.no_reading;
+      continue;
+    }
     values_[static_cast<std::size_t>(s.field)] = physical_value(f, s);
     fresh_[static_cast<std::size_t>(s.field)] = true;
     if (s.field == SampleField::kTSampleS)

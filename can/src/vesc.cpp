@@ -363,7 +363,7 @@ core::AveragedSample to_averaged_sample(const Values& v, std::int64_t t_start_ns
   s.u_dq_V = {v.v_d_V, v.v_q_V};
   s.omega_el_rad_s = core::rpm_to_rad_s(v.erpm);
   s.u_dc_V = v.v_in_V;
-  s.t_winding_C = v.temp_motor_C;
+  s.t_winding_C = is_no_motor_reading(v.temp_motor_C) ? kNaN : v.temp_motor_C;
   s.t_drive_C = v.temp_fet_C;
   return s;
 }

@@ -15,13 +15,14 @@ namespace {
 using Diag = rpem::diagnostics_t;
 using can::SignalMapCounters;
 
-constexpr std::array<CounterRow<SignalMapCounters, std::uint64_t>, 6> kMapRows{{
+constexpr std::array<CounterRow<SignalMapCounters, std::uint64_t>, 7> kMapRows{{
     {&SignalMapCounters::frames, &Diag::can_frames},
     {&SignalMapCounters::unknown_id, &Diag::can_unknown_id},
     {&SignalMapCounters::wrong_length, &Diag::can_wrong_dlc},
     {&SignalMapCounters::incomplete, &Diag::can_incomplete},
     {&SignalMapCounters::non_finite, &Diag::can_invalid_value},
     {&SignalMapCounters::stale, &Diag::can_stale},
+    {&SignalMapCounters::no_reading, &Diag::temperature_no_reading},
 }};
 static_assert(kMapRows.size() + kChannelRows.size() + 1 <= DiagnosticsRows::kMaxCounts);
 

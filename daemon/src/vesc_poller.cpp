@@ -203,6 +203,7 @@ bool VescPoller::on_frame(const can::CanFrame& f, std::int64_t rx_ns, core::Aver
   gap_ = false;
   window_start_ns_ = t;
   ++counters_.samples;
+  if (vesc::is_no_motor_reading(decoder_.values().temp_motor_C)) ++counters_.no_motor_reading;
   return true;
 }
 

@@ -21,7 +21,7 @@ namespace {
 using Diag = rpem::diagnostics_t;
 using can::vesc::VescCounters;
 
-constexpr std::array<CounterRow<VescPollerCounters, std::uint64_t>, 10> kPollerRows{{
+constexpr std::array<CounterRow<VescPollerCounters, std::uint64_t>, 11> kPollerRows{{
     {&VescPollerCounters::polls, &Diag::vesc_polls},
     {&VescPollerCounters::send_failures, &Diag::vesc_send_failures},
     {&VescPollerCounters::samples, &Diag::vesc_replies},
@@ -32,6 +32,7 @@ constexpr std::array<CounterRow<VescPollerCounters, std::uint64_t>, 10> kPollerR
     {&VescPollerCounters::short_windows, &Diag::vesc_short_windows},
     {&VescPollerCounters::empty_reads, &Diag::vesc_empty_reads},
     {&VescPollerCounters::long_windows, &Diag::vesc_long_windows},
+    {&VescPollerCounters::no_motor_reading, &Diag::temperature_no_reading},
 }};
 constexpr std::array<CounterRow<VescCounters, std::uint64_t>, 7> kVescDecoderRows{{
     {&VescCounters::frames, &Diag::can_frames},

@@ -73,7 +73,10 @@ bool DriveLogReader::next(DriveLogRow& row) {
     s.current_frame = core::Frame::kDq;
     s.i_A = {r[Quantity::kID], r[Quantity::kIQ], 0.0};
   }
-  auto optional = [&](bool present, Quantity q) { return present ? std::optional(r[q]) : std::nullopt; };
+  // A cell holding its column's no-reading value is NaN (MappedColumn::no_reading): no value on this row.
+  auto optional = [&](bool present, Quantity q) {
+    return present && !std::isnan(r[q]) ? std::optional(r[q]) : std::nullopt;
+  };
   row.t_winding_C = optional(layout_.t_winding, Quantity::kTWinding);
   row.t_magnet_C = optional(layout_.t_magnet, Quantity::kTMagnet);
   row.t_coolant_C = optional(layout_.t_coolant, Quantity::kTCoolant);

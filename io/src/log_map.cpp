@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cassert>
+#include <cmath>
 #include <numbers>
 #include <string>
 #include <string_view>
@@ -148,6 +149,13 @@ MappedColumn parse_column(YamlMap& m, Quantity q, QuantityKind kind, bool header
            "only a quantity every log may lack (T_winding, T_magnet, T_drive, T_coolant, travel_el, duty, i_motor; "
            "in an averaged log also u_d, u_q, i_d, i_q where duty and u_dc or i_motor stand for them)");
   }
+  if (m.has("no_reading")) {
+    if (kind != QuantityKind::kTemperature) {
+      m.fail("no_reading",
+             "only a temperature sensor's column has a value for no reading (T_winding, T_magnet, T_drive, T_coolant)");
+    }
+    c.no_reading = m.number("no_reading", -1e12, 1e12);
+  }
   m.finish();
   return c;
 }
@@ -164,6 +172,12 @@ bool present(const QuantitySet& p, Quantity q) { return p[static_cast<std::size_
 }  // namespace
 
 const std::array<QuantityInfo, kQuantityCount>& quantities() noexcept { return kQuantities; }
+
+bool is_no_reading(const MappedColumn& c, double cell) noexcept {
+  if (!c.no_reading) return false;
+  constexpr double kSixDigitsHalfStep = 5e-6;  // half the sixth significant digit, relative
+  return std::abs(cell - *c.no_reading) <= kSixDigitsHalfStep * std::max(1.0, std::abs(*c.no_reading));
+}
 
 const QuantityInfo& info(Quantity q) noexcept {
   const QuantityInfo& i = kQuantities[static_cast<std::size_t>(q)];

@@ -116,6 +116,13 @@ std::string describe(const ReadRepairs& r) {
     for (std::size_t k = 0; k < r.never_recorded.size(); ++k) s += (k > 0 ? ", " : "") + r.never_recorded[k];
     s += " named in the header but empty on every row: read as absent (the map marks them optional)";
   }
+  for (const ReadRepairs::NoReading& n : r.no_reading) {
+    s += "; " + n.column +
+         (n.every_row
+              ? " holds " + n.value + ", its logger's value for no reading, on every row: no such sensor, read as absent"
+              : ": " + std::to_string(n.rows) + (n.rows == 1 ? " row holds " : " rows hold ") + n.value +
+                    ", its logger's value for no reading: no reading there");
+  }
   return s;
 }
 

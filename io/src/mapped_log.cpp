@@ -2,6 +2,8 @@
 #include "rpem/core/non_finite.hpp"
 
 #include <algorithm>
+#include <array>
+#include <cassert>
 #include <charconv>
 #include <cmath>
 #include <cstdio>
@@ -182,10 +184,20 @@ void MappedLogReader::read_header() {
 }
 
 void MappedLogReader::drop_columns_never_recorded() {
-  std::vector<const MappedColumn*> unseen;  // optional columns in the header without a value so far
+  // Columns in the header without a value so far: optional ones, and those a logger may fill with its no-reading value.
+  std::vector<const MappedColumn*> unseen;
+  std::array<bool, kQuantityCount> saw_no_reading{};
   for (const MappedColumn& c : map_.columns) {
-    if (c.optional && index_[static_cast<std::size_t>(c.quantity)] >= 0) unseen.push_back(&c);
+    if ((c.optional || c.no_reading) && index_[static_cast<std::size_t>(c.quantity)] >= 0) unseen.push_back(&c);
   }
+  auto holds_a_value = [&](const MappedColumn& c, const std::string& text) {
+    if (text.empty()) return false;
+    double v = 0.0;
+    const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), v);
+    const bool no_reading = ec == std::errc() && end == text.data() + text.size() && is_no_reading(c, v);
+    saw_no_reading[static_cast<std::size_t>(c.quantity)] |= no_reading;
+    return !no_reading;  // anything else is a value, or an error its row's read reports
+  };
   const std::istream::pos_type start = in_.tellg();
   if (unseen.empty() || start == std::istream::pos_type(-1)) return;  // nothing to look for, or a stream read once
   const std::size_t line = line_;
@@ -196,7 +208,7 @@ void MappedLogReader::drop_columns_never_recorded() {
     any_row = true;
     std::erase_if(unseen, [&](const MappedColumn* c) {
       const auto k = static_cast<std::size_t>(index_[static_cast<std::size_t>(c->quantity)]);
-      return k < cells_.size() && !cells_[k].empty();
+      return k < cells_.size() && holds_a_value(*c, cells_[k]);
     });
   }
   in_.clear();
@@ -205,10 +217,25 @@ void MappedLogReader::drop_columns_never_recorded() {
   bytes_read_ = bytes;
   if (!any_row) return;  // a file without rows: its own error, at the first read
   for (const MappedColumn* c : unseen) {
-    repairs_.never_recorded.push_back(label(c->quantity));
-    index_[static_cast<std::size_t>(c->quantity)] = -1;
-    column_[static_cast<std::size_t>(c->quantity)] = nullptr;
+    const auto q = static_cast<std::size_t>(c->quantity);
+    if (saw_no_reading[q]) {
+      no_reading_of(label(c->quantity), *c).every_row = true;
+    } else if (c->optional) {
+      repairs_.never_recorded.push_back(label(c->quantity));
+    } else {
+      continue;  // a required column empty on every row: its first row's read says so
+    }
+    index_[q] = -1;
+    column_[q] = nullptr;
   }
+}
+
+ReadRepairs::NoReading& MappedLogReader::no_reading_of(const std::string& label, const MappedColumn& c) {
+  for (ReadRepairs::NoReading& r : repairs_.no_reading) {
+    if (r.column == label) return r;
+  }
+  assert(c.no_reading);
+  return repairs_.no_reading.emplace_back(ReadRepairs::NoReading{label, g6(*c.no_reading) + " " + c.unit});
 }
 
 void MappedLogReader::fail_empty_cell(int index, const std::string& label) {
@@ -261,6 +288,10 @@ double MappedLogReader::cell(int index, const std::string& label, const MappedCo
     fail_cell(index, label, "NaN");
   }
   if (!std::isfinite(v)) fail_cell(index, label, "'" + s + "' is not finite");
+  if (is_no_reading(c, v)) {
+    ++no_reading_of(label, c).rows;
+    return kNaN;
+  }
   const double si = c.unit_factor * (v * c.scale + c.offset) + c.unit_offset;
   if (!std::isfinite(si)) fail_cell(index, label, "'" + s + "' is not finite in SI (" + c.unit + ")");
   return si;

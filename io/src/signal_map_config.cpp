@@ -1,5 +1,7 @@
 #include "rpem/io/signal_map_config.hpp"
 
+#include <limits>
+
 #include "rpem/io/yaml_map.hpp"
 
 namespace rpem::io {
@@ -23,6 +25,8 @@ can::SignalSpec read_signal(YamlMap m) {
   s.is_signed = m.boolean_or("signed", false);
   s.scale = m.number_or("scale", 1.0, -1e12, 1e12);
   s.offset = m.number_or("offset", 0.0, -1e12, 1e12);
+  if (m.has("no_reading"))
+    s.no_reading_raw = m.integer("no_reading", std::numeric_limits<long>::min(), std::numeric_limits<long>::max());
   const std::string unit = m.text("unit");
   if (unit != can::field_unit(s.field)) {
     m.fail("unit", "'" + unit + "' for " + field + ", which is in " + std::string(can::field_unit(s.field)) +

@@ -303,6 +303,51 @@ TEST(SignalMapConfig, UnusableMapsAreRefusedNamingWhy) {
   expect_refused(head + i + u + w + "colour: blue\n", "colour");
 }
 
+// A temperature sensor's "no reading" (SAE J1939's all-ones "not available" for a 16-bit unsigned parameter,
+// here J1939's temperature scaling 0.03125 °C/bit, offset −273 °C): the field is not received in that frame, the
+// sample is one as ever, and it is counted; a reading again is used again.
+TEST(SignalMapNoReading, ATemperaturesNoReadingValueLeavesTheSampleWithoutIt) {
+  const std::string text =
+      "name: j1939ish\nsample: {trigger: 0x10}\nframes:\n"
+      "  - {id: 0x10, signals: [\n"
+      "      {field: i_d, start_bit: 0, length: 16, signed: true, scale: 0.01, unit: A},\n"
+      "      {field: i_q, start_bit: 16, length: 16, signed: true, scale: 0.01, unit: A},\n"
+      "      {field: u_d, start_bit: 32, length: 8, signed: true, scale: 0.1, unit: V},\n"
+      "      {field: u_q, start_bit: 40, length: 8, signed: true, scale: 0.1, unit: V},\n"
+      "      {field: erpm, start_bit: 48, length: 16, signed: true, unit: rpm}]}\n"
+      "  - {id: 0x11, length: 2, signals: [\n"
+      "      {field: T_winding, start_bit: 0, length: 16, scale: 0.03125, offset: -273, no_reading: 65535, unit: degC}]}\n";
+  SignalMapDecoder dec(io::parse_signal_map(text, "j1939ish.yaml"));
+  const CanFrame values = frame(0x10, {0x64, 0x00, 0xC8, 0x00, 0x0A, 0x14, 0xE8, 0x03});
+  core::AveragedSample s;
+  EXPECT_FALSE(dec.decode(frame(0x11, {0xFF, 0xFF}), 1'000'000, s));
+  ASSERT_TRUE(dec.decode(values, 1'000'000, s));
+  EXPECT_TRUE(std::isnan(s.t_winding_C));
+  EXPECT_DOUBLE_EQ(s.i_dq_A[1], 2.0);
+  EXPECT_DOUBLE_EQ(s.u_dq_V[1], 2.0);
+  EXPECT_EQ(dec.counters().no_reading, 1U);
+  EXPECT_EQ(dec.counters().samples, 1U);
+  EXPECT_FALSE(dec.decode(frame(0x11, {0x80, 0x25}), 2'000'000, s));  // 9600 · 0.03125 − 273 = 27 °C
+  ASSERT_TRUE(dec.decode(values, 2'000'000, s));
+  EXPECT_DOUBLE_EQ(s.t_winding_C, 27.0);
+  EXPECT_EQ(dec.counters().no_reading, 1U);
+  // Refused at load: on a field other than a temperature, on a float, and a value its bits cannot hold.
+  const std::string head = text.substr(0, text.find("  - {id: 0x11"));
+  expect_refused(head + "  - {id: 0x11, signals: [{field: u_dc, start_bit: 0, length: 16, no_reading: 65535, unit: V}]}\n",
+                 "no_reading is a temperature sensor's");
+  expect_refused(head +
+                     "  - {id: 0x11, signals: [{field: T_winding, start_bit: 0, length: 32, value_type: float, "
+                     "no_reading: 0, unit: degC}]}\n",
+                 "no_reading is an integer signal's raw value");
+  expect_refused(
+      head + "  - {id: 0x11, signals: [{field: T_winding, start_bit: 0, length: 16, no_reading: 65536, unit: degC}]}\n",
+      "no_reading 65536 is not a raw value of 16 unsigned bits");
+  expect_refused(head +
+                     "  - {id: 0x11, signals: [{field: T_winding, start_bit: 0, length: 8, signed: true, no_reading: -129, "
+                     "unit: degC}]}\n",
+                 "no_reading -129 is not a raw value of 8 signed bits");
+}
+
 TEST(SignalMapConfig, FloatSignalsMustBeWholeByteAlignedIeeeValues) {
   const std::string head = "name: m\nsample: {trigger: 0x10}\nframes:\n  - id: 0x10\n    signals:\n";
   const std::string u =

@@ -73,6 +73,21 @@ TEST(Vesc, ReassemblesAndDecodesAGetValuesSelectiveReply) {
   EXPECT_TRUE(std::isnan(s.t_magnet_C));
 }
 
+TEST(Vesc, AMotorTemperatureOfMinus100IsNoWindingReading) {
+  // GIVEN the reply of a VESC without a reading of its motor sensor (T_motor −100.0 °C: the firmware's value for
+  // none) WHEN decoded THEN the reply holds it as sent, and the sample has no winding temperature, the rest as ever.
+  VescDecoder dec(kController, kHost);
+  ASSERT_EQ(feed(dec, test::vesc_frames::reply_frames_no_motor_reading()).back(), VescDecoder::Event::kValues);
+  EXPECT_EQ(dec.values().temp_motor_C, kNoMotorReading_C);
+  EXPECT_TRUE(is_no_motor_reading(dec.values().temp_motor_C));
+  const core::AveragedSample s = to_averaged_sample(dec.values(), 1'000'000, 6'000'000);
+  EXPECT_TRUE(std::isnan(s.t_winding_C));
+  EXPECT_DOUBLE_EQ(s.t_drive_C, 41.3);
+  EXPECT_DOUBLE_EQ(s.i_dq_A[1], 27.45);
+  // A tenth of a degree away is a reading.
+  EXPECT_FALSE(is_no_motor_reading(-99.9));
+}
+
 TEST(Vesc, ShortReplyInOneFrame) {
   // Mask bit 15 (fault code 3): a 6-byte reply, sent as PROCESS_SHORT_BUFFER [sender][commands_send][payload].
   VescDecoder dec(kController, kHost, bit(kFault));

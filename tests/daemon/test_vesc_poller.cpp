@@ -124,6 +124,28 @@ TEST(VescPoller, RepliesBecomeWindowsBetweenTheirReceiveTimes) {
   EXPECT_EQ(p.counters().timeouts + p.counters().unrequested + p.counters().stolen_reads, 0U);
 }
 
+TEST(VescPoller, AWindowWithoutAMotorSensorReadingIsASampleWithoutAWindingTemperature) {
+  // GIVEN replies of a VESC whose motor sensor gives no reading (T_motor −100.0 °C, the firmware's value for none)
+  // WHEN they close windows THEN each is a sample as ever, without a winding temperature, and counted.
+  VescPoller p = make_poller();
+  const auto frames = test::vesc_frames::reply_frames_no_motor_reading();
+  EXPECT_FALSE(poll_and_receive(p, kT0, frames).has_value());  // the first reply only opens a window
+  for (int k = 1; k <= 2; ++k) {
+    const auto s = poll_and_receive(p, kT0 + k * 5 * kMs, frames);
+    ASSERT_TRUE(s.has_value());
+    EXPECT_TRUE(std::isnan(s->t_winding_C));
+    EXPECT_DOUBLE_EQ(s->i_dq_A[1], 27.45);
+    EXPECT_DOUBLE_EQ(s->t_drive_C, 41.3);
+  }
+  EXPECT_EQ(p.counters().samples, 2U);
+  EXPECT_EQ(p.counters().no_motor_reading, 2U);
+  // A reading again: a winding temperature again, and the count stands.
+  const auto s = poll_and_receive(p, kT0 + 15 * kMs, reply_frames());
+  ASSERT_TRUE(s.has_value());
+  EXPECT_DOUBLE_EQ(s->t_winding_C, 67.8);
+  EXPECT_EQ(p.counters().no_motor_reading, 2U);
+}
+
 // The reply's ERPM is the PLL's speed at the read: the window's mean speed is rebuilt from it and the
 // previous reply's, ω̂_k + (ω̂_k − ω̂_{k−1})·(τ/h − ½) with the configured PLL's τ = k_p/k_i
 // (docs/derivations.md §13, "Speed at the read"; the function itself: test_core's ReportedSpeed.*).

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <numbers>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -179,6 +180,40 @@ struct BadMap {
   std::string yaml;
   const char* expected;  ///< the whole message after "map.yaml:"
 };
+
+TEST(LogMap, ACellHoldingItsSensorsNoReadingValueIsNoReadingOnItsRow) {
+  // GIVEN a logger that writes −273.15 °C where its winding sensor gives no reading (an open NTC's formula), once
+  // as typed and once from a float32 with nine digits (−273.149994: within half the sixth significant digit)
+  // WHEN read THEN those rows have no winding temperature, −273.1 (a tenth away) is a reading, and both are counted.
+  const LogMap m = parse_log_map(kMinimal + "  T_winding: {column: tw, no_reading: -273.15}\n", "map.yaml");
+  const test::TempFile f("nr.csv",
+                         "time,w,ud,uq,id,iq,tw\n0,1,2,3,4,5,61.5\n1,1,2,3,4,5,-273.15\n"
+                         "2,1,2,3,4,5,-273.149994\n3,1,2,3,4,5,-273.1\n");
+  DriveLogReader reader(f.path(), m, DriveLogLimits{});
+  EXPECT_TRUE(reader.layout().t_winding);
+  DriveLogRow r;
+  std::vector<std::optional<double>> read;
+  while (reader.next(r)) read.push_back(r.t_winding_C);
+  ASSERT_EQ(read.size(), 4U);
+  EXPECT_EQ(read[0], std::optional(61.5));
+  EXPECT_FALSE(read[1].has_value());
+  EXPECT_FALSE(read[2].has_value());
+  EXPECT_EQ(read[3], std::optional(-273.1));
+  ASSERT_EQ(reader.reader().repairs().no_reading.size(), 1U);
+  EXPECT_EQ(reader.reader().repairs().no_reading[0].rows, 2U);
+  EXPECT_EQ(reader.reader().repairs().no_reading[0].value, "-273.15 degC");
+  // Nothing else on any row (nor an empty cell): the log has no such sensor, as if it lacked the column.
+  const test::TempFile none("none.csv", "time,w,ud,uq,id,iq,tw\n0,1,2,3,4,5,-273.15\n1,1,2,3,4,5,\n2,1,2,3,4,5,-273.15\n");
+  DriveLogReader absent(none.path(), m, DriveLogLimits{});
+  EXPECT_FALSE(absent.layout().t_winding);
+  ASSERT_EQ(absent.reader().repairs().no_reading.size(), 1U);
+  EXPECT_TRUE(absent.reader().repairs().no_reading[0].every_row);
+  // Only a temperature sensor has one.
+  EXPECT_NE(
+      map_error(kMinimal + "  u_dc: {column: vdc, no_reading: 0}\n").find("columns.u_dc.no_reading: only a temperature"),
+      std::string::npos)
+      << map_error(kMinimal + "  u_dc: {column: vdc, no_reading: 0}\n");
+}
 
 class MalformedMap : public ::testing::TestWithParam<BadMap> {};
 

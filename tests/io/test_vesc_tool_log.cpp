@@ -2,11 +2,13 @@
 // (tests/support/vesc_tool_vectors.hpp), none produced by our code.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <string>
 #include <vector>
 
+#include "rpem/can/vesc.hpp"
 #include "rpem/io/averaged_log.hpp"
 #include "rpem/io/log_source.hpp"
 #include "rpem/io/vesc_tool_log.hpp"
@@ -82,6 +84,59 @@ TEST(VescToolLog, ReadsTheCurrentHeaderAsAveragedSamplesSinceThePreviousRow) {
   EXPECT_DOUBLE_EQ(s[0].t_drive_C, 41.3);
   EXPECT_TRUE(std::isnan(s[0].t_magnet_C));
   EXPECT_TRUE(read.layout.u_dc && read.layout.t_winding && read.layout.t_drive && !read.layout.t_magnet);
+}
+
+TEST(VescToolLog, ARowAtTheFirmwaresMinus100HasNoWindingReading) {
+  // GIVEN temp_motor at −100 on two rows: the value the firmware filters in where it has no reading of the motor's
+  // sensor (vedderb/bldc motor/mc_interface.c, update_override_limits), as std::to_string writes it ("-100.000000")
+  // WHEN read THEN those samples have no winding temperature, the others theirs, and the summary counts the two.
+  test::TempFile f("vesc.csv", kHeader120 + row120_with_motor(45000000, 55.0, -0.5, 3.2, 6000, -0.31, 8.7) +
+                                   row120_with_motor(45000100, -100.0, -1.25, 10.5, 6100, -0.9, 9.25) +
+                                   row120_with_motor(45000200, 56.5, -1.5, 11.0, 6200, -1.0, 9.5) +
+                                   row120_with_motor(45000300, -100.0, -1.5, 11.0, 6200, -1.0, 9.5));
+  const LogSource source = log_source(f.path());
+  AveragedLogRead read;
+  const auto s = read_averaged_log(f.path(), source.map, DriveLogLimits{}, &read);
+  ASSERT_EQ(s.size(), 3U);
+  EXPECT_TRUE(read.layout.t_winding);
+  EXPECT_TRUE(std::isnan(s[0].t_winding_C));
+  EXPECT_DOUBLE_EQ(s[1].t_winding_C, 56.5);
+  EXPECT_TRUE(std::isnan(s[2].t_winding_C));
+  ASSERT_EQ(read.repairs.no_reading.size(), 1U);
+  EXPECT_EQ(read.repairs.no_reading[0].rows, 2U);
+  EXPECT_FALSE(read.repairs.no_reading[0].every_row);
+  EXPECT_NE(describe(source, read).find("temp_motor (T_winding): 2 rows hold -100 degC, its logger's value for no reading"),
+            std::string::npos)
+      << describe(source, read);
+}
+
+TEST(VescToolLog, ALogAtMinus100OnEveryRowHasNoMotorSensor) {
+  // GIVEN a VESC without a motor sensor: temp_motor −100 on every row WHEN read THEN the log has no winding
+  // temperature at all (as a log without the column), and the summary says why.
+  std::string rows;
+  for (long k = 0; k < 4; ++k) rows += row120_with_motor(45000000 + 100 * k, -100.0, -1.0, 10.0, 6000, -0.9, 9.25);
+  test::TempFile f("vesc.csv", kHeader120 + rows);
+  const LogSource source = log_source(f.path());
+  AveragedLogRead read;
+  const auto s = read_averaged_log(f.path(), source.map, DriveLogLimits{}, &read);
+  ASSERT_EQ(s.size(), 3U);
+  EXPECT_FALSE(read.layout.t_winding);
+  for (const auto& x : s) EXPECT_TRUE(std::isnan(x.t_winding_C));
+  ASSERT_EQ(read.repairs.no_reading.size(), 1U);
+  EXPECT_TRUE(read.repairs.no_reading[0].every_row);
+  EXPECT_NE(describe(source, read).find("holds -100 degC, its logger's value for no reading, on every row: no such sensor"),
+            std::string::npos)
+      << describe(source, read);
+}
+
+TEST(VescToolLog, TheMapsNoReadingIsTheFirmwaresAsTheCanDecoderHasIt) {
+  // One fact in two forms: the compiled-in map's temp_motor no_reading and can::vesc::kNoMotorReading_C.
+  const LogMap map = vesc_tool_log_map();
+  const auto c = std::find_if(map.columns.begin(), map.columns.end(),
+                              [](const MappedColumn& m) { return m.quantity == Quantity::kTWinding; });
+  ASSERT_NE(c, map.columns.end());
+  ASSERT_TRUE(c->no_reading.has_value());
+  EXPECT_EQ(*c->no_reading, can::vesc::kNoMotorReading_C);
 }
 
 TEST(VescToolLog, EachWindowsCountedSpeedIsTheTachometersOverItAndItsNeighbours) {

@@ -39,9 +39,14 @@ inline std::string values22(long ms, double v_in, double t_motor, double i_d, do
 }
 /// A row of the 1.20 header: the 22 values, v_d, v_q, 13 setup, 10 IMU (their times −1: never received,
 /// as VESC Tool writes them), 8 GNSS (posTime −1: no position).
-inline std::string row120(long ms, double i_d, double i_q, double erpm, double v_d, double v_q, long tachometer = 1234) {
-  return values22(ms, 40.1, 55.0, i_d, i_q, erpm, tachometer) + std::to_string(v_d) + ";" + std::to_string(v_q) + ";" +
+/// `t_motor`: temp_motor, the motor sensor's °C (−100 where the firmware has no reading of it).
+inline std::string row120_with_motor(long ms, double t_motor, double i_d, double i_q, double erpm, double v_d, double v_q,
+                                     long tachometer = 1234) {
+  return values22(ms, 40.1, t_motor, i_d, i_q, erpm, tachometer) + std::to_string(v_d) + ";" + std::to_string(v_q) + ";" +
          "-1;0;0;0;0;0;0;0;0;0;0;0;0;" + "-1;0;0;0;0;0;0;0;0;0;" + "-1;0.00000000;0.00000000;0;0;0;0;0;\n";
+}
+inline std::string row120(long ms, double i_d, double i_q, double erpm, double v_d, double v_q, long tachometer = 1234) {
+  return row120_with_motor(ms, 55.0, i_d, i_q, erpm, v_d, v_q, tachometer);
 }
 inline std::string row120test(long ms, double i_d, double i_q, double erpm, double v_d, double v_q) {
   return values22(ms, 40.1, 55.0, i_d, i_q, erpm) + std::to_string(v_d) + ";" + std::to_string(v_q) + ";" +

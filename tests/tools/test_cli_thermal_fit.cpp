@@ -283,5 +283,65 @@ TEST_F(CliThermalFit, ALogThatDoesNotStartSoakedIsAnchoredAtItsWindingWithTheBan
   EXPECT_GE(static_cast<double>(covered), 0.9 * static_cast<double>(judged)) << covered << " of " << judged;
 }
 
+// A VESC without a motor sensor: its NTC input open, the firmware filters in −100 °C for the reading it does not have
+// (vedderb/bldc motor/mc_interface.c, update_override_limits; the generator does as the firmware, its README), so
+// temp_motor is −100 on every row. Read as a winding at −100 °C, the log seemed 125 K below its coolant at the start:
+// the fit anchored the magnet law there (the magnet observed at −108…−100 °C) and wrote no network. It is read as a
+// log without a winding sensor: the fit says so and fits without one. The ride: soaked at the coolant's 25 °C, 7 min at
+// 40 A against an eddy-current brake (the generator's plant heats the winding to 57 °C and the magnet to 33 °C),
+// then coasting. The fused magnet's band holds the generator's true magnet on at least 90 % of the rows (measured:
+// all, RMS 3.9 K), and the fused winding never falls below the coolant it starts at, less 1 K (the losses only heat a
+// soaked machine; measured: 25.0 °C).
+TEST_F(CliThermalFit, AVescWithoutAMotorSensorIsReadAsALogWithoutOne) {
+  const std::string log = dir_ + "/vesc.csv", truth = dir_ + "/truth.json", scenario = dir_ + "/heat.csv";
+  std::ofstream(scenario) << "kind,duration_s,current_A,ramp_s,until_erpm,erpm_per_s,external_Nm,friction_Nm,viscous_Nm_s\n"
+                             "off,2,0,0,0,1000,0,0,0\ncurrent,420,40,1,0,1000,0,0,0.0073\ncoast,170,0,0,0,1000,0,0,0\n";
+  const test::ProcessResult g =
+      test::run_command(test::binary_dir() + "/tests/independent_vesc/indep_vesc_log --config " + outrunner_config() +
+                        " --seed 3 --duration-s 600" + " --scenario " + scenario +
+                        " --set sensors.motor_sensor_fitted=0 --out " + log + " --truth " + truth);
+  ASSERT_EQ(g.exit_code, 0) << g.output;
+  const MotorTemperatures m = motor_temperatures(log);
+  ASSERT_FALSE(m.t_motor_C.empty());
+  for (const double t : m.t_motor_C) ASSERT_EQ(t, -100.0);
+
+  const test::ProcessResult r =
+      test::run_command(rpem_tool() + " thermal fit --log " + log + " --config " + outrunner_config() + " --out " + dir_ +
+                        "/thermal.yaml --report " + dir_ + "/report");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("temp_motor (T_winding) holds -100 degC, its logger's value for no reading, on every row: no "
+                          "such sensor, read as absent"),
+            std::string::npos)
+      << r.output;
+  EXPECT_EQ(r.output.find("does not start soaked"), std::string::npos) << r.output;
+  const nlohmann::json j = nlohmann::json::parse(std::ifstream(dir_ + "/report/fit.json"));
+  for (const nlohmann::json& s : j.at("signals")) EXPECT_NE(s.at("name"), "winding sensor") << j.at("signals").dump();
+
+  const test::ProcessResult e =
+      test::run_command(rpem_tool() + " estimate --log " + log + " --config " + outrunner_config() + " --thermal " + dir_ +
+                        "/thermal.yaml --out " + dir_ + "/estimate.csv");
+  ASSERT_EQ(e.exit_code, 0) << e.output;
+  const io::CsvTable estimate = io::CsvTable::read(dir_ + "/estimate.csv", true);
+  const std::vector<double>& est_t = estimate.column("t");
+  const std::vector<double>& fused = estimate.column("t_magnet_fused_C");
+  const std::vector<double>& sd = estimate.column("t_magnet_fused_sd_C");
+  const std::vector<double>& winding = estimate.column("t_winding_fused_C");
+  const nlohmann::json t = nlohmann::json::parse(std::ifstream(truth));
+  const nlohmann::json& rows = t.at("rows");
+  const double t0_s = t.at("start_ms_today").get<double>() / 1000.0;
+  std::size_t judged = 0, covered = 0, k = 0;
+  for (std::size_t n = 0; n < estimate.rows(); ++n) {
+    if (std::isfinite(winding[n])) {
+      EXPECT_GE(winding[n], 25.0 - 1.0) << "at " << est_t[n];
+    }
+    if (!std::isfinite(fused[n])) continue;
+    while (k + 1 < rows.size() && rows[k + 1].at("t_s").get<double>() <= est_t[n] - t0_s) ++k;
+    ++judged;
+    covered += std::abs(fused[n] - rows[k].at("T_magnet_C").get<double>()) <= 2.0 * sd[n] ? 1 : 0;
+  }
+  ASSERT_GT(judged, 500U);
+  EXPECT_GE(static_cast<double>(covered), 0.9 * static_cast<double>(judged)) << covered << " of " << judged;
+}
+
 }  // namespace
 }  // namespace rpem

@@ -111,7 +111,8 @@ class VescFeed final : public Feed {
            std::to_string(c.timeouts) + ", late " + std::to_string(c.late) + ", unrequested " +
            std::to_string(c.unrequested) + ", stolen reads " + std::to_string(c.stolen_reads) + ", short windows " +
            std::to_string(c.short_windows) + ", empty reads " + std::to_string(c.empty_reads) + ", long windows " +
-           std::to_string(c.long_windows) + ", send failures " + std::to_string(c.send_failures);
+           std::to_string(c.long_windows) + ", send failures " + std::to_string(c.send_failures) +
+           ", no motor temperature " + std::to_string(c.no_motor_reading);
   }
   [[nodiscard]] io::AveragedLogLayout layout() const override { return {true, true, false, true}; }
 

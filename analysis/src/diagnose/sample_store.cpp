@@ -114,12 +114,15 @@ std::int64_t SampleStore::t_ns(std::size_t k) const noexcept {
   return c.dt_ns.empty() ? c.t_ns[j] : c.t0_ns + c.dt_ns[j];
 }
 
+// NaN: the log has the column, but no reading on this row (its logger's value for none, io::MappedColumn::no_reading).
 std::optional<double> SampleStore::t_winding_C(std::size_t k) const noexcept {
-  return has_winding_ ? std::optional(value(kWinding, k)) : std::nullopt;
+  const double v = has_winding_ ? value(kWinding, k) : kNaN;
+  return std::isnan(v) ? std::nullopt : std::optional(v);
 }
 
 std::optional<double> SampleStore::t_magnet_C(std::size_t k) const noexcept {
-  return has_magnet_ ? std::optional(value(kMagnet, k)) : std::nullopt;
+  const double v = has_magnet_ ? value(kMagnet, k) : kNaN;
+  return std::isnan(v) ? std::nullopt : std::optional(v);
 }
 
 std::size_t SampleStore::bytes() const noexcept {

@@ -90,6 +90,8 @@ Case resolve_defaults(Case c) {
   in_range(s.voltage_noise_lsb, 0.0, 100.0, "sensors.voltage_noise_lsb");
   in_range(s.bus_gain, 0.5, 1.5, "sensors.bus_gain");
   in_range(s.phase_voltage_gain, 0.5, 1.5, "sensors.phase_voltage_gain");
+  require(s.motor_sensor_fitted == 0.0 || s.motor_sensor_fitted == 1.0,
+          "sensors.motor_sensor_fitted is 1 (fitted) or 0 (none)");
   require(4095.0 * s.current_lsb_A / 2.0 > 1.5 * std::sqrt(2.0) * m.rated.current_rms_A * 1.5,
           "sensors.current_lsb_A: the ADC's range (±2048 counts) does not cover the current limit");
 
@@ -174,6 +176,7 @@ const std::vector<ParameterEntry>& parameter_catalogue() {
       INDEP_VESC_PARAM("sensors.bus_gain", "1", sensors.bus_gain),
       INDEP_VESC_PARAM("sensors.phase_voltage_gain", "1", sensors.phase_voltage_gain),
       INDEP_VESC_PARAM("sensors.motor_temp_noise_K", "K", sensors.motor_temp_noise_K),
+      INDEP_VESC_PARAM("sensors.motor_sensor_fitted", "1", sensors.motor_sensor_fitted),
       INDEP_VESC_PARAM("sensors.fet_temp_start_C", "degC", sensors.fet_temp_start_C),
       INDEP_VESC_PARAM("sensors.hall_offset_deg", "deg", sensors.hall_offset_deg),
       INDEP_VESC_PARAM("firmware.f_zv_Hz", "Hz", firmware.f_zv_Hz),

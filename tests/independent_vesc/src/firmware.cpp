@@ -339,6 +339,9 @@ void VescFirmware::timer_1ms() {
 }
 
 void VescFirmware::temperatures_1ms(double motor_C, double fet_C) {
+  // mc_interface.c (update_override_limits): a motor reading that is not finite or outside −200…600 °C goes into
+  // the filter as −100 °C.
+  if (!std::isfinite(motor_C) || motor_C > 600.0 || motor_C < -200.0) motor_C = -100.0;
   if (!temps_init_) {
     temp_motor_ = motor_C;
     temp_fet_ = fet_C;

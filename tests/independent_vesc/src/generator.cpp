@@ -214,7 +214,10 @@ Result generate(const Case& input) {
       plant.set_viscous(c.mechanics.viscous_Nm_s + app.added_viscous_Nm_s());
       fw.timer_1ms();
       const double fet = c.sensors.fet_temp_start_C + 0.3 * (t_w - th.winding_start_C);
-      fw.temperatures_1ms(t_w + c.sensors.motor_temp_noise_K * normal(adc_rng), fet);
+      // An open NTC input: infinite resistance, which the NTC formula 1/(ln(R/R0)/β + 1/T0) turns into 0 K.
+      const double motor_C =
+          c.sensors.motor_sensor_fitted != 0.0 ? t_w + c.sensors.motor_temp_noise_K * normal(adc_rng) : -273.15;
+      fw.temperatures_1ms(motor_C, fet);
       ++ms;
     }
     if (bridge_on && !fw.running()) {  // stop_pwm_hw forces the outputs off at once

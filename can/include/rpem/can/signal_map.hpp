@@ -60,6 +60,10 @@ struct SignalSpec {
   bool is_signed = false;   ///< two's complement (integers only: an IEEE float carries its own sign)
   double scale = 1.0, offset = 0.0;
   ValueType value_type = ValueType::kInteger;
+  /// The raw value (integers, before scale and offset; sign-extended where signed) the drive sends where its sensor
+  /// gives no reading (a temperature's: J1939's all-ones "not available", a firmware's −273.15 °C as a count): the
+  /// field is then not received in that frame (SignalMapCounters::no_reading).
+  std::optional<std::int64_t> no_reading_raw{};
 };
 
 struct FrameSpec {
@@ -103,6 +107,7 @@ struct SignalMapCounters {
   std::uint64_t incomplete = 0;    ///< a trigger before every needed quantity arrived since the last sample
   std::uint64_t non_finite = 0;    ///< a frame with a NaN or infinite value (dropped), or a sample that came out so
   std::uint64_t stale = 0;         ///< a sample the drive stamped (t_sample) at or before the previous one (dropped)
+  std::uint64_t no_reading = 0;    ///< a temperature signal holding its no-reading value (SignalSpec::no_reading_raw)
   std::uint64_t error_frames = 0;
 };
 

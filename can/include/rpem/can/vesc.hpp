@@ -104,6 +104,16 @@ inline constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 inline constexpr double kDefaultPllKp = 2000.0;
 inline constexpr double kDefaultPllKi = 30000.0;
 
+/// The motor temperature the firmware reports where it has no reading of the motor's sensor: a reading that is NaN,
+/// infinite, above 600 °C or below −200 °C (an open or shorted NTC, or none fitted: the NTC formula's −273.15) is
+/// replaced by −100 °C before its low-pass filter (vedderb/bldc motor/mc_interface.c, update_override_limits), and
+/// the reply and status 4 carry it as float16 ×10: exactly −1000. The VESC Tool log map says the same
+/// (config/log-maps/vesc-tool.yaml, temp_motor's no_reading; a test holds the two equal).
+inline constexpr double kNoMotorReading_C = -100.0;
+[[nodiscard]] constexpr bool is_no_motor_reading(double temp_motor_C) noexcept {
+  return temp_motor_C == kNoMotorReading_C;  // exact: −1000 / 10 in a double
+}
+
 /// A COMM_GET_VALUES_SELECTIVE reply in SI; fields the mask left out are NaN (or 0 for the integers).
 struct Values {
   std::uint32_t mask = 0;
@@ -195,7 +205,8 @@ class VescDecoder {
 
 /// A reply as an averaged rotor-frame sample over the window [t_start_ns, t_ns] (the previous reply's
 /// and this one's receive times: VESC's averages run from read to read). ω_el = ERPM·2π/60; T_winding is
-/// the motor sensor, T_drive the FET's. The sample carries no magnet temperature.
+/// the motor sensor (NaN where the firmware has no reading of it: kNoMotorReading_C), T_drive the FET's. The
+/// sample carries no magnet temperature.
 [[nodiscard]] core::AveragedSample to_averaged_sample(const Values& v, std::int64_t t_start_ns, std::int64_t t_ns) noexcept;
 
 }  // namespace rpem::can::vesc

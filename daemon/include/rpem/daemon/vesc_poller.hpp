@@ -73,6 +73,9 @@ struct VescPollerCounters {
   std::uint64_t short_windows = 0;
   std::uint64_t empty_reads = 0;
   std::uint64_t long_windows = 0;
+  /// Windows delivered without a winding reading: the reply's motor temperature is the firmware's value for none
+  /// (can::vesc::kNoMotorReading_C: an open, shorted or absent sensor).
+  std::uint64_t no_motor_reading = 0;
 };
 
 class VescPoller {

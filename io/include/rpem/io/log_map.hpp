@@ -84,7 +84,15 @@ struct MappedColumn {
   /// Read where the header has it, the quantity absent where not (`optional: true`; a header map's temperatures
   /// and travel_el only: quantities every log may lack).
   bool optional = false;
+  /// The value, in the column's own unit, its logger writes where the sensor gives no reading (`no_reading:`; a
+  /// temperature's only: VESC's −100 °C for a motor without a sensor). Such a cell is no reading on its row, and a
+  /// column that holds nothing else is absent (ReadRepairs::no_reading).
+  std::optional<double> no_reading{};
 };
+
+/// Whether a cell's value (the column's own unit, before scale and offset) is the column's no-reading value: equal to
+/// within half the last digit of six significant ones, the precision QTextStream and printf's %g write by default.
+[[nodiscard]] bool is_no_reading(const MappedColumn& c, double cell) noexcept;
 
 /// How a sample's window is known (averaged logs).
 enum class Window : std::uint8_t {

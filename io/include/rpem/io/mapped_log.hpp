@@ -39,6 +39,14 @@ struct ReadRepairs {
   /// Columns the header names, optional in the map, that hold no value on any row: read as absent (a logger that
   /// prints a format's whole header but leaves the cells of what it does not read empty).
   std::vector<std::string> never_recorded;
+  /// A column's cells that held its no-reading value (MappedColumn::no_reading): no reading on their rows.
+  struct NoReading {
+    std::string column;      ///< the column's label
+    std::string value;       ///< the value with the map's unit ("-100 degC")
+    std::uint64_t rows = 0;  ///< rows read with it
+    bool every_row = false;  ///< no row holds anything else (but empty cells): the column is read as absent
+  };
+  std::vector<NoReading> no_reading;
 };
 
 class MappedLogReader {
@@ -69,9 +77,12 @@ class MappedLogReader {
 
  private:
   void read_header();
-  /// After the header: an optional column empty on every row is taken as absent (ReadRepairs::never_recorded).
-  /// Reads ahead only while some optional column's cells have all been empty, then returns to the first row.
+  /// After the header: an optional column empty on every row is taken as absent (ReadRepairs::never_recorded), and
+  /// so is a column with a no-reading value that holds nothing else (ReadRepairs::no_reading). Reads ahead only while
+  /// some such column's cells have all been empty or no reading, then returns to the first row.
   void drop_columns_never_recorded();
+  /// The repairs' entry of a column with a no-reading value, added at its first use.
+  ReadRepairs::NoReading& no_reading_of(const std::string& label, const MappedColumn& c);
   void index_positions();  ///< a headerless map's cells: its columns' positions
   bool next_line(std::string& text);
   bool next_cells();  ///< the next row's cells, of the file's width; false at the end (or at a cut last row)

@@ -68,8 +68,9 @@ struct Sensors {
   double bus_gain = 1.0;            // measured/true input voltage (the divider's tolerance)
   double phase_voltage_gain = 1.0;  // measured/true phase voltage (undriven back-EMF tracking)
   double motor_temp_noise_K = 0.3;
-  double fet_temp_start_C = kAuto;  // ambient
-  double hall_offset_deg = 0.0;     // Hall mode: sensor 1's electrical position from phase a (hall.hpp)
+  double motor_sensor_fitted = 1.0;  // 0: no motor NTC, its ADC input open (README "What runs", the columns)
+  double fet_temp_start_C = kAuto;   // ambient
+  double hall_offset_deg = 0.0;      // Hall mode: sensor 1's electrical position from phase a (hall.hpp)
 };
 
 enum class OffVoltage { measured, zero };
