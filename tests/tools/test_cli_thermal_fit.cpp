@@ -84,6 +84,28 @@ nlohmann::json winding_sensor_signal(const nlohmann::json& fit) {
   return {};
 }
 
+/// How many of `rpem estimate --thermal`'s rows with a fused magnet (judged) hold the generator's true magnet of the row
+/// before them (truth.json's rows) within ±2σ (covered).
+struct BandCover {
+  std::size_t judged = 0, covered = 0;
+};
+BandCover magnet_band_cover(const io::CsvTable& estimate, const nlohmann::json& truth) {
+  const std::vector<double>& est_t = estimate.column("t");
+  const std::vector<double>& fused = estimate.column("t_magnet_fused_C");
+  const std::vector<double>& sd = estimate.column("t_magnet_fused_sd_C");
+  const nlohmann::json& rows = truth.at("rows");
+  const double t0_s = truth.at("start_ms_today").get<double>() / 1000.0;
+  BandCover b;
+  std::size_t k = 0;
+  for (std::size_t n = 0; n < estimate.rows(); ++n) {
+    if (!std::isfinite(fused[n])) continue;
+    while (k + 1 < rows.size() && rows[k + 1].at("t_s").get<double>() <= est_t[n] - t0_s) ++k;
+    ++b.judged;
+    b.covered += std::abs(fused[n] - rows[k].at("T_magnet_C").get<double>()) <= 2.0 * sd[n] ? 1 : 0;
+  }
+  return b;
+}
+
 class CliThermalFit : public ::testing::Test {
  protected:
   void SetUp() override {
@@ -266,21 +288,10 @@ TEST_F(CliThermalFit, ALogThatDoesNotStartSoakedIsAnchoredAtItsWindingWithTheBan
       test::run_command(rpem_tool() + " estimate --log " + log + " --config " + outrunner_config() + " --thermal " + dir_ +
                         "/thermal.yaml --out " + dir_ + "/estimate.csv");
   ASSERT_EQ(e.exit_code, 0) << e.output;
-  const io::CsvTable estimate = io::CsvTable::read(dir_ + "/estimate.csv", true);
-  const std::vector<double>& est_t = estimate.column("t");
-  const std::vector<double>& fused = estimate.column("t_magnet_fused_C");
-  const std::vector<double>& sd = estimate.column("t_magnet_fused_sd_C");
-  const nlohmann::json& rows = t.at("rows");
-  const double t0_s = t.at("start_ms_today").get<double>() / 1000.0;
-  std::size_t judged = 0, covered = 0, k = 0;
-  for (std::size_t n = 0; n < estimate.rows(); ++n) {
-    if (!std::isfinite(fused[n])) continue;
-    while (k + 1 < rows.size() && rows[k + 1].at("t_s").get<double>() <= est_t[n] - t0_s) ++k;
-    ++judged;
-    covered += std::abs(fused[n] - rows[k].at("T_magnet_C").get<double>()) <= 2.0 * sd[n] ? 1 : 0;
-  }
-  ASSERT_GT(judged, 500U);
-  EXPECT_GE(static_cast<double>(covered), 0.9 * static_cast<double>(judged)) << covered << " of " << judged;
+  const BandCover band = magnet_band_cover(io::CsvTable::read(dir_ + "/estimate.csv", true), t);
+  ASSERT_GT(band.judged, 500U);
+  EXPECT_GE(static_cast<double>(band.covered), 0.9 * static_cast<double>(band.judged))
+      << band.covered << " of " << band.judged;
 }
 
 // A VESC without a motor sensor: its NTC input open, the firmware filters in −100 °C for the reading it does not have
@@ -322,25 +333,15 @@ TEST_F(CliThermalFit, AVescWithoutAMotorSensorIsReadAsALogWithoutOne) {
                         "/thermal.yaml --out " + dir_ + "/estimate.csv");
   ASSERT_EQ(e.exit_code, 0) << e.output;
   const io::CsvTable estimate = io::CsvTable::read(dir_ + "/estimate.csv", true);
-  const std::vector<double>& est_t = estimate.column("t");
-  const std::vector<double>& fused = estimate.column("t_magnet_fused_C");
-  const std::vector<double>& sd = estimate.column("t_magnet_fused_sd_C");
-  const std::vector<double>& winding = estimate.column("t_winding_fused_C");
-  const nlohmann::json t = nlohmann::json::parse(std::ifstream(truth));
-  const nlohmann::json& rows = t.at("rows");
-  const double t0_s = t.at("start_ms_today").get<double>() / 1000.0;
-  std::size_t judged = 0, covered = 0, k = 0;
-  for (std::size_t n = 0; n < estimate.rows(); ++n) {
-    if (std::isfinite(winding[n])) {
-      EXPECT_GE(winding[n], 25.0 - 1.0) << "at " << est_t[n];
+  for (const double w : estimate.column("t_winding_fused_C")) {
+    if (std::isfinite(w)) {
+      EXPECT_GE(w, 25.0 - 1.0);
     }
-    if (!std::isfinite(fused[n])) continue;
-    while (k + 1 < rows.size() && rows[k + 1].at("t_s").get<double>() <= est_t[n] - t0_s) ++k;
-    ++judged;
-    covered += std::abs(fused[n] - rows[k].at("T_magnet_C").get<double>()) <= 2.0 * sd[n] ? 1 : 0;
   }
-  ASSERT_GT(judged, 500U);
-  EXPECT_GE(static_cast<double>(covered), 0.9 * static_cast<double>(judged)) << covered << " of " << judged;
+  const BandCover band = magnet_band_cover(estimate, nlohmann::json::parse(std::ifstream(truth)));
+  ASSERT_GT(band.judged, 500U);
+  EXPECT_GE(static_cast<double>(band.covered), 0.9 * static_cast<double>(band.judged))
+      << band.covered << " of " << band.judged;
 }
 
 }  // namespace
