@@ -68,6 +68,9 @@ void ThermalFilter::predict(const ThermalLoad& load, const ThermalRates& rates) 
   g << tr.phi, tr.gamma_d;
   x_.head<kN>() = g * x_.head<kDynamic>() + tr.gamma;  // a product that may alias: Eigen evaluates it first
   x_.segment<kN>(kN).array() *= decay.array();         // eq. 14.20
+  transition_ = tr;
+  decay_ = decay;
+  predicted_ = true;
   // P⁺ = F·P·Fᵀ + Q_d blockwise (docs/derivations.md §14, eq. 14.12, 14.21): c is a random walk and d scales
   // by A, so the rows of T become G·P[T,d rows] (from the prior P), the rows and columns of d scale by A, and
   // the T–d block is then G·P[·,d]·A. Small fixed sizes: coefficient-wise products, no blocking.
@@ -88,19 +91,32 @@ void ThermalFilter::predict(const ThermalLoad& load, const ThermalRates& rates) 
   p_.block<kN, kN>(kN, kN).diagonal() += d_var;
 }
 
-ObservationResult ThermalFilter::observe(const ThermalObservation& o) noexcept {
-  if (!all_finite(o.h, o.h_d, o.h_c, o.offset, o.value, o.variance, o.bilinear) || !(o.variance > 0.0) ||
-      o.bilinear_node < 0 || o.bilinear_node >= kN)
-    return ObservationResult::kRejectedInvalid;
+ThermalStateVec ThermalFilter::cross_covariance(const ThermalObservation& o) const noexcept {
   // H = [h, h_d, h_c]: h_d is zero but for a sensor that sees the winding's rate (eq. 14.22).
-  const ThermalStateVec a = p_.leftCols<kN>().lazyProduct(o.h) + p_.middleCols<kN>(kN).lazyProduct(o.h_d) +
-                            p_.rightCols<kCalibrationStates>().lazyProduct(o.h_c);
+  return p_.leftCols<kN>().lazyProduct(o.h) + p_.middleCols<kN>(kN).lazyProduct(o.h_d) +
+         p_.rightCols<kCalibrationStates>().lazyProduct(o.h_c);
+}
+
+double ThermalFilter::innovation_variance(const ThermalObservation& o, const ThermalStateVec& a) const noexcept {
   // The bilinear term b·δT_i·δc_k over the Gaussian prior (eq. 14.10a): mean b·P_ik, variance b²·(P_ii·P_kk + P_ik²),
   // no covariance with the state (third moments vanish), so a is unchanged.
   const int k = kDynamic + static_cast<int>(o.bilinear_state), i = o.bilinear_node;
   const double p_ik = p_(i, k);
-  const double s = o.h.dot(a.head<kN>()) + o.h_d.dot(a.segment<kN>(kN)) + o.h_c.dot(a.tail<kCalibrationStates>()) +
-                   o.variance + o.bilinear * o.bilinear * (p_(i, i) * p_(k, k) + p_ik * p_ik);
+  return o.h.dot(a.head<kN>()) + o.h_d.dot(a.segment<kN>(kN)) + o.h_c.dot(a.tail<kCalibrationStates>()) + o.variance +
+         o.bilinear * o.bilinear * (p_(i, i) * p_(k, k) + p_ik * p_ik);
+}
+
+double ThermalFilter::innovation_variance(const ThermalObservation& o) const noexcept {
+  return innovation_variance(o, cross_covariance(o));
+}
+
+ObservationResult ThermalFilter::observe(const ThermalObservation& o) noexcept {
+  if (!all_finite(o.h, o.h_d, o.h_c, o.offset, o.value, o.variance, o.bilinear) || !(o.variance > 0.0) ||
+      o.bilinear_node < 0 || o.bilinear_node >= kN)
+    return ObservationResult::kRejectedInvalid;
+  const ThermalStateVec a = cross_covariance(o);
+  const double s = innovation_variance(o, a);
+  const double p_ik = p_(o.bilinear_node, kDynamic + static_cast<int>(o.bilinear_state));
   const double nu = o.value - o.h.dot(x_.head<kN>()) - o.h_d.dot(x_.segment<kN>(kN)) -
                     o.h_c.dot(x_.tail<kCalibrationStates>()) - o.offset - o.bilinear * p_ik;
   innovation_ = nu;
@@ -116,6 +132,20 @@ ObservationResult ThermalFilter::observe(const ThermalObservation& o) noexcept {
   for (int j = 0; j < kThermalStates; ++j) p_.col(j).head<kDynamic>() -= (a_x * a[j]) * inv_s;
   p_.bottomLeftCorner<kCalibrationStates, kDynamic>() = p_.topRightCorner<kDynamic, kCalibrationStates>().transpose();
   return ObservationResult::kAccepted;
+}
+
+void ThermalFilter::withdraw_to(const ThermalVec& t_C, const ThermalVec& d_W) noexcept {
+  ThermalVec delta = t_C - x_.head<kN>();
+  for (int i = config_.network.nodes; i < kN; ++i) delta[i] = 0.0;  // unused nodes stay
+  x_.head<kN>() += delta;
+  for (int i = 0; i < config_.network.nodes; ++i) x_[kN + i] = d_W[i];
+  p_.topLeftCorner<kN, kN>() += delta * delta.transpose();  // a rank-one PSD term on T: P stays PSD
+}
+
+void ThermalFilter::advance_open_loop(ThermalVec& t_C, ThermalVec& d_W) const noexcept {
+  if (!predicted_) return;
+  t_C = transition_.phi * t_C + transition_.gamma + transition_.gamma_d * d_W;  // Eigen evaluates before assigning
+  d_W.array() *= decay_.array();
 }
 
 double ThermalFilter::sigma_K(int node) const noexcept { return std::sqrt(std::max(p_(node, node), 0.0)); }

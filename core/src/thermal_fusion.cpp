@@ -183,6 +183,11 @@ void ThermalFusion::start(const ThermalStepData& s) noexcept {
                               : 0.0;
   for (int i = 0; i < config_.filter.network.nodes; ++i) p(i, i) = std::max(p(i, i), excess_K * excess_K);
   filter_.set_temperatures(start_temperatures_C(config_, s), p);
+  held_reading_.restart();
+  ThermalStepData without = s;
+  without.winding_sensor_C = std::numeric_limits<double>::quiet_NaN();
+  start_without_reading_C_ = start_temperatures_C(config_, without);
+  first_step_ = true;
   out_.started = true;
 }
 
@@ -212,27 +217,78 @@ void ThermalFusion::coast(double dt_s) noexcept {
   finish_step(none, rates, dt_s);
 }
 
+StepObservations ThermalFusion::observations_now(const ThermalStepData& d, const ThermalRates& rates) const noexcept {
+  const ThermalVec slope = rates.a * filter_.temperature_C() + rates.u;
+  return step_observations(config_, d, rates, filter_.temperature_C(), slope, sensor_lag_);
+}
+
+ReadingMotion ThermalFusion::check_held_reading(const ThermalStepData& d, const ThermalRates& rates,
+                                                StepObservations& obs) noexcept {
+  held_reading_.advance(filter_);
+  const bool present = obs.present[kSensorObservation];
+  const ReadingMotion motion =  // a step without a reading holds nothing
+      present ? held_reading_.check(filter_, obs.item[kSensorObservation]) : ReadingMotion::kMoved;
+  if (present && motion == ReadingMotion::kMoved) {
+    sensor_taken_since_move_ = false;
+    if (first_step_) {  // the value set the start: without it the filter starts where start_without_reading_ says
+      ThermalVec d_W = ThermalVec::Zero();
+      filter_.advance_open_loop(start_without_reading_C_, d_W);
+      held_reading_.retarget(start_without_reading_C_, d_W);
+    }
+  }
+  first_step_ = false;
+  if (motion == ReadingMotion::kFrozenNow && sensor_taken_since_move_) {  // nothing to withdraw where none was taken
+    filter_.withdraw_to(held_reading_.target_temperature_C(), held_reading_.target_disturbance_W());
+    obs = observations_now(d, rates);
+  }
+  return motion;
+}
+
+ObservationResult ThermalFusion::observe(std::size_t k, const ThermalObservation& o, int node,
+                                         ReadingMotion motion) noexcept {
+  const bool sensor = k == kSensorObservation;
+  if (sensor && is_frozen(motion)) {
+    reports_[k] = {true, ObservationResult::kRejectedHeld, 0.0, filter_.innovation_variance(o)};
+    out_.winding_reading_held = true;
+    ++out_.winding_readings_held;
+    return ObservationResult::kRejectedHeld;
+  }
+  ObservationResult result = filter_.observe(o);
+  reports_[k] = {true, result, filter_.last_innovation(), filter_.last_innovation_variance()};
+  if (sensor && result == ObservationResult::kRejectedGate) {
+    // A run of refusals says the model drifted only where the refused readings move (thermal_held_reading.hpp).
+    sensor_moved_in_run_ = rejected_in_a_row_[k] > 0 && (sensor_moved_in_run_ || motion == ReadingMotion::kMoved);
+  }
+  const int reset_after = config_.filter.gate_reset_after;
+  if (result == ObservationResult::kRejectedGate && reset_after > 0 && ++rejected_in_a_row_[k] >= reset_after) {
+    if (sensor && !sensor_moved_in_run_) {
+      out_.winding_reading_held = true;
+      ++out_.winding_readings_held;
+    } else {
+      // The observations keep disagreeing: the model has drifted. Open the node's variance to the miss.
+      filter_.inflate(node, filter_.last_innovation() * filter_.last_innovation() / (o.h[node] * o.h[node]));
+      result = filter_.observe(o);
+      ++out_.gate_resets;
+    }
+  }
+  if (result != ObservationResult::kRejectedGate) rejected_in_a_row_[k] = 0;
+  if (result == ObservationResult::kAccepted) sensor_taken_since_move_ = sensor_taken_since_move_ || sensor;
+  return result;
+}
+
 void ThermalFusion::finish_step(const ThermalStepData& d, const ThermalRates& rates, double dt_s) noexcept {
   const ThermalNetwork& n = config_.filter.network;
-  const ThermalVec slope = rates.a * filter_.temperature_C() + rates.u;
-  const StepObservations obs = step_observations(config_, d, rates, filter_.temperature_C(), slope, sensor_lag_);
+  StepObservations obs = observations_now(d, rates);
+  // A winding reading that does not move while the network says it must is refused, and what it had told the
+  // filter withdrawn (eq. 14.28); the other observations are then formed at the withdrawn state.
+  const ReadingMotion motion = check_held_reading(d, rates, obs);
+  out_.winding_reading_held = false;
   const int node_of[3] = {n.magnet, n.winding, n.winding};
   std::array<bool, kMaxThermalNodes> observed{};
   for (std::size_t k = 0; k < obs.item.size(); ++k) {
     reports_[k] = ObservationReport{};
     if (!obs.present[k]) continue;
-    ObservationResult result = filter_.observe(obs.item[k]);
-    reports_[k] = {true, result, filter_.last_innovation(), filter_.last_innovation_variance()};
-    const int reset_after = config_.filter.gate_reset_after;
-    if (result == ObservationResult::kRejectedGate && reset_after > 0 && ++rejected_in_a_row_[k] >= reset_after) {
-      // The observations keep disagreeing: the model has drifted. Open the node's variance to the miss.
-      const double h = obs.item[k].h[node_of[k]];
-      filter_.inflate(node_of[k], filter_.last_innovation() * filter_.last_innovation() / (h * h));
-      result = filter_.observe(obs.item[k]);
-      ++out_.gate_resets;
-    }
-    if (result != ObservationResult::kRejectedGate) rejected_in_a_row_[k] = 0;
-    if (result == ObservationResult::kAccepted) {
+    if (observe(k, obs.item[k], node_of[k], motion) == ObservationResult::kAccepted) {
       ++out_.observations_accepted;
       observed[static_cast<std::size_t>(node_of[k])] = true;
     } else {

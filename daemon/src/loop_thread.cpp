@@ -32,7 +32,7 @@ constexpr std::array<CounterRow<LoopCounters>, 12> kLoopRows{{
 constexpr std::array<DiagnosticsCount, core::kRegimeCount> kRegimeFields{
     &Diag::regime_excites_both, &Diag::regime_excites_psi_m, &Diag::regime_excites_r_s, &Diag::regime_unexcited,
     &Diag::regime_transient,    &Diag::regime_not_locked,    &Diag::regime_bridge_off,  &Diag::regime_invalid};
-static_assert(kLoopRows.size() + kRegimeFields.size() + 3 <= DiagnosticsRows::kMaxCounts);
+static_assert(kLoopRows.size() + kRegimeFields.size() + 4 <= DiagnosticsRows::kMaxCounts);
 
 std::int64_t interval_ns(double rate_Hz) noexcept {
   return rate_Hz > 0.0 ? static_cast<std::int64_t>(1e9 / rate_Hz) : INT64_MAX / 4;
@@ -256,6 +256,7 @@ void LoopThread::report_stats() noexcept {
     r.rows.set(kRegimeFields[k], static_cast<std::int64_t>(counters_.regimes.n[k]));
   }
   r.rows.set(&Diag::r_s_on_assumed_frame, static_cast<std::int64_t>(counters_.regimes.r_s_on_assumed_frame));
+  r.rows.set(&Diag::thermal_readings_held, thermal_.estimate().winding_readings_held);
   timer_.report(r.rows);
   const double n = eps_n_ > 0 ? static_cast<double>(eps_n_) : 1.0;
   r.rows.set(&Diag::epsilon_rms_d_A, std::sqrt(eps2_d_ / n));

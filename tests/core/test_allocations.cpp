@@ -218,8 +218,8 @@ TEST(RegimeAllocations, NoneThroughEveryRegimeAndTheSparsePath) {
 TEST(ThermalAllocations, NoneAcrossOneHundredThousandFusedSteps) {
   // The thermal fusion beside the estimator (rpemd's loop and `rpem estimate --thermal`): loss accumulation,
   // observations, a 3-node network's exact step every 1 ms (so the filter steps 10⁴ times), gate resets,
-  // coasting without samples, a reload (to the reading node of eq. 14.24) and a non-finite sample; one node's
-  // disturbance Gauss–Markov.
+  // coasting without samples, a reload (to the reading node of eq. 14.24), a non-finite sample and a sensor that
+  // holds one value (eq. 14.28); one node's disturbance Gauss–Markov.
   const MachineSi machine = test::paper_machine_si();
   AveragedDriveEstimator est(machine, test::paper_settings());
   ThermalFusionConfig c = test::paper_thermal_fusion();
@@ -247,7 +247,9 @@ TEST(ThermalAllocations, NoneAcrossOneHundredThousandFusedSteps) {
     const Estimate e = est.step(samples[k]);
     ThermalSample s;
     s.dt_s = 1e-9 * static_cast<double>(samples[k].t_ns - previous);
-    s.winding_sensor_C = k % 50 == 0 ? 60.0 + 1e-4 * static_cast<double>(k) : std::nan("");
+    // From step 60 000 the sensor holds one value: the frozen-reading check's withdrawal and refusals (eq. 14.28).
+    const double reading_C = k < 60'000 ? 60.0 + 1e-4 * static_cast<double>(k) : 20.0;
+    s.winding_sensor_C = k % 50 == 0 ? reading_C : std::nan("");
     s.coolant_C = 40.0;
     previous = samples[k].t_ns;
     fusion.step(e, s);
@@ -258,6 +260,7 @@ TEST(ThermalAllocations, NoneAcrossOneHundredThousandFusedSteps) {
   EXPECT_EQ(g_allocations.load() - before, 0);
   EXPECT_TRUE(std::isfinite(sink));
   EXPECT_GT(fusion.estimate().observations_accepted, 1000);
+  EXPECT_GT(fusion.estimate().winding_readings_held, 0);
 }
 
 TEST(AllocationCounter, CountsAnAllocation) {

@@ -1,12 +1,14 @@
 // A winding sensor that lags the winding node (core/thermal_sensor.hpp, docs/derivations.md eq. 14.22): the
 // step coefficients against their limits, and the filter fed the exact step means of a first-order element
 // behind the network's exact response (closed form, below) — within the bound of the model's remainder with the
-// lag modelled, pulled off by the lag without it.
+// lag modelled, pulled off by the lag without it. And a sensor that holds one value (core/thermal_held_reading.hpp,
+// eq. 14.28): refused once the network says the winding moved, while live readings of any resolution are kept.
 #include <gtest/gtest.h>
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <vector>
 
 #include "rpem/core/thermal_fusion.hpp"
@@ -122,23 +124,29 @@ ThermalNetwork two_node_network() {
   return n;
 }
 
+/// The fusion of these tests: two_node_network, no calibration or copper-loss uncertainty, a winding sensor of σ 1 K;
+/// what a fit gives a model that is not exact: white noise on the rates and a drifting heat.
+ThermalFusionConfig sensor_test_fusion() {
+  ThermalFusionConfig c;
+  c.filter.network = two_node_network();
+  c.filter.calibration_sigma.setZero();
+  c.filter.copper_rel_sigma = 0.0;
+  c.filter.process_noise_K2_per_s << 1e-3, 1e-3, 0.0, 0.0;
+  c.filter.disturbance_W2_per_s << 1.0, 1.0, 0.0, 0.0;
+  c.winding_sensor_sigma_K = 1.0;
+  c.initial_sigma_K = 1.0;
+  return c;
+}
+
 /// A machine soaked at the coolant, `current_A` for 20 min, then 0 A for 20 min, steps of 1 s; the filter reads a
 /// sensor of time constant `tau_true_s` — each step the exact mean of its continuous reading (`rows` = 0) or the
 /// mean of `rows` readings at the ends of equal rows (as a log's temperature columns are) — and models it with
 /// `tau_model_s` and the readings' age `model_age`.
 LaggedRun run_lagged(double tau_true_s, double tau_model_s, int rows = 0, ReadingAge model_age = continuous_mean(1.0),
                      double current_A = 120.0) {
-  ThermalFusionConfig c;
-  c.filter.network = two_node_network();
+  ThermalFusionConfig c = sensor_test_fusion();
   const ThermalNetwork& n = c.filter.network;
-  c.filter.calibration_sigma.setZero();
-  c.filter.copper_rel_sigma = 0.0;
-  // What a fit gives a model that is not exact: white noise on the rates and a drifting heat.
-  c.filter.process_noise_K2_per_s << 1e-3, 1e-3, 0.0, 0.0;
-  c.filter.disturbance_W2_per_s << 1.0, 1.0, 0.0, 0.0;
-  c.winding_sensor_sigma_K = 1.0;
   c.winding_sensor_time_constant_s = tau_model_s;
-  c.initial_sigma_K = 1.0;
   ThermalFusion fusion(c, PerUnitBase{}, MachineSi{});
   const double dt = 1.0;
   Eigen::Vector2d t0(25.0, 25.0);
@@ -332,6 +340,172 @@ TEST(ThermalFusionStart, AMachineNotSoakedStartsEveryNodeAtTheWindingWithinItsDi
     }
     EXPECT_EQ(unsoaked_excess_K(winding_C, 25.0, 1.0), excess_K > 3.0 ? excess_K : 0.0);
   }
+}
+
+// A winding sensor that holds one value (core/thermal_held_reading.hpp, eq. 14.28). The exact network, soaked at
+// the 25 °C coolant, runs 120 A for 20 min and 0 A for 20 min in 1 s steps; the filter (the same network: the model
+// is exact, so every miss below is the held value's) reads `reading(step, true winding)`.
+struct HeldRun {
+  int first_held_step = -1;  ///< the first step whose reading was refused as held; −1: none
+  std::int64_t held_steps = 0, gate_resets = 0;
+  double worst_z_after = 0.0;  ///< max |fused − true|/σ of the winding and the magnet, from 30 steps after the first refusal
+  double worst_K_end = 0.0;  ///< max |fused − true| of both nodes over the last 5 min
+  double worst_K_all = 0.0;  ///< max |fused − true| of the winding over the run
+};
+
+/// The machine: the filter's network (`exact`), or one the filter's is 15 % off of — conductances to the coolant
+/// 15 % lower, between the nodes 15 % higher, capacitances 10 % higher — as a fitted model is off a real machine
+/// (its winding's steady rise at 120 A is ≈ 5 K above the model's).
+ThermalNetwork held_test_machine(bool exact) {
+  ThermalNetwork n = two_node_network();
+  if (exact) return n;
+  n.to_coolant_W_per_K *= 0.85;
+  n.between_W_per_K *= 1.15;
+  n.capacitance_J_per_K *= 1.1;
+  return n;
+}
+
+HeldRun run_held(const std::function<double(int, double)>& reading, bool exact) {
+  const ThermalFusionConfig c = sensor_test_fusion();
+  const ThermalNetwork& n = c.filter.network;
+  ThermalFusion fusion(c, PerUnitBase{}, MachineSi{});
+  ThermalVec t = ThermalVec::Constant(25.0);
+  HeldRun out;
+  int k = 0;
+  for (const double i_A : {120.0, 0.0}) {
+    ThermalLoad l;
+    l.dt_s = 1.0;
+    l.current_sq_A2 = i_A * i_A;
+    l.coolant_C = 25.0;
+    const ThermalTransition tr = thermal_transition(held_test_machine(exact), l);
+    for (int j = 0; j < 1200; ++j) {
+      t = tr.phi * t + tr.gamma;
+      ThermalStepData d;
+      d.t_ns = static_cast<std::int64_t>(++k) * 1000000000;
+      d.load = l;
+      d.winding_sensor_C = reading(k, t[n.winding]);
+      d.winding_sensor_age = {0.0, 0.0};
+      fusion.apply(d);
+      const ThermalEstimate& e = fusion.estimate();
+      if (e.winding_reading_held && out.first_held_step < 0) out.first_held_step = k;
+      for (const int node : {n.winding, n.magnet}) {
+        const ThermalNodeEstimate& f = e.node[static_cast<std::size_t>(node)];
+        const double miss = std::abs(f.t_C - t[node]);
+        if (out.first_held_step >= 0 && k >= out.first_held_step + 30)
+          out.worst_z_after = std::max(out.worst_z_after, miss / f.sigma_K);
+        if (k > 2100) out.worst_K_end = std::max(out.worst_K_end, miss);
+        if (node == n.winding) out.worst_K_all = std::max(out.worst_K_all, miss);
+      }
+    }
+  }
+  out.held_steps = fusion.estimate().winding_readings_held;
+  out.gate_resets = fusion.estimate().gate_resets;
+  return out;
+}
+
+/// What a model 15 % off (held_test_machine) may miss by where nothing corrects it: its winding's steady rise at
+/// 120 A is 31 K·15 % ≈ 5 K off the machine's.
+constexpr double kHeldTestModelMiss_K = 5.0;
+
+/// After a withdrawal: with the exact model the band holds the machine on both nodes within 2σ at every step from 30
+/// after it and the last 5 min are on it; with the model 15 % off, within the model's own miss.
+void expect_on_the_machine_after_withdrawal(const HeldRun& r, bool exact) {
+  if (exact) {
+    EXPECT_LT(r.worst_z_after, 2.0);
+    EXPECT_LT(r.worst_K_end, 0.5);
+  } else {
+    EXPECT_LT(r.worst_K_end, kHeldTestModelMiss_K);
+  }
+}
+
+TEST(HeldReading, ADisabledInputsConstantIsRefusedOnceTheNetworkSaysTheWindingMustHaveMoved) {
+  // A sensor input set to "disabled" that reports 0 °C (docs/can-vesc.md) on a machine at the 25 °C coolant: the
+  // start takes it as a machine 25 K below its coolant (not soaked). From there the network warms the winding by the
+  // coolant's 25 K·(30 + 10)/5 kJ = 0.2 K/s and the copper's 1.5·(120 A)²·50 mΩ/5 kJ = 0.22 K/s: past the gate
+  // (5·√(σ² + P) ≈ 5·√2 K) within ~20 s. Bound: 60 steps.
+  for (const bool exact : {true, false}) {
+    SCOPED_TRACE(exact);
+    const HeldRun r = run_held([](int, double) { return 0.0; }, exact);
+    ASSERT_GT(r.first_held_step, 0);
+    EXPECT_LE(r.first_held_step, 60);
+    EXPECT_GT(r.held_steps, 2300);   // every step after that
+    EXPECT_GT(r.worst_K_all, 20.0);  // before it, the start took the held value: 25 K off
+    // Withdrawn to the soaked start (the start without the reading) run open loop, the band widened by the move.
+    expect_on_the_machine_after_withdrawal(r, exact);
+  }
+}
+
+TEST(HeldReading, ASensorThatSticksAtItsLastReadingIsRefusedAndTheBandCoversTheMachine) {
+  // Live (0.1 K resolution, as a VESC's) for 10 min of the heat-up, then its last reading for ever. The heat-up's
+  // rest moves the winding by less than the gate; the cool-down after 20 min moves it by more within a minute.
+  for (const bool exact : {true, false}) {
+    SCOPED_TRACE(exact);
+    double last = 0.0;
+    const HeldRun r = run_held(
+        [&last](int k, double winding_C) {
+          if (k <= 600) last = std::round(winding_C * 10.0) / 10.0;
+          return last;
+        },
+        exact);
+    EXPECT_GT(r.first_held_step, 1200);
+    EXPECT_LE(r.first_held_step, 1300);
+    expect_on_the_machine_after_withdrawal(r, exact);
+  }
+}
+
+TEST(HeldReading, AValueThatJumpsAwayAndStaysIsNotTakenByTheGatesReset) {
+  // At 15 min (a winding ≈ 30 K above the coolant) the input drops to 0 °C and stays. The gate refuses it;
+  // gate_reset_after refusals would take the model to be wrong and accept it — unless the refused readings move,
+  // which a held value does not. The fused winding stays on the machine, 55 K from the held value.
+  for (const bool exact : {true, false}) {
+    SCOPED_TRACE(exact);
+    const HeldRun r =
+        run_held([](int k, double winding_C) { return k <= 900 ? std::round(winding_C * 10.0) / 10.0 : 0.0; }, exact);
+    EXPECT_EQ(r.gate_resets, 0);
+    EXPECT_GT(r.held_steps, 1400);  // every step from the third refusal (903) on
+    EXPECT_LT(r.worst_K_all, exact ? 0.5 : kHeldTestModelMiss_K);
+  }
+}
+
+TEST(HeldReading, LiveReadingsOfAnyResolutionAndAReadingAtRestAreKept) {
+  // 1 K steps (the coarsest a drive reports), 0.1 K, and exact: each moves by one step long before the network's
+  // change reaches the gate, with the model exact or 15 % off. The cool-down's end rests on one value for minutes:
+  // the network's change from there is the model's miss, inside the gate.
+  for (const bool exact : {true, false}) {
+    for (const double resolution_K : {1.0, 0.1, 0.0}) {
+      SCOPED_TRACE(testing::Message() << "exact " << exact << ", resolution " << resolution_K << " K");
+      const HeldRun r = run_held(
+          [resolution_K](int, double winding_C) {
+            return resolution_K > 0.0 ? std::round(winding_C / resolution_K) * resolution_K : winding_C;
+          },
+          exact);
+      EXPECT_EQ(r.held_steps, 0);
+      EXPECT_EQ(r.gate_resets, 0);
+      EXPECT_LT(r.worst_K_all, 0.5 * resolution_K + 0.5);  // the reading's rounding and the filter's settling
+    }
+  }
+}
+
+TEST(HeldReading, AWithdrawalMovesTheStateAndWidensTheTemperaturesCovarianceByTheirMove) {
+  ThermalFilterConfig c;
+  c.network = two_node_network();
+  ThermalFilter f(c);
+  f.reset(25.0, 1.0);
+  const ThermalStateMat before = f.covariance();
+  ThermalVec t = ThermalVec::Constant(25.0), d = ThermalVec::Zero();
+  t[0] = 35.0;
+  t[1] = 20.0;
+  d[0] = 4.0;
+  f.withdraw_to(t, d);
+  EXPECT_DOUBLE_EQ(f.temperature_C()[0], 35.0);
+  EXPECT_DOUBLE_EQ(f.temperature_C()[1], 20.0);
+  EXPECT_DOUBLE_EQ(f.disturbance_W()[0], 4.0);
+  EXPECT_DOUBLE_EQ(f.covariance()(0, 0), before(0, 0) + 100.0);  // δ_T0 = 10
+  EXPECT_DOUBLE_EQ(f.covariance()(0, 1), before(0, 1) - 50.0);   // δ_T0·δ_T1 = 10·(−5)
+  EXPECT_DOUBLE_EQ(f.covariance()(0, 4), before(0, 4));          // the disturbances replaced, not widened
+  EXPECT_DOUBLE_EQ(f.covariance()(4, 4), before(4, 4));
+  EXPECT_DOUBLE_EQ(f.covariance()(2, 2), before(2, 2));  // an unused node stays
+  EXPECT_TRUE(f.covariance().isApprox(f.covariance().transpose(), 0.0));
 }
 
 }  // namespace

@@ -75,6 +75,28 @@ double motor_quantile(const MotorTemperatures& m, double from_s, double until_s,
   return v.empty() ? std::nan("") : v[static_cast<std::size_t>(q * static_cast<double>(v.size() - 1))];
 }
 
+/// A copy of a VESC Tool log whose temp_motor holds, from the row `fraction` of the way in, that row's cell: a sensor
+/// that sticks (the cells copied as written).
+void write_with_held_motor_temperature(const std::string& log, const std::string& out, double fraction) {
+  std::ifstream f(log);
+  std::vector<std::string> lines;
+  for (std::string line; std::getline(f, line);) lines.push_back(line);
+  ASSERT_GT(lines.size(), 3U);
+  const std::vector<std::string> names = cells(lines[0], ';');
+  const auto motor = static_cast<std::size_t>(std::find(names.begin(), names.end(), "temp_motor") - names.begin());
+  ASSERT_LT(motor, names.size());
+  const auto from = static_cast<std::size_t>(fraction * static_cast<double>(lines.size() - 1)) + 1;
+  const std::string held = cells(lines[from], ';').at(motor);
+  std::ofstream o(out);
+  for (std::size_t k = 0; k < lines.size(); ++k) {
+    std::vector<std::string> values = cells(lines[k], ';');
+    if (k >= from && values.size() > motor) values[motor] = held;
+    for (std::size_t c = 0; c < values.size(); ++c) o << (c ? ";" : "") << values[c];
+    if (!lines[k].empty() && lines[k].back() == ';') o << ';';  // a trailing separator, as VESC Tool writes it
+    o << '\n';
+  }
+}
+
 /// The winding sensor's signal of fit.json.
 nlohmann::json winding_sensor_signal(const nlohmann::json& fit) {
   for (const nlohmann::json& s : fit.at("signals")) {
@@ -168,6 +190,23 @@ TEST_F(CliThermalFit, ReadsAVescToolLogItsMotorSensorTheWinding) {
   ASSERT_GT(estimate.rows(), 0U);
   const double fused_C = estimate.column("t_winding_fused_C").back();
   EXPECT_NEAR(fused_C, motor_temperatures(log).t_motor_C.back(), 5.0 * kSensorResolution_K);
+
+  // The same log with a sensor that sticks a third of the way in (temp_motor holds that row's value to the end, the
+  // winding cooling on): rpem estimate says it refused a held value (eq. 14.28) and the fused winding ends on the
+  // live sensor's last reading within the network's own error (held out above: 0.17 K worst; 2 K allowed), not on the
+  // held value ~10 K above it.
+  const std::string stuck = dir_ + "/stuck.csv";
+  write_with_held_motor_temperature(log, stuck, 1.0 / 3.0);
+  const MotorTemperatures live = motor_temperatures(log), held = motor_temperatures(stuck);
+  ASSERT_GT(held.t_motor_C.back() - live.t_motor_C.back(), 5.0);
+  const test::ProcessResult h =
+      test::run_command(rpem_tool() + " estimate --log " + stuck + " --config " + outrunner_config() + " --thermal " + dir_ +
+                        "/thermal.yaml --out " + dir_ + "/stuck_estimate.csv");
+  ASSERT_EQ(h.exit_code, 0) << h.output;
+  EXPECT_NE(h.output.find("the winding sensor's reading was refused as a held value in "), std::string::npos) << h.output;
+  const io::CsvTable stuck_estimate = io::CsvTable::read(dir_ + "/stuck_estimate.csv", true);
+  ASSERT_GT(stuck_estimate.rows(), 0U);
+  EXPECT_NEAR(stuck_estimate.column("t_winding_fused_C").back(), live.t_motor_C.back(), 2.0);
 }
 
 // What the training part observes, and what a fit that identifies nothing says of it. The cool-down above moves the

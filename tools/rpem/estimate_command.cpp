@@ -93,6 +93,16 @@ class ThermalRun {
     }
   }
   [[nodiscard]] const core::ThermalEstimate* estimate() const { return fusion_ ? &fusion_->estimate() : nullptr; }
+  /// On stderr: the winding readings refused as a held value (thermal_held_reading.hpp), where there were any.
+  void explain() const {
+    if (!fusion_ || fusion_->estimate().winding_readings_held == 0) return;
+    std::fprintf(stderr,
+                 "rpem estimate: thermal: the winding sensor's reading was refused as a held value in %lld filter "
+                 "steps: it stayed on one value while the network says the winding moved by more than the filter's "
+                 "gate, or while the gate refused it (docs/thermal.md, \"A winding reading that holds one value\"); "
+                 "the fused winding is predicted there\n",
+                 static_cast<long long>(fusion_->estimate().winding_readings_held));
+  }
   /// The fused temperatures' peaks so far, as the estimate CSV reports them at each sample.
   [[nodiscard]] const TemperaturePeak& magnet_peak() const { return magnet_; }
   [[nodiscard]] const TemperaturePeak& winding_peak() const { return winding_; }
@@ -223,6 +233,7 @@ Tally run_averaged(const EstimateOptions& o, const std::string& log, const std::
   std::fprintf(stderr, "rpem estimate: %s\n", tally.summary(cfg.estimator.algorithm, "averaged samples").c_str());
   tally.explain();
   if (!samples.empty()) tally.identifiable = check_identifiable(samples, cfg, tally.last, tally.adapted, rebuilt);
+  thermal.explain();
   tally.take_peaks(thermal);
   return tally;
 }
@@ -252,6 +263,7 @@ Tally run_instantaneous(const EstimateOptions& o, const std::string& log, const 
   }
   progress.finish(tally.summary(cfg.estimator.algorithm, "samples") + io::describe(reader.reader().repairs()));
   tally.explain();
+  thermal.explain();
   tally.take_peaks(thermal);
   return tally;
 }

@@ -36,6 +36,8 @@ std::vector<FilterStep> run_filter(const core::ThermalFusionConfig& c, const The
     f.estimate = fusion->estimate();
     f.observations = fusion->last_observations();
     for (const auto& o : f.observations) {
+      // A held reading (eq. 14.28) costs what a refusal at the gate does: a network that made readings look held
+      // must not gain by it.
       if (!o.present || o.result == core::ObservationResult::kRejectedInvalid) continue;
       const double z2 = o.result == core::ObservationResult::kAccepted ? o.innovation * o.innovation / o.variance : gate2;
       f.log_likelihood -= 0.5 * (std::log(2.0 * core::kPi * o.variance) + z2);

@@ -49,7 +49,8 @@ struct ThermalObservation {
   Calibration bilinear_state = Calibration::kMagnetCoefficient;  ///< k
 };
 
-enum class ObservationResult : std::uint8_t { kAccepted = 0, kRejectedGate = 1, kRejectedInvalid = 2 };
+/// kRejectedHeld: a reading that holds one value (thermal_held_reading.hpp), never offered to the filter.
+enum class ObservationResult : std::uint8_t { kAccepted = 0, kRejectedGate = 1, kRejectedInvalid = 2, kRejectedHeld = 3 };
 
 struct ThermalFilterConfig {
   ThermalNetwork network;
@@ -85,6 +86,15 @@ class ThermalFilter {
   [[nodiscard]] ObservationResult observe(const ThermalObservation& o) noexcept;
   /// Adds `variance_K2` to one node's variance (the model has drifted: a gate reset).
   void inflate(int node, double variance_K2) noexcept { p_(node, node) += variance_K2; }
+  /// Moves [T; d] to the given values and widens the temperatures' covariance by δ·δᵀ, δ their move, so the band
+  /// covers both; the disturbances are replaced, not widened (what a held reading had told the filter is
+  /// withdrawn: its disturbances were learnt from it; thermal_held_reading.hpp, eq. 14.28a).
+  void withdraw_to(const ThermalVec& t_C, const ThermalVec& d_W) noexcept;
+  /// s = H·P·Hᵀ + r of an observation at the current state (what observe() gates by).
+  [[nodiscard]] double innovation_variance(const ThermalObservation& o) const noexcept;
+  /// Runs [T; d] through the newest prediction's transition, noise-free: T⁺ = Φ·T + γ + Γ_d·d, d⁺ = a·d (an
+  /// open-loop copy of the network beside the filter). Nothing before the first prediction.
+  void advance_open_loop(ThermalVec& t_C, ThermalVec& d_W) const noexcept;
   /// Replaces the model (a reload), keeping the state.
   void reconfigure(const ThermalFilterConfig& config) noexcept { config_ = config; }
 
@@ -101,11 +111,17 @@ class ThermalFilter {
   using LossTerms = Eigen::Matrix<double, kLossForms + 1, kMaxThermalNodes>;
   /// The modelled loss terms of each node under `l` at the state's winding temperature: copper, then the forms.
   [[nodiscard]] LossTerms loss_terms(const ThermalLoad& l) const noexcept;
+  /// a = P·Hᵀ of an observation, and s from it.
+  [[nodiscard]] ThermalStateVec cross_covariance(const ThermalObservation& o) const noexcept;
+  [[nodiscard]] double innovation_variance(const ThermalObservation& o, const ThermalStateVec& a) const noexcept;
 
   ThermalFilterConfig config_;
   ThermalStateVec x_ = ThermalStateVec::Zero();
   ThermalStateMat p_ = ThermalStateMat::Zero();
   LossTerms previous_terms_ = LossTerms::Zero();
+  ThermalTransition transition_{};         ///< the newest prediction's (advance_open_loop)
+  ThermalVec decay_ = ThermalVec::Ones();  ///< its disturbances' a
+  bool predicted_ = false;
   double innovation_ = 0.0, innovation_variance_ = 0.0;
 };
 

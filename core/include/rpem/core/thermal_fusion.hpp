@@ -18,6 +18,7 @@
 #include <cstdint>
 
 #include "rpem/core/thermal_filter.hpp"
+#include "rpem/core/thermal_held_reading.hpp"
 #include "rpem/core/thermal_observer.hpp"
 #include "rpem/core/thermal_resume.hpp"
 #include "rpem/core/thermal_sensor.hpp"
@@ -72,6 +73,10 @@ struct ThermalEstimate {
   std::int64_t observations_accepted = 0;
   std::int64_t observations_rejected = 0;  ///< beyond the gate (gate_sigma) or not finite
   std::int64_t gate_resets = 0;            ///< the model taken to be wrong (gate_reset_after rejections in a row)
+  /// Steps whose winding reading was refused as a held value (thermal_held_reading.hpp): frozen (eq. 14.28), or
+  /// beyond the gate gate_reset_after times and more without moving; and whether the newest step's was.
+  std::int64_t winding_readings_held = 0;
+  bool winding_reading_held = false;
   [[nodiscard]] const ThermalNodeEstimate& magnet_node() const noexcept { return node[static_cast<std::size_t>(magnet)]; }
   [[nodiscard]] const ThermalNodeEstimate& winding_node() const noexcept { return node[static_cast<std::size_t>(winding)]; }
 };
@@ -152,6 +157,15 @@ class ThermalFusion {
   void start(const ThermalStepData& s) noexcept;
   /// `rates`: the network's at d.load, as the prediction took them.
   void finish_step(const ThermalStepData& d, const ThermalRates& rates, double dt_s) noexcept;
+  /// The step's observations at the filter's current state.
+  [[nodiscard]] StepObservations observations_now(const ThermalStepData& d, const ThermalRates& rates) const noexcept;
+  /// The held-reading check of the step's winding reading (eq. 14.28): withdraws the filter where it fires, and then
+  /// forms `obs` again at the withdrawn state.
+  ReadingMotion check_held_reading(const ThermalStepData& d, const ThermalRates& rates, StepObservations& obs) noexcept;
+  /// Applies observation `k` of the step (of `node`): a held reading refused, the gate's refusals and resets; the
+  /// report and the counters of held readings and resets. What the filter made of it.
+  ObservationResult observe(std::size_t k, const ThermalObservation& o, int node, ReadingMotion motion) noexcept;
+  static constexpr std::size_t kSensorObservation = 2;  ///< StepObservations' order: magnet, winding from r̂s, sensor
 
   ThermalFusionConfig config_;
   ThermalObserver observer_;
@@ -162,7 +176,12 @@ class ThermalFusion {
   std::array<bool, kMaxThermalNodes> ever_observed_{};
   std::array<ObservationReport, 3> reports_{};
   std::array<int, 3> rejected_in_a_row_{};
-  SensorLag sensor_lag_;  ///< the winding sensor's lag at the next step's start (eq. 14.22)
+  SensorLag sensor_lag_;                  ///< the winding sensor's lag at the next step's start (eq. 14.22)
+  HeldReadingCheck held_reading_;         ///< the winding sensor's (eq. 14.28)
+  bool sensor_moved_in_run_ = false;      ///< the winding readings of the current run of gate refusals are not one value
+  bool sensor_taken_since_move_ = false;  ///< a winding reading was applied since the value last moved
+  bool first_step_ = false;               ///< the step after start(): its reading may have set the start
+  ThermalVec start_without_reading_C_ = ThermalVec::Zero();  ///< where start() would have put the nodes without it
   double last_psi_m_Wb_ = 0.0, last_r_s_Ohm_ = 0.0;
   ThermalSnapshot resumed_;  ///< where the first step starts (resume); nodes 0: from the coolant
 };
