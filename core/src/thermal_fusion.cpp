@@ -244,8 +244,8 @@ ReadingMotion ThermalFusion::check_held_reading(const ThermalStepData& d, const 
   return motion;
 }
 
-ObservationResult ThermalFusion::observe(std::size_t k, const ThermalObservation& o, int node,
-                                         ReadingMotion motion) noexcept {
+ObservationResult ThermalFusion::apply_observation(std::size_t k, const ThermalObservation& o, int node,
+                                                   ReadingMotion motion) noexcept {
   const bool sensor = k == kSensorObservation;
   if (sensor && is_frozen(motion)) {
     reports_[k] = {true, ObservationResult::kRejectedHeld, 0.0, filter_.innovation_variance(o)};
@@ -288,7 +288,7 @@ void ThermalFusion::finish_step(const ThermalStepData& d, const ThermalRates& ra
   for (std::size_t k = 0; k < obs.item.size(); ++k) {
     reports_[k] = ObservationReport{};
     if (!obs.present[k]) continue;
-    if (observe(k, obs.item[k], node_of[k], motion) == ObservationResult::kAccepted) {
+    if (apply_observation(k, obs.item[k], node_of[k], motion) == ObservationResult::kAccepted) {
       ++out_.observations_accepted;
       observed[static_cast<std::size_t>(node_of[k])] = true;
     } else {

@@ -242,13 +242,15 @@ TEST(ThermalAllocations, NoneAcrossOneHundredThousandFusedSteps) {
   samples[6000].i_dq_A[0] = std::nan("");
   const long before = g_allocations.load();
   double sink = 0.0;
+  int withdrawn_steps = 0;  // refused by eq. 14.28 after the held value had been taken (so withdrawn)
   std::int64_t previous = samples.front().t_ns;
   for (std::size_t k = 0; k < samples.size(); ++k) {
     const Estimate e = est.step(samples[k]);
     ThermalSample s;
     s.dt_s = 1e-9 * static_cast<double>(samples[k].t_ns - previous);
-    // From step 60 000 the sensor holds one value: the frozen-reading check's withdrawal and refusals (eq. 14.28).
-    const double reading_C = k < 60'000 ? 60.0 + 1e-4 * static_cast<double>(k) : 20.0;
+    // For the first 20 000 steps the sensor holds 0 °C (a disabled input: the start takes it, the check withdraws it
+    // and refuses it, eq. 14.28), from 60 000 one value 40 K below the winding (the gate's refusals, no reset).
+    const double reading_C = k < 20'000 ? 0.0 : k < 60'000 ? 60.0 + 1e-4 * static_cast<double>(k) : 20.0;
     s.winding_sensor_C = k % 50 == 0 ? reading_C : std::nan("");
     s.coolant_C = 40.0;
     previous = samples[k].t_ns;
@@ -256,11 +258,13 @@ TEST(ThermalAllocations, NoneAcrossOneHundredThousandFusedSteps) {
     if (k == 50'000) fusion.reconfigure(reading, test::paper_base(), machine);
     if (k % 20'000 == 0) fusion.coast(0.5);
     sink += fusion.estimate().magnet_node().t_C;
+    withdrawn_steps += k < 20'000 && fusion.last_observations()[2].result == ObservationResult::kRejectedHeld ? 1 : 0;
   }
   EXPECT_EQ(g_allocations.load() - before, 0);
   EXPECT_TRUE(std::isfinite(sink));
   EXPECT_GT(fusion.estimate().observations_accepted, 1000);
   EXPECT_GT(fusion.estimate().winding_readings_held, 0);
+  EXPECT_GT(withdrawn_steps, 0);
 }
 
 TEST(AllocationCounter, CountsAnAllocation) {

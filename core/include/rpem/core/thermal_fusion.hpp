@@ -164,7 +164,7 @@ class ThermalFusion {
   ReadingMotion check_held_reading(const ThermalStepData& d, const ThermalRates& rates, StepObservations& obs) noexcept;
   /// Applies observation `k` of the step (of `node`): a held reading refused, the gate's refusals and resets; the
   /// report and the counters of held readings and resets. What the filter made of it.
-  ObservationResult observe(std::size_t k, const ThermalObservation& o, int node, ReadingMotion motion) noexcept;
+  ObservationResult apply_observation(std::size_t k, const ThermalObservation& o, int node, ReadingMotion motion) noexcept;
   static constexpr std::size_t kSensorObservation = 2;  ///< StepObservations' order: magnet, winding from r̂s, sensor
 
   ThermalFusionConfig config_;

@@ -24,9 +24,10 @@
 // "One value" is within kHeldReadingRelTolerance: far below any sensor's resolution, far above the rounding of a
 // step's weighted mean of equal readings. Where (14.28) fires after the filter took the value, the filter is
 // withdrawn to where it would be without it (ThermalFilter::withdraw_to: [T; d] moved there, the temperatures'
-// covariance widened by their move, so the band covers both; eq. 14.28a): the copy, or for a value held from the filter's start — which set the
-// start (a machine read as not soaked) — the start without it run open loop to now. The reading is refused
-// (ObservationResult::kRejectedHeld, counted) until it changes, when the copy restarts. Real-time safe.
+// covariance widened by their move, so the band covers both; eq. 14.28a): the copy, or, for a value held from the
+// filter's start (which set the start: a machine read as not soaked), the start without it run open loop to now.
+// The reading is refused (ObservationResult::kRejectedHeld, counted) until it changes, when the copy restarts.
+// Real-time safe.
 
 #include "rpem/core/thermal_filter.hpp"
 
