@@ -1,8 +1,5 @@
 #include "rpem/core/thermal_held_reading.hpp"
 
-#include <algorithm>
-#include <cmath>
-
 namespace rpem::core {
 
 void HeldReadingCheck::advance(const ThermalFilter& f) noexcept {
@@ -12,8 +9,7 @@ void HeldReadingCheck::advance(const ThermalFilter& f) noexcept {
 }
 
 ReadingMotion HeldReadingCheck::check(const ThermalFilter& f, const ThermalObservation& o) noexcept {
-  const double tolerance = kHeldReadingRelTolerance * std::max({1.0, std::abs(o.value), std::abs(value_)});
-  if (!running_ || !(std::abs(o.value - value_) <= tolerance)) {  // a new value: the copy starts here
+  if (!running_ || !same_reading(o.value, value_)) {  // a new value: the copy starts here
     running_ = true;
     frozen_ = false;
     value_ = o.value;

@@ -279,6 +279,79 @@ TEST_F(CliThermalSessions, SessionsWithoutASensorOrAStepAreTakenAsTheyAre) {
   EXPECT_EQ(r.output.find("takes the whole log"), std::string::npos) << r.output;
 }
 
+/// A copy of a plant log whose T_winding holds, from `from_s` on, the reading it had there.
+void write_with_winding_held_from(const std::string& log, const std::string& out, double from_s) {
+  std::ifstream in(log);
+  std::ofstream o(out);
+  std::string line;
+  std::getline(in, line);
+  o << line << '\n';
+  const std::size_t column = 7;  // t,i_d,i_q,u_d,u_q,omega_el,T_coolant,T_winding
+  ASSERT_EQ(line, "t,i_d,i_q,u_d,u_q,omega_el,T_coolant,T_winding");
+  std::string held;
+  while (std::getline(in, line)) {
+    std::vector<std::string> cells;
+    std::stringstream row(line);
+    for (std::string c; std::getline(row, c, ',');) cells.push_back(c);
+    ASSERT_EQ(cells.size(), column + 1) << line;
+    if (std::stod(cells[0]) >= from_s) {
+      if (held.empty()) held = cells[column];
+      cells[column] = held;
+    }
+    for (std::size_t k = 0; k < cells.size(); ++k) o << (k > 0 ? "," : "") << cells[k];
+    o << '\n';
+  }
+}
+
+// A winding sensor that holds one value while r̂s reads the winding moving (eq. 14.28b) is set aside before the
+// network is fitted to it. The plant heats its winding 25 → 67 °C at standstill (150 A, r̂s adapting on every step).
+// Held from the start, the column is read as absent, and the network fitted without it follows the plant's winding
+// open loop within 3 K (measured 1.3 K; fitted to the held 25.3 °C it could not follow it at all); stuck from 90 s
+// (the winding at 52 °C, still rising), the readings from there are not used and the first 90 s are. The live
+// column is kept whole.
+TEST_F(CliThermalSessions, AWindingSensorThatHoldsOneValueIsSetAside) {
+  write_session("standstill", 0.0, 150.0, -50.0, 1200.0);
+  write_with_winding_held_from(at("standstill.csv"), at("held.csv"), 0.0);
+  write_with_winding_held_from(at("standstill.csv"), at("stuck.csv"), 90.0);
+  const auto fit = [&](const std::string& name) {
+    return test::run_command(rpem_tool() + " thermal fit --log " + at(name + ".csv") + pmsm_config() + " --out " +
+                             at(name + ".yaml") + " --report " + at(name + "_report"));
+  };
+  const test::ProcessResult live = fit("standstill");
+  ASSERT_EQ(live.exit_code, 0) << live.output;
+  EXPECT_EQ(live.output.find("eq. 14.28b"), std::string::npos) << live.output;
+
+  const test::ProcessResult held = fit("held");
+  ASSERT_EQ(held.exit_code, 0) << held.output;
+  EXPECT_NE(held.output.find("the winding sensor (T_winding) holds 25.3 °C on every step of " + at("held.csv")),
+            std::string::npos)
+      << held.output;
+  EXPECT_NE(held.output.find("no such sensor there, read as absent"), std::string::npos) << held.output;
+  const nlohmann::json held_fit = read_json(at("held_report/fit.json"));
+  for (const nlohmann::json& s : held_fit.at("signals")) EXPECT_NE(s.at("name"), "winding sensor");
+  const io::CsvTable p = io::CsvTable::read(at("held_report/predictions.csv"), false,
+                                            {"T_magnet_observed", "T_winding_observed", "T_winding_sensor"});
+  const io::CsvTable truth = io::CsvTable::read(at("standstill_truth.csv"));
+  ASSERT_GT(p.rows(), 1000U);
+  for (std::size_t k = 0; k < p.rows(); ++k) {
+    const auto row = static_cast<std::size_t>(std::lround(p.column("t")[k]));  // truth rows at 1 Hz from t = 0
+    ASSERT_LT(row, truth.rows());
+    EXPECT_NEAR(p.column("T_winding_model")[k], truth.column("T_winding")[row], 3.0) << p.column("t")[k];
+  }
+
+  const test::ProcessResult stuck = fit("stuck");
+  ASSERT_EQ(stuck.exit_code, 0) << stuck.output;
+  EXPECT_NE(stuck.output.find("a held value, not a reading: not used"), std::string::npos) << stuck.output;
+  std::size_t sensor_points = 0;
+  const nlohmann::json stuck_fit = read_json(at("stuck_report/fit.json"));
+  for (const nlohmann::json& s : stuck_fit.at("signals")) {
+    if (s.at("name") == "winding sensor")
+      sensor_points = s.at("fit_points").get<std::size_t>() + s.at("heldout_points").get<std::size_t>();
+  }
+  EXPECT_GT(sensor_points, 80U) << stuck_fit.at("signals").dump();
+  EXPECT_LE(sensor_points, 90U);
+}
+
 // The folders and options it refuses: a log that cannot be read ends the fit with its file:line (65), since a fit
 // without it would be another fit; holding out every session (64); --held-out-sessions beside --fit-until-s (64).
 TEST_F(CliThermalSessions, RefusesWhatCannotBeFitted) {

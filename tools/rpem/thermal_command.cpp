@@ -19,6 +19,7 @@
 #include "log_folder.hpp"
 #include "log_options.hpp"
 #include "option_checks.hpp"
+#include "rpem/analysis/thermal/held_winding_column.hpp"
 #include "rpem/analysis/thermal/thermal_fit.hpp"
 #include "rpem/analysis/thermal/thermal_report.hpp"
 #include "rpem/analysis/thermal/thermal_topology.hpp"
@@ -59,6 +60,12 @@ analysis::ThermalRecord record_sessions(const ThermalFitCliOptions& o, const io:
     std::fprintf(stderr, "rpem thermal fit: %s\n", r.read_as.c_str());
     if (const std::string note = io::assumed_frame_note(r.counts); !note.empty())
       std::fprintf(stderr, "rpem thermal fit: note: %s\n", note.c_str());
+    const double sensor_sigma_K =
+        laws.fusion.winding_sensor_sigma_K > 0.0 ? laws.fusion.winding_sensor_sigma_K : o.winding_sensor_sigma_K;
+    const analysis::HeldWindingColumn held = analysis::drop_held_winding_readings(
+        r, laws.fusion.filter.network.copper, sensor_sigma_K, laws.fusion.winding_sensor_time_constant_s);
+    if (const std::string said = held.describe("the winding sensor (T_winding)"); !said.empty())
+      std::fprintf(stderr, "rpem thermal fit: %s", said.c_str());
     if (!r.coolant) {
       std::fprintf(stderr,
                    "rpem thermal fit: %s has no T_coolant column: the coolant is taken as %.4g °C throughout "

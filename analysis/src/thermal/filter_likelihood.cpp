@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "rpem/analysis/diagnose/effect_fit.hpp"
+#include "rpem/analysis/normal_quantile.hpp"
 #include "rpem/analysis/thermal/golden_section.hpp"
 #include "rpem/analysis/thermal/sensor_lag.hpp"
 #include "rpem/analysis/thermal/thermal_replay.hpp"
@@ -139,17 +140,11 @@ void fit_sensor_lag(io::ThermalConfig& c, const ThermalRecord& r, std::size_t tr
 }
 
 /// What a chosen τ_d must gain over the walk. The walk is the nested model (τ_d → ∞), so a finite τ_d is one more
-/// parameter: 2·ΔlnL > χ²₁(1 − 0.05/m) = z², z the normal quantile at 1 − 0.05/(2m) (eq. 14.21a), found by
-/// bisection on erfc in [0, 10].
+/// parameter: 2·ΔlnL > χ²₁(1 − 0.05/m) = z², z the normal quantile at 1 − 0.05/(2m) (eq. 14.21a).
 double likelihood_ratio_threshold(std::size_t trials) {
   constexpr double kAlpha = 0.05;  // the fit's 95 % intervals' level
-  const double tail = kAlpha / static_cast<double>(std::max<std::size_t>(trials, 1));
-  double lo = 0.0, hi = 10.0;
-  for (int k = 0; k < 100; ++k) {
-    const double z = 0.5 * (lo + hi);
-    (std::erfc(z / std::sqrt(2.0)) > tail ? lo : hi) = z;  // erfc(z/√2): two-sided tail of the normal
-  }
-  return 0.5 * lo * lo;
+  const double z = upper_normal_quantile(0.5 * kAlpha / static_cast<double>(std::max<std::size_t>(trials, 1)));
+  return 0.5 * z * z;
 }
 
 /// The disturbances' correlation times τ_d (eq. 14.19) jointly with q_d, by the training part's innovation

@@ -29,6 +29,9 @@
 // The reading is refused (ObservationResult::kRejectedHeld, counted) until it changes, when the copy restarts.
 // Real-time safe.
 
+#include <algorithm>
+#include <cmath>
+
 #include "rpem/core/thermal_filter.hpp"
 
 namespace rpem::core {
@@ -36,6 +39,12 @@ namespace rpem::core {
 /// Two step means closer than this (relative to the larger, at least 1 K) are one value: 10⁻⁹ K at room
 /// temperature, ~10⁶ times a mean's rounding and ~10⁸ times below a 0.1 K resolution.
 inline constexpr double kHeldReadingRelTolerance = 1e-9;
+
+/// Whether two readings are one value (kHeldReadingRelTolerance); a NaN is no value and never one.
+[[nodiscard]] inline bool same_reading(double a, double b) noexcept {
+  const double larger = std::max({1.0, std::abs(a), std::abs(b)});
+  return std::abs(a - b) <= kHeldReadingRelTolerance * larger;
+}
 
 /// A step's reading against the one before it.
 enum class ReadingMotion : std::uint8_t {
