@@ -26,7 +26,8 @@ What the comments mean here:
   - the comment before `struct` documents the struct;
   - a comment on a line of its own inside the struct opens a group (its first line, up to a colon, is the
     group's title): `rpem listen` separates groups with " | ";
-  - a field's trailing comment documents it; a leading [label] there is the short name `rpem listen` shows
+  - a field's trailing comment documents it, continued on the lines right below that start in its column
+    (not a group); a leading [label] there is the short name `rpem listen` shows
     and its CSV column (else the field's name) — unless an earlier field of the struct has that label: a
     key is unique, so the later field keeps its name (with a warning);
   - the unit is the name's suffix (_V _A _Wb _Ohm _rad _rad_s _Hz _C _s _us _ns _pu: the project's rule that
@@ -71,8 +72,8 @@ class Token:
 
 
 class Comment:
-    def __init__(self, text, line, standalone):
-        self.text, self.line, self.standalone = text, line, standalone
+    def __init__(self, text, line, standalone, col):
+        self.text, self.line, self.standalone, self.col = text, line, standalone, col
 
 
 TOKEN = re.compile(r"(?P<comment>//[^\n]*|/\*.*?\*/)|(?P<ident>[A-Za-z_][A-Za-z0-9_]*)|"
@@ -99,7 +100,7 @@ def tokenize(path, text):
         value = m.group(m.lastgroup)
         if m.lastgroup == "comment":
             body = value[2:] if value.startswith("//") else value[2:-2]
-            comments.append(Comment(body, line, not code_on_line))
+            comments.append(Comment(body, line, not code_on_line, col))
             if "\n" in value:
                 line += value.count("\n")
                 line_start = pos + value.rfind("\n") + 1
@@ -146,6 +147,19 @@ class Parser:
     def comments_between(self, first_line, last_line, standalone):
         return [c for c in self.comments if first_line <= c.line <= last_line and c.standalone == standalone]
 
+    def continuation(self, trailing):
+        """The lines that continue a field's trailing comment: comments on lines of their own, one right after
+        another from the line below it, each starting in the trailing comment's column."""
+        if not trailing:
+            return []
+        out, line, col = [], trailing[-1].line + 1, trailing[-1].col
+        while True:
+            below = [c for c in self.comments if c.line == line and c.standalone and c.col == col]
+            if not below:
+                return out
+            out += below
+            line += 1
+
     def parse(self):
         self.take("ident", "package")
         package = self.take("ident", what="a package name").text
@@ -177,9 +191,9 @@ class Parser:
                 group = blocks[0].text.strip().split(":")[0].strip()
             if first.text == "const":
                 self.parse_const(s)
+                last_line = self.tokens[self.k - 1].line
             else:
-                self.parse_field(s, group)
-            last_line = self.tokens[self.k - 1].line
+                last_line = self.parse_field(s, group)
         self.take("punct", "}", what="'}'")
         self.check_authentication(s)
         return s
@@ -225,6 +239,7 @@ class Parser:
         if end.text != ";":
             self.error(end, "one field per declaration")
         trailing = self.comments_between(end.line, end.line, False)
+        trailing += self.continuation(trailing)
         doc = " ".join(c.text.strip() for c in trailing)
         label = ""
         m = re.match(r"\[([^\]]+)\]\s*(.*)", doc)
@@ -239,6 +254,7 @@ class Parser:
                   f"earlier field; '{name_token.text}' keeps its name", file=sys.stderr)
             label = ""
         s.fields.append(Field(lcm_type, name_token.text, size, name_token.line, doc, label, group))
+        return trailing[-1].line if trailing else end.line
 
     def check_authentication(self, s):
         auth_names = {name for name, _, _ in AUTH_FIELDS}

@@ -76,6 +76,27 @@ class Reads(unittest.TestCase):
         self.assertIn("kAuthenticated = false", out)
         self.assertIn('"x_V", "double", "", "V"', out)
 
+    def test_a_trailing_comment_continued_in_its_column_is_the_fields_doc_not_a_group(self):
+        # The lines right below a field's comment, starting in its column, continue it; a comment line after a
+        # blank line, or in another column, opens a group as before.
+        code, err, out = run("package rpem;\nstruct probe_t {\n"
+                             "    // Counters: grow\n"
+                             "    int64_t held;   // [held] steps refused as held:\n"
+                             "                    // unchanged while the network moved\n"
+                             "                    // by more than the gate\n"
+                             "    int64_t other;  // one line\n"
+                             "    // not a continuation: a group of its own\n"
+                             "    int64_t next;\n"
+                             "\n"
+                             "    // Transport: frames\n"
+                             "    int64_t frames;\n}\n")
+        self.assertEqual(code, 0, err)
+        self.assertIn('FieldInfo{"held", "int64_t", "held", "", "Counters", "steps refused as held: unchanged while '
+                      'the network moved by more than the gate"}', out)
+        self.assertIn('FieldInfo{"other", "int64_t", "", "", "Counters", "one line"}', out)
+        self.assertIn('FieldInfo{"next", "int64_t", "", "", "not a continuation", ""}', out)
+        self.assertIn('FieldInfo{"frames", "int64_t", "", "", "Transport", ""}', out)
+
 
 class Refuses(unittest.TestCase):
     def refused(self, text, where, why, name="rpem_probe_t.lcm"):
