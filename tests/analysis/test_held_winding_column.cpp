@@ -1,7 +1,8 @@
 // A winding-sensor column that holds one value while r̂s says the winding moved (docs/derivations.md eq. 14.28b):
 // `rpem thermal fit` sets those readings aside before it fits a network to them. Records built here step by step:
 // a first-order winding (τ 600 s, 25 → 85 °C), r̂s reading it through copper's law with Gaussian noise of a stated σ,
-// and the sensor's column live, lagging, quantised or held.
+// and the sensor's column live, lagging, quantised or held. And the fit's second look (eq. 14.28c), where r̂s never
+// adapts: the filter with a fitted network (here the machine's own) refuses the held value, and its run goes.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -10,6 +11,7 @@
 
 #include "rpem/analysis/normal_quantile.hpp"
 #include "rpem/analysis/thermal/held_winding_column.hpp"
+#include "support/paper_thermal.hpp"
 
 namespace rpem::analysis {
 namespace {
@@ -158,6 +160,78 @@ TEST(HeldWindingColumn, EachSessionOnItsOwn) {
   EXPECT_EQ(held.runs[0].log, "second.csv");
   EXPECT_EQ(readings(r), w.size());
   EXPECT_TRUE(r.winding_sensor);
+}
+
+/// The paper's three-node network (tests/support/paper_thermal.hpp) soaked at 25 °C, its winding under 10 A for
+/// `heated_steps` 1 s steps and then at rest, with no r̂s observation; the winding node's temperature per step.
+struct NetworkRide {
+  core::ThermalFusionConfig fusion = test::paper_thermal_fusion();
+  std::vector<core::ThermalLoad> loads;
+  std::vector<double> winding_C;
+};
+NetworkRide network_ride(std::size_t steps, std::size_t heated_steps) {
+  NetworkRide ride;
+  const core::ThermalNetwork& n = ride.fusion.filter.network;
+  core::ThermalVec t = core::ThermalVec::Constant(25.0);
+  for (std::size_t k = 0; k < steps; ++k) {
+    core::ThermalLoad l;
+    l.dt_s = 1.0;
+    l.current_sq_A2 = k < heated_steps ? 100.0 : 0.0;
+    l.coolant_C = 25.0;
+    const core::ThermalTransition tr = core::thermal_transition(n, l);
+    t = tr.phi * t + tr.gamma;
+    ride.loads.push_back(l);
+    ride.winding_C.push_back(t[n.winding]);
+  }
+  return ride;
+}
+
+ThermalRecord record_of(const NetworkRide& ride, const std::vector<double>& reading_C) {
+  ThermalRecord r = record_of(ride.winding_C, reading_C, 1.0, 1, false);
+  for (std::size_t k = 0; k < r.steps.size(); ++k) {
+    r.steps[k].load = ride.loads[k];
+    r.steps[k].t_ns = static_cast<std::int64_t>(k + 1) * 1000000000;
+  }
+  return r;
+}
+
+// Eq. 14.28c. A 0.1 K sensor stuck 10 min into 20 min at 10 A (the winding 25 → 36.9 °C, at 36.6 °C then) while the
+// winding cools for 20 min at rest (to 25.1 °C): once the current stops the network moves the winding beyond the
+// filter's gate, the filter refuses the stuck value, and the whole run of that value goes — from the step the live
+// sensor first read it (the run is that value's), to the end. A live 0.1 K reading of the same ride, and one resting
+// on the soaked 25 °C for an hour with no load, lose nothing; a 0 °C on every step is no sensor.
+TEST(HeldWindingColumn, TheFittedNetworkFindsAValueHeldWhereRsNeverAdapts) {
+  const NetworkRide ride = network_ride(2400, 1200);
+  ASSERT_GT(ride.winding_C[599] - ride.winding_C.back(), 10.0);  // what the held value hides
+  std::vector<double> stuck = live_sensor(ride.winding_C, 0.1, 0.0);
+  std::size_t came = 599;  // the step the live sensor first read the value it sticks on
+  while (came > 0 && stuck[came - 1] == stuck[599]) --came;
+  for (std::size_t k = 600; k < stuck.size(); ++k) stuck[k] = stuck[599];
+  ThermalRecord r = record_of(ride, stuck);
+  const HeldWindingColumn held = drop_winding_readings_the_network_holds(r, ride.fusion);
+  ASSERT_EQ(held.runs.size(), 1U);
+  EXPECT_EQ(held.runs[0].found_by, HeldWindingRun::FoundBy::kFittedNetwork);
+  EXPECT_EQ(held.runs[0].first, came);
+  EXPECT_EQ(held.runs[0].end, stuck.size());
+  EXPECT_GT(held.runs[0].refused_steps, 0U);
+  EXPECT_EQ(readings(r), held.runs[0].first);
+  EXPECT_TRUE(r.winding_sensor);
+  EXPECT_NE(held.describe("T_winding").find("the filter refused it as held on"), std::string::npos)
+      << held.describe("T_winding");
+
+  ThermalRecord live = record_of(ride, live_sensor(ride.winding_C, 0.1, 0.0));
+  EXPECT_TRUE(drop_winding_readings_the_network_holds(live, ride.fusion).runs.empty());
+  EXPECT_EQ(readings(live), ride.winding_C.size());
+
+  const NetworkRide at_rest = network_ride(3600, 0);
+  ThermalRecord resting = record_of(at_rest, std::vector<double>(3600, 25.0));
+  EXPECT_TRUE(drop_winding_readings_the_network_holds(resting, at_rest.fusion).runs.empty());
+
+  ThermalRecord disabled = record_of(ride, std::vector<double>(ride.winding_C.size(), 0.0));
+  const HeldWindingColumn none = drop_winding_readings_the_network_holds(disabled, ride.fusion);
+  ASSERT_EQ(none.runs.size(), 1U);
+  EXPECT_TRUE(none.runs[0].whole_session);
+  EXPECT_FALSE(disabled.winding_sensor);
 }
 
 }  // namespace

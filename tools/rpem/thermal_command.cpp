@@ -87,54 +87,9 @@ analysis::ThermalRecord record_sessions(const ThermalFitCliOptions& o, const io:
   return analysis::join_sessions(std::move(sessions), o.log);
 }
 
-int run_thermal_fit(const ThermalFitCliOptions& o) {
-  const io::MachineConfig machine = o.config.empty() ? io::builtin_paper_config() : io::load_machine_config(o.config);
-  const std::string config_name = o.config.empty() ? "builtin:paper-ipmsm" : o.config;
-  io::ThermalConfig laws = o.start.empty() ? io::default_thermal_config(machine)
-                                           : io::load_thermal_config(o.start, machine, io::NetworkRequired::kNo);
-  if (o.period_s > 0.0) laws.fusion.observer.period_s = o.period_s;
-  if (laws.has_network && o.nodes > 0) {
-    std::fprintf(stderr,
-                 "rpem thermal fit: --nodes %d: --start %s has a network of %d nodes to start from; give --nodes "
-                 "with a start of laws only, or neither\n",
-                 o.nodes, o.start.c_str(), laws.fusion.filter.network.nodes);
-    return kExitUsage;
-  }
-  const analysis::ThermalRecord record = record_sessions(o, machine, laws);
-  if (record.winding_sensor && laws.fusion.winding_sensor_sigma_K <= 0.0)
-    laws.fusion.winding_sensor_sigma_K = o.winding_sensor_sigma_K;
-  const io::ThermalConfig start =
-      laws.has_network ? laws : analysis::default_topology(laws, record, o.nodes > 0 ? o.nodes : 2);
-  analysis::ThermalFitOptions options;
-  options.fit_until_s = o.fit_until_s;
-  if (o.held_out_sessions > 0) {
-    const std::size_t sessions = record.session_first_step.size();
-    if (static_cast<std::size_t>(o.held_out_sessions) >= sessions) {
-      std::fprintf(stderr,
-                   "rpem thermal fit: --held-out-sessions %d: %s gives %zu session%s with steps of the filter; at least "
-                   "one must be left to fit\n",
-                   o.held_out_sessions, o.log.c_str(), sessions, sessions == 1 ? "" : "s");
-      return kExitUsage;
-    }
-    // The training part ends with the last step before the first held-out session.
-    options.fit_until_s =
-        record.t_s[record.session_first_step[sessions - static_cast<std::size_t>(o.held_out_sessions)] - 1];
-  }
-  options.anchor_magnet_reference = !o.keep_magnet_reference;
-  if (o.disturbance_time_constant_s > 0.0) options.disturbance_time_constant_s = o.disturbance_time_constant_s;
-  std::fprintf(stderr, "rpem thermal fit: %zu steps of %.3g s; fitting a %d-node network\n", record.steps.size(),
-               start.fusion.observer.period_s, start.fusion.filter.network.nodes);
-  const analysis::ThermalFitResult fit = analysis::fit_thermal(record, start, options);
-
-  // A network every reader would refuse is not written (its report is: it shows what the log bounds).
-  const std::optional<std::string> runaway = io::runaway_at_rating(fit.config, machine);
-  if (!runaway) analysis::write_thermal_yaml(o.out, fit, record, config_name);
-  if (!o.report.empty()) {
-    io::create_output_directory(o.report);
-    analysis::write_thermal_fit_json(o.report + "/fit.json", fit, record, config_name);
-    analysis::write_thermal_fit_report(o.report + "/report.md", fit, record, config_name);
-    analysis::write_thermal_predictions(o.report + "/predictions.csv", fit, record);
-  }
+/// What the fit found, on the terminal: each signal's fit and held-out error, each parameter with its interval, what
+/// the log cannot tell apart, the notes, and the noise the filter takes (the caller ends the line).
+void print_fit(const analysis::ThermalFitResult& fit, const analysis::ThermalRecord& record) {
   for (const analysis::SignalFit& s : fit.signals) {
     std::printf("%s: %s in training (σ %.2g K); fit %.3g K RMS, ", s.name.c_str(), analysis::training_span(s).c_str(),
                 s.training_sigma_K, s.fit_rms_K);
@@ -163,6 +118,78 @@ int run_thermal_fit(const ThermalFitCliOptions& o) {
   for (int i = 0; i < fit.config.fusion.filter.network.nodes; ++i)
     std::printf(" %s %.3g s", fit.config.node_names[static_cast<std::size_t>(i)].c_str(),
                 fit.disturbance_time_constant_s[i]);
+}
+
+/// How often the fit looks again at the winding sensor's column with the network it fitted (eq. 14.28c): each look
+/// that sets readings aside is followed by a fit without them.
+constexpr int kHeldReadingLooks = 2;
+
+/// The fit, and again without the winding readings its own network's filter refuses as held (eq. 14.28c); what was
+/// set aside goes to stderr. `start_for`: the network to start from for a record (its sensor may be gone).
+template <class StartFor>
+analysis::ThermalFitResult fit_without_held_readings(analysis::ThermalRecord& record, const StartFor& start_for,
+                                                     const analysis::ThermalFitOptions& options) {
+  analysis::ThermalFitResult fit = analysis::fit_thermal(record, start_for(record), options);
+  for (int look = 0; look < kHeldReadingLooks; ++look) {
+    const analysis::HeldWindingColumn held = analysis::drop_winding_readings_the_network_holds(record, fit.config.fusion);
+    if (held.runs.empty()) break;
+    std::fprintf(stderr, "rpem thermal fit: %s", held.describe("the winding sensor (T_winding)").c_str());
+    fit = analysis::fit_thermal(record, start_for(record), options);
+  }
+  return fit;
+}
+
+int run_thermal_fit(const ThermalFitCliOptions& o) {
+  const io::MachineConfig machine = o.config.empty() ? io::builtin_paper_config() : io::load_machine_config(o.config);
+  const std::string config_name = o.config.empty() ? "builtin:paper-ipmsm" : o.config;
+  io::ThermalConfig laws = o.start.empty() ? io::default_thermal_config(machine)
+                                           : io::load_thermal_config(o.start, machine, io::NetworkRequired::kNo);
+  if (o.period_s > 0.0) laws.fusion.observer.period_s = o.period_s;
+  if (laws.has_network && o.nodes > 0) {
+    std::fprintf(stderr,
+                 "rpem thermal fit: --nodes %d: --start %s has a network of %d nodes to start from; give --nodes "
+                 "with a start of laws only, or neither\n",
+                 o.nodes, o.start.c_str(), laws.fusion.filter.network.nodes);
+    return kExitUsage;
+  }
+  analysis::ThermalRecord record = record_sessions(o, machine, laws);
+  if (record.winding_sensor && laws.fusion.winding_sensor_sigma_K <= 0.0)
+    laws.fusion.winding_sensor_sigma_K = o.winding_sensor_sigma_K;
+  const auto start_for = [&](const analysis::ThermalRecord& r) {
+    return laws.has_network ? laws : analysis::default_topology(laws, r, o.nodes > 0 ? o.nodes : 2);
+  };
+  const io::ThermalConfig start = start_for(record);
+  analysis::ThermalFitOptions options;
+  options.fit_until_s = o.fit_until_s;
+  if (o.held_out_sessions > 0) {
+    const std::size_t sessions = record.session_first_step.size();
+    if (static_cast<std::size_t>(o.held_out_sessions) >= sessions) {
+      std::fprintf(stderr,
+                   "rpem thermal fit: --held-out-sessions %d: %s gives %zu session%s with steps of the filter; at least "
+                   "one must be left to fit\n",
+                   o.held_out_sessions, o.log.c_str(), sessions, sessions == 1 ? "" : "s");
+      return kExitUsage;
+    }
+    // The training part ends with the last step before the first held-out session.
+    options.fit_until_s =
+        record.t_s[record.session_first_step[sessions - static_cast<std::size_t>(o.held_out_sessions)] - 1];
+  }
+  options.anchor_magnet_reference = !o.keep_magnet_reference;
+  if (o.disturbance_time_constant_s > 0.0) options.disturbance_time_constant_s = o.disturbance_time_constant_s;
+  std::fprintf(stderr, "rpem thermal fit: %zu steps of %.3g s; fitting a %d-node network\n", record.steps.size(),
+               start.fusion.observer.period_s, start.fusion.filter.network.nodes);
+  const analysis::ThermalFitResult fit = fit_without_held_readings(record, start_for, options);
+
+  // A network every reader would refuse is not written (its report is: it shows what the log bounds).
+  const std::optional<std::string> runaway = io::runaway_at_rating(fit.config, machine);
+  if (!runaway) analysis::write_thermal_yaml(o.out, fit, record, config_name);
+  if (!o.report.empty()) {
+    io::create_output_directory(o.report);
+    analysis::write_thermal_fit_json(o.report + "/fit.json", fit, record, config_name);
+    analysis::write_thermal_fit_report(o.report + "/report.md", fit, record, config_name);
+    analysis::write_thermal_predictions(o.report + "/predictions.csv", fit, record);
+  }
+  print_fit(fit, record);
   if (runaway) {
     std::printf("\n");
     std::fprintf(stderr,

@@ -7,6 +7,7 @@
 #include <optional>
 
 #include "rpem/analysis/normal_quantile.hpp"
+#include "rpem/analysis/thermal/thermal_replay.hpp"
 #include "rpem/core/non_finite.hpp"
 #include "rpem/core/thermal_held_reading.hpp"
 #include "rpem/core/thermal_observer.hpp"
@@ -50,26 +51,24 @@ double column_resolution_K(const ThermalRecord& r) {
   return std::isfinite(q) ? q : kCoarsestReadingResolution_K;
 }
 
-/// The runs of one reading in session j, each with the r̂s observations not within 5·τ_s of the next change.
-void collect_runs(const ThermalRecord& r, std::size_t j, const core::DriftLaw& copper, double tau_s,
-                  std::vector<ReadingRun>& out) {
+/// The runs of one reading in session j (no reading leaves a run open).
+std::vector<HeldWindingRun> reading_runs(const ThermalRecord& r, std::size_t j) {
   const std::size_t begin = r.session_first_step[j], end = r.session_end(j);
-  const double per_ohm = 1.0 / std::abs(copper.value_ref * copper.coeff_per_K);
+  std::vector<HeldWindingRun> out;
   std::size_t first = end;                    // the open run's first step (end: none open)
   const auto close = [&](std::size_t next) {  // next: the step of the next value, or the session's end
     if (first == end) return;
-    ReadingRun run;
-    run.run = {first, next, r.t_s[first], r.t_s[next - 1], r.session_logs.at(j), r.steps[first].winding_sensor_C};
-    run.run.whole_session =
+    HeldWindingRun run{};
+    run.first = first;
+    run.end = next;
+    run.t_first_s = r.t_s[first];
+    run.t_last_s = r.t_s[next - 1];
+    run.log = r.session_logs.at(j);
+    run.value_C = r.steps[first].winding_sensor_C;
+    run.whole_session =
         next == end && std::none_of(r.steps.begin() + static_cast<std::ptrdiff_t>(begin),
                                     r.steps.begin() + static_cast<std::ptrdiff_t>(first),
                                     [](const core::ThermalStepData& s) { return std::isfinite(s.winding_sensor_C); });
-    const double compared_until_s = next == end ? kInf : r.t_s[next] - 5.0 * tau_s;
-    for (std::size_t k = first; k < next && r.t_s[k] <= compared_until_s; ++k) {
-      const core::ParameterObservation& p = r.steps[k].parameter[core::kRs];
-      if (p.valid && std::isfinite(p.value) && p.variance >= 0.0)
-        run.observations.push_back({copper.temperature_C(p.value), std::sqrt(p.variance) * per_ohm});
-    }
     out.push_back(std::move(run));
   };
   for (std::size_t k = begin; k < end; ++k) {
@@ -80,6 +79,36 @@ void collect_runs(const ThermalRecord& r, std::size_t j, const core::DriftLaw& c
     first = k;
   }
   close(end);
+  return out;
+}
+
+/// The runs of one reading in session j, each with the r̂s observations not within 5·τ_s of the next change.
+void collect_runs(const ThermalRecord& r, std::size_t j, const core::DriftLaw& copper, double tau_s,
+                  std::vector<ReadingRun>& out) {
+  const double per_ohm = 1.0 / std::abs(copper.value_ref * copper.coeff_per_K);
+  for (HeldWindingRun& held : reading_runs(r, j)) {
+    ReadingRun run;
+    run.run = std::move(held);
+    const double compared_until_s = run.run.end == r.session_end(j) ? kInf : r.t_s[run.run.end] - 5.0 * tau_s;
+    for (std::size_t k = run.run.first; k < run.run.end && r.t_s[k] <= compared_until_s; ++k) {
+      const core::ParameterObservation& p = r.steps[k].parameter[core::kRs];
+      if (p.valid && std::isfinite(p.value) && p.variance >= 0.0)
+        run.observations.push_back({copper.temperature_C(p.value), std::sqrt(p.variance) * per_ohm});
+    }
+    out.push_back(std::move(run));
+  }
+}
+
+/// Sets the run's readings aside (NaN) and keeps it in `out`.
+void set_run_aside(ThermalRecord& r, const HeldWindingRun& run, HeldWindingColumn& out) {
+  for (std::size_t k = run.first; k < run.end; ++k) r.steps[k].winding_sensor_C = kNaN;
+  out.runs.push_back(run);
+}
+
+/// Whether any reading is left: a record without one has no winding sensor.
+bool has_winding_readings(const ThermalRecord& r) {
+  return std::any_of(r.steps.begin(), r.steps.end(),
+                     [](const core::ThermalStepData& s) { return std::isfinite(s.winding_sensor_C); });
 }
 
 /// Whether (14.28b) holds in the run; sets its moved_K and allowed_K at the widest margin.
@@ -117,30 +146,53 @@ HeldWindingColumn drop_held_winding_readings(ThermalRecord& r, const core::Drift
   out.z = upper_normal_quantile(kHeldColumnFalseRate / (2.0 * static_cast<double>(comparisons)));
   const double rho = move_scale(copper);
   for (ReadingRun& run : runs) {
-    if (!is_held(run, rho, out.resolution_K, out.z, sensor_sigma_K)) continue;
-    for (std::size_t k = run.run.first; k < run.run.end; ++k) r.steps[k].winding_sensor_C = kNaN;
-    out.runs.push_back(run.run);
+    if (is_held(run, rho, out.resolution_K, out.z, sensor_sigma_K)) set_run_aside(r, run.run, out);
   }
-  r.winding_sensor = std::any_of(r.steps.begin(), r.steps.end(),
-                                 [](const core::ThermalStepData& s) { return std::isfinite(s.winding_sensor_C); });
+  r.winding_sensor = has_winding_readings(r);
+  return out;
+}
+
+HeldWindingColumn drop_winding_readings_the_network_holds(ThermalRecord& r, const core::ThermalFusionConfig& fitted) {
+  HeldWindingColumn out;
+  if (!r.winding_sensor || r.steps.empty()) return out;
+  out.resolution_K = column_resolution_K(r);
+  const std::vector<FilterStep> steps = run_filter(fitted, r);
+  assert(steps.size() == r.steps.size());
+  for (std::size_t j = 0; j < r.session_first_step.size(); ++j) {
+    for (HeldWindingRun& run : reading_runs(r, j)) {
+      run.found_by = HeldWindingRun::FoundBy::kFittedNetwork;
+      for (std::size_t k = run.first; k < run.end; ++k) run.refused_steps += steps[k].estimate.winding_reading_held ? 1 : 0;
+      if (run.refused_steps > 0) set_run_aside(r, run, out);
+    }
+  }
+  r.winding_sensor = has_winding_readings(r);
   return out;
 }
 
 std::string HeldWindingColumn::describe(const std::string& column) const {
   std::string s;
   for (const HeldWindingRun& h : runs) {
-    char line[640];
+    char line[768];
     char span[256];
     if (h.whole_session) {
       std::snprintf(span, sizeof span, "on every step of %s", h.log.c_str());
     } else {
       std::snprintf(span, sizeof span, "in %s from t %.1f s to %.1f s", h.log.c_str(), h.t_first_s, h.t_last_s);
     }
-    std::snprintf(line, sizeof line,
-                  "%s holds %.4g °C %s (%zu steps) while the winding r̂s reads moved by %.3g K, more than the %.3g K "
-                  "a live reading's resolution (%.3g K) and noise allow (z %.2f; docs/derivations.md eq. 14.28b): %s\n",
-                  column.c_str(), h.value_C, span, h.end - h.first, h.moved_K, h.allowed_K, resolution_K, z,
-                  h.whole_session ? "no such sensor there, read as absent" : "a held value, not a reading: not used");
+    if (h.found_by == HeldWindingRun::FoundBy::kFittedNetwork) {
+      std::snprintf(line, sizeof line,
+                    "%s holds %.4g °C %s (%zu steps) while the network fitted to it says the winding moved away: the "
+                    "filter refused it as held on %zu of them (docs/derivations.md eq. 14.28c): %s; the network is "
+                    "fitted again without it\n",
+                    column.c_str(), h.value_C, span, h.end - h.first, h.refused_steps,
+                    h.whole_session ? "no such sensor there, read as absent" : "a held value, not a reading: not used");
+    } else {
+      std::snprintf(line, sizeof line,
+                    "%s holds %.4g °C %s (%zu steps) while the winding r̂s reads moved by %.3g K, more than the %.3g K "
+                    "a live reading's resolution (%.3g K) and noise allow (z %.2f; docs/derivations.md eq. 14.28b): %s\n",
+                    column.c_str(), h.value_C, span, h.end - h.first, h.moved_K, h.allowed_K, resolution_K, z,
+                    h.whole_session ? "no such sensor there, read as absent" : "a held value, not a reading: not used");
+    }
     s += line;
   }
   return s;

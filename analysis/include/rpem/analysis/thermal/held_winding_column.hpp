@@ -15,7 +15,10 @@
 // (Bonferroni: 2·M·Φ(−z) ≤ kHeldColumnFalseRate). A live sensor moves by q once the winding it reads moves by q, so
 // only a reading that no longer reads passes (14.28b). Readings the sensor's lag τ_s would still hold — within 5·τ_s
 // of the step the reading next changes — are not compared. What it cannot see: a held value where r̂s never adapts
-// (at speed, or without current); rpem estimate's filter still refuses that one against the fitted network.
+// (at speed, or without current). The fit's second look finds that one where the column is live elsewhere and the
+// losses change while it holds (eq. 14.28c): the filter, run with the network fitted to the column, refuses a reading
+// the network says the winding has moved away from (eq. 14.28); a run of one reading holding such a step is set aside
+// as (14.28b) sets one, and the network fitted again without it.
 
 #include <cstddef>
 #include <string>
@@ -23,6 +26,7 @@
 
 #include "rpem/analysis/thermal/thermal_record.hpp"
 #include "rpem/core/thermal.hpp"
+#include "rpem/core/thermal_fusion.hpp"
 
 namespace rpem::analysis {
 
@@ -33,13 +37,19 @@ inline constexpr double kCoarsestReadingResolution_K = 1.0;
 
 /// One run of a held value: the readings of steps [first, end) set aside.
 struct HeldWindingRun {
+  enum class FoundBy {
+    kRsObservations,  ///< eq. 14.28b: moved_K and allowed_K say why
+    kFittedNetwork,   ///< eq. 14.28c: refused_steps say why
+  };
+  FoundBy found_by = FoundBy::kRsObservations;
   std::size_t first = 0, end = 0;
   double t_first_s = 0.0, t_last_s = 0.0;  ///< the record's times of its first and last step
   std::string log;                         ///< its session's log
   double value_C = 0.0;
-  double moved_K = 0.0;        ///< ρ·|T_k − T_0| where (14.28b) holds by the widest margin
-  double allowed_K = 0.0;      ///< its right-hand side there
-  bool whole_session = false;  ///< every reading of its session
+  double moved_K = 0.0;           ///< ρ·|T_k − T_0| where (14.28b) holds by the widest margin
+  double allowed_K = 0.0;         ///< its right-hand side there
+  std::size_t refused_steps = 0;  ///< eq. 14.28c: the steps the fitted network's filter refused as held
+  bool whole_session = false;     ///< every reading of its session
 };
 
 struct HeldWindingColumn {
@@ -55,5 +65,10 @@ struct HeldWindingColumn {
 /// `sensor_time_constant_s`: τ_s (0: none known).
 HeldWindingColumn drop_held_winding_readings(ThermalRecord& r, const core::DriftLaw& copper, double sensor_sigma_K,
                                              double sensor_time_constant_s);
+
+/// The fit's second look (eq. 14.28c): the filter with `fitted` (the network fitted to the column) over the whole
+/// record; each run of one reading holding a step the filter refused as held (eq. 14.28) is set to NaN, as
+/// drop_held_winding_readings does. Nothing found: the record is unchanged.
+HeldWindingColumn drop_winding_readings_the_network_holds(ThermalRecord& r, const core::ThermalFusionConfig& fitted);
 
 }  // namespace rpem::analysis
