@@ -231,11 +231,15 @@ TEST_F(CliThermalFit, ReadsAVescToolLogItsMotorSensorTheWinding) {
       test::run_command(rpem_tool() + " thermal fit --log " + stuck + " --config " + outrunner_config() + " --out " + dir_ +
                         "/stuck_thermal.yaml --report " + dir_ + "/stuck_report");
   ASSERT_EQ(sf.exit_code, 0) << sf.output;
-  EXPECT_NE(sf.output.find("rpem thermal fit: the winding sensor (T_winding) holds "), std::string::npos) << sf.output;
+  // Said as one of the fit's notes: on the terminal, in thermal.yaml's header and in fit.json.
+  const std::string said = "the winding sensor (T_winding) holds ";
+  EXPECT_NE(sf.output.find("note: " + said), std::string::npos) << sf.output;
   EXPECT_NE(sf.output.find("eq. 14.28c): a held value, not a reading: not used; the network is fitted again without it"),
             std::string::npos)
       << sf.output;
+  EXPECT_NE(test::read_file(dir_ + "/stuck_thermal.yaml").find("# note: " + said), std::string::npos);
   const nlohmann::json stuck_fit = nlohmann::json::parse(std::ifstream(dir_ + "/stuck_report/fit.json"));
+  EXPECT_EQ(stuck_fit.at("notes").at(0).get<std::string>().rfind(said, 0), 0U) << stuck_fit.at("notes").dump();
   const auto stuck_steps = stuck_fit.at("steps").get<std::size_t>();
   const nlohmann::json kept = winding_sensor_signal(stuck_fit);
   const std::size_t readings_kept = kept.at("fit_points").get<std::size_t>() + kept.at("heldout_points").get<std::size_t>();

@@ -41,11 +41,14 @@ struct ThermalFitCliOptions {
   bool keep_magnet_reference = false;
 };
 
+/// How the notes name the winding sensor's column.
+constexpr const char* kWindingColumn = "the winding sensor (T_winding)";
+
 /// The estimator run over --log: one log, or each log of a folder on its own, joined as one machine's sessions (a
 /// folder's log that gives no step of the filter is left out, and said so). What each was read as and assumed goes
-/// to stderr.
+/// to stderr; the winding readings set aside as held (eq. 14.28b) to `set_aside`, for the fit's notes.
 analysis::ThermalRecord record_sessions(const ThermalFitCliOptions& o, const io::MachineConfig& machine,
-                                        const io::ThermalConfig& laws) {
+                                        const io::ThermalConfig& laws, std::vector<std::string>& set_aside) {
   const bool folder = std::filesystem::is_directory(o.log);
   std::vector<std::string> logs;
   if (folder) {
@@ -64,8 +67,7 @@ analysis::ThermalRecord record_sessions(const ThermalFitCliOptions& o, const io:
         laws.fusion.winding_sensor_sigma_K > 0.0 ? laws.fusion.winding_sensor_sigma_K : o.winding_sensor_sigma_K;
     const analysis::HeldWindingColumn held = analysis::drop_held_winding_readings(
         r, laws.fusion.filter.network.copper, sensor_sigma_K, laws.fusion.winding_sensor_time_constant_s);
-    if (const std::string said = held.describe("the winding sensor (T_winding)"); !said.empty())
-      std::fprintf(stderr, "rpem thermal fit: %s", said.c_str());
+    for (std::string& said : held.describe(kWindingColumn)) set_aside.push_back(std::move(said));
     if (!r.coolant) {
       std::fprintf(stderr,
                    "rpem thermal fit: %s has no T_coolant column: the coolant is taken as %.4g °C throughout "
@@ -124,18 +126,21 @@ void print_fit(const analysis::ThermalFitResult& fit, const analysis::ThermalRec
 /// that sets readings aside is followed by a fit without them.
 constexpr int kHeldReadingLooks = 2;
 
-/// The fit, and again without the winding readings its own network's filter refuses as held (eq. 14.28c); what was
-/// set aside goes to stderr. `start_for`: the network to start from for a record (its sensor may be gone).
+/// The fit, and again without the winding readings its own network's filter refuses as held (eq. 14.28c).
+/// `start_for`: the network to start from for a record (its sensor may be gone); `set_aside`: the readings set aside
+/// before the fit (eq. 14.28b). Every run set aside is one of the fit's notes (the terminal, thermal.yaml, the report).
 template <class StartFor>
 analysis::ThermalFitResult fit_without_held_readings(analysis::ThermalRecord& record, const StartFor& start_for,
-                                                     const analysis::ThermalFitOptions& options) {
+                                                     const analysis::ThermalFitOptions& options,
+                                                     std::vector<std::string> set_aside) {
   analysis::ThermalFitResult fit = analysis::fit_thermal(record, start_for(record), options);
   for (int look = 0; look < kHeldReadingLooks; ++look) {
     const analysis::HeldWindingColumn held = analysis::drop_winding_readings_the_network_holds(record, fit.config.fusion);
     if (held.runs.empty()) break;
-    std::fprintf(stderr, "rpem thermal fit: %s", held.describe("the winding sensor (T_winding)").c_str());
+    for (std::string& said : held.describe(kWindingColumn)) set_aside.push_back(std::move(said));
     fit = analysis::fit_thermal(record, start_for(record), options);
   }
+  fit.notes.insert(fit.notes.begin(), set_aside.begin(), set_aside.end());
   return fit;
 }
 
@@ -152,7 +157,8 @@ int run_thermal_fit(const ThermalFitCliOptions& o) {
                  o.nodes, o.start.c_str(), laws.fusion.filter.network.nodes);
     return kExitUsage;
   }
-  analysis::ThermalRecord record = record_sessions(o, machine, laws);
+  std::vector<std::string> set_aside;
+  analysis::ThermalRecord record = record_sessions(o, machine, laws, set_aside);
   if (record.winding_sensor && laws.fusion.winding_sensor_sigma_K <= 0.0)
     laws.fusion.winding_sensor_sigma_K = o.winding_sensor_sigma_K;
   const auto start_for = [&](const analysis::ThermalRecord& r) {
@@ -178,7 +184,7 @@ int run_thermal_fit(const ThermalFitCliOptions& o) {
   if (o.disturbance_time_constant_s > 0.0) options.disturbance_time_constant_s = o.disturbance_time_constant_s;
   std::fprintf(stderr, "rpem thermal fit: %zu steps of %.3g s; fitting a %d-node network\n", record.steps.size(),
                start.fusion.observer.period_s, start.fusion.filter.network.nodes);
-  const analysis::ThermalFitResult fit = fit_without_held_readings(record, start_for, options);
+  const analysis::ThermalFitResult fit = fit_without_held_readings(record, start_for, options, std::move(set_aside));
 
   // A network every reader would refuse is not written (its report is: it shows what the log bounds).
   const std::optional<std::string> runaway = io::runaway_at_rating(fit.config, machine);

@@ -169,8 +169,8 @@ HeldWindingColumn drop_winding_readings_the_network_holds(ThermalRecord& r, cons
   return out;
 }
 
-std::string HeldWindingColumn::describe(const std::string& column) const {
-  std::string s;
+std::vector<std::string> HeldWindingColumn::describe(const std::string& column) const {
+  std::vector<std::string> s;
   for (const HeldWindingRun& h : runs) {
     char line[768];
     char span[256];
@@ -182,18 +182,18 @@ std::string HeldWindingColumn::describe(const std::string& column) const {
     if (h.found_by == HeldWindingRun::FoundBy::kFittedNetwork) {
       std::snprintf(line, sizeof line,
                     "%s holds %.4g °C %s (%zu steps) while the network fitted to it says the winding moved away: the "
-                    "filter refused it as held on %zu of them (docs/derivations.md eq. 14.28c): %s; the network is "
-                    "fitted again without it\n",
+                    "filter refused it as held on %zu of them (docs/derivations.md eq. 14.28c): %s; the network "
+                    "is fitted again without it",
                     column.c_str(), h.value_C, span, h.end - h.first, h.refused_steps,
                     h.whole_session ? "no such sensor there, read as absent" : "a held value, not a reading: not used");
     } else {
       std::snprintf(line, sizeof line,
                     "%s holds %.4g °C %s (%zu steps) while the winding r̂s reads moved by %.3g K, more than the %.3g K "
-                    "a live reading's resolution (%.3g K) and noise allow (z %.2f; docs/derivations.md eq. 14.28b): %s\n",
+                    "a live reading's resolution (%.3g K) and noise allow (z %.2f; docs/derivations.md eq. 14.28b): %s",
                     column.c_str(), h.value_C, span, h.end - h.first, h.moved_K, h.allowed_K, resolution_K, z,
                     h.whole_session ? "no such sensor there, read as absent" : "a held value, not a reading: not used");
     }
-    s += line;
+    s.emplace_back(line);
   }
   return s;
 }

@@ -56,8 +56,8 @@ struct HeldWindingColumn {
   std::vector<HeldWindingRun> runs;
   double resolution_K = 0.0;  ///< q
   double z = 0.0;             ///< the quantile used
-  /// One line per run for the tools (empty: none); `column` names the sensor's column.
-  [[nodiscard]] std::string describe(const std::string& column) const;
+  /// One sentence per run for the tools' notes (empty: none); `column` names the sensor's column.
+  [[nodiscard]] std::vector<std::string> describe(const std::string& column) const;
 };
 
 /// Finds (14.28b) in the record's winding-sensor column and sets those readings to NaN; a record whose every reading
