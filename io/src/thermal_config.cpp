@@ -1,6 +1,7 @@
 #include "rpem/io/thermal_config.hpp"
 
 #include <cmath>
+#include <cstdio>
 #include <iomanip>
 #include <limits>
 #include <optional>
@@ -8,6 +9,7 @@
 
 #include "rpem/core/non_finite.hpp"
 #include "rpem/core/per_unit.hpp"
+#include "rpem/core/plausibility.hpp"
 #include "rpem/core/thermal_stability.hpp"
 #include "rpem/core/thermal_terms.hpp"
 #include "rpem/io/number_format.hpp"
@@ -52,6 +54,21 @@ double coefficient_rel_sigma(const std::array<core::MaterialCoefficient, N>& mat
   return m ? m->rel_sigma() : 0.1;
 }
 
+/// Why no value within the estimator's bounds [lo, hi] reads through the law as a temperature a machine can have
+/// (core::PlausibleMagnitudes: absolute zero to 1 000 °C), or nothing. Such a law is another machine's (a thermal.yaml
+/// fitted with another --config): every estimate would be read as an impossible temperature.
+std::optional<std::string> law_outside_bounds(const core::DriftLaw& law, double lo, double hi, const char* bounds_key) {
+  const core::PlausibleMagnitudes limits;
+  const double a = law.temperature_C(lo), b = law.temperature_C(hi);
+  if (std::max(a, b) >= limits.temperature_min_C && std::min(a, b) <= limits.temperature_max_C) return std::nullopt;
+  std::ostringstream why;
+  why << std::setprecision(4) << "reads the estimator's whole range " << bounds_key << " [" << lo << ", " << hi << "] as "
+      << std::min(a, b) << " to " << std::max(a, b) << " °C, outside " << limits.temperature_min_C << " to "
+      << limits.temperature_max_C << " °C: this law is not the configured machine's (a thermal.yaml fitted with "
+      << "another machine's configuration?)";
+  return why.str();
+}
+
 }  // namespace
 
 int node_index(const ThermalConfig& c, const std::string& name) {
@@ -73,6 +90,7 @@ ThermalConfig default_thermal_config(const MachineConfig& machine) {
   n.base = core::loss_base_of(core::PerUnitBase::from_rated(machine.machine.rated), machine.machine);
   n.copper = machine.rs_drift.law.value_or(core::DriftLaw{core::kCopper.typical_per_K, core::kMaterialReference_C, 0.0});
   c.copper_reference_stated = machine.rs_drift.law.has_value();
+  c.magnet_law_stated = machine.psim_drift.law.has_value();
   if (n.copper.value_ref <= 0.0) n.copper.value_ref = machine.machine.r_s_Ohm;
   core::DriftLaw& m = c.fusion.magnet_law;
   m = machine.psim_drift.law.value_or(core::DriftLaw{core::kNdFeB.typical_per_K, core::kMaterialReference_C, 0.0});
@@ -233,6 +251,7 @@ ThermalConfig parse_thermal_config(YamlMap& section, const MachineConfig& machin
         parse_law(*m, "r_s_ref_Ohm", n.copper, 1e4, true, f.filter.calibration_sigma, core::Calibration::kCopperOffset,
                   core::Calibration::kCopperCoefficient, &f.filter.copper_rel_sigma, &n.copper_scale);
   }
+  c.magnet_law_stated = c.magnet_law_stated || section.has("magnet_law");
   if (auto m = section.optional_map("magnet_law")) {
     f.magnet_law = parse_law(*m, "psi_m_ref_Wb", f.magnet_law, 100.0, false, f.filter.calibration_sigma,
                              core::Calibration::kMagnetOffset, core::Calibration::kMagnetCoefficient, nullptr, nullptr);
@@ -256,6 +275,11 @@ ThermalConfig parse_thermal_config(YamlMap& section, const MachineConfig& machin
     f.observer.settle_time_constants = m->number_or("settle_time_constants", f.observer.settle_time_constants, 0.0, 100.0);
     m->finish();
   }
+  const core::EstimatorSettings& bounds = machine.estimator;
+  if (auto why = law_outside_bounds(f.magnet_law, bounds.psi_m_min_Wb, bounds.psi_m_max_Wb, "estimator.bounds.psi_m_Wb"))
+    section.fail("magnet_law", "magnet_law " + *why);
+  if (auto why = law_outside_bounds(n.copper, bounds.r_s_min_Ohm, bounds.r_s_max_Ohm, "estimator.bounds.r_s_Ohm"))
+    section.fail("copper", "copper law " + *why);
   if (c.has_network) {
     if (const std::optional<std::string> why = runaway_at_rating(c, machine)) section.fail("nodes", *why);
   }
@@ -270,19 +294,40 @@ std::optional<std::string> runaway_at_rating(const ThermalConfig& c, const Machi
   load.current_sq_A2 = rated.current_A * rated.current_A;
   load.convection_basis = std::sqrt(std::abs(rated.omega_el_rad_s) / n.base.omega_el_rad_s);
   if (core::thermal_settles(n, load)) return std::nullopt;
-  const int w = n.winding;
-  double conducted = core::coolant_conductance_W_per_K(n, load, w);
-  for (int j = 0; j < n.nodes; ++j) {
-    if (j != w) conducted += core::node_conductance_W_per_K(n, load, w, j);
-  }
   std::ostringstream why;
   why << std::setprecision(4) << "the network has no steady state at the machine's rated point (" << rated.current_A
       << " A peak at " << rated.omega_el_rad_s << " rad/s electrical, machine.rated): the copper loss grows by "
       << core::copper_loss_per_K(n, load)
-      << " W/K with the winding's temperature (copper: loss_scale, r_s_ref_Ohm, coeff_per_K) against the " << conducted
-      << " W/K the winding conducts to its neighbours and the coolant: a winding that runs away at the current it "
-         "is rated to carry (docs/derivations.md, eq. 14.27)";
+      << " W/K with the winding's temperature (copper: loss_scale, r_s_ref_Ohm, coeff_per_K), at least the "
+      << core::winding_conductance_to_coolant_W_per_K(n, load)
+      << " W/K the winding conducts to the coolant through the network (directly and through the other nodes): a "
+         "winding that runs away at the current it is rated to carry (docs/derivations.md, eq. 14.27)";
   return why.str();
+}
+
+std::vector<std::string> assumed_law_notes(const ThermalConfig& c, bool magnet) {
+  // One law's note: the value taken, where it could have been stated, what an error of it does, the key to state it.
+  const auto note = [](const char* name, const char* quantity, const core::DriftLaw& law, const char* unit,
+                       const char* drift, const char* section_key, const char* consequence) {
+    char text[512];
+    std::snprintf(text, sizeof text,
+                  "the %s law takes %s_ref %.5g %s at %.4g °C, an assumption: neither the machine's %s nor the thermal "
+                  "section's %s says at what temperature %s was measured. If it was measured hot, %s (docs/thermal.md)",
+                  name, quantity, law.value_ref, unit, law.reference_C, drift, section_key, quantity, consequence);
+    return std::string(text);
+  };
+  std::vector<std::string> notes;
+  if (!c.copper_reference_stated) {
+    notes.push_back(note("copper", "r_s", c.fusion.filter.network.copper, "Ohm", "rs_drift", "copper",
+                         "every winding temperature r_s gives and the copper loss are off; say so with copper: "
+                         "{reference_C: …}"));
+  }
+  if (magnet && !c.magnet_law_stated) {
+    notes.push_back(note("magnet", "psi_m", c.fusion.magnet_law, "Wb", "psim_drift", "magnet_law",
+                         "every magnet temperature psi_m gives is off by about the difference; give magnet_law "
+                         "(`rpem thermal fit` writes it, anchored at a soaked start)"));
+  }
+  return notes;
 }
 
 ThermalConfig load_thermal_config(const std::string& path, const MachineConfig& machine, NetworkRequired network) {

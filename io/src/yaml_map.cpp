@@ -1,5 +1,6 @@
 #include "rpem/io/yaml_map.hpp"
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <filesystem>
@@ -7,6 +8,7 @@
 #include <set>
 #include <sstream>
 #include <system_error>
+#include <vector>
 
 namespace rpem::io {
 namespace {
@@ -15,6 +17,22 @@ std::string describe_range(double lo, double hi) {
   std::ostringstream s;
   s << "[" << lo << ", " << hi << "]";
   return s.str();
+}
+
+/// The edit distance between two keys (insertions, deletions, substitutions; Levenshtein).
+std::size_t edit_distance(const std::string& a, const std::string& b) {
+  std::vector<std::size_t> row(b.size() + 1);
+  for (std::size_t j = 0; j <= b.size(); ++j) row[j] = j;
+  for (std::size_t i = 1; i <= a.size(); ++i) {
+    std::size_t diagonal = row[0];
+    row[0] = i;
+    for (std::size_t j = 1; j <= b.size(); ++j) {
+      const std::size_t above = row[j];
+      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] == b[j - 1] ? 0 : 1)});
+      diagonal = above;
+    }
+  }
+  return row[b.size()];
 }
 
 }  // namespace
@@ -78,7 +96,16 @@ bool YamlMap::has(const std::string& key) const { return static_cast<bool>(node_
 YAML::Node YamlMap::get(const std::string& key) {
   used_.insert(key);
   const YAML::Node n = node_[key];
-  if (!n) fail_at(node_, key, "required key is missing");
+  if (!n) {
+    // A key within an edit per four characters is a misspelling of this one (finish() would name it as unknown,
+    // but only after this); `min` for `max` is not.
+    const std::size_t typo = std::max<std::size_t>(1, key.size() / 4);
+    for (const auto& entry : node_) {
+      if (!entry.first.IsScalar() || edit_distance(entry.first.Scalar(), key) > typo) continue;
+      fail_at(entry.first, key, "required key is missing; `" + entry.first.Scalar() + "` is given: misspelt?");
+    }
+    fail_at(node_, key, "required key is missing");
+  }
   return n;
 }
 

@@ -4,7 +4,10 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <regex>
+#include <string>
+#include <vector>
 
 #include "rpem/io/thermal_config.hpp"
 #include "support/temp_file.hpp"
@@ -31,7 +34,14 @@ const char* kThreeNodes = R"(thermal:
   filter: {period_s: 0.5, initial_sigma_K: 5, gate_sigma: 4, gate_reset_after: 2, residual_time_constant_s: 8, settle_time_constants: 4}
 )";
 
-MachineConfig machine() { return builtin_paper_config(); }
+/// The paper's machine with bounds that hold the fixtures' laws (a 0.117 Wb, 70 mΩ machine's): a law no bounded
+/// estimate reads as a possible temperature is another machine's, and refused (AnotherMachinesLawIsRefused).
+MachineConfig machine() {
+  MachineConfig m = builtin_paper_config();
+  m.estimator.psi_m_min_Wb = 0.05;
+  m.estimator.r_s_min_Ohm = 0.03;
+  return m;
+}
 
 ThermalConfig load_text(const std::string& text) {
   test::TempFile f("thermal.yaml", text);
@@ -109,6 +119,7 @@ TEST(ThermalConfig, DefaultsComeFromTheMachineAndTheMaterials) {
   // The built-in machine has no rs_drift: r_s_Ohm is assumed at copper's 20 °C, and the fit must say so.
   EXPECT_DOUBLE_EQ(c.fusion.filter.network.copper.reference_C, 20.0);
   EXPECT_FALSE(c.copper_reference_stated);
+  EXPECT_FALSE(c.magnet_law_stated);  // nor psim_drift: ψm assumed at NdFeB's 20 °C
   // σ of α (eq. 14.11a): NdFeB's typical −0.12 %/K is 0.04 %/K from its range's farther end (−0.08), half of
   // which is 16.7 % of it, more than the uniform spread's 0.05/(√12·0.12) = 12.0 %. Copper: the uniform's 8.7 %.
   EXPECT_NEAR(c.fusion.filter.calibration_sigma[static_cast<int>(core::Calibration::kMagnetCoefficient)],
@@ -141,6 +152,12 @@ TEST(ThermalConfig, BadSectionsNameFileLineKeyAndReason) {
                 .find("thermal.nodes[2].capacitance_J_per_K: -1 is outside"),
             std::string::npos);
   EXPECT_NE(error_of("coolant_C: 35", "coolant_C: 35\n  coolnat: 3").find("thermal.coolnat"), std::string::npos);
+  // A required key misspelt: the error points at what was given, not only at the key that is missing.
+  EXPECT_NE(error_of("capacitance_J_per_K: 6500", "capacitence_J_per_K: 6500")
+                .find(":5:22: thermal.nodes[2].capacitance_J_per_K: required key is missing; `capacitence_J_per_K` is "
+                      "given: misspelt?"),
+            std::string::npos)
+      << error_of("capacitance_J_per_K: 6500", "capacitence_J_per_K: 6500");
   // eq. 14.1b's speed part: never negative, named with its place.
   EXPECT_NE(error_of("to_coolant_at_base_speed_W_per_K: 4", "to_coolant_at_base_speed_W_per_K: -4")
                 .find("thermal.nodes[2].to_coolant_at_base_speed_W_per_K: -4 is outside"),
@@ -191,6 +208,16 @@ TEST(ThermalConfig, ANetworkWhoseWindingRunsAwayAtTheRatingIsRefused) {
             std::string::npos)
       << error;
   EXPECT_NE(error.find("the copper loss grows by 142.9 W/K"), std::string::npos) << error;
+  // The figure it is held against: the winding's conductance to the coolant, reduced here by hand as series and
+  // parallel paths (the core inverts the conductance matrix): 3 W/K directly, and 44 W/K in series with the iron's
+  // 95 W/K to the coolant in parallel with the magnet's path (13 + 6·s W/K in series with 2.5 + 4·s W/K),
+  // s = √(ω_rated/ω_b) with the section's ω_b = 2000 rad/s (eq. 14.1b).
+  const double s = std::sqrt(core::PerUnitBase::from_rated(machine().machine.rated).omega_el_rad_s / 2000.0);
+  const auto series = [](double a, double b) { return 1.0 / (1.0 / a + 1.0 / b); };
+  const double conducted = 3.0 + series(44.0, 95.0 + series(13.0 + 6.0 * s, 2.5 + 4.0 * s));
+  char figure[64];
+  std::snprintf(figure, sizeof figure, "at least the %.4g W/K the winding conducts to the coolant", conducted);
+  EXPECT_NE(error.find(figure), std::string::npos) << figure << "\n" << error;
   EXPECT_NE(error.find("eq. 14.27"), std::string::npos) << error;
   // The same network at 10 Ω settles (K = 2.04 W/K): the check is the steady state's, not a bound on R_ref.
   EXPECT_EQ(error_of("r_s_ref_Ohm: 0.07,", "r_s_ref_Ohm: 10,"), "");
@@ -216,6 +243,56 @@ TEST(ThermalConfig, DisturbanceTimeConstantPerNodeAbsentIsTheWalk) {
     EXPECT_NE(e.find(":4:"), std::string::npos) << bad << ": " << e;
     EXPECT_NE(e.find("thermal.nodes[1].disturbance_time_constant_s"), std::string::npos) << bad << ": " << e;
   }
+}
+
+// A thermal.yaml fitted with another machine's configuration (rpem estimate --config A --thermal B's): its laws read
+// every estimate the bounds allow as an impossible temperature, and it is refused with the law's place.
+TEST(ThermalConfig, AnotherMachinesLawIsRefused) {
+  const MachineConfig paper = builtin_paper_config();  // ψm in [0.57, 1.71] Wb, R_s in [1, 4.5] Ω
+  const auto error_with = [&](const std::string& text) -> std::string {
+    test::TempFile f("thermal.yaml", text);
+    try {
+      (void)load_thermal_config(f.path(), paper);
+    } catch (const ConfigError& e) {
+      return e.what();
+    }
+    return "";
+  };
+  // 20 + (0.57/0.117 − 1)/(−0.00105) = −3 667 °C and 20 + (1.71/0.117 − 1)/(−0.00105) = −12 947 °C.
+  const std::string magnet = error_with(kThreeNodes);
+  EXPECT_NE(magnet.find(":14:15: thermal.magnet_law: magnet_law reads the estimator's whole range "
+                        "estimator.bounds.psi_m_Wb [0.57, 1.71] as -1.295e+04 to -3667 °C, outside -273.1 to 1000 °C"),
+            std::string::npos)
+      << magnet;
+  // The magnet law the machine's, the copper law still the 70 mΩ one: 120 + (1/0.07 − 1)/0.0028 = 4 865 °C.
+  const std::string with_magnet =
+      std::regex_replace(std::string(kThreeNodes), std::regex("psi_m_ref_Wb: 0.117"), "psi_m_ref_Wb: 1.2");
+  const std::string copper = error_with(with_magnet);
+  EXPECT_NE(copper.find(":13:11: thermal.copper: copper law reads the estimator's whole range "
+                        "estimator.bounds.r_s_Ohm [1, 4.5] as 4865 to"),
+            std::string::npos)
+      << copper;
+  // A law that reads one end of the bounds as a possible temperature is kept: ψm 0.5 Wb at 20 °C reads 0.57 Wb as
+  // 20 + (1.14 − 1)/(−0.00105) = −113 °C; likewise R_s 0.9 Ω at 120 °C reads 1 Ω as 164 °C.
+  const std::string near =
+      std::regex_replace(std::regex_replace(with_magnet, std::regex("psi_m_ref_Wb: 1.2"), "psi_m_ref_Wb: 0.5"),
+                         std::regex("r_s_ref_Ohm: 0.07"), "r_s_ref_Ohm: 0.9");
+  EXPECT_EQ(error_with(near), "");
+}
+
+TEST(ThermalConfig, AnAssumedLawIsANote) {
+  // Without magnet_law (nor the machine's psim_drift) the machine's ψm is taken at 20 °C: a reader says so.
+  const std::string without = std::regex_replace(std::string(kThreeNodes), std::regex("  magnet_law: [^\n]*\n"), "");
+  ASSERT_NE(without, kThreeNodes);
+  const ThermalConfig c = load_text(without);
+  EXPECT_FALSE(c.magnet_law_stated);
+  EXPECT_TRUE(c.copper_reference_stated);
+  const std::vector<std::string> notes = assumed_law_notes(c, true);
+  ASSERT_EQ(notes.size(), 1U);
+  EXPECT_NE(notes[0].find("the magnet law takes psi_m_ref 1.14 Wb at 20 °C, an assumption"), std::string::npos) << notes[0];
+  EXPECT_TRUE(assumed_law_notes(c, false).empty());  // a fit anchors the magnet law itself
+  EXPECT_TRUE(load_text(kThreeNodes).magnet_law_stated);
+  EXPECT_TRUE(assumed_law_notes(load_text(kThreeNodes), true).empty());
 }
 
 TEST(ThermalConfig, AFitsStartMayGiveTheLawsOnly) {

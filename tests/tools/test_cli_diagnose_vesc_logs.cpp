@@ -26,6 +26,14 @@ std::string rpem_tool() { return test::binary_dir() + "/tools/rpem"; }
 std::string outrunner_config() { return test::source_dir() + "/config/vesc-6374-outrunner.yaml"; }
 std::string firmware_config() { return test::source_dir() + "/config/vesc-6374-firmware.yaml"; }
 
+/// The rest of the first line of `output` after `prefix` ("" if none).
+std::string line_after(const std::string& output, const std::string& prefix) {
+  const std::size_t at = output.find(prefix);
+  if (at == std::string::npos) return "";
+  const std::size_t from = at + prefix.size();
+  return output.substr(from, output.find('\n', from) - from);
+}
+
 class VescToolLogs : public ::testing::Test {
  protected:
   void SetUp() override {
@@ -47,6 +55,14 @@ class VescToolLogs : public ::testing::Test {
               config == firmware_config())
         << r.output;
     EXPECT_NE(r.output.find("rpem diagnose: regimes: "), std::string::npos) << r.output;
+    // One classification for every consumer (issue 23, item 2): rpem estimate counts the same samples in each regime.
+    // (Before 2026-12-04 diagnose classified the windows without the reader's speed error, and counted 40 % fewer
+    // transient windows on a user's log than estimate.)
+    const test::ProcessResult e = test::run_command(rpem_tool() + " estimate --log " + log + " --config " + config +
+                                                    " --out " + dir_ + "/estimate.csv");
+    EXPECT_EQ(e.exit_code, 0) << e.output;
+    EXPECT_EQ(line_after(r.output, "rpem diagnose: regimes: "), line_after(e.output, "rpem estimate: regimes: "))
+        << r.output << e.output;
     std::ifstream f(out + "/diagnosis.json");
     nlohmann::json d = nlohmann::json::parse(f);
     // What was excluded and why: counts per regime, and a rule with its keys for each that took over a tenth.

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <regex>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -177,6 +178,7 @@ TEST_F(CliThermalFit, ReadsAVescToolLogItsMotorSensorTheWinding) {
   EXPECT_NE(r.output.find("vesc.csv as VESC Tool realtime log (the header of VESC Tool 1.20 and later)"), std::string::npos)
       << r.output;
   EXPECT_NE(r.output.find("has no T_coolant column"), std::string::npos) << r.output;
+  EXPECT_EQ(r.output.find("the winding is observed on no step"), std::string::npos) << r.output;  // temp_motor is
   // The outrunner's configuration says nothing of where its 25 mOhm were measured: the fit says what it assumed,
   // on the terminal and in thermal.yaml, where the user who reads it can correct it.
   const std::string assumed = "the copper law takes r_s_ref 0.025 Ohm at 20 °C, an assumption";
@@ -206,8 +208,12 @@ TEST_F(CliThermalFit, ReadsAVescToolLogItsMotorSensorTheWinding) {
   EXPECT_EQ(test::read_file(dir_ + "/mapped.yaml"), test::read_file(dir_ + "/thermal.yaml"));
 
   // rpem estimate runs the fitted network over the log: the fused winding ends at the sensor's last reading.
-  EXPECT_NEAR(fused_winding_at_end(log, dir_ + "/thermal.yaml", dir_ + "/estimate.csv").t_C,
-              motor_temperatures(log).t_motor_C.back(), 5.0 * kSensorResolution_K);
+  const FusedWindingEnd live_end = fused_winding_at_end(log, dir_ + "/thermal.yaml", dir_ + "/estimate.csv");
+  EXPECT_NEAR(live_end.t_C, motor_temperatures(log).t_motor_C.back(), 5.0 * kSensorResolution_K);
+  // A VESC Tool log has no coolant: rpem estimate says, as the fit does, what it took instead, on every sample.
+  EXPECT_TRUE(std::regex_search(live_end.said, std::regex("rpem estimate: thermal: ([0-9]+) of \\1 samples have no "
+                                                          "coolant temperature .*: the coolant is taken as")))
+      << live_end.said;
 
   // The same log with a sensor that sticks a third of the way in (temp_motor holds that row's value to the end, the
   // winding cooling on): rpem estimate says it refused a held value (eq. 14.28) and the fused winding ends on the
@@ -406,6 +412,13 @@ TEST_F(CliThermalFit, AVescWithoutAMotorSensorIsReadAsALogWithoutOne) {
   EXPECT_EQ(r.output.find("does not start soaked"), std::string::npos) << r.output;
   const nlohmann::json j = nlohmann::json::parse(std::ifstream(dir_ + "/report/fit.json"));
   for (const nlohmann::json& s : j.at("signals")) EXPECT_NE(s.at("name"), "winding sensor") << j.at("signals").dump();
+  // Nor does r̂s adapt in the training part of this ride at speed: the fit says its winding is unchecked.
+  bool winding_observed = false;
+  for (const nlohmann::json& s : j.at("signals")) {
+    winding_observed |= s.at("name").get<std::string>().rfind("winding", 0) == 0 && s.at("fit_points").get<int>() > 0;
+  }
+  EXPECT_FALSE(winding_observed) << j.at("signals").dump();
+  EXPECT_NE(r.output.find("note: the winding is observed on no step of the training part"), std::string::npos) << r.output;
 
   const test::ProcessResult e =
       test::run_command(rpem_tool() + " estimate --log " + log + " --config " + outrunner_config() + " --thermal " + dir_ +

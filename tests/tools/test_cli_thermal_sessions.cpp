@@ -373,6 +373,12 @@ TEST_F(CliThermalSessions, RefusesWhatCannotBeFitted) {
   const test::ProcessResult both = test::run_command(fit + at("bad") + " --held-out-sessions 1 --fit-until-s 100");
   EXPECT_EQ(both.exit_code, 64) << both.output;
   EXPECT_NE(both.output.find("excludes"), std::string::npos) << both.output;
+  // thermal.yaml into a directory that does not exist: said before the estimator runs, not after the fit.
+  const test::ProcessResult nowhere = test::run_command(rpem_tool() + " thermal fit" + pmsm_config() + " --out " +
+                                                        at("no/such/out.yaml") + " --log " + at("bad"));
+  EXPECT_EQ(nowhere.exit_code, 74) << nowhere.output;
+  EXPECT_NE(nowhere.output.find("out.yaml: cannot create file: no directory "), std::string::npos) << nowhere.output;
+  EXPECT_EQ(nowhere.output.find("running the estimator"), std::string::npos) << nowhere.output;
 }
 
 // A fit whose network would run away at the configured rating (eq. 14.27) is not written: every reader would refuse

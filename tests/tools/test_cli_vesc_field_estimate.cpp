@@ -25,6 +25,7 @@
 #include <cstdio>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <regex>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -77,6 +78,24 @@ void expect_field_accuracy(const Final& f, const Truth& truth, const std::string
                 f.output.find("the angle-lock test cannot exclude a sensorless drive's open-loop start-ups") !=
                     std::string::npos)
         << f.output;
+    // It says how often R_s adapted against how often a window excited it (the regimes line's excites_both +
+    // excites_r_s), and names the gain schedule's key that keeps an excited window from adapting.
+    std::smatch regimes, clause;
+    if (f.output.find("its start still decides") != std::string::npos) {
+      const bool counted = std::regex_search(
+          f.output, regimes, std::regex("regimes: excites_both ([0-9]+), excites_psi_m [0-9]+, excites_r_s ([0-9]+)"));
+      const bool said = std::regex_search(
+          f.output, clause,
+          std::regex("r_s not identifiable[^\n]*it adapted on ([0-9]+) of the ([0-9]+) samples that excite it; the "
+                     "others: outside the gain schedule \\(r_s adapts only below "
+                     "estimator.scheduler.r_s_max_speed_rpm, [0-9.]+ rpm\\)"));
+      EXPECT_TRUE(counted) << f.output;
+      EXPECT_TRUE(said) << f.output;
+      if (counted && said) {
+        EXPECT_EQ(std::stoull(clause[2]), std::stoull(regimes[1]) + std::stoull(regimes[2])) << f.output;
+        EXPECT_LE(std::stoull(clause[1]), std::stoull(clause[2])) << f.output;
+      }
+    }
   }
   if (!declared || r_s_required) {
     EXPECT_NEAR(f.r_s_Ohm / truth.r_s_Ohm, 1.0, 0.05) << what << "\n" << f.output;

@@ -73,6 +73,9 @@ class ThermalRun {
     if (o.thermal.empty()) return;
     const io::ThermalConfig t = io::load_thermal_config(o.thermal, cfg);
     for (int i = 0; i < t.fusion.filter.network.nodes; ++i) names_.push_back(t.node_names[static_cast<std::size_t>(i)]);
+    for (const std::string& note : io::assumed_law_notes(t, true))
+      std::fprintf(stderr, "rpem estimate: thermal: note: %s\n", note.c_str());
+    coolant_C_ = t.fusion.coolant_C;
     fusion_.emplace(t.fusion, base, cfg.machine);
   }
   [[nodiscard]] const std::vector<std::string>& node_names() const { return names_; }
@@ -83,6 +86,8 @@ class ThermalRun {
     s.dt_s = previous_ns_ ? 1e-9 * static_cast<double>(t_ns - *previous_ns_) : 0.0;
     s.coolant_C = coolant_C;
     s.winding_sensor_C = winding_C;
+    ++samples_;
+    if (std::isnan(coolant_C)) ++without_coolant_;
     previous_ns_ = t_ns;
     fusion_->step(e, s);
     const core::ThermalEstimate& now = fusion_->estimate();
@@ -95,7 +100,15 @@ class ThermalRun {
   [[nodiscard]] const core::ThermalEstimate* estimate() const { return fusion_ ? &fusion_->estimate() : nullptr; }
   /// On stderr: the winding readings refused as a held value (thermal_held_reading.hpp), where there were any.
   void explain() const {
-    if (!fusion_ || fusion_->estimate().winding_readings_held == 0) return;
+    if (!fusion_) return;
+    if (without_coolant_ > 0) {
+      std::fprintf(stderr,
+                   "rpem estimate: thermal: %llu of %llu samples have no coolant temperature (no T_coolant column or "
+                   "an empty cell): the coolant is taken as %.4g °C there (thermal.coolant_C); a coolant that moves "
+                   "shows as a model error (docs/thermal.md)\n",
+                   static_cast<unsigned long long>(without_coolant_), static_cast<unsigned long long>(samples_), coolant_C_);
+    }
+    if (fusion_->estimate().winding_readings_held == 0) return;
     std::fprintf(stderr,
                  "rpem estimate: thermal: the winding sensor's reading was refused as a held value in %lld filter "
                  "steps: it stayed on one value while the network says the winding moved by more than the filter's "
@@ -112,6 +125,8 @@ class ThermalRun {
   std::vector<std::string> names_;
   std::optional<core::ThermalFusion> fusion_;
   std::optional<std::int64_t> previous_ns_;
+  std::uint64_t samples_ = 0, without_coolant_ = 0;  ///< samples the filter was given, those without a coolant
+  double coolant_C_ = 0.0;                           ///< what the filter takes for a missing coolant
 };
 
 /// What the run did, for its summary on stderr (and a folder's summary.csv): the last estimate and the samples per
@@ -164,9 +179,28 @@ struct Identifiability {
   double from_lo = 0.0, from_hi = 0.0;
 };
 
+/// How often parameter k (0: ψm, 1: R_s) adapted against how often a sample excited it, and what else keeps it from
+/// adapting where it is excited: the gain schedule's speed limit (its key and value), outliers, a resync's restart.
+std::string adapted_clause(std::size_t k, const core::RegimeCounts& regimes, std::uint64_t adapted,
+                           const core::EstimatorSettings& e) {
+  const auto n = [&](core::Regime r) { return regimes.n[static_cast<std::size_t>(r)]; };
+  const std::uint64_t excited =
+      n(core::Regime::kExcitesBoth) + n(k == 0 ? core::Regime::kExcitesPsiM : core::Regime::kExcitesRs);
+  char text[400];
+  std::snprintf(text, sizeof text,
+                "it adapted on %llu of the %llu samples that excite it; the others: outside the gain schedule (%s adapts "
+                "only %s estimator.scheduler.%s, %.4g rpm), outliers, or a resync's restart. The regimes above say why "
+                "the rest did not excite it",
+                static_cast<unsigned long long>(adapted), static_cast<unsigned long long>(excited), k == 0 ? "psi_m" : "r_s",
+                k == 0 ? "above" : "below", k == 0 ? "psi_m_min_speed_rpm" : "r_s_max_speed_rpm",
+                k == 0 ? e.psi_m_min_speed_rpm : e.r_s_max_speed_rpm);
+  return text;
+}
+
 std::array<std::optional<bool>, 2> check_identifiable(const std::vector<core::AveragedSample>& samples,
                                                       const io::MachineConfig& cfg, const core::Estimate& last,
                                                       const std::array<std::uint64_t, 2>& adapted,
+                                                      const core::RegimeCounts& regimes,
                                                       const io::RotorFrameRebuild& rebuilt) {
   const core::EstimatorSettings& e = cfg.estimator;
   std::array<std::optional<bool>, 2> identifiable;
@@ -198,9 +232,9 @@ std::array<std::optional<bool>, 2> check_identifiable(const std::vector<core::Av
         stderr,
         "rpem estimate: %s not identifiable from this log: started at the ends of its bounds (%.5g, %.5g %s) "
         "the estimator ends at %.5g and %.5g %s: its start still decides +-%.0f %% of %.5g %s, more than the %.0f %% "
-        "asked of it (it adapted on %llu samples; the regimes above say why not more)\n",
+        "asked of it (%s)\n",
         p[k].name, p[k].lo, p[k].hi, p[k].unit, p[k].from_lo, p[k].from_hi, p[k].unit, 100.0 * half, estimate[k], p[k].unit,
-        100.0 * p[k].tolerance, static_cast<unsigned long long>(adapted[k]));
+        100.0 * p[k].tolerance, adapted_clause(k, regimes, adapted[k], e).c_str());
   }
   return identifiable;
 }
@@ -232,7 +266,8 @@ Tally run_averaged(const EstimateOptions& o, const std::string& log, const std::
   }
   std::fprintf(stderr, "rpem estimate: %s\n", tally.summary(cfg.estimator.algorithm, "averaged samples").c_str());
   tally.explain();
-  if (!samples.empty()) tally.identifiable = check_identifiable(samples, cfg, tally.last, tally.adapted, rebuilt);
+  if (!samples.empty())
+    tally.identifiable = check_identifiable(samples, cfg, tally.last, tally.adapted, tally.counts.regimes, rebuilt);
   thermal.explain();
   tally.take_peaks(thermal);
   return tally;

@@ -7,6 +7,7 @@
 // sensor in the log (T_magnet) is never used. A folder's logs are one machine's sessions, each recorded on its own and
 // fitted together, each from its own start (docs/thermal.md, "A folder of logs").
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -91,6 +92,18 @@ analysis::ThermalRecord record_sessions(const ThermalFitCliOptions& o, const io:
 
 /// What the fit found, on the terminal: each signal's fit and held-out error, each parameter with its interval, what
 /// the log cannot tell apart, the notes, and the noise the filter takes (the caller ends the line).
+/// The median time between the filter's steps within a session (0 with fewer than two).
+double median_step_s(const analysis::ThermalRecord& r) {
+  std::vector<double> dt;
+  for (std::size_t j = 0; j < r.session_first_step.size(); ++j) {
+    for (std::size_t k = r.session_first_step[j] + 1; k < r.session_end(j); ++k) dt.push_back(r.t_s[k] - r.t_s[k - 1]);
+  }
+  if (dt.empty()) return 0.0;
+  const auto middle = dt.begin() + static_cast<std::ptrdiff_t>(dt.size() / 2);
+  std::nth_element(dt.begin(), middle, dt.end());
+  return *middle;
+}
+
 void print_fit(const analysis::ThermalFitResult& fit, const analysis::ThermalRecord& record) {
   for (const analysis::SignalFit& s : fit.signals) {
     std::printf("%s: %s in training (σ %.2g K); fit %.3g K RMS, ", s.name.c_str(), analysis::training_span(s).c_str(),
@@ -147,6 +160,11 @@ analysis::ThermalFitResult fit_without_held_readings(analysis::ThermalRecord& re
 int run_thermal_fit(const ThermalFitCliOptions& o) {
   const io::MachineConfig machine = o.config.empty() ? io::builtin_paper_config() : io::load_machine_config(o.config);
   const std::string config_name = o.config.empty() ? "builtin:paper-ipmsm" : o.config;
+  // Where thermal.yaml goes, checked before the fit's minutes (its writer would find it only at the end).
+  if (const std::filesystem::path dir = std::filesystem::path(o.out).parent_path();
+      !dir.empty() && !std::filesystem::is_directory(dir)) {
+    throw io::InputError(o.out, 0, 0, "", "cannot create file: no directory " + dir.string());
+  }
   io::ThermalConfig laws = o.start.empty() ? io::default_thermal_config(machine)
                                            : io::load_thermal_config(o.start, machine, io::NetworkRequired::kNo);
   if (o.period_s > 0.0) laws.fusion.observer.period_s = o.period_s;
@@ -182,8 +200,11 @@ int run_thermal_fit(const ThermalFitCliOptions& o) {
   }
   options.anchor_magnet_reference = !o.keep_magnet_reference;
   if (o.disturbance_time_constant_s > 0.0) options.disturbance_time_constant_s = o.disturbance_time_constant_s;
-  std::fprintf(stderr, "rpem thermal fit: %zu steps of %.3g s; fitting a %d-node network\n", record.steps.size(),
-               start.fusion.observer.period_s, start.fusion.filter.network.nodes);
+  std::fprintf(stderr,
+               "rpem thermal fit: %zu steps of the filter, %.3g s apart (median; its period %.3g s, a row's interval "
+               "where rows are further apart); fitting a %d-node network\n",
+               record.steps.size(), median_step_s(record), start.fusion.observer.period_s,
+               start.fusion.filter.network.nodes);
   const analysis::ThermalFitResult fit = fit_without_held_readings(record, start_for, options, std::move(set_aside));
 
   // A network every reader would refuse is not written (its report is: it shows what the log bounds).

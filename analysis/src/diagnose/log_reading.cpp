@@ -88,15 +88,21 @@ class SessionJoiner {
         samples, read, machine_, options_.voltage_is_command ? options_.control_period_s : 0.0, path);
     // Rebuilt voltages are applied rotor-frame means already: not turned again.
     const bool turn = options_.voltage_is_command && options_.control_period_s > 0.0 && !rebuilt.voltages;
+    for (const core::AveragedSample& s : samples) d_.window_reported_u_V.push_back(s.u_dq_V);
     const std::string voltage = turn ? apply_reported_command(samples, options_) : "";
     open(path, io::rotor_frame_layout(read.layout), true);
+    d_.session_voltage_rebuilt.push_back(rebuilt.voltages);
     d_.window_start_ns.reserve(d_.window_start_ns.size() + samples.size());
+    d_.window_speed_error_rad_s.reserve(d_.window_start_ns.capacity());
+    d_.window_speed_error_noise_rad_s.reserve(d_.window_start_ns.capacity());
     for (core::AveragedSample& s : samples) {
       const std::int64_t shift = shift_ns(s.t_start_ns);
       s.t_start_ns += shift;
       s.t_ns += shift;
       push(io::to_drive_log_row(s));
       d_.window_start_ns.push_back(s.t_start_ns);
+      d_.window_speed_error_rad_s.push_back(s.omega_el_error_rad_s);
+      d_.window_speed_error_noise_rad_s.push_back(s.omega_el_error_noise_rad_s);
     }
     d_.voltage_applied = d_.voltage_applied || turn || rebuilt.voltages;
     return io::describe(source, read) + voltage + (rebuilt.any() ? "; " + rebuilt.describe() : "");

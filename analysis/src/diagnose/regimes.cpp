@@ -3,6 +3,7 @@
 #include <cassert>
 #include <cmath>
 #include <limits>
+#include <optional>
 
 #include "rpem/core/averaged_estimator.hpp"
 #include "rpem/core/drive_estimator.hpp"
@@ -21,8 +22,10 @@ core::AveragedSample window_of(const LogData& log, std::size_t k) {
   s.t_start_ns = log.window_start_ns[k];
   s.t_ns = r.t_ns;
   s.i_dq_A = r.i_A.head<2>();
-  s.u_dq_V = r.u_V.head<2>();
-  s.omega_el_rad_s = r.omega_el_rad_s;
+  s.u_dq_V = log.window_reported_u_V[k];  // as reported: the estimator turns a command itself, as in rpem estimate
+  s.omega_el_rad_s = r.omega_el_rad_s;    // the counted speed already taken where the angle is a staircase (at reading)
+  s.omega_el_error_rad_s = log.window_speed_error_rad_s[k];
+  s.omega_el_error_noise_rad_s = log.window_speed_error_noise_rad_s[k];
   s.u_dc_V = log.layout.u_dc ? r.u_dc_V : kNaN;
   s.t_winding_C = log.samples.t_winding_C(k).value_or(kNaN);
   s.t_magnet_C = log.samples.t_magnet_C(k).value_or(kNaN);
@@ -45,16 +48,18 @@ LogRegimes classify_regimes(const LogData& log, const io::MachineConfig& config,
     if ((k + 1) % kMonitorSamples == 0) report_work(monitor, kMonitorSamples);
   };
   if (log.averaged) {
-    assert(log.window_start_ns.size() == n);
-    // Commands already turned into applied means at reading are not turned again.
-    const core::EstimatorSettings settings =
-        log.voltage_applied ? core::for_applied_voltages(config.estimator) : config.estimator;
-    core::AveragedDriveEstimator estimator(config.machine, settings);
-    for (std::size_t k = 0; k < n; ++k) {
-      if (log.starts_session(k)) estimator.reset();  // each session from the configuration, as its log alone
-      record(k, estimator.step(window_of(log, k)));
+    assert(log.window_start_ns.size() == n && log.window_speed_error_rad_s.size() == n &&
+           log.window_speed_error_noise_rad_s.size() == n && log.window_reported_u_V.size() == n &&
+           log.session_voltage_rebuilt.size() == log.sessions());
+    // Each session from the configuration, as its log alone in rpem estimate: rebuilt voltages are applied means,
+    // not turned again (io::estimator_settings); reported ones are turned by the estimator where they are commands.
+    std::optional<core::AveragedDriveEstimator> estimator;
+    for (std::size_t j = 0; j < log.sessions(); ++j) {
+      estimator.emplace(config.machine,
+                        log.session_voltage_rebuilt[j] ? core::for_applied_voltages(config.estimator) : config.estimator);
+      for (std::size_t k = log.session_first[j]; k < log.session_end(j); ++k) record(k, estimator->step(window_of(log, k)));
     }
-    out.noise_pu = estimator.classifier().current_noise();
+    out.noise_pu = estimator->classifier().current_noise();
   } else {
     core::DriveEstimator estimator(config.machine, config.estimator);
     for (std::size_t k = 0; k < n; ++k) {

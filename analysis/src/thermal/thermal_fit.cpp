@@ -316,6 +316,18 @@ void judge(const io::ThermalConfig& c, const ThermalRecord& r, std::size_t train
   }
 }
 
+/// Whether any winding signal (r̂s or a sensor) is observed on a step of the training part.
+bool winding_observed_in_training(const ThermalFitResult& out) {
+  return std::any_of(out.signals.begin(), out.signals.end(),
+                     [](const SignalFit& s) { return s.name.rfind("winding", 0) == 0 && s.fit_points > 0; });
+}
+
+constexpr const char* kWindingUnobserved =
+    "the winding is observed on no step of the training part (no winding sensor, and r_s adapts on none: the log "
+    "runs at speed or without current): the network's winding follows only from the magnet node, the losses' forms "
+    "and the priors, so the fused winding is a prediction this log cannot check, and its band may not hold it. Keep "
+    "a winding sensor in the log, or include standstills or low speeds with current (docs/thermal.md)";
+
 /// The steps [first, end) of session j.
 struct SessionSpan {
   std::size_t first = 0, end = 0;
@@ -453,18 +465,6 @@ AnchorPlan plan_anchor(io::ThermalConfig& c, const ThermalRecord& r, std::vector
   return plan;
 }
 
-/// The note when the copper law's reference temperature was not stated but assumed (io::ThermalConfig).
-std::string assumed_copper_reference(const core::DriftLaw& copper) {
-  char text[384];
-  std::snprintf(text, sizeof text,
-                "the copper law takes r_s_ref %.5g Ohm at %.4g °C, an assumption: neither the machine's rs_drift nor "
-                "the start's copper says at what temperature R_s was measured. If it was measured hot, every "
-                "winding temperature r_s gives and the copper loss are off; say so with copper: {reference_C: …} "
-                "(docs/thermal.md)",
-                copper.value_ref, copper.reference_C);
-  return text;
-}
-
 /// The filter's noises for the fitted network: the temperatures' white noise, then the disturbances' drift, each the
 /// most likely; each node's disturbance correlation time; a winding sensor's lag where none is configured.
 void fit_filter_noises(const ThermalRecord& record, std::size_t training, const ThermalFitOptions& options,
@@ -511,6 +511,13 @@ std::string nothing_identified(const ThermalFitResult& fit) {
          "not each). A log with several loads and speeds separates them; or start from a known network (--start)";
 }
 
+/// The notes on what the fitted network rests on: nothing identified, a winding never observed.
+void add_closing_notes(ThermalFitResult& out) {
+  if (std::none_of(out.parameters.begin(), out.parameters.end(), [](const FittedParameter& p) { return p.identified; }))
+    out.notes.push_back(nothing_identified(out));
+  if (!winding_observed_in_training(out)) out.notes.emplace_back(kWindingUnobserved);
+}
+
 }  // namespace
 
 ThermalFitResult fit_thermal(const ThermalRecord& record, const io::ThermalConfig& start_config,
@@ -535,7 +542,7 @@ ThermalFitResult fit_thermal(const ThermalRecord& record, const io::ThermalConfi
   out.training_steps = training;
 
   io::ThermalConfig start = start_config;
-  if (!start.copper_reference_stated) out.notes.push_back(assumed_copper_reference(start.fusion.filter.network.copper));
+  for (std::string& note : io::assumed_law_notes(start, false)) out.notes.push_back(std::move(note));
   // A winding sensor without a configured lag: τ_s from the standstills where r̂s reads the winding (eq. 14.25),
   // before the network, which then stands for the sensor's reading (eq. 14.24).
   if (record.winding_sensor && start.fusion.winding_sensor_sigma_K > 0.0 &&
@@ -591,8 +598,7 @@ ThermalFitResult fit_thermal(const ThermalRecord& record, const io::ThermalConfi
   intervals(fitted_layout, record, training, points, best.x, options.blocks, out);
   fit_filter_noises(record, training, options, out);
   judge(out.config, record, training, points, out);
-  if (std::none_of(out.parameters.begin(), out.parameters.end(), [](const FittedParameter& p) { return p.identified; }))
-    out.notes.push_back(nothing_identified(out));
+  add_closing_notes(out);
   return out;
 }
 

@@ -7,6 +7,7 @@
 #include <array>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "rpem/core/thermal_fusion.hpp"
 #include "rpem/io/machine_config.hpp"
@@ -21,6 +22,9 @@ struct ThermalConfig {
   /// Whether the temperature at which the copper law's r_s_ref holds was stated (the machine's `rs_drift` or
   /// the section's `copper`), or the machine's r_s_Ohm was assumed to hold at copper's 20 °C reference.
   bool copper_reference_stated = true;
+  /// Whether the magnet law was stated (the machine's `psim_drift` or the section's `magnet_law`), or the machine's
+  /// psi_m_Wb was assumed to hold at NdFeB's 20 °C reference.
+  bool magnet_law_stated = true;
 };
 
 /// Whether a section must give the network (rpemd, `rpem estimate`) or may give the laws only (a fit's start).
@@ -41,6 +45,11 @@ enum class NetworkRequired : bool { kNo = false, kYes = true };
 /// temperature there: the reader refuses a section whose network does not (at `nodes`), and `rpem thermal fit`
 /// does not write one.
 [[nodiscard]] std::optional<std::string> runaway_at_rating(const ThermalConfig& c, const MachineConfig& machine);
+
+/// What a reader should be told of the laws' assumptions (each a sentence, for a `note:`): the copper law's reference
+/// temperature where it was not stated, the magnet law where it was not (`magnet`: whether to say the latter —
+/// a fit anchors the magnet law at the log's soaked start instead).
+[[nodiscard]] std::vector<std::string> assumed_law_notes(const ThermalConfig& c, bool magnet);
 
 /// The defaults a fit starts from (docs/thermal.md; no network: has_network false): the laws of the machine's
 /// drifts or of copper and NdFeB (core/thermal.hpp) about the machine's values at 20 °C, the loss base

@@ -38,6 +38,16 @@ struct LogData {
   bool averaged = false;  ///< an averaged rotor-frame log (docs/drive-log.md, "Averaged logs"): always steady state
   /// Averaged logs: each row's window start (its t is the window's end); empty for phase-sample logs.
   std::vector<std::int64_t> window_start_ns;
+  /// Averaged logs: what the regime classification is given beside the row, so that it classifies each window as
+  /// `rpem estimate` does (issue 23: one classification for every consumer): the window's speed error and its noise as
+  /// the reader states them (core::AveragedSample's omega_el_error_rad_s, omega_el_error_noise_rad_s), and its voltage
+  /// as the drive reported it (before the turn of LogOptions::voltage_is_command, which the estimator makes itself:
+  /// the classifier judges the reported value's resolution and zero).
+  std::vector<double> window_speed_error_rad_s, window_speed_error_noise_rad_s;
+  std::vector<core::Vec2> window_reported_u_V;
+  /// Averaged logs, per session: whether its voltages were rebuilt (io::RotorFrameRebuild; applied means, which the
+  /// estimator must not turn: io::estimator_settings).
+  std::vector<bool> session_voltage_rebuilt;
   double t_start_s = 0.0, t_end_s = 0.0;
   double median_dt_s = 0.0;
   double max_current_A = 0.0;    ///< largest measured current amplitude
