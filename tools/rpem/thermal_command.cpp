@@ -90,8 +90,6 @@ analysis::ThermalRecord record_sessions(const ThermalFitCliOptions& o, const io:
   return analysis::join_sessions(std::move(sessions), o.log);
 }
 
-/// What the fit found, on the terminal: each signal's fit and held-out error, each parameter with its interval, what
-/// the log cannot tell apart, the notes, and the noise the filter takes (the caller ends the line).
 /// The median time between the filter's steps within a session (0 with fewer than two).
 double median_step_s(const analysis::ThermalRecord& r) {
   std::vector<double> dt;
@@ -104,6 +102,8 @@ double median_step_s(const analysis::ThermalRecord& r) {
   return *middle;
 }
 
+/// What the fit found, on the terminal: each signal's fit and held-out error, each parameter with its interval, what
+/// the log cannot tell apart, the notes, and the noise the filter takes (the caller ends the line).
 void print_fit(const analysis::ThermalFitResult& fit, const analysis::ThermalRecord& record) {
   for (const analysis::SignalFit& s : fit.signals) {
     std::printf("%s: %s in training (σ %.2g K); fit %.3g K RMS, ", s.name.c_str(), analysis::training_span(s).c_str(),
