@@ -48,16 +48,22 @@ ThermalConfig load_text(const std::string& text) {
   return load_thermal_config(f.path(), machine());
 }
 
-std::string error_of(const std::string& pattern, const std::string& replacement) {
-  const std::string text = std::regex_replace(std::string(kThreeNodes), std::regex(pattern), replacement,
-                                              std::regex_constants::format_first_only);
-  EXPECT_NE(text, kThreeNodes) << "pattern did not match: " << pattern;
+/// The reader's error on `text` for machine `m`, "" if it reads.
+std::string load_error(const std::string& text, const MachineConfig& m = machine()) {
+  test::TempFile f("thermal.yaml", text);
   try {
-    (void)load_text(text);
+    (void)load_thermal_config(f.path(), m);
   } catch (const ConfigError& e) {
     return e.what();
   }
   return "";
+}
+
+std::string error_of(const std::string& pattern, const std::string& replacement) {
+  const std::string text = std::regex_replace(std::string(kThreeNodes), std::regex(pattern), replacement,
+                                              std::regex_constants::format_first_only);
+  EXPECT_NE(text, kThreeNodes) << "pattern did not match: " << pattern;
+  return load_error(text);
 }
 
 TEST(ThermalConfig, ReadsEveryKeyAndTheWriterReadsBack) {
@@ -249,15 +255,7 @@ TEST(ThermalConfig, DisturbanceTimeConstantPerNodeAbsentIsTheWalk) {
 // every estimate the bounds allow as an impossible temperature, and it is refused with the law's place.
 TEST(ThermalConfig, AnotherMachinesLawIsRefused) {
   const MachineConfig paper = builtin_paper_config();  // ψm in [0.57, 1.71] Wb, R_s in [1, 4.5] Ω
-  const auto error_with = [&](const std::string& text) -> std::string {
-    test::TempFile f("thermal.yaml", text);
-    try {
-      (void)load_thermal_config(f.path(), paper);
-    } catch (const ConfigError& e) {
-      return e.what();
-    }
-    return "";
-  };
+  const auto error_with = [&](const std::string& text) { return load_error(text, paper); };
   // 20 + (0.57/0.117 − 1)/(−0.00105) = −3 667 °C and 20 + (1.71/0.117 − 1)/(−0.00105) = −12 947 °C.
   const std::string magnet = error_with(kThreeNodes);
   EXPECT_NE(magnet.find(":14:15: thermal.magnet_law: magnet_law reads the estimator's whole range "
@@ -273,7 +271,8 @@ TEST(ThermalConfig, AnotherMachinesLawIsRefused) {
             std::string::npos)
       << copper;
   // A law that reads one end of the bounds as a possible temperature is kept: ψm 0.5 Wb at 20 °C reads 0.57 Wb as
-  // 20 + (1.14 − 1)/(−0.00105) = −113 °C; likewise R_s 0.9 Ω at 120 °C reads 1 Ω as 164 °C.
+  // 20 + (1.14 − 1)/(−0.00105) = −113 °C; likewise R_s 0.9 Ω at 120 °C reads 1 Ω as
+  // 120 + (1/0.9 − 1)/0.0028 = 160 °C.
   const std::string near =
       std::regex_replace(std::regex_replace(with_magnet, std::regex("psi_m_ref_Wb: 1.2"), "psi_m_ref_Wb: 0.5"),
                          std::regex("r_s_ref_Ohm: 0.07"), "r_s_ref_Ohm: 0.9");

@@ -93,8 +93,8 @@ class SessionJoiner {
     open(path, io::rotor_frame_layout(read.layout), true);
     d_.session_voltage_rebuilt.push_back(rebuilt.voltages);
     d_.window_start_ns.reserve(d_.window_start_ns.size() + samples.size());
-    d_.window_speed_error_rad_s.reserve(d_.window_start_ns.capacity());
-    d_.window_speed_error_noise_rad_s.reserve(d_.window_start_ns.capacity());
+    d_.window_speed_error_rad_s.reserve(d_.window_speed_error_rad_s.size() + samples.size());
+    d_.window_speed_error_noise_rad_s.reserve(d_.window_speed_error_noise_rad_s.size() + samples.size());
     for (core::AveragedSample& s : samples) {
       const std::int64_t shift = shift_ns(s.t_start_ns);
       s.t_start_ns += shift;
