@@ -146,10 +146,13 @@ Estimate AveragedDriveEstimator::step(const AveragedSample& sample) noexcept {
   in.u_reported_pu = Vec2(base_.voltage_pu(sample.u_dq_V[0]), base_.voltage_pu(sample.u_dq_V[1]));
   in.i_reported_pu = Vec2(base_.current_pu(sample.i_dq_A[0]), base_.current_pu(sample.i_dq_A[1]));
   in.weight = gains.gain;
+  // A sample that does not continue the chain leaves the previous window unjudged (§13, "Mixed windows").
+  if (timing_ != SampleTiming::kContiguous) end_chain();
   const Classification regime = classifier_.step(in);
   // A release inside the previous window (§13, "Mixed windows"): what it adapted is undone.
   if (regime.bits & regime_bit::kPreviousMixed) core_.retract(before_previous_);
   before_previous_ = core_.adaptation();
+  judge_pending_ = in.window_s > 0.0 && timing_ == SampleTiming::kContiguous && !regime.excluded();
   if (options_.inductive_correction && timing_ == SampleTiming::kContiguous) {
     // (x/ω_n)·di/dt with di/dt from the means of consecutive windows, between their centres (§11).
     const Vec2& di_dt = classifier_.slope_pu_s();
@@ -179,8 +182,20 @@ Estimate AveragedDriveEstimator::finish(const AveragedSample& sample, const Stea
   return e;
 }
 
+bool AveragedDriveEstimator::end_chain() noexcept {
+  if (!judge_pending_) return false;
+  judge_pending_ = false;
+  const Vec2 theta_pu = core_.state().theta_pu;
+  core_.retract(before_previous_);
+  before_previous_ = core_.adaptation();
+  const bool moved = core_.state().theta_pu != theta_pu;
+  unjudged_windows_ += moved ? 1U : 0U;
+  return moved;
+}
+
 void AveragedDriveEstimator::reset() noexcept {
   has_previous_ = false;
+  judge_pending_ = false;
   core_.reset();
   classifier_.reset();
   before_previous_ = core_.adaptation();
@@ -191,6 +206,7 @@ void AveragedDriveEstimator::reset() noexcept {
 void AveragedDriveEstimator::set_estimates(double psi_m_Wb, double r_s_Ohm) noexcept {
   core_.set_theta({base_.flux_pu(psi_m_Wb), base_.resistance_pu(r_s_Ohm)});
   before_previous_ = core_.adaptation();  // a retraction never undoes the seed
+  judge_pending_ = false;
 }
 
 void AveragedDriveEstimator::reconfigure(const MachineSi& machine, const EstimatorSettings& settings) noexcept {

@@ -5,6 +5,7 @@
 #include <charconv>
 #include <cstdlib>
 #include <filesystem>
+#include <optional>
 #include <variant>
 
 #include "rpem/core/reported_speed.hpp"
@@ -185,15 +186,18 @@ DaemonConfig parse(io::YamlMap& root, const std::string& name, const std::string
     machine = io::builtin_paper_config();
   }
   temperature_from_drifts(name, machine, c.live.temperature);
+  std::optional<io::ThermalConfig> thermal;
   if (!thermal_file.empty()) {
     if (root.has("thermal")) root.fail("thermal", "give the thermal section inline or daemon.thermal_config, not both");
-    c.live.thermal =
-        io::load_thermal_config((fs::path(base_dir) / thermal_file).lexically_normal().string(), machine).fusion;
-    c.live.thermal_active = true;
+    thermal = io::load_thermal_config((fs::path(base_dir) / thermal_file).lexically_normal().string(), machine);
   } else if (root.has("thermal")) {
     io::YamlMap t = root.map("thermal");
-    c.live.thermal = io::parse_thermal_config(t, machine).fusion;
+    thermal = io::parse_thermal_config(t, machine);
+  }
+  if (thermal) {
+    c.live.thermal = thermal->fusion;
     c.live.thermal_active = true;
+    c.notes = io::assumed_law_notes(*thermal, true);
   }
   if (d) parse_daemon(*d, c, base_dir);
   root.finish();

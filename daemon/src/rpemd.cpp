@@ -64,6 +64,7 @@ int main(int argc, char** argv) {  // NOLINT(bugprone-exception-escape): only a 
   }
   try {
     daemon::DaemonConfig config = daemon::load_configuration(options);
+    for (const std::string& note : config.notes) std::fprintf(stderr, "rpemd: note: %s\n", note.c_str());
     if (check_only) return check_configuration(config);
     return daemon::Daemon(options, std::move(config)).run();
   } catch (const io::InputError& e) {

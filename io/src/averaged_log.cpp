@@ -214,16 +214,11 @@ std::vector<core::AveragedSample> read_averaged_log(const std::string& path, con
   }
   MappedLogReader reader(path, map, limits);
   if (map.columns_optional && map.window == Window::kStartColumn && !reader.has(Quantity::kTStart)) {
-    reader.fail_at(reader.line(), "t_start", "required column is missing from the header");
+    reader.fail_header({"t_start", "required"});
   }
   // Our own format names its quantities in the header, a map's optional columns may be absent from it: what an
   // averaged log needs is checked against what the header has.
-  if (const std::optional<LayoutProblem> p = averaged_log_layout_problem(reader.present())) {
-    reader.fail_at(reader.line(), p->column,
-                   p->reason.rfind("required", 0) == 0
-                       ? "required column is missing from the header" + p->reason.substr(std::string("required").size())
-                       : p->reason);
-  }
+  if (const std::optional<LayoutProblem> p = averaged_log_layout_problem(reader.present())) reader.fail_header(*p);
   AveragedLogRead read;
   read.layout.u_dc = reader.has(Quantity::kUDc);
   read.layout.t_winding = reader.has(Quantity::kTWinding);

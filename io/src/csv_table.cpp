@@ -31,7 +31,7 @@ CsvTable CsvTable::read(const std::string& path, bool allow_nan, const std::vect
   CsvTable t;
   t.path_ = path;
   std::string line;
-  if (!std::getline(in, line)) throw InputError(path, 1, 0, "", "empty file: expected a header row");
+  if (!std::getline(in, line)) throw DataError(path, 1, 0, "", "empty file: expected a header row");
   t.header_ = split(line);
   t.columns_.resize(t.header_.size());
   std::vector<bool> is_text(t.header_.size(), false);
@@ -44,8 +44,8 @@ CsvTable CsvTable::read(const std::string& path, bool allow_nan, const std::vect
     if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
     const auto cells = split(line);
     if (cells.size() != t.header_.size()) {
-      throw InputError(path, line_no, 0, "",
-                       "row has " + std::to_string(cells.size()) + " cells, header has " + std::to_string(t.header_.size()));
+      throw DataError(path, line_no, 0, "",
+                      "row has " + std::to_string(cells.size()) + " cells, header has " + std::to_string(t.header_.size()));
     }
     for (std::size_t c = 0; c < cells.size(); ++c) {
       double v = std::nan("");
@@ -53,14 +53,15 @@ CsvTable CsvTable::read(const std::string& path, bool allow_nan, const std::vect
         const std::string& s = cells[c];
         const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
         if (s.empty() || ec != std::errc() || end != s.data() + s.size()) {
-          throw InputError(path, line_no, c + 1, "column " + t.header_[c], "'" + s + "' is not a number");
+          throw DataError(path, line_no, c + 1, "column " + t.header_[c], "'" + s + "' is not a number");
         }
-        if (std::isnan(v) && !allow_nan) throw InputError(path, line_no, c + 1, "column " + t.header_[c], "NaN");
-        if (std::isinf(v)) throw InputError(path, line_no, c + 1, "column " + t.header_[c], "not finite");
+        if (std::isnan(v) && !allow_nan) throw DataError(path, line_no, c + 1, "column " + t.header_[c], "NaN");
+        if (std::isinf(v)) throw DataError(path, line_no, c + 1, "column " + t.header_[c], "not finite");
       }
       t.columns_[c].push_back(v);
     }
     ++t.rows_;
+    t.row_lines_.push_back(line_no);
   }
   return t;
 }
@@ -71,8 +72,21 @@ bool CsvTable::has(const std::string& name) const {
 
 const std::vector<double>& CsvTable::column(const std::string& name) const {
   const auto it = std::find(header_.begin(), header_.end(), name);
-  if (it == header_.end()) throw InputError(path_, 1, 0, "column " + name, "required column is missing");
+  if (it == header_.end()) throw DataError(path_, 1, 0, "column " + name, "required column is missing");
   return columns_[static_cast<std::size_t>(it - header_.begin())];
+}
+
+void CsvTable::require_increasing(const std::string& name) const {
+  const std::vector<double>& v = column(name);
+  const std::size_t c = static_cast<std::size_t>(std::find(header_.begin(), header_.end(), name) - header_.begin()) + 1;
+  for (std::size_t k = 0; k < v.size(); ++k) {
+    if (!std::isfinite(v[k]))
+      throw DataError(path_, row_lines_[k], c, "column " + name, "NaN: a time is needed on every row");
+    if (k > 0 && v[k] <= v[k - 1]) {
+      throw DataError(path_, row_lines_[k], c, "column " + name,
+                      "does not increase (" + std::to_string(v[k]) + " after " + std::to_string(v[k - 1]) + ")");
+    }
+  }
 }
 
 }  // namespace rpem::io

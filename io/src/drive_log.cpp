@@ -32,11 +32,7 @@ DriveLogReader::DriveLogReader(const std::string& path, LogMap map, DriveLogLimi
 void DriveLogReader::check_layout() {
   // Our own format names its quantities in the header, so what a drive log needs is checked here; a map
   // was checked when it was loaded.
-  if (const std::optional<LayoutProblem> p = drive_log_layout_problem(reader_.present())) {
-    const std::string reason =
-        p->reason.rfind("required", 0) == 0 ? "required column is missing from the header" + p->reason.substr(8) : p->reason;
-    reader_.fail_at(reader_.line(), p->column, reason);
-  }
+  if (const std::optional<LayoutProblem> p = drive_log_layout_problem(reader_.present())) reader_.fail_header(*p);
   auto has = [&](Quantity q) { return reader_.has(q); };
   layout_.angle = has(Quantity::kThetaEl);
   layout_.u_dc = has(Quantity::kUDc);

@@ -134,6 +134,16 @@ std::string describe(const LogSource& source, const AveragedLogRead& read) {
     s += "; " + std::to_string(read.unknown_windows) +
          " windows unknown, not used: each begins or ends at a read stamped perhaps long after it was taken (a row " +
          "after the logger asked again, or a count its stamps cannot hold; docs/drive-log.md, \"Rows stamped late\")";
+    // Over a tenth (where the regimes' rules name their keys too): the key that decides which rows are late replies.
+    if (10 * read.unknown_windows > read.rows && source.map.request_timeout_s > 0.0) {
+      char key[320];
+      std::snprintf(key, sizeof key,
+                    ". Key: request_timeout_s, %.4g s in %s (a row that long after the one before is taken for a reply "
+                    "to a request asked again); a logger that waits longer for its replies needs a copy of the map with "
+                    "its own timeout (--log-map)",
+                    source.map.request_timeout_s, source.map.name.c_str());
+      s += key;
+    }
   }
   if (source.map.speed_pll.given()) {
     char lag[160];

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <string_view>
 
 namespace rpem::io {
 namespace {
@@ -45,6 +46,26 @@ void MappedLogReader::fail_at(std::size_t line, const std::string& column, const
 void MappedLogReader::fail_at(std::size_t line, Quantity q, const std::string& reason) const {
   const int index = index_[static_cast<std::size_t>(q)];
   throw DriveLogError(path_, line, index >= 0 ? static_cast<std::size_t>(index) + 1 : 0, "column " + label(q), reason);
+}
+
+void MappedLogReader::fail_header(const LayoutProblem& problem) const {
+  constexpr std::string_view kRequired = "required";
+  std::string reason = problem.reason.rfind(kRequired, 0) == 0
+                           ? "required column is missing from the header" + problem.reason.substr(kRequired.size())
+                           : problem.reason;
+  const std::string& only = header_.size() == 1 ? header_.front() : std::string();
+  const std::size_t other = only.find_first_of(";,\t|");
+  if (other != std::string::npos && only[other] != map_.separator) {
+    const std::string shown = only[other] == '\t' ? std::string("a tab") : "'" + std::string(1, only[other]) + "'";
+    reason += "; the header is one cell, \"" + only.substr(0, 60) + (only.size() > 60 ? "…" : "") +
+              "\": are its cells separated by " + shown + "? rpem reads '" + std::string(1, map_.separator) +
+              "' here; a column map's `separator:` reads another (--log-map; docs/drive-log.md, \"Column maps\")";
+  } else if (map_.columns_optional) {
+    reason +=
+        "; a CSV of another layout is read through a column map: --log-map MAP.yaml (docs/drive-log.md, \"Column "
+        "maps\")";
+  }
+  fail_at(line_, problem.column, reason);
 }
 
 void MappedLogReader::fail_cell(int index, const std::string& label, const std::string& reason) const {
@@ -158,9 +179,8 @@ void MappedLogReader::read_header() {
     return index;
   };
   auto missing = [&](const std::string& label) {
-    fail_at(line_, label,
-            map_.columns_optional ? "required column is missing from the header"
-                                  : "is missing from the header (the map " + map_.name + " reads it)");
+    fail_header(
+        {label, map_.columns_optional ? "required" : "is missing from the header (the map " + map_.name + " reads it)"});
   };
   if (map_.session) session_index_ = find(map_.session->name, map_.session->name);  // where the file has it
   if (map_.time) {

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <charconv>
+#include <string>
+#include <string_view>
 
 #include "rpem/io/errors.hpp"
 #include "rpem/io/vesc_tool_columns.hpp"
@@ -54,9 +56,15 @@ void check_vesc_tool_header(const std::string& path, std::size_t line, const std
                          (version ? std::string("the header of VESC Tool ") + version->versions
                                   : std::string("a header of no VESC Tool version known")) +
                          "), and rpem needs it";
-    if (added != vesc_tool_headers().end()) {
+    if (added == vesc_tool_headers().begin()) {
+      // Every header VESC Tool writes has it: no version to record with, the header is not VESC Tool's own.
+      reason += std::string("; every VESC Tool header has it (since ") + added->source +
+                "): this header was edited, or written by another logger that leaves it out";
+    } else if (added != vesc_tool_headers().end()) {
+      const std::string_view versions(added->versions);
+      const std::string_view first = versions.substr(0, versions.find(' '));
       reason += std::string("; VESC Tool ") + added->versions + " added it (" + added->source +
-                "): record the log with VESC Tool 1.20 or later";
+                "): record the log with VESC Tool " + std::string(first) + " or later";
     }
     throw DriveLogError(path, line, 0, "column " + name, reason);
   }

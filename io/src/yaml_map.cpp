@@ -1,12 +1,14 @@
 #include "rpem/io/yaml_map.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <charconv>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <set>
 #include <sstream>
+#include <string_view>
 #include <system_error>
 #include <vector>
 
@@ -35,6 +37,38 @@ std::size_t edit_distance(const std::string& a, const std::string& b) {
   return row[b.size()];
 }
 
+/// Whether `s` is one of YAML 1.2's non-finite floats: [-+]?.inf, .nan, in any case.
+bool yaml_non_finite(std::string_view s) {
+  if (!s.empty() && (s.front() == '-' || s.front() == '+')) s.remove_prefix(1);
+  if (s.size() != 4 || s.front() != '.') return false;
+  std::string lower(s.substr(1));
+  for (char& c : lower) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return lower == "nan" || lower == "inf";
+}
+
+/// YAML notices a bracket or a quote left open only at a later token, often a later line's first: where the error
+/// stands at a line's start and the line with content before it leaves a `[`, `{` or `"` open, that line is named.
+std::string line_before_hint(const std::string& text, int error_line, int error_column) {
+  if (error_line <= 0) return "";
+  std::vector<std::string> lines;
+  std::istringstream in(text);
+  for (std::string l; std::getline(in, l);) lines.push_back(l);
+  const auto at = static_cast<std::size_t>(error_line);
+  if (at < lines.size() && static_cast<std::size_t>(error_column) > lines[at].find_first_not_of(' ')) return "";
+  for (std::size_t k = std::min(at, lines.size()); k-- > 0;) {
+    const std::string& line = lines[k];
+    const std::size_t first = line.find_first_not_of(" \t\r");
+    if (first == std::string::npos || line[first] == '#') continue;
+    std::string content = line.substr(0, line.find(" #"));
+    content.erase(content.find_last_not_of(" \t\r") + 1);
+    const auto count = [&](char c) { return std::count(content.begin(), content.end(), c); };
+    if (count('[') <= count(']') && count('{') <= count('}') && count('"') % 2 == 0) return "";
+    return " (YAML notices it only here: line " + std::to_string(k + 1) + " leaves a bracket or a quote open, `" +
+           content.substr(first, 60) + "`)";
+  }
+  return "";
+}
+
 }  // namespace
 
 YamlMap YamlMap::load_file(const std::string& path) {
@@ -56,7 +90,7 @@ YamlMap YamlMap::load_string(const std::string& text, const std::string& name) {
     root = YAML::Load(text);
   } catch (const YAML::ParserException& e) {
     throw ConfigError(name, static_cast<std::size_t>(e.mark.line + 1), static_cast<std::size_t>(e.mark.column + 1), "",
-                      "YAML syntax: " + e.msg);
+                      "YAML syntax: " + e.msg + line_before_hint(text, e.mark.line, e.mark.column));
   }
   if (!root.IsMap()) throw ConfigError(name, 1, 1, "", "the document must be a mapping");
   return YamlMap(root, name, "");
@@ -114,6 +148,8 @@ double YamlMap::as_number(const YAML::Node& n, const std::string& key, double lo
   const std::string& s = n.Scalar();
   double v = 0.0;
   const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
+  // YAML's own spellings of the non-finite (.nan, .inf, -.Inf, …) read as what they are, as C's `nan` and `inf` do.
+  if (yaml_non_finite(s)) fail_at(n, key, "'" + s + "' is not finite");
   if (ec != std::errc() || end != s.data() + s.size()) fail_at(n, key, "'" + s + "' is not a number");
   if (!std::isfinite(v)) fail_at(n, key, "'" + s + "' is not finite");
   if (v < lo || v > hi) fail_at(n, key, s + " is outside " + describe_range(lo, hi));

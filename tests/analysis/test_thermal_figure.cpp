@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "rpem/analysis/thermal/thermal_figure.hpp"
+#include "rpem/io/errors.hpp"
 #include "support/gnuplot_text.hpp"
 #include "support/temp_file.hpp"
 
@@ -42,6 +43,32 @@ TEST(ThermalFigure, CoverageCountsTheMeasuredPointsAfterTheLineInsideTheBand) {
   EXPECT_NE(gp.find("title \"measured (T_magnet)\" noenhanced"), std::string::npos) << gp.substr(gp.rfind("plot"));
   EXPECT_NE(gp.find("title \"measured (T_winding)\" noenhanced"), std::string::npos);
   EXPECT_EQ(test::misprinted_gnuplot_text(gp), std::vector<std::string>{});
+}
+
+TEST(ThermalFigure, TimesThatDoNotIncreaseAreRefusedAtTheirLine) {
+  // The band is interpolated at each measured time and the curves drawn in order: a time that goes back or is NaN is
+  // a data error at its line (exit 65), not a figure of crossed lines. A missing temperature reading (NaN) is not.
+  const std::string est =
+      "t,T_magnet_rpem,T_winding_rpem,t_magnet_fused_C,t_magnet_fused_sd_C,t_winding_fused_C,t_winding_fused_sd_C\n"
+      "0,49,81,50,1,80,2\n1,49,81,50,1,80,2\n2,49,81,50,1,80,2\n";
+  const test::TempFile est_csv("est.csv", est), png("fused.png");
+  auto refusal = [&](const std::string& measured) -> std::string {
+    const test::TempFile measured_csv("measured.csv", measured);
+    ThermalFigureInput in;
+    in.estimate_csv = est_csv.path();
+    in.measured_csv = measured_csv.path();
+    try {
+      (void)write_thermal_figure(png.path(), in);
+    } catch (const io::DataError& e) {
+      return e.what();
+    }
+    return "";
+  };
+  EXPECT_NE(refusal("t,T_magnet,T_winding\n0.5,50,80\n\n0.2,50,80\n").find("measured.csv:4:1: column t: does not increase"),
+            std::string::npos);
+  EXPECT_NE(refusal("t,T_magnet,T_winding\n0.5,50,80\nnan,50,80\n").find("measured.csv:3:1: column t: NaN"),
+            std::string::npos);
+  EXPECT_EQ(refusal("t,T_magnet,T_winding\n0.5,50,80\n1.5,nan,80\n"), "");
 }
 
 TEST(ThermalFigure, RpemAloneIsDrawnFromItsFirstAdaptationAndSaidWhereItNeverAdapted) {

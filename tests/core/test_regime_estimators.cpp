@@ -166,6 +166,62 @@ TEST(RegimeEstimators, AReleaseInsideAWindowRetractsWhatThatWindowAdapted) {
   EXPECT_EQ(counts[Regime::kBridgeOff], 5U);
 }
 
+TEST(RegimeEstimators, AChainsLastWindowIsNeverJudgedAndIsLeftOut) {
+  // §13, "Mixed windows": a release shows only in the window after it, so a window no window of its chain
+  // follows — at the log's end, or before a gap — is unjudged and retracted (end_chain()). The windows of the
+  // test above: the release half-way through window 20; here nothing adjacent follows it.
+  MachineSi truth = test::outrunner_machine_si();
+  truth.psi_m_Wb *= 0.85;
+  const double h = 0.09, omega = 1500.0;
+  const Vec2 i(0.0, 5.0);
+  const Vec2 u(truth.r_s_Ohm * i[0] - omega * truth.l_q_H * i[1],
+               truth.r_s_Ohm * i[1] + omega * (truth.l_d_H * i[0] + truth.psi_m_Wb));
+  EstimatorSettings settings = test::outrunner_settings();
+  settings.regimes.voltage_resolution_V = 0.01;
+  settings.regimes.current_resolution_A = 0.01;
+  auto window = [&](int j, double share) {
+    AveragedSample w;
+    w.t_start_ns = std::llround(j * h * 1e9);
+    w.t_ns = std::llround((j + 1) * h * 1e9);
+    w.i_dq_A = share * i;
+    w.u_dq_V = share * u;
+    w.omega_el_rad_s = omega;
+    return w;
+  };
+  enum class Next { kNone, kGap, kLost };  // the log ends; a flagged gap; windows lost (starts 3 windows late)
+  for (const Next next : {Next::kNone, Next::kGap, Next::kLost}) {
+    AveragedDriveEstimator est(test::outrunner_machine_si(), settings);
+    for (int j = 0; j < 20; ++j) (void)est.step(window(j, 1.0));
+    const double psi_before_mixed = est.psi_m_Wb();
+    EXPECT_FALSE(est.step(window(20, 0.5)).regime.excluded());
+    EXPECT_LT(est.psi_m_Wb(), 0.9 * psi_before_mixed);  // what the mixed window did
+    if (next == Next::kNone) {
+      EXPECT_TRUE(est.end_chain());
+      EXPECT_FALSE(est.end_chain());  // once
+    } else {
+      AveragedSample off = window(next == Next::kGap ? 21 : 24, 0.0);
+      off.gap_before = next == Next::kGap;
+      const Estimate e = est.step(off);
+      EXPECT_EQ(e.detail.code, StepCode::kSynchronized);
+      EXPECT_FALSE(e.regime.bits & regime_bit::kPreviousMixed);  // not judged: its chain ended
+      EXPECT_FALSE(est.end_chain());                             // an off window adapted nothing
+    }
+    EXPECT_EQ(est.psi_m_Wb(), psi_before_mixed) << static_cast<int>(next);  // undone, exactly
+    EXPECT_EQ(est.unjudged_windows(), 1U);
+  }
+  // A window judged by its successor stays: the chain's last, unjudged, alone is left out, and only once.
+  AveragedDriveEstimator est(test::outrunner_machine_si(), settings);
+  for (int j = 0; j < 20; ++j) (void)est.step(window(j, 1.0));
+  const double psi_judged = est.psi_m_Wb();
+  (void)est.step(window(20, 1.0));
+  const double psi_last = est.psi_m_Wb();
+  est.resynchronize();  // rpemd's stream broken off
+  EXPECT_EQ(est.psi_m_Wb(), psi_judged);
+  EXPECT_NE(psi_last, psi_judged);
+  EXPECT_FALSE(est.end_chain());
+  EXPECT_EQ(est.unjudged_windows(), 1U);
+}
+
 /// Rows a test bench writes seconds apart at steady operating points of the paper's machine (ψm 8 % low,
 /// R_s 12 % high), from the steady-state dq equations, with measurement noise: a rotor-frame drive log.
 std::vector<DriveSample> bench_rows(std::uint64_t seed, double spacing_s, int count) {

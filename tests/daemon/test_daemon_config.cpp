@@ -87,6 +87,12 @@ TEST(DaemonConfig, AThermalSectionInlineOrInItsOwnFileRunsTheFusion) {
   EXPECT_EQ(c.live.thermal.filter.network.nodes, 2);
   EXPECT_DOUBLE_EQ(c.live.thermal.filter.network.between_W_per_K(0, 1), 12.0);
   EXPECT_DOUBLE_EQ(c.live.thermal.coolant_C, 35.0);
+  // The section states neither law, and the paper machine no drift: rpemd says both assumptions at start, as rpem
+  // estimate does (io::assumed_law_notes, tested with the reader).
+  ASSERT_EQ(c.notes.size(), 2U);
+  EXPECT_NE(c.notes[0].find("the copper law takes r_s_ref"), std::string::npos) << c.notes[0];
+  EXPECT_NE(c.notes[1].find("the magnet law takes psi_m_ref 1.14 Wb at 20 °C"), std::string::npos) << c.notes[1];
+  EXPECT_TRUE(builtin_daemon_config().notes.empty());
   // The file `rpem thermal fit` wrote, named relative to the configuration.
   test::TempFile own("thermal_own.yaml", section);
   test::TempFile named("thermal_named.yaml", machine + "daemon:\n  thermal_config: " +
@@ -94,6 +100,7 @@ TEST(DaemonConfig, AThermalSectionInlineOrInItsOwnFileRunsTheFusion) {
   const DaemonConfig d = load_daemon_config(named.path());
   ASSERT_TRUE(d.live.thermal_active);
   EXPECT_DOUBLE_EQ(d.live.thermal.filter.network.capacitance_J_per_K[1], 7000.0);
+  EXPECT_EQ(d.notes, c.notes);
   // Both: an error naming the key; a bad section: the thermal section's own error.
   test::TempFile both("thermal_both.yaml", machine + section + "daemon:\n  thermal_config: x.yaml\n");
   EXPECT_THROW((void)load_daemon_config(both.path()), io::ConfigError);

@@ -90,6 +90,13 @@ INSTANTIATE_TEST_SUITE_P(
         BadCase{"empty", "", ":1: empty file"},
         BadCase{"missing_time", "theta_el,omega_el,u_dc,u_a,u_b,u_c,i_a,i_b,i_c\n", ":1: column t: required column"},
         BadCase{"no_current", "t,theta_el,omega_el,u_dc,u_a,u_b,u_c\n", "no current columns"},
+        // Another layout, or rpem's with another separator: the header says which way out.
+        BadCase{"another_layout", "time_s,Ia,Ib,Ic,Ua,Ub,Uc,speed\n",
+                ":1: column t: required column is missing from the header; a CSV of another layout is read through a "
+                "column map: --log-map MAP.yaml"},
+        BadCase{"semicolons", "t;theta_el;omega_el;u_dc;u_a;u_b;u_c;i_a;i_b;i_c\n0;0;0;220;1;2;3;0;0;0\n",
+                ":1: column t: required column is missing from the header; the header is one cell, "
+                "\"t;theta_el;omega_el;u_dc;u_a;u_b;u_c;i_a;i_b;i_c\": are its cells separated by ';'? rpem reads ','"},
         BadCase{"no_angle_with_phases", "t,omega_el,u_dc,u_a,u_b,u_c,i_a,i_b,i_c\n",
                 ":1: column theta_el: required column is missing from the header (optional only when"},
         BadCase{"no_dc_link_with_phases", "t,theta_el,omega_el,u_d,u_q,i_a,i_b,i_c\n", ":1: column u_dc: required"},

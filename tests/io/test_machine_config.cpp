@@ -109,6 +109,14 @@ INSTANTIATE_TEST_SUITE_P(
                 "estimator.gains.sga.psi_m.gain: 3.25 is outside [0, 1]"},
         BadEdit{"negative_resistance", "r_s_Ohm: 2.25", "r_s_Ohm: -2.25", "machine.r_s_Ohm: -2.25 is outside"},
         BadEdit{"not_a_number", "l_d_H: 0.0953", "l_d_H: small", "machine.l_d_H: 'small' is not a number"},
+        // C's and YAML's spellings of NaN and infinity are refused alike.
+        BadEdit{"nan", "l_d_H: 0.0953", "l_d_H: nan", "machine.l_d_H: 'nan' is not finite"},
+        BadEdit{"yaml_nan", "l_d_H: 0.0953", "l_d_H: .NaN", "machine.l_d_H: '.NaN' is not finite"},
+        BadEdit{"yaml_minus_inf", "l_d_H: 0.0953", "l_d_H: -.inf", "machine.l_d_H: '-.inf' is not finite"},
+        // A bracket left open: YAML notices it at the next line's key; the message names the line that opened it.
+        BadEdit{"bracket_left_open", "l_d_H: 0.0953", "l_d_H: [0.0953",
+                "YAML syntax: end of sequence flow not found (YAML notices it only here: line 13 leaves a bracket or a "
+                "quote open, `l_d_H: [0.0953`)"},
         BadEdit{"bad_choice", "algorithm: sga", "algorithm: kalman",
                 "estimator.algorithm: 'kalman' is not one of: sga, gna, phyint"},
         BadEdit{"missing", "    pole_pairs: 3 .*\n", "", "machine.rated.pole_pairs: required key is missing"},

@@ -191,6 +191,10 @@ TEST(VescToolLog, ARowAfterVescToolAskedAgainAndTheRowAfterItHaveUnknownWindows)
   EXPECT_EQ(s[3].t_start_ns, 1'380'000'000);  // 980 ms: VESC Tool still waited for this reply
   EXPECT_NE(describe(source, read).find("5 averaged samples"), std::string::npos) << describe(source, read);
   EXPECT_NE(describe(source, read).find("2 windows unknown, not used"), std::string::npos) << describe(source, read);
+  // Two of eight rows, over a tenth: the key that decides which rows are late replies, with its value and map.
+  EXPECT_NE(describe(source, read).find(". Key: request_timeout_s, 0.99 s in builtin:config/log-maps/vesc-tool.yaml"),
+            std::string::npos)
+      << describe(source, read);
 }
 
 TEST(VescToolLog, PolledSlowerThanItsTimeoutARowIsJudgedAgainstTheLogsOwnSpacing) {
@@ -287,6 +291,10 @@ TEST(VescToolLog, AHeaderWithoutDqVoltagesKeepsTheDutyCycleAndAMissingColumnName
                      "known)"),
             std::string::npos)
       << msg;
+  // Every VESC Tool header has erpm: no version to record with (it said "1.17 to 1.19 added it: record the log with
+  // VESC Tool 1.20 or later").
+  EXPECT_NE(msg.find("; every VESC Tool header has it (since vedderb/vesc_tool 95f18604"), std::string::npos) << msg;
+  EXPECT_EQ(msg.find("record the log with"), std::string::npos) << msg;
 }
 
 TEST(VescToolLog, TheHeaderlessLogOfVersions111To116IsRefusedWithWhy) {

@@ -6,11 +6,13 @@
 // key) on stderr, in diagnosis.json and in the report (issue 23 item 6).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -124,6 +126,35 @@ TEST_F(VescToolLogs, IndependentGeneratorSeed2ZerosWhileOffAcrossMidnight) {
       independent_log(dir_, "--seed 2 --psi-m-rel -0.15 --r-s-rel 0.2 --off-voltage zero --midnight"), firmware_config());
   EXPECT_NEAR(d["calibration"]["psi_m_Wb"].get<double>() / 3.93805e-3, 1.0, 0.02);
   expect_implied_psi_m(d, 3.93805e-3);
+}
+
+TEST_F(VescToolLogs, IndependentGeneratorInVescTool117sHeaderWithoutDqVoltages) {
+  // Seed 3 (ψm 5.4800 mWb, R_s 0.03080 Ohm at the end) as VESC Tool 1.17 wrote it: no d/q voltages, rebuilt from the
+  // duty cycle (docs/drive-log.md, "Logs without d/q values"). A magnitude carries no back-EMF direction, so with the
+  // sensorless frame no lock test excludes the open-loop start-ups, where R_s and a voltage along the current are
+  // excited; and u_d is the configured L_q's own. Before 2026-12-04 diagnose calibrated R_s 0.0239 Ohm with a 95 %
+  // interval of [0.0222, 0.0256] (22 % low, the truth outside it) and L_q to its configured value within 0.014 %;
+  // rpem estimate declared R_s not identifiable on the same log.
+  const std::string log = independent_log(dir_, "--seed 3 --header-version 1");
+  const nlohmann::json d = diagnose(log, outrunner_config());
+  EXPECT_NEAR(d["calibration"]["psi_m_Wb"].get<double>() / 5.4800e-3, 1.0, 0.02);
+  const nlohmann::json& identifiable = d["calibration"]["identifiable"];
+  for (const char* withheld : {"r_s_Ohm", "l_q_H"}) {
+    EXPECT_EQ(std::find(identifiable.begin(), identifiable.end(), withheld), identifiable.end()) << identifiable.dump();
+  }
+  for (const auto& e : d["effects"]) {
+    EXPECT_NE(e["name"], "deadtime");
+    EXPECT_NE(e["name"], "rs_drift");
+  }
+  bool r_s_said = false;
+  for (const auto& u : d["not_identifiable"]) {
+    const std::vector<std::string> names = u["effects"];
+    if (names.front() != "r_s_Ohm") continue;
+    r_s_said = true;
+    EXPECT_EQ(names, (std::vector<std::string>{"r_s_Ohm", "deadtime", "rs_drift"}));
+    EXPECT_NE(u["reason"].get<std::string>().find("no back-EMF direction"), std::string::npos) << u.dump();
+  }
+  EXPECT_TRUE(r_s_said) << d["not_identifiable"].dump();
 }
 
 TEST_F(VescToolLogs, EmulatedFieldRide) {

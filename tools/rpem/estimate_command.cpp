@@ -149,9 +149,23 @@ struct Tally {
     adapted[0] += (e.detail.flags & core::step_flag::kPsiMActive) ? 1 : 0;
     adapted[1] += (e.detail.flags & core::step_flag::kRsActive) ? 1 : 0;
   }
+  /// The log's end ends the last chain: its newest window, never judged, is retracted (docs/derivations.md §13,
+  /// "Mixed windows"); the final estimates are the estimator's, and the windows so left out are said.
+  void end_chain(core::AveragedDriveEstimator& estimator) {
+    estimator.end_chain();
+    last.psi_m_Wb = estimator.psi_m_Wb();
+    last.r_s_Ohm = estimator.r_s_Ohm();
+    if (const std::uint64_t n = estimator.unjudged_windows(); n > 0) {
+      std::fprintf(stderr,
+                   "rpem estimate: %llu window%s ending a chain (before a gap or at the log's end) left out of the "
+                   "estimates: a bridge release inside a window shows only in the next one (docs/derivations.md §13, "
+                   "\"Mixed windows\")\n",
+                   static_cast<unsigned long long>(n), n == 1 ? "" : "s");
+    }
+  }
   [[nodiscard]] std::string summary(core::Algorithm a, const char* kind) const {
     char text[256];
-    std::snprintf(text, sizeof text, "%llu %s, psi_m = %.5f Wb, r_s = %.5f Ohm (%s), %llu resyncs",
+    std::snprintf(text, sizeof text, "%llu %s, psi_m = %.6g Wb, r_s = %.6g Ohm (%s), %llu resyncs",
                   static_cast<unsigned long long>(counts.samples), kind, last.psi_m_Wb, last.r_s_Ohm, io::to_string(a),
                   static_cast<unsigned long long>(counts.resyncs));
     return text;
@@ -223,6 +237,7 @@ std::array<std::optional<bool>, 2> check_identifiable(const std::vector<core::Av
       (k == 0 ? s.initial_psi_m_Wb : s.initial_r_s_Ohm) = high ? p[k].hi : p[k].lo;
       core::AveragedDriveEstimator run(cfg.machine, s);
       for (const core::AveragedSample& a : samples) (void)run.step(a);
+      run.end_chain();
       (high ? p[k].from_hi : p[k].from_lo) = k == 0 ? run.psi_m_Wb() : run.r_s_Ohm();
     }
     const double half = 0.5 * std::abs(p[k].from_hi - p[k].from_lo) / std::abs(estimate[k]);
@@ -264,6 +279,7 @@ Tally run_averaged(const EstimateOptions& o, const std::string& log, const std::
     if (decimation.take(e.t_ns)) writer.write(e, estimator.core(), thermal.estimate());
     tally.count(e);
   }
+  tally.end_chain(estimator);
   std::fprintf(stderr, "rpem estimate: %s\n", tally.summary(cfg.estimator.algorithm, "averaged samples").c_str());
   tally.explain();
   if (!samples.empty())

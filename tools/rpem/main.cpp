@@ -51,6 +51,9 @@ int main(int argc, char** argv) {  // NOLINT(bugprone-exception-escape): only a 
   } catch (const rpem::io::DriveLogError& e) {
     std::fprintf(stderr, "rpem: drive-log error: %s\n", e.what());
     return kExitDataError;
+  } catch (const rpem::io::DataError& e) {
+    std::fprintf(stderr, "rpem: data error: %s\n", e.what());
+    return kExitDataError;
   } catch (const rpem::io::InputError& e) {
     std::fprintf(stderr, "rpem: %s\n", e.what());
     return kExitIoError;

@@ -36,11 +36,20 @@ struct ThermalFitCliOptions {
   int nodes = 0;              ///< --nodes; 0: not given (2 without a network to start from)
   int held_out_sessions = 0;  ///< --held-out-sessions: a folder's last sessions, judged and not fitted
   double fit_until_s = std::numeric_limits<double>::quiet_NaN();
-  double winding_sensor_sigma_K = 1.0;
+  std::optional<double> winding_sensor_sigma_K;  ///< --winding-sensor-sigma-K; wins over --start's
   double period_s = 0.0;
   double disturbance_time_constant_s = 0.0;  ///< 0: chosen by the likelihood
   bool keep_magnet_reference = false;
 };
+
+/// The winding sensor's σ where neither --winding-sensor-sigma-K nor --start gives one.
+constexpr double kDefaultWindingSensorSigma_K = 1.0;
+
+/// The winding sensor's σ: the option's, else --start's, else the default.
+double winding_sensor_sigma_K(const ThermalFitCliOptions& o, const io::ThermalConfig& laws) {
+  if (o.winding_sensor_sigma_K) return *o.winding_sensor_sigma_K;
+  return laws.fusion.winding_sensor_sigma_K > 0.0 ? laws.fusion.winding_sensor_sigma_K : kDefaultWindingSensorSigma_K;
+}
 
 /// How the notes name the winding sensor's column.
 constexpr const char* kWindingColumn = "the winding sensor (T_winding)";
@@ -64,8 +73,7 @@ analysis::ThermalRecord record_sessions(const ThermalFitCliOptions& o, const io:
     std::fprintf(stderr, "rpem thermal fit: %s\n", r.read_as.c_str());
     if (const std::string note = io::assumed_frame_note(r.counts); !note.empty())
       std::fprintf(stderr, "rpem thermal fit: note: %s\n", note.c_str());
-    const double sensor_sigma_K =
-        laws.fusion.winding_sensor_sigma_K > 0.0 ? laws.fusion.winding_sensor_sigma_K : o.winding_sensor_sigma_K;
+    const double sensor_sigma_K = winding_sensor_sigma_K(o, laws);
     const analysis::HeldWindingColumn held = analysis::drop_held_winding_readings(
         r, laws.fusion.filter.network.copper, sensor_sigma_K, laws.fusion.winding_sensor_time_constant_s);
     for (std::string& said : held.describe(kWindingColumn)) set_aside.push_back(std::move(said));
@@ -177,8 +185,7 @@ int run_thermal_fit(const ThermalFitCliOptions& o) {
   }
   std::vector<std::string> set_aside;
   analysis::ThermalRecord record = record_sessions(o, machine, laws, set_aside);
-  if (record.winding_sensor && laws.fusion.winding_sensor_sigma_K <= 0.0)
-    laws.fusion.winding_sensor_sigma_K = o.winding_sensor_sigma_K;
+  if (record.winding_sensor) laws.fusion.winding_sensor_sigma_K = winding_sensor_sigma_K(o, laws);
   const auto start_for = [&](const analysis::ThermalRecord& r) {
     return laws.has_network ? laws : analysis::default_topology(laws, r, o.nodes > 0 ? o.nodes : 2);
   };
@@ -256,7 +263,8 @@ Runner add_thermal_command(CLI::App& app) {
                   "a folder: judge its last N sessions, fit the ones before (instead of --fit-until-s)")
       ->check(CLI::PositiveNumber)
       ->excludes(until);
-  fit->add_option("--winding-sensor-sigma-K", opts->winding_sensor_sigma_K, "σ of the log's winding sensor (default 1 K)")
+  fit->add_option("--winding-sensor-sigma-K", opts->winding_sensor_sigma_K,
+                  "σ of the log's winding sensor (default: --start's winding_sensor_sigma_K, else 1 K)")
       ->check(CLI::Range(1e-3, 100.0));
   fit->add_option("--period-s", opts->period_s, "the filter's step (default: thermal.yaml's, 1 s)")
       ->check(CLI::Range(1e-3, 3600.0));

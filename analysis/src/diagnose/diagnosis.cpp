@@ -108,8 +108,9 @@ void calibrate_and_select(const EffectFitter& fitter, double floor, Diagnosis& d
   EffectSet start;
   const CalibrationIntervals excitation = fitter.intervals(start, floor);
   std::array<bool, kCalibrated.size()> admissible{};
+  const std::array<std::string_view, kCalibrated.size()> withheld = withheld_constants(d.context);
   for (std::size_t i = 0; i < kCalibrated.size(); ++i) {
-    admissible[i] = excitation.excitation_half_width[i] <= kIdentifiableHalfWidth;
+    admissible[i] = excitation.excitation_half_width[i] <= kIdentifiableHalfWidth && withheld[i].empty();
     start.calibrated[i] = d.calibration.identifiable[i] = admissible[i];
     d.calibration.configured[i] = d.context.base.machine.*kCalibratedFields[i];
   }
@@ -209,6 +210,7 @@ Diagnosis diagnose(LogData log, const io::MachineConfig& config, const DiagnoseO
   const ExtendedModel base =
       make_base_model(config.machine, config.estimator.extensions, config.rs_drift.law, config.psim_drift.law, *d.log);
   d.context = EffectContext::of(*d.log, config.machine, base, options.reference_C, f_sw);
+  d.context.frame_sensorless = config.estimator.regimes.sensorless;
 
   const WorkPool pool(std::max(1, options.jobs));
   const ModelReplay replay(*d.log, config.machine.rated, pool, options.monitor);

@@ -102,6 +102,8 @@ EffectContext EffectContext::of(const LogData& log, const core::MachineSi& machi
   c.sample_period_s = log.median_dt_s;
   c.mean_u_dc_V = log.mean_u_dc_V;
   c.switching_frequency_Hz = switching_frequency_Hz;
+  c.voltages_logged = std::none_of(log.session_voltage_rebuilt.begin(), log.session_voltage_rebuilt.end(),
+                                   [](bool rebuilt) { return rebuilt; });
   return c;
 }
 
@@ -120,9 +122,12 @@ Effect effect(std::string_view name, int phase) { return {&effect_row(name), pha
 
 std::vector<Effect> candidates(const EffectContext& c) {
   std::vector<Effect> out;
+  const std::array<std::string_view, kCalibrated.size()> withheld = withheld_constants(c);
   for (const EffectRow& r : catalogue()) {
     if (c.mode == ModelMode::kSteadyState && !r.steady_state) continue;
     if (r.applies && !r.applies(c)) continue;
+    if (r.fitted_constant() >= 0 && !withheld[static_cast<std::size_t>(r.fitted_constant())].empty()) continue;
+    if (r.name == "deadtime" && !withheld[1].empty()) continue;
     if (!r.per_phase) {
       out.push_back({&r, -1});
       continue;
@@ -132,8 +137,35 @@ std::vector<Effect> candidates(const EffectContext& c) {
   return out;
 }
 
+std::array<std::string_view, kCalibrated.size()> withheld_constants(const EffectContext& c) {
+  std::array<std::string_view, kCalibrated.size()> why{};
+  if (c.voltages_logged) return why;
+  // u_d = R_s·i_d − ω·L_q·i_q from the configuration (io/src/rotor_frame_rebuild.cpp): L_q's only steady-state column.
+  why[3] =
+      "u_d is rebuilt from the configured R_s and L_q (docs/drive-log.md, \"Logs without d/q values\"), so the d "
+      "axis holds the configuration's L_q, not the machine's";
+  if (c.frame_sensorless) {
+    why[1] =
+        "the voltages are rebuilt from the duty cycle's magnitude, which carries no back-EMF direction, so no "
+        "angle-lock test excludes the sensorless drive's open-loop start-ups, where R_s and a voltage along the "
+        "current are excited (docs/drive-log.md, \"Logs without d/q values\")";
+  }
+  return why;
+}
+
 std::vector<Unidentifiable> unobservable(const EffectContext& c) {
   std::vector<Unidentifiable> out;
+  // Constants withheld, with the effects that act through them (an effect's row points at the constant it frees or
+  // shapes; dead time is a voltage along the current, R_s' own column at standstill).
+  const std::array<std::string_view, kCalibrated.size()> withheld = withheld_constants(c);
+  for (std::size_t i = 0; i < kCalibrated.size(); ++i) {
+    if (withheld[i].empty()) continue;
+    Unidentifiable u{{kCalibrated[i]}, std::string(withheld[i])};
+    for (const EffectRow& r : catalogue()) {
+      if (r.fitted_constant() == static_cast<int>(i) || (i == 1 && r.name == "deadtime")) u.effects.emplace_back(r.name);
+    }
+    out.push_back(std::move(u));
+  }
   if (c.mode != ModelMode::kSteadyState) return out;
   for (const EffectRow& r : catalogue()) {
     if (r.steady_state) continue;

@@ -105,14 +105,17 @@ double panel(GnuplotFigure& fig, const io::CsvTable& est, const io::CsvTable* me
 ThermalFigureCoverage write_thermal_figure(const std::string& png_path, const ThermalFigureInput& in) {
   const io::CsvTable est = io::CsvTable::read(in.estimate_csv, /*allow_nan=*/true);
   if (!est.has("T_magnet_rpem")) {
-    throw io::InputError(in.estimate_csv, 1, 0, "header", "no thermal columns: write it with `rpem estimate --thermal`");
+    throw io::DataError(in.estimate_csv, 1, 0, "header", "no thermal columns: write it with `rpem estimate --thermal`");
   }
+  est.require_increasing("t");  // at() interpolates in it
+  // Measured temperatures may be NaN where a reading is missing (not plotted, not counted); their times may not.
   std::optional<io::CsvTable> measured;
   if (!in.measured_csv.empty()) {
     measured = io::CsvTable::read(in.measured_csv, /*allow_nan=*/true);
     for (const std::string& c : {std::string("t"), in.magnet_column, in.winding_column}) {
-      if (!measured->has(c)) throw io::InputError(in.measured_csv, 1, 0, c, "column missing from the header");
+      if (!measured->has(c)) throw io::DataError(in.measured_csv, 1, 0, c, "column missing from the header");
     }
+    measured->require_increasing("t");
   }
   GnuplotFigure fig(png_path, 1400, 800);
   fig.add_line("set multiplot layout 2,1");

@@ -461,6 +461,16 @@ AnchorPlan plan_anchor(io::ThermalConfig& c, const ThermalRecord& r, std::vector
                   sessions == 1 ? "the log" : ("the session " + r.session_logs[j]).c_str(), start_C, start_C - coolant_C,
                   coolant_C, core::kSoakBound_sigma, soak_test_sigma_K(c.fusion), std::abs(start_C - coolant_C));
     notes.emplace_back(text);
+    if (!r.coolant) {
+      // The coolant was not measured but taken from thermal.coolant_C: the test cannot tell a warm start from a
+      // coolant constant that is not the log's.
+      std::snprintf(text, sizeof text,
+                    "%s has no coolant column: the %.1f °C it is judged against is thermal.coolant_C, not a "
+                    "measurement. If the machine was at rest and cooled at the start, it is that constant that is "
+                    "off: set thermal.coolant_C to %.1f °C (the sensor's first reading) in --start, or log the coolant",
+                    sessions == 1 ? "the log" : ("the session " + r.session_logs[j]).c_str(), coolant_C, start_C);
+      notes.emplace_back(text);
+    }
   }
   return plan;
 }

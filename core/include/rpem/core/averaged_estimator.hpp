@@ -34,11 +34,19 @@ class AveragedDriveEstimator {
 
   /// θ̂ and the Hessians back to their initial values; the next sample starts a new chain.
   void reset() noexcept;
-  /// The next sample starts a new chain (adapts nothing).
+  /// The next sample starts a new chain (adapts nothing); the chain it breaks ends (end_chain()).
   void resynchronize() noexcept {
+    end_chain();
     has_previous_ = false;
     classifier_.break_chain();
   }
+  /// The chain ends (the log's end, a gap, a stream broken off): its newest window is never judged, since a
+  /// release inside it shows only in the window after it (docs/derivations.md §13, "Mixed windows"), so what
+  /// it adapted is retracted. A sample that does not continue the chain ends it the same way. Returns whether
+  /// θ̂ moved back. Real-time safe.
+  bool end_chain() noexcept;
+  /// Windows that ended a chain and were retracted by end_chain() (θ̂ moved back), since construction.
+  [[nodiscard]] std::uint64_t unjudged_windows() const noexcept { return unjudged_windows_; }
   void set_frozen(bool frozen) noexcept { core_.set_frozen(frozen); }
   void set_estimates(double psi_m_Wb, double r_s_Ohm) noexcept;
   /// Reloads gains, limits and model extensions, keeping θ̂ and the Hessians. Not real-time.
@@ -81,6 +89,9 @@ class AveragedDriveEstimator {
   SampleTiming timing_ = SampleTiming::kFirst;  ///< of the sample being stepped
   /// The core's adaptation before the previous sample: what a release found inside that window retracts (§13).
   RpemEstimator::Adaptation before_previous_{};
+  /// The previous sample is a window that adapted in a chain and awaits its successor's release test.
+  bool judge_pending_ = false;
+  std::uint64_t unjudged_windows_ = 0;
   Vec2 instrument_i_pu_ = Vec2::Zero();  ///< low-passed current of the samples before this one
   double instrument_n_pu_ = 0.0;
 };

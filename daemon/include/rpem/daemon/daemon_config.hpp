@@ -11,6 +11,7 @@
 
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include "rpem/core/thermal.hpp"
 #include "rpem/core/thermal_fusion.hpp"
@@ -102,6 +103,9 @@ struct DaemonConfig {
   std::string source_file;  ///< where it was loaded from ("<built-in>")
   LiveConfig live;
   FixedConfig fixed;
+  /// What the configuration leaves to an assumption a user should know of (io::assumed_law_notes: a magnet law
+  /// taken from the machine's ψm at 20 °C, a copper law's reference temperature); rpemd says each at start.
+  std::vector<std::string> notes;
 };
 
 [[nodiscard]] DaemonConfig load_daemon_config(const std::string& path);

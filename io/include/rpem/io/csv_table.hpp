@@ -1,6 +1,7 @@
 #pragma once
 // A small numeric CSV table (data files such as flux maps and bench profiles): a header row and
-// numeric cells. Every problem throws InputError with file, line and column.
+// numeric cells. Every problem throws InputError with file, line and column: DataError for the content (exit 65),
+// InputError where the file cannot be opened.
 
 #include <string>
 #include <vector>
@@ -16,8 +17,10 @@ class CsvTable {
   static CsvTable read(const std::string& path, bool allow_nan = false, const std::vector<std::string>& text_columns = {});
 
   [[nodiscard]] bool has(const std::string& name) const;
-  /// The column's values; throws InputError naming the file if it is missing.
+  /// The column's values; throws DataError naming the file if it is missing.
   [[nodiscard]] const std::vector<double>& column(const std::string& name) const;
+  /// Throws DataError at the first row whose value in column `name` is NaN or not above the row before's (a time).
+  void require_increasing(const std::string& name) const;
   [[nodiscard]] std::size_t rows() const noexcept { return rows_; }
   [[nodiscard]] const std::vector<std::string>& header() const noexcept { return header_; }
   [[nodiscard]] const std::string& path() const noexcept { return path_; }
@@ -27,6 +30,7 @@ class CsvTable {
   std::vector<std::string> header_;
   std::vector<std::vector<double>> columns_;
   std::size_t rows_ = 0;
+  std::vector<std::size_t> row_lines_;  ///< each row's line in the file (blank lines skipped)
 };
 
 }  // namespace rpem::io

@@ -30,9 +30,14 @@ class ConfigError : public InputError {
   using InputError::InputError;
 };
 
-/// Drive-log CSV problems.
-class DriveLogError : public InputError {
+/// A data file's content (a cell, a row, a header) is wrong, where the file itself could be read: tools exit 65.
+class DataError : public InputError {
   using InputError::InputError;
+};
+
+/// Drive-log CSV problems.
+class DriveLogError : public DataError {
+  using DataError::DataError;
 };
 
 /// Creates `directory` (and its parents) for a tool's output; InputError naming it and why where it cannot be (a

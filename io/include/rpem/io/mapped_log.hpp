@@ -74,6 +74,10 @@ class MappedLogReader {
   /// Throws DriveLogError at `line` and the quantity's cell (its column; 0 for a header-level problem).
   [[noreturn]] void fail_at(std::size_t line, Quantity q, const std::string& reason) const;
   [[noreturn]] void fail_at(std::size_t line, const std::string& column, const std::string& reason) const;
+  /// Refuses the header for what it lacks (a layout problem; "required …" reads "required column is missing from the
+  /// header …"), adding what the header suggests: another separator where it is a single cell holding one, a column
+  /// map (--log-map) where rpem's own format was assumed.
+  [[noreturn]] void fail_header(const LayoutProblem& problem) const;
 
  private:
   void read_header();

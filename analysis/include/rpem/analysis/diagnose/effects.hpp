@@ -59,6 +59,11 @@ struct EffectContext {
   double sample_period_s = 0.0;                     ///< median sample interval
   double mean_u_dc_V = 0.0;
   double switching_frequency_Hz = 0.0;  ///< 0: unknown (t_dead_s is then not reported)
+  /// Every session's voltages are logged d/q values; false where one's were rebuilt from the duty cycle's magnitude
+  /// (LogData::session_voltage_rebuilt; docs/drive-log.md, "Logs without d/q values").
+  bool voltages_logged = true;
+  /// The frame is a sensorless observer's or Hall sensors' (estimator.regimes.sensorless): it has open-loop start-ups.
+  bool frame_sensorless = false;
 
   /// `base`: the configuration's model as it replays on this log (make_base_model).
   [[nodiscard]] static EffectContext of(const LogData& log, const core::MachineSi& machine, const ExtendedModel& base,
@@ -193,6 +198,11 @@ inline constexpr std::array<const char*, 4> kCalibrated{"psi_m_Wb", "r_s_Ohm", "
 inline constexpr double kCalibrationScale = 0.01;
 /// A calibrated constant stays within ±50 % of the configuration's.
 inline constexpr double kCalibrationBound = 50.0;
+
+/// Why this log cannot identify each calibrated constant whatever its excitation (kCalibrated order; empty: it
+/// can): rebuilt voltages (docs/drive-log.md, "Logs without d/q values") hold the configuration in u_d, and with
+/// a sensorless frame no lock test excludes the open-loop start-ups where R_s is excited.
+[[nodiscard]] std::array<std::string_view, 4> withheld_constants(const EffectContext& c);
 
 /// The machine's fields in kCalibrated order.
 inline constexpr std::array<double core::MachineSi::*, 4> kCalibratedFields{
