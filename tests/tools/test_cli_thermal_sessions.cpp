@@ -268,9 +268,13 @@ TEST_F(CliThermalSessions, SessionsWithoutASensorOrAStepAreTakenAsTheyAre) {
   write_start("sensor.json");
   write_folder("uneven", {"sensor", "no_sensor"});
   { std::ofstream(at("uneven/3_short.csv")) << "t,i_d,i_q,u_d,u_q,omega_el\n0,0,0,0,0,0\n0.5,0,0,0,0,0\n"; }
-  const test::ProcessResult r = test::run_command(rpem_tool() + " thermal fit --log " + at("uneven") + pmsm_config() +
-                                                  " --start " + at("start.yaml") + " --out " + at("uneven.yaml"));
+  // --winding-sensor-sigma-K, given, wins over --start's sigma_K of 1 K (before 2026-12-04 --start's won).
+  const test::ProcessResult r =
+      test::run_command(rpem_tool() + " thermal fit --log " + at("uneven") + pmsm_config() + " --start " + at("start.yaml") +
+                        " --winding-sensor-sigma-K 0.5 --out " + at("uneven.yaml"));
   ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(test::read_file(at("uneven.yaml")).find("winding_sensor: {sigma_K: 0.5,"), std::string::npos)
+      << test::read_file(at("uneven.yaml"));
   EXPECT_NE(r.output.find(at("uneven") + "/3_short.csv gives no step of the thermal filter (1 s): left out"),
             std::string::npos)
       << r.output;
