@@ -129,6 +129,7 @@ Estimate AveragedDriveEstimator::step(const AveragedSample& sample) noexcept {
     }
     previous_centre2_ns_ = sample.t_start_ns + sample.t_ns;
     previous_i_pu_ = s.i_meas_pu;
+    judge_pending_ = false;  // without regimes no window is judged, nor retracted
     return finish(sample, s, core_.step_steady_state(s, gains.hessian, gains.gain, Admission{}), kUnclassified, point,
                   gains);
   }
@@ -146,13 +147,18 @@ Estimate AveragedDriveEstimator::step(const AveragedSample& sample) noexcept {
   in.u_reported_pu = Vec2(base_.voltage_pu(sample.u_dq_V[0]), base_.voltage_pu(sample.u_dq_V[1]));
   in.i_reported_pu = Vec2(base_.current_pu(sample.i_dq_A[0]), base_.current_pu(sample.i_dq_A[1]));
   in.weight = gains.gain;
-  // A sample that does not continue the chain leaves the previous window unjudged (§13, "Mixed windows").
-  if (timing_ != SampleTiming::kContiguous) end_chain();
   const Classification regime = classifier_.step(in);
-  // A release inside the previous window (§13, "Mixed windows"): what it adapted is undone.
-  if (regime.bits & regime_bit::kPreviousMixed) core_.retract(before_previous_);
+  // Only a finite window continuing the chain judges the previous one (§13, "Mixed windows"): a release found inside
+  // it undoes what it adapted. Any other sample (a gap, an instantaneous or a non-finite one) ends the chain with the
+  // previous window unjudged, and it is undone all the same ("A chain's last window").
+  const bool judges = in.window_s > 0.0 && timing_ == SampleTiming::kContiguous && regime.regime != Regime::kInvalid;
+  if (!judges) {
+    end_chain();
+  } else if ((regime.bits & regime_bit::kPreviousMixed) && !core_.state().frozen) {
+    core_.retract(before_previous_);
+  }
   before_previous_ = core_.adaptation();
-  judge_pending_ = in.window_s > 0.0 && timing_ == SampleTiming::kContiguous && !regime.excluded();
+  judge_pending_ = judges && !regime.excluded();
   if (options_.inductive_correction && timing_ == SampleTiming::kContiguous) {
     // (x/ω_n)·di/dt with di/dt from the means of consecutive windows, between their centres (§11).
     const Vec2& di_dt = classifier_.slope_pu_s();
@@ -185,6 +191,7 @@ Estimate AveragedDriveEstimator::finish(const AveragedSample& sample, const Stea
 bool AveragedDriveEstimator::end_chain() noexcept {
   if (!judge_pending_) return false;
   judge_pending_ = false;
+  if (core_.state().frozen) return false;  // frozen: nothing moves θ̂, a retraction neither
   const Vec2 theta_pu = core_.state().theta_pu;
   core_.retract(before_previous_);
   before_previous_ = core_.adaptation();
@@ -213,6 +220,9 @@ void AveragedDriveEstimator::reconfigure(const MachineSi& machine, const Estimat
   base_ = PerUnitBase::from_rated(machine.rated);
   conditioner_.reconfigure(base_, to_pu(base_, machine), rotor_frame_extensions(settings.extensions));
   core_.reconfigure(make_estimator_config(base_, machine, settings));
+  // A saved adaptation is of the old bounds (θ̂ was projected onto the new ones): no retraction reaches across a reload.
+  before_previous_ = core_.adaptation();
+  judge_pending_ = false;
   classifier_.reconfigure(make_regime_config(base_, machine, settings));
   configure(settings);
 }

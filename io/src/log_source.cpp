@@ -136,13 +136,11 @@ std::string describe(const LogSource& source, const AveragedLogRead& read) {
          "after the logger asked again, or a count its stamps cannot hold; docs/drive-log.md, \"Rows stamped late\")";
     // Over a tenth (where the regimes' rules name their keys too): the key that decides which rows are late replies.
     if (10 * read.unknown_windows > read.rows && source.map.request_timeout_s > 0.0) {
-      char key[320];
-      std::snprintf(key, sizeof key,
-                    ". Key: request_timeout_s, %.4g s in %s (a row that long after the one before is taken for a reply "
-                    "to a request asked again); a logger that waits longer for its replies needs a copy of the map with "
-                    "its own timeout (--log-map)",
-                    source.map.request_timeout_s, source.map.name.c_str());
-      s += key;
+      char timeout[32];
+      std::snprintf(timeout, sizeof timeout, "%.4g", source.map.request_timeout_s);
+      s += std::string(". Key: request_timeout_s, ") + timeout + " s in " + source.map.name +
+           " (a row that long after the one before is taken for a reply to a request asked again); a logger that waits "
+           "longer for its replies needs a copy of the map with its own timeout (--log-map)";
     }
   }
   if (source.map.speed_pll.given()) {

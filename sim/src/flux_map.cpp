@@ -33,7 +33,7 @@ FluxMap FluxMap::load_csv(const std::string& path) {
   q_axis.erase(std::unique(q_axis.begin(), q_axis.end()), q_axis.end());
   const std::size_t n = d_axis.size() * q_axis.size();
   if (t.rows() != n) {
-    throw io::InputError(
+    throw io::DataError(
         path, 0, 0, "",
         "expected a full grid of " + std::to_string(n) + " points, found " + std::to_string(t.rows()) + " rows");
   }

@@ -201,11 +201,15 @@ TEST(AveragedEstimator, InstantaneousSamplesAreAcceptedWithTheirSpacing) {
 TEST(AveragedEstimator, NonFiniteSampleIsRejectedAndTheChainRestarts) {
   auto g = averaged_generator(200.0, 0.4, 0.5, 0.95);
   AveragedDriveEstimator est(test::paper_machine_si(), test::paper_settings());
-  for (int k = 0; k < 10; ++k) (void)est.step(g.next());
+  for (int k = 0; k < 9; ++k) (void)est.step(g.next());
   const Vec2 theta = est.core().state().theta_pu;
+  (void)est.step(g.next());
+  EXPECT_NE(est.core().state().theta_pu, theta);
   AveragedSample bad = g.next();
   bad.u_dq_V[1] = std::nan("");
   EXPECT_EQ(est.step(bad).detail.code, StepCode::kRejectedNonFinite);
+  // It adapts nothing, and the window before it, which it cannot judge for a bridge release inside, is retracted
+  // (docs/derivations.md §13, "A chain's last window").
   EXPECT_EQ(est.core().state().theta_pu, theta);
   EXPECT_EQ(est.step(g.next()).detail.code, StepCode::kAdapted);  // the last finite sample anchors the chain
 }

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <random>
 
 #include "rpem/core/averaged_estimator.hpp"
@@ -188,8 +189,9 @@ TEST(RegimeEstimators, AChainsLastWindowIsNeverJudgedAndIsLeftOut) {
     w.omega_el_rad_s = omega;
     return w;
   };
-  enum class Next { kNone, kGap, kLost };  // the log ends; a flagged gap; windows lost (starts 3 windows late)
-  for (const Next next : {Next::kNone, Next::kGap, Next::kLost}) {
+  // The log ends; a flagged gap; windows lost (the next starts 3 windows late); a non-finite window in its place.
+  enum class Next { kNone, kGap, kLost, kNonFinite };
+  for (const Next next : {Next::kNone, Next::kGap, Next::kLost, Next::kNonFinite}) {
     AveragedDriveEstimator est(test::outrunner_machine_si(), settings);
     for (int j = 0; j < 20; ++j) (void)est.step(window(j, 1.0));
     const double psi_before_mixed = est.psi_m_Wb();
@@ -199,15 +201,24 @@ TEST(RegimeEstimators, AChainsLastWindowIsNeverJudgedAndIsLeftOut) {
       EXPECT_TRUE(est.end_chain());
       EXPECT_FALSE(est.end_chain());  // once
     } else {
-      AveragedSample off = window(next == Next::kGap ? 21 : 24, 0.0);
+      AveragedSample off = window(next == Next::kLost ? 24 : 21, 0.0);
       off.gap_before = next == Next::kGap;
+      if (next == Next::kNonFinite) off.i_dq_A[1] = std::numeric_limits<double>::quiet_NaN();
       const Estimate e = est.step(off);
-      EXPECT_EQ(e.detail.code, StepCode::kSynchronized);
+      EXPECT_EQ(e.regime.regime, next == Next::kNonFinite ? Regime::kInvalid : Regime::kBridgeOff);
       EXPECT_FALSE(e.regime.bits & regime_bit::kPreviousMixed);  // not judged: its chain ended
-      EXPECT_FALSE(est.end_chain());                             // an off window adapted nothing
+      EXPECT_FALSE(est.end_chain());                             // the sample after it adapted nothing
     }
     EXPECT_EQ(est.psi_m_Wb(), psi_before_mixed) << static_cast<int>(next);  // undone, exactly
     EXPECT_EQ(est.unjudged_windows(), 1U);
+  }
+  {  // Frozen (rpemd's freeze command), nothing moves θ̂: not a retraction either.
+    AveragedDriveEstimator est(test::outrunner_machine_si(), settings);
+    for (int j = 0; j <= 20; ++j) (void)est.step(window(j, j < 20 ? 1.0 : 0.5));
+    const double psi_frozen = est.psi_m_Wb();
+    est.set_frozen(true);
+    EXPECT_FALSE(est.end_chain());
+    EXPECT_EQ(est.psi_m_Wb(), psi_frozen);
   }
   // A window judged by its successor stays: the chain's last, unjudged, alone is left out, and only once.
   AveragedDriveEstimator est(test::outrunner_machine_si(), settings);

@@ -461,7 +461,7 @@ AnchorPlan plan_anchor(io::ThermalConfig& c, const ThermalRecord& r, std::vector
                   sessions == 1 ? "the log" : ("the session " + r.session_logs[j]).c_str(), start_C, start_C - coolant_C,
                   coolant_C, core::kSoakBound_sigma, soak_test_sigma_K(c.fusion), std::abs(start_C - coolant_C));
     notes.emplace_back(text);
-    if (!r.coolant) {
+    if (!r.session_has_coolant(j)) {
       // The coolant was not measured but taken from thermal.coolant_C: the test cannot tell a warm start from a
       // coolant constant that is not the log's.
       std::snprintf(text, sizeof text,

@@ -61,6 +61,7 @@ ThermalRecord join_sessions(std::vector<ThermalRecord> sessions, const std::stri
     const double shift_s = out.t_s.empty() ? 0.0 : out.t_s.back() + s.steps.front().load.dt_s - s.t_s.front();
     out.session_first_step.push_back(out.steps.size());
     out.session_logs.push_back(s.log);
+    out.session_coolant.push_back(s.coolant);
     out.steps.insert(out.steps.end(), s.steps.begin(), s.steps.end());
     for (double t : s.t_s) out.t_s.push_back(t + shift_s);
     out.winding_sensor = out.winding_sensor || s.winding_sensor;
@@ -87,6 +88,7 @@ ThermalRecord record_thermal(const io::LogSource& source, const io::MachineConfi
         io::complete_rotor_frame(samples, read, machine.machine, io::command_hold_s(machine.estimator), source.path);
     r.winding_sensor = read.layout.t_winding;
     r.coolant = read.layout.t_coolant;
+    r.session_coolant = {r.coolant};
     r.read_as = io::describe(source, read) + (rebuilt.any() ? "; " + rebuilt.describe() : "");
     core::AveragedDriveEstimator estimator(machine.machine, io::estimator_settings(machine, rebuilt));
     Recorder rec(r, machine, thermal, estimator.base());
@@ -97,6 +99,7 @@ ThermalRecord record_thermal(const io::LogSource& source, const io::MachineConfi
   io::check_log_supports(machine, "configuration", reader.layout().u_dc, source.path);
   r.winding_sensor = reader.layout().t_winding;
   r.coolant = reader.layout().t_coolant;
+  r.session_coolant = {r.coolant};
   core::DriveEstimator estimator(machine.machine, machine.estimator);
   Recorder rec(r, machine, thermal, estimator.base());
   io::DriveLogRow row;

@@ -28,6 +28,12 @@ struct ThermalRecord {
   /// its first step (core::start_temperatures_C) — and its steps' t_s follow the session before's end.
   std::vector<std::size_t> session_first_step{0};
   std::vector<std::string> session_logs;  ///< each session's log, in that order
+  std::vector<bool> session_coolant;      ///< whether each session's log has T_coolant, in that order
+
+  /// Whether session j's log has T_coolant (a record built without session_coolant: the record's own flag).
+  [[nodiscard]] bool session_has_coolant(std::size_t j) const {
+    return j < session_coolant.size() ? session_coolant[j] : coolant;
+  }
 
   /// Whether step k is the first of a session.
   [[nodiscard]] bool starts_session(std::size_t k) const;
