@@ -123,33 +123,46 @@ TEST(RegimeEstimators, WindowLengthAloneNeverResynchronises) {
   EXPECT_NEAR(est.psi_m_Wb() / drive.psi_m_Wb, 1.0, 0.02);
 }
 
-TEST(RegimeEstimators, AReleaseInsideAWindowRetractsWhatThatWindowAdapted) {
-  // §13, "Mixed windows": 90 ms windows of the outrunner (ψm 15 % below the configuration) at 1500 rad/s and
-  // 5 A; the bridge is released half-way through window 20 and the drive reports zeros while off. Window 20
-  // reads ψm at half (inside D_M) and adapts; window 21, the first off one, marks it mixed and the estimator
-  // goes back to where it stood before window 20 — exactly.
-  MachineSi truth = test::outrunner_machine_si();
-  truth.psi_m_Wb *= 0.85;
-  const double h = 0.09, omega = 1500.0;
-  const Vec2 i(0.0, 5.0);
-  const Vec2 u(truth.r_s_Ohm * i[0] - omega * truth.l_q_H * i[1],
-               truth.r_s_Ohm * i[1] + omega * (truth.l_d_H * i[0] + truth.psi_m_Wb));
-  EstimatorSettings settings = test::outrunner_settings();
-  settings.regimes.voltage_resolution_V = 0.01;
-  settings.regimes.current_resolution_A = 0.01;
-  AveragedDriveEstimator est(test::outrunner_machine_si(), settings);
-  double psi_before_mixed = 0.0, psi_after_mixed = 0.0;
-  RegimeCounts counts;
-  for (int j = 0; j < 26; ++j) {
-    const double share = j < 20 ? 1.0 : (j == 20 ? 0.5 : 0.0);
+/// §13, "Mixed windows": 90 ms windows of the outrunner (ψm 15 % below the configuration) at 1500 rad/s and 5 A, from
+/// its steady-state equations; `share` of each window modulating, zeros reported while off. Read with 10 mV / 10 mA.
+struct ReleaseWindows {
+  MachineSi truth = [] {
+    MachineSi m = test::outrunner_machine_si();
+    m.psi_m_Wb *= 0.85;
+    return m;
+  }();
+  double h = 0.09, omega = 1500.0;
+  Vec2 i = Vec2(0.0, 5.0);
+  Vec2 u = Vec2(truth.r_s_Ohm * i[0] - omega * truth.l_q_H * i[1],
+                truth.r_s_Ohm* i[1] + omega * (truth.l_d_H * i[0] + truth.psi_m_Wb));
+
+  [[nodiscard]] AveragedSample window(int j, double share) const {
     AveragedSample w;
     w.t_start_ns = std::llround(j * h * 1e9);
     w.t_ns = std::llround((j + 1) * h * 1e9);
     w.i_dq_A = share * i;
     w.u_dq_V = share * u;
     w.omega_el_rad_s = omega;
+    return w;
+  }
+  [[nodiscard]] static EstimatorSettings settings() {
+    EstimatorSettings s = test::outrunner_settings();
+    s.regimes.voltage_resolution_V = 0.01;
+    s.regimes.current_resolution_A = 0.01;
+    return s;
+  }
+};
+
+TEST(RegimeEstimators, AReleaseInsideAWindowRetractsWhatThatWindowAdapted) {
+  // The bridge is released half-way through window 20. Window 20 reads ψm at half (inside D_M) and adapts; window 21,
+  // the first off one, marks it mixed and the estimator goes back to where it stood before window 20 — exactly.
+  const ReleaseWindows r;
+  AveragedDriveEstimator est(test::outrunner_machine_si(), ReleaseWindows::settings());
+  double psi_before_mixed = 0.0, psi_after_mixed = 0.0;
+  RegimeCounts counts;
+  for (int j = 0; j < 26; ++j) {
     if (j == 20) psi_before_mixed = est.psi_m_Wb();
-    const Estimate e = est.step(w);
+    const Estimate e = est.step(r.window(j, j < 20 ? 1.0 : (j == 20 ? 0.5 : 0.0)));
     counts.add(e.regime);
     if (j == 20) {
       EXPECT_FALSE(e.regime.excluded());
@@ -162,33 +175,18 @@ TEST(RegimeEstimators, AReleaseInsideAWindowRetractsWhatThatWindowAdapted) {
   }
   EXPECT_LT(psi_after_mixed, 0.9 * psi_before_mixed);  // what the mixed window did (γ ≈ 0.3 per window)
   EXPECT_EQ(est.psi_m_Wb(), psi_before_mixed);         // and undid
-  EXPECT_NEAR(psi_before_mixed / truth.psi_m_Wb, 1.0, 0.01);
+  EXPECT_NEAR(psi_before_mixed / r.truth.psi_m_Wb, 1.0, 0.01);
   EXPECT_EQ(counts[Regime::kTransient], 1U);
   EXPECT_EQ(counts[Regime::kBridgeOff], 5U);
 }
 
 TEST(RegimeEstimators, AChainsLastWindowIsNeverJudgedAndIsLeftOut) {
   // §13, "Mixed windows": a release shows only in the window after it, so a window no window of its chain
-  // follows — at the log's end, or before a gap — is unjudged and retracted (end_chain()). The windows of the
-  // test above: the release half-way through window 20; here nothing adjacent follows it.
-  MachineSi truth = test::outrunner_machine_si();
-  truth.psi_m_Wb *= 0.85;
-  const double h = 0.09, omega = 1500.0;
-  const Vec2 i(0.0, 5.0);
-  const Vec2 u(truth.r_s_Ohm * i[0] - omega * truth.l_q_H * i[1],
-               truth.r_s_Ohm * i[1] + omega * (truth.l_d_H * i[0] + truth.psi_m_Wb));
-  EstimatorSettings settings = test::outrunner_settings();
-  settings.regimes.voltage_resolution_V = 0.01;
-  settings.regimes.current_resolution_A = 0.01;
-  auto window = [&](int j, double share) {
-    AveragedSample w;
-    w.t_start_ns = std::llround(j * h * 1e9);
-    w.t_ns = std::llround((j + 1) * h * 1e9);
-    w.i_dq_A = share * i;
-    w.u_dq_V = share * u;
-    w.omega_el_rad_s = omega;
-    return w;
-  };
+  // follows — at the log's end, or before a gap — is unjudged and retracted (end_chain()). The release half-way
+  // through window 20, as above; here nothing adjacent follows it.
+  const ReleaseWindows r;
+  const EstimatorSettings settings = ReleaseWindows::settings();
+  const auto window = [&r](int j, double share) { return r.window(j, share); };
   // The log ends; a flagged gap; windows lost (the next starts 3 windows late); a non-finite window in its place.
   enum class Next { kNone, kGap, kLost, kNonFinite };
   for (const Next next : {Next::kNone, Next::kGap, Next::kLost, Next::kNonFinite}) {
