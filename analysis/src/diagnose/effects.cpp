@@ -120,14 +120,31 @@ const EffectRow& effect_row(std::string_view name) {
 
 Effect effect(std::string_view name, int phase) { return {&effect_row(name), phase}; }
 
+namespace {
+
+/// Whether the effect acts through calibrated constant i: the one its row frees or shapes, and dead time through R_s
+/// (a voltage along the current, R_s' own column at standstill).
+bool acts_through(const EffectRow& r, std::size_t i) {
+  return r.fitted_constant() == static_cast<int>(i) || (i == 1 && r.name == "deadtime");
+}
+
+/// Whether a constant the effect acts through is withheld from this log (withheld_constants).
+bool acts_through_withheld(const EffectRow& r, const std::array<std::string_view, kCalibrated.size()>& withheld) {
+  for (std::size_t i = 0; i < withheld.size(); ++i) {
+    if (!withheld[i].empty() && acts_through(r, i)) return true;
+  }
+  return false;
+}
+
+}  // namespace
+
 std::vector<Effect> candidates(const EffectContext& c) {
   std::vector<Effect> out;
   const std::array<std::string_view, kCalibrated.size()> withheld = withheld_constants(c);
   for (const EffectRow& r : catalogue()) {
     if (c.mode == ModelMode::kSteadyState && !r.steady_state) continue;
     if (r.applies && !r.applies(c)) continue;
-    if (r.fitted_constant() >= 0 && !withheld[static_cast<std::size_t>(r.fitted_constant())].empty()) continue;
-    if (r.name == "deadtime" && !withheld[1].empty()) continue;
+    if (acts_through_withheld(r, withheld)) continue;
     if (!r.per_phase) {
       out.push_back({&r, -1});
       continue;
@@ -155,14 +172,13 @@ std::array<std::string_view, kCalibrated.size()> withheld_constants(const Effect
 
 std::vector<Unidentifiable> unobservable(const EffectContext& c) {
   std::vector<Unidentifiable> out;
-  // Constants withheld, with the effects that act through them (an effect's row points at the constant it frees or
-  // shapes; dead time is a voltage along the current, R_s' own column at standstill).
+  // Constants withheld, with the effects that act through them.
   const std::array<std::string_view, kCalibrated.size()> withheld = withheld_constants(c);
   for (std::size_t i = 0; i < kCalibrated.size(); ++i) {
     if (withheld[i].empty()) continue;
     Unidentifiable u{{kCalibrated[i]}, std::string(withheld[i])};
     for (const EffectRow& r : catalogue()) {
-      if (r.fitted_constant() == static_cast<int>(i) || (i == 1 && r.name == "deadtime")) u.effects.emplace_back(r.name);
+      if (acts_through(r, i)) u.effects.emplace_back(r.name);
     }
     out.push_back(std::move(u));
   }
