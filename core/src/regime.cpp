@@ -113,6 +113,23 @@ bool track_resolution(double& q, double change) noexcept {
   return remnant.squaredNorm() > 0.0 && remnant.cwiseProduct(remnant).maxCoeff() > bound ? regime_bit::kTransient : 0;
 }
 
+/// Whether window m's flux leaves both a's and b's on one side: each difference beyond what the configuration's
+/// tolerance does over the operating points' difference (and stated speed errors), by more than z·σ of the difference.
+bool flux_leaves_both(const WindowFlux& m, const WindowFlux& a, const WindowFlux& b, const RegimeNoise& noise,
+                      const RegimeConfig& c, double dx_q_over_omega_n, double z_sq) noexcept {
+  const double var_m = m.variance(noise);
+  const auto side = [&](const WindowFlux& o) {
+    const double d = m.psi_pu - o.psi_pu;
+    const double reach = c.dr_pu * std::abs(m.lever_r - o.lever_r) + c.dx_d_pu * std::abs(m.lever_x_d - o.lever_x_d) +
+                         dx_q_over_omega_n * std::abs(m.lever_x_q - o.lever_x_q) + (m.bias_pu + o.bias_pu);
+    const double excess = std::abs(d) - reach;
+    const bool beyond = excess > 0.0 && excess * excess > z_sq * (var_m + o.variance(noise));
+    return beyond ? (d > 0.0 ? 1 : -1) : 0;
+  };
+  const int left = side(a);
+  return left != 0 && left == side(b);
+}
+
 /// learn()'s noise medians while a quantity warms up or a nonzero residual meets a zero median (which starts
 /// a warm-up): each quantity's residuals in their order, d then q. Out of line: the common path stays as small as it was.
 [[gnu::noinline]] void learn_noise_warming(RegimeState& s, const Vec2& ru, const Vec2& ri, double rn) noexcept {
@@ -236,6 +253,7 @@ void RegimeClassifier::reconfigure(const RegimeConfig& config) noexcept {
   const double cos_least = std::max(k.cos_angle, k.cos_hall);
   const double dpsi_frame = c.dpsi_pu + (c.sensorless ? c.psi_max_pu * std::sqrt(2.0 * (1.0 - cos_least)) : 0.0);
   k.dpsi_frame_sq = dpsi_frame * dpsi_frame;
+  k.dx_q_over_omega_n = k.inv_omega_n * c.dx_q_pu;
   update_quantisation();
 }
 
@@ -380,6 +398,61 @@ std::uint8_t RegimeClassifier::contiguous_transient_bits(const RegimeInput& in, 
   return transient ? regime_bit::kTransient : 0;
 }
 
+// A window's flux against its neighbours (§13, "… inside one window"). A release and a take-over both inside one
+// window leave its means m times the modulating ones where the drive reports zeros while off: the flux reads m·ψm,
+// which no test of the window alone tells from a machine with that flux, but its neighbours do. The steady state mixed
+// over a window (a load changed inside it, a ramp) is linear in u, i at the window's speed, so its flux lies between
+// its neighbours' but for what Δr and Δx do over the operating points' difference. A window whose flux leaves both
+// on one side beyond that and the noise is mixed with something the model does not describe: judged one window late,
+// against this window and the last one before it not found mixed. Only windows admitted as exciting ψm take part.
+std::uint8_t RegimeClassifier::flux_excursion_bits(const RegimeInput& in, const Terms& t, std::uint8_t bits) noexcept {
+  RegimeState& s = state_;
+  // A chain's first window (after a gap) adapts nothing and is never judged, but it is the next one's left neighbour.
+  const bool chained = in.timing == SampleTiming::kContiguous || in.timing == SampleTiming::kFirst;
+  const bool candidate = in.window_s > 0.0 && chained && s.noise_known && (bits & regime_bit::kExcluded) == 0 &&
+                         (bits & regime_bit::kExcitesPsiM) != 0;
+  if (!candidate) {
+    s.flux_previous.valid = s.flux_reference.valid = false;
+    return 0;
+  }
+  WindowFlux here = window_flux(in, t);
+  // A median still warming up is the median of a few residuals (§13, "Start (warm-up)"): no window entering then is
+  // judged on it.
+  here.settled = (s.noise_warm_up_left[0] | s.noise_warm_up_left[1] | s.noise_warm_up_left[2]) == 0;
+  const WindowFlux& judged = s.flux_previous;
+  const bool mixed = judged.valid && judged.settled && s.flux_reference.valid &&
+                     flux_leaves_both(judged, s.flux_reference, here, s.flux_noise, config_, k_.dx_q_over_omega_n, k_.z_sq);
+  if (!mixed) s.flux_reference = s.flux_previous;
+  s.flux_previous = here;
+  s.flux_noise = noise_;
+  return mixed ? regime_bit::kPreviousMixed : 0;
+}
+
+WindowFlux RegimeClassifier::window_flux(const RegimeInput& in, const Terms& t) const noexcept {
+  const RegimeConfig& c = config_;
+  const Constants& k = k_;
+  const Vec2& i = in.i_pu;
+  const double n = in.n_pu, inv_n = 1.0 / n, inv_n_sq = inv_n * inv_n;
+  RPEM_ASSERT(n != 0.0, "a window that excites ψm turns");
+  const double slope_q = t.slope[1];
+  WindowFlux f;
+  f.psi_pu = (in.u_pu[1] - c.r_pu * i[1] - k.x_over_omega_n[1] * slope_q - n * c.x_d_pu * i[0]) * inv_n;
+  // Noise: the q row's (σ_u² + (r² + n²·x_d²)·σ_i²), the slope's with 3·σ_i²/Δt² (neighbours' slopes share a mean:
+  // their difference holds 2·i_k − i_{k−1} − i_{k+1}, 6·σ_i²/Δt², half to each), and the speed's through the flux.
+  const double flux_q = c.psi_max_pu + c.x_d_pu * std::abs(i[0]);
+  const double flux_q_sq = flux_q * flux_q;
+  f.var_per_u = inv_n_sq;
+  f.var_per_i = (k.r_sq + t.n2_x2[1] + 3.0 * t.inv_dt * t.inv_dt * k.slope_var_x_sq[1]) * inv_n_sq;
+  f.var_per_n = flux_q_sq * inv_n_sq;
+  f.var_stated_pu = flux_q_sq * (in.n_error_noise_pu * in.n_error_noise_pu) * inv_n_sq;
+  f.bias_pu = flux_q * std::abs(in.n_error_pu * inv_n);
+  f.lever_r = i[1] * inv_n;
+  f.lever_x_d = i[0];
+  f.lever_x_q = slope_q * inv_n;
+  f.valid = true;
+  return f;
+}
+
 // A speed off by up to E (a tracker's reads rebuilt to the window's mean, §13 "Speed at the read", "… where the
 // acceleration changes"): the steady state's speed terms n·(−x_q·i_q, x_d·i_d + ψm) are then off by up to
 // E·(x_q·|i_q|, x_d·|i_d| + ψ_max), which the inductive correction and the slope terms do not see where the current
@@ -510,6 +583,7 @@ Classification RegimeClassifier::step(const RegimeInput& in) noexcept {
   }
   s.previous_window = window;
   s.previous_bridge_off = off;
+  bits |= flux_excursion_bits(in, t, bits);
   if (learn(s, in, t_s, w)) [[unlikely]]
     update_quantisation();
   if (standalone) [[unlikely]]

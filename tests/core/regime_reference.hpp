@@ -49,6 +49,15 @@ struct State {
   bool previous_transient = false;  ///< the previous sample's own slope test failed (the junction straddles)
   /// The chain's previous sample: a window (averaged), and whether it was bridge off (mixed windows).
   bool previous_window = false, previous_bridge_off = false;
+  /// A window's flux against its neighbours: the window awaiting judgement, the last one before it not found mixed,
+  /// and the noise before the first of them entered.
+  struct Flux {
+    double psi = 0.0, var_per_u = 0.0, var_per_i = 0.0, var_per_n = 0.0, var_stated = 0.0, bias = 0.0;
+    double lever_r = 0.0, lever_x_d = 0.0, lever_x_q = 0.0;
+    bool valid = false, settled = false;
+  };
+  Flux flux_previous{}, flux_reference{};
+  RegimeNoise flux_noise{};
 };
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
@@ -146,6 +155,7 @@ class Classifier {
     state_.points = state_.chained = 0;
     state_.slope_valid = state_.previous_slope_valid = false;
     state_.previous_window = state_.previous_bridge_off = false;
+    state_.flux_previous.valid = state_.flux_reference.valid = false;
   }
   [[nodiscard]] const RegimeNoise& noise() const noexcept { return noise_; }
   [[nodiscard]] const Vec2& slope_pu_s() const noexcept { return state_.slope_pu_s; }
@@ -357,12 +367,69 @@ class Classifier {
     }
     s.previous_window = window;
     s.previous_bridge_off = off;
+    bits |= flux_bits(in, bits);
     if (learn(s, in, t_s)) [[unlikely]]
       update_quantisation();
     return core::Classification::of(bits);
   }
 
  private:
+  /// A freewheel inside one window (§13): the previous window's ψ = e_q/n outside both its neighbours' (this window's,
+  /// and the last before it not found mixed) on one side, each difference beyond the tolerance's reach over the
+  /// levers plus z·σ; judged on the noise before it entered, and only where no median was warming up then.
+  std::uint8_t flux_bits(const RegimeInput& in, std::uint8_t bits) noexcept {
+    const RegimeConfig& c = config_;
+    const Constants& k = k_;
+    State& s = state_;
+    const bool chained = in.timing == SampleTiming::kContiguous || in.timing == SampleTiming::kFirst;
+    const bool candidate = in.window_s > 0.0 && chained && s.noise_known && (bits & regime_bit::kExcluded) == 0 &&
+                           (bits & regime_bit::kExcitesPsiM) != 0;
+    if (!candidate) {
+      s.flux_previous.valid = s.flux_reference.valid = false;
+      return 0;
+    }
+    const double n = in.n_pu, inv_n = 1.0 / n, inv_n_sq = inv_n * inv_n;
+    const double i_d = in.i_pu[0], i_q = in.i_pu[1], s_q = s.slope_pu_s[1];
+    State::Flux f;
+    f.psi = (in.u_pu[1] - c.r_pu * i_q - k.x_over_omega_n[1] * s_q - n * c.x_d_pu * i_d) * inv_n;
+    const double flux_q = c.psi_max_pu + c.x_d_pu * std::abs(i_d);
+    const double flux_q_sq = flux_q * flux_q;
+    const double n2_xd2 = n * n * c.x_d_pu * c.x_d_pu;
+    f.var_per_u = inv_n_sq;
+    f.var_per_i = (k.r_sq + n2_xd2 + 3.0 * s.inv_dt * s.inv_dt * k.slope_var_x_sq[1]) * inv_n_sq;
+    f.var_per_n = flux_q_sq * inv_n_sq;
+    f.var_stated = flux_q_sq * (in.n_error_noise_pu * in.n_error_noise_pu) * inv_n_sq;
+    f.bias = flux_q * std::abs(in.n_error_pu * inv_n);
+    f.lever_r = i_q * inv_n;
+    f.lever_x_d = i_d;
+    f.lever_x_q = s_q * inv_n;
+    f.valid = true;
+    f.settled = true;
+    for (int q : s.warm_up_count) f.settled = f.settled && !(q > 0 && q < core::kNoiseWarmUp);
+    const RegimeNoise& v = s.flux_noise;
+    const auto variance = [&v](const State::Flux& x) {
+      return x.var_per_u * v.u_sq + x.var_per_i * v.i_sq + x.var_per_n * v.n_sq + x.var_stated;
+    };
+    const State::Flux& m = s.flux_previous;
+    const auto side = [&](const State::Flux& o) {
+      const double d = m.psi - o.psi;
+      const double reach = c.dr_pu * std::abs(m.lever_r - o.lever_r) + c.dx_d_pu * std::abs(m.lever_x_d - o.lever_x_d) +
+                           k.inv_omega_n * c.dx_q_pu * std::abs(m.lever_x_q - o.lever_x_q) + (m.bias + o.bias);
+      const double excess = std::abs(d) - reach;
+      if (!(excess > 0.0 && excess * excess > k.z_sq * (variance(m) + variance(o)))) return 0;
+      return d > 0.0 ? 1 : -1;
+    };
+    bool mixed = false;
+    if (m.valid && m.settled && s.flux_reference.valid) {
+      const int left = side(s.flux_reference);
+      mixed = left != 0 && left == side(f);
+    }
+    if (!mixed) s.flux_reference = s.flux_previous;
+    s.flux_previous = f;
+    s.flux_noise = noise_;
+    return mixed ? regime_bit::kPreviousMixed : 0;
+  }
+
   struct Constants {
     double z_sq = 0.0;                                  ///< z²
     double r_sq = 0.0;                                  ///< r²

@@ -571,6 +571,128 @@ TEST(Regime, AWindowHoldingTheBridgesReleaseOrTakeOverIsMixed) {
   // windows are the model's own (u = n·ψm at i = 0 while off), and nothing is set aside.
 }
 
+/// Contiguous 90 ms windows at speed n with white noise of σ (pu) on u and i: window `mixed_at` holds `inside(u, i)`,
+/// what the bridge did inside it; a steady operating point elsewhere. The classifications, and the noise the window
+/// after `mixed_at` judged it against (RegimeState::flux_noise, read before that window enters).
+struct NoisyWindows {
+  double h = 0.09, n = 0.4, sigma = 1e-3;
+  Vec2 i = Vec2::Zero();
+  int count = 60, mixed_at = 40;
+  std::uint64_t seed = 1;
+  template <typename Inside>
+  std::vector<Classification> classify(const RegimeConfig& c, const MachinePu& m, Inside inside,
+                                       RegimeNoise* judged_with = nullptr) const {
+    std::mt19937_64 rng(seed);
+    std::normal_distribution<double> noise(0.0, sigma);
+    RegimeClassifier k(c);
+    std::vector<Classification> out;
+    const Vec2 u = steady_state_voltage(m, n, i);
+    for (int j = 0; j < count; ++j) {
+      Vec2 uj = u, ij = i;
+      if (j == mixed_at) inside(uj, ij);
+      RegimeInput in = chain_sample(j, std::llround((j + 1) * h * 1e9), uj + Vec2(noise(rng), noise(rng)),
+                                    ij + Vec2(noise(rng), noise(rng)), n);
+      in.window_s = h;
+      out.push_back(k.step(in));
+      if (j == mixed_at && judged_with) *judged_with = k.state().flux_noise;
+    }
+    return out;
+  }
+};
+
+TEST(Regime, AWindowWhoseFluxLeavesBothNeighboursHeldAFreewheel) {
+  // §13, "… inside one window": the bridge released and taken over inside one window, zeros reported while off, its
+  // means m times the modulating ones. At zero current (coasting, the bridge modulating) the flux reads m·ψ and no
+  // lever of the tolerance moves: the edge is (1 − m)·ψ = z·√(2·σ_ψ²), σ_ψ² = (σ_u² + (r² + n²·x_d² + 3·x_q²/(ω_n·h)²)·σ_i²
+  // + (ψ_max)²·σ_n²)/n², recomputed here from the noise the judging window used. Checked at twice the edge (flagged,
+  // by the window after it: kPreviousMixed) and at a quarter of it (not), over seeds.
+  Outrunner s;
+  s.settings.regimes.voltage_resolution_V = 0.0;  // the noise, measured
+  const RegimeConfig c = s.config();
+  for (std::uint64_t seed = 1; seed <= 8; ++seed) {
+    NoisyWindows w;
+    w.seed = test::test_seed(seed);
+    RegimeNoise v;
+    (void)w.classify(
+        c, s.nominal, [](Vec2&, Vec2&) {}, &v);
+    const double inv_dt = 1.0 / w.h, n2 = w.n * w.n;
+    const double per_i = c.r_pu * c.r_pu + n2 * c.x_d_pu * c.x_d_pu +
+                         3.0 * inv_dt * inv_dt * c.x_q_pu * c.x_q_pu / (c.omega_n_rad_s * c.omega_n_rad_s);
+    const double var = (v.u_sq + per_i * v.i_sq + c.psi_max_pu * c.psi_max_pu * v.n_sq) / n2;
+    const double edge = c.z * std::sqrt(2.0 * var) / s.nominal.psi_m_pu;  // 1 − m at the edge
+    ASSERT_GT(edge, 0.0);
+    ASSERT_LT(edge, 0.2);
+    for (const double factor : {2.0, 0.25}) {
+      const double m = 1.0 - factor * edge;
+      const auto v2 = w.classify(c, s.nominal, [m](Vec2& u, Vec2& i) {
+        u *= m;
+        i *= m;
+      });
+      EXPECT_FALSE(v2[40].excluded()) << w.seed;  // nothing in the window alone tells it
+      EXPECT_EQ((v2[41].bits & regime_bit::kPreviousMixed) != 0, factor > 1.0) << w.seed << " m " << m;
+      for (int j = 1; j < 60; ++j) {
+        if (j != 41) {
+          EXPECT_FALSE(v2[j].bits & regime_bit::kPreviousMixed) << w.seed << " " << j;
+        }
+      }
+    }
+  }
+  // Under load the levers move with the mix: a half-window freewheel at 0.1 pu of q current is found all the same, and
+  // counted as transient once the next window has judged it.
+  NoisyWindows w;
+  w.i = Vec2(0.0, 0.1);
+  RegimeCounts counts;
+  const auto v = w.classify(c, s.nominal, [](Vec2& u, Vec2& i) {
+    u *= 0.5;
+    i *= 0.5;
+  });
+  for (const Classification& r : v) counts.add(r);
+  EXPECT_TRUE(v[41].bits & regime_bit::kPreviousMixed);
+  EXPECT_EQ(counts[Regime::kTransient], 1U);
+}
+
+TEST(Regime, AWindowMixingTwoOperatingPointsOfAMachineWithinTheToleranceStaysBetweenItsNeighbours) {
+  // A load changed inside a window (a step, or a pulse that ends inside it) mixes two steady states: at the window's
+  // speed the flux the nominal model reads is linear in u and i, so the mix lies between its neighbours' but for what
+  // Δr, Δx_d do over the operating points' difference — the tolerance the test allows. Seeded machines with r_s in
+  // D_M and x_d within 90 % of the tolerance, and little noise, so that the tolerance alone decides: nothing is mixed.
+  Outrunner s;
+  s.settings.regimes.voltage_resolution_V = 0.0;
+  s.settings.regimes.current_resolution_A = 0.0;
+  const RegimeConfig c = s.config();
+  const std::uint64_t seed = test::test_seed(2302);
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  int flagged = 0, judged = 0;
+  for (int run = 0; run < 100; ++run) {
+    MachinePu plant = s.nominal;
+    plant.r_s_pu = std::max(0.5 * c.r_min_pu, c.r_pu + 0.9 * c.dr_pu * (2.0 * unit(rng) - 1.0));  // |Δr| within D_M's
+    plant.x_d_pu = s.nominal.x_d_pu * (1.0 + 0.9 * 0.3 * (2.0 * unit(rng) - 1.0));
+    const double n = 0.2 + 0.8 * unit(rng);
+    const Vec2 a(-0.5 * unit(rng), 2.0 * unit(rng) - 1.0), b(-0.5 * unit(rng), 2.0 * unit(rng) - 1.0);
+    const double share = unit(rng);
+    const bool pulse = run % 2 == 1;
+    std::normal_distribution<double> noise(0.0, 1e-6);
+    RegimeClassifier k(c);
+    for (int j = 0; j < 40; ++j) {
+      const Vec2 i = j < 20 ? a : (j == 20 || pulse ? a : b);
+      const Vec2 i_mix = share * a + (1.0 - share) * b;
+      const Vec2 ij = j == 20 ? i_mix : i;
+      const Vec2 uj = j == 20 ? share * steady_state_voltage(plant, n, a) + (1.0 - share) * steady_state_voltage(plant, n, b)
+                              : steady_state_voltage(plant, n, i);
+      RegimeInput in =
+          chain_sample(j, (j + 1) * 90'000'000LL, uj + Vec2(noise(rng), noise(rng)), ij + Vec2(noise(rng), noise(rng)), n);
+      in.window_s = 0.09;
+      const Classification r = k.step(in);
+      if (j == 21) {
+        ++judged;
+        flagged += (r.bits & regime_bit::kPreviousMixed) ? 1 : 0;
+      }
+    }
+  }
+  EXPECT_EQ(flagged, 0) << "seed " << seed << " of " << judged;
+}
+
 TEST(Regime, AStandaloneSampleIsSteadyOnceTheTransientHasDecayedIntoTheNoise) {
   Outrunner s;
   s.settings.regimes.current_resolution_A = 0.05;
@@ -786,7 +908,7 @@ TEST(Regime, LockedSteadyNoisyDataIsExcludedNoMoreOftenThanTheFalseRate) {
   const std::uint64_t seed = test::test_seed(2301);
   std::mt19937_64 rng(seed);
   std::uniform_real_distribution<double> unit(0.0, 1.0);
-  long judged = 0, excluded = 0;
+  long judged = 0, excluded = 0, mixed = 0;
   for (int run = 0; run < 200; ++run) {
     MachinePu plant = s.nominal;
     plant.r_s_pu = c.r_min_pu + (2.0 * c.dr_pu) * unit(rng) * 0.7;
@@ -812,11 +934,15 @@ TEST(Regime, LockedSteadyNoisyDataIsExcludedNoMoreOftenThanTheFalseRate) {
       if (j < 50) continue;  // the noise tracker settling
       ++judged;
       excluded += r.excluded() ? 1 : 0;
+      mixed += (r.bits & regime_bit::kPreviousMixed) ? 1 : 0;  // the window before found mixed: as false
     }
   }
   const double alpha = std::erfc(c.z / std::sqrt(2.0));
   EXPECT_LE(static_cast<double>(excluded), 4.0 * alpha * static_cast<double>(judged) + 3.0)
       << "seed " << seed << ": " << excluded << " of " << judged;
+  // Both of a window's differences beyond z·σ on one side: no likelier than one of them (α, two-sided).
+  EXPECT_LE(static_cast<double>(mixed), 4.0 * alpha * static_cast<double>(judged) + 3.0)
+      << "seed " << seed << ": " << mixed << " of " << judged;
 }
 
 }  // namespace

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <limits>
 #include <random>
+#include <vector>
 
 #include "rpem/core/averaged_estimator.hpp"
 #include "rpem/core/drive_estimator.hpp"
@@ -153,31 +154,57 @@ struct ReleaseWindows {
   }
 };
 
+/// The estimator through `count` windows: window 20 half modulating, those after it `after` of theirs.
+struct MixedWindowRun {
+  double psi_before_mixed = 0.0, psi_after_mixed = 0.0;  ///< ψ̂m before and after window 20
+  Classification mixed, next;                            ///< windows 20 and 21
+  RegimeCounts counts;
+  std::vector<double> psi_after;  ///< ψ̂m after each window from 21 on
+  MixedWindowRun(const ReleaseWindows& r, int count, double after) {
+    AveragedDriveEstimator est(test::outrunner_machine_si(), ReleaseWindows::settings());
+    for (int j = 0; j < count; ++j) {
+      if (j == 20) psi_before_mixed = est.psi_m_Wb();
+      const Estimate e = est.step(r.window(j, j < 20 ? 1.0 : (j == 20 ? 0.5 : after)));
+      counts.add(e.regime);
+      if (j == 20) {
+        mixed = e.regime;
+        psi_after_mixed = est.psi_m_Wb();
+      }
+      if (j == 21) next = e.regime;
+      if (j > 20) psi_after.push_back(est.psi_m_Wb());
+    }
+  }
+};
+
 TEST(RegimeEstimators, AReleaseInsideAWindowRetractsWhatThatWindowAdapted) {
   // The bridge is released half-way through window 20. Window 20 reads ψm at half (inside D_M) and adapts; window 21,
   // the first off one, marks it mixed and the estimator goes back to where it stood before window 20 — exactly.
   const ReleaseWindows r;
-  AveragedDriveEstimator est(test::outrunner_machine_si(), ReleaseWindows::settings());
-  double psi_before_mixed = 0.0, psi_after_mixed = 0.0;
-  RegimeCounts counts;
-  for (int j = 0; j < 26; ++j) {
-    if (j == 20) psi_before_mixed = est.psi_m_Wb();
-    const Estimate e = est.step(r.window(j, j < 20 ? 1.0 : (j == 20 ? 0.5 : 0.0)));
-    counts.add(e.regime);
-    if (j == 20) {
-      EXPECT_FALSE(e.regime.excluded());
-      psi_after_mixed = est.psi_m_Wb();
-    }
-    if (j == 21) {
-      EXPECT_EQ(e.regime.regime, Regime::kBridgeOff);
-      EXPECT_TRUE(e.regime.bits & regime_bit::kPreviousMixed);
-    }
-  }
-  EXPECT_LT(psi_after_mixed, 0.9 * psi_before_mixed);  // what the mixed window did (γ ≈ 0.3 per window)
-  EXPECT_EQ(est.psi_m_Wb(), psi_before_mixed);         // and undid
-  EXPECT_NEAR(psi_before_mixed / r.truth.psi_m_Wb, 1.0, 0.01);
-  EXPECT_EQ(counts[Regime::kTransient], 1U);
-  EXPECT_EQ(counts[Regime::kBridgeOff], 5U);
+  const MixedWindowRun run(r, 26, 0.0);
+  EXPECT_FALSE(run.mixed.excluded());
+  EXPECT_EQ(run.next.regime, Regime::kBridgeOff);
+  EXPECT_TRUE(run.next.bits & regime_bit::kPreviousMixed);
+  EXPECT_LT(run.psi_after_mixed, 0.9 * run.psi_before_mixed);  // what the mixed window did (γ ≈ 0.3 per window)
+  EXPECT_EQ(run.psi_after.back(), run.psi_before_mixed);       // and undid
+  EXPECT_NEAR(run.psi_before_mixed / r.truth.psi_m_Wb, 1.0, 0.01);
+  EXPECT_EQ(run.counts[Regime::kTransient], 1U);
+  EXPECT_EQ(run.counts[Regime::kBridgeOff], 5U);
+}
+
+TEST(RegimeEstimators, AFreewheelInsideOneWindowIsFoundByItsNeighboursAndRetracted) {
+  // §13, "… inside one window": the bridge released and taken over inside window 20 (half of it off), zeros reported
+  // while off. No window is bridge off, so no release marks it; its flux (half the machine's) leaves both neighbours',
+  // and window 21 marks it mixed: the estimator goes back to where it stood before window 20, then adapts on.
+  const ReleaseWindows r;
+  const MixedWindowRun run(r, 30, 1.0);
+  EXPECT_FALSE(run.mixed.excluded());
+  EXPECT_FALSE(run.next.excluded());
+  EXPECT_TRUE(run.next.bits & regime_bit::kPreviousMixed);
+  EXPECT_LT(run.psi_after_mixed, 0.9 * run.psi_before_mixed);  // what the mixed window did, for one window
+  for (const double psi : run.psi_after) EXPECT_NEAR(psi / run.psi_before_mixed, 1.0, 0.005);  // no dip once judged
+  EXPECT_NEAR(run.psi_after.back() / r.truth.psi_m_Wb, 1.0, 0.01);
+  EXPECT_EQ(run.counts[Regime::kTransient], 1U);
+  EXPECT_EQ(run.counts[Regime::kBridgeOff], 0U);
 }
 
 TEST(RegimeEstimators, AChainsLastWindowIsNeverJudgedAndIsLeftOut) {

@@ -14,7 +14,9 @@
 //   transient    a term the steady state leaves out (slope change, speed-current covariance; a
 //                standalone sample: the decayed remnant e^{−Δt/τ_el}·|Δi|) beyond z·σ of its row;
 //                a mixed window: the bridge was released or took over inside it (the window next to a
-//                bridge-off one; the release shows one window late: kPreviousMixed)
+//                bridge-off one; the release shows one window late: kPreviousMixed); or both inside it, found
+//                by its neighbours: ψ = e_q/n outside both theirs, on one side, beyond z·σ of each difference
+//                plus what Δr, Δx do over the operating points' difference (kPreviousMixed, one window late)
 //   excites ψm   |n|·ψ_min − Δr·|i_q| − |n|·Δx_d·|i_d| > z·h_ψ·N_ψ   (h² = γ/(2 − γ): the estimator's averaging)
 //   excites r_s  r_min·|i| − |n|·(Δψ + F + Δx·|i|)   > z·h_r·N_r
 //                F = 0 for a sensor's frame; sensorless: ψ_max·2·sin(δ_max/2), the largest frame error the lock test
@@ -55,9 +57,10 @@ inline constexpr std::uint8_t kTransient = 1U << 2;
 inline constexpr std::uint8_t kExcitesPsiM = 1U << 3;
 inline constexpr std::uint8_t kExcitesRs = 1U << 4;
 inline constexpr std::uint8_t kInvalid = 1U << 5;
-/// Not this sample's: the window before it (its chain's, adjacent) held the bridge's release — this one is
-/// bridge off, that one was not — so that one is mixed, transient from now on (docs/derivations.md §13,
-/// "Mixed windows"). An online consumer retracts what it adapted there; counts move it (RegimeCounts).
+/// Not this sample's: the window before it (its chain's, adjacent) is mixed, transient from now on
+/// (docs/derivations.md §13, "Mixed windows"): it held the bridge's release (this one is bridge off, that one was
+/// not), or a release and a take-over both (its flux left both neighbours', "… inside one window"). An online
+/// consumer retracts what it adapted there; counts move it (RegimeCounts).
 inline constexpr std::uint8_t kPreviousMixed = 1U << 6;
 /// Not a test of its own: r_s' term stood out only because the frame's source was not given and a position
 /// sensor's was assumed (RegimeSettings::angle_source_assumed); a sensorless frame's possible error would have
@@ -251,6 +254,27 @@ struct RegimeInput {
 /// i two lanes), before the tracker steps from it. From the quantity's first nonzero residual.
 inline constexpr int kNoiseWarmUp = 17;
 
+/// The noise of a quantity [pu]: σ² = (median/0.6745)² + q²/12 (the measured noise and the quantisation).
+struct RegimeNoise {
+  double u_sq = 0.0, i_sq = 0.0, n_sq = 0.0;  ///< σ² of u, i, n
+};
+
+/// A window as the test against its neighbours takes it (docs/derivations.md §13, "… inside one window"): the flux
+/// the nominal model leaves to the magnet, its noise, and the levers the configuration's tolerance acts through.
+struct WindowFlux {
+  double psi_pu = 0.0;  ///< ψ = e_q/n, e = u − r·i − (x/ω_n)·s − n·J·x·i (s: the inductive correction's slope)
+  /// ψ's variance per σ_u², σ_i², σ_n², and from a stated speed error's noise.
+  double var_per_u = 0.0, var_per_i = 0.0, var_per_n = 0.0, var_stated_pu = 0.0;
+  double bias_pu = 0.0;  ///< what a stated speed error E can put there: (ψ_max + x_d·|i_d|)·|E/n|
+  /// Where Δr, Δx_d and Δx_q act on ψ: i_q/n, i_d, s_q/n.
+  double lever_r = 0.0, lever_x_d = 0.0, lever_x_q = 0.0;
+  bool valid = false;    ///< a window of the chain admitted as exciting ψm
+  bool settled = false;  ///< no noise median was warming up when it entered: its noise may judge it
+  [[nodiscard]] double variance(const RegimeNoise& v) const noexcept {
+    return var_per_u * v.u_sq + var_per_i * v.i_sq + var_per_n * v.n_sq + var_stated_pu;
+  }
+};
+
 struct RegimeState {
   /// Per quantity (u, i, n): the running median of the normalised second difference |r| (its noise, with
   /// σ = median/0.6745), and the smallest nonzero change seen (its resolution; +∞: none yet).
@@ -275,16 +299,16 @@ struct RegimeState {
   bool previous_transient = false;  ///< the previous sample's own slope test failed (the junction straddles)
   /// The chain's previous sample: a window (averaged), and whether it was bridge off (mixed windows).
   bool previous_window = false, previous_bridge_off = false;
+  /// The window before this one, awaiting its neighbour's judgement, and the last one before it not found mixed.
+  WindowFlux flux_previous{}, flux_reference{};
+  /// The noise before flux_previous entered: what it and its neighbours are judged against (neither it nor its
+  /// successor has moved it).
+  RegimeNoise flux_noise{};
   /// Per quantity, how many residuals its median's warm-up has still to take (0: none under way; a nonzero
   /// residual where the median is zero starts one, §13), and those taken, |r| ascending (last: read only
   /// during a warm-up).
   std::array<int, 3> noise_warm_up_left{};
   std::array<std::array<double, kNoiseWarmUp>, 3> noise_warm_up_pu{};
-};
-
-/// The noise of a quantity [pu]: σ² = (median/0.6745)² + q²/12 (the measured noise and the quantisation).
-struct RegimeNoise {
-  double u_sq = 0.0, i_sq = 0.0, n_sq = 0.0;  ///< σ² of u, i, n
 };
 
 class RegimeClassifier {
@@ -299,6 +323,7 @@ class RegimeClassifier {
     state_.points = state_.chained = 0;
     state_.slope_valid = state_.previous_slope_valid = false;
     state_.previous_window = state_.previous_bridge_off = false;
+    state_.flux_previous.valid = state_.flux_reference.valid = false;
   }
   /// Everything learnt back to the start.
   void reset() noexcept;
@@ -337,7 +362,8 @@ class RegimeClassifier {
     double x_max = 0.0, dx_max = 0.0;                   ///< the larger inductance and tolerance
     double cos_angle = 1.0, sin_angle = 0.0;            ///< cos δ_tol, sin δ_tol
     double cos_hall = -1.0;                             ///< cos of the Hall sensors' largest frame error (−1: none)
-    double dpsi_frame_sq = 0.0;  ///< (Δψ + a sensorless frame's least error)²: r_s' test's first check
+    double dpsi_frame_sq = 0.0;      ///< (Δψ + a sensorless frame's least error)²: r_s' test's first check
+    double dx_q_over_omega_n = 0.0;  ///< Δx_q/ω_n: the tolerance on WindowFlux::lever_x_q
   };
 
   /// Recomputes quantisation_var_ (after a resolution changed or the configuration did).
@@ -356,6 +382,10 @@ class RegimeClassifier {
   [[nodiscard]] std::uint8_t contiguous_transient_bits(const RegimeInput& in, const Terms& t) noexcept;
   [[nodiscard]] std::uint8_t speed_error_bits(const RegimeInput& in, const Terms& t) const noexcept;
   [[nodiscard]] std::uint8_t excitation_bits(const RegimeInput& in, const Terms& t) const noexcept;
+  /// kPreviousMixed where the previous window's flux left both neighbours' (this one's and the reference's), or 0;
+  /// `bits`: this window's so far. Moves the neighbours on.
+  [[nodiscard]] std::uint8_t flux_excursion_bits(const RegimeInput& in, const Terms& t, std::uint8_t bits) noexcept;
+  [[nodiscard]] WindowFlux window_flux(const RegimeInput& in, const Terms& t) const noexcept;
 
   RegimeConfig config_;
   Constants k_;
