@@ -116,12 +116,12 @@ bool track_resolution(double& q, double change) noexcept {
 /// Whether window m's flux leaves both a's and b's on one side: each difference beyond what the configuration's
 /// tolerance does over the operating points' difference (and stated speed errors), by more than z·σ of the difference.
 bool flux_leaves_both(const WindowFlux& m, const WindowFlux& a, const WindowFlux& b, const RegimeNoise& noise,
-                      const RegimeConfig& c, double dx_q_over_omega_n, double z_sq) noexcept {
+                      const RegimeConfig& c, double slope_reach, double z_sq) noexcept {
   const double var_m = m.variance(noise);
   const auto side = [&](const WindowFlux& o) {
     const double d = m.psi_pu - o.psi_pu;
     const double reach = c.dr_pu * std::abs(m.lever_r - o.lever_r) + c.dx_d_pu * std::abs(m.lever_x_d - o.lever_x_d) +
-                         dx_q_over_omega_n * std::abs(m.lever_x_q - o.lever_x_q) + (m.bias_pu + o.bias_pu);
+                         slope_reach * (std::abs(m.lever_x_q) + std::abs(o.lever_x_q)) + (m.bias_pu + o.bias_pu);
     const double excess = std::abs(d) - reach;
     const bool beyond = excess > 0.0 && excess * excess > z_sq * (var_m + o.variance(noise));
     return beyond ? (d > 0.0 ? 1 : -1) : 0;
@@ -253,7 +253,10 @@ void RegimeClassifier::reconfigure(const RegimeConfig& config) noexcept {
   const double cos_least = std::max(k.cos_angle, k.cos_hall);
   const double dpsi_frame = c.dpsi_pu + (c.sensorless ? c.psi_max_pu * std::sqrt(2.0 * (1.0 - cos_least)) : 0.0);
   k.dpsi_frame_sq = dpsi_frame * dpsi_frame;
-  k.dx_q_over_omega_n = k.inv_omega_n * c.dx_q_pu;
+  k.slope_reach = k.inv_omega_n * (c.x_q_pu + c.dx_q_pu);
+  k.frame_reach_pu = c.sensorless ? 0.5 * c.psi_max_pu * (1.0 - k.cos_angle) : 0.0;
+  // Neighbours formed with the old constants are no neighbours of a window formed with the new ones.
+  state_.flux_previous.valid = state_.flux_reference.valid = false;
   update_quantisation();
 }
 
@@ -421,7 +424,7 @@ std::uint8_t RegimeClassifier::flux_excursion_bits(const RegimeInput& in, const 
   here.settled = (s.noise_warm_up_left[0] | s.noise_warm_up_left[1] | s.noise_warm_up_left[2]) == 0;
   const WindowFlux& judged = s.flux_previous;
   const bool mixed = judged.valid && judged.settled && s.flux_reference.valid &&
-                     flux_leaves_both(judged, s.flux_reference, here, s.flux_noise, config_, k_.dx_q_over_omega_n, k_.z_sq);
+                     flux_leaves_both(judged, s.flux_reference, here, s.flux_noise, config_, k_.slope_reach, k_.z_sq);
   if (!mixed) s.flux_reference = s.flux_previous;
   s.flux_previous = here;
   s.flux_noise = noise_;
@@ -437,15 +440,17 @@ WindowFlux RegimeClassifier::window_flux(const RegimeInput& in, const Terms& t) 
   const double slope_q = t.slope[1];
   WindowFlux f;
   f.psi_pu = (in.u_pu[1] - c.r_pu * i[1] - k.x_over_omega_n[1] * slope_q - n * c.x_d_pu * i[0]) * inv_n;
-  // Noise: the q row's (σ_u² + (r² + n²·x_d²)·σ_i²), the slope's with 3·σ_i²/Δt² (neighbours' slopes share a mean:
-  // their difference holds 2·i_k − i_{k−1} − i_{k+1}, 6·σ_i²/Δt², half to each), and the speed's through the flux.
+  // Noise: u's; i_q's through r and the slope a·(i_k − i_{k−1}), a = x_q/(ω_n·Δt), whose difference from a neighbour's
+  // holds (r + 2a)²·σ_i² + (r + a)²·σ_i² + a²·σ_i² = 2·(r² + 3·a·(r + a))·σ_i², half to each; i_d's through n·x_d; and
+  // the speed's through the flux (§13, "A freewheel inside one window").
   const double flux_q = c.psi_max_pu + c.x_d_pu * std::abs(i[0]);
   const double flux_q_sq = flux_q * flux_q;
+  const double a = k.x_over_omega_n[1] * t.inv_dt;
   f.var_per_u = inv_n_sq;
-  f.var_per_i = (k.r_sq + t.n2_x2[1] + 3.0 * t.inv_dt * t.inv_dt * k.slope_var_x_sq[1]) * inv_n_sq;
+  f.var_per_i = (k.r_sq + 3.0 * a * (c.r_pu + a) + t.n2_x2[1]) * inv_n_sq;
   f.var_per_n = flux_q_sq * inv_n_sq;
   f.var_stated_pu = flux_q_sq * (in.n_error_noise_pu * in.n_error_noise_pu) * inv_n_sq;
-  f.bias_pu = flux_q * std::abs(in.n_error_pu * inv_n);
+  f.bias_pu = flux_q * std::abs(in.n_error_pu * inv_n) + k.frame_reach_pu;
   f.lever_r = i[1] * inv_n;
   f.lever_x_d = i[0];
   f.lever_x_q = slope_q * inv_n;

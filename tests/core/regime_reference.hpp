@@ -190,6 +190,7 @@ class Classifier {
     k.x_max = std::max(c.x_d_pu, c.x_q_pu);
     k.dx_max = std::max(c.dx_d_pu, c.dx_q_pu);
     update_quantisation();
+    state_.flux_previous.valid = state_.flux_reference.valid = false;
   }
 
   void update_quantisation() noexcept {
@@ -396,10 +397,12 @@ class Classifier {
     const double flux_q_sq = flux_q * flux_q;
     const double n2_xd2 = n * n * c.x_d_pu * c.x_d_pu;
     f.var_per_u = inv_n_sq;
-    f.var_per_i = (k.r_sq + n2_xd2 + 3.0 * s.inv_dt * s.inv_dt * k.slope_var_x_sq[1]) * inv_n_sq;
+    const double a = k.x_over_omega_n[1] * s.inv_dt;
+    f.var_per_i = (k.r_sq + 3.0 * a * (c.r_pu + a) + n2_xd2) * inv_n_sq;
     f.var_per_n = flux_q_sq * inv_n_sq;
     f.var_stated = flux_q_sq * (in.n_error_noise_pu * in.n_error_noise_pu) * inv_n_sq;
-    f.bias = flux_q * std::abs(in.n_error_pu * inv_n);
+    const double cos_tol = 1.0 / std::sqrt(1.0 + c.tan_angle * c.tan_angle);
+    f.bias = flux_q * std::abs(in.n_error_pu * inv_n) + (c.sensorless ? 0.5 * c.psi_max_pu * (1.0 - cos_tol) : 0.0);
     f.lever_r = i_q * inv_n;
     f.lever_x_d = i_d;
     f.lever_x_q = s_q * inv_n;
@@ -414,7 +417,8 @@ class Classifier {
     const auto side = [&](const State::Flux& o) {
       const double d = m.psi - o.psi;
       const double reach = c.dr_pu * std::abs(m.lever_r - o.lever_r) + c.dx_d_pu * std::abs(m.lever_x_d - o.lever_x_d) +
-                           k.inv_omega_n * c.dx_q_pu * std::abs(m.lever_x_q - o.lever_x_q) + (m.bias + o.bias);
+                           k.inv_omega_n * (c.x_q_pu + c.dx_q_pu) * (std::abs(m.lever_x_q) + std::abs(o.lever_x_q)) +
+                           (m.bias + o.bias);
       const double excess = std::abs(d) - reach;
       if (!(excess > 0.0 && excess * excess > k.z_sq * (variance(m) + variance(o)))) return 0;
       return d > 0.0 ? 1 : -1;

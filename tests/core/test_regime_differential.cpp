@@ -69,6 +69,10 @@ class Stream {
       in.u_pu = Vec2(0.0, -0.0);
       in.i_pu = Vec2(-0.0, 0.0);
       in.n_pu = uniform(0.0, 1.0) < 0.5 ? 0.0 : -0.0;
+    } else if (mode < 0.13) {  // the bridge off for part of the window, zeros reported: the means scaled
+      const double share = uniform(0.2, 0.95);
+      in.u_pu *= share;
+      in.i_pu *= share;
     }
     last_u_ = in.u_pu;
     last_i_ = in.i_pu;
@@ -157,6 +161,7 @@ void run(const RegimeConfig& config, std::uint64_t seed, int samples) {
   test::reference::Classifier before(config);
   Stream stream(seed);
   std::array<std::uint64_t, 8> seen{};
+  std::uint64_t flux_marks = 0;  // kPreviousMixed on a window that is not bridge off: the flux rule's
   for (int k = 0; k < samples; ++k) {
     const double event = stream.uniform(0.0, 1.0);
     if (event < 0.0005) {  // everything learnt forgotten: the noise medians warm up again (§13)
@@ -181,7 +186,9 @@ void run(const RegimeConfig& config, std::uint64_t seed, int samples) {
       ASSERT_TRUE(same(now.state().measured_resolution_pu[q], before.state().measured_resolution_pu[q])) << "sample " << k;
     }
     for (std::size_t bit = 0; bit < 8; ++bit) seen[bit] += (b.bits >> bit) & 1U;
+    flux_marks += (b.bits & regime_bit::kPreviousMixed) && !(b.bits & regime_bit::kBridgeOff) ? 1U : 0U;
   }
+  EXPECT_GT(flux_marks, 0U) << "the flux rule never marked a window";
   using namespace regime_bit;
   for (std::uint8_t bit : {kBridgeOff, kNotLocked, kTransient, kExcitesPsiM, kExcitesRs, kInvalid, kPreviousMixed}) {
     EXPECT_GT(seen[static_cast<std::size_t>(std::countr_zero(bit))], 0U) << "bit " << int{bit} << " never set";
@@ -238,7 +245,10 @@ void run_assumed(EstimatorSettings settings, const PerUnitBase& base, const Mach
     ASSERT_EQ(a.bits & ~regime_bit::kRsOnAssumedFrame, s.bits) << "sample " << k;
     ASSERT_EQ(a.regime, s.regime) << "sample " << k;
     ASSERT_EQ(flag, (s.bits & regime_bit::kExcitesRs) != 0 && (l.bits & regime_bit::kExcitesRs) == 0) << "sample " << k;
-    ASSERT_EQ(s.bits & ~regime_bit::kExcitesRs, l.bits & ~regime_bit::kExcitesRs) << "sample " << k;
+    // Besides R_s' test, the flux rule allows a sensorless frame its cone (§13, "A freewheel inside one window"): its
+    // marks on windows that are not bridge off may differ; a release's (on a bridge-off window) may not.
+    const std::uint8_t own = regime_bit::kExcitesRs | ((s.bits & regime_bit::kBridgeOff) ? 0 : regime_bit::kPreviousMixed);
+    ASSERT_EQ(s.bits & ~own, l.bits & ~own) << "sample " << k;
     flagged += flag ? 1 : 0;
     kept += (s.bits & l.bits & regime_bit::kExcitesRs) != 0 ? 1 : 0;
   }

@@ -265,8 +265,9 @@ struct WindowFlux {
   double psi_pu = 0.0;  ///< ψ = e_q/n, e = u − r·i − (x/ω_n)·s − n·J·x·i (s: the inductive correction's slope)
   /// ψ's variance per σ_u², σ_i², σ_n², and from a stated speed error's noise.
   double var_per_u = 0.0, var_per_i = 0.0, var_per_n = 0.0, var_stated_pu = 0.0;
-  double bias_pu = 0.0;  ///< what a stated speed error E can put there: (ψ_max + x_d·|i_d|)·|E/n|
-  /// Where Δr, Δx_d and Δx_q act on ψ: i_q/n, i_d, s_q/n.
+  /// What a stated speed error E can put there, (ψ_max + x_d·|i_d|)·|E/n|, and a sensorless frame's share.
+  double bias_pu = 0.0;
+  /// Where Δr and Δx_d act on ψ (i_q/n, i_d), and the inductive correction (s_q/n).
   double lever_r = 0.0, lever_x_d = 0.0, lever_x_q = 0.0;
   bool valid = false;    ///< a window of the chain admitted as exciting ψm
   bool settled = false;  ///< no noise median was warming up when it entered: its noise may judge it
@@ -362,8 +363,9 @@ class RegimeClassifier {
     double x_max = 0.0, dx_max = 0.0;                   ///< the larger inductance and tolerance
     double cos_angle = 1.0, sin_angle = 0.0;            ///< cos δ_tol, sin δ_tol
     double cos_hall = -1.0;                             ///< cos of the Hall sensors' largest frame error (−1: none)
-    double dpsi_frame_sq = 0.0;      ///< (Δψ + a sensorless frame's least error)²: r_s' test's first check
-    double dx_q_over_omega_n = 0.0;  ///< Δx_q/ω_n: the tolerance on WindowFlux::lever_x_q
+    double dpsi_frame_sq = 0.0;   ///< (Δψ + a sensorless frame's least error)²: r_s' test's first check
+    double slope_reach = 0.0;     ///< (x_q + Δx_q)/ω_n: what the inductive correction may miss, per |s_q/n|
+    double frame_reach_pu = 0.0;  ///< ½·ψ_max·(1 − cos δ_tol) for a sensorless or Hall frame, else 0
   };
 
   /// Recomputes quantisation_var_ (after a resolution changed or the configuration did).
