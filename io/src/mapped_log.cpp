@@ -113,9 +113,16 @@ void MappedLogReader::split(const std::string& line) {
     start = sep + 1;
   }
   cells_.resize(n);
-  // VESC Tool ends every line with its separator: the empty cell after it is no column.
-  closed_ = trailing_separator_ && cells_.size() == width_ + 1 && cells_.back().empty();
+  // VESC Tool ends every line with its separator: the empty cell after it is no column. Whether a row is so closed
+  // is read from the row's own last character, never from its count: a row missing one value but closed has as
+  // many cells as the header has names, and would be read with its values shifted into the wrong columns.
+  closed_ = trailing_separator_ && ends_with_separator(line);
   if (closed_) cells_.pop_back();
+}
+
+bool MappedLogReader::ends_with_separator(const std::string& line) const {
+  const auto last = std::find_if_not(line.rbegin(), line.rend(), [&](char c) { return blank(c) && c != map_.separator; });
+  return last != line.rend() && *last == map_.separator;
 }
 
 // A logger writes a row at a time and ends it with a newline (VESC Tool flushes each row: vedderb/vesc_tool
@@ -159,12 +166,8 @@ void MappedLogReader::read_header() {
   if (!next_line(header_line))
     throw DriveLogError(path_, line_ == 0 ? 1 : line_, 0, "", "empty file: expected a header row");
   if (header_line.rfind("\xEF\xBB\xBF", 0) == 0) header_line.erase(0, 3);  // a UTF-8 byte-order mark
-  const auto last =
-      std::find_if_not(header_line.rbegin(), header_line.rend(), [&](char c) { return blank(c) && c != map_.separator; });
-  trailing_separator_ = last != header_line.rend() && *last == map_.separator;
-  width_ = std::numeric_limits<std::size_t>::max();  // no trailing cell dropped from the header itself
-  split(header_line);
-  if (trailing_separator_ && !cells_.empty() && cells_.back().empty()) cells_.pop_back();
+  trailing_separator_ = ends_with_separator(header_line);
+  split(header_line);  // closed by its separator if it ends with one: that empty cell is no column's name
   header_ = cells_;
   header_line_ = line_;
   width_ = header_.size();

@@ -349,6 +349,23 @@ TEST(VescToolLog, AWholeLastRowWithoutItsNewlineAndAShortRowInsideAreNoCutRow) {
   EXPECT_NE(msg.find("vesc.csv:4: column *: row has"), std::string::npos) << msg;
 }
 
+TEST(VescToolLog, ARowMissingOneValueButClosedByItsSeparatorIsRefusedNotShifted) {
+  // GIVEN a row of the 1.20 test builds (32 values, each followed by ';') with d_axis_voltage's cell gone: its
+  // 31 values and closing ';' split into as many cells as the header has names. WHEN read THEN it is refused at
+  // its line, counting the values it holds (not the empty cell after its last ';') — never read with u_q's value
+  // as u_d and gnss_posTime's as u_q. The same counts for a row with one value too many.
+  std::string missing = row120test(1100, 0, 1, 100, -0.31, 8.7);
+  const std::size_t v_d = missing.find("-0.310000;");
+  ASSERT_NE(v_d, std::string::npos);
+  missing.erase(v_d, 10);
+  const std::string good = row120test(1000, 0, 1, 100, -0.31, 8.7);
+  std::string msg = vesc_tool_error_of(kHeader120Test + good + missing + row120test(1200, 0, 1, 100, -0.31, 8.7));
+  EXPECT_NE(msg.find("vesc.csv:3: column *: row has 31 cells, header has 32"), std::string::npos) << msg;
+  const std::string extra = good.substr(0, good.size() - 1) + "7;\n";
+  msg = vesc_tool_error_of(kHeader120Test + good + extra + good);
+  EXPECT_NE(msg.find("vesc.csv:3: column *: row has 33 cells, header has 32"), std::string::npos) << msg;
+}
+
 TEST(VescToolLog, ADecimalCommaIsRefusedWithItsLikelyCause) {
   // A spreadsheet in a locale with decimal commas saves 40.1 V as "40,1" (';' between cells, as VESC Tool's).
   std::string row = row120(1000, 0, 1, 100, 0, 1);

@@ -93,6 +93,7 @@ class MappedLogReader {
   bool read_raw(MappedRow& row);
   void check_session();  ///< the row belongs to the first row's recording (LogMap::session), else a DriveLogError
   void split(const std::string& line);
+  [[nodiscard]] bool ends_with_separator(const std::string& line) const;  ///< blanks after it aside
   [[nodiscard]] bool cut_off() const;
   [[nodiscard]] double cell(int index, const std::string& label, const MappedColumn& c, bool allow_nan);
   /// An empty cell: the error says how many rows from here leave the column empty (read to the file's end: the
@@ -114,7 +115,7 @@ class MappedLogReader {
   std::size_t header_line_ = 0;  ///< the file's line the header was read from
   std::size_t width_ = 0;        ///< cells per row (the header's, or a headerless file's first row's)
   bool trailing_separator_ = false;
-  bool closed_ = false;  ///< the row just split ended with the separator its header ends with
+  bool closed_ = false;  ///< the line just split ends with the separator its header ends with
   std::vector<std::string> cells_;
   std::array<int, kQuantityCount> index_{};  ///< 0-based cell of each quantity; −1 absent
   std::array<const MappedColumn*, kQuantityCount> column_{};
