@@ -102,8 +102,7 @@ EffectContext EffectContext::of(const LogData& log, const core::MachineSi& machi
   c.sample_period_s = log.median_dt_s;
   c.mean_u_dc_V = log.mean_u_dc_V;
   c.switching_frequency_Hz = switching_frequency_Hz;
-  c.voltages_logged = std::none_of(log.session_voltage_rebuilt.begin(), log.session_voltage_rebuilt.end(),
-                                   [](bool rebuilt) { return rebuilt; });
+  c.voltages_logged = !log.uses_rebuilt_voltages();
   return c;
 }
 

@@ -125,6 +125,25 @@ void leave_out_idle_and_transitional(LogData& d) {
   }
 }
 
+/// A folder whose sessions both log d/q voltages and rebuild them from the duty cycle (VESC Tool 1.17–1.19 beside
+/// later versions): the rebuilt sessions' u_d is the configuration's R_s·i_d − ω·L_q·i_q, so in one fit with the
+/// others they would pull L_q (and, where the frame is sensorless, R_s through the open-loop start-ups no lock test
+/// excludes) towards the configuration, and what that leaves would be named as an effect. The logged sessions carry
+/// those constants: the rebuilt ones are left out, marked and counted, rather than the constants withheld from all.
+void leave_out_rebuilt_sessions(LogData& d) {
+  const std::vector<bool>& rebuilt = d.session_voltage_rebuilt;
+  if (rebuilt.size() != d.sessions()) return;  // phase-sample logs carry no such flag
+  const auto count = static_cast<std::size_t>(std::count(rebuilt.begin(), rebuilt.end(), true));
+  if (count == 0 || count == rebuilt.size()) return;
+  for (std::size_t j = 0; j < d.sessions(); ++j) {
+    if (!rebuilt[j]) continue;
+    for (std::size_t k = d.session_first[j]; k < d.session_end(j); ++k) {
+      d.samples.set_mark(k, sample_mark::kLeftOut, true);
+      ++d.excluded_rebuilt;
+    }
+  }
+}
+
 }  // namespace
 
 void prepare_log(LogData& d, const core::MachineSi& machine, const LogOptions& options) {
@@ -170,6 +189,7 @@ void prepare_log(LogData& d, const core::MachineSi& machine, const LogOptions& o
                                                                                               : ModelMode::kTransient);
   d.speed_half_window = d.mode == ModelMode::kTransient ? std::max(0, options.speed_half_window) : 0;
 
+  leave_out_rebuilt_sessions(d);
   if (d.mode == ModelMode::kSteadyState) leave_out_idle_and_transitional(d);
 
   // Block b holds the samples whose sampled time lies in [b, b + 1)·span/blocks (the last one's end included):
@@ -221,6 +241,21 @@ std::vector<std::string> left_out_explanations(const LogData& log) {
                 "predicts nothing a constant could be fitted to. Keys: none (nothing to fit there)",
                 100.0 * kIdleShare);
   explain(log.excluded_idle, text);
+  if (log.excluded_rebuilt > 0) {  // whole sessions: said whatever their share
+    std::string names;
+    for (std::size_t j = 0; j < log.sessions(); ++j) {
+      if (log.session_voltage_rebuilt[j]) names += (names.empty() ? "" : ", ") + log.session_logs[j];
+    }
+    std::snprintf(text, sizeof text, "%zu of %zu rows (%.1f %%) ", log.excluded_rebuilt, log.size(),
+                  100.0 * static_cast<double>(log.excluded_rebuilt) / n);
+    out.push_back(text +
+                  std::string("were left out: they are the sessions whose voltages are rebuilt from the duty "
+                              "cycle (") +
+                  names +
+                  "), whose u_d holds the configuration's R_s and L_q, while the folder's other sessions log the d/q "
+                  "voltages, which carry them (docs/diagnose.md, \"A folder of logs\"). Keys: none — diagnose those "
+                  "sessions on their own to use them");
+  }
   return out;
 }
 

@@ -59,8 +59,8 @@ struct EffectContext {
   double sample_period_s = 0.0;                     ///< median sample interval
   double mean_u_dc_V = 0.0;
   double switching_frequency_Hz = 0.0;  ///< 0: unknown (t_dead_s is then not reported)
-  /// Every session's voltages are logged d/q values; false where one's were rebuilt from the duty cycle's magnitude
-  /// (LogData::session_voltage_rebuilt; docs/drive-log.md, "Logs without d/q values").
+  /// Every session that takes part logs d/q values; false where one's were rebuilt from the duty cycle's magnitude
+  /// (LogData::uses_rebuilt_voltages; docs/drive-log.md, "Logs without d/q values").
   bool voltages_logged = true;
   /// The frame is a sensorless observer's or Hall sensors' (estimator.regimes.sensorless): it has open-loop start-ups.
   bool frame_sensorless = false;

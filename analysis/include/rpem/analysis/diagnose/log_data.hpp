@@ -48,6 +48,9 @@ struct LogData {
   /// Averaged logs, per session: whether its voltages were rebuilt (io::RotorFrameRebuild; applied means, which the
   /// estimator must not turn: io::estimator_settings).
   std::vector<bool> session_voltage_rebuilt;
+  /// Samples of sessions with rebuilt voltages left out because the folder's other sessions log d/q voltages
+  /// (leave_out_rebuilt_sessions): those alone carry the constants a rebuilt u_d holds at their configured values.
+  std::size_t excluded_rebuilt = 0;
   double t_start_s = 0.0, t_end_s = 0.0;
   double median_dt_s = 0.0;
   double max_current_A = 0.0;    ///< largest measured current amplitude
@@ -80,6 +83,11 @@ struct LogData {
   std::vector<std::string> session_logs;
 
   [[nodiscard]] std::size_t size() const noexcept { return samples.size(); }
+  /// Whether samples whose voltages were rebuilt from the duty cycle take part (effects.cpp: withheld_constants).
+  [[nodiscard]] bool uses_rebuilt_voltages() const noexcept {
+    return excluded_rebuilt == 0 &&
+           std::any_of(session_voltage_rebuilt.begin(), session_voltage_rebuilt.end(), [](bool r) { return r; });
+  }
   [[nodiscard]] std::size_t sessions() const noexcept { return session_first.size(); }
   /// One past session j's last sample.
   [[nodiscard]] std::size_t session_end(std::size_t j) const noexcept {
