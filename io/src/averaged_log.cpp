@@ -205,6 +205,27 @@ void previous_row_samples(const std::vector<PreviousRowRead>& rows, const LogMap
   if (counted) set_counted_speeds(out, reads, read_ending, step_rad);
 }
 
+/// The median window against one control period (DriveLogLimits::control_period_s): a window holds at least one
+/// cycle, and its two stamps, each within half a cycle of the read, still make it at least half of one.
+void check_window_lengths(const std::string& path, std::size_t first_line, const std::vector<core::AveragedSample>& out,
+                          double control_period_s) {
+  if (!(control_period_s > 0.0)) return;
+  std::vector<std::int64_t> lengths;
+  lengths.reserve(out.size());
+  for (const core::AveragedSample& s : out) lengths.push_back(s.t_ns - s.t_start_ns);
+  const auto mid = lengths.begin() + static_cast<std::ptrdiff_t>(lengths.size() / 2);
+  std::nth_element(lengths.begin(), mid, lengths.end());
+  const double median_s = core::to_seconds(*mid);
+  if (median_s >= 0.5 * control_period_s) return;
+  char text[400];
+  std::snprintf(text, sizeof text,
+                "the windows are %.3g µs long (the median of %zu), shorter than half a control period (%.3g µs, "
+                "estimator.averaged.control_period_s), though each mean holds whole control cycles: the time column is "
+                "likely in another unit than the log's map says (its `unit:`), or the configuration is another drive's",
+                median_s * 1e6, out.size(), control_period_s * 1e6);
+  throw DriveLogError(path, first_line, 0, "column t", text);
+}
+
 }  // namespace
 
 std::vector<core::AveragedSample> read_averaged_log(const std::string& path, const LogMap& map, const DriveLogLimits& limits,
@@ -282,6 +303,7 @@ std::vector<core::AveragedSample> read_averaged_log(const std::string& path, con
                             : "no samples: the only row holds means since a read before the log began (an unknown "
                               "window); a sample needs the row before it");
   }
+  check_window_lengths(path, first_line, out, limits.control_period_s);
   read.repairs = reader.repairs();
   if (read_out) *read_out = read;
   return out;

@@ -353,7 +353,15 @@ QuantitySet parse_columns(YamlMap& columns, LogMap& m, long pole_pairs, bool& me
       pll->finish();
       m.speed_pll = {kp, ki};
     }
-    m.columns.push_back(parse_column(*c, q.quantity, q.kind, m.header, m.averaged(), pole_pairs, mechanical));
+    MappedColumn column = parse_column(*c, q.quantity, q.kind, m.header, m.averaged(), pole_pairs, mechanical);
+    // Two quantities are never one cell (i_d and i_q from one column read each as the other, silently).
+    for (const MappedColumn& other : m.columns) {
+      if (other.column.name == column.column.name && other.column.position == column.column.position) {
+        c->fail("column", "'" + column.column.label() + "' is read as " + info(other.quantity).name +
+                              " already: each quantity has a column of its own");
+      }
+    }
+    m.columns.push_back(std::move(column));
     present[static_cast<std::size_t>(q.quantity)] = true;
   }
   return present;

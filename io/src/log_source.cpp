@@ -104,8 +104,8 @@ std::string describe(const ReadRepairs& r) {
   if (r.wraps > 0)
     s += "; " + std::to_string(r.wraps) + (r.wraps == 1 ? " wrap" : " wraps") + " of the time column (midnight)";
   if (r.tied_rows > 0) {
-    s += "; " + std::to_string(r.tied_rows) +
-         " rows shared their time stamp with the row before (spread over its resolution)";
+    s += "; " + std::to_string(r.tied_rows) + (r.tied_rows == 1 ? " row shared its" : " rows shared their") +
+         " time stamp with the row before (spread over its resolution)";
   }
   if (r.cut_line > 0) {
     s += "; its last line (" + std::to_string(r.cut_line) +

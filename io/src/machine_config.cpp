@@ -362,6 +362,12 @@ DriveLogLimits machine_limits(const core::MachineSi& machine) {
   return limits;
 }
 
+DriveLogLimits log_limits(const MachineConfig& config) {
+  DriveLogLimits limits = machine_limits(config.machine);
+  limits.control_period_s = config.estimator.averaged.control_period_s;
+  return limits;
+}
+
 std::string model_extensions_yaml(const MachineConfig& c) {
   const core::ModelExtensions& x = c.estimator.extensions;
   std::ostringstream out;

@@ -75,6 +75,48 @@ TEST(LogMap, APllSpeedIsASpeedAtTheReadsOfPreviousRowWindows) {
             std::string::npos);
 }
 
+// Two quantities from one column: i_q read as i_d too gave ψm 2.6 % off and no word (a user's map, 2026-12-04).
+TEST(LogMap, TwoQuantitiesFromOneColumnAreRefused) {
+  const std::string named =
+      "samples: instantaneous\ntime: {column: time, unit: ms}\ncolumns:\n"
+      "  omega_el: {column: w}\n  u_d: {column: ud}\n  u_q: {column: uq}\n  i_d: {column: iq}\n"
+      "  i_q: {column: iq}\n";
+  EXPECT_NE(map_error(named).find("map.yaml:8"), std::string::npos) << map_error(named);
+  EXPECT_NE(map_error(named).find("'iq' is read as i_d already: each quantity has a column of its own"), std::string::npos)
+      << map_error(named);
+  const std::string positions =
+      "header: false\nsamples: instantaneous\ntime: {column: 1}\ncolumns:\n"
+      "  omega_el: {column: 2}\n  u_d: {column: 3}\n  u_q: {column: 4}\n  i_d: {column: 5}\n"
+      "  i_q: {column: 3}\n";
+  EXPECT_NE(map_error(positions).find("is read as u_d already"), std::string::npos) << map_error(positions);
+  EXPECT_EQ(map_error(kMinimal), "");
+}
+
+// A map whose time unit is ms for a column in seconds reads 20 ms windows as 20 µs: shorter than half a control
+// period of 80 µs, which no averaged window can be (its means hold whole cycles). Refused, naming the unit; read
+// where the configuration gives no control period, and where the windows are as long as the period.
+TEST(LogMap, WindowsShorterThanHalfAControlPeriodAreRefusedAsAWrongTimeUnit) {
+  const LogMap m = parse_log_map(
+      "samples: averaged\nwindow: previous_row\ntime: {column: t, unit: ms}\ncolumns:\n"
+      "  omega_el: {column: w}\n  u_d: {column: ud}\n  u_q: {column: uq}\n  i_d: {column: id}\n  i_q: {column: iq}\n",
+      "map.yaml");
+  const test::TempFile log("seconds.csv", "t,w,ud,uq,id,iq\n0.00,100,0,1,0,1\n0.02,100,0,1,0,1\n0.04,100,0,1,0,1\n");
+  DriveLogLimits limits;
+  EXPECT_EQ(read_averaged_log(log.path(), m, limits).size(), 2U);  // no control period: not checked
+  limits.control_period_s = 80e-6;
+  try {
+    (void)read_averaged_log(log.path(), m, limits);
+    FAIL() << "no error";
+  } catch (const DriveLogError& e) {
+    EXPECT_NE(std::string(e.what()).find("seconds.csv:2: column t: the windows are 20 µs long (the median of 2), "
+                                         "shorter than half a control period (80 µs"),
+              std::string::npos)
+        << e.what();
+  }
+  limits.control_period_s = 40e-6;  // 20 µs windows are half of it: stamps rounded by up to half a cycle
+  EXPECT_EQ(read_averaged_log(log.path(), m, limits).size(), 2U);
+}
+
 // `optional: true` reads a column where the header has it and leaves the quantity absent where not; only for what
 // every log may lack (temperatures, travel_el) and only by header name.
 // A logger built on VescUart (duty, input voltage, erpm, motor current; no d/q values) read through a map: duty in

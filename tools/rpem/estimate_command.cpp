@@ -258,8 +258,7 @@ std::array<std::optional<bool>, 2> check_identifiable(const std::vector<core::Av
 Tally run_averaged(const EstimateOptions& o, const std::string& log, const std::string& out, const io::LogSource& source,
                    const io::MachineConfig& config, const std::string& config_name) {
   io::AveragedLogRead read;
-  std::vector<core::AveragedSample> samples =
-      io::read_averaged_log(log, source.map, io::machine_limits(config.machine), &read);
+  std::vector<core::AveragedSample> samples = io::read_averaged_log(log, source.map, io::log_limits(config), &read);
   std::fprintf(stderr, "rpem estimate: %s\n", io::describe(source, read).c_str());
   const io::RotorFrameRebuild rebuilt =
       io::complete_rotor_frame(samples, read, config.machine, io::command_hold_s(config.estimator), log);

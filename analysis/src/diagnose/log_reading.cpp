@@ -52,7 +52,9 @@ std::string layout_difference(const io::DriveLogLayout& a, const io::DriveLogLay
 class SessionJoiner {
  public:
   SessionJoiner(LogData& d, const core::MachineSi& machine, const LogOptions& options)
-      : d_(d), machine_(machine), options_(options), limits_(io::machine_limits(machine)) {}
+      : d_(d), machine_(machine), options_(options), limits_(io::machine_limits(machine)) {
+    limits_.control_period_s = options.control_period_s;  // io::log_limits' from the configuration
+  }
 
   void append(const std::string& path, const std::function<void(std::uint64_t, std::uint64_t)>& progress) {
     const io::LogSource source = io::log_source(path, options_.log_map);

@@ -77,7 +77,7 @@ ThermalRecord record_thermal(const io::LogSource& source, const io::MachineConfi
   ThermalRecord r;
   r.log = source.path;
   r.session_logs = {source.path};
-  const io::DriveLogLimits limits = io::machine_limits(machine.machine);
+  const io::DriveLogLimits limits = io::log_limits(machine);
   if (source.averaged()) {
     r.averaged = true;
     r.counts.averaged = true;

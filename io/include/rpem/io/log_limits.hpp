@@ -36,6 +36,11 @@ struct DriveLogLimits {
   /// A voltage command may be at most this multiple of the same row's u_dc (when u_dc ≥ 1 V): a two-level
   /// inverter applies at most u_dc/2 from the link's midpoint, and 2·u_dc/π as a six-step fundamental.
   double command_per_dc_link = 2.0;
+  /// The drive's control period T_c (estimator.averaged.control_period_s; 0: not known, not checked). An averaged
+  /// window's means hold whole control cycles, so a log whose median window is shorter than half of one (its stamps'
+  /// rounding allowed) has its time in
+  /// another unit than it says (a map's `unit:`) or the configuration has another drive's T_c.
+  double control_period_s = 0.0;
 };
 
 }  // namespace rpem::io

@@ -57,6 +57,8 @@ void check_log_supports(const MachineConfig& c, const std::string& config_name, 
 /// overload and field-weakening range, so a value there means the log's units or the configured name
 /// plate are wrong. Never wider than the absolute limits.
 [[nodiscard]] DriveLogLimits machine_limits(const core::MachineSi& machine);
+/// machine_limits for the configuration's machine, with its drive's control period (the windows' shortest).
+[[nodiscard]] DriveLogLimits log_limits(const MachineConfig& config);
 
 /// The `model_extensions` section for a configuration's extensions and drifts (flow-style YAML that
 /// parse_machine_config() reads back to the same values); empty when the model is nominal.
