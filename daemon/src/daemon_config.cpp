@@ -198,6 +198,7 @@ DaemonConfig parse(io::YamlMap& root, const std::string& name, const std::string
     c.live.thermal = thermal->fusion;
     c.live.thermal_active = true;
     c.notes = io::assumed_law_notes(*thermal, true);
+    if (std::optional<std::string> note = io::process_noise_note(*thermal)) c.notes.push_back(std::move(*note));
   }
   if (d) parse_daemon(*d, c, base_dir);
   root.finish();

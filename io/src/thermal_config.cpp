@@ -132,6 +132,8 @@ void parse_nodes(YamlMap& t, ThermalConfig& c) {
     n.to_coolant_W_per_K[idx] = m.number_or("to_coolant_W_per_K", 0.0, 0.0, 1e6);
     // eq. 14.1b's speed part; absent: a conductance that does not change with speed.
     n.to_coolant_at_base_speed_W_per_K[idx] = m.number_or("to_coolant_at_base_speed_W_per_K", 0.0, 0.0, 1e6);
+    if (i == 0) c.process_noise_stated = false;
+    c.process_noise_stated = c.process_noise_stated || m.has("process_noise_K2_per_s") || m.has("disturbance_W2_per_s");
     f.filter.process_noise_K2_per_s[idx] = m.number_or("process_noise_K2_per_s", 0.0, 0.0, 1e3);
     f.filter.disturbance_W2_per_s[idx] = m.number_or("disturbance_W2_per_s", 0.0, 0.0, 1e12);
     // τ_d of eq. 14.19; absent: the random walk (τ_d = ∞).
@@ -328,6 +330,15 @@ std::vector<std::string> assumed_law_notes(const ThermalConfig& c, bool magnet) 
                          "(`rpem thermal fit` writes it, anchored at a soaked start)"));
   }
   return notes;
+}
+
+std::optional<std::string> process_noise_note(const ThermalConfig& c) {
+  if (!c.has_network || c.process_noise_stated) return std::nullopt;
+  return std::string(
+      "no node states process_noise_K2_per_s or disturbance_W2_per_s: both are 0, so the filter takes the network as "
+      "exact between observations and its band holds only the start's and the observations' uncertainty — too narrow, "
+      "and the estimate deaf to its observations, wherever the network is not exact. `rpem thermal fit` fits both; "
+      "give them where the network was written by hand (docs/thermal.md, \"thermal.yaml\")");
 }
 
 ThermalConfig load_thermal_config(const std::string& path, const MachineConfig& machine, NetworkRequired network) {

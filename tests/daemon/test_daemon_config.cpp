@@ -88,10 +88,12 @@ TEST(DaemonConfig, AThermalSectionInlineOrInItsOwnFileRunsTheFusion) {
   EXPECT_DOUBLE_EQ(c.live.thermal.filter.network.between_W_per_K(0, 1), 12.0);
   EXPECT_DOUBLE_EQ(c.live.thermal.coolant_C, 35.0);
   // The section states neither law, and the paper machine no drift: rpemd says both assumptions at start, as rpem
-  // estimate does (io::assumed_law_notes, tested with the reader).
-  ASSERT_EQ(c.notes.size(), 2U);
+  // estimate does (io::assumed_law_notes, tested with the reader); and no node a process noise or a disturbance
+  // (io::process_noise_note).
+  ASSERT_EQ(c.notes.size(), 3U);
   EXPECT_NE(c.notes[0].find("the copper law takes r_s_ref"), std::string::npos) << c.notes[0];
   EXPECT_NE(c.notes[1].find("the magnet law takes psi_m_ref 1.14 Wb at 20 °C"), std::string::npos) << c.notes[1];
+  EXPECT_NE(c.notes[2].find("no node states process_noise_K2_per_s"), std::string::npos) << c.notes[2];
   EXPECT_TRUE(builtin_daemon_config().notes.empty());
   // The file `rpem thermal fit` wrote, named relative to the configuration.
   test::TempFile own("thermal_own.yaml", section);

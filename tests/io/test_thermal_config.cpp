@@ -294,6 +294,27 @@ TEST(ThermalConfig, AnAssumedLawIsANote) {
   EXPECT_TRUE(assumed_law_notes(load_text(kThreeNodes), true).empty());
 }
 
+TEST(ThermalConfig, ANetworkWithoutProcessNoiseOnAnyNodeIsANote) {
+  // Neither key on any node: both 0, the filter takes the network as exact — said. One key on one node, zero
+  // included, is a statement: nothing said.
+  EXPECT_TRUE(load_text(kThreeNodes).process_noise_stated);
+  EXPECT_FALSE(process_noise_note(load_text(kThreeNodes)).has_value());
+  const std::string without = std::regex_replace(std::string(kThreeNodes),
+                                                 std::regex(", process_noise_K2_per_s: 0.001, disturbance_W2_per_s: 2"), "");
+  ASSERT_NE(without, kThreeNodes);
+  const ThermalConfig c = load_text(without);
+  EXPECT_FALSE(c.process_noise_stated);
+  EXPECT_EQ(c.fusion.filter.process_noise_K2_per_s, core::ThermalVec::Zero());
+  EXPECT_EQ(c.fusion.filter.disturbance_W2_per_s, core::ThermalVec::Zero());
+  const std::optional<std::string> note = process_noise_note(c);
+  ASSERT_TRUE(note.has_value());
+  EXPECT_NE(note->find("no node states process_noise_K2_per_s or disturbance_W2_per_s: both are 0"), std::string::npos)
+      << *note;
+  const std::string zero =
+      std::regex_replace(without, std::regex("to_coolant_W_per_K: 95"), "to_coolant_W_per_K: 95, process_noise_K2_per_s: 0");
+  EXPECT_FALSE(process_noise_note(load_text(zero)).has_value());
+}
+
 TEST(ThermalConfig, AFitsStartMayGiveTheLawsOnly) {
   test::TempFile f("laws.yaml", "thermal:\n  copper: {r_s_ref_Ohm: 0.0758, reference_C: 120}\n");
   const ThermalConfig c = load_thermal_config(f.path(), machine(), NetworkRequired::kNo);

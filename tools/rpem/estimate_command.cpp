@@ -75,6 +75,8 @@ class ThermalRun {
     for (int i = 0; i < t.fusion.filter.network.nodes; ++i) names_.push_back(t.node_names[static_cast<std::size_t>(i)]);
     for (const std::string& note : io::assumed_law_notes(t, true))
       std::fprintf(stderr, "rpem estimate: thermal: note: %s\n", note.c_str());
+    if (const std::optional<std::string> note = io::process_noise_note(t))
+      std::fprintf(stderr, "rpem estimate: thermal: note: %s\n", note->c_str());
     coolant_C_ = t.fusion.coolant_C;
     fusion_.emplace(t.fusion, base, cfg.machine);
   }

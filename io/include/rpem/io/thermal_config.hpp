@@ -25,6 +25,9 @@ struct ThermalConfig {
   /// Whether the magnet law was stated (the machine's `psim_drift` or the section's `magnet_law`), or the machine's
   /// psi_m_Wb was assumed to hold at NdFeB's 20 °C reference.
   bool magnet_law_stated = true;
+  /// Whether any node states its process noise or heat disturbance (either key, zero included); absent from every
+  /// node, both are 0 and the filter takes the network as exact between observations (process_noise_note).
+  bool process_noise_stated = true;
 };
 
 /// Whether a section must give the network (rpemd, `rpem estimate`) or may give the laws only (a fit's start).
@@ -50,6 +53,11 @@ enum class NetworkRequired : bool { kNo = false, kYes = true };
 /// temperature where it was not stated, the magnet law where it was not (`magnet`: whether to say the latter —
 /// a fit anchors the magnet law at the log's soaked start instead).
 [[nodiscard]] std::vector<std::string> assumed_law_notes(const ThermalConfig& c, bool magnet);
+
+/// What a reader of a network should be told where no node states a process noise or a disturbance (a network
+/// written by hand: `rpem thermal fit` writes both): the band then holds the start's and the observations'
+/// uncertainty only, and is too narrow wherever the network is not exact. Nothing where one is stated.
+[[nodiscard]] std::optional<std::string> process_noise_note(const ThermalConfig& c);
 
 /// The defaults a fit starts from (docs/thermal.md; no network: has_network false): the laws of the machine's
 /// drifts or of copper and NdFeB (core/thermal.hpp) about the machine's values at 20 °C, the loss base
