@@ -38,7 +38,14 @@ struct Handler {
 
 int main(int argc, char** argv) {
   using namespace rpem;
-  if (argc < 3) {
+  // SECONDS: how long to run, a whole positive number (default: a million, i.e. until stopped).
+  long seconds = 1000000;
+  char* end_of_seconds = nullptr;
+  if (argc > 3) seconds = std::strtol(argv[3], &end_of_seconds, 10);
+  if (argc < 3 || argc > 4 ||
+      (argc > 3 && (*end_of_seconds != '\0' || end_of_seconds == argv[3] || seconds < 1 || seconds > 1000000000))) {
+    if (argc > 3)
+      std::fprintf(stderr, "%s: SECONDS '%s' is not a whole number of seconds from 1 to 1e9\n", argv[0], argv[3]);
     std::fprintf(stderr, "usage: %s CONFIG PUBLISH_KEY_FILE [SECONDS]\n", argv[0]);
     return io::kExitUsage;
   }
@@ -60,7 +67,7 @@ int main(int argc, char** argv) {
   Handler handler{supervisor};
   lcm.subscribe("RPEM_ESTIMATE", &Handler::on_message, &handler);
   std::setvbuf(stdout, nullptr, _IOLBF, 0);
-  const auto end = std::chrono::steady_clock::now() + std::chrono::seconds(argc > 3 ? std::atoi(argv[3]) : 1000000);
+  const auto end = std::chrono::steady_clock::now() + std::chrono::seconds(seconds);
   // Between messages: a line when the estimate ages out, or I_max moves by 0.1 A (held values heating).
   supervisor::CurrentLimit printed = supervisor.current_limit(core::unix_us());
   std::printf("%s\n", supervisor::limit_line(core::unix_us(), printed).c_str());

@@ -69,6 +69,12 @@ TEST(ThermalFigure, TimesThatDoNotIncreaseAreRefusedAtTheirLine) {
   EXPECT_NE(refusal("t,T_magnet,T_winding\n0.5,50,80\nnan,50,80\n").find("measured.csv:3:1: column t: NaN"),
             std::string::npos);
   EXPECT_EQ(refusal("t,T_magnet,T_winding\n0.5,50,80\n1.5,nan,80\n"), "");
+  // Times on another clock (a thermocouple log from 0 beside an estimate on the drive's): nothing judged, said so.
+  EXPECT_NE(refusal("t,T_magnet,T_winding\n43200,50,80\n43201,50,80\n")
+                .find("measured.csv:2: column t: its times (43200 to 43201 s) share none with the estimate's (0 to 2 s"),
+            std::string::npos)
+      << refusal("t,T_magnet,T_winding\n43200,50,80\n43201,50,80\n");
+  EXPECT_EQ(refusal("t,T_magnet,T_winding\n1.5,50,80\n3,50,80\n"), "");  // one point within: judged
 }
 
 TEST(ThermalFigure, RpemAloneIsDrawnFromItsFirstAdaptationAndSaidWhereItNeverAdapted) {

@@ -59,6 +59,19 @@ struct Eavesdropper {
   }
 };
 
+TEST(SupervisorLcm, ASecondsArgumentThatIsNoWholePositiveNumberIsAUsageError) {
+  // Before 2026-12-04 atoi read "abc", "nan" and "-3" as 0 s (exit 0 at once) and "2.5" as 2 s.
+  const std::string program = test::binary_dir() + "/examples/example_supervisor " + RPEM_TEST_SOURCE_DIR +
+                              "/examples/supervisor/supervisor.yaml /nonexistent.key ";
+  for (const char* bad : {"abc", "nan", "-3", "0", "2.5", "1e3", "99999999999"}) {
+    const test::ProcessResult r = test::run_command(program + bad);
+    EXPECT_EQ(r.exit_code, 64) << bad << ": " << r.output;
+    EXPECT_NE(r.output.find(std::string("SECONDS '") + bad + "' is not a whole number of seconds"), std::string::npos)
+        << r.output;
+  }
+  EXPECT_EQ(test::run_command(program + "5").exit_code, 78);  // read as 5 s: on to the key file, which is missing
+}
+
 TEST(SupervisorLcm, DeratesOnVerifiedEstimatesFromRpemdAndTheAuthLibraryAndIgnoresAReplay) {
   const fs::path dir = fs::path(test::TempFile("supervisor").path());
   fs::remove_all(dir);

@@ -89,8 +89,9 @@ void sensor_lag_at_standstill(io::ThermalConfig& c, const ThermalRecord& r, std:
   out.notes.push_back("winding sensor time constant without the network (eq. 14.25, " + std::to_string(e.runs) +
                       " standstill runs of r̂s beside the sensor): " + std::to_string(e.tau_s) + " s, 95 % interval [" +
                       std::to_string(e.lower_s) + ", " + std::to_string(e.upper_s) + "] s; " +
-                      (used ? "used, the winding node standing for the sensor's reading (eq. 14.24)"
-                            : "not used (fewer than three runs, or no lag within the interval)"));
+                      (used         ? "used, the winding node standing for the sensor's reading (eq. 14.24)"
+                       : e.runs < 3 ? "not used (fewer than three runs)"
+                                    : "not used (its interval reaches down to no lag at all)"));
   if (!used) return;
   c.fusion.winding_sensor_time_constant_s = e.tau_s;
   c.fusion.winding_node_is_reading = true;

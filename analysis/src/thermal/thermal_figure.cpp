@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <optional>
 #include <utility>
@@ -100,6 +101,18 @@ double panel(GnuplotFigure& fig, const io::CsvTable& est, const io::CsvTable* me
   return counted > 0.0 ? covered / counted : kNaN;
 }
 
+/// The measured times against the estimate's (both increasing, non-empty): a thermocouple log that starts at 0
+/// beside an estimate on VESC Tool's seconds since midnight shares no time, and would judge nothing, silently.
+void check_times_overlap(const ThermalFigureInput& in, const std::vector<double>& t_est, const std::vector<double>& t_m) {
+  if (t_est.empty() || t_m.empty() || (t_m.front() <= t_est.back() && t_m.back() >= t_est.front())) return;
+  char text[320];
+  std::snprintf(text, sizeof text,
+                "its times (%.6g to %.6g s) share none with the estimate's (%.6g to %.6g s, %s): both need one clock "
+                "(shift the measured t by the difference of their starts)",
+                t_m.front(), t_m.back(), t_est.front(), t_est.back(), in.estimate_csv.c_str());
+  throw io::DataError(in.measured_csv, 2, 0, "column t", text);
+}
+
 }  // namespace
 
 ThermalFigureCoverage write_thermal_figure(const std::string& png_path, const ThermalFigureInput& in) {
@@ -116,6 +129,7 @@ ThermalFigureCoverage write_thermal_figure(const std::string& png_path, const Th
       if (!measured->has(c)) throw io::DataError(in.measured_csv, 1, 0, c, "column missing from the header");
     }
     measured->require_increasing("t");
+    check_times_overlap(in, est.column("t"), measured->column("t"));
   }
   GnuplotFigure fig(png_path, 1400, 800);
   fig.add_line("set multiplot layout 2,1");
