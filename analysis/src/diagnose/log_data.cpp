@@ -221,8 +221,9 @@ LogData prepare_log(const std::vector<io::DriveLogRow>& rows, const io::DriveLog
 std::vector<std::string> left_out_explanations(const LogData& log) {
   std::vector<std::string> out;
   const double n = static_cast<double>(log.size());
-  auto explain = [&](std::size_t count, const std::string& what) {
-    if (static_cast<double>(count) <= io::kExplainedShare * n) return;
+  // Said where the rule took more than `share` of the rows (whole sessions: whatever their share).
+  auto explain = [&](std::size_t count, const std::string& what, double share = io::kExplainedShare) {
+    if (count == 0 || static_cast<double>(count) <= share * n) return;
     char head[96];
     std::snprintf(head, sizeof head, "%zu of %zu rows (%.1f %%) ", count, log.size(),
                   100.0 * static_cast<double>(count) / n);
@@ -241,21 +242,16 @@ std::vector<std::string> left_out_explanations(const LogData& log) {
                 "predicts nothing a constant could be fitted to. Keys: none (nothing to fit there)",
                 100.0 * kIdleShare);
   explain(log.excluded_idle, text);
-  if (log.excluded_rebuilt > 0) {  // whole sessions: said whatever their share
-    std::string names;
-    for (std::size_t j = 0; j < log.sessions(); ++j) {
-      if (log.session_voltage_rebuilt[j]) names += (names.empty() ? "" : ", ") + log.session_logs[j];
-    }
-    std::snprintf(text, sizeof text, "%zu of %zu rows (%.1f %%) ", log.excluded_rebuilt, log.size(),
-                  100.0 * static_cast<double>(log.excluded_rebuilt) / n);
-    out.push_back(text +
-                  std::string("were left out: they are the sessions whose voltages are rebuilt from the duty "
-                              "cycle (") +
-                  names +
-                  "), whose u_d holds the configuration's R_s and L_q, while the folder's other sessions log the d/q "
-                  "voltages, which carry them (docs/diagnose.md, \"A folder of logs\"). Keys: none — diagnose those "
-                  "sessions on their own to use them");
+  std::string names;
+  for (std::size_t j = 0; j < log.session_voltage_rebuilt.size(); ++j) {
+    if (log.session_voltage_rebuilt[j]) names += (names.empty() ? "" : ", ") + log.session_logs[j];
   }
+  explain(log.excluded_rebuilt,
+          "were left out: they are the sessions whose voltages are rebuilt from the duty cycle (" + names +
+              "), whose u_d holds the configuration's R_s and L_q, while the folder's other sessions log the d/q "
+              "voltages, which carry them (docs/diagnose.md, \"A folder of logs\"). Keys: none — diagnose those "
+              "sessions on their own to use them",
+          0.0);
   return out;
 }
 
