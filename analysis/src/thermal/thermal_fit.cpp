@@ -377,14 +377,58 @@ double soak_test_sigma_K(const core::ThermalFusionConfig& f) {
   return f.winding_sensor_sigma_K > 0.0 ? f.winding_sensor_sigma_K : kUnfusedWindingSensorSigma_K;
 }
 
+/// Whether the session starting at step `first` has a winding reading there to test its soak with.
+bool soak_testable(const ThermalRecord& r, std::size_t first) {
+  return r.winding_sensor && first < r.steps.size() && std::isfinite(r.steps[first].winding_sensor_C);
+}
+
 /// Whether the session starting at step `first` starts soaked, as the anchor and the open-loop start assume (every
 /// node at the coolant): where it has a winding sensor, its first reading within core::kSoakBound_sigma of the
 /// sensor's σ from the coolant. Returns that first reading where it does not.
 std::optional<double> unsoaked_start_C(const io::ThermalConfig& c, const ThermalRecord& r, std::size_t first) {
-  if (!r.winding_sensor || first >= r.steps.size() || !std::isfinite(r.steps[first].winding_sensor_C)) return std::nullopt;
+  if (!soak_testable(r, first)) return std::nullopt;
   const double winding_C = r.steps[first].winding_sensor_C, coolant_C = r.steps[first].load.coolant_C;
   if (core::unsoaked_excess_K(winding_C, coolant_C, soak_test_sigma_K(c.fusion)) == 0.0) return std::nullopt;
   return winding_C;
+}
+
+/// The note for sessions whose soak nothing tests (no winding reading at their start): the anchor assumes it, and a
+/// warm start reads every magnet temperature cold with no sign in the band. Where r̂s adapts early, its first reading
+/// (through the copper law, whose reference may itself be assumed) is said beside it, for the user to judge.
+std::string untested_soak_note(const io::ThermalConfig& c, const ThermalRecord& r,
+                               const std::vector<std::size_t>& untested) {
+  constexpr double kEarly_s = 300.0;
+  const core::DriftLaw& copper = c.fusion.filter.network.copper;
+  std::string names, readings;
+  for (std::size_t j : untested) {
+    const SessionSpan span = session_span(r, j);
+    if (r.session_first_step.size() > 1) names += (names.empty() ? "" : ", ") + r.session_logs[j];
+    for (std::size_t k = span.first; k < span.end && r.t_s[k] - r.t_s[span.first] <= kEarly_s; ++k) {
+      const core::ParameterObservation& p = r.steps[k].parameter[core::kRs];
+      if (!p.valid) continue;
+      const double winding_C = copper.temperature_C(p.value), coolant_C = r.steps[k].load.coolant_C;
+      char text[224];
+      std::snprintf(
+          text, sizeof text, "%sr_s's first reading%s puts the winding at %.1f °C, %+.1f K from the coolant, %.0f s in",
+          readings.empty() ? "" : "; ", r.session_first_step.size() > 1 ? (" in " + r.session_logs[j]).c_str() : "",
+          winding_C, winding_C - coolant_C, r.t_s[k] - r.t_s[span.first]);
+      readings += text;
+      break;
+    }
+  }
+  std::string note = (names.empty() ? std::string("the log has") : "the sessions " + names + " have") +
+                     " no winding reading at the start: that the machine starts soaked (every node at the coolant) is "
+                     "assumed, not tested, and the magnet law's reference is anchored on it. A start warmer than the "
+                     "coolant (a restart on a warm machine, a log cut from a longer run) reads every magnet temperature "
+                     "cold by up to the magnet's excess there, and the band does not show it";
+  if (!readings.empty()) {
+    note += ". " + readings + " (through the copper law's reference" +
+            (c.copper_reference_stated ? std::string(")") : ", itself assumed)") +
+            ": far more than the load since the start heats a winding, it says the start was warm";
+  }
+  return note +
+         ". Log a winding sensor, or start the log with the machine at rest and cooled "
+         "(docs/thermal.md, \"A log that does not start soaked\")";
 }
 
 /// Each step's magnet and winding temperatures at its session's start (core::start_temperatures_C at its first step):
@@ -418,9 +462,11 @@ AnchorPlan plan_anchor(io::ThermalConfig& c, const ThermalRecord& r, std::vector
   const std::size_t sessions = r.session_first_step.size();
   AnchorPlan plan;
   std::vector<std::optional<double>> unsoaked(sessions);
+  std::vector<std::size_t> untested;
   std::string unsoaked_names;
   for (std::size_t j = 0; j < sessions; ++j) {
     unsoaked[j] = unsoaked_start_C(c, r, r.session_first_step[j]);
+    if (!soak_testable(r, r.session_first_step[j])) untested.push_back(j);
     if (!unsoaked[j]) {
       plan.sessions.push_back(j);
     } else {
@@ -430,6 +476,7 @@ AnchorPlan plan_anchor(io::ThermalConfig& c, const ThermalRecord& r, std::vector
       unsoaked_names += (unsoaked_names.empty() ? "" : ", ") + r.session_logs[j] + reading;
     }
   }
+  if (!untested.empty()) notes.push_back(untested_soak_note(c, r, untested));
   if (!plan.sessions.empty()) {
     if (!unsoaked_names.empty()) {
       notes.push_back("sessions that do not start soaked (their winding sensor's first reading more than " +
