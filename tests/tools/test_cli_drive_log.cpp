@@ -128,12 +128,29 @@ TEST(CliDriveLog, ToolsThatNeedALongerLogSaySoWithTheDataErrorsExit) {
   EXPECT_FALSE(fs::exists(dir / "t.yaml"));
   // 15 s of rows: enough filter steps (1 s each), but not before a training part's end at 3 s.
   write_rows(151, 0.1);
+  // The option's fault, not the log's: a usage error (64), the log's span said.
   const test::ProcessResult u = rpem("thermal fit --fit-until-s 3", "t.yaml");
-  EXPECT_EQ(u.exit_code, 65) << u.output;
-  EXPECT_NE(u.output.find("short.csv: fewer than 10 steps of the thermal filter end before the training part's end "
-                          "(--fit-until-s 3.000000 s; the log runs from 1"),
+  EXPECT_EQ(u.exit_code, 64) << u.output;
+  EXPECT_NE(u.output.find("rpem thermal fit: --fit-until-s 3: "), std::string::npos) << u.output;
+  EXPECT_NE(u.output.find(" end by then, a fit needs at least 10; "), std::string::npos) << u.output;
+  EXPECT_NE(u.output.find("short.csv's steps end from 1"), std::string::npos) << u.output;
+  EXPECT_FALSE(fs::exists(dir / "t.yaml"));
+  // 12 s of rows: 10 steps or more, but fewer in the default training part (its first 75 %): the log's fault (65),
+  // and the message names the default, not an option that was not given.
+  write_rows(121, 0.1);
+  const test::ProcessResult w = rpem("thermal fit", "t.yaml");
+  EXPECT_EQ(w.exit_code, 65) << w.output;
+  EXPECT_NE(w.output.find("short.csv: fewer than 10 steps of the thermal filter end by the training part's end (the "
+                          "first 75 % of the log, to "),
             std::string::npos)
-      << u.output;
+      << w.output;
+  // Three rows are too few for figures' timeline too; it says what for, not diagnose's blocks, which it does not cut.
+  write_rows(3, 125e-6);
+  const test::ProcessResult g = rpem("figures", "g");
+  EXPECT_EQ(g.exit_code, 65) << g.output;
+  EXPECT_NE(g.output.find("short.csv: the log gives 3 samples; at least 4 are needed (for a timeline"), std::string::npos)
+      << g.output;
+  EXPECT_EQ(g.output.find("training and held-out"), std::string::npos) << g.output;
   fs::remove_all(dir);
 }
 

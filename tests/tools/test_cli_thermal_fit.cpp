@@ -329,6 +329,10 @@ TEST_F(CliThermalFit, SaysWhatTheTrainingPartObserves) {
     ASSERT_EQ(early.exit_code, 0) << early.output;
     EXPECT_NE(early.output.find("magnet (from psi_m): none in training"), std::string::npos) << early.output;
     EXPECT_NE(test::read_file(report + "_early.yaml").find("# magnet (from psi_m): none in training"), std::string::npos);
+    // A part without points has no figure, not one of 0 K.
+    const std::size_t at = early.output.find("magnet (from psi_m): none in training");
+    EXPECT_EQ(early.output.substr(at, early.output.find('\n', at) - at).find("fit "), std::string::npos) << early.output;
+    EXPECT_EQ(test::read_file(report + "_early.yaml").find("K RMS (0)"), std::string::npos);
   }
 }
 
@@ -416,6 +420,12 @@ TEST_F(CliThermalFit, ALogWithoutAWindingReadingSaysItsSoakIsAssumedAndWhereRsFi
   EXPECT_LE(t_s, 300.0);
   EXPECT_NEAR(winding_C, 45.0 + 50.0 * (1.0 - std::exp(-t_s / 400.0)), 1.0) << r.output;
   EXPECT_GT(winding_C - 25.0, 15.0);  // the reading says the start was warm
+  // A ratio prints without a unit ("= 1.25", not "= 1.25 1").
+  const std::size_t scale = r.output.find("copper loss scale = ");
+  ASSERT_NE(scale, std::string::npos) << r.output;
+  const std::string after = r.output.substr(scale + 20, r.output.find('\n', scale) - scale - 20);
+  EXPECT_EQ(after.find(" 1 ("), std::string::npos) << after;
+  EXPECT_NE(after.find(" ("), std::string::npos) << after;
 }
 
 // A VESC without a motor sensor: its NTC input open, the firmware filters in −100 °C for the reading it does not have

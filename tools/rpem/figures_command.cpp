@@ -62,6 +62,8 @@ int run_figures(const FiguresOptions& o) {
     analysis::LogOptions options = analysis::log_options(cfg);
     options.log_map = o.log_map;
     options.blocks = 2;  // the timeline uses no blocks: the fewest the log's preparation takes, so short logs draw
+    options.samples_needed_for =
+        "for a timeline: its log is prepared as diagnose prepares one, in 2 blocks of 2 samples at least";
     log = load_log_or_sessions(o.log, cfg.machine, options);
     print_log_read("rpem figures", *log);
     regimes = analysis::classify_regimes(*log, cfg);

@@ -114,8 +114,8 @@ double median_step_s(const analysis::ThermalRecord& r) {
 /// the log cannot tell apart, the notes, and the noise the filter takes (the caller ends the line).
 void print_fit(const analysis::ThermalFitResult& fit, const analysis::ThermalRecord& record) {
   for (const analysis::SignalFit& s : fit.signals) {
-    std::printf("%s: %s in training (σ %.2g K); fit %.3g K RMS, ", s.name.c_str(), analysis::training_span(s).c_str(),
-                s.training_sigma_K, s.fit_rms_K);
+    std::printf("%s: %s in training (σ %.2g K); ", s.name.c_str(), analysis::training_span(s).c_str(), s.training_sigma_K);
+    if (s.fit_points > 0) std::printf("fit %.3g K RMS, ", s.fit_rms_K);  // none in training: no figure of 0 K
     if (s.heldout_points == 0) {
       if (fit.training_steps == record.steps.size()) {
         std::printf("nothing held out (the training part, to %.6g s, takes the whole log)\n", fit.fit_until_s);
@@ -128,10 +128,11 @@ void print_fit(const analysis::ThermalFitResult& fit, const analysis::ThermalRec
   }
   for (const analysis::FittedParameter& p : fit.parameters) {
     if (p.half_width_rel <= 10.0) {
-      std::printf("%s = %.5g %s (±%.3g %%%s)\n", p.name.c_str(), p.value, p.unit.c_str(), 100.0 * p.half_width_rel,
-                  p.identified ? "" : ", not identified");
+      std::printf("%s = %.5g%s (±%.3g %%%s)\n", p.name.c_str(), p.value, p.unit_after_value().c_str(),
+                  100.0 * p.half_width_rel, p.identified ? "" : ", not identified");
     } else {
-      std::printf("%s = %.5g %s (not identified: the log does not bound it)\n", p.name.c_str(), p.value, p.unit.c_str());
+      std::printf("%s = %.5g%s (not identified: the log does not bound it)\n", p.name.c_str(), p.value,
+                  p.unit_after_value().c_str());
     }
   }
   for (const std::string& s : fit.not_identifiable) std::printf("not identifiable together: %s\n", s.c_str());
@@ -192,6 +193,16 @@ int run_thermal_fit(const ThermalFitCliOptions& o) {
   const io::ThermalConfig start = start_for(record);
   analysis::ThermalFitOptions options;
   options.fit_until_s = o.fit_until_s;
+  // A --fit-until-s that leaves too short a training part is the command's fault, not the log's (64).
+  if (const std::size_t training = analysis::steps_until(record, o.fit_until_s);
+      !std::isnan(o.fit_until_s) && !record.t_s.empty() && training < analysis::kMinFitSteps) {
+    std::fprintf(stderr,
+                 "rpem thermal fit: --fit-until-s %.6g: %zu step%s of the thermal filter end by then, a fit needs at "
+                 "least %zu; %s's steps end from %.6g to %.6g s\n",
+                 o.fit_until_s, training, training == 1 ? "" : "s", analysis::kMinFitSteps, o.log.c_str(),
+                 record.t_s.front(), record.t_s.back());
+    return kExitUsage;
+  }
   if (o.held_out_sessions > 0) {
     const std::size_t sessions = record.session_first_step.size();
     if (static_cast<std::size_t>(o.held_out_sessions) >= sessions) {

@@ -92,10 +92,12 @@ void check_enough_samples(const LogData& d, const LogOptions& options) {
   if (n < 2 * static_cast<std::size_t>(std::max(2, options.blocks))) {
     // Samples, not rows: an averaged or VESC Tool log's first row only opens the first window.
     const int blocks = std::max(2, options.blocks);
+    const std::string purpose = options.samples_needed_for.empty()
+                                    ? std::to_string(blocks) + " training and held-out blocks, 2 each"
+                                    : options.samples_needed_for;
     throw io::DriveLogError(d.path, 0, 0, "",
                             "the log gives " + std::to_string(n) + (n == 1 ? " sample" : " samples") + "; at least " +
-                                std::to_string(2 * blocks) + " are needed (" + std::to_string(blocks) +
-                                " training and held-out blocks, 2 each)");
+                                std::to_string(2 * blocks) + " are needed (" + purpose + ")");
   }
 }
 

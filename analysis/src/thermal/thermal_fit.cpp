@@ -577,24 +577,32 @@ void add_closing_notes(ThermalFitResult& out) {
 
 }  // namespace
 
+std::size_t steps_until(const ThermalRecord& r, double fit_until_s) {
+  std::size_t n = 0;
+  while (n < r.t_s.size() && r.t_s[n] <= fit_until_s) ++n;
+  return n;
+}
+
 ThermalFitResult fit_thermal(const ThermalRecord& record, const io::ThermalConfig& start_config,
                              const ThermalFitOptions& options) {
-  if (record.steps.size() < 10) {  // the data's fault, not the program's: exit 65, the file named
-    throw io::DriveLogError(
-        record.log, 0, 0, "",
-        "the log gives " + std::to_string(record.steps.size()) +
-            " steps of the thermal filter; a fit needs at least 10 (a longer log, or a shorter filter.period_s)");
+  if (record.steps.size() < kMinFitSteps) {  // the data's fault, not the program's: exit 65, the file named
+    throw io::DriveLogError(record.log, 0, 0, "",
+                            "the log gives " + std::to_string(record.steps.size()) +
+                                " steps of the thermal filter; a fit needs at least " + std::to_string(kMinFitSteps) +
+                                " (a longer log, or a shorter period of the filter: filter.period_s, or `rpem thermal "
+                                "fit --period-s`)");
   }
   ThermalFitResult out;
   const double t0 = record.t_s.front(), t_end = record.t_s.back();
-  out.fit_until_s = std::isnan(options.fit_until_s) ? t0 + 0.75 * (t_end - t0) : options.fit_until_s;
-  std::size_t training = 0;
-  while (training < record.steps.size() && record.t_s[training] <= out.fit_until_s) ++training;
-  if (training < 10) {
-    throw io::DriveLogError(record.log, 0, 0, "",
-                            "fewer than 10 steps of the thermal filter end before the training part's end (--fit-until-s " +
-                                std::to_string(out.fit_until_s) + " s; the log runs from " + std::to_string(t0) + " to " +
-                                std::to_string(t_end) + " s)");
+  const bool default_training = std::isnan(options.fit_until_s);
+  out.fit_until_s = default_training ? t0 + 0.75 * (t_end - t0) : options.fit_until_s;
+  const std::size_t training = steps_until(record, out.fit_until_s);
+  if (training < kMinFitSteps) {
+    throw io::DriveLogError(
+        record.log, 0, 0, "",
+        "fewer than " + std::to_string(kMinFitSteps) + " steps of the thermal filter end by the training part's end (" +
+            (default_training ? "the first 75 % of the log, to " : "--fit-until-s ") + std::to_string(out.fit_until_s) +
+            " s; the log's steps end from " + std::to_string(t0) + " to " + std::to_string(t_end) + " s)");
   }
   out.training_steps = training;
 

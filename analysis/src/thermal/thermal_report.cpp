@@ -59,10 +59,16 @@ void write_thermal_yaml(const std::string& path, const ThermalFitResult& fit, co
   }
   f << "# training: t <= " << fit.fit_until_s << " s (" << fit.training_steps << " steps); the rest held out\n";
   for (const SignalFit& s : fit.signals) {
+    // A part without points has no figure (not one of 0 K).
     f << "# " << s.name << ": " << training_span(s) << " in training (5–95 %, σ " << significant(s.training_sigma_K)
-      << " K); fit " << significant(s.fit_rms_K) << " K RMS (" << s.fit_points << "), held out "
-      << significant(s.heldout_rms_K) << " K RMS, worst " << significant(s.heldout_worst_K) << " K (" << s.heldout_points
-      << ")\n";
+      << " K); ";
+    if (s.fit_points > 0) f << "fit " << significant(s.fit_rms_K) << " K RMS (" << s.fit_points << "), ";
+    if (s.heldout_points > 0) {
+      f << "held out " << significant(s.heldout_rms_K) << " K RMS, worst " << significant(s.heldout_worst_K) << " K ("
+        << s.heldout_points << ")\n";
+    } else {
+      f << "nothing held out\n";
+    }
   }
   for (const FittedParameter& p : fit.parameters) {
     if (!p.identified) f << "# not identified: " << p.name << " (95 % interval " << interval(p.half_width_rel) << ")\n";
@@ -141,10 +147,12 @@ void write_thermal_fit_report(const std::string& path, const ThermalFitResult& f
   }
   o << "| signal | observed in training, 5–95 % | σ [K] | fit RMS [K] | points | held-out RMS [K] | held-out worst "
        "[K] | points |\n|---|---|---|---|---|---|---|---|\n";
+  // A part without points has no figure: "—", not 0 K.
+  const auto figure = [](double k, std::size_t points) { return points > 0 ? significant(k) : std::string("—"); };
   for (const SignalFit& s : fit.signals) {
     o << "| " << s.name << " | " << training_span(s) << " | " << significant(s.training_sigma_K) << " | "
-      << significant(s.fit_rms_K) << " | " << s.fit_points << " | " << significant(s.heldout_rms_K) << " | "
-      << significant(s.heldout_worst_K) << " | " << s.heldout_points << " |\n";
+      << figure(s.fit_rms_K, s.fit_points) << " | " << s.fit_points << " | " << figure(s.heldout_rms_K, s.heldout_points)
+      << " | " << figure(s.heldout_worst_K, s.heldout_points) << " | " << s.heldout_points << " |\n";
   }
   o << "\n## Parameters (95 % intervals: cluster-robust over "
     << "blocks of the training part; excitation alone)\n\n";

@@ -145,7 +145,9 @@ struct LogOptions {
   /// estimator.regimes.hall_interpolation_speed_rad_s: below it an averaged window's speed is its step count's
   /// (core::window_speed_rad_s); 0: the reported speed everywhere.
   double staircase_below_rad_s = 0.0;
-  int blocks = 40;            ///< training and held-out blocks, alternating, equal in sampled time
+  int blocks = 40;  ///< training and held-out blocks, alternating, equal in sampled time
+  /// What the caller needs the samples for, said where a log has too few (empty: the blocks, as diagnose does).
+  std::string samples_needed_for;
   int speed_half_window = 4;  ///< transient logs: replay speed from the angle over ±this many samples
   std::string log_map;        ///< a column map (YAML) to read the log with; empty: detected (io::log_source)
 };

@@ -18,6 +18,9 @@
 
 namespace rpem::analysis {
 
+/// The fewest steps of the filter a fit takes, in the log and in its training part.
+inline constexpr std::size_t kMinFitSteps = 10;
+
 struct ThermalFitOptions {
   /// Steps ending at or before this time train; the rest is held out. NaN: the first 75 % of the log's time.
   double fit_until_s = std::numeric_limits<double>::quiet_NaN();
@@ -29,9 +32,14 @@ struct ThermalFitOptions {
   double disturbance_time_constant_s = std::numeric_limits<double>::quiet_NaN();
 };
 
+/// The steps of `r` that end at or before `fit_until_s`: the training part a fit to that time has.
+[[nodiscard]] std::size_t steps_until(const ThermalRecord& r, double fit_until_s);
+
 struct FittedParameter {
   std::string name;  ///< e.g. "C winding", "G winding–magnet", "iron_eddy at magnet", "psi_m_ref"
-  std::string unit;
+  std::string unit;  ///< SI; "1" for a ratio
+  /// The unit as it follows a value in text: " W/K", nothing for a ratio.
+  [[nodiscard]] std::string unit_after_value() const { return unit == "1" ? std::string() : " " + unit; }
   double value = 0.0;
   double half_width_rel = 0.0;             ///< 95 %, cluster-robust, relative (∞: not excited)
   double excitation_half_width_rel = 0.0;  ///< 95 %, what the excitation alone allows
