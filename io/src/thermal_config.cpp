@@ -54,18 +54,34 @@ double coefficient_rel_sigma(const std::array<core::MaterialCoefficient, N>& mat
   return m ? m->rel_sigma() : 0.1;
 }
 
-/// Why no value within the estimator's bounds [lo, hi] reads through the law as a temperature a machine can have
-/// (core::PlausibleMagnitudes: absolute zero to 1 000 °C), or nothing. Such a law is another machine's (a thermal.yaml
-/// fitted with another --config): every estimate would be read as an impossible temperature.
-std::optional<std::string> law_outside_bounds(const core::DriftLaw& law, double lo, double hi, const char* bounds_key) {
-  const core::PlausibleMagnitudes limits;
+/// The highest temperature a law can describe: its material's (core::MaterialCoefficient::highest_C, a magnet's Curie
+/// temperature) where its coefficient at the materials' reference temperature lies in one of `materials`' ranges,
+/// else the plausible maximum.
+template <std::size_t N>
+double highest_temperature_C(const std::array<core::MaterialCoefficient, N>& materials, const core::DriftLaw& law) {
+  const std::optional<core::MaterialCoefficient> m =
+      core::material_of(materials, law.referred_to(core::kMaterialReference_C).coeff_per_K);
+  return std::min(core::PlausibleMagnitudes{}.temperature_max_C, m ? m->highest_C : 1e300);
+}
+
+/// Why no value within the estimator's bounds [lo, hi] reads through the law as a temperature the machine can have
+/// (absolute zero to `highest_C`, the material's highest), or nothing. Such a law is another machine's (a thermal.yaml
+/// fitted with another --config): every estimate would be read as an impossible temperature. A magnet law from a
+/// larger machine reads every value of a smaller one's bounds near T_ref + 1/|α| (853 °C for NdFeB), below 1 000 °C
+/// but far above any NdFeB magnet's Curie temperature: only the material's limit refuses it.
+std::optional<std::string> law_outside_bounds(const core::DriftLaw& law, double lo, double hi, const char* bounds_key,
+                                              double highest_C) {
+  const double lowest_C = core::PlausibleMagnitudes{}.temperature_min_C;
   const double a = law.temperature_C(lo), b = law.temperature_C(hi);
-  if (std::max(a, b) >= limits.temperature_min_C && std::min(a, b) <= limits.temperature_max_C) return std::nullopt;
+  if (std::max(a, b) >= lowest_C && std::min(a, b) <= highest_C) return std::nullopt;
   std::ostringstream why;
   why << std::setprecision(4) << "reads the estimator's whole range " << bounds_key << " [" << lo << ", " << hi << "] as "
-      << std::min(a, b) << " to " << std::max(a, b) << " °C, outside " << limits.temperature_min_C << " to "
-      << limits.temperature_max_C << " °C: this law is not the configured machine's (a thermal.yaml fitted with "
-      << "another machine's configuration?)";
+      << std::min(a, b) << " to " << std::max(a, b) << " °C, outside " << lowest_C << " to " << highest_C
+      << " °C (absolute zero to the "
+      << (highest_C < core::PlausibleMagnitudes{}.temperature_max_C
+              ? "highest Curie temperature of the magnet material its coefficient is"
+              : "highest plausible temperature")
+      << "): this law is not the configured machine's (a thermal.yaml fitted with another machine's configuration?)";
   return why.str();
 }
 
@@ -278,9 +294,11 @@ ThermalConfig parse_thermal_config(YamlMap& section, const MachineConfig& machin
     m->finish();
   }
   const core::EstimatorSettings& bounds = machine.estimator;
-  if (auto why = law_outside_bounds(f.magnet_law, bounds.psi_m_min_Wb, bounds.psi_m_max_Wb, "estimator.bounds.psi_m_Wb"))
+  if (auto why = law_outside_bounds(f.magnet_law, bounds.psi_m_min_Wb, bounds.psi_m_max_Wb, "estimator.bounds.psi_m_Wb",
+                                    highest_temperature_C(core::kMagnetMaterials, f.magnet_law)))
     section.fail("magnet_law", "magnet_law " + *why);
-  if (auto why = law_outside_bounds(n.copper, bounds.r_s_min_Ohm, bounds.r_s_max_Ohm, "estimator.bounds.r_s_Ohm"))
+  if (auto why = law_outside_bounds(n.copper, bounds.r_s_min_Ohm, bounds.r_s_max_Ohm, "estimator.bounds.r_s_Ohm",
+                                    highest_temperature_C(core::kWindingMaterials, n.copper)))
     section.fail("copper", "copper law " + *why);
   if (c.has_network) {
     if (const std::optional<std::string> why = runaway_at_rating(c, machine)) section.fail("nodes", *why);

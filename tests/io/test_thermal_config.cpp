@@ -259,7 +259,7 @@ TEST(ThermalConfig, AnotherMachinesLawIsRefused) {
   // 20 + (0.57/0.117 − 1)/(−0.00105) = −3 667 °C and 20 + (1.71/0.117 − 1)/(−0.00105) = −12 947 °C.
   const std::string magnet = error_with(kThreeNodes);
   EXPECT_NE(magnet.find(":14:15: thermal.magnet_law: magnet_law reads the estimator's whole range "
-                        "estimator.bounds.psi_m_Wb [0.57, 1.71] as -1.295e+04 to -3667 °C, outside -273.1 to 1000 °C"),
+                        "estimator.bounds.psi_m_Wb [0.57, 1.71] as -1.295e+04 to -3667 °C, outside -273.1 to 400 °C"),
             std::string::npos)
       << magnet;
   // The magnet law the machine's, the copper law still the 70 mΩ one: 120 + (1/0.07 − 1)/0.0028 = 4 865 °C.
@@ -277,6 +277,39 @@ TEST(ThermalConfig, AnotherMachinesLawIsRefused) {
       std::regex_replace(std::regex_replace(with_magnet, std::regex("psi_m_ref_Wb: 1.2"), "psi_m_ref_Wb: 0.5"),
                          std::regex("r_s_ref_Ohm: 0.07"), "r_s_ref_Ohm: 0.9");
   EXPECT_EQ(error_with(near), "");
+}
+
+// A larger machine's magnet law read with a smaller one's bounds: every value reads near T_ref + 1/|α| (−0.00105/K:
+// 972 °C), below the plausible 1 000 °C, so the absolute limits kept it (a walk's VESC 6374 configuration with a law
+// fitted on Paderborn's bench read ψ̂m as 815 °C). Its coefficient is NdFeB's, whose Curie temperature (at most 400 °C)
+// no reading of a magnet can exceed: refused. ψ_ref 10 Wb with the paper machine's [0.57, 1.71] Wb:
+// 20 + (1.71/10 − 1)/(−0.00105) = 809.5 °C to 20 + (0.57/10 − 1)/(−0.00105) = 918.1 °C. The same law with SmCo's
+// coefficient (−0.0004/K) reads the bounds' top as 20 + (0.171 − 1)/(−0.0004) = 2 092.5 °C, beyond SmCo's Curie
+// temperature (at most 920 °C): refused; at ψ_ref 2 Wb it reads 1.71 Wb as 20 + (0.855 − 1)/(−0.0004) = 382.5 °C, a SmCo
+// magnet's possible temperature, and is kept.
+TEST(ThermalConfig, AMagnetLawReadingEveryValueAboveItsMaterialsCurieTemperatureIsRefused) {
+  const MachineConfig paper = builtin_paper_config();
+  const auto law = [](const char* psi_ref, const char* coeff) {
+    return std::regex_replace(
+        std::string(kThreeNodes),
+        std::regex("magnet_law: \\{psi_m_ref_Wb: 0.117, reference_C: 20, coeff_per_K: -0.00105\\}"),
+        std::string("magnet_law: {psi_m_ref_Wb: ") + psi_ref + ", reference_C: 20, coeff_per_K: " + coeff + "}");
+  };
+  const auto with_copper = [](std::string text) {  // the copper law the paper machine's, so that only the magnet's is judged
+    return std::regex_replace(text, std::regex("r_s_ref_Ohm: 0.07"), "r_s_ref_Ohm: 2.4");
+  };
+  const std::string ndfeb = with_copper(law("10", "-0.00105"));
+  ASSERT_NE(ndfeb, with_copper(std::string(kThreeNodes)));
+  const std::string e = load_error(ndfeb, paper);
+  EXPECT_NE(e.find("thermal.magnet_law: magnet_law reads the estimator's whole range estimator.bounds.psi_m_Wb [0.57, "
+                   "1.71] as 809.5 to 918.1 °C, outside -273.1 to 400 °C (absolute zero to the highest Curie temperature "
+                   "of the magnet material its coefficient is)"),
+            std::string::npos)
+      << e;
+  const std::string smco = load_error(with_copper(law("10", "-0.0004")), paper);
+  EXPECT_NE(smco.find("[0.57, 1.71] as 2092 to 2378 °C, outside -273.1 to 920 °C"), std::string::npos) << smco;
+  EXPECT_EQ(load_error(with_copper(law("2", "-0.0004")), paper), "");
+  EXPECT_EQ(load_error(with_copper(law("1.2", "-0.00105")), paper), "");  // the machine's own: kept
 }
 
 TEST(ThermalConfig, AnAssumedLawIsANote) {

@@ -49,6 +49,10 @@ struct MaterialCoefficient {
   double typical_per_K;
   double min_per_K;
   double max_per_K;
+  /// The highest temperature at which the material is what its law describes [°C]: a magnet's Curie temperature,
+  /// the highest among its grades (above it the magnet holds no magnetisation); for copper, which melts only at
+  /// 1 085 °C, the plausible maximum of every temperature (plausibility.hpp).
+  double highest_C;
   [[nodiscard]] constexpr bool contains(double alpha) const noexcept { return alpha >= min_per_K && alpha <= max_per_K; }
   /// σ of α relative to the typical value, for a prior centred on it (eq. 14.11a): the larger of the range's
   /// uniform spread (max − min)/√12 and half the typical value's distance to the range's farther end, so that
@@ -62,10 +66,13 @@ struct MaterialCoefficient {
   }
 };
 
-inline constexpr MaterialCoefficient kCopper{"copper", 0.00393, 0.00393 * 0.85, 0.00393 * 1.15};
-inline constexpr MaterialCoefficient kNdFeB{"NdFeB", -0.0012, -0.0013, -0.0008};
-inline constexpr MaterialCoefficient kSmCo{"SmCo", -0.0004, -0.0005, -0.0003};
-inline constexpr MaterialCoefficient kFerrite{"ferrite", -0.002, -0.0022, -0.0018};
+// Curie temperatures: Nd₂Fe₁₄B 310–400 °C (312 °C pure; cobalt and dysprosium raise it), SmCo₅ 720 °C and Sm₂Co₁₇
+// 800–920 °C, strontium and barium ferrite 450–470 °C (J. M. D. Coey, "Magnetism and Magnetic Materials", 2010, ch. 11;
+// magnet makers' tables). The highest of each family's range is taken.
+inline constexpr MaterialCoefficient kCopper{"copper", 0.00393, 0.00393 * 0.85, 0.00393 * 1.15, 1000.0};
+inline constexpr MaterialCoefficient kNdFeB{"NdFeB", -0.0012, -0.0013, -0.0008, 400.0};
+inline constexpr MaterialCoefficient kSmCo{"SmCo", -0.0004, -0.0005, -0.0003, 920.0};
+inline constexpr MaterialCoefficient kFerrite{"ferrite", -0.002, -0.0022, -0.0018, 470.0};
 /// Winding materials (what R_s follows) and magnet materials (what ψm follows).
 inline constexpr std::array<MaterialCoefficient, 1> kWindingMaterials{kCopper};
 inline constexpr std::array<MaterialCoefficient, 3> kMagnetMaterials{kNdFeB, kSmCo, kFerrite};
