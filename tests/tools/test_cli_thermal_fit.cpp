@@ -384,6 +384,7 @@ TEST_F(CliThermalFit, ALogThatDoesNotStartSoakedIsAnchoredAtItsWindingWithTheBan
       test::run_command(rpem_tool() + " estimate --log " + log + " --config " + outrunner_config() + " --thermal " + dir_ +
                         "/thermal.yaml --out " + dir_ + "/estimate.csv");
   ASSERT_EQ(e.exit_code, 0) << e.output;
+  EXPECT_EQ(e.output.find("the filter starts soaked"), std::string::npos) << e.output;  // its sensor tests the soak
   const BandCover band = magnet_band_cover(io::CsvTable::read(dir_ + "/estimate.csv", true), t);
   ASSERT_GT(band.judged, 500U);
   EXPECT_GE(static_cast<double>(band.covered), 0.9 * static_cast<double>(band.judged))
@@ -420,6 +421,15 @@ TEST_F(CliThermalFit, ALogWithoutAWindingReadingSaysItsSoakIsAssumedAndWhereRsFi
   EXPECT_LE(t_s, 300.0);
   EXPECT_NEAR(winding_C, 45.0 + 50.0 * (1.0 - std::exp(-t_s / 400.0)), 1.0) << r.output;
   EXPECT_GT(winding_C - 25.0, 15.0);  // the reading says the start was warm
+  // rpem estimate --thermal starts its filter soaked too, and says that it assumes it.
+  const test::ProcessResult e =
+      test::run_command(rpem_tool() + " estimate --log " + log + " --config " + test::source_dir() +
+                        "/config/paper-ipmsm.yaml --thermal " + dir_ + "/thermal.yaml --out " + dir_ + "/estimate.csv");
+  ASSERT_EQ(e.exit_code, 0) << e.output;
+  EXPECT_NE(e.output.find("thermal: note: the filter starts soaked, every node at the coolant, an assumption: the log "
+                          "gives no winding reading the filter fuses"),
+            std::string::npos)
+      << e.output;
   // A ratio prints without a unit ("= 1.25", not "= 1.25 1").
   const std::size_t scale = r.output.find("copper loss scale = ");
   ASSERT_NE(scale, std::string::npos) << r.output;

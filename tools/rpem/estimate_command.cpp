@@ -78,6 +78,7 @@ class ThermalRun {
     if (const std::optional<std::string> note = io::process_noise_note(t))
       std::fprintf(stderr, "rpem estimate: thermal: note: %s\n", note->c_str());
     coolant_C_ = t.fusion.coolant_C;
+    sensor_fused_ = t.fusion.winding_sensor_sigma_K > 0.0;
     fusion_.emplace(t.fusion, base, cfg.machine);
   }
   [[nodiscard]] const std::vector<std::string>& node_names() const { return names_; }
@@ -88,6 +89,7 @@ class ThermalRun {
     s.dt_s = previous_ns_ ? 1e-9 * static_cast<double>(t_ns - *previous_ns_) : 0.0;
     s.coolant_C = coolant_C;
     s.winding_sensor_C = winding_C;
+    if (samples_ == 0) first_winding_C_ = winding_C;
     ++samples_;
     if (std::isnan(coolant_C)) ++without_coolant_;
     previous_ns_ = t_ns;
@@ -110,6 +112,16 @@ class ThermalRun {
                    "shows as a model error (docs/thermal.md)\n",
                    static_cast<unsigned long long>(without_coolant_), static_cast<unsigned long long>(samples_), coolant_C_);
     }
+    if (samples_ > 0 && !(sensor_fused_ && std::isfinite(first_winding_C_))) {
+      // core::start_temperatures_C: without a fused winding reading at the start, the soak is assumed.
+      std::fprintf(stderr,
+                   "rpem estimate: thermal: note: the filter starts soaked, every node at the coolant, an assumption: "
+                   "the log gives no %s at its start to test it. A start warmer than the coolant (a restart on a warm "
+                   "machine, a log cut from a longer run) reads the magnet cold until the observations correct it "
+                   "(docs/thermal.md, \"A log that does not start soaked\")\n",
+                   sensor_fused_ ? "winding reading"
+                                 : "winding reading the filter fuses (the thermal section has no winding_sensor)");
+    }
     if (fusion_->estimate().winding_readings_held == 0) return;
     std::fprintf(stderr,
                  "rpem estimate: thermal: the winding sensor's reading was refused as a held value in %lld filter "
@@ -129,6 +141,8 @@ class ThermalRun {
   std::optional<std::int64_t> previous_ns_;
   std::uint64_t samples_ = 0, without_coolant_ = 0;  ///< samples the filter was given, those without a coolant
   double coolant_C_ = 0.0;                           ///< what the filter takes for a missing coolant
+  bool sensor_fused_ = false;                        ///< a winding reading is fused (its σ given)
+  double first_winding_C_ = std::numeric_limits<double>::quiet_NaN();  ///< the first sample's reading
 };
 
 /// What the run did, for its summary on stderr (and a folder's summary.csv): the last estimate and the samples per
