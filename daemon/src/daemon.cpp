@@ -146,6 +146,18 @@ void Daemon::resume_thermal(const PersistedThermal& saved, std::int64_t now_s) {
   }
 }
 
+void Daemon::say_untested_soak() const {
+  // core::start_temperatures_C: without a resumed state, and without a winding sensor whose first reading could show
+  // the machine warm, the fusion takes every node at the coolant.
+  if (!config_.live.thermal_active || resumed_thermal_.state.nodes > 0 || config_.live.thermal.winding_sensor_sigma_K > 0.0)
+    return;
+  std::fprintf(stderr,
+               "rpemd: note: the thermal network starts soaked, every node at the coolant, an assumption: no thermal "
+               "state resumed from the state file, and no winding sensor (thermal.winding_sensor) to test it. A machine "
+               "warmer than its coolant now reads a cold magnet until the observations correct it (docs/thermal.md, "
+               "\"A log that does not start soaked\")\n");
+}
+
 void Daemon::start_threads() {
   publisher_thread_ = std::thread([this] { publisher_->run(stop_publisher_); });
   loop_thread_ = std::thread([this] { loop_->run(stop_acquisition_); });
@@ -193,6 +205,7 @@ int Daemon::run() {
       config_,
       LoopThread::Queues{std::move(samples_.consumer), std::move(commands_.consumer), std::move(reports_.producer)});
   seed_from_state_file();
+  say_untested_soak();
   const char* source_type = SourceCatalogue::type(fixed.source);
   publisher_ = std::make_unique<PersistingPublisher>(
       fixed, PersistingPublisher::Identity{source_type, source_name_, state_file_status_, resumed_thermal_},

@@ -49,6 +49,8 @@ class Daemon {
 
  private:
   void seed_from_state_file();
+  /// On stderr, where the fusion starts soaked with nothing to test it (docs/thermal.md).
+  void say_untested_soak() const;
   /// The thermal fusion starts from the file's state where it is of the configured network (or says why not).
   void resume_thermal(const PersistedThermal& saved, std::int64_t now_s);
   void start_threads();
