@@ -28,6 +28,11 @@ namespace fs = std::filesystem;
 std::string rpem_tool() { return test::binary_dir() + "/tools/rpem"; }
 std::string outrunner_config() { return test::source_dir() + "/config/vesc-6374-outrunner.yaml"; }
 
+/// The fit's note where nothing tests a log's soak (no winding reading at its start).
+constexpr const char* kUntestedSoakNote =
+    "note: the log has no winding reading at the start: that the machine starts soaked (every node at the coolant) is "
+    "assumed, not tested, and the magnet law's reference is anchored on it";
+
 /// VESC Tool writes temp_motor with one decimal: the sensor's resolution [K].
 constexpr double kSensorResolution_K = 0.1;
 
@@ -406,10 +411,7 @@ TEST_F(CliThermalFit, ALogWithoutAWindingReadingSaysItsSoakIsAssumedAndWhereRsFi
       test::run_command(rpem_tool() + " thermal fit --log " + log + " --config " + test::source_dir() +
                         "/config/paper-ipmsm.yaml --out " + dir_ + "/thermal.yaml");
   ASSERT_EQ(r.exit_code, 0) << r.output;
-  EXPECT_NE(r.output.find("note: the log has no winding reading at the start: that the machine starts soaked (every "
-                          "node at the coolant) is assumed, not tested, and the magnet law's reference is anchored on it"),
-            std::string::npos)
-      << r.output;
+  EXPECT_NE(r.output.find(kUntestedSoakNote), std::string::npos) << r.output;
   const std::string head = "r_s's first reading puts the winding at ";
   const std::size_t at = r.output.find(head);
   ASSERT_NE(at, std::string::npos) << r.output;
@@ -470,10 +472,7 @@ TEST_F(CliThermalFit, AVescWithoutAMotorSensorIsReadAsALogWithoutOne) {
       << r.output;
   EXPECT_EQ(r.output.find("note: the log does not start soaked"), std::string::npos) << r.output;
   // Without a winding reading nothing tests the soak the anchor takes: the fit says it assumes it.
-  EXPECT_NE(r.output.find("note: the log has no winding reading at the start: that the machine starts soaked (every "
-                          "node at the coolant) is assumed, not tested"),
-            std::string::npos)
-      << r.output;
+  EXPECT_NE(r.output.find(kUntestedSoakNote), std::string::npos) << r.output;
   const nlohmann::json j = nlohmann::json::parse(std::ifstream(dir_ + "/report/fit.json"));
   for (const nlohmann::json& s : j.at("signals")) EXPECT_NE(s.at("name"), "winding sensor") << j.at("signals").dump();
   // Nor does r̂s adapt in the training part of this ride at speed: the fit says its winding is unchecked.
