@@ -407,12 +407,11 @@ std::string untested_soak_note(const io::ThermalConfig& c, const ThermalRecord& 
       const core::ParameterObservation& p = r.steps[k].parameter[core::kRs];
       if (!p.valid) continue;
       const double winding_C = copper.temperature_C(p.value), coolant_C = r.steps[k].load.coolant_C;
-      char text[224];
-      std::snprintf(
-          text, sizeof text, "%sr_s's first reading%s puts the winding at %.1f °C, %+.1f K from the coolant, %.0f s in",
-          readings.empty() ? "" : "; ", r.session_first_step.size() > 1 ? (" in " + r.session_logs[j]).c_str() : "",
-          winding_C, winding_C - coolant_C, r.t_s[k] - r.t_s[span.first]);
-      readings += text;
+      char figures[128];
+      std::snprintf(figures, sizeof figures, " puts the winding at %.1f °C, %+.1f K from the coolant, %.0f s in", winding_C,
+                    winding_C - coolant_C, r.t_s[k] - r.t_s[span.first]);
+      readings += (readings.empty() ? "" : "; ") + std::string("r_s's first reading") +
+                  (r.session_first_step.size() > 1 ? " in " + r.session_logs[j] : std::string()) + figures;
       break;
     }
   }
@@ -424,7 +423,7 @@ std::string untested_soak_note(const io::ThermalConfig& c, const ThermalRecord& 
   if (!readings.empty()) {
     note += ". " + readings + " (through the copper law's reference" +
             (c.copper_reference_stated ? std::string(")") : ", itself assumed)") +
-            ": far more than the load since the start heats a winding, it says the start was warm";
+            ": where that is more than the load since the start can have heated a soaked winding, the start was warm";
   }
   return note +
          ". Log a winding sensor, or start the log with the machine at rest and cooled "
