@@ -18,6 +18,7 @@
 #include "rpem/daemon/state_file.hpp"
 #include "rpem/daemon/vesc_source.hpp"
 #include "rpem/io/exit_codes.hpp"
+#include "rpem/io/thermal_config.hpp"
 
 namespace rpem::daemon {
 namespace {
@@ -151,11 +152,9 @@ void Daemon::say_untested_soak() const {
   // the machine warm, the fusion takes every node at the coolant.
   if (!config_.live.thermal_active || resumed_thermal_.state.nodes > 0 || config_.live.thermal.winding_sensor_sigma_K > 0.0)
     return;
-  std::fprintf(stderr,
-               "rpemd: note: the thermal network starts soaked, every node at the coolant, an assumption: no thermal "
-               "state resumed from the state file, and no winding sensor (thermal.winding_sensor) to test it. A machine "
-               "warmer than its coolant now reads a cold magnet until the observations correct it (docs/thermal.md, "
-               "\"A log that does not start soaked\")\n");
+  const std::string note = io::soaked_start_note(
+      "no thermal state resumed from the state file, and no winding sensor (thermal.winding_sensor) to test it");
+  std::fprintf(stderr, "rpemd: note: %s\n", note.c_str());
 }
 
 void Daemon::start_threads() {

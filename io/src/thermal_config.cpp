@@ -61,7 +61,8 @@ template <std::size_t N>
 double highest_temperature_C(const std::array<core::MaterialCoefficient, N>& materials, const core::DriftLaw& law) {
   const std::optional<core::MaterialCoefficient> m =
       core::material_of(materials, law.referred_to(core::kMaterialReference_C).coeff_per_K);
-  return std::min(core::PlausibleMagnitudes{}.temperature_max_C, m ? m->highest_C : 1e300);
+  const double plausible_C = core::PlausibleMagnitudes{}.temperature_max_C;
+  return m ? std::min(plausible_C, m->highest_C) : plausible_C;
 }
 
 /// Why no value within the estimator's bounds [lo, hi] reads through the law as a temperature the machine can have
@@ -348,6 +349,13 @@ std::vector<std::string> assumed_law_notes(const ThermalConfig& c, bool magnet) 
                          "(`rpem thermal fit` writes it, anchored at a soaked start)"));
   }
   return notes;
+}
+
+std::string soaked_start_note(const std::string& untested_because) {
+  return "the thermal network starts soaked, every node at the coolant, an assumption: " + untested_because +
+         ". A machine warmer than its coolant at the start (a restart on a warm machine, a log cut from a longer run) "
+         "reads a cold magnet until the observations correct it (docs/thermal.md, \"A log that does not start "
+         "soaked\")";
 }
 
 std::optional<std::string> process_noise_note(const ThermalConfig& c) {

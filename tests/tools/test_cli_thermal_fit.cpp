@@ -389,7 +389,7 @@ TEST_F(CliThermalFit, ALogThatDoesNotStartSoakedIsAnchoredAtItsWindingWithTheBan
       test::run_command(rpem_tool() + " estimate --log " + log + " --config " + outrunner_config() + " --thermal " + dir_ +
                         "/thermal.yaml --out " + dir_ + "/estimate.csv");
   ASSERT_EQ(e.exit_code, 0) << e.output;
-  EXPECT_EQ(e.output.find("the filter starts soaked"), std::string::npos) << e.output;  // its sensor tests the soak
+  EXPECT_EQ(e.output.find("starts soaked, every node"), std::string::npos) << e.output;  // its sensor tests the soak
   const BandCover band = magnet_band_cover(io::CsvTable::read(dir_ + "/estimate.csv", true), t);
   ASSERT_GT(band.judged, 500U);
   EXPECT_GE(static_cast<double>(band.covered), 0.9 * static_cast<double>(band.judged))
@@ -428,8 +428,8 @@ TEST_F(CliThermalFit, ALogWithoutAWindingReadingSaysItsSoakIsAssumedAndWhereRsFi
       test::run_command(rpem_tool() + " estimate --log " + log + " --config " + test::source_dir() +
                         "/config/paper-ipmsm.yaml --thermal " + dir_ + "/thermal.yaml --out " + dir_ + "/estimate.csv");
   ASSERT_EQ(e.exit_code, 0) << e.output;
-  EXPECT_NE(e.output.find("thermal: note: the filter starts soaked, every node at the coolant, an assumption: the log "
-                          "gives no winding reading the filter fuses"),
+  EXPECT_NE(e.output.find("thermal: note: the thermal network starts soaked, every node at the coolant, an assumption: "
+                          "the log gives no winding reading the filter fuses"),
             std::string::npos)
       << e.output;
   // A ratio prints without a unit ("= 1.25", not "= 1.25 1").

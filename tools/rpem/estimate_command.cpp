@@ -114,13 +114,12 @@ class ThermalRun {
     }
     if (samples_ > 0 && !(sensor_fused_ && std::isfinite(first_winding_C_))) {
       // core::start_temperatures_C: without a fused winding reading at the start, the soak is assumed.
-      std::fprintf(stderr,
-                   "rpem estimate: thermal: note: the filter starts soaked, every node at the coolant, an assumption: "
-                   "the log gives no %s at its start to test it. A start warmer than the coolant (a restart on a warm "
-                   "machine, a log cut from a longer run) reads the magnet cold until the observations correct it "
-                   "(docs/thermal.md, \"A log that does not start soaked\")\n",
-                   sensor_fused_ ? "winding reading"
-                                 : "winding reading the filter fuses (the thermal section has no winding_sensor)");
+      const std::string note = io::soaked_start_note(
+          std::string("the log gives no ") +
+          (sensor_fused_ ? "winding reading"
+                         : "winding reading the filter fuses (the thermal section has no winding_sensor)") +
+          " at its start to test it");
+      std::fprintf(stderr, "rpem estimate: thermal: note: %s\n", note.c_str());
     }
     if (fusion_->estimate().winding_readings_held == 0) return;
     std::fprintf(stderr,

@@ -334,6 +334,9 @@ struct SessionSpan {
 };
 SessionSpan session_span(const ThermalRecord& r, std::size_t j) { return {r.session_first_step[j], r.session_end(j)}; }
 
+/// The start of a session whose readings stand for the start: the magnet law's anchor and r̂s's first reading.
+constexpr double kAnchorWithin_s = 300.0;
+
 /// The magnet law's reference from the soaked start (docs/thermal.md, "A log that does not start soaked"): the mean of
 /// the first kAnchorSteps magnet observations of each session in `sessions`, each corrected for the held R_s
 /// (κ·(R_s(T_w) − r̂s)), at the magnet temperatures `t_magnet_C` of those steps (the soak's, or the network's
@@ -343,7 +346,6 @@ std::size_t anchor_magnet_reference(io::ThermalConfig& c, const ThermalRecord& r
                                     const std::vector<double>& t_magnet_C, const std::vector<double>& t_winding_C,
                                     std::vector<std::string>& notes) {
   constexpr std::size_t kAnchorSteps = 4;
-  constexpr double kAnchorWithin_s = 300.0;
   core::DriftLaw& law = c.fusion.magnet_law;
   const core::DriftLaw& copper = c.fusion.filter.network.copper;
   double sum = 0.0;
@@ -397,13 +399,12 @@ std::optional<double> unsoaked_start_C(const io::ThermalConfig& c, const Thermal
 /// (through the copper law, whose reference may itself be assumed) is said beside it, for the user to judge.
 std::string untested_soak_note(const io::ThermalConfig& c, const ThermalRecord& r,
                                const std::vector<std::size_t>& untested) {
-  constexpr double kEarly_s = 300.0;
   const core::DriftLaw& copper = c.fusion.filter.network.copper;
   std::string names, readings;
   for (std::size_t j : untested) {
     const SessionSpan span = session_span(r, j);
     if (r.session_first_step.size() > 1) names += (names.empty() ? "" : ", ") + r.session_logs[j];
-    for (std::size_t k = span.first; k < span.end && r.t_s[k] - r.t_s[span.first] <= kEarly_s; ++k) {
+    for (std::size_t k = span.first; k < span.end && r.t_s[k] - r.t_s[span.first] <= kAnchorWithin_s; ++k) {
       const core::ParameterObservation& p = r.steps[k].parameter[core::kRs];
       if (!p.valid) continue;
       const double winding_C = copper.temperature_C(p.value), coolant_C = r.steps[k].load.coolant_C;

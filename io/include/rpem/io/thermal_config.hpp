@@ -59,6 +59,10 @@ enum class NetworkRequired : bool { kNo = false, kYes = true };
 /// uncertainty only, and is too narrow wherever the network is not exact. Nothing where one is stated.
 [[nodiscard]] std::optional<std::string> process_noise_note(const ThermalConfig& c);
 
+/// What a filter that starts soaked with nothing to test it says (core::start_temperatures_C; docs/thermal.md, "A log
+/// that does not start soaked"): `untested_because`, why nothing tests the soak.
+[[nodiscard]] std::string soaked_start_note(const std::string& untested_because);
+
 /// The defaults a fit starts from (docs/thermal.md; no network: has_network false): the laws of the machine's
 /// drifts or of copper and NdFeB (core/thermal.hpp) about the machine's values at 20 °C, the loss base
 /// of the machine (core::loss_base_of).
