@@ -61,7 +61,29 @@ TEST(SensorLagWithoutNetwork, RecoversTheSensorsTimeConstantFromFiveRuns) {
   EXPECT_GT(e.lower_s, 0.0);  // a lag shown: what the fit asks before it uses it
   // A sensor without a lag is found without one.
   for (SensorLagRun& r : runs) r.sensor_C = r.t_rs_C;  // the sensor reads what r̂s reads: lag_τs(T_rs) = lag_τr(T_rs)
-  EXPECT_NEAR(sensor_lag_without_network(runs, 0.1, 300.0, 20).tau_s, kTauR, 0.02 * kTauR);
+  const SensorLagEstimate same = sensor_lag_without_network(runs, 0.1, 300.0, 20);
+  EXPECT_NEAR(same.tau_s, kTauR, 0.02 * kTauR);
+  EXPECT_NEAR(same.rs_above_sensor_K, 0.0, 0.01);
+}
+
+// A copper law whose reference is a few kelvin off (assumed, or stated roughly) reads every r̂s temperature that
+// much above or below the sensor: the offset is fitted with τ_s (eq. 14.25a), not taken as lag. Unfitted, a 3 K
+// offset moved the drive cycle's τ_s from 5.5 s to 11.8 s (+3 K) and to 0.1 s (−3 K; docs/thermal.md).
+TEST(SensorLagWithoutNetwork, AnOffsetOfTheCopperLawIsFittedBesideTheLagNotTakenForIt) {
+  for (const double offset_K : {3.0, -3.0}) {
+    std::mt19937 rng(11);
+    std::vector<SensorLagRun> runs;
+    for (int i = 0; i < 5; ++i) runs.push_back(make_run(i, 150, 0.05, rng));
+    for (SensorLagRun& r : runs)
+      for (double& t : r.t_rs_C) t += offset_K;
+    const SensorLagEstimate e = sensor_lag_without_network(runs, 0.1, 300.0, 20);
+    // As without the offset (the same runs, the same noise): within 2 % of 6 s; the offset to 0.05 K (3 σ of
+    // the noise's mean over the ≈ 650 judged steps is 0.006 K; the lag's start and discretisation take the rest).
+    EXPECT_NEAR(e.tau_s, kTauS, 0.02 * kTauS) << offset_K;
+    EXPECT_NEAR(e.rs_above_sensor_K, offset_K, 0.05) << offset_K;
+    EXPECT_GT(e.lower_s, 0.0) << offset_K;
+    EXPECT_GT(e.upper_s, kTauS) << offset_K;
+  }
 }
 
 TEST(SensorLagWithoutNetwork, FewRunsGiveNoIntervalAndNoneGiveNoEstimate) {

@@ -15,19 +15,42 @@ double lag_step(double y, double u_from, double u_to, double tau_s, double dt_s)
   return phi * y + (1.0 - phi) * 0.5 * (u_from + u_to);
 }
 
-/// Σ over the runs (after `warm` steps) of (lag_τs(T_rs) − lag_τr(T_sensor))² at τ_s = e^{log_tau} (eq. 14.25).
-double squared_misses(const std::vector<const SensorLagRun*>& runs, std::size_t warm, double log_tau) {
+/// The sums over the runs (after `warm` steps) that give (14.25a)'s misses at τ_s for any offset c: the residual
+/// is e − c·g with e = lag_τs(T_rs) − lag_τr(T_sensor), both started at the run's first reading, and
+/// g = lag_τs(1) started at 0 (what lag_τs(T_rs − c) loses to lag_τs(T_rs) per kelvin of c).
+struct MissSums {
+  double ee = 0.0, eg = 0.0, gg = 0.0;
+  [[nodiscard]] double squared_misses(double c) const { return ee - 2.0 * c * eg + c * c * gg; }
+  /// The offset that minimises the misses (0 where no step is judged).
+  [[nodiscard]] double best_offset() const { return gg > 0.0 ? eg / gg : 0.0; }
+};
+
+MissSums miss_sums(const std::vector<const SensorLagRun*>& runs, std::size_t warm, double log_tau) {
   const double tau_s = std::exp(log_tau);
-  double sum = 0.0;
+  MissSums m;
   for (const SensorLagRun* x : runs) {
-    double lagged_rs = x->sensor_C.front(), lagged_sensor = x->sensor_C.front();
+    double lagged_rs = x->sensor_C.front(), lagged_sensor = x->sensor_C.front(), lagged_one = 0.0;
     for (std::size_t k = 1; k < x->sensor_C.size(); ++k) {
       lagged_rs = lag_step(lagged_rs, x->t_rs_C[k - 1], x->t_rs_C[k], tau_s, x->dt_s[k]);
+      lagged_one = lag_step(lagged_one, 1.0, 1.0, tau_s, x->dt_s[k]);
       lagged_sensor = lag_step(lagged_sensor, x->sensor_C[k - 1], x->sensor_C[k], x->tau_r_s[k], x->dt_s[k]);
-      if (k >= warm) sum += (lagged_rs - lagged_sensor) * (lagged_rs - lagged_sensor);
+      if (k < warm) continue;
+      const double e = lagged_rs - lagged_sensor;
+      m.ee += e * e, m.eg += e * lagged_one, m.gg += lagged_one * lagged_one;
     }
   }
-  return sum;
+  return m;
+}
+
+/// τ_s on [lo, hi] (in log τ_s) that minimises (14.25a)'s misses, the offset c profiled out where `offset` is
+/// null (c at its least squares for each τ_s), held at `*offset` otherwise.
+double best_tau(const std::vector<const SensorLagRun*>& runs, std::size_t warm, double lo, double hi, const double* offset) {
+  constexpr double kTolerance = 0.005;  // in log τ_s: 0.5 %
+  auto misses = [&](double log_tau) {
+    const MissSums m = miss_sums(runs, warm, log_tau);
+    return m.squared_misses(offset != nullptr ? *offset : m.best_offset());
+  };
+  return std::exp(golden_section_minimum(misses, lo, hi, kTolerance));
 }
 
 /// Student's t quantile at 0.975 for ν degrees of freedom (table for ν ≤ 10, the normal's beyond 30).
@@ -50,16 +73,14 @@ SensorLagEstimate sensor_lag_without_network(const std::vector<SensorLagRun>& ru
   out.runs = usable.size();
   if (usable.empty() || !(low_s > 0.0) || !(high_s > low_s)) return out;
   const double lo = std::log(low_s), hi = std::log(high_s);
-  constexpr double kTolerance = 0.005;  // in log τ_s: 0.5 %
-  out.tau_s =
-      std::exp(golden_section_minimum([&](double x) { return squared_misses(usable, warm, x); }, lo, hi, kTolerance));
+  out.tau_s = best_tau(usable, warm, lo, hi, nullptr);
+  out.rs_above_sensor_K = miss_sums(usable, warm, std::log(out.tau_s)).best_offset();
   if (usable.size() < 3) return out;
-  // Each run's own τ_s: their spread is the estimate's (runs are independent stretches of the log).
+  // Each run's own τ_s at the pooled offset (the law's, one for the log): their spread is the estimate's (runs
+  // are independent stretches of the log).
   double sum = 0.0, sum2 = 0.0;
   for (const SensorLagRun* r : usable) {
-    const std::vector<const SensorLagRun*> one{r};
-    const double t =
-        std::exp(golden_section_minimum([&](double x) { return squared_misses(one, warm, x); }, lo, hi, kTolerance));
+    const double t = best_tau({r}, warm, lo, hi, &out.rs_above_sensor_K);
     sum += t, sum2 += t * t;
   }
   const auto m = static_cast<double>(usable.size());

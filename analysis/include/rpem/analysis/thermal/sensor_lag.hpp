@@ -5,7 +5,12 @@
 //
 //   lag_τs(T_rs) = lag_τs(lag_τr(T_w)) = lag_τr(lag_τs(T_w)) = lag_τr(T_sensor)                        (14.25)
 //
-// whatever the winding did: over runs of steps where both read, τ_s is the least squares of that identity.
+// whatever the winding did: over runs of steps where both read, τ_s is the least squares of that identity. A copper
+// law whose reference is off reads r̂s's winding c kelvin above the sensor's, c one constant for the log, so
+//
+//   lag_τs(T_rs − c) = lag_τr(T_sensor)                                                                (14.25a)
+//
+// with c fitted beside τ_s (linear in c: profiled out at each τ_s); unfitted, a few kelvin of c pass for lag.
 // Each run's own least-squares τ_s gives the spread from which the estimate's interval comes.
 
 #include <cstddef>
@@ -27,6 +32,7 @@ struct SensorLagEstimate {
   /// 95 % interval from the runs' own estimates (Student's t over their spread; ±∞ with fewer than three).
   double lower_s = -std::numeric_limits<double>::infinity(), upper_s = std::numeric_limits<double>::infinity();
   std::size_t runs = 0;
+  double rs_above_sensor_K = 0.0;  ///< c of (14.25a): how far r̂s's law reads the winding above the sensor
 };
 
 /// τ_s on [low_s, high_s] from the runs; each run judged after its first `warm` steps (the two
