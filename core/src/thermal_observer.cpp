@@ -142,6 +142,7 @@ bool ThermalObserver::add(const Estimate& e, const ThermalSample& s) noexcept {
       p.variance = acc.variance * n;
       p.variance_noise = acc.variance_noise * n;
       p.time_constant_s = acc.tau * n;
+      p.sample_dt_s = acc.adapted_s * n;
       p.valid = 2.0 * acc.adapted_s >= duration && settled_[j] >= config_.settle_time_constants &&
                 all_finite(p.value, p.cross, p.other_held, p.variance);
     }

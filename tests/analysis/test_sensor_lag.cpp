@@ -86,6 +86,27 @@ TEST(SensorLagWithoutNetwork, AnOffsetOfTheCopperLawIsFittedBesideTheLagNotTaken
   }
 }
 
+// r̂s's own lag (eq. 14.25b) against the update itself: θ⁺ = θ + a·(θ* − θ) run on a ramp until its lag is
+// steady, θ* the ramp at each sample's instant or its mean over the sample's window; the observer reports
+// τ_r = Δt/a. Exact for a ramp (the recursion's steady lag is Δt·(1 − a)/a plus the information's age).
+TEST(SensorLagWithoutNetwork, TheEstimatorsLagBehindARampIsItsTimeConstantLessTheAgeOfItsInformation) {
+  constexpr double kRate = 0.3;  // K/s
+  for (const double dt : {0.1, 0.5, 2.0})
+    for (const double a : {0.05, 0.22, 0.6})
+      for (const bool window_means : {false, true}) {
+        double theta = 0.0, t = 0.0;
+        for (int k = 0; k < 2000; ++k) {
+          t += dt;
+          const double target = kRate * (window_means ? t - 0.5 * dt : t);
+          theta += a * (target - theta);
+        }
+        const double lag_s = t - theta / kRate;
+        EXPECT_NEAR(estimator_ramp_lag_s(dt / a, dt, window_means), lag_s, 1e-9 * (1.0 + lag_s))
+            << "dt " << dt << " a " << a << (window_means ? " window means" : " instants");
+      }
+  EXPECT_EQ(estimator_ramp_lag_s(0.5, 1.0, false), 0.0);  // a > 1 would lead the ramp: no lag, not a negative one
+}
+
 TEST(SensorLagWithoutNetwork, FewRunsGiveNoIntervalAndNoneGiveNoEstimate) {
   std::mt19937 rng(5);
   std::vector<SensorLagRun> runs{make_run(0, 150, 0.05, rng), make_run(1, 150, 0.05, rng)};

@@ -67,6 +67,7 @@ TEST(ThermalObserver, HeldResistanceBiasesPsiMByKappaTimesItsError) {
   ASSERT_TRUE(p.valid);
   EXPECT_FALSE(last.parameter[kRs].valid);  // r̂s does not adapt
   EXPECT_NEAR(p.other_held, 2.25, 1e-12);
+  EXPECT_NEAR(p.sample_dt_s, 1.0 / 200.0, 1e-9);  // the adapted windows' mean length (eq. 14.25b): 200 Hz, no jitter
   const double psi_true = base.flux_Wb_of(plant.psi_m_pu), r_true = base.resistance_Ohm_of(plant.r_s_pu);
   const double bias = r.psi_m_Wb.back() - psi_true;
   // The linearised equilibrium of eq. 13.6 against the estimator's own: within 2 % of the bias.

@@ -70,7 +70,7 @@ void sensor_lag_at_standstill(io::ThermalConfig& c, const ThermalRecord& r, std:
     }
     run.t_rs_C.push_back(copper.temperature_C(p.value));
     run.sensor_C.push_back(sensor);
-    run.tau_r_s.push_back(p.time_constant_s);
+    run.tau_r_s.push_back(estimator_ramp_lag_s(p.time_constant_s, p.sample_dt_s, r.averaged));
     run.dt_s.push_back(r.steps[k].load.dt_s);
   }
   close();

@@ -62,6 +62,10 @@ double t975(std::size_t nu) {
 
 }  // namespace
 
+double estimator_ramp_lag_s(double tau_r_s, double sample_dt_s, bool window_means) {
+  return std::max(0.0, tau_r_s - (window_means ? 0.5 : 1.0) * sample_dt_s);
+}
+
 SensorLagEstimate sensor_lag_without_network(const std::vector<SensorLagRun>& runs, double low_s, double high_s,
                                              std::size_t warm) {
   SensorLagEstimate out;

@@ -52,6 +52,7 @@ struct ParameterObservation {
   double variance = 0.0;    ///< σ²_noise + σ²_model [SI²]
   double variance_noise = 0.0;
   double time_constant_s = 0.0;
+  double sample_dt_s = 0.0;  ///< the mean Δt of the adapted samples (a row, or an averaged log's window)
 };
 
 /// When a step's readings were taken, as their mean and variance of age at the step's end (weighted as the

@@ -35,6 +35,11 @@ struct SensorLagEstimate {
   double rs_above_sensor_K = 0.0;  ///< c of (14.25a): how far r̂s's law reads the winding above the sensor
 };
 
+/// r̂s's lag behind the winding it reads (eq. 14.25b), from the observer's τ_r = Δt/a: the update
+/// θ⁺ = θ + a·(θ* − θ) on samples Δt apart follows a ramp Δt·(1 − a)/a = τ_r − Δt behind its newest information,
+/// which is the sample's own instant, or for a window mean (an averaged log's row) Δt/2 before its end.
+[[nodiscard]] double estimator_ramp_lag_s(double tau_r_s, double sample_dt_s, bool window_means);
+
 /// τ_s on [low_s, high_s] from the runs; each run judged after its first `warm` steps (the two
 /// lagged signals start from the same reading and need a few time constants to forget it).
 [[nodiscard]] SensorLagEstimate sensor_lag_without_network(const std::vector<SensorLagRun>& runs, double low_s,
