@@ -89,6 +89,70 @@ TEST(SensorLagWithoutNetwork, AnOffsetOfTheCopperLawIsFittedBesideTheLagNotTaken
 // r̂s's own lag (eq. 14.25b) against the update itself: θ⁺ = θ + a·(θ* − θ) run on a ramp until its lag is
 // steady, θ* the ramp at each sample's instant or its mean over the sample's window; the observer reports
 // τ_r = Δt/a. Exact for a ramp (the recursion's steady lag is Δt·(1 − a)/a plus the information's age).
+/// `steps` of an AR(1) of stationary σ `sigma` and correlation `rho` per step.
+std::vector<double> ar1(std::size_t steps, double sigma, double rho, std::mt19937& rng) {
+  std::normal_distribution<double> unit(0.0, 1.0);
+  std::vector<double> n(steps);
+  n[0] = sigma * unit(rng);
+  for (std::size_t k = 1; k < steps; ++k) n[k] = rho * n[k - 1] + sigma * std::sqrt(1.0 - rho * rho) * unit(rng);
+  return n;
+}
+
+TEST(SensorLagWithoutNetwork, CorrelatedNoiseVarianceComesFromSecondDifferences) {
+  // On a slow winding (make_run's shapes, periods ≥ 40 s) with AR(1) noise of σ 0.5 K: within 5 % of σ² over 5 000
+  // steps (the estimate's own relative σ there is ≈ 3 %), for a noise correlated over 0, 1 and 3 steps.
+  for (const double rho : {0.0, std::exp(-1.0), std::exp(-1.0 / 3.0)}) {
+    std::mt19937 rng(3);
+    std::vector<double> values;
+    for (int i = 0; i < 40; ++i) {
+      const SensorLagRun r = make_run(i % 5, 125, 1e-9, rng);
+      values.insert(values.end(), r.t_rs_C.begin(), r.t_rs_C.end());
+    }
+    // The runs joined end to end jump between them: judged per run as the fit does.
+    const std::vector<double> n = ar1(values.size(), 0.5, rho, rng);
+    double sum = 0.0;
+    for (std::size_t at = 0; at < values.size(); at += 125) {
+      std::vector<double> run(values.begin() + static_cast<std::ptrdiff_t>(at),
+                              values.begin() + static_cast<std::ptrdiff_t>(at + 125));
+      for (std::size_t k = 0; k < run.size(); ++k) run[k] += n[at + k];
+      sum += correlated_noise_variance(run, rho);
+    }
+    EXPECT_NEAR(sum / 40.0, 0.25, 0.05 * 0.25) << rho;
+  }
+  EXPECT_EQ(correlated_noise_variance({1.0, 2.0}, 0.5), 0.0);
+}
+
+// r̂s's own noise is correlated over its time constant (the update's AR(1)); lagged by τ_s it shrinks as τ_s grows,
+// so the plain least squares takes a longer τ_s than the sensor's (eq. 14.25c). With the noise's correlation time
+// given, its variance comes from each run's second differences and its expected share is taken out.
+TEST(SensorLagWithoutNetwork, RsOwnCorrelatedNoiseIsTakenOutNotTakenForLag) {
+  constexpr double kSigma = 1.0;  // K: r̂s's stationary correlated noise
+  constexpr int kSeeds = 10;      // the mean over ten logs of eight runs: one log's spread is ±5 %
+  double plain_sum = 0.0, compensated_sum = 0.0;
+  int held = 0;
+  for (int seed = 20; seed < 20 + kSeeds; ++seed) {
+    std::mt19937 rng(static_cast<unsigned>(seed));
+    std::vector<SensorLagRun> runs;
+    for (int i = 0; i < 8; ++i) {
+      SensorLagRun r = make_run(i, 150, 0.05, rng);  // 0.05 K white on both; r̂s's correlated noise on top
+      const std::vector<double> n = ar1(r.t_rs_C.size(), kSigma, std::exp(-kDt / kTauR), rng);
+      for (std::size_t k = 0; k < n.size(); ++k) r.t_rs_C[k] += n[k];
+      runs.push_back(r);
+    }
+    plain_sum += sensor_lag_without_network(runs, 0.1, 300.0, 20).tau_s;
+    for (SensorLagRun& r : runs) r.rs_noise_tau_s.assign(r.t_rs_C.size(), kTauR);
+    const SensorLagEstimate e = sensor_lag_without_network(runs, 0.1, 300.0, 20);
+    compensated_sum += e.tau_s;
+    if (e.lower_s < kTauS && kTauS < e.upper_s) ++held;
+    runs.front().rs_noise_tau_s.pop_back();  // a correlation time missing on a step: not a run
+    EXPECT_EQ(sensor_lag_without_network(runs, 0.1, 300.0, 20).runs, runs.size() - 1);
+  }
+  // Seen: the plain mean 6.51 s (+8.5 %), compensated 6.09 s (+1.5 %), 9 of the 10 intervals holding 6 s.
+  EXPECT_GT(plain_sum / kSeeds, 1.05 * kTauS);                 // the bias this removes, seen
+  EXPECT_NEAR(compensated_sum / kSeeds, kTauS, 0.03 * kTauS);  // removed
+  EXPECT_GE(held, 8);
+}
+
 TEST(SensorLagWithoutNetwork, TheEstimatorsLagBehindARampIsItsTimeConstantLessTheAgeOfItsInformation) {
   constexpr double kRate = 0.3;  // K/s
   for (const double dt : {0.1, 0.5, 2.0})

@@ -11,6 +11,8 @@
 //   lag_τs(T_rs − c) = lag_τr(T_sensor)                                                                (14.25a)
 //
 // with c fitted beside τ_s (linear in c: profiled out at each τ_s); unfitted, a few kelvin of c pass for lag.
+// r̂s's own noise, lagged by τ_s, shrinks as τ_s grows and would pull τ_s long: its expected share of the misses is
+// taken out (eq. 14.25c), its variance measured from each run's own second differences.
 // Each run's own least-squares τ_s gives the spread from which the estimate's interval comes.
 
 #include <cstddef>
@@ -25,6 +27,9 @@ struct SensorLagRun {
   std::vector<double> sensor_C;  ///< the sensor's reading
   std::vector<double> tau_r_s;   ///< the estimator's own time constant over each step (the observer's Δt/a)
   std::vector<double> dt_s;      ///< each step's length (from the previous step's end)
+  /// The correlation time of r̂s's own noise over each step (the observer's τ_r, eq. 14.25c); empty: none known,
+  /// the noise not compensated.
+  std::vector<double> rs_noise_tau_s;
 };
 
 struct SensorLagEstimate {
@@ -39,6 +44,11 @@ struct SensorLagEstimate {
 /// θ⁺ = θ + a·(θ* − θ) on samples Δt apart follows a ramp Δt·(1 − a)/a = τ_r − Δt behind its newest information,
 /// which is the sample's own instant, or for a window mean (an averaged log's row) Δt/2 before its end.
 [[nodiscard]] double estimator_ramp_lag_s(double tau_r_s, double sample_dt_s, bool window_means);
+
+/// The variance of an AR(1) noise of correlation ρ per step from the second differences of a signal that holds it
+/// (eq. 14.25c): E[(Δ²n)²] = (6 − 8ρ + 2ρ²)·v, the slow signal's own second differences negligible. 0 with fewer
+/// than three values.
+[[nodiscard]] double correlated_noise_variance(const std::vector<double>& values, double rho);
 
 /// τ_s on [low_s, high_s] from the runs; each run judged after its first `warm` steps (the two
 /// lagged signals start from the same reading and need a few time constants to forget it).
