@@ -47,17 +47,31 @@ struct MissSums {
   [[nodiscard]] double best_offset() const { return gg > 0.0 ? eg / gg : 0.0; }
 };
 
-MissSums miss_sums(const std::vector<const SensorLagRun*>& runs, std::size_t warm, double log_tau) {
+/// A run with its noise's ρ and variance (eq. 14.25c), which do not depend on τ_s: found once per run.
+struct JudgedRun {
+  const SensorLagRun* run = nullptr;
+  bool compensated = false;
+  double rho = 0.0, v = 0.0;
+};
+
+JudgedRun judged(const SensorLagRun& x) {
+  JudgedRun j{&x, !x.rs_noise_tau_s.empty(), 0.0, 0.0};
+  if (j.compensated) {
+    j.rho = mean_noise_correlation(x);
+    j.v = correlated_noise_variance(x.t_rs_C, j.rho);
+  }
+  return j;
+}
+
+MissSums miss_sums(const std::vector<JudgedRun>& runs, std::size_t warm, double log_tau) {
   const double tau_s = std::exp(log_tau);
   MissSums m;
-  for (const SensorLagRun* x : runs) {
+  for (const JudgedRun& j : runs) {
+    const SensorLagRun* x = j.run;
     double lagged_rs = x->sensor_C.front(), lagged_sensor = x->sensor_C.front(), lagged_one = 0.0;
-    const bool compensated = !x->rs_noise_tau_s.empty();
-    const double rho = compensated ? mean_noise_correlation(*x) : 0.0;
-    const double v = compensated ? correlated_noise_variance(x->t_rs_C, rho) : 0.0;
     LaggedNoise noise;
     for (std::size_t k = 1; k < x->sensor_C.size(); ++k) {
-      if (compensated) noise.step(decay(tau_s, x->dt_s[k]), rho, v);
+      if (j.compensated) noise.step(decay(tau_s, x->dt_s[k]), j.rho, j.v);
       lagged_rs = lag_step(lagged_rs, x->t_rs_C[k - 1], x->t_rs_C[k], tau_s, x->dt_s[k]);
       lagged_one = lag_step(lagged_one, 1.0, 1.0, tau_s, x->dt_s[k]);
       lagged_sensor = lag_step(lagged_sensor, x->sensor_C[k - 1], x->sensor_C[k], x->tau_r_s[k], x->dt_s[k]);
@@ -71,7 +85,7 @@ MissSums miss_sums(const std::vector<const SensorLagRun*>& runs, std::size_t war
 
 /// τ_s on [lo, hi] (in log τ_s) that minimises (14.25a)'s misses, the offset c profiled out where `offset` is
 /// null (c at its least squares for each τ_s), held at `*offset` otherwise.
-double best_tau(const std::vector<const SensorLagRun*>& runs, std::size_t warm, double lo, double hi, const double* offset) {
+double best_tau(const std::vector<JudgedRun>& runs, std::size_t warm, double lo, double hi, const double* offset) {
   constexpr double kTolerance = 0.005;  // in log τ_s: 0.5 %
   auto misses = [&](double log_tau) {
     const MissSums m = miss_sums(runs, warm, log_tau);
@@ -106,11 +120,11 @@ double estimator_ramp_lag_s(double tau_r_s, double sample_dt_s, bool window_mean
 SensorLagEstimate sensor_lag_without_network(const std::vector<SensorLagRun>& runs, double low_s, double high_s,
                                              std::size_t warm) {
   SensorLagEstimate out;
-  std::vector<const SensorLagRun*> usable;
+  std::vector<JudgedRun> usable;
   for (const SensorLagRun& r : runs)
     if (r.sensor_C.size() > warm && r.t_rs_C.size() == r.sensor_C.size() && r.tau_r_s.size() == r.sensor_C.size() &&
         r.dt_s.size() == r.sensor_C.size() && (r.rs_noise_tau_s.empty() || r.rs_noise_tau_s.size() == r.sensor_C.size()))
-      usable.push_back(&r);
+      usable.push_back(judged(r));
   out.runs = usable.size();
   if (usable.empty() || !(low_s > 0.0) || !(high_s > low_s)) return out;
   const double lo = std::log(low_s), hi = std::log(high_s);
@@ -120,7 +134,7 @@ SensorLagEstimate sensor_lag_without_network(const std::vector<SensorLagRun>& ru
   // Each run's own τ_s at the pooled offset (the law's, one for the log): their spread is the estimate's (runs
   // are independent stretches of the log).
   double sum = 0.0, sum2 = 0.0;
-  for (const SensorLagRun* r : usable) {
+  for (const JudgedRun& r : usable) {
     const double t = best_tau({r}, warm, lo, hi, &out.rs_above_sensor_K);
     sum += t, sum2 += t * t;
   }
