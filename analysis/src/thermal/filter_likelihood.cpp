@@ -73,6 +73,8 @@ void sensor_lag_at_standstill(io::ThermalConfig& c, const ThermalRecord& r, std:
     run.tau_r_s.push_back(estimator_ramp_lag_s(p.time_constant_s, p.sample_dt_s, r.averaged));
     run.dt_s.push_back(r.steps[k].load.dt_s);
     run.rs_noise_tau_s.push_back(p.time_constant_s);  // r̂s's noise: the update's AR(1) (eq. 14.25c)
+    run.rs_samples_per_step.push_back(p.sample_dt_s > 0.0 ? std::max(1.0, r.steps[k].load.dt_s / p.sample_dt_s)
+                                                          : 1.0);  // 14.25d
   }
   close();
   const SensorLagEstimate e = sensor_lag_without_network(runs, kSensorLagLow_s, kSensorLagHigh_s, kWarm);

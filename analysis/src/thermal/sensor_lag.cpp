@@ -1,7 +1,9 @@
 #include "rpem/analysis/thermal/sensor_lag.hpp"
 
 #include <algorithm>
+#include <cassert>
 #include <cmath>
+#include <limits>
 
 #include "rpem/analysis/thermal/golden_section.hpp"
 
@@ -18,22 +20,32 @@ double lag_step(double y, double u_from, double u_to, double tau_s, double dt_s)
   return phi * y + (1.0 - phi) * 0.5 * (u_from + u_to);
 }
 
-/// E[y²] and E[y·n] of y = lag_τs(n) for r̂s's noise n (eq. 14.25c): n an AR(1) of variance v and correlation ρ with
-/// the step before, y started at 0 (the run's first reading holds none of it).
+/// E[y²] of y = lag_τs(n) for r̂s's noise n (eq. 14.25c, d): n_k the mean of step k's samples s, an AR(1) of
+/// variance v; y started at 0 (the run's first reading holds none of it). The moments carried: E[y²], E[y·n] and
+/// E[y·s] with n and s of the step last lagged; the new step's n_k = A·s_{k−1} + w_k, w_k independent of the past.
 struct LaggedNoise {
-  double yy = 0.0, yn = 0.0;
-  void step(double phi, double rho, double v) {
-    const double beta = 0.5 * (1.0 - phi), y_from_n_to = rho * yn;  // E[y_{k−1}·n_k]
-    yy = phi * phi * yy + beta * beta * 2.0 * (1.0 + rho) * v + 2.0 * phi * beta * (yn + y_from_n_to);
-    yn = phi * y_from_n_to + beta * (1.0 + rho) * v;
+  double yy = 0.0, yn = 0.0, ys = 0.0;
+  void step(double phi, const StepMeanNoise& n, double v) {
+    const double beta = 0.5 * (1.0 - phi), a = n.carry, q = n.last_to_last;
+    const double ny = ys * a;  // E[y_{k−1}·n_k]
+    yy = phi * phi * yy + 2.0 * beta * beta * (n.variance + a * n.with_last) * v + 2.0 * phi * beta * (yn + ny);
+    yn = phi * ny + beta * (n.variance + a * n.with_last) * v;
+    ys = phi * q * ys + beta * (1.0 + q) * n.with_last * v;
   }
 };
 
-/// ρ of r̂s's noise between the run's steps: the mean of e^{−Δt/τ_r} over them.
-double mean_noise_correlation(const SensorLagRun& x) {
-  double sum = 0.0;
-  for (std::size_t k = 1; k < x.dt_s.size(); ++k) sum += decay(x.rs_noise_tau_s[k], x.dt_s[k]);
-  return x.dt_s.size() > 1 ? sum / static_cast<double>(x.dt_s.size() - 1) : 0.0;
+/// r̂s's noise over the run (eq. 14.25d): x from the mean over its steps of the sample-to-sample correlation
+/// e^{−Δt/(m·τ_r)}, m the mean of the samples per step (one where not given).
+StepMeanNoise run_noise(const SensorLagRun& x) {
+  double q = 0.0, m = 0.0;
+  for (std::size_t k = 1; k < x.dt_s.size(); ++k) {
+    const double samples = x.rs_samples_per_step.empty() ? 1.0 : x.rs_samples_per_step[k];
+    q += decay(x.rs_noise_tau_s[k], x.dt_s[k] / samples);
+    m += samples;
+  }
+  const double steps = static_cast<double>(std::max<std::size_t>(1, x.dt_s.size() - 1));
+  constexpr double kMinX = 1e-6;  // a step of no length: correlation 1, which the block's sums cannot divide by
+  return {std::max(kMinX, -std::log(q / steps)), std::max(1.0, m / steps)};
 }
 
 /// The sums over the runs (after `warm` steps) that give (14.25a)'s misses at τ_s for any offset c: the residual
@@ -47,18 +59,19 @@ struct MissSums {
   [[nodiscard]] double best_offset() const { return gg > 0.0 ? eg / gg : 0.0; }
 };
 
-/// A run with its noise's ρ and variance (eq. 14.25c), which do not depend on τ_s: found once per run.
+/// A run with its noise's correlation and variance (eq. 14.25c, d), which do not depend on τ_s: found once per run.
 struct JudgedRun {
   const SensorLagRun* run = nullptr;
   bool compensated = false;
-  double rho = 0.0, v = 0.0;
+  StepMeanNoise noise{std::numeric_limits<double>::infinity(), 1.0};
+  double v = 0.0;
 };
 
 JudgedRun judged(const SensorLagRun& x) {
-  JudgedRun j{&x, !x.rs_noise_tau_s.empty(), 0.0, 0.0};
+  JudgedRun j{&x, !x.rs_noise_tau_s.empty(), StepMeanNoise(std::numeric_limits<double>::infinity(), 1.0), 0.0};
   if (j.compensated) {
-    j.rho = mean_noise_correlation(x);
-    j.v = correlated_noise_variance(x.t_rs_C, j.rho);
+    j.noise = run_noise(x);
+    j.v = correlated_noise_variance(x.t_rs_C, j.noise);
   }
   return j;
 }
@@ -71,7 +84,7 @@ MissSums miss_sums(const std::vector<JudgedRun>& runs, std::size_t warm, double 
     double lagged_rs = x->sensor_C.front(), lagged_sensor = x->sensor_C.front(), lagged_one = 0.0;
     LaggedNoise noise;
     for (std::size_t k = 1; k < x->sensor_C.size(); ++k) {
-      if (j.compensated) noise.step(decay(tau_s, x->dt_s[k]), j.rho, j.v);
+      if (j.compensated) noise.step(decay(tau_s, x->dt_s[k]), j.noise, j.v);
       lagged_rs = lag_step(lagged_rs, x->t_rs_C[k - 1], x->t_rs_C[k], tau_s, x->dt_s[k]);
       lagged_one = lag_step(lagged_one, 1.0, 1.0, tau_s, x->dt_s[k]);
       lagged_sensor = lag_step(lagged_sensor, x->sensor_C[k - 1], x->sensor_C[k], x->tau_r_s[k], x->dt_s[k]);
@@ -103,14 +116,35 @@ double t975(std::size_t nu) {
 
 }  // namespace
 
-double correlated_noise_variance(const std::vector<double>& values, double rho) {
+namespace {
+
+/// (1/m)·Σ_{t<m} e^{−t·x}: the block mean's weight on its last sample's past (eq. 14.25d).
+double block_weight(double x, double m) { return std::expm1(-m * x) / (m * std::expm1(-x)); }
+
+/// γ₀/v: the variance of the mean of m consecutive samples of an AR(1) of correlation q = e^{−x}, per unit of its own.
+double block_variance(double x, double m) {
+  const double q = std::exp(-x), one_q = -std::expm1(-x), one_Q = -std::expm1(-m * x);
+  return (m * (1.0 + q) / one_q - 2.0 * q * one_Q / (one_q * one_q)) / (m * m);
+}
+
+}  // namespace
+
+StepMeanNoise::StepMeanNoise(double x, double m)
+    : last_to_last(std::exp(-m * x)),
+      with_last(block_weight(x, m)),
+      carry(std::exp(-x) * with_last),
+      variance(block_variance(x, m)) {
+  assert(x > 0.0 && m >= 1.0);  // x = ∞: white samples (e^{−x} = 0)
+}
+
+double correlated_noise_variance(const std::vector<double>& values, const StepMeanNoise& noise) {
   if (values.size() < 3) return 0.0;
   double sum = 0.0;
   for (std::size_t k = 1; k + 1 < values.size(); ++k) {
     const double d = values[k + 1] - 2.0 * values[k] + values[k - 1];
     sum += d * d;
   }
-  return sum / static_cast<double>(values.size() - 2) / (6.0 - 8.0 * rho + 2.0 * rho * rho);
+  return sum / static_cast<double>(values.size() - 2) / noise.second_difference();
 }
 
 double estimator_ramp_lag_s(double tau_r_s, double sample_dt_s, bool window_means) {
@@ -123,7 +157,8 @@ SensorLagEstimate sensor_lag_without_network(const std::vector<SensorLagRun>& ru
   std::vector<JudgedRun> usable;
   for (const SensorLagRun& r : runs)
     if (r.sensor_C.size() > warm && r.t_rs_C.size() == r.sensor_C.size() && r.tau_r_s.size() == r.sensor_C.size() &&
-        r.dt_s.size() == r.sensor_C.size() && (r.rs_noise_tau_s.empty() || r.rs_noise_tau_s.size() == r.sensor_C.size()))
+        r.dt_s.size() == r.sensor_C.size() && (r.rs_noise_tau_s.empty() || r.rs_noise_tau_s.size() == r.sensor_C.size()) &&
+        (r.rs_samples_per_step.empty() || r.rs_samples_per_step.size() == r.sensor_C.size()))
       usable.push_back(judged(r));
   out.runs = usable.size();
   if (usable.empty() || !(low_s > 0.0) || !(high_s > low_s)) return out;

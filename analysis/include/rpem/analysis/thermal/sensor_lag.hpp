@@ -12,7 +12,9 @@
 //
 // with c fitted beside τ_s (linear in c: profiled out at each τ_s); unfitted, a few kelvin of c pass for lag.
 // r̂s's own noise, lagged by τ_s, shrinks as τ_s grows and would pull τ_s long: its expected share of the misses is
-// taken out (eq. 14.25c), its variance measured from each run's own second differences.
+// taken out (eq. 14.25c), its variance measured from each run's own second differences. A step's r̂s is the mean
+// of the samples the step holds, which are an AR(1) from sample to sample: the steps' noise is that AR(1)'s block
+// means (eq. 14.25d), more correlated from step to step than the AR(1) over a step's Δt.
 // Each run's own least-squares τ_s gives the spread from which the estimate's interval comes.
 
 #include <cstddef>
@@ -30,6 +32,22 @@ struct SensorLagRun {
   /// The correlation time of r̂s's own noise over each step (the observer's τ_r, eq. 14.25c); empty: none known,
   /// the noise not compensated.
   std::vector<double> rs_noise_tau_s;
+  /// How many of r̂s's samples each step's value is the mean of (the step's Δt over the samples' spacing, eq.
+  /// 14.25d); empty: one, the step's value a sample of the AR(1) over the step's Δt.
+  std::vector<double> rs_samples_per_step;
+};
+
+/// r̂s's noise as one step holds it (eq. 14.25d): the mean n_k of m consecutive samples s of an AR(1) of variance
+/// v and correlation e^{−x} from sample to sample (x: the samples' spacing over the update's τ_r; ∞: white). Its
+/// second moments per unit of v; m = 1 is the AR(1) itself, of correlation e^{−x} from step to step.
+struct StepMeanNoise {
+  StepMeanNoise(double x, double m);
+  double last_to_last = 0.0;  ///< Q = e^{−m·x}: E[s_k·s_{k−1}]/v, s_k the last sample of step k
+  double with_last = 1.0;     ///< κ = E[n_k·s_k]/v
+  double carry = 0.0;         ///< A = e^{−x}·κ: E[n_k | s_{k−1}] = A·s_{k−1}
+  double variance = 1.0;      ///< γ₀ = E[n_k²]/v
+  /// E[(n_{k+1} − 2n_k + n_{k−1})²]/v = 6γ₀ − 8γ₁ + 2γ₂, with γ_j = A·Q^{j−1}·κ for j ≥ 1.
+  [[nodiscard]] double second_difference() const { return 6.0 * variance - 2.0 * carry * with_last * (4.0 - last_to_last); }
 };
 
 struct SensorLagEstimate {
@@ -45,10 +63,10 @@ struct SensorLagEstimate {
 /// which is the sample's own instant, or for a window mean (an averaged log's row) Δt/2 before its end.
 [[nodiscard]] double estimator_ramp_lag_s(double tau_r_s, double sample_dt_s, bool window_means);
 
-/// The variance of an AR(1) noise of correlation ρ per step from the second differences of a signal that holds it
-/// (eq. 14.25c): E[(Δ²n)²] = (6 − 8ρ + 2ρ²)·v, the slow signal's own second differences negligible. 0 with fewer
-/// than three values.
-[[nodiscard]] double correlated_noise_variance(const std::vector<double>& values, double rho);
+/// The variance v of the samples of an AR(1) noise, held by a signal as `noise` says (eq. 14.25c, d), from the
+/// signal's second differences: E[(Δ²n)²] = `noise.second_difference()`·v ((6 − 8ρ + 2ρ²)·v for the AR(1) itself),
+/// the slow signal's own second differences negligible. 0 with fewer than three values.
+[[nodiscard]] double correlated_noise_variance(const std::vector<double>& values, const StepMeanNoise& noise);
 
 /// τ_s on [low_s, high_s] from the runs; each run judged after its first `warm` steps (the two
 /// lagged signals start from the same reading and need a few time constants to forget it).
