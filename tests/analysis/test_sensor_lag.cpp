@@ -88,9 +88,6 @@ TEST(SensorLagWithoutNetwork, AnOffsetOfTheCopperLawIsFittedBesideTheLagNotTaken
   }
 }
 
-// r̂s's own lag (eq. 14.25b) against the update itself: θ⁺ = θ + a·(θ* − θ) run on a ramp until its lag is
-// steady, θ* the ramp at each sample's instant or its mean over the sample's window; the observer reports
-// τ_r = Δt/a. Exact for a ramp (the recursion's steady lag is Δt·(1 − a)/a plus the information's age).
 /// `steps` of an AR(1) of stationary σ `sigma` and correlation `rho` per step.
 std::vector<double> ar1(std::size_t steps, double sigma, double rho, std::mt19937& rng) {
   std::normal_distribution<double> unit(0.0, 1.0);
@@ -237,6 +234,9 @@ TEST(SensorLagWithoutNetwork, RsNoiseAsTheStepsMeanIsTakenOut) {
   EXPECT_GE(s.held, 8);
 }
 
+// r̂s's own lag (eq. 14.25b) against the update itself: θ⁺ = θ + a·(θ* − θ) run on a ramp until its lag is
+// steady, θ* the ramp at each sample's instant or its mean over the sample's window; the observer reports
+// τ_r = Δt/a. Exact for a ramp (the recursion's steady lag is Δt·(1 − a)/a plus the information's age).
 TEST(SensorLagWithoutNetwork, TheEstimatorsLagBehindARampIsItsTimeConstantLessTheAgeOfItsInformation) {
   constexpr double kRate = 0.3;  // K/s
   for (const double dt : {0.1, 0.5, 2.0})
