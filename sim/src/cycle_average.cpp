@@ -40,6 +40,7 @@ std::optional<ControlCycle> CycleExtractor::add(const io::DriveLogRow& row) noex
     c.u_dc_V = a.u_dc_V;
     c.t_winding_C = previous_->t_winding_C.value_or(std::nan(""));
     c.t_magnet_C = previous_->t_magnet_C.value_or(std::nan(""));
+    c.t_coolant_C = previous_->t_coolant_C.value_or(std::nan(""));
     out = c;
   }
   previous_ = row;
@@ -56,6 +57,7 @@ void CycleAccumulator::add(const ControlCycle& c) noexcept {
   u_dc_ += c.u_dc_V;
   t_winding_ += c.t_winding_C;
   t_magnet_ += c.t_magnet_C;
+  t_coolant_ += c.t_coolant_C;
 }
 
 core::AveragedSample CycleAccumulator::read_reset() noexcept {
@@ -69,6 +71,7 @@ core::AveragedSample CycleAccumulator::read_reset() noexcept {
   s.u_dc_V = u_dc_ * inv;
   s.t_winding_C = t_winding_ * inv;
   s.t_magnet_C = t_magnet_ * inv;
+  s.t_coolant_C = t_coolant_ * inv;
   *this = CycleAccumulator{};
   return s;
 }

@@ -31,7 +31,10 @@ DriveSimulator::DriveSimulator(Scenario scenario)
       samples_total_(std::llround(scenario_.duration_s / scenario_.sample_period_s)),
       warmup_periods_(std::llround(scenario_.warmup_s / scenario_.sample_period_s)),
       substeps_(static_cast<int>(std::lround(scenario_.sample_period_s / scenario_.plant_step_s))),
-      regimes_(scenario_.regimes) {
+      regimes_(scenario_.regimes),
+      thermal_(scenario_.thermal_plant.enabled
+                   ? ThermalPlant(scenario_.thermal_plant, core::PerUnitBase::from_rated(scenario_.machine.machine.rated))
+                   : ThermalPlant()) {
   // Start at the operating point of t = 0 (then settle over the warm-up).
   const int p = scenario_.machine.machine.rated.pole_pairs;
   parameters_ = parameters_at(-scenario_.warmup_s);
@@ -56,8 +59,9 @@ DriveSimulator::DriveSimulator(Scenario scenario)
 
 PlantParameters DriveSimulator::parameters_at(double t_s) noexcept {
   Scenario& s = scenario_;
-  const double tw = s.signal(Quantity::kTWinding).at(t_s);
-  const double tm = s.signal(Quantity::kTMagnet).at(t_s);
+  const bool heated = s.thermal_plant.enabled;
+  const double tw = heated ? thermal_.winding_C() : s.signal(Quantity::kTWinding).at(t_s);
+  const double tm = heated ? thermal_.magnet_C() : s.signal(Quantity::kTMagnet).at(t_s);
   PlantParameters p;
   p.r_s_Ohm = s.signal(Quantity::kRs).at(t_s) * s.thermal.r_s.factor(tw);
   p.psi_m_Wb = s.signal(Quantity::kPsiM).at(t_s) * s.thermal.psi_m.factor(tm);
@@ -187,6 +191,8 @@ void DriveSimulator::fill_row(std::int64_t t_ns, io::DriveLogRow& row) const noe
   s.gap_before = false;
   row.t_winding_C = scenario_.log.temperatures ? std::optional(t_winding_C_) : std::nullopt;
   row.t_magnet_C = scenario_.log.temperatures ? std::optional(t_magnet_C_) : std::nullopt;
+  const bool coolant = scenario_.log.temperatures && scenario_.thermal_plant.enabled;
+  row.t_coolant_C = coolant ? std::optional(thermal_.coolant_C()) : std::nullopt;
   row.torque_cmd_Nm = scenario_.log.torque_cmd ? std::optional(torque_cmd_Nm_) : std::nullopt;
 }
 
@@ -220,7 +226,16 @@ bool DriveSimulator::next(io::DriveLogRow& row, TruthRow& truth) noexcept {
   sample_and_control(t_s);
   fill_row(t_ns, row);
   fill_truth(t_ns, truth);
-  integrate(k_);
+  if (scenario_.thermal_plant.enabled) {
+    // The losses at t_k, held over the period (the temperatures' time constants are minutes, the period µs).
+    const PlantState& st = plant_.state();
+    const double omega_el_rad_s = st.omega_el_rad_s;
+    const ThermalLosses losses = thermal_.losses(st.i_A, st.psi_Wb, omega_el_rad_s, parameters_.r_s_Ohm);
+    integrate(k_);
+    thermal_.step(losses, omega_el_rad_s, scenario_.sample_period_s);
+  } else {
+    integrate(k_);
+  }
   ++k_;
   return true;
 }
@@ -229,6 +244,7 @@ io::DriveLogLayout DriveSimulator::layout() const noexcept {
   io::DriveLogLayout l;
   l.voltage_dq = l.current_dq = scenario_.log.dq_columns;
   l.t_winding = l.t_magnet = scenario_.log.temperatures;
+  l.t_coolant = scenario_.log.temperatures && scenario_.thermal_plant.enabled;
   l.torque_cmd = scenario_.log.torque_cmd;
   return l;
 }

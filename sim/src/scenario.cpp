@@ -6,6 +6,7 @@
 #include <optional>
 #include <sstream>
 #include <system_error>
+#include <utility>
 
 namespace rpem::sim {
 namespace {
@@ -121,6 +122,9 @@ void parse_events(std::vector<io::YamlMap> events, Scenario& s) {
     if (ev.t_s < last) e.fail("t_s", "events of one quantity must be in time order");
     last = ev.t_s;
     s.signal(q).add(ev);
+    if ((q == Quantity::kTWinding || q == Quantity::kTMagnet) && s.thermal_plant.enabled) {
+      e.fail("quantity", "the temperatures are thermal_plant's state, driven by the losses; not events");
+    }
     if (q == Quantity::kLoadTorque) {
       if (s.mechanics.dynamometer)
         e.fail("quantity", "load_torque_Nm needs plant.mechanics.mode: inertia (a dynamometer imposes the speed)");
@@ -175,6 +179,35 @@ void parse_regimes(std::vector<io::YamlMap> events, Scenario& s) {
   }
 }
 
+void parse_thermal_plant(io::YamlMap m, Scenario& s) {
+  // The machine's own heat capacities, conductances and losses: required, as no default fits every machine.
+  ThermalPlantConfig& t = s.thermal_plant;
+  t.enabled = true;
+  t.coolant_C = m.number("coolant_C", -273.0, 1000.0);
+  for (auto [key, v] : {std::pair{"winding_J_K", &t.winding_J_K},
+                        {"iron_J_K", &t.iron_J_K},
+                        {"magnet_J_K", &t.magnet_J_K},
+                        {"winding_iron_W_K", &t.winding_iron_W_K},
+                        {"iron_coolant_W_K", &t.iron_coolant_W_K},
+                        {"gap_W_K", &t.gap_W_K}}) {
+    *v = m.number(key, 1e-9, 1e12);
+  }
+  for (auto [key, v] : {std::pair{"magnet_coolant_W_K", &t.magnet_coolant_W_K},
+                        {"hysteresis_W", &t.hysteresis_W},
+                        {"eddy_W", &t.eddy_W},
+                        {"magnet_eddy_W", &t.magnet_eddy_W}}) {
+    *v = m.number(key, 0.0, 1e12);
+  }
+  t.gap_speed_gain = m.number_or("gap_speed_gain", t.gap_speed_gain, 0.0, 1e3);
+  t.steinmetz_beta = m.number_or("steinmetz_beta", t.steinmetz_beta, 1.0, 3.0);
+  if (auto start = m.optional_map("start_C")) {
+    const std::array<const char*, 3> keys = {"winding", "iron", "magnet"};
+    for (std::size_t n = 0; n < keys.size(); ++n) t.start_C[n] = start->number_or(keys[n], t.coolant_C, -273.0, 1000.0);
+    start->finish();
+  }
+  m.finish();
+}
+
 void parse_vesc(io::YamlMap m, Scenario& s) {
   VescConfig& v = s.vesc;
   v.wheel_diameter_m = m.number_or("wheel_diameter_m", v.wheel_diameter_m, 1e-3, 100.0);
@@ -199,6 +232,16 @@ void set_initial_signals(Scenario& s, std::optional<io::YamlMap> init) {
   s.signal(Quantity::kTWinding) = Signal(value("t_winding_C", s.thermal.r_s.reference_C, -273.0, 1000.0));
   s.signal(Quantity::kTMagnet) = Signal(value("t_magnet_C", s.thermal.psi_m.reference_C, -273.0, 1000.0));
   s.signal(Quantity::kLoadTorque) = Signal(value("load_torque_Nm", 0.0, -1e6, 1e6));
+  if (s.thermal_plant.enabled && init) {
+    for (const char* key : {"t_winding_C", "t_magnet_C"}) {
+      if (init->has(key)) init->fail(key, "with thermal_plant the temperatures start at thermal_plant.start_C");
+    }
+  }
+  if (s.thermal_plant.enabled) {
+    // The signals stand still at the plant's start; the simulator reads the plant's state instead.
+    s.signal(Quantity::kTWinding) = Signal(s.thermal_plant.start_temperature_C(0));
+    s.signal(Quantity::kTMagnet) = Signal(s.thermal_plant.start_temperature_C(2));
+  }
   s.separate_load = init && init->has("load_torque_Nm");
   if (s.separate_load && s.mechanics.dynamometer) {
     init->fail("load_torque_Nm", "needs plant.mechanics.mode: inertia (a dynamometer imposes the speed)");
@@ -255,6 +298,7 @@ Scenario parse_scenario(const std::string& text, const std::string& name, const 
     t.psi_m.coeff_per_K = m->number_or("psi_m_coeff_per_K", t.psi_m.coeff_per_K, -1.0, 1.0);
     m->finish();
   }
+  if (auto m = root.optional_map("thermal_plant")) parse_thermal_plant(*m, s);
   set_initial_signals(s, root.optional_map("initial"));
   if (root.has("events")) {
     parse_events(root.maps("events"), s);

@@ -134,6 +134,23 @@ INSTANTIATE_TEST_SUITE_P(
             "bad.yaml:2:27: initial.load_torque_Nm: needs plant.mechanics.mode: inertia"},
         Bad{"load_event_on_dyno", "duration_s: 1\nevents:\n  - {t_s: 1, quantity: load_torque_Nm, kind: step, value: 1}\n",
             "events[0].quantity: load_torque_Nm needs plant.mechanics.mode: inertia"},
+        Bad{"thermal_plant_event",
+            "duration_s: 1\nthermal_plant: {coolant_C: 25, winding_J_K: 1, iron_J_K: 1, magnet_J_K: 1, "
+            "winding_iron_W_K: 1, iron_coolant_W_K: 1, gap_W_K: 1, magnet_coolant_W_K: 0, hysteresis_W: 0, eddy_W: 0, "
+            "magnet_eddy_W: 0}\nevents:\n  - {t_s: 1, quantity: t_winding_C, kind: thermal, value: 90, tau_s: 60}\n",
+            "bad.yaml:4:24: events[0].quantity: the temperatures are thermal_plant's state"},
+        Bad{"thermal_plant_initial",
+            "duration_s: 1\nthermal_plant: {coolant_C: 25, winding_J_K: 1, iron_J_K: 1, magnet_J_K: 1, "
+            "winding_iron_W_K: 1, iron_coolant_W_K: 1, gap_W_K: 1, magnet_coolant_W_K: 0, hysteresis_W: 0, eddy_W: 0, "
+            "magnet_eddy_W: 0}\ninitial: {t_magnet_C: 60}\n",
+            "initial.t_magnet_C: with thermal_plant the temperatures start at thermal_plant.start_C"},
+        Bad{"thermal_plant_missing", "duration_s: 1\nthermal_plant: {coolant_C: 25}\n",
+            "thermal_plant.winding_J_K: required key is missing"},
+        Bad{"thermal_plant_negative",
+            "duration_s: 1\nthermal_plant: {coolant_C: 25, winding_J_K: 1, iron_J_K: 1, magnet_J_K: 1, "
+            "winding_iron_W_K: -1, iron_coolant_W_K: 1, gap_W_K: 1, magnet_coolant_W_K: 0, hysteresis_W: 0, eddy_W: 0, "
+            "magnet_eddy_W: 0}\n",
+            "thermal_plant.winding_iron_W_K"},
         Bad{"vesc_key", "duration_s: 1\nvesc: {wheel_mm: 3}\n", "bad.yaml:2:8: vesc.wheel_mm: unknown key"},
         // A directory opens and then fails to read: it escaped as std::ios_base::failure (fuzz_scenario).
         Bad{"machine_directory", "duration_s: 1\nmachine: /\n", "/: is a directory, not a file"}),

@@ -93,8 +93,8 @@ int run_drive_sim(const SimOptions& o) {
   sim::CycleExtractor cycles;
   sim::WindowAverager windows(o.averaged_rate_Hz, o.averaged_jitter, o.averaged_seed);
   if (!o.averaged_out.empty()) {
-    const auto& l = simulator.scenario().log;
-    averaged_log.emplace(o.averaged_out, io::AveragedLogLayout{true, l.temperatures, l.temperatures, false});
+    const io::DriveLogLayout l = simulator.layout();
+    averaged_log.emplace(o.averaged_out, io::AveragedLogLayout{true, l.t_winding, l.t_magnet, false, l.t_coolant});
   }
   if (!log && !streamer && !averaged_log) {
     std::fprintf(

@@ -27,7 +27,7 @@ struct ControlCycle {
   double omega_el_rad_s = 0.0;
   double theta_el_rad = 0.0;  ///< the measured angle at the cycle's start (the frame of i_dq_A)
   double u_dc_V = 0.0;
-  double t_winding_C = 0.0, t_magnet_C = 0.0;
+  double t_winding_C = 0.0, t_magnet_C = 0.0, t_coolant_C = 0.0;
 };
 
 /// Turns consecutive drive-log rows into control cycles: cycle k is complete when row k+1 arrives.
@@ -51,7 +51,7 @@ class CycleAccumulator {
   int n_ = 0;
   std::int64_t first_ns_ = 0, last_end_ns_ = 0;
   core::Vec2 i_ = core::Vec2::Zero(), u_ = core::Vec2::Zero();
-  double omega_ = 0.0, u_dc_ = 0.0, t_winding_ = 0.0, t_magnet_ = 0.0;
+  double omega_ = 0.0, u_dc_ = 0.0, t_winding_ = 0.0, t_magnet_ = 0.0, t_coolant_ = 0.0;
 };
 
 /// Windows of uneven length — uniform in (1 ± jitter)/rate, clipped to [0.5, 20] ms — closing at the first

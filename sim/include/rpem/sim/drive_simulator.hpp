@@ -26,6 +26,7 @@
 #include "rpem/sim/regime.hpp"
 #include "rpem/sim/scenario.hpp"
 #include "rpem/sim/sensors.hpp"
+#include "rpem/sim/thermal_plant.hpp"
 
 namespace rpem::sim {
 
@@ -65,6 +66,10 @@ class DriveSimulator {
   /// Bridge-off periods whose back EMF (line-to-line peak √3·|ω|·ψm) reached the DC link: the diodes would
   /// have rectified, which the freewheeling plant does not model.
   [[nodiscard]] std::uint64_t rectifying_periods() const noexcept { return rectifying_periods_; }
+  /// The loss-driven thermal plant (`thermal_plant:`); null when the temperatures are signals.
+  [[nodiscard]] const ThermalPlant* thermal_plant() const noexcept {
+    return scenario_.thermal_plant.enabled ? &thermal_ : nullptr;
+  }
   /// The edge-to-edge integrator (its counters); null with fixed steps.
   [[nodiscard]] const EdgeIntegrator* edge_integrator() const noexcept { return edge_to_edge_ ? &edges_ : nullptr; }
 
@@ -94,6 +99,7 @@ class DriveSimulator {
 
   PlantParameters parameters_;
   RegimeTimeline regimes_;
+  ThermalPlant thermal_;  ///< enabled by the scenario's thermal_plant
   RegimeNow regime_;
   double theta_frame_rad_ = 0.0;    ///< open loop: the commanded angle (unwrapped)
   double omega_frame_rad_s_ = 0.0;  ///< open loop: the commanded speed (electrical)

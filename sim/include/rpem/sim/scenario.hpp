@@ -14,6 +14,7 @@
 #include "rpem/sim/regime.hpp"
 #include "rpem/sim/sensors.hpp"
 #include "rpem/sim/signal.hpp"
+#include "rpem/sim/thermal_plant.hpp"
 
 namespace rpem::sim {
 
@@ -75,6 +76,9 @@ struct Scenario {
   /// Temperature coupling (core/thermal.hpp): r_s and ψm signals are the values at the laws' reference
   /// temperature; the laws' value_ref is unused.
   core::ThermalModel thermal;
+  /// Temperatures from the machine's losses (`thermal_plant:`); when enabled, t_winding_C and t_magnet_C are
+  /// its state, not signals.
+  ThermalPlantConfig thermal_plant;
   double r_fe_Ohm = 0.0;  ///< iron-loss resistance; 0: none (hidden effect)
   std::array<Signal, static_cast<int>(Quantity::kCount)> signals;
   /// Inertia mechanics: the load is load_torque_Nm (given in `initial` or by an event) rather than torque_Nm.
