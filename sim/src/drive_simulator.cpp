@@ -226,16 +226,14 @@ bool DriveSimulator::next(io::DriveLogRow& row, TruthRow& truth) noexcept {
   sample_and_control(t_s);
   fill_row(t_ns, row);
   fill_truth(t_ns, truth);
-  if (scenario_.thermal_plant.enabled) {
-    // The losses at t_k, held over the period (the temperatures' time constants are minutes, the period µs).
-    const PlantState& st = plant_.state();
-    const double omega_el_rad_s = st.omega_el_rad_s;
-    const ThermalLosses losses = thermal_.losses(st.i_A, st.psi_Wb, omega_el_rad_s, parameters_.r_s_Ohm);
-    integrate(k_);
-    thermal_.step(losses, omega_el_rad_s, scenario_.sample_period_s);
-  } else {
-    integrate(k_);
-  }
+  // The losses at t_k, held over the period (the temperatures' time constants are minutes, the period µs).
+  const bool heated = scenario_.thermal_plant.enabled;
+  const PlantState& st = plant_.state();
+  const double omega_el_rad_s = st.omega_el_rad_s;
+  const ThermalLosses losses =
+      heated ? thermal_.losses(st.i_A, st.psi_Wb, omega_el_rad_s, parameters_.r_s_Ohm) : ThermalLosses{};
+  integrate(k_);
+  if (heated) thermal_.step(losses, omega_el_rad_s, scenario_.sample_period_s);
   ++k_;
   return true;
 }

@@ -121,7 +121,6 @@ void parse_events(std::vector<io::YamlMap> events, Scenario& s) {
     auto& last = last_t[static_cast<std::size_t>(q)];
     if (ev.t_s < last) e.fail("t_s", "events of one quantity must be in time order");
     last = ev.t_s;
-    s.signal(q).add(ev);
     if ((q == Quantity::kTWinding || q == Quantity::kTMagnet) && s.thermal_plant.enabled) {
       e.fail("quantity", "the temperatures are thermal_plant's state, driven by the losses; not events");
     }
@@ -130,6 +129,7 @@ void parse_events(std::vector<io::YamlMap> events, Scenario& s) {
         e.fail("quantity", "load_torque_Nm needs plant.mechanics.mode: inertia (a dynamometer imposes the speed)");
       s.separate_load = true;
     }
+    s.signal(q).add(ev);
   }
 }
 

@@ -22,14 +22,13 @@ Cases (one per ctest, --case):
   independent_validation.py --case NAME --rpem BIN --plant BIN --source-dir DIR --work DIR [--json OUT.json]
 
 Prints the table and asserts the bounds below (two-sided where the acceptance is not met: the figures measured)."""
-import argparse
 import csv
 import json
 import os
 import re
 import sys
 
-from thermal_judge import Bounds, judge, print_table, read, run
+from thermal_judge import Bounds, arguments, judge, print_table, read, run, write_json
 
 PROFILE = "tests/independent_thermal/profiles/paderborn_profile_a_like.csv"
 CASES = {
@@ -208,19 +207,9 @@ MEASURED = {
 
 
 def main() -> int:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--case", required=True, choices=sorted(CASES))
-    ap.add_argument("--rpem", required=True)
-    ap.add_argument("--plant", required=True)
-    ap.add_argument("--source-dir", required=True)
-    ap.add_argument("--work", required=True)
-    ap.add_argument("--json")
-    a = ap.parse_args()
-    os.makedirs(a.work, exist_ok=True)
+    a = arguments(__doc__, (("--case", {"required": True, "choices": sorted(CASES)}), ("--plant", {"required": True})))
     r = validate(a, a.case)
-    if a.json:
-        with open(a.json, "w") as f:
-            json.dump(r, f, indent=2)
+    write_json(a.json, r)
     b = Bounds()
     check(a.case, r, b)
     return b.exit_code()

@@ -15,25 +15,18 @@ Prints the table and asserts the bounds below; exit 1 on a miss. Only the standa
 Bounds. Issue 24's acceptance is fused <= 3 K RMS and <= 6 K worst on both, the 2-sigma band covering >= 90 %
 of the measured points. What is met is asserted as that; what is not (docs/thermal.md says why) is asserted
 as the figures measured, two-sided, so that a change in either direction is seen."""
-import argparse
 import json
 import os
 import re
 import sys
 
-from thermal_judge import Bounds, judge, print_table, read, run
+from thermal_judge import Bounds, arguments, judge, print_table, read, run, write_json
 
 SPLIT_S = 4400.0  # the load change: heat-up before, cool-down after (docs/diagnose.md)
 
 
 def main() -> int:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--rpem", required=True)
-    ap.add_argument("--source-dir", required=True)
-    ap.add_argument("--work", required=True)
-    ap.add_argument("--json")
-    a = ap.parse_args()
-    os.makedirs(a.work, exist_ok=True)
+    a = arguments(__doc__)
     src = os.path.join(a.source_dir, "data/paderborn-motor-temperature/profile_A_every5th.csv")
     cfg = os.path.join(a.source_dir, "config/paderborn-pmsm.yaml")
     start = os.path.join(a.source_dir, "config/paderborn-thermal.yaml")
@@ -72,9 +65,7 @@ def main() -> int:
     fig_cover = re.search(r"magnet ([0-9.]+) %, winding ([0-9.]+) %", fig_out)
     fit = json.load(open(w("fit/fit.json")))
     result["fit"] = {"signals": fit["signals"], "process_noise_K2_per_s": fit["process_noise_K2_per_s"]}
-    if a.json:
-        with open(a.json, "w") as f:
-            json.dump(result, f, indent=2)
+    write_json(a.json, result)
 
     bounds = Bounds()
     check = bounds.check

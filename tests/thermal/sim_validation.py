@@ -16,13 +16,11 @@ judged part, and with it, against the plant's, beside the model alone and RPEM a
 Asserts that the fit writes its network, issue 24's acceptance (fused <= 3 K RMS and <= 6 K worst on both
 temperatures, the 2σ band covering >= 90 %), and that the judged part's temperatures move (a judge of constants
 would prove nothing)."""
-import argparse
 import csv
-import json
 import os
 import sys
 
-from thermal_judge import Bounds, judge, print_table, read, run
+from thermal_judge import Bounds, arguments, judge, print_table, read, run, write_json
 
 SPLIT_S = 2400.0
 
@@ -39,13 +37,7 @@ def write_without(rows, path, winding_after_s):
 
 
 def main() -> int:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--rpem", required=True)
-    ap.add_argument("--source-dir", required=True)
-    ap.add_argument("--work", required=True)
-    ap.add_argument("--json")
-    a = ap.parse_args()
-    os.makedirs(a.work, exist_ok=True)
+    a = arguments(__doc__)
     w = lambda name: os.path.join(a.work, name)
     cfg = os.path.join(a.source_dir, "config/paper-ipmsm.yaml")
     run([a.rpem, "sim", "--scenario", os.path.join(a.source_dir, "scenarios/thermal-heatup.yaml"),
@@ -70,9 +62,7 @@ def main() -> int:
     span = {node: max(float(r[f"T_{node}"]) for r in judged) - min(float(r[f"T_{node}"]) for r in judged)
             for node in ("magnet", "winding")}
     print(f"judged part's span: magnet {span['magnet']:.2f} K, winding {span['winding']:.2f} K")
-    if a.json:
-        with open(a.json, "w") as f:
-            json.dump({"result": result, "span_K": span}, f, indent=1)
+    write_json(a.json, {"result": result, "span_K": span})
 
     b = Bounds()
     # The rotor lags the winding (C_m/(G_gap + G_mc) ≈ 9 min at speed): 3.6 K over the judged part, the winding 28 K.

@@ -1,9 +1,33 @@
 """What the thermal validations share (docs/thermal.md, "Validation"): running the tools, judging estimate CSVs
 against measured or true temperatures, and two-sided bounds. Only the standard library."""
+import argparse
 import csv
+import json
 import math
+import os
 import subprocess
 import sys
+
+
+def arguments(doc, extra=()):
+    """The command line every validation takes (--rpem, --source-dir, --work, --json) and its own `extra`
+    ((flag, add_argument's keywords) pairs), described by the first line of its `doc`; the work directory made."""
+    ap = argparse.ArgumentParser(description=doc.splitlines()[0])
+    for flag, keywords in extra:
+        ap.add_argument(flag, **keywords)
+    for flag in ("--rpem", "--source-dir", "--work"):
+        ap.add_argument(flag, required=True)
+    ap.add_argument("--json", help="write the figures here")
+    a = ap.parse_args()
+    os.makedirs(a.work, exist_ok=True)
+    return a
+
+
+def write_json(path, figures):
+    """The figures for docs/thermal.md, where --json asked for them."""
+    if path:
+        with open(path, "w") as f:
+            json.dump(figures, f, indent=1)
 
 
 def run(cmd):

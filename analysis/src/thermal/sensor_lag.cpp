@@ -68,7 +68,9 @@ struct JudgedRun {
 };
 
 JudgedRun judged(const SensorLagRun& x) {
-  JudgedRun j{&x, !x.rs_noise_tau_s.empty(), StepMeanNoise(std::numeric_limits<double>::infinity(), 1.0), 0.0};
+  JudgedRun j;
+  j.run = &x;
+  j.compensated = !x.rs_noise_tau_s.empty();
   if (j.compensated) {
     j.noise = run_noise(x);
     j.v = correlated_noise_variance(x.t_rs_C, j.noise);
