@@ -14,6 +14,7 @@
 
 #include "rpem/core/clock.hpp"
 #include "rpem/daemon/realtime.hpp"
+#include "rpem/daemon/status_line.hpp"
 #include "rpem/estimate_t.hpp"
 #include "rpem/io/machine_config.hpp"
 #include "rpem/measurement_t.hpp"
@@ -36,19 +37,6 @@ constexpr std::array<CounterRow<PublisherCounters>, 3> kPublisherRows{{
     {&PublisherCounters::state_writes, &Diag::state_writes},
     {&PublisherCounters::state_write_failures, &Diag::state_write_failures},
 }};
-
-/// After a parameter's value on the status line: "*" adapting, " held N s" held since its last
-/// adaptation; "?" when not valid.
-const char* mark(char* buf, std::size_t size, bool adapting, double age_s, bool valid) {
-  if (adapting) {
-    std::snprintf(buf, size, "*%s", valid ? "" : "?");
-  } else if (age_s >= 0.0) {
-    std::snprintf(buf, size, " held %.0f s%s", age_s, valid ? "" : "?");
-  } else {
-    std::snprintf(buf, size, "%s", valid ? "" : "?");
-  }
-  return buf;
-}
 
 }  // namespace
 
@@ -173,26 +161,7 @@ void PersistingPublisher::maybe_write_state(bool force) {
 void PersistingPublisher::print_status(const EstimateReport& r) {
   if (config_.status_interval_s <= 0.0 || r.utime < next_status_us_) return;
   next_status_us_ = r.utime + static_cast<std::int64_t>(config_.status_interval_s * 1e6);
-  static const char* kStates[] = {"starting", "running", "STALE", "stopping"};
-  char truth[96] = "";
-  if (source_.has_truth) {
-    std::snprintf(truth, sizeof truth, "  [sim truth %.4f Wb %.4f Ohm]", source_.truth_psi_m_Wb, source_.truth_r_s_Ohm);
-  }
-  char vesc[192] = "";  // a VESC source's poll counters (docs/rpemd.md, "source: vesc")
-  if (const DiagnosticsRows& s = source_.rows; s.get(&rpem::diagnostics_t::vesc_polls) >= 0) {
-    using D = rpem::diagnostics_t;
-    std::snprintf(
-        vesc, sizeof vesc, "  [vesc polls %lld replies %lld timeouts %lld late %lld unrequested %lld stolen_reads %lld]",
-        static_cast<long long>(s.get(&D::vesc_polls)), static_cast<long long>(s.get(&D::vesc_replies)),
-        static_cast<long long>(s.get(&D::vesc_timeouts)), static_cast<long long>(s.get(&D::vesc_late_replies)),
-        static_cast<long long>(s.get(&D::vesc_unrequested_replies)), static_cast<long long>(s.get(&D::vesc_stolen_reads)));
-  }
-  char psi[32], rs[32];
-  std::printf("rpemd %-8s n=%+.3f pu  psi_m=%.4f Wb%s (T_magnet %5.1f C)  r_s=%.4f Ohm%s (T_winding %5.1f C)%s%s%s\n",
-              kStates[static_cast<std::uint8_t>(r.state)], r.speed_pu, r.psi_m_Wb,
-              mark(psi, sizeof psi, r.psi_m_adapting, r.psi_m_age_s, r.psi_m_valid), r.t_magnet_C, r.r_s_Ohm,
-              mark(rs, sizeof rs, r.r_s_adapting, r.r_s_age_s, r.r_s_valid), r.t_winding_C, truth, vesc,
-              r.frozen ? "  FROZEN" : "");
+  std::printf("%s\n", status_line(r, source_).c_str());
   std::fflush(stdout);
 }
 

@@ -54,6 +54,8 @@ class SimSampleSource final : public SampleSource {
         r.has_truth = true;
         r.truth_psi_m_Wb = truth.parameters.psi_m_Wb;
         r.truth_r_s_Ohm = truth.parameters.r_s_Ohm;
+        r.truth_t_magnet_C = truth.t_magnet_C;
+        r.truth_t_winding_C = truth.t_winding_C;
         out.report(r, target);
       }
     }

@@ -6,6 +6,8 @@
 
 #include <array>
 #include <cmath>
+#include <functional>
+#include <limits>
 
 #include "rpem/core/clock.hpp"
 #include "rpem/daemon/loop_thread.hpp"
@@ -13,6 +15,7 @@
 #include "support/loop_queues.hpp"
 #include "support/model_data.hpp"
 #include "support/paper_machine.hpp"
+#include "support/paper_thermal.hpp"
 
 namespace rpem::daemon {
 namespace {
@@ -28,10 +31,15 @@ struct AveragedRig {
   std::int64_t pushed = 0;
   bool have_next = false;
   core::AveragedSample next;
+  double t_winding_C = std::numeric_limits<double>::quiet_NaN();  ///< the drive's winding sensor on every window
 
-  explicit AveragedRig(double rate_Hz, double psi_scale = 1.0, bool angle_source_assumed = false) {
+  /// `configure` changes the configuration before the loop is made.
+  explicit AveragedRig(
+      double rate_Hz, double psi_scale = 1.0, bool angle_source_assumed = false,
+      const std::function<void(DaemonConfig&)>& configure = [](DaemonConfig&) {}) {
     config.fixed.source = VescSource::Options{};
     config.live.machine.estimator.regimes.angle_source_assumed = angle_source_assumed;
+    configure(config);
     loop = std::make_unique<LoopThread>(config, std::move(queues.loop));
     gen.base = test::paper_base();
     gen.plant = test::paper_machine_pu();
@@ -51,6 +59,7 @@ struct AveragedRig {
           next = gen.next();
           next.t_start_ns += 1'000'000'000;  // host time: the windows start when the loop does
           next.t_ns += 1'000'000'000;
+          next.t_winding_C = t_winding_C;
           have_next = true;
         }
         if (next.t_ns > now_ns) break;
@@ -192,6 +201,45 @@ TEST(AveragedLoop, MeasurementsCarryTheDrivesSensorsAndNoAngle) {
   EXPECT_EQ(m.t_drive_sensor_C, 42.0);
   EXPECT_TRUE(std::isnan(m.theta_el_rad));
   EXPECT_EQ(m.sample_time_us, s.t_ns / 1000);
+}
+
+// A drive's winding sensor (a VESC's temp_motor, a signal map's T_winding) reaches the loop's thermal fusion
+// (docs/thermal.md, "In rpemd"): a machine 35 K above its coolant at rpemd's start is found unsoaked by the first
+// reading and the winding follows the sensor, observed in every filter step; when the sensor stops reporting (a
+// VESC's −100 °C, read as no reading) the winding is predicted and its observation ages. At 0.5 pu r̂s does not
+// adapt, so the sensor is the winding's only observation.
+TEST(AveragedLoop, TheDrivesWindingSensorIsFusedAndItsSilenceIsPredicted) {
+  constexpr double kCoolant_C = 40.0, kSensor_C = 75.0;
+  AveragedRig rig(200.0, 1.0, false, [&](DaemonConfig& c) {
+    c.live.thermal = test::paper_thermal_fusion();
+    c.live.thermal.coolant_C = kCoolant_C;
+    c.live.thermal_active = true;
+  });
+  const double sensor_sigma_K = rig.config.live.thermal.winding_sensor_sigma_K;
+  ASSERT_GT(sensor_sigma_K, 0.0);  // the network's settings fuse a winding sensor
+  rig.t_winding_C = kSensor_C;
+  rig.run(10.0);
+  rig.drain();
+  const EstimateReport observed = rig.estimate;
+  ASSERT_TRUE(observed.thermal_active);
+  EXPECT_EQ(observed.t_winding_source, 1);
+  EXPECT_GE(observed.t_winding_observed_age_s, 0.0);
+  EXPECT_LE(observed.t_winding_observed_age_s, 1.5);  // the filter's step (1 s) and the report's spacing
+  // Ten readings of σ_s at one value: the fused winding within 3 of its own σ of them, that σ no wider than one
+  // reading's. A soaked start (the coolant, σ = initial_sigma_K) could not be there after ten readings of 1 K.
+  EXPECT_LE(observed.t_winding_fused_sd_C, sensor_sigma_K);
+  EXPECT_NEAR(observed.t_winding_fused_C, kSensor_C, 3.0 * observed.t_winding_fused_sd_C);
+  EXPECT_EQ(rig.measurement.t_winding_sensor_C, kSensor_C);
+
+  rig.t_winding_C = std::numeric_limits<double>::quiet_NaN();
+  rig.run(20.0);
+  rig.drain();
+  const EstimateReport predicted = rig.estimate;
+  EXPECT_EQ(predicted.t_winding_source, 2);
+  EXPECT_GE(predicted.t_winding_observed_age_s, 19.0);
+  EXPECT_LE(predicted.t_winding_observed_age_s, 21.5);
+  EXPECT_GT(predicted.t_winding_fused_sd_C, observed.t_winding_fused_sd_C);  // the band widens without readings
+  EXPECT_TRUE(std::isnan(rig.measurement.t_winding_sensor_C));
 }
 
 TEST(AveragedLoop, APhaseSampleIsCountedNotStepped) {

@@ -1,7 +1,8 @@
 // The real rpemd restarted on a hot machine (docs/thermal.md, "A restart"): on its simulated drive with a thermal
 // network it keeps the fusion's state in its state file; killed (no last write) and restarted with that state made
 // hot and 30 s old, it says it resumes, and what it writes next stands where core::across_unknown_load puts the
-// saved state after the gap — not at the coolant, where a start from nothing puts it (~6 s, real time).
+// saved state after the gap — not at the coolant, where a start from nothing puts it — in its state file and on its
+// status line (~6 s, real time).
 #include <gtest/gtest.h>
 
 #include <csignal>
@@ -90,6 +91,11 @@ TEST(RpemdThermalRestart, AKilledRpemdRestartsItsFusionWhereTheSavedStateStandsN
   const double magnet_C = after["thermal"]["t_C"][1];
   EXPECT_NEAR(magnet_C, expected.t_C[1], 2.0);
   EXPECT_GT(magnet_C, 35.0 + 45.0);
+  // Its status line says so too (docs/rpemd.md, "The status line"): the newest fused magnet where the gap left it.
+  const std::string fused = "fused: T_magnet ";
+  const std::size_t at = log.rfind(fused);
+  ASSERT_NE(at, std::string::npos) << log;
+  EXPECT_NEAR(std::stod(log.substr(at + fused.size())), expected.t_C[1], 2.0) << log;
 }
 
 }  // namespace

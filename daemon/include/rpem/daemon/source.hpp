@@ -20,6 +20,7 @@ struct SourceReport {
   bool has_truth = false;
   double truth_psi_m_Wb = 0.0;
   double truth_r_s_Ohm = 0.0;
+  double truth_t_magnet_C = 0.0, truth_t_winding_C = 0.0;  ///< the temperatures behind them
 };
 
 /// The source thread's two outputs.
