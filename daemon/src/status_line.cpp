@@ -21,9 +21,9 @@ std::string mark(bool adapting, double age_s, bool valid) {
   return buf;
 }
 
-/// A fused temperature (core::ThermalNodeReport's fields as RPEM_ESTIMATE carries them): "T_magnet 61.2 C sd 3.1 K
-/// observed", or "… predicted, observed 40 s ago" / "… predicted, never observed".
-std::string fused(const char* name, double t_C, double sd_K, std::int8_t source, double observed_age_s) {
+}  // namespace
+
+std::string fused_temperature(const char* name, double t_C, double sd_K, std::int8_t source, double observed_age_s) {
   char how[48];
   if (source == 1) {
     std::snprintf(how, sizeof how, "observed");
@@ -37,8 +37,6 @@ std::string fused(const char* name, double t_C, double sd_K, std::int8_t source,
   return buf;
 }
 
-}  // namespace
-
 std::string status_line(const EstimateReport& r, const SourceReport& source) {
   static const char* kStates[] = {"starting", "running", "STALE", "stopping"};
   char head[256];
@@ -49,10 +47,7 @@ std::string status_line(const EstimateReport& r, const SourceReport& source) {
                 mark(r.r_s_adapting, r.r_s_age_s, r.r_s_valid).c_str(), r.t_winding_C);
   std::string line = head;
   if (r.thermal_active) {
-    line += "  fused: " +
-            fused("T_magnet", r.t_magnet_fused_C, r.t_magnet_fused_sd_C, r.t_magnet_source, r.t_magnet_observed_age_s) +
-            ", " +
-            fused("T_winding", r.t_winding_fused_C, r.t_winding_fused_sd_C, r.t_winding_source, r.t_winding_observed_age_s);
+    line += "  " + fused_temperatures(r);
   }
   if (source.has_truth) {
     char truth[128];

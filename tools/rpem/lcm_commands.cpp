@@ -9,6 +9,7 @@
 // rpem keygen --id N --out FILE                            writes a new key file (mode 0600)
 // Keys: rpem/auth/key_file.hpp, docs/rpemd.md "Authentication".
 
+#include <algorithm>
 #include <array>
 #include <atomic>
 #include <chrono>
@@ -30,6 +31,7 @@
 #include "rpem/command_t.hpp"
 #include "rpem/core/clock.hpp"
 #include "rpem/daemon/signal_map_source.hpp"
+#include "rpem/daemon/status_line.hpp"
 #include "rpem/mirror/diagnostics_t.hpp"
 #include "rpem/mirror/estimate_t.hpp"
 #include "rpem/schema/decode.hpp"
@@ -86,6 +88,17 @@ constexpr std::array<std::string_view, 16> kEstimateHead{"sample_time_us", "stat
                                                          "r_s_Ohm",        "r_s_adapting", "r_s_age_s",   "r_s_valid",
                                                          "r_s_converged",  "t_magnet_C",   "t_winding_C", "algorithm"};
 static_assert(schema::has_fields<rpem::estimate_t>(kEstimateHead));
+/// With a thermal network that has stepped (thermal_active), the head shows the fused temperatures too, in the
+/// status line's words (daemon/status_line.hpp): these fields then leave the tail.
+constexpr std::array<std::string_view, 9> kFusedFields{
+    "thermal_active",    "t_magnet_fused_C",     "t_magnet_fused_sd_C", "t_magnet_source",         "t_magnet_observed_age_s",
+    "t_winding_fused_C", "t_winding_fused_sd_C", "t_winding_source",    "t_winding_observed_age_s"};
+static_assert(schema::has_fields<rpem::estimate_t>(kFusedFields));
+constexpr std::array<std::string_view, kEstimateHead.size() + kFusedFields.size()> kEstimateHeadFused = [] {
+  std::array<std::string_view, kEstimateHead.size() + kFusedFields.size()> all{};
+  std::copy(kFusedFields.begin(), kFusedFields.end(), std::copy(kEstimateHead.begin(), kEstimateHead.end(), all.begin()));
+  return all;
+}();
 /// A diagnostics line starts "diag UTIME:".
 constexpr std::array<std::string_view, 1> kDiagnosticsHead{"utime"};
 static_assert(schema::has_fields<rpem::diagnostics_t>(kDiagnosticsHead));
@@ -152,12 +165,16 @@ struct Listener {
   void on_estimate(const lcm::ReceiveBuffer* rbuf, const std::string& channel, const rpem::estimate_t* m) {
     ++estimates;
     const std::string verdict = check(rbuf, channel);
+    const std::string fused = m->thermal_active ? "  " + daemon::fused_temperatures(*m) : std::string();
+    const std::string tail =
+        schema::format_fields(*m, m->thermal_active ? std::span<const std::string_view>(kEstimateHeadFused)
+                                                    : std::span<const std::string_view>(kEstimateHead));
     std::printf(
-        "%.3f s  state %d  n %+.3f pu  psi_m %.5f Wb %s  r_s %.5f Ohm %s  T_magnet %.1f C  T_winding %.1f C  %s  %s | %s\n",
+        "%.3f s  state %d  n %+.3f pu  psi_m %.5f Wb %s  r_s %.5f Ohm %s  T_magnet %.1f C  T_winding %.1f C%s  %s  %s | %s\n",
         1e-6 * static_cast<double>(m->sample_time_us), m->state, m->speed_pu, m->psi_m_Wb,
         describe(m->psi_m_adapting, m->psi_m_age_s, m->psi_m_valid, m->psi_m_converged).c_str(), m->r_s_Ohm,
         describe(m->r_s_adapting, m->r_s_age_s, m->r_s_valid, m->r_s_converged).c_str(), m->t_magnet_C, m->t_winding_C,
-        m->algorithm.c_str(), verdict.c_str(), schema::format_fields(*m, kEstimateHead).c_str());
+        fused.c_str(), m->algorithm.c_str(), verdict.c_str(), tail.c_str());
     std::fflush(stdout);
     if (csv.is_open()) {
       csv << schema::csv_row(*m) << ',' << verdict.substr(0, verdict.find(' ')) << '\n';
