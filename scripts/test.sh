@@ -40,7 +40,7 @@ cmake --build build/ci -j "$jobs"
 sanitizer_builds() {
   cmake -S . -B build/sanitize -G Ninja -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS_DEBUG="-g1" -DRPEM_WERROR=ON \
     -DRPEM_SANITIZE=address,undefined -DRPEM_BUILD_BENCHMARKS=OFF -DRPEM_BUILD_DAEMON=OFF -DRPEM_BUILD_TOOLS=OFF \
-    -DRPEM_UNITY_BUILD=ON -DCMAKE_EXE_LINKER_FLAGS=-no-pie
+    -DRPEM_UNITY_BUILD=ON
   cmake --build build/sanitize -j "$jobs" --target test_core test_io test_can test_sim test_sim_vesc test_analysis \
     test_auth test_indep_drive indep_drive_log test_indep_thermal indep_thermal_plant
   cmake -S . -B build/tsan -G Ninja -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS_DEBUG="-O1 -g1" -DRPEM_WERROR=ON \
@@ -67,11 +67,9 @@ if ! wait "$sanitizer_pid"; then
   exit 1
 fi
 
-# ctest starts one process per test case (879), each paying the instrumented binary's start-up before its test:
-# the ASan tree links position-dependent executables (-no-pie, above), whose start-up applies none of the 1.2
-# million relative relocations a PIE test_core has (its page faults were most of its 0.26 s of CPU to a test's
-# first line; 0.16 s without). The compile_fail cases (label compile) are left out: their compiler command is
-# their own, whatever the tree's flags, and it ran in build/ci.
+# Each test binary runs in RPEM_SANITIZED_SHARDS GoogleTest shards, not a process per case (tests/CMakeLists.txt,
+# rpem_add_test: an instrumented binary's start-up was 0.19 s of CPU a process). The compile_fail cases (label
+# compile) are left out: their compiler command is their own, whatever the tree's flags, and it ran in build/ci.
 UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1 ASAN_OPTIONS=detect_leaks=1 \
   ctest --test-dir build/sanitize --output-on-failure -j "$jobs" -L unit -LE '^compile$'
 # The ThreadSanitizer daemon tests, one process each. The last is the storm (a real rpemd's loop and its control
