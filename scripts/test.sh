@@ -67,9 +67,9 @@ if ! wait "$sanitizer_pid"; then
   exit 1
 fi
 
-# Each test binary runs in RPEM_SANITIZED_SHARDS GoogleTest shards, not a process per case (tests/CMakeLists.txt,
-# rpem_add_test: an instrumented binary's start-up was 0.19 s of CPU a process). The compile_fail cases (label
-# compile) are left out: their compiler command is their own, whatever the tree's flags, and it ran in build/ci.
+# Each test binary runs in GoogleTest shards, not a process per case (tests/CMakeLists.txt, rpem_add_test, says
+# why). The compile_fail cases (label compile) are left out: their compiler command is their own, whatever the
+# tree's flags, and it ran in build/ci.
 UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1 ASAN_OPTIONS=detect_leaks=1 \
   ctest --test-dir build/sanitize --output-on-failure -j "$jobs" -L unit -LE '^compile$'
 # The ThreadSanitizer daemon tests, one process each. The last is the storm (a real rpemd's loop and its control
