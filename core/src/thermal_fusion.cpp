@@ -34,7 +34,7 @@ ThermalNodeReport report_node(const ThermalEstimate& e, int node, std::int64_t t
   const ThermalNodeEstimate& n = e.node[static_cast<std::size_t>(node)];
   r.t_C = n.t_C;
   r.sd_K = n.sigma_K;
-  r.source = static_cast<std::int8_t>(n.observed ? 1 : 2);
+  r.source = n.observed ? ThermalSource::observed : ThermalSource::predicted;
   if (n.age_s >= 0.0) r.observed_age_s = n.age_s + std::max(0.0, to_seconds(t_ns - e.t_ns));
   return r;
 }

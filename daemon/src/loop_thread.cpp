@@ -45,6 +45,12 @@ bool within(const SourceSample& s, const core::PlausibleMagnitudes& m) noexcept 
   return false;
 }
 
+/// estimate_t's t_*_source code of a core::ThermalSource: its number, which is the .lcm's SOURCE_* constant.
+constexpr std::int8_t source_code(core::ThermalSource s) noexcept { return static_cast<std::int8_t>(s); }
+static_assert(source_code(core::ThermalSource::none) == mirror::estimate_t::SOURCE_NONE &&
+              source_code(core::ThermalSource::observed) == mirror::estimate_t::SOURCE_OBSERVED &&
+              source_code(core::ThermalSource::predicted) == mirror::estimate_t::SOURCE_PREDICTED);
+
 }  // namespace
 
 LoopThread::LoopThread(const DaemonConfig& config, Queues queues)
@@ -237,11 +243,11 @@ void LoopThread::report_thermal(EstimateReport& r) const noexcept {
   const core::ThermalNodeReport w = core::report_node(e, r.thermal_active ? e.winding : -1, t_ns);
   r.t_magnet_fused_C = m.t_C;
   r.t_magnet_fused_sd_C = m.sd_K;
-  r.t_magnet_source = m.source;
+  r.t_magnet_source = source_code(m.source);
   r.t_magnet_observed_age_s = m.observed_age_s;
   r.t_winding_fused_C = w.t_C;
   r.t_winding_fused_sd_C = w.sd_K;
-  r.t_winding_source = w.source;
+  r.t_winding_source = source_code(w.source);
   r.t_winding_observed_age_s = w.observed_age_s;
   r.thermal = r.thermal_active ? thermal_.snapshot() : core::ThermalSnapshot{};
 }

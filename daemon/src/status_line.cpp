@@ -25,7 +25,7 @@ std::string mark(bool adapting, double age_s, bool valid) {
 
 std::string fused_temperature(const char* name, double t_C, double sd_K, std::int8_t source, double observed_age_s) {
   char how[48];
-  if (source == 1) {
+  if (source == mirror::estimate_t::SOURCE_OBSERVED) {
     std::snprintf(how, sizeof how, "observed");
   } else if (observed_age_s >= 0.0) {
     std::snprintf(how, sizeof how, "predicted, observed %.0f s ago", observed_age_s);

@@ -56,7 +56,7 @@ void EstimateLogWriter::write(const core::Estimate& e, const core::RpemEstimator
       append_number(line_ += ',', n.t_C);
       append_number(line_ += ',', n.sd_K);
       line_ += static_cast<char>(',');
-      line_ += static_cast<char>('0' + n.source);
+      line_ += static_cast<char>('0' + static_cast<int>(n.source));
       append_number(line_ += ',', n.observed_age_s);
     }
   }

@@ -222,7 +222,7 @@ TEST(AveragedLoop, TheDrivesWindingSensorIsFusedAndItsSilenceIsPredicted) {
   rig.drain();
   const EstimateReport observed = rig.estimate;
   ASSERT_TRUE(observed.thermal_active);
-  EXPECT_EQ(observed.t_winding_source, 1);
+  EXPECT_EQ(observed.t_winding_source, mirror::estimate_t::SOURCE_OBSERVED);
   EXPECT_GE(observed.t_winding_observed_age_s, 0.0);
   EXPECT_LE(observed.t_winding_observed_age_s, 1.5);  // the filter's step (1 s) and the report's spacing
   // Ten readings of σ_s at one value: the fused winding within 3 of its own σ of them, that σ no wider than one
@@ -235,7 +235,7 @@ TEST(AveragedLoop, TheDrivesWindingSensorIsFusedAndItsSilenceIsPredicted) {
   rig.run(20.0);
   rig.drain();
   const EstimateReport predicted = rig.estimate;
-  EXPECT_EQ(predicted.t_winding_source, 2);
+  EXPECT_EQ(predicted.t_winding_source, mirror::estimate_t::SOURCE_PREDICTED);
   EXPECT_GE(predicted.t_winding_observed_age_s, 19.0);
   EXPECT_LE(predicted.t_winding_observed_age_s, 21.5);
   EXPECT_GT(predicted.t_winding_fused_sd_C, observed.t_winding_fused_sd_C);  // the band widens without readings

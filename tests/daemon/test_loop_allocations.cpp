@@ -88,7 +88,8 @@ long phase_path_allocations(const DaemonConfig& config, ThermalSeen& seen) {
       while (output.pop(drain)) {
         if (const auto* e = std::get_if<EstimateReport>(&drain)) {
           seen.active += e->thermal_active;
-          seen.observed += e->t_magnet_source == 1 || e->t_winding_source == 1;
+          seen.observed += e->t_magnet_source == mirror::estimate_t::SOURCE_OBSERVED ||
+                           e->t_winding_source == mirror::estimate_t::SOURCE_OBSERVED;
         }
       }
       g_allocations.store(counted);

@@ -66,8 +66,8 @@ TEST(LoopThermal, WithoutANetworkTheFieldsSayNone) {
   EXPECT_FALSE(e.thermal_active);
   EXPECT_TRUE(std::isnan(e.t_magnet_fused_C));
   EXPECT_TRUE(std::isnan(e.t_winding_fused_sd_C));
-  EXPECT_EQ(e.t_magnet_source, 0);
-  EXPECT_EQ(e.t_winding_source, 0);
+  EXPECT_EQ(e.t_magnet_source, mirror::estimate_t::SOURCE_NONE);
+  EXPECT_EQ(e.t_winding_source, mirror::estimate_t::SOURCE_NONE);
   EXPECT_EQ(e.t_magnet_observed_age_s, -1.0);
 }
 
@@ -81,8 +81,9 @@ TEST(LoopThermal, WithANetworkTheFusedTemperaturesAreReported) {
   EXPECT_GT(e.t_magnet_fused_sd_C, 0.0);
   EXPECT_LT(e.t_magnet_fused_sd_C, test::paper_thermal_fusion().initial_sigma_K);
   EXPECT_GT(e.t_winding_fused_sd_C, 0.0);
-  EXPECT_TRUE(e.t_magnet_source == 1 || e.t_magnet_source == 2);
-  EXPECT_TRUE(e.t_winding_source == 1 || e.t_winding_source == 2);
+  for (std::int8_t source : {e.t_magnet_source, e.t_winding_source}) {
+    EXPECT_TRUE(source == mirror::estimate_t::SOURCE_OBSERVED || source == mirror::estimate_t::SOURCE_PREDICTED);
+  }
   EXPECT_GE(e.t_magnet_observed_age_s, 0.0);  // observed at least once
   EXPECT_LT(e.t_magnet_observed_age_s, 10.0);
 }

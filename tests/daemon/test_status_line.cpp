@@ -46,8 +46,10 @@ TEST(StatusLine, WithoutANetworkItIsTheParametersAndTheirDerivedTemperatures) {
 TEST(StatusLine, WithANetworkItShowsBothFusedTemperaturesAndHowEachStands) {
   EstimateReport r = docs_example();
   r.thermal_active = true;
-  r.t_magnet_fused_C = 61.24, r.t_magnet_fused_sd_C = 3.06, r.t_magnet_source = 1, r.t_magnet_observed_age_s = 0.0;
-  r.t_winding_fused_C = 75.04, r.t_winding_fused_sd_C = 0.81, r.t_winding_source = 2, r.t_winding_observed_age_s = 40.4;
+  r.t_magnet_fused_C = 61.24, r.t_magnet_fused_sd_C = 3.06, r.t_magnet_observed_age_s = 0.0;
+  r.t_magnet_source = mirror::estimate_t::SOURCE_OBSERVED;
+  r.t_winding_fused_C = 75.04, r.t_winding_fused_sd_C = 0.81, r.t_winding_observed_age_s = 40.4;
+  r.t_winding_source = mirror::estimate_t::SOURCE_PREDICTED;
   EXPECT_EQ(status_line(r, SourceReport{}), std::string(kHead) +
                                                 "  fused: T_magnet 61.2 C sd 3.1 K observed, T_winding 75.0 C sd 0.8 K "
                                                 "predicted, observed 40 s ago");

@@ -51,10 +51,10 @@ TEST(SupervisorReadings, FusedWhenTheThermalModelRunsWhateverTheRawValuesSay) {
   m.thermal_active = true;
   m.t_magnet_fused_C = 105.0;
   m.t_magnet_fused_sd_C = 1.5;
-  m.t_magnet_source = 2;  // predicted
+  m.t_magnet_source = rpem::estimate_t::SOURCE_PREDICTED;
   m.t_winding_fused_C = 118.0;
   m.t_winding_fused_sd_C = 0.8;
-  m.t_winding_source = 0;  // none
+  m.t_winding_source = rpem::estimate_t::SOURCE_NONE;
   const PartReadings r = readings_of(m, config());
   ASSERT_TRUE(r.magnet);
   EXPECT_EQ(r.magnet->t_C, 105.0);

@@ -6,9 +6,10 @@
 namespace rpem::supervisor {
 namespace {
 
-/// A fused temperature, if the filter gives one (source 1 observed or 2 predicted) and it is a number.
+/// A fused temperature, if the filter gives one (observed or predicted) and it is a number.
 std::optional<TemperatureEstimate> fused(double t_C, double sd_K, std::int8_t source) noexcept {
-  if (source == 0 || !std::isfinite(t_C) || !std::isfinite(sd_K) || sd_K < 0.0) return std::nullopt;
+  if (source == rpem::estimate_t::SOURCE_NONE) return std::nullopt;
+  if (!std::isfinite(t_C) || !std::isfinite(sd_K) || sd_K < 0.0) return std::nullopt;
   return TemperatureEstimate{t_C, sd_K, 0.0};
 }
 

@@ -81,14 +81,21 @@ struct ThermalEstimate {
   [[nodiscard]] const ThermalNodeEstimate& winding_node() const noexcept { return node[static_cast<std::size_t>(winding)]; }
 };
 
+/// Where a reported node temperature comes from. The values are what RPEM_ESTIMATE's t_*_source and the estimate
+/// log's *_source columns carry (rpem_estimate_t.lcm's SOURCE_* constants, which the daemon asserts agree).
+enum class ThermalSource : std::int8_t {
+  none = 0,       ///< the filter has not stepped
+  observed = 1,   ///< corrected in the filter's newest step
+  predicted = 2,  ///< not corrected in it
+};
+
 /// What RPEM_ESTIMATE and `rpem estimate --thermal` report of a node at `t_ns` (the newest sample, at or after
-/// the filter's newest step): source 0 none (the filter has not stepped), 1 observed in the newest step,
-/// 2 predicted; the age of the last observation run on to t_ns, −1: never observed; NaN values before the
-/// first step.
+/// the filter's newest step): where it comes from; the age of the last observation run on to t_ns, −1: never
+/// observed; NaN values before the first step.
 struct ThermalNodeReport {
   double t_C = 0.0;
   double sd_K = 0.0;
-  std::int8_t source = 0;
+  ThermalSource source = ThermalSource::none;
   double observed_age_s = -1.0;
 };
 [[nodiscard]] ThermalNodeReport report_node(const ThermalEstimate& e, int node, std::int64_t t_ns) noexcept;
