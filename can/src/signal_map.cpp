@@ -19,7 +19,7 @@ constexpr std::array<FieldInfo, kSampleFieldCount> kFields = {{
     {"i_d", "A"},          {"i_q", "A"},          {"u_d", "V"},        {"u_q", "V"},          {"i_a", "A"},
     {"i_b", "A"},          {"i_c", "A"},          {"u_a", "V"},        {"u_b", "V"},          {"u_c", "V"},
     {"theta_el", "rad"},   {"omega_el", "rad/s"}, {"erpm", "rpm"},     {"speed_mech", "rpm"}, {"u_dc", "V"},
-    {"T_winding", "degC"}, {"T_magnet", "degC"},  {"T_drive", "degC"}, {"t_sample", "s"},
+    {"T_winding", "degC"}, {"T_magnet", "degC"},  {"T_drive", "degC"}, {"T_coolant", "degC"}, {"t_sample", "s"},
 }};
 
 /// DBC bit positions of a signal, MSB first for big endian (the "sawtooth" numbering: bit 7 of byte 0 is
@@ -60,8 +60,9 @@ std::string float_problem(const SignalSpec& s) {
 /// What is wrong with a signal's no-reading value, or "": a temperature's only, an integer's, and one its bits hold.
 std::string no_reading_problem(const SignalSpec& s) {
   if (!s.no_reading_raw) return {};
-  if (s.field != SampleField::kTWindingC && s.field != SampleField::kTMagnetC && s.field != SampleField::kTDriveC)
-    return "no_reading is a temperature sensor's (T_winding, T_magnet, T_drive)";
+  if (s.field != SampleField::kTWindingC && s.field != SampleField::kTMagnetC && s.field != SampleField::kTDriveC &&
+      s.field != SampleField::kTCoolantC)
+    return "no_reading is a temperature sensor's (T_winding, T_magnet, T_drive, T_coolant)";
   if (s.value_type != ValueType::kInteger) return "no_reading is an integer signal's raw value (a float's is NaN)";
   const int bits = std::clamp(s.length, 1, 64);
   const std::int64_t raw = *s.no_reading_raw;
@@ -285,6 +286,7 @@ bool SignalMapDecoder::complete(std::int64_t t_ns, core::AveragedSample& out) no
   s.t_winding_C = optional(F::kTWindingC);
   s.t_magnet_C = optional(F::kTMagnetC);
   s.t_drive_C = optional(F::kTDriveC);
+  s.t_coolant_C = optional(F::kTCoolantC);
   if (!s.i_dq_A.allFinite() || !s.u_dq_V.allFinite() || !std::isfinite(s.omega_el_rad_s)) {
     ++counters_.non_finite;
     has_previous_ = false;

@@ -99,7 +99,10 @@ void ThermalObserver::add_residual(const EstimatorOutput& d, double dt_s) noexce
 
 bool ThermalObserver::add(const Estimate& e, const ThermalSample& s) noexcept {
   const double dt = std::isfinite(s.dt_s) && s.dt_s > 0.0 ? s.dt_s : 0.0;
-  const double coolant = std::isfinite(s.coolant_C) ? s.coolant_C : coolant_C_;
+  // The coolant is an input the step integrates: a reading holds until the next one (a zero-order hold of a
+  // slow temperature that a log or a bus may give less often than the currents).
+  if (std::isfinite(s.coolant_C)) measured_coolant_C_ = s.coolant_C;
+  const double coolant = std::isfinite(measured_coolant_C_) ? measured_coolant_C_ : coolant_C_;
   const Vec2 i = e.i_meas_A;
   const double omega = base_.omega_el_rad_s_of(e.speed_pu);
   // The stator flux linkage of the dq model with the current ψ̂m (docs/derivations.md §14, "Losses").

@@ -44,7 +44,7 @@ bool LoopEstimator::step(const SourceSample& sample, core::Estimate& estimate, d
     estimate = phase->step(s);
     dt_s = nominal_period_s_;
     constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-    summary = {s.t_ns, s.rx_ns, s.theta_el_rad, s.omega_el_rad_s, s.u_dc_V, kNaN, kNaN};
+    summary = {s.t_ns, s.rx_ns, s.theta_el_rad, s.omega_el_rad_s, s.u_dc_V, kNaN, kNaN, kNaN};
     return true;
   }
   const core::AveragedSample& a = *std::get_if<core::AveragedSample>(&sample);
@@ -56,8 +56,8 @@ bool LoopEstimator::step(const SourceSample& sample, core::Estimate& estimate, d
   estimate = averaged.step(a);
   const double interval_s = previous_t_ns ? core::to_seconds(a.t_ns - *previous_t_ns) : 0.0;
   dt_s = a.t_start_ns < a.t_ns ? std::max(interval_s, 0.0) : std::clamp(interval_s, 0.0, max_interval_s_);
-  summary = {a.t_ns,        a.t_ns,     std::numeric_limits<double>::quiet_NaN(), a.omega_el_rad_s, a.u_dc_V,
-             a.t_winding_C, a.t_drive_C};
+  summary = {a.t_ns,      a.t_ns,       std::numeric_limits<double>::quiet_NaN(), a.omega_el_rad_s, a.u_dc_V, a.t_winding_C,
+             a.t_drive_C, a.t_coolant_C};
   return true;
 }
 

@@ -166,6 +166,7 @@ void LoopThread::step(const SourceSample& s, std::int64_t now_ns) noexcept {
     core::ThermalSample t;
     t.dt_s = dt_s;
     t.winding_sensor_C = last_sample_.t_winding_sensor_C;  // NaN: none (the filter uses it if configured)
+    t.coolant_C = last_sample_.t_coolant_sensor_C;         // NaN: none (the newest reading holds, else the configured)
     thermal_.step(last_, t);
   }
 }
@@ -186,6 +187,7 @@ void LoopThread::report_measurement() noexcept {
   m.epsilon_q_A = last_.epsilon_A[1];
   m.t_winding_sensor_C = s.t_winding_sensor_C;
   m.t_drive_sensor_C = s.t_drive_sensor_C;
+  m.t_coolant_sensor_C = s.t_coolant_sensor_C;
   push(m);
 }
 

@@ -303,22 +303,29 @@ TEST(SignalMapConfig, UnusableMapsAreRefusedNamingWhy) {
   expect_refused(head + i + u + w + "colour: blue\n", "colour");
 }
 
-// A temperature sensor's "no reading" (SAE J1939's all-ones "not available" for a 16-bit unsigned parameter,
-// here J1939's temperature scaling 0.03125 °C/bit, offset −273 °C): the field is not received in that frame, the
-// sample is one as ever, and it is counted; a reading again is used again.
+// A map whose frame 0x10 carries a sample's currents, voltages and speed, and whose frame 0x11 carries one temperature
+// `field` as SAE J1939 scales one (0.03125 °C/bit, offset −273 °C; all ones, 65535, its "not available").
+std::string j1939_temperature_map(const std::string& field) {
+  return "name: j1939ish\nsample: {trigger: 0x10}\nframes:\n"
+         "  - {id: 0x10, signals: [\n"
+         "      {field: i_d, start_bit: 0, length: 16, signed: true, scale: 0.01, unit: A},\n"
+         "      {field: i_q, start_bit: 16, length: 16, signed: true, scale: 0.01, unit: A},\n"
+         "      {field: u_d, start_bit: 32, length: 8, signed: true, scale: 0.1, unit: V},\n"
+         "      {field: u_q, start_bit: 40, length: 8, signed: true, scale: 0.1, unit: V},\n"
+         "      {field: erpm, start_bit: 48, length: 16, signed: true, unit: rpm}]}\n"
+         "  - {id: 0x11, length: 2, signals: [\n"
+         "      {field: " +
+         field + ", start_bit: 0, length: 16, scale: 0.03125, offset: -273, no_reading: 65535, unit: degC}]}\n";
+}
+/// j1939_temperature_map's frame 0x10: i = (1, 2) A, u = (1, 2) V, 1000 erpm.
+CanFrame j1939_values() { return frame(0x10, {0x64, 0x00, 0xC8, 0x00, 0x0A, 0x14, 0xE8, 0x03}); }
+
+// A temperature sensor's "no reading" (SAE J1939's all-ones "not available" for a 16-bit unsigned parameter): the
+// field is not received in that frame, the sample is one as ever, and it is counted; a reading again is used again.
 TEST(SignalMapNoReading, ATemperaturesNoReadingValueLeavesTheSampleWithoutIt) {
-  const std::string text =
-      "name: j1939ish\nsample: {trigger: 0x10}\nframes:\n"
-      "  - {id: 0x10, signals: [\n"
-      "      {field: i_d, start_bit: 0, length: 16, signed: true, scale: 0.01, unit: A},\n"
-      "      {field: i_q, start_bit: 16, length: 16, signed: true, scale: 0.01, unit: A},\n"
-      "      {field: u_d, start_bit: 32, length: 8, signed: true, scale: 0.1, unit: V},\n"
-      "      {field: u_q, start_bit: 40, length: 8, signed: true, scale: 0.1, unit: V},\n"
-      "      {field: erpm, start_bit: 48, length: 16, signed: true, unit: rpm}]}\n"
-      "  - {id: 0x11, length: 2, signals: [\n"
-      "      {field: T_winding, start_bit: 0, length: 16, scale: 0.03125, offset: -273, no_reading: 65535, unit: degC}]}\n";
+  const std::string text = j1939_temperature_map("T_winding");
   SignalMapDecoder dec(io::parse_signal_map(text, "j1939ish.yaml"));
-  const CanFrame values = frame(0x10, {0x64, 0x00, 0xC8, 0x00, 0x0A, 0x14, 0xE8, 0x03});
+  const CanFrame values = j1939_values();
   core::AveragedSample s;
   EXPECT_FALSE(dec.decode(frame(0x11, {0xFF, 0xFF}), 1'000'000, s));
   ASSERT_TRUE(dec.decode(values, 1'000'000, s));
@@ -346,6 +353,24 @@ TEST(SignalMapNoReading, ATemperaturesNoReadingValueLeavesTheSampleWithoutIt) {
                      "  - {id: 0x11, signals: [{field: T_winding, start_bit: 0, length: 8, signed: true, no_reading: -129, "
                      "unit: degC}]}\n",
                  "no_reading -129 is not a raw value of 8 signed bits");
+}
+
+// The coolant's sensor (T_coolant: the thermal network's boundary, docs/thermal.md) is read as any temperature is:
+// its value in the sample's t_coolant_C, its no-reading value and a cycle without its frame none.
+TEST(SignalMapNoReading, TheCoolantIsATemperatureWithItsNoReadingValue) {
+  SignalMapDecoder dec(io::parse_signal_map(j1939_temperature_map("T_coolant"), "j1939ish.yaml"));
+  core::AveragedSample s;
+  EXPECT_FALSE(dec.decode(frame(0x11, {0x40, 0x24}), 1'000'000, s));  // 9280 · 0.03125 − 273 = 17 °C
+  ASSERT_TRUE(dec.decode(j1939_values(), 1'000'000, s));
+  EXPECT_DOUBLE_EQ(s.t_coolant_C, 17.0);
+  EXPECT_TRUE(std::isnan(s.t_winding_C));
+  EXPECT_FALSE(dec.decode(frame(0x11, {0xFF, 0xFF}), 2'000'000, s));
+  ASSERT_TRUE(dec.decode(j1939_values(), 2'000'000, s));
+  EXPECT_TRUE(std::isnan(s.t_coolant_C));
+  EXPECT_EQ(dec.counters().no_reading, 1U);
+  ASSERT_TRUE(dec.decode(j1939_values(), 3'000'000, s));  // no coolant frame in this cycle
+  EXPECT_TRUE(std::isnan(s.t_coolant_C));
+  EXPECT_EQ(dec.counters().samples, 3U);
 }
 
 TEST(SignalMapConfig, FloatSignalsMustBeWholeByteAlignedIeeeValues) {

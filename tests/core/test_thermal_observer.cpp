@@ -7,6 +7,8 @@
 
 #include <cmath>
 #include <random>
+#include <utility>
+#include <vector>
 
 #include "rpem/core/averaged_estimator.hpp"
 #include "rpem/core/thermal_fusion.hpp"
@@ -145,6 +147,41 @@ TEST(ThermalObserver, SensorReadingsAgeIsTheirTimesMeanAndSpreadAtTheStepsEnd) {
   const ThermalStepData dense = sensor_step(1.0 / n);
   EXPECT_NEAR(dense.winding_sensor_age.mean_s, (n - 1.0) / (2.0 * n), 1e-12);
   EXPECT_NEAR(dense.winding_sensor_age.variance_s2, (n * n - 1.0) / (12.0 * n * n), 1e-12);
+}
+
+/// One 1 s step of eight samples 0.125 s apart (exact in binary), the coolant read at the samples `readings` names
+/// (1–8; NaN elsewhere).
+ThermalStepData coolant_step(ThermalObserver& observer, const std::vector<std::pair<int, double>>& readings) {
+  Estimate e;
+  e.speed_pu = 0.5;
+  e.i_meas_A = Vec2(1.0, 2.0);
+  e.psi_m_Wb = test::paper_machine_si().psi_m_Wb;
+  for (int k = 1; k <= 8; ++k) {
+    ThermalSample s;
+    s.dt_s = 0.125;
+    for (const auto& [at, value] : readings) {
+      if (at == k) s.coolant_C = value;
+    }
+    if (observer.add(e, s)) {
+      EXPECT_EQ(k, 8);
+      return observer.step();
+    }
+  }
+  ADD_FAILURE() << "no step in 1 s";
+  return {};
+}
+
+TEST(ThermalObserver, ACoolantReadingHoldsUntilTheNextAndTheConfiguredOneStandsInBeforeTheFirst) {
+  // The step's coolant is the time-weighted mean of what each sample stands for (eq. 14.1b's boundary): a sample
+  // without a reading (a log's empty cell, a CAN sample whose coolant frame did not come) holds the newest reading.
+  const MachineSi machine = test::paper_machine_si();
+  const PerUnitBase base = test::paper_base();
+  ThermalObserver observer(ThermalObserverConfig{}, base, machine, loss_base_of(base, machine), 25.0);
+  EXPECT_NEAR(coolant_step(observer, {}).load.coolant_C, 25.0, 1e-12);           // none yet: the configured one
+  EXPECT_NEAR(coolant_step(observer, {{1, 31.0}}).load.coolant_C, 31.0, 1e-12);  // read once, held (not 25.75)
+  // Held at 31 over samples 1–4, read 37 at the 5th and held: (4·31 + 4·37)/8.
+  EXPECT_NEAR(coolant_step(observer, {{5, 37.0}}).load.coolant_C, 34.0, 1e-12);
+  EXPECT_NEAR(coolant_step(observer, {}).load.coolant_C, 37.0, 1e-12);  // a step without a reading holds too
 }
 
 }  // namespace

@@ -32,6 +32,8 @@ struct AveragedRig {
   bool have_next = false;
   core::AveragedSample next;
   double t_winding_C = std::numeric_limits<double>::quiet_NaN();  ///< the drive's winding sensor on every window
+  double t_coolant_C = std::numeric_limits<double>::quiet_NaN();  ///< its coolant sensor, on every coolant_every-th
+  int coolant_every = 1;                                          ///< window (NaN on the others)
 
   /// `configure` changes the configuration before the loop is made.
   explicit AveragedRig(
@@ -60,6 +62,7 @@ struct AveragedRig {
           next.t_start_ns += 1'000'000'000;  // host time: the windows start when the loop does
           next.t_ns += 1'000'000'000;
           next.t_winding_C = t_winding_C;
+          next.t_coolant_C = pushed % coolant_every == 0 ? t_coolant_C : std::numeric_limits<double>::quiet_NaN();
           have_next = true;
         }
         if (next.t_ns > now_ns) break;
@@ -192,6 +195,7 @@ TEST(AveragedLoop, MeasurementsCarryTheDrivesSensorsAndNoAngle) {
   s.t_ns = rig.now_ns + 4'000'000;
   s.t_winding_C = 71.5;
   s.t_drive_C = 42.0;
+  s.t_coolant_C = 18.25;
   ASSERT_TRUE(rig.input.push(s));
   rig.now_ns += 200'000'000;
   rig.loop->process(rig.now_ns);
@@ -199,6 +203,7 @@ TEST(AveragedLoop, MeasurementsCarryTheDrivesSensorsAndNoAngle) {
   const MeasurementReport& m = rig.measurement;
   EXPECT_EQ(m.t_winding_sensor_C, 71.5);
   EXPECT_EQ(m.t_drive_sensor_C, 42.0);
+  EXPECT_EQ(m.t_coolant_sensor_C, 18.25);
   EXPECT_TRUE(std::isnan(m.theta_el_rad));
   EXPECT_EQ(m.sample_time_us, s.t_ns / 1000);
 }
@@ -240,6 +245,28 @@ TEST(AveragedLoop, TheDrivesWindingSensorIsFusedAndItsSilenceIsPredicted) {
   EXPECT_LE(predicted.t_winding_observed_age_s, 21.5);
   EXPECT_GT(predicted.t_winding_fused_sd_C, observed.t_winding_fused_sd_C);  // the band widens without readings
   EXPECT_TRUE(std::isnan(rig.measurement.t_winding_sensor_C));
+}
+
+// A drive's coolant sensor (a signal map's T_coolant) is the network's boundary in place of thermal.coolant_C
+// (docs/thermal.md, "In rpemd"). Read on one window in 50 (a coolant frame at 4 Hz beside currents at 200 Hz), each
+// reading holds until the next, so a filter step's coolant is the reading; without the hold it would be 1/50 of the
+// reading and 49/50 of the configured 40 °C (39.65 °C).
+TEST(AveragedLoop, TheDrivesCoolantSensorIsTheNetworksBoundaryAndHolds) {
+  constexpr double kConfigured_C = 40.0, kMeasured_C = 22.5;
+  AveragedRig rig(200.0, 1.0, false, [&](DaemonConfig& c) {
+    c.live.thermal = test::paper_thermal_fusion();
+    c.live.thermal.coolant_C = kConfigured_C;
+    c.live.thermal_active = true;
+  });
+  rig.run(3.0);  // no coolant reading yet: the configured one
+  rig.drain();
+  ASSERT_TRUE(rig.estimate.thermal_active);
+  EXPECT_DOUBLE_EQ(rig.estimate.thermal.load.coolant_C, kConfigured_C);
+  rig.t_coolant_C = kMeasured_C;
+  rig.coolant_every = 50;
+  rig.run(3.0);  // the newest 1 s step lies wholly after the first reading
+  rig.drain();
+  EXPECT_NEAR(rig.estimate.thermal.load.coolant_C, kMeasured_C, 1e-9);
 }
 
 TEST(AveragedLoop, APhaseSampleIsCountedNotStepped) {

@@ -91,7 +91,13 @@ class ThermalRun {
     s.winding_sensor_C = winding_C;
     if (samples_ == 0) first_winding_C_ = winding_C;
     ++samples_;
-    if (std::isnan(coolant_C)) ++without_coolant_;
+    if (!std::isnan(coolant_C)) {
+      coolant_read_ = true;
+    } else if (coolant_read_) {
+      ++coolant_held_;
+    } else {
+      ++without_coolant_;
+    }
     previous_ns_ = t_ns;
     fusion_->step(e, s);
     const core::ThermalEstimate& now = fusion_->estimate();
@@ -108,9 +114,15 @@ class ThermalRun {
     if (without_coolant_ > 0) {
       std::fprintf(stderr,
                    "rpem estimate: thermal: %llu of %llu samples have no coolant temperature (no T_coolant column or "
-                   "an empty cell): the coolant is taken as %.4g °C there (thermal.coolant_C); a coolant that moves "
-                   "shows as a model error (docs/thermal.md)\n",
+                   "an empty cell) and none before them: the coolant is taken as %.4g °C there (thermal.coolant_C); a "
+                   "coolant that moves shows as a model error (docs/thermal.md)\n",
                    static_cast<unsigned long long>(without_coolant_), static_cast<unsigned long long>(samples_), coolant_C_);
+    }
+    if (coolant_held_ > 0) {
+      std::fprintf(stderr,
+                   "rpem estimate: thermal: %llu of %llu samples have an empty coolant cell after a reading: the newest "
+                   "reading holds there\n",
+                   static_cast<unsigned long long>(coolant_held_), static_cast<unsigned long long>(samples_));
     }
     if (samples_ > 0 && !(sensor_fused_ && std::isfinite(first_winding_C_))) {
       // core::start_temperatures_C: without a fused winding reading at the start, the soak is assumed.
@@ -138,9 +150,11 @@ class ThermalRun {
   std::vector<std::string> names_;
   std::optional<core::ThermalFusion> fusion_;
   std::optional<std::int64_t> previous_ns_;
-  std::uint64_t samples_ = 0, without_coolant_ = 0;  ///< samples the filter was given, those without a coolant
-  double coolant_C_ = 0.0;                           ///< what the filter takes for a missing coolant
-  bool sensor_fused_ = false;                        ///< a winding reading is fused (its σ given)
+  /// Samples the filter was given; those without a coolant reading before the first one, and after it (held).
+  std::uint64_t samples_ = 0, without_coolant_ = 0, coolant_held_ = 0;
+  bool coolant_read_ = false;
+  double coolant_C_ = 0.0;     ///< what the filter takes for a coolant before its first reading
+  bool sensor_fused_ = false;  ///< a winding reading is fused (its σ given)
   double first_winding_C_ = std::numeric_limits<double>::quiet_NaN();  ///< the first sample's reading
 };
 

@@ -38,7 +38,8 @@ enum class SampleField : std::uint8_t {
   kTWindingC,
   kTMagnetC,
   kTDriveC,
-  kTSampleS,  // the drive's own time of the sample (SampleClock)
+  kTCoolantC,  // the coolant's: the thermal network's boundary (docs/thermal.md)
+  kTSampleS,   // the drive's own time of the sample (SampleClock)
   kCount
 };
 inline constexpr std::size_t kSampleFieldCount = static_cast<std::size_t>(SampleField::kCount);

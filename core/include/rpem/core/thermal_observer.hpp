@@ -38,8 +38,10 @@ struct ThermalObserverConfig {
 
 /// What the thermal block needs of a sample besides its Estimate.
 struct ThermalSample {
-  double dt_s = 0.0;                                            ///< the time the sample stands for (since the previous one)
-  double coolant_C = std::numeric_limits<double>::quiet_NaN();  ///< measured; NaN: the configured one
+  double dt_s = 0.0;  ///< the time the sample stands for (since the previous one)
+  /// Measured; NaN: none with this sample (a log's empty cell, a CAN sample whose coolant frame did not come this
+  /// time): the newest earlier reading holds, and before the first one the configured coolant stands in.
+  double coolant_C = std::numeric_limits<double>::quiet_NaN();
   double winding_sensor_C = std::numeric_limits<double>::quiet_NaN();  ///< NaN: none
 };
 
@@ -76,7 +78,7 @@ struct ThermalStepData {
 
 class ThermalObserver {
  public:
-  /// `coolant_C`: the temperature used where a sample carries none.
+  /// `coolant_C`: the temperature used until a sample carries a reading (ThermalSample::coolant_C).
   ThermalObserver(const ThermalObserverConfig& config, const PerUnitBase& base, const MachineSi& machine,
                   const LossBase& loss_base, double coolant_C) noexcept;
 
@@ -102,6 +104,7 @@ class ThermalObserver {
   MachineSi machine_;
   LossBase loss_base_;
   double coolant_C_;
+  double measured_coolant_C_ = std::numeric_limits<double>::quiet_NaN();  ///< the newest reading; NaN: none yet
   LossAccumulator losses_;
   static constexpr int kMaxBatch = 32;
   Vec2 eps_mean_ = Vec2::Zero();   ///< ε̄, per sample

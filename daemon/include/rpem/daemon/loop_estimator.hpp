@@ -23,6 +23,7 @@ struct SampleSummary {
   double u_dc_V = 0.0;
   double t_winding_sensor_C = 0.0;  ///< a drive's own sensors (NaN: not reported)
   double t_drive_sensor_C = 0.0;
+  double t_coolant_sensor_C = 0.0;
 };
 
 /// One of the estimators `E`, each a core::SampleEstimator, the k-th stepping a SourceSample's k-th
