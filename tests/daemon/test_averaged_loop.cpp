@@ -208,6 +208,15 @@ TEST(AveragedLoop, MeasurementsCarryTheDrivesSensorsAndNoAngle) {
   EXPECT_EQ(m.sample_time_us, s.t_ns / 1000);
 }
 
+/// An AveragedRig's configuration change: the paper machine's network (support/paper_thermal.hpp) at `coolant_C`, active.
+std::function<void(DaemonConfig&)> with_network(double coolant_C) {
+  return [coolant_C](DaemonConfig& c) {
+    c.live.thermal = test::paper_thermal_fusion();
+    c.live.thermal.coolant_C = coolant_C;
+    c.live.thermal_active = true;
+  };
+}
+
 // A drive's winding sensor (a VESC's temp_motor, a signal map's T_winding) reaches the loop's thermal fusion
 // (docs/thermal.md, "In rpemd"): a machine 35 K above its coolant at rpemd's start is found unsoaked by the first
 // reading and the winding follows the sensor, observed in every filter step; when the sensor stops reporting (a
@@ -215,11 +224,7 @@ TEST(AveragedLoop, MeasurementsCarryTheDrivesSensorsAndNoAngle) {
 // adapt, so the sensor is the winding's only observation.
 TEST(AveragedLoop, TheDrivesWindingSensorIsFusedAndItsSilenceIsPredicted) {
   constexpr double kCoolant_C = 40.0, kSensor_C = 75.0;
-  AveragedRig rig(200.0, 1.0, false, [&](DaemonConfig& c) {
-    c.live.thermal = test::paper_thermal_fusion();
-    c.live.thermal.coolant_C = kCoolant_C;
-    c.live.thermal_active = true;
-  });
+  AveragedRig rig(200.0, 1.0, false, with_network(kCoolant_C));
   const double sensor_sigma_K = rig.config.live.thermal.winding_sensor_sigma_K;
   ASSERT_GT(sensor_sigma_K, 0.0);  // the network's settings fuse a winding sensor
   rig.t_winding_C = kSensor_C;
@@ -253,11 +258,7 @@ TEST(AveragedLoop, TheDrivesWindingSensorIsFusedAndItsSilenceIsPredicted) {
 // reading and 49/50 of the configured 40 °C (39.65 °C).
 TEST(AveragedLoop, TheDrivesCoolantSensorIsTheNetworksBoundaryAndHolds) {
   constexpr double kConfigured_C = 40.0, kMeasured_C = 22.5;
-  AveragedRig rig(200.0, 1.0, false, [&](DaemonConfig& c) {
-    c.live.thermal = test::paper_thermal_fusion();
-    c.live.thermal.coolant_C = kConfigured_C;
-    c.live.thermal_active = true;
-  });
+  AveragedRig rig(200.0, 1.0, false, with_network(kConfigured_C));
   rig.run(3.0);  // no coolant reading yet: the configured one
   rig.drain();
   ASSERT_TRUE(rig.estimate.thermal_active);
