@@ -20,7 +20,7 @@ std::vector<can::CanFrame> frames(can::BusMode mode, int samples) {
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   can::TelemetryEncoder enc(mode, 3);
   std::vector<can::CanFrame> out;
-  std::array<can::CanFrame, 5> buf;
+  std::array<can::CanFrame, can::TelemetryEncoder::kMaxFramesPerAdd> buf;
   for (int k = 0; k < samples; ++k) {
     core::DriveSample s;
     s.t_ns = k * 125'000LL;

@@ -2,8 +2,8 @@
 //   [id low byte][id high byte][flags: bit0 FD, bit1 error, bit2 fix CRC, bits 3–7 r][len][len bytes of data]
 // "fix CRC" re-protects the frame with its correct Data ID, so mutations reach past the E2E check; the
 // frame is received r²·20 ms after the previous one (up to 19 s: past a classic frame's 16.8 s clock wrap).
-// The decoder must never crash, never deliver a non-finite value, never deliver a sample whose time
-// does not increase, and keep its counters consistent.
+// The decoder must never crash, never deliver a non-finite value (a temperature: NaN for no reading, else within
+// the protocol's range), never deliver a sample whose time does not increase, and keep its counters consistent.
 #include <array>
 #include <cmath>
 #include <cstddef>
@@ -43,6 +43,10 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       if (!s.i_A.allFinite() || !s.u_V.allFinite() || !std::isfinite(s.theta_el_rad) || !std::isfinite(s.omega_el_rad_s) ||
           !std::isfinite(s.u_dc_V)) {
         std::abort();
+      }
+      for (double t_C : {s.t_winding_C, s.t_coolant_C}) {
+        const double limit_C = (rpem::can::protocol::kSaturatedI16 - 1) * rpem::can::protocol::kTemperatureLsb_C;
+        if (!std::isnan(t_C) && !(std::abs(t_C) <= limit_C + 1e-9)) std::abort();
       }
       if (s.t_ns <= last_t) std::abort();
       last_t = s.t_ns;

@@ -1,5 +1,7 @@
 #include "rpem/can/decoder.hpp"
 
+#include <utility>
+
 #include "rpem/can/e2e.hpp"
 #include "rpem/can/protocol.hpp"
 
@@ -61,7 +63,9 @@ void TelemetryDecoder::resynchronize() noexcept {
   gap_pending_ = true;
   has_last_fd_counter_ = false;
   has_last_classic_counter_ = false;
+  has_last_temperature_counter_ = false;
   classic_mask_ = 0;
+  winding_C_ = coolant_C_ = std::numeric_limits<double>::quiet_NaN();
 }
 
 TelemetryDecoder::Sequence TelemetryDecoder::check_sequence(std::uint8_t counter, bool& has_last,
@@ -106,6 +110,8 @@ bool TelemetryDecoder::accept(core::DriveSample& s) noexcept {
   }
   has_time_ = true;
   last_time_us_ = t_us;
+  s.t_winding_C = std::exchange(winding_C_, std::numeric_limits<double>::quiet_NaN());
+  s.t_coolant_C = std::exchange(coolant_C_, std::numeric_limits<double>::quiet_NaN());
   s.gap_before = gap_pending_;
   if (gap_pending_) ++counters_.gaps;
   gap_pending_ = false;
@@ -122,8 +128,51 @@ std::size_t TelemetryDecoder::decode(const CanFrame& f, std::int64_t rx_ns, std:
   }
   if (f.id == p::kFdId) return decode_fd(f, rx_ns, out);
   if (f.id >= p::kClassicFirstId && f.id < p::kClassicFirstId + p::kClassicFrames) return decode_classic(f, rx_ns, out);
+  if (f.id == p::kTemperatureId) {
+    decode_temperatures(f);
+    return 0;
+  }
   ++counters_.unknown_id;
   return 0;
+}
+
+void TelemetryDecoder::decode_temperatures(const CanFrame& f) noexcept {
+  if (f.fd || f.len != p::kClassicLength) {
+    ++counters_.wrong_dlc;
+    return;
+  }
+  if (!e2e_check(f, p::data_id(f.id))) {  // a temperature is no sample: a bad one leaves the samples' stream whole
+    ++counters_.crc_error;
+    return;
+  }
+  switch (check_sequence(e2e_counter(f), has_last_temperature_counter_, last_temperature_counter_)) {
+    case Sequence::kDuplicate:
+      ++counters_.duplicated;
+      return;
+    case Sequence::kReordered:
+      ++counters_.reordered;
+      return;
+    case Sequence::kFirst:
+    case Sequence::kNext:
+    case Sequence::kLost:  // counted; the readings stand on their own
+      break;
+  }
+  // The no-valid-value code is a sensor the drive has not (or has no reading of): NaN, nothing counted.
+  auto reading = [&](int at, double held) {
+    const std::int16_t raw = p::get_i16(f, at);
+    switch (check(raw)) {
+      case Value::kOk:
+        return raw * p::kTemperatureLsb_C;
+      case Value::kSaturated:
+        ++counters_.out_of_range;
+        return held;
+      case Value::kInvalid:
+        return held;
+    }
+    return held;
+  };
+  winding_C_ = reading(3, winding_C_);
+  coolant_C_ = reading(5, coolant_C_);
 }
 
 std::size_t TelemetryDecoder::decode_fd(const CanFrame& f, std::int64_t rx_ns, std::span<core::DriveSample> out) noexcept {

@@ -5,6 +5,7 @@
 
 #include "rpem/can/e2e.hpp"
 #include "rpem/can/protocol.hpp"
+#include "rpem/core/assert.hpp"
 #include "rpem/core/frames.hpp"
 
 namespace rpem::can {
@@ -36,9 +37,13 @@ TelemetryEncoder::Quantized TelemetryEncoder::quantize(const core::DriveSample& 
 }
 
 std::size_t TelemetryEncoder::add(const core::DriveSample& sample, std::uint8_t status, std::span<CanFrame> out) noexcept {
+  RPEM_ASSERT(out.size() >= kMaxFramesPerAdd, "room for every frame one sample can complete");
   const Quantized q = quantize(sample);
   if (!std::isfinite(sample.theta_el_rad)) status |= p::status::kAngleInvalid;
-  if (mode_ == BusMode::kClassic) return emit_classic(q, status, out);
+  if (mode_ == BusMode::kClassic) {
+    const std::size_t n = emit_classic(q, status, out);
+    return n + emit_temperatures(sample, out.subspan(n));
+  }
 
   std::size_t n = 0;
   // A frame holds equally spaced samples only; a sample off the grid closes the frame.
@@ -54,7 +59,22 @@ std::size_t TelemetryEncoder::add(const core::DriveSample& sample, std::uint8_t 
   status_ |= status;
   pending_[static_cast<std::size_t>(n_pending_++)] = q;
   if (n_pending_ == samples_per_frame_) n += emit_fd(out.subspan(n));
-  return n;
+  return n + emit_temperatures(sample, out.subspan(n));
+}
+
+std::size_t TelemetryEncoder::emit_temperatures(const core::DriveSample& s, std::span<CanFrame> out) noexcept {
+  if (std::isnan(s.t_winding_C) && std::isnan(s.t_coolant_C)) return 0;
+  if (sent_temperatures_ && s.t_ns - temperatures_t_ns_ < p::kTemperaturePeriod_ns) return 0;
+  sent_temperatures_ = true;
+  temperatures_t_ns_ = s.t_ns;
+  CanFrame& f = out[0];
+  f = CanFrame{};
+  f.id = p::kTemperatureId;
+  f.len = p::kClassicLength;
+  p::put_i16(f, 3, p::to_i16(s.t_winding_C, p::kTemperatureLsb_C));
+  p::put_i16(f, 5, p::to_i16(s.t_coolant_C, p::kTemperatureLsb_C));
+  e2e_protect(f, p::data_id(f.id), temperature_counter_++);
+  return 1;
 }
 
 std::size_t TelemetryEncoder::flush(std::span<CanFrame> out) noexcept {

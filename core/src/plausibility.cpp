@@ -35,7 +35,8 @@ PlausibleMagnitudes machine_plausible(const RatedData& rated) noexcept {
 
 bool within(const DriveSample& s, const PlausibleMagnitudes& m) noexcept {
   return below(s.theta_el_rad, m.angle_rad) && below(s.omega_el_rad_s, m.speed_rad_s) && below(s.u_dc_V, m.dc_link_V) &&
-         all_below(s.u_V, m.voltage_V) && all_below(s.i_A, m.current_A);
+         all_below(s.u_V, m.voltage_V) && all_below(s.i_A, m.current_A) && temperature_within(s.t_winding_C, m) &&
+         temperature_within(s.t_coolant_C, m);
 }
 
 bool within(const AveragedSample& s, const PlausibleMagnitudes& m) noexcept {

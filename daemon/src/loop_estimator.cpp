@@ -43,8 +43,8 @@ bool LoopEstimator::step(const SourceSample& sample, core::Estimate& estimate, d
     const core::DriveSample& s = *std::get_if<core::DriveSample>(&sample);
     estimate = phase->step(s);
     dt_s = nominal_period_s_;
-    constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-    summary = {s.t_ns, s.rx_ns, s.theta_el_rad, s.omega_el_rad_s, s.u_dc_V, kNaN, kNaN, kNaN};
+    constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();  // a phase sample carries no drive sensor
+    summary = {s.t_ns, s.rx_ns, s.theta_el_rad, s.omega_el_rad_s, s.u_dc_V, s.t_winding_C, kNaN, s.t_coolant_C};
     return true;
   }
   const core::AveragedSample& a = *std::get_if<core::AveragedSample>(&sample);

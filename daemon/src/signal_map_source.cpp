@@ -90,6 +90,8 @@ bool SignalMapSampler::on_frame(const can::CanFrame& f, std::int64_t rx_ns, Sour
   s.current_frame = core::Frame::kDq;
   s.i_A = core::Vec3(a.i_dq_A[0], a.i_dq_A[1], 0.0);
   s.gap_before = a.gap_before;
+  s.t_winding_C = a.t_winding_C;
+  s.t_coolant_C = a.t_coolant_C;
   out = s;
   return true;
 }

@@ -97,7 +97,8 @@ void run_instantaneous(const rpem::io::LogSource& source, const rpem::io::Machin
     check(x.voltage_frame == (layout.voltage_abc ? core::Frame::kAbc : core::Frame::kDq));
     check(x.current_frame == (layout.current_abc ? core::Frame::kAbc : core::Frame::kDq));
     for (int k = 0; k < 3; ++k) check(within(x.u_V[k], limits.voltage_V) && within(x.i_A[k], limits.current_A));
-    check(absent_or_plausible_C(row.t_magnet_C.value_or(std::nan("")), limits));
+    for (double t : {row.t_magnet_C.value_or(std::nan("")), x.t_winding_C, x.t_coolant_C})
+      check(absent_or_plausible_C(t, limits));
     check(fuzz::estimate_in_bounds(estimator.step(x), config.estimator));
   }
   check(rows > 0);  // a log without samples must have thrown

@@ -348,9 +348,9 @@ DriveLogRow to_drive_log_row(const core::AveragedSample& s) {
   r.sample.current_frame = core::Frame::kDq;
   r.sample.i_A = {s.i_dq_A[0], s.i_dq_A[1], 0.0};
   r.sample.gap_before = s.gap_before;
-  if (!std::isnan(s.t_winding_C)) r.t_winding_C = s.t_winding_C;
+  r.sample.t_winding_C = s.t_winding_C;
   if (!std::isnan(s.t_magnet_C)) r.t_magnet_C = s.t_magnet_C;
-  if (!std::isnan(s.t_coolant_C)) r.t_coolant_C = s.t_coolant_C;
+  r.sample.t_coolant_C = s.t_coolant_C;
   return r;
 }
 

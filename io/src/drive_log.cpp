@@ -73,9 +73,10 @@ bool DriveLogReader::next(DriveLogRow& row) {
   auto optional = [&](bool present, Quantity q) {
     return present && !std::isnan(r[q]) ? std::optional(r[q]) : std::nullopt;
   };
-  row.t_winding_C = optional(layout_.t_winding, Quantity::kTWinding);
+  constexpr double kNoReading = std::numeric_limits<double>::quiet_NaN();
+  s.t_winding_C = layout_.t_winding ? r[Quantity::kTWinding] : kNoReading;
+  s.t_coolant_C = layout_.t_coolant ? r[Quantity::kTCoolant] : kNoReading;
   row.t_magnet_C = optional(layout_.t_magnet, Quantity::kTMagnet);
-  row.t_coolant_C = optional(layout_.t_coolant, Quantity::kTCoolant);
   row.torque_cmd_Nm = optional(layout_.torque_cmd, Quantity::kTorqueCmd);
   return true;
 }
@@ -135,9 +136,9 @@ void DriveLogWriter::write(const DriveLogRow& row) {
     const core::Vec2 i = to_dq(s.current_frame, s.i_A);
     for (int k = 0; k < 2; ++k) append_number(line_ += ',', i[k]);
   }
-  if (layout_.t_winding) append_number(line_ += ',', row.t_winding_C.value_or(std::nan("")));
+  if (layout_.t_winding) append_number(line_ += ',', s.t_winding_C);
   if (layout_.t_magnet) append_number(line_ += ',', row.t_magnet_C.value_or(std::nan("")));
-  if (layout_.t_coolant) append_number(line_ += ',', row.t_coolant_C.value_or(std::nan("")));
+  if (layout_.t_coolant) append_number(line_ += ',', s.t_coolant_C);
   if (layout_.torque_cmd) append_number(line_ += ',', row.torque_cmd_Nm.value_or(std::nan("")));
   line_ += '\n';
   out_ << line_;

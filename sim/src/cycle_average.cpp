@@ -38,9 +38,9 @@ std::optional<ControlCycle> CycleExtractor::add(const io::DriveLogRow& row) noex
     c.omega_el_rad_s = a.omega_el_rad_s;
     c.theta_el_rad = a.theta_el_rad;
     c.u_dc_V = a.u_dc_V;
-    c.t_winding_C = previous_->t_winding_C.value_or(std::nan(""));
+    c.t_winding_C = previous_->sample.t_winding_C;
     c.t_magnet_C = previous_->t_magnet_C.value_or(std::nan(""));
-    c.t_coolant_C = previous_->t_coolant_C.value_or(std::nan(""));
+    c.t_coolant_C = previous_->sample.t_coolant_C;
     out = c;
   }
   previous_ = row;

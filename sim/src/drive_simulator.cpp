@@ -189,10 +189,11 @@ void DriveSimulator::fill_row(std::int64_t t_ns, io::DriveLogRow& row) const noe
   s.current_frame = core::Frame::kAbc;
   s.i_A = i_meas_A_;
   s.gap_before = false;
-  row.t_winding_C = scenario_.log.temperatures ? std::optional(t_winding_C_) : std::nullopt;
+  constexpr double kNoReading = std::numeric_limits<double>::quiet_NaN();
+  s.t_winding_C = scenario_.log.temperatures ? t_winding_C_ : kNoReading;
   row.t_magnet_C = scenario_.log.temperatures ? std::optional(t_magnet_C_) : std::nullopt;
   const bool coolant = scenario_.log.temperatures && scenario_.thermal_plant.enabled;
-  row.t_coolant_C = coolant ? std::optional(thermal_.coolant_C()) : std::nullopt;
+  s.t_coolant_C = coolant ? thermal_.coolant_C() : kNoReading;
   row.torque_cmd_Nm = scenario_.log.torque_cmd ? std::optional(torque_cmd_Nm_) : std::nullopt;
 }
 

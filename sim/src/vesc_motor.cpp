@@ -140,7 +140,7 @@ can::vesc::Status VescMotor::status(int number) const noexcept {
   s.watt_hours_Wh = watt_hours_;
   s.watt_hours_charged_Wh = watt_hours_charged_;
   s.temp_fet_C = settings_.temp_fet_C;
-  s.temp_motor_C = row_.t_winding_C.value_or(settings_.temp_fet_C);
+  s.temp_motor_C = std::isnan(row_.sample.t_winding_C) ? settings_.temp_fet_C : row_.sample.t_winding_C;
   s.current_in_A = last_input_current_A_;
   s.pid_pos_deg = std::remainder(row_.sample.theta_el_rad, 2.0 * core::kPi) * 180.0 / core::kPi;
   s.tachometer = static_cast<std::int32_t>(tacho_steps_);

@@ -42,9 +42,9 @@ LogData model_log(double psi_scale, bool standstill_first = true) {
   std::vector<io::DriveLogRow> rows;
   std::int64_t t_ns = 0;
   gen.i_ref_pu = core::mtpa_reference(gen.plant, 0.4);
-  for (int k = 0; k < (standstill_first ? 8000 : 0); ++k) rows.push_back({gen.next_si(base, t_ns), {}, {}, {}, {}});
+  for (int k = 0; k < (standstill_first ? 8000 : 0); ++k) rows.push_back({gen.next_si(base, t_ns), {}, {}});
   gen.n_pu = 0.4;
-  for (int k = 0; k < 16000; ++k) rows.push_back({gen.next_si(base, t_ns), {}, {}, {}, {}});
+  for (int k = 0; k < 16000; ++k) rows.push_back({gen.next_si(base, t_ns), {}, {}});
   return prepare_log(std::move(rows), io::DriveLogLayout{}, test::paper_machine_si(), {});
 }
 

@@ -35,7 +35,7 @@ void write_session(const std::string& path, int rows, double i_d_A, double i_q_A
     r.sample.u_dc_V = 400.0;
     r.sample.i_A = core::Vec3(i_d_A, i_q_A, 0.0);
     r.sample.u_V = core::Vec3(10.0, 200.0, 0.0);
-    if (winding) r.t_winding_C = 40.0;
+    if (winding) r.sample.t_winding_C = 40.0;
     writer.write(r);
   }
   writer.flush();

@@ -26,7 +26,7 @@ inline core::DriveSample random_sample(std::mt19937_64& rng, std::int64_t t_ns) 
 /// Encodes the samples (and flushes); returns the frames in send order.
 inline std::vector<can::CanFrame> encode_all(can::TelemetryEncoder& enc, const std::vector<core::DriveSample>& samples) {
   std::vector<can::CanFrame> frames;
-  std::array<can::CanFrame, 5> buf;
+  std::array<can::CanFrame, can::TelemetryEncoder::kMaxFramesPerAdd> buf;
   for (const auto& s : samples) {
     const std::size_t n = enc.add(s, 0, buf);
     frames.insert(frames.end(), buf.begin(), buf.begin() + static_cast<long>(n));

@@ -63,7 +63,7 @@ TEST(Codec, FdFrameLayoutMatchesTheDocumentedOffsets) {
   s.theta_el_rad = core::kPi / 2;
   s.omega_el_rad_s = 100.0;
   TelemetryEncoder enc(BusMode::kFd, 1);
-  std::array<CanFrame, 5> buf;
+  std::array<CanFrame, TelemetryEncoder::kMaxFramesPerAdd> buf;
   ASSERT_EQ(enc.add(s, p::status::kPwmEnabled, buf), 1U);
   const CanFrame& f = buf[0];
   EXPECT_EQ(f.id, 0x100U);

@@ -25,10 +25,14 @@
 namespace rpem::daemon {
 namespace {
 
+/// The drive's temperature sensors on a phase sample (the k-th of the run).
+using Sensors = std::function<void(core::DriveSample&, int k)>;
+
 /// Runs `seconds` of the model's phase samples at 8 kHz (n = 0.4 pu: ψm adapts) through a loop; the last estimate.
-/// `before` sees the loop before it runs (as rpemd's start-up does).
+/// `before` sees the loop before it runs (as rpemd's start-up does); `sensors` gives the samples' temperatures.
 EstimateReport run_loop(
-    const DaemonConfig& config, int seconds, const std::function<void(LoopThread&)>& before = [](LoopThread&) {}) {
+    const DaemonConfig& config, int seconds, const std::function<void(LoopThread&)>& before = [](LoopThread&) {},
+    const Sensors& sensors = [](core::DriveSample&, int) {}) {
   auto [input, commands, output, ends] = test::loop_queues(4096, 16, 1 << 12);
   LoopThread loop(config, std::move(ends));
   before(loop);
@@ -42,7 +46,11 @@ EstimateReport run_loop(
   EstimateReport last;
   Report r;
   for (int period = 0; period < seconds * 1000; ++period) {
-    for (int s = 0; s < 8; ++s) (void)input.push(gen.next_si(base, t_ns));
+    for (int s = 0; s < 8; ++s) {
+      core::DriveSample sample = gen.next_si(base, t_ns);
+      sensors(sample, period * 8 + s);
+      (void)input.push(sample);
+    }
     now += 1'000'000;
     loop.process(now);
     while (output.pop(r)) {
@@ -86,6 +94,23 @@ TEST(LoopThermal, WithANetworkTheFusedTemperaturesAreReported) {
   }
   EXPECT_GE(e.t_magnet_observed_age_s, 0.0);  // observed at least once
   EXPECT_LT(e.t_magnet_observed_age_s, 10.0);
+}
+
+// A phase sample carries the drive's sensors (the native protocol's temperature frame, a signal map of phases, the
+// simulated drive): its coolant is the network's boundary, held between readings (here one sample in 800: 10 Hz
+// of an 8 kHz stream), as an averaged sample's is (AveragedLoop.TheDrivesCoolantSensorIsTheNetworksBoundaryAndHolds).
+TEST(LoopThermal, APhaseSamplesCoolantReadingIsTheNetworksBoundary) {
+  constexpr double kConfigured_C = 40.0, kMeasured_C = 22.5;
+  ASSERT_EQ(with_network().live.thermal.coolant_C, kConfigured_C);
+  const EstimateReport without = run_loop(with_network(), 3);
+  ASSERT_TRUE(without.thermal_active);
+  EXPECT_DOUBLE_EQ(without.thermal.load.coolant_C, kConfigured_C);
+  const EstimateReport with = run_loop(
+      with_network(), 3, [](LoopThread&) {},
+      [](core::DriveSample& s, int k) {
+        if (k % 800 == 0) s.t_coolant_C = kMeasured_C;
+      });
+  EXPECT_NEAR(with.thermal.load.coolant_C, kMeasured_C, 1e-9);
 }
 
 // A restart (docs/thermal.md, "A restart"): the state the loop reports goes through the state file and starts

@@ -1,5 +1,6 @@
 // Writes the seed corpus for the decoder fuzzer: valid FD and classic streams (with and without
-// defects) in the fuzzer's input format. Run once; the files are committed under can/fuzz/corpus.
+// defects, each with a temperature frame) in the fuzzer's input format. Run once; the files are
+// committed under can/fuzz/corpus.
 #include <algorithm>
 #include <fstream>
 #include <random>
@@ -27,7 +28,7 @@ int main(int argc, char** argv) {
   for (int mode = 0; mode < 2; ++mode) {
     can::TelemetryEncoder enc(mode == 0 ? can::BusMode::kFd : can::BusMode::kClassic, 3);
     std::vector<can::CanFrame> frames;
-    std::array<can::CanFrame, 5> buf;
+    std::array<can::CanFrame, can::TelemetryEncoder::kMaxFramesPerAdd> buf;
     for (int k = 0; k < 12; ++k) {
       core::DriveSample s;
       s.t_ns = 1'000'000 + k * 125'000LL;
@@ -36,7 +37,9 @@ int main(int argc, char** argv) {
       s.u_dc_V = 220.0;
       s.u_V = {100 * u(rng), 100 * u(rng), 100 * u(rng)};
       s.i_A = {5 * u(rng), 5 * u(rng), 5 * u(rng)};
-      if (k == 7) s.i_A[1] = 50.0;  // a saturated value
+      if (k == 7) s.i_A[1] = 50.0;     // a saturated value
+      s.t_winding_C = 60.0 + 0.1 * k;  // the first sample sends a temperature frame (ID 0x118)
+      s.t_coolant_C = 40.0;
       const std::size_t n = enc.add(s, 1, buf);
       frames.insert(frames.end(), buf.begin(), buf.begin() + static_cast<long>(n));
     }

@@ -39,7 +39,7 @@ TEST(DriveLog, ReadsAbcLogWithExtraAndOptionalColumns) {
   EXPECT_EQ(rows[0].sample.voltage_frame, core::Frame::kAbc);
   EXPECT_DOUBLE_EQ(rows[1].sample.u_V[0], 11.0);
   EXPECT_DOUBLE_EQ(rows[1].sample.i_A[2], -0.55);
-  EXPECT_EQ(rows[0].t_winding_C, 25.5);
+  EXPECT_EQ(rows[0].sample.t_winding_C, 25.5);
   EXPECT_FALSE(rows[0].t_magnet_C.has_value());
   EXPECT_EQ(rows[0].torque_cmd_Nm, 3.5);
 }

@@ -134,8 +134,7 @@ TEST(ThermalPlantInTheDrive, TheWindingTakesTheCopperLossTheTruthShows) {
   while (d.next(row, truth)) {
     heat_J += 1.5 * truth.parameters.r_s_Ohm * truth.i_dq_A.squaredNorm() * d.scenario().sample_period_s;
     EXPECT_DOUBLE_EQ(truth.parameters.r_s_Ohm, 2.25 * d.scenario().thermal.r_s.factor(truth.t_winding_C));
-    ASSERT_TRUE(row.t_coolant_C.has_value());
-    EXPECT_DOUBLE_EQ(*row.t_coolant_C, 30.0);
+    EXPECT_DOUBLE_EQ(row.sample.t_coolant_C, 30.0);
   }
   const ThermalPlant& plant = *d.thermal_plant();
   const double rise_K = plant.winding_C() - 30.0;

@@ -107,7 +107,7 @@ TEST(VescEmulator, RepliesCarryTheAveragesOfEveryCycleSinceThePreviousRead) {
     // DC link and winding temperature.
     EXPECT_NEAR(v.erpm, row.sample.omega_el_rad_s * 60.0 / (2.0 * std::numbers::pi), 1.0);
     EXPECT_NEAR(v.v_in_V, row.sample.u_dc_V, 0.1);
-    EXPECT_NEAR(v.temp_motor_C, row.t_winding_C.value(), 0.1);
+    EXPECT_NEAR(v.temp_motor_C, row.sample.t_winding_C, 0.1);
     EXPECT_NEAR(v.temp_fet_C, 40.0, 1e-9);
     ++reads;
   }

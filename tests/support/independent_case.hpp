@@ -78,7 +78,7 @@ inline std::vector<io::DriveLogRow> rows_of(const indep::Result& r) {
     s.voltage_frame = s.current_frame = core::Frame::kAbc;
     s.u_V = core::Vec3(l.u_abc_V[0], l.u_abc_V[1], l.u_abc_V[2]);
     s.i_A = core::Vec3(l.i_abc_A[0], l.i_abc_A[1], l.i_abc_A[2]);
-    row.t_winding_C = l.T_winding_C;
+    s.t_winding_C = l.T_winding_C;
     row.t_magnet_C = l.T_magnet_C;
     rows.push_back(row);
   }

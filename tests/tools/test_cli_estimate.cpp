@@ -53,9 +53,9 @@ TEST(CliEstimate, RecoversPsiMAndRsFromADriveLog) {
     const int seconds_rs = 25, seconds_psi = 8;
     gen.n_pu = 0.0;
     gen.i_ref_pu = core::mtpa_reference(gen.plant, 0.4);
-    for (int k = 0; k < seconds_rs * 8000; ++k) w.write({gen.next_si(base, t_ns), {}, {}, {}, {}});
+    for (int k = 0; k < seconds_rs * 8000; ++k) w.write({gen.next_si(base, t_ns), {}, {}});
     gen.n_pu = 0.4;
-    for (int k = 0; k < seconds_psi * 8000; ++k) w.write({gen.next_si(base, t_ns), {}, {}, {}, {}});
+    for (int k = 0; k < seconds_psi * 8000; ++k) w.write({gen.next_si(base, t_ns), {}, {}});
   }
   const std::string cmd = test::binary_dir() + "/tools/rpem estimate --log " + log.path() + " --config " +
                           test::source_dir() + "/config/paper-ipmsm.yaml --out " + est.path() + " --every 10";
@@ -83,7 +83,7 @@ TEST(CliEstimate, RateWritesOneEstimatePerPeriodOfTheLogsTime) {
     std::int64_t t_ns = 0;
     for (int k = 0; k < 16000; ++k) {
       if (k == 8000) t_ns += 250'000'000;
-      w.write({gen.next_si(base, t_ns), {}, {}, {}, {}});
+      w.write({gen.next_si(base, t_ns), {}, {}});
     }
   }
   const std::string rpem = test::binary_dir() + "/tools/rpem estimate --log " + log.path() + " --out " + est.path();

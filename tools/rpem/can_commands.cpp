@@ -100,7 +100,7 @@ int run_record(const RecordOptions& o) {
       const std::size_t got = decoder.decode(frames[f].frame, can::receive_time_ns(frames[f], received_ns), samples);
       if (got > 0) last_data = core::now_ns(CLOCK_MONOTONIC);
       for (std::size_t k = 0; k < got; ++k) {
-        writer.write({samples[k], {}, {}, {}, {}});
+        writer.write({samples[k], {}, {}});
         ++written;
       }
       if (o.latency && got > 0 && frames[f].kernel_rx_ns > 0) {

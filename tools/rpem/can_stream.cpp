@@ -93,7 +93,7 @@ void TelemetryStreamer::send(core::DriveSample sample, std::uint8_t status) {
       options_.rate > 0.0 ? static_cast<std::int64_t>(static_cast<double>(offset_ns) / options_.rate) : offset_ns;
   last_real_ns_ = start_real_ns_ + scheduled;
   if (options_.wall_timestamps) sample.t_ns = last_real_ns_;
-  std::array<can::CanFrame, 5> frames;
+  std::array<can::CanFrame, can::TelemetryEncoder::kMaxFramesPerAdd> frames;
   const std::size_t n = encoder_.add(sample, status, frames);
   // A frame leaves when its last sample is due (one wake-up per frame, not per sample).
   if (n > 0 && options_.rate > 0.0) {
@@ -116,7 +116,7 @@ std::string TelemetryStreamer::lateness_summary() const {
 }
 
 void TelemetryStreamer::finish() {
-  std::array<can::CanFrame, 5> frames;
+  std::array<can::CanFrame, can::TelemetryEncoder::kMaxFramesPerAdd> frames;
   const std::size_t n = encoder_.flush(frames);
   for (std::size_t k = 0; k < n; ++k) emit(frames[k]);
   if (candump_.is_open()) candump_.flush();

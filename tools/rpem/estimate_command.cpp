@@ -331,11 +331,10 @@ Tally run_instantaneous(const EstimateOptions& o, const std::string& log, const 
 
   io::DriveLogRow row;
   Tally tally;
-  constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
   Decimation decimation(o);
   while (reader.next(row)) {
     const core::Estimate e = estimator.step(row.sample);
-    thermal.step(e, row.sample.t_ns, row.t_coolant_C.value_or(kNaN), row.t_winding_C.value_or(kNaN));
+    thermal.step(e, row.sample.t_ns, row.sample.t_coolant_C, row.sample.t_winding_C);
     if (decimation.take(e.t_ns)) writer.write(e, estimator, thermal.estimate());
     tally.count(e);
     if ((tally.counts.samples & 0xFFF) == 0) progress.update(reader.bytes_read(), reader.bytes_total());

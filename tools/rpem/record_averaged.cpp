@@ -48,7 +48,7 @@ class NativeFeed final : public Feed {
     const std::size_t n = decoder_.decode(f.frame, rx_ns, samples_);
     bool got = false;
     for (std::size_t k = 0; k < n; ++k) {
-      if (const auto cycle = cycles_.add(io::DriveLogRow{samples_[k], {}, {}, {}, {}})) {
+      if (const auto cycle = cycles_.add(io::DriveLogRow{samples_[k], {}, {}})) {
         if (const auto w = windows_.add(*cycle)) {
           out = *w;
           got = true;  // windows are ≥ 0.5 ms, a frame carries ≤ 3 samples: at most one per frame

@@ -45,7 +45,7 @@ void SampleStore::push_back(const io::DriveLogRow& row) {
                                    s.i_A[0],
                                    s.i_A[1],
                                    s.i_A[2],
-                                   has_winding_ ? row.t_winding_C.value_or(kNaN) : 0.0,
+                                   has_winding_ ? row.sample.t_winding_C : 0.0,
                                    has_magnet_ ? row.t_magnet_C.value_or(kNaN) : 0.0};
   for (std::size_t c = 0; c < kColumns; ++c) staged_[c].push_back(values[c]);
   ++size_;

@@ -104,7 +104,7 @@ ThermalRecord record_thermal(const io::LogSource& source, const io::MachineConfi
   Recorder rec(r, machine, thermal, estimator.base());
   io::DriveLogRow row;
   while (reader.next(row)) {
-    rec.add(estimator.step(row.sample), row.sample.t_ns, row.t_coolant_C.value_or(kNaN), row.t_winding_C.value_or(kNaN));
+    rec.add(estimator.step(row.sample), row.sample.t_ns, row.sample.t_coolant_C, row.sample.t_winding_C);
   }
   r.read_as = source.path + " as " + source.format + io::describe(reader.reader().repairs());
   return r;

@@ -4,6 +4,7 @@
 // counted by kind; the next sample that passes carries gap_before so the estimator resynchronises.
 
 #include <cstdint>
+#include <limits>
 #include <span>
 
 #include "rpem/can/frame.hpp"
@@ -20,11 +21,11 @@ struct DecoderCounters {
   std::uint64_t wrong_dlc = 0;      ///< wrong length or FD/classic type for the ID, or bad n_samples
   std::uint64_t bad_version = 0;    ///< protocol version other than 1
   std::uint64_t crc_error = 0;      ///< E2E CRC mismatch
-  std::uint64_t frames_lost = 0;    ///< alive-counter jumps: frames (FD) or samples (classic) missing
+  std::uint64_t frames_lost = 0;    ///< alive-counter jumps: frames (FD, temperatures) or samples (classic) missing
   std::uint64_t duplicated = 0;     ///< same counter as the previous frame
   std::uint64_t reordered = 0;      ///< counter behind the previous one
   std::uint64_t stale = 0;          ///< drive time not after the last delivered sample
-  std::uint64_t out_of_range = 0;   ///< a saturated value
+  std::uint64_t out_of_range = 0;   ///< a saturated value (a saturated temperature: that reading dropped)
   std::uint64_t invalid_value = 0;  ///< a "no valid value" code, or an invalid angle
   std::uint64_t incomplete = 0;     ///< classic: a sample missing some of its five frames
   std::uint64_t gaps = 0;           ///< samples delivered with gap_before
@@ -33,7 +34,9 @@ struct DecoderCounters {
 class TelemetryDecoder {
  public:
   /// Decodes one frame, received at rx_ns (the host's clock: it tells how often the drive's time wrapped over
-  /// a silence), into up to three samples (SI, phase frames, at the drive's time). Returns how many.
+  /// a silence), into up to three samples (SI, phase frames, at the drive's time). Returns how many. A
+  /// temperature frame's readings go with the next sample delivered (its t_winding_C, t_coolant_C; NaN on the
+  /// others).
   [[nodiscard]] std::size_t decode(const CanFrame& frame, std::int64_t rx_ns, std::span<core::DriveSample> out) noexcept;
 
   /// Forgets the stream state (counters are kept): the next frame starts a new stream with a gap.
@@ -46,6 +49,7 @@ class TelemetryDecoder {
   [[nodiscard]] Sequence check_sequence(std::uint8_t counter, bool& has_last, std::uint8_t& last) noexcept;
   [[nodiscard]] std::size_t decode_fd(const CanFrame& f, std::int64_t rx_ns, std::span<core::DriveSample> out) noexcept;
   [[nodiscard]] std::size_t decode_classic(const CanFrame& f, std::int64_t rx_ns, std::span<core::DriveSample> out) noexcept;
+  void decode_temperatures(const CanFrame& f) noexcept;
   /// The drive's time [ns] of a frame's T_first (FD) or T_low (classic), or false when the clock says stale
   /// (its `samples` counted stale).
   [[nodiscard]] bool drive_time(SampleClock& clock, std::uint32_t t_us, std::int64_t rx_ns, int samples,
@@ -59,6 +63,10 @@ class TelemetryDecoder {
   std::uint8_t last_fd_counter_ = 0;
   bool has_last_classic_counter_ = false;
   std::uint8_t last_classic_counter_ = 0;
+  bool has_last_temperature_counter_ = false;
+  std::uint8_t last_temperature_counter_ = 0;
+  double winding_C_ = std::numeric_limits<double>::quiet_NaN();  ///< readings for the next delivered sample
+  double coolant_C_ = std::numeric_limits<double>::quiet_NaN();
   bool has_time_ = false;
   std::int64_t last_time_us_ = 0;                    ///< unwrapped drive time of the last delivered sample
   SampleClock fd_clock_{32, false, 1e-6, 0.0};       ///< T_first: 32 bits of µs

@@ -11,6 +11,10 @@
 // with CRC-16 · counter (= sample counter) and five payload bytes:
 //   0x110 i_a i_b status · 0x111 i_c ϑ_el · 0x112 u_a u_b · 0x113 u_c ω_el · 0x114 u_dc t[µs, low 24 bits]
 //
+// Temperatures (either bus), one classic 8-byte frame, ID 0x118, at the sensors' own slow rate:
+//   0–1 CRC-16 · 2 alive counter (its own) · 3–4 T_winding · 5–6 T_coolant [0.1 °C, i16] · 7 zero
+// The readings go with the next sample delivered after the frame.
+//
 // Little endian throughout. Reserved raw codes: i16 −32768 and u16 65535 mean "no valid value" (NaN);
 // i16 ±32767 means "saturated" (out of range). Data IDs for the E2E CRC: 0x5100 + (CAN ID − 0x100).
 
@@ -34,9 +38,15 @@ inline constexpr std::uint32_t kClassicFirstId = 0x110;
 inline constexpr int kClassicFrames = 5;
 inline constexpr std::uint8_t kClassicLength = 8;
 
+inline constexpr std::uint32_t kTemperatureId = 0x118;
+/// How often the encoder sends the temperatures a drive's samples carry: a thermal time constant is seconds
+/// or more (docs/thermal.md), so 10 Hz resolves it and costs the bus 0.14 % at 1 Mbit/s.
+inline constexpr std::int64_t kTemperaturePeriod_ns = 100'000'000;
+
 /// Every telemetry CAN ID: what a receiver's kernel filter lets through.
-inline constexpr std::array<std::uint32_t, 1 + kClassicFrames> kTelemetryIds = {
-    kFdId, kClassicFirstId, kClassicFirstId + 1, kClassicFirstId + 2, kClassicFirstId + 3, kClassicFirstId + 4};
+inline constexpr std::array<std::uint32_t, 2 + kClassicFrames> kTelemetryIds = {
+    kFdId,         kClassicFirstId, kClassicFirstId + 1, kClassicFirstId + 2, kClassicFirstId + 3, kClassicFirstId + 4,
+    kTemperatureId};
 
 [[nodiscard]] constexpr std::uint16_t data_id(std::uint32_t can_id) noexcept {
   return static_cast<std::uint16_t>(0x5100 + (can_id - kFdId));
@@ -48,6 +58,7 @@ inline constexpr double kVoltageLsb_V = 0.02;
 inline constexpr double kAngleLsb_rad = 2.0 * 3.14159265358979323846 / 65536.0;
 inline constexpr double kSpeedLsb_rad_s = 0.05;
 inline constexpr double kDcLinkLsb_V = 0.02;
+inline constexpr double kTemperatureLsb_C = 0.1;
 
 inline constexpr std::int16_t kInvalidI16 = INT16_MIN;
 inline constexpr std::int16_t kSaturatedI16 = INT16_MAX;

@@ -22,11 +22,10 @@
 
 namespace rpem::io {
 
+/// A row: the sample (with the winding and coolant sensors' readings, NaN for none) and what only a log carries.
 struct DriveLogRow {
   core::DriveSample sample;
-  std::optional<double> t_winding_C;
-  std::optional<double> t_magnet_C;
-  std::optional<double> t_coolant_C;
+  std::optional<double> t_magnet_C;  ///< a magnet sensor (a test bench's; validation only, never an input)
   std::optional<double> torque_cmd_Nm;
 };
 
