@@ -8,8 +8,8 @@
 #include <vector>
 
 #include "rpem/can/e2e.hpp"
-#include "rpem/core/clock.hpp"
 #include "rpem/can/protocol.hpp"
+#include "rpem/core/clock.hpp"
 #include "support_can.hpp"
 
 namespace rpem::can {
@@ -51,6 +51,13 @@ CanFrame temperature_frame(std::int16_t winding_raw, std::int16_t coolant_raw, s
   return f;
 }
 
+/// The FD frame of one random sample at 1 ms of drive time, from a fresh encoder.
+CanFrame one_sample(std::uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  TelemetryEncoder enc(BusMode::kFd, 1);
+  return test::encode_all(enc, {test::random_sample(rng, 1'000'000)}).at(0);
+}
+
 class TemperaturesOnEitherBus : public ::testing::TestWithParam<BusMode> {};
 
 // 0.35 s of samples: frames at 0, 0.1, 0.2 and 0.3 s of drive time (protocol::kTemperaturePeriod_ns), each
@@ -90,13 +97,10 @@ TEST_P(TemperaturesOnEitherBus, EveryTenthOfASecondTheReadingsGoWithTheNextSampl
 INSTANTIATE_TEST_SUITE_P(Bus, TemperaturesOnEitherBus, ::testing::Values(BusMode::kFd, BusMode::kClassic));
 
 TEST(Temperatures, AFrameBuiltFromTheDocumentedLayoutDecodes) {
-  std::mt19937_64 rng(3);
-  TelemetryEncoder enc(BusMode::kFd, 1);
-  const std::vector<CanFrame> sample = test::encode_all(enc, {test::random_sample(rng, 1'000'000)});
   TelemetryDecoder dec;
   std::array<core::DriveSample, 3> out;
   EXPECT_EQ(dec.decode(temperature_frame(812, -157, 0), 0, out), 0U);  // 81.2 °C, −15.7 °C
-  ASSERT_EQ(dec.decode(sample[0], 0, out), 1U);
+  ASSERT_EQ(dec.decode(one_sample(3), 0, out), 1U);
   EXPECT_NEAR(out[0].t_winding_C, 81.2, 1e-12);
   EXPECT_NEAR(out[0].t_coolant_C, -15.7, 1e-12);
 }
@@ -172,14 +176,11 @@ TEST(Temperatures, BadTemperatureFramesAreCountedAndLeaveTheSamplesWhole) {
 
 // resynchronize() forgets a reading not yet delivered: it belonged to the stream before the break.
 TEST(Temperatures, AResynchronisedDecoderForgetsAPendingReading) {
-  std::mt19937_64 rng(13);
-  TelemetryEncoder enc(BusMode::kFd, 1);
-  const std::vector<CanFrame> samples = test::encode_all(enc, {test::random_sample(rng, 1'000'000)});
   TelemetryDecoder dec;
   std::array<core::DriveSample, 3> out;
   EXPECT_EQ(dec.decode(temperature_frame(600, 300, 0), 0, out), 0U);
   dec.resynchronize();
-  ASSERT_EQ(dec.decode(samples[0], 0, out), 1U);
+  ASSERT_EQ(dec.decode(one_sample(13), 0, out), 1U);
   EXPECT_TRUE(std::isnan(out[0].t_winding_C));
   EXPECT_TRUE(std::isnan(out[0].t_coolant_C));
 }
