@@ -137,10 +137,18 @@ TEST(SupervisorLcm, DeratesOnVerifiedEstimatesFromRpemdAndTheAuthLibraryAndIgnor
   const std::string out = test::read_file(log.path());
   const std::vector<Line> lines = lines_of(out);
   // 1. rpemd's estimates, about ten a second: all accepted (the limit lines between are the output
-  // ageing, or first fresh).
+  // ageing, or first fresh) — but the last: rpemd's estimate as it stops (LoopThread::run) repeats the previous
+  // one's sample when no sample came between them (a host busy enough that the simulated drive's thread lagged,
+  // as in a fresh-clone run of 4f43035), and the gate refuses a sample it has seen as not newer.
+  std::size_t last_estimate = 0;
+  for (std::size_t k = 0; k < from_rpemd; ++k)
+    if (lines[k].what.rfind("limit", 0) != 0) last_estimate = k;
   int accepted = 0;
   for (std::size_t k = 0; k < from_rpemd; ++k) {
-    EXPECT_TRUE(lines[k].what == "accepted" || lines[k].what.rfind("limit", 0) == 0) << lines[k].what << "\n" << out;
+    const bool stopping_repeat = k == last_estimate && lines[k].what == "ignored (not newer (replayed or reordered))";
+    EXPECT_TRUE(lines[k].what == "accepted" || lines[k].what.rfind("limit", 0) == 0 || stopping_repeat)
+        << lines[k].what << "\n"
+        << out;
     accepted += lines[k].what == "accepted";
   }
   EXPECT_GE(accepted, 15) << out;
