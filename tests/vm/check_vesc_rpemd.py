@@ -13,7 +13,11 @@
   stale timeout rpemd chooses for it), no estimate is stale but in the silence and after the emulator stops; it
   times out only the polls nobody answered — those of the emulator's silence, which the emulator counts, and those
   sent before it listens and after it stops (a second at each end: tests/vm/vesc_rpemd.sh) — and takes no reply
-  as late (at most 1 % of them, for a VM that stalls a whole period).
+  as late (at most 1 % of them, for a VM that stalls a whole period). A reply the emulator itself sent later than
+  rpemd's reply timeout after the poll reached it (its histogram of reply delays; a VM under TCG on a busy host
+  stalls for 100 ms and more) cannot have come in time: its timeout, and its late arrival, are the VM's, and each is
+  allowed once more. A chain of timeouts behind one lost reply (the poller's fault this check exists for) would
+  still exceed that by hundreds.
 
   check_vesc_rpemd.py DIR NAME [--prompt-replies]
 """
@@ -87,7 +91,9 @@ def main():
     if not stolen or max(stolen) == 0:
         errors.append('the second poller was not counted')
     if '--prompt-replies' in sys.argv[3:]:
-        check_prompt_replies(emu, text, est, report, errors)
+        config = open('%s/%s_config.yaml' % (d, name)).read()  # the configuration rpemd ran (vesc_rpemd.sh)
+        timeout_s = float(re.search(r'reply_timeout_s: *([0-9.eE+-]+)', config).group(1))
+        check_prompt_replies(emu, text, est, timeout_s, report, errors)
     print('check_vesc_rpemd %s: %d estimates; %s' % (name, len(est), '; '.join(report)))
     if errors:
         print('check_vesc_rpemd %s: FAILED\n  %s' % (name, '\n  '.join(errors)))
@@ -95,7 +101,17 @@ def main():
     print('check_vesc_rpemd %s: passed' % name)
 
 
-def check_prompt_replies(emu, text, est, report, errors):
+def replies_sent_later_than(emu, timeout_s):
+    """Replies the emulator sent later than timeout_s after their poll's arrival: its histogram's bins that begin
+    at or after timeout_s (vesc_emulator.cpp prints `<=EDGE ms COUNT, ..., later COUNT`)."""
+    line = re.search(r'replies sent after their poll.s arrival:(.*)', emu).group(1)
+    bins = [(float(edge), int(n)) for edge, n in re.findall(r'<=(\d+) ms (\d+)', line)]
+    later = int(re.search(r'later (\d+)', line).group(1))
+    lower_edges = [0.0] + [edge for edge, _ in bins[:-1]]
+    return later + sum(n for lower, (_, n) in zip(lower_edges, bins) if lower >= 1e3 * timeout_s)
+
+
+def check_prompt_replies(emu, text, est, timeout_s, report, errors):
     """Timeouts only where nobody answered; no chain of late replies after them; stale only where nobody answered."""
     stale = [e['te'] for e in est if e['state'] == 2 and not 45.0 <= e['te'] <= 49.0 and e['te'] < 69.5]
     if stale:
@@ -107,13 +123,15 @@ def check_prompt_replies(emu, text, est, report, errors):
         return
     polls, replies, timeouts, late = (int(x) for x in counters[-1])
     rate_hz = polls / 70.0  # the emulator's 70 s
-    allowed = unheard + 2 * math.ceil(rate_hz)  # the silence, and a second at each end
-    report.append('timeouts %d of %d polls (%d unheard while silent), late replies %d of %d'
-                  % (timeouts, polls, unheard, late, replies))
+    stalled = replies_sent_later_than(emu, timeout_s)
+    allowed = unheard + 2 * math.ceil(rate_hz) + stalled  # the silence, a second at each end, the VM's stalls
+    report.append('timeouts %d of %d polls (%d unheard while silent, %d replies the emulator sent later than %g s), '
+                  'late replies %d of %d' % (timeouts, polls, unheard, stalled, timeout_s, late, replies))
     if timeouts > allowed:
-        errors.append('%d timeouts, more than the %d polls nobody answered (silence, a second at each end)' % (timeouts, allowed))
-    if late > 0.01 * replies:
-        errors.append('%d of %d replies taken as late' % (late, replies))
+        errors.append('%d timeouts, more than the %d polls nobody answered in time (silence, a second at each end, '
+                      'replies the emulator sent late)' % (timeouts, allowed))
+    if late > stalled + 0.01 * replies:
+        errors.append('%d of %d replies taken as late, %d sent late by the emulator' % (late, replies, stalled))
 
 
 if __name__ == '__main__':

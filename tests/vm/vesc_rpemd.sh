@@ -10,6 +10,7 @@ run() {  # name poll-rate reply-timeout [default-stale: stale_timeout_s left out
   sed -e "s/poll_rate_Hz: .*/poll_rate_Hz: $2/" -e "s/reply_timeout_s: [0-9.e-]*/reply_timeout_s: $3/" \
     rpemd-vesc-vcan.yaml > "/tmp/$name.yaml"
   [ "${4:-}" = default-stale ] && sed -i "/stale_timeout_s/d" "/tmp/$name.yaml"
+  cp "/tmp/$name.yaml" "$out/${name}_config.yaml"   # the configuration rpemd ran, for the checks
   cp vesc-6374-outrunner.yaml /tmp/
   rm -rf /tmp/rpemd-vesc
   rpem sim --scenario vesc-6374.yaml --vesc vcan0 --controller-id 17 --truth "$out/${name}_truth.csv" \
