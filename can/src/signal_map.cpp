@@ -122,12 +122,14 @@ std::string check_layout(const SignalMap& map) {
   return {};
 }
 
+bool maps_field(const SignalMap& map, SampleField field) noexcept {
+  return std::any_of(map.frames.begin(), map.frames.end(), [&](const FrameSpec& f) {
+    return std::any_of(f.signals.begin(), f.signals.end(), [&](const SignalSpec& s) { return s.field == field; });
+  });
+}
+
 std::string missing_quantities(const SignalMap& map) {
-  std::array<bool, kSampleFieldCount> m{};
-  for (const FrameSpec& f : map.frames) {
-    for (const SignalSpec& s : f.signals) m[static_cast<std::size_t>(s.field)] = true;
-  }
-  auto has = [&](SampleField f) { return m[static_cast<std::size_t>(f)]; };
+  auto has = [&](SampleField f) { return maps_field(map, f); };
   using F = SampleField;
   std::string missing;
   auto add = [&](const char* what) { missing += (missing.empty() ? "" : "; ") + std::string(what); };

@@ -137,6 +137,9 @@ void LoopThread::step(const SourceSample& s, std::int64_t now_ns) noexcept {
     return;
   }
   ++counters_.samples;
+  winding_sensor_.on_sample(last_sample_.t_winding_sensor_C, last_sample_.t_ns);
+  drive_sensor_.on_sample(last_sample_.t_drive_sensor_C, last_sample_.t_ns);
+  coolant_sensor_.on_sample(last_sample_.t_coolant_sensor_C, last_sample_.t_ns);
   const core::EstimatorOutput& d = last_.detail;
   switch (d.code) {
     case core::StepCode::kSynchronized:
@@ -185,9 +188,12 @@ void LoopThread::report_measurement() noexcept {
   m.i_hat_q_A = last_.i_hat_A[1];
   m.epsilon_d_A = last_.epsilon_A[0];
   m.epsilon_q_A = last_.epsilon_A[1];
-  m.t_winding_sensor_C = s.t_winding_sensor_C;
-  m.t_drive_sensor_C = s.t_drive_sensor_C;
-  m.t_coolant_sensor_C = s.t_coolant_sensor_C;
+  m.t_winding_sensor_C = winding_sensor_.value_C();
+  m.t_winding_sensor_age_s = winding_sensor_.age_s(s.t_ns);
+  m.t_drive_sensor_C = drive_sensor_.value_C();
+  m.t_drive_sensor_age_s = drive_sensor_.age_s(s.t_ns);
+  m.t_coolant_sensor_C = coolant_sensor_.value_C();
+  m.t_coolant_sensor_age_s = coolant_sensor_.age_s(s.t_ns);
   push(m);
 }
 

@@ -209,6 +209,7 @@ LogMap drive_log_map(const std::string& name) {
   t.column.name = "t";
   t.unit = "s";
   m.time = t;
+  m.nan_temperature_is_no_reading = true;
   for (const QuantityInfo& q : kQuantities) {
     if (q.quantity != Quantity::kTStart && q.quantity != Quantity::kTDrive) m.columns.push_back(identity(q.quantity));
   }
@@ -219,7 +220,8 @@ LogMap averaged_log_map(const std::string& name) {
   LogMap m;
   m.name = name;
   m.columns_optional = true;
-  m.nan_is_missing = true;
+  m.nan_temperature_is_no_reading = true;
+  m.nan_u_dc_is_missing = true;
   m.window = Window::kStartColumn;
   MappedColumn t;
   t.column.name = "t";

@@ -483,8 +483,8 @@ bool MappedLogReader::read_raw(MappedRow& row) {
   for (std::size_t q = 0; q < kQuantityCount; ++q) {
     if (index_[q] < 0) continue;
     const MappedColumn& c = *column_[q];
-    const bool allow_nan =
-        map_.nan_is_missing && (c.quantity == Quantity::kUDc || info(c.quantity).kind == QuantityKind::kTemperature);
+    const bool allow_nan = (map_.nan_u_dc_is_missing && c.quantity == Quantity::kUDc) ||
+                           (map_.nan_temperature_is_no_reading && info(c.quantity).kind == QuantityKind::kTemperature);
     row.value[q] = cell(index_[q], label(c.quantity), c, allow_nan);
   }
   // Checked after every cell is read: a command is held to its row's u_dc.

@@ -55,9 +55,9 @@ void CycleAccumulator::add(const ControlCycle& c) noexcept {
   u_ += c.u_dq_V;
   omega_ += c.omega_el_rad_s;
   u_dc_ += c.u_dc_V;
-  t_winding_ += c.t_winding_C;
-  t_magnet_ += c.t_magnet_C;
-  t_coolant_ += c.t_coolant_C;
+  t_winding_.add(c.t_winding_C);
+  t_magnet_.add(c.t_magnet_C);
+  t_coolant_.add(c.t_coolant_C);
 }
 
 core::AveragedSample CycleAccumulator::read_reset() noexcept {
@@ -69,9 +69,9 @@ core::AveragedSample CycleAccumulator::read_reset() noexcept {
   s.u_dq_V = u_ * inv;
   s.omega_el_rad_s = omega_ * inv;
   s.u_dc_V = u_dc_ * inv;
-  s.t_winding_C = t_winding_ * inv;
-  s.t_magnet_C = t_magnet_ * inv;
-  s.t_coolant_C = t_coolant_ * inv;
+  s.t_winding_C = t_winding_.mean();
+  s.t_magnet_C = t_magnet_.mean();
+  s.t_coolant_C = t_coolant_.mean();
   *this = CycleAccumulator{};
   return s;
 }

@@ -9,8 +9,12 @@ with its own Clarke/Park and no project code.
 - Without (a signal map of instantaneous samples, stamped with the drive's own time, its t_sample signal):
   the k-th recorded sample is the k-th sent row in the rotor frame, at the row's time (the drive's clock
   counts µs) however the frames were delayed on the way.
+- With --temperatures (native telemetry whose drive sends its temperature frame every 100 ms): a window's
+  T_winding is the mean of the readings it received — each within half a step (0.1 °C per bit) of the sent
+  values over the window widened by three samples (the frame goes with the next sample received), one window
+  with a reading per 100 ms of samples; without a sent reading, no window has one.
 
-  check_averaged_record.py SENT.csv AVERAGED.csv [--rate HZ]
+  check_averaged_record.py SENT.csv AVERAGED.csv [--rate HZ] [--temperatures]
 """
 import argparse
 import csv
@@ -29,6 +33,7 @@ def main():
     ap.add_argument('sent')
     ap.add_argument('averaged')
     ap.add_argument('--rate', type=float)
+    ap.add_argument('--temperatures', action='store_true')
     a = ap.parse_args()
     sent = [{k: float(v) for k, v in r.items()} for r in csv.DictReader(open(a.sent))]
     avg = [{k: float(v) for k, v in r.items()} for r in csv.DictReader(open(a.averaged))]
@@ -88,12 +93,39 @@ def main():
             errors.append('worst sample error %.4f A' % worst_i)
         if len(avg) < 0.98 * (len(sent) - best):
             errors.append('%d samples of %d sent rows' % (len(avg), len(sent) - best))
+    if a.temperatures:
+        check_temperatures(sent, avg, errors)
     print('check_averaged_record: %s: %d samples, worst |i| error %.4f A, |u| error %.4f V'
           % (a.averaged, len(avg), worst_i, worst_u))
     if errors:
         print('check_averaged_record: FAILED\n  ' + '\n  '.join(errors[:20]))
         sys.exit(1)
     print('check_averaged_record: passed')
+
+
+def check_temperatures(sent, avg, errors):
+    half = 0.05
+    period = sent[1]['t'] - sent[0]['t']
+    for column in ('T_winding', 'T_coolant'):
+        got = [w for w in avg if math.isfinite(w.get(column, math.nan))]
+        values = [(r['t'], r[column]) for r in sent if math.isfinite(r.get(column, math.nan))]
+        if not values:
+            if got:
+                errors.append('%s %g in the window ending %g s, none sent' % (column, got[0][column], got[0]['t']))
+            continue
+        for w in got:
+            near = [v for t, v in values if w['t_start'] - 3 * period - 1e-7 <= t <= w['t'] + 3 * period + 1e-7]
+            if not near or not min(near) - half - 1e-9 <= w[column] <= max(near) + half + 1e-9:
+                errors.append('%s %g in the window [%g, %g]; sent around it: %s'
+                              % (column, w[column], w['t_start'], w['t'], near[:8]))
+        span = sent[-1]['t'] - sent[0]['t']
+        frames = int(span / 0.1 + 1e-9) + 1
+        if not frames - 1 <= len(got) <= frames:
+            errors.append('%d windows with a %s reading over %g s of samples (one every 100 ms: %d or %d)'
+                          % (len(got), column, span, frames - 1, frames))
+        else:
+            print('check_averaged_record: %d windows with a %s reading, each within half a step of those sent'
+                  % (len(got), column))
 
 
 if __name__ == '__main__':

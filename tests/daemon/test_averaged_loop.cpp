@@ -190,6 +190,9 @@ TEST(AveragedLoop, MeasurementsCarryTheDrivesSensorsAndNoAngle) {
   AveragedRig rig(200.0);
   rig.gen.plant = test::paper_machine_pu();
   rig.run(0.1);
+  rig.drain();
+  EXPECT_TRUE(std::isnan(rig.measurement.t_drive_sensor_C));  // no reading yet: neither a value nor an age
+  EXPECT_TRUE(std::isnan(rig.measurement.t_drive_sensor_age_s));
   core::AveragedSample s = rig.gen.next();
   s.t_start_ns = rig.now_ns;
   s.t_ns = rig.now_ns + 4'000'000;
@@ -204,6 +207,8 @@ TEST(AveragedLoop, MeasurementsCarryTheDrivesSensorsAndNoAngle) {
   EXPECT_EQ(m.t_winding_sensor_C, 71.5);
   EXPECT_EQ(m.t_drive_sensor_C, 42.0);
   EXPECT_EQ(m.t_coolant_sensor_C, 18.25);
+  EXPECT_EQ(m.t_winding_sensor_age_s, 0.0);  // read on the very sample the measurement is of
+  EXPECT_EQ(m.t_coolant_sensor_age_s, 0.0);
   EXPECT_TRUE(std::isnan(m.theta_el_rad));
   EXPECT_EQ(m.sample_time_us, s.t_ns / 1000);
 }
@@ -249,7 +254,11 @@ TEST(AveragedLoop, TheDrivesWindingSensorIsFusedAndItsSilenceIsPredicted) {
   EXPECT_GE(predicted.t_winding_observed_age_s, 19.0);
   EXPECT_LE(predicted.t_winding_observed_age_s, 21.5);
   EXPECT_GT(predicted.t_winding_fused_sd_C, observed.t_winding_fused_sd_C);  // the band widens without readings
-  EXPECT_TRUE(std::isnan(rig.measurement.t_winding_sensor_C));
+  // RPEM_MEASUREMENT keeps the newest reading and says how old it is: 20 s of the windows' time, within the
+  // measurement's decimation (10 ms at 100 Hz) and a window either side (at most 6.5 ms: 5 ms ± 30 % jitter).
+  EXPECT_EQ(rig.measurement.t_winding_sensor_C, kSensor_C);
+  EXPECT_GE(rig.measurement.t_winding_sensor_age_s, 20.0 - 0.01 - 2 * 0.0065);
+  EXPECT_LE(rig.measurement.t_winding_sensor_age_s, 20.0 + 2 * 0.0065);
 }
 
 // A drive's coolant sensor (a signal map's T_coolant) is the network's boundary in place of thermal.coolant_C
@@ -268,6 +277,11 @@ TEST(AveragedLoop, TheDrivesCoolantSensorIsTheNetworksBoundaryAndHolds) {
   rig.run(3.0);  // the newest 1 s step lies wholly after the first reading
   rig.drain();
   EXPECT_NEAR(rig.estimate.thermal.load.coolant_C, kMeasured_C, 1e-9);
+  // RPEM_MEASUREMENT shows the coolant read on one window in 50 on every measurement, no older than 49 windows
+  // (each at most 6.5 ms: 5 ms ± 30 % jitter), though the window it is decimated from has no reading 49 times in 50.
+  EXPECT_EQ(rig.measurement.t_coolant_sensor_C, kMeasured_C);
+  EXPECT_GE(rig.measurement.t_coolant_sensor_age_s, 0.0);
+  EXPECT_LE(rig.measurement.t_coolant_sensor_age_s, 49 * 0.0065);
 }
 
 TEST(AveragedLoop, APhaseSampleIsCountedNotStepped) {

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <random>
 #include <sstream>
 
@@ -244,6 +245,51 @@ TEST(DriveLog, WriteThenReadIsBitExact) {
     EXPECT_EQ(read[k].sample.i_A, written[k].sample.i_A);
     EXPECT_EQ(read[k].t_magnet_C, written[k].t_magnet_C);
   }
+}
+
+// A temperature sensor reads far more slowly than the phases are sampled (the native protocol's temperature frame
+// every 100 ms; `rpem record --out`): the writer puts `nan` on the rows between readings, the reader takes it as
+// no reading on that row, and every other row's value comes back bit-exactly.
+TEST(DriveLog, TemperatureCellsBetweenReadingsRoundTripAsNoReading) {
+  test::TempFile f("sparse.csv");
+  DriveLogLayout layout;
+  layout.t_winding = layout.t_magnet = layout.t_coolant = true;
+  constexpr double kNoReading = std::numeric_limits<double>::quiet_NaN();
+  {
+    DriveLogWriter w(f.path(), layout);
+    for (int k = 0; k < 10; ++k) {
+      DriveLogRow row;
+      row.sample.t_ns = 125'000LL * k;
+      row.sample.u_dc_V = 48.0;
+      row.sample.t_winding_C = k % 4 == 1 ? 60.0 + 0.1 * k : kNoReading;
+      row.sample.t_coolant_C = k == 7 ? 31.4 : kNoReading;
+      if (k == 3) row.t_magnet_C = 55.5;
+      w.write(row);
+    }
+  }
+  const auto read = read_drive_log(f.path());
+  ASSERT_EQ(read.size(), 10U);
+  for (int k = 0; k < 10; ++k) {
+    const DriveLogRow& r = read[static_cast<std::size_t>(k)];
+    if (k % 4 == 1) {
+      EXPECT_EQ(r.sample.t_winding_C, 60.0 + 0.1 * k) << "row " << k;
+    } else {
+      EXPECT_TRUE(std::isnan(r.sample.t_winding_C)) << "row " << k;
+    }
+    EXPECT_EQ(std::isnan(r.sample.t_coolant_C), k != 7) << "row " << k;
+    EXPECT_EQ(r.t_magnet_C.has_value(), k == 3) << "row " << k;
+  }
+  EXPECT_EQ(read[7].sample.t_coolant_C, 31.4);
+  EXPECT_EQ(read[3].t_magnet_C, 55.5);
+}
+
+// Only a temperature's cell may say "no reading": the other quantities of a sample have a value on every row.
+TEST(DriveLog, ANanOutsideATemperatureColumnIsStillRefused) {
+  const std::string header = "t,theta_el,omega_el,u_dc,u_a,u_b,u_c,i_a,i_b,i_c,T_winding\n";
+  EXPECT_EQ(drive_log_error_of(header + "0,0,0,220,1,2,3,0,0,0,nan\n0.1,0,0,220,1,2,3,0,0,0,25\n"), "");
+  EXPECT_NE(drive_log_error_of(header + "0,0,0,220,1,2,3,nan,0,0,25\n").find(":2:8: column i_a: NaN"), std::string::npos);
+  EXPECT_NE(drive_log_error_of(header + "0,0,nan,220,1,2,3,0,0,0,25\n").find(":2:3: column omega_el: NaN"),
+            std::string::npos);
 }
 
 TEST(DriveLog, WriterDerivesRotorFrameColumnsWithPark) {

@@ -64,7 +64,7 @@ TEST(Schema, EachFieldListIsLcmGensReadingOfTheSameFile) {
   EXPECT_EQ(fingerprint_of_list<diagnostics_t>(), diagnostics_t::getHash());
   EXPECT_EQ(fingerprint_of_list<command_t>(), command_t::getHash());
   EXPECT_EQ(schema::kFieldCount<estimate_t>, 30u);        // 21, and 9 of thermal fusion
-  EXPECT_EQ(schema::kFieldCount<measurement_t>, 14u);     // 11, and the drive's three temperature sensors
+  EXPECT_EQ(schema::kFieldCount<measurement_t>, 17u);     // 11, and the drive's three temperature sensors with their ages
   EXPECT_EQ(schema::spelled_count<diagnostics_t>(), 2u);  // source, source_name
 }
 
@@ -140,8 +140,9 @@ TEST(Schema, ALineShowsEachFieldByNameOrLabelWithGroupsApart) {
   m.t_winding_sensor_C = std::numeric_limits<double>::quiet_NaN();
   EXPECT_EQ(schema::format_fields(m),
             "utime 1700000000123456 sample_time_us 42 theta_el_rad 0.333333 omega_el_rad_s 314.159 u_dc_V 560 i_d_A -1.25 "
-            "i_q_A 1e-07 i_hat_d_A 0 i_hat_q_A 0 epsilon_d_A 0 epsilon_q_A 0 t_winding_sensor_C nan t_drive_sensor_C 0 "
-            "t_coolant_sensor_C 0");
+            "i_q_A 1e-07 i_hat_d_A 0 i_hat_q_A 0 epsilon_d_A 0 epsilon_q_A 0 | t_winding_sensor_C nan "
+            "t_winding_sensor_age_s 0 t_drive_sensor_C 0 t_drive_sensor_age_s 0 t_coolant_sensor_C 0 "
+            "t_coolant_sensor_age_s 0");
 
   estimate_t e{};
   e.psi_m_Wb = 1.0987;

@@ -5,6 +5,7 @@
 #   3. the same traffic captured with candump -L (checked against the DBC on the host)
 #   4. canplayer replays that capture into rpem record
 #   5. classic-CAN mapping through vcan0
+#   6. a drive sending its temperature frame (can-temperatures.yaml), recorded as phase samples and as windows
 out=${1:-/host}
 fail=0
 step() { echo "vcan_suite: $*"; }
@@ -47,4 +48,17 @@ head -n 2001 "$out/sent.csv" > "$out/classic_sent.csv"
 rpem replay "$out/classic_sent.csv" --can vcan0 --classic --rate 4 || fail=1
 wait $rec || fail=1
 cat "$out/record3.txt"
+
+step "sim with temperatures -> record --out and --averaged-out (CAN FD)"
+rpem record --can vcan0 --out "$out/temps_recorded.csv" --idle-timeout 1.5 > "$out/record4.txt" 2>&1 &
+rec=$!
+rpem record --can vcan0 --averaged-out "$out/temps_avg.csv" --window-rate 200 --idle-timeout 1.5 \
+  > "$out/record5.txt" 2>&1 &
+rec_avg=$!
+wait_listening "$out/record4.txt"
+wait_listening "$out/record5.txt"
+rpem sim --scenario can-temperatures.yaml --can vcan0 --out "$out/temps_sent.csv" 2> "$out/sim_temps.txt" || fail=1
+wait $rec || fail=1
+wait $rec_avg || fail=1
+cat "$out/record4.txt" "$out/record5.txt"
 exit $fail

@@ -78,7 +78,12 @@ int run_record(const RecordOptions& o) {
   co.ids.assign(can::protocol::kTelemetryIds.begin(), can::protocol::kTelemetryIds.end());
   can::SocketCanChannel channel(co);
   can::TelemetryDecoder decoder;
-  io::DriveLogWriter writer(o.out, io::DriveLogLayout{});
+  // The temperature frame's two sensors (docs/can-protocol.md): each reading on the sample it arrived before,
+  // `nan` on the rows between readings and where the drive has no such sensor (docs/drive-log.md).
+  io::DriveLogLayout layout;
+  layout.t_winding = true;
+  layout.t_coolant = true;
+  io::DriveLogWriter writer(o.out, layout);
   std::signal(SIGINT, on_can_stop_signal);
   std::signal(SIGTERM, on_can_stop_signal);
   std::fprintf(stderr, "rpem record: listening on %s\n", o.interface.c_str());

@@ -112,16 +112,17 @@ class ThermalRun {
   void explain() const {
     if (!fusion_) return;
     if (without_coolant_ > 0) {
-      std::fprintf(stderr,
-                   "rpem estimate: thermal: %llu of %llu samples have no coolant temperature (no T_coolant column or "
-                   "an empty cell) and none before them: the coolant is taken as %.4g °C there (thermal.coolant_C); a "
-                   "coolant that moves shows as a model error (docs/thermal.md)\n",
-                   static_cast<unsigned long long>(without_coolant_), static_cast<unsigned long long>(samples_), coolant_C_);
+      std::fprintf(
+          stderr,
+          "rpem estimate: thermal: %llu of %llu samples have no coolant temperature (no T_coolant column, or "
+          "no reading in their cell) and none before them: the coolant is taken as %.4g °C there (thermal.coolant_C); a "
+          "coolant that moves shows as a model error (docs/thermal.md)\n",
+          static_cast<unsigned long long>(without_coolant_), static_cast<unsigned long long>(samples_), coolant_C_);
     }
     if (coolant_held_ > 0) {
       std::fprintf(stderr,
-                   "rpem estimate: thermal: %llu of %llu samples have an empty coolant cell after a reading: the newest "
-                   "reading holds there\n",
+                   "rpem estimate: thermal: %llu of %llu samples have no coolant reading after one: the newest reading "
+                   "holds there\n",
                    static_cast<unsigned long long>(coolant_held_), static_cast<unsigned long long>(samples_));
     }
     if (samples_ > 0 && !(sensor_fused_ && std::isfinite(first_winding_C_))) {

@@ -63,7 +63,12 @@ class NativeFeed final : public Feed {
            std::to_string(d.frames_lost) + ", crc " + std::to_string(d.crc_error) + ", unknown id " +
            std::to_string(d.unknown_id);
   }
-  [[nodiscard]] io::AveragedLogLayout layout() const override { return {true, false, false, false}; }
+  /// The temperature frame's two sensors: each window the mean of the readings in it (sim/cycle_average.hpp).
+  [[nodiscard]] io::AveragedLogLayout layout() const override {
+    io::AveragedLogLayout l;
+    l.u_dc = l.t_winding = l.t_coolant = true;
+    return l;
+  }
 
  private:
   can::TelemetryDecoder decoder_;
@@ -87,7 +92,17 @@ class SignalMapFeed final : public Feed {
            std::to_string(c.wrong_length) + ", incomplete " + std::to_string(c.incomplete) + ", non-finite " +
            std::to_string(c.non_finite) + ", stale " + std::to_string(c.stale);
   }
-  [[nodiscard]] io::AveragedLogLayout layout() const override { return {true, true, true, true}; }
+  /// Every temperature the map has a signal for (a sample without its reading writes nan).
+  [[nodiscard]] io::AveragedLogLayout layout() const override {
+    const can::SignalMap& m = decoder_.map();
+    io::AveragedLogLayout l;
+    l.u_dc = true;
+    l.t_winding = can::maps_field(m, can::SampleField::kTWindingC);
+    l.t_magnet = can::maps_field(m, can::SampleField::kTMagnetC);
+    l.t_drive = can::maps_field(m, can::SampleField::kTDriveC);
+    l.t_coolant = can::maps_field(m, can::SampleField::kTCoolantC);
+    return l;
+  }
 
  private:
   can::SignalMapDecoder decoder_;

@@ -78,10 +78,11 @@ analysis::ThermalRecord record_sessions(const ThermalFitCliOptions& o, const io:
         r, laws.fusion.filter.network.copper, sensor_sigma_K, laws.fusion.winding_sensor_time_constant_s);
     for (std::string& said : held.describe(kWindingColumn)) set_aside.push_back(std::move(said));
     if (!r.coolant) {
-      std::fprintf(stderr,
-                   "rpem thermal fit: %s has no T_coolant column: the coolant is taken as %.4g °C throughout "
-                   "(thermal.coolant_C); a coolant that moves shows as a model error (docs/thermal.md)\n",
-                   log.c_str(), laws.fusion.coolant_C);
+      std::fprintf(
+          stderr,
+          "rpem thermal fit: %s has no T_coolant column (or no reading in it): the coolant is taken as %.4g °C throughout "
+          "(thermal.coolant_C); a coolant that moves shows as a model error (docs/thermal.md)\n",
+          log.c_str(), laws.fusion.coolant_C);
     }
     if (folder && r.steps.empty()) {
       std::fprintf(stderr, "rpem thermal fit: %s gives no step of the thermal filter (%.3g s): left out\n", log.c_str(),

@@ -4,6 +4,7 @@
 
 #include "rpem/core/clock.hpp"
 #include "rpem/core/conditioner.hpp"
+#include "rpem/core/non_finite.hpp"
 
 namespace rpem::analysis {
 namespace {
@@ -92,9 +93,9 @@ double ResidualSums::regressor(std::size_t j, std::size_t k, const core::Vec2& i
     default:
       break;
   }
-  // The temperatures, in the order the constructor lists them.
+  // The temperatures, in the order the constructor lists them; NaN on a row without a reading.
   const bool winding = j == 6 && log_->layout.t_winding;
-  return (winding ? log_->samples.t_winding_C(k) : log_->samples.t_magnet_C(k)).value_or(0.0);
+  return (winding ? log_->samples.t_winding_C(k) : log_->samples.t_magnet_C(k)).value_or(core::kNaN);
 }
 
 void ResidualSums::add(std::size_t k, const core::Vec2& nominal_A, const core::Vec2& extended_A) {
@@ -132,6 +133,7 @@ void ResidualSums::add(std::size_t k, const core::Vec2& nominal_A, const core::V
   }
   for (std::size_t j = 0; j < regressors_.size(); ++j) {
     const double v = regressor(j, k, i, n);
+    if (std::isnan(v)) continue;  // a temperature's row without a reading (a slow sensor's, a logger's no-reading)
     corr_[j][0].add(v, nominal_A[0]);
     corr_[j][1].add(v, nominal_A[1]);
     corr_[j][2].add(v, extended_A[0]);

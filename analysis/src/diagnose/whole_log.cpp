@@ -139,19 +139,23 @@ void merge_figures(const LogData& log, const EffectContext& context, const std::
     figures.overlay.insert(figures.overlay.end(), f.overlay.begin(), f.overlay.end());
   }
   for (std::size_t start = 0, j = 0; start < n; start += per_bin, ++j) {
-    double t = 0, sp = 0, iq = 0, temp = 0, all_samples = 0;
+    double t = 0, sp = 0, iq = 0, temp = 0, temp_readings = 0, all_samples = 0;
     for (std::size_t k = start; k < std::min(n, start + per_bin); ++k) {
       t += log.t_s(k);
       sp += speed_rpm(context, log.samples.omega_el_rad_s(k));
       iq += log.logged_i_dq_A(k)[1];
       all_samples += 1;
-      temp += log.samples.t_winding_C(k).value_or(log.samples.t_magnet_C(k).value_or(kNaN));
+      // The bin's mean of the readings it has: a slow sensor reads on few rows (docs/drive-log.md).
+      const double reading = log.samples.t_winding_C(k).value_or(log.samples.t_magnet_C(k).value_or(kNaN));
+      if (std::isnan(reading)) continue;
+      temp += reading;
+      temp_readings += 1;
     }
     const auto& r = bins[j];
     const double cnt = r[4];
     figures.time.push_back({t / all_samples, sp / all_samples, iq / all_samples, cnt != 0.0 ? std::sqrt(r[0] / cnt) : kNaN,
                             cnt != 0.0 ? std::sqrt(r[1] / cnt) : kNaN, cnt != 0.0 ? r[2] / cnt : kNaN,
-                            cnt != 0.0 ? r[3] / cnt : kNaN, temp / all_samples});
+                            cnt != 0.0 ? r[3] / cnt : kNaN, temp_readings > 0 ? temp / temp_readings : kNaN});
   }
 }
 

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cassert>
+#include <cmath>
 #include <limits>
 #include <optional>
 #include <stdexcept>
@@ -29,16 +30,21 @@ class Recorder {
     s.dt_s = previous_ns_ ? 1e-9 * static_cast<double>(t_ns - *previous_ns_) : 0.0;
     s.coolant_C = coolant_C;
     s.winding_sensor_C = winding_C;
+    coolant_read_ = coolant_read_ || std::isfinite(coolant_C);
     previous_ns_ = t_ns;
     if (!observer_.add(e, s)) return;
     record_.steps.push_back(observer_.step());
     record_.t_s.push_back(1e-9 * static_cast<double>(observer_.step().t_ns));
   }
+  /// A sample carried a coolant reading: a T_coolant column with none (a recording of a drive without the
+  /// sensor, docs/drive-log.md) is no coolant.
+  [[nodiscard]] bool coolant_read() const noexcept { return coolant_read_; }
 
  private:
   ThermalRecord& record_;
   core::ThermalObserver observer_;
   std::optional<std::int64_t> previous_ns_;
+  bool coolant_read_ = false;
 };
 
 }  // namespace
@@ -87,25 +93,25 @@ ThermalRecord record_thermal(const io::LogSource& source, const io::MachineConfi
     const io::RotorFrameRebuild rebuilt =
         io::complete_rotor_frame(samples, read, machine.machine, io::command_hold_s(machine.estimator), source.path);
     r.winding_sensor = read.layout.t_winding;
-    r.coolant = read.layout.t_coolant;
-    r.session_coolant = {r.coolant};
     r.read_as = io::describe(source, read) + (rebuilt.any() ? "; " + rebuilt.describe() : "");
     core::AveragedDriveEstimator estimator(machine.machine, io::estimator_settings(machine, rebuilt));
     Recorder rec(r, machine, thermal, estimator.base());
     for (const core::AveragedSample& s : samples) rec.add(estimator.step(s), s.t_ns, s.t_coolant_C, s.t_winding_C);
+    r.coolant = read.layout.t_coolant && rec.coolant_read();
+    r.session_coolant = {r.coolant};
     return r;
   }
   io::DriveLogReader reader(source.path, source.map, limits);
   io::check_log_supports(machine, "configuration", reader.layout().u_dc, source.path);
   r.winding_sensor = reader.layout().t_winding;
-  r.coolant = reader.layout().t_coolant;
-  r.session_coolant = {r.coolant};
   core::DriveEstimator estimator(machine.machine, machine.estimator);
   Recorder rec(r, machine, thermal, estimator.base());
   io::DriveLogRow row;
   while (reader.next(row)) {
     rec.add(estimator.step(row.sample), row.sample.t_ns, row.sample.t_coolant_C, row.sample.t_winding_C);
   }
+  r.coolant = reader.layout().t_coolant && rec.coolant_read();
+  r.session_coolant = {r.coolant};
   r.read_as = source.path + " as " + source.format + io::describe(reader.reader().repairs());
   return r;
 }

@@ -89,6 +89,8 @@ struct SignalMap {
 /// for binary32 and 64 for binary64, starts on a byte boundary and is not `signed`): "" or the first
 /// problem, naming the frame and signal.
 [[nodiscard]] std::string check_layout(const SignalMap& map);
+/// The map has a signal for the field.
+[[nodiscard]] bool maps_field(const SignalMap& map, SampleField f) noexcept;
 /// What the estimator needs and the map does not give: "" or a sentence naming the missing quantities
 /// (current and voltage in the rotor frame or as phases with theta_el; a speed; pole pairs for a
 /// mechanical speed).

@@ -20,6 +20,7 @@
 #include "rpem/daemon/loop_estimator.hpp"
 #include "rpem/daemon/loop_timer.hpp"
 #include "rpem/daemon/messages.hpp"
+#include "rpem/daemon/sensor_reading.hpp"
 #include "rpem/daemon/spsc_queue.hpp"
 #include "rpem/daemon/validity.hpp"
 
@@ -106,6 +107,7 @@ class LoopThread {
   std::int64_t last_sample_mono_ns_ = 0;
   core::Estimate last_;
   SampleSummary last_sample_;
+  SensorReading winding_sensor_, drive_sensor_, coolant_sensor_;  ///< the drive's own, for RPEM_MEASUREMENT
   LoopCounters counters_;
   double eps2_d_ = 0.0, eps2_q_ = 0.0;
   std::int64_t eps_n_ = 0;

@@ -111,8 +111,11 @@ struct LogMap {
   /// Every mapped column may be absent from the header (the quantity is then absent): our own formats,
   /// where the header names the quantities. A user's map requires each of its columns.
   bool columns_optional = false;
-  /// A cell "nan" in a quantity the consumer treats as optional means "not reported" (our averaged log).
-  bool nan_is_missing = false;
+  /// A cell "nan" in a temperature sensor's column is no reading on its row (our own drive and averaged logs:
+  /// their writers put it where a sensor gave none, e.g. a slow sensor's frame between its readings).
+  bool nan_temperature_is_no_reading = false;
+  /// A cell "nan" in u_dc means "not reported" (our averaged log: a window without a DC-link reading).
+  bool nan_u_dc_is_missing = false;
 
   // Time: a column (time.has_value()), or rows evenly spaced by period_s from 0.
   std::optional<MappedColumn> time;  ///< quantity ignored; SI value in s

@@ -24,7 +24,7 @@ namespace rpem::io {
 
 struct MappedRow {
   std::int64_t t_ns = 0;
-  /// SI values by Quantity; NaN where the quantity is absent (or, for nan_is_missing columns, not reported).
+  /// SI values by Quantity; NaN where the quantity is absent (or, for a nan cell its format allows, not reported).
   std::array<double, kQuantityCount> value{};
   std::size_t line = 0;  ///< the file's line the row came from
   [[nodiscard]] double operator[](Quantity q) const noexcept { return value[static_cast<std::size_t>(q)]; }

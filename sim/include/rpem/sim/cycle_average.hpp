@@ -8,9 +8,12 @@
 // stator frame over the cycle, at the measured angles,
 //   ū_k = sinc(Δϑ/2)·T(ϑ_k + Δϑ/2)·u^s_k,   Δϑ = ϑ_k+1 − ϑ_k
 // (a drive with exact phase compensation, as VESC's advance of the angle by ω·dt/2 intends); speed, DC link
-// and temperatures as measured at t_k.
+// and temperatures as measured at t_k. A window's temperature is the mean of the readings its cycles have (a slow
+// sensor reads on few of them: the native protocol's temperature frame comes every 100 ms), NaN with none.
 
+#include <cmath>
 #include <cstdint>
+#include <limits>
 #include <optional>
 #include <random>
 
@@ -39,6 +42,21 @@ class CycleExtractor {
   std::optional<io::DriveLogRow> previous_;
 };
 
+/// The mean of the readings added since the last read, NaN without one (a NaN added is no reading).
+class ReadingMean {
+ public:
+  void add(double v) noexcept {
+    if (std::isnan(v)) return;
+    sum_ += v;
+    ++n_;
+  }
+  [[nodiscard]] double mean() const noexcept { return n_ > 0 ? sum_ / n_ : std::numeric_limits<double>::quiet_NaN(); }
+
+ private:
+  double sum_ = 0.0;
+  int n_ = 0;
+};
+
 /// Means of control cycles since the last read (no allocation).
 class CycleAccumulator {
  public:
@@ -51,7 +69,8 @@ class CycleAccumulator {
   int n_ = 0;
   std::int64_t first_ns_ = 0, last_end_ns_ = 0;
   core::Vec2 i_ = core::Vec2::Zero(), u_ = core::Vec2::Zero();
-  double omega_ = 0.0, u_dc_ = 0.0, t_winding_ = 0.0, t_magnet_ = 0.0, t_coolant_ = 0.0;
+  double omega_ = 0.0, u_dc_ = 0.0;
+  ReadingMean t_winding_, t_magnet_, t_coolant_;
 };
 
 /// Windows of uneven length — uniform in (1 ± jitter)/rate, clipped to [0.5, 20] ms — closing at the first

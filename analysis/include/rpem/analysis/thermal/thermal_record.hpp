@@ -19,7 +19,7 @@ struct ThermalRecord {
   std::vector<core::ThermalStepData> steps;
   std::vector<double> t_s;      ///< each step's end [s]
   bool winding_sensor = false;  ///< the log has T_winding
-  bool coolant = false;         ///< the log has T_coolant (else thermal.coolant_C is used)
+  bool coolant = false;         ///< the log has T_coolant with a reading in it (else thermal.coolant_C is used)
   bool averaged = false;
   std::string read_as;      ///< what the log was read as, for the tools (io::describe; the format for phase samples)
   io::SampleCounts counts;  ///< what the estimator run did with the samples (its regimes)
