@@ -17,7 +17,7 @@ TEST(SensorReading, HoldsTheNewestReadingAndSaysHowOldItIs) {
   s.on_sample(kNoReading, 1'000'000);
   EXPECT_TRUE(std::isnan(s.value_C()));
   EXPECT_TRUE(std::isnan(s.age_s(1'000'000)));
-  s.on_sample(61.5, 2'000'000);  // read on the sample at 2 ms
+  s.on_sample(61.5, 2'000'000);                                                                 // read on the sample at 2 ms
   for (std::int64_t t = 2'125'000; t <= 102'000'000; t += 125'000) s.on_sample(kNoReading, t);  // 100 ms at 8 kHz
   EXPECT_EQ(s.value_C(), 61.5);
   EXPECT_DOUBLE_EQ(s.age_s(102'000'000), 0.1);
