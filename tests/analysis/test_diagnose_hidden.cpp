@@ -24,6 +24,7 @@ std::string name_of(const ::testing::TestParamInfo<test::HiddenCase>& p) {
   std::string n = p.param.profile;
   for (const auto& e : p.param.effects) n += "_" + e;
   if (p.param.effects.empty()) n += "_none";
+  if (p.param.reading_interval_s > 0.0) n += "_slow_sensor";
   return n + "_" + std::to_string(p.param.seed);
 }
 
@@ -39,6 +40,14 @@ INSTANTIATE_TEST_SUITE_P(
                       test::HiddenCase{"bench", {"rs_drift", "current_offset"}, 113},
                       test::HiddenCase{"beckhoff400", {}, 114}, test::HiddenCase{"beckhoff800", {}, 115}),
     name_of);
+
+// A slow temperature sensor (docs/drive-log.md): a reading every 0.5 s or 1 s on a log of 8 kHz rows (NaN
+// between, as `rpem record` writes one), the first not on the first row. The drift is found against the
+// readings held between them: on 1 row in 4 000–8 000 alone it would act on almost none.
+INSTANTIATE_TEST_SUITE_P(SlowSensor, HiddenEffect,
+                         ::testing::Values(test::HiddenCase{"bench", {"rs_drift"}, 116, 0.5},
+                                           test::HiddenCase{"bench", {"psim_drift"}, 117, 1.0}),
+                         name_of);
 
 TEST(HiddenEffect, WhatTheDataCannotSeparateIsReportedNotGuessed) {
   // Standstill at one current: a dead time and a current-sensor offset on the phase that carries the

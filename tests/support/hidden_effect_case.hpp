@@ -27,13 +27,31 @@ struct HiddenCase {
   std::string profile = "bench";     ///< "bench", "beckhoff400" or "beckhoff800"
   std::vector<std::string> effects;  ///< catalogue names; empty: a null case
   std::uint64_t seed = 1;
+  /// > 0: a slow temperature sensor — the drift effects' temperature columns logged, each with a reading only
+  /// every so often (NaN between, the first a fraction of this after the start), as `rpem record` writes one.
+  double reading_interval_s = 0.0;
 };
+
+/// Keeps a reading of the temperature columns only where t passes phase + m·interval (NaN elsewhere).
+inline void thin_temperature_readings(std::vector<io::DriveLogRow>& rows, double interval_s, double phase_s) {
+  long last = -1;
+  for (io::DriveLogRow& r : rows) {
+    const long m = static_cast<long>(std::floor((static_cast<double>(r.sample.t_ns) * 1e-9 - phase_s) / interval_s));
+    if (m >= 0 && m != last) {
+      last = m;
+      continue;
+    }
+    r.sample.t_winding_C = std::nan("");
+    if (r.t_magnet_C) r.t_magnet_C = std::nan("");
+  }
+}
 
 /// GoogleTest's name for a case in test listings.
 inline void PrintTo(const HiddenCase& c, std::ostream* os) {
   *os << c.profile << " seed " << c.seed << " hidden:";
   for (const auto& e : c.effects) *os << ' ' << e;
   if (c.effects.empty()) *os << " none";
+  if (c.reading_interval_s > 0.0) *os << ", temperatures read every " << c.reading_interval_s << " s";
 }
 
 struct CaseOutcome {
@@ -139,10 +157,12 @@ inline CaseOutcome run_hidden_case(const HiddenCase& c) {
   std::vector<HiddenEffect> hidden;
   for (const std::string& name : c.effects) {
     hidden.push_back(draw_effect(rng, s, name));
+    if (c.reading_interval_s > 0.0) hidden.back().temperatures_logged = true;
     hide(s, hidden.back());
   }
   io::DriveLogLayout layout;
   std::vector<io::DriveLogRow> rows = simulate(s, &layout);
+  if (c.reading_interval_s > 0.0) thin_temperature_readings(rows, c.reading_interval_s, 0.37 * c.reading_interval_s);
   analysis::LogData log = analysis::prepare_log(std::move(rows), layout, s.machine.machine, {});
   analysis::DiagnoseOptions options;
   options.switching_frequency_Hz = s.inverter.switching_frequency_Hz;

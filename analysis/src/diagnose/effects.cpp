@@ -55,8 +55,12 @@ double drifted(double value, const std::optional<core::DriftLaw>& law, double tr
 
 }  // namespace
 
-TemperatureColumn winding_column(const LogData& log) { return column(log, log.layout.t_winding, &SampleStore::t_winding_C); }
-TemperatureColumn magnet_column(const LogData& log) { return column(log, log.layout.t_magnet, &SampleStore::t_magnet_C); }
+TemperatureColumn winding_column(const LogData& log) {
+  return column(log, log.layout.t_winding, &SampleStore::t_winding_held_C);
+}
+TemperatureColumn magnet_column(const LogData& log) {
+  return column(log, log.layout.t_magnet, &SampleStore::t_magnet_held_C);
+}
 
 ExtendedModel make_base_model(const core::MachineSi& machine, const core::ModelExtensions& extensions,
                               const std::optional<core::DriftLaw>& r_s_law, const std::optional<core::DriftLaw>& psi_m_law,
@@ -212,12 +216,12 @@ std::pair<double, double> parameter_bounds(const Effect& e, const EffectContext&
 
 double r_s_at(const ExtendedModel& m, const LogData& log, std::size_t k) noexcept {
   if (!m.r_s_law && m.r_s_trend == 0.0) return m.machine.r_s_Ohm;
-  return drifted(m.machine.r_s_Ohm, m.r_s_law, m.r_s_trend, log.samples.t_winding_C(k), log.time_fraction(k));
+  return drifted(m.machine.r_s_Ohm, m.r_s_law, m.r_s_trend, log.samples.t_winding_held_C(k), log.time_fraction(k));
 }
 
 double psi_m_at(const ExtendedModel& m, const LogData& log, std::size_t k) noexcept {
   if (!m.psi_m_law && m.psi_m_trend == 0.0) return m.machine.psi_m_Wb;
-  return drifted(m.machine.psi_m_Wb, m.psi_m_law, m.psi_m_trend, log.samples.t_magnet_C(k), log.time_fraction(k));
+  return drifted(m.machine.psi_m_Wb, m.psi_m_law, m.psi_m_trend, log.samples.t_magnet_held_C(k), log.time_fraction(k));
 }
 
 core::DriftLaw recorded_law(const core::DriftLaw& law, double value_at_law_reference, double reference_C) {

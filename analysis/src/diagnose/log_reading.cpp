@@ -158,7 +158,10 @@ class SessionJoiner {
   }
 
   void push(io::DriveLogRow row) {
-    if (opens_session_) row.sample.gap_before = true;  // nothing carries over from the last session
+    if (opens_session_) {
+      row.sample.gap_before = true;  // nothing carries over from the last session
+      d_.samples.start_session();    // not its temperatures either
+    }
     opens_session_ = false;
     last_t_ns_ = row.sample.t_ns;
     d_.samples.push_back(row);

@@ -93,9 +93,10 @@ double ResidualSums::regressor(std::size_t j, std::size_t k, const core::Vec2& i
     default:
       break;
   }
-  // The temperatures, in the order the constructor lists them; NaN on a row without a reading.
+  // The temperatures, in the order the constructor lists them: as the models take them (held between a slow
+  // sensor's readings); NaN where the row's session has no reading.
   const bool winding = j == 6 && log_->layout.t_winding;
-  return (winding ? log_->samples.t_winding_C(k) : log_->samples.t_magnet_C(k)).value_or(core::kNaN);
+  return (winding ? log_->samples.t_winding_held_C(k) : log_->samples.t_magnet_held_C(k)).value_or(core::kNaN);
 }
 
 void ResidualSums::add(std::size_t k, const core::Vec2& nominal_A, const core::Vec2& extended_A) {

@@ -1,8 +1,10 @@
 #include "rpem/analysis/diagnose/sample_store.hpp"
 #include "rpem/core/non_finite.hpp"
 
+#include <algorithm>
 #include <cassert>
 #include <cmath>
+#include <iterator>
 #include <limits>
 #include <stdexcept>
 
@@ -34,8 +36,12 @@ void SampleStore::push_back(const io::DriveLogRow& row) {
     staged_marks_.reserve(kChunk);
     for (auto& c : staged_) c.reserve(kChunk);
   }
+  const double winding = has_winding_ ? row.sample.t_winding_C : kNaN;
+  const double magnet = has_magnet_ ? row.t_magnet_C.value_or(kNaN) : kNaN;
   staged_t_.push_back(s.t_ns);
-  staged_marks_.push_back(s.gap_before ? sample_mark::kGapBefore : 0);
+  staged_marks_.push_back(static_cast<std::uint8_t>((s.gap_before ? sample_mark::kGapBefore : 0) |
+                                                    (std::isnan(winding) ? 0 : sample_mark::kWindingReading) |
+                                                    (std::isnan(magnet) ? 0 : sample_mark::kMagnetReading)));
   const double values[kColumns] = {s.theta_el_rad,
                                    s.omega_el_rad_s,
                                    s.u_dc_V,
@@ -45,11 +51,35 @@ void SampleStore::push_back(const io::DriveLogRow& row) {
                                    s.i_A[0],
                                    s.i_A[1],
                                    s.i_A[2],
-                                   has_winding_ ? row.sample.t_winding_C : 0.0,
-                                   has_magnet_ ? row.t_magnet_C.value_or(kNaN) : 0.0};
+                                   has_winding_ ? winding_.push(winding, size_) : 0.0,
+                                   has_magnet_ ? magnet_.push(magnet, size_) : 0.0};
   for (std::size_t c = 0; c < kColumns; ++c) staged_[c].push_back(values[c]);
   ++size_;
   if (staged_t_.size() == kChunk) store_chunk();
+}
+
+void SampleStore::start_session() noexcept {
+  winding_.start_session();
+  magnet_.start_session();
+}
+
+double SampleStore::HeldReading::push(double reading, std::size_t k) {
+  if (std::isnan(reading)) {
+    if (std::isnan(newest_) && !lead_first_) lead_first_ = k;
+    return newest_;
+  }
+  if (lead_first_) leads_.push_back({*lead_first_, k, reading});
+  lead_first_.reset();
+  newest_ = reading;
+  return reading;
+}
+
+std::optional<double> SampleStore::HeldReading::lead_of(std::size_t k) const noexcept {
+  const auto after =
+      std::upper_bound(leads_.begin(), leads_.end(), k, [](std::size_t r, const Lead& l) { return r < l.first; });
+  if (after == leads_.begin()) return std::nullopt;
+  const Lead& l = *std::prev(after);
+  return k < l.end ? std::optional(l.value) : std::nullopt;
 }
 
 void SampleStore::store_chunk() {
@@ -114,15 +144,27 @@ std::int64_t SampleStore::t_ns(std::size_t k) const noexcept {
   return c.dt_ns.empty() ? c.t_ns[j] : c.t0_ns + c.dt_ns[j];
 }
 
-// NaN: the log has the column, but no reading on this row (its logger's value for none, io::MappedColumn::no_reading).
-std::optional<double> SampleStore::t_winding_C(std::size_t k) const noexcept {
-  const double v = has_winding_ ? value(kWinding, k) : kNaN;
-  return std::isnan(v) ? std::nullopt : std::optional(v);
+std::optional<double> SampleStore::reading(Column c, std::uint8_t bit, std::size_t k) const noexcept {
+  return (mark(k) & bit) != 0 ? std::optional(value(c, k)) : std::nullopt;
 }
 
+// The stored value is the session's newest reading (NaN: none yet in the session).
+std::optional<double> SampleStore::held(Column c, const HeldReading& h, std::size_t k) const noexcept {
+  const double v = value(c, k);
+  return std::isnan(v) ? h.lead_of(k) : std::optional(v);
+}
+
+std::optional<double> SampleStore::t_winding_C(std::size_t k) const noexcept {
+  return reading(kWinding, sample_mark::kWindingReading, k);
+}
 std::optional<double> SampleStore::t_magnet_C(std::size_t k) const noexcept {
-  const double v = has_magnet_ ? value(kMagnet, k) : kNaN;
-  return std::isnan(v) ? std::nullopt : std::optional(v);
+  return reading(kMagnet, sample_mark::kMagnetReading, k);
+}
+std::optional<double> SampleStore::t_winding_held_C(std::size_t k) const noexcept {
+  return has_winding_ ? held(kWinding, winding_, k) : std::nullopt;
+}
+std::optional<double> SampleStore::t_magnet_held_C(std::size_t k) const noexcept {
+  return has_magnet_ ? held(kMagnet, magnet_, k) : std::nullopt;
 }
 
 std::size_t SampleStore::bytes() const noexcept {
@@ -131,7 +173,7 @@ std::size_t SampleStore::bytes() const noexcept {
     b += c.dt_ns.capacity() * sizeof(std::uint32_t) + c.t_ns.capacity() * sizeof(std::int64_t) + c.marks.capacity();
     for (const Values& v : c.columns) b += v.single.capacity() * sizeof(float) + v.full.capacity() * sizeof(double);
   }
-  b += staged_t_.capacity() * sizeof(std::int64_t) + staged_marks_.capacity();
+  b += staged_t_.capacity() * sizeof(std::int64_t) + staged_marks_.capacity() + winding_.bytes() + magnet_.bytes();
   for (const auto& v : staged_) b += v.capacity() * sizeof(double);
   return b;
 }

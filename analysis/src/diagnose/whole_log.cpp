@@ -15,9 +15,10 @@ using core::kNaN;
 /// The figures' ranges start from these (no sample: the range is then the figure's default).
 constexpr double kFar = 1e300;
 
-/// The temperature the figure draws against at sample k (the winding's if logged, else the magnet's).
+/// The temperature the figure draws against at sample k (the winding's if logged, else the magnet's), as the
+/// models take it (held between a slow sensor's readings).
 double drawn_temperature(const LogData& log, const EffectContext& context, std::size_t k) {
-  return (context.t_winding.logged ? log.samples.t_winding_C(k) : log.samples.t_magnet_C(k)).value_or(kNaN);
+  return (context.t_winding.logged ? log.samples.t_winding_held_C(k) : log.samples.t_magnet_held_C(k)).value_or(kNaN);
 }
 
 /// The figures' sums of one block of the comparison's pass: its time bins from `first_bin` on, the map's

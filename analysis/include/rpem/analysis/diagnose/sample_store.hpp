@@ -5,8 +5,10 @@
 // value of it is a float exactly (a temperature logged in whole degrees, a VESC current in steps of 1/16 A),
 // else as double: nothing a replay computes from a sample changes with the storage. Times are integer
 // nanoseconds, as 32-bit offsets from the chunk's first where the chunk spans less than 4.29 s. One byte per
-// sample marks it: a gap before it, left out of the replay, and a regime (core::Regime's number: room for a
-// per-sample classification, 3 bits). What a sample is not stored with: torque_cmd and the receive stamp
+// sample marks it: a gap before it, left out of the replay, a regime (core::Regime's number: room for a
+// per-sample classification, 3 bits), and whether each temperature column has a reading on it. A temperature
+// column is stored as its newest reading held (a slow sensor reads on few rows: docs/drive-log.md), so that the
+// temperature at every row costs nothing more. What a sample is not stored with: torque_cmd and the receive stamp
 // (rx_ns), which no diagnosis reads; the frames, which a log keeps throughout.
 //
 // Appending (push_back, then finish) needs a chunk of staging space, not the log's; reading decodes one
@@ -15,6 +17,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <optional>
 #include <vector>
 
@@ -29,6 +32,8 @@ inline constexpr std::uint8_t kGapBefore = 1U << 0;  ///< samples were lost befo
 inline constexpr std::uint8_t kLeftOut = 1U << 1;    ///< takes no part in the replay (LogData::used)
 inline constexpr unsigned kRegimeShift = 2;          ///< core::Regime's number in bits 2–4
 inline constexpr std::uint8_t kRegimeMask = 0x7U << kRegimeShift;
+inline constexpr std::uint8_t kWindingReading = 1U << 5;  ///< the winding temperature column has a reading on it
+inline constexpr std::uint8_t kMagnetReading = 1U << 6;   ///< the magnet temperature column has a reading on it
 }  // namespace sample_mark
 
 class SampleStore {
@@ -44,6 +49,8 @@ class SampleStore {
   /// Appends a row; its frames must be those of the first (a log keeps its frames) and its time not before
   /// the previous (throws std::invalid_argument otherwise: rows built in memory). Not after finish().
   void push_back(const io::DriveLogRow& row);
+  /// The next row opens another session (a folder's next log): no reading is held over into it.
+  void start_session() noexcept;
   /// Stores the last, partial chunk; the store is then complete and read-only.
   void finish();
 
@@ -56,9 +63,16 @@ class SampleStore {
   [[nodiscard]] double theta_el_rad(std::size_t k) const noexcept { return value(kTheta, k); }
   [[nodiscard]] double omega_el_rad_s(std::size_t k) const noexcept { return value(kOmega, k); }
   [[nodiscard]] double u_dc_V(std::size_t k) const noexcept { return value(kUDc, k); }
-  /// The temperatures, where the log has the column (its value may be NaN: a missing reading).
+  /// The temperatures read on row k: none where the log has no such column or no reading on the row (its
+  /// logger's value for none, io::MappedColumn::no_reading; a slow sensor between its readings).
   [[nodiscard]] std::optional<double> t_winding_C(std::size_t k) const noexcept;
   [[nodiscard]] std::optional<double> t_magnet_C(std::size_t k) const noexcept;
+  /// The temperatures at row k, as the diagnosis's models take them: the newest reading of the row's session
+  /// at or before it, else (rows before the session's first reading) that first reading; none where the
+  /// column or the session has no reading. Off the true temperature by at most |dT/dt| times the interval
+  /// between readings (docs/diagnose.md, "Temperatures between readings").
+  [[nodiscard]] std::optional<double> t_winding_held_C(std::size_t k) const noexcept;
+  [[nodiscard]] std::optional<double> t_magnet_held_C(std::size_t k) const noexcept;
   [[nodiscard]] bool has_t_winding() const noexcept { return has_winding_; }
   [[nodiscard]] bool has_t_magnet() const noexcept { return has_magnet_; }
 
@@ -78,6 +92,31 @@ class SampleStore {
  private:
   enum Column : std::size_t { kTheta, kOmega, kUDc, kU0, kU1, kU2, kI0, kI1, kI2, kWinding, kMagnet, kColumns };
 
+  /// A temperature column's newest reading, held while rows come (push); and, per session whose first rows
+  /// came before its first reading, those rows and that reading (lead_of), which the held value cannot give.
+  class HeldReading {
+   public:
+    /// Row k's reading (NaN: none) → the value to store: the reading, else the session's newest (NaN: none yet).
+    double push(double reading, std::size_t k);
+    void start_session() noexcept {
+      newest_ = kNoReading;
+      lead_first_.reset();
+    }
+    /// The first reading of row k's session where k came before it; none otherwise.
+    [[nodiscard]] std::optional<double> lead_of(std::size_t k) const noexcept;
+    [[nodiscard]] std::size_t bytes() const noexcept { return leads_.capacity() * sizeof(Lead); }
+
+   private:
+    static constexpr double kNoReading = std::numeric_limits<double>::quiet_NaN();
+    struct Lead {
+      std::size_t first = 0, end = 0;  ///< rows [first, end) take `value`, their session's first reading
+      double value = 0.0;
+    };
+    double newest_ = kNoReading;
+    std::optional<std::size_t> lead_first_;  ///< the session's rows without a reading so far start here
+    std::vector<Lead> leads_;
+  };
+
   /// One column's values of one chunk: float where all of them are floats exactly, else double.
   struct Values {
     std::vector<float> single;
@@ -96,7 +135,11 @@ class SampleStore {
   [[nodiscard]] double value(Column c, std::size_t k) const noexcept { return chunk(k).columns[c].at(k & (kChunk - 1)); }
   void store_chunk();
 
+  [[nodiscard]] std::optional<double> reading(Column c, std::uint8_t bit, std::size_t k) const noexcept;
+  [[nodiscard]] std::optional<double> held(Column c, const HeldReading& h, std::size_t k) const noexcept;
+
   bool has_winding_ = false, has_magnet_ = false;
+  HeldReading winding_, magnet_;
   core::Frame voltage_frame_ = core::Frame::kAbc, current_frame_ = core::Frame::kAbc;
   std::size_t size_ = 0;
   bool finished_ = false;
