@@ -78,8 +78,8 @@ struct EffectContext {
                                             const std::optional<core::DriftLaw>& r_s_law,
                                             const std::optional<core::DriftLaw>& psi_m_law, const LogData& log);
 
-/// The temperature columns of a log: their span and time-weighted mean over the used rows, each row's
-/// temperature the one the models take (SampleStore::t_winding_held_C).
+/// The temperature columns of a log: their span and mean over the used rows, each row's temperature the one
+/// the models take (SampleStore::t_winding_held_C).
 [[nodiscard]] TemperatureColumn winding_column(const LogData& log);
 [[nodiscard]] TemperatureColumn magnet_column(const LogData& log);
 
