@@ -99,14 +99,9 @@ class VescSampleSource final : public SampleSource {
                                 : std::unique_ptr<CountDelay>();
     const std::int64_t gather_ns = reply_gather_ns(poller_config(options_).period_ns);
     const timespec gather{0, static_cast<long>(gather_ns)};
-    while (!stop.load(std::memory_order_relaxed)) {
-      // The poll schedule and the windows run on CLOCK_REALTIME, the kernel's receive timestamps' clock.
-      std::int64_t now = core::now_ns(CLOCK_REALTIME);
-      poller.on_time(now);
-      if (poller.poll_due(now)) poller.polled(now, channel.send(poller.poll_frame(), 0));
-      const std::int64_t wait_ns = std::clamp<std::int64_t>(poller.wake_ns(now) - now, 0, 50'000'000);
-      const std::size_t n = channel.receive_for(frames, wait_ns);
-      now = core::now_ns(CLOCK_REALTIME);
+    // Takes n received frames (their kernel receive times; `now` where a frame has none); true if one completed a
+    // reply that became a sample.
+    auto take = [&](std::size_t n, std::int64_t now) {
       bool completed = false;
       for (std::size_t f = 0; f < n; ++f) {
         const std::uint64_t reads_before = poller.reads();
@@ -127,11 +122,32 @@ class VescSampleSource final : public SampleSource {
         if (counting) delay->add_read(poller.last_read());
         if (sampled) speed_error.hold(sample);
       }
+      return completed;
+    };
+    std::int64_t wait_ns = 0;
+    while (!stop.load(std::memory_order_relaxed)) {
+      const std::size_t n = channel.receive_for(frames, wait_ns);
+      // The poll schedule and the windows run on CLOCK_REALTIME, the kernel's receive timestamps' clock.
+      const std::int64_t now = core::now_ns(CLOCK_REALTIME);
+      bool completed = take(n, now);
+      std::size_t received = n;
+      // Every frame the kernel received by `now` is taken before a deadline is judged at `now`: a reply that came in
+      // time is not timed out because this thread ran late (a host that held it off the CPU past the deadline).
+      for (std::size_t more = 1; more > 0; received += more) {
+        more = channel.receive_for(frames, 0);
+        completed = take(more, now) || completed;
+      }
+      poller.on_time(now);
+      if (poller.poll_due(now)) poller.polled(now, channel.send(poller.poll_frame(), 0));
+      wait_ns = std::clamp<std::int64_t>(poller.wake_ns(now) - now, 0, 50'000'000);
       if (counting) {
         for (core::AveragedSample due; delay->release(now, due);) out.push(due);
       }
       // Frames but no complete reply: the rest of it is on its way — take it in one wake-up, not one per frame.
-      if (n > 0 && !completed) nanosleep(&gather, nullptr);
+      if (received > 0 && !completed) {
+        nanosleep(&gather, nullptr);
+        wait_ns = std::max<std::int64_t>(0, wait_ns - gather_ns);
+      }
       report_when_due(out, channel, [&](DiagnosticsRows& rows) { report_vesc_counters(poller, rows); });
     }
   }
