@@ -2,11 +2,14 @@
 
 #include <cmath>
 
+#include "rpem/core/thermal_terms.hpp"
+
 namespace rpem::core {
 namespace {
 
 constexpr int kN = kMaxThermalNodes;
 constexpr int kDynamic = kDynamicThermalStates;
+constexpr int kCoolant = kDynamic + static_cast<int>(Calibration::kCoolantError);
 
 }  // namespace
 
@@ -63,9 +66,13 @@ void ThermalFilter::predict(const ThermalLoad& load, const ThermalRates& rates) 
   }
   for (int i = n.nodes; i < kN; ++i) d_var[i] = 0.0;
 
-  // x⁺ = F·x + [γ; 0; 0]: only the rows of T change, through G = [Φ Γ_d] acting on [T; d].
+  // x⁺ = F·x + [γ; 0; 0]: only the rows of T change, through G = [Φ Γ_d] acting on [T; d] and b = Γ_d·g_c on the
+  // coolant's error (eq. 14.29), whose mean is zero (a consider state), so that it moves only the covariance.
   Eigen::Matrix<double, kN, kDynamic> g;
   g << tr.phi, tr.gamma_d;
+  ThermalVec g_c = ThermalVec::Zero();
+  for (int i = 0; i < n.nodes; ++i) g_c[i] = coolant_conductance_W_per_K(n, load, i);
+  const ThermalVec b = tr.gamma_d * g_c;
   x_.head<kN>() = g * x_.head<kDynamic>() + tr.gamma;  // a product that may alias: Eigen evaluates it first
   x_.segment<kN>(kN).array() *= decay.array();         // eq. 14.20
   transition_ = tr;
@@ -75,7 +82,8 @@ void ThermalFilter::predict(const ThermalLoad& load, const ThermalRates& rates) 
   // by A, so the rows of T become G·P[T,d rows] (from the prior P), the rows and columns of d scale by A, and
   // the T–d block is then G·P[·,d]·A. Small fixed sizes: coefficient-wise products, no blocking.
   Eigen::Matrix<double, kN, kThermalStates> rows = g.lazyProduct(p_.topRows<kDynamic>());
-  ThermalMat p_tt = rows.leftCols<kDynamic>().lazyProduct(g.transpose());
+  rows += b * p_.row(kCoolant);
+  ThermalMat p_tt = rows.leftCols<kDynamic>().lazyProduct(g.transpose()) + rows.col(kCoolant) * b.transpose();
   // P_dd(i, j)·(a_i·a_j): the same product for (i, j) and (j, i), so P_dd stays exactly symmetric; P_cd follows P_dc.
   rows.middleCols<kN>(kN) *= decay.asDiagonal();
   p_.block<kN, kN>(kN, kN).array() *= (decay * decay.transpose()).array();
@@ -89,6 +97,13 @@ void ThermalFilter::predict(const ThermalLoad& load, const ThermalRates& rates) 
   // Rounding must not make P asymmetric: P_TT is the only block not symmetric by construction.
   p_.topLeftCorner<kN, kN>() = 0.5 * (p_tt + p_tt.transpose());
   p_.block<kN, kN>(kN, kN).diagonal() += d_var;
+  if (coolant_seen_) p_(kCoolant, kCoolant) += config_.coolant_drift_K2_per_s * load.dt_s;  // eq. 14.29
+}
+
+void ThermalFilter::coolant_read() noexcept {
+  p_.row(kCoolant).setZero();
+  p_.col(kCoolant).setZero();
+  coolant_seen_ = true;
 }
 
 ThermalStateVec ThermalFilter::cross_covariance(const ThermalObservation& o) const noexcept {

@@ -199,6 +199,7 @@ void ThermalFusion::apply(const ThermalStepData& d) noexcept {
   if (!out_.started) start(d);
   const ThermalRates rates = thermal_rates(config_.filter.network, d.load);
   filter_.predict(d.load, rates);
+  if (d.coolant_read) filter_.coolant_read();  // the coolant's error starts again (eq. 14.29)
   last_load_ = d.load;
   finish_step(d, rates, d.load.dt_s);
 }

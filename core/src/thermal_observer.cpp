@@ -101,7 +101,10 @@ bool ThermalObserver::add(const Estimate& e, const ThermalSample& s) noexcept {
   const double dt = std::isfinite(s.dt_s) && s.dt_s > 0.0 ? s.dt_s : 0.0;
   // The coolant is an input the step integrates: a reading holds until the next one (a zero-order hold of a
   // slow temperature that a log or a bus may give less often than the currents).
-  if (std::isfinite(s.coolant_C)) measured_coolant_C_ = s.coolant_C;
+  if (std::isfinite(s.coolant_C)) {
+    measured_coolant_C_ = s.coolant_C;
+    coolant_read_ = true;
+  }
   const double coolant = std::isfinite(measured_coolant_C_) ? measured_coolant_C_ : coolant_C_;
   const Vec2 i = e.i_meas_A;
   const double omega = base_.omega_el_rad_s_of(e.speed_pu);
@@ -127,6 +130,8 @@ bool ThermalObserver::add(const Estimate& e, const ThermalSample& s) noexcept {
   step_.r_s_Ohm = e.r_s_Ohm;
   step_.winding_sensor_C = sensor_time_ > 0.0 ? sensor_sum_ / sensor_time_ : std::numeric_limits<double>::quiet_NaN();
   step_.winding_sensor_age = ReadingAge{};
+  step_.coolant_read = coolant_read_;
+  coolant_read_ = false;
   if (sensor_time_ > 0.0) {
     const double mean_elapsed = sensor_elapsed_ / sensor_time_;
     step_.winding_sensor_age = {std::max(0.0, duration - mean_elapsed),

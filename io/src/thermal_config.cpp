@@ -276,6 +276,8 @@ ThermalConfig parse_thermal_config(YamlMap& section, const MachineConfig& machin
                              core::Calibration::kMagnetOffset, core::Calibration::kMagnetCoefficient, nullptr, nullptr);
   }
   f.coolant_C = section.number_or("coolant_C", f.coolant_C, -60.0, 300.0);
+  // q_c: how fast an unread coolant may move (docs/derivations.md eq. 14.29); 0: a held reading is exact.
+  f.filter.coolant_drift_K2_per_s = section.number_or("coolant_drift_K2_per_s", f.filter.coolant_drift_K2_per_s, 0.0, 1e3);
   if (auto s = section.optional_map("winding_sensor")) {
     f.winding_sensor_sigma_K = s->number("sigma_K", 1e-3, 100.0);
     // Its lag behind the winding node (docs/derivations.md eq. 14.19); 0: the reading is the node.
@@ -427,6 +429,8 @@ std::string thermal_config_yaml(const ThermalConfig& c) {
     << ", coeff_per_K: " << num(m.coeff_per_K) << ", reference_sigma_K: " << s(core::Calibration::kMagnetOffset)
     << ", coeff_rel_sigma: " << s(core::Calibration::kMagnetCoefficient) << "}\n";
   o << "  coolant_C: " << num(f.coolant_C) << "\n";
+  if (f.filter.coolant_drift_K2_per_s > 0.0)
+    o << "  coolant_drift_K2_per_s: " << num(f.filter.coolant_drift_K2_per_s) << "\n";
   if (f.winding_sensor_sigma_K > 0.0) {
     o << "  winding_sensor: {sigma_K: " << num(f.winding_sensor_sigma_K);
     if (f.winding_sensor_time_constant_s > 0.0) o << ", time_constant_s: " << num(f.winding_sensor_time_constant_s);

@@ -2,7 +2,7 @@
 // and closed-form limits: the scalar update, a correlated update, Schmidt's consider states (the calibration
 // bounds what observations can teach), the gate, the prediction's covariance, and a heat disturbance the
 // filter learns from observations of one node; the blockwise prediction and sparse update against the dense
-// forms on all twelve states; a law's bilinear calibration term taken over the prior (eq. 14.10a).
+// forms on all thirteen states; a law's bilinear calibration term taken over the prior (eq. 14.10a).
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -147,7 +147,8 @@ TEST(ThermalFilter, LearnsAHeatDisturbanceFromOneNodesReadingsAndCorrectsTheOthe
 }
 
 // The filter predicts blockwise and updates with a sparse H (docs/derivations.md §14, eq. 14.11, 14.12, 14.21);
-// here the dense forms on all 12 states: P⁺ = F·P·Fᵀ + Q_d with F = [Φ Γ_d 0; 0 A 0; 0 0 I], A = diag(e^{−Δt/τ_d}),
+// here the dense forms on all 13 states: P⁺ = F·P·Fᵀ + Q_d with F = [Φ Γ_d b; 0 A 0; 0 0 I], A = diag(e^{−Δt/τ_d}),
+// b = Γ_d·g_c in the coolant error's column (eq. 14.29), Q_d's coolant entry q_c·Δt,
 // and the Joseph form (I − K·H)·P·(I − K·H)ᵀ + K·r·Kᵀ with K = [P·Hᵀ/s on T and d; 0 on c]. Four nodes in use, so
 // every row of the network moves, with a disturbance and cross-covariances built by earlier steps.
 void expect_blockwise_steps_are_the_dense_formulas(const ThermalVec& tau_s) {
@@ -158,6 +159,7 @@ void expect_blockwise_steps_are_the_dense_formulas(const ThermalVec& tau_s) {
   n.winding = 0, n.magnet = 3;
   n.capacitance_J_per_K << 3000.0, 12000.0, 5000.0, 7000.0;
   n.to_coolant_W_per_K << 2.0, 90.0, 10.0, 4.0;
+  n.to_coolant_at_base_speed_W_per_K[3] = 6.0;  // g_c's speed part (eq. 14.1b)
   n.between_W_per_K(0, 1) = n.between_W_per_K(1, 0) = 40.0;
   n.between_W_per_K(1, 2) = n.between_W_per_K(2, 1) = 25.0;
   n.between_W_per_K(2, 3) = n.between_W_per_K(3, 2) = 12.0;
@@ -169,16 +171,19 @@ void expect_blockwise_steps_are_the_dense_formulas(const ThermalVec& tau_s) {
   c.disturbance_W2_per_s << 1.0, 2.0, 3.0, 4.0;
   c.copper_rel_sigma = 0.0;  // Var(v) = q_d·Δt: the loss terms' changes are not what this test is about
   c.gate_sigma = 100.0;
+  c.coolant_drift_K2_per_s = 0.05;
   ThermalFilter f(c);
   f.reset(40.0, 5.0);
+  f.coolant_read();  // then unread: e_c walks through every step below and correlates with [T; d]
   ThermalLoad l;
   l.dt_s = 7.0;
+  l.convection_basis = 0.6;
   l.current_sq_A2 = 900.0;
   l.basis[static_cast<std::size_t>(LossForm::kIronEddy)] = 0.5;
   l.coolant_C = 30.0;
   ThermalObservation magnet;  // the magnet through a law with its calibration states, and the winding
   magnet.h << 0.1, 0.0, 0.0, -1.4e-3;
-  magnet.h_c << -1.4e-3, -0.04, 0.0, 0.0;
+  magnet.h_c << -1.4e-3, -0.04, 0.0, 0.0, 0.0;
   magnet.offset = 1.2;
   magnet.variance = 1e-6;
   ThermalObservation winding;
@@ -200,6 +205,8 @@ void expect_blockwise_steps_are_the_dense_formulas(const ThermalVec& tau_s) {
   const ThermalStateMat p0 = f.covariance();
   ASSERT_GT((p0.block<4, 4>(0, 4).cwiseAbs().minCoeff()), 0.0);  // T and d correlated: the blocks matter
   ASSERT_GT((p0.block<kMaxThermalNodes, kCalibrationStates>(0, kDynamicThermalStates).cwiseAbs().maxCoeff()), 0.0);
+  const int ke = kDynamicThermalStates + static_cast<int>(Calibration::kCoolantError);
+  ASSERT_GT(p0.col(ke).head<4>().cwiseAbs().minCoeff(), 0.0);  // the coolant's error reached every node
   EXPECT_TRUE(p0 == p0.transpose());
 
   f.predict(l);
@@ -207,6 +214,8 @@ void expect_blockwise_steps_are_the_dense_formulas(const ThermalVec& tau_s) {
   ThermalStateMat big_f = ThermalStateMat::Identity();
   big_f.block<4, 4>(0, 0) = tr.phi;
   big_f.block<4, 4>(0, 4) = tr.gamma_d;
+  ThermalVec g_c = n.to_coolant_W_per_K + n.to_coolant_at_base_speed_W_per_K * 0.6;
+  big_f.block<4, 1>(0, ke) = tr.gamma_d * g_c;
   ThermalVec drift_var = c.disturbance_W2_per_s * l.dt_s;  // eq. 14.9, and 14.20 where τ_d is finite
   for (int i = 0; i < 4; ++i) {
     if (std::isinf(tau_s[i])) continue;
@@ -218,6 +227,7 @@ void expect_blockwise_steps_are_the_dense_formulas(const ThermalVec& tau_s) {
   const ThermalMat q_t = c.process_noise_K2_per_s.asDiagonal();
   q_d.block<4, 4>(0, 0) = 0.5 * l.dt_s * (tr.phi * q_t * tr.phi.transpose() + q_t);
   q_d.block<4, 4>(4, 4) = drift_var.asDiagonal();
+  q_d(ke, ke) = c.coolant_drift_K2_per_s * l.dt_s;
   const ThermalStateMat p1 = big_f * p0 * big_f.transpose() + q_d;
   ThermalStateVec x1 = big_f * x0;
   x1.head<4>() += tr.gamma;
@@ -231,7 +241,7 @@ void expect_blockwise_steps_are_the_dense_formulas(const ThermalVec& tau_s) {
   h << magnet.h, ThermalVec::Zero(), magnet.h_c;
   const double s = h.dot(p1 * h) + magnet.variance;
   ThermalStateVec k = p1 * h / s;
-  k.tail<4>().setZero();  // Schmidt: the calibration states are considered, not estimated
+  k.tail<kCalibrationStates>().setZero();  // Schmidt: the calibration states are considered, not estimated
   const ThermalStateMat i_kh = ThermalStateMat::Identity() - k * h.transpose();
   const ThermalStateMat p2 = i_kh * p1 * i_kh.transpose() + k * magnet.variance * k.transpose();
   const ThermalStateVec x2 = x1 + k * (magnet.value - h.dot(x1) - magnet.offset);
@@ -410,7 +420,7 @@ TEST(ThermalFilter, BilinearCalibrationTermEntersTheInnovationAndItsVariance) {
   f.reset(100.0, 100.0);  // a vague prior: T's error ends almost wholly along the calibration's, as on Paderborn
   const auto reading = [](double value, double d_K) {
     ThermalObservation o = magnet_reading(value, 0.13);
-    o.h_c << 1.0, d_K, 0.0, 0.0;
+    o.h_c << 1.0, d_K, 0.0, 0.0, 0.0;
     o.bilinear = 1.0;
     o.bilinear_node = 1;
     o.bilinear_state = Calibration::kMagnetCoefficient;
@@ -424,7 +434,7 @@ TEST(ThermalFilter, BilinearCalibrationTermEntersTheInnovationAndItsVariance) {
   const ThermalObservation o = reading(98.0, 78.5);
   ThermalStateVec h = ThermalStateVec::Zero();
   h[kt] = 1.0;
-  h.tail<4>() = o.h_c;
+  h.tail<kCalibrationStates>() = o.h_c;
   const double second = p(kt, kt) * p(ke, ke) + p(kt, ke) * p(kt, ke);
   const double s = h.dot(p * h) + o.variance + second;
   const double nu = o.value - t0 - p(kt, ke);

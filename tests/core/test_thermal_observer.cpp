@@ -177,11 +177,20 @@ TEST(ThermalObserver, ACoolantReadingHoldsUntilTheNextAndTheConfiguredOneStandsI
   const MachineSi machine = test::paper_machine_si();
   const PerUnitBase base = test::paper_base();
   ThermalObserver observer(ThermalObserverConfig{}, base, machine, loss_base_of(base, machine), 25.0);
-  EXPECT_NEAR(coolant_step(observer, {}).load.coolant_C, 25.0, 1e-12);           // none yet: the configured one
-  EXPECT_NEAR(coolant_step(observer, {{1, 31.0}}).load.coolant_C, 31.0, 1e-12);  // read once, held (not 25.75)
+  // Each step says whether a reading came in it (the filter's coolant error starts again there, eq. 14.29).
+  ThermalStepData s = coolant_step(observer, {});
+  EXPECT_NEAR(s.load.coolant_C, 25.0, 1e-12);  // none yet: the configured one
+  EXPECT_FALSE(s.coolant_read);
+  s = coolant_step(observer, {{1, 31.0}});
+  EXPECT_NEAR(s.load.coolant_C, 31.0, 1e-12);  // read once, held (not 25.75)
+  EXPECT_TRUE(s.coolant_read);
   // Held at 31 over samples 1–4, read 37 at the 5th and held: (4·31 + 4·37)/8.
-  EXPECT_NEAR(coolant_step(observer, {{5, 37.0}}).load.coolant_C, 34.0, 1e-12);
-  EXPECT_NEAR(coolant_step(observer, {}).load.coolant_C, 37.0, 1e-12);  // a step without a reading holds too
+  s = coolant_step(observer, {{5, 37.0}});
+  EXPECT_NEAR(s.load.coolant_C, 34.0, 1e-12);
+  EXPECT_TRUE(s.coolant_read);
+  s = coolant_step(observer, {});
+  EXPECT_NEAR(s.load.coolant_C, 37.0, 1e-12);  // a step without a reading holds too
+  EXPECT_FALSE(s.coolant_read);                // and is unread
 }
 
 }  // namespace

@@ -30,6 +30,7 @@ const char* kThreeNodes = R"(thermal:
   copper: {r_s_ref_Ohm: 0.07, reference_C: 120, coeff_per_K: 0.0028, reference_sigma_K: 2, coeff_rel_sigma: 0.05, loss_rel_sigma: 0.08}
   magnet_law: {psi_m_ref_Wb: 0.117, reference_C: 20, coeff_per_K: -0.00105}
   coolant_C: 35
+  coolant_drift_K2_per_s: 0.0025
   winding_sensor: {sigma_K: 1.5, time_constant_s: 12, node: reading}
   filter: {period_s: 0.5, initial_sigma_K: 5, gate_sigma: 4, gate_reset_after: 2, residual_time_constant_s: 8, settle_time_constants: 4}
 )";
@@ -94,6 +95,7 @@ TEST(ThermalConfig, ReadsEveryKeyAndTheWriterReadsBack) {
   EXPECT_DOUBLE_EQ(c.fusion.observer.period_s, 0.5);
   EXPECT_EQ(c.fusion.filter.gate_reset_after, 2);
   EXPECT_DOUBLE_EQ(c.fusion.filter.disturbance_W2_per_s[0], 2.0);
+  EXPECT_DOUBLE_EQ(c.fusion.filter.coolant_drift_K2_per_s, 0.0025);
 
   const ThermalConfig back = load_text(thermal_config_yaml(c));
   const core::ThermalNetwork& m = back.fusion.filter.network;
@@ -111,6 +113,7 @@ TEST(ThermalConfig, ReadsEveryKeyAndTheWriterReadsBack) {
   EXPECT_DOUBLE_EQ(m.copper.value_ref, n.copper.value_ref);
   EXPECT_DOUBLE_EQ(back.fusion.magnet_law.value_ref, c.fusion.magnet_law.value_ref);
   EXPECT_DOUBLE_EQ(back.fusion.coolant_C, 35.0);
+  EXPECT_DOUBLE_EQ(back.fusion.filter.coolant_drift_K2_per_s, 0.0025);
   EXPECT_DOUBLE_EQ(back.fusion.winding_sensor_time_constant_s, 12.0);
   EXPECT_TRUE(back.fusion.winding_node_is_reading);
   EXPECT_DOUBLE_EQ(m.base.current_A, 150.0);
@@ -158,6 +161,9 @@ TEST(ThermalConfig, BadSectionsNameFileLineKeyAndReason) {
                 .find("thermal.nodes[2].capacitance_J_per_K: -1 is outside"),
             std::string::npos);
   EXPECT_NE(error_of("coolant_C: 35", "coolant_C: 35\n  coolnat: 3").find("thermal.coolnat"), std::string::npos);
+  EXPECT_NE(error_of("coolant_drift_K2_per_s: 0.0025", "coolant_drift_K2_per_s: -1")
+                .find("thermal.coolant_drift_K2_per_s: -1 is outside"),
+            std::string::npos);
   // A required key misspelt: the error points at what was given, not only at the key that is missing.
   EXPECT_NE(error_of("capacitance_J_per_K: 6500", "capacitence_J_per_K: 6500")
                 .find(":5:22: thermal.nodes[2].capacitance_J_per_K: required key is missing; `capacitence_J_per_K` is "

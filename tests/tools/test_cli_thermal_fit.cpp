@@ -183,6 +183,9 @@ TEST_F(CliThermalFit, ReadsAVescToolLogItsMotorSensorTheWinding) {
   EXPECT_NE(r.output.find("vesc.csv as VESC Tool realtime log (the header of VESC Tool 1.20 and later)"), std::string::npos)
       << r.output;
   EXPECT_NE(r.output.find("has no T_coolant column"), std::string::npos) << r.output;
+  // Nor, so, a coolant that moves unread to measure (eq. 14.29b): said, and nothing written for it.
+  EXPECT_NE(r.output.find("Coolant drift: the training part has no coolant readings"), std::string::npos) << r.output;
+  EXPECT_EQ(test::read_file(dir_ + "/thermal.yaml").find("coolant_drift_K2_per_s"), std::string::npos);
   EXPECT_EQ(r.output.find("the winding is observed on no step"), std::string::npos) << r.output;  // temp_motor is
   // The outrunner's configuration says nothing of where its 25 mOhm were measured: the fit says what it assumed,
   // on the terminal and in thermal.yaml, where the user who reads it can correct it.

@@ -122,8 +122,11 @@ class ThermalRun {
     if (coolant_held_ > 0) {
       std::fprintf(stderr,
                    "rpem estimate: thermal: %llu of %llu samples have no coolant reading after one: the newest reading "
-                   "holds there\n",
-                   static_cast<unsigned long long>(coolant_held_), static_cast<unsigned long long>(samples_));
+                   "holds there, and the fused band widens over each filter step without a reading as an unread "
+                   "coolant may move (thermal.coolant_drift_K2_per_s: %.3g K²/s%s; eq. 14.29)\n",
+                   static_cast<unsigned long long>(coolant_held_), static_cast<unsigned long long>(samples_),
+                   fusion_->config().filter.coolant_drift_K2_per_s,
+                   fusion_->config().filter.coolant_drift_K2_per_s > 0.0 ? "" : ", so it does not widen");
     }
     if (samples_ > 0 && !(sensor_fused_ && std::isfinite(first_winding_C_))) {
       // core::start_temperatures_C: without a fused winding reading at the start, the soak is assumed.

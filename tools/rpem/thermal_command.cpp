@@ -143,6 +143,7 @@ void print_fit(const analysis::ThermalFitResult& fit, const analysis::ThermalRec
   for (int i = 0; i < fit.config.fusion.filter.network.nodes; ++i)
     std::printf(" %s %.3g s", fit.config.node_names[static_cast<std::size_t>(i)].c_str(),
                 fit.disturbance_time_constant_s[i]);
+  std::printf("\n%s", analysis::coolant_drift_sentence(fit.coolant_drift).c_str());
 }
 
 /// How often the fit looks again at the winding sensor's column with the network it fitted (eq. 14.28c): each look

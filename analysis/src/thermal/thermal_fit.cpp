@@ -662,6 +662,8 @@ ThermalFitResult fit_thermal(const ThermalRecord& record, const io::ThermalConfi
   out.config = fitted_layout.apply(best.x.data());
   intervals(fitted_layout, record, training, points, best.x, options.blocks, out);
   fit_filter_noises(record, training, options, out);
+  out.coolant_drift = coolant_drift(record, training);
+  out.config.fusion.filter.coolant_drift_K2_per_s = out.coolant_drift.q_K2_per_s;
   judge(out.config, record, training, points, out);
   add_closing_notes(out);
   return out;

@@ -98,6 +98,9 @@ void write_thermal_fit_json(const std::string& path, const ThermalFitResult& fit
   for (int i = 0; i < fit.config.fusion.filter.network.nodes; ++i)
     j["disturbance_time_constant_s"].push_back(fit.disturbance_time_constant_s[i]);
   j["disturbance_time_constant_threshold"] = fit.disturbance_time_constant_threshold;
+  j["coolant_drift_K2_per_s"] = fit.coolant_drift.q_K2_per_s;
+  j["coolant_drift_at_lag_s"] = fit.coolant_drift.at_lag_s;
+  j["coolant_reading_floor_K2"] = fit.coolant_drift.floor_K2;
   for (const ThermalFitResult::TimeConstantTrial& t : fit.disturbance_time_constant_log_likelihood) {
     j["disturbance_time_constant_grid"].push_back(
         {{"node", t.node}, {"time_constant_s", t.time_constant_s}, {"log_likelihood", t.log_likelihood}});
@@ -171,6 +174,7 @@ void write_thermal_fit_report(const std::string& path, const ThermalFitResult& f
   }
   o << " (a finite one kept only where it gains more than " << significant(fit.disturbance_time_constant_threshold)
     << " in log-likelihood over the walk: the likelihood-ratio test at 5 % over the grid, eq. 14.21a).\n";
+  o << "\n" << coolant_drift_sentence(fit.coolant_drift) << "\n";
   if (!fit.not_identifiable.empty()) {
     o << "\n## Not identifiable\n\nParameters the log cannot tell apart (they move together along a direction the "
          "residuals barely change):\n\n";

@@ -1,13 +1,18 @@
 #pragma once
 // The Kalman filter of the node temperatures (docs/derivations.md §14, "Fusion"): the thermal network as its
 // process model, augmented by each node's heat disturbance d [W] — what the loss model gets wrong — and by
-// the temperature laws' calibration errors c, which it carries but does not estimate (Schmidt's "consider"
-// states: nothing in the data tells a calibration error from a model error), corrected by scalar linear
-// observations (a parameter estimate through its temperature law, a sensor).
+// the temperature laws' calibration errors and the held coolant reading's error c, which it carries but does not
+// estimate (Schmidt's "consider" states: nothing in the data tells a calibration error from a model error, nor a
+// coolant that moved unread from a heat disturbance), corrected by scalar linear observations (a parameter
+// estimate through its temperature law, a sensor).
 //
-//   state x = [T; d; c],  T⁺ = Φ·T + γ + Γ_d·d,  d⁺ = a·d + v,  c⁺ = c            (eq. 14.4, 14.9, 14.19)
+//   state x = [T; d; c],  T⁺ = Φ·T + γ + Γ_d·(d + g_c·e_c),  d⁺ = a·d + v,  c⁺ = c + [0 0 0 0 w_c]
+//                                                                          (eq. 14.4, 14.9, 14.19, 14.29)
 //   a = e^{−Δt/τ_d} per node: a first-order Gauss–Markov disturbance, τ_d = ∞ (a = 1) the random walk
-//   c = [e_ref,magnet, e_α,magnet, e_ref,copper, e_α,copper]: a law's temperature reads T + e_ref + e_α·(T − T_ref)
+//   c = [e_ref,magnet, e_α,magnet, e_ref,copper, e_α,copper, e_c]: a law's temperature reads T + e_ref + e_α·(T − T_ref);
+//   e_c [K] the coolant's move since its newest reading, which heats node i by g_c,i·e_c = G_i0(ω)·e_c (eq. 14.1):
+//   a random walk, Var(w_c) = q_c·Δt once a reading has been seen, and a new reading starts it again at zero
+//   (coolant_read: the coolant's error is then the sensor's, independent of every earlier error)
 //   Var(v_i) = q_d,i·(τ_d/2)·(1 − a²) [→ q_d,i·Δt as τ_d → ∞] + Σ_terms (σ_rel,term·ΔP_term,i)²: a loss model's error moves with the loss it
 //   models, so each change ΔP of a modelled loss term between steps adds its relative uncertainty squared
 //   P⁺ = F·P·Fᵀ + Q_d,  F = [Φ Γ_d 0; 0 A 0; 0 0 I] (A = diag a),  Q_d = (Δt/2)·(Φ·Q_T·Φᵀ + Q_T) on T (trapezoidal rule),
@@ -24,7 +29,7 @@
 
 namespace rpem::core {
 
-inline constexpr int kCalibrationStates = 4;
+inline constexpr int kCalibrationStates = 5;
 /// T and d: what the model moves and the filter estimates; the calibration states follow them.
 inline constexpr int kDynamicThermalStates = 2 * kMaxThermalNodes;
 inline constexpr int kThermalStates = kDynamicThermalStates + kCalibrationStates;
@@ -32,8 +37,14 @@ using ThermalStateVec = Eigen::Matrix<double, kThermalStates, 1>;
 using ThermalStateMat = Eigen::Matrix<double, kThermalStates, kThermalStates>;
 using CalibrationVec = Eigen::Matrix<double, kCalibrationStates, 1>;
 
-/// The calibration states: which law, and offset or coefficient.
-enum class Calibration : int { kMagnetOffset = 0, kMagnetCoefficient = 1, kCopperOffset = 2, kCopperCoefficient = 3 };
+/// The consider states: which law, and offset or coefficient; and the held coolant reading's error e_c (eq. 14.29).
+enum class Calibration : int {
+  kMagnetOffset = 0,
+  kMagnetCoefficient = 1,
+  kCopperOffset = 2,
+  kCopperCoefficient = 3,
+  kCoolantError = 4
+};
 
 /// One scalar observation y = h·T + h_d·d + h_c·c + offset + b·δT_i·δc_k + v, v ~ N(0, variance); δ the errors of
 /// the prior mean. The bilinear term is a law's e_α·(T − T_ref) beyond its linearisation at T̂ (eq. 14.10, 14.10a).
@@ -62,8 +73,11 @@ struct ThermalFilterConfig {
   Eigen::Matrix<double, kLossForms, kMaxThermalNodes> loss_rel_sigma =
       Eigen::Matrix<double, kLossForms, kMaxThermalNodes>::Zero();
   double copper_rel_sigma = 0.1;  ///< σ_rel of the copper loss (R_s's law and reference)
-  /// σ of the calibration states (Calibration order): [K, relative, K, relative].
-  CalibrationVec calibration_sigma = CalibrationVec(1.0, kNdFeB.rel_sigma(), 1.0, kCopper.rel_sigma());
+  /// σ of the calibration states at the start (Calibration order): [K, relative, K, relative, K]; the coolant's
+  /// error starts at 0, the configured coolant standing in until a reading comes.
+  CalibrationVec calibration_sigma = (CalibrationVec() << 1.0, kNdFeB.rel_sigma(), 1.0, kCopper.rel_sigma(), 0.0).finished();
+  /// q_c [K²/s]: how fast an unread coolant may move, as a random walk (eq. 14.29); 0: a held reading is exact.
+  double coolant_drift_K2_per_s = 0.0;
   double gate_sigma = 5.0;
   /// After this many consecutive rejected observations of one kind the model, not the observation, is taken
   /// to be wrong: the observed node's variance grows by ν²/h² and the observation is applied (0: never).
@@ -84,6 +98,9 @@ class ThermalFilter {
   void predict(const ThermalLoad& load, const ThermalRates& rates) noexcept;
   /// Applies one observation unless it is not finite or its innovation lies beyond the gate.
   [[nodiscard]] ObservationResult observe(const ThermalObservation& o) noexcept;
+  /// A coolant reading came in the step just predicted: the coolant's error e_c starts again, at zero and
+  /// uncorrelated (eq. 14.29); from now on it walks between readings. Call after predict().
+  void coolant_read() noexcept;
   /// Adds `variance_K2` to one node's variance (the model has drifted: a gate reset).
   void inflate(int node, double variance_K2) noexcept { p_(node, node) += variance_K2; }
   /// Moves [T; d] to the given values and widens the temperatures' covariance by δ·δᵀ, δ their move, so the band
@@ -122,6 +139,7 @@ class ThermalFilter {
   ThermalTransition transition_{};         ///< the newest prediction's (advance_open_loop)
   ThermalVec decay_ = ThermalVec::Ones();  ///< its disturbances' a
   bool predicted_ = false;
+  bool coolant_seen_ = false;  ///< a coolant reading has come: e_c walks (eq. 14.29)
   double innovation_ = 0.0, innovation_variance_ = 0.0;
 };
 

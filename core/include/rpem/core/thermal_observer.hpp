@@ -73,7 +73,8 @@ struct ThermalStepData {
   std::array<ParameterObservation, 2> parameter;                       ///< indexed by kPsiM, kRs
   double winding_sensor_C = std::numeric_limits<double>::quiet_NaN();  ///< the step's mean; NaN: none
   ReadingAge winding_sensor_age;                                       ///< when its readings were taken
-  double psi_m_Wb = 0.0, r_s_Ohm = 0.0;                                ///< the estimates at the step's end
+  bool coolant_read = false;             ///< a sample of the step carried a coolant reading (ThermalFilter::coolant_read)
+  double psi_m_Wb = 0.0, r_s_Ohm = 0.0;  ///< the estimates at the step's end
 };
 
 class ThermalObserver {
@@ -105,6 +106,7 @@ class ThermalObserver {
   LossBase loss_base_;
   double coolant_C_;
   double measured_coolant_C_ = std::numeric_limits<double>::quiet_NaN();  ///< the newest reading; NaN: none yet
+  bool coolant_read_ = false;                                             ///< in the current step
   LossAccumulator losses_;
   static constexpr int kMaxBatch = 32;
   Vec2 eps_mean_ = Vec2::Zero();   ///< ε̄, per sample

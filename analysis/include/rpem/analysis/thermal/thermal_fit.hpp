@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "rpem/analysis/thermal/coolant_drift.hpp"
 #include "rpem/analysis/thermal/thermal_record.hpp"
 #include "rpem/io/thermal_config.hpp"
 
@@ -81,6 +82,8 @@ struct ThermalFitResult {
   std::vector<TimeConstantTrial> disturbance_time_constant_log_likelihood;
   /// The gain in log-likelihood a chosen τ_d had to show over the walk (eq. 14.21a; 0 where τ_d was given).
   double disturbance_time_constant_threshold = 0.0;
+  /// q_c of an unread coolant (eq. 14.29b) from the training part's coolant readings; also in config (0: none read).
+  CoolantDrift coolant_drift;
   double training_cost = 0.0;                 ///< Σ of the squared weighted residuals
   std::vector<core::ThermalVec> open_loop_C;  ///< the model alone over the whole log, per step
 };

@@ -1,0 +1,221 @@
+// A coolant that moves unread (core/thermal_filter.hpp, docs/derivations.md eq. 14.29): the held reading's error e_c
+// as a consider state that walks between readings. The nodes' added variance over a silence against two computations
+// that share nothing with the filter's discrete step — the continuous Lyapunov equation of [T; e_c] integrated by RK4,
+// and a Monte Carlo of the walk through an Euler-integrated plant — and against the bound q_c·s (a node's step
+// response to the coolant lies in [0, 1]); a reading on every step changes nothing to the last bit, a reading after
+// a silence starts e_c again, and a filter that never saw a reading does not widen.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+#include <vector>
+
+#include "rpem/core/thermal_fusion.hpp"
+#include "support/paper_machine.hpp"
+
+namespace rpem::core {
+namespace {
+
+constexpr double kQc_K2_per_s = 2e-3;
+
+/// Two nodes with time constants of about 60 and 300 s, no loss at zero current.
+ThermalFilterConfig coolant_test_network(double q_c) {
+  ThermalFilterConfig c;
+  ThermalNetwork& n = c.network;
+  n.nodes = 2;
+  n.capacitance_J_per_K << 2000.0, 4000.0, 1.0, 1.0;
+  n.to_coolant_W_per_K << 20.0, 10.0, 0.0, 0.0;
+  n.between_W_per_K(0, 1) = n.between_W_per_K(1, 0) = 10.0;
+  n.copper = {0.00393, 20.0, 0.05};
+  n.base = {1000.0, 0.1, 100.0};
+  c.calibration_sigma.setZero();
+  c.copper_rel_sigma = 0.0;
+  c.coolant_drift_K2_per_s = q_c;
+  return c;
+}
+
+ThermalLoad at_rest_load(double dt_s) {
+  ThermalLoad l;
+  l.dt_s = dt_s;
+  l.coolant_C = 25.0;
+  return l;
+}
+
+using CoolantMat3 = Eigen::Matrix3d;
+using ThermalMat2N = Eigen::Matrix<double, kDynamicThermalStates, kDynamicThermalStates>;
+
+/// dP/dt = M·P + P·Mᵀ + Q of z = [T₀, T₁, e_c], dT/dt = A·T + C⁻¹·g_c·e_c, de_c/dt = white of intensity q_c:
+/// P(t) from P(0) = 0, by RK4 at `h_s`, sampled at whole seconds.
+std::vector<CoolantMat3> coolant_lyapunov(const ThermalNetwork& n, double q_c, double seconds, double h_s) {
+  CoolantMat3 m = CoolantMat3::Zero();
+  for (int i = 0; i < 2; ++i) {
+    const double c = n.capacitance_J_per_K[i], g0 = n.to_coolant_W_per_K[i], g = n.between_W_per_K(0, 1);
+    m(i, i) = -(g0 + g) / c;
+    m(i, 1 - i) = g / c;
+    m(i, 2) = g0 / c;
+  }
+  CoolantMat3 q = CoolantMat3::Zero();
+  q(2, 2) = q_c;
+  const auto rate = [&](const CoolantMat3& p) -> CoolantMat3 { return m * p + p * m.transpose() + q; };
+  std::vector<CoolantMat3> out{CoolantMat3::Zero()};
+  CoolantMat3 p = CoolantMat3::Zero();
+  const int per_second = static_cast<int>(std::lround(1.0 / h_s));
+  for (int k = 1; k <= static_cast<int>(seconds) * per_second; ++k) {
+    const CoolantMat3 k1 = rate(p), k2 = rate(p + 0.5 * h_s * k1), k3 = rate(p + 0.5 * h_s * k2), k4 = rate(p + h_s * k3);
+    p += (h_s / 6.0) * (k1 + 2.0 * k2 + 2.0 * k3 + k4);
+    if (k % per_second == 0) out.push_back(p);
+  }
+  return out;
+}
+
+TEST(ThermalCoolantError, NodesWidenAsTheContinuousLyapunovEquationSays) {
+  ThermalFilter f(coolant_test_network(kQc_K2_per_s));
+  f.reset(25.0, 0.0);
+  f.coolant_read();  // the last reading: from here the coolant is unread
+  const std::vector<CoolantMat3> truth = coolant_lyapunov(f.config().network, kQc_K2_per_s, 3000.0, 0.02);
+  for (int s = 1; s <= 3000; ++s) {
+    f.predict(at_rest_load(1.0));
+    if (s != 60 && s != 600 && s != 3000) continue;
+    // The filter holds e_c over each step at its start value (eq. 14.4's hold): it lags the continuous walk by half
+    // a step, and P_TT grows as s³ at first (a walk through a lag), so the relative difference is about 1.5·Δt/s.
+    const double tol_rel = 1.5 / s + 1e-3;
+    for (int i = 0; i < 2; ++i) {
+      EXPECT_NEAR(f.covariance()(i, i), truth[s](i, i), tol_rel * truth[s](i, i)) << "node " << i << " at " << s << " s";
+      // The steady-state bound (eq. 14.29): a node's step response to the coolant lies in [0, 1], so a walk of
+      // intensity q_c adds at most q_c·s to its variance.
+      EXPECT_LE(f.covariance()(i, i), kQc_K2_per_s * s);
+    }
+    EXPECT_NEAR(f.covariance()(0, 1), truth[s](0, 1), tol_rel * truth[s](0, 1)) << s << " s";
+  }
+}
+
+TEST(ThermalCoolantError, NodesWidenAsAMonteCarloOfTheWalkThroughTheNetwork) {
+  // The true coolant walks (Euler–Maruyama at 0.1 s) and drives the network (Euler at 0.1 s); the filter holds the
+  // newest reading. The sample covariance of the nodes' error after 600 s against the filter's: 1000 runs, whose
+  // sample variance has a relative standard error of √(2/1000) = 4.5 %, so 5 standard errors are 22 %.
+  const ThermalFilterConfig c = coolant_test_network(kQc_K2_per_s);
+  ThermalFilter f(c);
+  f.reset(25.0, 0.0);
+  f.coolant_read();
+  constexpr int kSeconds = 600, kRuns = 1000, kPerSecond = 10;
+  for (int s = 0; s < kSeconds; ++s) f.predict(at_rest_load(1.0));
+  const ThermalNetwork& n = c.network;
+  const double h = 1.0 / kPerSecond, g = n.between_W_per_K(0, 1);
+  std::mt19937_64 rng(2912);
+  std::normal_distribution<double> normal(0.0, std::sqrt(kQc_K2_per_s * h));
+  Eigen::Matrix2d sum_sq = Eigen::Matrix2d::Zero();
+  Eigen::Vector2d sum = Eigen::Vector2d::Zero();
+  for (int run = 0; run < kRuns; ++run) {
+    Eigen::Vector2d t(25.0, 25.0);
+    double coolant = 25.0;
+    for (int k = 0; k < kSeconds * kPerSecond; ++k) {
+      Eigen::Vector2d dt_dt;
+      for (int i = 0; i < 2; ++i)
+        dt_dt[i] = (n.to_coolant_W_per_K[i] * (coolant - t[i]) + g * (t[1 - i] - t[i])) / n.capacitance_J_per_K[i];
+      t += h * dt_dt;
+      coolant += normal(rng);
+    }
+    const Eigen::Vector2d error = t - f.temperature_C().head<2>();
+    sum += error;
+    sum_sq += error * error.transpose();
+  }
+  const Eigen::Vector2d mean = sum / kRuns;
+  const Eigen::Matrix2d sample = (sum_sq - kRuns * mean * mean.transpose()) / (kRuns - 1);
+  for (int i = 0; i < 2; ++i) {
+    const double p = f.covariance()(i, i);
+    EXPECT_NEAR(sample(i, i), p, 0.22 * p) << "node " << i;
+    EXPECT_NEAR(mean[i], 0.0, 5.0 * std::sqrt(p / kRuns)) << "node " << i;  // the held reading is unbiased
+  }
+}
+
+TEST(ThermalCoolantError, AReadingOnEveryStepChangesNothingToTheLastBit) {
+  ThermalFilterConfig c = coolant_test_network(0.5);  // a walk far faster than any coolant
+  c.process_noise_K2_per_s << 1e-3, 2e-3, 0.0, 0.0;
+  c.disturbance_W2_per_s << 0.5, 0.5, 0.0, 0.0;
+  ThermalFilterConfig exact = c;
+  exact.coolant_drift_K2_per_s = 0.0;
+  ThermalFilter walking(c), held(exact);
+  walking.reset(30.0, 3.0);
+  held.reset(30.0, 3.0);
+  ThermalObservation magnet;
+  magnet.h[1] = 1.0;
+  magnet.variance = 0.3;
+  for (int k = 0; k < 200; ++k) {
+    ThermalLoad l = at_rest_load(1.0);
+    l.current_sq_A2 = 400.0 * (k % 7);
+    l.convection_basis = 0.1 * (k % 5);
+    walking.predict(l);
+    held.predict(l);
+    walking.coolant_read();
+    held.coolant_read();
+    magnet.value = 31.0 + 0.01 * k;
+    ASSERT_EQ(walking.observe(magnet), held.observe(magnet));
+    ASSERT_TRUE(walking.covariance() == held.covariance()) << "step " << k;
+    ASSERT_TRUE(walking.temperature_C() == held.temperature_C()) << "step " << k;
+  }
+}
+
+TEST(ThermalCoolantError, NoReadingYetMeansNoWalkAndAReadingStartsItAgain) {
+  ThermalFilter walking(coolant_test_network(kQc_K2_per_s)), held(coolant_test_network(0.0));
+  walking.reset(25.0, 1.0);
+  held.reset(25.0, 1.0);
+  // Before any reading the configured coolant stands in: the no-coolant-column case keeps its own failure mode.
+  for (int k = 0; k < 100; ++k) {
+    walking.predict(at_rest_load(1.0));
+    held.predict(at_rest_load(1.0));
+  }
+  ASSERT_TRUE(walking.covariance() == held.covariance());
+  walking.coolant_read();
+  for (int k = 0; k < 300; ++k) {
+    walking.predict(at_rest_load(1.0));
+    held.predict(at_rest_load(1.0));
+  }
+  const int ke = kDynamicThermalStates + static_cast<int>(Calibration::kCoolantError);
+  const ThermalStateMat silent = walking.covariance();
+  EXPECT_NEAR(silent(ke, ke), kQc_K2_per_s * 300.0, 1e-12);
+  EXPECT_GT(silent(1, 1), held.covariance()(1, 1));
+  // A reading: e_c is the reading's own error, independent of all before — its row and column go, P_TT stays.
+  walking.coolant_read();
+  EXPECT_TRUE(walking.covariance().row(ke).isZero(0.0));
+  EXPECT_TRUE(walking.covariance().col(ke).isZero(0.0));
+  const auto dynamic_block = [](const ThermalStateMat& p) {
+    return ThermalMat2N(p.topLeftCorner<kDynamicThermalStates, kDynamicThermalStates>());
+  };
+  EXPECT_TRUE(dynamic_block(walking.covariance()) == dynamic_block(silent));
+}
+
+TEST(ThermalCoolantError, ASilentCoolantSensorWidensTheFusedBandBoundedByTheCoolantsOwnWalk) {
+  // ThermalFusion end to end on recorded steps (no observation valid: the band is the prediction's).
+  ThermalFusionConfig c;
+  c.filter = coolant_test_network(kQc_K2_per_s);
+  c.initial_sigma_K = 1.0;
+  ThermalFusionConfig exact = c;
+  exact.filter.coolant_drift_K2_per_s = 0.0;
+  const PerUnitBase base = test::paper_base();
+  const MachineSi machine = test::paper_machine_si();
+  constexpr int kSteps = 2100, kRead = 300;
+  const auto run = [&](const ThermalFusionConfig& config, int read_steps) {
+    ThermalFusion fusion(config, base, machine);
+    for (int k = 0; k < kSteps; ++k) {
+      ThermalStepData d;
+      d.t_ns = static_cast<std::int64_t>(k + 1) * 1'000'000'000;
+      d.load = at_rest_load(1.0);
+      d.coolant_read = k < read_steps;
+      fusion.apply(d);
+    }
+    return fusion.estimate().magnet_node().sigma_K;
+  };
+  const double exact_sigma = run(exact, kSteps);
+  EXPECT_EQ(run(c, kSteps), exact_sigma);  // read on every step: the same band
+  const double silent_sigma = run(c, kRead);
+  const double added_K2 = silent_sigma * silent_sigma - exact_sigma * exact_sigma;
+  // P_TT's propagation is linear and no observation comes, so the walk adds what it adds from zero: the continuous
+  // Lyapunov equation's after the kSteps − kRead predictions since the last reading, within the hold's half step.
+  constexpr int kUnread = kSteps - kRead;
+  const std::vector<CoolantMat3> truth = coolant_lyapunov(c.filter.network, kQc_K2_per_s, kUnread, 0.02);
+  EXPECT_NEAR(added_K2, truth[kUnread](1, 1), (1.5 / kUnread + 1e-3) * truth[kUnread](1, 1));
+  EXPECT_LE(added_K2, kQc_K2_per_s * kUnread);  // never more than the coolant's whole walk (eq. 14.29)
+}
+
+}  // namespace
+}  // namespace rpem::core
