@@ -78,9 +78,10 @@ void ThermalFilter::predict(const ThermalLoad& load, const ThermalRates& rates) 
   transition_ = tr;
   decay_ = decay;
   predicted_ = true;
-  // P⁺ = F·P·Fᵀ + Q_d blockwise (docs/derivations.md §14, eq. 14.12, 14.21): c is a random walk and d scales
-  // by A, so the rows of T become G·P[T,d rows] (from the prior P), the rows and columns of d scale by A, and
-  // the T–d block is then G·P[·,d]·A. Small fixed sizes: coefficient-wise products, no blocking.
+  // P⁺ = F·P·Fᵀ + Q_d blockwise (docs/derivations.md §14, eq. 14.12, 14.21, 14.29): c is constant but for e_c's
+  // walk and d scales by A, so the rows of T become G·P[T,d rows] + b·P[e_c row] (from the prior P), the rows and
+  // columns of d scale by A, and the T–d block is then that times A. Small fixed sizes: coefficient-wise products,
+  // no blocking.
   Eigen::Matrix<double, kN, kThermalStates> rows = g.lazyProduct(p_.topRows<kDynamic>());
   rows += b * p_.row(kCoolant);
   ThermalMat p_tt = rows.leftCols<kDynamic>().lazyProduct(g.transpose()) + rows.col(kCoolant) * b.transpose();

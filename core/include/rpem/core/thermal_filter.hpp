@@ -15,7 +15,8 @@
 //   (coolant_read: the coolant's error is then the sensor's, independent of every earlier error)
 //   Var(v_i) = q_d,i·(τ_d/2)·(1 − a²) [→ q_d,i·Δt as τ_d → ∞] + Σ_terms (σ_rel,term·ΔP_term,i)²: a loss model's error moves with the loss it
 //   models, so each change ΔP of a modelled loss term between steps adds its relative uncertainty squared
-//   P⁺ = F·P·Fᵀ + Q_d,  F = [Φ Γ_d 0; 0 A 0; 0 0 I] (A = diag a),  Q_d = (Δt/2)·(Φ·Q_T·Φᵀ + Q_T) on T (trapezoidal rule),
+//   P⁺ = F·P·Fᵀ + Q_d,  F = [Φ Γ_d B; 0 A 0; 0 0 I] (A = diag a; B zero but for Γ_d·g_c in e_c's column),
+//        Q_d = (Δt/2)·(Φ·Q_T·Φᵀ + Q_T) on T (trapezoidal rule), Var(v) on d, q_c·Δt on e_c,
 //        formed blockwise: only the rows and columns of T change (eq. 14.12)
 //   observe:  y = h·T + h_d·d + h_c·c + offset + v_y,  v_y ~ N(0, r);  ν = y − ŷ,  s = H·P·Hᵀ + r
 //             K = [P_xx·Hᵀ/s on T and d; 0 on c],  x += K·ν,  P −= rank-one terms of that gain (eq. 14.11)
