@@ -17,7 +17,9 @@
   rpemd's reply timeout after the poll reached it (its histogram of reply delays; a VM under TCG on a busy host
   stalls for 100 ms and more) cannot have come in time: its timeout, and its late arrival, are the VM's, and each is
   allowed once more. A chain of timeouts behind one lost reply (the poller's fault this check exists for) would
-  still exceed that by hundreds.
+  still exceed that by hundreds. Likewise an estimate goes stale while the emulator itself sits on a reply (it lists
+  each reply it sent 100 ms or more after its poll): such an estimate is excused from the poll's arrival until two
+  of rpemd's publishing periods after the reply went out.
 
   check_vesc_rpemd.py DIR NAME [--prompt-replies]
 """
@@ -93,7 +95,9 @@ def main():
     if '--prompt-replies' in sys.argv[3:]:
         config = open('%s/%s_config.yaml' % (d, name)).read()  # the configuration rpemd ran (vesc_rpemd.sh)
         timeout_s = float(re.search(r'reply_timeout_s: *([0-9.eE+-]+)', config).group(1))
-        check_prompt_replies(emu, text, est, timeout_s, report, errors)
+        rate = re.search(r'estimate_rate_Hz: *([0-9.eE+-]+)', config)
+        publish_s = 1.0 / float(rate.group(1)) if rate else 0.1  # rpemd's default: 10 Hz
+        check_prompt_replies(emu, text, est, timeout_s, publish_s, report, errors)
     print('check_vesc_rpemd %s: %d estimates; %s' % (name, len(est), '; '.join(report)))
     if errors:
         print('check_vesc_rpemd %s: FAILED\n  %s' % (name, '\n  '.join(errors)))
@@ -111,9 +115,28 @@ def replies_sent_later_than(emu, timeout_s):
     return later + sum(n for lower, (_, n) in zip(lower_edges, bins) if lower >= 1e3 * timeout_s)
 
 
-def check_prompt_replies(emu, text, est, timeout_s, report, errors):
+def emulator_stalls(emu):
+    """The replies the emulator sent 100 ms or more after their poll (vesc_emulator.cpp): the count, and the listed
+    ones as (poll's arrival, reply's delay) in seconds of the drive's time, which is the check's."""
+    m = re.search(r'stalled \d+ ms or more (\d+) times \([^)]*\):(.*)', emu)
+    if not m:
+        sys.exit('check_vesc_rpemd: the emulator did not list its stalls')
+    return int(m.group(1)), [(float(a), float(b)) for a, b in re.findall(r'([0-9.]+):([0-9.]+)', m.group(2))]
+
+
+def check_prompt_replies(emu, text, est, timeout_s, publish_s, report, errors):
     """Timeouts only where nobody answered; no chain of late replies after them; stale only where nobody answered."""
+    stall_count, stalls = emulator_stalls(emu)
+    report.append('the emulator stalled 100 ms or more %d times' % stall_count)
+
+    def emulator_stalled(t):
+        return any(a <= t <= a + delay + 2 * publish_s for a, delay in stalls)
+
     stale = [e['te'] for e in est if e['state'] == 2 and not 45.0 <= e['te'] <= 49.0 and e['te'] < 69.5]
+    excused = [t for t in stale if emulator_stalled(t)]
+    stale = [t for t in stale if not emulator_stalled(t)]
+    if excused:
+        report.append('%d estimates stale while the emulator stalled' % len(excused))
     if stale:
         errors.append('%d estimates stale outside the silence, the first at %.1f s' % (len(stale), stale[0]))
     unheard = int(re.search(r'(\d+) unheard while silent', emu).group(1))

@@ -26,7 +26,7 @@ run() {  # name poll-rate reply-timeout [default-stale: stale_timeout_s left out
   sleep 1
   kill -TERM $daemon; wait $daemon || fail=1
   kill -INT $listen; wait $listen
-  tail -n 3 "$out/${name}_emulator.txt"
+  tail -n 4 "$out/${name}_emulator.txt"
 }
 run r200 200 0.005
 run r1k 1000 0.001
@@ -50,5 +50,5 @@ wait $emu || fail=1
 sleep 1
 kill -TERM $daemon; wait $daemon || fail=1
 kill -INT $listen; wait $listen
-tail -n 3 "$out/hall_emulator.txt"
+tail -n 4 "$out/hall_emulator.txt"
 exit $fail

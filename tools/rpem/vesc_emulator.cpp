@@ -31,16 +31,30 @@ void on_usr1(int) { g_toggle_silence = true; }
 /// receive time, at most (the last class: later).
 constexpr std::array<std::int64_t, 7> kDelayEdgesMs{1, 2, 5, 10, 20, 100, 1000};
 
+/// A reply this late after its poll's arrival is the emulator's own stall (a VM under TCG on a busy host), not
+/// the poller's: the report lists each, so a check can tell the two apart (tests/vm/check_vesc_rpemd.py).
+constexpr std::int64_t kStallNs = 100'000'000;
+
+/// One reply sent kStallNs or more after its poll arrived: when the poll arrived and how late the reply went out.
+struct EmulatorStall {
+  std::int64_t arrived_ns = 0, delay_ns = 0;
+};
+
 struct EmulatorCounters {
   std::uint64_t requests = 0, replies = 0, reply_frames = 0, unsupported = 0, unheard = 0, send_failures = 0;
   std::array<std::uint64_t, kDelayEdgesMs.size() + 1> reply_delay{};  ///< replies per delay class
   std::int64_t reply_delay_max_ns = 0;
+  std::array<EmulatorStall, 64> stalls{};  ///< the first of them, in order
+  std::uint64_t stall_count = 0;           ///< all of them
 
-  void add_delay(std::int64_t ns) noexcept {
+  void add_delay(std::int64_t arrived_ns, std::int64_t ns) noexcept {
     std::size_t k = 0;
     while (k < kDelayEdgesMs.size() && ns > kDelayEdgesMs[k] * 1'000'000) ++k;
     ++reply_delay[k];
     reply_delay_max_ns = std::max(reply_delay_max_ns, ns);
+    if (ns < kStallNs) return;
+    if (stall_count < stalls.size()) stalls[stall_count] = {arrived_ns, ns};
+    ++stall_count;
   }
 };
 
@@ -199,7 +213,7 @@ class VescEmulator {
     // send_packet_wrapper → comm_can_send_buffer(rx_buffer_last_id, …, rx_buffer_response_type = 1)
     const std::size_t frames = vesc::buffer_frames(request->sender, id_, 1, {payload_.data(), len}, tx_);
     for (std::size_t f = 0; f < frames; ++f) send(tx_[f]);
-    n_.add_delay(host_now() - arrived_ns);
+    n_.add_delay(arrived_ns, host_now() - arrived_ns);
     ++n_.replies;
     n_.reply_frames += frames;
   }
@@ -237,6 +251,15 @@ void VescEmulator::report() const {
   }
   std::fprintf(stderr, " later %llu; the latest %.3f s\n", static_cast<unsigned long long>(n_.reply_delay.back()),
                core::to_seconds(n_.reply_delay_max_ns));
+  // The stalls, in the drive's (and the check's) time base: a poll's arrival [s] and its reply's delay [s].
+  std::fprintf(stderr,
+               "rpem sim: VESC %d stalled %.0f ms or more %llu times (arrival s:delay s, the first %zu):", o_.controller_id,
+               1e3 * core::to_seconds(kStallNs), static_cast<unsigned long long>(n_.stall_count), n_.stalls.size());
+  const std::size_t listed = std::min<std::size_t>(n_.stall_count, n_.stalls.size());
+  for (std::size_t k = 0; k < listed; ++k) {
+    std::fprintf(stderr, " %.3f:%.3f", core::to_seconds(n_.stalls[k].arrived_ns), core::to_seconds(n_.stalls[k].delay_ns));
+  }
+  std::fprintf(stderr, "\n");
 }
 
 }  // namespace
