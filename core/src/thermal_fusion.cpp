@@ -88,11 +88,13 @@ StepObservations step_observations(const ThermalFusionConfig& c, const ThermalSt
     const double lag_K = dt_dt_K_per_s[r.own] * p.time_constant_s;
     o.variance = p.variance + r.own_law.slope * r.own_law.slope * lag_K * lag_K;
     if (c.winding_node_is_reading) {
-      // r̂s and ψ̂m's κ term see the winding, which leads the node that stands for the reading (eq. 14.24).
+      // r̂s and ψ̂m's κ term see the winding, which leads the node that stands for the reading (eq. 14.24), its
+      // rate holding the coolant's error (eq. 14.29a).
       const double h_w = o.h[w];
       o.h[w] = 0.0;
       o.h += h_w * g.row.head<kMaxThermalNodes>();
-      o.h_d += h_w * g.row.tail<kMaxThermalNodes>();
+      o.h_d += h_w * g.row.segment<kMaxThermalNodes>(kMaxThermalNodes);
+      o.h_c += h_w * g.row.tail<kCalibrationStates>();
       o.offset += h_w * g.constant_K;
     }
     out.present[j] = true;
@@ -106,10 +108,12 @@ StepObservations step_observations(const ThermalFusionConfig& c, const ThermalSt
     const double lag_s = c.winding_node_is_reading ? 0.0 : c.winding_sensor_time_constant_s;
     const SensorLagStep k = sensor_lag_step(lag_s, s.load.dt_s, s.winding_sensor_age);
     if (k.rate_s > 0.0) {
-      // The step's mean reading T_w − κ·(A_w·T + u_w + d_w/C_w) − β·e (eq. 14.22); e's error in the variance.
+      // The step's mean reading T_w − κ·(A_w·T + u_w + d_w/C_w + (G_w0/C_w)·e_c) − β·e (eq. 14.22, 14.29a); e's
+      // error in the variance.
       const WindingRate rate = winding_rate(n, rates);
       o.h -= k.rate_s * rate.row.head<kMaxThermalNodes>();
-      o.h_d = -k.rate_s * rate.row.tail<kMaxThermalNodes>();
+      o.h_d = -k.rate_s * rate.row.segment<kMaxThermalNodes>(kMaxThermalNodes);
+      o.h_c = -k.rate_s * rate.row.tail<kCalibrationStates>();
       o.offset = -k.rate_s * rate.constant_K_per_s - k.carry * lag.lag_K;
       o.variance += k.carry * k.carry * lag.variance_K2;
     }
@@ -298,12 +302,12 @@ void ThermalFusion::finish_step(const ThermalStepData& d, const ThermalRates& ra
   }
   if (config_.winding_sensor_time_constant_s > 0.0 && !config_.winding_node_is_reading) {
     // The sensor's lag over this step at the posterior's rate of the winding (eq. 14.22), that rate's variance
-    // from the posterior covariance of [T; d] along its row.
+    // from the posterior covariance of the whole state along its row (e_c's mean is zero, its variance is not:
+    // eq. 14.29a).
     const WindingRate g = winding_rate(n, rates);
     const double rate = g.row.head<kMaxThermalNodes>().dot(filter_.temperature_C()) +
-                        g.row.tail<kMaxThermalNodes>().dot(filter_.disturbance_W()) + g.constant_K_per_s;
-    const double rate_variance =
-        g.row.dot(filter_.covariance().topLeftCorner<kDynamicThermalStates, kDynamicThermalStates>() * g.row);
+                        g.row.segment<kMaxThermalNodes>(kMaxThermalNodes).dot(filter_.disturbance_W()) + g.constant_K_per_s;
+    const double rate_variance = g.row.dot(filter_.covariance() * g.row);
     sensor_lag_.advance(sensor_lag_step(config_.winding_sensor_time_constant_s, dt_s, d.winding_sensor_age), rate,
                         rate_variance);
   }
@@ -311,9 +315,9 @@ void ThermalFusion::finish_step(const ThermalStepData& d, const ThermalRates& ra
   last_r_s_Ohm_ = d.r_s_Ohm;
   out_.t_ns = d.t_ns;
   out_.coolant_C = d.load.coolant_C;
-  // The winding as reported: the node, or the node led by the sensor's τ_s (eq. 14.24), its variance g·P·gᵀ.
+  // The winding as reported: the node, or the node led by the sensor's τ_s (eq. 14.24), its variance g·P·gᵀ over
+  // the whole state (the coolant's error moves the rate, eq. 14.29a; its mean is zero).
   const WindingReadout g = winding_readout(config_, rates);
-  const auto& p_dyn = filter_.covariance().topLeftCorner<kDynamicThermalStates, kDynamicThermalStates>();
   Eigen::Matrix<double, kDynamicThermalStates, 1> x_dyn;
   x_dyn << filter_.temperature_C(), filter_.disturbance_W();
   for (int i = 0; i < kMaxThermalNodes; ++i) {
@@ -322,8 +326,8 @@ void ThermalFusion::finish_step(const ThermalStepData& d, const ThermalRates& ra
     node.t_C = filter_.temperature_C()[i];
     node.sigma_K = filter_.sigma_K(i);
     if (i == n.winding && config_.winding_node_is_reading) {
-      node.t_C = g.row.dot(x_dyn) + g.constant_K;
-      node.sigma_K = std::sqrt(std::max(g.row.dot(p_dyn * g.row), 0.0));
+      node.t_C = g.row.head<kDynamicThermalStates>().dot(x_dyn) + g.constant_K;
+      node.sigma_K = std::sqrt(std::max(g.row.dot(filter_.covariance() * g.row), 0.0));
     }
     node.observed = observed[k];
     if (observed[k]) {

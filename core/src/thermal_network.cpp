@@ -83,6 +83,7 @@ ThermalRates thermal_rates(const ThermalNetwork& n, const ThermalLoad& l) noexce
     const double inv_c = 1.0 / n.capacitance_J_per_K[i];
     out.a.row(i) *= inv_c;
     out.u[i] *= inv_c;
+    out.coolant_per_s[i] = g_coolant * inv_c;
   }
   return out;
 }

@@ -10,6 +10,7 @@ WindingRate winding_rate(const ThermalNetwork& n, const ThermalRates& rates) noe
   const int w = n.winding;
   r.row.head<kMaxThermalNodes>() = rates.a.row(w).transpose();
   r.row[kMaxThermalNodes + w] = 1.0 / n.capacitance_J_per_K[w];
+  r.row[kDynamicThermalStates + static_cast<int>(Calibration::kCoolantError)] = rates.coolant_per_s[w];  // (14.29a)
   r.constant_K_per_s = rates.u[w];
   return r;
 }

@@ -3,7 +3,9 @@
 // that share nothing with the filter's discrete step — the continuous Lyapunov equation of [T; e_c] integrated by RK4,
 // and a Monte Carlo of the walk through an Euler-integrated plant — and against the bound q_c·s (a node's step
 // response to the coolant lies in [0, 1]); a reading on every step changes nothing to the last bit, a reading after
-// a silence starts e_c again, and a filter that never saw a reading does not widen.
+// a silence starts e_c again, and a filter that never saw a reading does not widen. The winding's rate carries e_c
+// (eq. 14.29a): every row built on it takes e_c as the coolant itself enters it, and the winding reported ahead of a
+// reading node widens as the Lyapunov equation says along that row.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -11,6 +13,7 @@
 #include <vector>
 
 #include "rpem/core/thermal_fusion.hpp"
+#include "rpem/core/thermal_sensor.hpp"
 #include "support/paper_machine.hpp"
 
 namespace rpem::core {
@@ -215,6 +218,105 @@ TEST(ThermalCoolantError, ASilentCoolantSensorWidensTheFusedBandBoundedByTheCool
   const std::vector<CoolantMat3> truth = coolant_lyapunov(c.filter.network, kQc_K2_per_s, kUnread, 0.02);
   EXPECT_NEAR(added_K2, truth[kUnread](1, 1), (1.5 / kUnread + 1e-3) * truth[kUnread](1, 1));
   EXPECT_LE(added_K2, kQc_K2_per_s * kUnread);  // never more than the coolant's whole walk (eq. 14.29)
+}
+
+/// A fusion configuration over coolant_test_network with a winding sensor of τ_s = 8 s; the winding's coolant
+/// conductance also grows with speed, so g_c,w depends on the load (eq. 14.1b).
+ThermalFusionConfig coolant_sensor_config(bool node_is_reading) {
+  ThermalFusionConfig c;
+  c.filter = coolant_test_network(kQc_K2_per_s);
+  c.filter.network.to_coolant_at_base_speed_W_per_K[0] = 5.0;
+  c.initial_sigma_K = 1.0;
+  c.winding_sensor_sigma_K = 0.1;
+  c.winding_sensor_time_constant_s = 8.0;
+  c.winding_node_is_reading = node_is_reading;
+  return c;
+}
+
+TEST(ThermalCoolantError, TheCoolantErrorEntersEveryRateRowAsTheCoolantItselfDoes) {
+  // e_c is the true coolant less the held reading, so wherever the winding's rate enters a row — a lagging sensor's
+  // mean reading (eq. 14.22), the winding that leads a reading node and the parameter observations read through it
+  // (eq. 14.24) — e_c's coefficient is the row's derivative with respect to the held coolant (eq. 14.29a). The
+  // offsets are linear in the coolant, so a difference of one kelvin is that derivative exactly, to rounding.
+  const int ke = static_cast<int>(Calibration::kCoolantError);
+  const ThermalVec t_C(40.0, 35.0, 0.0, 0.0);
+  for (const bool node_is_reading : {false, true}) {
+    const ThermalFusionConfig c = coolant_sensor_config(node_is_reading);
+    ThermalStepData d;
+    d.load = at_rest_load(1.0);
+    d.load.current_sq_A2 = 2500.0;
+    d.load.convection_basis = 0.6;
+    d.winding_sensor_C = 38.0;
+    d.winding_sensor_age = {0.25, 0.0625};
+    d.parameter[1].valid = true;  // r̂s adapting: an observation of the winding
+    d.parameter[1].value = 0.055;
+    d.parameter[1].variance = 1e-8;
+    ThermalStepData warmer = d;
+    warmer.load.coolant_C += 1.0;
+    const StepObservations o = step_observations(c, d, t_C, ThermalVec::Zero());
+    const StepObservations o1 = step_observations(c, warmer, t_C, ThermalVec::Zero());
+    ASSERT_TRUE(o.present[1] && o.present[2]);
+    for (std::size_t k : {std::size_t{1}, std::size_t{2}}) {
+      const double derivative = o1.item[k].offset - o.item[k].offset;
+      EXPECT_NEAR(o.item[k].h_c[ke], derivative, 1e-12 * std::max(1.0, std::abs(o.item[k].offset)))
+          << (node_is_reading ? "reading node, " : "lagging sensor, ") << "observation " << k;
+    }
+    const WindingReadout g = winding_readout(c, thermal_rates(c.filter.network, d.load));
+    const WindingReadout g1 = winding_readout(c, thermal_rates(c.filter.network, warmer.load));
+    EXPECT_NEAR(g.row[kDynamicThermalStates + ke], g1.constant_K - g.constant_K, 1e-12 * std::abs(g.constant_K));
+    // Where the rate enters — the lagging sensor; r̂s through the reading node — the term is there and has the rate's
+    // sign: a warmer coolant than read heats the winding, so a lagging sensor reads less of it now (−κ·G_w0/C_w) and
+    // the winding leads the reading node by more (+τ_s·G_w0/C_w).
+    const double g_w0 = 20.0 + 5.0 * 0.6, c_w = 2000.0;
+    if (node_is_reading) {
+      EXPECT_NEAR(g.row[kDynamicThermalStates + ke], 8.0 * g_w0 / c_w, 1e-15);
+      EXPECT_GT(o.item[1].h_c[ke], 0.0);
+      EXPECT_EQ(o.item[2].h_c[ke], 0.0);  // the sensor observes the reading node as it is
+    } else {
+      EXPECT_EQ(g.row[kDynamicThermalStates + ke], 0.0);
+      const double kappa_s = sensor_lag_step(8.0, 1.0, d.winding_sensor_age).rate_s;  // κ of eq. 14.22
+      EXPECT_NEAR(o.item[2].h_c[ke], -kappa_s * g_w0 / c_w, 1e-15);
+      EXPECT_LT(o.item[2].h_c[ke], 0.0);
+      EXPECT_EQ(o.item[1].h_c[ke], 0.0);  // r̂s sees the winding node itself
+    }
+  }
+}
+
+TEST(ThermalCoolantError, TheReportedWindingLedByItsRateWidensAsTheLyapunovEquationSays) {
+  // The winding node standing for a reading (eq. 14.24): the reported winding is T_0 + τ_s·dT_0/dt, whose rate holds
+  // the coolant's error (eq. 14.29a). Its added variance over a silence against the continuous Lyapunov equation of
+  // [T; e_c], read along the row e_0 + τ_s·(dT_0/dt's row) formed here from the network's conductances.
+  ThermalFusionConfig c = coolant_sensor_config(true);
+  c.filter.network.to_coolant_at_base_speed_W_per_K[0] = 0.0;  // the Lyapunov helper's network: no speed term
+  ThermalFusionConfig exact = c;
+  exact.filter.coolant_drift_K2_per_s = 0.0;
+  const PerUnitBase base = test::paper_base();
+  const MachineSi machine = test::paper_machine_si();
+  constexpr int kSteps = 2100, kRead = 300;
+  const auto run = [&](const ThermalFusionConfig& config) {
+    ThermalFusion fusion(config, base, machine);
+    for (int k = 0; k < kSteps; ++k) {
+      ThermalStepData d;
+      d.t_ns = static_cast<std::int64_t>(k + 1) * 1'000'000'000;
+      d.load = at_rest_load(1.0);
+      d.coolant_read = k < kRead;
+      fusion.apply(d);
+    }
+    return fusion.estimate().node[0].sigma_K;
+  };
+  const double exact_sigma = run(exact), silent_sigma = run(c);
+  const double added_K2 = silent_sigma * silent_sigma - exact_sigma * exact_sigma;
+  constexpr int kUnread = kSteps - kRead;
+  const ThermalNetwork& n = c.filter.network;
+  const std::vector<CoolantMat3> truth = coolant_lyapunov(n, kQc_K2_per_s, kUnread, 0.02);
+  const double tau = c.winding_sensor_time_constant_s, c0 = n.capacitance_J_per_K[0];
+  const double g0 = n.to_coolant_W_per_K[0], g01 = n.between_W_per_K(0, 1);
+  const Eigen::Vector3d row(1.0 - tau * (g0 + g01) / c0, tau * g01 / c0, tau * g0 / c0);
+  const double expected = row.dot(truth[kUnread] * row);
+  EXPECT_NEAR(added_K2, expected, (1.5 / kUnread + 1e-3) * expected);
+  // Without e_c in the rate the same row would stop at the nodes: a different figure, by more than the tolerance.
+  const Eigen::Vector3d nodes_only(row[0], row[1], 0.0);
+  EXPECT_GT(std::abs(nodes_only.dot(truth[kUnread] * nodes_only) - expected), 0.01 * expected);
 }
 
 }  // namespace

@@ -100,10 +100,11 @@ struct ThermalNodeReport {
 };
 [[nodiscard]] ThermalNodeReport report_node(const ThermalEstimate& e, int node, std::int64_t t_ns) noexcept;
 
-/// The winding's temperature as a linear function of the filter's [T; d]: T_w = row·[T; d] + constant_K. The
-/// winding node itself, or with `winding_node_is_reading` the node led by τ_s times its modelled rate (eq. 14.24).
+/// The winding's temperature as a linear function of the filter's state [T; d; c]: T_w = row·[T; d; c] + constant_K.
+/// The winding node itself, or with `winding_node_is_reading` the node led by τ_s times its modelled rate, the
+/// coolant's error included (eq. 14.24, 14.29a).
 struct WindingReadout {
-  Eigen::Matrix<double, kDynamicThermalStates, 1> row = Eigen::Matrix<double, kDynamicThermalStates, 1>::Zero();
+  ThermalStateVec row = ThermalStateVec::Zero();
   double constant_K = 0.0;
 };
 /// `rates`: the network's at the step's load (thermal_rates).

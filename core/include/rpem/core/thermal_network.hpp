@@ -110,6 +110,7 @@ class LossAccumulator {
 struct ThermalRates {
   ThermalMat a = ThermalMat::Zero();
   ThermalVec u = ThermalVec::Zero();
+  ThermalVec coolant_per_s = ThermalVec::Zero();  ///< ∂(dT_i/dt)/∂T_coolant = G_i0(ω)/C_i: u's coolant part per kelvin
 };
 [[nodiscard]] ThermalRates thermal_rates(const ThermalNetwork& n, const ThermalLoad& l) noexcept;
 

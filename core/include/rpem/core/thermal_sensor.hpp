@@ -19,10 +19,11 @@
 
 namespace rpem::core {
 
-/// The winding's rate s = dT_w/dt = A_w·T + d_w/C_w + u_w as a row over the filter's [T; d] and its constant
-/// (eq. 14.22): what the lagging sensor's observation takes (h, h_d) and its lag advances by.
+/// The winding's rate s = dT_w/dt = A_w·T + d_w/C_w + u_w + (G_w0/C_w)·e_c as a row over the filter's whole state
+/// [T; d; c] and its constant (eq. 14.22, 14.29a): what the lagging sensor's observation takes (h, h_d, h_c) and
+/// its lag advances by. Of the calibration states only the coolant's error e_c moves the rate.
 struct WindingRate {
-  Eigen::Matrix<double, kDynamicThermalStates, 1> row = Eigen::Matrix<double, kDynamicThermalStates, 1>::Zero();
+  ThermalStateVec row = ThermalStateVec::Zero();
   double constant_K_per_s = 0.0;
 };
 [[nodiscard]] WindingRate winding_rate(const ThermalNetwork& n, const ThermalRates& rates) noexcept;
