@@ -187,26 +187,29 @@ TEST(ThermalCoolantError, NoReadingYetMeansNoWalkAndAReadingStartsItAgain) {
   EXPECT_TRUE(dynamic_block(walking.covariance()) == dynamic_block(silent));
 }
 
+/// ThermalFusion end to end on `steps` recorded steps at rest, 1 s each, the coolant read on the first `read_steps`
+/// (no observation valid: the band is the prediction's); the estimate at the end.
+ThermalEstimate fused_at_rest(const ThermalFusionConfig& config, int steps, int read_steps) {
+  ThermalFusion fusion(config, test::paper_base(), test::paper_machine_si());
+  for (int k = 0; k < steps; ++k) {
+    ThermalStepData d;
+    d.t_ns = static_cast<std::int64_t>(k + 1) * 1'000'000'000;
+    d.load = at_rest_load(1.0);
+    d.coolant_read = k < read_steps;
+    fusion.apply(d);
+  }
+  return fusion.estimate();
+}
+
 TEST(ThermalCoolantError, ASilentCoolantSensorWidensTheFusedBandBoundedByTheCoolantsOwnWalk) {
-  // ThermalFusion end to end on recorded steps (no observation valid: the band is the prediction's).
   ThermalFusionConfig c;
   c.filter = coolant_test_network(kQc_K2_per_s);
   c.initial_sigma_K = 1.0;
   ThermalFusionConfig exact = c;
   exact.filter.coolant_drift_K2_per_s = 0.0;
-  const PerUnitBase base = test::paper_base();
-  const MachineSi machine = test::paper_machine_si();
   constexpr int kSteps = 2100, kRead = 300;
   const auto run = [&](const ThermalFusionConfig& config, int read_steps) {
-    ThermalFusion fusion(config, base, machine);
-    for (int k = 0; k < kSteps; ++k) {
-      ThermalStepData d;
-      d.t_ns = static_cast<std::int64_t>(k + 1) * 1'000'000'000;
-      d.load = at_rest_load(1.0);
-      d.coolant_read = k < read_steps;
-      fusion.apply(d);
-    }
-    return fusion.estimate().magnet_node().sigma_K;
+    return fused_at_rest(config, kSteps, read_steps).magnet_node().sigma_K;
   };
   const double exact_sigma = run(exact, kSteps);
   EXPECT_EQ(run(c, kSteps), exact_sigma);  // read on every step: the same band
@@ -290,20 +293,8 @@ TEST(ThermalCoolantError, TheReportedWindingLedByItsRateWidensAsTheLyapunovEquat
   c.filter.network.to_coolant_at_base_speed_W_per_K[0] = 0.0;  // the Lyapunov helper's network: no speed term
   ThermalFusionConfig exact = c;
   exact.filter.coolant_drift_K2_per_s = 0.0;
-  const PerUnitBase base = test::paper_base();
-  const MachineSi machine = test::paper_machine_si();
   constexpr int kSteps = 2100, kRead = 300;
-  const auto run = [&](const ThermalFusionConfig& config) {
-    ThermalFusion fusion(config, base, machine);
-    for (int k = 0; k < kSteps; ++k) {
-      ThermalStepData d;
-      d.t_ns = static_cast<std::int64_t>(k + 1) * 1'000'000'000;
-      d.load = at_rest_load(1.0);
-      d.coolant_read = k < kRead;
-      fusion.apply(d);
-    }
-    return fusion.estimate().node[0].sigma_K;
-  };
+  const auto run = [&](const ThermalFusionConfig& config) { return fused_at_rest(config, kSteps, kRead).node[0].sigma_K; };
   const double exact_sigma = run(exact), silent_sigma = run(c);
   const double added_K2 = silent_sigma * silent_sigma - exact_sigma * exact_sigma;
   constexpr int kUnread = kSteps - kRead;

@@ -121,7 +121,7 @@ def emulator_stalls(emu):
     m = re.search(r'stalled \d+ ms or more (\d+) times \([^)]*\):(.*)', emu)
     if not m:
         sys.exit('check_vesc_rpemd: the emulator did not list its stalls')
-    return int(m.group(1)), [(float(a), float(b)) for a, b in re.findall(r'([0-9.]+):([0-9.]+)', m.group(2))]
+    return int(m.group(1)), [(float(a), float(b)) for a, b in re.findall(r'(-?[0-9.]+):([0-9.]+)', m.group(2))]
 
 
 def check_prompt_replies(emu, text, est, timeout_s, publish_s, report, errors):
