@@ -152,9 +152,11 @@ Estimate AveragedDriveEstimator::step(const AveragedSample& sample) noexcept {
   // it undoes what it adapted. Any other sample (a gap, an instantaneous or a non-finite one) ends the chain with the
   // previous window unjudged, and it is undone all the same ("A chain's last window").
   const bool judges = in.window_s > 0.0 && timing_ == SampleTiming::kContiguous && regime.regime != Regime::kInvalid;
+  bool retracted = false;
   if (!judges) {
-    end_chain();
+    retracted = end_chain();
   } else if ((regime.bits & regime_bit::kPreviousMixed) && !core_.state().frozen) {
+    retracted = judge_pending_;  // an excluded window adapted nothing: there is nothing of it to take back
     core_.retract(before_previous_);
   }
   before_previous_ = core_.adaptation();
@@ -168,7 +170,9 @@ Estimate AveragedDriveEstimator::step(const AveragedSample& sample) noexcept {
   const RegimeNoise noise = classifier_.noise();
   const Admission admission{!regime.excluded(), regime.excites_psi_m(), regime.excites_r_s(), true, noise.u_sq, noise.i_sq,
                             noise.n_sq};
-  return finish(sample, s, core_.step_steady_state(s, gains.hessian, gains.gain, admission), regime, point, gains);
+  Estimate e = finish(sample, s, core_.step_steady_state(s, gains.hessian, gains.gain, admission), regime, point, gains);
+  e.retracted_previous = retracted;
+  return e;
 }
 
 Estimate AveragedDriveEstimator::finish(const AveragedSample& sample, const SteadyStateSample& s,
@@ -195,9 +199,8 @@ bool AveragedDriveEstimator::end_chain() noexcept {
   const Vec2 theta_pu = core_.state().theta_pu;
   core_.retract(before_previous_);
   before_previous_ = core_.adaptation();
-  const bool moved = core_.state().theta_pu != theta_pu;
-  unjudged_windows_ += moved ? 1U : 0U;
-  return moved;
+  unjudged_windows_ += core_.state().theta_pu != theta_pu ? 1U : 0U;
+  return true;
 }
 
 void AveragedDriveEstimator::reset() noexcept {

@@ -130,10 +130,11 @@ void DriveEstimator::reset() noexcept {
   point_gains_.start(rates_per_s_, core_.config().nominal_sample_period_s);
 }
 
-void DriveEstimator::resynchronize() noexcept {
+bool DriveEstimator::resynchronize() noexcept {
   conditioner_.reset();
   core_.resynchronize();
   regimes_.break_chain();
+  return false;  // a dense sample is never taken back
 }
 
 void DriveEstimator::set_estimates(double psi_m_Wb, double r_s_Ohm) noexcept {

@@ -20,14 +20,10 @@ void ThermalObserver::reconfigure(const ThermalObserverConfig& config, const Per
 }
 
 void ThermalObserver::restart() noexcept {
-  settled_ = {};
-  eps_started_ = batch_started_ = false;
-  eps_mean_.setZero();
-  eps_cov_.setZero();
-  batch_sum_.setZero();
-  batch_mean_.setZero();
-  batch_dt_s_ = batch_a_ = 0.0;
-  batch_count_ = 0;
+  const std::array<Accumulated, 2> acc = learnt_.acc;  // the step's sums stay: its samples were
+  learnt_ = Learnt{};
+  learnt_.acc = acc;
+  before_last_ = learnt_;  // no retraction reaches behind a restart
 }
 
 void ThermalObserver::add_parameter(int j, const Estimate& e, double dt_s) noexcept {
@@ -42,21 +38,22 @@ void ThermalObserver::add_parameter(int j, const Estimate& e, double dt_s) noexc
   const Eigen::Matrix<double, 1, 2> l = d.gain.row(j);
   const double a = l.dot(d.gradient.col(j));
   if (!adapting || !(a > 0.0 && a < 2.0)) {  // a ≥ 2: the update overshoots, no stationary variance
-    settled_[jj] = 0.0;
+    learnt_.settled[jj] = 0.0;
     return;
   }
-  settled_[jj] += a;
+  learnt_.settled[jj] += a;
   // κ (eq. 14.6): zero when the other parameter adapted too (their joint equilibrium has no bias).
   const bool other_adapting = (d.flags & flag[1 - jj]) != 0;
   const double kappa_pu = other_adapting ? 0.0 : l.dot(d.gradient.col(o)) / a;
   const double base_j = j == kPsiM ? base_.flux_Wb : base_.impedance_Ohm;
   const double base_o = j == kPsiM ? base_.impedance_Ohm : base_.flux_Wb;
   // σ² (eq. 14.7, 14.8), pu, then SI.
-  const double noise = (l * eps_cov_ * l.transpose())(0, 0) / (a * (2.0 - a));
+  const double noise = (l * learnt_.eps_cov * l.transpose())(0, 0) / (a * (2.0 - a));
   const double l2 = l.squaredNorm();
-  const Vec2 eps_perp = l2 > 0.0 ? Vec2(eps_mean_ - (l.dot(eps_mean_) / l2) * l.transpose()) : eps_mean_;
+  const Vec2& eps_mean = learnt_.eps_mean;
+  const Vec2 eps_perp = l2 > 0.0 ? Vec2(eps_mean - (l.dot(eps_mean) / l2) * l.transpose()) : eps_mean;
   const double model = eps_perp.squaredNorm() * l2 / (a * a);
-  Accumulated& acc = acc_[jj];
+  Accumulated& acc = learnt_.acc[jj];
   acc.adapted_s += dt_s;
   acc.value += j == kPsiM ? e.psi_m_Wb : e.r_s_Ohm;
   acc.other += j == kPsiM ? e.r_s_Ohm : e.psi_m_Wb;
@@ -68,32 +65,33 @@ void ThermalObserver::add_parameter(int j, const Estimate& e, double dt_s) noexc
 }
 
 void ThermalObserver::add_residual(const EstimatorOutput& d, double dt_s) noexcept {
+  Learnt& l = learnt_;
   const Vec2 eps = d.epsilon_pu;
   const double tau = config_.residual_time_constant_s;
-  eps_mean_ = eps_started_ ? Vec2(eps_mean_ - std::expm1(-dt_s / tau) * (eps - eps_mean_)) : eps;
-  eps_started_ = true;
-  batch_sum_ += eps;
-  batch_dt_s_ += dt_s;
+  l.eps_mean = l.eps_started ? Vec2(l.eps_mean - std::expm1(-dt_s / tau) * (eps - l.eps_mean)) : eps;
+  l.eps_started = true;
+  l.batch_sum += eps;
+  l.batch_dt_s += dt_s;
   double a = 0.0;
   for (int j = 0; j < 2; ++j) a = std::max(a, d.gain.row(j).dot(d.gradient.col(j)));
-  batch_a_ += a;
-  if (++batch_count_ >= kMaxBatch || batch_a_ >= 0.25) {
+  l.batch_a += a;
+  if (++l.batch_count >= kMaxBatch || l.batch_a >= 0.25) {
     // Batch means, exponentially weighted (West's update), weight w of this batch of M samples.
-    const double m = batch_count_;
-    const Vec2 b = batch_sum_ / m;
-    if (!batch_started_) {
-      batch_mean_ = b;
-      eps_cov_.setZero();
-      batch_started_ = true;
+    const double m = l.batch_count;
+    const Vec2 b = l.batch_sum / m;
+    if (!l.batch_started) {
+      l.batch_mean = b;
+      l.eps_cov.setZero();
+      l.batch_started = true;
     } else {
-      const double w = -std::expm1(-batch_dt_s_ / tau);
-      const Vec2 delta = b - batch_mean_;
-      batch_mean_ += w * delta;
-      eps_cov_ = (1.0 - w) * (eps_cov_ + (w * m) * delta * delta.transpose());
+      const double w = -std::expm1(-l.batch_dt_s / tau);
+      const Vec2 delta = b - l.batch_mean;
+      l.batch_mean += w * delta;
+      l.eps_cov = (1.0 - w) * (l.eps_cov + (w * m) * delta * delta.transpose());
     }
-    batch_sum_.setZero();
-    batch_dt_s_ = batch_a_ = 0.0;
-    batch_count_ = 0;
+    l.batch_sum.setZero();
+    l.batch_dt_s = l.batch_a = 0.0;
+    l.batch_count = 0;
   }
 }
 
@@ -119,10 +117,20 @@ bool ThermalObserver::add(const Estimate& e, const ThermalSample& s) noexcept {
     sensor_elapsed_sq_ += elapsed * elapsed * w;
   }
 
+  if (e.retracted_previous) {
+    // The previous sample's adaptation was taken back (§13, "Mixed windows"): so is what it taught, but for the sums
+    // of a step it completed, which the filter has already had.
+    const std::array<Accumulated, 2> acc = learnt_.acc;
+    learnt_ = before_last_;
+    if (stepped_since_last_) learnt_.acc = acc;
+  }
+  before_last_ = learnt_;
+  stepped_since_last_ = false;
   if (e.detail.code == StepCode::kAdapted && all_finite(e.epsilon_A)) add_residual(e.detail, dt);
   for (int j = 0; j < 2; ++j) add_parameter(j, e, dt);
 
   if (losses_.duration_s() < config_.period_s) return false;
+  stepped_since_last_ = true;
   const double duration = losses_.duration_s();
   step_.t_ns = e.t_ns;
   step_.load = losses_.take();
@@ -139,7 +147,7 @@ bool ThermalObserver::add(const Estimate& e, const ThermalSample& s) noexcept {
   }
   sensor_sum_ = sensor_time_ = sensor_elapsed_ = sensor_elapsed_sq_ = 0.0;
   for (std::size_t j = 0; j < 2; ++j) {
-    Accumulated& acc = acc_[j];
+    Accumulated& acc = learnt_.acc[j];
     ParameterObservation& p = step_.parameter[j];
     p = ParameterObservation{};
     if (acc.samples > 0) {
@@ -151,7 +159,7 @@ bool ThermalObserver::add(const Estimate& e, const ThermalSample& s) noexcept {
       p.variance_noise = acc.variance_noise * n;
       p.time_constant_s = acc.tau * n;
       p.sample_dt_s = acc.adapted_s * n;
-      p.valid = 2.0 * acc.adapted_s >= duration && settled_[j] >= config_.settle_time_constants &&
+      p.valid = 2.0 * acc.adapted_s >= duration && learnt_.settled[j] >= config_.settle_time_constants &&
                 all_finite(p.value, p.cross, p.other_held, p.variance);
     }
     acc = Accumulated{};

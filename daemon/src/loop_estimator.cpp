@@ -64,8 +64,8 @@ bool LoopEstimator::step(const SourceSample& sample, core::Estimate& estimate, d
 void LoopEstimator::reset() noexcept {
   visit_estimator(estimator_, [](core::SampleEstimator auto& e) { e.reset(); });
 }
-void LoopEstimator::resynchronize() noexcept {
-  visit_estimator(estimator_, [](core::SampleEstimator auto& e) { e.resynchronize(); });
+bool LoopEstimator::resynchronize() noexcept {
+  return visit_estimator(estimator_, [](core::SampleEstimator auto& e) { return e.resynchronize(); });
 }
 void LoopEstimator::set_frozen(bool frozen) noexcept {
   visit_estimator(estimator_, [frozen](core::SampleEstimator auto& e) { e.set_frozen(frozen); });

@@ -128,7 +128,8 @@ void LoopThread::apply(const Command& c) noexcept {
 void LoopThread::step(const SourceSample& s, std::int64_t now_ns) noexcept {
   if (!within(s, plausible_)) {
     ++counters_.rejected_implausible;
-    estimator_.resynchronize();  // the next sample does not continue across the one left out
+    // The next sample does not continue across the one left out; an averaged chain's last window is taken back.
+    if (estimator_.resynchronize()) validity_.retract_last();
     return;
   }
   double dt_s = 0.0;
@@ -164,6 +165,7 @@ void LoopThread::step(const SourceSample& s, std::int64_t now_ns) noexcept {
   }
   counters_.regimes.add(last_.regime);
   if (d.flags & (core::step_flag::kProjectedPsiM | core::step_flag::kProjectedRs)) ++counters_.projections;
+  if (last_.retracted_previous) validity_.retract_last();  // the previous sample's adaptation, taken back
   validity_.on_sample(d.flags, dt_s, now_ns);
   if (live_.thermal_active) {
     core::ThermalSample t;
@@ -306,7 +308,7 @@ void LoopThread::process(std::int64_t now_ns) noexcept {
              now_ns - last_sample_mono_ns_ > static_cast<std::int64_t>(loop_config_.stale_timeout_s * 1e9)) {
     // No samples: hold the estimates, flag them, and start over from the next sample.
     state_ = DaemonState::kStale;
-    estimator_.resynchronize();
+    if (estimator_.resynchronize()) validity_.retract_last();  // an averaged chain's unjudged last window
     validity_.hold();
   }
   if (now_ns >= next_estimate_ns_) {

@@ -24,8 +24,9 @@ void ValidityTracker::reconfigure(const ValidityConfig& config) noexcept {
 
 void ValidityTracker::seed(int parameter, double age_s, std::int64_t now_ns) noexcept {
   Parameter& p = parameters_[static_cast<std::size_t>(parameter)];
-  p.identified = true;
-  p.last_adapted_ns = now_ns - static_cast<std::int64_t>(std::max(0.0, age_s) * 1e9);
+  p.now.identified = true;
+  p.now.last_adapted_ns = now_ns - static_cast<std::int64_t>(std::max(0.0, age_s) * 1e9);
+  p.before_last = p.now;  // no retraction reaches behind a seed
 }
 
 void ValidityTracker::restart() noexcept {
@@ -33,8 +34,11 @@ void ValidityTracker::restart() noexcept {
 }
 
 void ValidityTracker::hold() noexcept {
-  for (Parameter& p : parameters_) p.adapting = false;
-  parameters_[core::kPsiM].adapted_s = 0.0;  // a pause
+  parameters_[core::kPsiM].now.adapted_s = 0.0;  // a pause
+  for (Parameter& p : parameters_) {
+    p.adapting = false;
+    p.before_last = p.now;  // no retraction reaches behind a pause
+  }
 }
 
 void ValidityTracker::on_sample(std::uint16_t flags, double dt_s, std::int64_t now_ns) noexcept {
@@ -42,14 +46,23 @@ void ValidityTracker::on_sample(std::uint16_t flags, double dt_s, std::int64_t n
   const double after_s[2] = {config_.psi_m_after_s, config_.r_s_after_s};
   for (int j = 0; j < 2; ++j) {
     Parameter& p = parameters_[static_cast<std::size_t>(j)];
+    p.before_last = p.now;
     p.adapting = active[j];
+    Adaptation& a = p.now;
     if (active[j]) {
-      p.adapted_s += dt_s;
-      p.last_adapted_ns = now_ns;
+      a.adapted_s += dt_s;
+      a.last_adapted_ns = now_ns;
     } else if (j == core::kPsiM) {
-      p.adapted_s = 0.0;  // ψm is identified by adaptation without a pause
+      a.adapted_s = 0.0;  // ψm is identified by adaptation without a pause
     }
-    if (p.adapted_s >= after_s[j]) p.identified = true;
+    if (a.adapted_s >= after_s[j]) a.identified = true;
+  }
+}
+
+void ValidityTracker::retract_last() noexcept {
+  for (Parameter& p : parameters_) {
+    p.now = p.before_last;
+    p.adapting = false;
   }
 }
 
@@ -71,8 +84,10 @@ ValidityTracker::Status ValidityTracker::report(int parameter, double value, std
   Status s;
   s.adapting = p.adapting;
   s.converged = converged(p);
-  if (p.last_adapted_ns != kNever) s.age_s = core::to_seconds(std::max<std::int64_t>(0, now_ns - p.last_adapted_ns));
-  s.valid = p.identified && s.age_s >= 0.0 && s.age_s <= config_.max_hold_s;
+  if (p.now.last_adapted_ns != kNever) {
+    s.age_s = core::to_seconds(std::max<std::int64_t>(0, now_ns - p.now.last_adapted_ns));
+  }
+  s.valid = p.now.identified && s.age_s >= 0.0 && s.age_s <= config_.max_hold_s;
   s.good = s.valid && s.converged && s.adapting;
   return s;
 }

@@ -160,12 +160,14 @@ struct MixedWindowRun {
   Classification mixed, next;                            ///< windows 20 and 21
   RegimeCounts counts;
   std::vector<double> psi_after;  ///< ψ̂m after each window from 21 on
+  std::vector<int> retracted_at;  ///< the windows whose estimate says they took back their predecessor's adaptation
   MixedWindowRun(const ReleaseWindows& r, int count, double after) {
     AveragedDriveEstimator est(test::outrunner_machine_si(), ReleaseWindows::settings());
     for (int j = 0; j < count; ++j) {
       if (j == 20) psi_before_mixed = est.psi_m_Wb();
       const Estimate e = est.step(r.window(j, j < 20 ? 1.0 : (j == 20 ? 0.5 : after)));
       counts.add(e.regime);
+      if (e.retracted_previous) retracted_at.push_back(j);
       if (j == 20) {
         mixed = e.regime;
         psi_after_mixed = est.psi_m_Wb();
@@ -189,6 +191,8 @@ TEST(RegimeEstimators, AReleaseInsideAWindowRetractsWhatThatWindowAdapted) {
   EXPECT_NEAR(run.psi_before_mixed / r.truth.psi_m_Wb, 1.0, 0.01);
   EXPECT_EQ(run.counts[Regime::kTransient], 1U);
   EXPECT_EQ(run.counts[Regime::kBridgeOff], 5U);
+  // The estimate that retracted says so, and no other (the off windows after it adapted nothing to take back).
+  EXPECT_EQ(run.retracted_at, std::vector<int>{21});
 }
 
 TEST(RegimeEstimators, AFreewheelInsideOneWindowIsFoundByItsNeighboursAndRetracted) {
@@ -205,6 +209,7 @@ TEST(RegimeEstimators, AFreewheelInsideOneWindowIsFoundByItsNeighboursAndRetract
   EXPECT_NEAR(run.psi_after.back() / r.truth.psi_m_Wb, 1.0, 0.01);
   EXPECT_EQ(run.counts[Regime::kTransient], 1U);
   EXPECT_EQ(run.counts[Regime::kBridgeOff], 0U);
+  EXPECT_EQ(run.retracted_at, std::vector<int>{21});
 }
 
 TEST(RegimeEstimators, AChainsLastWindowIsNeverJudgedAndIsLeftOut) {
@@ -232,6 +237,7 @@ TEST(RegimeEstimators, AChainsLastWindowIsNeverJudgedAndIsLeftOut) {
       const Estimate e = est.step(off);
       EXPECT_EQ(e.regime.regime, next == Next::kNonFinite ? Regime::kInvalid : Regime::kBridgeOff);
       EXPECT_FALSE(e.regime.bits & regime_bit::kPreviousMixed);  // not judged: its chain ended
+      EXPECT_TRUE(e.retracted_previous);                         // and taken back, as this estimate says
       EXPECT_FALSE(est.end_chain());                             // the sample after it adapted nothing
     }
     EXPECT_EQ(est.psi_m_Wb(), psi_before_mixed) << static_cast<int>(next);  // undone, exactly
@@ -251,10 +257,11 @@ TEST(RegimeEstimators, AChainsLastWindowIsNeverJudgedAndIsLeftOut) {
   const double psi_judged = est.psi_m_Wb();
   (void)est.step(window(20, 1.0));
   const double psi_last = est.psi_m_Wb();
-  est.resynchronize();  // rpemd's stream broken off
+  EXPECT_TRUE(est.resynchronize());  // rpemd's stream broken off: the chain's last window taken back, as it says
   EXPECT_EQ(est.psi_m_Wb(), psi_judged);
   EXPECT_NE(psi_last, psi_judged);
   EXPECT_FALSE(est.end_chain());
+  EXPECT_FALSE(est.resynchronize());  // nothing left to take back
   EXPECT_EQ(est.unjudged_windows(), 1U);
 }
 

@@ -193,5 +193,124 @@ TEST(ThermalObserver, ACoolantReadingHoldsUntilTheNextAndTheConfiguredOneStandsI
   EXPECT_FALSE(s.coolant_read);                // and is unread
 }
 
+/// The real estimator's estimates over `seconds` of noisy 200 Hz windows (ψ̂m settled, r̂s held), each with its Δt.
+std::vector<Estimate> noisy_estimates(double seconds) {
+  const MachineSi machine = test::paper_machine_si();
+  EstimatorSettings settings = test::paper_settings();
+  settings.adapt_r_s = false;
+  AveragedDriveEstimator estimator(machine, settings);
+  test::AveragedDataGenerator gen;
+  gen.base = test::paper_base();
+  gen.plant = test::paper_machine_pu();
+  gen.jitter = 0.0;
+  gen.n_pu = [](double) { return 0.8; };
+  gen.i_pu = [](double) { return Vec2(-0.3, 0.9); };
+  std::mt19937_64 rng(11);
+  std::normal_distribution<double> noise(0.0, 0.01 * gen.base.current_A);
+  std::vector<Estimate> out;
+  while (gen.t_s < seconds) {
+    AveragedSample s = gen.next();
+    s.i_dq_A += Vec2(noise(rng), noise(rng));
+    out.push_back(estimator.step(s));
+  }
+  return out;
+}
+
+/// How the observer is told of a mixed window inserted before estimate `at`: adapted and then taken back by the next
+/// estimate (what the averaged estimator reports), adapted and never taken back, or never adapted (excluded).
+enum class MixedWindow { kRetracted, kKept, kExcluded };
+
+struct InsertedRun {
+  std::vector<ThermalStepData> steps;
+  bool inserted_completed_a_step = false;
+};
+
+InsertedRun observe_with_mixed_window(const std::vector<Estimate>& estimates, std::size_t at, MixedWindow how) {
+  const MachineSi machine = test::paper_machine_si();
+  const PerUnitBase base = test::paper_base();
+  ThermalObserverConfig oc;
+  oc.residual_time_constant_s = 2.0;
+  ThermalObserver observer(oc, base, machine, loss_base_of(base, machine), 25.0);
+  ThermalSample ts;
+  ts.dt_s = 1.0 / 200.0;
+  InsertedRun out;
+  for (std::size_t k = 0; k < estimates.size(); ++k) {
+    Estimate e = estimates[k];
+    if (k == at) {
+      Estimate mixed = e;  // a freewheel half-way through: the flux read at 0.6 of it, a large residual
+      mixed.psi_m_Wb *= 0.94;
+      mixed.detail.epsilon_pu *= 40.0;
+      mixed.epsilon_A *= 40.0;
+      if (how == MixedWindow::kExcluded) mixed.detail.code = StepCode::kExcluded;
+      const bool stepped = observer.add(mixed, ts);
+      out.inserted_completed_a_step = stepped;
+      if (stepped) out.steps.push_back(observer.step());
+      e.retracted_previous = how == MixedWindow::kRetracted;
+    }
+    if (observer.add(e, ts)) out.steps.push_back(observer.step());
+  }
+  return out;
+}
+
+void expect_same_observations(const ThermalStepData& a, const ThermalStepData& b, std::size_t step) {
+  for (int j = 0; j < 2; ++j) {
+    const ParameterObservation& p = a.parameter[static_cast<std::size_t>(j)];
+    const ParameterObservation& q = b.parameter[static_cast<std::size_t>(j)];
+    EXPECT_EQ(p.valid, q.valid) << "step " << step << " parameter " << j;
+    EXPECT_EQ(p.value, q.value) << "step " << step << " parameter " << j;
+    EXPECT_EQ(p.variance, q.variance) << "step " << step << " parameter " << j;
+    EXPECT_EQ(p.variance_noise, q.variance_noise) << "step " << step << " parameter " << j;
+    EXPECT_EQ(p.cross, q.cross) << "step " << step << " parameter " << j;
+    EXPECT_EQ(p.time_constant_s, q.time_constant_s) << "step " << step << " parameter " << j;
+    EXPECT_EQ(p.sample_dt_s, q.sample_dt_s) << "step " << step << " parameter " << j;
+  }
+}
+
+TEST(ThermalObserver, AWindowTakenBackByTheEstimatorIsTakenOutOfItsStepAsIfItHadNotAdapted) {
+  // §13, "Mixed windows": the averaged estimator takes back what a window found mixed afterwards adapted
+  // (Estimate::retracted_previous). The observer then holds every observation to the last bit as if that window had
+  // been excluded — its value out of the step's mean, its a out of the settling, its residual out of ε̄ and Σ_ε.
+  const std::vector<Estimate> estimates = noisy_estimates(20.0);
+  const std::size_t at = 2400 + 37;  // mid-step, ψ̂m settled
+  const InsertedRun retracted = observe_with_mixed_window(estimates, at, MixedWindow::kRetracted);
+  const InsertedRun excluded = observe_with_mixed_window(estimates, at, MixedWindow::kExcluded);
+  const InsertedRun kept = observe_with_mixed_window(estimates, at, MixedWindow::kKept);
+  ASSERT_FALSE(retracted.inserted_completed_a_step);
+  ASSERT_EQ(retracted.steps.size(), excluded.steps.size());
+  for (std::size_t k = 0; k < retracted.steps.size(); ++k) {
+    expect_same_observations(retracted.steps[k], excluded.steps[k], k);
+  }
+  // Kept, the window moves its step's ψ̂m by its share (1 of 200 windows, 6 % low: 0.03 %) and the residual statistics.
+  std::size_t step = 0;  // the step holding the window
+  while (step < kept.steps.size() && kept.steps[step].t_ns < estimates[at].t_ns) ++step;
+  ASSERT_LT(step + 1, kept.steps.size());
+  ASSERT_TRUE(kept.steps[step].parameter[kPsiM].valid);
+  const double shift = kept.steps[step].parameter[kPsiM].value / excluded.steps[step].parameter[kPsiM].value - 1.0;
+  EXPECT_NEAR(shift, -0.06 / 201.0, 0.2 * 0.06 / 201.0);
+  EXPECT_GT(kept.steps[step + 1].parameter[kPsiM].variance, excluded.steps[step + 1].parameter[kPsiM].variance);
+}
+
+TEST(ThermalObserver, AWindowTakenBackAfterItsStepCompletedLeavesThatStepAndLaterOnesLearnNothingOfIt) {
+  // The window completed its step: the filter has had that step, so its sums stand; the settling and the residual
+  // statistics after it are as if the window had been excluded, so every later step is.
+  const std::vector<Estimate> estimates = noisy_estimates(20.0);
+  std::size_t at = 2390;
+  while (!observe_with_mixed_window(estimates, at, MixedWindow::kExcluded).inserted_completed_a_step) ++at;
+  ASSERT_LT(at, 2410U);
+  const InsertedRun retracted = observe_with_mixed_window(estimates, at, MixedWindow::kRetracted);
+  const InsertedRun excluded = observe_with_mixed_window(estimates, at, MixedWindow::kExcluded);
+  const InsertedRun kept = observe_with_mixed_window(estimates, at, MixedWindow::kKept);
+  ASSERT_TRUE(retracted.inserted_completed_a_step);
+  ASSERT_EQ(retracted.steps.size(), kept.steps.size());
+  std::size_t completed = 0;  // the step the window completed
+  while (completed < retracted.steps.size() && retracted.steps[completed].t_ns != estimates[at].t_ns) ++completed;
+  ASSERT_LT(completed + 1, retracted.steps.size());
+  expect_same_observations(retracted.steps[completed], kept.steps[completed], completed);
+  for (std::size_t k = completed + 1; k < retracted.steps.size(); ++k) {
+    expect_same_observations(retracted.steps[k], excluded.steps[k], k);
+  }
+  EXPECT_NE(kept.steps[completed + 1].parameter[kPsiM].variance, excluded.steps[completed + 1].parameter[kPsiM].variance);
+}
+
 }  // namespace
 }  // namespace rpem::core

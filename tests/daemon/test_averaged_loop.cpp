@@ -8,6 +8,7 @@
 #include <cmath>
 #include <functional>
 #include <limits>
+#include <vector>
 
 #include "rpem/core/clock.hpp"
 #include "rpem/daemon/loop_thread.hpp"
@@ -29,6 +30,7 @@ struct AveragedRig {
   test::AveragedDataGenerator gen;
   std::int64_t now_ns = 1'000'000'000;
   std::int64_t pushed = 0;
+  std::vector<std::int64_t> push_ns;  ///< the loop's time at which each window was pushed (and stepped)
   bool have_next = false;
   core::AveragedSample next;
   double t_winding_C = std::numeric_limits<double>::quiet_NaN();  ///< the drive's winding sensor on every window
@@ -68,6 +70,7 @@ struct AveragedRig {
         if (next.t_ns > now_ns) break;
         ASSERT_TRUE(input.push(next));
         ++pushed;
+        push_ns.push_back(now_ns);
         have_next = false;
       }
       loop->process(now_ns);
@@ -184,6 +187,35 @@ TEST(AveragedLoop, SilenceIsStaleAndTheNextWindowRestartsTheChain) {
   rig.drain();
   EXPECT_EQ(rig.estimate.state, DaemonState::kRunning);
   EXPECT_EQ(rig.stats.rows.get(&diagnostics_t::resyncs), 2);
+}
+
+// The stream broken off ends the chain, and its last window — never judged for a bridge release inside it — is taken
+// back (docs/derivations.md §13, "A chain's last window"). Its adaptation is taken back in the validity tracker too:
+// once stale, ψm's age counts from the window before it, whose value the estimate is again.
+TEST(AveragedLoop, AWindowTakenBackAtTheStreamsEndNoLongerCountsAsAdapted) {
+  AveragedRig rig(200.0, 0.92);
+  rig.run(3.0);
+  rig.drain();
+  ASSERT_TRUE(rig.estimate.psi_m_adapting);
+  ASSERT_GE(rig.push_ns.size(), 2U);
+  const std::int64_t last_ns = rig.push_ns.back(), before_last_ns = rig.push_ns[rig.push_ns.size() - 2];
+  ASSERT_GT(last_ns - before_last_ns, 2'000'000);  // 200 Hz windows on 1 ms ticks: 4–6 ms apart
+  // Tick by tick through the silence: each report's age against the loop's time of the tick that made it.
+  bool stale_seen = false;
+  for (int tick = 0; tick < 600 && !stale_seen; ++tick) {
+    rig.now_ns += 1'000'000;
+    rig.loop->process(rig.now_ns);
+    Report r;
+    while (rig.output.pop(r)) {
+      const auto* e = std::get_if<EstimateReport>(&r);
+      if (e == nullptr) continue;
+      const std::int64_t adapted_ns = e->state == DaemonState::kStale ? before_last_ns : last_ns;
+      EXPECT_NEAR(e->psi_m_age_s, core::to_seconds(rig.now_ns - adapted_ns), 1e-9)
+          << "state " << static_cast<int>(e->state) << " at tick " << tick;
+      stale_seen = stale_seen || e->state == DaemonState::kStale;
+    }
+  }
+  EXPECT_TRUE(stale_seen);
 }
 
 TEST(AveragedLoop, MeasurementsCarryTheDrivesSensorsAndNoAngle) {

@@ -34,16 +34,19 @@ class AveragedDriveEstimator {
 
   /// θ̂ and the Hessians back to their initial values; the next sample starts a new chain.
   void reset() noexcept;
-  /// The next sample starts a new chain (adapts nothing); the chain it breaks ends (end_chain()).
-  void resynchronize() noexcept {
-    end_chain();
+  /// The next sample starts a new chain (adapts nothing); the chain it breaks ends (end_chain(), whose result it
+  /// returns).
+  bool resynchronize() noexcept {
+    const bool retracted = end_chain();
     has_previous_ = false;
     classifier_.break_chain();
+    return retracted;
   }
   /// The chain ends (the log's end, a gap, a stream broken off): its newest window is never judged, since a
   /// release inside it shows only in the window after it (docs/derivations.md §13, "Mixed windows"), so what
   /// it adapted is retracted. A sample that does not continue the chain ends it the same way. Returns whether
-  /// θ̂ moved back. Real-time safe.
+  /// a window's adaptation was taken back (not frozen, and the window was admitted): its step flags no longer
+  /// hold (Estimate::retracted_previous). Real-time safe.
   bool end_chain() noexcept;
   /// Windows that ended a chain and were retracted by end_chain() (θ̂ moved back), since construction.
   [[nodiscard]] std::uint64_t unjudged_windows() const noexcept { return unjudged_windows_; }

@@ -25,6 +25,10 @@ struct Estimate {
   double speed_pu = 0.0;
   EstimatorOutput detail;  ///< per-unit detail: θ̂, Ψᵀ, L, code, flags
   Classification regime;   ///< the sample's regime (regime.hpp)
+  /// This step undid what the previous sample adapted (an averaged window found mixed by this one, or left unjudged
+  /// by this one ending its chain: docs/derivations.md §13, "Mixed windows"): θ̂ is back where it stood before that
+  /// sample, and whoever counted its adaptation (its step flags) takes it back.
+  bool retracted_previous = false;
 };
 
 class DriveEstimator {
@@ -37,7 +41,9 @@ class DriveEstimator {
   [[nodiscard]] Estimate step(const DriveSample& sample) noexcept;
 
   void reset() noexcept;
-  void resynchronize() noexcept;
+  /// The next sample starts a new chain. Returns false: nothing this estimator adapted is taken back
+  /// (AveragedDriveEstimator's counterpart returns whether a window was).
+  bool resynchronize() noexcept;
   void set_frozen(bool frozen) noexcept { core_.set_frozen(frozen); }
   void set_estimates(double psi_m_Wb, double r_s_Ohm) noexcept;
   /// Reloads gains, limits and model extensions, keeping θ̂, Hessians and predictor state.

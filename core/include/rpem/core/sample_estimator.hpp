@@ -22,7 +22,7 @@ concept SampleEstimator = std::is_nothrow_constructible_v<E, const MachineSi&, c
   { e.reset() }
   noexcept;
   { e.resynchronize() }
-  noexcept;
+  noexcept->std::same_as<bool>;  ///< whether the previous sample's adaptation was taken back
   { e.set_frozen(frozen) }
   noexcept;
   { e.set_estimates(value, value) }

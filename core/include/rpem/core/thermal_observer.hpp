@@ -19,7 +19,10 @@
 // constant (Σa ≥ ¼) or kMaxBatch samples — long against the noise's correlation, short against what the
 // estimator itself moves (a differenced noise, which the averaged path's inductive correction puts into ε
 // and which the update does not see, keeps 2/M of its variance; rows seconds apart, a ≈ 1: M = 1). A step's observation is the mean of its
-// adapted samples' values, κ, variances and τ; nothing here depends on the thermal model. Real-time safe.
+// adapted samples' values, κ, variances and τ; nothing here depends on the thermal model. A sample whose adaptation
+// the estimator takes back afterwards (Estimate::retracted_previous: an averaged window found mixed, docs/derivations.md
+// §13, "Mixed windows") is taken out again — of the step, the settling and the residual statistics — unless its step
+// has already completed. Real-time safe.
 
 #include <array>
 #include <cstdint>
@@ -96,6 +99,19 @@ class ThermalObserver {
     double adapted_s = 0.0, value = 0.0, cross = 0.0, other = 0.0, variance = 0.0, variance_noise = 0.0, tau = 0.0;
     int samples = 0;
   };
+  static constexpr int kMaxBatch = 32;
+  /// What the adapted samples teach: the step's sums, the settling and ε̄, Σ_ε — what a retraction takes back.
+  struct Learnt {
+    std::array<Accumulated, 2> acc{};
+    std::array<double, 2> settled{};  ///< Σa over the current uninterrupted adaptation
+    Vec2 eps_mean = Vec2::Zero();     ///< ε̄, per sample
+    Vec2 batch_sum = Vec2::Zero();    ///< the current batch's residuals
+    double batch_dt_s = 0.0, batch_a = 0.0;
+    int batch_count = 0;
+    Vec2 batch_mean = Vec2::Zero();  ///< the batch means' mean
+    Mat2 eps_cov = Mat2::Zero();     ///< Σ_ε = kBatch·Cov(batch means)
+    bool eps_started = false, batch_started = false;
+  };
   void add_parameter(int j, const Estimate& e, double dt_s) noexcept;
   /// ε̄ and Σ_ε (batch means) from an adapted sample's residual.
   void add_residual(const EstimatorOutput& d, double dt_s) noexcept;
@@ -108,16 +124,9 @@ class ThermalObserver {
   double measured_coolant_C_ = std::numeric_limits<double>::quiet_NaN();  ///< the newest reading; NaN: none yet
   bool coolant_read_ = false;                                             ///< in the current step
   LossAccumulator losses_;
-  static constexpr int kMaxBatch = 32;
-  Vec2 eps_mean_ = Vec2::Zero();   ///< ε̄, per sample
-  Vec2 batch_sum_ = Vec2::Zero();  ///< the current batch's residuals
-  double batch_dt_s_ = 0.0, batch_a_ = 0.0;
-  int batch_count_ = 0;
-  Vec2 batch_mean_ = Vec2::Zero();  ///< the batch means' mean
-  Mat2 eps_cov_ = Mat2::Zero();     ///< Σ_ε = kBatch·Cov(batch means)
-  bool eps_started_ = false, batch_started_ = false;
-  std::array<double, 2> settled_{};  ///< Σa over the current uninterrupted adaptation
-  std::array<Accumulated, 2> acc_{};
+  Learnt learnt_;
+  Learnt before_last_;               ///< learnt_ before the newest sample
+  bool stepped_since_last_ = false;  ///< the newest sample completed a step (its sums are published)
   // The sensor's readings: Σw·T, Σw, and Σw·τ, Σw·τ² of their times τ since the step's start (w: the time each stands for).
   double sensor_sum_ = 0.0, sensor_time_ = 0.0, sensor_elapsed_ = 0.0, sensor_elapsed_sq_ = 0.0;
   ThermalStepData step_;

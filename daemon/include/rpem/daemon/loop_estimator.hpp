@@ -45,7 +45,9 @@ class LoopEstimator {
   bool step(const SourceSample& sample, core::Estimate& estimate, double& dt_s, SampleSummary& summary) noexcept;
 
   void reset() noexcept;
-  void resynchronize() noexcept;
+  /// The next sample starts a new chain; true where that took back what the previous sample adapted (an averaged
+  /// chain's unjudged last window: its step flags no longer hold).
+  bool resynchronize() noexcept;
   void set_frozen(bool frozen) noexcept;
   void set_estimates(double psi_m_Wb, double r_s_Ohm) noexcept;
   /// Not real-time (a reload).

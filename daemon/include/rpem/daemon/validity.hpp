@@ -11,7 +11,10 @@
 // It is *identified* after validity.r_s_after_s of adaptation in all (r_s) or validity.psi_m_after_s of
 // adaptation without a pause (ψm), until a reset or new initial values; *valid* while identified and
 // its age is at most validity.max_hold_s; *converged* when its spread over the last
-// validity.convergence_window_s is within validity.convergence_band. Real-time safe.
+// validity.convergence_window_s is within validity.convergence_band. A sample whose adaptation the estimator took
+// back (an averaged window found mixed afterwards, or its chain's unjudged last: docs/derivations.md §13, "Mixed
+// windows") is taken back here too: the value is the one before it, and so are its age and identification.
+// Real-time safe.
 
 #include <array>
 #include <cstdint>
@@ -43,17 +46,25 @@ class ValidityTracker {
   void hold() noexcept;
   /// One stepped sample: its step flags and nominal length, at `now_ns`.
   void on_sample(std::uint16_t flags, double dt_s, std::int64_t now_ns) noexcept;
+  /// The newest sample's adaptation was taken back (core::Estimate::retracted_previous, or a resynchronize that
+  /// retracted): where each parameter stood before that sample, and adapting in none. Once: a second call changes
+  /// nothing.
+  void retract_last() noexcept;
   /// At each estimate report: adds the value to the parameter's window and says where it stands.
   [[nodiscard]] Status report(int parameter, double value, std::int64_t now_ns) noexcept;
 
  private:
   static constexpr std::int64_t kNever = INT64_MIN;
   static constexpr int kWindow = 64;
-  struct Parameter {
+  /// What a sample changes, and retract_last() restores.
+  struct Adaptation {
     double adapted_s = 0.0;  ///< toward identification
     bool identified = false;
-    bool adapting = false;
     std::int64_t last_adapted_ns = kNever;
+  };
+  struct Parameter {
+    Adaptation now, before_last;  ///< before_last: before the newest sample
+    bool adapting = false;
     std::array<double, kWindow> window{};
     int count = 0, head = 0;
   };
