@@ -125,6 +125,32 @@ TEST_F(SupervisorTest, ForgedOrReplayedColdMagnetsNeverLiftTheLimit) {
   EXPECT_EQ(supervisor.current_limit(kT0 + 3'600'000'000).current_A, 30.0);  // the floor, not 120 A
 }
 
+TEST_F(SupervisorTest, AStaleRpemdsHeldEstimatesNeverLiftTheFloorAfterTheSilence) {
+  // A new user's walk (2026-12-06): rpemd stale at 6 s, its estimates (state 2) repeating the last sample time at
+  // 10 Hz; once the last running one aged out, the silence rule took the next stale one as a restart, and I_max
+  // flipped between the floor and 120 A for as long as rpemd stayed stale.
+  rpem::estimate_t running = test::raw_estimate(kT0, 45.0, 44.7);
+  ASSERT_EQ(send(test::encode_signed(running, &key), kT0 + 1'000), Admission::kAccepted);
+  for (int k = 1; k <= 30; ++k) {  // 3 s of held estimates
+    rpem::estimate_t held = running;
+    held.utime = kT0 + k * 100'000;
+    held.state = rpem::estimate_t::STATE_STALE;
+    ASSERT_EQ(send(test::encode_signed(held, &key), held.utime + 1'000), Admission::kNotRunning) << k;
+    const CurrentLimit l = supervisor.current_limit(held.utime + 2'000);
+    EXPECT_EQ(l.current_A, held.utime + 2'000 - kT0 <= 550'000 ? 120.0 : 30.0) << k;  // the floor once stale
+  }
+  // Starting (no sample yet: initial or resumed values) and stopping are held values too; running again, accepted.
+  for (const std::int8_t state : {rpem::estimate_t::STATE_STARTING, rpem::estimate_t::STATE_STOPPING}) {
+    rpem::estimate_t held = test::raw_estimate(kT0 + 3'100'000, 25.0, 25.0);
+    held.state = state;
+    EXPECT_EQ(send(test::encode_signed(held, &key), kT0 + 3'101'000), Admission::kNotRunning);
+  }
+  EXPECT_EQ(supervisor.current_limit(kT0 + 3'102'000).current_A, 30.0);
+  ASSERT_EQ(send(test::encode_signed(test::raw_estimate(kT0 + 3'200'000, 45.0, 44.7), &key), kT0 + 3'201'000),
+            Admission::kAccepted);
+  EXPECT_EQ(supervisor.current_limit(kT0 + 3'202'000).current_A, 120.0);
+}
+
 TEST(SupervisorConfig, TheExampleFileLoads) {
   const Config c = load_config(std::string(RPEM_TEST_SOURCE_DIR) + "/examples/supervisor/supervisor.yaml");
   const Config e = config();

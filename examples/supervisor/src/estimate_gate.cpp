@@ -23,6 +23,8 @@ const char* to_string(Admission a) noexcept {
       return "from the future";
     case Admission::kNotNewer:
       return "not newer (replayed or reordered)";
+    case Admission::kNotRunning:
+      return "not running (rpemd starting, stale or stopping)";
   }
   return "?";
 }
@@ -54,6 +56,7 @@ Admission EstimateGate::admit(std::string_view channel, std::span<const std::uin
     const std::int64_t age_us = now_unix_us - stamp.utime_us;
     if (freshness_.stale(age_us)) return Admission::kStale;
     if (freshness_.from_future(age_us)) return Admission::kFromFuture;
+    if (out.state != rpem::estimate_t::STATE_RUNNING) return Admission::kNotRunning;
     Stamp& last = last_of(auth::key_id_of(encoded));
     if (stamp.utime_us <= last.utime_us) return Admission::kNotNewer;
     const bool silence = freshness_.stale(now_unix_us - last.utime_us);  // rpemd may have restarted

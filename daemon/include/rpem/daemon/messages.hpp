@@ -21,7 +21,12 @@
 
 namespace rpem::daemon {
 
-enum class DaemonState : std::int8_t { kStarting = 0, kRunning = 1, kStale = 2, kStopping = 3 };
+enum class DaemonState : std::int8_t {
+  kStarting = mirror::estimate_t::STATE_STARTING,
+  kRunning = mirror::estimate_t::STATE_RUNNING,
+  kStale = mirror::estimate_t::STATE_STALE,
+  kStopping = mirror::estimate_t::STATE_STOPPING,
+};
 /// estimate_t.state and diagnostics_t.state carry a DaemonState's number.
 [[nodiscard]] constexpr bool operator==(std::int8_t state, DaemonState s) noexcept {
   return state == static_cast<std::int8_t>(s);

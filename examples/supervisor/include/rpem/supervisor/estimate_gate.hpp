@@ -5,12 +5,14 @@
 //      of it is decoded; then it must decode as exactly one estimate_t (else malformed);
 //   2. fresh — its utime, against the supervisor's clock: now − utime ≤ max_age + max_skew (not stale)
 //      and utime − now ≤ max_skew (not from the future);
-//   3. newer — per key id, utime and sample_time_us strictly larger than those of the last estimate
+//   3. live — rpemd's state running: starting, stale (no samples) and stopping estimates hold values no
+//      sample renewed;
+//   4. newer — per key id, utime and sample_time_us strictly larger than those of the last estimate
 //      accepted under that key id. A copy of a genuine message re-sent later (a replay: a cold magnet
-//      an hour ago) fails 2 or, inside the freshness window, 3; so does a reordered one.
+//      an hour ago) fails 2 or, inside the freshness window, 4; so does a reordered one.
 // The sample time is the drive's clock, which starts again when rpemd does: after a silence (the last
-// accepted estimate under the key id no longer fresh by 2) the first fresh, newer-utime estimate sets
-// its baseline anew. That opens nothing to an attacker — what passes 1–3 is new from rpemd's hand.
+// accepted estimate under the key id no longer fresh by 2) the first fresh, live, newer-utime estimate sets
+// its baseline anew. That opens nothing to an attacker — what passes 1–4 is new from rpemd's hand.
 
 #include <array>
 #include <cstdint>
@@ -42,8 +44,9 @@ enum class Admission : std::int8_t {
   kStale = 5,       ///< older than max_age + max_skew
   kFromFuture = 6,  ///< newer than now + max_skew
   kNotNewer = 7,    ///< utime or sample time not past the last accepted one's: a replay or reordered
+  kNotRunning = 8,  ///< rpemd's state not running (starting, stale, stopping): its estimates are held values
 };
-inline constexpr int kAdmissionCount = 8;
+inline constexpr int kAdmissionCount = 9;
 [[nodiscard]] const char* to_string(Admission a) noexcept;
 /// Whether the gate got as far as decoding the message (it was authentic and well-formed).
 [[nodiscard]] constexpr bool decoded(Admission a) noexcept { return a >= Admission::kStale || a == Admission::kAccepted; }
