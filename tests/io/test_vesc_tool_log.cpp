@@ -86,6 +86,63 @@ TEST(VescToolLog, ReadsTheCurrentHeaderAsAveragedSamplesSinceThePreviousRow) {
   EXPECT_TRUE(read.layout.u_dc && read.layout.t_winding && read.layout.t_drive && !read.layout.t_magnet);
 }
 
+/// `csv` (';'-separated, a header line first) without the columns named `drop`, from the header and every row.
+std::string without_vesc_columns(const std::string& csv, const std::vector<std::string>& drop) {
+  std::vector<std::vector<std::string>> lines;
+  std::size_t from = 0;
+  while (from < csv.size()) {
+    const std::size_t end = csv.find('\n', from);
+    const std::string line = csv.substr(from, end - from);
+    std::vector<std::string> cells;
+    std::size_t c = 0;
+    while (c <= line.size()) {
+      const std::size_t semi = std::min(line.find(';', c), line.size());
+      cells.push_back(line.substr(c, semi - c));
+      c = semi + 1;
+    }
+    lines.push_back(cells);
+    from = end == std::string::npos ? csv.size() : end + 1;
+  }
+  std::string out;
+  for (const auto& cells : lines) {
+    for (std::size_t k = 0; k < cells.size(); ++k) {
+      if (std::find(drop.begin(), drop.end(), lines[0][k]) != drop.end()) continue;
+      out += cells[k] + (k + 1 < cells.size() ? ";" : "");
+    }
+    out += '\n';
+  }
+  return out;
+}
+
+TEST(VescToolLog, ALogCutDownWithoutItsTemperaturesIsReadWithoutThem) {
+  // A new user's walk (2026-12-06): temp_motor and temp_mos_max cut out of a log (a spreadsheet's copy) were refused
+  // as "rpem needs it", though nothing but the thermal fusion reads them. GIVEN the current header's three reads with
+  // both columns removed WHEN read THEN the same samples as the whole log's, and no temperatures.
+  const std::string whole = kHeader120 + row120(45000000, -0.5, 3.2, 6000, -0.31, 8.7) +
+                            row120(45000090, -1.25, 10.5, 6100, -0.9, 9.25) + row120(45000200, -1.5, 11.0, 6200, -1.0, 9.5);
+  const std::string cut = without_vesc_columns(whole, {"temp_motor", "temp_mos_max"});
+  ASSERT_EQ(cut.find("temp_motor"), std::string::npos) << cut;
+  ASSERT_EQ(cut.find("temp_mos_max"), std::string::npos) << cut;
+  test::TempFile f_whole("whole.csv", whole), f_cut("vesc.csv", cut);
+  AveragedLogRead read_whole, read_cut;
+  const auto s_whole = read_averaged_log(f_whole.path(), log_source(f_whole.path()).map, DriveLogLimits{}, &read_whole);
+  const auto s_cut = read_averaged_log(f_cut.path(), log_source(f_cut.path()).map, DriveLogLimits{}, &read_cut);
+  ASSERT_EQ(s_cut.size(), s_whole.size());
+  for (std::size_t k = 0; k < s_cut.size(); ++k) {
+    EXPECT_EQ(s_cut[k].t_ns, s_whole[k].t_ns);
+    EXPECT_EQ(s_cut[k].i_dq_A, s_whole[k].i_dq_A);
+    EXPECT_EQ(s_cut[k].u_dq_V, s_whole[k].u_dq_V);
+    EXPECT_EQ(s_cut[k].omega_el_rad_s, s_whole[k].omega_el_rad_s);
+    EXPECT_EQ(s_cut[k].u_dc_V, s_whole[k].u_dc_V);
+    EXPECT_TRUE(std::isnan(s_cut[k].t_winding_C) && std::isnan(s_cut[k].t_drive_C));
+  }
+  EXPECT_TRUE(read_whole.layout.t_winding && read_whole.layout.t_drive);
+  EXPECT_FALSE(read_cut.layout.t_winding || read_cut.layout.t_drive);
+  // The quantities the estimator needs stay required, with the version that added them.
+  const std::string msg = vesc_tool_error_of(without_vesc_columns(whole, {"input_voltage"}));
+  EXPECT_NE(msg.find("column input_voltage: not in this VESC Tool realtime log"), std::string::npos) << msg;
+}
+
 TEST(VescToolLog, ARowAtTheFirmwaresMinus100HasNoWindingReading) {
   // GIVEN temp_motor at −100 on two rows: the value the firmware filters in where it has no reading of the motor's
   // sensor (vedderb/bldc motor/mc_interface.c, update_override_limits), as std::to_string writes it ("-100.000000")
