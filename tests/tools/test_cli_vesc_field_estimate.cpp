@@ -255,5 +255,36 @@ TEST(CliVescFieldEstimate, IndependentGeneratorAsAThirdPartyLoggerPrintsIt) {
                    true);
 }
 
+// A new user's walk (2026-12-06): a machine whose ψm lies above the configured D_M. The estimator holds ψ̂m at the
+// bound, and rpem estimate printed the bound as the estimate, blaming the start ("its start still decides ±27 %").
+// It says the estimate ended at the bound, which key to widen, and that it is no identification.
+TEST(CliVescFieldEstimate, AMachineBeyondTheBoundsIsSaidToEndAtTheBound) {
+  test::TempFile log("indep-bound.csv"), truth("indep-bound-truth.json");
+  const auto gen = test::run_command(indep_vesc_log() + " --config " + config("vesc-6374-outrunner.yaml") +
+                                     " --seed 1 --duration-s 600 --psi-m-rel 0.2 --r-s-rel -0.25 --out " + log.path() +
+                                     " --truth " + truth.path());
+  ASSERT_EQ(gen.exit_code, 0) << gen.output;
+  const nlohmann::json j = nlohmann::json::parse(test::read_file(truth.path()));
+  const double psi_true = j.at("true_at_end").at("psi_m_Wb").get<double>();
+  std::string cfg = test::read_file(config("vesc-6374-firmware.yaml"));
+  const std::string bounds = "psi_m_Wb: [0.0023, 0.0070]";
+  ASSERT_NE(cfg.find(bounds), std::string::npos);
+  ASSERT_GT(psi_true, 0.0052);  // the machine above the bound below
+  cfg.replace(cfg.find(bounds), bounds.size(), "psi_m_Wb: [0.0023, 0.0050]");
+  test::TempFile narrow("narrow.yaml", cfg);
+  const Final f = estimate(log.path(), narrow.path());
+  EXPECT_NEAR(f.psi_m_Wb, 0.005, 1e-12) << f.output;
+  EXPECT_NE(f.output.find("psi_m ended at its upper bound 0.005 Wb (estimator.bounds.psi_m_Wb: [0.0023, 0.005]), where "
+                          "the estimator holds it: the machine's value may lie beyond it, so 0.005 Wb is no "
+                          "identification; if the machine can have such a value, widen the bound"),
+            std::string::npos)
+      << f.output;
+  EXPECT_EQ(f.output.find("psi_m not identifiable from this log: started at the ends"), std::string::npos) << f.output;
+  // Within the configuration's bounds the same log says nothing of them.
+  const Final wide = estimate(log.path(), config("vesc-6374-firmware.yaml"));
+  EXPECT_EQ(wide.output.find("ended at its"), std::string::npos) << wide.output;
+  EXPECT_NEAR(wide.psi_m_Wb / psi_true, 1.0, 0.02) << wide.output;
+}
+
 }  // namespace
 }  // namespace rpem

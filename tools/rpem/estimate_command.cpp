@@ -177,15 +177,20 @@ struct Tally {
   }
   void count(const core::Estimate& e) {
     if (!first_t_ns) first_t_ns = e.t_ns;
+    if (e.retracted_previous) uncount_adaptation(last);  // a window found mixed: what it adapted was taken back
     last = e;
     counts.add(e);
     adapted[0] += (e.detail.flags & core::step_flag::kPsiMActive) ? 1 : 0;
     adapted[1] += (e.detail.flags & core::step_flag::kRsActive) ? 1 : 0;
   }
+  void uncount_adaptation(const core::Estimate& e) {
+    adapted[0] -= (e.detail.flags & core::step_flag::kPsiMActive) ? 1 : 0;
+    adapted[1] -= (e.detail.flags & core::step_flag::kRsActive) ? 1 : 0;
+  }
   /// The log's end ends the last chain: its newest window, never judged, is retracted (docs/derivations.md §13,
   /// "Mixed windows"); the final estimates are the estimator's, and the windows so left out are said.
   void end_chain(core::AveragedDriveEstimator& estimator) {
-    estimator.end_chain();
+    if (estimator.end_chain()) uncount_adaptation(last);
     last.psi_m_Wb = estimator.psi_m_Wb();
     last.r_s_Ohm = estimator.r_s_Ohm();
     if (const std::uint64_t n = estimator.unjudged_windows(); n > 0) {
@@ -244,6 +249,33 @@ std::string adapted_clause(std::size_t k, const core::RegimeCounts& regimes, std
   return text;
 }
 
+/// Whether each parameter's last estimate lies on an end of D_M (estimator.bounds), where the projection holds it;
+/// says so on stderr for each that does: the machine's value may lie beyond, and the value is no identification.
+std::array<bool, 2> say_estimates_at_bounds(const core::Estimate& last, const core::EstimatorSettings& e) {
+  struct Bound {
+    const char* name;
+    const char* key;
+    const char* unit;
+    double value, lo, hi;
+  };
+  const std::array<Bound, 2> b{{{"psi_m", "psi_m_Wb", "Wb", last.psi_m_Wb, e.psi_m_min_Wb, e.psi_m_max_Wb},
+                                {"r_s", "r_s_Ohm", "Ohm", last.r_s_Ohm, e.r_s_min_Ohm, e.r_s_max_Ohm}}};
+  std::array<bool, 2> at{};
+  for (std::size_t k = 0; k < b.size(); ++k) {
+    constexpr double kRounding = 1e-9;  // the projection is onto D_M in pu: back in SI it rounds
+    const bool low = b[k].value <= b[k].lo * (1.0 + kRounding), high = b[k].value >= b[k].hi * (1.0 - kRounding);
+    at[k] = low || high;
+    if (!at[k]) continue;
+    std::fprintf(stderr,
+                 "rpem estimate: %s ended at its %s bound %.5g %s (estimator.bounds.%s: [%.5g, %.5g]), where the "
+                 "estimator holds it: the machine's value may lie beyond it, so %.5g %s is no identification; if the "
+                 "machine can have such a value, widen the bound (docs/configuration.md)\n",
+                 b[k].name, low ? "lower" : "upper", low ? b[k].lo : b[k].hi, b[k].unit, b[k].key, b[k].lo, b[k].hi,
+                 b[k].value, b[k].unit);
+  }
+  return at;
+}
+
 std::array<std::optional<bool>, 2> check_identifiable(const std::vector<core::AveragedSample>& samples,
                                                       const io::MachineConfig& cfg, const core::Estimate& last,
                                                       const std::array<std::uint64_t, 2>& adapted,
@@ -264,7 +296,12 @@ std::array<std::optional<bool>, 2> check_identifiable(const std::vector<core::Av
   std::array<Identifiability, 2> p{
       {{"psi_m", "Wb", 0.02, e.psi_m_min_Wb, e.psi_m_max_Wb}, {"r_s", "Ohm", 0.05, e.r_s_min_Ohm, e.r_s_max_Ohm}}};
   const std::array<double, 2> estimate{last.psi_m_Wb, last.r_s_Ohm};
+  const std::array<bool, 2> at_bound = say_estimates_at_bounds(last, e);
   for (std::size_t k = 0; k < p.size(); ++k) {
+    if (at_bound[k]) {  // said above; where it ends is the bound's, not the log's
+      identifiable[k] = false;
+      continue;
+    }
     for (const bool high : {false, true}) {
       core::EstimatorSettings s = e;
       (k == 0 ? s.initial_psi_m_Wb : s.initial_r_s_Ohm) = high ? p[k].hi : p[k].lo;
@@ -345,6 +382,12 @@ Tally run_instantaneous(const EstimateOptions& o, const std::string& log, const 
   }
   progress.finish(tally.summary(cfg.estimator.algorithm, "samples") + io::describe(reader.reader().repairs()));
   tally.explain();
+  if (tally.first_t_ns) {
+    const std::array<bool, 2> at_bound = say_estimates_at_bounds(tally.last, cfg.estimator);
+    for (std::size_t k = 0; k < at_bound.size(); ++k) {
+      if (at_bound[k]) tally.identifiable[k] = false;
+    }
+  }
   thermal.explain();
   tally.take_peaks(thermal);
   return tally;

@@ -1,4 +1,5 @@
 // diagnosis.json and extended.yaml (schema: docs/diagnose.md).
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -176,6 +177,25 @@ std::vector<std::string> calibration_findings(const Diagnosis& d) {
     out.push_back(std::string("the configuration's ") + kCalibratedName[i] + " is " + abs_percent(rel) + " % " +
                   (rel > 0.0 ? "high" : "low"));
   }
+  for (const std::string& b : calibrated_outside_bounds(d)) out.push_back(b);
+  return out;
+}
+
+std::vector<std::string> calibrated_outside_bounds(const Diagnosis& d) {
+  // ψm and R_s are the estimator's: a calibrated value outside D_M is one rpem estimate and rpemd hold at its bound.
+  const core::EstimatorSettings& e = d.config.estimator;
+  const std::array<std::array<double, 2>, 2> bounds{{{e.psi_m_min_Wb, e.psi_m_max_Wb}, {e.r_s_min_Ohm, e.r_s_max_Ohm}}};
+  std::vector<std::string> out;
+  for (std::size_t i = 0; i < bounds.size(); ++i) {
+    const double v = d.calibration.value[i];
+    if (!d.calibration.identifiable[i] || (v >= bounds[i][0] && v <= bounds[i][1])) continue;
+    char text[400];
+    std::snprintf(text, sizeof text,
+                  "%s calibrated at %.6g lies outside estimator.bounds.%s [%.6g, %.6g], which extended.yaml keeps: rpem "
+                  "estimate and rpemd would hold it at the bound; widen the bounds to hold it",
+                  kCalibrated[i], v, kCalibrated[i], bounds[i][0], bounds[i][1]);
+    out.emplace_back(text);
+  }
   return out;
 }
 
@@ -315,6 +335,7 @@ void write_extended_yaml(const std::string& path, const Diagnosis& d, const std:
   bool kept = false;
   for (const EstimatorCheck& c : d.estimator_checks) kept = kept || c.kept;
   if (!kept) header += "# No effect was added: the model_extensions are the input's.\n";
+  for (const std::string& b : calibrated_outside_bounds(d)) header += "# Note: " + b + ".\n";
   std::vector<std::pair<std::string, double>> constants;
   for (std::size_t i = 0; i < kCalibrated.size(); ++i) {
     const double v = d.extended_config.machine.*kCalibratedFields[i];

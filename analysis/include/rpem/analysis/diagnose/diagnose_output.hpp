@@ -38,6 +38,10 @@ void write_diagnose_report(const std::string& dir, const Diagnosis& d, const std
 /// What the calibration says about the configuration, one sentence per identifiable constant whose
 /// configured value lies outside the calibrated 95 % interval widened by its mismatch allowance (e.g. "the configuration's ψm is 5.1 % high").
 [[nodiscard]] std::vector<std::string> calibration_findings(const Diagnosis& d);
+/// One sentence per identifiable ψm or R_s calibrated outside the configuration's estimator.bounds (D_M), which
+/// extended.yaml keeps: the estimator would hold it at the bound. Part of calibration_findings, and a note in
+/// extended.yaml's header.
+[[nodiscard]] std::vector<std::string> calibrated_outside_bounds(const Diagnosis& d);
 
 /// The estimator check of the found effect j (nullptr if none).
 [[nodiscard]] const EstimatorCheck* estimator_check(const Diagnosis& d, std::size_t j);
