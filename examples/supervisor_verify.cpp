@@ -3,14 +3,16 @@
 //   example_supervisor_verify PUBLISH_KEY_FILE [SECONDS]
 #include <chrono>
 #include <cstdio>
-#include <cstdlib>
 #include <lcm/lcm-cpp.hpp>
+#include <optional>
 #include <span>
 #include <string>
 
 #include "rpem/auth/key_file.hpp"
 #include "rpem/estimate_t.hpp"
+#include "rpem/io/exit_codes.hpp"
 #include "rpem/schema/decode.hpp"
+#include "rpem/supervisor/command_line.hpp"
 #include "rpem/supervisor/estimate_gate.hpp"
 
 // [snippet]
@@ -26,21 +28,40 @@ struct Supervisor {
     }
     rpem::estimate_t m;
     if (!rpem::schema::decode_exactly(bytes, m)) return;
-    if (m.psi_m_valid) std::printf("T_magnet %.1f C (verified)\n", m.t_magnet_C);  // derate: docs/supervisor.md
+    if (m.psi_m_valid && m.psi_m_converged)
+      std::printf("T_magnet %.1f C (verified)\n", m.t_magnet_C);  // derate: docs/supervisor.md
   }
 };
 // [snippet]
 
 int main(int argc, char** argv) {
-  if (argc < 2) {
+  // SECONDS: how long to run (default: until stopped). Exit codes as example_supervisor's.
+  const std::optional<long> seconds = argc > 2 ? rpem::supervisor::parse_seconds(argv[2]) : 1'000'000'000L;
+  if (argc < 2 || argc > 3 || !seconds) {
+    if (argc > 2)
+      std::fprintf(stderr, "%s: SECONDS '%s' is not a whole number of seconds from 1 to 1e9\n", argv[0], argv[2]);
     std::fprintf(stderr, "usage: %s PUBLISH_KEY_FILE [SECONDS]\n", argv[0]);
-    return 64;
+    return rpem::io::kExitUsage;
   }
   Supervisor supervisor;
-  supervisor.keys.add(rpem::auth::load_key_file(argv[1]));
-  lcm::LCM lcm;
+  try {
+    supervisor.keys.add(rpem::auth::load_key_file(argv[1]));
+  } catch (const rpem::auth::KeyError& e) {
+    std::fprintf(stderr, "example_supervisor_verify: %s\n", e.what());
+    return rpem::io::kExitConfig;
+  }
+  lcm::LCM lcm;  // LCM's URL: LCM_DEFAULT_URL
+  if (!lcm.good()) {
+    std::fprintf(stderr, "example_supervisor_verify: LCM is not available (check LCM_DEFAULT_URL)\n");
+    return rpem::io::kExitIoError;
+  }
   lcm.subscribe("RPEM_ESTIMATE", &Supervisor::on_estimate, &supervisor);
-  const auto end = std::chrono::steady_clock::now() + std::chrono::seconds(argc > 2 ? std::atoi(argv[2]) : 1000000);
-  while (std::chrono::steady_clock::now() < end) lcm.handleTimeout(100);
-  return 0;
+  const auto end = std::chrono::steady_clock::now() + std::chrono::seconds(*seconds);
+  while (std::chrono::steady_clock::now() < end) {
+    if (lcm.handleTimeout(100) < 0) {
+      std::fprintf(stderr, "example_supervisor_verify: LCM stopped receiving\n");
+      return rpem::io::kExitIoError;
+    }
+  }
+  return rpem::io::kExitOk;
 }

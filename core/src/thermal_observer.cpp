@@ -95,6 +95,16 @@ void ThermalObserver::add_residual(const EstimatorOutput& d, double dt_s) noexce
   }
 }
 
+void ThermalObserver::retract_last() noexcept {
+  // The newest sample's adaptation was taken back (§13, "Mixed windows"): so is what it taught, but for the sums
+  // of a step it completed, which the filter has already had.
+  const std::array<Accumulated, 2> acc = learnt_.acc;
+  learnt_ = before_last_;
+  if (stepped_since_last_) learnt_.acc = acc;
+  before_last_ = learnt_;
+  stepped_since_last_ = false;
+}
+
 bool ThermalObserver::add(const Estimate& e, const ThermalSample& s) noexcept {
   const double dt = std::isfinite(s.dt_s) && s.dt_s > 0.0 ? s.dt_s : 0.0;
   // The coolant is an input the step integrates: a reading holds until the next one (a zero-order hold of a
@@ -117,13 +127,7 @@ bool ThermalObserver::add(const Estimate& e, const ThermalSample& s) noexcept {
     sensor_elapsed_sq_ += elapsed * elapsed * w;
   }
 
-  if (e.retracted_previous) {
-    // The previous sample's adaptation was taken back (§13, "Mixed windows"): so is what it taught, but for the sums
-    // of a step it completed, which the filter has already had.
-    const std::array<Accumulated, 2> acc = learnt_.acc;
-    learnt_ = before_last_;
-    if (stepped_since_last_) learnt_.acc = acc;
-  }
+  if (e.retracted_previous) retract_last();
   before_last_ = learnt_;
   stepped_since_last_ = false;
   if (e.detail.code == StepCode::kAdapted && all_finite(e.epsilon_A)) add_residual(e.detail, dt);

@@ -41,6 +41,7 @@ class CanSampleSource final : public SampleSource {
     o.interface = options_.interface;
     o.ids.assign(can::protocol::kTelemetryIds.begin(), can::protocol::kTelemetryIds.end());
     can::SocketCanChannel channel(o);
+    ChannelNotices notices;
     can::TelemetryDecoder decoder;
     std::vector<can::ReceivedFrame> frames(64);
     std::array<core::DriveSample, 3> samples;
@@ -59,7 +60,8 @@ class CanSampleSource final : public SampleSource {
           out.push(samples[k]);
         }
       }
-      report_when_due(out, channel, [&](DiagnosticsRows& rows) { rows.set_all(kCanDecoderRows, decoder.counters()); });
+      report_when_due(out, channel, notices, options_.interface,
+                      [&](DiagnosticsRows& rows) { rows.set_all(kCanDecoderRows, decoder.counters()); });
     }
   }
   [[nodiscard]] std::string name() const override { return options_.interface; }

@@ -125,11 +125,18 @@ void LoopThread::apply(const Command& c) noexcept {
   }
 }
 
+void LoopThread::resynchronize() noexcept {
+  // An averaged chain's unjudged last window is taken back (§13): by all who counted it, as for
+  // Estimate::retracted_previous in step().
+  if (!estimator_.resynchronize()) return;
+  validity_.retract_last();
+  if (live_.thermal_active) thermal_.retract_last();
+}
+
 void LoopThread::step(const SourceSample& s, std::int64_t now_ns) noexcept {
   if (!within(s, plausible_)) {
     ++counters_.rejected_implausible;
-    // The next sample does not continue across the one left out; an averaged chain's last window is taken back.
-    if (estimator_.resynchronize()) validity_.retract_last();
+    resynchronize();  // the next sample does not continue across the one left out
     return;
   }
   double dt_s = 0.0;
@@ -308,7 +315,7 @@ void LoopThread::process(std::int64_t now_ns) noexcept {
              now_ns - last_sample_mono_ns_ > static_cast<std::int64_t>(loop_config_.stale_timeout_s * 1e9)) {
     // No samples: hold the estimates, flag them, and start over from the next sample.
     state_ = DaemonState::kStale;
-    if (estimator_.resynchronize()) validity_.retract_last();  // an averaged chain's unjudged last window
+    resynchronize();
     validity_.hold();
   }
   if (now_ns >= next_estimate_ns_) {

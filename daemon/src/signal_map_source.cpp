@@ -43,6 +43,7 @@ class SignalMapSampleSource final : public SampleSource {
     can::SocketCanChannel::Options o;
     o.interface = options_.interface;  // every frame: those the map does not name are counted
     can::SocketCanChannel channel(o);
+    ChannelNotices notices;
     std::array<can::ReceivedFrame, 64> frames;
     SourceSample sample;
     while (!stop.load(std::memory_order_relaxed)) {
@@ -51,7 +52,7 @@ class SignalMapSampleSource final : public SampleSource {
       for (std::size_t f = 0; f < n; ++f) {
         if (sampler_.on_frame(frames[f].frame, receive_time_ns(frames[f], now), sample)) out.push(sample);
       }
-      report_when_due(out, channel, [&](DiagnosticsRows& rows) { sampler_.report(rows); });
+      report_when_due(out, channel, notices, options_.interface, [&](DiagnosticsRows& rows) { sampler_.report(rows); });
     }
   }
   [[nodiscard]] std::string name() const override { return options_.interface + " map " + options_.map; }

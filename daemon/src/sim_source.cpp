@@ -3,6 +3,7 @@
 #include <filesystem>
 
 #include "rpem/core/clock.hpp"
+#include "rpem/io/errors.hpp"
 #include "rpem/sim/drive_simulator.hpp"
 
 namespace rpem::daemon {
@@ -77,6 +78,12 @@ SimSource::Options SimSource::parse(io::YamlMap& section, const std::string& bas
   }
   o.loop = section.boolean_or("loop", o.loop);
   section.finish();
+  // Read now, so that a scenario rpemd cannot run stops it at start (and --check-config) as the rest of the file does.
+  try {
+    (void)load_demo_or_file(o.scenario);
+  } catch (const io::InputError& e) {
+    section.fail("scenario", std::string("cannot be run: ") + e.what());
+  }
   return o;
 }
 

@@ -67,7 +67,8 @@ void ValidityTracker::retract_last() noexcept {
 }
 
 bool ValidityTracker::converged(const Parameter& p) const noexcept {
-  if (p.count < window_) return false;
+  // A value never identified is still for want of adaptation, not because it has converged.
+  if (!p.now.identified || p.count < window_) return false;
   double lo = p.window[0], hi = p.window[0];
   for (int k = 1; k < window_; ++k) {
     lo = std::min(lo, p.window[static_cast<std::size_t>(k)]);

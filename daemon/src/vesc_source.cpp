@@ -88,6 +88,7 @@ class VescSampleSource final : public SampleSource {
                                                    static_cast<std::uint8_t>(options_.host_id));
     o.filters.assign(filters.begin(), filters.end());
     can::SocketCanChannel channel(o);
+    ChannelNotices notices;
     VescPoller poller(poller_config(options_));
     std::array<can::ReceivedFrame, 64> frames;
     core::AveragedSample sample;
@@ -148,7 +149,8 @@ class VescSampleSource final : public SampleSource {
         nanosleep(&gather, nullptr);
         wait_ns = std::max<std::int64_t>(0, wait_ns - gather_ns);
       }
-      report_when_due(out, channel, [&](DiagnosticsRows& rows) { report_vesc_counters(poller, rows); });
+      report_when_due(out, channel, notices, options_.interface,
+                      [&](DiagnosticsRows& rows) { report_vesc_counters(poller, rows); });
     }
   }
   [[nodiscard]] std::string name() const override {

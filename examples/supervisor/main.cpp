@@ -10,7 +10,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <cstdlib>
+#include <optional>
 #include <span>
 #include <string>
 
@@ -18,6 +18,7 @@
 #include "rpem/core/clock.hpp"
 #include "rpem/io/errors.hpp"
 #include "rpem/io/exit_codes.hpp"
+#include "rpem/supervisor/command_line.hpp"
 #include "rpem/supervisor/config.hpp"
 #include "rpem/supervisor/report.hpp"
 #include "rpem/supervisor/supervisor.hpp"
@@ -38,12 +39,9 @@ struct Handler {
 
 int main(int argc, char** argv) {
   using namespace rpem;
-  // SECONDS: how long to run, a whole positive number (default: a million, i.e. until stopped).
-  long seconds = 1000000;
-  char* end_of_seconds = nullptr;
-  if (argc > 3) seconds = std::strtol(argv[3], &end_of_seconds, 10);
-  if (argc < 3 || argc > 4 ||
-      (argc > 3 && (*end_of_seconds != '\0' || end_of_seconds == argv[3] || seconds < 1 || seconds > 1000000000))) {
+  // SECONDS: how long to run (default: a billion, i.e. until stopped).
+  const std::optional<long> seconds = argc > 3 ? supervisor::parse_seconds(argv[3]) : 1'000'000'000L;
+  if (argc < 3 || argc > 4 || !seconds) {
     if (argc > 3)
       std::fprintf(stderr, "%s: SECONDS '%s' is not a whole number of seconds from 1 to 1e9\n", argv[0], argv[3]);
     std::fprintf(stderr, "usage: %s CONFIG PUBLISH_KEY_FILE [SECONDS]\n", argv[0]);
@@ -63,16 +61,24 @@ int main(int argc, char** argv) {
   }
   supervisor::Supervisor supervisor(config, std::move(keys));
   lcm::LCM lcm;
-  if (!lcm.good()) return io::kExitIoError;
+  if (!lcm.good()) {
+    std::fprintf(stderr, "example_supervisor: LCM is not available (check LCM_DEFAULT_URL)\n");
+    return io::kExitIoError;
+  }
   Handler handler{supervisor};
   lcm.subscribe("RPEM_ESTIMATE", &Handler::on_message, &handler);
   std::setvbuf(stdout, nullptr, _IOLBF, 0);
-  const auto end = std::chrono::steady_clock::now() + std::chrono::seconds(seconds);
+  const auto end = std::chrono::steady_clock::now() + std::chrono::seconds(*seconds);
   // Between messages: a line when the estimate ages out, or I_max moves by 0.1 A (held values heating).
   supervisor::CurrentLimit printed = supervisor.current_limit(core::unix_us());
   std::printf("%s\n", supervisor::limit_line(core::unix_us(), printed).c_str());
   while (std::chrono::steady_clock::now() < end) {
-    const bool handled = lcm.handleTimeout(100) > 0;
+    const int handled_count = lcm.handleTimeout(100);
+    if (handled_count < 0) {
+      std::fprintf(stderr, "example_supervisor: LCM stopped receiving\n");
+      return io::kExitIoError;
+    }
+    const bool handled = handled_count > 0;
     const supervisor::CurrentLimit limit = supervisor.current_limit(core::unix_us());
     const bool moved = limit.fresh != printed.fresh || std::abs(limit.current_A - printed.current_A) >= 0.1;
     if (!handled && moved) std::printf("%s\n", supervisor::limit_line(core::unix_us(), limit).c_str());

@@ -1,7 +1,7 @@
 #include "rpem/io/csv_table.hpp"
+#include "rpem/io/number_text.hpp"
 
 #include <algorithm>
-#include <charconv>
 #include <cmath>
 #include <fstream>
 
@@ -51,10 +51,11 @@ CsvTable CsvTable::read(const std::string& path, bool allow_nan, const std::vect
       double v = std::nan("");
       if (!is_text[c]) {
         const std::string& s = cells[c];
-        const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
-        if (s.empty() || ec != std::errc() || end != s.data() + s.size()) {
-          throw DataError(path, line_no, c + 1, "column " + t.header_[c], "'" + s + "' is not a number");
+        const NumberText read = read_number(s);
+        if (read.kind != NumberText::Kind::kNumber) {
+          throw DataError(path, line_no, c + 1, "column " + t.header_[c], read.reason(s));
         }
+        v = read.value;
         if (std::isnan(v) && !allow_nan) throw DataError(path, line_no, c + 1, "column " + t.header_[c], "NaN");
         if (std::isinf(v)) throw DataError(path, line_no, c + 1, "column " + t.header_[c], "not finite");
       }

@@ -1,7 +1,7 @@
 #include "rpem/io/log_source.hpp"
+#include "rpem/io/number_text.hpp"
 
 #include <algorithm>
-#include <charconv>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -36,11 +36,7 @@ std::vector<std::string> header_cells(const std::string& line, char separator) {
 bool numbers_only(const std::string& line) {
   for (char separator : {',', ';'}) {
     const std::vector<std::string> cells = header_cells(line, separator);
-    const auto number = [](const std::string& c) {
-      double v = 0.0;
-      const auto [end, ec] = std::from_chars(c.data(), c.data() + c.size(), v);
-      return !c.empty() && ec == std::errc() && end == c.data() + c.size();
-    };
+    const auto number = [](const std::string& c) { return is_number_text(c); };
     if (cells.size() >= 2 && std::all_of(cells.begin(), cells.end(), number)) return true;
   }
   return false;

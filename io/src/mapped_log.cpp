@@ -1,10 +1,10 @@
 #include "rpem/io/mapped_log.hpp"
 #include "rpem/core/non_finite.hpp"
+#include "rpem/io/number_text.hpp"
 
 #include <algorithm>
 #include <array>
 #include <cassert>
-#include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -166,6 +166,15 @@ void MappedLogReader::read_header() {
   if (!next_line(header_line))
     throw DriveLogError(path_, line_ == 0 ? 1 : line_, 0, "", "empty file: expected a header row");
   if (header_line.rfind("\xEF\xBB\xBF", 0) == 0) header_line.erase(0, 3);  // a UTF-8 byte-order mark
+  if (std::all_of(header_line.begin(), header_line.end(), blank))
+    throw DriveLogError(path_, line_, 0, "", "empty file: expected a header row (the file holds a byte-order mark alone)");
+  if (const std::size_t cr = header_line.find('\r');
+      cr != std::string::npos &&
+      !std::all_of(header_line.begin() + static_cast<std::ptrdiff_t>(cr), header_line.end(), blank))
+    throw DriveLogError(path_, line_, 0, "",
+                        "its lines end in a carriage return alone (classic Mac OS line endings), so the whole file reads "
+                        "as one line; rpem reads lines ending in a newline or CR LF: convert it, e.g. tr '\\r' '\\n' < "
+                        "FILE > FIXED.csv");
   trailing_separator_ = ends_with_separator(header_line);
   split(header_line);  // closed by its separator if it ends with one: that empty cell is no column's name
   header_ = cells_;
@@ -215,9 +224,8 @@ void MappedLogReader::drop_columns_never_recorded() {
   }
   auto holds_a_value = [&](const MappedColumn& c, const std::string& text) {
     if (text.empty()) return false;
-    double v = 0.0;
-    const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), v);
-    const bool no_reading = ec == std::errc() && end == text.data() + text.size() && is_no_reading(c, v);
+    const NumberText read = read_number(text);
+    const bool no_reading = read.kind == NumberText::Kind::kNumber && is_no_reading(c, read.value);
     saw_no_reading[static_cast<std::size_t>(c.quantity)] |= no_reading;
     return !no_reading;  // anything else is a value, or an error its row's read reports
   };
@@ -295,16 +303,18 @@ void MappedLogReader::fail_empty_cell(int index, const std::string& label) {
 double MappedLogReader::cell(int index, const std::string& label, const MappedColumn& c, bool allow_nan) {
   const std::string& s = cells_[static_cast<std::size_t>(index)];
   if (s.empty()) fail_empty_cell(index, label);
-  double v = 0.0;
-  const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
-  if (ec != std::errc() || end != s.data() + s.size()) {
+  const NumberText read = read_number(s);
+  const double v = read.value;
+  if (read.kind != NumberText::Kind::kNumber) {
     // A spreadsheet saving the file in a locale with a decimal comma writes "24,9" (and ';' between cells).
-    const bool decimal_comma = std::count(s.begin(), s.end(), ',') == 1 && end != s.data() && *end == ',';
+    std::string with_point = s;
+    std::replace(with_point.begin(), with_point.end(), ',', '.');
+    const bool decimal_comma = std::count(s.begin(), s.end(), ',') == 1 && is_number_text(with_point);
     fail_cell(index, label,
-              "'" + s + "' is not a number" +
-                  (decimal_comma ? " (a decimal comma: saved by a spreadsheet in a locale that writes them? rpem reads "
-                                   "a decimal point, as VESC Tool and most loggers write it)"
-                                 : ""));
+              read.reason(s) + (decimal_comma
+                                    ? " (a decimal comma: saved by a spreadsheet in a locale that writes them? rpem reads "
+                                      "a decimal point, as VESC Tool and most loggers write it)"
+                                    : ""));
   }
   if (std::isnan(v)) {
     if (allow_nan) return kNaN;
@@ -417,12 +427,8 @@ void MappedLogReader::check_session() {
   }
   if (here == session_) return;
   // A different spelling of one number ("4", "4.0") is the same recording.
-  double a = 0.0, b = 0.0;
-  const auto [ea, xa] = std::from_chars(here.data(), here.data() + here.size(), a);
-  const auto [eb, xb] = std::from_chars(session_.data(), session_.data() + session_.size(), b);
-  if (xa == std::errc() && xb == std::errc() && ea == here.data() + here.size() && eb == session_.data() + session_.size() &&
-      a == b)
-    return;
+  const NumberText a = read_number(here), b = read_number(session_);
+  if (a.kind == NumberText::Kind::kNumber && b.kind == NumberText::Kind::kNumber && a.value == b.value) return;
   fail_cell(session_index_, map_.session->label(),
             "a second recording begins here ('" + here + "'; the rows from line " + std::to_string(session_line_) +
                 " are '" + session_ +

@@ -1,7 +1,7 @@
 #include "rpem/io/vesc_tool_log.hpp"
+#include "rpem/io/number_text.hpp"
 
 #include <algorithm>
-#include <charconv>
 #include <string>
 #include <string_view>
 
@@ -78,9 +78,7 @@ bool is_headerless_vesc_tool_row(std::string_view line) {
   while (true) {
     const std::size_t sep = line.find(';');
     const std::string_view cell = line.substr(0, sep);
-    double v = 0.0;
-    const auto [end, ec] = std::from_chars(cell.data(), cell.data() + cell.size(), v);
-    if (cell.empty() || ec != std::errc() || end != cell.data() + cell.size()) return false;
+    if (!is_number_text(cell)) return false;
     ++n;
     if (sep == std::string_view::npos) break;
     line.remove_prefix(sep + 1);

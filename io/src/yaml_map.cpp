@@ -1,4 +1,5 @@
 #include "rpem/io/yaml_map.hpp"
+#include "rpem/io/number_text.hpp"
 
 #include <algorithm>
 #include <cctype>
@@ -146,11 +147,11 @@ YAML::Node YamlMap::get(const std::string& key) {
 double YamlMap::as_number(const YAML::Node& n, const std::string& key, double lo, double hi) const {
   if (!n.IsScalar()) fail_at(n, key, "expected a number");
   const std::string& s = n.Scalar();
-  double v = 0.0;
-  const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
   // YAML's own spellings of the non-finite (.nan, .inf, -.Inf, …) read as what they are, as C's `nan` and `inf` do.
   if (yaml_non_finite(s)) fail_at(n, key, "'" + s + "' is not finite");
-  if (ec != std::errc() || end != s.data() + s.size()) fail_at(n, key, "'" + s + "' is not a number");
+  const NumberText read = read_number(s);
+  if (read.kind != NumberText::Kind::kNumber) fail_at(n, key, read.reason(s));
+  const double v = read.value;
   if (!std::isfinite(v)) fail_at(n, key, "'" + s + "' is not finite");
   if (v < lo || v > hi) fail_at(n, key, s + " is outside " + describe_range(lo, hi));
   return v;

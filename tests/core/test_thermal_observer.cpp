@@ -25,35 +25,44 @@ struct ObserverRun {
 
 /// The paper machine's averaged estimator over `seconds` of 200 Hz windows at 0.8 pu speed and i = (−0.3, 0.9)
 /// pu, the plant at `plant`, the estimator holding r̂s at its initial value; `noise_pu` white on the currents.
-ObserverRun run(const MachinePu& plant, double seconds, double noise_pu, std::uint64_t seed) {
-  const MachineSi machine = test::paper_machine_si();
+/// Calls `on_window(window, estimate)` for each.
+template <class OnWindow>
+void each_held_r_s_window(const MachinePu& plant, double seconds, double noise_pu, std::uint64_t seed, OnWindow on_window) {
   EstimatorSettings settings = test::paper_settings();
   settings.adapt_r_s = false;
-  AveragedDriveEstimator estimator(machine, settings);
+  AveragedDriveEstimator estimator(test::paper_machine_si(), settings);
   test::AveragedDataGenerator gen;
   gen.base = test::paper_base();
   gen.plant = plant;
   gen.jitter = 0.0;
   gen.n_pu = [](double) { return 0.8; };
   gen.i_pu = [](double) { return Vec2(-0.3, 0.9); };
-  ThermalObserverConfig oc;
-  oc.period_s = 1.0;
-  oc.residual_time_constant_s = 2.0;
-  ThermalObserver observer(oc, gen.base, machine, loss_base_of(gen.base, machine), 25.0);
   std::mt19937_64 rng(seed);
   std::normal_distribution<double> noise(0.0, noise_pu * gen.base.current_A);
-  ObserverRun out;
-  std::int64_t previous = 0;
   while (gen.t_s < seconds) {
     AveragedSample s = gen.next();
     if (noise_pu > 0.0) s.i_dq_A += Vec2(noise(rng), noise(rng));
-    const Estimate e = estimator.step(s);
+    on_window(s, estimator.step(s));
+  }
+}
+
+/// each_held_r_s_window's estimates through an observer of 1 s steps.
+ObserverRun run(const MachinePu& plant, double seconds, double noise_pu, std::uint64_t seed) {
+  const MachineSi machine = test::paper_machine_si();
+  const PerUnitBase base = test::paper_base();
+  ThermalObserverConfig oc;
+  oc.period_s = 1.0;
+  oc.residual_time_constant_s = 2.0;
+  ThermalObserver observer(oc, base, machine, loss_base_of(base, machine), 25.0);
+  ObserverRun out;
+  std::int64_t previous = 0;
+  each_held_r_s_window(plant, seconds, noise_pu, seed, [&](const AveragedSample& s, const Estimate& e) {
     ThermalSample ts;
     ts.dt_s = previous ? 1e-9 * static_cast<double>(s.t_ns - previous) : 0.0;
     previous = s.t_ns;
     if (observer.add(e, ts)) out.steps.push_back(observer.step());
     out.psi_m_Wb.push_back(e.psi_m_Wb);
-  }
+  });
   return out;
 }
 
@@ -195,30 +204,16 @@ TEST(ThermalObserver, ACoolantReadingHoldsUntilTheNextAndTheConfiguredOneStandsI
 
 /// The real estimator's estimates over `seconds` of noisy 200 Hz windows (ψ̂m settled, r̂s held), each with its Δt.
 std::vector<Estimate> noisy_estimates(double seconds) {
-  const MachineSi machine = test::paper_machine_si();
-  EstimatorSettings settings = test::paper_settings();
-  settings.adapt_r_s = false;
-  AveragedDriveEstimator estimator(machine, settings);
-  test::AveragedDataGenerator gen;
-  gen.base = test::paper_base();
-  gen.plant = test::paper_machine_pu();
-  gen.jitter = 0.0;
-  gen.n_pu = [](double) { return 0.8; };
-  gen.i_pu = [](double) { return Vec2(-0.3, 0.9); };
-  std::mt19937_64 rng(11);
-  std::normal_distribution<double> noise(0.0, 0.01 * gen.base.current_A);
   std::vector<Estimate> out;
-  while (gen.t_s < seconds) {
-    AveragedSample s = gen.next();
-    s.i_dq_A += Vec2(noise(rng), noise(rng));
-    out.push_back(estimator.step(s));
-  }
+  each_held_r_s_window(test::paper_machine_pu(), seconds, 0.01, 11,
+                       [&](const AveragedSample&, const Estimate& e) { out.push_back(e); });
   return out;
 }
 
 /// How the observer is told of a mixed window inserted before estimate `at`: adapted and then taken back by the next
-/// estimate (what the averaged estimator reports), adapted and never taken back, or never adapted (excluded).
-enum class MixedWindow { kRetracted, kKept, kExcluded };
+/// estimate (what the averaged estimator reports), taken back by a call before the next estimate (twice: what rpemd
+/// does when a resynchronize() retracts), adapted and never taken back, or never adapted (excluded).
+enum class MixedWindow { kRetracted, kRetractedByCall, kKept, kExcluded };
 
 struct InsertedRun {
   std::vector<ThermalStepData> steps;
@@ -246,6 +241,10 @@ InsertedRun observe_with_mixed_window(const std::vector<Estimate>& estimates, st
       out.inserted_completed_a_step = stepped;
       if (stepped) out.steps.push_back(observer.step());
       e.retracted_previous = how == MixedWindow::kRetracted;
+      if (how == MixedWindow::kRetractedByCall) {
+        observer.retract_last();
+        observer.retract_last();  // once: the second changes nothing
+      }
     }
     if (observer.add(e, ts)) out.steps.push_back(observer.step());
   }
@@ -273,12 +272,15 @@ TEST(ThermalObserver, AWindowTakenBackByTheEstimatorIsTakenOutOfItsStepAsIfItHad
   const std::vector<Estimate> estimates = noisy_estimates(20.0);
   const std::size_t at = 2400 + 37;  // mid-step, ψ̂m settled
   const InsertedRun retracted = observe_with_mixed_window(estimates, at, MixedWindow::kRetracted);
+  const InsertedRun by_call = observe_with_mixed_window(estimates, at, MixedWindow::kRetractedByCall);
   const InsertedRun excluded = observe_with_mixed_window(estimates, at, MixedWindow::kExcluded);
   const InsertedRun kept = observe_with_mixed_window(estimates, at, MixedWindow::kKept);
   ASSERT_FALSE(retracted.inserted_completed_a_step);
   ASSERT_EQ(retracted.steps.size(), excluded.steps.size());
+  ASSERT_EQ(by_call.steps.size(), excluded.steps.size());
   for (std::size_t k = 0; k < retracted.steps.size(); ++k) {
     expect_same_observations(retracted.steps[k], excluded.steps[k], k);
+    expect_same_observations(by_call.steps[k], excluded.steps[k], k);
   }
   // Kept, the window moves its step's ψ̂m by its share (1 of 200 windows, 6 % low: 0.03 %) and the residual statistics.
   std::size_t step = 0;  // the step holding the window
@@ -298,16 +300,20 @@ TEST(ThermalObserver, AWindowTakenBackAfterItsStepCompletedLeavesThatStepAndLate
   while (!observe_with_mixed_window(estimates, at, MixedWindow::kExcluded).inserted_completed_a_step) ++at;
   ASSERT_LT(at, 2410U);
   const InsertedRun retracted = observe_with_mixed_window(estimates, at, MixedWindow::kRetracted);
+  const InsertedRun by_call = observe_with_mixed_window(estimates, at, MixedWindow::kRetractedByCall);
   const InsertedRun excluded = observe_with_mixed_window(estimates, at, MixedWindow::kExcluded);
   const InsertedRun kept = observe_with_mixed_window(estimates, at, MixedWindow::kKept);
   ASSERT_TRUE(retracted.inserted_completed_a_step);
   ASSERT_EQ(retracted.steps.size(), kept.steps.size());
+  ASSERT_EQ(by_call.steps.size(), kept.steps.size());
   std::size_t completed = 0;  // the step the window completed
   while (completed < retracted.steps.size() && retracted.steps[completed].t_ns != estimates[at].t_ns) ++completed;
   ASSERT_LT(completed + 1, retracted.steps.size());
   expect_same_observations(retracted.steps[completed], kept.steps[completed], completed);
+  expect_same_observations(by_call.steps[completed], kept.steps[completed], completed);
   for (std::size_t k = completed + 1; k < retracted.steps.size(); ++k) {
     expect_same_observations(retracted.steps[k], excluded.steps[k], k);
+    expect_same_observations(by_call.steps[k], excluded.steps[k], k);
   }
   EXPECT_NE(kept.steps[completed + 1].parameter[kPsiM].variance, excluded.steps[completed + 1].parameter[kPsiM].variance);
 }

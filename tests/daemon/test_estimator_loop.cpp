@@ -89,6 +89,7 @@ TEST(EstimatorLoop, SamplesBecomeEstimatesThatConverge) {
   EXPECT_TRUE(e.psi_m_valid);
   EXPECT_TRUE(e.psi_m_converged);
   EXPECT_FALSE(e.r_s_valid);
+  EXPECT_FALSE(e.r_s_converged);  // held at its initial value all along: still, but not converged to anything
   // ψm −8 % at −0.12 %/K: T_magnet = 20 + (0.92 − 1)/(−0.0012) ≈ 86.7 °C.
   EXPECT_NEAR(e.t_magnet_C, 20.0 + (e.psi_m_Wb / 1.14 - 1.0) / -0.0012, 1e-9);
   EXPECT_NEAR(e.t_magnet_C, 86.7, 1.0);
@@ -132,6 +133,7 @@ TEST(EstimatorLoop, HeldValuesSayHowOldTheyAreAndLapseAfterMaxHold) {
   EXPECT_NEAR(e.r_s_age_s, 0.0, 1e-3);    // adapted in this period
   EXPECT_DOUBLE_EQ(e.psi_m_age_s, -1.0);  // ψm has never adapted: the configured initial value
   EXPECT_FALSE(e.psi_m_valid);
+  EXPECT_FALSE(e.psi_m_converged);
 
   rig.gen.n_pu = 0.4;
   rig.run(2.0);

@@ -43,6 +43,13 @@ TEST(SupervisorReadings, RawWhileValidWithConfiguredSigmaAndRpemdsAge) {
   const PartReadings none = readings_of(m, config());
   EXPECT_FALSE(none.magnet);
   EXPECT_FALSE(none.winding);
+  // Just identified and still moving towards the part's temperature (outside the convergence band): not yet one.
+  m = test::raw_estimate(kT0, 90.0, 80.0);
+  m.psi_m_converged = false;
+  const PartReadings moving = readings_of(m, config());
+  EXPECT_FALSE(moving.magnet);
+  ASSERT_TRUE(moving.winding);
+  EXPECT_EQ(moving.winding->t_C, 80.0);
 }
 
 TEST(SupervisorReadings, FusedWhenTheThermalModelRunsWhateverTheRawValuesSay) {

@@ -73,6 +73,31 @@ TEST(SupervisorLcm, ASecondsArgumentThatIsNoWholePositiveNumberIsAUsageError) {
   EXPECT_EQ(test::run_command(program + "5").exit_code, 78);  // read as 5 s: on to the key file, which is missing
 }
 
+TEST(SupervisorLcm, TheVerifyExampleSaysWhyItCannotRunAndExits) {
+  // It aborted on a missing key file (an uncaught KeyError) and spun at 100 % of a core on an LCM URL it could not
+  // open (handleTimeout returning −1 at once).
+  const std::string program = test::binary_dir() + "/examples/example_supervisor_verify ";
+  const test::ProcessResult seconds = test::run_command(program + "/nonexistent.key 2.5");
+  EXPECT_EQ(seconds.exit_code, 64) << seconds.output;
+  EXPECT_NE(seconds.output.find("SECONDS '2.5' is not a whole number of seconds"), std::string::npos) << seconds.output;
+  const test::ProcessResult missing = test::run_command(program + "/nonexistent.key 5");
+  EXPECT_EQ(missing.exit_code, 78) << missing.output;
+  EXPECT_NE(missing.output.find("example_supervisor_verify: "), std::string::npos) << missing.output;
+  EXPECT_NE(missing.output.find("/nonexistent.key"), std::string::npos) << missing.output;
+  const test::TempFile key("verify.key");
+  auth::write_key_file(key.path(), auth::generate_key(3));
+  for (const char* program_name : {"example_supervisor_verify ", "example_supervisor "}) {
+    const std::string args = std::string(program_name) == "example_supervisor "
+                                 ? std::string(RPEM_TEST_SOURCE_DIR) + "/examples/supervisor/supervisor.yaml " + key.path()
+                                 : key.path();
+    const test::ProcessResult url = test::run_command("LCM_DEFAULT_URL=nosuchprovider://x timeout 20 " + test::binary_dir() +
+                                                      "/examples/" + program_name + args + " 5");
+    EXPECT_EQ(url.exit_code, 74) << program_name << url.output;
+    EXPECT_NE(url.output.find("LCM is not available (check LCM_DEFAULT_URL)"), std::string::npos)
+        << program_name << url.output;
+  }
+}
+
 TEST(SupervisorLcm, DeratesOnVerifiedEstimatesFromRpemdAndTheAuthLibraryAndIgnoresAReplay) {
   const fs::path dir = fs::path(test::TempFile("supervisor").path());
   fs::remove_all(dir);

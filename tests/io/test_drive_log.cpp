@@ -89,6 +89,10 @@ INSTANTIATE_TEST_SUITE_P(
     Cases, MalformedLog,
     ::testing::Values(
         BadCase{"empty", "", ":1: empty file"},
+        BadCase{"byte_order_mark_alone", "\xEF\xBB\xBF\n",
+                ":1: empty file: expected a header row (the file holds a byte-order mark alone)"},
+        BadCase{"carriage_returns_alone", "t,theta_el,omega_el,u_dc,u_a,u_b,u_c,i_a,i_b,i_c\r0,0,0,220,1,2,3,0,0,0\r",
+                ":1: its lines end in a carriage return alone (classic Mac OS line endings)"},
         BadCase{"missing_time", "theta_el,omega_el,u_dc,u_a,u_b,u_c,i_a,i_b,i_c\n", ":1: column t: required column"},
         BadCase{"no_current", "t,theta_el,omega_el,u_dc,u_a,u_b,u_c\n", "no current columns"},
         // Another layout, or rpem's with another separator: the header says which way out.
@@ -105,6 +109,8 @@ INSTANTIATE_TEST_SUITE_P(
         BadCase{"duplicate", "t,t,theta_el,omega_el,u_dc,u_a,u_b,u_c,i_a,i_b,i_c\n", "column t: column appears twice"},
         BadCase{"non_numeric", kHeader + "0,0,0,220,1,2,3,abc,0,0\n", ":2:8: column i_a: 'abc' is not a number"},
         BadCase{"trailing_garbage", kHeader + "0,0,0,220,1,2,3,1.5x,0,0\n", ":2:8: column i_a: '1.5x'"},
+        BadCase{"beyond_a_double", kHeader + "0,0,0,220,1,2,3,1e400,0,0\n",
+                ":2:8: column i_a: '1e400' is beyond the range of a double (±1.8e308)"},
         // A control character in a cell is written out: a NUL would end the message where it is printed.
         BadCase{"nul_in_cell", kHeader + "0,0,0,220,1,2,3,1.5" + '\0' + "x,0,0\n",
                 ":2:8: column i_a: '1.5\\x00x' is not a number"},

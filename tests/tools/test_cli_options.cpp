@@ -124,6 +124,13 @@ TEST_F(CliOptions, OptionsOfAnotherModeAreRefusedNotIgnored) {
   EXPECT_FALSE(fs::exists(path("t.yaml")));
 }
 
+TEST_F(CliOptions, ASetCommandCarriesBothValuesAndNoOtherCommandCarriesEither) {
+  // `set` replaces both initial values: one left out was sent as 0 Ω (or 0 Wb). Refused before anything is sent.
+  EXPECT_REFUSED(rpem("command --seq 1 set --psi-m 0.6"), 64, "--r-s: set needs both --psi-m WB and --r-s OHM");
+  EXPECT_REFUSED(rpem("command --seq 1 set --r-s 1.2"), 64, "--psi-m: set needs both");
+  EXPECT_REFUSED(rpem("command --seq 1 freeze --r-s 1.2"), 64, "--r-s: is for set only, not freeze");
+}
+
 TEST_F(CliOptions, OutputsAndInputsThatCannotBeUsedSaySo) {
   // An output directory where a file is: exit 74 (EX_IOERR) naming it, as diagnose already did.
   std::ofstream(path("f")) << "a file\n";

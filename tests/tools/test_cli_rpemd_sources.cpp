@@ -4,11 +4,15 @@
 // value, stops rpemd at start with exit 78 (EX_CONFIG) and a message naming the map file and the reason.
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <filesystem>
 #include <fstream>
+#include <regex>
 #include <string>
+#include <thread>
 #include <utility>
 
+#include "support/child_process.hpp"
 #include "support/process.hpp"
 #include "support/temp_file.hpp"
 
@@ -48,6 +52,49 @@ TEST(CliRpemdSources, CheckConfigChecksTheCommandKeysWhereItSeesThem) {
     const auto r = rpem::test::run_command(rpemd() + bad);
     EXPECT_EQ(r.exit_code, 64) << bad << ": " << r.output;
   }
+}
+
+// --check-config reads the simulated drive's scenario as rpemd will: a missing file or a bad key in it is exit 78
+// naming the scenario, not "is valid" and a source thread that fails later.
+TEST(CliRpemdSources, CheckConfigReadsTheSimulatedDrivesScenario) {
+  const std::string steady = rpem::test::read_file(rpem::test::source_dir() + "/scenarios/e2e-steady.yaml");
+  ASSERT_NE(steady.find("duration_s: 20"), std::string::npos);
+  const rpem::test::TempFile bad("bad-scenario.yaml",
+                                 std::regex_replace(steady, std::regex("duration_s: 20"), "duration_z: 20"));
+  for (const std::string& scenario : {std::string("/nonexistent/scenario.yaml"), bad.path()}) {
+    const rpem::test::TempFile config("sim-scenario.yaml",
+                                      "daemon:\n  source: {type: sim, sim: {scenario: " + scenario + "}}\n");
+    const auto r = rpem::test::run_command(rpemd() + " --check-config --config " + config.path());
+    EXPECT_EQ(r.exit_code, 78) << scenario << ": " << r.output;
+    EXPECT_NE(r.output.find("cannot be run: "), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find(scenario), std::string::npos) << r.output;
+    EXPECT_EQ(r.output.find("is valid"), std::string::npos) << r.output;
+  }
+  const rpem::test::TempFile good("sim-good.yaml", "daemon:\n  source: {type: sim, sim: {scenario: " +
+                                                       rpem::test::source_dir() + "/scenarios/e2e-steady.yaml}}\n");
+  const auto ok = rpem::test::run_command(rpemd() + " --check-config --config " + good.path());
+  EXPECT_EQ(ok.exit_code, 0) << ok.output;
+}
+
+// A CAN interface that is not there (a typo, a module not loaded, a bus not brought up) is said in the journal once,
+// naming it and why, and retried — not once per retry, and not in silence.
+TEST(CliRpemdSources, AMissingCanInterfaceIsSaidOnceAndRetried) {
+  const rpem::test::TempFile config("missing-can.yaml",
+                                    "daemon:\n  machine_config: " + rpem::test::source_dir() +
+                                        "/config/paper-ipmsm.yaml\n  source: {type: can, can: {interface: rpemnosuch0}}\n"
+                                        "  loop: {realtime: off}\n  lcm: {url: \"udpm://239.255.76.67:7891?ttl=0\"}\n"
+                                        "  status_interval_s: 0\n");
+  const rpem::test::TempFile log("missing-can.log");
+  {
+    rpem::test::ChildProcess daemon({rpemd(), "--config", config.path()}, log.path());
+    std::this_thread::sleep_for(std::chrono::milliseconds(1500));  // ≈ 15 tries at the 100 ms reopen interval
+  }
+  const std::string text = rpem::test::read_file(log.path());
+  const std::string said = "rpemd: rpemnosuch0: cannot read CAN: ";
+  const auto first = text.find(said);
+  ASSERT_NE(first, std::string::npos) << text;
+  EXPECT_NE(text.find("retrying", first), std::string::npos) << text;
+  EXPECT_EQ(text.find(said, first + 1), std::string::npos) << "said once, not per retry:\n" << text;
 }
 
 // Each "### `source: X`" section of docs/rpemd.md gives a complete configuration in its first yaml block; written

@@ -349,12 +349,22 @@ Runner add_command_command(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand("command", "Send a supervisory command to rpemd (RPEM_COMMAND)");
   cmd->add_option("action", opts->action, "reset | freeze | unfreeze | set")
       ->check(CLI::IsMember({"reset", "freeze", "unfreeze", "set"}));
-  cmd->callback([cmd, opts] {
-    if (opts->resend.empty() && !opts->malformed && opts->action.empty()) throw CLI::RequiredError("action");
-  });
   cmd->add_option("--seq", opts->seq, "sequence number, larger than the last accepted one");
-  cmd->add_option("--psi-m", opts->psi_m_Wb, "set: magnet flux linkage [Wb]");
-  cmd->add_option("--r-s", opts->r_s_Ohm, "set: stator resistance [Ohm]");
+  const CLI::Option* psi_m = cmd->add_option("--psi-m", opts->psi_m_Wb, "set: magnet flux linkage [Wb]");
+  const CLI::Option* r_s = cmd->add_option("--r-s", opts->r_s_Ohm, "set: stator resistance [Ohm]");
+  cmd->callback([opts, psi_m, r_s] {
+    if (opts->resend.empty() && !opts->malformed && opts->action.empty()) throw CLI::RequiredError("action");
+    // `set` replaces both initial values: an omitted one would be sent as 0, not "keep it".
+    const bool set = opts->action == "set";
+    for (const CLI::Option* o : {psi_m, r_s}) {
+      if (set && o->count() == 0)
+        throw CLI::ValidationError(o->get_name(),
+                                   "set needs both --psi-m WB and --r-s OHM (identification starts over "
+                                   "from them)");
+      if (!set && !opts->action.empty() && o->count() > 0)
+        throw CLI::ValidationError(o->get_name(), "is for set only, not " + opts->action);
+    }
+  });
   cmd->add_option("--prefix", opts->prefix, "channel prefix of the rpemd instance");
   cmd->add_option("--lcm-url", opts->url, "LCM URL (default: LCM's default)");
   cmd->add_option("--key", opts->key_file, "sign with this key file (one of rpemd's command keys)");

@@ -14,9 +14,11 @@ std::optional<TemperatureEstimate> fused(double t_C, double sd_K, std::int8_t so
 }
 
 /// A raw RPEM-derived temperature while rpemd calls it valid (identified, held no longer than
-/// validity.max_hold_s); its σ configured, its age rpemd's.
-std::optional<TemperatureEstimate> raw(double t_C, bool valid, double age_s, const PartLimits& part) noexcept {
-  if (!valid || !std::isfinite(t_C) || !std::isfinite(age_s)) return std::nullopt;
+/// validity.max_hold_s) and converged (still within the band over its window: a value still moving towards the
+/// part's temperature is not yet one); its σ configured, its age rpemd's.
+std::optional<TemperatureEstimate> raw(double t_C, bool valid, bool converged, double age_s,
+                                       const PartLimits& part) noexcept {
+  if (!valid || !converged || !std::isfinite(t_C) || !std::isfinite(age_s)) return std::nullopt;
   return TemperatureEstimate{t_C, part.raw_sd_K, std::max(age_s, 0.0)};
 }
 
@@ -27,8 +29,8 @@ PartReadings readings_of(const rpem::estimate_t& m, const Config& config) noexce
     return {fused(m.t_magnet_fused_C, m.t_magnet_fused_sd_C, m.t_magnet_source),
             fused(m.t_winding_fused_C, m.t_winding_fused_sd_C, m.t_winding_source)};
   }
-  return {raw(m.t_magnet_C, m.psi_m_valid, m.psi_m_age_s, config.magnet),
-          raw(m.t_winding_C, m.r_s_valid, m.r_s_age_s, config.winding)};
+  return {raw(m.t_magnet_C, m.psi_m_valid, m.psi_m_converged, m.psi_m_age_s, config.magnet),
+          raw(m.t_winding_C, m.r_s_valid, m.r_s_converged, m.r_s_age_s, config.winding)};
 }
 
 Received Supervisor::on_message(std::string_view channel, std::span<const std::uint8_t> encoded,

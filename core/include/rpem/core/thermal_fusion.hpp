@@ -141,6 +141,9 @@ class ThermalFusion {
   void coast(double dt_s) noexcept;
   /// The estimator was reset or given new values: observations wait until it settles again.
   void restart_observations() noexcept { observer_.restart(); }
+  /// The newest sample's adaptation was taken back outside step() (a resynchronize() that retracted: rpemd's stale and
+  /// implausible paths); ThermalObserver::retract_last. Real-time safe.
+  void retract_last() noexcept { observer_.retract_last(); }
   /// The filter's state for a restart (rpemd's state file); nodes 0 before the first step. Real-time safe.
   [[nodiscard]] ThermalSnapshot snapshot() const noexcept;
   /// The first step starts from a state saved `gap_s` ago (across_unknown_load, in observer steps) instead of

@@ -89,6 +89,10 @@ class ThermalObserver {
   /// One estimator sample; true when it completed a step (then step() holds it).
   bool add(const Estimate& e, const ThermalSample& s) noexcept;
   [[nodiscard]] const ThermalStepData& step() const noexcept { return step_; }
+  /// The newest sample's adaptation was taken back (Estimate::retracted_previous, or a resynchronize() that
+  /// retracted): what it taught is taken out, but for the sums of a step it completed. Once: a second call changes
+  /// nothing.
+  void retract_last() noexcept;
   /// Forgets the settling and the residual statistics (an estimator reset or new initial values).
   void restart() noexcept;
   void reconfigure(const ThermalObserverConfig& config, const PerUnitBase& base, const MachineSi& machine,

@@ -80,6 +80,8 @@ class LoopThread {
 
  private:
   void apply(const Command& c) noexcept;
+  /// The next sample starts a new stream; a window the estimator takes back here is taken back by all who counted it.
+  void resynchronize() noexcept;
   void step(const SourceSample& s, std::int64_t now_ns) noexcept;
   void report_measurement() noexcept;
   void report_estimate(std::int64_t now_ns) noexcept;

@@ -15,9 +15,10 @@
 
 namespace rpem::daemon {
 
-inline constexpr std::array<CounterRow<can::ChannelCounters, std::uint64_t>, 6> kChannelRows{{
+inline constexpr std::array<CounterRow<can::ChannelCounters, std::uint64_t>, 7> kChannelRows{{
     {&can::ChannelCounters::kernel_drops, &rpem::diagnostics_t::can_kernel_drops},
     {&can::ChannelCounters::reopens, &rpem::diagnostics_t::can_reopens},
+    {&can::ChannelCounters::open_failures, &rpem::diagnostics_t::can_open_failures},
     {&can::ChannelCounters::error_frames, &rpem::diagnostics_t::can_error_frames},
     {&can::ChannelCounters::bus_off, &rpem::diagnostics_t::can_bus_off},
     {&can::ChannelCounters::error_passive, &rpem::diagnostics_t::can_error_passive},
@@ -33,11 +34,23 @@ inline constexpr std::array<CounterRow<can::ChannelCounters, std::uint64_t>, 6> 
 
 using can::receive_time_ns;
 
+/// Says in the journal when the interface cannot be opened or is lost, and when it is open again: once per change,
+/// not once per retry (can_open_failures counts the retries). The source thread's, outside the loop.
+class ChannelNotices {
+ public:
+  void check(const can::SocketCanChannel& channel, const std::string& interface);
+
+ private:
+  std::string said_;  ///< the problem last said; empty: none since it was last open
+};
+
 /// Sends the source's report when due: `fill(rows)` adds the decoder's rows, the socket's are added here.
 template <class Fill>
-void report_when_due(SourceOutput& out, const can::SocketCanChannel& channel, Fill&& fill) {
+void report_when_due(SourceOutput& out, const can::SocketCanChannel& channel, ChannelNotices& notices,
+                     const std::string& interface, Fill&& fill) {
   const std::int64_t now = core::now_ns(CLOCK_MONOTONIC);
   if (!out.report_due(now)) return;
+  notices.check(channel, interface);
   SourceReport r;
   fill(r.rows);
   r.rows.set_all(kChannelRows, channel.counters());

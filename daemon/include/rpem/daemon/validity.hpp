@@ -10,8 +10,9 @@
 // last sample in which it adapted, on the loop's clock (−1: never, the value is an initial or a set one).
 // It is *identified* after validity.r_s_after_s of adaptation in all (r_s) or validity.psi_m_after_s of
 // adaptation without a pause (ψm), until a reset or new initial values; *valid* while identified and
-// its age is at most validity.max_hold_s; *converged* when its spread over the last
-// validity.convergence_window_s is within validity.convergence_band. A sample whose adaptation the estimator took
+// its age is at most validity.max_hold_s; *converged* when identified and its spread over the last
+// validity.convergence_window_s is within validity.convergence_band (a value never identified is still for want
+// of adaptation). A sample whose adaptation the estimator took
 // back (an averaged window found mixed afterwards, or its chain's unjudged last: docs/derivations.md §13, "Mixed
 // windows") is taken back here too: the value is the one before it, and so are its age and identification.
 // Real-time safe.
