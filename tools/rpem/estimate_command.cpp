@@ -293,6 +293,18 @@ std::array<std::optional<bool>, 2> check_identifiable(const std::vector<core::Av
                  "%.5g Ohm is not an identification\n",
                  last.r_s_Ohm);
   }
+  // R_s excited where only the assumption that the frame is a sensor's made it so (io::assumed_frame_note, said
+  // above): how well the log determines it says nothing of whether that assumption holds.
+  const bool r_s_on_assumed_frame = !r_s_declared && regimes.r_s_on_assumed_frame > 0;
+  if (r_s_on_assumed_frame) {
+    std::fprintf(stderr,
+                 "rpem estimate: r_s not identifiable from this log as configured: %llu of the samples that excited it "
+                 "did so only if the drive's dq frame is a position sensor's, which the configuration does not say "
+                 "(the note above); %.5g Ohm is no identification until estimator.regimes.angle_source says where the "
+                 "frame comes from\n",
+                 static_cast<unsigned long long>(regimes.r_s_on_assumed_frame), last.r_s_Ohm);
+  }
+  const bool r_s_excluded = r_s_declared || r_s_on_assumed_frame;
   std::array<Identifiability, 2> p{
       {{"psi_m", "Wb", 0.02, e.psi_m_min_Wb, e.psi_m_max_Wb}, {"r_s", "Ohm", 0.05, e.r_s_min_Ohm, e.r_s_max_Ohm}}};
   const std::array<double, 2> estimate{last.psi_m_Wb, last.r_s_Ohm};
@@ -311,8 +323,8 @@ std::array<std::optional<bool>, 2> check_identifiable(const std::vector<core::Av
       (high ? p[k].from_hi : p[k].from_lo) = k == 0 ? run.psi_m_Wb() : run.r_s_Ohm();
     }
     const double half = 0.5 * std::abs(p[k].from_hi - p[k].from_lo) / std::abs(estimate[k]);
-    identifiable[k] = half <= p[k].tolerance && !(k == 1 && r_s_declared);
-    if (half <= p[k].tolerance || (k == 1 && r_s_declared)) continue;
+    identifiable[k] = half <= p[k].tolerance && !(k == 1 && r_s_excluded);
+    if (half <= p[k].tolerance || (k == 1 && r_s_excluded)) continue;
     std::fprintf(
         stderr,
         "rpem estimate: %s not identifiable from this log: started at the ends of its bounds (%.5g, %.5g %s) "
