@@ -177,6 +177,7 @@ void ThermalFusion::start(const ThermalStepData& s) noexcept {
   if (fits_network(resumed_, config_.filter.network)) {
     filter_.set_temperatures(resumed_.t_C, resumed_.p_K2);
     out_.started = true;
+    out_.start_assumed_soaked = false;
     return;
   }
   ThermalMat p = ThermalMat::Identity() * (config_.initial_sigma_K * config_.initial_sigma_K);
@@ -193,6 +194,7 @@ void ThermalFusion::start(const ThermalStepData& s) noexcept {
   start_without_reading_C_ = start_temperatures_C(config_, without);
   first_step_ = true;
   out_.started = true;
+  out_.start_assumed_soaked = !(config_.winding_sensor_sigma_K > 0.0 && std::isfinite(s.winding_sensor_C));
 }
 
 void ThermalFusion::step(const Estimate& e, const ThermalSample& s) noexcept {

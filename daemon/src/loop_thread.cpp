@@ -267,6 +267,8 @@ void LoopThread::report_thermal(EstimateReport& r) const noexcept {
   r.t_winding_source = source_code(w.source);
   r.t_winding_observed_age_s = w.observed_age_s;
   r.thermal = r.thermal_active ? thermal_.snapshot() : core::ThermalSnapshot{};
+  r.thermal_start_untested_by_sensor =
+      r.thermal_active && e.start_assumed_soaked && live_.thermal.winding_sensor_sigma_K > 0.0;
 }
 
 void LoopThread::report_stats() noexcept {

@@ -17,6 +17,7 @@
 #include "rpem/daemon/status_line.hpp"
 #include "rpem/estimate_t.hpp"
 #include "rpem/io/machine_config.hpp"
+#include "rpem/io/thermal_config.hpp"
 #include "rpem/measurement_t.hpp"
 #include "rpem/mirror/diagnostics_t.hpp"
 #include "rpem/schema/field.hpp"
@@ -158,6 +159,15 @@ void PersistingPublisher::maybe_write_state(bool force) {
   }
 }
 
+void PersistingPublisher::say_untested_start(const EstimateReport& r) {
+  if (said_untested_start_ || !r.thermal_start_untested_by_sensor) return;
+  said_untested_start_ = true;
+  const std::string note = io::soaked_start_note(
+      "no thermal state was resumed, and the winding sensor (thermal.winding_sensor) gave no reading in the filter's "
+      "first step to test it");
+  std::fprintf(stderr, "rpemd: note: %s\n", note.c_str());
+}
+
 void PersistingPublisher::print_status(const EstimateReport& r) {
   if (config_.status_interval_s <= 0.0 || r.utime < next_status_us_) return;
   next_status_us_ = r.utime + static_cast<std::int64_t>(config_.status_interval_s * 1e6);
@@ -200,6 +210,7 @@ void PersistingPublisher::run(const std::atomic<bool>& stop) {
         have_estimate_ = true;
         publish_estimate(*e);
         print_status(*e);
+        say_untested_start(*e);
       } else if (const auto* m = std::get_if<MeasurementReport>(&report)) {
         publish_measurement(*m);
       } else if (const auto* d = std::get_if<LoopStatsReport>(&report)) {

@@ -366,26 +366,37 @@ DriveLogLayout rotor_frame_layout(const AveragedLogLayout& layout) {
   return l;
 }
 
-void check_voltages_recorded(const std::vector<core::AveragedSample>& samples, double psi_m_Wb,
+void check_voltages_recorded(const std::vector<core::AveragedSample>& samples, const core::MachineSi& machine,
                              const std::string& log_path) {
   double emf_V = 0.0, emf_at_s = 0.0, current_A = 0.0;
   for (const core::AveragedSample& s : samples) {
     if (s.u_dq_V.x() != 0.0 || s.u_dq_V.y() != 0.0) return;
-    if (const double e = std::abs(s.omega_el_rad_s) * psi_m_Wb; e > emf_V) {
+    if (const double e = std::abs(s.omega_el_rad_s) * machine.psi_m_Wb; e > emf_V) {
       emf_V = e;
       emf_at_s = core::to_seconds(s.t_ns);
     }
     current_A = std::max(current_A, s.i_dq_A.norm());
   }
   if (!(emf_V > 0.0 || current_A > 0.0)) return;
-  char text[720];
+  char implied[240];
+  if (emf_V > 0.0) {
+    std::snprintf(implied, sizeof implied,
+                  "while the machine's turning implies a back EMF of up to %.4g V (|omega| x the configured psi_m %.4g "
+                  "Wb, at t = %.6g s) and the current reaches %.4g A",
+                  emf_V, machine.psi_m_Wb, emf_at_s, current_A);
+  } else {  // at rest throughout: only the resistive drop
+    std::snprintf(implied, sizeof implied,
+                  "while the machine stood still and the current reaches %.4g A, a drop of %.4g V across the configured "
+                  "r_s %.4g Ohm",
+                  current_A, current_A * machine.r_s_Ohm, machine.r_s_Ohm);
+  }
+  char text[760];
   std::snprintf(text, sizeof text,
-                "exactly 0 in every one of the %zu samples, while the machine's turning implies a back EMF of up to "
-                "%.4g V (|omega| x the configured psi_m %.4g Wb, at t = %.6g s) and the current reaches %.4g A: the "
-                "log carries no voltages (a logger that writes zeros for values it does not read, a bridge off "
-                "throughout whose logger writes zeros then, or voltages below the column's resolution throughout; "
-                "docs/drive-log.md, \"Errors\"), and nothing in it can be estimated or diagnosed",
-                samples.size(), emf_V, psi_m_Wb, emf_at_s, current_A);
+                "exactly 0 in every one of the %zu samples, %s: the log carries no voltages (a logger that writes zeros "
+                "for values it does not read, a bridge off throughout whose logger writes zeros then, or voltages below "
+                "the column's resolution throughout; docs/drive-log.md, \"Errors\"), and nothing in it can be estimated "
+                "or diagnosed",
+                samples.size(), implied);
   throw DriveLogError(log_path, 0, 0, "columns u_d, u_q", text);
 }
 

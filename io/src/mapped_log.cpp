@@ -65,7 +65,15 @@ void MappedLogReader::fail_header(const LayoutProblem& problem) const {
         "; a CSV of another layout is read through a column map: --log-map MAP.yaml (docs/drive-log.md, \"Column "
         "maps\")";
   }
-  fail_at(line_, problem.column, reason);
+  // Named as the file would name it: the map's column for that quantity (VESC Tool's d_axis_voltage for u_d).
+  std::string column = problem.column;
+  for (const MappedColumn& c : map_.columns) {
+    if (problem.column == info(c.quantity).name && c.column.label() != problem.column) {
+      column = c.column.label() + " (" + problem.column + ")";
+      break;
+    }
+  }
+  fail_at(line_, column, reason);
 }
 
 void MappedLogReader::fail_cell(int index, const std::string& label, const std::string& reason) const {

@@ -55,7 +55,7 @@ RotorFrameRebuild complete_rotor_frame(std::vector<core::AveragedSample>& sample
                (!read.layout.u_dq || (all_zero(samples, &core::AveragedSample::u_dq_V) && any_nonzero(read.duty)));
   r.currents =
       motor && (!read.layout.i_dq || (all_zero(samples, &core::AveragedSample::i_dq_A) && any_nonzero(read.i_motor_A)));
-  if (!r.voltages) check_voltages_recorded(samples, machine.psi_m_Wb, log_path);
+  if (!r.voltages) check_voltages_recorded(samples, machine, log_path);
   if (!r.voltages && !r.currents) return r;
 
   for (std::size_t k = 0; k < samples.size(); ++k) {

@@ -113,6 +113,29 @@ TEST(LoopThermal, APhaseSamplesCoolantReadingIsTheNetworksBoundary) {
   EXPECT_NEAR(with.thermal.load.coolant_C, kMeasured_C, 1e-9);
 }
 
+// A winding sensor configured (thermal.winding_sensor) but silent leaves the soaked start untested: the report says
+// so (the publisher notes it once); with a reading in the first step, or without a sensor configured (rpemd says
+// that at its start), it does not.
+TEST(LoopThermal, AConfiguredWindingSensorThatGivesNoReadingLeavesTheSoakedStartUntested) {
+  DaemonConfig config = with_network();
+  config.live.thermal.winding_sensor_sigma_K = 1.0;
+  const EstimateReport silent = run_loop(config, 2);
+  ASSERT_TRUE(silent.thermal_active);
+  EXPECT_TRUE(silent.thermal_start_untested_by_sensor);
+  const EstimateReport read = run_loop(
+      config, 2, [](LoopThread&) {},
+      [](core::DriveSample& s, int k) {
+        if (k % 800 == 0) s.t_winding_C = 40.0;
+      });
+  ASSERT_TRUE(read.thermal_active);
+  EXPECT_FALSE(read.thermal_start_untested_by_sensor);
+  DaemonConfig unsensed = with_network();
+  unsensed.live.thermal.winding_sensor_sigma_K = 0.0;
+  const EstimateReport without_sensor = run_loop(unsensed, 2);
+  ASSERT_TRUE(without_sensor.thermal_active);
+  EXPECT_FALSE(without_sensor.thermal_start_untested_by_sensor);
+}
+
 // A restart (docs/thermal.md, "A restart"): the state the loop reports goes through the state file and starts
 // the next loop's fusion where it stands after the gap (core::across_unknown_load), not at the coolant. The
 // second run makes no observation (its observer does not settle), so what it reports is the resumed state carried

@@ -150,8 +150,9 @@ TEST(LogMap, ALoggerWithoutDqValuesReadsThroughAMapOfItsDutyAndMotorCurrent) {
     (void)read_averaged_log(bare.path(), no_duty, DriveLogLimits{});
     FAIL() << "no error";
   } catch (const DriveLogError& e) {
-    EXPECT_NE(std::string(e.what()).find("bare.csv:1: column u_d: required column is missing from the header (or duty "
-                                         "and u_dc)"),
+    // Named as the file names it (the map's column), the quantity beside it.
+    EXPECT_NE(std::string(e.what()).find("bare.csv:1: column vd (u_d): required column is missing from the header (or "
+                                         "duty and u_dc)"),
               std::string::npos)
         << e.what();
   }

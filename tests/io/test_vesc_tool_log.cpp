@@ -508,6 +508,9 @@ TEST(VescToolLog, OneRowHoldsNoSample) {
 // the error names the back EMF the speeds imply at the configured ψm and the largest current, so that a reader sees
 // the zeros cannot be the machine's; one voltage in the log, or a machine at rest unexcited, and there is no error.
 TEST(AveragedLog, VoltagesZeroInEverySampleOfATurningMachineAreAnError) {
+  core::MachineSi machine;
+  machine.psi_m_Wb = 5e-3;
+  machine.r_s_Ohm = 0.025;
   std::vector<core::AveragedSample> samples(3);
   for (std::size_t k = 0; k < samples.size(); ++k) {
     samples[k].t_ns = static_cast<std::int64_t>(k + 1) * 1'000'000'000;
@@ -516,7 +519,7 @@ TEST(AveragedLog, VoltagesZeroInEverySampleOfATurningMachineAreAnError) {
   }
   std::string msg;
   try {
-    check_voltages_recorded(samples, 5e-3, "zeros.csv");
+    check_voltages_recorded(samples, machine, "zeros.csv");
   } catch (const DriveLogError& e) {
     msg = e.what();
   }
@@ -526,9 +529,22 @@ TEST(AveragedLog, VoltagesZeroInEverySampleOfATurningMachineAreAnError) {
   EXPECT_NE(msg.find("the current reaches 8.544 A"), std::string::npos) << msg;
 
   samples[1].u_dq_V = {0.0, 0.01};  // one reported voltage: the columns are recorded
-  EXPECT_NO_THROW(check_voltages_recorded(samples, 5e-3, "zeros.csv"));
-  const std::vector<core::AveragedSample> at_rest(4);  // no speed, no current: nothing was there to record
-  EXPECT_NO_THROW(check_voltages_recorded(at_rest, 5e-3, "rest.csv"));
+  EXPECT_NO_THROW(check_voltages_recorded(samples, machine, "zeros.csv"));
+  std::vector<core::AveragedSample> at_rest(4);  // no speed, no current: nothing was there to record
+  EXPECT_NO_THROW(check_voltages_recorded(at_rest, machine, "rest.csv"));
+  // At rest with current (a few standstill rows): no back EMF to name, but the current's drop across R_s.
+  at_rest[2].i_dq_A = {0.0, 2.0};
+  msg.clear();
+  try {
+    check_voltages_recorded(at_rest, machine, "rest.csv");
+  } catch (const DriveLogError& e) {
+    msg = e.what();
+  }
+  EXPECT_NE(msg.find("exactly 0 in every one of the 4 samples, while the machine stood still and the current reaches "
+                     "2 A, a drop of 0.05 V across the configured r_s 0.025 Ohm: the log carries no voltages"),
+            std::string::npos)
+      << msg;
+  EXPECT_EQ(msg.find("back EMF"), std::string::npos) << msg;
 }
 
 TEST(VescToolLog, ACommaSeparatedCopyAndAnUnknownVariantAreReadByName) {

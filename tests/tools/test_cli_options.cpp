@@ -131,6 +131,19 @@ TEST_F(CliOptions, ASetCommandCarriesBothValuesAndNoOtherCommandCarriesEither) {
   EXPECT_REFUSED(rpem("command --seq 1 freeze --r-s 1.2"), 64, "--r-s: is for set only, not freeze");
 }
 
+TEST_F(CliOptions, WithoutAConfigTheBuiltInMachineIsSaidToStandIn) {
+  // A log of another machine is otherwise judged against the paper's ratings, whose plausibility limits name "the
+  // configured machine" (a new user's VESC log refused at 3220 rad/s, 2026-12-06).
+  const std::string said = "note: no --config: the built-in configuration stands for the machine";
+  const test::ProcessResult without = rpem("estimate --log " + log_ + " --out " + path("e.csv"));
+  EXPECT_EQ(without.exit_code, 0) << without.output;
+  EXPECT_NE(without.output.find("rpem estimate: " + said), std::string::npos) << without.output;
+  const test::ProcessResult with = rpem("estimate --log " + log_ + " --out " + path("e.csv") + " --config " +
+                                        test::source_dir() + "/config/paper-ipmsm.yaml");
+  EXPECT_EQ(with.exit_code, 0) << with.output;
+  EXPECT_EQ(with.output.find(said), std::string::npos) << with.output;
+}
+
 TEST_F(CliOptions, OutputsAndInputsThatCannotBeUsedSaySo) {
   // An output directory where a file is: exit 74 (EX_IOERR) naming it, as diagnose already did.
   std::ofstream(path("f")) << "a file\n";

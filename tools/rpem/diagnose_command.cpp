@@ -18,6 +18,7 @@
 #include "diagnose_monitor.hpp"
 #include "log_options.hpp"
 #include "log_sessions.hpp"
+#include "machine_option.hpp"
 #include "rpem/analysis/diagnose/diagnose_output.hpp"
 #include "rpem/analysis/work_pool.hpp"
 #include "rpem/io/errors.hpp"
@@ -173,7 +174,7 @@ int run_diagnose(const DiagnoseCliOptions& o) {
     return kExitUsage;
   }
   const std::string config_text = o.config.empty() ? io::builtin_paper_config_text() : read_text(o.config);
-  const io::MachineConfig config = o.config.empty() ? io::builtin_paper_config() : io::load_machine_config(o.config);
+  const io::MachineConfig config = machine_config_or_builtin(o.config, "rpem diagnose");
   const std::string config_name = o.config.empty() ? "builtin:paper-ipmsm" : o.config;
 
   analysis::LogOptions log_options = analysis::log_options(config);

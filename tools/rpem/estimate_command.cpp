@@ -17,6 +17,7 @@
 #include "commands.hpp"
 #include "log_folder.hpp"
 #include "log_options.hpp"
+#include "machine_option.hpp"
 #include "option_checks.hpp"
 #include "progress.hpp"
 #include "rpem/core/averaged_estimator.hpp"
@@ -89,7 +90,6 @@ class ThermalRun {
     s.dt_s = previous_ns_ ? 1e-9 * static_cast<double>(t_ns - *previous_ns_) : 0.0;
     s.coolant_C = coolant_C;
     s.winding_sensor_C = winding_C;
-    if (samples_ == 0) first_winding_C_ = winding_C;
     ++samples_;
     if (!std::isnan(coolant_C)) {
       coolant_read_ = true;
@@ -128,7 +128,7 @@ class ThermalRun {
                    fusion_->config().filter.coolant_drift_K2_per_s,
                    fusion_->config().filter.coolant_drift_K2_per_s > 0.0 ? "" : ", so it does not widen");
     }
-    if (samples_ > 0 && !(sensor_fused_ && std::isfinite(first_winding_C_))) {
+    if (fusion_->estimate().start_assumed_soaked) {
       // core::start_temperatures_C: without a fused winding reading at the start, the soak is assumed.
       const std::string note = io::soaked_start_note(
           std::string("the log gives no ") +
@@ -159,7 +159,6 @@ class ThermalRun {
   bool coolant_read_ = false;
   double coolant_C_ = 0.0;     ///< what the filter takes for a coolant before its first reading
   bool sensor_fused_ = false;  ///< a winding reading is fused (its σ given)
-  double first_winding_C_ = std::numeric_limits<double>::quiet_NaN();  ///< the first sample's reading
 };
 
 /// What the run did, for its summary on stderr (and a folder's summary.csv): the last estimate and the samples per
@@ -467,7 +466,7 @@ int run_folder(const EstimateOptions& o, const io::MachineConfig& cfg, const std
 }
 
 int run_estimate(const EstimateOptions& o) {
-  io::MachineConfig cfg = o.config.empty() ? io::builtin_paper_config() : io::load_machine_config(o.config);
+  io::MachineConfig cfg = machine_config_or_builtin(o.config, "rpem estimate");
   if (!o.algorithm.empty()) cfg.estimator.algorithm = io::parse_algorithm(o.algorithm);
   const std::string config_name = o.config.empty() ? "builtin:paper-ipmsm" : o.config;
   if (std::filesystem::is_directory(o.log)) return run_folder(o, cfg, config_name);

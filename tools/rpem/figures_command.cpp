@@ -16,6 +16,7 @@
 #include "commands.hpp"
 #include "log_options.hpp"
 #include "log_sessions.hpp"
+#include "machine_option.hpp"
 #include "rpem/analysis/analysis_figures.hpp"
 #include "rpem/analysis/diagnose/diagnose_output.hpp"
 #include "rpem/analysis/diagnose/regimes.hpp"
@@ -54,7 +55,7 @@ int run_figures(const FiguresOptions& o) {
     std::fprintf(stderr, "\n");
     return kExitOk;
   }
-  const io::MachineConfig cfg = o.config.empty() ? io::builtin_paper_config() : io::load_machine_config(o.config);
+  const io::MachineConfig cfg = machine_config_or_builtin(o.config, "rpem figures");
   // The log first: a log that cannot be read fails before any figure is drawn.
   std::optional<analysis::LogData> log;
   analysis::LogRegimes regimes;

@@ -19,6 +19,7 @@
 #include "commands.hpp"
 #include "log_folder.hpp"
 #include "log_options.hpp"
+#include "machine_option.hpp"
 #include "option_checks.hpp"
 #include "rpem/analysis/thermal/held_winding_column.hpp"
 #include "rpem/analysis/thermal/thermal_fit.hpp"
@@ -169,7 +170,7 @@ analysis::ThermalFitResult fit_without_held_readings(analysis::ThermalRecord& re
 }
 
 int run_thermal_fit(const ThermalFitCliOptions& o) {
-  const io::MachineConfig machine = o.config.empty() ? io::builtin_paper_config() : io::load_machine_config(o.config);
+  const io::MachineConfig machine = machine_config_or_builtin(o.config, "rpem thermal fit");
   const std::string config_name = o.config.empty() ? "builtin:paper-ipmsm" : o.config;
   // Where thermal.yaml goes, checked before the fit's minutes (its writer would find it only at the end).
   if (const std::filesystem::path dir = std::filesystem::path(o.out).parent_path();

@@ -65,6 +65,9 @@ struct ThermalNodeEstimate {
 struct ThermalEstimate {
   std::int64_t t_ns = 0;  ///< the newest step's end
   bool started = false;   ///< at least one step
+  /// The filter started every node at the coolant, an assumption nothing tested: no state resumed and no fused
+  /// winding reading in its first step (start_temperatures_C).
+  bool start_assumed_soaked = false;
   int nodes = 0, winding = 0, magnet = 1;
   std::array<ThermalNodeEstimate, kMaxThermalNodes> node{};
   /// The inverse laws of the current estimates (what the estimator alone says, held where it does not adapt).

@@ -68,6 +68,9 @@ struct EstimateReport : mirror::estimate_t {
   double good_psi_m_Wb = 0.0, good_r_s_Ohm = 0.0;
   double good_psi_m_age_s = 0.0, good_r_s_age_s = 0.0;
   core::ThermalSnapshot thermal;  ///< the fusion's state (persisted: a restart resumes it); nodes 0: none
+  /// The fusion started soaked although a winding sensor is configured: it gave no reading in the first step to test
+  /// the start (core::ThermalEstimate::start_assumed_soaked; without a sensor rpemd says so at its start).
+  bool thermal_start_untested_by_sensor = false;
 };
 
 /// RPEM_MEASUREMENT's fields (the mirror of lcm_types/rpem_measurement_t.lcm).

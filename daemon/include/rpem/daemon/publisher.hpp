@@ -74,6 +74,8 @@ class PersistingPublisher {
   void publish_diagnostics(const LoopStatsReport& r);
   void maybe_write_state(bool force);
   void print_status(const EstimateReport& r);
+  /// Once: the note that the thermal fusion's soaked start went untested although a winding sensor is configured.
+  void say_untested_start(const EstimateReport& r);
   template <class Message>
   void publish(const std::string& channel, Message& m);
 
@@ -94,6 +96,7 @@ class PersistingPublisher {
   WideLatencyHistogram rx_to_publish_run_;  ///< the whole run
   EstimateReport last_estimate_;
   bool have_estimate_ = false;
+  bool said_untested_start_ = false;
   PersistedThermal thermal_;  ///< the fusion's newest state (or the resumed one), persisted
   std::int64_t next_state_write_s_ = 0;
   std::int64_t next_status_us_ = 0;

@@ -84,9 +84,11 @@ class AveragedLogWriter {
 /// while the machine turned or carried current — zeros a logger wrote for values it does not read (docs/drive-log.md,
 /// "Errors"), a bridge off throughout whose logger writes zeros then, or voltages below the column's resolution
 /// throughout: in each case nothing in the log can be estimated or diagnosed. The error names the back EMF the
-/// speeds imply at the configured `psi_m_Wb` and the largest current, so that the reader can judge. A machine at rest
-/// unexcited throughout is no error (nothing was there to record; the tools say that nothing adapted).
-void check_voltages_recorded(const std::vector<core::AveragedSample>& samples, double psi_m_Wb, const std::string& log_path);
+/// speeds imply at the configured ψm and the largest current — at rest throughout, the drop that current implies
+/// across the configured R_s — so that the reader can judge. A machine at rest unexcited throughout is no error
+/// (nothing was there to record; the tools say that nothing adapted).
+void check_voltages_recorded(const std::vector<core::AveragedSample>& samples, const core::MachineSi& machine,
+                             const std::string& log_path);
 
 /// Throws ConfigError when the configuration needs what averaged samples cannot carry: per-phase current
 /// offsets and gains (no rotor-frame mean), or a dead time in seconds without the log's u_dc.
