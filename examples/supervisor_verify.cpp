@@ -38,8 +38,7 @@ int main(int argc, char** argv) {
   // SECONDS: how long to run (default: until stopped). Exit codes as example_supervisor's.
   const std::optional<long> seconds = argc > 2 ? rpem::supervisor::parse_seconds(argv[2]) : 1'000'000'000L;
   if (argc < 2 || argc > 3 || !seconds) {
-    if (argc > 2)
-      std::fprintf(stderr, "%s: SECONDS '%s' is not a whole number of seconds from 1 to 1e9\n", argv[0], argv[2]);
+    if (argc > 2) rpem::supervisor::say_seconds_refused(argv[0], argv[2]);
     std::fprintf(stderr, "usage: %s PUBLISH_KEY_FILE [SECONDS]\n", argv[0]);
     return rpem::io::kExitUsage;
   }

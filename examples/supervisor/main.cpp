@@ -42,8 +42,7 @@ int main(int argc, char** argv) {
   // SECONDS: how long to run (default: a billion, i.e. until stopped).
   const std::optional<long> seconds = argc > 3 ? supervisor::parse_seconds(argv[3]) : 1'000'000'000L;
   if (argc < 3 || argc > 4 || !seconds) {
-    if (argc > 3)
-      std::fprintf(stderr, "%s: SECONDS '%s' is not a whole number of seconds from 1 to 1e9\n", argv[0], argv[3]);
+    if (argc > 3) rpem::supervisor::say_seconds_refused(argv[0], argv[3]);
     std::fprintf(stderr, "usage: %s CONFIG PUBLISH_KEY_FILE [SECONDS]\n", argv[0]);
     return io::kExitUsage;
   }

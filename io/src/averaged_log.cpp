@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <iomanip>
+#include <limits>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -120,6 +121,40 @@ UnknownTiming unknown_timing(const std::vector<PreviousRowRead>& rows, const Log
   return u;
 }
 
+/// The count against the speed over the whole log: a window's count moves at most what excess() in unknown_timing
+/// allows it (the faster of its reads' speeds over the time since the read before the window's start, the PLL's lead,
+/// two steps), so the count summed over the windows whose times are known cannot exceed those allowances summed —
+/// unless the time column's windows are shorter than the drive's: a time in seconds read as ms makes them 1000 times
+/// so (docs/drive-log.md, "A count against the speed").
+void check_count_against_speed(const std::vector<PreviousRowRead>& rows, const LogMap& map, const UnknownTiming& unknown,
+                               double step_rad, const MappedLogReader& reader) {
+  double counted_rad = 0.0, allowed_rad = 0.0, integrated_rad = 0.0;
+  std::size_t windows = 0;
+  for (std::size_t j = 2; j < rows.size(); ++j) {
+    if (unknown.window[j]) continue;
+    const PreviousRowRead& a = rows[j - 1];
+    const PreviousRowRead& b = rows[j];
+    const double reads_apart_s = core::to_seconds(b.sample.t_ns - rows[j - 2].sample.t_ns);
+    counted_rad += std::abs(b.travel_el_rad - a.travel_el_rad);
+    allowed_rad += std::max(std::abs(a.omega_at_read_rad_s), std::abs(b.omega_at_read_rad_s)) * reads_apart_s +
+                   map.speed_pll.ramp_lag_s() * std::abs(b.omega_at_read_rad_s - a.omega_at_read_rad_s) + 2.0 * step_rad;
+    integrated_rad += 0.5 * (std::abs(a.omega_at_read_rad_s) + std::abs(b.omega_at_read_rad_s)) *
+                      core::to_seconds(b.sample.t_ns - a.sample.t_ns);
+    ++windows;
+  }
+  if (!(counted_rad > allowed_rad)) return;
+  std::ostringstream why;
+  why << std::setprecision(4) << "over the " << windows << " windows whose times are known the drive's count moved "
+      << counted_rad << " rad, more than the speed column allows in the time column's windows (" << allowed_rad
+      << " rad at most: each window's faster read over its time, the PLL's lead and two count steps); the speeds over "
+         "those times integrate to "
+      << integrated_rad << " rad, "
+      << (integrated_rad > 0.0 ? counted_rad / integrated_rad : std::numeric_limits<double>::infinity())
+      << " times less than counted. The time column is likely in another unit than the log's map says (its `unit:`: "
+         "a column in seconds read as ms is a factor of 1000), or the count's unit is not the drive's";
+  reader.fail_at(rows.front().line, Quantity::kTravelEl, why.str());
+}
+
 /// The change of the PLL's mean acceleration at each read j, over reads j − 2, j − 1, j (core::read_accel_change_rad_s2);
 /// NaN where either window is unknown, or at the first two reads.
 std::vector<double> accel_changes(const std::vector<PreviousRowRead>& rows, const UnknownTiming& unknown) {
@@ -164,6 +199,7 @@ void previous_row_samples(const std::vector<PreviousRowRead>& rows, const LogMap
   for (const PreviousRowRead& row : rows) all_reads.push_back({row.sample.t_ns, row.travel_el_rad});
   const double step_rad = counted ? count_step_rad(all_reads) : 0.0;
   const UnknownTiming unknown = unknown_timing(rows, map, step_rad);
+  if (counted && step_rad > 0.0) check_count_against_speed(rows, map, unknown, step_rad, reader);
   const std::vector<double> accel_change = map.speed_pll.given() ? accel_changes(rows, unknown) : std::vector<double>{};
   read.opening_rows = 1;
   bool after_unknown = false;
@@ -311,7 +347,7 @@ std::vector<core::AveragedSample> read_averaged_log(const std::string& path, con
 
 AveragedLogWriter::AveragedLogWriter(const std::string& path, const AveragedLogLayout& layout)
     : out_(path, std::ios::binary | std::ios::trunc), layout_(layout) {
-  if (!out_) throw DriveLogError(path, 0, 0, "", "cannot create file");
+  if (!out_) throw InputError(path, 0, 0, "", "cannot create file");  // an output: not the data's fault
   std::string h = "t,t_start,i_d,i_q,u_d,u_q,omega_el";
   if (layout_.u_dc) h += ",u_dc";
   if (layout_.t_winding) h += ",T_winding";

@@ -25,7 +25,8 @@ std::vector<std::string> split(const std::string& line) {
 
 }  // namespace
 
-CsvTable CsvTable::read(const std::string& path, bool allow_nan, const std::vector<std::string>& text_columns) {
+template <typename IsText>
+CsvTable CsvTable::read_with(const std::string& path, bool allow_nan, IsText is_text) {
   std::ifstream in(path);
   if (!in) throw InputError(path, 0, 0, "", "cannot open file");
   CsvTable t;
@@ -34,10 +35,8 @@ CsvTable CsvTable::read(const std::string& path, bool allow_nan, const std::vect
   if (!std::getline(in, line)) throw DataError(path, 1, 0, "", "empty file: expected a header row");
   t.header_ = split(line);
   t.columns_.resize(t.header_.size());
-  std::vector<bool> is_text(t.header_.size(), false);
-  for (std::size_t c = 0; c < t.header_.size(); ++c) {
-    is_text[c] = std::find(text_columns.begin(), text_columns.end(), t.header_[c]) != text_columns.end();
-  }
+  std::vector<bool> text(t.header_.size(), false);
+  for (std::size_t c = 0; c < t.header_.size(); ++c) text[c] = is_text(t.header_[c]);
   std::size_t line_no = 1;
   while (std::getline(in, line)) {
     ++line_no;
@@ -49,7 +48,7 @@ CsvTable CsvTable::read(const std::string& path, bool allow_nan, const std::vect
     }
     for (std::size_t c = 0; c < cells.size(); ++c) {
       double v = std::nan("");
-      if (!is_text[c]) {
+      if (!text[c]) {
         const std::string& s = cells[c];
         const NumberText read = read_number(s);
         if (read.kind != NumberText::Kind::kNumber) {
@@ -65,6 +64,18 @@ CsvTable CsvTable::read(const std::string& path, bool allow_nan, const std::vect
     t.row_lines_.push_back(line_no);
   }
   return t;
+}
+
+CsvTable CsvTable::read(const std::string& path, bool allow_nan, const std::vector<std::string>& text_columns) {
+  return read_with(path, allow_nan, [&](const std::string& name) {
+    return std::find(text_columns.begin(), text_columns.end(), name) != text_columns.end();
+  });
+}
+
+CsvTable CsvTable::read_numeric(const std::string& path, const std::vector<std::string>& numeric_columns) {
+  return read_with(path, false, [&](const std::string& name) {
+    return std::find(numeric_columns.begin(), numeric_columns.end(), name) == numeric_columns.end();
+  });
 }
 
 bool CsvTable::has(const std::string& name) const {

@@ -91,7 +91,7 @@ std::vector<DriveLogRow> read_drive_log(const std::string& path, const DriveLogL
 
 DriveLogWriter::DriveLogWriter(const std::string& path, const DriveLogLayout& layout)
     : out_(path, std::ios::binary | std::ios::trunc), layout_(layout) {
-  if (!out_) throw DriveLogError(path, 0, 0, "", "cannot create file");
+  if (!out_) throw InputError(path, 0, 0, "", "cannot create file");  // an output: not the data's fault
   std::string h = "t,theta_el,omega_el,u_dc";
   if (layout_.voltage_abc) h += ",u_a,u_b,u_c";
   if (layout_.voltage_dq) h += ",u_d,u_q";

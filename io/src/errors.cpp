@@ -51,4 +51,12 @@ void create_output_directory(const std::string& directory) {
   if (!std::filesystem::is_directory(directory, ec)) throw InputError(directory, 0, 0, "", "is not a directory");
 }
 
+void require_output_directory(const std::string& file) {
+  const std::filesystem::path dir = std::filesystem::path(file).parent_path();
+  std::error_code ec;
+  if (!dir.empty() && !std::filesystem::is_directory(dir, ec)) {
+    throw InputError(file, 0, 0, "", "cannot create file: no directory " + dir.string() + " (create it first)");
+  }
+}
+
 }  // namespace rpem::io

@@ -469,6 +469,20 @@ bool MappedLogReader::read_raw(MappedRow& row) {
                       g6(map_.wrap_s) + " s)");
       }
     }
+    if (map_.resolution_s > 0.0) {
+      // A stamp is a whole number of its clock's steps: a value between two is a clock in another unit than the map
+      // says (seconds under `unit: ms` with `resolution: 1`). The tolerance is the double's own, at the value's size.
+      const MappedColumn& c = *map_.time;
+      const double ticks =
+          read_number(cells_[static_cast<std::size_t>(time_index_)]).value * c.unit_factor * c.scale / map_.resolution_s;
+      if (std::abs(ticks - std::round(ticks)) > 1e-9 * std::abs(ticks) + 1e-6) {
+        fail_cell(time_index_, time_label_,
+                  "'" + cells_[static_cast<std::size_t>(time_index_)] + "' lies between two steps of the column's " +
+                      "resolution (" + g6(map_.resolution_s / (c.unit_factor * c.scale)) + " " + c.unit +
+                      ", the map's time.resolution): is the column in another unit than the map's `unit: " + c.unit +
+                      "` (seconds read as ms)?");
+      }
+    }
     if (previous_cell_s_ && map_.wrap_s > 0.0 && t_s < *previous_cell_s_ - 0.5 * map_.wrap_s) {
       // A step back by more than half the period is the column wrapping (ms_today at midnight): the
       // shorter way round the clock is forward. A shorter step back is time going back.

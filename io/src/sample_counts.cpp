@@ -74,8 +74,12 @@ std::string sentence(std::uint64_t n, std::uint64_t total, const Rule& r) {
 void SampleCounts::add(const core::Estimate& e) noexcept {
   ++samples;
   regimes.add(e.regime);
+  const bool first = !started_;
+  started_ = true;
   switch (e.detail.code) {
     case core::StepCode::kSynchronized:
+      resyncs += first ? 0 : 1;
+      break;
     case core::StepCode::kPredictorDiverged:
       ++resyncs;
       break;

@@ -78,9 +78,13 @@ std::int64_t VescToolSession::draw_interval_ns() {
   return std::max<std::int64_t>(std::llround(u(rng_) / link_.rate_Hz * 1e9), 1);
 }
 
+std::int64_t VescToolSession::log_time_ms(std::int64_t t_ns) const noexcept {
+  return link_.start_ms_today + t_ns / 1'000'000;
+}
+
 std::int32_t VescToolSession::ms_today(std::int64_t t_ns) const noexcept {
   // QTime::msecsSinceStartOfDay: whole milliseconds, wrapping at midnight.
-  const std::int64_t ms = link_.start_ms_today + t_ns / 1'000'000;
+  const std::int64_t ms = log_time_ms(t_ns);
   return static_cast<std::int32_t>(((ms % kMsPerDay) + kMsPerDay) % kMsPerDay);
 }
 
@@ -122,6 +126,7 @@ VescToolTruth VescToolSession::summarize(const Window& w, std::int64_t t_ns) con
   const double inv = w.cycles > 0 ? 1.0 / w.cycles : std::nan("");
   t.t_ns = t_ns;
   t.ms_today = ms_today(t_ns);
+  t.log_time_ms = log_time_ms(t_ns);
   t.window_start_ns = window_start_ns_;
   t.cycles = w.cycles;
   t.lost_before = lost_;
@@ -188,7 +193,7 @@ bool VescToolSession::next(VescToolRow& row, VescToolTruth& truth) {
 VescToolTruthWriter::VescToolTruthWriter(const std::string& path) : out_(path, std::ios::binary | std::ios::trunc) {
   if (!out_) throw io::InputError(path, 0, 0, "", "cannot create file");
   out_ << "ms_today,t_s,t_start_s,cycles,lost_before,psi_m,r_s,l_d,l_q,T_winding,T_magnet,modulating,angle_locked,"
-          "off_zero,regime,omega_el_start,omega_el_end,omega_el_mean,i_d,i_q,torque,frame_error\n";
+          "off_zero,regime,omega_el_start,omega_el_end,omega_el_mean,i_d,i_q,torque,frame_error,t\n";
 }
 
 void VescToolTruthWriter::write(const VescToolTruth& t) {
@@ -212,7 +217,7 @@ void VescToolTruthWriter::write(const VescToolTruth& t) {
     first = false;
   }
   for (double v : {t.omega_el_start_rad_s, t.omega_el_end_rad_s, t.omega_el_mean_rad_s, t.i_dq_A[0], t.i_dq_A[1],
-                   t.torque_Nm, t.frame_error_rad}) {
+                   t.torque_Nm, t.frame_error_rad, 1e-3 * static_cast<double>(t.log_time_ms)}) {
     number(v);
   }
   line_ += '\n';

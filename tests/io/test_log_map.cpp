@@ -117,6 +117,53 @@ TEST(LogMap, WindowsShorterThanHalfAControlPeriodAreRefusedAsAWrongTimeUnit) {
   EXPECT_EQ(read_averaged_log(log.path(), m, limits).size(), 2U);
 }
 
+/// The message of read_averaged_log's DriveLogError on `csv` read with `map` ("" where it reads).
+std::string averaged_read_error(const std::string& map, const std::string& csv) {
+  const test::TempFile log("unit.csv", csv);
+  try {
+    (void)read_averaged_log(log.path(), parse_log_map(map, "map.yaml"), DriveLogLimits{});
+  } catch (const DriveLogError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+// Without a control period in the configuration, a seconds column under `unit: ms` is still refused where the log
+// says enough: (a) a map that gives the clock's resolution, since a stamp lies on its steps; (b) a log with the
+// drive's count, since the count cannot move further than the speeds over the windows' times allow. A walk
+// (2026-12-06) read such a log with neither check and ended with ψm 10 % off. Read with the right unit, both pass.
+TEST(LogMap, ASecondsColumnReadAsMsIsRefusedByItsResolutionOrByTheCount) {
+  const std::string columns =
+      "columns:\n  omega_el: {column: w}\n  u_d: {column: ud}\n  u_q: {column: uq}\n  i_d: {column: id}\n"
+      "  i_q: {column: iq}\n";
+  const std::string head = "samples: averaged\nwindow: previous_row\n";
+  // (a) 0.1 s steps under ms with a 1 ms resolution: 0.1 lies between two steps.
+  const std::string rows = "t,w,ud,uq,id,iq\n0.0,100,0,1,0,1\n0.1,100,0,1,0,1\n0.2,100,0,1,0,1\n";
+  const std::string error = averaged_read_error(head + "time: {column: t, unit: ms, resolution: 1}\n" + columns, rows);
+  EXPECT_NE(error.find("unit.csv:3:1: column t: '0.1' lies between two steps of the column's resolution (1 ms, the "
+                       "map's time.resolution)"),
+            std::string::npos)
+      << error;
+  EXPECT_EQ(averaged_read_error(head + "time: {column: t, unit: s, resolution: 0.001}\n" + columns, rows), "");
+  // (b) 100 rad/s for 0.1 s moves the count 10 rad a window (40 steps of 0.25 rad), then 2.5 rad/s one step a window
+  // (which shows the step). Read as 0.1 ms windows the 14 windows allow 9·(100·0.2e-3 + 2·0.25) + (100·0.2e-3 + 0.5)
+  // + 4·(2.5·0.2e-3 + 0.5) = 7.202 rad where the count moved 9·10 + 5·0.25 = 91.25 rad; the speeds integrate
+  // (trapezoids) to 9·0.01 + 51.25·1e-4 + 4·2.5e-4 = 0.096125 rad, 949.3 times less.
+  std::string counted = "t,w,ud,uq,id,iq,n\n";
+  for (int k = 0; k <= 15; ++k) {
+    counted += std::to_string(0.1 * k) + (k <= 10 ? ",100" : ",2.5") + ",0,1,0,1," +
+               std::to_string(k <= 10 ? 40 * k : 400 + (k - 10)) + "\n";
+  }
+  const std::string travel = "  travel_el: {column: n, unit: rad, scale: 0.25}\n";
+  const std::string count_error = averaged_read_error(head + "time: {column: t, unit: ms}\n" + columns + travel, counted);
+  EXPECT_NE(count_error.find("over the 14 windows whose times are known the drive's count moved 91.25 rad, more than "
+                             "the speed column allows in the time column's windows (7.202 rad at most"),
+            std::string::npos)
+      << count_error;
+  EXPECT_NE(count_error.find("integrate to 0.09613 rad, 949.3 times less than counted"), std::string::npos) << count_error;
+  EXPECT_EQ(averaged_read_error(head + "time: {column: t, unit: s}\n" + columns + travel, counted), "");
+}
+
 // `optional: true` reads a column where the header has it and leaves the quantity absent where not; only for what
 // every log may lack (temperatures, travel_el) and only by header name.
 // A logger built on VescUart (duty, input voltage, erpm, motor current; no d/q values) read through a map: duty in

@@ -1,6 +1,6 @@
 // io::SampleCounts (its core::RegimeCounts): the samples that excited R_s only because a position sensor's frame was
 // assumed (the configuration does not say estimator.regimes.angle_source) are counted where they adapted, and the
-// tools' note says how many of all that excited R_s.
+// tools' note says how many of all that excited R_s; a resync is a chain started over, not its start.
 #include <gtest/gtest.h>
 
 #include <cstdint>
@@ -13,11 +13,29 @@
 namespace rpem::io {
 namespace {
 
-core::Estimate estimate(std::uint8_t bits) {
+core::Estimate estimate(std::uint8_t bits, core::StepCode code = core::StepCode::kAdapted) {
   core::Estimate e;
   e.regime = core::Classification::of(bits);
-  e.detail.code = core::StepCode::kAdapted;
+  e.detail.code = code;
   return e;
+}
+
+// Before, a clean log's summary said "1 resyncs": its first sample's synchronisation.
+TEST(SampleCounts, AResyncIsAChainStartedOverNotTheStartOfOne) {
+  using core::StepCode;
+  SampleCounts c;
+  c.add(estimate(0, StepCode::kSynchronized));  // the estimator's first sample
+  c.add(estimate(0));
+  EXPECT_EQ(c.resyncs, 0U);
+  c.add(estimate(0, StepCode::kSynchronized));  // a gap
+  c.add(estimate(0, StepCode::kPredictorDiverged));
+  EXPECT_EQ(c.resyncs, 2U);
+  c.start_session();                            // the estimator reset for a session
+  c.add(estimate(0, StepCode::kSynchronized));  // its first sample
+  EXPECT_EQ(c.resyncs, 2U);
+  c.add(estimate(0, StepCode::kSynchronized));
+  EXPECT_EQ(c.resyncs, 3U);
+  EXPECT_EQ(c.samples, 6U);
 }
 
 TEST(SampleCounts, WhatExcitedRsOnlyOnAnAssumedFrameIsCountedWhereItAdapted) {

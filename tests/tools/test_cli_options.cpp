@@ -157,6 +157,25 @@ TEST_F(CliOptions, OutputsAndInputsThatCannotBeUsedSaySo) {
                  74, "/dev/stdin: is not a regular file");
 }
 
+TEST_F(CliOptions, AFileIntoADirectoryThatIsNotThereIsRefusedBeforeTheWork) {
+  // Before, rpem estimate read the whole log first, rpem sim --out ran as a data error (65), and only rpem thermal
+  // fit checked. Now every written file's directory is checked after parsing: exit 74, nothing created.
+  const std::string nowhere = path("missing") + "/out.csv";
+  const std::string scenario = test::source_dir() + "/scenarios/vesc-6374.yaml";
+  for (const std::string& args :
+       {"estimate --log " + log_ + " --out " + nowhere, "sim --scenario " + scenario + " --out " + nowhere,
+        "sim --scenario " + scenario + " --vesc-tool-out " + path("v.csv") + " --vesc-tool-truth " + nowhere,
+        "thermal fit --log " + log_ + " --out " + nowhere}) {
+    EXPECT_REFUSED(rpem(args), 74, nowhere + ": cannot create file: no directory " + path("missing"));
+    EXPECT_FALSE(fs::exists(path("v.csv"))) << args;
+  }
+  // A folder of logs writes into a folder it creates, parents and all.
+  fs::create_directories(path("logs"));
+  fs::copy_file(log_, path("logs/run.csv"));
+  const test::ProcessResult folder = rpem("estimate --log " + path("logs") + " --out " + path("new/estimates"));
+  EXPECT_TRUE(fs::exists(path("new/estimates/summary.csv"))) << folder.output;
+}
+
 TEST_F(CliOptions, ATruthThatDoesNotCoverTheJudgedHalfIsBadData) {
   // diagnose --truth judges the estimates over the log's second half (here 12.5 ms to 24.9 ms): a truth must cover it,
   // increase and hold positive finite values — else it is the data's fault, exit 65 at its row.

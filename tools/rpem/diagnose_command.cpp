@@ -258,7 +258,8 @@ Runner add_diagnose_command(CLI::App& app) {
   cmd->add_option("--out", o->out, "directory for report.html, report.md, figures, diagnosis.json, extended.yaml")
       ->required();
   cmd->add_option("--truth", o->truth,
-                  "true parameters (t, psi_m, r_s) to judge the estimates against, e.g. rpem sim --truth")
+                  "true parameters (columns t, psi_m, r_s; others ignored) to judge the estimates against, e.g. "
+                  "rpem sim --truth or --vesc-tool-truth")
       ->check(CLI::ExistingFile);
   cmd->add_option("--model", o->model, "replay model: auto (from the sample interval), transient, steady_state")
       ->check(CLI::IsMember({"auto", "transient", "steady_state"}));

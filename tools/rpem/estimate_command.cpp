@@ -200,11 +200,13 @@ struct Tally {
                    static_cast<unsigned long long>(n), n == 1 ? "" : "s");
     }
   }
+  /// `kind`: the sample's noun, singular ("sample").
   [[nodiscard]] std::string summary(core::Algorithm a, const char* kind) const {
     char text[256];
-    std::snprintf(text, sizeof text, "%llu %s, psi_m = %.6g Wb, r_s = %.6g Ohm (%s), %llu resyncs",
-                  static_cast<unsigned long long>(counts.samples), kind, last.psi_m_Wb, last.r_s_Ohm, io::to_string(a),
-                  static_cast<unsigned long long>(counts.resyncs));
+    std::snprintf(text, sizeof text, "%llu %s%s, psi_m = %.6g Wb, r_s = %.6g Ohm (%s), %llu resync%s",
+                  static_cast<unsigned long long>(counts.samples), kind, counts.samples == 1 ? "" : "s", last.psi_m_Wb,
+                  last.r_s_Ohm, io::to_string(a), static_cast<unsigned long long>(counts.resyncs),
+                  counts.resyncs == 1 ? "" : "s");
     return text;
   }
   /// The regimes' counts, and why, where more than a tenth of the samples adapted nothing (and where R_s adapted
@@ -360,7 +362,7 @@ Tally run_averaged(const EstimateOptions& o, const std::string& log, const std::
     tally.count(e);
   }
   tally.end_chain(estimator);
-  std::fprintf(stderr, "rpem estimate: %s\n", tally.summary(cfg.estimator.algorithm, "averaged samples").c_str());
+  std::fprintf(stderr, "rpem estimate: %s\n", tally.summary(cfg.estimator.algorithm, "averaged sample").c_str());
   tally.explain();
   if (!samples.empty())
     tally.identifiable = check_identifiable(samples, cfg, tally.last, tally.adapted, tally.counts.regimes, rebuilt);
@@ -391,7 +393,7 @@ Tally run_instantaneous(const EstimateOptions& o, const std::string& log, const 
     tally.count(e);
     if ((tally.counts.samples & 0xFFF) == 0) progress.update(reader.bytes_read(), reader.bytes_total());
   }
-  progress.finish(tally.summary(cfg.estimator.algorithm, "samples") + io::describe(reader.reader().repairs()));
+  progress.finish(tally.summary(cfg.estimator.algorithm, "sample") + io::describe(reader.reader().repairs()));
   tally.explain();
   if (tally.first_t_ns) {
     const std::array<bool, 2> at_bound = say_estimates_at_bounds(tally.last, cfg.estimator);
@@ -470,6 +472,7 @@ int run_estimate(const EstimateOptions& o) {
   if (!o.algorithm.empty()) cfg.estimator.algorithm = io::parse_algorithm(o.algorithm);
   const std::string config_name = o.config.empty() ? "builtin:paper-ipmsm" : o.config;
   if (std::filesystem::is_directory(o.log)) return run_folder(o, cfg, config_name);
+  io::require_output_directory(o.out);  // before the log is read, which may take long
   (void)run_log(o, o.log, o.out, cfg, config_name);
   return kExitOk;
 }
@@ -484,7 +487,8 @@ Runner add_estimate_command(CLI::App& app) {
       ->check(CLI::ExistingFile);
   writes_file(cmd->add_option("--out", opts->out,
                               "estimate CSV to write; with a folder of logs, the folder to write each log's estimate "
-                              "and summary.csv in"))
+                              "and summary.csv in"),
+              Written::kFileOrFolder)
       ->required();
   cmd->add_option("--algorithm", opts->algorithm, "override the configured gain algorithm")
       ->check(CLI::IsMember({"sga", "gna", "phyint"}));

@@ -40,6 +40,7 @@ int main(int argc, char** argv) {  // NOLINT(bugprone-exception-escape): only a 
     return kExitUsage;
   }
   try {
+    require_output_directories();
     rpem::auth::initialise();  // libsodium, once, before any key exists
     for (const Runner& run : runners) {
       const int code = run();

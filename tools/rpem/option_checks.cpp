@@ -7,11 +7,19 @@
 #include <system_error>
 #include <vector>
 
+#include "rpem/io/errors.hpp"
+
 namespace rpem::tools {
 namespace {
 
 std::vector<const CLI::Option*>& written_options() {
   static std::vector<const CLI::Option*> options;  // filled while the subcommands register, before parsing
+  return options;
+}
+
+/// The written options that may name a folder (Written::kFileOrFolder).
+std::vector<const CLI::Option*>& maybe_folders() {
+  static std::vector<const CLI::Option*> options;
   return options;
 }
 
@@ -33,9 +41,18 @@ void collect_given(const CLI::App& app, std::vector<const CLI::Option*>& given) 
 
 }  // namespace
 
-CLI::Option* writes_file(CLI::Option* option) {
+CLI::Option* writes_file(CLI::Option* option, Written kind) {
   written_options().push_back(option);
+  if (kind == Written::kFileOrFolder) maybe_folders().push_back(option);
   return option;
+}
+
+void require_output_directories() {
+  for (const CLI::Option* out : written_options()) {
+    if (out->count() == 0) continue;
+    if (std::find(maybe_folders().begin(), maybe_folders().end(), out) != maybe_folders().end()) continue;
+    io::require_output_directory(out->as<std::string>());
+  }
 }
 
 void require_finite_numbers(CLI::App& app) {

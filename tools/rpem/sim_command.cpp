@@ -19,6 +19,7 @@
 #include "rpem/core/drive_estimator.hpp"
 #include "rpem/io/averaged_log.hpp"
 #include "rpem/io/estimate_log.hpp"
+#include "rpem/io/number_format.hpp"
 #include "rpem/sim/cycle_average.hpp"
 #include "rpem/sim/drive_simulator.hpp"
 #include "rpem/sim/truth_log.hpp"
@@ -45,10 +46,10 @@ struct SimOptions {
 /// What the simulation did: its samples, where they were written (`out`, if a drive log was) and streamed.
 std::string drive_sim_summary(std::uint64_t n, const std::string& name, const std::string& out,
                               const TelemetryStreamer* streamer) {
-  std::string summary = std::to_string(n) + " samples of '" + name + "'";
+  std::string summary = io::counted(n, "sample") + " of '" + name + "'";
   if (!out.empty()) summary += " written to " + out;
   if (streamer != nullptr) {
-    summary += ", streamed as " + std::to_string(streamer->frames_sent()) + " frames";
+    summary += ", streamed as " + io::counted(streamer->frames_sent(), "frame");
     if (streamer->frames_dropped() > 0)
       summary += " (" + std::to_string(streamer->frames_dropped()) + " dropped on purpose)";
   }

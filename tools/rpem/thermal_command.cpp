@@ -172,11 +172,6 @@ analysis::ThermalFitResult fit_without_held_readings(analysis::ThermalRecord& re
 int run_thermal_fit(const ThermalFitCliOptions& o) {
   const io::MachineConfig machine = machine_config_or_builtin(o.config, "rpem thermal fit");
   const std::string config_name = o.config.empty() ? "builtin:paper-ipmsm" : o.config;
-  // Where thermal.yaml goes, checked before the fit's minutes (its writer would find it only at the end).
-  if (const std::filesystem::path dir = std::filesystem::path(o.out).parent_path();
-      !dir.empty() && !std::filesystem::is_directory(dir)) {
-    throw io::InputError(o.out, 0, 0, "", "cannot create file: no directory " + dir.string());
-  }
   io::ThermalConfig laws = o.start.empty() ? io::default_thermal_config(machine)
                                            : io::load_thermal_config(o.start, machine, io::NetworkRequired::kNo);
   if (o.period_s > 0.0) laws.fusion.observer.period_s = o.period_s;

@@ -7,6 +7,7 @@
 #include "commands.hpp"
 #include "option_checks.hpp"
 #include "progress.hpp"
+#include "rpem/io/number_format.hpp"
 #include "rpem/sim/vesc_tool_log.hpp"
 
 namespace rpem::tools {
@@ -69,8 +70,8 @@ int run_vesc_tool_log(sim::Scenario scenario, const VescToolOptions& o) {
     progress.update(static_cast<std::uint64_t>(row_truth.t_ns / 1'000'000), total_ms);
   }
   const auto& n = session.counters();
-  std::string summary = std::to_string(n.rows) + " VESC Tool rows of '" + name + "' written to " + o.out + " (" +
-                        std::to_string(n.lost_requests + n.lost_replies) + " polls lost)";
+  std::string summary = io::counted(n.rows, "VESC Tool row") + " of '" + name + "' written to " + o.out + " (" +
+                        io::counted(n.lost_requests + n.lost_replies, "poll") + " lost)";
   progress.finish(summary);
   if (const std::uint64_t r = session.motor().simulator().rectifying_periods(); r > 0) {
     std::fprintf(stderr,

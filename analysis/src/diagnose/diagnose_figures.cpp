@@ -6,6 +6,7 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <initializer_list>
 #include <limits>
 
 #include "../median.hpp"
@@ -290,10 +291,11 @@ DataBlock track_block(const char* name, const ParameterTrack& t) { return {name,
 /// A panel's y range for the values rows imply: their median ± 6 robust standard deviations (1.4826·MAD), widened
 /// to the models' values, so that a few rows the steady-state model cannot represent (a transient inside a
 /// window, an unlocked start-up too slow to judge) do not shrink the rest to a line. Empty: autoscale (no spread).
-/// Steady-state logs only: the implied values are one per row of the models' tracks.
+/// Steady-state logs only: the implied values are one per row of the models' tracks. `shown`: the lines plotted
+/// with them (the models' values, a truth), each wholly in range.
 /// `outside`: how many implied values the range leaves out.
-std::string robust_yrange(const std::vector<double>& implied, const std::vector<double>& nominal,
-                          const std::vector<double>& extended, std::size_t& outside) {
+std::string robust_yrange(const std::vector<double>& implied, std::initializer_list<const std::vector<double>*> shown,
+                          std::size_t& outside) {
   std::vector<double> v;
   for (double x : implied) {
     if (std::isfinite(x)) v.push_back(x);
@@ -306,8 +308,8 @@ std::string robust_yrange(const std::vector<double>& implied, const std::vector<
   const double spread = 6.0 * 1.4826 * median(deviation);
   if (!(spread > 1e-6 * std::abs(m))) return "";  // no spread to speak of: gnuplot's autoscale widens a constant
   double lo = m - spread, hi = m + spread;
-  for (const std::vector<double>* model : {&nominal, &extended}) {
-    for (double x : *model) {
+  for (const std::vector<double>* line : shown) {
+    for (double x : *line) {
       lo = std::min(lo, x);
       hi = std::max(hi, x);
     }
@@ -333,11 +335,14 @@ std::string estimates(const std::string& dir, const Diagnosis& d) {
   fig.add_data(track_block("nom", c.nominal));
   fig.add_data(track_block("ext", c.extended));
   if (!c.truth.empty()) fig.add_data(track_block("truth", c.truth));
-  // rpem: the estimates against the truth; steady state: the models' values against what the data implies.
+  if (!c.implied.empty()) fig.add_data(track_block("implied", c.implied));
+  // The estimates (rpem) or the models' values (steady state) against the truth given, and what the rows imply.
   auto with_truth = [&](int col) {
-    if (c.truth.empty()) return std::string();
-    return ", $truth u 1:" + std::to_string(col) +
-           (rpem ? " w l lw 2 dt 2 lc rgb 'black' t 'truth'" : " w p pt 7 ps 0.4 lc rgb 'black' t 'implied by the data'");
+    const std::string n = std::to_string(col);
+    std::string plots;
+    if (!c.implied.empty()) plots += ", $implied u 1:" + n + " w p pt 7 ps 0.4 lc rgb 'black' t 'implied by the data'";
+    if (!c.truth.empty()) plots += ", $truth u 1:" + n + " w l lw 2 dt 2 lc rgb 'black' t 'truth'";
+    return plots;
   };
   fig.add_line(std::string("set multiplot layout 2,1 title '") +
                (rpem ? "RPEM estimates with the configuration and the extended model"
@@ -347,8 +352,10 @@ std::string estimates(const std::string& dir, const Diagnosis& d) {
   mark_session_starts(fig, *d.log);
   std::size_t psi_outside = 0, r_outside = 0;
   const std::string psi_range =
-      rpem ? "" : robust_yrange(c.truth.psi_m_Wb, c.nominal.psi_m_Wb, c.extended.psi_m_Wb, psi_outside);
-  const std::string r_range = rpem ? "" : robust_yrange(c.truth.r_s_Ohm, c.nominal.r_s_Ohm, c.extended.r_s_Ohm, r_outside);
+      rpem ? ""
+           : robust_yrange(c.implied.psi_m_Wb, {&c.nominal.psi_m_Wb, &c.extended.psi_m_Wb, &c.truth.psi_m_Wb}, psi_outside);
+  const std::string r_range =
+      rpem ? "" : robust_yrange(c.implied.r_s_Ohm, {&c.nominal.r_s_Ohm, &c.extended.r_s_Ohm, &c.truth.r_s_Ohm}, r_outside);
   fig.add_line(psi_range + "set title " + gp_quote(implied_title("magnet flux linkage", psi_outside)) +
                "; set ylabel 'ψm [Wb]'; plot $nom u 1:2 " + style + " lc rgb '#d62728' t 'configuration', $ext u 1:2 " +
                style + " lc rgb '#2ca02c' t 'extended'" + with_truth(2));

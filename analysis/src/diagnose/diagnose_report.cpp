@@ -362,14 +362,14 @@ void estimator(ReportDocument& doc, const Diagnosis& d) {
             "ψm = (u_q − R_s·i_q)/ω − L_d·i_d, with the extended model's corrections — set against what the "
             "configuration assumes and what the extended model assumes (its drifts). A row implies a value only "
             "where the data's noise determines it (the value beyond z of its standard deviation; not ψm near "
-            "standstill, not R_s where i_d is near zero). Values: mean over the last quarter; errors: the median "
-            "of the relative error's magnitude against the implied values over the second half (a few rows the "
-            "steady-state model cannot represent imply anything at all; the figure's range leaves them out and "
-            "says how many).");
+            "standstill, not R_s where i_d is near zero). Values: mean over the last quarter; errors over the second "
+            "half: RMS against the truth where one was given, else the median of the relative error's magnitude "
+            "against the implied values (a few rows the steady-state model cannot represent imply anything at all; "
+            "the figure's range leaves them out and says how many).");
   doc.figure("estimates.png", c.method == "rpem"
                                   ? "ψm and R_s estimated with the configuration (red) and the extended model (green)."
                                   : "ψm and R_s as the configuration (red) and the extended model (green) assume them, "
-                                    "and as the data implies them (black).");
+                                    "as the data implies them (black points) and, where given, the truth (dashed).");
   doc.table({"model", "ψm [Wb]", "R_s [Ω]", "ψm error", "R_s error"},
             {{"configuration", num(c.nominal_summary.psi_m_Wb), num(c.nominal_summary.r_s_Ohm),
               optional_pct(c.nominal_summary.psi_m_error_pct), optional_pct(c.nominal_summary.r_s_error_pct)},

@@ -50,14 +50,14 @@ struct RelativeError {
   }
 };
 
-/// `implied`: the truth is what the steady-state rows imply (one value per row of the track, NaN where not
-/// determined), else a true track (RPEM estimates against a simulation's truth).
+/// `implied`: `truth` is what the steady-state rows imply (one value per row of the track, NaN where not
+/// determined), else a true track (e.g. a simulation's).
 EstimateSummary summarise(const ParameterTrack& track, const ParameterTrack& truth, bool implied) {
   EstimateSummary s;
   if (track.empty()) return s;
   // What the rows imply is compared row by row (a row where it is not determined is NaN, and interpolating would
   // carry the NaN to its neighbours).
-  assert(!implied || truth.t_s == track.t_s);
+  assert(!implied || truth.empty() || truth.t_s == track.t_s);
   const double t0 = track.t_s.front(), t1 = track.t_s.back();
   double psi = 0.0, r = 0.0, n = 0.0;
   RelativeError e_psi{implied, {}}, e_r{implied, {}};
@@ -123,8 +123,8 @@ void steady_state_tracks(const LogData& log, const EffectContext& context, const
     const bool psi_determined = psi_implied * psi_implied > z_sq * psi_var;
     const bool r_determined = r_implied * r_implied > z_sq * r_var;
     const double t = core::to_seconds(sample.t_ns);
-    c.truth.add(t, psi_determined ? base.flux_Wb_of(psi_implied) : kNaN,
-                r_determined ? base.resistance_Ohm_of(r_implied) : kNaN);
+    c.implied.add(t, psi_determined ? base.flux_Wb_of(psi_implied) : kNaN,
+                  r_determined ? base.resistance_Ohm_of(r_implied) : kNaN);
     c.nominal.add(t, psi_m_at(context.base, log, k), r_s_at(context.base, log, k));
     c.extended.add(t, psi_model, r_model);
   }
@@ -154,7 +154,9 @@ double estimator_heldout_rms_A(const LogData& log, const io::MachineConfig& conf
 ParameterTrack load_truth(const std::string& path, double judged_from_s, double judged_to_s) {
   ParameterTrack t;
   try {  // the truth is data: its faults are the data's (exit 65), as a log's
-    const io::CsvTable table = io::CsvTable::read(path);
+    // Only the three columns are the truth's: a simulator's truth may carry more, text among them (rpem sim
+    // --vesc-tool-truth's `regime`).
+    const io::CsvTable table = io::CsvTable::read_numeric(path, {"t", "psi_m", "r_s"});
     t.t_s = table.column("t");
     t.psi_m_Wb = table.column("psi_m");
     t.r_s_Ohm = table.column("r_s");
@@ -202,9 +204,12 @@ EstimatorComparison compare_estimates(const LogData& log, const io::MachineConfi
     c.method = "steady_state";
     steady_state_tracks(log, context, extended, noise_pu, nominal.estimator.regimes.significance_sigma, c);
   }
-  const bool implied = c.method == "steady_state";
-  c.nominal_summary = summarise(c.nominal, c.truth, implied);
-  c.extended_summary = summarise(c.extended, c.truth, implied);
+  // A given truth is the reference on either kind of log; without one, a steady-state log's rows are.
+  const bool implied = c.truth.empty();
+  const ParameterTrack& reference = implied ? c.implied : c.truth;
+  c.judged_against = !c.truth.empty() ? "truth" : !c.implied.empty() ? "implied" : "";
+  c.nominal_summary = summarise(c.nominal, reference, implied);
+  c.extended_summary = summarise(c.extended, reference, implied);
   return c;
 }
 

@@ -57,13 +57,17 @@ LogRegimes classify_regimes(const LogData& log, const io::MachineConfig& config,
     for (std::size_t j = 0; j < log.sessions(); ++j) {
       estimator.emplace(config.machine,
                         log.session_voltage_rebuilt[j] ? core::for_applied_voltages(config.estimator) : config.estimator);
+      out.counts.start_session();
       for (std::size_t k = log.session_first[j]; k < log.session_end(j); ++k) record(k, estimator->step(window_of(log, k)));
     }
     out.noise_pu = estimator->classifier().current_noise();
   } else {
     core::DriveEstimator estimator(config.machine, config.estimator);
     for (std::size_t k = 0; k < n; ++k) {
-      if (log.starts_session(k)) estimator.reset();
+      if (log.starts_session(k)) {
+        estimator.reset();
+        out.counts.start_session();
+      }
       record(k, estimator.step(log.sample(k)));
     }
     out.noise_pu = estimator.classifier().current_noise();

@@ -15,6 +15,8 @@ class CsvTable {
   /// Reads `path`. Non-numeric cells are errors unless their column is listed in `text_columns`
   /// (those read as NaN). "nan" cells are accepted only when `allow_nan` is true.
   static CsvTable read(const std::string& path, bool allow_nan = false, const std::vector<std::string>& text_columns = {});
+  /// Reads `path` for `numeric_columns` alone: every other column is text (read as NaN), whatever it holds.
+  static CsvTable read_numeric(const std::string& path, const std::vector<std::string>& numeric_columns);
 
   [[nodiscard]] bool has(const std::string& name) const;
   /// The column's values; throws DataError naming the file if it is missing.
@@ -26,6 +28,10 @@ class CsvTable {
   [[nodiscard]] const std::string& path() const noexcept { return path_; }
 
  private:
+  /// `is_text(name)`: the column's cells are not read.
+  template <typename IsText>
+  static CsvTable read_with(const std::string& path, bool allow_nan, IsText is_text);
+
   std::string path_;
   std::vector<std::string> header_;
   std::vector<std::vector<double>> columns_;

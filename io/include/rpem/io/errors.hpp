@@ -44,4 +44,8 @@ class DriveLogError : public DataError {
 /// file in its place, no permission).
 void create_output_directory(const std::string& directory);
 
+/// InputError naming `file` where the directory it is to be written in does not exist: said before a command's
+/// work, not after it (a tool creates no parents for a file).
+void require_output_directory(const std::string& file);
+
 }  // namespace rpem::io

@@ -17,12 +17,19 @@ namespace rpem::io {
 struct SampleCounts {
   core::RegimeCounts regimes;
   std::uint64_t samples = 0;
-  std::uint64_t resyncs = 0;   ///< StepCode kSynchronized and kPredictorDiverged: a new chain, nothing adapted
+  /// StepCode kSynchronized and kPredictorDiverged: a chain started over, nothing adapted — not the first sample's
+  /// synchronisation after the estimator was made or reset (a start, not a restart).
+  std::uint64_t resyncs = 0;
   std::uint64_t outliers = 0;  ///< StepCode kOutlier
   bool averaged = false;       ///< an averaged log (its resyncs are gaps and late windows)
 
   /// Counts one estimator output.
   void add(const core::Estimate& e) noexcept;
+  /// The estimator was reset (a session's start): its next synchronisation is a start.
+  void start_session() noexcept { started_ = false; }
+
+ private:
+  bool started_ = false;  ///< a sample was counted since the estimator was made or reset
 };
 
 /// "regimes: excites_both 12, excites_psi_m 8012, …, resyncs 3, outliers 0".

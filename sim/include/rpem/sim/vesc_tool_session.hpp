@@ -38,6 +38,7 @@ struct VescToolLink {
 /// The truth of one row: what happened over its window.
 struct VescToolTruth {
   std::int32_t ms_today = 0;
+  std::int64_t log_time_ms = 0;      ///< ms_today unwrapped (+1 day per midnight since the first row): the log's time
   std::int64_t t_ns = 0;             ///< the firmware's read (drive time)
   std::int64_t window_start_ns = 0;  ///< the previous read: the window's start (a lost reply's read included)
   int cycles = 0;                    ///< control cycles averaged
@@ -83,6 +84,8 @@ class VescToolSession {
   /// Runs the drive up to `t_ns`, summing each completed cycle's truth. False once the scenario has ended.
   bool run_to(std::int64_t t_ns);
   [[nodiscard]] std::int64_t draw_interval_ns();
+  /// The UTC time of day at drive time t_ns, unwrapped [ms since the first day's midnight].
+  [[nodiscard]] std::int64_t log_time_ms(std::int64_t t_ns) const noexcept;
   [[nodiscard]] std::int32_t ms_today(std::int64_t t_ns) const noexcept;
   /// COMM_GET_VALUES_SETUP now (mc_interface_get_setup_values and friends), as VESC Tool decodes it.
   [[nodiscard]] VescSetupValues read_setup(const can::vesc::Values& now) const noexcept;
@@ -105,8 +108,10 @@ class VescToolSession {
 
 /// The truth CSV beside a VESC Tool log, one line per row:
 ///   ms_today,t_s,t_start_s,cycles,lost_before,psi_m,r_s,l_d,l_q,T_winding,T_magnet,modulating,angle_locked,
-///   off_zero,regime,omega_el_start,omega_el_end,omega_el_mean,i_d,i_q,torque,frame_error
-/// (SI; `regime` is closed_loop, open_loop, bridge_off, or their names joined by '+' when the window holds several).
+///   off_zero,regime,omega_el_start,omega_el_end,omega_el_mean,i_d,i_q,torque,frame_error,t
+/// (SI; `regime` is closed_loop, open_loop, bridge_off, or their names joined by '+' when the window holds several;
+/// `t` is the row's time as a reader of the log has it — ms_today in seconds, a day added at each midnight — so that
+/// the file is a truth `rpem diagnose --truth` reads: t, psi_m, r_s).
 class VescToolTruthWriter {
  public:
   explicit VescToolTruthWriter(const std::string& path);

@@ -12,7 +12,7 @@
 // "The estimator with the extended model"); elsewhere — ω near zero for ψm, i_d near zero for R_s, as on a
 // drive that holds i_d at 0 — the row implies nothing of that parameter (NaN). Set against them, a model's error
 // is the median of the relative error's magnitude: a few rows the steady-state model cannot represent imply
-// anything at all.
+// anything at all. Where a truth is given, every error is against it (RMS), on either kind of log.
 
 #include <optional>
 #include <string>
@@ -47,8 +47,8 @@ inline constexpr double kJudgedFromFraction = 0.5;
 
 struct EstimateSummary {
   double psi_m_Wb = 0.0, r_s_Ohm = 0.0;  ///< mean over the last quarter of the log
-  /// The error against truth over the second half, at the rows where the truth is determined (none: empty): the
-  /// RMS against a true track (rpem), the median of its magnitude against what the rows imply (steady_state).
+  /// The error over the second half, at the rows where the reference is determined (none: empty): the RMS against
+  /// a true track, else the median of its magnitude against what the rows imply (steady_state).
   std::optional<double> psi_m_error_pct;
   std::optional<double> r_s_error_pct;
 };
@@ -57,9 +57,12 @@ struct EstimatorComparison {
   std::string method;  ///< "rpem" or "steady_state"
   /// rpem: the estimates; steady_state: what each model assumes.
   ParameterTrack nominal, extended;
-  /// rpem: the truth given (may be empty); steady_state: what the data implies. The summaries'
-  /// errors are against it.
+  /// The truth given (`--truth`; may be empty).
   ParameterTrack truth;
+  /// steady_state: what each row of the tracks implies (NaN where not determined); rpem: empty.
+  ParameterTrack implied;
+  /// What the summaries' errors are against: "truth" where one was given, else "implied" (steady_state), else "".
+  std::string judged_against;
   EstimateSummary nominal_summary, extended_summary;
 };
 

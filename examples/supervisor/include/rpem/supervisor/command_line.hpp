@@ -1,6 +1,7 @@
 #pragma once
 // What the example programs read from their command line beyond file names.
 
+#include <cstdio>
 #include <cstdlib>
 #include <optional>
 
@@ -13,6 +14,11 @@ namespace rpem::supervisor {
   const long seconds = std::strtol(text, &rest, 10);
   if (rest == text || *rest != '\0' || seconds < 1 || seconds > 1'000'000'000) return std::nullopt;
   return seconds;
+}
+
+/// Says on stderr why `program` refused SECONDS `text` (parse_seconds gave nullopt).
+inline void say_seconds_refused(const char* program, const char* text) {
+  std::fprintf(stderr, "%s: SECONDS '%s' is not a whole number of seconds from 1 to 1e9\n", program, text);
 }
 
 }  // namespace rpem::supervisor
