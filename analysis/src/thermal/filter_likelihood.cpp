@@ -92,7 +92,8 @@ void sensor_lag_at_standstill(io::ThermalConfig& c, const ThermalRecord& r, std:
   out.notes.push_back("winding sensor time constant without the network (eq. 14.25, " + std::to_string(e.runs) +
                       " standstill runs of r̂s beside the sensor): " + std::to_string(e.tau_s) + " s, 95 % interval [" +
                       std::to_string(e.lower_s) + ", " + std::to_string(e.upper_s) + "] s, fitted beside r̂s's law reading " +
-                      std::to_string(e.rs_above_sensor_K) + " K above the sensor (eq. 14.25a); " +
+                      std::to_string(e.rs_above_sensor_K) + " K above the sensor at its runs' mean, " +
+                      std::to_string(1.0 / e.law.gain) + " K per kelvin of the sensor's (eq. 14.25e); " +
                       (used         ? "used, the winding node standing for the sensor's reading (eq. 14.24)"
                        : e.runs < 3 ? "not used (fewer than three runs)"
                                     : "not used (its interval reaches down to no lag at all)"));

@@ -48,15 +48,33 @@ StepMeanNoise run_noise(const SensorLagRun& x) {
   return {std::max(kMinX, -std::log(q / steps)), std::max(1.0, m / steps)};
 }
 
-/// The sums over the runs (after `warm` steps) that give (14.25a)'s misses at τ_s for any offset c: the residual
-/// is e − c·g with e = lag_τs(T_rs) − lag_τr(T_sensor), both started at the run's first reading, and
-/// g = lag_τs(1) started at 0 (what lag_τs(T_rs − c) loses to lag_τs(T_rs) per kelvin of c).
+/// The sums over the runs (after `warm` steps) that give (14.25e)'s misses at τ_s for any law (b, a): the residual
+/// is e + d·z + a·g with d = b − 1, e = lag_τs(T_rs) − lag_τr(T_sensor), both started at the run's first reading,
+/// z = lag_τs(T_rs) and g = lag_τs(1), both started at 0 (what b and a add per unit). r̂s's noise enters through
+/// b·z: its expected share (1 + d)²·N is taken out (eq. 14.25c), which makes the law's least squares a corrected one
+/// (z's noise would otherwise pull d down).
 struct MissSums {
-  double ee = 0.0, eg = 0.0, gg = 0.0;
-  double noise = 0.0;  ///< the share of ee that r̂s's noise is expected to make (eq. 14.25c)
-  [[nodiscard]] double squared_misses(double c) const { return ee - noise - 2.0 * c * eg + c * c * gg; }
-  /// The offset that minimises the misses (0 where no step is judged).
-  [[nodiscard]] double best_offset() const { return gg > 0.0 ? eg / gg : 0.0; }
+  double ee = 0.0, ez = 0.0, eg = 0.0, zz = 0.0, zg = 0.0, gg = 0.0;
+  double noise = 0.0;     ///< N: the share of ee that r̂s's noise is expected to make (eq. 14.25c)
+  double t_rs_sum = 0.0;  ///< Σ T_rs over the judged steps (their mean: where the law's offset is said)
+  double judged = 0.0;    ///< judged steps
+  [[nodiscard]] double squared_misses(const SensorLaw& law) const {
+    const double d = law.gain - 1.0, a = law.offset_K;
+    return ee + 2.0 * d * ez + 2.0 * a * eg + d * d * zz + 2.0 * d * a * zg + a * a * gg - law.gain * law.gain * noise;
+  }
+  /// The law that minimises the misses: the 2×2 normal equations in (d, a); where the runs' temperatures do not
+  /// tell a gain from an offset (z a multiple of g: the determinant below a millionth of its terms), the gain is 1.
+  [[nodiscard]] SensorLaw best_law() const {
+    if (!(gg > 0.0)) return {};
+    const double zz_c = zz - noise;  // (z's noise taken out)
+    const double det = zz_c * gg - zg * zg;
+    if (det > 1e-6 * std::abs(zz_c * gg)) {
+      const double rhs_d = noise - ez, rhs_a = -eg;
+      const double d = (rhs_d * gg - zg * rhs_a) / det, a = (zz_c * rhs_a - zg * rhs_d) / det;
+      return {1.0 + d, a};
+    }
+    return {1.0, -eg / gg};
+  }
 };
 
 /// A run with its noise's correlation and variance (eq. 14.25c, d), which do not depend on τ_s: found once per run.
@@ -83,28 +101,31 @@ MissSums miss_sums(const std::vector<JudgedRun>& runs, std::size_t warm, double 
   MissSums m;
   for (const JudgedRun& j : runs) {
     const SensorLagRun* x = j.run;
-    double lagged_rs = x->sensor_C.front(), lagged_sensor = x->sensor_C.front(), lagged_one = 0.0;
+    double lagged_rs = x->sensor_C.front(), lagged_sensor = x->sensor_C.front(), lagged_one = 0.0, lagged_law = 0.0;
     LaggedNoise noise;
     for (std::size_t k = 1; k < x->sensor_C.size(); ++k) {
       if (j.compensated) noise.step(decay(tau_s, x->dt_s[k]), j.noise, j.v);
       lagged_rs = lag_step(lagged_rs, x->t_rs_C[k - 1], x->t_rs_C[k], tau_s, x->dt_s[k]);
       lagged_one = lag_step(lagged_one, 1.0, 1.0, tau_s, x->dt_s[k]);
+      lagged_law = lag_step(lagged_law, x->t_rs_C[k - 1], x->t_rs_C[k], tau_s, x->dt_s[k]);
       lagged_sensor = lag_step(lagged_sensor, x->sensor_C[k - 1], x->sensor_C[k], x->tau_r_s[k], x->dt_s[k]);
       if (k < warm) continue;
       const double e = lagged_rs - lagged_sensor;
-      m.ee += e * e, m.eg += e * lagged_one, m.gg += lagged_one * lagged_one, m.noise += noise.yy;
+      m.ee += e * e, m.ez += e * lagged_law, m.eg += e * lagged_one;
+      m.zz += lagged_law * lagged_law, m.zg += lagged_law * lagged_one, m.gg += lagged_one * lagged_one;
+      m.noise += noise.yy, m.t_rs_sum += x->t_rs_C[k], m.judged += 1.0;
     }
   }
   return m;
 }
 
-/// τ_s on [lo, hi] (in log τ_s) that minimises (14.25a)'s misses, the offset c profiled out where `offset` is
-/// null (c at its least squares for each τ_s), held at `*offset` otherwise.
-double best_tau(const std::vector<JudgedRun>& runs, std::size_t warm, double lo, double hi, const double* offset) {
+/// τ_s on [lo, hi] (in log τ_s) that minimises (14.25e)'s misses, the law profiled out where `law` is null (at its
+/// least squares for each τ_s), held at `*law` otherwise.
+double best_tau(const std::vector<JudgedRun>& runs, std::size_t warm, double lo, double hi, const SensorLaw* law) {
   constexpr double kTolerance = 0.005;  // in log τ_s: 0.5 %
   auto misses = [&](double log_tau) {
     const MissSums m = miss_sums(runs, warm, log_tau);
-    return m.squared_misses(offset != nullptr ? *offset : m.best_offset());
+    return m.squared_misses(law != nullptr ? *law : m.best_law());
   };
   return std::exp(golden_section_minimum(misses, lo, hi, kTolerance));
 }
@@ -166,13 +187,17 @@ SensorLagEstimate sensor_lag_without_network(const std::vector<SensorLagRun>& ru
   if (usable.empty() || !(low_s > 0.0) || !(high_s > low_s)) return out;
   const double lo = std::log(low_s), hi = std::log(high_s);
   out.tau_s = best_tau(usable, warm, lo, hi, nullptr);
-  out.rs_above_sensor_K = miss_sums(usable, warm, std::log(out.tau_s)).best_offset();
+  const MissSums at_best = miss_sums(usable, warm, std::log(out.tau_s));
+  out.law = at_best.best_law();
+  // Where r̂s's law reads the winding above the sensor, at the mean of its judged readings: T̄ − (b·T̄ + a).
+  const double mean_rs_C = at_best.judged > 0.0 ? at_best.t_rs_sum / at_best.judged : 0.0;
+  out.rs_above_sensor_K = mean_rs_C - (out.law.gain * mean_rs_C + out.law.offset_K);
   if (usable.size() < 3) return out;
-  // Each run's own τ_s at the pooled offset (the law's, one for the log): their spread is the estimate's (runs
-  // are independent stretches of the log).
+  // Each run's own τ_s at the pooled law (one for the log): their spread is the estimate's (runs are independent
+  // stretches of the log).
   double sum = 0.0, sum2 = 0.0;
   for (const JudgedRun& r : usable) {
-    const double t = best_tau({r}, warm, lo, hi, &out.rs_above_sensor_K);
+    const double t = best_tau({r}, warm, lo, hi, &out.law);
     sum += t, sum2 += t * t;
   }
   const auto m = static_cast<double>(usable.size());

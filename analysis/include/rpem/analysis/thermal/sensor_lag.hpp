@@ -10,7 +10,13 @@
 //
 //   lag_τs(T_rs − c) = lag_τr(T_sensor)                                                                (14.25a)
 //
-// with c fitted beside τ_s (linear in c: profiled out at each τ_s); unfitted, a few kelvin of c pass for lag.
+// with c fitted beside τ_s (linear in c: profiled out at each τ_s); unfitted, a few kelvin of c pass for lag. A law
+// whose coefficient or reference resistance is off reads the winding through an affine map, not one offset:
+//
+//   lag_τs(b·T_rs + a) = lag_τr(T_sensor)                                                              (14.25e)
+//
+// with b and a both fitted (linear: profiled out at each τ_s); with one offset, a 2.4 % coefficient error left the
+// independent drive cycle's τ_s 4.2 s [−0.2, 8.5] (not used) against 4.84 s.
 // r̂s's own noise, lagged by τ_s, shrinks as τ_s grows and would pull τ_s long: its expected share of the misses is
 // taken out (eq. 14.25c), its variance measured from each run's own second differences. A step's r̂s is the mean
 // of the samples the step holds, which are an AR(1) from sample to sample: the steps' noise is that AR(1)'s block
@@ -50,12 +56,19 @@ struct StepMeanNoise {
   [[nodiscard]] double second_difference() const { return 6.0 * variance - 2.0 * carry * with_last * (4.0 - last_to_last); }
 };
 
+/// How the sensor's winding follows r̂s's law reading (eq. 14.25e): T = gain·T_rs + offset_K.
+struct SensorLaw {
+  double gain = 1.0;
+  double offset_K = 0.0;
+};
+
 struct SensorLagEstimate {
   double tau_s = std::numeric_limits<double>::quiet_NaN();  ///< pooled least squares over the runs; NaN: none
   /// 95 % interval from the runs' own estimates (Student's t over their spread; ±∞ with fewer than three).
   double lower_s = -std::numeric_limits<double>::infinity(), upper_s = std::numeric_limits<double>::infinity();
   std::size_t runs = 0;
-  double rs_above_sensor_K = 0.0;  ///< c of (14.25a): how far r̂s's law reads the winding above the sensor
+  SensorLaw law;                   ///< (14.25e): the sensor's winding from r̂s's law reading
+  double rs_above_sensor_K = 0.0;  ///< how far r̂s's law reads the winding above the sensor, at its mean reading
 };
 
 /// r̂s's lag behind the winding it reads (eq. 14.25b), from the observer's τ_r = Δt/a: the update
