@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "rpem/core/assert.hpp"
 #include "rpem/core/clock.hpp"
 #include "rpem/core/reported_speed.hpp"
 #include "rpem/io/number_format.hpp"
@@ -68,6 +69,21 @@ struct UnknownTiming {
   std::vector<bool> window;  ///< row k's window (from row k − 1's read) is unknown
 };
 
+/// The most window j's count can move (j ≥ 2: the bound needs row j − 2's arrival): a logger that asks only while no
+/// request is outstanding took read j − 1 after row j − 2 arrived and read j before row j did, so the count moves at
+/// most the faster of its two speeds read over t_j − t_{j−2}, plus the rotor's lead over a PLL's speed (lag·|Δω̂|) and
+/// the count's 2 steps (core::grown_count_speed_rad_s).
+double window_count_allowance_rad(const std::vector<PreviousRowRead>& rows, std::size_t j, const LogMap& map,
+                                  double step_rad) {
+  RPEM_ASSERT(j >= 2 && j < rows.size(), "the bound needs row j − 2's arrival");
+  const PreviousRowRead& a = rows[j - 1];
+  const PreviousRowRead& b = rows[j];
+  const double reads_apart_s = core::to_seconds(b.sample.t_ns - rows[j - 2].sample.t_ns);
+  const double speed_rad_s = std::max(std::abs(a.omega_at_read_rad_s), std::abs(b.omega_at_read_rad_s));
+  return speed_rad_s * reads_apart_s + map.speed_pll.ramp_lag_s() * std::abs(b.omega_at_read_rad_s - a.omega_at_read_rad_s) +
+         2.0 * step_rad;
+}
+
 /// A read at an unknown time ends one window and starts the next, so both are unknown. A read is:
 /// - row k, `request_timeout_s` or more after row k − 1 and at least 1.5 of the log's median spacing: the logger asked
 ///   again, and the request it gave up on may have been read (the means reset then) and be answered only now. A
@@ -75,11 +91,9 @@ struct UnknownTiming {
 ///   next tick), and a request it gave up on costs a tick: 2P, so a row is judged against the midpoint as well;
 ///   polling faster, the timeout decides;
 /// - row k, a stale reply arriving out of order: its count steps back against the motion and forward again, each
-///   step further than the reads can lie apart. A logger that asks only while no request is outstanding took read
-///   j − 1 after row j − 2 arrived and read j before row j did, so window j's count moves at most the faster of its
-///   two speeds read over t_j − t_{j−2}, plus the rotor's lead over a PLL's speed (lag·|Δω̂|) and the count's 2
-///   steps (core::grown_count_speed_rad_s). One window beyond that could be a speed read wrong (a Hall drive's PLL
-///   at a crawl follows a staircase); two beside one read, in opposite directions, is a read out of its place.
+///   step further than the reads can lie apart (window_count_allowance_rad). One window beyond that could be a speed
+///   read wrong (a Hall drive's PLL at a crawl follows a staircase); two beside one read, in opposite directions, is
+///   a read out of its place.
 UnknownTiming unknown_timing(const std::vector<PreviousRowRead>& rows, const LogMap& map, double step_rad) {
   const std::size_t n = rows.size();
   std::vector<std::int64_t> spacing_ns;
@@ -99,18 +113,10 @@ UnknownTiming unknown_timing(const std::vector<PreviousRowRead>& rows, const Log
     if (j + 1 < n) u.window[j + 1] = true;
   };
   if (n > 0) u.window[0] = true;  // the first row's window began before the log
-  // Window j's count beyond what the reads allow, signed by its direction (0: within, or no count); j ≥ 2, since the
-  // bound needs row j − 2's arrival.
+  // Window j's count beyond what the reads allow, signed by its direction (0: within, or no count); j ≥ 2.
   const auto excess = [&](std::size_t j) {
-    const PreviousRowRead& a = rows[j - 1];
-    const PreviousRowRead& b = rows[j];
-    const double travel_rad = b.travel_el_rad - a.travel_el_rad;
-    const double reads_apart_s = core::to_seconds(b.sample.t_ns - rows[j - 2].sample.t_ns);
-    const double speed_rad_s = std::max(std::abs(a.omega_at_read_rad_s), std::abs(b.omega_at_read_rad_s));
-    const double allowed_rad = speed_rad_s * reads_apart_s +
-                               map.speed_pll.ramp_lag_s() * std::abs(b.omega_at_read_rad_s - a.omega_at_read_rad_s) +
-                               2.0 * step_rad;
-    return step_rad > 0.0 && std::abs(travel_rad) > allowed_rad ? travel_rad : 0.0;
+    const double travel_rad = rows[j].travel_el_rad - rows[j - 1].travel_el_rad;
+    return step_rad > 0.0 && std::abs(travel_rad) > window_count_allowance_rad(rows, j, map, step_rad) ? travel_rad : 0.0;
   };
   for (std::size_t k = 1; k < n; ++k) {
     if (map.request_timeout_s > 0.0 && core::to_seconds(rows[k].sample.t_ns - rows[k - 1].sample.t_ns) >= asked_again_s) {
@@ -121,9 +127,8 @@ UnknownTiming unknown_timing(const std::vector<PreviousRowRead>& rows, const Log
   return u;
 }
 
-/// The count against the speed over the whole log: a window's count moves at most what excess() in unknown_timing
-/// allows it (the faster of its reads' speeds over the time since the read before the window's start, the PLL's lead,
-/// two steps), so the count summed over the windows whose times are known cannot exceed those allowances summed —
+/// The count against the speed over the whole log: a window's count moves at most window_count_allowance_rad, so the
+/// count summed over the windows whose times are known cannot exceed those allowances summed —
 /// unless the time column's windows are shorter than the drive's: a time in seconds read as ms makes them 1000 times
 /// so (docs/drive-log.md, "A count against the speed").
 void check_count_against_speed(const std::vector<PreviousRowRead>& rows, const LogMap& map, const UnknownTiming& unknown,
@@ -134,10 +139,8 @@ void check_count_against_speed(const std::vector<PreviousRowRead>& rows, const L
     if (unknown.window[j]) continue;
     const PreviousRowRead& a = rows[j - 1];
     const PreviousRowRead& b = rows[j];
-    const double reads_apart_s = core::to_seconds(b.sample.t_ns - rows[j - 2].sample.t_ns);
     counted_rad += std::abs(b.travel_el_rad - a.travel_el_rad);
-    allowed_rad += std::max(std::abs(a.omega_at_read_rad_s), std::abs(b.omega_at_read_rad_s)) * reads_apart_s +
-                   map.speed_pll.ramp_lag_s() * std::abs(b.omega_at_read_rad_s - a.omega_at_read_rad_s) + 2.0 * step_rad;
+    allowed_rad += window_count_allowance_rad(rows, j, map, step_rad);
     integrated_rad += 0.5 * (std::abs(a.omega_at_read_rad_s) + std::abs(b.omega_at_read_rad_s)) *
                       core::to_seconds(b.sample.t_ns - a.sample.t_ns);
     ++windows;

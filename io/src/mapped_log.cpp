@@ -308,7 +308,7 @@ void MappedLogReader::fail_empty_cell(int index, const std::string& label) {
   fail_cell(index, label, reason);
 }
 
-double MappedLogReader::cell(int index, const std::string& label, const MappedColumn& c, bool allow_nan) {
+double MappedLogReader::number_in_cell(int index, const std::string& label, bool allow_nan) {
   const std::string& s = cells_[static_cast<std::size_t>(index)];
   if (s.empty()) fail_empty_cell(index, label);
   const NumberText read = read_number(s);
@@ -329,12 +329,19 @@ double MappedLogReader::cell(int index, const std::string& label, const MappedCo
     fail_cell(index, label, "NaN");
   }
   if (!std::isfinite(v)) fail_cell(index, label, "'" + s + "' is not finite");
-  if (is_no_reading(c, v)) {
+  return v;
+}
+
+double MappedLogReader::in_si(int index, const std::string& label, const MappedColumn& c, double written) {
+  if (std::isnan(written)) return kNaN;
+  if (is_no_reading(c, written)) {
     ++no_reading_of(label, c).rows;
     return kNaN;
   }
-  const double si = c.unit_factor * (v * c.scale + c.offset) + c.unit_offset;
-  if (!std::isfinite(si)) fail_cell(index, label, "'" + s + "' is not finite in SI (" + c.unit + ")");
+  const double si = c.unit_factor * (written * c.scale + c.offset) + c.unit_offset;
+  if (!std::isfinite(si)) {
+    fail_cell(index, label, "'" + cells_[static_cast<std::size_t>(index)] + "' is not finite in SI (" + c.unit + ")");
+  }
   return si;
 }
 
@@ -453,7 +460,9 @@ bool MappedLogReader::read_raw(MappedRow& row) {
   // Time: the column's value (unwrapped), or the row's index times the period.
   std::int64_t t_ns = 0;
   if (map_.time) {
-    double t_s = cell(time_index_, time_label_, *map_.time, false);
+    const MappedColumn& c = *map_.time;
+    const double written = number_in_cell(time_index_, time_label_, false);
+    double t_s = in_si(time_index_, time_label_, c, written);
     if (std::abs(t_s) > limits_.time_s.max_abs) {
       fail_cell(time_index_, time_label_,
                 g6(t_s) + " s is beyond the plausible ±" + g6(limits_.time_s.max_abs) + " s (" + limits_.time_s.why + ")");
@@ -461,7 +470,6 @@ bool MappedLogReader::read_raw(MappedRow& row) {
     if (map_.wrap_s > 0.0) {
       // A wrapping clock's value lies within one period of its zero (ms_today: 0 to a day): what lies outside is
       // not that clock, and would unwrap to a window years long or a wrap that never happened.
-      const MappedColumn& c = *map_.time;
       const double zero_s = c.unit_factor * c.offset + c.unit_offset;  // the column's 0 in seconds
       if (!(t_s >= zero_s && t_s < zero_s + map_.wrap_s)) {
         fail_cell(time_index_, time_label_,
@@ -472,9 +480,7 @@ bool MappedLogReader::read_raw(MappedRow& row) {
     if (map_.resolution_s > 0.0) {
       // A stamp is a whole number of its clock's steps: a value between two is a clock in another unit than the map
       // says (seconds under `unit: ms` with `resolution: 1`). The tolerance is the double's own, at the value's size.
-      const MappedColumn& c = *map_.time;
-      const double ticks =
-          read_number(cells_[static_cast<std::size_t>(time_index_)]).value * c.unit_factor * c.scale / map_.resolution_s;
+      const double ticks = written * c.unit_factor * c.scale / map_.resolution_s;
       if (std::abs(ticks - std::round(ticks)) > 1e-9 * std::abs(ticks) + 1e-6) {
         fail_cell(time_index_, time_label_,
                   "'" + cells_[static_cast<std::size_t>(time_index_)] + "' lies between two steps of the column's " +

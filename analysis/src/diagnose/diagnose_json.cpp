@@ -5,6 +5,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <stdexcept>
+#include <string>
 
 #include "rpem/analysis/diagnose/diagnose_output.hpp"
 
@@ -281,8 +282,8 @@ void write_diagnosis_json(const std::string& path, const Diagnosis& d, const std
                      {"gain_pct", gain},
                      {"estimates", summary_json(d.estimates.extended_summary)}};
   out["estimates_method"] = d.estimates.method;
-  out["estimates_judged_against"] =
-      d.estimates.judged_against.empty() ? nlohmann::json(nullptr) : nlohmann::json(d.estimates.judged_against);
+  const std::string judged_against = d.estimates.judged_against();
+  out["estimates_judged_against"] = judged_against.empty() ? nlohmann::json(nullptr) : nlohmann::json(judged_against);
   out["not_identifiable"] = nlohmann::json::array();
   for (const Unidentifiable& u : s.not_identifiable)
     out["not_identifiable"].push_back({{"effects", u.effects}, {"reason", u.reason}});

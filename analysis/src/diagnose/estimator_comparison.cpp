@@ -207,7 +207,6 @@ EstimatorComparison compare_estimates(const LogData& log, const io::MachineConfi
   // A given truth is the reference on either kind of log; without one, a steady-state log's rows are.
   const bool implied = c.truth.empty();
   const ParameterTrack& reference = implied ? c.implied : c.truth;
-  c.judged_against = !c.truth.empty() ? "truth" : !c.implied.empty() ? "implied" : "";
   c.nominal_summary = summarise(c.nominal, reference, implied);
   c.extended_summary = summarise(c.extended, reference, implied);
   return c;

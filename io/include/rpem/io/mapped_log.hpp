@@ -95,7 +95,13 @@ class MappedLogReader {
   void split(const std::string& line);
   [[nodiscard]] bool ends_with_separator(const std::string& line) const;  ///< blanks after it aside
   [[nodiscard]] bool cut_off() const;
-  [[nodiscard]] double cell(int index, const std::string& label, const MappedColumn& c, bool allow_nan);
+  /// The cell's number as written (a cell that is not one is refused by line and cell); NaN only where allow_nan.
+  [[nodiscard]] double number_in_cell(int index, const std::string& label, bool allow_nan);
+  /// A cell's written number in SI through its column's map; NaN where it is NaN or the column's no-reading value.
+  [[nodiscard]] double in_si(int index, const std::string& label, const MappedColumn& c, double written);
+  [[nodiscard]] double cell(int index, const std::string& label, const MappedColumn& c, bool allow_nan) {
+    return in_si(index, label, c, number_in_cell(index, label, allow_nan));
+  }
   /// An empty cell: the error says how many rows from here leave the column empty (read to the file's end: the
   /// error ends the read anyway) — every one is a column the logger names and never recorded.
   [[noreturn]] void fail_empty_cell(int index, const std::string& label);

@@ -61,9 +61,12 @@ struct EstimatorComparison {
   ParameterTrack truth;
   /// steady_state: what each row of the tracks implies (NaN where not determined); rpem: empty.
   ParameterTrack implied;
-  /// What the summaries' errors are against: "truth" where one was given, else "implied" (steady_state), else "".
-  std::string judged_against;
   EstimateSummary nominal_summary, extended_summary;
+
+  /// What the summaries' errors are against: "truth" where one was given, else "implied" (steady_state), else "".
+  [[nodiscard]] const char* judged_against() const noexcept {
+    return !truth.empty() ? "truth" : !implied.empty() ? "implied" : "";
+  }
 };
 
 /// `extended` is the model with the found effects (drifts apply to the steady-state method only:
