@@ -133,7 +133,7 @@ def check_sensor_lag(r, b):
     truth = r["truth_s"]
     b.check("standstill runs", r["runs"], 3, 1e9)
     b.check("τ_s used", 1.0 if r["used"] else 0.0, 1.0, 1.0)
-    # Measured 5.12 s [4.68, 5.56] against 4.84 s (2026-12-04); over eight plants the errors were −1.2…+5.2 %.
+    # Measured 5.11 s [4.26, 5.96] against 4.84 s (2026-12-06, eq. 14.25f); over eight plants the errors were −1.3…+5.2 %.
     b.check(f"τ_s within 10 % of the plant's {truth:.3f} s", r["tau_s"], 0.9 * truth, 1.1 * truth)
     b.check("the interval holds the plant's τ_s: lower end", r["lower_s"], 0.0, truth)
     b.check("the interval holds the plant's τ_s: upper end", r["upper_s"], truth, 1e9)

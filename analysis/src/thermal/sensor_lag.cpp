@@ -119,13 +119,14 @@ MissSums miss_sums(const std::vector<JudgedRun>& runs, std::size_t warm, double 
   return m;
 }
 
-/// τ_s on [lo, hi] (in log τ_s) that minimises (14.25e)'s misses, the law profiled out where `law` is null (at its
-/// least squares for each τ_s), held at `*law` otherwise.
-double best_tau(const std::vector<JudgedRun>& runs, std::size_t warm, double lo, double hi, const SensorLaw* law) {
-  constexpr double kTolerance = 0.005;  // in log τ_s: 0.5 %
+/// τ_s on [lo, hi] (in log τ_s) that minimises (14.25e)'s misses, the law profiled out (at its least squares for each
+/// τ_s).
+double best_tau(const std::vector<JudgedRun>& runs, std::size_t warm, double lo, double hi) {
+  // In log τ_s: 0.05 %, well below the differences between the jackknife's fits (eq. 14.25f).
+  constexpr double kTolerance = 0.0005;
   auto misses = [&](double log_tau) {
     const MissSums m = miss_sums(runs, warm, log_tau);
-    return m.squared_misses(law != nullptr ? *law : m.best_law());
+    return m.squared_misses(m.best_law());
   };
   return std::exp(golden_section_minimum(misses, lo, hi, kTolerance));
 }
@@ -186,23 +187,27 @@ SensorLagEstimate sensor_lag_without_network(const std::vector<SensorLagRun>& ru
   out.runs = usable.size();
   if (usable.empty() || !(low_s > 0.0) || !(high_s > low_s)) return out;
   const double lo = std::log(low_s), hi = std::log(high_s);
-  out.tau_s = best_tau(usable, warm, lo, hi, nullptr);
+  out.tau_s = best_tau(usable, warm, lo, hi);
   const MissSums at_best = miss_sums(usable, warm, std::log(out.tau_s));
   out.law = at_best.best_law();
   // Where r̂s's law reads the winding above the sensor, at the mean of its judged readings: T̄ − (b·T̄ + a).
   const double mean_rs_C = at_best.judged > 0.0 ? at_best.t_rs_sum / at_best.judged : 0.0;
   out.rs_above_sensor_K = mean_rs_C - (out.law.gain * mean_rs_C + out.law.offset_K);
   if (usable.size() < 3) return out;
-  // Each run's own τ_s at the pooled law (one for the log): their spread is the estimate's (runs are independent
-  // stretches of the log).
+  // The delete-one jackknife over the runs (eq. 14.25f): the pooled fit, law and all, with each run left out in turn.
+  // The runs are independent stretches of the log; refitting the law each time carries its error into τ_s.
   double sum = 0.0, sum2 = 0.0;
-  for (const JudgedRun& r : usable) {
-    const double t = best_tau({r}, warm, lo, hi, &out.law);
+  for (std::size_t left_out = 0; left_out < usable.size(); ++left_out) {
+    std::vector<JudgedRun> rest;
+    rest.reserve(usable.size() - 1);
+    for (std::size_t k = 0; k < usable.size(); ++k)
+      if (k != left_out) rest.push_back(usable[k]);
+    const double t = best_tau(rest, warm, lo, hi);
     sum += t, sum2 += t * t;
   }
   const auto m = static_cast<double>(usable.size());
-  const double sd = std::sqrt(std::max(0.0, (sum2 - sum * sum / m) / (m - 1.0)));
-  const double half = t975(usable.size() - 1) * sd / std::sqrt(m);
+  const double se = std::sqrt(std::max(0.0, (m - 1.0) / m * (sum2 - sum * sum / m)));
+  const double half = t975(usable.size() - 1) * se;
   out.lower_s = out.tau_s - half;
   out.upper_s = out.tau_s + half;
   return out;

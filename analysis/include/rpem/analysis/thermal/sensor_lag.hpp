@@ -64,7 +64,7 @@ struct SensorLaw {
 
 struct SensorLagEstimate {
   double tau_s = std::numeric_limits<double>::quiet_NaN();  ///< pooled least squares over the runs; NaN: none
-  /// 95 % interval from the runs' own estimates (Student's t over their spread; ±∞ with fewer than three).
+  /// 95 % interval: the delete-one jackknife over the runs, Student's t (eq. 14.25f; ±∞ with fewer than three runs).
   double lower_s = -std::numeric_limits<double>::infinity(), upper_s = std::numeric_limits<double>::infinity();
   std::size_t runs = 0;
   SensorLaw law;                   ///< (14.25e): the sensor's winding from r̂s's law reading
