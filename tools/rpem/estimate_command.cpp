@@ -6,6 +6,7 @@
 // network's filter runs beside it as in rpemd (core::ThermalFusion, docs/thermal.md) and the estimate CSV
 // gains the fused temperatures. A folder of logs: each log on its own, as if it were the only one (log_folder.hpp).
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdio>
@@ -13,6 +14,7 @@
 #include <limits>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "commands.hpp"
 #include "log_folder.hpp"
@@ -20,6 +22,7 @@
 #include "machine_option.hpp"
 #include "option_checks.hpp"
 #include "progress.hpp"
+#include "rpem/analysis/rs_along_current.hpp"
 #include "rpem/core/averaged_estimator.hpp"
 #include "rpem/core/drive_estimator.hpp"
 #include "rpem/io/averaged_log.hpp"
@@ -174,17 +177,24 @@ struct Tally {
     magnet = t.magnet_peak();
     winding = t.winding_peak();
   }
+  /// The windows R_s adapted on, where each leaves the drop along its current (analysis::RsReading).
+  std::vector<analysis::RsReading> rs_readings;
   void count(const core::Estimate& e) {
+    const bool has_previous = first_t_ns.has_value();
     if (!first_t_ns) first_t_ns = e.t_ns;
     if (e.retracted_previous) uncount_adaptation(last);  // a window found mixed: what it adapted was taken back
+    last_read_rs_ = has_previous && (e.detail.flags & core::step_flag::kRsActive) && read_rs(last.r_s_Ohm, e);
     last = e;
     counts.add(e);
     adapted[0] += (e.detail.flags & core::step_flag::kPsiMActive) ? 1 : 0;
     adapted[1] += (e.detail.flags & core::step_flag::kRsActive) ? 1 : 0;
   }
+  /// Takes back `e`'s adaptations: `e` is `last`, whose reading (if any) is the newest.
   void uncount_adaptation(const core::Estimate& e) {
     adapted[0] -= (e.detail.flags & core::step_flag::kPsiMActive) ? 1 : 0;
     adapted[1] -= (e.detail.flags & core::step_flag::kRsActive) ? 1 : 0;
+    if (last_read_rs_) rs_readings.pop_back();
+    last_read_rs_ = false;
   }
   /// The log's end ends the last chain: its newest window, never judged, is retracted (docs/derivations.md §13,
   /// "Mixed windows"); the final estimates are the estimator's, and the windows so left out are said.
@@ -217,6 +227,17 @@ struct Tally {
       std::fprintf(stderr, "rpem estimate: %s\n", why.c_str());
     if (const std::string note = io::assumed_frame_note(counts); !note.empty())
       std::fprintf(stderr, "rpem estimate: note: %s\n", note.c_str());
+  }
+
+ private:
+  bool last_read_rs_ = false;  ///< `last` left a reading in rs_readings
+  /// The drop along the current the model leaves at a window R_s adapted on (eq. 12.1): î is predicted with the
+  /// r̂s before the window, î = e/r̂s where ω·L ≪ r̂s (the speeds R_s adapts at), so y = r̂s·(î·i)/|i|.
+  bool read_rs(double r_before_Ohm, const core::Estimate& e) {
+    const double current_A = e.i_meas_A.norm();
+    if (!(current_A > 0.0)) return false;
+    rs_readings.push_back({core::to_seconds(e.t_ns), current_A, r_before_Ohm * e.i_hat_A.dot(e.i_meas_A) / current_A});
+    return true;
   }
 };
 
@@ -277,11 +298,37 @@ std::array<bool, 2> say_estimates_at_bounds(const core::Estimate& last, const co
   return at;
 }
 
+/// Whether the windows R_s adapted on imply the resistance it ends at (eq. 12.1): where their drop along the current
+/// is R·|i| + V with a V the model leaves out, every start agrees on R + V/|i|, which the runs from the bounds
+/// cannot see. R at the last window differing from r̂s by more than the accuracy asked and z of its standard errors
+/// (`significance_sigma`) is said, and the estimate is no identification.
+bool check_rs_along_current(const std::vector<analysis::RsReading>& readings, double r_s_Ohm, double tolerance,
+                            const core::EstimatorSettings& e) {
+  const std::optional<analysis::RsAlongCurrent> fit = analysis::fit_rs_along_current(readings);
+  if (!fit) return true;
+  const double difference_Ohm = r_s_Ohm - fit->r_at_last_Ohm;
+  const double z = e.regimes.significance_sigma;
+  if (!(std::abs(difference_Ohm) > std::max(tolerance * r_s_Ohm, z * fit->r_at_last_se_Ohm))) return true;
+  std::fprintf(stderr,
+               "rpem estimate: r_s not identifiable from this log: the %zu windows it adapted on (%.3g to %.3g A) read "
+               "their drop along the current as R·|i| + V with V = %.3g V (+-%.2g V) and R = %.5g Ohm (+-%.2g) at the "
+               "last of them, %+.0f %% from the %.5g Ohm the estimator ends at (%.1f standard errors): "
+               "a voltage the model leaves out, nearly constant along the current (an inverter's dead time the drive "
+               "does not fully compensate, largest against a low current), reads R_s as R + V/|i| from every start. "
+               "Standstill at two or more currents tells them apart; rpem diagnose shows the error; "
+               "model_extensions.deadtime models it (docs/drive-log.md, \"A voltage along the current\")\n",
+               fit->readings, fit->current_min_A, fit->current_max_A, fit->v_V, fit->v_se_V, fit->r_at_last_Ohm,
+               fit->r_at_last_se_Ohm, 100.0 * (r_s_Ohm / fit->r_at_last_Ohm - 1.0), r_s_Ohm,
+               std::abs(difference_Ohm) / fit->r_at_last_se_Ohm);
+  return false;
+}
+
 std::array<std::optional<bool>, 2> check_identifiable(const std::vector<core::AveragedSample>& samples,
                                                       const io::MachineConfig& cfg, const core::Estimate& last,
                                                       const std::array<std::uint64_t, 2>& adapted,
                                                       const core::RegimeCounts& regimes,
-                                                      const io::RotorFrameRebuild& rebuilt) {
+                                                      const io::RotorFrameRebuild& rebuilt,
+                                                      const std::vector<analysis::RsReading>& rs_readings) {
   const core::EstimatorSettings& e = cfg.estimator;
   std::array<std::optional<bool>, 2> identifiable;
   const bool r_s_declared = rebuilt.voltages && e.regimes.sensorless;
@@ -334,6 +381,8 @@ std::array<std::optional<bool>, 2> check_identifiable(const std::vector<core::Av
         p[k].name, p[k].lo, p[k].hi, p[k].unit, p[k].from_lo, p[k].from_hi, p[k].unit, 100.0 * half, estimate[k], p[k].unit,
         100.0 * p[k].tolerance, adapted_clause(k, regimes, adapted[k], e).c_str());
   }
+  if (identifiable[1].value_or(false) && !check_rs_along_current(rs_readings, last.r_s_Ohm, p[1].tolerance, e))
+    identifiable[1] = false;
   return identifiable;
 }
 
@@ -365,7 +414,8 @@ Tally run_averaged(const EstimateOptions& o, const std::string& log, const std::
   std::fprintf(stderr, "rpem estimate: %s\n", tally.summary(cfg.estimator.algorithm, "averaged sample").c_str());
   tally.explain();
   if (!samples.empty())
-    tally.identifiable = check_identifiable(samples, cfg, tally.last, tally.adapted, tally.counts.regimes, rebuilt);
+    tally.identifiable =
+        check_identifiable(samples, cfg, tally.last, tally.adapted, tally.counts.regimes, rebuilt, tally.rs_readings);
   thermal.explain();
   tally.take_peaks(thermal);
   return tally;

@@ -3,20 +3,20 @@
 #include <algorithm>
 #include <cassert>
 #include <cmath>
-#include <limits>
 #include <optional>
 #include <string>
 
 #include "../median.hpp"
 #include "rpem/core/clock.hpp"
 #include "rpem/core/drive_estimator.hpp"
+#include "rpem/core/non_finite.hpp"
 #include "rpem/io/csv_table.hpp"
 #include "rpem/io/errors.hpp"
 
 namespace rpem::analysis {
 namespace {
 
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+using core::kNaN;
 
 /// Points kept per track.
 constexpr std::size_t kTrackPoints = 2000;
