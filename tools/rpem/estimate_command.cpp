@@ -313,10 +313,11 @@ bool check_rs_along_current(const std::vector<analysis::RsReading>& readings, do
                "rpem estimate: r_s not identifiable from this log: the %zu windows it adapted on (%.3g to %.3g A) read "
                "their drop along the current as R·|i| + V with V = %.3g V (+-%.2g V) and R = %.5g Ohm (+-%.2g) at the "
                "last of them, %+.0f %% from the %.5g Ohm the estimator ends at (%.1f standard errors): "
-               "a voltage the model leaves out, nearly constant along the current (an inverter's dead time the drive "
-               "does not fully compensate, largest against a low current), reads R_s as R + V/|i| from every start. "
-               "Standstill at two or more currents tells them apart; rpem diagnose shows the error; "
-               "model_extensions.deadtime models it (docs/drive-log.md, \"A voltage along the current\")\n",
+               "a voltage the model leaves out along the current reads R_s as R + V/|i| from every start: a sensorless "
+               "drive's stall, where the rotor moves while the frame is not the rotor's and its back EMF falls along the "
+               "current, or an inverter's dead time the drive does not fully compensate (model_extensions.deadtime). "
+               "rpem diagnose shows the error; standstill with the rotor held at two or more currents tells R from V "
+               "(docs/drive-log.md, \"A voltage along the current\")\n",
                fit->readings, fit->current_min_A, fit->current_max_A, fit->v_V, fit->v_se_V, fit->r_at_last_Ohm,
                fit->r_at_last_se_Ohm, 100.0 * (r_s_Ohm / fit->r_at_last_Ohm - 1.0), r_s_Ohm,
                std::abs(difference_Ohm) / fit->r_at_last_se_Ohm);
