@@ -143,6 +143,7 @@ Estimate AveragedDriveEstimator::step(const AveragedSample& sample) noexcept {
   const SpeedError speed_error = window_speed_error(sample, staircase_below_rad_s_);
   in.n_error_pu = base_.speed_pu(speed_error.error_rad_s);
   in.n_error_noise_pu = base_.speed_pu(speed_error.noise_rad_s);
+  if (std::isfinite(sample.omega_el_at_reads_max_rad_s)) in.n_reach_pu = base_.speed_pu(sample.omega_el_at_reads_max_rad_s);
   in.u_reported_sq_pu = sample.u_dq_V.squaredNorm() / (base_.voltage_V * base_.voltage_V);
   in.u_reported_pu = Vec2(base_.voltage_pu(sample.u_dq_V[0]), base_.voltage_pu(sample.u_dq_V[1]));
   in.i_reported_pu = Vec2(base_.current_pu(sample.i_dq_A[0]), base_.current_pu(sample.i_dq_A[1]));

@@ -251,8 +251,7 @@ void RegimeClassifier::reconfigure(const RegimeConfig& config) noexcept {
   // A sensorless frame's error within the cone at least (a = 0): ψ_max·√(2·(1 − cos δ_tol)), or within the Hall
   // sensors' error where that is smaller.
   const double cos_least = std::max(k.cos_angle, k.cos_hall);
-  const double dpsi_frame = c.dpsi_pu + (c.sensorless ? c.psi_max_pu * std::sqrt(2.0 * (1.0 - cos_least)) : 0.0);
-  k.dpsi_frame_sq = dpsi_frame * dpsi_frame;
+  k.frame_least_pu = c.sensorless ? c.psi_max_pu * std::sqrt(2.0 * (1.0 - cos_least)) : 0.0;
   k.slope_reach = k.inv_omega_n * (c.x_q_pu + c.dx_q_pu);
   k.frame_reach_pu = c.sensorless ? 0.5 * c.psi_max_pu * (1.0 - k.cos_angle) : 0.0;
   // Neighbours formed with the old constants are no neighbours of a window formed with the new ones.
@@ -492,11 +491,17 @@ std::uint8_t RegimeClassifier::excitation_bits(const RegimeInput& in, const Term
     if (psi_term * psi_term > k.z_sq * h_sq[0] * noise) bits |= regime_bit::kExcitesPsiM;
   }
   // r_min·|i| must at least exceed |n|·Δψ (and a sensorless frame's least error): checked on the squares before
-  // |i| is taken. A sensorless frame's possible error only where it is needed (three roots and a division).
-  if (k.r_min_sq * i_sq > n2 * k.dpsi_frame_sq) {
+  // |i| is taken. A sensorless frame's possible error only where it is needed (three roots and a division). That
+  // error's voltage acts at the speeds the window passed through, not only at its mean: where the frame wanders and
+  // the rotor turns back inside the window its mean along the current is the power the motion took (§13).
+  const double reach_n = std::max(abs_n, in.n_reach_pu);
+  const double least = abs_n * c.dpsi_pu + reach_n * k.frame_least_pu;
+  if (k.r_min_sq * i_sq > least * least) {
     const double i_abs = std::sqrt(i_sq);
-    const auto term = [&](double frame) { return c.r_min_pu * i_abs - abs_n * ((c.dpsi_pu + frame) + k.dx_max * i_abs); };
-    const double own = term(c.sensorless && abs_n > 0.0 ? frame_flux(in, t) : 0.0);
+    const auto term = [&](double frame) {
+      return c.r_min_pu * i_abs - abs_n * (c.dpsi_pu + k.dx_max * i_abs) - reach_n * frame;
+    };
+    const double own = term(c.sensorless && reach_n > 0.0 ? frame_flux(in, t) : 0.0);
     if (own > 0.0) {
       const double flux = c.psi_max_pu + k.x_max * i_abs;
       const double noise = v.u_sq + (k.r_sq + n2 * k.x_max * k.x_max) * v.i_sq + flux * flux * v.n_sq;
@@ -504,7 +509,7 @@ std::uint8_t RegimeClassifier::excitation_bits(const RegimeInput& in, const Term
       if (own * own > bound_sq) {
         bits |= regime_bit::kExcitesRs;
         // A sensor's frame only assumed: would a sensorless frame's possible error have kept the term down?
-        if (c.angle_source_assumed && abs_n > 0.0) {
+        if (c.angle_source_assumed && reach_n > 0.0) {
           const double sensorless = term(frame_flux(in, t));
           if (!(sensorless > 0.0 && sensorless * sensorless > bound_sq)) bits |= regime_bit::kRsOnAssumedFrame;
         }

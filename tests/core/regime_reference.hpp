@@ -279,6 +279,7 @@ class Classifier {
     // which hides while sin(δ − δ_tol) ≤ cos δ_tol·(B_d + tan δ_tol·B_q + z·σ_L)/(|n|·ψ_min); a frame turning with
     // the rotor stays within δ_tol + π/2. Its error beside the model's [0, n·ψ̂] is |n|·ψ·2·sin(δ/2).
     double frame_flux = 0.0;
+    const double reach_n = std::max(abs_n, in.n_reach_pu);  // the speeds the window passed through (its reads)
     if (c.sensorless) {
       const double delta_tol = std::atan(c.tan_angle);
       const double reach = std::cos(delta_tol) * (b[0] + c.tan_angle * b[1] + c.z * sigma_lock);
@@ -344,7 +345,8 @@ class Classifier {
     // r_min·|i| must at least exceed |n|·Δψ: checked on the squares before |i| is taken.
     if (k.r_min_sq * i_sq > n2 * c.dpsi_pu * c.dpsi_pu) {
       const double i_abs = std::sqrt(i_sq);
-      const double term = c.r_min_pu * i_abs - abs_n * (c.dpsi_pu + frame_flux + k.dx_max * i_abs);
+      // The frame's error at the speeds the window passed through.
+      const double term = c.r_min_pu * i_abs - abs_n * (c.dpsi_pu + k.dx_max * i_abs) - reach_n * frame_flux;
       if (term > 0.0) {
         const double h_sq = in.weight[1] / (2.0 - in.weight[1]);
         const double flux = c.psi_max_pu + k.x_max * i_abs;

@@ -292,6 +292,41 @@ TEST(Regime, ASensorlessFramesRsIsExcitedOnlyBeyondTheFrameErrorTheLockTestLeave
   EXPECT_GT(std::abs(implied / s.nominal.r_s_pu - 1.0), 0.05);
 }
 
+// A sensorless stall's rocking (docs/derivations.md §13, "A stall's rocking"): a window whose mean speed is zero while
+// its reads show the rotor at speed. The frame's error acts at the speeds the window passed through: r_s is excited
+// where r_min·|i| − n_reach·F > z·N, F the frame error's flux where the lock test cannot judge (at a zero mean speed,
+// δ_max = δ_tol + π/2: F = ψ_max·√(2·(1 + sin δ_tol))). The edge from both sides; without reads (n_reach 0) the
+// standstill edge; a sensor's frame unmoved by the reads; reads slower than the mean change nothing.
+TEST(Regime, ARockingStallsReadsTakeTheFrameErrorWhereTheWindowsMeanHidesIt) {
+  const double gamma = 1e-3;
+  Outrunner s;
+  const RegimeConfig sensor = s.config();
+  s.settings.regimes.sensorless = true;
+  const RegimeConfig c = s.config();
+  const double noise = std::sqrt(gamma / (2.0 - gamma)) * c.resolution_pu[0] / std::sqrt(12.0);
+  const double delta_tol = s.settings.regimes.angle_tolerance_rad;
+  const double frame = c.psi_max_pu * std::sqrt(2.0 * (1.0 + std::sin(delta_tol)));
+  const auto at = [&](const RegimeConfig& config, double n, double current, double reads) {
+    RegimeInput in = steady(s.nominal, n, Vec2(0.0, current));
+    in.weight = Vec2::Constant(gamma);
+    in.n_reach_pu = reads;
+    return probe(config, in);
+  };
+  const double reads = 2e-3;  // 84 erpm on the outrunner's base (42 000 erpm): a rocking rotor's read
+  const double edge = (c.z * noise + reads * frame) / c.r_min_pu;
+  const double standstill = c.z * noise / c.r_min_pu;
+  ASSERT_GT(edge, 3.0 * standstill);
+  EXPECT_TRUE(at(c, 0.0, 1.01 * edge, reads).bits & regime_bit::kExcitesRs) << "edge " << edge;
+  EXPECT_FALSE(at(c, 0.0, 0.99 * edge, reads).bits & regime_bit::kExcitesRs) << "edge " << edge;
+  EXPECT_TRUE(at(c, 0.0, 1.01 * standstill, 0.0).bits & regime_bit::kExcitesRs);
+  EXPECT_TRUE(at(sensor, 0.0, 1.01 * standstill, reads).bits & regime_bit::kExcitesRs);
+  // A window at its reads' speed or faster: the mean decides, as without them.
+  for (const double n : {2e-3, -3e-3}) {
+    EXPECT_EQ(at(c, n, 2.0 * edge, 0.5 * std::abs(n)).bits, at(c, n, 2.0 * edge, 0.0).bits) << "n " << n;
+    EXPECT_EQ(at(c, n, 0.9 * edge, std::abs(n)).bits, at(c, n, 0.9 * edge, 0.0).bits) << "n " << n;
+  }
+}
+
 // Hall sensors (`angle_source: hall`): below their speed the frame is within their own error δ_h of the rotor's, so
 // r_s' frame term takes the smaller of the two bounds, δ_max = min(δ_tol + asin(min(1, a)), δ_h) — the edge found by
 // bisection on that form and checked from both sides, where the Hall bound decides and where the lock test's does;

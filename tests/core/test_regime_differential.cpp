@@ -100,6 +100,7 @@ class Stream {
     const double speed_error = draw(0.0, 1.0);
     if (speed_error < 0.3) in.n_error_pu = std::pow(10.0, draw(-8.0, -1.0));
     if (speed_error < 0.2) in.n_error_noise_pu = std::pow(10.0, draw(-8.0, -1.0));
+    if (speed_error > 0.7) in.n_reach_pu = std::abs(in.n_pu) * draw(0.5, 3.0);  // the reads' speeds, below and beyond
     if (speed_error < 0.001) {
       in.n_error_pu = kNaN;
     } else if (speed_error < 0.002) {

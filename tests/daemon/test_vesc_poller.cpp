@@ -164,6 +164,8 @@ TEST(VescPoller, TheWindowsSpeedIsRebuiltFromThePllSpeedsAtItsTwoReads) {
     EXPECT_TRUE(std::isnan(p.last_accel_change_rad_s2())) << "two reads show no change of acceleration";
     const double tau = kp / 30000.0, h = 5e-3;
     EXPECT_NEAR(s->omega_el_rad_s, kRadSPerErpm * (22000.0 + 1000.0 * (tau / h - 0.5)), 1e-9) << kp;
+    // The larger speed at its two reads, which R_s' test takes a sensorless frame's error at (§13, "A stall's rocking").
+    EXPECT_DOUBLE_EQ(s->omega_el_at_reads_max_rad_s, kRadSPerErpm * 22000.0) << kp;
     // The same speed again: a constant speed is its own mean.
     const auto c = poll_and_receive(p, kT0 + 10 * kMs, test::vesc_frames::reply_frames_22000_erpm());
     ASSERT_TRUE(c.has_value());

@@ -76,6 +76,9 @@ TEST(VescToolLog, ReadsTheCurrentHeaderAsAveragedSamplesSinceThePreviousRow) {
   constexpr double kTau = 2000.0 / 30000.0;
   EXPECT_NEAR(s[0].omega_el_rad_s, (6100.0 + 100.0 * (kTau / 0.090 - 0.5)) * 2.0 * std::numbers::pi / 60.0, 1e-9);
   EXPECT_NEAR(s[1].omega_el_rad_s, (6200.0 + 100.0 * (kTau / 0.110 - 0.5)) * 2.0 * std::numbers::pi / 60.0, 1e-9);
+  // The larger |speed| at each window's two reads (docs/derivations.md §13, "A stall's rocking").
+  EXPECT_DOUBLE_EQ(s[0].omega_el_at_reads_max_rad_s, 6100.0 * 2.0 * std::numbers::pi / 60.0);
+  EXPECT_DOUBLE_EQ(s[1].omega_el_at_reads_max_rad_s, 6200.0 * 2.0 * std::numbers::pi / 60.0);
   EXPECT_NE(describe(source, read).find("mean speed rebuilt from the PLL speeds at its two reads (lag 66.67 ms)"),
             std::string::npos)
       << describe(source, read);

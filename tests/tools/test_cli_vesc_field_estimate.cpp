@@ -246,7 +246,8 @@ TEST(CliVescFieldEstimate, IndependentGeneratorZerosWhileOffAcrossMidnight) {
 // Seed 1 as a third-party logger prints it (two decimals: the voltages in 10 mV steps). Its hard stop at 581.7 s
 // (−32 000 erpm to standstill in 0.37 s at a constant 14 A) holds a window whose speed the PLL's reads rebuild
 // 101 rad/s off (docs/derivations.md §13, "… where the acceleration changes"); with the coarser voltage no slope
-// test flagged it, and that one window moved ψm by +7.8 %. It is transient now: ψm +0.01 %, R_s −0.4 % (2026-12-01).
+// test flagged it, and that one window moved ψm by +7.8 %. It is transient now: ψm +0.01 %, R_s −0.4 % (2026-12-01;
+// −3.4 % since the reads' speeds entered R_s' test, 2026-12-07, docs/derivations.md §13 "A stall's rocking").
 TEST(CliVescFieldEstimate, IndependentGeneratorAsAThirdPartyLoggerPrintsIt) {
   independent_case("--seed 1 --duration-s 600 --psi-m-rel 0.2 --r-s-rel -0.25", "independent seed 1, two decimals", true,
                    true);

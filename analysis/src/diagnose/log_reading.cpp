@@ -97,6 +97,7 @@ class SessionJoiner {
     d_.window_start_ns.reserve(d_.window_start_ns.size() + samples.size());
     d_.window_speed_error_rad_s.reserve(d_.window_speed_error_rad_s.size() + samples.size());
     d_.window_speed_error_noise_rad_s.reserve(d_.window_speed_error_noise_rad_s.size() + samples.size());
+    d_.window_speed_at_reads_max_rad_s.reserve(d_.window_speed_at_reads_max_rad_s.size() + samples.size());
     for (core::AveragedSample& s : samples) {
       const std::int64_t shift = shift_ns(s.t_start_ns);
       s.t_start_ns += shift;
@@ -105,6 +106,7 @@ class SessionJoiner {
       d_.window_start_ns.push_back(s.t_start_ns);
       d_.window_speed_error_rad_s.push_back(s.omega_el_error_rad_s);
       d_.window_speed_error_noise_rad_s.push_back(s.omega_el_error_noise_rad_s);
+      d_.window_speed_at_reads_max_rad_s.push_back(s.omega_el_at_reads_max_rad_s);
     }
     d_.voltage_applied = d_.voltage_applied || turn || rebuilt.voltages;
     return io::describe(source, read) + voltage + (rebuilt.any() ? "; " + rebuilt.describe() : "");

@@ -26,6 +26,7 @@ core::AveragedSample window_of(const LogData& log, std::size_t k) {
   s.omega_el_rad_s = r.omega_el_rad_s;    // the counted speed already taken where the angle is a staircase (at reading)
   s.omega_el_error_rad_s = log.window_speed_error_rad_s[k];
   s.omega_el_error_noise_rad_s = log.window_speed_error_noise_rad_s[k];
+  s.omega_el_at_reads_max_rad_s = log.window_speed_at_reads_max_rad_s[k];
   s.u_dc_V = log.layout.u_dc ? r.u_dc_V : kNaN;
   s.t_winding_C = log.samples.t_winding_C(k).value_or(kNaN);
   s.t_magnet_C = log.samples.t_magnet_C(k).value_or(kNaN);
@@ -49,8 +50,8 @@ LogRegimes classify_regimes(const LogData& log, const io::MachineConfig& config,
   };
   if (log.averaged) {
     assert(log.window_start_ns.size() == n && log.window_speed_error_rad_s.size() == n &&
-           log.window_speed_error_noise_rad_s.size() == n && log.window_reported_u_V.size() == n &&
-           log.session_voltage_rebuilt.size() == log.sessions());
+           log.window_speed_error_noise_rad_s.size() == n && log.window_speed_at_reads_max_rad_s.size() == n &&
+           log.window_reported_u_V.size() == n && log.session_voltage_rebuilt.size() == log.sessions());
     // Each session from the configuration, as its log alone in rpem estimate: rebuilt voltages are applied means,
     // not turned again (io::estimator_settings); reported ones are turned by the estimator where they are commands.
     std::optional<core::AveragedDriveEstimator> estimator;

@@ -18,7 +18,9 @@
 //                by its neighbours: ψ = e_q/n outside both theirs, on one side, beyond z·σ of each difference
 //                plus what Δr, Δx do over the operating points' difference (kPreviousMixed, one window late)
 //   excites ψm   |n|·ψ_min − Δr·|i_q| − |n|·Δx_d·|i_d| > z·h_ψ·N_ψ   (h² = γ/(2 − γ): the estimator's averaging)
-//   excites r_s  r_min·|i| − |n|·(Δψ + F + Δx·|i|)   > z·h_r·N_r
+//   excites r_s  r_min·|i| − |n|·(Δψ + Δx·|i|) − n_reach·F   > z·h_r·N_r
+//                n_reach = max(|n|, the speeds at the window's reads): a frame's error acts at the speeds the window
+//                passed through, which its mean hides where the rotor turned back inside it (a sensorless stall)
 //                F = 0 for a sensor's frame; sensorless: ψ_max·2·sin(δ_max/2), the largest frame error the lock test
 //                passes, δ_max = δ_tol + asin(min(1, cos δ_tol·(B_d + tan δ_tol·B_q + z·σ_L)/(|n|·ψ_min)))
 //                Hall sensors (below their speed): δ_max no larger than their own frame error
@@ -233,6 +235,9 @@ struct RegimeInput {
   /// AveragedSample::omega_el_error_rad_s, omega_el_error_noise_rad_s); 0: the speed is the window's own.
   double n_error_pu = 0.0;
   double n_error_noise_pu = 0.0;
+  /// The largest |speed| the window is known to have passed through beyond its mean (its reads':
+  /// AveragedSample::omega_el_at_reads_max_rad_s); 0: only the mean is known. A sensorless frame's error acts at it.
+  double n_reach_pu = 0.0;
   double u_reported_sq_pu = 0.0;  ///< |u|² as the drive reports it, before corrections (bridge off)
   /// The voltage and current as the drive reported them, before the model's corrections (a command turned into
   /// the applied mean, the sampled means' term): their resolution is measured here, since a correction's
@@ -363,7 +368,7 @@ class RegimeClassifier {
     double x_max = 0.0, dx_max = 0.0;                   ///< the larger inductance and tolerance
     double cos_angle = 1.0, sin_angle = 0.0;            ///< cos δ_tol, sin δ_tol
     double cos_hall = -1.0;                             ///< cos of the Hall sensors' largest frame error (−1: none)
-    double dpsi_frame_sq = 0.0;   ///< (Δψ + a sensorless frame's least error)²: r_s' test's first check
+    double frame_least_pu = 0.0;  ///< a sensorless frame's least error as a flux (0: a sensor's): r_s' first check
     double slope_reach = 0.0;     ///< (x_q + Δx_q)/ω_n: what the inductive correction may miss, per |s_q/n|
     double frame_reach_pu = 0.0;  ///< ½·ψ_max·(1 − cos δ_tol) for a sensorless or Hall frame, else 0
   };

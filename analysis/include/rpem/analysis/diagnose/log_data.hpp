@@ -44,6 +44,8 @@ struct LogData {
   /// as the drive reported it (before the turn of LogOptions::voltage_is_command, which the estimator makes itself:
   /// the classifier judges the reported value's resolution and zero).
   std::vector<double> window_speed_error_rad_s, window_speed_error_noise_rad_s;
+  /// ... and the larger |speed| at its two reads (core::AveragedSample::omega_el_at_reads_max_rad_s; NaN: none).
+  std::vector<double> window_speed_at_reads_max_rad_s;
   std::vector<core::Vec2> window_reported_u_V;
   /// Averaged logs, per session: whether its voltages were rebuilt (io::RotorFrameRebuild; applied means, which the
   /// estimator must not turn: io::estimator_settings).
