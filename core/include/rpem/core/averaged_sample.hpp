@@ -25,7 +25,7 @@ struct AveragedSample {
   double omega_el_error_noise_rad_s = 0.0;
   /// The larger |speed| the drive reported at the window's two reads (a PLL's speed at each read, from which
   /// omega_el_rad_s is rebuilt): a speed the window passed through, which its mean can hide where the rotor turned back
-  /// inside it (a stall's rocking, docs/derivations.md §13 "Excitation"); NaN: no reads, the speed is the window's own.
+  /// inside it (docs/derivations.md §13, "A stall's rocking"); NaN: no reads, the speed is the window's own.
   double omega_el_at_reads_max_rad_s = std::numeric_limits<double>::quiet_NaN();
   /// The mean electrical speed the drive's own count of its angle's steps gives over a run of reads centred on this
   /// window (VESC's tachometer: core::grown_count_speed_rad_s, docs/derivations.md §13); NaN: not counted.
