@@ -2,8 +2,9 @@
 // Whether the windows R_s adapted on agree on one resistance (docs/drive-log.md, "A voltage along the current";
 // docs/derivations.md §12, eq. 12.1). At each such window k the estimator's model leaves the voltage
 // y_k = r̂_{k−1}·(î_k·i_k)/|i_k| to the drop along the current (î = e/r̂ with the speed terms taken out). A voltage
-// the model leaves out, nearly constant along the current (an inverter's dead time, which the drive compensates
-// in part), makes it y = R·|i| + V: the estimator, which takes V = 0, reads R + V/|i|, and every start it is run
+// the model leaves out along the current (an inverter's dead time the drive compensates in part; a sensorless
+// stall's rocking, whose back EMF falls along the current: docs/drive-log.md, "What the stall is") makes it
+// y = R·|i| + V: the estimator, which takes V = 0, reads R + V/|i|, and every start it is run
 // from agrees on that, so the identifiability runs cannot see it. Fitted by least squares over the windows,
 //   y_k = R·|i_k| + V + R₁·(t_k − t̄)·|i_k|                                                         (12.1)
 // (R₁: the winding's drift over the log, to first order), R at the last window is the resistance the log implies
