@@ -196,8 +196,7 @@ bool VescPoller::on_frame(const can::CanFrame& f, std::int64_t rx_ns, core::Aver
   sample = vesc::to_averaged_sample(decoder_.values(), window_start_ns_, t);
   sample.omega_el_rad_s =
       core::window_mean_speed_rad_s(previous_speed, previous_speed_, window_start_ns_, config_.pll.ramp_lag_s());
-  sample.omega_el_at_reads_max_rad_s =
-      std::fmax(std::fabs(previous_speed.omega_el_rad_s), std::fabs(previous_speed_.omega_el_rad_s));
+  sample.omega_el_at_reads_max_rad_s = core::reads_speed_max_rad_s(previous_speed, previous_speed_);
   // The change of acceleration the last three replies show: SpeedErrorDelay judges the window by it and the next's.
   if (three_reads)
     last_accel_change_rad_s2_ = core::read_accel_change_rad_s2(earlier_speed, previous_speed, previous_speed_);

@@ -222,12 +222,11 @@ void previous_row_samples(const std::vector<PreviousRowRead>& rows, const LogMap
       // A PLL's speed at each read: the window's mean from this read's and the previous one's (§13), its error from
       // the larger change of acceleration the reads show at the window's two ends (a change inside the window shows
       // in the PLL's speed by the next read, not yet at this one), and that error's noise from the changes around it.
-      s.omega_el_rad_s =
-          core::window_mean_speed_rad_s({previous.sample.t_ns, previous.omega_at_read_rad_s},
-                                        {s.t_ns, rows[k].omega_at_read_rad_s}, s.t_start_ns, map.speed_pll.ramp_lag_s());
+      const core::SpeedRead read_before{previous.sample.t_ns, previous.omega_at_read_rad_s},
+          read_now{s.t_ns, rows[k].omega_at_read_rad_s};
+      s.omega_el_rad_s = core::window_mean_speed_rad_s(read_before, read_now, s.t_start_ns, map.speed_pll.ramp_lag_s());
       check_rebuilt_speed(reader, previous, rows[k], s);
-      s.omega_el_at_reads_max_rad_s =
-          std::fmax(std::fabs(previous.omega_at_read_rad_s), std::fabs(rows[k].omega_at_read_rad_s));
+      s.omega_el_at_reads_max_rad_s = core::reads_speed_max_rad_s(read_before, read_now);
       const double h_s = core::to_seconds(s.t_ns - s.t_start_ns);
       const double after = k + 1 < rows.size() ? accel_change[k + 1] : std::nan("");
       const double change = std::fmax(std::fabs(accel_change[k]), std::fabs(after));  // fmax: a NaN side left out

@@ -188,6 +188,21 @@ TEST(ReportedSpeed, ConstantSpeedAndDegenerateReads) {
   EXPECT_NEAR(window_mean_speed_rad_s({0, 100.0}, {100'000'000, 200.0}, 50'000'000, 0.0667), 175.0 + 66.7, 1e-9);
 }
 
+// A rocking stall's reads: the window's mean can be near zero while the reads show the speeds it passed through
+// (docs/derivations.md §13, "A stall's rocking"). The larger magnitude of the two, either sign; a missing read (NaN)
+// leaves the other.
+TEST(ReportedSpeed, TheReadsSpeedMaximumIsTheLargerMagnitudeOfTheTwoReads) {
+  using rpem::core::reads_speed_max_rad_s;
+  EXPECT_DOUBLE_EQ(reads_speed_max_rad_s({0, -4.0}, {90'000'000, -142.0}), 142.0);
+  EXPECT_DOUBLE_EQ(reads_speed_max_rad_s({0, 153.0}, {90'000'000, -102.0}), 153.0);
+  EXPECT_DOUBLE_EQ(reads_speed_max_rad_s({0, std::nan("")}, {90'000'000, -102.0}), 102.0);
+  // A window whose rebuilt mean is zero (VESC's lag k_p/k_i = 66.7 ms leads a 90 ms window's trapezoid by 21.7 ms:
+  // mean = ω̂₂ + (ω̂₂ − ω̂₁)·0.2407) while its reads show −103 rad/s: the frame's error acts at the reads' speed.
+  const double mean = window_mean_speed_rad_s({0, -103.08}, {90'000'000, -20.0}, 0, kKp / kKi);
+  EXPECT_NEAR(mean, 0.0, 0.01);
+  EXPECT_DOUBLE_EQ(reads_speed_max_rad_s({0, -103.08}, {90'000'000, -20.0}), 103.08);
+}
+
 // A count of the angle's steps: the run's mean speed is travel over time; the window's speed is the count's only
 // below the staircase speed (strictly), and the reported one without a count, above it, or with no staircase.
 TEST(ReportedSpeed, TheCountsSpeedReplacesTheReportedOneOnlyBelowTheStaircaseSpeed) {

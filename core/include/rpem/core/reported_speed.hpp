@@ -53,6 +53,13 @@ struct SpeedRead {
   return now.omega_el_rad_s - slope * (0.5 * to_seconds(now.t_ns - t_start_ns) - lag_s);
 }
 
+/// The larger |speed| the tracker reported at a window's two reads [rad/s]: what the window is known to have passed
+/// through beside its mean (AveragedSample::omega_el_at_reads_max_rad_s; docs/derivations.md §13, "A stall's rocking").
+/// A NaN read is left out (fmax).
+[[nodiscard]] inline double reads_speed_max_rad_s(const SpeedRead& previous, const SpeedRead& now) noexcept {
+  return std::fmax(std::fabs(previous.omega_el_rad_s), std::fabs(now.omega_el_rad_s));
+}
+
 /// The tracker's mean acceleration over the window ending at `now` less that over the window before it, from its
 /// speeds at three consecutive reads [rad/s²]; 0 where two reads share an instant.
 [[nodiscard]] inline double read_accel_change_rad_s2(const SpeedRead& earlier, const SpeedRead& previous,
