@@ -20,11 +20,13 @@
 #include "log_folder.hpp"
 #include "log_options.hpp"
 #include "machine_option.hpp"
+#include "one_window.hpp"
 #include "option_checks.hpp"
 #include "progress.hpp"
 #include "rpem/analysis/rs_along_current.hpp"
 #include "rpem/core/averaged_estimator.hpp"
 #include "rpem/core/drive_estimator.hpp"
+#include "rpem/core/units.hpp"
 #include "rpem/io/averaged_log.hpp"
 #include "rpem/io/drive_log.hpp"
 #include "rpem/io/estimate_log.hpp"
@@ -179,20 +181,33 @@ struct Tally {
   }
   /// The windows R_s adapted on, where each leaves the drop along its current (analysis::RsReading).
   std::vector<analysis::RsReading> rs_readings;
+  /// Per parameter (ψm, R_s), each window it adapted on and the step it took there (window_that_decides).
+  std::array<std::vector<AdaptationStep>, 2> steps;
   void count(const core::Estimate& e) {
     const bool has_previous = first_t_ns.has_value();
     if (!first_t_ns) first_t_ns = e.t_ns;
-    if (e.retracted_previous) uncount_adaptation(last);  // a window found mixed: what it adapted was taken back
-    last_read_rs_ = has_previous && (e.detail.flags & core::step_flag::kRsActive) && read_rs(last.r_s_Ohm, e);
+    std::array<double, 2> before{last.psi_m_Wb, last.r_s_Ohm};
+    if (e.retracted_previous) uncount_adaptation(last, &before);  // a window found mixed: what it adapted was taken back
+    last_read_rs_ = has_previous && active(e, 1) && read_rs(last.r_s_Ohm, e);
+    const std::array<double, 2> now{e.psi_m_Wb, e.r_s_Ohm};
+    for (std::size_t k = 0; k < steps.size(); ++k) {
+      if (has_previous && active(e, k)) steps[k].push_back({samples_seen_, now[k] - before[k]});
+      adapted[k] += active(e, k) ? 1 : 0;
+    }
+    ++samples_seen_;
     last = e;
     counts.add(e);
-    adapted[0] += (e.detail.flags & core::step_flag::kPsiMActive) ? 1 : 0;
-    adapted[1] += (e.detail.flags & core::step_flag::kRsActive) ? 1 : 0;
   }
-  /// Takes back `e`'s adaptations: `e` is `last`, whose reading (if any) is the newest.
-  void uncount_adaptation(const core::Estimate& e) {
-    adapted[0] -= (e.detail.flags & core::step_flag::kPsiMActive) ? 1 : 0;
-    adapted[1] -= (e.detail.flags & core::step_flag::kRsActive) ? 1 : 0;
+  /// Takes back `e`'s adaptations: `e` is `last`, whose reading and steps (if any) are the newest. `before`, if given,
+  /// becomes the estimates before `e`.
+  void uncount_adaptation(const core::Estimate& e, std::array<double, 2>* before = nullptr) {
+    for (std::size_t k = 0; k < steps.size(); ++k) {
+      if (!active(e, k)) continue;
+      --adapted[k];
+      if (steps[k].empty() || steps[k].back().index + 1 != samples_seen_) continue;  // the log's first sample
+      if (before != nullptr) (*before)[k] -= steps[k].back().change;
+      steps[k].pop_back();
+    }
     if (last_read_rs_) rs_readings.pop_back();
     last_read_rs_ = false;
   }
@@ -231,6 +246,10 @@ struct Tally {
 
  private:
   bool last_read_rs_ = false;  ///< `last` left a reading in rs_readings
+  std::size_t samples_seen_ = 0;
+  static bool active(const core::Estimate& e, std::size_t k) {
+    return (e.detail.flags & (k == 0 ? core::step_flag::kPsiMActive : core::step_flag::kRsActive)) != 0;
+  }
   /// The drop along the current the model leaves at a window R_s adapted on (eq. 12.1): î is predicted with the
   /// r̂s before the window, î = e/r̂s where ω·L ≪ r̂s (the speeds R_s adapts at), so y = r̂s·(î·i)/|i|.
   bool read_rs(double r_before_Ohm, const core::Estimate& e) {
@@ -324,12 +343,32 @@ bool check_rs_along_current(const std::vector<analysis::RsReading>& readings, do
   return false;
 }
 
-std::array<std::optional<bool>, 2> check_identifiable(const std::vector<core::AveragedSample>& samples,
-                                                      const io::MachineConfig& cfg, const core::Estimate& last,
-                                                      const std::array<std::uint64_t, 2>& adapted,
-                                                      const core::RegimeCounts& regimes,
-                                                      const io::RotorFrameRebuild& rebuilt,
-                                                      const std::vector<analysis::RsReading>& rs_readings) {
+/// Whether the estimate rests on one window (docs/drive-log.md, "One window decides"): said, with the window, where
+/// taking out the step one window took moves the end by more than the accuracy asked. Every start agrees on such an
+/// estimate, so the runs from the bounds cannot see it; whether that one window's model holds (a stall's onset, a
+/// transient the classifier did not see) nothing else in the log confirms.
+bool check_one_window(const std::vector<core::AveragedSample>& samples, const io::MachineConfig& cfg, std::size_t k,
+                      const std::vector<AdaptationStep>& steps, double estimate, double tolerance, const char* name,
+                      const char* unit) {
+  const std::optional<DecidingWindow> w = window_that_decides(samples, cfg, k, steps, estimate, tolerance);
+  if (!w) return true;
+  const core::AveragedSample& a = samples[w->index];
+  std::fprintf(stderr,
+               "rpem estimate: %s not identifiable from this log: one window decides it: the window ending at t = %.3f s "
+               "(the estimate CSV's t; %.0f erpm, %.3g A) moved it by %+.1f %%, and without that step the estimator ends "
+               "at %.5g %s, %+.1f %% from the %.5g %s it ends at, more than the %.0f %% asked of it; no other window "
+               "confirms that one's model (a sensorless drive's stall or its onset, a transient inside the window): "
+               "rpem diagnose shows the window (docs/drive-log.md, \"One window decides\")\n",
+               name, core::to_seconds(a.t_ns), core::rad_s_to_rpm(a.omega_el_rad_s), a.i_dq_A.norm(),
+               100.0 * w->change / estimate, w->without, unit, 100.0 * (w->without / estimate - 1.0), estimate, unit,
+               100.0 * tolerance);
+  return false;
+}
+
+std::array<std::optional<bool>, 2> check_identifiable(
+    const std::vector<core::AveragedSample>& samples, const io::MachineConfig& cfg, const core::Estimate& last,
+    const std::array<std::uint64_t, 2>& adapted, const core::RegimeCounts& regimes, const io::RotorFrameRebuild& rebuilt,
+    const std::vector<analysis::RsReading>& rs_readings, const std::array<std::vector<AdaptationStep>, 2>& steps) {
   const core::EstimatorSettings& e = cfg.estimator;
   std::array<std::optional<bool>, 2> identifiable;
   const bool r_s_declared = rebuilt.voltages && e.regimes.sensorless;
@@ -373,6 +412,8 @@ std::array<std::optional<bool>, 2> check_identifiable(const std::vector<core::Av
     }
     const double half = 0.5 * std::abs(p[k].from_hi - p[k].from_lo) / std::abs(estimate[k]);
     identifiable[k] = half <= p[k].tolerance && !(k == 1 && r_s_excluded);
+    if (*identifiable[k])
+      identifiable[k] = check_one_window(samples, cfg, k, steps[k], estimate[k], p[k].tolerance, p[k].name, p[k].unit);
     if (half <= p[k].tolerance || (k == 1 && r_s_excluded)) continue;
     std::fprintf(
         stderr,
@@ -415,8 +456,8 @@ Tally run_averaged(const EstimateOptions& o, const std::string& log, const std::
   std::fprintf(stderr, "rpem estimate: %s\n", tally.summary(cfg.estimator.algorithm, "averaged sample").c_str());
   tally.explain();
   if (!samples.empty())
-    tally.identifiable =
-        check_identifiable(samples, cfg, tally.last, tally.adapted, tally.counts.regimes, rebuilt, tally.rs_readings);
+    tally.identifiable = check_identifiable(samples, cfg, tally.last, tally.adapted, tally.counts.regimes, rebuilt,
+                                            tally.rs_readings, tally.steps);
   thermal.explain();
   tally.take_peaks(thermal);
   return tally;
