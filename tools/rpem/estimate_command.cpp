@@ -405,10 +405,7 @@ std::array<std::optional<bool>, 2> check_identifiable(
     for (const bool high : {false, true}) {
       core::EstimatorSettings s = e;
       (k == 0 ? s.initial_psi_m_Wb : s.initial_r_s_Ohm) = high ? p[k].hi : p[k].lo;
-      core::AveragedDriveEstimator run(cfg.machine, s);
-      for (const core::AveragedSample& a : samples) (void)run.step(a);
-      run.end_chain();
-      (high ? p[k].from_hi : p[k].from_lo) = k == 0 ? run.psi_m_Wb() : run.r_s_Ohm();
+      (high ? p[k].from_hi : p[k].from_lo) = estimate_at_end(samples, cfg.machine, s, k);
     }
     const double half = 0.5 * std::abs(p[k].from_hi - p[k].from_lo) / std::abs(estimate[k]);
     identifiable[k] = half <= p[k].tolerance && !(k == 1 && r_s_excluded);

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "rpem/core/averaged_sample.hpp"
+#include "rpem/core/settings.hpp"
 #include "rpem/io/machine_config.hpp"
 
 namespace rpem::tools {
@@ -20,12 +21,18 @@ struct AdaptationStep {
   double change = 0.0;  ///< in the parameter's SI unit
 };
 
-/// The window whose step, taken out, moves the estimate the most beyond `tolerance` of it, and where it then ends.
+/// A window whose step, taken out, moves the estimate beyond `tolerance` of it, and where the estimate then ends.
 struct DecidingWindow {
   std::size_t index = 0;
   double change = 0.0;   ///< the window's own step
   double without = 0.0;  ///< the estimate at the log's end without that step
 };
+
+/// The averaged estimator run again over a whole log with `settings` (the run's machine), `frozen` (if any) the one
+/// window whose adaptation is held; parameter 0: ψm's end, 1: R_s' [Wb, Ohm]. The identifiability checks' one pass.
+[[nodiscard]] double estimate_at_end(const std::vector<core::AveragedSample>& samples, const core::MachineSi& machine,
+                                     const core::EstimatorSettings& settings, std::size_t parameter,
+                                     std::optional<std::size_t> frozen = std::nullopt);
 
 /// How many windows are run again at most, the largest steps first: a log with more windows that each move the
 /// estimate beyond its accuracy is erratic before any one of them decides it.
