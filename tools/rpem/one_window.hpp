@@ -1,7 +1,8 @@
 #pragma once
 // Whether one window decides an estimate (docs/drive-log.md, "One window decides"): the estimator run again over the
-// log with one window's adaptation frozen. Its step is taken out exactly (the estimator is not linearised), and the
-// windows after it adapt from where the others left the estimate. A window can move the end by no more than its own
+// log with one window's adaptation frozen. Its step is taken out exactly (the estimator is not linearised; the gain's
+// Hessian still takes that window's trace, as a frozen estimator's does), and the windows after it adapt from where the
+// others left the estimate. A window can move the end by no more than its own
 // step (in the linearised recursion the difference is that step times what the later windows leave of it), so only
 // windows whose step exceeds the accuracy asked are run again.
 
