@@ -3,6 +3,7 @@
 #include <array>
 #include <cmath>
 #include <filesystem>
+#include <stdexcept>
 
 #include "rpem/can/socketcan.hpp"
 #include "rpem/core/clock.hpp"
@@ -107,14 +108,15 @@ SignalMapSource::Options SignalMapSource::parse(io::YamlMap& section, const std:
     o.map = (std::filesystem::path(base_dir) / o.map).lexically_normal().string();
   section.finish();
   // Refused here, at start (and on a reload), naming the map file and what it lacks.
-  const can::SignalMap map = io::load_signal_map(o.map);
-  o.kind = sample_kind_of(map);
-  o.gives_u_dc = maps(map, can::SampleField::kUdcV);
+  o.map_read = ReadAtParse<can::SignalMap>(io::load_signal_map(o.map));
+  o.kind = sample_kind_of(*o.map_read);
+  o.gives_u_dc = maps(*o.map_read, can::SampleField::kUdcV);
   return o;
 }
 
 std::unique_ptr<SampleSource> SignalMapSource::make(const Options& options) {
-  return std::make_unique<SignalMapSampleSource>(options, io::load_signal_map(options.map));
+  if (!options.map_read.has_value()) throw std::logic_error("signal map source: options not parsed");
+  return std::make_unique<SignalMapSampleSource>(options, *options.map_read);
 }
 
 }  // namespace rpem::daemon

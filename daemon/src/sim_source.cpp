@@ -16,13 +16,13 @@ sim::Scenario load_demo_or_file(const std::string& spec) {
 
 class SimSampleSource final : public SampleSource {
  public:
-  explicit SimSampleSource(const SimSource::Options& o) : loop_(o.loop), scenario_(load_demo_or_file(o.scenario)) {}
+  SimSampleSource(bool loop, std::shared_ptr<const sim::Scenario> scenario) : loop_(loop), scenario_(std::move(scenario)) {}
 
   void run(const std::atomic<bool>& stop, SourceOutput& out) override {
     // The drive produces its samples in 1 ms batches, in step with the wall clock: every sample whose
     // drive time has passed is pushed. On restart (loop) the drive time carries on.
     constexpr std::int64_t kBatchNs = 1'000'000;
-    auto drive = std::make_unique<sim::DriveSimulator>(scenario_);
+    auto drive = std::make_unique<sim::DriveSimulator>(*scenario_);
     const std::int64_t wall_start = core::now_ns(CLOCK_MONOTONIC);
     std::int64_t target = wall_start;
     std::int64_t offset_ns = 0;
@@ -39,7 +39,7 @@ class SimSampleSource final : public SampleSource {
           if (!drive->next(row, truth)) {
             if (!loop_) return;
             offset_ns = last_t + drive->period_ns();
-            drive = std::make_unique<sim::DriveSimulator>(scenario_);
+            drive = std::make_unique<sim::DriveSimulator>(*scenario_);
             continue;
           }
           row.sample.t_ns += offset_ns;
@@ -61,11 +61,11 @@ class SimSampleSource final : public SampleSource {
       }
     }
   }
-  [[nodiscard]] std::string name() const override { return scenario_.name; }
+  [[nodiscard]] std::string name() const override { return scenario_->name; }
 
  private:
   bool loop_;
-  sim::Scenario scenario_;
+  std::shared_ptr<const sim::Scenario> scenario_;
 };
 
 }  // namespace
@@ -80,13 +80,18 @@ SimSource::Options SimSource::parse(io::YamlMap& section, const std::string& bas
   section.finish();
   // Read now, so that a scenario rpemd cannot run stops it at start (and --check-config) as the rest of the file does.
   try {
-    (void)load_demo_or_file(o.scenario);
+    o.scenario_read = ReadAtParse<sim::Scenario>(load_demo_or_file(o.scenario));
   } catch (const io::InputError& e) {
     section.fail("scenario", std::string("cannot be run: ") + e.what());
   }
   return o;
 }
 
-std::unique_ptr<SampleSource> SimSource::make(const Options& options) { return std::make_unique<SimSampleSource>(options); }
+std::unique_ptr<SampleSource> SimSource::make(const Options& options) {
+  auto scenario = options.scenario_read.has_value()
+                      ? options.scenario_read.shared()
+                      : std::make_shared<const sim::Scenario>(load_demo_or_file(options.scenario));
+  return std::make_unique<SimSampleSource>(options.loop, std::move(scenario));
+}
 
 }  // namespace rpem::daemon

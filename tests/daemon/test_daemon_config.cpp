@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <fstream>
 #include <variant>
 
 #include "rpem/daemon/daemon_config.hpp"
@@ -29,6 +30,19 @@ TEST(DaemonConfig, ShippedExamplesLoad) {
   const DaemonConfig can = load_daemon_config(test::source_dir() + "/config/rpemd-can.yaml");
   ASSERT_TRUE(std::holds_alternative<CanSource::Options>(can.fixed.source));
   EXPECT_EQ(std::get<CanSource::Options>(can.fixed.source).interface, "can0");
+}
+
+// The simulated drive runs the scenario the configuration checked: read once, so an edit between the check
+// and the start (here the file made unreadable as a scenario) does not reach the loop.
+TEST(DaemonConfig, TheSimulatedDriveRunsTheScenarioItsConfigurationChecked) {
+  const test::TempFile scenario("checked-scenario.yaml", test::read_file(test::source_dir() + "/scenarios/rpemd-demo.yaml"));
+  const test::TempFile config("rpemd-checked-scenario.yaml",
+                              "daemon:\n  source: {type: sim, sim: {scenario: " + scenario.path() + ", loop: false}}\n");
+  const DaemonConfig c = load_daemon_config(config.path());
+  std::ofstream(scenario.path()) << "name: [not, a, scenario\n";
+  const auto source = SourceCatalogue::make(c.fixed.source);
+  ASSERT_NE(source, nullptr);
+  EXPECT_EQ(source->name(), "rpemd-demo");
 }
 
 TEST(DaemonConfig, WakeAheadIsOffANumberOrAuto) {

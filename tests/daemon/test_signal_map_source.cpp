@@ -6,8 +6,10 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <memory>
 #include <numbers>
 #include <variant>
 
@@ -122,6 +124,23 @@ TEST(SignalMapSource, AMapWithoutANeededQuantityIsRefusedNamingFileAndQuantity) 
     EXPECT_NE(what.find("no-voltage-map.yaml"), std::string::npos) << what;
     EXPECT_NE(what.find("voltage (u_d and u_q"), std::string::npos) << what;
   }
+}
+
+// The source runs on the map the configuration checked: the file is read once, so a map removed (or edited)
+// between the check and the start does not reach the loop.
+TEST(SignalMapSource, RunsOnTheMapItsConfigurationChecked) {
+  auto map = std::make_unique<test::TempFile>(
+      "checked-map.yaml", test::read_file(test::source_dir() + "/config/signal-maps/beckhoff-ax8000-cia402.yaml"));
+  const test::TempFile config(
+      "rpemd-checked-map.yaml",
+      "daemon:\n  source:\n    type: signal_map\n    signal_map: {interface: can0, map: " + map->path() + "}\n");
+  const DaemonConfig c = load_daemon_config(config.path());
+  const std::string map_path = map->path();
+  map.reset();  // removed after the check
+  ASSERT_FALSE(std::filesystem::exists(map_path));
+  const auto source = SourceCatalogue::make(c.fixed.source);
+  ASSERT_NE(source, nullptr);
+  EXPECT_NE(source->name().find("checked-map.yaml"), std::string::npos) << source->name();
 }
 
 // An averaged source cannot be corrected for per-phase current errors: refused, naming the source.

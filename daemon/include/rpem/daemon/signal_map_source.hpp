@@ -14,6 +14,7 @@
 #include <string>
 
 #include "rpem/can/signal_map.hpp"
+#include "rpem/daemon/read_at_parse.hpp"
 #include "rpem/daemon/source.hpp"
 #include "rpem/io/yaml_map.hpp"
 
@@ -26,9 +27,11 @@ struct SignalMapSource {
     std::string map;                          ///< the map file (relative paths: to the configuration's directory)
     SampleKind kind = SampleKind::kAveraged;  ///< from the map, when it was loaded
     bool gives_u_dc = false;                  ///< the map carries the DC link (a dead time in seconds needs it)
+    ReadAtParse<can::SignalMap> map_read;     ///< the map as checked: the source runs on it
     bool operator==(const Options&) const = default;
   };
-  /// Loads the map (io::ConfigError naming the map file if it is bad or lacks a needed quantity).
+  /// Loads the map (io::ConfigError naming the map file if it is bad or lacks a needed quantity); `make` runs on
+  /// what this read.
   [[nodiscard]] static Options parse(io::YamlMap& section, const std::string& base_dir);
   [[nodiscard]] static SampleKind sample_kind(const Options& o) noexcept { return o.kind; }
   [[nodiscard]] static std::unique_ptr<SampleSource> make(const Options& options);

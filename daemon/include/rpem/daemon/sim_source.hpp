@@ -6,8 +6,10 @@
 #include <memory>
 #include <string>
 
+#include "rpem/daemon/read_at_parse.hpp"
 #include "rpem/daemon/source.hpp"
 #include "rpem/io/yaml_map.hpp"
+#include "rpem/sim/scenario.hpp"
 
 namespace rpem::daemon {
 
@@ -16,11 +18,12 @@ struct SimSource {
   struct Options {
     std::string scenario = "builtin:rpemd-demo";  ///< a file (relative to the configuration) or builtin:rpemd-demo
     bool loop = true;
+    ReadAtParse<sim::Scenario> scenario_read;  ///< the scenario as checked (none before a parse: the built-in demo)
     bool operator==(const Options&) const = default;
   };
   [[nodiscard]] static Options parse(io::YamlMap& section, const std::string& base_dir);
   [[nodiscard]] static SampleKind sample_kind(const Options&) noexcept { return SampleKind::kPhase; }
-  /// Loads the scenario: throws io::ConfigError if it is bad.
+  /// Runs the scenario `parse` read; options made without a parse load theirs (io::ConfigError if it is bad).
   [[nodiscard]] static std::unique_ptr<SampleSource> make(const Options& options);
 };
 
