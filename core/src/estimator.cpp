@@ -206,10 +206,13 @@ EstimatorOutput RpemEstimator::held(StepCode code) const noexcept {
       gain = {sga_matrix(s.scale, g), s.flags};
       break;
     }
-    case Algorithm::kGna:
-      gain = gna_gain(u.gradient, gna_hessian_sequence(active, gamma_r), gamma_l, config_.floors, state_.gna_hessian_pu);
+    case Algorithm::kGna: {
+      const int only = u.steady_state && active.psi_m != active.r_s ? (active.psi_m ? kPsiM : kRs) : kBothParameters;
+      gain =
+          gna_gain(u.gradient, gna_hessian_sequence(active, gamma_r), gamma_l, config_.floors, state_.gna_hessian_pu, only);
       change = gain.gain * u.epsilon_pu;
       break;
+    }
     case Algorithm::kPhyInt:
       gain = phyint_gain(MachinePu(u.model), u.n_pu, u.i_gain_pu, gamma_l,
                          config_.floors);  // a copy: `model` stays in registers
@@ -299,7 +302,7 @@ EstimatorOutput RpemEstimator::held(StepCode code) const noexcept {
     gamma_l_ = scaled(seq.gain, factor);
     scaled_for_dt_s_ = iv.dt_s;
   }
-  const Update u{model, iv.n_end_pu, i_hat, epsilon, i_hat, select_gradient(model, iv.n_end_pu)};
+  const Update u{model, iv.n_end_pu, i_hat, epsilon, i_hat, select_gradient(model, iv.n_end_pu), false};
   if (admission.judge && config_.outlier_bound_sigma > 0.0 && outlier(u, admission)) [[unlikely]] {
     return predicted_only(StepCode::kOutlier, epsilon, i_hat);
   }
@@ -339,7 +342,7 @@ EstimatorOutput RpemEstimator::step_steady_state(const SteadyStateSample& sample
   }
   if (!admission.adapt) return predicted_only(StepCode::kExcluded, epsilon, i_hat);
   const Mat2 gradient = steady_state_gradients(model, sample.n_gradient_pu, sample.i_gradient_pu);
-  const Update u{model, sample.n_pu, sample.i_gradient_pu, epsilon, i_hat, gradient};
+  const Update u{model, sample.n_pu, sample.i_gradient_pu, epsilon, i_hat, gradient, true};
   if (admission.judge && config_.outlier_bound_sigma > 0.0 && outlier(u, admission)) {
     return predicted_only(StepCode::kOutlier, epsilon, i_hat);
   }

@@ -1,5 +1,6 @@
 #include <cmath>
 
+#include "rpem/core/assert.hpp"
 #include "rpem/core/gain.hpp"
 
 namespace rpem::core {
@@ -32,11 +33,21 @@ Mat2 symmetric_pseudo_inverse(const Mat2& r, double eigenvalue_min) noexcept {
 }
 
 GainOutput gna_gain(const Mat2& gradient, double gamma_hessian, const Vec2& gamma_gain, const GainFloors& floors,
-                    Mat2& hessian) noexcept {
+                    Mat2& hessian, int only) noexcept {
+  RPEM_ASSERT(only == kBothParameters || only == 0 || only == 1, "only: one parameter's index, or both");
   const Mat2 psi = gradient.transpose();
   hessian += gamma_hessian * (psi * psi.transpose() - hessian);
 
   GainOutput out;
+  if (only != kBothParameters) {
+    const double r = hessian(only, only);
+    if (r > floors.gna_eigenvalue_min_pu) {
+      out.gain.row(only) = (gamma_gain[only] / r) * psi.row(only);
+    } else {
+      out.flags |= gain_flag::kPseudoInverse;  // R_jj's pseudo-inverse: 0
+    }
+    return out;
+  }
   const double det = det2(hessian);  // |R|, eq:InverseR
   Mat2 inverse;
   if (det >= floors.gna_determinant_min_pu && det > 0.0) {

@@ -276,6 +276,12 @@ std::optional<LayoutProblem> drive_log_layout_problem(const QuantitySet& p) {
   return std::nullopt;
 }
 
+std::string instead_text(const LayoutProblem& problem, const std::function<std::string(Quantity)>& name) {
+  std::string names;
+  for (const Quantity q : problem.instead) names += (names.empty() ? "" : " and ") + name(q);
+  return names.empty() ? std::string() : " (or " + names + ")";
+}
+
 std::optional<LayoutProblem> averaged_log_layout_problem(const QuantitySet& p) {
   // The rotor-frame voltage, or the duty cycle and the DC link it is rebuilt from; the rotor-frame current, or
   // the motor current (rotor_frame_rebuild.hpp).
@@ -285,8 +291,9 @@ std::optional<LayoutProblem> averaged_log_layout_problem(const QuantitySet& p) {
     const bool rebuilt = ((q == Quantity::kUD || q == Quantity::kUQ) && voltage_from_duty) ||
                          ((q == Quantity::kID || q == Quantity::kIQ) && current_from_motor);
     if (!present(p, q) && !rebuilt) {
-      if (q == Quantity::kUD || q == Quantity::kUQ) return LayoutProblem{info(q).name, "required (or duty and u_dc)"};
-      if (q == Quantity::kID || q == Quantity::kIQ) return LayoutProblem{info(q).name, "required (or i_motor)"};
+      if (q == Quantity::kUD || q == Quantity::kUQ)
+        return LayoutProblem{info(q).name, "required", {Quantity::kDuty, Quantity::kUDc}};
+      if (q == Quantity::kID || q == Quantity::kIQ) return LayoutProblem{info(q).name, "required", {Quantity::kIMotor}};
       return LayoutProblem{info(q).name, "required"};
     }
   }
@@ -414,8 +421,9 @@ LogMap parse(YamlMap root) {
   const std::optional<LayoutProblem> problem =
       m.averaged() ? averaged_log_layout_problem(present) : drive_log_layout_problem(present);
   if (problem) {
-    columns.fail("", problem->column + ": " + problem->reason + " in " + (m.averaged() ? "an averaged" : "a drive") +
-                         " log, which this map gives");
+    const auto quantity_name = [](Quantity q) { return std::string(info(q).name); };
+    columns.fail("", problem->column + ": " + problem->reason + instead_text(*problem, quantity_name) + " in " +
+                         (m.averaged() ? "an averaged" : "a drive") + " log, which this map gives");
   }
   if ((m.window == Window::kStartColumn) != present[static_cast<std::size_t>(Quantity::kTStart)]) {
     columns.fail("", m.window == Window::kStartColumn ? "window: t_start needs a t_start column"

@@ -3,6 +3,7 @@
 #include <array>
 #include <cstdio>
 #include <limits>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 #include <tuple>
@@ -415,6 +416,45 @@ std::string model_extensions_yaml(const MachineConfig& c) {
   return body.empty() ? "" : "model_extensions:\n" + body;
 }
 
+namespace {
+
+/// `line`, a direct child `key: value` of a block at `indent`, with its value replaced by `value`, followed by
+/// `comment` and the value it replaced. False where the line is not that key's.
+bool replace_child_value(std::string& line, std::size_t indent, const std::string& key_name, double value,
+                         const std::string& comment) {
+  const std::string key = key_name + ":";
+  if (line.compare(indent, key.size(), key) != 0) return false;
+  std::string old = line.substr(indent + key.size());
+  old = old.substr(0, old.find('#'));
+  old.erase(0, old.find_first_not_of(' '));
+  old.erase(old.find_last_not_of(' ') + 1);
+  line = line.substr(0, indent).append(key).append(" ");
+  append_number(line, value);
+  line.append("  # ").append(comment).append(" (was ").append(old).append(")");
+  return true;
+}
+
+/// In a flow map's text ("{psi_m_Wb: 0.0045, r_s_Ohm: 0.022}"), the value of `key` replaced; the old value's text,
+/// or nothing where the map has no such key.
+std::optional<std::string> replace_flow_value(std::string& flow, const std::string& key, double value) {
+  for (std::size_t at = flow.find(key + ":"); at != std::string::npos; at = flow.find(key + ":", at + 1)) {
+    if (at > 0 && flow[at - 1] != '{' && flow[at - 1] != ',' && flow[at - 1] != ' ') continue;  // a longer key's end
+    const std::size_t begin = flow.find_first_not_of(' ', at + key.size() + 1);
+    if (begin == std::string::npos) return std::nullopt;
+    std::size_t end = flow.find_first_of(",}", begin);
+    if (end == std::string::npos) end = flow.size();
+    std::string old = flow.substr(begin, end - begin);
+    old.erase(old.find_last_not_of(' ') + 1);
+    std::string number;
+    append_number(number, value);
+    flow.replace(begin, old.size(), number);
+    return old;
+  }
+  return std::nullopt;
+}
+
+}  // namespace
+
 std::string replace_machine_values(const std::string& yaml_text, const std::vector<std::pair<std::string, double>>& values,
                                    const std::string& comment) {
   std::istringstream in(yaml_text);
@@ -426,24 +466,61 @@ std::string replace_machine_values(const std::string& yaml_text, const std::vect
     if (top_level) inside = line.rfind("machine:", 0) == 0;
     const std::size_t indent = line.find_first_not_of(' ');
     if (inside && indent != std::string::npos && indent > 0) {
+      // A direct child: the first indented level of the section.
       for (std::size_t j = 0; j < values.size(); ++j) {
-        const std::string key = values[j].first + ":";
-        if (line.compare(indent, key.size(), key) != 0) continue;
-        // A direct child: the first indented level of the section.
-        std::string old = line.substr(indent + key.size());
-        old = old.substr(0, old.find('#'));
-        old.erase(0, old.find_first_not_of(' '));
-        old.erase(old.find_last_not_of(' ') + 1);
-        line = line.substr(0, indent).append(key).append(" ");
-        append_number(line, values[j].second);
-        line.append("  # ").append(comment).append(" (was ").append(old).append(")");
-        done[j] = true;
+        if (replace_child_value(line, indent, values[j].first, values[j].second, comment)) done[j] = true;
       }
     }
     out += line + "\n";
   }
   for (std::size_t j = 0; j < values.size(); ++j) {
     if (!done[j]) throw ConfigError("<configuration text>", 0, 0, "machine." + values[j].first, "not found to replace");
+  }
+  return out;
+}
+
+std::string replace_estimator_initial(const std::string& yaml_text,
+                                      const std::vector<std::pair<std::string, double>>& values,
+                                      const std::string& comment) {
+  std::istringstream in(yaml_text);
+  std::string line, out;
+  bool inside = false, in_block = false;
+  std::size_t child_indent = std::string::npos, block_indent = 0;
+  while (std::getline(in, line)) {
+    const bool top_level = !line.empty() && line[0] != ' ' && line[0] != '\t' && line[0] != '#';
+    if (top_level) {
+      inside = line.rfind("estimator:", 0) == 0;
+      in_block = false;
+      child_indent = std::string::npos;
+    }
+    const std::size_t indent = line.find_first_not_of(' ');
+    if (inside && indent != std::string::npos && indent > 0 && line[indent] != '#') {
+      if (in_block && indent <= block_indent) in_block = false;
+      if (child_indent == std::string::npos) child_indent = indent;
+      if (in_block) {
+        for (const auto& [key, value] : values) replace_child_value(line, indent, key, value, comment);
+      } else if (indent == child_indent && line.compare(indent, 8, "initial:") == 0) {
+        std::string rest = line.substr(indent + 8);
+        rest = rest.substr(0, rest.find('#'));
+        if (rest.find('{') == std::string::npos) {
+          in_block = true;  // `initial:` and its keys below it
+          block_indent = indent;
+        } else {
+          std::string keys, olds;
+          for (const auto& [key, value] : values) {
+            if (const std::optional<std::string> old = replace_flow_value(rest, key, value)) {
+              keys += (keys.empty() ? "" : ", ") + key;
+              olds += (olds.empty() ? "" : ", ") + *old;
+            }
+          }
+          rest.erase(rest.find_last_not_of(' ') + 1);
+          line.erase(indent + 8).append(rest);
+          if (!keys.empty())
+            line.append("  # ").append(keys).append(": ").append(comment).append(" (was ").append(olds).append(")");
+        }
+      }
+    }
+    out += line + "\n";
   }
   return out;
 }

@@ -49,10 +49,19 @@ void MappedLogReader::fail_at(std::size_t line, Quantity q, const std::string& r
 }
 
 void MappedLogReader::fail_header(const LayoutProblem& problem) const {
+  // Named as the file would name it: the map's column for that quantity (VESC Tool's d_axis_voltage for u_d).
+  const auto named = [&](Quantity q) {
+    std::string quantity = info(q).name;
+    for (const MappedColumn& c : map_.columns) {
+      if (c.quantity == q && c.column.label() != quantity) return c.column.label() + " (" + quantity + ")";
+    }
+    return quantity;
+  };
   constexpr std::string_view kRequired = "required";
   std::string reason = problem.reason.rfind(kRequired, 0) == 0
                            ? "required column is missing from the header" + problem.reason.substr(kRequired.size())
                            : problem.reason;
+  reason += instead_text(problem, named);
   const std::string& only = header_.size() == 1 ? header_.front() : std::string();
   const std::size_t other = only.find_first_of(";,\t|");
   if (other != std::string::npos && only[other] != map_.separator) {
@@ -65,13 +74,9 @@ void MappedLogReader::fail_header(const LayoutProblem& problem) const {
         "; a CSV of another layout is read through a column map: --log-map MAP.yaml (docs/drive-log.md, \"Column "
         "maps\")";
   }
-  // Named as the file would name it: the map's column for that quantity (VESC Tool's d_axis_voltage for u_d).
-  std::string column = problem.column;
+  std::string column = problem.column;  // a quantity's name, or a group of them
   for (const MappedColumn& c : map_.columns) {
-    if (problem.column == info(c.quantity).name && c.column.label() != problem.column) {
-      column = c.column.label() + " (" + problem.column + ")";
-      break;
-    }
+    if (problem.column == info(c.quantity).name) column = named(c.quantity);
   }
   fail_at(line_, column, reason);
 }
@@ -173,6 +178,12 @@ void MappedLogReader::read_header() {
   std::string header_line;
   if (!next_line(header_line))
     throw DriveLogError(path_, line_ == 0 ? 1 : line_, 0, "", "empty file: expected a header row");
+  if (header_line.rfind("\xFF\xFE", 0) == 0 || header_line.rfind("\xFE\xFF", 0) == 0 ||
+      header_line.find('\0') != std::string::npos)
+    throw DriveLogError(path_, line_, 0, "",
+                        "the file is UTF-16 text (a byte-order mark FF FE or FE FF, or a zero byte beside each "
+                        "character: what Windows Notepad saves as \"Unicode\"); rpem reads UTF-8 or ASCII: save it as "
+                        "UTF-8, e.g. iconv -f UTF-16 -t UTF-8 FILE > FIXED.csv");
   if (header_line.rfind("\xEF\xBB\xBF", 0) == 0) header_line.erase(0, 3);  // a UTF-8 byte-order mark
   if (std::all_of(header_line.begin(), header_line.end(), blank))
     throw DriveLogError(path_, line_, 0, "", "empty file: expected a header row (the file holds a byte-order mark alone)");

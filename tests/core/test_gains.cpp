@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
+#include <cmath>
 #include <random>
 
 #include "rpem/core/gain.hpp"
@@ -99,6 +100,49 @@ TEST(Gna, UsesPseudoInverseBelowTheDeterminantFloorAndStillAdaptsRsAtStandstill)
   const double drs = -0.004;
   const Vec2 eps = g.col(kRs) * drs;
   EXPECT_NEAR((out.gain * eps)[kRs], gamma[kRs] * drs, 1e-15);
+}
+
+// A steady-state sample (a window) on which only ψ̂m adapts (docs/derivations.md §5, "One parameter of a steady-state
+// sample"). At i_d = 0 both columns of Ψᵀ are along Z⁻¹·e_q, in the ratio n : i_q, so R of a window at n₁ and this one at
+// n₂ (the drive accelerating) is full rank but nearly singular, and the joint step's ψ̂m row contracts δψ̂m by exactly
+// a = (γ_L/γ_r)·n₂/(n₂ − n₁) — 23 for a 2.5 % change of speed: ψ̂m thrown far past the value. ψ̂m's own Newton step,
+// L_ψ = γ_L·Ψ_ψ/R_ψψ, contracts by γ_L·|Ψ_ψ|²/R_ψψ ∈ [0, γ_L/γ_r], whatever R holds.
+TEST(Gna, AWindowOnWhichOneParameterAdaptsTakesItsOwnNewtonStep) {
+  const MachinePu m{0.05, 0.1, 0.1, 1.0};  // a surface-magnet machine, pu
+  const Vec2 i(0.0, 0.5);
+  const double n1 = 0.40, n2 = 0.41, gamma_r = 0.3;
+  const Vec2 gamma_l(0.17, 0.02);
+  const Mat2 g1 = steady_state_gradients(m, n1, i), g2 = steady_state_gradients(m, n2, i);
+  const auto contraction = [&](const GainOutput& out) { return out.gain.row(kPsiM).dot(g2.col(kPsiM)); };
+
+  Mat2 joint_r = g1.transpose() * g1;
+  const GainOutput joint = gna_gain(g2, gamma_r, gamma_l, no_floors(), joint_r);
+  const double a_joint = contraction(joint);  // the row eq:GainSchedule keeps
+  EXPECT_NEAR(a_joint, gamma_l[kPsiM] / gamma_r * n2 / (n2 - n1), 1e-6 * std::abs(a_joint));
+  EXPECT_GT(a_joint, 2.0);  // |1 − a| > 1: the masked step diverges
+
+  Mat2 own_r = g1.transpose() * g1;
+  const GainOutput own = gna_gain(g2, gamma_r, gamma_l, no_floors(), own_r, kPsiM);
+  EXPECT_EQ(own_r, joint_r);           // the same R: only the step differs
+  const Vec2 psi_row = g2.col(kPsiM);  // Ψ_ψ: dî/dψ̂m
+  EXPECT_LT((own.gain.row(kPsiM).transpose() - gamma_l[kPsiM] / own_r(kPsiM, kPsiM) * psi_row).norm(),
+            1e-15 * psi_row.norm());
+  EXPECT_EQ(own.gain.row(kRs).norm(), 0.0);
+  EXPECT_EQ(own.flags, 0);
+  const double a_own = contraction(own);
+  EXPECT_GE(a_own, 0.0);
+  EXPECT_LE(a_own, gamma_l[kPsiM] / gamma_r);
+  // The same for r̂s alone; and an R_jj at the eigenvalue floor takes no step, flagged as R⁺.
+  Mat2 rs_r = g1.transpose() * g1;
+  const GainOutput rs = gna_gain(g2, gamma_r, gamma_l, no_floors(), rs_r, kRs);
+  EXPECT_NEAR(rs.gain(kRs, 1), gamma_l[kRs] / rs_r(kRs, kRs) * g2(1, kRs), 1e-15);
+  EXPECT_EQ(rs.gain.row(kPsiM).norm(), 0.0);
+  GainFloors floors;
+  floors.gna_eigenvalue_min_pu = 1e3;
+  Mat2 floored_r = g1.transpose() * g1;
+  const GainOutput floored = gna_gain(g2, gamma_r, gamma_l, floors, floored_r, kPsiM);
+  EXPECT_EQ(floored.gain.norm(), 0.0);
+  EXPECT_TRUE(floored.flags & gain_flag::kPseudoInverse);
 }
 
 TEST(PseudoInverse, SatisfiesThePenroseConditionsOnRandomSymmetricMatrices) {

@@ -197,9 +197,10 @@ TEST(LogMap, ALoggerWithoutDqValuesReadsThroughAMapOfItsDutyAndMotorCurrent) {
     (void)read_averaged_log(bare.path(), no_duty, DriveLogLimits{});
     FAIL() << "no error";
   } catch (const DriveLogError& e) {
-    // Named as the file names it (the map's column), the quantity beside it.
+    // Named as the file names it (the map's column), the quantity beside it: the missing one and those that would
+    // stand for it.
     EXPECT_NE(std::string(e.what()).find("bare.csv:1: column vd (u_d): required column is missing from the header (or "
-                                         "duty and u_dc)"),
+                                         "d (duty) and vin (u_dc))"),
               std::string::npos)
         << e.what();
   }

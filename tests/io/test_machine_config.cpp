@@ -5,6 +5,7 @@
 #include <fstream>
 #include <regex>
 #include <sstream>
+#include <vector>
 
 #include "rpem/core/settings.hpp"
 #include "rpem/io/machine_config.hpp"
@@ -328,6 +329,40 @@ TEST(MachineConfig, ExtensionsWrittenAsYamlReadBackToTheSameValues) {
   EXPECT_EQ(back.psim_drift.rel_change, c.psim_drift.rel_change);
   EXPECT_EQ(back.machine.r_s_Ohm, c.machine.r_s_Ohm);  // the rest of the file is kept
   EXPECT_EQ(replace_model_extensions(paper_text(), ""), paper_text());
+}
+
+// rpem diagnose's extended.yaml starts the estimator at what it calibrated: estimator.initial rewritten where the file
+// gives it, as a flow map (every shipped configuration) or a block; a file without it is left as it is.
+TEST(MachineConfig, TheEstimatorsStartIsReplacedWhereTheFileGivesIt) {
+  const std::vector<std::pair<std::string, double>> start{{"psi_m_Wb", 1.1}, {"r_s_Ohm", 2.4}};
+  const std::string flow = replace_estimator_initial(paper_text(), start, "calibrated");
+  EXPECT_NE(flow.find("  initial: {psi_m_Wb: 1.1, r_s_Ohm: 2.4}  # psi_m_Wb, r_s_Ohm: calibrated (was 1.14, 2.25)"),
+            std::string::npos)
+      << flow;
+  const MachineConfig a = load_machine_config(test::TempFile("flow.yaml", flow).path());
+  EXPECT_EQ(a.estimator.initial_psi_m_Wb, 1.1);
+  EXPECT_EQ(a.estimator.initial_r_s_Ohm, 2.4);
+  EXPECT_EQ(a.machine.psi_m_Wb, 1.14);  // the machine's constants are replace_machine_values'
+
+  const std::string block_text =
+      std::regex_replace(paper_text(), std::regex(R"(  initial: \{psi_m_Wb: 1\.14, r_s_Ohm: 2\.25\})"),
+                         "  initial:\n    r_s_Ohm: 2.25   # measured\n    psi_m_Wb: 1.14");
+  ASSERT_NE(block_text, paper_text());
+  const std::string block = replace_estimator_initial(block_text, start, "calibrated");
+  EXPECT_NE(block.find("    r_s_Ohm: 2.4  # calibrated (was 2.25)\n    psi_m_Wb: 1.1  # calibrated (was 1.14)\n"),
+            std::string::npos)
+      << block;
+  const MachineConfig b = load_machine_config(test::TempFile("block.yaml", block).path());
+  EXPECT_EQ(b.estimator.initial_psi_m_Wb, 1.1);
+  EXPECT_EQ(b.estimator.initial_r_s_Ohm, 2.4);
+
+  const std::string none = std::regex_replace(paper_text(), std::regex(R"(  initial: \{[^}]*\}\n)"), "");
+  ASSERT_NE(none, paper_text());
+  EXPECT_EQ(replace_estimator_initial(none, start, "calibrated"), none);
+  // Only R_s calibrated: ψm's start stays.
+  const std::string one = replace_estimator_initial(paper_text(), {{"r_s_Ohm", 2.4}}, "calibrated");
+  EXPECT_NE(one.find("  initial: {psi_m_Wb: 1.14, r_s_Ohm: 2.4}  # r_s_Ohm: calibrated (was 2.25)"), std::string::npos)
+      << one;
 }
 
 TEST(MachineConfig, MissingFileIsAConfigError) {

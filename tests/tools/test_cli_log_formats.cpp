@@ -73,6 +73,50 @@ TEST_F(CliLogFormats, AVescToolLogIsReadWithoutAFlag) {
   EXPECT_NE(d.output.find("119 samples, steady_state model"), std::string::npos) << d.output;
 }
 
+// A log read under another machine's configuration — here none, so the built-in paper machine's (1.14 Wb, 2.25 Ohm):
+// its back EMF on q, (u_q − R_s·i_q − ω·L_d·i_d)/ω, lies far outside the configured bounds, and rpem estimate says
+// so (it still runs: a note, not a refusal). Under the outrunner's own configuration the same reading is the log's
+// 4.633 mWb to the digit, inside its bounds: no note.
+TEST_F(CliLogFormats, ALogUnderAnotherMachinesConfigurationIsNoted) {
+  const std::string log = vesc_log(120);
+  const test::ProcessResult other = test::run_command(rpem() + " estimate --log " + log + " --out " + path("est.csv"));
+  EXPECT_EQ(other.exit_code, 0) << other.output;
+  EXPECT_NE(other.output.find("rpem estimate: note: the log's back EMF reads psi_m "), std::string::npos) << other.output;
+  EXPECT_NE(other.output.find("this configuration most likely describes another machine (without --config the tools "
+                              "take the paper's 1.14 Wb machine)"),
+            std::string::npos)
+      << other.output;
+  const test::ProcessResult own =
+      test::run_command(rpem() + " estimate --log " + log + " --config " + vesc_config() + " --out " + path("own.csv"));
+  EXPECT_EQ(own.exit_code, 0) << own.output;
+  EXPECT_EQ(own.output.find("back EMF reads psi_m"), std::string::npos) << own.output;
+}
+
+// A log of a machine at rest (every read at 0 erpm, no current): `rpem diagnose` has nothing to fit and says so,
+// exit 65 with the rule that left the rows out, and writes nothing (it once went on to draw an empty residual and
+// stopped on gnuplot's error, exit 1).
+TEST_F(CliLogFormats, AVescToolLogOfAMachineAtRestIsNothingToDiagnose) {
+  const std::string log = path("rest.csv");
+  {
+    std::ofstream out(log);
+    out << test::vesc_tool::kHeader120;
+    // VESC Tool's 55 columns, every current, speed, duty and voltage 0 (the 22 values, 2 voltages, 13 setup values,
+    // 10 IMU values, 8 GNSS values).
+    for (int k = 0; k < 200; ++k) {
+      out << 36'000'000 + 90 * k << ";50;30;30;29;29.5;25;0;0;0;0;0;0;0;0;0;0;0;0;0;0;0;0;0;"
+          << "-1;0;0;0;0;0;0;0;0;0;0;0;0;-1;0;0;0;0;0;0;0;0;0;-1;0.00000000;0.00000000;0;0;0;0;0;\n";
+    }
+  }
+  const test::ProcessResult d = test::run_command(rpem() + " diagnose --log " + log + " --config " + vesc_config() +
+                                                  " --blocks 4 --out " + path("diag"));
+  EXPECT_EQ(d.exit_code, 65) << d.output;
+  EXPECT_NE(d.output.find("nothing to diagnose: of its 199 samples, 0 in the training blocks and 0 held out take part"),
+            std::string::npos)
+      << d.output;
+  EXPECT_NE(d.output.find("199 of 199 rows (100.0 %) were left out as idle"), std::string::npos) << d.output;
+  EXPECT_FALSE(fs::exists(path("diag"))) << d.output;
+}
+
 // A configuration that does not say where the dq frame comes from: the tools decide as for a position sensor's frame
 // and say where a result rests on it — here the log's slow reads with current, whose R_s term stands out only if the
 // frame is the rotor's (a sensorless frame's error is unbounded there: the back EMF at 400–600 erpm is below what the

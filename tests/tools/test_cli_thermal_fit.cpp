@@ -174,7 +174,8 @@ TEST_F(CliThermalFit, ReadsAVescToolLogItsMotorSensorTheWinding) {
   const std::string log = dir_ + "/vesc.csv";
   const test::ProcessResult g = test::run_command(
       test::binary_dir() + "/tests/independent_vesc/indep_vesc_log --config " + outrunner_config() +
-      " --seed 3 --duration-s 900 --set thermal.winding_start_C=70 --set thermal.magnet_start_C=60 --out " + log);
+      " --seed 3 --duration-s 900 --set thermal.winding_start_C=70 --set thermal.magnet_start_C=60 --out " + log +
+      " --truth " + dir_ + "/truth.json");
   ASSERT_EQ(g.exit_code, 0) << g.output;
 
   const std::string fit = rpem_tool() + " thermal fit --log " + log + " --config " + outrunner_config();
@@ -187,11 +188,26 @@ TEST_F(CliThermalFit, ReadsAVescToolLogItsMotorSensorTheWinding) {
   EXPECT_NE(r.output.find("Coolant drift: the training part has no coolant readings"), std::string::npos) << r.output;
   EXPECT_EQ(test::read_file(dir_ + "/thermal.yaml").find("coolant_drift_K2_per_s"), std::string::npos);
   EXPECT_EQ(r.output.find("the winding is observed on no step"), std::string::npos) << r.output;  // temp_motor is
-  // The outrunner's configuration says nothing of where its 25 mOhm were measured: the fit says what it assumed,
-  // on the terminal and in thermal.yaml, where the user who reads it can correct it.
-  const std::string assumed = "the copper law takes r_s_ref 0.025 Ohm at 20 °C, an assumption";
-  EXPECT_NE(r.output.find("note: " + assumed), std::string::npos) << r.output;
-  EXPECT_NE(test::read_file(dir_ + "/thermal.yaml").find("# note: " + assumed), std::string::npos);
+  // The outrunner's configuration says nothing of where its 25 mOhm were measured, and the generator's machine has
+  // R_s 23 % above it: the fit anchors the copper law where the magnet law is anchored, at r̂s held there and the
+  // winding sensor's reading (docs/thermal.md, "The copper law's reference"), and says so on the terminal and in
+  // thermal.yaml, where the user who reads it can state a measured reference instead. The anchored r_s_ref at 20 °C
+  // lies within the 5 % asked of r̂s (issue 23) of the generator's true R_s there (measured +0.9 %; the configured
+  // 0.025 Ohm is −17 %).
+  const std::string anchored = "the copper law's reference is anchored where the magnet law's is: r_s held there (";
+  EXPECT_NE(r.output.find("note: " + anchored), std::string::npos) << r.output;
+  EXPECT_EQ(r.output.find("the copper law takes r_s_ref 0.025 Ohm at 20 °C, an assumption"), std::string::npos);
+  const std::string yaml = test::read_file(dir_ + "/thermal.yaml");
+  EXPECT_NE(yaml.find("# note: " + anchored), std::string::npos);
+  {
+    const nlohmann::json truth = nlohmann::json::parse(test::read_file(dir_ + "/truth.json"));
+    const double r_true = truth.at("true_machine").at("r_s_Ohm").get<double>();
+    const double alpha = truth.at("thermal").at("r_s_coeff_per_K").get<double>();
+    const double ref_C = truth.at("true_machine").at("reference_temperature_C").get<double>();
+    std::smatch m;
+    ASSERT_TRUE(std::regex_search(yaml, m, std::regex("copper: \\{r_s_ref_Ohm: ([0-9.e+-]+), reference_C: 20,"))) << yaml;
+    EXPECT_NEAR(std::stod(m[1]) / (r_true * (1.0 + alpha * (20.0 - ref_C))), 1.0, 0.05) << yaml;
+  }
 
   // Every step of the filter has the motor sensor, and the network fitted on the first 75 % follows the held-out
   // quarter of a 30 K cool-down open loop within a few of the sensor's quanta (measured 0.11 K RMS, 0.17 K worst).
@@ -281,7 +297,17 @@ TEST_F(CliThermalFit, SaysWhatTheTrainingPartObserves) {
     const std::string report = dir_ + (isothermal ? "/isothermal" : "/cooling");
     const test::ProcessResult r = test::run_command(rpem_tool() + " thermal fit --log " + log + outrunner + " --out " +
                                                     report + ".yaml --report " + report);
-    ASSERT_EQ(r.exit_code, 0) << r.output;
+    if (isothermal) {
+      // Nothing identified, the network is its prior's; with the copper law anchored at r̂s (R_s 14 % above the
+      // configured, as the generator's machine has it) that prior's winding runs away at the rated current, and
+      // thermal.yaml is refused as such (exit 65); the report is written all the same.
+      EXPECT_EQ(r.exit_code, 65) << r.output;
+      EXPECT_NE(r.output.find("not written: the network has no steady state at the machine's rated point"),
+                std::string::npos)
+          << r.output;
+    } else {
+      ASSERT_EQ(r.exit_code, 0) << r.output;
+    }
     std::ifstream json(report + "/fit.json");
     const nlohmann::json j = nlohmann::json::parse(json);
     const nlohmann::json sensor = winding_sensor_signal(j);

@@ -49,11 +49,12 @@ struct Final {
   std::string output;  ///< rpem estimate's stdout and stderr
 };
 
-/// rpem estimate on the log; the last estimate row.
-Final estimate(const std::string& log, const std::string& cfg) {
+/// rpem estimate on the log (with `options`); the last estimate row.
+Final estimate(const std::string& log, const std::string& cfg, const std::string& options = "") {
   test::TempFile out("estimates.csv");
   Final f;
-  const auto r = test::run_command(rpem() + " estimate --log " + log + " --config " + cfg + " --out " + out.path());
+  const auto r =
+      test::run_command(rpem() + " estimate --log " + log + " --config " + cfg + " --out " + out.path() + " " + options);
   f.output = r.output;
   EXPECT_EQ(r.exit_code, 0) << r.output;
   std::ifstream in(out.path());
@@ -124,6 +125,13 @@ TEST(CliVescFieldEstimate, OurEmulatorsFieldRide) {
   }
   ASSERT_GT(t.psi_m_Wb, 0.0);
   expect_field_accuracy(estimate(log.path(), config("vesc-6374-outrunner.yaml")), t, "vesc-tool-field");
+  // Gauss–Newton on the same ride (docs/derivations.md §5, "One parameter of a steady-state sample"): where only ψ̂m
+  // adapts, each window takes ψ̂m's own Newton step. The masked joint step threw ψ̂m from bound to bound wherever the
+  // speed changed between windows (i_d = 0: R nearly singular) and ended at +63 % (2026-12-07); now −1.7 %.
+  const Final gna = estimate(log.path(), config("vesc-6374-outrunner.yaml"), "--algorithm gna");
+  EXPECT_NEAR(gna.psi_m_Wb / t.psi_m_Wb, 1.0, 0.02) << gna.output;
+  EXPECT_EQ(gna.output.find("psi_m ended at its"), std::string::npos) << gna.output;
+  std::printf("[ field    ] vesc-tool-field, gna: psi_m %+.2f %%\n", 100.0 * (gna.psi_m_Wb / t.psi_m_Wb - 1.0));
 }
 
 /// A log rewritten as a logger that writes VESC Tool's header prints it: every value it holds as a float with two

@@ -30,6 +30,7 @@
 #include "rpem/io/averaged_log.hpp"
 #include "rpem/io/drive_log.hpp"
 #include "rpem/io/estimate_log.hpp"
+#include "rpem/io/flux_reading.hpp"
 #include "rpem/io/log_source.hpp"
 #include "rpem/io/machine_config.hpp"
 #include "rpem/io/rotor_frame_rebuild.hpp"
@@ -434,6 +435,8 @@ Tally run_averaged(const EstimateOptions& o, const std::string& log, const std::
   const io::RotorFrameRebuild rebuilt =
       io::complete_rotor_frame(samples, read, config.machine, io::command_hold_s(config.estimator), log);
   if (rebuilt.any()) std::fprintf(stderr, "rpem estimate: %s\n", rebuilt.describe().c_str());
+  if (const auto note = io::flux_mismatch_note(io::flux_reading(samples, config), config))
+    std::fprintf(stderr, "rpem estimate: note: %s\n", note->c_str());
   io::check_averaged_supports(config, config_name, read.layout.u_dc, log);
   io::MachineConfig cfg = config;
   cfg.estimator = io::estimator_settings(config, rebuilt);

@@ -330,6 +330,24 @@ void write_diagnosis_json(const std::string& path, const Diagnosis& d, const std
   write_text(path, out.dump(2) + "\n");
 }
 
+namespace {
+
+/// The estimator's start (`estimator.initial`, where the text gives it) at the calibrated ψm and R_s, so that the
+/// next run starts where the diagnosis found the machine; not where one lies outside the bounds, which the
+/// configuration's loader would refuse as a start (calibrated_outside_bounds says so in the header).
+std::string with_calibrated_start(const std::string& text, const Diagnosis& d) {
+  const core::EstimatorSettings& e = d.config.estimator;
+  const std::array<std::array<double, 2>, 2> bounds{{{e.psi_m_min_Wb, e.psi_m_max_Wb}, {e.r_s_min_Ohm, e.r_s_max_Ohm}}};
+  std::vector<std::pair<std::string, double>> start;
+  for (std::size_t i = 0; i < bounds.size(); ++i) {
+    const double v = d.calibration.value[i];
+    if (d.calibration.identifiable[i] && v >= bounds[i][0] && v <= bounds[i][1]) start.emplace_back(kCalibrated[i], v);
+  }
+  return start.empty() ? text : io::replace_estimator_initial(text, start, "calibrated by rpem diagnose");
+}
+
+}  // namespace
+
 void write_extended_yaml(const std::string& path, const Diagnosis& d, const std::string& config_text) {
   std::string header = "# Written by rpem diagnose: " + d.log->path +
                        " diagnosed with this configuration as the baseline;\n"
@@ -347,7 +365,8 @@ void write_extended_yaml(const std::string& path, const Diagnosis& d, const std:
   }
   const std::string text =
       constants.empty() ? config_text : io::replace_machine_values(config_text, constants, "calibrated by rpem diagnose");
-  write_text(path, header + io::replace_model_extensions(text, io::model_extensions_yaml(d.extended_config)));
+  write_text(path, header + io::replace_model_extensions(with_calibrated_start(text, d),
+                                                         io::model_extensions_yaml(d.extended_config)));
 }
 
 }  // namespace rpem::analysis

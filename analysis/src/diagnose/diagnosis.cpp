@@ -205,6 +205,7 @@ Diagnosis diagnose(LogData log, const io::MachineConfig& config, const DiagnoseO
   d.regimes = classify_regimes(*d.log, config, options.monitor);
   exclude_regimes(*d.log, d.regimes);
   for (std::string& why : left_out_explanations(*d.log)) d.regimes.explanations.push_back(std::move(why));
+  require_samples_to_fit(*d.log, d.regimes.explanations);
   const double f_sw = options.switching_frequency_Hz > 0.0 ? options.switching_frequency_Hz
                                                            : config.estimator.extensions.switching_frequency_Hz;
   const ExtendedModel base =

@@ -257,6 +257,20 @@ std::vector<std::string> left_out_explanations(const LogData& log) {
   return out;
 }
 
+void require_samples_to_fit(const LogData& log, const std::vector<std::string>& why) {
+  std::size_t training = 0, heldout = 0;
+  for (std::size_t k = 0; k < log.size(); ++k) {
+    training += log.training(k) ? 1 : 0;
+    heldout += log.heldout(k) ? 1 : 0;
+  }
+  if (training >= 2 && heldout >= 2) return;
+  std::string message = "nothing to diagnose: of its " + std::to_string(log.size()) + " samples, " +
+                        std::to_string(training) + " in the training blocks and " + std::to_string(heldout) +
+                        " held out take part, and at least 2 of each are needed";
+  for (const std::string& w : why) message += "; " + w;
+  throw io::DriveLogError(log.path, 0, 0, "", message);
+}
+
 core::Vec2 applied_mean_V(const core::Vec2& command_V, double omega_el_rad_s, double control_period_s,
                           double delay_periods) noexcept {
   const double wt = omega_el_rad_s * control_period_s;

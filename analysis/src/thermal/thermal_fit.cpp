@@ -337,6 +337,67 @@ SessionSpan session_span(const ThermalRecord& r, std::size_t j) { return {r.sess
 /// The start of a session whose readings stand for the start: the magnet law's anchor and r̂s's first reading.
 constexpr double kAnchorWithin_s = 300.0;
 
+/// The steps whose magnet observations anchor the magnet law: the first kAnchorSteps with one within kAnchorWithin_s
+/// of each session's start in `sessions`.
+std::vector<std::size_t> anchor_steps(const ThermalRecord& r, const std::vector<std::size_t>& sessions) {
+  constexpr std::size_t kAnchorSteps = 4;
+  std::vector<std::size_t> steps;
+  for (std::size_t j : sessions) {
+    const SessionSpan span = session_span(r, j);
+    std::size_t used_here = 0;
+    for (std::size_t k = span.first;
+         k < span.end && used_here < kAnchorSteps && r.t_s[k] - r.t_s[span.first] <= kAnchorWithin_s; ++k) {
+      if (!r.steps[k].parameter[core::kPsiM].valid) continue;
+      steps.push_back(k);
+      ++used_here;
+    }
+  }
+  return steps;
+}
+
+/// The copper law's reference where nothing states it (no rs_drift, no copper: {reference_C: …}; docs/thermal.md,
+/// "The copper law's reference"), at the magnet anchor's steps: r̂s held there, which adapted at or before them, taken
+/// as R_s at the winding sensor's reading of those steps. ψ̂m's κ term (eq. 14.10) then removes only what R_s has moved
+/// since (the winding's rise), not the configured r_s's own error, which the assumed reference would read as the held
+/// R_s's and move every magnet observation by (R_s 27 % low: 24 K). Where r̂s adapted on no step up to them (it is
+/// still the configured start) or the sensor reads none of them, the assumed reference stands and assumed_law_notes
+/// says so.
+void anchor_copper_reference(io::ThermalConfig& c, const ThermalRecord& r, const std::vector<std::size_t>& steps,
+                             std::vector<std::string>& notes) {
+  if (steps.empty() || !r.winding_sensor) return;
+  core::DriftLaw& copper = c.fusion.filter.network.copper;
+  bool adapted = false;  // r̂s adapted on a step up to the last anchor step
+  for (std::size_t k = 0; k <= steps.back() && !adapted; ++k) adapted = r.steps[k].parameter[core::kRs].value > 0.0;
+  if (!adapted) return;
+  double sum = 0.0, held_sum = 0.0, winding_sum = 0.0;
+  std::size_t used = 0;
+  for (const std::size_t k : steps) {
+    const double held = r.steps[k].parameter[core::kPsiM].other_held, winding_C = r.steps[k].winding_sensor_C;
+    if (!std::isfinite(winding_C)) continue;
+    sum += held / copper.factor(winding_C);
+    held_sum += held;
+    winding_sum += winding_C;
+    ++used;
+  }
+  if (used == 0) return;
+  const double n = static_cast<double>(used);
+  const double configured_reads_K = copper.temperature_C(held_sum / n) - winding_sum / n;
+  const double configured_Ohm = copper.value_ref;
+  copper.value_ref = sum / n;
+  c.copper_reference_stated = true;
+  char text[700];
+  std::snprintf(
+      text, sizeof text,
+      "the copper law's reference is anchored where the magnet law's is: r_s held there (%.5g Ohm, adapted "
+      "before) at the winding sensor's %.1f °C gives r_s_ref %.5g Ohm at %.4g °C; the configuration's r_s %.5g Ohm, "
+      "taken at %.4g °C, read that r_s %+.1f K from the sensor. Where r_s was measured at a known "
+      "temperature, say so (rs_drift, or the thermal section's copper: {reference_C: …}) and it is kept "
+      "(docs/thermal.md, \"The copper law's reference\")",
+      held_sum / n, winding_sum / n, copper.value_ref, copper.reference_C, configured_Ohm, copper.reference_C,
+      configured_reads_K);
+  notes.emplace_back(text);
+}
+
 /// The magnet law's reference from the soaked start (docs/thermal.md, "A log that does not start soaked"): the mean of
 /// the first kAnchorSteps magnet observations of each session in `sessions`, each corrected for the held R_s
 /// (κ·(R_s(T_w) − r̂s)), at the magnet temperatures `t_magnet_C` of those steps (the soak's, or the network's
@@ -345,24 +406,16 @@ constexpr double kAnchorWithin_s = 300.0;
 std::size_t anchor_magnet_reference(io::ThermalConfig& c, const ThermalRecord& r, const std::vector<std::size_t>& sessions,
                                     const std::vector<double>& t_magnet_C, const std::vector<double>& t_winding_C,
                                     std::vector<std::string>& notes) {
-  constexpr std::size_t kAnchorSteps = 4;
   core::DriftLaw& law = c.fusion.magnet_law;
   const core::DriftLaw& copper = c.fusion.filter.network.copper;
+  const std::vector<std::size_t> steps = anchor_steps(r, sessions);
   double sum = 0.0;
-  std::size_t used = 0;
-  for (std::size_t j : sessions) {
-    const SessionSpan span = session_span(r, j);
-    std::size_t used_here = 0;
-    for (std::size_t k = span.first;
-         k < span.end && used_here < kAnchorSteps && r.t_s[k] - r.t_s[span.first] <= kAnchorWithin_s; ++k) {
-      const core::ParameterObservation& p = r.steps[k].parameter[core::kPsiM];
-      if (!p.valid) continue;
-      const double psi = p.value - p.cross * (copper.at(t_winding_C[k]) - p.other_held);
-      sum += psi / (1.0 + law.coeff_per_K * (t_magnet_C[k] - law.reference_C));  // ψ at the reference temperature
-      ++used_here;
-    }
-    used += used_here;
+  for (const std::size_t k : steps) {
+    const core::ParameterObservation& p = r.steps[k].parameter[core::kPsiM];
+    const double psi = p.value - p.cross * (copper.at(t_winding_C[k]) - p.other_held);
+    sum += psi / (1.0 + law.coeff_per_K * (t_magnet_C[k] - law.reference_C));  // ψ at the reference temperature
   }
+  const std::size_t used = steps.size();
   if (used == 0) {
     notes.push_back(std::string("no magnet observation within the first 300 s") +
                     (r.session_first_step.size() > 1 ? " of a session that anchors it" : "") +
@@ -607,6 +660,17 @@ ThermalFitResult fit_thermal(const ThermalRecord& record, const io::ThermalConfi
   out.training_steps = training;
 
   io::ThermalConfig start = start_config;
+  // The magnet's reference: first at the soak temperature, then once more at the fitted network's magnet
+  // temperatures of the anchor's steps (the rise since the soak), and the network fitted again.
+  std::vector<double> t_magnet, t_winding;
+  session_start_temperatures(start.fusion, record, t_magnet, t_winding);
+  // A start that is not soaked: anchored at the winding's reading, in one pass (the network's rise since the soak
+  // does not apply).
+  const AnchorPlan anchor =
+      options.anchor_magnet_reference ? plan_anchor(start, record, t_magnet, out.notes) : AnchorPlan{{}, false};
+  // The copper law, where nothing states its reference, at the same steps, before anything reads r̂s as a temperature.
+  if (options.anchor_magnet_reference && !start.copper_reference_stated)
+    anchor_copper_reference(start, record, anchor_steps(record, anchor.sessions), out.notes);
   for (std::string& note : io::assumed_law_notes(start, false)) out.notes.push_back(std::move(note));
   // A winding sensor without a configured lag: τ_s from the standstills where r̂s reads the winding (eq. 14.25),
   // before the network, which then stands for the sensor's reading (eq. 14.24).
@@ -616,14 +680,6 @@ ThermalFitResult fit_thermal(const ThermalRecord& record, const io::ThermalConfi
   const std::vector<LossTie> ties = network::tie_collinear_losses(start, record, training, out.notes);
   const Layout layout(start, ties);
   const std::vector<double> prior = layout.values(start);
-  // The magnet's reference: first at the soak temperature, then once more at the fitted network's magnet
-  // temperatures of the anchor's steps (the rise since the soak), and the network fitted again.
-  std::vector<double> t_magnet, t_winding;
-  session_start_temperatures(start.fusion, record, t_magnet, t_winding);
-  // A start that is not soaked: anchored at the winding's reading, in one pass (the network's rise since the soak
-  // does not apply).
-  const AnchorPlan anchor =
-      options.anchor_magnet_reference ? plan_anchor(start, record, t_magnet, out.notes) : AnchorPlan{{}, false};
   Solved best;
   std::vector<Point> points;
   for (int pass = 0; pass < (options.anchor_magnet_reference && anchor.refine ? 2 : 1); ++pass) {

@@ -225,6 +225,9 @@ class RpemEstimator {
     double n_pu;
     Vec2 i_gain_pu, epsilon_pu, i_hat_pu;
     Mat2 gradient;
+    /// A steady-state sample (a window, a point observation): its gain is not small, and GNA takes the Newton step
+    /// of the one parameter the schedule lets adapt (gna_gain's `only`; docs/derivations.md §5).
+    bool steady_state;
   };
   /// The update both sample kinds share: gain (SGA, GNA, PhyInt), eq:GainSchedule, θ̂ += L·ε, projection
   /// onto D_M (eq:paramsubset); the sample's output.

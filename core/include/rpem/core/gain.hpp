@@ -73,13 +73,19 @@ struct SgaScale {
   return {sga_matrix(s.scale, gradient), s.flags};
 }
 
+/// gna_gain's `only` where the step is the joint one.
+inline constexpr int kBothParameters = -1;
+
 /// GNA (eq:GNA_full … eq:GNA_GainElements):
 ///   R[k] = R[k−1] + γ_r·(Ψ·Ψᵀ − R[k−1]),   L = diag(γ_L)·R⁻¹·Ψ,
 /// with R⁻¹ from eq:InverseR, or R⁺ (Moore–Penrose) when |R| < floor. γ_r is one scalar, so R stays a
 /// convex combination of positive semi-definite matrices; the estimator picks the γ_r of the parameter
 /// the scheduler lets adapt (tab_psimgains lists one per estimation case; docs/derivations.md).
+/// With `only` = j (0: ψ̂m, 1: r̂s) the Newton step of parameter j alone, the other held: L_j = γ_L,j·Ψ_j/R_jj
+/// (R_jj at or below the eigenvalue floor: no step, flagged as R⁺), the other row 0 — what a steady-state sample
+/// takes where the schedule lets one parameter adapt (docs/derivations.md §5, "One parameter of a window").
 [[nodiscard]] GainOutput gna_gain(const Mat2& gradient, double gamma_hessian, const Vec2& gamma_gain,
-                                  const GainFloors& floors, Mat2& hessian) noexcept;
+                                  const GainFloors& floors, Mat2& hessian, int only = kBothParameters) noexcept;
 
 /// PhyInt (eq:PhyInterPRet, eq:PhyInterPRet_Rs), from the steady-state prediction error:
 ///   L_11 = −γ_ψ·x̂_d,  L_12 = 0

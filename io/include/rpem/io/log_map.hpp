@@ -10,6 +10,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -165,7 +166,11 @@ using QuantitySet = std::array<bool, kQuantityCount>;
 struct LayoutProblem {
   std::string column;  ///< a quantity name, or a group such as "u_a,u_b,u_c|u_d,u_q"
   std::string reason;
+  std::vector<Quantity> instead = {};  ///< the quantities that would stand for the missing one (named as the file does)
 };
+/// " (or duty and u_dc)": what would stand for the missing quantity, each named by `name` (a map's quantity name, a
+/// file's column); empty where nothing would.
+[[nodiscard]] std::string instead_text(const LayoutProblem& problem, const std::function<std::string(Quantity)>& name);
 [[nodiscard]] std::optional<LayoutProblem> drive_log_layout_problem(const QuantitySet& present);
 [[nodiscard]] std::optional<LayoutProblem> averaged_log_layout_problem(const QuantitySet& present);
 

@@ -71,6 +71,12 @@ void check_log_supports(const MachineConfig& c, const std::string& config_name, 
                                                  const std::vector<std::pair<std::string, double>>& values,
                                                  const std::string& comment);
 
+/// `yaml_text` with the values of `estimator.initial` (flow map or block) replaced where it gives those keys (each
+/// pair: key, value), followed by `comment` and what they replaced; a text without them is returned as it is.
+[[nodiscard]] std::string replace_estimator_initial(const std::string& yaml_text,
+                                                    const std::vector<std::pair<std::string, double>>& values,
+                                                    const std::string& comment);
+
 /// `yaml_text` with its top-level `model_extensions` section (if any) replaced by `section`.
 [[nodiscard]] std::string replace_model_extensions(const std::string& yaml_text, const std::string& section);
 

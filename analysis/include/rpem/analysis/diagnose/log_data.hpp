@@ -162,6 +162,11 @@ struct LogOptions {
 /// one sentence per rule, how many, why, and what changes it (docs/diagnose.md, "The replay").
 [[nodiscard]] std::vector<std::string> left_out_explanations(const LogData& log);
 
+/// A log whose training or held-out blocks keep fewer than 2 samples once every exclusion is made (a log of a
+/// machine at rest, a bridge off throughout) has nothing to fit or judge: io::DriveLogError, "nothing to
+/// diagnose", with `why` (the exclusions' explanations) appended.
+void require_samples_to_fit(const LogData& log, const std::vector<std::string>& why);
+
 /// Loads and characterises a log, a phase-sample or an averaged one, in any format io::log_source reads
 /// (throws io::DriveLogError on bad input, io::ConfigError on a bad map). `progress`, if given, is told the
 /// bytes read of the file's total as it goes.
