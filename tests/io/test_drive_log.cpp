@@ -95,7 +95,7 @@ INSTANTIATE_TEST_SUITE_P(
                 ":1: its lines end in a carriage return alone (classic Mac OS line endings)"},
         BadCase{"missing_time", "theta_el,omega_el,u_dc,u_a,u_b,u_c,i_a,i_b,i_c\n", ":1: column t: required column"},
         // Windows Notepad's "Unicode": UTF-16 little-endian with its byte-order mark.
-        BadCase{"utf16", std::string("\xFF\xFEt\0,\0t\0h\0\n\0", 14),
+        BadCase{"utf16", std::string("\xFF\xFEt\0,\0t\0h\0\n\0", 12),
                 ":1: the file is UTF-16 text (a byte-order mark FF FE or FE FF, or a zero byte beside each character"},
         BadCase{"no_current", "t,theta_el,omega_el,u_dc,u_a,u_b,u_c\n", "no current columns"},
         // Another layout, or rpem's with another separator: the header says which way out.
