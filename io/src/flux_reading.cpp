@@ -3,7 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <numbers>
+
+#include "rpem/core/units.hpp"
 
 namespace rpem::io {
 namespace {
@@ -19,7 +20,7 @@ double median(std::vector<double> v) {
 FluxReading flux_reading(const std::vector<core::AveragedSample>& samples, const MachineConfig& config) {
   const core::MachineSi& m = config.machine;
   const core::EstimatorSettings& e = config.estimator;
-  const double speed_min_rad_s = e.psi_m_min_speed_rpm * m.rated.pole_pairs * 2.0 * std::numbers::pi / 60.0;
+  const double speed_min_rad_s = core::rpm_to_rad_s(e.psi_m_min_speed_rpm) * m.rated.pole_pairs;  // electrical
   const double r_spread_Ohm = std::max(std::abs(e.r_s_max_Ohm - m.r_s_Ohm), std::abs(m.r_s_Ohm - e.r_s_min_Ohm));
   std::vector<double> psi, allowance;
   for (const core::AveragedSample& s : samples) {

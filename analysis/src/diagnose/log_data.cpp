@@ -258,11 +258,8 @@ std::vector<std::string> left_out_explanations(const LogData& log) {
 }
 
 void require_samples_to_fit(const LogData& log, const std::vector<std::string>& why) {
-  std::size_t training = 0, heldout = 0;
-  for (std::size_t k = 0; k < log.size(); ++k) {
-    training += log.training(k) ? 1 : 0;
-    heldout += log.heldout(k) ? 1 : 0;
-  }
+  const std::size_t training = log.training_count(),
+                    heldout = log.used_count() - training;  // a used sample is one or the other
   if (training >= 2 && heldout >= 2) return;
   std::string message = "nothing to diagnose: of its " + std::to_string(log.size()) + " samples, " +
                         std::to_string(training) + " in the training blocks and " + std::to_string(heldout) +
